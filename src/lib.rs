@@ -1,0 +1,16 @@
+//! Idle-loop head motion for a three-servo animatronic head.
+//!
+//! This crate is the hardware-free core (`no_std`, no allocation, no `unsafe`):
+//! motion generation after Kocoń's idle-loop method, servo mapping and frame
+//! playback. Board images (Raspberry Pi Pico, QEMU) live in `src/bin/`.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+#![warn(clippy::pedantic)]
+#![allow(clippy::module_name_repetitions, clippy::cast_possible_truncation, clippy::cast_possible_wrap, clippy::cast_sign_loss, clippy::cast_lossless, clippy::cast_precision_loss)]
+
+pub mod axis;
+pub mod units;
+
+pub use axis::Axis;
+pub use units::{Angle, AngleRange, Microseconds, Millis};
