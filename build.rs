@@ -7,7 +7,7 @@ use std::{env, fs, path::PathBuf};
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
-    println!("cargo:rerun-if-changed=memory.x");
+    println!("cargo:rerun-if-changed=src/bin/pico/memory.x");
     println!("cargo:rerun-if-changed=src/bin/qemu/memory.x");
 
     if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
@@ -16,7 +16,7 @@ fn main() {
     let pico = env::var_os("CARGO_FEATURE_PICO").is_some();
     let qemu = env::var_os("CARGO_FEATURE_QEMU").is_some();
     let memory = match (pico, qemu) {
-        (true, false) => "memory.x",
+        (true, false) => "src/bin/pico/memory.x",
         (false, true) => "src/bin/qemu/memory.x",
         (true, true) => panic!(
             "features `pico` and `qemu` select different memory maps; \
@@ -26,7 +26,8 @@ fn main() {
     };
 
     // Put the chosen layout on the linker search path as `memory.x`, which
-    // cortex-m-rt's link.x includes.
+    // cortex-m-rt's link.x includes. No `memory.x` may sit in the package root:
+    // the linker runs there and would find that one first, for every image.
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     fs::copy(memory, out.join("memory.x")).unwrap();
     println!("cargo:rustc-link-search={}", out.display());
