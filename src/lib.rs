@@ -7,10 +7,23 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 #![warn(clippy::pedantic)]
-#![allow(clippy::module_name_repetitions, clippy::cast_possible_truncation, clippy::cast_possible_wrap, clippy::cast_sign_loss, clippy::cast_lossless, clippy::cast_precision_loss)]
+#![allow(
+    clippy::module_name_repetitions,
+    clippy::cast_possible_truncation,
+    clippy::cast_possible_wrap,
+    clippy::cast_sign_loss,
+    clippy::cast_lossless,
+    clippy::cast_precision_loss
+)]
 
 pub mod axis;
+pub mod driver;
+pub mod playback;
+pub mod servo;
 pub mod units;
 
 pub use axis::Axis;
+pub use driver::{DriverConfig, FrameClock, FrameDriver, FrameReport};
+pub use playback::{LoopSource, Playback};
+pub use servo::{Direction, PwmTiming, ServoCalibration};
 pub use units::{Angle, AngleRange, Microseconds, Millis};
