@@ -1,0 +1,454 @@
+//! The integer pipeline: walk → Hann smoothing → scaling → loop closure.
+//!
+//! # Smoothing in O(N), independent of W
+//!
+//! Smoothing the walk u with the Hann kernel h equals smoothing its steps
+//! e(k) = u(k) − u(k−1) ∈ {−1, 0, +1} and integrating, because convolution
+//! commutes with summation. With h(m) = ½ − ½·cos(ωm), ω = 2π/W, the smoothed
+//! velocity at n is
+//!
+//! ```text
+//! v(n) = Σₘ h(m)·e(n−m) = ½·B(n) − ½·Σₖ e(k)·cos(ω(n−k))          (k over the window)
+//!      = ½·B(n) − ½·[cos ωn · Σₖ e(k) cos ωk  +  sin ωn · Σₖ e(k) sin ωk]
+//! ```
+//!
+//! where B(n) is the plain window sum. B and the two phasor sums P꜀, Pₛ are
+//! *sliding sums over absolute time*: when the window moves by one sample the
+//! entering and the leaving step share the same residue n mod W, so each sum
+//! changes by (e_new − e_old)·T[n mod W] — one table entry, no rotation, no
+//! rounding. The sums are therefore exact integers at every n: there is no
+//! drift to re-anchor. Only the table rounding (≈ 1/Q per tap) separates the
+//! result from the real-valued Hann smoothing; `host-tests` measures it against
+//! a direct-form f64 convolution.
+//!
+//! # Magnitudes (all fit `i32`)
+//!
+//! With table scale Q (Q²·W < 2²⁹) and bits b ∈ {0,1} of the steps:
+//! - `Pb = Σ b(k)·T[k mod W]` is a 2-vector of length ≤ W·(Q+1);
+//! - `cp = T꜀[j]·Pb꜀ + Tₛ[j]·Pbₛ` ≤ (Q+1)²·W (Cauchy–Schwarz) < 2²⁹·(1 + 3/Q);
+//! - `V = Q²·Bb − cp` = 2Q²·Σ h·b ∈ [0, Q²W] up to rounding, |V| < 2³⁰;
+//! - `V − q` with the detrend q ≤ Q²W, plus the quantiser's residue < 2¹⁶: < 2³¹.
+//! - `Vq = (V − q + err) >> 16` is stored as `i16`: |Vq| ≤ 2¹⁴ + 1.
+//! - The integral J of Vq over ≤ 8192 samples: |J| < 2²⁷.
+//! - The scaling pass forms `Vq·M` with M < 2¹⁶: < 2³¹.
+//!
+//! The quantiser carries its residue forward (error feedback), so the integral
+//! of the stored Vq equals ⌊(exact integral)/2¹⁶⌋ at every sample: quantising
+//! the velocity to 16 bits adds no drift, and a periodic walk's loop closes to
+//! the exact integer.
+
+use super::kernel::HannKernel;
+use super::lcg::Lcg;
+use super::storage::{FINE_PER_MDEG, Sample};
+use super::{AxisConfig, Closure, MotionError};
+
+/// Right shift from the smoother's `V` units to the stored velocity `Vq`.
+const VQ_SHIFT: u32 = 16;
+/// Smallest extent of the smoothed integral (in `Vq` units) that is scaled;
+/// below it the walk is treated as flat ([`MotionError::Degenerate`]).
+const MIN_EXTENT: i64 = 64;
+
+/// What the engine decided for one loop.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LoopInfo {
+    /// The sample of the smoothed, scaled loop that became index 0 (the split
+    /// point p of the paper's Figure 6).
+    pub split: u16,
+    /// How many zero crossings were candidates for the split.
+    pub crossings: u16,
+    /// Up-steps (+δ) among the walk's steps.
+    pub up_steps: u16,
+}
+
+/// Observer of intermediate stages, for previews and tests.
+///
+/// All methods default to doing nothing; `()` implements it as a no-op that
+/// compiles away.
+pub trait Trace {
+    /// The smoothed walk before scaling, at loop index `n` (generation order),
+    /// in units of the walk step δ (up to an additive constant).
+    fn smoothed(&mut self, _n: usize, _walk_steps: f32) {}
+    /// The scaled loop before closure at index `n` (generation order), in fine
+    /// units of 1/256 millidegree.
+    fn normalized(&mut self, _n: usize, _fine: i32) {}
+}
+
+impl Trace for () {}
+
+/// Runs the pipeline for one axis into `out` (length N, validated by the caller).
+pub(super) fn generate<S: Sample, T: Trace>(
+    out: &mut [S],
+    cfg: &AxisConfig,
+    kernel: &HannKernel,
+    trace: &mut T,
+) -> Result<LoopInfo, MotionError> {
+    if kernel.window() != cfg.window || out.len() <= 2 * usize::from(cfg.window) - 1 {
+        // Callers validate first; this keeps the function total on its own.
+        return Err(MotionError::WindowTooLarge {
+            window: cfg.window,
+            max: (out.len() / 2) as u16,
+        });
+    }
+    match cfg.closure {
+        Closure::Seamless => seamless(out, cfg, kernel, trace),
+        Closure::Paper => paper(out, cfg, kernel, trace),
+    }
+}
+
+/// Running extent of the smoothed integral.
+#[derive(Clone, Copy)]
+struct Extent {
+    min: i32,
+    max: i32,
+}
+
+impl Extent {
+    const fn new(v: i32) -> Self {
+        Self { min: v, max: v }
+    }
+    #[inline(always)]
+    fn add(&mut self, v: i32) {
+        if v < self.min {
+            self.min = v;
+        }
+        if v > self.max {
+            self.max = v;
+        }
+    }
+}
+
+/// Error-feedback quantiser from `V` units to `Vq` (see the module docs).
+#[derive(Clone, Copy)]
+struct Quantiser {
+    residue: i32,
+}
+
+impl Quantiser {
+    const MASK: i32 = (1 << VQ_SHIFT) - 1;
+    #[inline(always)]
+    fn push(&mut self, v: i32) -> i32 {
+        let r = v + self.residue;
+        self.residue = r & Self::MASK;
+        r >> VQ_SHIFT
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Seamless closure: periodic walk, circular smoothing, start at a crossing.
+// ---------------------------------------------------------------------------
+
+/// The seamless loop.
+///
+/// The circular step sequence is e(k) = ±1 from r(k+1), k = 0..N−1. Removing
+/// its mean step D/N makes the walk periodic; the detrend is applied to the
+/// smoothed velocity, where it is the constant q = Q²·W·(up steps)/N. The
+/// window for output n covers k = n−W+1..n taken modulo N.
+fn seamless<S: Sample, T: Trace>(
+    out: &mut [S],
+    cfg: &AxisConfig,
+    kernel: &HannKernel,
+    trace: &mut T,
+) -> Result<LoopInfo, MotionError> {
+    let n = out.len();
+    let w = usize::from(cfg.window);
+    let table = kernel.table();
+    let q = kernel.scale();
+    let qq = q * q;
+
+    // Pass 1: count the up-steps of the whole circular walk.
+    let mut g = Lcg::new(cfg.seed);
+    let mut ones: u32 = 0;
+    for _ in 0..n {
+        ones += g.next_step_bit();
+    }
+    // Detrend: Σₙ V(n) over the loop is exactly Q²·W·ones (zero-sum table), so
+    // subtracting q = ⌊Q²·W·ones/N⌋ per sample leaves a total in [0, N), which
+    // the quantiser (step 2¹⁶ > N) turns into an exact closure of J.
+    let detrend = (i64::from(qq) * w as i64 * i64::from(ones) / n as i64) as i32;
+
+    // Initial window: k = 0..W−1, output index W−1.
+    let mut main = Lcg::new(cfg.seed);
+    let (mut pc, mut ps, mut bb) = (0i32, 0i32, 0i32);
+    for &(tc, ts) in table {
+        if main.next_step_bit() == 1 {
+            pc += i32::from(tc);
+            ps += i32::from(ts);
+            bb += qq;
+        }
+    }
+    let mut lag = Lcg::new(cfg.seed);
+    let mut quant = Quantiser { residue: 0 };
+
+    // Pass 2: slide the window around the loop, storing the quantised velocity.
+    let mut j = w - 1; // residue of the output index
+    let mut slot = w - 1; // where the output goes (index mod N)
+    let mut k_next = w; // absolute index of the next entering step
+    let mut integral: i32 = 0;
+    let mut extent = Extent::new(0);
+    let mut at_slot0: i32 = 0;
+    let scale = 2.0 * (1u32 << VQ_SHIFT) as f32 / (qq as f32 * w as f32);
+    for t in 0..n {
+        // Output for the current window.
+        let (tc, ts) = table[j];
+        let cp = i32::from(tc) * pc + i32::from(ts) * ps;
+        let vq = quant.push(bb - cp - detrend);
+        integral += vq;
+        extent.add(integral);
+        out[slot] = S::from_scratch(vq as i16);
+        if slot == 0 {
+            at_slot0 = integral;
+        }
+        trace.smoothed(slot, integral as f32 * scale);
+        if t + 1 == n {
+            break;
+        }
+        // Slide: step k_next enters, step k_next − W leaves; same residue.
+        j += 1;
+        if j == w {
+            j = 0;
+        }
+        slot += 1;
+        if slot == n {
+            slot = 0;
+        }
+        if k_next == n {
+            main = Lcg::new(cfg.seed); // the circular walk wraps to e(0)
+        }
+        k_next += 1;
+        let enter = main.next_step_bit();
+        let leave = lag.next_step_bit();
+        if enter != leave {
+            let (tc, ts) = table[j];
+            if enter == 1 {
+                pc += i32::from(tc);
+                ps += i32::from(ts);
+                bb += qq;
+            } else {
+                pc -= i32::from(tc);
+                ps -= i32::from(ts);
+                bb -= qq;
+            }
+        }
+    }
+    // `integral` is now exactly 0: the loop closes (see `detrend`).
+
+    let (lo, hi) = (i64::from(extent.min), i64::from(extent.max));
+    if hi - lo < MIN_EXTENT {
+        return Err(MotionError::Degenerate { seed: cfg.seed });
+    }
+    let a1 = i64::from(cfg.range.min.millidegrees()) * i64::from(FINE_PER_MDEG);
+    let a2 = i64::from(cfg.range.max.millidegrees()) * i64::from(FINE_PER_MDEG);
+    // The level that the range's zero maps to under the paper's normalisation.
+    let zero_level = lo + (-a1 * (hi - lo)) / (a2 - a1);
+
+    // The first sample, walking from index 0, where the loop crosses that level.
+    let (split, pivot) = first_crossing(out, at_slot0, zero_level);
+
+    // Scale about the pivot so that it maps to exactly 0 and both extremes
+    // stay inside [α1, α2]; the tighter side reaches its bound.
+    let up = hi - i64::from(pivot);
+    let down = i64::from(pivot) - lo;
+    let (num, den) = if down == 0 || (up != 0 && a2 * down <= -a1 * up) {
+        (a2, up)
+    } else {
+        (-a1, down)
+    };
+    let (m, shift) = multiplier(num, den).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
+
+    out.rotate_left(split);
+    // Pass 3: integrate the stored velocity from the pivot and scale it.
+    scale_pass(out, 0, 0, m, shift, |i, fine| {
+        trace.normalized((i + split) % n, fine);
+        fine
+    });
+    Ok(LoopInfo {
+        split: split as u16,
+        crossings: 1,
+        up_steps: ones as u16,
+    })
+}
+
+/// Walks the integral `J` from index 0 (where it is `at_slot0`) and returns the
+/// first index where it crosses `level` — the sample nearer the level — and
+/// `J` there. A closed loop that spans the level always crosses it.
+fn first_crossing<S: Sample>(vel: &[S], at_slot0: i32, level: i64) -> (usize, i32) {
+    let mut prev = at_slot0;
+    for (i, v) in vel
+        .iter()
+        .enumerate()
+        .skip(1)
+        .chain(vel.iter().enumerate().take(1))
+    {
+        let cur = prev + i32::from(v.to_scratch());
+        let (dp, dc) = (i64::from(prev) - level, i64::from(cur) - level);
+        if dp == 0 {
+            return ((i + vel.len() - 1) % vel.len(), prev);
+        }
+        if dc == 0 || (dc < 0) != (dp < 0) {
+            return if dc.abs() <= dp.abs() {
+                (i, cur)
+            } else {
+                ((i + vel.len() - 1) % vel.len(), prev)
+            };
+        }
+        prev = cur;
+    }
+    (0, at_slot0)
+}
+
+/// `num/den` as a multiplier `m / 2^shift` with m < 2¹⁶ (rounded down, so
+/// scaled values never overshoot), or `None` if the ratio does not fit.
+fn multiplier(num: i64, den: i64) -> Option<(i32, u32)> {
+    if num <= 0 || den <= 0 {
+        return None;
+    }
+    // ratio · 2³², exact floor; num < 2²⁴, so no overflow.
+    let r = ((num as u64) << 32) / den as u64;
+    let bits = 64 - r.leading_zeros();
+    if bits <= 16 {
+        return Some((r as i32, 32));
+    }
+    let drop = bits - 16;
+    if drop > 32 {
+        return None; // ratio ≥ 2¹⁶: the smoothed extent is too small to scale
+    }
+    Some(((r >> drop) as i32, 32 - drop))
+}
+
+/// Integrates the stored velocity `Vq` and stores the scaled loop in place:
+/// value(i) = `start_fine` + ⌊Σ_{1≤m≤i} Vq[m]·m/2^shift⌋ (error feedback keeps
+/// the running sum exact), value(0) = `start_fine`; `post` maps each value
+/// (index, fine units) to what is stored.
+fn scale_pass<S: Sample>(
+    out: &mut [S],
+    start_fine: i32,
+    start_residue: i64,
+    m: i32,
+    shift: u32,
+    mut post: impl FnMut(usize, i32) -> i32,
+) {
+    let mask: i64 = (1i64 << shift) - 1;
+    let mut fine = start_fine;
+    let mut residue = start_residue;
+    if let Some(first) = out.first_mut() {
+        *first = S::from_fine(post(0, fine));
+    }
+    for (i, s) in out.iter_mut().enumerate().skip(1) {
+        let acc = i64::from(s.to_scratch()) * i64::from(m) + residue;
+        residue = acc & mask;
+        fine += (acc >> shift) as i32;
+        *s = S::from_fine(post(i, fine));
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Paper closure: causal smoothing, normalisation, Hann taper, split, exchange.
+// ---------------------------------------------------------------------------
+
+/// The paper's loop (Figure 6).
+///
+/// The open walk has u(0) = 0 and steps e(k) = ±1 from r(k), k = 1..N−1
+/// (e(0) = 0 and e(k) = 0 before the start: the paper's u(n−m) = 0 for n−m < 0).
+fn paper<S: Sample, T: Trace>(
+    out: &mut [S],
+    cfg: &AxisConfig,
+    kernel: &HannKernel,
+    trace: &mut T,
+) -> Result<LoopInfo, MotionError> {
+    let n = out.len();
+    let w = usize::from(cfg.window);
+    let table = kernel.table();
+    let q = kernel.scale();
+    let qq = q * q;
+
+    // Pass 2 (causal): steps in {−1, 0, +1}; V = Q²·B − cp = 2Q²·v.
+    let mut main = Lcg::new(cfg.seed);
+    let mut lag = Lcg::new(cfg.seed);
+    let (mut pc, mut ps, mut b) = (0i32, 0i32, 0i32);
+    let mut quant = Quantiser { residue: 0 };
+    let mut integral: i32 = 0;
+    let mut extent = Extent::new(0);
+    let mut ones: u32 = 0;
+    let scale = (1u32 << VQ_SHIFT) as f32 / (qq as f32 * w as f32);
+    let mut j = 0usize;
+    for (i, s) in out.iter_mut().enumerate() {
+        let enter = if i == 0 {
+            0
+        } else {
+            step(main.next_step_bit())
+        };
+        ones += u32::from(enter > 0);
+        // e(i−W) leaves: zero before the start and for e(0).
+        let leave = if i <= w { 0 } else { step(lag.next_step_bit()) };
+        let d = enter - leave;
+        let (tc, ts) = table[j];
+        pc += d * i32::from(tc);
+        ps += d * i32::from(ts);
+        b += d;
+        let cp = i32::from(tc) * pc + i32::from(ts) * ps;
+        let vq = quant.push(qq * b - cp);
+        integral += vq;
+        extent.add(integral);
+        *s = S::from_scratch(vq as i16);
+        trace.smoothed(i, integral as f32 * scale);
+        j += 1;
+        if j == w {
+            j = 0;
+        }
+    }
+
+    let (lo, hi) = (i64::from(extent.min), i64::from(extent.max));
+    if hi - lo < MIN_EXTENT {
+        return Err(MotionError::Degenerate { seed: cfg.seed });
+    }
+    let a1 = i64::from(cfg.range.min.millidegrees()) * i64::from(FINE_PER_MDEG);
+    let a2 = i64::from(cfg.range.max.millidegrees()) * i64::from(FINE_PER_MDEG);
+    let (m, shift) =
+        multiplier(a2 - a1, hi - lo).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
+
+    // Normalise: α1 + (J − J_min)·(α2 − α1)/(J_max − J_min), then taper with
+    // the symmetric length-N Hann window (both ends exactly zero).
+    let first = i64::from(out.first().map_or(0, |s| s.to_scratch()));
+    let acc0 = (first - lo) * i64::from(m);
+    let start_fine = (a1 + (acc0 >> shift)) as i32;
+    let start_residue = acc0 & ((1i64 << shift) - 1);
+    let span = (n - 1) as u64;
+    scale_pass(out, start_fine, start_residue, m, shift, |i, fine| {
+        trace.normalized(i, fine);
+        if i == 0 || i == n - 1 {
+            return 0; // the taper's ends are exactly zero
+        }
+        let phase = ((i as u64) << 32) / span;
+        let (c, _) = idsp::cossin(phase as u32 as i32);
+        // ½ − ½·cos(2πi/(N−1)) in Q31: (2³¹ − cos)/2.
+        let hann = ((1i64 << 31) - i64::from(c)) >> 1;
+        ((i64::from(fine) * hann + (1 << 30)) >> 31) as i32
+    });
+
+    // Zero crossings: v(n) = sign x(n+1) − sign x(n) ≠ 0, n = 0..N−2, on the
+    // stored angles; one is drawn with the LCG value after the walk, r(N).
+    let sign = |s: &S| s.angle().millidegrees().signum();
+    let crossings = out
+        .windows(2)
+        .filter(|p| sign(&p[1]) != sign(&p[0]))
+        .count();
+    let pick = main.next_index(crossings as u32) as usize;
+    let split = out
+        .windows(2)
+        .enumerate()
+        .filter(|(_, p)| sign(&p[1]) != sign(&p[0]))
+        .nth(pick)
+        .map_or(0, |(i, _)| i);
+    out.rotate_left(split);
+    Ok(LoopInfo {
+        split: split as u16,
+        crossings: crossings as u16,
+        up_steps: ones as u16,
+    })
+}
+
+#[inline(always)]
+fn step(bit: u32) -> i32 {
+    (bit as i32) * 2 - 1
+}
