@@ -1,1 +1,137 @@
-fn main() { println!("xtask args: {:?}", std::env::args().skip(1).collect::<Vec<_>>()); }
+//! Host-side project commands, run as `cargo xtask <command>` from anywhere in
+//! the repository (the alias in `.cargo/config.toml` builds this crate for the
+//! host).
+//!
+//! - `cargo xtask qemu`: build the QEMU image, run it and show the head's motion.
+//! - `cargo xtask test`: every check the project has (host tests, formatting,
+//!   lints, the Pico build and its memory budget, the QEMU log snapshot).
+//!
+//! Both install what they need and is missing: the firmware's Rust target and,
+//! when running as root on Debian or Ubuntu, QEMU.
+
+mod elf;
+mod project;
+mod qemu;
+mod reference;
+mod render;
+mod setup;
+mod snapshot;
+mod test;
+
+use std::{process::ExitCode, time::Duration};
+
+use anyhow::{Context, Result, bail};
+
+const HELP: &str = "\
+Usage: cargo xtask <command> [options]
+
+Commands:
+  qemu     Build the QEMU image, run it under emulation and show the head's
+           motion: the decoded defmt log, the summary line and a plot of the
+           three axes over the run.
+  test     Run every check: host tests, rustfmt, clippy (firmware and host
+           crates), the Pico build with its memory budget, and the QEMU run
+           compared with src/bin/qemu/expected.log. Ends with `N passed, M failed`.
+  help     Show this text.
+
+Options:
+  --bless          Re-record src/bin/qemu/expected.log from this run (the run
+                   itself must succeed).
+  --timeout <s>    Stop QEMU after this many seconds of wall time
+                   (default 120); a run that times out fails.
+  -h, --help       Show this text.
+
+Both commands install what is missing: the thumbv6m-none-eabi Rust target
+(rustup) and, as root on Debian/Ubuntu, the qemu-system-arm package (apt-get).
+";
+
+/// Options shared by the commands.
+#[derive(Debug, Clone, Copy)]
+pub struct Options {
+    /// Re-record the expected QEMU log instead of comparing against it.
+    pub bless: bool,
+    /// Wall-clock limit for one QEMU run.
+    pub timeout: Duration,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            bless: false,
+            // A hung firmware must fail CI, not stall it; the QEMU run takes
+            // well under a minute.
+            timeout: Duration::from_secs(120),
+        }
+    }
+}
+
+enum Command {
+    Qemu(Options),
+    Test(Options),
+    Help,
+}
+
+fn parse_args(mut args: impl Iterator<Item = String>) -> Result<Command> {
+    let Some(command) = args.next() else {
+        return Ok(Command::Help);
+    };
+    let mut options = Options::default();
+    let mut help = false;
+    while let Some(arg) = args.next() {
+        match arg.as_str() {
+            "--bless" => options.bless = true,
+            "--timeout" => {
+                let value = args
+                    .next()
+                    .context("`--timeout` needs a number of seconds")?;
+                options.timeout = parse_seconds(&value)?;
+            }
+            "-h" | "--help" => help = true,
+            other => {
+                if let Some(value) = other.strip_prefix("--timeout=") {
+                    options.timeout = parse_seconds(value)?;
+                } else {
+                    bail!("unknown option `{other}` (see `cargo xtask help`)");
+                }
+            }
+        }
+    }
+    if help {
+        return Ok(Command::Help);
+    }
+    Ok(match command.as_str() {
+        "qemu" => Command::Qemu(options),
+        "test" => Command::Test(options),
+        "help" | "-h" | "--help" => Command::Help,
+        other => bail!("unknown command `{other}` (see `cargo xtask help`)"),
+    })
+}
+
+fn parse_seconds(value: &str) -> Result<Duration> {
+    let seconds: u64 = value
+        .parse()
+        .with_context(|| format!("`--timeout {value}`: expected whole seconds"))?;
+    if seconds == 0 {
+        bail!("`--timeout` must be at least 1 second");
+    }
+    Ok(Duration::from_secs(seconds))
+}
+
+fn main() -> ExitCode {
+    let result = parse_args(std::env::args().skip(1)).and_then(|command| match command {
+        Command::Help => {
+            print!("{HELP}");
+            Ok(true)
+        }
+        Command::Qemu(options) => qemu::command(options),
+        Command::Test(options) => test::command(options),
+    });
+    match result {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::FAILURE,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,252 @@
+//! Reads a firmware ELF: section placement and sizes, memory budgets, and
+//! symbols that must not be linked.
+
+use std::{fmt::Write as _, path::Path};
+
+use anyhow::{Context, Result, bail};
+use object::{Object, ObjectSection, ObjectSymbol, SectionFlags, SectionKind, elf};
+
+/// Static RAM budget of the Pico image: `.data + .bss + .uninit`.
+pub const RAM_BUDGET: u64 = 8 * 1024;
+/// Flash budget of the Pico image: everything stored in flash
+/// (`.boot2 + .vector_table + .text + .rodata` and `.data`'s initial values).
+pub const FLASH_BUDGET: u64 = 32 * 1024;
+/// Where the RP2040 boot ROM looks for the 256-byte second-stage bootloader:
+/// the first flash page (XIP base `0x1000_0000`).
+pub const BOOT2_ADDRESS: u64 = 0x1000_0000;
+/// Size of the second stage: 252 bytes of code plus a 4-byte CRC32.
+pub const BOOT2_SIZE: u64 = 256;
+
+/// Parts of the names of symbols that are only present when an allocator is
+/// linked (`alloc`'s shims and the `#[global_allocator]` glue). Recent
+/// compilers mangle the shims (`_RNv..7___rustc12___rust_alloc`), so names are
+/// matched by substring.
+const ALLOCATOR_SYMBOLS: &[&str] = &[
+    "__rust_alloc",
+    "__rust_realloc",
+    "__rust_dealloc",
+    "__rg_alloc",
+    "__rdl_alloc",
+];
+
+/// One allocated section of the image.
+#[derive(Debug, Clone)]
+pub struct Section {
+    /// Section name, e.g. `.text`.
+    pub name: String,
+    /// Run-time address.
+    pub address: u64,
+    /// Size in bytes.
+    pub size: u64,
+    /// Whether the section has contents in the file (and so in flash);
+    /// `.bss` and `.uninit` do not.
+    pub stored: bool,
+}
+
+/// What the checks need to know about a firmware ELF.
+#[derive(Debug)]
+pub struct Image {
+    /// Allocated sections in address order.
+    pub sections: Vec<Section>,
+    /// Allocator symbols found (there should be none).
+    pub allocator_symbols: Vec<String>,
+}
+
+impl Image {
+    /// Parses the ELF at `path`.
+    pub fn read(path: &Path) -> Result<Self> {
+        let data = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+        let file =
+            object::File::parse(&*data).with_context(|| format!("parsing {}", path.display()))?;
+        let mut sections: Vec<Section> = file
+            .sections()
+            .filter(|section| match section.flags() {
+                SectionFlags::Elf { sh_flags } => sh_flags & u64::from(elf::SHF_ALLOC) != 0,
+                _ => false,
+            })
+            .filter(|section| section.size() > 0)
+            .map(|section| Section {
+                name: section.name().unwrap_or("?").to_owned(),
+                address: section.address(),
+                size: section.size(),
+                stored: !matches!(
+                    section.kind(),
+                    SectionKind::UninitializedData | SectionKind::UninitializedTls
+                ),
+            })
+            .collect();
+        sections.sort_by_key(|section| section.address);
+        let mut allocator_symbols: Vec<String> = file
+            .symbols()
+            .filter_map(|symbol| symbol.name().ok())
+            .filter(|name| ALLOCATOR_SYMBOLS.iter().any(|part| name.contains(part)))
+            .map(str::to_owned)
+            .collect();
+        allocator_symbols.sort();
+        allocator_symbols.dedup();
+        Ok(Self {
+            sections,
+            allocator_symbols,
+        })
+    }
+
+    /// The section called `name`, if present and non-empty.
+    pub fn section(&self, name: &str) -> Option<&Section> {
+        self.sections.iter().find(|section| section.name == name)
+    }
+
+    fn size_of(&self, names: &[&str]) -> u64 {
+        names
+            .iter()
+            .filter_map(|name| self.section(name))
+            .map(|section| section.size)
+            .sum()
+    }
+
+    /// Bytes of RAM taken before `main` runs: `.data + .bss + .uninit`.
+    pub fn static_ram(&self) -> u64 {
+        self.size_of(&[".data", ".bss", ".uninit"])
+    }
+
+    /// Bytes written to flash: every allocated section with contents
+    /// (this includes the initial values of `.data`).
+    pub fn flash(&self) -> u64 {
+        self.sections
+            .iter()
+            .filter(|section| section.stored)
+            .map(|section| section.size)
+            .sum()
+    }
+
+    /// A table of the sections with their addresses and sizes.
+    pub fn table(&self) -> String {
+        let mut table = String::new();
+        let _ = writeln!(
+            table,
+            "  {:<16} {:>10}  {:>7}",
+            "section", "address", "bytes"
+        );
+        for section in &self.sections {
+            let _ = writeln!(
+                table,
+                "  {:<16} {:#010x}  {:>7}",
+                section.name, section.address, section.size
+            );
+        }
+        table
+    }
+
+    /// Fails unless the image links no allocator.
+    pub fn check_no_allocator(&self) -> Result<()> {
+        if !self.allocator_symbols.is_empty() {
+            bail!(
+                "an allocator is linked (symbols {}); the firmware must not allocate",
+                self.allocator_symbols.join(", ")
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Prints the Pico image's sections and budgets; fails if `.boot2` is misplaced,
+/// a budget is exceeded or an allocator is linked.
+pub fn check_pico(path: &Path) -> Result<()> {
+    let image = Image::read(path)?;
+    println!("{}", path.display());
+    print!("{}", image.table());
+
+    let mut problems = Vec::new();
+    match image.section(".boot2") {
+        Some(boot2) if boot2.address == BOOT2_ADDRESS && boot2.size == BOOT2_SIZE => {}
+        Some(boot2) => problems.push(format!(
+            "`.boot2` is {} bytes at {:#010x}; the RP2040 boot ROM needs {BOOT2_SIZE} bytes at \
+             {BOOT2_ADDRESS:#010x} (is `-Tlink-rp.x` passed to the linker?)",
+            boot2.size, boot2.address
+        )),
+        None => problems.push(
+            "no `.boot2` section: the RP2040 would not boot (is `-Tlink-rp.x` passed to the \
+             linker?)"
+                .to_owned(),
+        ),
+    }
+
+    let flash = image.flash();
+    let ram = image.static_ram();
+    println!(
+        "  flash      {:>6} B = {:>5.1} KiB of {} KiB budget  ({})",
+        flash,
+        kib(flash),
+        FLASH_BUDGET / 1024,
+        stored_names(&image)
+    );
+    println!(
+        "  static RAM {:>6} B = {:>5.1} KiB of {} KiB budget  (.data + .bss + .uninit)",
+        ram,
+        kib(ram),
+        RAM_BUDGET / 1024
+    );
+    if flash > FLASH_BUDGET {
+        problems.push(format!(
+            "flash use {flash} B is over the {FLASH_BUDGET} B budget"
+        ));
+    }
+    if ram > RAM_BUDGET {
+        problems.push(format!(
+            "static RAM use {ram} B is over the {RAM_BUDGET} B budget"
+        ));
+    }
+    if let Err(error) = image.check_no_allocator() {
+        problems.push(error.to_string());
+    } else {
+        println!("  no allocator linked");
+    }
+
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        bail!("{}", problems.join("; "))
+    }
+}
+
+/// Prints the QEMU image's sections and sizes (no budget: it is a test image);
+/// fails if an allocator is linked.
+pub fn check_qemu(path: &Path) -> Result<()> {
+    let image = Image::read(path)?;
+    println!("{}", path.display());
+    print!("{}", image.table());
+    println!(
+        "  flash {} B, static RAM {} B (no budget for the QEMU image)",
+        image.flash(),
+        image.static_ram()
+    );
+    image.check_no_allocator()
+}
+
+fn stored_names(image: &Image) -> String {
+    image
+        .sections
+        .iter()
+        .filter(|section| section.stored)
+        .map(|section| section.name.as_str())
+        .collect::<Vec<_>>()
+        .join(" + ")
+}
+
+#[allow(clippy::cast_precision_loss)] // sizes far below 2^52
+fn kib(bytes: u64) -> f64 {
+    bytes as f64 / 1024.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// This test binary links std, and with it an allocator: the check must see it.
+    #[test]
+    fn finds_the_allocator_of_a_std_binary() {
+        let image = Image::read(&std::env::current_exe().unwrap()).unwrap();
+        assert!(image.check_no_allocator().is_err());
+        assert!(image.section(".text").is_some_and(|text| text.size > 0));
+        assert!(image.flash() > 0);
+    }
+}

@@ -1,0 +1,136 @@
+//! A small text plot of the three axes' motion, read back from the QEMU log.
+//!
+//! Frame lines are recognised by their angles, written either as
+//! `pitch=<n> roll=<n> yaw=<n>` (a unit may follow each number) or as a
+//! bracketed triple after a word starting with `angle` (`angles=[p, r, y]`).
+
+// Frame counts and plot rows are small; the float conversions are exact.
+#![allow(
+    clippy::cast_precision_loss,
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss
+)]
+
+use std::fmt::Write as _;
+
+/// Columns of the plot (frames are averaged into this many buckets).
+const WIDTH: usize = 64;
+/// Rows per axis.
+const HEIGHT: usize = 5;
+const AXES: [&str; 3] = ["pitch", "roll", "yaw"];
+
+/// The plot, or `None` if the log has fewer than two frame lines.
+pub fn plot(log: &[crate::qemu::LogLine]) -> Option<String> {
+    let samples: Vec<[f64; 3]> = log
+        .iter()
+        .filter_map(|line| angles(&line.message))
+        .collect();
+    if samples.len() < 2 {
+        return None;
+    }
+    let width = samples.len().min(WIDTH);
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "motion over {} logged frames ({} per column), values as logged:",
+        samples.len(),
+        samples.len().div_ceil(width)
+    );
+    for (axis, name) in AXES.iter().enumerate() {
+        let columns: Vec<f64> = (0..width)
+            .map(|column| {
+                let from = column * samples.len() / width;
+                let to = ((column + 1) * samples.len() / width).max(from + 1);
+                let bucket = &samples[from..to];
+                bucket.iter().map(|sample| sample[axis]).sum::<f64>() / bucket.len() as f64
+            })
+            .collect();
+        let min = columns.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = columns.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let span = if max > min { max - min } else { 1.0 };
+        let row_of = |value: f64| {
+            // Row 0 is the top (max), row HEIGHT-1 the bottom (min).
+            let fraction = (max - value) / span;
+            (fraction * (HEIGHT - 1) as f64).round() as usize
+        };
+        let zero_row = (min <= 0.0 && 0.0 <= max).then(|| row_of(0.0));
+        for row in 0..HEIGHT {
+            let label = match row {
+                0 => format!("{name:<5} {max:>9.1}"),
+                r if r == HEIGHT - 1 => format!("{:<5} {min:>9.1}", ""),
+                _ => String::new(),
+            };
+            let line: String = columns
+                .iter()
+                .map(|&value| {
+                    if row_of(value) == row {
+                        '*'
+                    } else if zero_row == Some(row) {
+                        '-'
+                    } else {
+                        ' '
+                    }
+                })
+                .collect();
+            let _ = writeln!(out, "{label:>15} |{line}|");
+        }
+    }
+    Some(out)
+}
+
+/// The three angles of a frame line, if `message` is one.
+fn angles(message: &str) -> Option<[f64; 3]> {
+    keyed(message).or_else(|| bracketed(message))
+}
+
+fn keyed(message: &str) -> Option<[f64; 3]> {
+    let mut found = [None; 3];
+    for token in message.split(|c: char| c.is_whitespace() || c == ',') {
+        let Some((key, value)) = token.split_once(['=', ':']) else {
+            continue;
+        };
+        if let Some(axis) = AXES.iter().position(|name| key.eq_ignore_ascii_case(name)) {
+            found[axis] = leading_number(value);
+        }
+    }
+    Some([found[0]?, found[1]?, found[2]?])
+}
+
+fn bracketed(message: &str) -> Option<[f64; 3]> {
+    let at = message.find("angle")?;
+    let rest = &message[at..];
+    let open = rest.find('[')?;
+    let close = rest[open..].find(']')? + open;
+    let values: Vec<f64> = rest[open + 1..close]
+        .split(',')
+        .map(|value| leading_number(value.trim()))
+        .collect::<Option<_>>()?;
+    <[f64; 3]>::try_from(values).ok()
+}
+
+/// The number at the start of `text` (`-12`, `3.5`, `+7mdeg` -> 7).
+fn leading_number(text: &str) -> Option<f64> {
+    let end = text
+        .char_indices()
+        .find(|&(i, c)| !(c.is_ascii_digit() || c == '.' || (i == 0 && (c == '-' || c == '+'))))
+        .map_or(text.len(), |(i, _)| i);
+    text[..end].parse().ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_keyed_and_bracketed_angles() {
+        assert_eq!(
+            angles("frame 3 pitch=-120 roll=45mdeg yaw=+7 pulses=[1500, 1490, 1510]"),
+            Some([-120.0, 45.0, 7.0])
+        );
+        assert_eq!(
+            angles("frame 3 angles=[1.5, -2, 3] pulses=[1500, 1490, 1510]"),
+            Some([1.5, -2.0, 3.0])
+        );
+        assert_eq!(angles("summary missed=0"), None);
+    }
+}

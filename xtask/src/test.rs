@@ -1,0 +1,285 @@
+//! `cargo xtask test`: every check, as a list of stages that all run; the
+//! command fails if any stage fails.
+
+use std::{path::Path, time::Instant};
+
+use anyhow::{Result, bail};
+
+use crate::{
+    Options, elf,
+    project::{self, Metadata, PICO, QEMU},
+    qemu::{self, Echo, Run},
+    setup, snapshot,
+};
+
+/// How a stage ended.
+enum Outcome {
+    Passed,
+    Failed(String),
+    Skipped(String),
+}
+
+/// Runs stages one after another and keeps score.
+struct Stages {
+    results: Vec<(String, Outcome, f64)>,
+}
+
+impl Stages {
+    fn new() -> Self {
+        Self {
+            results: Vec::new(),
+        }
+    }
+
+    /// Runs one stage; `Ok(())` passes, an error fails it.
+    fn run(&mut self, name: &str, stage: impl FnOnce() -> Result<()>) -> bool {
+        self.run_or_skip(name, || stage().map(|()| None))
+    }
+
+    /// Runs one stage that may decide to skip itself (`Ok(Some(reason))`).
+    fn run_or_skip(&mut self, name: &str, stage: impl FnOnce() -> Result<Option<String>>) -> bool {
+        println!();
+        println!("==> {name}");
+        let start = Instant::now();
+        let outcome = match stage() {
+            Ok(None) => Outcome::Passed,
+            Ok(Some(reason)) => Outcome::Skipped(reason),
+            Err(error) => Outcome::Failed(format!("{error:#}")),
+        };
+        let seconds = start.elapsed().as_secs_f64();
+        let passed = !matches!(outcome, Outcome::Failed(_));
+        match &outcome {
+            Outcome::Passed => println!("--- ok: {name} ({seconds:.1} s)"),
+            Outcome::Skipped(reason) => println!("--- skipped: {name}: {reason}"),
+            Outcome::Failed(error) => println!("--- FAILED: {name}: {error}"),
+        }
+        self.results.push((name.to_owned(), outcome, seconds));
+        passed
+    }
+
+    /// Records a stage that could not run because an earlier one failed.
+    fn blocked(&mut self, name: &str, by: &str) {
+        println!();
+        println!("==> {name}");
+        println!("--- FAILED: {name}: not run, {by} failed");
+        self.results.push((
+            name.to_owned(),
+            Outcome::Failed(format!("not run, {by} failed")),
+            0.0,
+        ));
+    }
+
+    /// Prints the score card and the closing `N passed, M failed` line.
+    fn finish(&self, start: Instant) -> bool {
+        let count = |f: fn(&Outcome) -> bool| self.results.iter().filter(|(_, o, _)| f(o)).count();
+        let passed = count(|o| matches!(o, Outcome::Passed));
+        let failed = count(|o| matches!(o, Outcome::Failed(_)));
+        let skipped = count(|o| matches!(o, Outcome::Skipped(_)));
+        println!();
+        println!("stages:");
+        for (name, outcome, seconds) in &self.results {
+            let verdict = match outcome {
+                Outcome::Passed => "ok",
+                Outcome::Failed(_) => "FAILED",
+                Outcome::Skipped(_) => "skipped",
+            };
+            println!("  {verdict:<8} {seconds:>6.1} s  {name}");
+        }
+        for (name, outcome, _) in &self.results {
+            if let Outcome::Failed(error) = outcome {
+                println!("failed: {name}: {error}");
+            }
+        }
+        println!("total time {:.0} s", start.elapsed().as_secs_f64().round());
+        if skipped > 0 {
+            println!("{passed} passed, {failed} failed, {skipped} skipped");
+        } else {
+            println!("{passed} passed, {failed} failed");
+        }
+        failed == 0
+    }
+}
+
+/// `cargo xtask test`. `Ok(false)` when a stage failed.
+pub fn command(options: Options) -> Result<bool> {
+    let start = Instant::now();
+    let root = project::root();
+    let host_tests = root.join("host-tests");
+    let xtask = root.join("xtask");
+    setup::ensure_toolchain(&root)?;
+    let metadata = project::metadata(&root)?;
+    let mut stages = Stages::new();
+
+    // 1. Host tests of the core, and its doc tests once they are switched on.
+    stages.run("host tests (host-tests/)", || {
+        project::run(project::cargo(&host_tests).arg("test"))
+    });
+    stages.run_or_skip("doc tests of the core library (host)", || {
+        doc_tests(&root, &metadata)
+    });
+    stages.run("xtask unit tests", || {
+        project::run(project::cargo(&xtask).arg("test"))
+    });
+
+    // 2. Formatting and lints: firmware (thumb, both images) and host crates.
+    stages.run("rustfmt: core, firmware, host-tests, xtask", || {
+        let mut failures = Vec::new();
+        for dir in [&root, &host_tests, &xtask] {
+            if let Err(error) = project::run(project::cargo(dir).args(["fmt", "--check"])) {
+                failures.push(format!("{error:#}"));
+            }
+        }
+        fail_if_any(&failures)
+    });
+    clippy_stages(&mut stages, &root, &host_tests, &xtask);
+
+    // 3. The Pico image: placement of the boot stage, memory budgets, no allocator.
+    let pico_built = stages.run("Pico build (cargo build --release)", || PICO.build(&root));
+    if pico_built {
+        stages.run(
+            "Pico image: .boot2 placement, memory budgets, no allocator",
+            || elf::check_pico(&PICO.elf(&metadata.target_dir)),
+        );
+    } else {
+        stages.blocked(
+            "Pico image: .boot2 placement, memory budgets, no allocator",
+            "the Pico build",
+        );
+    }
+
+    // 4. The QEMU run against the log on file, and the firmware's own verdict.
+    qemu_stages(&mut stages, &root, &metadata, options);
+
+    Ok(stages.finish(start))
+}
+
+fn clippy_stages(stages: &mut Stages, root: &Path, host_tests: &Path, xtask: &Path) {
+    // `--release` shares build scripts and proc-macros with the release builds below.
+    let lint = ["--", "-D", "warnings"];
+    stages.run("clippy: Pico image + core (thumbv6m)", || {
+        project::run(
+            project::cargo(root)
+                .args(["clippy", "--release", "--lib", "--bins"])
+                .args(PICO.cargo_args)
+                .args(lint)
+                .env("DEFMT_LOG", project::DEFMT_LOG),
+        )
+    });
+    stages.run("clippy: QEMU image + core (thumbv6m)", || {
+        project::run(
+            project::cargo(root)
+                .args(["clippy", "--release", "--lib"])
+                .args(QEMU.cargo_args)
+                .args(lint)
+                .env("DEFMT_LOG", project::DEFMT_LOG),
+        )
+    });
+    stages.run("clippy: core library (host)", || {
+        project::run(
+            project::cargo(root)
+                .args([
+                    "clippy",
+                    "--lib",
+                    "--no-default-features",
+                    "--target",
+                    "host-tuple",
+                ])
+                .args(lint),
+        )
+    });
+    stages.run("clippy: host-tests", || {
+        project::run(
+            project::cargo(host_tests)
+                .args(["clippy", "--all-targets"])
+                .args(lint),
+        )
+    });
+    stages.run("clippy: xtask", || {
+        project::run(
+            project::cargo(xtask)
+                .args(["clippy", "--all-targets"])
+                .args(lint),
+        )
+    });
+}
+
+fn qemu_stages(stages: &mut Stages, root: &Path, metadata: &Metadata, options: Options) {
+    const BUILD: &str = "QEMU build (no allocator linked)";
+    const RUN: &str = "QEMU run: firmware exits with success";
+    const SNAPSHOT: &str = "QEMU log matches src/bin/qemu/expected.log";
+    const SUMMARY: &str = "QEMU summary: missed=0 pulse_violations=0, checksum = host's";
+
+    let built = stages.run(BUILD, || {
+        setup::ensure_qemu()?;
+        QEMU.build(root)?;
+        elf::check_qemu(&QEMU.elf(&metadata.target_dir))
+    });
+    if !built {
+        for name in [RUN, SNAPSHOT, SUMMARY] {
+            stages.blocked(name, BUILD);
+        }
+        return;
+    }
+    let mut run: Option<Run> = None;
+    stages.run(RUN, || {
+        let done = qemu::run(
+            &QEMU.elf(&metadata.target_dir),
+            options.timeout,
+            Echo::Problems,
+        )?;
+        println!("{}", done.describe());
+        let succeeded = done.succeeded();
+        let describe = done.describe();
+        run = Some(done);
+        if succeeded {
+            Ok(())
+        } else {
+            bail!("{describe}")
+        }
+    });
+    let Some(run) = run else {
+        for name in [SNAPSHOT, SUMMARY] {
+            stages.blocked(name, RUN);
+        }
+        return;
+    };
+    stages.run(SNAPSHOT, || {
+        if options.bless {
+            if !run.succeeded() {
+                bail!("not re-recording the expected log: the run failed");
+            }
+            snapshot::bless(&run)
+        } else {
+            snapshot::compare(&run, &metadata.target_dir.join("qemu-actual.log"))
+        }
+    });
+    stages.run(SUMMARY, || {
+        let verdict = qemu::check_summary(&run.log)?;
+        println!("{verdict}");
+        Ok(())
+    });
+}
+
+fn doc_tests(root: &Path, metadata: &Metadata) -> Result<Option<String>> {
+    if !metadata.lib_doctests {
+        return Ok(Some(
+            "`doctest = false` in the root Cargo.toml's [lib]".to_owned(),
+        ));
+    }
+    project::run(project::cargo(root).args([
+        "test",
+        "--doc",
+        "--no-default-features",
+        "--target",
+        "host-tuple",
+    ]))?;
+    Ok(None)
+}
+
+fn fail_if_any(failures: &[String]) -> Result<()> {
+    if failures.is_empty() {
+        Ok(())
+    } else {
+        bail!("{}", failures.join("; "))
+    }
+}
