@@ -354,3 +354,40 @@ pub fn check_summary(log: &[LogLine]) -> Result<String> {
         bail!("{}", problems.join(", "))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(message: &str) -> LogLine {
+        LogLine {
+            level: Some("INFO".to_owned()),
+            message: message.to_owned(),
+            timestamp: None,
+            location: None,
+        }
+    }
+
+    #[test]
+    fn reads_the_last_summary_line() {
+        let log = [
+            line("frame 0 pitch=0 roll=0 yaw=0"),
+            line("summary frames=10 missed=3"),
+            line("summary frames=900 missed=0 pulse_violations=0, checksum=0x1a2B_3c4d"),
+        ];
+        let summary = Summary::find(&log).unwrap();
+        assert_eq!(summary.number("frames").unwrap(), 900);
+        assert_eq!(summary.number("missed").unwrap(), 0);
+        assert_eq!(summary.number("checksum").unwrap(), 0x1a2b_3c4d);
+        assert!(summary.number("absent").is_err());
+        assert!(Summary::find(&log[..1]).is_none());
+    }
+
+    #[test]
+    fn snapshot_lines_have_level_and_message_only() {
+        let mut with_extras = line("hello");
+        with_extras.timestamp = Some("1.000000".to_owned());
+        with_extras.location = Some("src/main.rs:3".to_owned());
+        assert_eq!(with_extras.snapshot(), "INFO  hello");
+    }
+}

@@ -32,7 +32,7 @@ pub fn plot(log: &[crate::qemu::LogLine]) -> Option<String> {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "motion over {} logged frames ({} per column), values as logged:",
+        "motion over {} logged frames (~{} per column), values as logged:",
         samples.len(),
         samples.len().div_ceil(width)
     );
@@ -120,6 +120,7 @@ fn leading_number(text: &str) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::qemu::LogLine;
 
     #[test]
     fn reads_keyed_and_bracketed_angles() {
@@ -132,5 +133,28 @@ mod tests {
             Some([1.5, -2.0, 3.0])
         );
         assert_eq!(angles("summary missed=0"), None);
+    }
+
+    #[test]
+    fn plots_three_bands() {
+        let log: Vec<LogLine> = (0..300)
+            .map(|i| {
+                let t = f64::from(i) / 300.0 * std::f64::consts::TAU;
+                LogLine {
+                    level: Some("INFO".to_owned()),
+                    message: format!(
+                        "frame {i} pitch={:.0} roll={:.0} yaw={:.0}",
+                        4000.0 * t.sin(),
+                        2000.0 * (2.0 * t).cos(),
+                        9000.0 * (t / 2.0).sin()
+                    ),
+                    timestamp: None,
+                    location: None,
+                }
+            })
+            .collect();
+        let plot = plot(&log).unwrap();
+        println!("{plot}");
+        assert_eq!(plot.lines().count(), 1 + 3 * HEIGHT);
     }
 }
