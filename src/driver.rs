@@ -293,12 +293,15 @@ impl ConfigError {
     /// A one-line description naming the offending field, for logs and build errors.
     #[must_use]
     pub const fn message(&self) -> &'static str {
+        /// `driver config: `<field>[<axis>]<sub>` <what>` as a literal per axis.
         macro_rules! per_axis {
-            ($axis:expr, $field:literal, $what:literal) => {
+            ($axis:expr, $field:literal, $sub:literal, $what:literal) => {
                 match $axis {
-                    Axis::Pitch => concat!("driver config: `", $field, "[pitch]`", $what),
-                    Axis::Roll => concat!("driver config: `", $field, "[roll]`", $what),
-                    Axis::Yaw => concat!("driver config: `", $field, "[yaw]`", $what),
+                    Axis::Pitch => {
+                        concat!("driver config: `", $field, "[pitch]", $sub, "` ", $what)
+                    }
+                    Axis::Roll => concat!("driver config: `", $field, "[roll]", $sub, "` ", $what),
+                    Axis::Yaw => concat!("driver config: `", $field, "[yaw]", $sub, "` ", $what),
                 }
             };
         }
@@ -308,47 +311,56 @@ impl ConfigError {
             Self::ZeroDisableAfter => "driver config: `faults.disable_after` must not be zero",
             Self::Servo { axis, error } => match error {
                 ServoError::PulseRangeEmpty { .. } => {
-                    per_axis!(axis, "servos", ".min_pulse` must be below `max_pulse`")
+                    per_axis!(axis, "servos", ".min_pulse", "must be below `max_pulse`")
                 }
                 ServoError::NeutralOutsidePulseRange { .. } => {
                     per_axis!(
                         axis,
                         "servos",
-                        ".neutral` must lie in [`min_pulse`, `max_pulse`]"
+                        ".neutral",
+                        "must lie in [`min_pulse`, `max_pulse`]"
                     )
                 }
                 ServoError::ZeroPerDegree => {
-                    per_axis!(axis, "servos", ".per_degree` must not be zero")
+                    per_axis!(axis, "servos", ".per_degree", "must not be zero")
                 }
                 ServoError::LimitsInverted { .. } => {
-                    per_axis!(axis, "servos", ".limits` is inverted (min > max)")
+                    per_axis!(axis, "servos", ".limits", "is inverted (min > max)")
                 }
                 ServoError::NeutralOutsideLimits { .. } => {
                     per_axis!(
                         axis,
                         "servos",
-                        ".limits` must contain 0° (the neutral angle)"
+                        ".limits",
+                        "must contain 0° (the neutral angle)"
                     )
                 }
                 ServoError::LimitUnreachable { .. } => per_axis!(
                     axis,
                     "servos",
-                    ".limits` needs a pulse outside [`min_pulse`, `max_pulse`]"
+                    ".limits",
+                    "needs a pulse outside [`min_pulse`, `max_pulse`]"
                 ),
             },
             Self::PulseLongerThanPeriod { axis, .. } => {
-                per_axis!(axis, "servos", ".max_pulse` is longer than `pwm.period`")
+                per_axis!(axis, "servos", ".max_pulse", "is longer than `pwm.period`")
             }
             Self::NeutralPoseOutsideLimits { axis, .. } => {
-                per_axis!(axis, "neutral_pose", " lies outside the servo's `limits`")
+                per_axis!(
+                    axis,
+                    "neutral_pose",
+                    "",
+                    "lies outside the servo's `limits`"
+                )
             }
             Self::ZeroSpeedLimit { axis } => {
-                per_axis!(axis, "motion", ".max_speed` must not be zero")
+                per_axis!(axis, "motion", ".max_speed", "must not be zero")
             }
             Self::AccelBelowResolution { axis } => per_axis!(
                 axis,
                 "motion",
-                ".max_accel` is below 1 µ° per frame² at this `frame_period`"
+                ".max_accel",
+                "is below 1 µ° per frame² at this `frame_period`"
             ),
         }
     }

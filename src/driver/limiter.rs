@@ -44,8 +44,10 @@ impl Slew {
         let target = (target.millidegrees() as i64 * MICRO_PER_MILLI).clamp(p.lo, p.hi);
         // |target|, |pos| ≤ 2^31 · 1000 < 2^41: differences < 2^42.
         let target_vel = target - self.last_target;
+        // Error before this frame's target motion: with perfect tracking it is
+        // 0 and the wanted step is exactly the target's step.
+        let err = self.last_target - self.pos;
         self.last_target = target;
-        let err = target - self.pos;
         let closing = err
             .unsigned_abs()
             .min(brake_speed(err.unsigned_abs(), p.max_accel)) as i64;
@@ -63,11 +65,34 @@ impl Slew {
     }
 }
 
-/// Largest speed that can still stop within `dist` at deceleration `accel`:
-/// ⌊√(2·a·d + a²/4) − a/2⌋ (a ≤ 2^48, d < 2^43: the radicand < 2^97).
+/// Largest step `v` after which the limiter can still stop within `dist`
+/// decelerating by at most `accel` per frame: the steps v, v − a, v − 2a, ...
+/// down to the last positive one must sum to at most `dist`.
+///
+/// With `k` further steps after this one (v ∈ (k·a, (k+1)·a]) the sum is
+/// S(v) = (k+1)·v − a·k(k+1)/2, increasing in v, so on segment `k` the largest
+/// v is min((k+1)·a, ⌊(dist + a·k(k+1)/2) / (k+1)⌋), valid if above k·a. The
+/// continuous estimate k ≈ (√(2·a·d + a²/4) − a/2) / a is within one segment
+/// of the answer; the two segments either side are checked too.
 fn brake_speed(dist: u64, accel: i64) -> u64 {
-    let a = accel.unsigned_abs() as u128;
-    let root = (2 * a * dist as u128 + a * a / 4).isqrt();
-    // root < 2^49; root ≥ a/2 since the radicand ≥ a²/4.
-    (root.saturating_sub(a / 2)) as u64
+    let accel = accel.unsigned_abs().max(1) as u128;
+    let dist = dist as u128;
+    // accel ≤ 2^48, dist < 2^43: the radicand < 2^97, every product below < 2^110.
+    let estimate = (2 * accel * dist + accel * accel / 4)
+        .isqrt()
+        .saturating_sub(accel / 2)
+        / accel;
+    let mut best = 0;
+    let mut segment = estimate.saturating_sub(2);
+    while segment <= estimate + 2 {
+        let steps = segment + 1;
+        let base = accel * segment * steps / 2;
+        let speed = (steps * accel).min((dist + base) / steps);
+        if speed > segment * accel && speed > best {
+            best = speed;
+        }
+        segment += 1;
+    }
+    // best ≤ (dist + base) / steps ≤ dist + accel < 2^64.
+    best.min(u64::MAX as u128) as u64
 }
