@@ -57,6 +57,8 @@ pub struct Recorder {
     pub written: Vec<u16>,
     /// Fail this many of the next writes.
     pub fail_next: u32,
+    /// Then fail write `n` (counting all writes) if `fail_pattern[n % len]`.
+    pub fail_pattern: Vec<bool>,
 }
 
 impl Recorder {
@@ -95,7 +97,11 @@ impl embedded_hal::pwm::SetDutyCycle for Recorder {
             self.fail_next -= 1;
             return Err(Broken);
         }
-        Ok(())
+        let n = self.written.len() - 1;
+        match self.fail_pattern.get(n % self.fail_pattern.len().max(1)) {
+            Some(true) => Err(Broken),
+            _ => Ok(()),
+        }
     }
 }
 

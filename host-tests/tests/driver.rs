@@ -578,3 +578,131 @@ fn frame_clock_saturates_instead_of_overflowing() {
     let t = c.tick(u64::MAX);
     assert_eq!(t.skipped, 0);
 }
+
+mod property {
+    use super::*;
+    use idle_head::servo::{NanosPerDegree, PwmTiming, ServoCalibration};
+    use proptest::prelude::*;
+
+    /// A valid calibration: random neutral, scale, direction and limits, with
+    /// pulse limits just wide enough (plus a random margin) to reach the limits.
+    fn calibration() -> impl Strategy<Value = ServoCalibration> {
+        (
+            1200u32..=1800,
+            5000u32..=20_000,
+            any::<bool>(),
+            -40_000i32..=0,
+            0i32..=40_000,
+            0u32..200,
+            0u32..200,
+        )
+            .prop_map(|(neutral, per_degree, reversed, lo, hi, below, above)| {
+                let mut cal = ServoCalibration {
+                    neutral: Microseconds(neutral),
+                    per_degree: NanosPerDegree(per_degree),
+                    direction: if reversed {
+                        Direction::Reversed
+                    } else {
+                        Direction::Normal
+                    },
+                    min_pulse: Microseconds(0),
+                    max_pulse: Microseconds(u32::MAX),
+                    limits: AngleRange {
+                        min: Angle::from_millidegrees(lo),
+                        max: Angle::from_millidegrees(hi),
+                    },
+                };
+                let ends = [
+                    cal.raw_pulse_us(cal.limits.min),
+                    cal.raw_pulse_us(cal.limits.max),
+                ];
+                let (p_lo, p_hi) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
+                cal.min_pulse = Microseconds((p_lo as u32).min(neutral - 1).saturating_sub(below));
+                cal.max_pulse = Microseconds((p_hi as u32).max(neutral + 1) + above);
+                cal
+            })
+    }
+
+    fn limits() -> impl Strategy<Value = MotionLimits> {
+        (1u32..=400, 1u32..=20_000).prop_map(|(v, a)| MotionLimits {
+            max_speed: DegreesPerSecond(v),
+            max_accel: DegreesPerSecondSquared(a),
+        })
+    }
+
+    prop_compose! {
+        fn config()(
+            servos in [calibration(), calibration(), calibration()],
+            motion in [limits(), limits(), limits()],
+            pose in [0.0f64..=1.0, 0.0f64..=1.0, 0.0f64..=1.0],
+            fade in 0u32..3000,
+            disable_after in 1u16..30,
+            frame_us in prop_oneof![Just(20_000u32), Just(10_000), Just(3_000)],
+        ) -> DriverConfig {
+            let mut cfg = DriverConfig::DEFAULT;
+            cfg.frame_period = Microseconds(frame_us);
+            cfg.servos = servos;
+            cfg.motion = motion;
+            for i in 0..3 {
+                let l = servos[i].limits;
+                let (lo, hi) = (f64::from(l.min.millidegrees()), f64::from(l.max.millidegrees()));
+                cfg.neutral_pose[i] = Angle::from_millidegrees((lo + pose[i] * (hi - lo)).round() as i32);
+            }
+            cfg.fade = Millis(fade);
+            cfg.faults.disable_after = disable_after;
+            cfg
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// For random loops, calibrations, limits and write errors: every duty
+        /// written lies within its servo's pulse range (except the single 0 that
+        /// switches a failing servo off), every angle within the axis limits,
+        /// and no frame-to-frame change exceeds the speed limit.
+        #[test]
+        fn duties_stay_in_range_and_speed_is_limited(
+            cfg in config(),
+            loops in proptest::collection::vec([-60_000i32..60_000, -60_000i32..60_000, -60_000i32..60_000], 1..30),
+            loop_ms in 20u32..5000,
+            max_duty in prop_oneof![Just(20_000u16), Just(62_500), Just(u16::MAX), Just(999)],
+            failures in [proptest::collection::vec(proptest::bool::weighted(0.2), 0..40),
+                         proptest::collection::vec(proptest::bool::weighted(0.2), 0..40),
+                         proptest::collection::vec(proptest::bool::weighted(0.05), 0..40)],
+            stop_at in 0usize..400,
+        ) {
+            let p = params(&cfg);
+            let n = loops.len();
+            let axis_loop = |a: usize| loops.iter().map(|s| Angle::from_millidegrees(s[a])).collect::<Vec<_>>();
+            let (lp, lr, ly) = (axis_loop(0), axis_loop(1), axis_loop(2));
+            let play = Playback::new(Millis(loop_ms), cfg.frame_period, n).unwrap();
+            let channels = failures.clone().map(|pattern| Recorder { max_duty, fail_pattern: pattern, ..Recorder::default() });
+            let mut d = FrameDriver::new(channels, p);
+            let mut prev = d.start().servos.map(|s| s.angle);
+            prop_assert_eq!(prev, [Angle::ZERO; 3]);
+            for frame in 0..300u64 {
+                if frame as usize == stop_at {
+                    d.request_stop();
+                }
+                let r = d.write_frame(play.offsets(frame, [lp.as_slice(), lr.as_slice(), ly.as_slice()]));
+                for (i, axis) in Axis::ALL.into_iter().enumerate() {
+                    let angle = r.servos[i].angle;
+                    prop_assert!(cfg.servos[i].limits.contains(angle));
+                    let step = (angle.millidegrees() - prev[i].millidegrees()).abs();
+                    prop_assert!(step <= p.max_step(axis).millidegrees(), "{axis:?}: {step}");
+                    prev[i] = angle;
+                }
+            }
+            let disabled = d.stats().disabled;
+            let timing = PwmTiming::SERVO_50HZ;
+            for (i, ch) in d.release().iter().enumerate() {
+                let lo = timing.duty(cfg.servos[i].min_pulse, max_duty).0;
+                let hi = timing.duty(cfg.servos[i].max_pulse, max_duty).0;
+                let (last, rest) = ch.written.split_last().unwrap();
+                prop_assert!(rest.iter().all(|w| (lo..=hi).contains(w)), "{i}: {lo}..={hi} {:?}", ch.written);
+                prop_assert!((lo..=hi).contains(last) || (disabled[i] && *last == 0));
+            }
+        }
+    }
+}
