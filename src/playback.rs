@@ -22,6 +22,8 @@
 //! assert_eq!(at(8), 0); // one loop later: back to the start
 //! ```
 
+use core::num::{NonZeroU64, NonZeroUsize};
+
 use crate::units::{Angle, Microseconds, Millis};
 
 /// A looping sequence of angles (one axis' trajectory).
@@ -83,11 +85,11 @@ const ONE: i64 = 1 << FRAC_BITS;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Playback {
     /// Loop duration in µs (≤ 2^32 · 1000 < 2^42).
-    loop_us: u64,
+    loop_us: NonZeroU64,
     /// Frame period in µs (≥ 1).
     frame_us: u32,
-    /// Samples per loop (≥ 1).
-    samples: usize,
+    /// Samples per loop.
+    samples: NonZeroUsize,
 }
 
 impl Playback {
@@ -105,17 +107,17 @@ impl Playback {
         frame_period: Microseconds,
         samples: usize,
     ) -> Result<Self, PlaybackError> {
-        if loop_duration.0 == 0 {
+        let Some(loop_us) = NonZeroU64::new(loop_duration.0 as u64 * 1000) else {
             return Err(PlaybackError::ZeroLoopDuration);
-        }
+        };
         if frame_period.0 == 0 {
             return Err(PlaybackError::ZeroFramePeriod);
         }
-        if samples == 0 {
+        let Some(samples) = NonZeroUsize::new(samples) else {
             return Err(PlaybackError::NoSamples);
-        }
+        };
         Ok(Self {
-            loop_us: loop_duration.0 as u64 * 1000,
+            loop_us,
             frame_us: frame_period.0,
             samples,
         })
@@ -124,7 +126,7 @@ impl Playback {
     /// The loop duration.
     #[must_use]
     pub const fn loop_duration(&self) -> Millis {
-        Millis((self.loop_us / 1000) as u32)
+        Millis((self.loop_us.get() / 1000) as u32)
     }
 
     /// The frame period.
@@ -136,7 +138,7 @@ impl Playback {
     /// Samples per loop.
     #[must_use]
     pub const fn samples(&self) -> usize {
-        self.samples
+        self.samples.get()
     }
 
     /// Position of frame `frame` in the loop: the sample index at or before it
@@ -145,10 +147,19 @@ impl Playback {
     /// Exact: time in the loop is `frame · frame_period mod loop_duration`, in µs.
     #[must_use]
     pub const fn position(&self, frame: u64) -> (usize, u32) {
+        // The divisions cannot fail (loop_us ≥ 1); checked forms keep any
+        // panic path out of the frame path.
+        let loop_us = self.loop_us.get() as u128;
         // frame < 2^64, frame_us < 2^32: the product fits u128.
-        let t = (frame as u128 * self.frame_us as u128) % self.loop_us as u128;
-        // t < 2^42, samples ≤ 2^64, · 2^16: < 2^122.
-        let pos = (t * self.samples as u128 * ONE as u128) / self.loop_us as u128;
+        let t = match (frame as u128 * self.frame_us as u128).checked_rem(loop_us) {
+            Some(t) => t,
+            None => 0,
+        };
+        // t < 2^42, samples < 2^64, · 2^16: < 2^122.
+        let pos = match (t * self.samples.get() as u128 * ONE as u128).checked_div(loop_us) {
+            Some(p) => p,
+            None => 0,
+        };
         let index = (pos >> FRAC_BITS) as usize; // < samples
         let frac = (pos & (ONE as u128 - 1)) as u32;
         (index, frac)
@@ -163,7 +174,7 @@ impl Playback {
     }
 
     fn interpolate<L: LoopSource + ?Sized>(&self, source: &L, i: usize, frac: u32) -> Angle {
-        let n = self.samples;
+        let n = self.samples.get();
         // Neighbours i−1, i, i+1, i+2, wrapping at the seam (i < n, so the
         // successor i + 1 ≤ n cannot overflow).
         let succ = |k: usize| if k + 1 >= n { 0 } else { k + 1 };

@@ -349,12 +349,11 @@ impl PwmTiming {
     /// ```
     #[must_use]
     pub const fn duty(&self, pulse: Microseconds, max_duty: u16) -> Duty {
-        if self.period.0 == 0 {
-            return Duty(max_duty);
-        }
         // < 2^32 · 2^16 + 2^32 < 2^64: no overflow.
         let num = pulse.0 as u64 * max_duty as u64 + self.period.0 as u64 / 2;
-        let ticks = num / self.period.0 as u64;
+        let Some(ticks) = num.checked_div(self.period.0 as u64) else {
+            return Duty(max_duty);
+        };
         if ticks >= max_duty as u64 {
             Duty(max_duty)
         } else {

@@ -82,7 +82,7 @@ impl FrameClock {
     pub fn tick(&mut self, now: u64) -> FrameTick {
         let late = now.saturating_sub(self.deadline);
         // late < (skipped + 1) · period, so the new deadline lies after `now`.
-        let skipped = late / self.period;
+        let skipped = late.checked_div(self.period).unwrap_or(0);
         let frame = self.next_frame.saturating_add(skipped);
         self.next_frame = frame.saturating_add(1);
         self.skipped = self.skipped.saturating_add(skipped);

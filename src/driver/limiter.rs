@@ -41,7 +41,7 @@ pub(crate) struct Slew {
 impl Slew {
     /// One frame towards `target`; returns the new angle.
     pub(crate) fn step(&mut self, target: Angle, p: &SlewParams) -> Angle {
-        let target = (target.millidegrees() as i64 * MICRO_PER_MILLI).clamp(p.lo, p.hi);
+        let target = bound(target.millidegrees() as i64 * MICRO_PER_MILLI, p.lo, p.hi);
         // |target|, |pos| ≤ 2^31 · 1000 < 2^41: differences < 2^42.
         let target_vel = target - self.last_target;
         // Error before this frame's target motion: with perfect tracking it is
@@ -53,16 +53,21 @@ impl Slew {
             .min(brake_speed(err.unsigned_abs(), p.max_accel)) as i64;
         let wanted = target_vel + err.signum() * closing;
         // vel ∈ [−max_step, max_step] ⇒ the accel window meets the speed window.
-        let vel = wanted
-            .clamp(self.vel - p.max_accel, self.vel + p.max_accel)
-            .clamp(-p.max_step, p.max_step);
-        let pos = (self.pos + vel).clamp(p.lo, p.hi);
+        let vel = bound(wanted, self.vel - p.max_accel, self.vel + p.max_accel);
+        let vel = bound(vel, -p.max_step, p.max_step);
+        let pos = bound(self.pos + vel, p.lo, p.hi);
         self.vel = pos - self.pos;
         self.pos = pos;
         // Round to the nearest m° (halves up); lo, hi are whole m°, so the
         // result stays inside the limits.
         Angle::from_millidegrees((pos + MICRO_PER_MILLI / 2).div_euclid(MICRO_PER_MILLI) as i32)
     }
+}
+
+/// `x` limited to `[lo, hi]` (`hi` wins if `lo > hi`; unlike `Ord::clamp`,
+/// this has no panic path).
+fn bound(x: i64, lo: i64, hi: i64) -> i64 {
+    x.max(lo).min(hi)
 }
 
 /// Largest step `v` after which the limiter can still stop within `dist`
@@ -87,7 +92,7 @@ fn brake_speed(dist: u64, accel: i64) -> u64 {
     while segment <= estimate + 2 {
         let steps = segment + 1;
         let base = accel * segment * steps / 2;
-        let speed = (steps * accel).min((dist + base) / steps);
+        let speed = (steps * accel).min((dist + base).checked_div(steps).unwrap_or(0));
         if speed > segment * accel && speed > best {
             best = speed;
         }
