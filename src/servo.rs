@@ -274,6 +274,17 @@ impl ServoCalibration {
     /// const _: () = CAL.assert_valid();
     /// ```
     ///
+    /// ```compile_fail
+    /// use idle_head::servo::ServoCalibration;
+    /// use idle_head::{Axis, Microseconds};
+    /// const CAL: ServoCalibration = {
+    ///     let mut c = ServoCalibration::hobby(Axis::Roll);
+    ///     c.neutral = Microseconds(2500); // "`neutral` must lie in [`min_pulse`, `max_pulse`]"
+    ///     c
+    /// };
+    /// const _: () = CAL.assert_valid();
+    /// ```
+    ///
     /// # Panics
     /// If [`validate`](Self::validate) fails (at compile time when used in a `const`).
     pub const fn assert_valid(&self) {
