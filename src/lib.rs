@@ -18,6 +18,7 @@
 
 pub mod axis;
 pub mod driver;
+pub mod metrics;
 pub mod motion;
 pub mod playback;
 pub mod servo;

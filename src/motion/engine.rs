@@ -42,11 +42,26 @@ use super::lcg::Lcg;
 use super::storage::{FINE_PER_MDEG, Sample};
 use super::{AxisConfig, Closure, MotionError};
 
-/// Right shift from the smoother's `V` units to the stored velocity `Vq`.
-const VQ_SHIFT: u32 = 16;
-/// Smallest extent of the smoothed integral (in `Vq` units) that is scaled;
+/// Smallest extent of the smoothed integral (in `X` units) that is scaled;
 /// below it the walk is treated as flat ([`MotionError::Degenerate`]).
 const MIN_EXTENT: i64 = 64;
+
+/// The quantisation step `2^shift` from `V` units to the stored integral `X`.
+///
+/// The pipeline stores the *second difference* of X (|ΔΔX| is small: the
+/// smoothed walk's acceleration), which buys 4 to 6 bits over storing its
+/// velocity. The step must keep
+/// - |ΔΔX| ≤ |ΔV|/2^shift + 2 < 2¹⁴, with |ΔV| ≤ 2Q² (the Hann kernel rises
+///   from 0 to 1 and back, so its total variation is 2) plus the table
+///   rounding, at most 8·(Q+1)·W, plus a margin of Q²;
+/// - 2^shift ≥ 2N, which bounds |X| < 2³¹ and makes the seamless loop's
+///   detrend residue (< N) vanish in the floor: the loop closes exactly.
+fn x_shift(q: i32, w: usize, n: usize) -> u32 {
+    let dv_bound = 3 * i64::from(q) * i64::from(q) + 8 * i64::from(q + 1) * w as i64;
+    let by_acc = 64 - ((dv_bound >> 13) as u64).leading_zeros();
+    let by_len = 64 - ((2 * n as u64 - 1).leading_zeros());
+    by_acc.max(by_len)
+}
 
 /// What the engine decided for one loop.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -118,19 +133,28 @@ impl Extent {
     }
 }
 
-/// Error-feedback quantiser from `V` units to `Vq` (see the module docs).
+/// Error-feedback quantiser from `V` units to the integral's increments `Vq`:
+/// after each push, Σ Vq = ⌊Σ v / 2^shift⌋ exactly (see the module docs).
 #[derive(Clone, Copy)]
 struct Quantiser {
     residue: i32,
+    shift: u32,
+    mask: i32,
 }
 
 impl Quantiser {
-    const MASK: i32 = (1 << VQ_SHIFT) - 1;
+    const fn new(shift: u32) -> Self {
+        Self {
+            residue: 0,
+            shift,
+            mask: (1 << shift) - 1,
+        }
+    }
     #[inline(always)]
     fn push(&mut self, v: i32) -> i32 {
         let r = v + self.residue;
-        self.residue = r & Self::MASK;
-        r >> VQ_SHIFT
+        self.residue = r & self.mask;
+        r >> self.shift
     }
 }
 
@@ -155,6 +179,7 @@ fn seamless<S: Sample, T: Trace>(
     let table = kernel.table();
     let q = kernel.scale();
     let qq = q * q;
+    let shift = x_shift(q, w, n);
 
     // Pass 1: count the up-steps of the whole circular walk.
     let mut g = Lcg::new(cfg.seed);
@@ -164,7 +189,7 @@ fn seamless<S: Sample, T: Trace>(
     }
     // Detrend: Σₙ V(n) over the loop is exactly Q²·W·ones (zero-sum table), so
     // subtracting q = ⌊Q²·W·ones/N⌋ per sample leaves a total in [0, N), which
-    // the quantiser (step 2¹⁶ > N) turns into an exact closure of J.
+    // the quantiser (step ≥ 2N) turns into an exact closure of X.
     let detrend = (i64::from(qq) * w as i64 * i64::from(ones) / n as i64) as i32;
 
     // Initial window: k = 0..W−1, output index W−1.
@@ -178,28 +203,36 @@ fn seamless<S: Sample, T: Trace>(
         }
     }
     let mut lag = Lcg::new(cfg.seed);
-    let mut quant = Quantiser { residue: 0 };
+    let mut quant = Quantiser::new(shift);
 
-    // Pass 2: slide the window around the loop, storing the quantised velocity.
+    // Pass 2: slide the window around the loop; store ΔΔX (see `x_shift`).
     let mut j = w - 1; // residue of the output index
     let mut slot = w - 1; // where the output goes (index mod N)
     let mut k_next = w; // absolute index of the next entering step
-    let mut integral: i32 = 0;
+    let mut x: i32 = 0; // the integral X
+    let mut vq_prev: i32 = 0;
+    let mut vq_first: i32 = 0;
     let mut extent = Extent::new(0);
-    let mut at_slot0: i32 = 0;
-    let scale = 2.0 * (1u32 << VQ_SHIFT) as f32 / (qq as f32 * w as f32);
+    let mut speed = Extent::new(0); // of ΔX, bounds the scaling product
+    let (mut x0, mut v0) = (0i32, 0i32); // X and ΔX at slot 0
+    let scale = trace_scale(shift, qq, w) * 2.0;
     for t in 0..n {
         // Output for the current window.
         let (tc, ts) = table[j];
         let cp = i32::from(tc) * pc + i32::from(ts) * ps;
         let vq = quant.push(bb - cp - detrend);
-        integral += vq;
-        extent.add(integral);
-        out[slot] = S::from_scratch(vq as i16);
-        if slot == 0 {
-            at_slot0 = integral;
+        x += vq;
+        extent.add(x);
+        speed.add(vq);
+        if t == 0 {
+            vq_first = vq;
         }
-        trace.smoothed(slot, integral as f32 * scale);
+        out[slot] = S::from_scratch((vq - vq_prev) as i16);
+        vq_prev = vq;
+        if slot == 0 {
+            (x0, v0) = (x, vq);
+        }
+        trace.smoothed(slot, x as f32 * scale);
         if t + 1 == n {
             break;
         }
@@ -231,9 +264,16 @@ fn seamless<S: Sample, T: Trace>(
             }
         }
     }
-    // `integral` is now exactly 0: the loop closes (see `detrend`).
-
-    let (lo, hi) = (i64::from(extent.min), i64::from(extent.max));
+    // The first output's ΔΔX refers to the last output's ΔX (cyclic).
+    if let Some(first) = out.get_mut(w - 1) {
+        *first = S::from_scratch((vq_first - vq_prev) as i16);
+    }
+    // Σ V over the loop equals Q²·W·ones up to the table rounding of windows
+    // that wrap around the loop's end, so `x` ends within a few units of 0;
+    // the scaling pass spreads this residue evenly (a constant velocity).
+    let residue = i64::from(x);
+    let lo = i64::from(extent.min) - residue.abs();
+    let hi = i64::from(extent.max) + residue.abs();
     if hi - lo < MIN_EXTENT {
         return Err(MotionError::Degenerate { seed: cfg.seed });
     }
@@ -243,7 +283,7 @@ fn seamless<S: Sample, T: Trace>(
     let zero_level = lo + (-a1 * (hi - lo)) / (a2 - a1);
 
     // The first sample, walking from index 0, where the loop crosses that level.
-    let (split, pivot) = first_crossing(out, at_slot0, zero_level);
+    let (split, pivot, v_split) = first_crossing(out, x0, v0, zero_level);
 
     // Scale about the pivot so that it maps to exactly 0 and both extremes
     // stay inside [α1, α2]; the tighter side reaches its bound.
@@ -254,11 +294,15 @@ fn seamless<S: Sample, T: Trace>(
     } else {
         (-a1, down)
     };
-    let (m, shift) = multiplier(num, den).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
+    let vmax = i64::from(speed.max.max(-speed.min)) + residue.abs() + 1;
+    let (m, mshift) =
+        multiplier(num, den, vmax).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
+    // The residue as a per-sample correction in the scaling pass' units.
+    let drift = ((residue * i64::from(m) * 2 + n as i64) / (2 * n as i64)) as i32;
 
     out.rotate_left(split);
-    // Pass 3: integrate the stored velocity from the pivot and scale it.
-    scale_pass(out, 0, 0, m, shift, |i, fine| {
+    // Pass 3: integrate twice from the pivot and scale.
+    scale_pass(out, v_split, 0, 0, drift, m, mshift, |i, fine| {
         trace.normalized((i + split) % n, fine);
         fine
     });
@@ -269,75 +313,93 @@ fn seamless<S: Sample, T: Trace>(
     })
 }
 
-/// Walks the integral `J` from index 0 (where it is `at_slot0`) and returns the
-/// first index where it crosses `level` — the sample nearer the level — and
-/// `J` there. A closed loop that spans the level always crosses it.
-fn first_crossing<S: Sample>(vel: &[S], at_slot0: i32, level: i64) -> (usize, i32) {
-    let mut prev = at_slot0;
-    for (i, v) in vel
+/// Converts the integral X to walk steps δ for [`Trace::smoothed`]
+/// (paper form; the seamless form's b-steps count half).
+fn trace_scale(shift: u32, qq: i32, w: usize) -> f32 {
+    (1u64 << shift) as f32 / (qq as f32 * w as f32)
+}
+
+/// Walks the loop from index 0 (where X = `x0`, ΔX = `v0`), rebuilding X from
+/// the stored ΔΔX, and returns the first index where X crosses `level` — the
+/// sample nearer the level — with X and ΔX there. A closed loop that spans
+/// the level always crosses it.
+fn first_crossing<S: Sample>(acc: &[S], x0: i32, v0: i32, level: i64) -> (usize, i32, i32) {
+    let n = acc.len();
+    let (mut x, mut v) = (x0, v0);
+    for (i, a) in acc
         .iter()
         .enumerate()
         .skip(1)
-        .chain(vel.iter().enumerate().take(1))
+        .chain(acc.iter().enumerate().take(1))
     {
-        let cur = prev + i32::from(v.to_scratch());
-        let (dp, dc) = (i64::from(prev) - level, i64::from(cur) - level);
+        let v_next = v + i32::from(a.to_scratch());
+        let x_next = x + v_next;
+        let (dp, dc) = (i64::from(x) - level, i64::from(x_next) - level);
         if dp == 0 {
-            return ((i + vel.len() - 1) % vel.len(), prev);
+            return ((i + n - 1) % n, x, v);
         }
         if dc == 0 || (dc < 0) != (dp < 0) {
             return if dc.abs() <= dp.abs() {
-                (i, cur)
+                (i, x_next, v_next)
             } else {
-                ((i + vel.len() - 1) % vel.len(), prev)
+                ((i + n - 1) % n, x, v)
             };
         }
-        prev = cur;
+        (x, v) = (x_next, v_next);
     }
-    (0, at_slot0)
+    (0, x0, v0)
 }
 
-/// `num/den` as a multiplier `m / 2^shift` with m < 2¹⁶ (rounded down, so
-/// scaled values never overshoot), or `None` if the ratio does not fit.
-fn multiplier(num: i64, den: i64) -> Option<(i32, u32)> {
-    if num <= 0 || den <= 0 {
+/// `num/den` (fine units per X unit) as a multiplier `m / 2^shift`, rounded
+/// down so scaled values never overshoot, with `m` as large as the product
+/// `ΔX·m` allows in `i32` for |ΔX| ≤ `vmax`: m·vmax + 2^shift ≤ 2³¹.
+/// `None` if the ratio does not fit.
+fn multiplier(num: i64, den: i64, vmax: i64) -> Option<(i32, u32)> {
+    if num <= 0 || den <= 0 || vmax <= 0 {
         return None;
     }
-    // ratio · 2³², exact floor; num < 2²⁴, so no overflow.
-    let r = ((num as u64) << 32) / den as u64;
-    let bits = 64 - r.leading_zeros();
-    if bits <= 16 {
-        return Some((r as i32, 32));
+    let m_max = ((1u64 << 30) / vmax as u64).max(1);
+    // ratio · 2³⁰, exact floor (num < 2²⁴): one division.
+    let r = ((num as u64) << 30) / den as u64;
+    let mut drop = 0u32;
+    while drop < 64 && (r >> drop) > m_max {
+        drop += 1;
     }
-    let drop = bits - 16;
-    if drop > 32 {
-        return None; // ratio ≥ 2¹⁶: the smoothed extent is too small to scale
+    let m = r.checked_shr(drop).unwrap_or(0);
+    if drop > 30 || m == 0 {
+        return None;
     }
-    Some(((r >> drop) as i32, 32 - drop))
+    Some((m as i32, 30 - drop))
 }
 
-/// Integrates the stored velocity `Vq` and stores the scaled loop in place:
-/// value(i) = `start_fine` + ⌊Σ_{1≤m≤i} Vq[m]·m/2^shift⌋ (error feedback keeps
-/// the running sum exact), value(0) = `start_fine`; `post` maps each value
-/// (index, fine units) to what is stored.
+/// Integrates the stored ΔΔX twice and stores the scaled loop in place:
+/// with ΔX(0) = `v_start`, value(i) = `start_fine` +
+/// ⌊Σ_{1≤k≤i} (ΔX(k)·m − drift)/2^shift⌋ (error feedback keeps the running
+/// sum exact) and value(0) = `start_fine`; `post` maps each value (index,
+/// fine units) to what is stored.
+#[allow(clippy::too_many_arguments)]
 fn scale_pass<S: Sample>(
     out: &mut [S],
+    v_start: i32,
     start_fine: i32,
-    start_residue: i64,
+    start_residue: i32,
+    drift: i32,
     m: i32,
     shift: u32,
     mut post: impl FnMut(usize, i32) -> i32,
 ) {
-    let mask: i64 = (1i64 << shift) - 1;
+    let mask: i32 = ((1i64 << shift) - 1) as i32;
     let mut fine = start_fine;
     let mut residue = start_residue;
+    let mut v = v_start;
     if let Some(first) = out.first_mut() {
         *first = S::from_fine(post(0, fine));
     }
     for (i, s) in out.iter_mut().enumerate().skip(1) {
-        let acc = i64::from(s.to_scratch()) * i64::from(m) + residue;
+        v += i32::from(s.to_scratch());
+        let acc = v * m + residue - drift;
         residue = acc & mask;
-        fine += (acc >> shift) as i32;
+        fine += acc >> shift;
         *s = S::from_fine(post(i, fine));
     }
 }
@@ -361,16 +423,19 @@ fn paper<S: Sample, T: Trace>(
     let table = kernel.table();
     let q = kernel.scale();
     let qq = q * q;
+    let shift = x_shift(q, w, n);
 
     // Pass 2 (causal): steps in {−1, 0, +1}; V = Q²·B − cp = 2Q²·v.
     let mut main = Lcg::new(cfg.seed);
     let mut lag = Lcg::new(cfg.seed);
     let (mut pc, mut ps, mut b) = (0i32, 0i32, 0i32);
-    let mut quant = Quantiser { residue: 0 };
-    let mut integral: i32 = 0;
+    let mut quant = Quantiser::new(shift);
+    let mut x: i32 = 0;
+    let mut vq_prev: i32 = 0;
     let mut extent = Extent::new(0);
+    let mut speed = Extent::new(0);
     let mut ones: u32 = 0;
-    let scale = (1u32 << VQ_SHIFT) as f32 / (qq as f32 * w as f32);
+    let scale = trace_scale(shift, qq, w);
     let mut j = 0usize;
     for (i, s) in out.iter_mut().enumerate() {
         let enter = if i == 0 {
@@ -388,10 +453,15 @@ fn paper<S: Sample, T: Trace>(
         b += d;
         let cp = i32::from(tc) * pc + i32::from(ts) * ps;
         let vq = quant.push(qq * b - cp);
-        integral += vq;
-        extent.add(integral);
-        *s = S::from_scratch(vq as i16);
-        trace.smoothed(i, integral as f32 * scale);
+        x += vq;
+        if i == 0 {
+            extent = Extent::new(x);
+        }
+        extent.add(x);
+        speed.add(vq);
+        *s = S::from_scratch((vq - vq_prev) as i16);
+        vq_prev = vq;
+        trace.smoothed(i, x as f32 * scale);
         j += 1;
         if j == w {
             j = 0;
@@ -404,27 +474,37 @@ fn paper<S: Sample, T: Trace>(
     }
     let a1 = i64::from(cfg.range.min.millidegrees()) * i64::from(FINE_PER_MDEG);
     let a2 = i64::from(cfg.range.max.millidegrees()) * i64::from(FINE_PER_MDEG);
-    let (m, shift) =
-        multiplier(a2 - a1, hi - lo).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
+    let vmax = i64::from(speed.max.max(-speed.min)) + 1;
+    let (m, mshift) =
+        multiplier(a2 - a1, hi - lo, vmax).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
 
-    // Normalise: α1 + (J − J_min)·(α2 − α1)/(J_max − J_min), then taper with
+    // Normalise: α1 + (X − X_min)·(α2 − α1)/(X_max − X_min), then taper with
     // the symmetric length-N Hann window (both ends exactly zero).
-    let first = i64::from(out.first().map_or(0, |s| s.to_scratch()));
-    let acc0 = (first - lo) * i64::from(m);
-    let start_fine = (a1 + (acc0 >> shift)) as i32;
-    let start_residue = acc0 & ((1i64 << shift) - 1);
+    let x0 = i64::from(out.first().map_or(0, |s| s.to_scratch())); // X(0) = ΔX(0) = ΔΔX(0)
+    let acc0 = (x0 - lo) * i64::from(m);
+    let start_fine = (a1 + (acc0 >> mshift)) as i32;
+    let start_residue = (acc0 & ((1i64 << mshift) - 1)) as i32;
     let span = (n - 1) as u64;
-    scale_pass(out, start_fine, start_residue, m, shift, |i, fine| {
-        trace.normalized(i, fine);
-        if i == 0 || i == n - 1 {
-            return 0; // the taper's ends are exactly zero
-        }
-        let phase = ((i as u64) << 32) / span;
-        let (c, _) = idsp::cossin(phase as u32 as i32);
-        // ½ − ½·cos(2πi/(N−1)) in Q31: (2³¹ − cos)/2.
-        let hann = ((1i64 << 31) - i64::from(c)) >> 1;
-        ((i64::from(fine) * hann + (1 << 30)) >> 31) as i32
-    });
+    scale_pass(
+        out,
+        x0 as i32,
+        start_fine,
+        start_residue,
+        0,
+        m,
+        mshift,
+        |i, fine| {
+            trace.normalized(i, fine);
+            if i == 0 || i == n - 1 {
+                return 0; // the taper's ends are exactly zero
+            }
+            let phase = ((i as u64) << 32) / span;
+            let (c, _) = idsp::cossin(phase as u32 as i32);
+            // ½ − ½·cos(2πi/(N−1)) in Q31: (2³¹ − cos)/2.
+            let hann = ((1i64 << 31) - i64::from(c)) >> 1;
+            ((i64::from(fine) * hann + (1 << 30)) >> 31) as i32
+        },
+    );
 
     // Zero crossings: v(n) = sign x(n+1) − sign x(n) ≠ 0, n = 0..N−2, on the
     // stored angles; one is drawn with the LCG value after the walk, r(N).
