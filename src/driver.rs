@@ -534,7 +534,8 @@ pub struct FrameDriver<P> {
     max_duty: [u16; 3],
     servos: [ServoState; 3],
     envelope: Envelope,
-    started: bool,
+    /// The last report; `None` until started.
+    last: Option<FrameReport>,
     frame: u64,
     stats: DriverStats,
     last_log: Option<u64>,
@@ -543,7 +544,8 @@ pub struct FrameDriver<P> {
 
 impl<P: SetDutyCycle> FrameDriver<P> {
     /// A driver for `channels` (`[pitch, roll, yaw]`). Reads each channel's
-    /// maximum duty once (pitch, roll, yaw); writes nothing until [`start`](Self::start).
+    /// maximum duty once (pitch, roll, yaw), so the PWM period must be set up
+    /// before and not change afterwards; writes nothing until [`start`](Self::start).
     pub fn new(channels: [P; 3], params: DriverParams) -> Self {
         let max_duty = [
             channels[0].max_duty_cycle(),
@@ -556,7 +558,7 @@ impl<P: SetDutyCycle> FrameDriver<P> {
             max_duty,
             servos: [ServoState::default(); 3],
             envelope: Envelope::new(params.fade_frames),
-            started: false,
+            last: None,
             frame: 0,
             stats: DriverStats::default(),
             last_log: None,
@@ -566,9 +568,11 @@ impl<P: SetDutyCycle> FrameDriver<P> {
 
     /// Writes every servo's neutral pulse (0°): the first pulse a servo ever
     /// receives. The idle motion then fades in from the next frame on.
-    /// Calling it again does nothing but report the servos as they are.
+    /// Once started, it writes nothing and returns the last frame's report.
     pub fn start(&mut self) -> FrameReport {
-        self.started = true;
+        if let Some(last) = self.last {
+            return last;
+        }
         let mut report = self.empty_report();
         for (i, slot) in report.servos.iter_mut().enumerate() {
             *slot = self.write_servo(i, Angle::ZERO);
@@ -580,7 +584,7 @@ impl<P: SetDutyCycle> FrameDriver<P> {
     /// neutral pose); see the [module docs](self) for what happens to them.
     /// Before [`start`](Self::start), it starts instead (ignoring `offsets`).
     pub fn write_frame(&mut self, offsets: [Angle; 3]) -> FrameReport {
-        if !self.started {
+        if self.last.is_none() {
             return self.start();
         }
         let gain = self.envelope.gain();
@@ -750,6 +754,7 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         }
         self.frame = self.frame.saturating_add(1);
         self.stats.frames = self.stats.frames.saturating_add(1);
+        self.last = Some(report);
         report
     }
 }

@@ -801,3 +801,14 @@ mod idle_loop {
         }
     }
 }
+
+#[test]
+fn start_twice_writes_nothing_more() {
+    let ch = || pwm(20_000, &writes(&[1500, 1600]));
+    let mut d = FrameDriver::new([ch(), ch(), ch()], params(&direct_config()));
+    d.start();
+    let r = d.write_frame(mdeg([9000; 3]));
+    assert_eq!(d.start(), r);
+    assert_eq!(d.stats().frames, 2);
+    done(d);
+}
