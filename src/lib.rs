@@ -18,6 +18,8 @@
 
 pub mod axis;
 pub mod driver;
+#[cfg(feature = "firmware")]
+pub mod firmware;
 pub mod metrics;
 pub mod motion;
 pub mod playback;

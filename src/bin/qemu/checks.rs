@@ -1,0 +1,381 @@
+//! The smoke run's schedule (fault injection, stop) and invariant checks,
+//! as the frame task's hooks.
+//!
+//! Frame indices below are frames of the time-compressed run, which are the
+//! Pico's 50 Hz frames one for one (see the crate docs): frame 1500 is 30 s
+//! into the loop on the board.
+
+use core::ops::Range;
+
+use idle_head::driver::{DriverConfig, FrameDriver, FrameTick, Outcome};
+use idle_head::firmware::{Flow, Frame, FrameHooks, RunStats};
+use idle_head::{Angle, Axis};
+
+use crate::pwm::VirtualPwm;
+
+/// Frames per loop: 1.5 s / 1 ms (= 30 s / 20 ms on the Pico).
+pub const LOOP_FRAMES: u64 = crate::LOOP.0 as u64 * 1000 / crate::CONFIG.frame_period.0 as u64;
+/// Fade-in frames (the soft start).
+const FADE_FRAMES: u64 = crate::PARAMS.fade_frames() as u64;
+/// A trace line every 50 frames (1 s on the Pico) for the host's plot.
+const TRACE_EVERY: u64 = 50;
+
+/// The servo whose PWM output gets the injected faults.
+const FAULTY: Axis = Axis::Yaw;
+/// A burst of failed writes shorter than the disable threshold: counted,
+/// logged, survived. Starts after one whole loop at full gain (frames
+/// `FADE_FRAMES..FADE_FRAMES + LOOP_FRAMES` = 100..1600).
+const BURST: Range<u64> = 1650..1660;
+/// From here on every write fails: the servo is switched off after
+/// `disable_after` (25) failed frames in a row, at frame 1724.
+const PERSISTENT_FROM: u64 = 1700;
+/// Fade-out (soft stop) requested here; it takes `FADE_FRAMES` frames.
+const STOP_AT: u64 = 1800;
+/// Frames played after the fade-out has finished.
+const TAIL: u64 = 2;
+
+const _: () = {
+    assert!(
+        BURST.start >= FADE_FRAMES + LOOP_FRAMES,
+        "faults only after a whole loop"
+    );
+    assert!(((BURST.end - BURST.start) as u16) < crate::CONFIG.faults.disable_after);
+    assert!(BURST.end < PERSISTENT_FROM);
+    assert!(PERSISTENT_FROM + (crate::CONFIG.faults.disable_after as u64) < STOP_AT);
+};
+
+/// Faults the schedule injects: the burst, then the failed frames up to the
+/// switch-off.
+const EXPECTED_FAULTS: u32 =
+    (BURST.end - BURST.start) as u32 + crate::CONFIG.faults.disable_after as u32;
+
+/// Largest frame-to-frame change of the trajectory offsets, per axis.
+#[derive(Clone, Copy, Default)]
+struct Steps {
+    inside: [u32; 3],
+    seam: [u32; 3],
+}
+
+/// Hooks of the smoke run: schedule, frame log, invariants.
+pub struct Checks {
+    config: DriverConfig,
+    failures: u32,
+    previous: Option<Frame>,
+    steps: Steps,
+    /// Frames after the first fault in which pitch or roll moved.
+    others_moved: [u32; 3],
+    disabled_at: Option<u64>,
+    stopped_at: Option<u64>,
+    last: u64,
+}
+
+impl Checks {
+    pub const fn new(config: DriverConfig) -> Self {
+        Self {
+            config,
+            failures: 0,
+            previous: None,
+            steps: Steps {
+                inside: [0; 3],
+                seam: [0; 3],
+            },
+            others_moved: [0; 3],
+            disabled_at: None,
+            stopped_at: None,
+            last: 0,
+        }
+    }
+
+    fn fail(&mut self) {
+        self.failures += 1;
+    }
+
+    /// The end-of-run checks; `true` if every invariant held.
+    pub fn finish(
+        &mut self,
+        stats: &RunStats,
+        driver: &mut FrameDriver<VirtualPwm>,
+        generated: bool,
+    ) -> bool {
+        if !generated {
+            self.fail();
+        }
+        if stats.missed != 0 {
+            defmt::error!("check: {=u64} frame(s) missed", stats.missed);
+            self.fail();
+        }
+        // One whole loop at full gain: from the end of the fade-in past the
+        // next loop boundary.
+        if self.last < FADE_FRAMES + LOOP_FRAMES {
+            defmt::error!(
+                "check: only {=u64} frames played, less than a whole loop",
+                self.last
+            );
+            self.fail();
+        }
+        for axis in Axis::ALL {
+            let i = axis.index();
+            defmt::info!(
+                "{=str}: largest offset step {=u32} mdeg inside the loop, {=u32} mdeg across the seam",
+                axis.name(),
+                self.steps.inside[i],
+                self.steps.seam[i]
+            );
+            if self.steps.seam[i] > self.steps.inside[i] {
+                defmt::error!("check: {=str} jumps at the loop seam", axis.name());
+                self.fail();
+            }
+        }
+        let driver_stats = *driver.stats();
+        let faults: u32 = driver_stats.faults.iter().sum();
+        let want_disabled = Axis::ALL.map(|a| a == FAULTY);
+        if faults != EXPECTED_FAULTS
+            || driver_stats.faults[FAULTY.index()] != EXPECTED_FAULTS
+            || driver_stats.disabled != want_disabled
+        {
+            defmt::error!(
+                "check: faults {} disabled {}, want {=u32} on {=str} and only it disabled",
+                driver_stats.faults,
+                driver_stats.disabled,
+                EXPECTED_FAULTS,
+                FAULTY.name()
+            );
+            self.fail();
+        }
+        let want_at = PERSISTENT_FROM + self.config.faults.disable_after as u64 - 1;
+        if self.disabled_at != Some(want_at) {
+            defmt::error!(
+                "check: {=str} not switched off at frame {=u64}",
+                FAULTY.name(),
+                want_at
+            );
+            self.fail();
+        }
+        for axis in Axis::ALL.into_iter().filter(|&a| a != FAULTY) {
+            let moved = self.others_moved[axis.index()];
+            defmt::info!(
+                "{=str} moved in {=u32} of the frames after the first injected fault",
+                axis.name(),
+                moved
+            );
+            if moved == 0 {
+                defmt::error!(
+                    "check: {=str} stopped moving during the faults",
+                    axis.name()
+                );
+                self.fail();
+            }
+        }
+        for (axis, channel) in Axis::ALL.iter().zip(driver.channels_mut().iter()) {
+            let log = channel.log();
+            defmt::info!(
+                "{=str} output: {=u32} writes accepted, {=u32} rejected, {=u32} violations, now {=u64} ns pulses",
+                axis.name(),
+                log.accepted,
+                log.rejected,
+                log.violations,
+                channel.pulse_ns(log.current)
+            );
+        }
+        if self.stopped_at.is_none() {
+            defmt::error!("check: the fade-out never finished");
+            self.fail();
+        }
+        self.failures == 0
+    }
+
+    /// Per-frame checks of the driver's own report.
+    fn check_frame(&mut self, frame: &Frame, driver: &mut FrameDriver<VirtualPwm>) {
+        let index = frame.tick.frame;
+        if frame.tick.skipped != 0 {
+            self.fail(); // also counted in `missed`; the run logs it
+        }
+        let servos = self.config.servos;
+        for (i, (servo, cal)) in frame.report.servos.iter().zip(servos.iter()).enumerate() {
+            if servo.outcome != Outcome::Written {
+                continue;
+            }
+            if servo.pulse < cal.min_pulse
+                || servo.pulse > cal.max_pulse
+                || !cal.limits.contains(servo.angle)
+            {
+                defmt::error!(
+                    "check: frame {=u64}: {=str} at {} = {=u32} us, outside its limits",
+                    index,
+                    Axis::ALL[i].name(),
+                    Deg(servo.angle),
+                    servo.pulse.0
+                );
+                self.fail();
+            }
+        }
+        if index == 0 {
+            // Soft start: the very first pulse of every output is its
+            // neutral pulse, and nothing was written before this frame.
+            for (i, channel) in driver.channels_mut().iter().enumerate() {
+                let log = channel.log();
+                let neutral_ns = u64::from(self.config.servos[i].neutral.0) * 1000;
+                let first_ns = log.first.map_or(0, |d| channel.pulse_ns(d));
+                // Within one count (305 ns) of the neutral pulse.
+                if log.accepted != 1 || first_ns.abs_diff(neutral_ns) > 400 {
+                    defmt::error!(
+                        "check: {=str}: first pulse {=u64} ns after {=u32} writes, want neutral {=u64} ns",
+                        Axis::ALL[i].name(),
+                        first_ns,
+                        log.accepted,
+                        neutral_ns
+                    );
+                    self.fail();
+                }
+            }
+        }
+        if let Some(previous) = &self.previous {
+            let seam = index.is_multiple_of(LOOP_FRAMES);
+            let after_fault = index >= BURST.start;
+            for i in 0..3 {
+                let step = frame.offsets[i]
+                    .millidegrees()
+                    .abs_diff(previous.offsets[i].millidegrees());
+                let slot = if seam {
+                    &mut self.steps.seam[i]
+                } else {
+                    &mut self.steps.inside[i]
+                };
+                *slot = (*slot).max(step);
+                if after_fault && frame.report.servos[i].angle != previous.report.servos[i].angle {
+                    self.others_moved[i] += 1;
+                }
+            }
+        }
+    }
+}
+
+impl FrameHooks<VirtualPwm> for Checks {
+    fn before_frame(&mut self, tick: &FrameTick, driver: &mut FrameDriver<VirtualPwm>) {
+        let inject = BURST.contains(&tick.frame) || tick.frame >= PERSISTENT_FROM;
+        let index = FAULTY.index();
+        if tick.frame == BURST.start {
+            defmt::info!(
+                "frame {=u64}: injecting PWM write errors on {=str} for {=u64} frames",
+                tick.frame,
+                FAULTY.name(),
+                BURST.end - BURST.start
+            );
+        } else if tick.frame == BURST.end {
+            defmt::info!(
+                "frame {=u64}: {=str} PWM writes succeed again",
+                tick.frame,
+                FAULTY.name()
+            );
+        } else if tick.frame == PERSISTENT_FROM {
+            defmt::info!(
+                "frame {=u64}: every {=str} PWM write fails from now on",
+                tick.frame,
+                FAULTY.name()
+            );
+        }
+        if let Some(channel) = driver.channels_mut().get_mut(index) {
+            channel.inject_faults(inject);
+        }
+    }
+
+    fn after_frame(&mut self, frame: &Frame, driver: &mut FrameDriver<VirtualPwm>) -> Flow {
+        let index = frame.tick.frame;
+        self.last = index;
+        self.check_frame(frame, driver);
+
+        if frame.report.disabled > 0 {
+            self.disabled_at = Some(index);
+        }
+        let stopping_now = self.stopped_at.is_none() && driver.is_stopped();
+        let seam = LOOP_FRAMES - 2..=LOOP_FRAMES + 2;
+        if index <= 2
+            || seam.contains(&index)
+            || index.is_multiple_of(TRACE_EVERY)
+            || frame.report.failed > 0 && frame.report.should_log
+            || index == BURST.end
+            || self.stopped_at.is_some()
+            || stopping_now
+        {
+            log_frame(frame);
+        }
+        if index == LOOP_FRAMES {
+            defmt::info!(
+                "frame {=u64}: loop seam (loop position back to sample 0)",
+                index
+            );
+        }
+        if index == STOP_AT {
+            defmt::info!("frame {=u64}: fading out", index);
+            driver.request_stop();
+        }
+        if stopping_now {
+            defmt::info!("frame {=u64}: fade-out done, at the neutral pose", index);
+            self.stopped_at = Some(index);
+        }
+        if let Some(at) = self.stopped_at
+            && index >= at + TAIL
+        {
+            for (i, servo) in frame.report.servos.iter().enumerate() {
+                if servo.outcome == Outcome::Written && servo.angle != self.config.neutral_pose[i] {
+                    defmt::error!(
+                        "check: {=str} not back at its neutral pose",
+                        Axis::ALL[i].name()
+                    );
+                    self.fail();
+                }
+            }
+            return Flow::Stop;
+        }
+        self.previous = Some(*frame);
+        Flow::Continue
+    }
+}
+
+/// One readable frame line: index, commanded angles, pulses.
+fn log_frame(frame: &Frame) {
+    let [p, r, y] = frame.report.servos;
+    let written = frame
+        .report
+        .servos
+        .iter()
+        .all(|s| s.outcome == Outcome::Written);
+    if written {
+        defmt::info!(
+            "frame {=u64}: pitch={} roll={} yaw={} deg, pulses {=u32} {=u32} {=u32} us",
+            frame.tick.frame,
+            Deg(p.angle),
+            Deg(r.angle),
+            Deg(y.angle),
+            p.pulse.0,
+            r.pulse.0,
+            y.pulse.0
+        );
+    } else {
+        defmt::info!(
+            "frame {=u64}: pitch={} roll={} yaw={} deg, pulses {=u32} {=u32} {=u32} us ({} {} {})",
+            frame.tick.frame,
+            Deg(p.angle),
+            Deg(r.angle),
+            Deg(y.angle),
+            p.pulse.0,
+            r.pulse.0,
+            y.pulse.0,
+            p.outcome,
+            r.outcome,
+            y.outcome
+        );
+    }
+}
+
+/// An angle shown in degrees with three decimals (`-1.234`).
+struct Deg(Angle);
+
+impl defmt::Format for Deg {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        let m = self.0.millidegrees();
+        let sign = if m < 0 { "-" } else { "+" };
+        let abs = m.unsigned_abs();
+        defmt::write!(f, "{=str}{=u32}.{=u32:03}", sign, abs / 1000, abs % 1000);
+    }
+}
