@@ -8,7 +8,8 @@
 //! 3. followed within the axis' speed and acceleration limits;
 //! 4. converted to a pulse (clamped to the servo's pulse limits) and duty ticks;
 //! 5. written; a write error is counted and reported, the other servos carry on
-//!    and the servo is written again next frame; a servo that fails
+//!    and the servo is written again next frame, its limiter continuing from
+//!    the last pulse it actually received; a servo that fails
 //!    [`FaultPolicy::disable_after`] frames in a row gets duty 0 once (no
 //!    pulses: it goes limp) and is never written again.
 //!
@@ -600,8 +601,16 @@ impl<P: SetDutyCycle> FrameDriver<P> {
             let Some(state) = self.servos.get_mut(i) else {
                 continue;
             };
+            let before = state.slew;
             let angle = state.slew.step(target, slew);
             *slot = self.write_servo(i, angle);
+            if slot.outcome != Outcome::Written {
+                // The servo still holds the last pulse written: continue from
+                // there, so that the next pulse it gets is within the limits.
+                if let Some(state) = self.servos.get_mut(i) {
+                    state.slew = before;
+                }
+            }
         }
         self.finish(report)
     }

@@ -660,7 +660,8 @@ mod property {
         /// For random loops, calibrations, limits and write errors: every duty
         /// written lies within its servo's pulse range (except the single 0 that
         /// switches a failing servo off), every angle within the axis limits,
-        /// and no frame-to-frame change exceeds the speed limit.
+        /// and no frame-to-frame change exceeds the speed limit, neither in the
+        /// commanded angle nor between two pulses a servo actually received.
         #[test]
         fn duties_stay_in_range_and_speed_is_limited(
             cfg in config(),
@@ -679,8 +680,12 @@ mod property {
             let play = Playback::new(Millis(loop_ms), cfg.frame_period, n).unwrap();
             let channels = failures.clone().map(|pattern| Recorder { max_duty, fail_pattern: pattern, ..Recorder::default() });
             let mut d = FrameDriver::new(channels, p);
-            let mut prev = d.start().servos.map(|s| s.angle);
-            prop_assert_eq!(prev, [Angle::ZERO; 3]);
+            let first = d.start().servos.map(|s| s.angle);
+            prop_assert_eq!(first, [Angle::ZERO; 3]);
+            // Last angle each servo actually received (the neutral pulse at 0°
+            // is where the limiter starts, whether or not that write worked).
+            // Every commanded angle lies within one frame's speed limit of it.
+            let mut received = [Angle::ZERO; 3];
             for frame in 0..300u64 {
                 if frame as usize == stop_at {
                     d.request_stop();
@@ -689,9 +694,11 @@ mod property {
                 for (i, axis) in Axis::ALL.into_iter().enumerate() {
                     let angle = r.servos[i].angle;
                     prop_assert!(cfg.servos[i].limits.contains(angle));
-                    let step = (angle.millidegrees() - prev[i].millidegrees()).abs();
+                    let step = (angle.millidegrees() - received[i].millidegrees()).abs();
                     prop_assert!(step <= p.max_step(axis).millidegrees(), "{axis:?}: {step}");
-                    prev[i] = angle;
+                    if r.servos[i].outcome == Outcome::Written {
+                        received[i] = angle;
+                    }
                 }
             }
             let disabled = d.stats().disabled;
@@ -811,4 +818,26 @@ fn start_twice_writes_nothing_more() {
     assert_eq!(d.start(), r);
     assert_eq!(d.stats().frames, 2);
     done(d);
+}
+
+#[test]
+fn after_failed_writes_the_limiter_resumes_from_the_last_pulse_received() {
+    let mut cfg = DriverConfig::DEFAULT;
+    cfg.fade = Millis(0);
+    let mut ch = recorders();
+    let mut d = FrameDriver::new(ch, params(&cfg));
+    d.start();
+    pitch_angles(&mut d, [0; 3], 5);
+    d.channels_mut()[0].fail_next = 10;
+    // A 15° step while the pitch channel fails for 10 frames: nothing moves.
+    let a = pitch_angles(&mut d, [15_000, 0, 0], 10);
+    assert!(a.iter().all(|&x| x == 240), "{a:?}"); // the commanded first step, never received
+    // Then it starts from 0°, accelerating as if from rest.
+    let a = pitch_angles(&mut d, [15_000, 0, 0], 3);
+    assert_eq!(a, [240, 720, 1440]);
+    ch = d.release();
+    // 0.24° → 2.67 µs → 1503 µs (10 failed attempts), then 0.72° → 1508, 1.44° → 1516.
+    assert_eq!(ch[0].written[..6], [1500; 6]);
+    assert_eq!(ch[0].written[6..16], [1503; 10]);
+    assert_eq!(ch[0].written[16..], [1503, 1508, 1516]);
 }
