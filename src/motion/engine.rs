@@ -15,7 +15,7 @@
 //! where B(n) is the plain window sum. B and the two phasor sums P꜀, Pₛ are
 //! *sliding sums over absolute time*: when the window moves by one sample the
 //! entering and the leaving step share the same residue n mod W, so each sum
-//! changes by (e_new − e_old)·T[n mod W] — one table entry, no rotation, no
+//! changes by (`e_new` − `e_old`)·T[n mod W] — one table entry, no rotation, no
 //! rounding. The sums are therefore exact integers at every n: there is no
 //! drift to re-anchor. Only the table rounding (≈ 1/Q per tap) separates the
 //! result from the real-valued Hann smoothing; `host-tests` measures it against
@@ -36,6 +36,8 @@
 //! of the stored Vq equals ⌊(exact integral)/2¹⁶⌋ at every sample: quantising
 //! the velocity to 16 bits adds no drift, and a periodic walk's loop closes to
 //! the exact integer.
+
+#![allow(clippy::many_single_char_names)] // the notation of the derivation above
 
 use super::kernel::HannKernel;
 use super::lcg::Lcg;
@@ -98,7 +100,7 @@ pub(super) fn generate<S: Sample, T: Trace>(
     kernel: &HannKernel,
     trace: &mut T,
 ) -> Result<LoopInfo, MotionError> {
-    if kernel.window() != cfg.window || out.len() <= 2 * usize::from(cfg.window) - 1 {
+    if kernel.window() != cfg.window || out.len() < 2 * usize::from(cfg.window) {
         // Callers validate first; this keeps the function total on its own.
         return Err(MotionError::WindowTooLarge {
             window: cfg.window,
@@ -122,7 +124,7 @@ impl Extent {
     const fn new(v: i32) -> Self {
         Self { min: v, max: v }
     }
-    #[inline(always)]
+    #[inline]
     fn add(&mut self, v: i32) {
         if v < self.min {
             self.min = v;
@@ -150,7 +152,7 @@ impl Quantiser {
             mask: (1 << shift) - 1,
         }
     }
-    #[inline(always)]
+    #[inline]
     fn push(&mut self, v: i32) -> i32 {
         let r = v + self.residue;
         self.residue = r & self.mask;
@@ -168,6 +170,7 @@ impl Quantiser {
 /// its mean step D/N makes the walk periodic; the detrend is applied to the
 /// smoothed velocity, where it is the constant q = Q²·W·(up steps)/N. The
 /// window for output n covers k = n−W+1..n taken modulo N.
+#[allow(clippy::too_many_lines)] // one pass after another, each commented
 fn seamless<S: Sample, T: Trace>(
     out: &mut [S],
     cfg: &AxisConfig,
@@ -208,13 +211,11 @@ fn seamless<S: Sample, T: Trace>(
     // Pass 2: slide the window around the loop; store ΔΔX (see `x_shift`).
     let mut j = w - 1; // residue of the output index
     let mut slot = w - 1; // where the output goes (index mod N)
-    let mut k_next = w; // absolute index of the next entering step
     let mut x: i32 = 0; // the integral X
     let mut vq_prev: i32 = 0;
     let mut vq_first: i32 = 0;
     let mut extent = Extent::new(0);
     let mut speed = Extent::new(0); // of ΔX, bounds the scaling product
-    let (mut x0, mut v0) = (0i32, 0i32); // X and ΔX at slot 0
     let scale = trace_scale(shift, qq, w) * 2.0;
     for t in 0..n {
         // Output for the current window.
@@ -229,9 +230,6 @@ fn seamless<S: Sample, T: Trace>(
         }
         out[slot] = S::from_scratch((vq - vq_prev) as i16);
         vq_prev = vq;
-        if slot == 0 {
-            (x0, v0) = (x, vq);
-        }
         trace.smoothed(slot, x as f32 * scale);
         if t + 1 == n {
             break;
@@ -245,10 +243,11 @@ fn seamless<S: Sample, T: Trace>(
         if slot == n {
             slot = 0;
         }
-        if k_next == n {
-            main = Lcg::new(cfg.seed); // the circular walk wraps to e(0)
+        if t + w == n {
+            // The entering step's absolute index w + t reaches N: the
+            // circular walk wraps to e(0).
+            main = Lcg::new(cfg.seed);
         }
-        k_next += 1;
         let enter = main.next_step_bit();
         let leave = lag.next_step_bit();
         if enter != leave {
@@ -268,22 +267,24 @@ fn seamless<S: Sample, T: Trace>(
     if let Some(first) = out.get_mut(w - 1) {
         *first = S::from_scratch((vq_first - vq_prev) as i16);
     }
-    // Σ V over the loop equals Q²·W·ones up to the table rounding of windows
-    // that wrap around the loop's end, so `x` ends within a few units of 0;
-    // the scaling pass spreads this residue evenly (a constant velocity).
-    let residue = i64::from(x);
-    let lo = i64::from(extent.min) - residue.abs();
-    let hi = i64::from(extent.max) + residue.abs();
-    if hi - lo < MIN_EXTENT {
-        return Err(MotionError::Degenerate { seed: cfg.seed });
-    }
+    // Σ V over the loop equals Q²·W·ones up to the table rounding of the
+    // windows that wrap around the loop's end (they see the table at phases
+    // shifted by N mod W), so `x` ends at a small residue R instead of 0.
+    // The loop used is C(t) = X(t) − ⌊(t+1)·R/N⌋ in generation order t: the
+    // residue removed as a constant velocity (spread by Bresenham), closing
+    // exactly. Its extent is X's, widened by R on one side.
+    let drift = Drift::new(x, n);
+    let lo = i64::from(extent.min) - i64::from(x.max(0));
+    let hi = i64::from(extent.max) - i64::from(x.min(0));
     let a1 = i64::from(cfg.range.min.millidegrees()) * i64::from(FINE_PER_MDEG);
     let a2 = i64::from(cfg.range.max.millidegrees()) * i64::from(FINE_PER_MDEG);
     // The level that the range's zero maps to under the paper's normalisation.
     let zero_level = lo + (-a1 * (hi - lo)) / (a2 - a1);
 
-    // The first sample, walking from index 0, where the loop crosses that level.
-    let (split, pivot, v_split) = first_crossing(out, x0, v0, zero_level);
+    // The first sample, in generation order, where the loop crosses that level.
+    let (split, x_split, v_split) = first_crossing(out, w - 1, vq_first, zero_level);
+    let t_split = (split + n - (w - 1)) % n;
+    let (pivot, drift) = drift.after(t_split, x_split);
 
     // Scale about the pivot so that it maps to exactly 0 and both extremes
     // stay inside [α1, α2]; the tighter side reaches its bound.
@@ -294,11 +295,9 @@ fn seamless<S: Sample, T: Trace>(
     } else {
         (-a1, down)
     };
-    let vmax = i64::from(speed.max.max(-speed.min)) + residue.abs() + 1;
+    let vmax = i64::from(speed.max.max(-speed.min)) + i64::from(drift.step.abs()) + 2;
     let (m, mshift) =
         multiplier(num, den, vmax).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
-    // The residue as a per-sample correction in the scaling pass' units.
-    let drift = ((residue * i64::from(m) * 2 + n as i64) / (2 * n as i64)) as i32;
 
     out.rotate_left(split);
     // Pass 3: integrate twice from the pivot and scale.
@@ -313,41 +312,94 @@ fn seamless<S: Sample, T: Trace>(
     })
 }
 
+/// A total spread evenly over `n` samples: `step` or `step + 1` each (Bresenham).
+#[derive(Clone, Copy)]
+struct Drift {
+    step: i32,
+    rem: i32,
+    n: i32,
+    frac: i32,
+}
+
+impl Drift {
+    const NONE: Self = Self {
+        step: 0,
+        rem: 0,
+        n: 1,
+        frac: 0,
+    };
+
+    fn new(total: i32, n: usize) -> Self {
+        let n = n as i32;
+        Self {
+            step: total.div_euclid(n),
+            rem: total.rem_euclid(n),
+            n,
+            frac: 0,
+        }
+    }
+
+    /// The spread after the first `t + 1` samples: `x` minus their sum
+    /// (⌊(t+1)·total/N⌋), and the state that continues from sample t + 1.
+    fn after(self, t: usize, x: i32) -> (i32, Self) {
+        let done = t as i64 + 1;
+        let frac = done * i64::from(self.rem);
+        let sum = done * i64::from(self.step) + frac / i64::from(self.n);
+        let state = Self {
+            frac: (frac % i64::from(self.n)) as i32,
+            ..self
+        };
+        ((i64::from(x) - sum) as i32, state)
+    }
+
+    #[inline]
+    fn next(&mut self) -> i32 {
+        self.frac += self.rem;
+        if self.frac >= self.n {
+            self.frac -= self.n;
+            self.step + 1
+        } else {
+            self.step
+        }
+    }
+}
+
 /// Converts the integral X to walk steps δ for [`Trace::smoothed`]
 /// (paper form; the seamless form's b-steps count half).
 fn trace_scale(shift: u32, qq: i32, w: usize) -> f32 {
     (1u64 << shift) as f32 / (qq as f32 * w as f32)
 }
 
-/// Walks the loop from index 0 (where X = `x0`, ΔX = `v0`), rebuilding X from
-/// the stored ΔΔX, and returns the first index where X crosses `level` — the
-/// sample nearer the level — with X and ΔX there. A closed loop that spans
-/// the level always crosses it.
-fn first_crossing<S: Sample>(acc: &[S], x0: i32, v0: i32, level: i64) -> (usize, i32, i32) {
+/// Walks the loop in generation order from `start` (where X = ΔX = `v0`),
+/// rebuilding X from the stored ΔΔX, and returns the first index where X
+/// crosses `level` — the sample nearer the level — with X and ΔX there. A
+/// closed loop that spans the level always crosses it.
+fn first_crossing<S: Sample>(acc: &[S], start: usize, v0: i32, level: i64) -> (usize, i32, i32) {
     let n = acc.len();
-    let (mut x, mut v) = (x0, v0);
-    for (i, a) in acc
+    let (mut x, mut v, mut prev) = (v0, v0, start);
+    let order = acc
         .iter()
         .enumerate()
-        .skip(1)
-        .chain(acc.iter().enumerate().take(1))
-    {
+        .skip(start + 1)
+        .chain(acc.iter().enumerate().take(start));
+    for (i, a) in order {
         let v_next = v + i32::from(a.to_scratch());
         let x_next = x + v_next;
         let (dp, dc) = (i64::from(x) - level, i64::from(x_next) - level);
         if dp == 0 {
-            return ((i + n - 1) % n, x, v);
+            return (prev, x, v);
         }
         if dc == 0 || (dc < 0) != (dp < 0) {
             return if dc.abs() <= dp.abs() {
                 (i, x_next, v_next)
             } else {
-                ((i + n - 1) % n, x, v)
+                (prev, x, v)
             };
         }
-        (x, v) = (x_next, v_next);
+        (x, v, prev) = (x_next, v_next, i);
     }
-    (0, x0, v0)
+    let _ = n;
+    (start, v0, v0)
 }
 
 /// `num/den` (fine units per X unit) as a multiplier `m / 2^shift`, rounded
@@ -374,7 +426,7 @@ fn multiplier(num: i64, den: i64, vmax: i64) -> Option<(i32, u32)> {
 
 /// Integrates the stored ΔΔX twice and stores the scaled loop in place:
 /// with ΔX(0) = `v_start`, value(i) = `start_fine` +
-/// ⌊Σ_{1≤k≤i} (ΔX(k)·m − drift)/2^shift⌋ (error feedback keeps the running
+/// ⌊Σ_{1≤k≤i} (ΔX(k) − drift(k))·m/2^shift⌋ (error feedback keeps the running
 /// sum exact) and value(0) = `start_fine`; `post` maps each value (index,
 /// fine units) to what is stored.
 #[allow(clippy::too_many_arguments)]
@@ -383,7 +435,7 @@ fn scale_pass<S: Sample>(
     v_start: i32,
     start_fine: i32,
     start_residue: i32,
-    drift: i32,
+    mut drift: Drift,
     m: i32,
     shift: u32,
     mut post: impl FnMut(usize, i32) -> i32,
@@ -397,7 +449,7 @@ fn scale_pass<S: Sample>(
     }
     for (i, s) in out.iter_mut().enumerate().skip(1) {
         v += i32::from(s.to_scratch());
-        let acc = v * m + residue - drift;
+        let acc = (v - drift.next()) * m + residue;
         residue = acc & mask;
         fine += acc >> shift;
         *s = S::from_fine(post(i, fine));
@@ -490,7 +542,7 @@ fn paper<S: Sample, T: Trace>(
         x0 as i32,
         start_fine,
         start_residue,
-        0,
+        Drift::NONE,
         m,
         mshift,
         |i, fine| {
@@ -528,7 +580,7 @@ fn paper<S: Sample, T: Trace>(
     })
 }
 
-#[inline(always)]
+#[inline]
 fn step(bit: u32) -> i32 {
     (bit as i32) * 2 - 1
 }

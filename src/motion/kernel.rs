@@ -33,7 +33,7 @@ const fn isqrt(v: u32) -> u32 {
     let mut lo = 0u32;
     let mut hi = 1u32 << 16;
     while hi - lo > 1 {
-        let mid = (lo + hi) / 2;
+        let mid = u32::midpoint(lo, hi);
         if (mid as u64) * (mid as u64) <= v as u64 {
             lo = mid;
         } else {

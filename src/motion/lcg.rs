@@ -40,14 +40,14 @@ impl Lcg {
     }
 
     /// Advances to r(n+1) and returns it.
-    #[inline(always)]
+    #[inline]
     pub fn next_value(&mut self) -> u32 {
         self.state = self.state.wrapping_mul(A).wrapping_add(C);
         self.state
     }
 
     /// Advances and returns the next walk step as a bit: `1` for +δ (r ≥ 2³¹), `0` for −δ.
-    #[inline(always)]
+    #[inline]
     pub fn next_step_bit(&mut self) -> u32 {
         self.next_value() >> 31
     }

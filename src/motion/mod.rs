@@ -330,6 +330,10 @@ impl HeadConfig {
     /// Fails compilation (in a `const` context) with a message naming the axis
     /// and the field when the configuration is invalid for `n` samples.
     ///
+    /// # Panics
+    /// When the configuration is invalid — by design, so that a `const`
+    /// evaluation fails the build.
+    ///
     /// ```compile_fail
     /// use idle_head::motion::{DEFAULT_HEAD, HeadConfig};
     /// const BAD: HeadConfig = HeadConfig { pitch: DEFAULT_HEAD.pitch.with_window(2), ..DEFAULT_HEAD };
@@ -452,7 +456,7 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
             assert!(
                 N >= MIN_N && N <= MAX_N,
                 "Trajectory length N must be in MIN_N..=MAX_N"
-            )
+            );
         };
         Self {
             samples: [S::ZERO; N],
@@ -485,13 +489,7 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
         kernel: &HannKernel,
         trace: &mut T,
     ) -> Result<LoopInfo, MotionError> {
-        let result = cfg
-            .validate(axis, N)
-            .and_then(|()| engine::generate(&mut self.samples, cfg, kernel, trace));
-        if result.is_err() {
-            self.samples = [S::ZERO; N];
-        }
-        result
+        generate_into(&mut self.samples, cfg, axis, kernel, trace)
     }
 
     /// The stored samples in playback order; index 0 is the neutral pose.
@@ -509,10 +507,44 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
     }
 }
 
+impl<S: Sample, const N: usize> crate::playback::LoopSource for Trajectory<S, N> {
+    fn len(&self) -> usize {
+        N
+    }
+
+    fn angle(&self, index: usize) -> Angle {
+        Trajectory::angle(self, index)
+    }
+}
+
 impl<S: Sample, const N: usize> Default for Trajectory<S, N> {
     fn default() -> Self {
         Self::new()
     }
+}
+
+/// Computes one loop into a buffer of any length (N = `out.len()`), for
+/// callers that size buffers at run time; [`Trajectory`] wraps it for
+/// const-generic buffers.
+///
+/// # Errors
+/// Any [`MotionError`] of [`AxisConfig::validate`], a kernel built for another
+/// window ([`MotionError::WindowTooLarge`]), or [`MotionError::Degenerate`].
+/// On error `out` is left all zero (the neutral pose).
+pub fn generate_into<S: Sample, T: Trace>(
+    out: &mut [S],
+    cfg: &AxisConfig,
+    axis: Axis,
+    kernel: &HannKernel,
+    trace: &mut T,
+) -> Result<LoopInfo, MotionError> {
+    let result = cfg
+        .validate(axis, out.len())
+        .and_then(|()| engine::generate(out, cfg, kernel, trace));
+    if result.is_err() {
+        out.fill(S::ZERO);
+    }
+    result
 }
 
 /// The three loops of a head (pitch, roll, yaw), usable in a `static`.

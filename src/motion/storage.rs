@@ -55,24 +55,24 @@ impl Sample for Mdeg16 {
     const ZERO: Self = Mdeg16(0);
     const BYTES: usize = 2;
 
-    #[inline(always)]
+    #[inline]
     fn from_scratch(v: i16) -> Self {
         Mdeg16(v)
     }
-    #[inline(always)]
+    #[inline]
     fn to_scratch(self) -> i16 {
         self.0
     }
-    #[inline(always)]
+    #[inline]
     fn from_fine(fine: i32) -> Self {
         // Round half up; the engine keeps |fine| ≤ 32767·256, so this never saturates.
         Mdeg16(((fine + FINE_PER_MDEG / 2) >> 8).clamp(i16::MIN as i32, i16::MAX as i32) as i16)
     }
-    #[inline(always)]
+    #[inline]
     fn fine(self) -> i32 {
         i32::from(self.0) * FINE_PER_MDEG
     }
-    #[inline(always)]
+    #[inline]
     fn angle(self) -> Angle {
         Angle::from_millidegrees(i32::from(self.0))
     }
@@ -85,15 +85,15 @@ impl Sample for f32 {
     const ZERO: Self = 0.0;
     const BYTES: usize = 4;
 
-    #[inline(always)]
+    #[inline]
     fn from_scratch(v: i16) -> Self {
         f32::from(v)
     }
-    #[inline(always)]
+    #[inline]
     fn to_scratch(self) -> i16 {
         self as i16
     }
-    #[inline(always)]
+    #[inline]
     fn from_fine(fine: i32) -> Self {
         fine as f32 / (FINE_PER_MDEG * Angle::SCALE) as f32
     }
