@@ -67,6 +67,10 @@ pub struct Checks {
     disabled_at: Option<u64>,
     stopped_at: Option<u64>,
     last: u64,
+    /// SysTick count when the current frame's write began.
+    write_started: u64,
+    /// Largest and total SysTick counts of the frame writes.
+    write_counts: (u64, u64),
 }
 
 impl Checks {
@@ -83,6 +87,8 @@ impl Checks {
             disabled_at: None,
             stopped_at: None,
             last: 0,
+            write_started: 0,
+            write_counts: (0, 0),
         }
     }
 
@@ -177,6 +183,12 @@ impl Checks {
                 channel.pulse_ns(log.current)
             );
         }
+        let insns = crate::systick::INSNS_PER_COUNT;
+        defmt::info!(
+            "frame work: {=u64} instructions on average, at most {=u64} (fault log included)",
+            self.write_counts.1 * insns / stats.frames.max(1),
+            self.write_counts.0 * insns
+        );
         if self.stopped_at.is_none() {
             defmt::error!("check: the fade-out never finished");
             self.fail();
@@ -277,9 +289,14 @@ impl FrameHooks<VirtualPwm> for Checks {
         if let Some(channel) = driver.channels_mut().get_mut(index) {
             channel.inject_faults(inject);
         }
+        self.write_started = crate::systick::now_counts();
     }
 
     fn after_frame(&mut self, frame: &Frame, driver: &mut FrameDriver<VirtualPwm>) -> Flow {
+        // Cost of the frame's work (interpolation, driver, PWM writes, fault
+        // log): between the two hooks. Logged frames cost more than others.
+        let spent = crate::systick::now_counts() - self.write_started;
+        self.write_counts = (self.write_counts.0.max(spent), self.write_counts.1 + spent);
         let index = frame.tick.frame;
         self.last = index;
         self.check_frame(frame, driver);
