@@ -171,13 +171,16 @@ impl Run {
 }
 
 /// QEMU's command line for `elf`. `-icount shift=0` makes one instruction one
-/// nanosecond of virtual time, so timing (and thus the log) repeats exactly.
+/// nanosecond of virtual time, so timing repeats exactly run after run;
+/// `sleep=off` lets the virtual clock jump over the time the core sleeps
+/// instead of following the wall clock, which would make wake-up times (and
+/// so the log) vary from run to run, and the run slower.
 pub fn qemu_command(elf: &Path) -> Command {
     let mut command = Command::new(setup::QEMU_BINARY);
     command
         .args(["-machine", "lm3s6965evb", "-cpu", "cortex-m0", "-nographic"])
         .args(["-semihosting-config", "enable=on,target=native"])
-        .args(["-icount", "shift=0"])
+        .args(["-icount", "shift=0,sleep=off"])
         .arg("-kernel")
         .arg(elf);
     command

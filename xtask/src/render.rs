@@ -13,38 +13,60 @@
 
 use std::fmt::Write as _;
 
-/// Columns of the plot (frames are averaged into this many buckets).
+/// Columns of the plot.
 const WIDTH: usize = 64;
 /// Rows per axis.
-const HEIGHT: usize = 5;
+const HEIGHT: usize = 7;
 const AXES: [&str; 3] = ["pitch", "roll", "yaw"];
+
+/// One frame line: its position on the time axis and the three angles.
+struct Sample {
+    /// The frame number (`frame <n>`), or the line's place among the frame lines.
+    x: f64,
+    angles: [f64; 3],
+}
 
 /// The plot, or `None` if the log has fewer than two frame lines.
 pub fn plot(log: &[crate::qemu::LogLine]) -> Option<String> {
-    let samples: Vec<[f64; 3]> = log
+    let mut samples: Vec<Sample> = log
         .iter()
         .filter_map(|line| angles(&line.message))
+        .enumerate()
+        .map(|(i, (frame, angles))| Sample {
+            x: frame.unwrap_or(i as f64),
+            angles,
+        })
         .collect();
-    if samples.len() < 2 {
+    samples.sort_by(|a, b| a.x.total_cmp(&b.x));
+    let first = samples.first()?.x;
+    let last = samples.last()?.x;
+    if samples.len() < 2 || last <= first {
         return None;
     }
-    let width = samples.len().min(WIDTH);
+    // Each column shows the motion at its centre, interpolated between the
+    // logged frames around it.
+    let at = |x: f64, axis: usize| {
+        let after = samples
+            .partition_point(|sample| sample.x < x)
+            .min(samples.len() - 1);
+        let before = after.saturating_sub(1);
+        let (a, b) = (&samples[before], &samples[after]);
+        if b.x > a.x {
+            a.angles[axis] + (b.angles[axis] - a.angles[axis]) * (x - a.x) / (b.x - a.x)
+        } else {
+            b.angles[axis]
+        }
+    };
+    let centre = |column: usize| first + (last - first) * (column as f64 + 0.5) / WIDTH as f64;
+
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "motion over {} logged frames (~{} per column), values as logged:",
+        "motion: {} logged frames, frame {first} to {last} left to right, angles as logged",
         samples.len(),
-        samples.len().div_ceil(width)
     );
     for (axis, name) in AXES.iter().enumerate() {
-        let columns: Vec<f64> = (0..width)
-            .map(|column| {
-                let from = column * samples.len() / width;
-                let to = ((column + 1) * samples.len() / width).max(from + 1);
-                let bucket = &samples[from..to];
-                bucket.iter().map(|sample| sample[axis]).sum::<f64>() / bucket.len() as f64
-            })
-            .collect();
+        let columns: Vec<f64> = (0..WIDTH).map(|column| at(centre(column), axis)).collect();
         let min = columns.iter().copied().fold(f64::INFINITY, f64::min);
         let max = columns.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let span = if max > min { max - min } else { 1.0 };
@@ -78,9 +100,14 @@ pub fn plot(log: &[crate::qemu::LogLine]) -> Option<String> {
     Some(out)
 }
 
-/// The three angles of a frame line, if `message` is one.
-fn angles(message: &str) -> Option<[f64; 3]> {
-    keyed(message).or_else(|| bracketed(message))
+/// The frame number (if given as `frame <n>`) and the three angles of a
+/// frame line, if `message` is one.
+fn angles(message: &str) -> Option<(Option<f64>, [f64; 3])> {
+    let angles = keyed(message).or_else(|| bracketed(message))?;
+    let frame = message
+        .split_once("frame ")
+        .and_then(|(_, rest)| leading_number(rest));
+    Some((frame, angles))
 }
 
 fn keyed(message: &str) -> Option<[f64; 3]> {
@@ -126,11 +153,11 @@ mod tests {
     fn reads_keyed_and_bracketed_angles() {
         assert_eq!(
             angles("frame 3 pitch=-120 roll=45mdeg yaw=+7 pulses=[1500, 1490, 1510]"),
-            Some([-120.0, 45.0, 7.0])
+            Some((Some(3.0), [-120.0, 45.0, 7.0]))
         );
         assert_eq!(
-            angles("frame 3 angles=[1.5, -2, 3] pulses=[1500, 1490, 1510]"),
-            Some([1.5, -2.0, 3.0])
+            angles("angles=[1.5, -2, 3] pulses=[1500, 1490, 1510]"),
+            Some((None, [1.5, -2.0, 3.0]))
         );
         assert_eq!(angles("summary missed=0"), None);
     }
