@@ -31,9 +31,17 @@
 //! (5 frames). If frames stop, the board resets; the next boot logs that the
 //! last reset came from the watchdog and starts softly again: outputs low,
 //! neutral pulses first, motion faded in.
+//!
+//! # Calibration
+//!
+//! `cargo run --release --features calibrate` plays a slow sweep of each
+//! axis to its limits instead of the idle loop and logs the pulses there
+//! (`calibrate.rs`).
 #![no_std]
 #![no_main]
 
+#[cfg(feature = "calibrate")]
+mod calibrate;
 mod servo_pwm;
 
 use defmt_rtt as _;
@@ -41,10 +49,10 @@ use embassy_executor::Spawner;
 use embassy_rp::watchdog::{ResetReason, Watchdog};
 use embassy_time::{Duration, Instant};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
+#[cfg(not(feature = "calibrate"))]
+use idle_head::firmware::TrajectoryLoop;
 use idle_head::firmware::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
-use idle_head::firmware::{
-    self, Flow, Frame, FrameHooks, FrameLoop, LOOP_DURATION, TrajectoryLoop,
-};
+use idle_head::firmware::{self, Flow, Frame, FrameHooks, FrameLoop, LOOP_DURATION};
 use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Mdeg16};
 use idle_head::{Axis, Playback};
 use panic_probe as _;
@@ -59,6 +67,7 @@ const PARAMS: DriverParams = match CONFIG.build() {
     Err(e) => panic!("{}", e.message()),
 };
 /// A 30 s loop at 20 ms frames: 1500 frames per loop.
+#[cfg(not(feature = "calibrate"))]
 const PLAYBACK: Playback = match Playback::new(LOOP_DURATION, CONFIG.frame_period, DEFAULT_N) {
     Ok(p) => p,
     Err(_) => panic!("invalid playback parameters"),
@@ -160,14 +169,27 @@ async fn main(spawner: Spawner) {
 
 #[embassy_executor::task]
 async fn frame_task(mut driver: FrameDriver<ServoPwm>, head: &'static Head, watchdog: Watchdog) {
-    let loops = Axis::ALL.map(|axis| TrajectoryLoop(head.axis(axis)));
-    let loops = [&loops[0], &loops[1], &loops[2]];
+    #[cfg(not(feature = "calibrate"))]
+    let (sources, playback) = (
+        Axis::ALL.map(|axis| TrajectoryLoop(head.axis(axis))),
+        PLAYBACK,
+    );
+    #[cfg(feature = "calibrate")]
+    let (sources, playback) = {
+        let _ = head;
+        let sweep = |axis: Axis| calibrate::Sweep::new(axis, CONFIG.servos[axis.index()].limits);
+        (
+            Axis::ALL.map(sweep),
+            calibrate::playback(CONFIG.frame_period),
+        )
+    };
+    let loops = [&sources[0], &sources[1], &sources[2]];
     let start = Instant::now().as_ticks();
-    let Ok(mut frames) = FrameLoop::new(PLAYBACK, loops, embassy_time::TICK_HZ, start) else {
+    let Ok(mut frames) = FrameLoop::new(playback, loops, embassy_time::TICK_HZ, start) else {
         defmt::error!("frame period below one timer tick");
         return;
     };
-    let mut hooks = PicoHooks::new(watchdog);
+    let mut hooks = PicoHooks::new(watchdog, playback);
     let stats = firmware::run(&mut driver, &mut frames, &mut hooks).await;
     // `PicoHooks` never stops; if it did, the watchdog would reset the board.
     defmt::error!("frame task ended: {}", stats);
@@ -176,14 +198,23 @@ async fn frame_task(mut driver: FrameDriver<ServoPwm>, head: &'static Head, watc
 /// Feeds the watchdog after every frame and logs a status line per loop.
 struct PicoHooks {
     watchdog: Watchdog,
+    #[cfg(feature = "calibrate")]
+    playback: Playback,
+    /// Frames per loop of the playback.
+    loop_frames: u64,
     started: bool,
     max_lateness: u64,
 }
 
 impl PicoHooks {
-    fn new(watchdog: Watchdog) -> Self {
+    fn new(watchdog: Watchdog, playback: Playback) -> Self {
+        let loop_ms = u64::from(playback.loop_duration().0);
+        let frame_us = u64::from(playback.frame_period().0).max(1);
         Self {
             watchdog,
+            #[cfg(feature = "calibrate")]
+            playback,
+            loop_frames: (loop_ms * 1000 / frame_us).max(1),
             started: false,
             max_lateness: 0,
         }
@@ -211,12 +242,14 @@ impl FrameHooks<ServoPwm> for PicoHooks {
         self.max_lateness = self
             .max_lateness
             .max(frame.woke.saturating_sub(frame.deadline));
+        #[cfg(feature = "calibrate")]
+        calibrate::log_frame(frame, &self.playback);
         let index = frame.tick.frame;
-        if index > 0 && index.is_multiple_of(LOOP_FRAMES) {
+        if index > 0 && index.is_multiple_of(self.loop_frames) {
             let stats = driver.stats();
             defmt::info!(
                 "loop {=u64} done: {=u64} frames written, wake-up at most {=u64} us late, faults {}, disabled {}",
-                index / LOOP_FRAMES,
+                index / self.loop_frames,
                 stats.frames,
                 Duration::from_ticks(self.max_lateness).as_micros(),
                 stats.faults,
