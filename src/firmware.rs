@@ -28,7 +28,6 @@ use embedded_hal::pwm::SetDutyCycle;
 
 use crate::Angle;
 use crate::driver::{FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod};
-use crate::motion::{Sample, Trajectory};
 use crate::playback::{LoopSource, Playback};
 
 /// Loop duration of the idle motion on the boards: 30 s, the longer end of
@@ -36,20 +35,6 @@ use crate::playback::{LoopSource, Playback};
 /// (`DEFAULT_N`) that is 30 samples per second; at 50 frames per second
 /// there are 30 s / 20 ms = 1500 frames per loop.
 pub const LOOP_DURATION: crate::Millis = crate::Millis(30_000);
-
-/// A generated loop as a [`LoopSource`].
-#[derive(Clone, Copy, Debug)]
-pub struct TrajectoryLoop<'a, S: Sample, const N: usize>(pub &'a Trajectory<S, N>);
-
-impl<S: Sample, const N: usize> LoopSource for TrajectoryLoop<'_, S, N> {
-    fn len(&self) -> usize {
-        N
-    }
-
-    fn angle(&self, index: usize) -> Angle {
-        self.0.angle(index)
-    }
-}
 
 /// One frame of the loop: what [`FrameLoop::write`] played.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

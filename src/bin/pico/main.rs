@@ -49,8 +49,6 @@ use embassy_executor::Spawner;
 use embassy_rp::watchdog::{ResetReason, Watchdog};
 use embassy_time::{Duration, Instant};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
-#[cfg(not(feature = "calibrate"))]
-use idle_head::firmware::TrajectoryLoop;
 use idle_head::firmware::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use idle_head::firmware::{self, Flow, Frame, FrameHooks, FrameLoop, LOOP_DURATION};
 use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Mdeg16};
@@ -170,10 +168,7 @@ async fn main(spawner: Spawner) {
 #[embassy_executor::task]
 async fn frame_task(mut driver: FrameDriver<ServoPwm>, head: &'static Head, watchdog: Watchdog) {
     #[cfg(not(feature = "calibrate"))]
-    let (sources, playback) = (
-        Axis::ALL.map(|axis| TrajectoryLoop(head.axis(axis))),
-        PLAYBACK,
-    );
+    let (loops, playback) = (Axis::ALL.map(|axis| head.axis(axis)), PLAYBACK);
     #[cfg(feature = "calibrate")]
     let (sources, playback) = {
         let _ = head;
@@ -183,6 +178,7 @@ async fn frame_task(mut driver: FrameDriver<ServoPwm>, head: &'static Head, watc
             calibrate::playback(CONFIG.frame_period),
         )
     };
+    #[cfg(feature = "calibrate")]
     let loops = [&sources[0], &sources[1], &sources[2]];
     let start = Instant::now().as_ticks();
     let Ok(mut frames) = FrameLoop::new(playback, loops, embassy_time::TICK_HZ, start) else {

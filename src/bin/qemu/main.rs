@@ -46,7 +46,7 @@ use embassy_executor::raw;
 use embassy_time::Instant;
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::firmware::rp2040_pwm::PICO_SERVO_CLOCK;
-use idle_head::firmware::{self, FrameLoop, LOOP_DURATION, TrajectoryLoop};
+use idle_head::firmware::{self, FrameLoop, LOOP_DURATION};
 use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Mdeg16};
 use idle_head::{Axis, Microseconds, Millis, Playback};
 
@@ -201,8 +201,7 @@ async fn frame_task(head: &'static Head, precompute_insns: u64, checksum: u32, g
         .servos
         .map(|servo| VirtualPwm::new(PICO_SERVO_CLOCK.top, CONFIG.pwm.period, &servo));
     let mut driver = FrameDriver::new(channels, PARAMS);
-    let loops = Axis::ALL.map(|axis| TrajectoryLoop(head.axis(axis)));
-    let loops = [&loops[0], &loops[1], &loops[2]];
+    let loops = Axis::ALL.map(|axis| head.axis(axis));
     let start = Instant::now().as_ticks();
     let Ok(mut frames) = FrameLoop::new(PLAYBACK, loops, embassy_time::TICK_HZ, start) else {
         defmt::error!("frame period below one timer tick");

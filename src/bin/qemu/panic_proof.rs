@@ -30,7 +30,7 @@ use core::hint::black_box;
 
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head::firmware::{FrameLoop, LOOP_DURATION, TrajectoryLoop};
+use idle_head::firmware::{FrameLoop, LOOP_DURATION};
 use idle_head::motion::{DEFAULT_N, HeadTrajectories, Mdeg16};
 use idle_head::{Axis, Playback};
 
@@ -82,8 +82,7 @@ fn panic(_: &core::panic::PanicInfo<'_>) -> ! {
 #[cortex_m_rt::entry]
 fn main() -> ! {
     let head = black_box(&HEAD);
-    let loops = Axis::ALL.map(|axis| TrajectoryLoop(head.axis(axis)));
-    let loops = [&loops[0], &loops[1], &loops[2]];
+    let loops = Axis::ALL.map(|axis| head.axis(axis));
     let mut driver = FrameDriver::new([OpaquePwm, OpaquePwm, OpaquePwm], black_box(PARAMS));
     let Ok(mut frames) = FrameLoop::new(
         black_box(PLAYBACK),
