@@ -10,6 +10,7 @@ use idle_head::motion::{
 };
 use idle_head::{Angle, AngleRange, Axis};
 use proptest::prelude::*;
+use proptest::test_runner::RngSeed;
 
 fn axis_strategy() -> impl Strategy<Value = Axis> {
     prop_oneof![Just(Axis::Pitch), Just(Axis::Roll), Just(Axis::Yaw)]
@@ -49,7 +50,17 @@ fn run<S: Sample + Default>(
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 10_000, failure_persistence: None, ..ProptestConfig::default() })]
+    // 10,000 cases each, from a fixed seed so that every run (and CI) checks
+    // the same configurations; set PROPTEST_RNG_SEED to explore others.
+    #![proptest_config(ProptestConfig {
+        cases: 10_000,
+        failure_persistence: None,
+        rng_seed: std::env::var("PROPTEST_RNG_SEED")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .map_or(RngSeed::Fixed(0x1d1e_4ead), RngSeed::Fixed),
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn valid_configurations_give_good_loops((axis, n, cfg) in valid_config()) {
@@ -85,12 +96,11 @@ proptest! {
         match cfg.closure {
             Closure::Seamless => {
                 // The range is used: the tighter side reaches its bound, short
-                // by at most the scale's rounding (< 0.01 %) and the
-                // loop-closure residue (see engine.rs): 0.1 % of that side
-                // plus the storage LSB.
+                // by at most the scale's rounding (the multiplier keeps ≥ 13
+                // bits in every loop tested: < 0.02 %) and the storage rounding.
                 let short_hi = f64::from(hi - m16.max.millidegrees()) / f64::from(hi);
                 let short_lo = f64::from(m16.min.millidegrees() - lo) / f64::from(-lo);
-                let allowed = |side: i32| 0.001 + 2.0 / f64::from(side);
+                let allowed = |side: i32| 0.0002 + 1.0 / f64::from(side);
                 prop_assert!(short_hi <= allowed(hi) || short_lo <= allowed(-lo), "short of the range by {}/{}", short_lo, short_hi);
                 // Starts exactly at the neutral pose.
                 prop_assert_eq!(l16[0].0, 0);

@@ -21,21 +21,34 @@
 //! result from the real-valued Hann smoothing; `host-tests` measures it against
 //! a direct-form f64 convolution.
 //!
+//! # Storage between passes
+//!
+//! The smoothed velocity V is quantised to the step 2^shift (see [`x_shift`])
+//! by an error-feedback quantiser, so the integral X of the quantised velocity
+//! equals ⌊(exact integral)/2^shift⌋ at every sample: no drift. The output
+//! buffer itself holds the *second difference* ΔΔX as `i16` between passes
+//! (the smoothed walk's acceleration is small), and the scaling pass
+//! integrates it twice. No scratch memory beyond the output buffer.
+//!
 //! # Magnitudes (all fit `i32`)
 //!
 //! With table scale Q (Q²·W < 2²⁹) and bits b ∈ {0,1} of the steps:
 //! - `Pb = Σ b(k)·T[k mod W]` is a 2-vector of length ≤ W·(Q+1);
 //! - `cp = T꜀[j]·Pb꜀ + Tₛ[j]·Pbₛ` ≤ (Q+1)²·W (Cauchy–Schwarz) < 2²⁹·(1 + 3/Q);
 //! - `V = Q²·Bb − cp` = 2Q²·Σ h·b ∈ [0, Q²W] up to rounding, |V| < 2³⁰;
-//! - `V − q` with the detrend q ≤ Q²W, plus the quantiser's residue < 2¹⁶: < 2³¹.
-//! - `Vq = (V − q + err) >> 16` is stored as `i16`: |Vq| ≤ 2¹⁴ + 1.
-//! - The integral J of Vq over ≤ 8192 samples: |J| < 2²⁷.
-//! - The scaling pass forms `Vq·M` with M < 2¹⁶: < 2³¹.
+//! - `V − q` with the detrend q ≤ Q²W, plus the quantiser's residue: < 2³¹;
+//! - ΔX = (V − q)/2^shift with 2^shift ≥ 2N, so |X| < 2³⁰ over the loop;
+//! - |ΔΔX| < 2¹⁴ (see [`x_shift`]), stored as `i16`;
+//! - the scaling pass forms ΔX·m with m sized by the largest |ΔX|: < 2³¹.
 //!
-//! The quantiser carries its residue forward (error feedback), so the integral
-//! of the stored Vq equals ⌊(exact integral)/2¹⁶⌋ at every sample: quantising
-//! the velocity to 16 bits adds no drift, and a periodic walk's loop closes to
-//! the exact integer.
+//! # Closing the seamless loop exactly
+//!
+//! The detrend q is the loop's total Σ V divided by N. The zero-sum table makes
+//! that total Q²·W·(up steps) exactly, except for the windows that wrap around
+//! the loop's end, whose steps are seen at table phases shifted by N mod W;
+//! `WrapCorrection` computes their share E exactly in O(W). With q =
+//! ⌊(Q²·W·ups − E)/N⌋ the remainder is below N < 2^shift, so the quantised
+//! integral returns exactly to its start.
 
 #![allow(clippy::many_single_char_names)] // the notation of the derivation above
 
@@ -190,21 +203,26 @@ fn seamless<S: Sample, T: Trace>(
     for _ in 0..n {
         ones += g.next_step_bit();
     }
-    // Detrend: Σₙ V(n) over the loop is exactly Q²·W·ones (zero-sum table), so
-    // subtracting q = ⌊Q²·W·ones/N⌋ per sample leaves a total in [0, N), which
-    // the quantiser (step ≥ 2N) turns into an exact closure of X.
-    let detrend = (i64::from(qq) * w as i64 * i64::from(ones) / n as i64) as i32;
-
-    // Initial window: k = 0..W−1, output index W−1.
+    // Initial window: k = 0..W−1, output index W−1. The same steps give the
+    // wrap correction E (see `wrap_correction`).
     let mut main = Lcg::new(cfg.seed);
     let (mut pc, mut ps, mut bb) = (0i32, 0i32, 0i32);
-    for &(tc, ts) in table {
+    let mut wrap = WrapCorrection::new(table, n);
+    for (k, &(tc, ts)) in table.iter().enumerate() {
         if main.next_step_bit() == 1 {
             pc += i32::from(tc);
             ps += i32::from(ts);
             bb += qq;
+            wrap.add(k);
         }
+        wrap.advance(k);
     }
+    // Detrend: Σₙ V(n) over the sweep is exactly Q²·W·ones − E, so subtracting
+    // q = ⌊(Q²·W·ones − E)/N⌋ per sample leaves a total in [0, N), which the
+    // quantiser (step ≥ 2N) turns into an exact closure of X.
+    let total = i64::from(qq) * w as i64 * i64::from(ones) - wrap.sum;
+    let detrend = total.div_euclid(n as i64) as i32;
+
     let mut lag = Lcg::new(cfg.seed);
     let mut quant = Quantiser::new(shift);
 
@@ -267,24 +285,15 @@ fn seamless<S: Sample, T: Trace>(
     if let Some(first) = out.get_mut(w - 1) {
         *first = S::from_scratch((vq_first - vq_prev) as i16);
     }
-    // Σ V over the loop equals Q²·W·ones up to the table rounding of the
-    // windows that wrap around the loop's end (they see the table at phases
-    // shifted by N mod W), so `x` ends at a small residue R instead of 0.
-    // The loop used is C(t) = X(t) − ⌊(t+1)·R/N⌋ in generation order t: the
-    // residue removed as a constant velocity (spread by Bresenham), closing
-    // exactly. Its extent is X's, widened by R on one side.
-    let drift = Drift::new(x, n);
-    let lo = i64::from(extent.min) - i64::from(x.max(0));
-    let hi = i64::from(extent.max) - i64::from(x.min(0));
+    debug_assert_eq!(x, 0, "the seamless loop closes exactly");
+    let (lo, hi) = (i64::from(extent.min), i64::from(extent.max));
     let a1 = i64::from(cfg.range.min.millidegrees()) * i64::from(FINE_PER_MDEG);
     let a2 = i64::from(cfg.range.max.millidegrees()) * i64::from(FINE_PER_MDEG);
     // The level that the range's zero maps to under the paper's normalisation.
     let zero_level = lo + (-a1 * (hi - lo)) / (a2 - a1);
 
     // The first sample, in generation order, where the loop crosses that level.
-    let (split, x_split, v_split) = first_crossing(out, w - 1, vq_first, zero_level);
-    let t_split = (split + n - (w - 1)) % n;
-    let (pivot, drift) = drift.after(t_split, x_split);
+    let (split, pivot, v_split) = first_crossing(out, w - 1, vq_first, zero_level);
 
     // Scale about the pivot so that it maps to exactly 0 and both extremes
     // stay inside [α1, α2]; the tighter side reaches its bound.
@@ -295,13 +304,13 @@ fn seamless<S: Sample, T: Trace>(
     } else {
         (-a1, down)
     };
-    let vmax = i64::from(speed.max.max(-speed.min)) + i64::from(drift.step.abs()) + 2;
+    let vmax = i64::from(speed.max.max(-speed.min)) + 1;
     let (m, mshift) =
         multiplier(num, den, vmax).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
 
     out.rotate_left(split);
     // Pass 3: integrate twice from the pivot and scale.
-    scale_pass(out, v_split, 0, 0, drift, m, mshift, |i, fine| {
+    scale_pass(out, v_split, 0, 0, m, mshift, |i, fine| {
         trace.normalized((i + split) % n, fine);
         fine
     });
@@ -312,54 +321,69 @@ fn seamless<S: Sample, T: Trace>(
     })
 }
 
-/// A total spread evenly over `n` samples: `step` or `step + 1` each (Bresenham).
-#[derive(Clone, Copy)]
-struct Drift {
-    step: i32,
-    rem: i32,
-    n: i32,
-    frac: i32,
+/// The part of Σₙ cp(n) that the zero-sum table does not cancel.
+///
+/// Over the circular sweep (outputs n = W−1..N+W−2) each absolute step index
+/// k contributes b(k)·T[k]·Σ_{n∋k} T[n]. Steps k = W−1..N−1 are in W
+/// consecutive windows, a full period of the table: zero. The first W−1
+/// steps appear twice, as k and k+N, each in part of its windows; with an
+/// exact cosine the two parts would again form one full period, but the
+/// table's rounding at the two phases differs. E collects exactly that:
+///
+/// ```text
+/// E = Σ_{k<W−1} b(k)·( T[k]·SA(k) + T[(k+N) mod W]·SB(k) )
+/// SA(k) = Σ_{n=W−1}^{k+W−1} T[n mod W],  SB(k) = Σ_{n=k+N}^{N+W−2} T[n mod W]
+/// ```
+///
+/// (products of 2-vectors are dot products). |S| ≤ Q·W/π + 2Q, so each
+/// product stays below Q²·W/π < 2²⁹; E is summed in `i64`. O(W), once per axis.
+struct WrapCorrection<'t> {
+    table: &'t [(i16, i16)],
+    sa: (i32, i32),
+    sb: (i32, i32),
+    late: usize, // (k + N) mod W
+    sum: i64,
 }
 
-impl Drift {
-    const NONE: Self = Self {
-        step: 0,
-        rem: 0,
-        n: 1,
-        frac: 0,
-    };
-
-    fn new(total: i32, n: usize) -> Self {
-        let n = n as i32;
+impl<'t> WrapCorrection<'t> {
+    fn new(table: &'t [(i16, i16)], n: usize) -> Self {
+        let w = table.len();
+        let t = |i: usize| {
+            table
+                .get(i % w)
+                .map_or((0, 0), |&(c, s)| (i32::from(c), i32::from(s)))
+        };
+        let (c_last, s_last) = t(w - 1);
+        let (c_before, s_before) = t(n + w - 1); // (N−1) mod W
         Self {
-            step: total.div_euclid(n),
-            rem: total.rem_euclid(n),
-            n,
-            frac: 0,
+            table,
+            sa: (c_last, s_last),
+            sb: (-c_before, -s_before),
+            late: n % w,
+            sum: 0,
         }
     }
 
-    /// The spread after the first `t + 1` samples: `x` minus their sum
-    /// (⌊(t+1)·total/N⌋), and the state that continues from sample t + 1.
-    fn after(self, t: usize, x: i32) -> (i32, Self) {
-        let done = t as i64 + 1;
-        let frac = done * i64::from(self.rem);
-        let sum = done * i64::from(self.step) + frac / i64::from(self.n);
-        let state = Self {
-            frac: (frac % i64::from(self.n)) as i32,
-            ..self
-        };
-        ((i64::from(x) - sum) as i32, state)
+    /// Step k (< W−1) is an up-step.
+    fn add(&mut self, k: usize) {
+        if k + 1 >= self.table.len() {
+            return;
+        }
+        let dot = |(c, s): (i16, i16), (a, b): (i32, i32)| i32::from(c) * a + i32::from(s) * b;
+        let early = self.table.get(k).copied().unwrap_or_default();
+        let late = self.table.get(self.late).copied().unwrap_or_default();
+        self.sum += i64::from(dot(early, self.sa)) + i64::from(dot(late, self.sb));
     }
 
-    #[inline]
-    fn next(&mut self) -> i32 {
-        self.frac += self.rem;
-        if self.frac >= self.n {
-            self.frac -= self.n;
-            self.step + 1
-        } else {
-            self.step
+    /// Moves from step k to step k + 1.
+    fn advance(&mut self, k: usize) {
+        let (c, s) = self.table.get(k).copied().unwrap_or_default();
+        self.sa = (self.sa.0 + i32::from(c), self.sa.1 + i32::from(s));
+        let (c, s) = self.table.get(self.late).copied().unwrap_or_default();
+        self.sb = (self.sb.0 - i32::from(c), self.sb.1 - i32::from(s));
+        self.late += 1;
+        if self.late == self.table.len() {
+            self.late = 0;
         }
     }
 }
@@ -426,7 +450,7 @@ fn multiplier(num: i64, den: i64, vmax: i64) -> Option<(i32, u32)> {
 
 /// Integrates the stored ΔΔX twice and stores the scaled loop in place:
 /// with ΔX(0) = `v_start`, value(i) = `start_fine` +
-/// ⌊Σ_{1≤k≤i} (ΔX(k) − drift(k))·m/2^shift⌋ (error feedback keeps the running
+/// ⌊Σ_{1≤k≤i} ΔX(k)·m/2^shift⌋ (error feedback keeps the running
 /// sum exact) and value(0) = `start_fine`; `post` maps each value (index,
 /// fine units) to what is stored.
 #[allow(clippy::too_many_arguments)]
@@ -435,7 +459,6 @@ fn scale_pass<S: Sample>(
     v_start: i32,
     start_fine: i32,
     start_residue: i32,
-    mut drift: Drift,
     m: i32,
     shift: u32,
     mut post: impl FnMut(usize, i32) -> i32,
@@ -449,7 +472,7 @@ fn scale_pass<S: Sample>(
     }
     for (i, s) in out.iter_mut().enumerate().skip(1) {
         v += i32::from(s.to_scratch());
-        let acc = (v - drift.next()) * m + residue;
+        let acc = v * m + residue;
         residue = acc & mask;
         fine += acc >> shift;
         *s = S::from_fine(post(i, fine));
@@ -542,7 +565,6 @@ fn paper<S: Sample, T: Trace>(
         x0 as i32,
         start_fine,
         start_residue,
-        Drift::NONE,
         m,
         mshift,
         |i, fine| {

@@ -105,15 +105,18 @@ pub fn seamless(seed: u32, n: usize, w: usize, a1: f64, a2: f64) -> RefLoop {
     }
     let (lo, hi) = minmax(&j);
     let level = lo + (-a1) * (hi - lo) / (a2 - a1);
-    let mut split = 0;
-    for i in 1..=n {
-        let (p, c) = (j[i - 1] - level, j[i % n] - level);
+    // The first crossing in generation order, which starts at the first
+    // full window's output, index W−1.
+    let mut split = w - 1;
+    for step in 1..=n {
+        let (a, b) = ((w - 2 + step) % n, (w - 1 + step) % n);
+        let (p, c) = (j[a] - level, j[b] - level);
         if p == 0.0 {
-            split = i - 1;
+            split = a;
             break;
         }
         if c == 0.0 || (c < 0.0) != (p < 0.0) {
-            split = if c.abs() <= p.abs() { i % n } else { i - 1 };
+            split = if c.abs() <= p.abs() { b } else { a };
             break;
         }
     }
