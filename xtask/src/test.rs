@@ -254,6 +254,14 @@ fn qemu_stages(stages: &mut Stages, root: &Path, metadata: &Metadata, options: O
         }
     });
     stages.run(SUMMARY, || {
+        if let Some(line) = run
+            .log
+            .iter()
+            .rev()
+            .find(|line| line.message.starts_with("summary"))
+        {
+            println!("{}", line.snapshot());
+        }
         let verdict = qemu::check_summary(&run.log)?;
         println!("{verdict}");
         Ok(())
