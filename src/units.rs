@@ -141,7 +141,10 @@ impl AngleRange {
     /// `[min, max]` in whole degrees.
     #[must_use]
     pub const fn degrees(min: i32, max: i32) -> Self {
-        Self { min: Angle::from_degrees(min), max: Angle::from_degrees(max) }
+        Self {
+            min: Angle::from_degrees(min),
+            max: Angle::from_degrees(max),
+        }
     }
 
     /// Whether `a` lies inside the range (inclusive).
