@@ -1,43 +1,39 @@
-//! Picks the memory layout and linker scripts for the board image being built.
+//! Linker setup for the Raspberry Pi Pico image (feature `pico`).
 //!
-//! Only firmware builds (`target_os = "none"`) link anything; a host build of the
-//! core library (the host tests) passes straight through.
+//! Only firmware builds (`target_os = "none"`) link anything; a host build of
+//! the core library (the host tests, the xtask) passes straight through, and
+//! so does a thumb build without `pico`: the core as a dependency of the QEMU
+//! images in `qemu/`, which link with their own memory map and scripts.
 
 use std::{env, fs, path::PathBuf};
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
-    println!("cargo:rerun-if-changed=src/bin/pico/memory.x");
-    println!("cargo:rerun-if-changed=src/bin/qemu/memory.x");
+    println!("cargo:rerun-if-changed=memory.x");
 
-    if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
+    if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none")
+        || env::var_os("CARGO_FEATURE_PICO").is_none()
+    {
         return;
     }
-    let pico = env::var_os("CARGO_FEATURE_PICO").is_some();
-    let qemu = env::var_os("CARGO_FEATURE_QEMU").is_some();
-    let memory = match (pico, qemu) {
-        (true, false) => "src/bin/pico/memory.x",
-        (false, true) => "src/bin/qemu/memory.x",
-        (true, true) => panic!(
-            "features `pico` and `qemu` select different memory maps; \
-             build the QEMU image with `--no-default-features --features qemu`"
-        ),
-        (false, false) => return, // library-only build for a thumb target (clippy, size checks)
-    };
 
-    // Put the chosen layout on the linker search path as `memory.x`, which
-    // cortex-m-rt's link.x includes. No `memory.x` may sit in the package root:
-    // the linker runs there and would find that one first, for every image.
+    // cortex-m-rt's link.x includes `memory.x`. The linker runs in the
+    // workspace root, this directory, and finds the top-level memory.x (the
+    // Pico's) there; the copy on the search path serves a build inside a larger
+    // workspace, where it runs elsewhere. Only the Pico build adds the path: a
+    // dependent package inherits its dependencies' search paths, and the QEMU
+    // images must link with their own memory map.
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
-    fs::copy(memory, out.join("memory.x")).unwrap();
+    fs::copy("memory.x", out.join("memory.x")).unwrap();
     println!("cargo:rustc-link-search={}", out.display());
 
+    // No page alignment of sections: it would only waste flash.
     println!("cargo:rustc-link-arg-bins=--nmagic");
     println!("cargo:rustc-link-arg-bins=-Tlink.x");
-    if pico {
-        // Places `.boot2` at the start of flash (0x10000000). Without it the image
-        // still links but the RP2040 boot ROM finds no valid second stage.
-        println!("cargo:rustc-link-arg-bins=-Tlink-rp.x");
-    }
+    // link-rp.x (from embassy-rp) places `.boot2`, the 256-byte second-stage
+    // bootloader, at the start of flash (0x10000000, the BOOT2 region of
+    // memory.x), where the RP2040 boot ROM loads and checksums it. Without it
+    // the image still links but the board does not boot, silently.
+    println!("cargo:rustc-link-arg-bins=-Tlink-rp.x");
     println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
 }

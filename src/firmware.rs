@@ -18,7 +18,7 @@
 //!
 //! The work of one frame, [`FrameLoop::next`] then [`FrameLoop::write`], is
 //! the code linked by the `frame-path-proof` image against a panic handler
-//! that does not exist (see `src/bin/qemu/panic_proof.rs`): the image only links if
+//! that does not exist (see `qemu/src/panic_proof.rs`): the image only links if
 //! no panic path survives optimisation.
 
 pub mod rp2040_pwm;

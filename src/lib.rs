@@ -2,7 +2,8 @@
 //!
 //! This crate is the hardware-free core (`no_std`, no allocation, no `unsafe`):
 //! motion generation after Kocoń's idle-loop method, servo mapping and frame
-//! playback. Board images (Raspberry Pi Pico, QEMU) live in `src/bin/`.
+//! playback. The Raspberry Pi Pico image is `src/bin/pico/`; the QEMU images
+//! are a package of their own, `qemu/`, with the emulated board's memory map.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]

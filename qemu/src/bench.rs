@@ -2,9 +2,10 @@
 //! the motion engine against a direct-form f32 implementation of the paper's
 //! smoothing (the costly stage it names), on the same core.
 //!
-//! Run with `cargo xtask bench` (QEMU `-icount shift=0`: one instruction is one
-//! nanosecond of virtual time, SysTick counts 12.5 MHz, so one count is 80
-//! instructions, the same every run). Each row measures three axes (pitch,
+//! Run with `cargo xtask bench`, or `cargo run --release --bin bench` in
+//! qemu/ (QEMU `-icount shift=0`: one instruction is one nanosecond of
+//! virtual time, SysTick counts 12.5 MHz, so one count is 80 instructions,
+//! the same every run). Each row measures three axes (pitch,
 //! roll, yaw) of the paper's Table 2 set with N and W as given:
 //!
 //! ```text

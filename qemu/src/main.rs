@@ -3,7 +3,9 @@
 //! with three virtual PWM outputs, logging through defmt over semihosting.
 //!
 //! ```text
-//! cargo xtask qemu        # build, run, decode, check the summary line
+//! cargo xtask qemu        # from the repository root: build, run, decode,
+//!                         # check the summary line and the log on file
+//! cargo run --release     # in qemu/: build, run, decode (see run.sh)
 //! ```
 //!
 //! The run generates the three loops (and measures the cost), plays a

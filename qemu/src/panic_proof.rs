@@ -1,8 +1,10 @@
 //! Link-time proof that the frame path cannot panic.
 //!
 //! ```text
-//! cargo build --release --no-default-features --features panic-proof --bin frame-path-proof
+//! cargo build --release --manifest-path qemu/Cargo.toml --bin frame-path-proof
 //! ```
+//!
+//! (from the repository root; in qemu/, `cargo build --release --bin frame-path-proof`).
 //!
 //! This image runs the per-frame work of the firmware — [`FrameLoop::next`]
 //! (frame clock) and [`FrameLoop::write`] (playback interpolation, fade,
