@@ -5,11 +5,16 @@
 //! - `cargo xtask qemu`: build the QEMU image, run it and show the head's motion.
 //! - `cargo xtask test`: every check the project has (host tests, formatting,
 //!   lints, the Pico build and its memory budget, the QEMU log snapshot).
+//! - `cargo xtask preview`: CSV and PNG of a loop's stages (walk, smoothing,
+//!   normalisation, closure), for people.
 //!
-//! Both install what they need and is missing: the firmware's Rust target and,
-//! when running as root on Debian or Ubuntu, QEMU.
+//! The firmware commands install what they need and is missing: the
+//! firmware's Rust target and, when running as root on Debian or Ubuntu, QEMU.
+//! `preview` runs the core library on the host only.
 
+mod args;
 mod elf;
+mod preview;
 mod project;
 mod qemu;
 mod reference;
@@ -32,16 +37,19 @@ Commands:
   test     Run every check: host tests, rustfmt, clippy (firmware and host
            crates), the Pico build with its memory budget, and the QEMU run
            compared with src/bin/qemu/expected.log. Ends with `N passed, M failed`.
+  preview  Write the stages of a loop as CSV and PNG (walk, smoothed,
+           normalised, final loop with the split point) with its metrics;
+           with no options, the three default axes. Options: `preview -h`.
   help     Show this text.
 
-Options:
+Options (qemu, test):
   --bless          Re-record src/bin/qemu/expected.log from this run (the run
                    itself must succeed).
   --timeout <s>    Stop QEMU after this many seconds of wall time
                    (default 120); a run that times out fails.
   -h, --help       Show this text.
 
-Both commands install what is missing: the thumbv6m-none-eabi Rust target
+qemu and test install what is missing: the thumbv6m-none-eabi Rust target
 (rustup) and, as root on Debian/Ubuntu, the qemu-system-arm package (apt-get).
 ";
 
@@ -68,13 +76,21 @@ impl Default for Options {
 enum Command {
     Qemu(Options),
     Test(Options),
+    Preview(preview::Args),
     Help,
+    /// A command's own help text.
+    Usage(&'static str),
 }
 
 fn parse_args(mut args: impl Iterator<Item = String>) -> Result<Command> {
     let Some(command) = args.next() else {
         return Ok(Command::Help);
     };
+    // Commands with options of their own.
+    if command == "preview" {
+        let args = preview::Args::parse(args)?;
+        return Ok(args.map_or(Command::Usage(preview::HELP), Command::Preview));
+    }
     let mut options = Options::default();
     let mut help = false;
     while let Some(arg) = args.next() {
@@ -123,8 +139,13 @@ fn main() -> ExitCode {
             print!("{HELP}");
             Ok(true)
         }
+        Command::Usage(text) => {
+            print!("{text}");
+            Ok(true)
+        }
         Command::Qemu(options) => qemu::command(options),
         Command::Test(options) => test::command(options),
+        Command::Preview(args) => preview::command(&args),
     });
     match result {
         Ok(true) => ExitCode::SUCCESS,
