@@ -52,7 +52,7 @@
 
 #![allow(clippy::many_single_char_names)] // the notation of the derivation above
 
-use super::kernel::HannKernel;
+use super::kernel::{HannKernel, MAX_WINDOW};
 use super::lcg::Lcg;
 use super::storage::{FINE_PER_MDEG, Sample};
 use super::{AxisConfig, Closure, MotionError};
@@ -96,6 +96,10 @@ pub struct LoopInfo {
 /// All methods default to doing nothing; `()` implements it as a no-op that
 /// compiles away.
 pub trait Trace {
+    /// Whether the observer wants the stages at all (`()` does not: the
+    /// engine then skips the work of rebuilding them).
+    const ENABLED: bool = true;
+
     /// The smoothed walk before scaling, at loop index `n` (generation order),
     /// in units of the walk step δ (up to an additive constant).
     fn smoothed(&mut self, _n: usize, _walk_steps: f32) {}
@@ -104,7 +108,9 @@ pub trait Trace {
     fn normalized(&mut self, _n: usize, _fine: i32) {}
 }
 
-impl Trace for () {}
+impl Trace for () {
+    const ENABLED: bool = false;
+}
 
 /// Runs the pipeline for one axis into `out` (length N, validated by the caller).
 pub(super) fn generate<S: Sample, T: Trace>(
@@ -204,12 +210,15 @@ fn seamless<S: Sample, T: Trace>(
         ones += g.next_step_bit();
     }
     // Initial window: k = 0..W−1, output index W−1. The same steps give the
-    // wrap correction E (see `wrap_correction`).
+    // wrap correction E (see `WrapCorrection`) and fill the tap ring.
     let mut main = Lcg::new(cfg.seed);
     let (mut pc, mut ps, mut bb) = (0i32, 0i32, 0i32);
     let mut wrap = WrapCorrection::new(table, n);
-    for (k, &(tc, ts)) in table.iter().enumerate() {
-        if main.next_step_bit() == 1 {
+    let mut taps = [Tap::default(); MAX_WINDOW as usize];
+    for (k, (tap, &(tc, ts))) in taps.iter_mut().zip(table).enumerate() {
+        let up = main.next_value() as i32 >> 31;
+        *tap = Tap { c: tc, s: ts, up };
+        if up != 0 {
             pc += i32::from(tc);
             ps += i32::from(ts);
             bb += qq;
@@ -217,74 +226,64 @@ fn seamless<S: Sample, T: Trace>(
         }
         wrap.advance(k);
     }
-    // Detrend: Σₙ V(n) over the sweep is exactly Q²·W·ones − E, so subtracting
-    // q = ⌊(Q²·W·ones − E)/N⌋ per sample leaves a total in [0, N), which the
-    // quantiser (step ≥ 2N) turns into an exact closure of X.
+    let taps = taps.get_mut(..w).unwrap_or_default();
     let total = i64::from(qq) * w as i64 * i64::from(ones) - wrap.sum;
     let detrend = total.div_euclid(n as i64) as i32;
-
-    let mut lag = Lcg::new(cfg.seed);
-    let mut quant = Quantiser::new(shift);
-
-    // Pass 2: slide the window around the loop; store ΔΔX (see `x_shift`).
-    let mut j = w - 1; // residue of the output index
-    let mut slot = w - 1; // where the output goes (index mod N)
-    let mut x: i32 = 0; // the integral X
-    let mut vq_prev: i32 = 0;
-    let mut vq_first: i32 = 0;
-    let mut extent = Extent::new(0);
-    let mut speed = Extent::new(0); // of ΔX, bounds the scaling product
     let scale = trace_scale(shift, qq, w) * 2.0;
-    for t in 0..n {
-        // Output for the current window.
-        let (tc, ts) = table[j];
-        let cp = i32::from(tc) * pc + i32::from(ts) * ps;
-        let vq = quant.push(bb - cp - detrend);
-        x += vq;
-        extent.add(x);
-        speed.add(vq);
-        if t == 0 {
-            vq_first = vq;
-        }
-        out[slot] = S::from_scratch((vq - vq_prev) as i16);
-        vq_prev = vq;
-        trace.smoothed(slot, x as f32 * scale);
-        if t + 1 == n {
-            break;
-        }
-        // Slide: step k_next enters, step k_next − W leaves; same residue.
-        j += 1;
-        if j == w {
-            j = 0;
-        }
-        slot += 1;
-        if slot == n {
-            slot = 0;
-        }
-        if t + w == n {
-            // The entering step's absolute index w + t reaches N: the
-            // circular walk wraps to e(0).
-            main = Lcg::new(cfg.seed);
-        }
-        let enter = main.next_step_bit();
-        let leave = lag.next_step_bit();
-        if enter != leave {
-            let (tc, ts) = table[j];
-            if enter == 1 {
-                pc += i32::from(tc);
-                ps += i32::from(ts);
-                bb += qq;
-            } else {
-                pc -= i32::from(tc);
-                ps -= i32::from(ts);
-                bb -= qq;
-            }
-        }
-    }
+
+    // Pass 2: slide the window around the loop, storing ΔΔX (see `x_shift`)
+    // in generation order: out[t] belongs to loop index (W−1+t) mod N.
+    let mut sweep = Sweep {
+        pc,
+        ps,
+        acc: bb - detrend,
+        residue: 0,
+        x: 0,
+        v_prev: 0,
+        a_prev: 0,
+        lo: 0,
+        hi: 0,
+        v_max: 0,
+    };
+    // The first output, n = W−1, at residue W−1 (written as ΔΔX later).
+    let (tc, ts) = table[w - 1];
+    let r = sweep.acc - (i32::from(tc) * pc + i32::from(ts) * ps);
+    let v_first = r >> shift;
+    (sweep.residue, sweep.x, sweep.v_prev) = (r - (v_first << shift), v_first, v_first);
+    (sweep.lo, sweep.hi, sweep.v_max) = (v_first, v_first, v_first.abs());
+    // Slides s = 1..N−1: step W−1+s enters, step s−1 leaves, both at residue
+    // (s−1) mod W. When the entering index reaches N (s = N−W+1) the circular
+    // walk wraps to e(0).
+    let wrap_at = n - w + 1;
+    let (head, tail) = out.split_at_mut(wrap_at);
+    sweep.run(&mut head[1..], taps, 0, &mut main, qq, shift);
+    let mut again = Lcg::new(cfg.seed);
+    sweep.run(tail, taps, (wrap_at - 1) % w, &mut again, qq, shift);
+    sweep.settle();
     // The first output's ΔΔX refers to the last output's ΔX (cyclic).
-    if let Some(first) = out.get_mut(w - 1) {
-        *first = S::from_scratch((vq_first - vq_prev) as i16);
+    if let Some(o) = out.first_mut() {
+        *o = S::from_scratch((v_first - sweep.v_prev) as i16);
     }
+    if T::ENABLED {
+        // Rebuild X along the loop for the observer (previews only).
+        let (mut x, mut v) = (v_first, v_first);
+        trace.smoothed(w - 1, x as f32 * scale);
+        for (t, o) in out.iter().enumerate().skip(1) {
+            v += i32::from(o.to_scratch());
+            x += v;
+            trace.smoothed((w - 1 + t) % n, x as f32 * scale);
+        }
+    }
+    let x = sweep.x;
+    let extent = Extent {
+        min: sweep.lo,
+        max: sweep.hi,
+    };
+    let speed = Extent {
+        min: -sweep.v_max,
+        max: sweep.v_max,
+    };
+    let vq_first = v_first;
     debug_assert_eq!(x, 0, "the seamless loop closes exactly");
     let (lo, hi) = (i64::from(extent.min), i64::from(extent.max));
     let a1 = i64::from(cfg.range.min.millidegrees()) * i64::from(FINE_PER_MDEG);
@@ -293,7 +292,8 @@ fn seamless<S: Sample, T: Trace>(
     let zero_level = lo + (-a1 * (hi - lo)) / (a2 - a1);
 
     // The first sample, in generation order, where the loop crosses that level.
-    let (split, pivot, v_split) = first_crossing(out, w - 1, vq_first, zero_level);
+    let (split_t, pivot, v_split) = first_crossing(out, 0, vq_first, zero_level);
+    let split = (split_t + w - 1) % n; // as a loop index
 
     // Scale about the pivot so that it maps to exactly 0 and both extremes
     // stay inside [α1, α2]; the tighter side reaches its bound.
@@ -308,10 +308,12 @@ fn seamless<S: Sample, T: Trace>(
     let (m, mshift) =
         multiplier(num, den, vmax).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
 
-    out.rotate_left(split);
+    out.rotate_left(split_t);
     // Pass 3: integrate twice from the pivot and scale.
     scale_pass(out, v_split, 0, 0, m, mshift, |i, fine| {
-        trace.normalized((i + split) % n, fine);
+        if T::ENABLED {
+            trace.normalized((i + split) % n, fine);
+        }
         fine
     });
     Ok(LoopInfo {
@@ -319,6 +321,122 @@ fn seamless<S: Sample, T: Trace>(
         crossings: 1,
         up_steps: ones as u16,
     })
+}
+
+/// One tap of the sliding window: the kernel table entry of its residue j
+/// and the step currently in the window at that residue (0 for down, −1 for
+/// up). The step leaving the window and the one entering it share the
+/// residue, so this small ring replaces a second, lagging generator.
+#[derive(Clone, Copy, Default)]
+struct Tap {
+    c: i16,
+    s: i16,
+    up: i32,
+}
+
+/// The state of the circular sweep (pass 2), shaped for ARMv6-M's eight low
+/// registers: the detrend is folded into `acc`, and the extremes of X and of
+/// ΔX are looked for only where ΔX or ΔΔX changes sign (a few times per
+/// smoothing length), not at every sample.
+#[derive(Clone, Copy)]
+struct Sweep {
+    pc: i32,
+    ps: i32,
+    /// Q²·Bb − q: the window's up-steps times Q², minus the detrend.
+    acc: i32,
+    residue: i32,
+    /// X after the last sample.
+    x: i32,
+    /// ΔX and ΔΔX of the last sample.
+    v_prev: i32,
+    a_prev: i32,
+    lo: i32,
+    hi: i32,
+    v_max: i32,
+}
+
+impl Sweep {
+    /// Slides over `out.len()` samples, the first at residue `j`, with the
+    /// entering steps drawn from `main`; stores ΔΔX.
+    #[inline(never)]
+    fn run<S: Sample>(
+        &mut self,
+        out: &mut [S],
+        taps: &mut [Tap],
+        mut j: usize,
+        main: &mut Lcg,
+        qq: i32,
+        shift: u32,
+    ) {
+        let Self {
+            mut pc,
+            mut ps,
+            mut acc,
+            mut residue,
+            mut x,
+            mut v_prev,
+            mut a_prev,
+            ..
+        } = *self;
+        let mut rest = out;
+        while !rest.is_empty() {
+            let ring = taps.get_mut(j..).unwrap_or_default();
+            let take = ring.len().min(rest.len());
+            let (now, later) = rest.split_at_mut(take);
+            for (o, tap) in now.iter_mut().zip(ring) {
+                let enter = main.next_value() as i32 >> 31;
+                let d = tap.up - enter; // +1: an up-step enters, a down-step leaves
+                tap.up = enter;
+                let (tc, ts) = (i32::from(tap.c), i32::from(tap.s));
+                if d != 0 {
+                    if d > 0 {
+                        pc += tc;
+                        ps += ts;
+                        acc += qq;
+                    } else {
+                        pc -= tc;
+                        ps -= ts;
+                        acc -= qq;
+                    }
+                }
+                let r = acc - (tc * pc + ts * ps) + residue;
+                let v = r >> shift;
+                residue = r - (v << shift);
+                let a = v - v_prev;
+                if (v ^ v_prev) < 0 {
+                    // ΔX changes sign: X (before this sample) is a local extreme.
+                    self.lo = self.lo.min(x);
+                    self.hi = self.hi.max(x);
+                }
+                if (a ^ a_prev) < 0 {
+                    // ΔΔX changes sign: the previous ΔX is a local extreme.
+                    self.v_max = self.v_max.max(v_prev.abs());
+                }
+                x += v;
+                v_prev = v;
+                a_prev = a;
+                *o = S::from_scratch(a as i16);
+            }
+            rest = later;
+            j = 0;
+        }
+        (
+            self.pc,
+            self.ps,
+            self.acc,
+            self.residue,
+            self.x,
+            self.v_prev,
+            self.a_prev,
+        ) = (pc, ps, acc, residue, x, v_prev, a_prev);
+    }
+
+    /// Includes the current X and ΔX in the extremes (the sweep's ends).
+    fn settle(&mut self) {
+        self.lo = self.lo.min(self.x);
+        self.hi = self.hi.max(self.x);
+        self.v_max = self.v_max.max(self.v_prev.abs());
+    }
 }
 
 /// The part of Σₙ cp(n) that the zero-sum table does not cancel.
@@ -536,7 +654,9 @@ fn paper<S: Sample, T: Trace>(
         speed.add(vq);
         *s = S::from_scratch((vq - vq_prev) as i16);
         vq_prev = vq;
-        trace.smoothed(i, x as f32 * scale);
+        if T::ENABLED {
+            trace.smoothed(i, x as f32 * scale);
+        }
         j += 1;
         if j == w {
             j = 0;
@@ -568,7 +688,9 @@ fn paper<S: Sample, T: Trace>(
         m,
         mshift,
         |i, fine| {
-            trace.normalized(i, fine);
+            if T::ENABLED {
+                trace.normalized(i, fine);
+            }
             if i == 0 || i == n - 1 {
                 return 0; // the taper's ends are exactly zero
             }
