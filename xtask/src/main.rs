@@ -7,13 +7,15 @@
 //!   lints, the Pico build and its memory budget, the QEMU log snapshot).
 //! - `cargo xtask preview`: CSV and PNG of a loop's stages (walk, smoothing,
 //!   normalisation, closure), for people.
+//! - `cargo xtask metrics`: loop-quality metrics over many seeds, both closures.
 //!
 //! The firmware commands install what they need and is missing: the
 //! firmware's Rust target and, when running as root on Debian or Ubuntu, QEMU.
-//! `preview` runs the core library on the host only.
+//! `preview` and `metrics` run the core library on the host only.
 
 mod args;
 mod elf;
+mod metrics;
 mod preview;
 mod project;
 mod qemu;
@@ -40,6 +42,8 @@ Commands:
   preview  Write the stages of a loop as CSV and PNG (walk, smoothed,
            normalised, final loop with the split point) with its metrics;
            with no options, the three default axes. Options: `preview -h`.
+  metrics  Loop-quality metrics (continuity, liveliness, range, start) of
+           both closures over many seeds. Options: `metrics -h`.
   help     Show this text.
 
 Options (qemu, test):
@@ -77,6 +81,7 @@ enum Command {
     Qemu(Options),
     Test(Options),
     Preview(preview::Args),
+    Metrics(metrics::Args),
     Help,
     /// A command's own help text.
     Usage(&'static str),
@@ -87,9 +92,16 @@ fn parse_args(mut args: impl Iterator<Item = String>) -> Result<Command> {
         return Ok(Command::Help);
     };
     // Commands with options of their own.
-    if command == "preview" {
-        let args = preview::Args::parse(args)?;
-        return Ok(args.map_or(Command::Usage(preview::HELP), Command::Preview));
+    match command.as_str() {
+        "preview" => {
+            let args = preview::Args::parse(args)?;
+            return Ok(args.map_or(Command::Usage(preview::HELP), Command::Preview));
+        }
+        "metrics" => {
+            let args = metrics::Args::parse(args)?;
+            return Ok(args.map_or(Command::Usage(metrics::HELP), Command::Metrics));
+        }
+        _ => {}
     }
     let mut options = Options::default();
     let mut help = false;
@@ -146,6 +158,7 @@ fn main() -> ExitCode {
         Command::Qemu(options) => qemu::command(options),
         Command::Test(options) => test::command(options),
         Command::Preview(args) => preview::command(&args),
+        Command::Metrics(args) => metrics::command(&args),
     });
     match result {
         Ok(true) => ExitCode::SUCCESS,
