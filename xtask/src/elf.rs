@@ -16,6 +16,10 @@ pub const FLASH_BUDGET: u64 = 32 * 1024;
 pub const BOOT2_ADDRESS: u64 = 0x1000_0000;
 /// Size of the second stage: 252 bytes of code plus a 4-byte CRC32.
 pub const BOOT2_SIZE: u64 = 256;
+/// Where the emulated LM3S6965 reads its vector table at reset: the start of
+/// its flash (`FLASH` in qemu/memory.x). An image linked with another board's
+/// memory map (the Pico's flash starts at `0x1000_0000`) does not start.
+pub const LM3S6965_VECTOR_TABLE: u64 = 0x0000_0000;
 
 /// Parts of the names of symbols that are only present when an allocator is
 /// linked (`alloc`'s shims and the `#[global_allocator]` glue). Recent
@@ -209,7 +213,8 @@ pub fn check_pico(path: &Path) -> Result<()> {
 }
 
 /// Prints the QEMU image's sections and sizes (no budget: it is a test image);
-/// fails if an allocator is linked.
+/// fails if the vector table is not where the LM3S6965 boots from or an
+/// allocator is linked.
 pub fn check_qemu(path: &Path) -> Result<()> {
     let image = Image::read(path)?;
     println!("{}", path.display());
@@ -219,6 +224,15 @@ pub fn check_qemu(path: &Path) -> Result<()> {
         image.flash(),
         image.static_ram()
     );
+    match image.section(".vector_table") {
+        Some(table) if table.address == LM3S6965_VECTOR_TABLE => {}
+        Some(table) => bail!(
+            "`.vector_table` is at {:#010x}; the LM3S6965 boots from {LM3S6965_VECTOR_TABLE:#010x} \
+             (was the image linked with another board's memory.x?)",
+            table.address
+        ),
+        None => bail!("no `.vector_table` section: the image cannot boot"),
+    }
     image.check_no_allocator()
 }
 

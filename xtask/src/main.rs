@@ -38,7 +38,7 @@ Commands:
            three axes over the run.
   test     Run every check: host tests, rustfmt, clippy (firmware and host
            crates), the Pico build with its memory budget, and the QEMU run
-           compared with src/bin/qemu/expected.log. Ends with `N passed, M failed`.
+           compared with qemu/expected.log. Ends with `N passed, M failed`.
   preview  Write the stages of a loop as CSV and PNG (walk, smoothed,
            normalised, final loop with the split point) with its metrics;
            with no options, the three default axes. Options: `preview -h`.
@@ -47,8 +47,8 @@ Commands:
   help     Show this text.
 
 Options (qemu, test):
-  --bless          Re-record src/bin/qemu/expected.log from this run (the run
-                   itself must succeed).
+  --bless          Re-record qemu/expected.log from this run (the run itself
+                   must succeed).
   --timeout <s>    Stop QEMU after this many seconds of wall time
                    (default 120); a run that times out fails.
   -h, --help       Show this text.

@@ -25,46 +25,75 @@ pub fn root() -> PathBuf {
         .to_path_buf()
 }
 
-/// A board image of the firmware: one `[[bin]]` of the root package with its features.
+/// A package of the repository that builds firmware images. Each has its own
+/// workspace, memory map (`memory.x`) and target directory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Package {
+    /// The root package `idle-head`: the core library and the Pico image.
+    Root,
+    /// `qemu/`, the package `idle-head-qemu`: the QEMU `lm3s6965evb` images.
+    Qemu,
+}
+
+impl Package {
+    /// Cargo arguments that select the package from the repository root
+    /// (where cargo is run, so the root `.cargo/config.toml` applies).
+    pub fn manifest_args(self) -> &'static [&'static str] {
+        match self {
+            Self::Root => &[],
+            Self::Qemu => &["--manifest-path", "qemu/Cargo.toml"],
+        }
+    }
+}
+
+/// A board image of the firmware: one `[[bin]]` of one of the packages.
 #[derive(Debug, Clone, Copy)]
 pub struct Image {
+    /// The package the image belongs to.
+    pub package: Package,
     /// Bin target name, also the ELF file name.
     pub bin: &'static str,
-    /// Cargo arguments that select the image (features and bin).
-    pub cargo_args: &'static [&'static str],
 }
 
 /// The Raspberry Pi Pico image: the default features, so plain `cargo build --release`.
 pub const PICO: Image = Image {
+    package: Package::Root,
     bin: "pico",
-    cargo_args: &[],
 };
 
-/// The QEMU `lm3s6965evb` image.
-pub const QEMU: Image = Image {
-    bin: "qemu",
-    cargo_args: &[
-        "--no-default-features",
-        "--features",
-        "qemu",
-        "--bin",
-        "qemu",
-    ],
-};
+/// The QEMU `lm3s6965evb` smoke image (`qemu/src/main.rs`).
+pub const QEMU: Image = Image::qemu("qemu");
 
 impl Image {
-    /// Release ELF of this image inside `target_dir`.
-    pub fn elf(&self, target_dir: &Path) -> PathBuf {
-        target_dir.join(TARGET).join("release").join(self.bin)
+    /// Bin `bin` of the QEMU package.
+    pub const fn qemu(bin: &'static str) -> Self {
+        Self {
+            package: Package::Qemu,
+            bin,
+        }
     }
 
-    /// `cargo build --release` for this image, with the project's defmt level.
+    /// Release ELF of this image in its package's target directory.
+    pub fn elf(&self, metadata: &Metadata) -> PathBuf {
+        metadata
+            .target_dir(self.package)
+            .join(TARGET)
+            .join("release")
+            .join(self.bin)
+    }
+
+    /// `cargo build --release` for this image, run in the repository root,
+    /// with the project's defmt level. The Pico image is the root package's
+    /// only bin, so its command is the one users type.
     pub fn build(&self, root: &Path) -> Result<()> {
         let mut cargo = cargo(root);
         cargo
             .args(["build", "--release"])
-            .args(self.cargo_args)
-            .env("DEFMT_LOG", DEFMT_LOG);
+            .args(self.package.manifest_args());
+        if self.package != Package::Root {
+            cargo.args(["--bin", self.bin]);
+        }
+        cargo.env("DEFMT_LOG", DEFMT_LOG);
         run(&mut cargo)
     }
 }
@@ -74,28 +103,28 @@ impl Image {
 pub struct Metadata {
     /// Where cargo puts build output for the root package.
     pub target_dir: PathBuf,
+    /// Where cargo puts build output for the QEMU package (`qemu/target`
+    /// unless configured otherwise).
+    pub qemu_target_dir: PathBuf,
     /// Whether the core library's doc tests are switched on (`[lib] doctest`).
     pub lib_doctests: bool,
 }
 
-/// Reads `cargo metadata` for the root package (no dependency resolution).
-pub fn metadata(root: &Path) -> Result<Metadata> {
-    let output = cargo(root)
-        .args(["metadata", "--no-deps", "--format-version", "1"])
-        .output()
-        .context("running `cargo metadata`")?;
-    if !output.status.success() {
-        bail!(
-            "`cargo metadata` failed:\n{}",
-            String::from_utf8_lossy(&output.stderr)
-        );
+impl Metadata {
+    /// The target directory of `package`.
+    pub fn target_dir(&self, package: Package) -> &Path {
+        match package {
+            Package::Root => &self.target_dir,
+            Package::Qemu => &self.qemu_target_dir,
+        }
     }
-    let json: serde_json::Value =
-        serde_json::from_slice(&output.stdout).context("parsing `cargo metadata` output")?;
-    let target_dir = json["target_directory"]
-        .as_str()
-        .context("`cargo metadata` gave no target_directory")?
-        .into();
+}
+
+/// Reads `cargo metadata` for both packages (no dependency resolution).
+pub fn metadata(root: &Path) -> Result<Metadata> {
+    let json = cargo_metadata(root, Package::Root)?;
+    let target_dir = target_directory(&json)?;
+    let qemu_target_dir = target_directory(&cargo_metadata(root, Package::Qemu)?)?;
     let lib_doctests = json["packages"]
         .as_array()
         .into_iter()
@@ -110,8 +139,32 @@ pub fn metadata(root: &Path) -> Result<Metadata> {
         });
     Ok(Metadata {
         target_dir,
+        qemu_target_dir,
         lib_doctests,
     })
+}
+
+/// `cargo metadata --no-deps` of `package`, run in the repository root.
+fn cargo_metadata(root: &Path, package: Package) -> Result<serde_json::Value> {
+    let output = cargo(root)
+        .args(["metadata", "--no-deps", "--format-version", "1"])
+        .args(package.manifest_args())
+        .output()
+        .context("running `cargo metadata`")?;
+    if !output.status.success() {
+        bail!(
+            "`cargo metadata` failed:\n{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+    serde_json::from_slice(&output.stdout).context("parsing `cargo metadata` output")
+}
+
+fn target_directory(json: &serde_json::Value) -> Result<PathBuf> {
+    Ok(json["target_directory"]
+        .as_str()
+        .context("`cargo metadata` gave no target_directory")?
+        .into())
 }
 
 /// A `cargo` command running in `dir`.

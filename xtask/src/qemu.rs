@@ -25,7 +25,7 @@ pub fn command(options: Options) -> Result<bool> {
     setup::ensure_qemu()?;
     let metadata = project::metadata(&root)?;
     QEMU.build(&root)?;
-    let elf = QEMU.elf(&metadata.target_dir);
+    let elf = QEMU.elf(&metadata);
     let run = run(&elf, options.timeout, Echo::All)?;
 
     if let Some(plot) = render::plot(&run.log) {

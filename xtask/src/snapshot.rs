@@ -1,4 +1,4 @@
-//! The QEMU log kept on file next to the QEMU image, compared on every test run.
+//! The QEMU log kept on file in the QEMU package, compared on every test run.
 //!
 //! The expected log is the decoded log, one `LEVEL message` line per frame.
 //! Where a line holds a value that changes with unrelated code changes (an
@@ -20,9 +20,9 @@ const MAX_DIFF_LINES: usize = 200;
 /// Matches any text within one line of the expected log.
 const WILDCARD: &str = "[..]";
 
-/// `src/bin/qemu/expected.log`.
+/// `qemu/expected.log`.
 pub fn expected_path() -> PathBuf {
-    project::root().join("src/bin/qemu/expected.log")
+    project::root().join("qemu/expected.log")
 }
 
 /// The run's log as it is kept on file.

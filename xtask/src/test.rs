@@ -7,7 +7,7 @@ use anyhow::{Result, bail};
 
 use crate::{
     Options, elf,
-    project::{self, Metadata, PICO, QEMU},
+    project::{self, Metadata, PICO, Package, QEMU},
     qemu::{self, Echo, Run},
     setup, snapshot,
 };
@@ -105,6 +105,7 @@ pub fn command(options: Options) -> Result<bool> {
     let start = Instant::now();
     let root = project::root();
     let host_tests = root.join("host-tests");
+    let qemu_package = root.join("qemu");
     let xtask = root.join("xtask");
     setup::ensure_toolchain(&root)?;
     let metadata = project::metadata(&root)?;
@@ -121,10 +122,10 @@ pub fn command(options: Options) -> Result<bool> {
         project::run(project::cargo(&xtask).arg("test"))
     });
 
-    // 2. Formatting and lints: firmware (thumb, both images) and host crates.
-    stages.run("rustfmt: core, firmware, host-tests, xtask", || {
+    // 2. Formatting and lints: firmware (thumb, both packages) and host crates.
+    stages.run("rustfmt: core + Pico, qemu/, host-tests, xtask", || {
         let mut failures = Vec::new();
-        for dir in [&root, &host_tests, &xtask] {
+        for dir in [&root, &qemu_package, &host_tests, &xtask] {
             if let Err(error) = project::run(project::cargo(dir).args(["fmt", "--check"])) {
                 failures.push(format!("{error:#}"));
             }
@@ -138,7 +139,7 @@ pub fn command(options: Options) -> Result<bool> {
     if pico_built {
         stages.run(
             "Pico image: .boot2 placement, memory budgets, no allocator",
-            || elf::check_pico(&PICO.elf(&metadata.target_dir)),
+            || elf::check_pico(&PICO.elf(&metadata)),
         );
     } else {
         stages.blocked(
@@ -160,16 +161,15 @@ fn clippy_stages(stages: &mut Stages, root: &Path, host_tests: &Path, xtask: &Pa
         project::run(
             project::cargo(root)
                 .args(["clippy", "--release", "--lib", "--bins"])
-                .args(PICO.cargo_args)
                 .args(lint)
                 .env("DEFMT_LOG", project::DEFMT_LOG),
         )
     });
-    stages.run("clippy: QEMU image + core (thumbv6m)", || {
+    stages.run("clippy: QEMU images, qemu/ (thumbv6m)", || {
         project::run(
             project::cargo(root)
-                .args(["clippy", "--release", "--lib"])
-                .args(QEMU.cargo_args)
+                .args(["clippy", "--release", "--bins"])
+                .args(Package::Qemu.manifest_args())
                 .args(lint)
                 .env("DEFMT_LOG", project::DEFMT_LOG),
         )
@@ -204,15 +204,15 @@ fn clippy_stages(stages: &mut Stages, root: &Path, host_tests: &Path, xtask: &Pa
 }
 
 fn qemu_stages(stages: &mut Stages, root: &Path, metadata: &Metadata, options: Options) {
-    const BUILD: &str = "QEMU build (no allocator linked)";
+    const BUILD: &str = "QEMU build (LM3S6965 memory map, no allocator linked)";
     const RUN: &str = "QEMU run: firmware exits with success";
-    const SNAPSHOT: &str = "QEMU log matches src/bin/qemu/expected.log";
+    const SNAPSHOT: &str = "QEMU log matches qemu/expected.log";
     const SUMMARY: &str = "QEMU summary: missed=0 pulse_violations=0, checksum = host's";
 
     let built = stages.run(BUILD, || {
         setup::ensure_qemu()?;
         QEMU.build(root)?;
-        elf::check_qemu(&QEMU.elf(&metadata.target_dir))
+        elf::check_qemu(&QEMU.elf(metadata))
     });
     if !built {
         for name in [RUN, SNAPSHOT, SUMMARY] {
@@ -222,11 +222,7 @@ fn qemu_stages(stages: &mut Stages, root: &Path, metadata: &Metadata, options: O
     }
     let mut run: Option<Run> = None;
     stages.run(RUN, || {
-        let done = qemu::run(
-            &QEMU.elf(&metadata.target_dir),
-            options.timeout,
-            Echo::Problems,
-        )?;
+        let done = qemu::run(&QEMU.elf(metadata), options.timeout, Echo::Problems)?;
         println!("{}", done.describe());
         let succeeded = done.succeeded();
         let describe = done.describe();
@@ -250,7 +246,7 @@ fn qemu_stages(stages: &mut Stages, root: &Path, metadata: &Metadata, options: O
             }
             snapshot::bless(&run)
         } else {
-            snapshot::compare(&run, &metadata.target_dir.join("qemu-actual.log"))
+            snapshot::compare(&run, &metadata.qemu_target_dir.join("qemu-actual.log"))
         }
     });
     stages.run(SUMMARY, || {
