@@ -4,7 +4,10 @@
 //!
 //! - `cargo xtask qemu`: build the QEMU image, run it and show the head's motion.
 //! - `cargo xtask test`: every check the project has (host tests, formatting,
-//!   lints, the Pico build and its memory budget, the QEMU log snapshot).
+//!   lints, the Pico build and its memory budget, the QEMU log snapshot, the
+//!   boot-time benchmark and its budget).
+//! - `cargo xtask bench`: the boot-time benchmark in QEMU (engine against a
+//!   direct-form f32 smoothing), as a table with a verdict.
 //! - `cargo xtask preview`: CSV and PNG of a loop's stages (walk, smoothing,
 //!   normalisation, closure), for people.
 //! - `cargo xtask metrics`: loop-quality metrics over many seeds, both closures.
@@ -14,6 +17,7 @@
 //! `preview` and `metrics` run the core library on the host only.
 
 mod args;
+mod bench;
 mod elf;
 mod metrics;
 mod preview;
@@ -37,8 +41,14 @@ Commands:
            motion: the decoded defmt log, the summary line and a plot of the
            three axes over the run.
   test     Run every check: host tests, rustfmt, clippy (firmware and host
-           crates), the Pico build with its memory budget, and the QEMU run
-           compared with qemu/expected.log. Ends with `N passed, M failed`.
+           crates), the Pico build with its memory budget, the QEMU run
+           compared with qemu/expected.log, and the benchmark with its
+           budget. Ends with `N passed, M failed`.
+  bench    Build the QEMU benchmark image and run it: instructions of the
+           motion engine for the default set, for W = 15, 59, 239 (N = 900)
+           and N = 450, 900, 1800 (W = 59), next to a direct-form f32
+           smoothing, then a verdict. Fails if the default set takes more
+           than 150,000 instructions.
   preview  Write the stages of a loop as CSV and PNG (walk, smoothed,
            normalised, final loop with the split point) with its metrics;
            with no options, the three default axes. Options: `preview -h`.
@@ -46,15 +56,18 @@ Commands:
            both closures over many seeds. Options: `metrics -h`.
   help     Show this text.
 
-Options (qemu, test):
+Options (qemu, test, bench):
   --bless          Re-record qemu/expected.log from this run (the run itself
-                   must succeed).
+                   must succeed; qemu and test).
   --timeout <s>    Stop QEMU after this many seconds of wall time
                    (default 120); a run that times out fails.
+  --no-budget      Report the benchmark's instruction budget without failing
+                   on it (bench and test).
   -h, --help       Show this text.
 
-qemu and test install what is missing: the thumbv6m-none-eabi Rust target
-(rustup) and, as root on Debian/Ubuntu, the qemu-system-arm package (apt-get).
+qemu, test and bench install what is missing: the thumbv6m-none-eabi Rust
+target (rustup) and, as root on Debian/Ubuntu, the qemu-system-arm package
+(apt-get).
 ";
 
 /// Options shared by the commands.
@@ -64,6 +77,8 @@ pub struct Options {
     pub bless: bool,
     /// Wall-clock limit for one QEMU run.
     pub timeout: Duration,
+    /// Report the benchmark's instruction budget without failing on it.
+    pub no_budget: bool,
 }
 
 impl Default for Options {
@@ -73,6 +88,7 @@ impl Default for Options {
             // A hung firmware must fail CI, not stall it; the QEMU run takes
             // well under a minute.
             timeout: Duration::from_secs(120),
+            no_budget: false,
         }
     }
 }
@@ -80,6 +96,7 @@ impl Default for Options {
 enum Command {
     Qemu(Options),
     Test(Options),
+    Bench(Options),
     Preview(preview::Args),
     Metrics(metrics::Args),
     Help,
@@ -108,6 +125,7 @@ fn parse_args(mut args: impl Iterator<Item = String>) -> Result<Command> {
     while let Some(arg) = args.next() {
         match arg.as_str() {
             "--bless" => options.bless = true,
+            "--no-budget" => options.no_budget = true,
             "--timeout" => {
                 let value = args
                     .next()
@@ -130,6 +148,7 @@ fn parse_args(mut args: impl Iterator<Item = String>) -> Result<Command> {
     Ok(match command.as_str() {
         "qemu" => Command::Qemu(options),
         "test" => Command::Test(options),
+        "bench" => Command::Bench(options),
         "help" | "-h" | "--help" => Command::Help,
         other => bail!("unknown command `{other}` (see `cargo xtask help`)"),
     })
@@ -157,6 +176,7 @@ fn main() -> ExitCode {
         }
         Command::Qemu(options) => qemu::command(options),
         Command::Test(options) => test::command(options),
+        Command::Bench(options) => bench::command(options),
         Command::Preview(args) => preview::command(&args),
         Command::Metrics(args) => metrics::command(&args),
     });

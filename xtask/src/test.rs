@@ -6,7 +6,7 @@ use std::{path::Path, time::Instant};
 use anyhow::{Result, bail};
 
 use crate::{
-    Options, elf,
+    Options, bench, elf,
     project::{self, Metadata, PICO, Package, QEMU},
     qemu::{self, Echo, Run},
     setup, snapshot,
@@ -150,6 +150,12 @@ pub fn command(options: Options) -> Result<bool> {
 
     // 4. The QEMU run against the log on file, and the firmware's own verdict.
     qemu_stages(&mut stages, &root, &metadata, options);
+
+    // 5. The boot-time benchmark in QEMU and the default set's instruction budget.
+    stages.run(bench::STAGE, || {
+        setup::ensure_qemu()?;
+        bench::run_and_check(&root, &metadata, options)
+    });
 
     Ok(stages.finish(start))
 }

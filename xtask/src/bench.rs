@@ -1,0 +1,414 @@
+//! `cargo xtask bench`: the boot-precompute benchmark, run in QEMU.
+//!
+//! The benchmark image (bin `bench`) generates the three axes of the default
+//! set for several N and W, and times a direct-form f32 implementation of the
+//! paper's smoothing next to it, on the same emulated Cortex-M0. Under
+//! `-icount shift=0` one instruction is one nanosecond of virtual time, so the
+//! counts it logs are instruction counts, identical run after run:
+//!
+//! ```text
+//! bench row=<label> n=<N> w=<W> engine=<insns> direct=<insns> (<checksum>)
+//! ```
+//!
+//! This module decodes that log, prints the table and checks the `default`
+//! row against [`BUDGET`].
+
+// Instruction counts are far below 2^52 and positive: the float conversions are exact.
+#![allow(
+    clippy::cast_precision_loss,
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss
+)]
+
+use std::{fmt::Write as _, path::Path};
+
+use anyhow::{Context, Result, bail};
+
+use crate::{
+    Options,
+    project::{self, Image, Metadata},
+    qemu::{self, Echo, LogLine},
+    setup,
+};
+
+/// The benchmark image: bin `bench` of the QEMU package (`qemu/src/bench.rs`).
+pub const BENCH: Image = Image::qemu("bench");
+
+/// Instructions the default set (three axes, N = 900, W = 59) may take at boot.
+pub const BUDGET: u64 = 150_000;
+
+/// The name of the benchmark's stage in `cargo xtask test`.
+pub const STAGE: &str = "QEMU bench: default set within 150,000 instructions";
+
+/// RP2040 system clock (Hz) the time column assumes: 125 MHz, the Pico's default.
+const RP2040_HZ: f64 = 125e6;
+
+/// Rows the image must report, in table order.
+const LABELS: [&str; 7] = ["default", "w15", "w59", "w239", "n450", "n900", "n1800"];
+
+/// The W rows (N = 900) and the N rows (W = 59).
+const W_ROWS: [&str; 3] = ["w15", "w59", "w239"];
+const N_ROWS: [&str; 3] = ["n450", "n900", "n1800"];
+
+/// Largest max/min engine count over the W rows still called flat: the
+/// engine's smoother is O(N) whatever W is, only the O(W) kernel table and
+/// wrap correction grow with W (the direct form grows 16× from W = 15 to 239).
+const FLAT_LIMIT: f64 = 1.5;
+
+/// How far the marginal cost per sample may change between N = 450..900 and
+/// N = 900..1800 (as a ratio) and still be called linear. The plain ratio
+/// n1800/n450 is 4 only without a fixed cost (kernel table, wrap correction,
+/// call overhead), which pulls it below 4; the marginal cost ignores that.
+const MARGINAL_TOLERANCE: f64 = 0.1;
+
+/// One `bench row=...` line.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Row {
+    /// `default`, `w15`, ...
+    pub label: String,
+    /// Samples per loop.
+    pub n: u64,
+    /// Hann window taps.
+    pub w: u64,
+    /// Instructions of the engine (three axes, whole pipeline).
+    pub engine: u64,
+    /// Instructions of the direct-form f32 smoothing (three axes).
+    pub direct: u64,
+}
+
+impl Row {
+    /// Parses a `bench row=<label> n=<N> w=<W> engine=<i> direct=<i> (...)`
+    /// message; `None` for any other message, an error for a malformed one.
+    pub fn parse(message: &str) -> Result<Option<Self>> {
+        let Some(rest) = message.trim_start().strip_prefix("bench ") else {
+            return Ok(None);
+        };
+        let field = |key: &str| -> Result<&str> {
+            rest.split_whitespace()
+                .find_map(|token| token.strip_prefix(key)?.strip_prefix('='))
+                .with_context(|| format!("`{message}` has no `{key}=`"))
+        };
+        let number = |key: &str| -> Result<u64> {
+            let value = field(key)?;
+            value
+                .replace('_', "")
+                .parse()
+                .with_context(|| format!("`{key}={value}` in `{message}` is not a whole number"))
+        };
+        Ok(Some(Self {
+            label: field("row")?.to_owned(),
+            n: number("n")?,
+            w: number("w")?,
+            engine: number("engine")?,
+            direct: number("direct")?,
+        }))
+    }
+
+    /// direct / engine.
+    pub fn ratio(&self) -> f64 {
+        self.direct as f64 / self.engine as f64
+    }
+
+    /// Engine instructions per generated sample (three axes of N samples).
+    pub fn per_sample(&self) -> f64 {
+        self.engine as f64 / (3 * self.n) as f64
+    }
+
+    /// The engine's time on a 125 MHz RP2040, in µs: a lower bound, since
+    /// every Cortex-M0+ instruction takes at least one cycle.
+    pub fn rp2040_us(&self) -> f64 {
+        self.engine as f64 / RP2040_HZ * 1e6
+    }
+}
+
+/// The rows of a benchmark log, in order; fails on a malformed line.
+pub fn rows(log: &[LogLine]) -> Result<Vec<Row>> {
+    log.iter()
+        .filter_map(|line| Row::parse(&line.message).transpose())
+        .collect()
+}
+
+/// The table of the rows, ready to print.
+pub fn table(rows: &[Row]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{:<8} {:>5} {:>4} {:>12} {:>13} {:>8} {:>11} {:>13}",
+        "row", "N", "W", "engine insn", "direct f32", "ratio", "insn/sample", "RP2040 µs ≥"
+    );
+    for row in rows {
+        let _ = writeln!(
+            out,
+            "{:<8} {:>5} {:>4} {:>12} {:>13} {:>7.1}× {:>11.1} {:>13.0}",
+            row.label,
+            row.n,
+            row.w,
+            thousands(row.engine),
+            thousands(row.direct),
+            row.ratio(),
+            row.per_sample(),
+            row.rp2040_us(),
+        );
+    }
+    let _ = writeln!(
+        out,
+        "engine: walk, smoothing, scaling and loop closure of 3 axes; direct f32: \
+         the paper's smoothing only, Σ h(m)·u(n−m), of 3 walks;"
+    );
+    let _ = writeln!(
+        out,
+        "ratio = direct/engine; insn/sample = engine/(3·N); RP2040 µs = engine/125 MHz \
+         (a lower bound: each M0+ instruction takes ≥ 1 cycle)."
+    );
+    out
+}
+
+/// What the rows say: the budget, flatness in W and linearity in N.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Verdict {
+    /// Engine instructions of the `default` row.
+    pub default: u64,
+    /// max/min of the engine counts over the W rows.
+    pub flatness: f64,
+    /// engine(n1800) / engine(n450): 4 if the cost is proportional to N.
+    pub linearity: f64,
+    /// Marginal engine instructions per unit of N (three axes) from N = 450
+    /// to 900 and from 900 to 1800.
+    pub marginal: [f64; 2],
+    /// The fixed cost this implies: engine(n450) − 450 × the first marginal cost.
+    pub fixed: f64,
+}
+
+impl Verdict {
+    /// Reads the verdict from the rows; fails if a row it needs is missing.
+    pub fn of(rows: &[Row]) -> Result<Self> {
+        let engine = |label: &str| -> Result<u64> {
+            rows.iter()
+                .find(|row| row.label == label)
+                .map(|row| row.engine)
+                .with_context(|| format!("the benchmark reported no `{label}` row"))
+        };
+        let w_counts = W_ROWS
+            .iter()
+            .map(|label| engine(label))
+            .collect::<Result<Vec<_>>>()?;
+        let [n450, n900, n1800] = N_ROWS.map(engine);
+        let (n450, n900, n1800) = (n450? as f64, n900? as f64, n1800? as f64);
+        let max = w_counts.iter().copied().max().unwrap_or(0);
+        let min = w_counts.iter().copied().min().unwrap_or(0).max(1);
+        Ok(Self {
+            default: engine("default")?,
+            flatness: max as f64 / min as f64,
+            linearity: n1800 / n450.max(1.0),
+            marginal: [(n900 - n450) / 450.0, (n1800 - n900) / 900.0],
+            fixed: n450 - (n900 - n450),
+        })
+    }
+
+    /// The default row fits [`BUDGET`].
+    pub fn within_budget(&self) -> bool {
+        self.default <= BUDGET
+    }
+
+    /// The engine count hardly depends on W.
+    pub fn flat(&self) -> bool {
+        self.flatness <= FLAT_LIMIT
+    }
+
+    /// The engine count grows linearly with N: the same marginal cost per
+    /// sample over both steps of N.
+    pub fn linear(&self) -> bool {
+        let [a, b] = self.marginal;
+        a > 0.0 && b > 0.0 && (b / a - 1.0).abs() <= MARGINAL_TOLERANCE
+    }
+
+    /// The verdict, one check a line.
+    pub fn lines(&self) -> String {
+        let mark = |ok: bool| if ok { "ok" } else { "NO" };
+        let [a, b] = self.marginal;
+        format!(
+            "verdict:\n\
+             \x20 budget: default = {} insn against {}: {} ({:.2}× the budget)\n\
+             \x20 flat in W: max/min over W = 15, 59, 239 is {:.2} (limit {FLAT_LIMIT}): {}\n\
+             \x20 linear in N: n1800/n450 = {:.2} (4 if proportional); marginal cost \
+             {a:.1} insn per unit of N from 450 to 900, {b:.1} from 900 to 1800 \
+             (ratio {:.3}, limit 1 ± {MARGINAL_TOLERANCE}): {}; fixed cost ≈ {} insn\n",
+            thousands(self.default),
+            thousands(BUDGET),
+            if self.within_budget() {
+                "within"
+            } else {
+                "OVER"
+            },
+            self.default as f64 / BUDGET as f64,
+            self.flatness,
+            mark(self.flat()),
+            self.linearity,
+            b / a,
+            mark(self.linear()),
+            thousands(self.fixed.max(0.0).round() as u64),
+        )
+    }
+}
+
+/// `1234567` as `1,234,567`.
+fn thousands(value: u64) -> String {
+    let digits = value.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// Builds and runs the benchmark image, prints the table and the verdict.
+/// Fails if the run or the log is broken, or (unless `no_budget`) if the
+/// default row is over [`BUDGET`].
+pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Result<()> {
+    BENCH.build(root)?;
+    let elf = BENCH.elf(metadata);
+    let run = qemu::run(&elf, options.timeout, Echo::Problems)?;
+    println!("{}", run.describe());
+    if !run.succeeded() {
+        bail!("{}", run.describe());
+    }
+    let rows = rows(&run.log)?;
+    let missing: Vec<&str> = LABELS
+        .into_iter()
+        .filter(|label| !rows.iter().any(|row| row.label == *label))
+        .collect();
+    if !missing.is_empty() {
+        bail!("the benchmark reported no row for {}", missing.join(", "));
+    }
+    println!();
+    print!("{}", table(&rows));
+    let verdict = Verdict::of(&rows)?;
+    print!("{}", verdict.lines());
+    if !verdict.within_budget() {
+        if options.no_budget {
+            println!("(--no-budget: the budget is reported, not enforced)");
+        } else {
+            bail!(
+                "the default set takes {} instructions, over the budget of {} \
+                 (pass --no-budget to report without failing)",
+                thousands(verdict.default),
+                thousands(BUDGET)
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `cargo xtask bench`. `Ok(false)` when the benchmark failed.
+pub fn command(options: Options) -> Result<bool> {
+    let root = project::root();
+    setup::ensure_toolchain(&root)?;
+    setup::ensure_qemu()?;
+    let metadata = project::metadata(&root)?;
+    match run_and_check(&root, &metadata, options) {
+        Ok(()) => Ok(true),
+        Err(error) => {
+            println!("bench FAILED: {error:#}");
+            Ok(false)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LOG: [&str; 7] = [
+        "bench row=default n=900 w=59 engine=563360 direct=37010000 (-160696.5)",
+        "bench row=w15 n=900 w=15 engine=541040 direct=9770720 (-34268.844)",
+        "bench row=w59 n=900 w=59 engine=563360 direct=37010000 (-160696.5)",
+        "bench row=w239 n=900 w=239 engine=676000 direct=133967040 (-885004.0)",
+        "bench row=n450 n=450 w=59 engine=305040 direct=18187840 (-39993.406)",
+        "bench row=n900 n=900 w=59 engine=563360 direct=37010000 (-160696.5)",
+        "bench row=n1800 n=1800 w=59 engine=1086400 direct=74700160 (529792.75)",
+    ];
+
+    fn log() -> Vec<LogLine> {
+        std::iter::once("boot")
+            .chain(LOG)
+            .map(|message| LogLine {
+                level: Some("INFO".to_owned()),
+                message: message.to_owned(),
+                timestamp: None,
+                location: None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn parses_bench_lines_and_skips_others() {
+        let row = Row::parse(LOG[3]).unwrap().unwrap();
+        assert_eq!(
+            row,
+            Row {
+                label: "w239".to_owned(),
+                n: 900,
+                w: 239,
+                engine: 676_000,
+                direct: 133_967_040,
+            }
+        );
+        assert!(Row::parse("summary frames=900").unwrap().is_none());
+        assert!(Row::parse("bench row=x n=9 w=3 engine=1").is_err());
+        assert!(Row::parse("bench row=x n=9 w=3 engine=1e3 direct=2").is_err());
+        assert_eq!(rows(&log()).unwrap().len(), 7);
+    }
+
+    #[test]
+    fn derived_columns() {
+        let row = Row::parse(LOG[0]).unwrap().unwrap();
+        assert!((row.ratio() - 37_010_000.0 / 563_360.0).abs() < 1e-9);
+        // 563360 / 2700 = 208.65
+        assert!((row.per_sample() - 208.651_851).abs() < 1e-5);
+        // 563360 / 125 = 4506.88 µs
+        assert!((row.rp2040_us() - 4506.88).abs() < 1e-9);
+    }
+
+    #[test]
+    fn verdict_of_the_sample_log() {
+        let verdict = Verdict::of(&rows(&log()).unwrap()).unwrap();
+        assert_eq!(verdict.default, 563_360);
+        assert!(!verdict.within_budget());
+        assert!((verdict.flatness - 676_000.0 / 541_040.0).abs() < 1e-12);
+        assert!(verdict.flat());
+        assert!((verdict.linearity - 1_086_400.0 / 305_040.0).abs() < 1e-12);
+        // (563360 − 305040)/450 = 574.04, (1086400 − 563360)/900 = 581.16
+        assert!((verdict.marginal[0] - 574.044_444).abs() < 1e-5);
+        assert!((verdict.marginal[1] - 581.155_555).abs() < 1e-5);
+        assert!(verdict.linear());
+        assert!(verdict.lines().contains("OVER"));
+        let quadratic = Verdict {
+            marginal: [100.0, 200.0],
+            ..verdict
+        };
+        assert!(!quadratic.linear());
+        let mut rows = rows(&log()).unwrap();
+        rows.retain(|row| row.label != "n450");
+        assert!(Verdict::of(&rows).is_err());
+    }
+
+    #[test]
+    fn table_has_a_row_per_line_default_first() {
+        let table = table(&rows(&log()).unwrap());
+        let lines: Vec<&str> = table.lines().collect();
+        assert!(lines[1].starts_with("default"));
+        assert!(lines[1].contains("563,360"));
+        assert!(lines[7].starts_with("n1800"));
+    }
+
+    #[test]
+    fn thousands_separators() {
+        assert_eq!(thousands(0), "0");
+        assert_eq!(thousands(999), "999");
+        assert_eq!(thousands(1000), "1,000");
+        assert_eq!(thousands(133_967_040), "133,967,040");
+    }
+}
