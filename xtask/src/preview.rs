@@ -543,10 +543,17 @@ impl Stages {
                 deg(cfg.range.max),
                 deg(m.start),
             ),
-            format!(
-                "split p = {} (of {} zero-crossing candidates); up-steps {} of the walk",
-                self.info.split, self.info.crossings, self.info.up_steps
-            ),
+            match cfg.closure {
+                Closure::Paper => format!(
+                    "split p = {} (drawn from {} zero crossings); {} up-steps in the walk",
+                    self.info.split, self.info.crossings, self.info.up_steps
+                ),
+                Closure::Seamless => format!(
+                    "split p = {} (where the smoothed loop crosses the level that maps to 0°); \
+                     {} up-steps in the walk",
+                    self.info.split, self.info.up_steps
+                ),
+            },
         ]
     }
 
