@@ -17,10 +17,7 @@ fn engine<const N: usize>(
     let mut t: Trajectory<Mdeg16, N> = Trajectory::new();
     let info = t.generate(&cfg, Axis::Yaw, &k).unwrap();
     (
-        t.samples()
-            .iter()
-            .map(|s| f64::from(s.0) / 1000.0)
-            .collect(),
+        t.playback().map(|s| f64::from(s.0) / 1000.0).collect(),
         usize::from(info.split),
     )
 }
@@ -72,11 +69,7 @@ fn paper_matches_reference() {
         let k = HannKernel::new(59).unwrap();
         let mut t: Trajectory<Mdeg16, 900> = Trajectory::new();
         let info = t.generate(&cfg, Axis::Yaw, &k).unwrap();
-        let mut unrot: Vec<f64> = t
-            .samples()
-            .iter()
-            .map(|s| f64::from(s.0) / 1000.0)
-            .collect();
+        let mut unrot: Vec<f64> = t.playback().map(|s| f64::from(s.0) / 1000.0).collect();
         unrot.rotate_right(usize::from(info.split));
         let r = reference::paper(seed, 900, 59, -9.0, 9.0);
         let mut want = r.final_deg.clone();

@@ -82,9 +82,12 @@ fn x_shift(q: i32, w: usize, n: usize) -> u32 {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct LoopInfo {
-    /// The sample of the smoothed, scaled loop that became index 0 (the split
-    /// point p of the paper's Figure 6).
+    /// The index, in generation order, of the sample of the smoothed, scaled
+    /// loop where playback starts (the split point p of the paper's Figure 6).
     pub split: u16,
+    /// Where playback starts in the stored buffer: the loop is kept as a ring
+    /// (exchanging the two halves is a matter of where reading starts).
+    pub start: u16,
     /// How many zero crossings were candidates for the split.
     pub crossings: u16,
     /// Up-steps (+δ) among the walk's steps.
@@ -217,7 +220,7 @@ fn seamless<S: Sample, T: Trace>(
     let mut taps = [Tap::default(); MAX_WINDOW as usize];
     for (k, (tap, &(tc, ts))) in taps.iter_mut().zip(table).enumerate() {
         let up = main.next_value() as i32 >> 31;
-        *tap = Tap { c: tc, s: ts, up };
+        *tap = Tap::new((tc, ts), up);
         if up != 0 {
             pc += i32::from(tc);
             ps += i32::from(ts);
@@ -240,17 +243,15 @@ fn seamless<S: Sample, T: Trace>(
         residue: 0,
         x: 0,
         v_prev: 0,
-        a_prev: 0,
         lo: 0,
         hi: 0,
-        v_max: 0,
     };
     // The first output, n = W−1, at residue W−1 (written as ΔΔX later).
     let (tc, ts) = table[w - 1];
     let r = sweep.acc - (i32::from(tc) * pc + i32::from(ts) * ps);
     let v_first = r >> shift;
     (sweep.residue, sweep.x, sweep.v_prev) = (r - (v_first << shift), v_first, v_first);
-    (sweep.lo, sweep.hi, sweep.v_max) = (v_first, v_first, v_first.abs());
+    (sweep.lo, sweep.hi) = (v_first, v_first);
     // Slides s = 1..N−1: step W−1+s enters, step s−1 leaves, both at residue
     // (s−1) mod W. When the entering index reaches N (s = N−W+1) the circular
     // walk wraps to e(0).
@@ -279,11 +280,6 @@ fn seamless<S: Sample, T: Trace>(
         min: sweep.lo,
         max: sweep.hi,
     };
-    let speed = Extent {
-        min: -sweep.v_max,
-        max: sweep.v_max,
-    };
-    let vq_first = v_first;
     debug_assert_eq!(x, 0, "the seamless loop closes exactly");
     let (lo, hi) = (i64::from(extent.min), i64::from(extent.max));
     let a1 = i64::from(cfg.range.min.millidegrees()) * i64::from(FINE_PER_MDEG);
@@ -291,9 +287,10 @@ fn seamless<S: Sample, T: Trace>(
     // The level that the range's zero maps to under the paper's normalisation.
     let zero_level = lo + (-a1 * (hi - lo)) / (a2 - a1);
 
-    // The first sample, in generation order, where the loop crosses that level.
-    let (split_t, pivot, v_split) = first_crossing(out, 0, vq_first, zero_level);
-    let split = (split_t + w - 1) % n; // as a loop index
+    // The first sample, in generation order, where the loop crosses that
+    // level: playback starts there (the stored order stays a ring).
+    let (start, pivot) = first_crossing(out, v_first, zero_level as i32);
+    let split = (start + w - 1) % n; // as a loop index
 
     // Scale about the pivot so that it maps to exactly 0 and both extremes
     // stay inside [α1, α2]; the tighter side reaches its bound.
@@ -304,40 +301,61 @@ fn seamless<S: Sample, T: Trace>(
     } else {
         (-a1, down)
     };
-    let vmax = i64::from(speed.max.max(-speed.min)) + 1;
+    // |ΔX| bound for the scaling product: V lies in [0, Q²·W] up to the
+    // table rounding (< 4·(Q+1)·W), so |V − q| ≤ max(q, Q²·W − q) + that.
+    let qqw = i64::from(qq) * w as i64;
+    let v_bound =
+        i64::from(detrend).max(qqw - i64::from(detrend)) + 4 * i64::from(q + 1) * w as i64;
+    let vmax = (v_bound >> shift) + 2;
     let (m, mshift) =
         multiplier(num, den, vmax).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
 
-    out.rotate_left(split_t);
-    // Pass 3: integrate twice from the pivot and scale.
-    scale_pass(out, v_split, 0, 0, m, mshift, |i, fine| {
-        if T::ENABLED {
-            trace.normalized((i + split) % n, fine);
+    // Pass 3: integrate twice and scale about the pivot, in stored order.
+    let acc0 = i64::from(v_first - pivot) * i64::from(m);
+    let mask = (1i64 << mshift) - 1;
+    let start0 = (v_first, (acc0 >> mshift) as i32, (acc0 & mask) as i32);
+    scale_pass(out, start0, m, mshift, |_, fine| fine);
+    if T::ENABLED {
+        for (t, o) in out.iter().enumerate() {
+            trace.normalized((t + w - 1) % n, o.fine());
         }
-        fine
-    });
+    }
     Ok(LoopInfo {
         split: split as u16,
+        start: start as u16,
         crossings: 1,
         up_steps: ones as u16,
     })
 }
 
-/// One tap of the sliding window: the kernel table entry of its residue j
-/// and the step currently in the window at that residue (0 for down, −1 for
-/// up). The step leaving the window and the one entering it share the
-/// residue, so this small ring replaces a second, lagging generator.
+/// One tap of the sliding window: the kernel table entry of its residue j,
+/// the step currently in the window at that residue (0 for down, −1 for
+/// up), and scratch for the window's velocity. The step leaving the window
+/// and the one entering it share the residue, so this ring replaces a
+/// second, lagging generator.
 #[derive(Clone, Copy, Default)]
 struct Tap {
-    c: i16,
-    s: i16,
+    /// (Q·cos, Q·sin) packed as `cos | sin << 16`: one load on ARMv6-M.
+    cs: u32,
     up: i32,
+    v: i32,
 }
 
-/// The state of the circular sweep (pass 2), shaped for ARMv6-M's eight low
-/// registers: the detrend is folded into `acc`, and the extremes of X and of
-/// ΔX are looked for only where ΔX or ΔΔX changes sign (a few times per
-/// smoothing length), not at every sample.
+impl Tap {
+    const fn new((c, s): (i16, i16), up: i32) -> Self {
+        Self {
+            cs: (c as u16 as u32) | ((s as u16 as u32) << 16),
+            up,
+            v: 0,
+        }
+    }
+}
+
+/// The state of the circular sweep (pass 2). Each stretch of taps is swept
+/// twice: once to slide the window and compute the velocities V − q (few
+/// values live: ARMv6-M has eight low registers), once to quantise them,
+/// store ΔΔX and track the extremes of X and ΔX — only where their slope
+/// changes sign, a few times per smoothing length.
 #[derive(Clone, Copy)]
 struct Sweep {
     pc: i32,
@@ -347,18 +365,15 @@ struct Sweep {
     residue: i32,
     /// X after the last sample.
     x: i32,
-    /// ΔX and ΔΔX of the last sample.
+    /// ΔX of the last sample.
     v_prev: i32,
-    a_prev: i32,
     lo: i32,
     hi: i32,
-    v_max: i32,
 }
 
 impl Sweep {
     /// Slides over `out.len()` samples, the first at residue `j`, with the
     /// entering steps drawn from `main`; stores ΔΔX.
-    #[inline(never)]
     fn run<S: Sample>(
         &mut self,
         out: &mut [S],
@@ -368,74 +383,76 @@ impl Sweep {
         qq: i32,
         shift: u32,
     ) {
-        let Self {
-            mut pc,
-            mut ps,
-            mut acc,
-            mut residue,
-            mut x,
-            mut v_prev,
-            mut a_prev,
-            ..
-        } = *self;
         let mut rest = out;
         while !rest.is_empty() {
             let ring = taps.get_mut(j..).unwrap_or_default();
             let take = ring.len().min(rest.len());
             let (now, later) = rest.split_at_mut(take);
-            for (o, tap) in now.iter_mut().zip(ring) {
-                let enter = main.next_value() as i32 >> 31;
-                let d = tap.up - enter; // +1: an up-step enters, a down-step leaves
-                tap.up = enter;
-                let (tc, ts) = (i32::from(tap.c), i32::from(tap.s));
-                if d != 0 {
-                    if d > 0 {
-                        pc += tc;
-                        ps += ts;
-                        acc += qq;
-                    } else {
-                        pc -= tc;
-                        ps -= ts;
-                        acc -= qq;
-                    }
-                }
-                let r = acc - (tc * pc + ts * ps) + residue;
-                let v = r >> shift;
-                residue = r - (v << shift);
-                let a = v - v_prev;
-                if (v ^ v_prev) < 0 {
-                    // ΔX changes sign: X (before this sample) is a local extreme.
-                    self.lo = self.lo.min(x);
-                    self.hi = self.hi.max(x);
-                }
-                if (a ^ a_prev) < 0 {
-                    // ΔΔX changes sign: the previous ΔX is a local extreme.
-                    self.v_max = self.v_max.max(v_prev.abs());
-                }
-                x += v;
-                v_prev = v;
-                a_prev = a;
-                *o = S::from_scratch(a as i16);
-            }
+            let ring = ring.get_mut(..take).unwrap_or_default();
+            self.slide(ring, main, qq);
+            self.store(now, ring, shift);
             rest = later;
             j = 0;
         }
-        (
-            self.pc,
-            self.ps,
-            self.acc,
-            self.residue,
-            self.x,
-            self.v_prev,
-            self.a_prev,
-        ) = (pc, ps, acc, residue, x, v_prev, a_prev);
     }
 
-    /// Includes the current X and ΔX in the extremes (the sweep's ends).
+    /// Slides the window over `ring`, leaving each sample's V − q in its tap.
+    #[inline(never)]
+    fn slide(&mut self, ring: &mut [Tap], main: &mut Lcg, qq: i32) {
+        let (mut pc, mut ps, mut acc) = (self.pc, self.ps, self.acc);
+        let mut r = main.value();
+        for tap in ring {
+            r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
+            let enter = r as i32 >> 31;
+            let d = tap.up - enter; // +1: an up-step enters, a down-step leaves
+            tap.up = enter;
+            let (tc, ts) = ((tap.cs as i32) << 16 >> 16, tap.cs as i32 >> 16);
+            if d != 0 {
+                if d > 0 {
+                    pc += tc;
+                    ps += ts;
+                    acc += qq;
+                } else {
+                    pc -= tc;
+                    ps -= ts;
+                    acc -= qq;
+                }
+            }
+            tap.v = acc - (tc * pc + ts * ps);
+        }
+        *main = Lcg::new(r);
+        (self.pc, self.ps, self.acc) = (pc, ps, acc);
+    }
+
+    /// Quantises the velocities in `ring`, advances X and stores ΔΔX in `out`.
+    #[inline(never)]
+    fn store<S: Sample>(&mut self, out: &mut [S], ring: &[Tap], shift: u32) {
+        let Self {
+            mut residue,
+            mut x,
+            mut v_prev,
+            ..
+        } = *self;
+        for (o, tap) in out.iter_mut().zip(ring) {
+            let r = tap.v + residue;
+            let v = r >> shift;
+            residue = r - (v << shift);
+            if (v ^ v_prev) < 0 {
+                // ΔX changes sign: X (before this sample) is a local extreme.
+                self.lo = self.lo.min(x);
+                self.hi = self.hi.max(x);
+            }
+            *o = S::from_scratch((v - v_prev) as i16);
+            x += v;
+            v_prev = v;
+        }
+        (self.residue, self.x, self.v_prev) = (residue, x, v_prev);
+    }
+
+    /// Includes the current X in the extremes (the sweep's end).
     fn settle(&mut self) {
         self.lo = self.lo.min(self.x);
         self.hi = self.hi.max(self.x);
-        self.v_max = self.v_max.max(self.v_prev.abs());
     }
 }
 
@@ -512,36 +529,29 @@ fn trace_scale(shift: u32, qq: i32, w: usize) -> f32 {
     (1u64 << shift) as f32 / (qq as f32 * w as f32)
 }
 
-/// Walks the loop in generation order from `start` (where X = ΔX = `v0`),
-/// rebuilding X from the stored ΔΔX, and returns the first index where X
-/// crosses `level` — the sample nearer the level — with X and ΔX there. A
-/// closed loop that spans the level always crosses it.
-fn first_crossing<S: Sample>(acc: &[S], start: usize, v0: i32, level: i64) -> (usize, i32, i32) {
-    let n = acc.len();
-    let (mut x, mut v, mut prev) = (v0, v0, start);
-    let order = acc
-        .iter()
-        .enumerate()
-        .skip(start + 1)
-        .chain(acc.iter().enumerate().take(start));
-    for (i, a) in order {
-        let v_next = v + i32::from(a.to_scratch());
-        let x_next = x + v_next;
-        let (dp, dc) = (i64::from(x) - level, i64::from(x_next) - level);
+/// Walks the stored loop from index 0 (where X = ΔX = `v0`), rebuilding X
+/// from the stored ΔΔX, and returns the first index where X crosses `level`
+/// — the sample nearer the level — with X there. A closed loop that spans the
+/// level always crosses it.
+fn first_crossing<S: Sample>(acc: &[S], v0: i32, level: i32) -> (usize, i32) {
+    let (mut x, mut v) = (v0, v0);
+    for (i, a) in acc.iter().enumerate().skip(1) {
+        v += i32::from(a.to_scratch());
+        let next = x + v;
+        let (dp, dc) = (x - level, next - level);
         if dp == 0 {
-            return (prev, x, v);
+            return (i - 1, x);
         }
-        if dc == 0 || (dc < 0) != (dp < 0) {
+        if dc == 0 || (dc ^ dp) < 0 {
             return if dc.abs() <= dp.abs() {
-                (i, x_next, v_next)
+                (i, next)
             } else {
-                (prev, x, v)
+                (i - 1, x)
             };
         }
-        (x, v, prev) = (x_next, v_next, i);
+        x = next;
     }
-    let _ = n;
-    (start, v0, v0)
+    (0, v0)
 }
 
 /// `num/den` (fine units per X unit) as a multiplier `m / 2^shift`, rounded
@@ -567,33 +577,30 @@ fn multiplier(num: i64, den: i64, vmax: i64) -> Option<(i32, u32)> {
 }
 
 /// Integrates the stored ΔΔX twice and stores the scaled loop in place:
-/// with ΔX(0) = `v_start`, value(i) = `start_fine` +
-/// ⌊Σ_{1≤k≤i} ΔX(k)·m/2^shift⌋ (error feedback keeps the running
-/// sum exact) and value(0) = `start_fine`; `post` maps each value (index,
-/// fine units) to what is stored.
-#[allow(clippy::too_many_arguments)]
+/// with ΔX(0) = `v_start`, value(i) = `start_fine` + ⌊Σ_{1≤k≤i} ΔX(k)·m/2^shift⌋
+/// (error feedback keeps the running sum exact; `start_residue` is value(0)'s
+/// remainder) and value(0) = `start_fine`.
+/// `post` maps each value (index, fine units) to what is stored.
+#[inline(never)]
 fn scale_pass<S: Sample>(
     out: &mut [S],
-    v_start: i32,
-    start_fine: i32,
-    start_residue: i32,
+    (v_start, start_fine, start_residue): (i32, i32, i32),
     m: i32,
     shift: u32,
     mut post: impl FnMut(usize, i32) -> i32,
 ) {
     let mask: i32 = ((1i64 << shift) - 1) as i32;
-    let mut fine = start_fine;
-    let mut residue = start_residue;
-    let mut v = v_start;
-    if let Some(first) = out.first_mut() {
-        *first = S::from_fine(post(0, fine));
-    }
-    for (i, s) in out.iter_mut().enumerate().skip(1) {
+    let (mut fine, mut residue, mut v) = (start_fine, start_residue, v_start);
+    let Some((first, rest)) = out.split_first_mut() else {
+        return;
+    };
+    *first = S::from_fine(post(0, fine));
+    for (i, s) in rest.iter_mut().enumerate() {
         v += i32::from(s.to_scratch());
         let acc = v * m + residue;
         residue = acc & mask;
         fine += acc >> shift;
-        *s = S::from_fine(post(i, fine));
+        *s = S::from_fine(post(i + 1, fine));
     }
 }
 
@@ -682,9 +689,7 @@ fn paper<S: Sample, T: Trace>(
     let span = (n - 1) as u64;
     scale_pass(
         out,
-        x0 as i32,
-        start_fine,
-        start_residue,
+        (x0 as i32, start_fine, start_residue),
         m,
         mshift,
         |i, fine| {
@@ -716,9 +721,9 @@ fn paper<S: Sample, T: Trace>(
         .filter(|(_, p)| sign(&p[1]) != sign(&p[0]))
         .nth(pick)
         .map_or(0, |(i, _)| i);
-    out.rotate_left(split);
     Ok(LoopInfo {
         split: split as u16,
+        start: split as u16,
         crossings: crossings as u16,
         up_steps: ones as u16,
     })

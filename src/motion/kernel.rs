@@ -53,6 +53,20 @@ impl HannKernel {
     /// [`MotionError::WindowTooSmall`] below [`MIN_WINDOW`] and
     /// [`MotionError::WindowTooLarge`] above [`MAX_WINDOW`].
     pub fn new(window: u16) -> Result<Self, MotionError> {
+        let mut kernel = Self {
+            window: 0,
+            q: 0,
+            table: [(0, 0); MAX_WINDOW as usize],
+        };
+        kernel.rebuild(window)?;
+        Ok(kernel)
+    }
+
+    /// Rebuilds the table in place for `window` taps (no 2 KiB move).
+    ///
+    /// # Errors
+    /// As [`HannKernel::new`]; the kernel is left unchanged on error.
+    pub fn rebuild(&mut self, window: u16) -> Result<(), MotionError> {
         if window < MIN_WINDOW {
             return Err(MotionError::WindowTooSmall {
                 window,
@@ -65,33 +79,52 @@ impl HannKernel {
                 max: MAX_WINDOW,
             });
         }
-        let w = u32::from(window);
-        let q = isqrt((1u32 << 29) / w) as i32 - 1;
-        let mut table = [(0i16, 0i16); MAX_WINDOW as usize];
-        let half = (w / 2) as usize;
+        if window == self.window {
+            return Ok(());
+        }
+        let w = usize::from(window);
+        let q = isqrt((1u32 << 29) / u32::from(window)) as i32 - 1;
+        // 32-bit phase, 2³² = one turn (idsp's convention: i32::MIN is −π):
+        // phase(j) = ⌊j·2³²/W⌋, stepped exactly (Bresenham on the remainder).
+        let step = ((1u64 << 32) / w as u64) as u32;
+        let rem = ((1u64 << 32) % w as u64) as u32;
+        let (mut phase, mut frac) = (0u32, 0u32);
+        // Scale from ±2³¹ full scale to ±Q, rounding to nearest:
+        // (x >> 15)·Q < 2¹⁶·2¹⁴ fits i32; the dropped bits move the result
+        // by less than Q/2¹⁶ < 0.21 LSB.
+        let scale = |x: i32| -> i16 { (((x >> 15) * q + (1 << 15)) >> 16) as i16 };
         let mut cos_sum: i32 = 0;
-        for j in 0..=half {
-            // 32-bit phase, 2³² = one turn (idsp's convention: i32::MIN is −π).
-            let phase = ((j as u64) << 32) / u64::from(w);
-            let (c, s) = idsp::cossin(phase as u32 as i32);
-            // Scale from ±2³¹ full scale to ±Q, rounding to nearest.
-            let scale =
-                |x: i32| -> i16 { ((i64::from(x) * i64::from(q) + (1 << 30)) >> 31) as i16 };
+        for j in 0..=w / 2 {
+            let (c, s) = idsp::cossin(phase as i32);
             let (tc, mut ts) = (scale(c), scale(s));
-            if j == 0 || 2 * j == w as usize {
+            if j == 0 || 2 * j == w {
                 ts = 0; // sin 0 = sin π = 0 exactly
             }
-            table[j] = (tc, ts);
-            cos_sum += i32::from(tc);
-            let mirror = w as usize - j;
-            if j != 0 && mirror != j && mirror < w as usize {
-                table[mirror] = (tc, -ts);
+            // Mirror: cos(2π(W−j)/W) = cos(2πj/W), sin(2π(W−j)/W) = −sin(2πj/W).
+            let mirror = w - j;
+            if let Some(e) = self.table.get_mut(j) {
+                *e = (tc, ts);
                 cos_sum += i32::from(tc);
+            }
+            if j != 0
+                && mirror != j
+                && let Some(e) = self.table.get_mut(mirror)
+            {
+                *e = (tc, -ts);
+                cos_sum += i32::from(tc);
+            }
+            phase = phase.wrapping_add(step);
+            frac += rem;
+            if frac >= u32::from(window) {
+                frac -= u32::from(window);
+                phase = phase.wrapping_add(1);
             }
         }
         // Zero-sum cosine column: fold the rounding residue into j = 0.
-        table[0].0 = (i32::from(table[0].0) - cos_sum) as i16;
-        Ok(Self { window, q, table })
+        self.table[0].0 = (i32::from(self.table[0].0) - cos_sum) as i16;
+        self.window = window;
+        self.q = q;
+        Ok(())
     }
 
     /// The window length W.

@@ -443,6 +443,8 @@ const _: () = DEFAULT_HEAD.assert_valid(DEFAULT_N);
 #[derive(Clone, Debug)]
 pub struct Trajectory<S: Sample, const N: usize> {
     samples: [S; N],
+    /// Where playback starts in `samples` (the loop is stored as a ring).
+    start: u16,
 }
 
 impl<S: Sample, const N: usize> Trajectory<S, N> {
@@ -460,6 +462,7 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
         };
         Self {
             samples: [S::ZERO; N],
+            start: 0,
         }
     }
 
@@ -489,21 +492,49 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
         kernel: &HannKernel,
         trace: &mut T,
     ) -> Result<LoopInfo, MotionError> {
-        generate_into(&mut self.samples, cfg, axis, kernel, trace)
+        // Validate, generate and keep the ring as computed: no rotation.
+        self.start = 0;
+        let result = cfg
+            .validate(axis, N)
+            .and_then(|()| engine::generate(&mut self.samples, cfg, kernel, trace));
+        match result {
+            Ok(info) => {
+                self.start = info.start;
+                Ok(info)
+            }
+            Err(e) => {
+                self.samples = [S::ZERO; N];
+                Err(e)
+            }
+        }
     }
 
-    /// The stored samples in playback order; index 0 is the neutral pose.
+    /// The stored samples, a ring: playback starts at [`Trajectory::start`].
     #[must_use]
     pub const fn samples(&self) -> &[S; N] {
         &self.samples
     }
 
-    /// Sample `index` (taken modulo N) as an angle.
+    /// Where playback starts in [`Trajectory::samples`].
+    #[must_use]
+    pub const fn start(&self) -> usize {
+        self.start as usize
+    }
+
+    /// The samples in playback order; the first is the neutral pose.
+    pub fn playback(&self) -> impl Iterator<Item = &S> + '_ {
+        let (head, tail) = self.samples.split_at(self.start().min(N));
+        tail.iter().chain(head)
+    }
+
+    /// Sample `index` of the loop in playback order (taken modulo N) as an angle.
     #[must_use]
     pub fn angle(&self, index: usize) -> Angle {
-        self.samples
-            .get(index % N)
-            .map_or(Angle::ZERO, |s| s.angle())
+        let mut i = self.start() + index % N;
+        if i >= N {
+            i -= N;
+        }
+        self.samples.get(i).map_or(Angle::ZERO, |s| s.angle())
     }
 }
 
@@ -524,8 +555,9 @@ impl<S: Sample, const N: usize> Default for Trajectory<S, N> {
 }
 
 /// Computes one loop into a buffer of any length (N = `out.len()`), for
-/// callers that size buffers at run time; [`Trajectory`] wraps it for
-/// const-generic buffers.
+/// callers that size buffers at run time, and returns it in playback order
+/// (index 0 is the neutral pose). [`Trajectory`] keeps const-generic loops as
+/// a ring instead and saves the rotation.
 ///
 /// # Errors
 /// Any [`MotionError`] of [`AxisConfig::validate`], a kernel built for another
@@ -541,10 +573,18 @@ pub fn generate_into<S: Sample, T: Trace>(
     let result = cfg
         .validate(axis, out.len())
         .and_then(|()| engine::generate(out, cfg, kernel, trace));
-    if result.is_err() {
-        out.fill(S::ZERO);
+    match result {
+        Ok(mut info) => {
+            // Slices come back in playback order.
+            out.rotate_left(usize::from(info.start));
+            info.start = 0;
+            Ok(info)
+        }
+        Err(e) => {
+            out.fill(S::ZERO);
+            Err(e)
+        }
     }
-    result
 }
 
 /// The three loops of a head (pitch, roll, yaw), usable in a `static`.
@@ -570,17 +610,18 @@ impl<S: Sample, const N: usize> HeadTrajectories<S, N> {
     pub fn generate(&mut self, cfg: &HeadConfig) -> Result<[LoopInfo; 3], AxisError> {
         cfg.validate(N)?;
         let mut infos = [LoopInfo::default(); 3];
-        let mut kernel: Option<HannKernel> = None;
+        let mut kernel = HannKernel::new(cfg.pitch.window).map_err(|error| AxisError {
+            axis: Axis::Pitch,
+            error,
+        })?;
         for axis in Axis::ALL {
             let c = cfg.axis(axis);
-            let k = match &kernel {
-                Some(k) if k.window() == c.window => k,
-                _ => kernel
-                    .insert(HannKernel::new(c.window).map_err(|error| AxisError { axis, error })?),
-            };
+            kernel
+                .rebuild(c.window)
+                .map_err(|error| AxisError { axis, error })?;
             let i = axis.index();
             infos[i] = self.axes[i]
-                .generate(c, axis, k)
+                .generate(c, axis, &kernel)
                 .map_err(|error| AxisError { axis, error })?;
         }
         Ok(infos)
@@ -592,12 +633,12 @@ impl<S: Sample, const N: usize> HeadTrajectories<S, N> {
         &self.axes[axis.index()]
     }
 
-    /// FNV-1a over the stored samples (little-endian), pitch, roll, yaw.
+    /// FNV-1a over the samples in playback order (little-endian), pitch, roll, yaw.
     #[must_use]
     pub fn checksum(&self) -> u32 {
         let mut h = Fnv1a::new();
         for t in &self.axes {
-            for s in &t.samples {
+            for s in t.playback() {
                 s.hash_into(&mut h);
             }
         }

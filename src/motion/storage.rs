@@ -65,8 +65,9 @@ impl Sample for Mdeg16 {
     }
     #[inline]
     fn from_fine(fine: i32) -> Self {
-        // Round half up; the engine keeps |fine| ≤ 32767·256, so this never saturates.
-        Mdeg16(((fine + FINE_PER_MDEG / 2) >> 8).clamp(i16::MIN as i32, i16::MAX as i32) as i16)
+        // Round half up. The engine keeps |fine| ≤ 32767·256 (ranges are
+        // validated against the i16 range), so the cast never wraps.
+        Mdeg16(((fine + FINE_PER_MDEG / 2) >> 8) as i16)
     }
     #[inline]
     fn fine(self) -> i32 {
