@@ -217,19 +217,20 @@ fn seamless<S: Sample, T: Trace>(
     let mut main = Lcg::new(cfg.seed);
     let (mut pc, mut ps, mut bb) = (0i32, 0i32, 0i32);
     let mut wrap = WrapCorrection::new(table, n);
-    let mut taps = [Tap::default(); MAX_WINDOW as usize];
-    for (k, (tap, &(tc, ts))) in taps.iter_mut().zip(table).enumerate() {
+    // A heapless vector: stack storage without clearing 6 KiB per axis.
+    let mut ring: heapless::Vec<Tap, { MAX_WINDOW as usize }> = heapless::Vec::new();
+    for &(tc, ts) in table {
         let up = main.next_value() as i32 >> 31;
-        *tap = Tap::new((tc, ts), up);
+        // Cannot fail: the table has at most MAX_WINDOW entries.
+        let _ = ring.push(Tap::new((tc, ts), up));
         if up != 0 {
             pc += i32::from(tc);
             ps += i32::from(ts);
             bb += qq;
-            wrap.add(k);
         }
-        wrap.advance(k);
+        wrap.step(up != 0);
     }
-    let taps = taps.get_mut(..w).unwrap_or_default();
+    let taps = ring.as_mut_slice();
     let total = i64::from(qq) * w as i64 * i64::from(ones) - wrap.sum;
     let detrend = total.div_euclid(n as i64) as i32;
     let scale = trace_scale(shift, qq, w) * 2.0;
@@ -333,7 +334,7 @@ fn seamless<S: Sample, T: Trace>(
 /// up), and scratch for the window's velocity. The step leaving the window
 /// and the one entering it share the residue, so this ring replaces a
 /// second, lagging generator.
-#[derive(Clone, Copy, Default)]
+#[derive(Clone, Copy)]
 struct Tap {
     /// (Q·cos, Q·sin) packed as `cos | sin << 16`: one load on ARMv6-M.
     cs: u32,
@@ -474,48 +475,51 @@ impl Sweep {
 /// product stays below Q²·W/π < 2²⁹; E is summed in `i64`. O(W), once per axis.
 struct WrapCorrection<'t> {
     table: &'t [(i16, i16)],
+    /// The next early step's index k (only k < W−1 contribute).
+    k: usize,
+    /// (k + N) mod W: the table entry of the step's late copy.
+    late: usize,
     sa: (i32, i32),
     sb: (i32, i32),
-    late: usize, // (k + N) mod W
     sum: i64,
 }
 
 impl<'t> WrapCorrection<'t> {
     fn new(table: &'t [(i16, i16)], n: usize) -> Self {
-        let w = table.len();
-        let t = |i: usize| {
+        let w = table.len().max(1);
+        let entry = |i: usize| {
             table
-                .get(i % w)
+                .get(i)
                 .map_or((0, 0), |&(c, s)| (i32::from(c), i32::from(s)))
         };
-        let (c_last, s_last) = t(w - 1);
-        let (c_before, s_before) = t(n + w - 1); // (N−1) mod W
+        let (c_last, s_last) = entry(w - 1);
+        let (c_before, s_before) = entry((n + w - 1) % w); // (N−1) mod W
         Self {
             table,
+            k: 0,
+            late: n % w,
             sa: (c_last, s_last),
             sb: (-c_before, -s_before),
-            late: n % w,
             sum: 0,
         }
     }
 
-    /// Step k (< W−1) is an up-step.
-    fn add(&mut self, k: usize) {
-        if k + 1 >= self.table.len() {
+    /// Takes the next step (up or down) of the initial window.
+    fn step(&mut self, up: bool) {
+        let (Some(&(ec, es)), Some(&(lc, ls))) =
+            (self.table.get(self.k), self.table.get(self.late))
+        else {
             return;
+        };
+        let (ec, es, lc, ls) = (i32::from(ec), i32::from(es), i32::from(lc), i32::from(ls));
+        if up && self.k + 1 < self.table.len() {
+            let early = ec * self.sa.0 + es * self.sa.1;
+            let late = lc * self.sb.0 + ls * self.sb.1;
+            self.sum += i64::from(early) + i64::from(late);
         }
-        let dot = |(c, s): (i16, i16), (a, b): (i32, i32)| i32::from(c) * a + i32::from(s) * b;
-        let early = self.table.get(k).copied().unwrap_or_default();
-        let late = self.table.get(self.late).copied().unwrap_or_default();
-        self.sum += i64::from(dot(early, self.sa)) + i64::from(dot(late, self.sb));
-    }
-
-    /// Moves from step k to step k + 1.
-    fn advance(&mut self, k: usize) {
-        let (c, s) = self.table.get(k).copied().unwrap_or_default();
-        self.sa = (self.sa.0 + i32::from(c), self.sa.1 + i32::from(s));
-        let (c, s) = self.table.get(self.late).copied().unwrap_or_default();
-        self.sb = (self.sb.0 - i32::from(c), self.sb.1 - i32::from(s));
+        self.sa = (self.sa.0 + ec, self.sa.1 + es);
+        self.sb = (self.sb.0 - lc, self.sb.1 - ls);
+        self.k += 1;
         self.late += 1;
         if self.late == self.table.len() {
             self.late = 0;
