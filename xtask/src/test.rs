@@ -148,6 +148,25 @@ pub fn command(options: Options) -> Result<bool> {
         );
     }
 
+    // The calibration image (same bin, feature `calibrate`): it must compile.
+    stages.run(
+        "Pico calibration image compiles (--features calibrate)",
+        || {
+            project::run(
+                project::cargo(&root)
+                    .args(["check", "--release", "--features", "calibrate"])
+                    .env("DEFMT_LOG", project::DEFMT_LOG),
+            )
+        },
+    );
+    // The frame path cannot panic: this image links the frame update against
+    // a panic handler that does not exist, so the link fails if any panic
+    // path survives optimisation (qemu/src/panic_proof.rs).
+    stages.run(
+        "frame path has no panic path (link of frame-path-proof)",
+        || project::Image::qemu("frame-path-proof").build(&root),
+    );
+
     // 4. The QEMU run against the log on file, and the firmware's own verdict.
     qemu_stages(&mut stages, &root, &metadata, options);
 
