@@ -1,9 +1,25 @@
-//! Idle-loop head motion for a three-servo animatronic head.
+//! The hardware-free core of the idle-head firmware (`no_std`, no
+//! allocation, no `unsafe`): motion generation after Kocoń's idle-loop method
+//! ([`motion`]), servo mapping ([`servo`]), frame playback ([`playback`]) and
+//! the frame driver ([`driver`]). The Raspberry Pi Pico image is
+//! `src/bin/pico/`; the QEMU images are a package of their own, `qemu/`.
 //!
-//! This crate is the hardware-free core (`no_std`, no allocation, no `unsafe`):
-//! motion generation after Kocoń's idle-loop method, servo mapping and frame
-//! playback. The Raspberry Pi Pico image is `src/bin/pico/`; the QEMU images
-//! are a package of their own, `qemu/`, with the emulated board's memory map.
+//! ```
+//! use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Mdeg16};
+//! use idle_head::{Angle, Axis, LoopSource};
+//!
+//! // The three loops of the paper's Table 2 set, as the firmware computes them at boot.
+//! let mut head: HeadTrajectories<Mdeg16, DEFAULT_N> = HeadTrajectories::new();
+//! head.generate(&DEFAULT_HEAD).unwrap();
+//! let yaw = head.axis(Axis::Yaw);
+//! assert_eq!(yaw.angle(0), Angle::ZERO); // every loop starts at the neutral pose
+//! let range = DEFAULT_HEAD.yaw.range;
+//! assert!((0..DEFAULT_N).all(|i| range.contains(yaw.angle(i))));
+//! ```
+//!
+//! The project's README follows.
+//!
+#![doc = include_str!("../README.md")]
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
