@@ -54,7 +54,7 @@
 
 use super::kernel::{HannKernel, MAX_WINDOW};
 use super::lcg::Lcg;
-use super::storage::{FINE_PER_MDEG, Sample};
+use super::storage::{FINE_PER_MDEG, LoopScale, Sample};
 use super::{AxisConfig, Closure, MotionError};
 
 /// Smallest extent of the smoothed integral (in `X` units) that is scaled;
@@ -115,13 +115,14 @@ impl Trace for () {
     const ENABLED: bool = false;
 }
 
-/// Runs the pipeline for one axis into `out` (length N, validated by the caller).
+/// Runs the pipeline for one axis into `out` (length N, validated by the
+/// caller); the samples map to angles with the returned scale.
 pub(super) fn generate<S: Sample, T: Trace>(
     out: &mut [S],
     cfg: &AxisConfig,
     kernel: &HannKernel,
     trace: &mut T,
-) -> Result<LoopInfo, MotionError> {
+) -> Result<(LoopInfo, LoopScale), MotionError> {
     if kernel.window() != cfg.window || out.len() < 2 * usize::from(cfg.window) {
         // Callers validate first; this keeps the function total on its own.
         return Err(MotionError::WindowTooLarge {
@@ -192,26 +193,26 @@ impl Quantiser {
 /// its mean step D/N makes the walk periodic; the detrend is applied to the
 /// smoothed velocity, where it is the constant q = Q²·W·(up steps)/N. The
 /// window for output n covers k = n−W+1..n taken modulo N.
+///
+/// The buffer receives the quantised integral X itself (wrapping `i16`, see
+/// [`raw_shift`]); the returned [`LoopScale`] maps it to angles about the
+/// loop's start.
 #[allow(clippy::too_many_lines)] // one pass after another, each commented
 fn seamless<S: Sample, T: Trace>(
     out: &mut [S],
     cfg: &AxisConfig,
     kernel: &HannKernel,
     trace: &mut T,
-) -> Result<LoopInfo, MotionError> {
+) -> Result<(LoopInfo, LoopScale), MotionError> {
     let n = out.len();
     let w = usize::from(cfg.window);
     let table = kernel.table();
     let q = kernel.scale();
     let qq = q * q;
-    let shift = x_shift(q, w, n);
+    let shift = raw_shift(qq, w, n);
 
     // Pass 1: count the up-steps of the whole circular walk.
-    let mut g = Lcg::new(cfg.seed);
-    let mut ones: u32 = 0;
-    for _ in 0..n {
-        ones += g.next_step_bit();
-    }
+    let ones = count_ups(cfg.seed, n);
     // Initial window: k = 0..W−1, output index W−1. The same steps give the
     // wrap correction E (see `WrapCorrection`) and fill the tap ring.
     let mut main = Lcg::new(cfg.seed);
@@ -233,26 +234,28 @@ fn seamless<S: Sample, T: Trace>(
     let taps = ring.as_mut_slice();
     let total = i64::from(qq) * w as i64 * i64::from(ones) - wrap.sum;
     let detrend = total.div_euclid(n as i64) as i32;
-    let scale = trace_scale(shift, qq, w) * 2.0;
 
-    // Pass 2: slide the window around the loop, storing ΔΔX (see `x_shift`)
-    // in generation order: out[t] belongs to loop index (W−1+t) mod N.
+    // Pass 2: slide the window around the loop, storing X in generation
+    // order: out[t] belongs to loop index (W−1+t) mod N.
     let mut sweep = Sweep {
         pc,
         ps,
         acc: bb - detrend,
         residue: 0,
         x: 0,
-        v_prev: 0,
+        rising: true,
         lo: 0,
         hi: 0,
     };
-    // The first output, n = W−1, at residue W−1 (written as ΔΔX later).
+    // The first output, n = W−1, at residue W−1.
     let (tc, ts) = table[w - 1];
     let r = sweep.acc - (i32::from(tc) * pc + i32::from(ts) * ps);
-    let v_first = r >> shift;
-    (sweep.residue, sweep.x, sweep.v_prev) = (r - (v_first << shift), v_first, v_first);
-    (sweep.lo, sweep.hi) = (v_first, v_first);
+    let x_first = r >> shift;
+    (sweep.residue, sweep.x, sweep.rising) = (r - (x_first << shift), x_first, x_first >= 0);
+    (sweep.lo, sweep.hi) = (x_first, x_first);
+    if let Some(o) = out.first_mut() {
+        *o = S::from_scratch(x_first as i16);
+    }
     // Slides s = 1..N−1: step W−1+s enters, step s−1 leaves, both at residue
     // (s−1) mod W. When the entering index reaches N (s = N−W+1) the circular
     // walk wraps to e(0).
@@ -262,84 +265,130 @@ fn seamless<S: Sample, T: Trace>(
     let mut again = Lcg::new(cfg.seed);
     sweep.run(tail, taps, (wrap_at - 1) % w, &mut again, qq, shift);
     sweep.settle();
-    // The first output's ΔΔX refers to the last output's ΔX (cyclic).
-    if let Some(o) = out.first_mut() {
-        *o = S::from_scratch((v_first - sweep.v_prev) as i16);
+    debug_assert_eq!(sweep.x, 0, "the seamless loop closes exactly");
+    let (mut lo, mut hi, mut x0) = (sweep.lo, sweep.hi, x_first);
+    // X spans at most 65535 raw units, so that its offsets from the lowest
+    // sample are exact in `u16`; a wider loop than `raw_shift` expects is
+    // quantised again.
+    let mut step_log = shift;
+    if hi - lo > i32::from(u16::MAX) {
+        let k = requantise(out, x0, lo, hi);
+        (lo, hi, x0, step_log) = (lo >> k, hi >> k, x0 >> k, shift + k);
     }
+    let low = lo as i16;
+    let offset = |s: &S| i32::from(s.to_scratch().wrapping_sub(low) as u16);
     if T::ENABLED {
-        // Rebuild X along the loop for the observer (previews only).
-        let (mut x, mut v) = (v_first, v_first);
-        trace.smoothed(w - 1, x as f32 * scale);
-        for (t, o) in out.iter().enumerate().skip(1) {
-            v += i32::from(o.to_scratch());
-            x += v;
-            trace.smoothed((w - 1 + t) % n, x as f32 * scale);
+        // X along the loop, for the observer (previews only).
+        let scale = trace_scale(step_log, qq, w) * 2.0;
+        for (t, o) in out.iter().enumerate() {
+            trace.smoothed((w - 1 + t) % n, (lo + offset(o)) as f32 * scale);
         }
     }
-    let x = sweep.x;
-    let extent = Extent {
-        min: sweep.lo,
-        max: sweep.hi,
-    };
-    debug_assert_eq!(x, 0, "the seamless loop closes exactly");
-    let (lo, hi) = (i64::from(extent.min), i64::from(extent.max));
+    let _ = x0;
     let a1 = i64::from(cfg.range.min.millidegrees()) * i64::from(FINE_PER_MDEG);
     let a2 = i64::from(cfg.range.max.millidegrees()) * i64::from(FINE_PER_MDEG);
-    // The level that the range's zero maps to under the paper's normalisation.
-    let zero_level = lo + (-a1 * (hi - lo)) / (a2 - a1);
+    // The level that the range's zero maps to under the paper's
+    // normalisation, as an offset from the lowest sample.
+    let span = hi - lo;
+    let level = (-a1 * i64::from(span)) / (a2 - a1);
 
     // The first sample, in generation order, where the loop crosses that
     // level: playback starts there (the stored order stays a ring).
-    let (start, pivot) = first_crossing(out, v_first, zero_level as i32);
+    let (start, pivot) = first_crossing(out, low, level as i32);
     let split = (start + w - 1) % n; // as a loop index
 
     // Scale about the pivot so that it maps to exactly 0 and both extremes
-    // stay inside [α1, α2]; the tighter side reaches its bound.
-    let up = hi - i64::from(pivot);
-    let down = i64::from(pivot) - lo;
+    // stay inside [α1, α2]; the tighter side reaches its bound (less one
+    // fine unit: the offset's floor may add one).
+    let up = i64::from(span - pivot);
+    let down = i64::from(pivot);
     let (num, den) = if down == 0 || (up != 0 && a2 * down <= -a1 * up) {
-        (a2, up)
+        (a2 - 1, up)
     } else {
-        (-a1, down)
+        (-a1 - 1, down)
     };
-    // |ΔX| bound for the scaling product: V lies in [0, Q²·W] up to the
-    // table rounding (< 4·(Q+1)·W), so |V − q| ≤ max(q, Q²·W − q) + that.
-    let qqw = i64::from(qq) * w as i64;
-    let v_bound =
-        i64::from(detrend).max(qqw - i64::from(detrend)) + 4 * i64::from(q + 1) * w as i64;
-    let vmax = (v_bound >> shift) + 2;
+    // Offsets from the lowest sample are below 2¹⁶.
     let (m, mshift) =
-        multiplier(num, den, vmax).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
-
-    // Pass 3: integrate twice and scale about the pivot, in stored order.
-    let acc0 = i64::from(v_first - pivot) * i64::from(m);
-    let mask = (1i64 << mshift) - 1;
-    let start0 = (v_first, (acc0 >> mshift) as i32, (acc0 & mask) as i32);
-    scale_pass(out, start0, m, mshift, |_, fine| fine);
+        multiplier(num, den, 1 << 16).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
+    let scale = LoopScale {
+        low,
+        m,
+        shift: mshift as u8,
+        offset: (pivot * m) >> mshift,
+    };
     if T::ENABLED {
         for (t, o) in out.iter().enumerate() {
-            trace.normalized((t + w - 1) % n, o.fine());
+            trace.normalized((t + w - 1) % n, scale.fine(o.to_scratch()));
         }
     }
-    Ok(LoopInfo {
+    let info = LoopInfo {
         split: split as u16,
         start: start as u16,
         crossings: 1,
         up_steps: ones as u16,
-    })
+    };
+    Ok((info, scale))
 }
 
-/// One tap of the sliding window: the kernel table entry of its residue j,
-/// the step currently in the window at that residue (0 for down, −1 for
-/// up), and scratch for the window's velocity. The step leaving the window
-/// and the one entering it share the residue, so this ring replaces a
-/// second, lagging generator.
+/// The quantisation step `2^shift` from `V` units to the stored integral X.
+///
+/// X is stored as `i16`, so its extent should stay below 2¹⁵ and use as much
+/// of it as it can. The smoothed integral is Q²·W/2 times the smoothed
+/// detrended walk (in steps δ), whose extent is about 0.9·√N for a typical
+/// seed (0.14 to 2.1·√N over many); with the step chosen so that a typical
+/// extent lands in 2¹⁵/3..2¹⁵·2/3, a loop needs quantising again
+/// ([`requantise`]) only in the upper tail. The step is at least 2¹⁵, which
+/// keeps each sample's |ΔX| below 2¹⁵ (|V − q| < 2³⁰), so differences of
+/// stored samples are exact in `i16`, and at least 2N, which makes the
+/// detrend's residue (< N) vanish in the floor: the loop closes exactly.
+fn raw_shift(qq: i32, w: usize, n: usize) -> u32 {
+    // Q²·W/2 · 0.9·√N · 3/2 ≈ Q²·W·√N·0.675; Q²·W < 2²⁹, √N < 2⁷: fits u64.
+    let typical = (qq as u64) * (w as u64) * u64::from(super::kernel::isqrt(n as u32)) * 27 / 40;
+    let by_extent = (64 - typical.leading_zeros()).saturating_sub(16);
+    let by_len = 64 - ((2 * n as u64 - 1).leading_zeros());
+    by_extent.max(by_len).max(15)
+}
+
+/// Pass 1: the number of up-steps among the first `n` steps of the walk.
+#[inline(never)]
+fn count_ups(seed: u32, n: usize) -> u32 {
+    let mut g = Lcg::new(seed);
+    let mut ones: u32 = 0;
+    for _ in 0..n {
+        ones += g.next_step_bit();
+    }
+    ones
+}
+
+/// Quantises the stored X again by the smallest 2^k that brings its extent
+/// [`lo`, `hi`] within 65535 units: X' = ⌊X/2^k⌋, exactly, for every sample
+/// (consecutive samples differ by less than 2¹⁵, so the ring unwraps from
+/// `x0`, the value of `out[0]`). Returns k.
+#[cold]
+fn requantise<S: Sample>(out: &mut [S], x0: i32, lo: i32, hi: i32) -> u32 {
+    let mut k = 1;
+    while (hi >> k) - (lo >> k) > i32::from(u16::MAX) {
+        k += 1;
+    }
+    let (mut x, mut prev) = (x0, x0 as i16);
+    for o in out.iter_mut() {
+        let raw = o.to_scratch();
+        x += i32::from(raw.wrapping_sub(prev));
+        prev = raw;
+        *o = S::from_scratch((x >> k) as i16);
+    }
+    k
+}
+
+/// One tap of the sliding window: the kernel table entry of its residue j
+/// and the step currently in the window at that residue (0 for down, −1 for
+/// up). The step leaving the window and the one entering it share the
+/// residue, so this ring replaces a second, lagging generator.
 #[derive(Clone, Copy)]
 struct Tap {
     /// (Q·cos, Q·sin) packed as `cos | sin << 16`: one load on ARMv6-M.
     cs: u32,
     up: i32,
-    v: i32,
 }
 
 impl Tap {
@@ -347,16 +396,13 @@ impl Tap {
         Self {
             cs: (c as u16 as u32) | ((s as u16 as u32) << 16),
             up,
-            v: 0,
         }
     }
 }
 
-/// The state of the circular sweep (pass 2). Each stretch of taps is swept
-/// twice: once to slide the window and compute the velocities V − q (few
-/// values live: ARMv6-M has eight low registers), once to quantise them,
-/// store ΔΔX and track the extremes of X and ΔX — only where their slope
-/// changes sign, a few times per smoothing length.
+/// The state of the circular sweep (pass 2): the sliding sums, the
+/// quantiser and X with its extremes, tracked only where its slope changes
+/// sign (a few times per smoothing length).
 #[derive(Clone, Copy)]
 struct Sweep {
     pc: i32,
@@ -366,15 +412,15 @@ struct Sweep {
     residue: i32,
     /// X after the last sample.
     x: i32,
-    /// ΔX of the last sample.
-    v_prev: i32,
+    /// Whether ΔX of the last sample was ≥ 0.
+    rising: bool,
     lo: i32,
     hi: i32,
 }
 
 impl Sweep {
     /// Slides over `out.len()` samples, the first at residue `j`, with the
-    /// entering steps drawn from `main`; stores ΔΔX.
+    /// entering steps drawn from `main`; stores X.
     fn run<S: Sample>(
         &mut self,
         out: &mut [S],
@@ -385,26 +431,38 @@ impl Sweep {
         shift: u32,
     ) {
         let mut rest = out;
+        let mut r = main.value();
         while !rest.is_empty() {
             let ring = taps.get_mut(j..).unwrap_or_default();
             let take = ring.len().min(rest.len());
             let (now, later) = rest.split_at_mut(take);
             let ring = ring.get_mut(..take).unwrap_or_default();
-            self.slide(ring, main, qq);
-            self.store(now, ring, shift);
+            r = self.stretch(now, ring, r, qq, shift);
             rest = later;
             j = 0;
         }
+        *main = Lcg::new(r);
     }
 
-    /// Slides the window over `ring`, leaving each sample's V − q in its tap.
+    /// One stretch of taps: slides the window, quantises V − q, advances X
+    /// and stores it. Two loops, one while X rises and one while it falls,
+    /// so that the slope's sign is where the code is, not a register.
     #[inline(never)]
-    fn slide(&mut self, ring: &mut [Tap], main: &mut Lcg, qq: i32) {
+    fn stretch<S: Sample>(
+        &mut self,
+        out: &mut [S],
+        ring: &mut [Tap],
+        mut r: u32,
+        qq: i32,
+        shift: u32,
+    ) -> u32 {
+        let mask = (1i32 << shift) - 1;
         let (mut pc, mut ps, mut acc) = (self.pc, self.ps, self.acc);
-        let mut r = main.value();
-        for tap in ring {
-            r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
-            let enter = r as i32 >> 31;
+        let (mut residue, mut x) = (self.residue, self.x);
+        let mut rising = self.rising;
+        let mut step = |tap: &mut Tap, r: &mut u32| -> i32 {
+            *r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
+            let enter = *r as i32 >> 31;
             let d = tap.up - enter; // +1: an up-step enters, a down-step leaves
             tap.up = enter;
             let (tc, ts) = ((tap.cs as i32) << 16 >> 16, tap.cs as i32 >> 16);
@@ -419,35 +477,51 @@ impl Sweep {
                     acc -= qq;
                 }
             }
-            tap.v = acc - (tc * pc + ts * ps);
-        }
-        *main = Lcg::new(r);
-        (self.pc, self.ps, self.acc) = (pc, ps, acc);
-    }
-
-    /// Quantises the velocities in `ring`, advances X and stores ΔΔX in `out`.
-    #[inline(never)]
-    fn store<S: Sample>(&mut self, out: &mut [S], ring: &[Tap], shift: u32) {
-        let Self {
-            mut residue,
-            mut x,
-            mut v_prev,
-            ..
-        } = *self;
-        for (o, tap) in out.iter_mut().zip(ring) {
-            let r = tap.v + residue;
-            let v = r >> shift;
-            residue = r - (v << shift);
-            if (v ^ v_prev) < 0 {
-                // ΔX changes sign: X (before this sample) is a local extreme.
-                self.lo = self.lo.min(x);
-                self.hi = self.hi.max(x);
+            let v = acc - (tc * pc + ts * ps) + residue;
+            residue = v & mask;
+            v >> shift
+        };
+        let mut samples = out.iter_mut().zip(ring.iter_mut());
+        'sweep: loop {
+            if rising {
+                loop {
+                    let Some((o, tap)) = samples.next() else {
+                        break 'sweep;
+                    };
+                    let v = step(tap, &mut r);
+                    if v < 0 {
+                        // X (before this sample) is a local maximum.
+                        self.hi = self.hi.max(x);
+                        x += v;
+                        *o = S::from_scratch(x as i16);
+                        rising = false;
+                        break;
+                    }
+                    x += v;
+                    *o = S::from_scratch(x as i16);
+                }
+            } else {
+                loop {
+                    let Some((o, tap)) = samples.next() else {
+                        break 'sweep;
+                    };
+                    let v = step(tap, &mut r);
+                    if v >= 0 {
+                        // X (before this sample) is a local minimum.
+                        self.lo = self.lo.min(x);
+                        x += v;
+                        *o = S::from_scratch(x as i16);
+                        rising = true;
+                        break;
+                    }
+                    x += v;
+                    *o = S::from_scratch(x as i16);
+                }
             }
-            *o = S::from_scratch((v - v_prev) as i16);
-            x += v;
-            v_prev = v;
         }
-        (self.residue, self.x, self.v_prev) = (residue, x, v_prev);
+        (self.pc, self.ps, self.acc) = (pc, ps, acc);
+        (self.residue, self.x, self.rising) = (residue, x, rising);
+        r
     }
 
     /// Includes the current X in the extremes (the sweep's end).
@@ -533,29 +607,31 @@ fn trace_scale(shift: u32, qq: i32, w: usize) -> f32 {
     (1u64 << shift) as f32 / (qq as f32 * w as f32)
 }
 
-/// Walks the stored loop from index 0 (where X = ΔX = `v0`), rebuilding X
-/// from the stored ΔΔX, and returns the first index where X crosses `level`
-/// — the sample nearer the level — with X there. A closed loop that spans the
-/// level always crosses it.
-fn first_crossing<S: Sample>(acc: &[S], v0: i32, level: i32) -> (usize, i32) {
-    let (mut x, mut v) = (v0, v0);
-    for (i, a) in acc.iter().enumerate().skip(1) {
-        v += i32::from(a.to_scratch());
-        let next = x + v;
-        let (dp, dc) = (x - level, next - level);
+/// Walks the stored loop X from index 0 and returns the first index where
+/// it crosses `level` — the sample nearer the level — with X there, both as
+/// offsets from the lowest sample `low` (exact in `u16`). A closed loop that
+/// spans the level always crosses it.
+fn first_crossing<S: Sample>(xs: &[S], low: i16, level: i32) -> (usize, i32) {
+    let diff = |s: &S| i32::from(s.to_scratch().wrapping_sub(low) as u16) - level;
+    let Some(first) = xs.first() else {
+        return (0, level);
+    };
+    let mut dp = diff(first);
+    for (i, s) in xs.iter().enumerate().skip(1) {
+        let dc = diff(s);
         if dp == 0 {
-            return (i - 1, x);
+            return (i - 1, level);
         }
         if dc == 0 || (dc ^ dp) < 0 {
             return if dc.abs() <= dp.abs() {
-                (i, next)
+                (i, level + dc)
             } else {
-                (i - 1, x)
+                (i - 1, level + dp)
             };
         }
-        x = next;
+        dp = dc;
     }
-    (0, v0)
+    (0, level + diff(first))
 }
 
 /// `num/den` (fine units per X unit) as a multiplier `m / 2^shift`, rounded
@@ -621,7 +697,7 @@ fn paper<S: Sample, T: Trace>(
     cfg: &AxisConfig,
     kernel: &HannKernel,
     trace: &mut T,
-) -> Result<LoopInfo, MotionError> {
+) -> Result<(LoopInfo, LoopScale), MotionError> {
     let n = out.len();
     let w = usize::from(cfg.window);
     let table = kernel.table();
@@ -725,12 +801,24 @@ fn paper<S: Sample, T: Trace>(
         .filter(|(_, p)| sign(&p[1]) != sign(&p[0]))
         .nth(pick)
         .map_or(0, |(i, _)| i);
-    Ok(LoopInfo {
+    let info = LoopInfo {
         split: split as u16,
         start: split as u16,
         crossings: crossings as u16,
         up_steps: ones as u16,
-    })
+    };
+    Ok((info, LoopScale::MDEG))
+}
+
+/// Maps samples stored with `scale` to the storage's own units
+/// ([`LoopScale::MDEG`] afterwards); nothing to do if they are already.
+pub(super) fn finalise<S: Sample>(out: &mut [S], scale: &LoopScale) {
+    if *scale == LoopScale::MDEG {
+        return;
+    }
+    for o in out {
+        *o = S::from_fine(scale.fine(o.to_scratch()));
+    }
 }
 
 #[inline]

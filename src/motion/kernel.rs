@@ -29,7 +29,7 @@ pub struct HannKernel {
 }
 
 /// Integer square root (floor), for the table scale.
-const fn isqrt(v: u32) -> u32 {
+pub(super) const fn isqrt(v: u32) -> u32 {
     let mut lo = 0u32;
     let mut hi = 1u32 << 16;
     while hi - lo > 1 {
