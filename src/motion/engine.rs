@@ -21,14 +21,22 @@
 //! result from the real-valued Hann smoothing; `host-tests` measures it against
 //! a direct-form f64 convolution.
 //!
-//! # Storage between passes
+//! # What the buffer holds
 //!
-//! The smoothed velocity V is quantised to the step 2^shift (see [`x_shift`])
-//! by an error-feedback quantiser, so the integral X of the quantised velocity
-//! equals ⌊(exact integral)/2^shift⌋ at every sample: no drift. The output
-//! buffer itself holds the *second difference* ΔΔX as `i16` between passes
-//! (the smoothed walk's acceleration is small), and the scaling pass
-//! integrates it twice. No scratch memory beyond the output buffer.
+//! The smoothed velocity V is quantised to a step 2^shift by an
+//! error-feedback quantiser, so the integral X of the quantised velocity
+//! equals ⌊(exact integral)/2^shift⌋ at every sample: no drift.
+//!
+//! - Seamless closure: the buffer receives X itself, wrapping in 16 bits,
+//!   with a step ([`raw_shift`]) that makes a typical loop span 2¹⁵..2¹⁶
+//!   units (a wider one is quantised again); a [`LoopScale`] maps it to
+//!   angles about the loop's start. [`Q16`](super::Q16) storage keeps it as
+//!   it is: no pass after the sweep touches every sample.
+//! - Paper closure (taper and split need the angles): the buffer holds the
+//!   *second difference* ΔΔX as `i16` (see [`x_shift`]) and a scaling pass
+//!   integrates it twice into angles.
+//!
+//! No scratch memory beyond the output buffer and the W-tap ring.
 //!
 //! # Magnitudes (all fit `i32`)
 //!
@@ -38,15 +46,17 @@
 //! - `V = Q²·Bb − cp` = 2Q²·Σ h·b ∈ [0, Q²W] up to rounding, |V| < 2³⁰;
 //! - `V − q` with the detrend q ≤ Q²W, plus the quantiser's residue: < 2³¹;
 //! - ΔX = (V − q)/2^shift with 2^shift ≥ 2N, so |X| < 2³⁰ over the loop;
-//! - |ΔΔX| < 2¹⁴ (see [`x_shift`]), stored as `i16`;
-//! - the scaling pass forms ΔX·m with m sized by the largest |ΔX|: < 2³¹.
+//! - seamless: 2^shift ≥ 2¹⁵, so |ΔX| < 2¹⁵ and neighbouring samples differ
+//!   by an exact `i16`; the scale multiplies offsets < 2¹⁶ by m < 2¹⁵;
+//! - paper: |ΔΔX| < 2¹⁴ (see [`x_shift`]), stored as `i16`; the scaling pass
+//!   forms ΔX·m with m sized by the largest |ΔX|: < 2³¹.
 //!
 //! # Closing the seamless loop exactly
 //!
 //! The detrend q is the loop's total Σ V divided by N. The zero-sum table makes
 //! that total Q²·W·(up steps) exactly, except for the windows that wrap around
 //! the loop's end, whose steps are seen at table phases shifted by N mod W;
-//! `WrapCorrection` computes their share E exactly in O(W). With q =
+//! [`initial_window`] computes their share E exactly in O(W). With q =
 //! ⌊(Q²·W·ups − E)/N⌋ the remainder is below N < 2^shift, so the quantised
 //! integral returns exactly to its start.
 
@@ -214,25 +224,13 @@ fn seamless<S: Sample, T: Trace>(
     // Pass 1: count the up-steps of the whole circular walk.
     let ones = count_ups(cfg.seed, n);
     // Initial window: k = 0..W−1, output index W−1. The same steps give the
-    // wrap correction E (see `WrapCorrection`) and fill the tap ring.
+    // wrap correction E (see `initial_window`) and fill the tap ring.
     let mut main = Lcg::new(cfg.seed);
-    let (mut pc, mut ps, mut bb) = (0i32, 0i32, 0i32);
-    let mut wrap = WrapCorrection::new(table, n);
-    // A heapless vector: stack storage without clearing 6 KiB per axis.
+    // A heapless vector: stack storage without clearing 4 KiB per axis.
     let mut ring: heapless::Vec<Tap, { MAX_WINDOW as usize }> = heapless::Vec::new();
-    for &(tc, ts) in table {
-        let up = main.next_value() as i32 >> 31;
-        // Cannot fail: the table has at most MAX_WINDOW entries.
-        let _ = ring.push(Tap::new((tc, ts), up));
-        if up != 0 {
-            pc += i32::from(tc);
-            ps += i32::from(ts);
-            bb += qq;
-        }
-        wrap.step(up != 0);
-    }
+    let (pc, ps, bb, wrap_sum) = initial_window(table, n, &mut main, qq, &mut ring);
     let taps = ring.as_mut_slice();
-    let total = i64::from(qq) * w as i64 * i64::from(ones) - wrap.sum;
+    let total = i64::from(qq * w as i32) * i64::from(ones) - wrap_sum;
     let detrend = total.div_euclid(n as i64) as i32;
 
     // Pass 2: slide the window around the loop, storing X in generation
@@ -352,10 +350,18 @@ fn raw_shift(qq: i32, w: usize, n: usize) -> u32 {
 /// Pass 1: the number of up-steps among the first `n` steps of the walk.
 #[inline(never)]
 fn count_ups(seed: u32, n: usize) -> u32 {
-    let mut g = Lcg::new(seed);
+    let mut r = seed;
     let mut ones: u32 = 0;
-    for _ in 0..n {
-        ones += g.next_step_bit();
+    let mut next = || {
+        r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
+        r >> 31
+    };
+    // Four steps a turn: the loop's own count and branch cost a quarter.
+    for _ in 0..n / 4 {
+        ones += next() + next() + next() + next();
+    }
+    for _ in 0..n % 4 {
+        ones += next();
     }
     ones
 }
@@ -389,6 +395,8 @@ struct Tap {
     /// (Q·cos, Q·sin) packed as `cos | sin << 16`: one load on ARMv6-M.
     cs: u32,
     up: i32,
+    /// Scratch: the velocity V − q of the tap's latest sample.
+    v: i32,
 }
 
 impl Tap {
@@ -396,6 +404,7 @@ impl Tap {
         Self {
             cs: (c as u16 as u32) | ((s as u16 as u32) << 16),
             up,
+            v: 0,
         }
     }
 }
@@ -444,25 +453,28 @@ impl Sweep {
         *main = Lcg::new(r);
     }
 
-    /// One stretch of taps: slides the window, quantises V − q, advances X
-    /// and stores it. Two loops, one while X rises and one while it falls,
-    /// so that the slope's sign is where the code is, not a register.
-    #[inline(never)]
+    /// One stretch of taps: slides the window ([`Sweep::slide`]), then
+    /// quantises V − q, advances X and stores it ([`Sweep::store`]).
     fn stretch<S: Sample>(
         &mut self,
         out: &mut [S],
         ring: &mut [Tap],
-        mut r: u32,
+        r: u32,
         qq: i32,
         shift: u32,
     ) -> u32 {
-        let mask = (1i32 << shift) - 1;
+        let r = self.slide(ring, r, qq);
+        self.store(out, ring, shift);
+        r
+    }
+
+    /// Slides the window over `ring`, leaving each sample's V − q in its tap.
+    #[inline(never)]
+    fn slide(&mut self, ring: &mut [Tap], mut r: u32, qq: i32) -> u32 {
         let (mut pc, mut ps, mut acc) = (self.pc, self.ps, self.acc);
-        let (mut residue, mut x) = (self.residue, self.x);
-        let mut rising = self.rising;
-        let mut step = |tap: &mut Tap, r: &mut u32| -> i32 {
-            *r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
-            let enter = *r as i32 >> 31;
+        for tap in ring {
+            r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
+            let enter = r as i32 >> 31;
             let d = tap.up - enter; // +1: an up-step enters, a down-step leaves
             tap.up = enter;
             let (tc, ts) = ((tap.cs as i32) << 16 >> 16, tap.cs as i32 >> 16);
@@ -477,18 +489,30 @@ impl Sweep {
                     acc -= qq;
                 }
             }
-            let v = acc - (tc * pc + ts * ps) + residue;
-            residue = v & mask;
-            v >> shift
-        };
-        let mut samples = out.iter_mut().zip(ring.iter_mut());
+            tap.v = acc - (tc * pc + ts * ps);
+        }
+        (self.pc, self.ps, self.acc) = (pc, ps, acc);
+        r
+    }
+
+    /// Quantises the velocities in `ring`, advances X and stores it in
+    /// `out`. Two loops, one while X rises and one while it falls, so that
+    /// the slope's sign is where the code is, not a register.
+    #[inline(never)]
+    fn store<S: Sample>(&mut self, out: &mut [S], ring: &[Tap], shift: u32) {
+        let mask = (1i32 << shift) - 1;
+        let (mut residue, mut x) = (self.residue, self.x);
+        let mut rising = self.rising;
+        let mut samples = out.iter_mut().zip(ring);
         'sweep: loop {
             if rising {
                 loop {
                     let Some((o, tap)) = samples.next() else {
                         break 'sweep;
                     };
-                    let v = step(tap, &mut r);
+                    let v = tap.v + residue;
+                    residue = v & mask;
+                    let v = v >> shift;
                     if v < 0 {
                         // X (before this sample) is a local maximum.
                         self.hi = self.hi.max(x);
@@ -505,7 +529,9 @@ impl Sweep {
                     let Some((o, tap)) = samples.next() else {
                         break 'sweep;
                     };
-                    let v = step(tap, &mut r);
+                    let v = tap.v + residue;
+                    residue = v & mask;
+                    let v = v >> shift;
                     if v >= 0 {
                         // X (before this sample) is a local minimum.
                         self.lo = self.lo.min(x);
@@ -519,9 +545,7 @@ impl Sweep {
                 }
             }
         }
-        (self.pc, self.ps, self.acc) = (pc, ps, acc);
         (self.residue, self.x, self.rising) = (residue, x, rising);
-        r
     }
 
     /// Includes the current X in the extremes (the sweep's end).
@@ -531,6 +555,11 @@ impl Sweep {
     }
 }
 
+/// Fills the tap ring with the initial window (steps k = 0..W−1, drawn from
+/// `main`) and returns its sums Pb꜀, Pbₛ, Q²·Bb and the wrap correction E.
+///
+/// ## The wrap correction E
+///
 /// The part of Σₙ cp(n) that the zero-sum table does not cancel.
 ///
 /// Over the circular sweep (outputs n = W−1..N+W−2) each absolute step index
@@ -547,58 +576,65 @@ impl Sweep {
 ///
 /// (products of 2-vectors are dot products). |S| ≤ Q·W/π + 2Q, so each
 /// product stays below Q²·W/π < 2²⁹; E is summed in `i64`. O(W), once per axis.
-struct WrapCorrection<'t> {
-    table: &'t [(i16, i16)],
-    /// The next early step's index k (only k < W−1 contribute).
-    k: usize,
-    /// (k + N) mod W: the table entry of the step's late copy.
-    late: usize,
-    sa: (i32, i32),
-    sb: (i32, i32),
-    sum: i64,
+///
+/// [`initial_window`] sums it while it fills the window.
+#[inline(never)] // a function of its own: registers of its own
+fn initial_window(
+    table: &[(i16, i16)],
+    n: usize,
+    main: &mut Lcg,
+    qq: i32,
+    ring: &mut heapless::Vec<Tap, { MAX_WINDOW as usize }>,
+) -> (i32, i32, i32, i64) {
+    let w = table.len();
+    // The window's steps and sums.
+    let (mut pc, mut ps, mut bb) = (0i32, 0i32, 0i32);
+    let mut r = main.value();
+    for &e in table {
+        r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
+        let up = r as i32 >> 31;
+        if up != 0 {
+            pc += i32::from(e.0);
+            ps += i32::from(e.1);
+            bb += qq;
+        }
+        // Cannot fail: the table has at most MAX_WINDOW entries.
+        let _ = ring.push(Tap::new(e, up));
+    }
+    *main = Lcg::new(r);
+    // E: the early copies at phases k, then the late ones at (k + N) mod W
+    // (the table from N mod W on, then from 0), for the first W − 1 steps.
+    let early = ring.get(..w - 1).unwrap_or_default();
+    let (late_b, late_a) = table.split_at(n % w);
+    let start_a = table.last().copied().unwrap_or_default();
+    let start_b = table.get((n + w - 1) % w).copied().unwrap_or_default();
+    let sum = wrap_part(early, table, start_a, 1)
+        + wrap_part(early, late_a.iter().chain(late_b), start_b, -1);
+    (pc, ps, bb, sum)
 }
 
-impl<'t> WrapCorrection<'t> {
-    fn new(table: &'t [(i16, i16)], n: usize) -> Self {
-        let w = table.len().max(1);
-        let entry = |i: usize| {
-            table
-                .get(i)
-                .map_or((0, 0), |&(c, s)| (i32::from(c), i32::from(s)))
-        };
-        let (c_last, s_last) = entry(w - 1);
-        let (c_before, s_before) = entry((n + w - 1) % w); // (N−1) mod W
-        Self {
-            table,
-            k: 0,
-            late: n % w,
-            sa: (c_last, s_last),
-            sb: (-c_before, -s_before),
-            sum: 0,
+/// One half of E: Σ over the up-steps k of `taps` of T(k)·S(k), with T(k) the
+/// k-th entry of `phases` and S(k) the running sum that starts at
+/// `sign`·`start` and moves by `sign`·T(k) after each step (SA and SB of the
+/// derivation, SB with the sign folded in: SB = −Σ).
+fn wrap_part<'t>(
+    taps: &[Tap],
+    phases: impl IntoIterator<Item = &'t (i16, i16)>,
+    start: (i16, i16),
+    sign: i32,
+) -> i64 {
+    let (mut sc, mut ss) = (sign * i32::from(start.0), sign * i32::from(start.1));
+    let mut sum = 0i64;
+    for (tap, &(c, s)) in taps.iter().zip(phases) {
+        let (c, s) = (i32::from(c), i32::from(s));
+        if tap.up != 0 {
+            // |T·S| < Q²·W/π < 2²⁹.
+            sum += i64::from(c * sc + s * ss);
         }
+        sc += sign * c;
+        ss += sign * s;
     }
-
-    /// Takes the next step (up or down) of the initial window.
-    fn step(&mut self, up: bool) {
-        let (Some(&(ec, es)), Some(&(lc, ls))) =
-            (self.table.get(self.k), self.table.get(self.late))
-        else {
-            return;
-        };
-        let (ec, es, lc, ls) = (i32::from(ec), i32::from(es), i32::from(lc), i32::from(ls));
-        if up && self.k + 1 < self.table.len() {
-            let early = ec * self.sa.0 + es * self.sa.1;
-            let late = lc * self.sb.0 + ls * self.sb.1;
-            self.sum += i64::from(early) + i64::from(late);
-        }
-        self.sa = (self.sa.0 + ec, self.sa.1 + es);
-        self.sb = (self.sb.0 - lc, self.sb.1 - ls);
-        self.k += 1;
-        self.late += 1;
-        if self.late == self.table.len() {
-            self.late = 0;
-        }
-    }
+    sum
 }
 
 /// Converts the integral X to walk steps δ for [`Trace::smoothed`]
@@ -612,26 +648,26 @@ fn trace_scale(shift: u32, qq: i32, w: usize) -> f32 {
 /// offsets from the lowest sample `low` (exact in `u16`). A closed loop that
 /// spans the level always crosses it.
 fn first_crossing<S: Sample>(xs: &[S], low: i16, level: i32) -> (usize, i32) {
-    let diff = |s: &S| i32::from(s.to_scratch().wrapping_sub(low) as u16) - level;
-    let Some(first) = xs.first() else {
+    let at = |s: &S| i32::from(s.to_scratch().wrapping_sub(low) as u16);
+    let Some(&first) = xs.first() else {
         return (0, level);
     };
-    let mut dp = diff(first);
-    for (i, s) in xs.iter().enumerate().skip(1) {
-        let dc = diff(s);
-        if dp == 0 {
-            return (i - 1, level);
-        }
-        if dc == 0 || (dc ^ dp) < 0 {
-            return if dc.abs() <= dp.abs() {
-                (i, level + dc)
-            } else {
-                (i - 1, level + dp)
-            };
-        }
-        dp = dc;
+    let x0 = at(&first);
+    // Every sample before the crossing lies on the start's side.
+    let found = match x0.cmp(&level) {
+        core::cmp::Ordering::Greater => xs.iter().position(|s| at(s) <= level),
+        core::cmp::Ordering::Less => xs.iter().position(|s| at(s) >= level),
+        core::cmp::Ordering::Equal => return (0, level),
+    };
+    let (Some(i), Some(prev)) = (found, found.and_then(|i| xs.get(i.wrapping_sub(1)))) else {
+        return (0, x0);
+    };
+    let (xc, xp) = (at(&xs[i]), at(prev));
+    if (xc - level).abs() <= (xp - level).abs() {
+        (i, xc)
+    } else {
+        (i - 1, xp)
     }
-    (0, level + diff(first))
 }
 
 /// `num/den` (fine units per X unit) as a multiplier `m / 2^shift`, rounded
@@ -645,8 +681,10 @@ fn multiplier(num: i64, den: i64, vmax: i64) -> Option<(i32, u32)> {
     let m_max = ((1u64 << 30) / vmax as u64).max(1);
     // ratio · 2³⁰, exact floor (num < 2²⁴): one division.
     let r = ((num as u64) << 30) / den as u64;
-    let mut drop = 0u32;
-    while drop < 64 && (r >> drop) > m_max {
+    // The fewest dropped bits that bring r to m_max or below: r's length
+    // less m_max's, or one more.
+    let mut drop = (64 - r.leading_zeros()).saturating_sub(64 - m_max.leading_zeros());
+    if r.checked_shr(drop).unwrap_or(0) > m_max {
         drop += 1;
     }
     let m = r.checked_shr(drop).unwrap_or(0);

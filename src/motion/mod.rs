@@ -630,10 +630,9 @@ impl<S: Sample, const N: usize> HeadTrajectories<S, N> {
     pub fn generate(&mut self, cfg: &HeadConfig) -> Result<[LoopInfo; 3], AxisError> {
         cfg.validate(N)?;
         let mut infos = [LoopInfo::default(); 3];
-        let mut kernel = HannKernel::new(cfg.pitch.window).map_err(|error| AxisError {
-            axis: Axis::Pitch,
-            error,
-        })?;
+        // Built in place, axis by axis (a window equal to the last one's is
+        // kept as it is).
+        let mut kernel = HannKernel::empty();
         for axis in Axis::ALL {
             let c = cfg.axis(axis);
             kernel
