@@ -445,7 +445,8 @@ pub struct Trajectory<S: Sample, const N: usize> {
     samples: [S; N],
     /// Where playback starts in `samples` (the loop is stored as a ring).
     start: u16,
-    /// How `samples` map to angles ([`LoopScale::MDEG`] unless `S` is [`Q16`]).
+    /// How `samples` map to angles: [`LoopScale::NEUTRAL`] before a loop is
+    /// generated, the loop's own scale for [`Q16`], else [`LoopScale::MDEG`].
     scale: LoopScale,
 }
 
@@ -465,7 +466,7 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
         Self {
             samples: [S::ZERO; N],
             start: 0,
-            scale: LoopScale::MDEG,
+            scale: LoopScale::NEUTRAL,
         }
     }
 
@@ -497,7 +498,7 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
     ) -> Result<LoopInfo, MotionError> {
         // Validate, generate and keep the ring as computed: no rotation.
         self.start = 0;
-        self.scale = LoopScale::MDEG;
+        self.scale = LoopScale::NEUTRAL;
         let result = cfg
             .validate(axis, N)
             .and_then(|()| engine::generate(&mut self.samples, cfg, kernel, trace));
@@ -508,6 +509,7 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
                     self.scale = scale;
                 } else {
                     engine::finalise(&mut self.samples, &scale);
+                    self.scale = LoopScale::MDEG;
                 }
                 Ok(info)
             }
@@ -531,7 +533,8 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
     }
 
     /// How [`Trajectory::samples`] map to angles: the loop's own scale for
-    /// [`Q16`], [`LoopScale::MDEG`] for the other storages.
+    /// [`Q16`], [`LoopScale::MDEG`] for the other storages
+    /// ([`LoopScale::NEUTRAL`] until a loop is generated).
     #[must_use]
     pub const fn scale(&self) -> &LoopScale {
         &self.scale

@@ -89,6 +89,16 @@ pub struct LoopScale {
 }
 
 impl LoopScale {
+    /// Every raw value maps to 0 (the neutral pose): the scale of a loop not
+    /// generated yet. All bits zero, so a `static` trajectory stays in
+    /// `.bss` and costs no flash.
+    pub const NEUTRAL: Self = Self {
+        low: 0,
+        m: 0,
+        shift: 0,
+        offset: 0,
+    };
+
     /// Raw units are millidegrees: fine = raw · 256 (the finalised
     /// storages): (raw + 2¹⁵)·256 − 2¹⁵·256.
     pub const MDEG: Self = Self {
