@@ -194,3 +194,35 @@ fn wrong_kernel_is_rejected_not_misused() {
     let mut buf = vec![Mdeg16(0); 900];
     assert!(generate_into(&mut buf, &cfg, Axis::Yaw, &kernel, &mut ()).is_err());
 }
+
+/// The firmware's storage: `Q16` with its loop scale reads exactly the
+/// angles that `Mdeg16` stores, and a fresh trajectory reads neutral.
+#[test]
+fn q16_reads_the_mdeg16_angles() {
+    use idle_head::motion::{LoopScale, Q16, Trajectory};
+    let fresh: Trajectory<Q16, 900> = Trajectory::new();
+    assert_eq!(*fresh.scale(), LoopScale::NEUTRAL);
+    assert!((0..900).all(|i| fresh.angle(i).millidegrees() == 0));
+    for seed in 0..200u32 {
+        let seed = seed.wrapping_mul(2_654_435_761);
+        for closure in [Closure::Seamless, Closure::Paper] {
+            let cfg = AxisConfig::paper_row(seed, 59, -4, 12).with_closure(closure);
+            let kernel = HannKernel::new(59).unwrap();
+            let mut q = Box::new(Trajectory::<Q16, 900>::new());
+            let mut m = Box::new(Trajectory::<Mdeg16, 900>::new());
+            let iq = q.generate(&cfg, Axis::Pitch, &kernel).unwrap();
+            let im = m.generate(&cfg, Axis::Pitch, &kernel).unwrap();
+            assert_eq!(iq, im);
+            if closure == Closure::Seamless {
+                assert_eq!(q.angle(0).millidegrees(), 0, "seed {seed}");
+            }
+            for (i, s) in m.playback().enumerate() {
+                assert_eq!(
+                    q.angle(i).millidegrees(),
+                    i32::from(s.0),
+                    "seed {seed} sample {i}"
+                );
+            }
+        }
+    }
+}

@@ -26,7 +26,7 @@ mod systick;
 
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
-use idle_head::motion::{DEFAULT_HEAD, HeadConfig, HeadTrajectories, Lcg, Mdeg16};
+use idle_head::motion::{DEFAULT_HEAD, HeadConfig, HeadTrajectories, Lcg, Q16};
 
 /// One row of the table: label, N, W.
 struct Row {
@@ -73,9 +73,9 @@ const ROWS: [Row; 7] = [
     },
 ];
 
-static mut H450: HeadTrajectories<Mdeg16, 450> = HeadTrajectories::new();
-static mut H900: HeadTrajectories<Mdeg16, 900> = HeadTrajectories::new();
-static mut H1800: HeadTrajectories<Mdeg16, 1800> = HeadTrajectories::new();
+static mut H450: HeadTrajectories<Q16, 450> = HeadTrajectories::new();
+static mut H900: HeadTrajectories<Q16, 900> = HeadTrajectories::new();
+static mut H1800: HeadTrajectories<Q16, 1800> = HeadTrajectories::new();
 static mut WALK: [f32; 1800] = [0.0; 1800];
 static mut SMOOTH: [f32; 1800] = [0.0; 1800];
 static mut HANN: [f32; 512] = [0.0; 512];

@@ -49,7 +49,7 @@ use embassy_time::Instant;
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::firmware::rp2040_pwm::PICO_SERVO_CLOCK;
 use idle_head::firmware::{self, FrameLoop, LOOP_DURATION};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Mdeg16};
+use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Q16};
 use idle_head::{Axis, Microseconds, Millis, Playback};
 
 use crate::checks::Checks;
@@ -96,7 +96,7 @@ const _: () = {
     assert!(LOOP.0 * SPEEDUP == LOOP_DURATION.0);
 };
 
-type Head = HeadTrajectories<Mdeg16, DEFAULT_N>;
+type Head = HeadTrajectories<Q16, DEFAULT_N>;
 
 /// The three loops: 3 · 900 · 2 B = 5400 B, generated once at boot.
 static mut HEAD: Head = Head::new();

@@ -33,7 +33,7 @@ use core::hint::black_box;
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::firmware::{FrameLoop, LOOP_DURATION};
-use idle_head::motion::{DEFAULT_N, HeadTrajectories, Mdeg16};
+use idle_head::motion::{DEFAULT_N, HeadTrajectories, Q16};
 use idle_head::{Axis, Playback};
 
 const PARAMS: DriverParams = match DriverConfig::DEFAULT.build() {
@@ -47,7 +47,7 @@ const PLAYBACK: Playback =
     };
 
 /// Loops with unknown contents (the optimiser sees them through `black_box`).
-static HEAD: HeadTrajectories<Mdeg16, DEFAULT_N> = HeadTrajectories::new();
+static HEAD: HeadTrajectories<Q16, DEFAULT_N> = HeadTrajectories::new();
 
 /// A PWM channel whose maximum duty and write results are unknown.
 struct OpaquePwm;

@@ -21,14 +21,22 @@
 //! result from the real-valued Hann smoothing; `host-tests` measures it against
 //! a direct-form f64 convolution.
 //!
-//! # Storage between passes
+//! # What the buffer holds
 //!
-//! The smoothed velocity V is quantised to the step 2^shift (see [`x_shift`])
-//! by an error-feedback quantiser, so the integral X of the quantised velocity
-//! equals ⌊(exact integral)/2^shift⌋ at every sample: no drift. The output
-//! buffer itself holds the *second difference* ΔΔX as `i16` between passes
-//! (the smoothed walk's acceleration is small), and the scaling pass
-//! integrates it twice. No scratch memory beyond the output buffer.
+//! The smoothed velocity V is quantised to a step 2^shift by an
+//! error-feedback quantiser, so the integral X of the quantised velocity
+//! equals ⌊(exact integral)/2^shift⌋ at every sample: no drift.
+//!
+//! - Seamless closure: the buffer receives X itself, wrapping in 16 bits,
+//!   with a step ([`raw_shift`]) that makes a typical loop span 2¹⁵..2¹⁶
+//!   units (a wider one is quantised again); a [`LoopScale`] maps it to
+//!   angles about the loop's start. [`Q16`](super::Q16) storage keeps it as
+//!   it is: no pass after the sweep touches every sample.
+//! - Paper closure (taper and split need the angles): the buffer holds the
+//!   *second difference* ΔΔX as `i16` (see [`x_shift`]) and a scaling pass
+//!   integrates it twice into angles.
+//!
+//! No scratch memory beyond the output buffer and the W-tap ring.
 //!
 //! # Magnitudes (all fit `i32`)
 //!
@@ -38,15 +46,17 @@
 //! - `V = Q²·Bb − cp` = 2Q²·Σ h·b ∈ [0, Q²W] up to rounding, |V| < 2³⁰;
 //! - `V − q` with the detrend q ≤ Q²W, plus the quantiser's residue: < 2³¹;
 //! - ΔX = (V − q)/2^shift with 2^shift ≥ 2N, so |X| < 2³⁰ over the loop;
-//! - |ΔΔX| < 2¹⁴ (see [`x_shift`]), stored as `i16`;
-//! - the scaling pass forms ΔX·m with m sized by the largest |ΔX|: < 2³¹.
+//! - seamless: 2^shift ≥ 2¹⁵, so |ΔX| < 2¹⁵ and neighbouring samples differ
+//!   by an exact `i16`; the scale multiplies offsets < 2¹⁶ by m < 2¹⁵;
+//! - paper: |ΔΔX| < 2¹⁴ (see [`x_shift`]), stored as `i16`; the scaling pass
+//!   forms ΔX·m with m sized by the largest |ΔX|: < 2³¹.
 //!
 //! # Closing the seamless loop exactly
 //!
 //! The detrend q is the loop's total Σ V divided by N. The zero-sum table makes
 //! that total Q²·W·(up steps) exactly, except for the windows that wrap around
 //! the loop's end, whose steps are seen at table phases shifted by N mod W;
-//! `WrapCorrection` computes their share E exactly in O(W). With q =
+//! [`initial_window`] computes their share E exactly in O(W). With q =
 //! ⌊(Q²·W·ups − E)/N⌋ the remainder is below N < 2^shift, so the quantised
 //! integral returns exactly to its start.
 
@@ -54,7 +64,7 @@
 
 use super::kernel::{HannKernel, MAX_WINDOW};
 use super::lcg::Lcg;
-use super::storage::{FINE_PER_MDEG, Sample};
+use super::storage::{FINE_PER_MDEG, LoopScale, Sample};
 use super::{AxisConfig, Closure, MotionError};
 
 /// Smallest extent of the smoothed integral (in `X` units) that is scaled;
@@ -115,13 +125,14 @@ impl Trace for () {
     const ENABLED: bool = false;
 }
 
-/// Runs the pipeline for one axis into `out` (length N, validated by the caller).
+/// Runs the pipeline for one axis into `out` (length N, validated by the
+/// caller); the samples map to angles with the returned scale.
 pub(super) fn generate<S: Sample, T: Trace>(
     out: &mut [S],
     cfg: &AxisConfig,
     kernel: &HannKernel,
     trace: &mut T,
-) -> Result<LoopInfo, MotionError> {
+) -> Result<(LoopInfo, LoopScale), MotionError> {
     if kernel.window() != cfg.window || out.len() < 2 * usize::from(cfg.window) {
         // Callers validate first; this keeps the function total on its own.
         return Err(MotionError::WindowTooLarge {
@@ -192,67 +203,57 @@ impl Quantiser {
 /// its mean step D/N makes the walk periodic; the detrend is applied to the
 /// smoothed velocity, where it is the constant q = Q²·W·(up steps)/N. The
 /// window for output n covers k = n−W+1..n taken modulo N.
+///
+/// The buffer receives the quantised integral X itself (wrapping `i16`, see
+/// [`raw_shift`]); the returned [`LoopScale`] maps it to angles about the
+/// loop's start.
 #[allow(clippy::too_many_lines)] // one pass after another, each commented
 fn seamless<S: Sample, T: Trace>(
     out: &mut [S],
     cfg: &AxisConfig,
     kernel: &HannKernel,
     trace: &mut T,
-) -> Result<LoopInfo, MotionError> {
+) -> Result<(LoopInfo, LoopScale), MotionError> {
     let n = out.len();
     let w = usize::from(cfg.window);
     let table = kernel.table();
     let q = kernel.scale();
     let qq = q * q;
-    let shift = x_shift(q, w, n);
+    let shift = raw_shift(qq, w, n);
 
     // Pass 1: count the up-steps of the whole circular walk.
-    let mut g = Lcg::new(cfg.seed);
-    let mut ones: u32 = 0;
-    for _ in 0..n {
-        ones += g.next_step_bit();
-    }
+    let ones = count_ups(cfg.seed, n);
     // Initial window: k = 0..W−1, output index W−1. The same steps give the
-    // wrap correction E (see `WrapCorrection`) and fill the tap ring.
+    // wrap correction E (see `initial_window`) and fill the tap ring.
     let mut main = Lcg::new(cfg.seed);
-    let (mut pc, mut ps, mut bb) = (0i32, 0i32, 0i32);
-    let mut wrap = WrapCorrection::new(table, n);
-    // A heapless vector: stack storage without clearing 6 KiB per axis.
+    // A heapless vector: stack storage without clearing 4 KiB per axis.
     let mut ring: heapless::Vec<Tap, { MAX_WINDOW as usize }> = heapless::Vec::new();
-    for &(tc, ts) in table {
-        let up = main.next_value() as i32 >> 31;
-        // Cannot fail: the table has at most MAX_WINDOW entries.
-        let _ = ring.push(Tap::new((tc, ts), up));
-        if up != 0 {
-            pc += i32::from(tc);
-            ps += i32::from(ts);
-            bb += qq;
-        }
-        wrap.step(up != 0);
-    }
+    let (pc, ps, bb, wrap_sum) = initial_window(table, n, &mut main, qq, &mut ring);
     let taps = ring.as_mut_slice();
-    let total = i64::from(qq) * w as i64 * i64::from(ones) - wrap.sum;
+    let total = i64::from(qq * w as i32) * i64::from(ones) - wrap_sum;
     let detrend = total.div_euclid(n as i64) as i32;
-    let scale = trace_scale(shift, qq, w) * 2.0;
 
-    // Pass 2: slide the window around the loop, storing ΔΔX (see `x_shift`)
-    // in generation order: out[t] belongs to loop index (W−1+t) mod N.
+    // Pass 2: slide the window around the loop, storing X in generation
+    // order: out[t] belongs to loop index (W−1+t) mod N.
     let mut sweep = Sweep {
         pc,
         ps,
         acc: bb - detrend,
         residue: 0,
         x: 0,
-        v_prev: 0,
+        rising: true,
         lo: 0,
         hi: 0,
     };
-    // The first output, n = W−1, at residue W−1 (written as ΔΔX later).
+    // The first output, n = W−1, at residue W−1.
     let (tc, ts) = table[w - 1];
     let r = sweep.acc - (i32::from(tc) * pc + i32::from(ts) * ps);
-    let v_first = r >> shift;
-    (sweep.residue, sweep.x, sweep.v_prev) = (r - (v_first << shift), v_first, v_first);
-    (sweep.lo, sweep.hi) = (v_first, v_first);
+    let x_first = r >> shift;
+    (sweep.residue, sweep.x, sweep.rising) = (r - (x_first << shift), x_first, x_first >= 0);
+    (sweep.lo, sweep.hi) = (x_first, x_first);
+    if let Some(o) = out.first_mut() {
+        *o = S::from_scratch(x_first as i16);
+    }
     // Slides s = 1..N−1: step W−1+s enters, step s−1 leaves, both at residue
     // (s−1) mod W. When the entering index reaches N (s = N−W+1) the circular
     // walk wraps to e(0).
@@ -262,83 +263,139 @@ fn seamless<S: Sample, T: Trace>(
     let mut again = Lcg::new(cfg.seed);
     sweep.run(tail, taps, (wrap_at - 1) % w, &mut again, qq, shift);
     sweep.settle();
-    // The first output's ΔΔX refers to the last output's ΔX (cyclic).
-    if let Some(o) = out.first_mut() {
-        *o = S::from_scratch((v_first - sweep.v_prev) as i16);
+    debug_assert_eq!(sweep.x, 0, "the seamless loop closes exactly");
+    let (mut lo, mut hi, mut x0) = (sweep.lo, sweep.hi, x_first);
+    // X spans at most 65535 raw units, so that its offsets from the lowest
+    // sample are exact in `u16`; a wider loop than `raw_shift` expects is
+    // quantised again.
+    let mut step_log = shift;
+    if hi - lo > i32::from(u16::MAX) {
+        let k = requantise(out, x0, lo, hi);
+        (lo, hi, x0, step_log) = (lo >> k, hi >> k, x0 >> k, shift + k);
     }
+    let low = lo as i16;
+    let offset = |s: &S| i32::from(s.to_scratch().wrapping_sub(low) as u16);
     if T::ENABLED {
-        // Rebuild X along the loop for the observer (previews only).
-        let (mut x, mut v) = (v_first, v_first);
-        trace.smoothed(w - 1, x as f32 * scale);
-        for (t, o) in out.iter().enumerate().skip(1) {
-            v += i32::from(o.to_scratch());
-            x += v;
-            trace.smoothed((w - 1 + t) % n, x as f32 * scale);
+        // X along the loop, for the observer (previews only).
+        let scale = trace_scale(step_log, qq, w) * 2.0;
+        for (t, o) in out.iter().enumerate() {
+            trace.smoothed((w - 1 + t) % n, (lo + offset(o)) as f32 * scale);
         }
     }
-    let x = sweep.x;
-    let extent = Extent {
-        min: sweep.lo,
-        max: sweep.hi,
-    };
-    debug_assert_eq!(x, 0, "the seamless loop closes exactly");
-    let (lo, hi) = (i64::from(extent.min), i64::from(extent.max));
+    let _ = x0;
     let a1 = i64::from(cfg.range.min.millidegrees()) * i64::from(FINE_PER_MDEG);
     let a2 = i64::from(cfg.range.max.millidegrees()) * i64::from(FINE_PER_MDEG);
-    // The level that the range's zero maps to under the paper's normalisation.
-    let zero_level = lo + (-a1 * (hi - lo)) / (a2 - a1);
+    // The level that the range's zero maps to under the paper's
+    // normalisation, as an offset from the lowest sample.
+    let span = hi - lo;
+    let level = (-a1 * i64::from(span)) / (a2 - a1);
 
     // The first sample, in generation order, where the loop crosses that
     // level: playback starts there (the stored order stays a ring).
-    let (start, pivot) = first_crossing(out, v_first, zero_level as i32);
+    let (start, pivot) = first_crossing(out, low, level as i32);
     let split = (start + w - 1) % n; // as a loop index
 
     // Scale about the pivot so that it maps to exactly 0 and both extremes
-    // stay inside [α1, α2]; the tighter side reaches its bound.
-    let up = hi - i64::from(pivot);
-    let down = i64::from(pivot) - lo;
+    // stay inside [α1, α2]; the tighter side reaches its bound (less one
+    // fine unit: the offset's floor may add one).
+    let up = i64::from(span - pivot);
+    let down = i64::from(pivot);
     let (num, den) = if down == 0 || (up != 0 && a2 * down <= -a1 * up) {
-        (a2, up)
+        (a2 - 1, up)
     } else {
-        (-a1, down)
+        (-a1 - 1, down)
     };
-    // |ΔX| bound for the scaling product: V lies in [0, Q²·W] up to the
-    // table rounding (< 4·(Q+1)·W), so |V − q| ≤ max(q, Q²·W − q) + that.
-    let qqw = i64::from(qq) * w as i64;
-    let v_bound =
-        i64::from(detrend).max(qqw - i64::from(detrend)) + 4 * i64::from(q + 1) * w as i64;
-    let vmax = (v_bound >> shift) + 2;
+    // Offsets from the lowest sample are below 2¹⁶.
     let (m, mshift) =
-        multiplier(num, den, vmax).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
-
-    // Pass 3: integrate twice and scale about the pivot, in stored order.
-    let acc0 = i64::from(v_first - pivot) * i64::from(m);
-    let mask = (1i64 << mshift) - 1;
-    let start0 = (v_first, (acc0 >> mshift) as i32, (acc0 & mask) as i32);
-    scale_pass(out, start0, m, mshift, |_, fine| fine);
+        multiplier(num, den, 1 << 16).ok_or(MotionError::Degenerate { seed: cfg.seed })?;
+    let scale = LoopScale {
+        low,
+        m,
+        shift: mshift as u8,
+        offset: (pivot * m) >> mshift,
+    };
     if T::ENABLED {
         for (t, o) in out.iter().enumerate() {
-            trace.normalized((t + w - 1) % n, o.fine());
+            trace.normalized((t + w - 1) % n, scale.fine(o.to_scratch()));
         }
     }
-    Ok(LoopInfo {
+    let info = LoopInfo {
         split: split as u16,
         start: start as u16,
         crossings: 1,
         up_steps: ones as u16,
-    })
+    };
+    Ok((info, scale))
 }
 
-/// One tap of the sliding window: the kernel table entry of its residue j,
-/// the step currently in the window at that residue (0 for down, −1 for
-/// up), and scratch for the window's velocity. The step leaving the window
-/// and the one entering it share the residue, so this ring replaces a
-/// second, lagging generator.
+/// The quantisation step `2^shift` from `V` units to the stored integral X.
+///
+/// X is stored as `i16`, so its extent should stay below 2¹⁵ and use as much
+/// of it as it can. The smoothed integral is Q²·W/2 times the smoothed
+/// detrended walk (in steps δ), whose extent is about 0.9·√N for a typical
+/// seed (0.14 to 2.1·√N over many); with the step chosen so that a typical
+/// extent lands in 2¹⁵/3..2¹⁵·2/3, a loop needs quantising again
+/// ([`requantise`]) only in the upper tail. The step is at least 2¹⁵, which
+/// keeps each sample's |ΔX| below 2¹⁵ (|V − q| < 2³⁰), so differences of
+/// stored samples are exact in `i16`, and at least 2N, which makes the
+/// detrend's residue (< N) vanish in the floor: the loop closes exactly.
+fn raw_shift(qq: i32, w: usize, n: usize) -> u32 {
+    // Q²·W/2 · 0.9·√N · 3/2 ≈ Q²·W·√N·0.675; Q²·W < 2²⁹, √N < 2⁷: fits u64.
+    let typical = (qq as u64) * (w as u64) * u64::from(super::kernel::isqrt(n as u32)) * 27 / 40;
+    let by_extent = (64 - typical.leading_zeros()).saturating_sub(16);
+    let by_len = 64 - ((2 * n as u64 - 1).leading_zeros());
+    by_extent.max(by_len).max(15)
+}
+
+/// Pass 1: the number of up-steps among the first `n` steps of the walk.
+#[inline(never)]
+fn count_ups(seed: u32, n: usize) -> u32 {
+    let mut r = seed;
+    let mut ones: u32 = 0;
+    let mut next = || {
+        r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
+        r >> 31
+    };
+    // Four steps a turn: the loop's own count and branch cost a quarter.
+    for _ in 0..n / 4 {
+        ones += next() + next() + next() + next();
+    }
+    for _ in 0..n % 4 {
+        ones += next();
+    }
+    ones
+}
+
+/// Quantises the stored X again by the smallest 2^k that brings its extent
+/// [`lo`, `hi`] within 65535 units: X' = ⌊X/2^k⌋, exactly, for every sample
+/// (consecutive samples differ by less than 2¹⁵, so the ring unwraps from
+/// `x0`, the value of `out[0]`). Returns k.
+#[cold]
+fn requantise<S: Sample>(out: &mut [S], x0: i32, lo: i32, hi: i32) -> u32 {
+    let mut k = 1;
+    while (hi >> k) - (lo >> k) > i32::from(u16::MAX) {
+        k += 1;
+    }
+    let (mut x, mut prev) = (x0, x0 as i16);
+    for o in out.iter_mut() {
+        let raw = o.to_scratch();
+        x += i32::from(raw.wrapping_sub(prev));
+        prev = raw;
+        *o = S::from_scratch((x >> k) as i16);
+    }
+    k
+}
+
+/// One tap of the sliding window: the kernel table entry of its residue j
+/// and the step currently in the window at that residue (0 for down, −1 for
+/// up). The step leaving the window and the one entering it share the
+/// residue, so this ring replaces a second, lagging generator.
 #[derive(Clone, Copy)]
 struct Tap {
     /// (Q·cos, Q·sin) packed as `cos | sin << 16`: one load on ARMv6-M.
     cs: u32,
     up: i32,
+    /// Scratch: the velocity V − q of the tap's latest sample.
     v: i32,
 }
 
@@ -352,11 +409,9 @@ impl Tap {
     }
 }
 
-/// The state of the circular sweep (pass 2). Each stretch of taps is swept
-/// twice: once to slide the window and compute the velocities V − q (few
-/// values live: ARMv6-M has eight low registers), once to quantise them,
-/// store ΔΔX and track the extremes of X and ΔX — only where their slope
-/// changes sign, a few times per smoothing length.
+/// The state of the circular sweep (pass 2): the sliding sums, the
+/// quantiser and X with its extremes, tracked only where its slope changes
+/// sign (a few times per smoothing length).
 #[derive(Clone, Copy)]
 struct Sweep {
     pc: i32,
@@ -366,15 +421,15 @@ struct Sweep {
     residue: i32,
     /// X after the last sample.
     x: i32,
-    /// ΔX of the last sample.
-    v_prev: i32,
+    /// Whether ΔX of the last sample was ≥ 0.
+    rising: bool,
     lo: i32,
     hi: i32,
 }
 
 impl Sweep {
     /// Slides over `out.len()` samples, the first at residue `j`, with the
-    /// entering steps drawn from `main`; stores ΔΔX.
+    /// entering steps drawn from `main`; stores X.
     fn run<S: Sample>(
         &mut self,
         out: &mut [S],
@@ -385,23 +440,38 @@ impl Sweep {
         shift: u32,
     ) {
         let mut rest = out;
+        let mut r = main.value();
         while !rest.is_empty() {
             let ring = taps.get_mut(j..).unwrap_or_default();
             let take = ring.len().min(rest.len());
             let (now, later) = rest.split_at_mut(take);
             let ring = ring.get_mut(..take).unwrap_or_default();
-            self.slide(ring, main, qq);
-            self.store(now, ring, shift);
+            r = self.stretch(now, ring, r, qq, shift);
             rest = later;
             j = 0;
         }
+        *main = Lcg::new(r);
+    }
+
+    /// One stretch of taps: slides the window ([`Sweep::slide`]), then
+    /// quantises V − q, advances X and stores it ([`Sweep::store`]).
+    fn stretch<S: Sample>(
+        &mut self,
+        out: &mut [S],
+        ring: &mut [Tap],
+        r: u32,
+        qq: i32,
+        shift: u32,
+    ) -> u32 {
+        let r = self.slide(ring, r, qq);
+        self.store(out, ring, shift);
+        r
     }
 
     /// Slides the window over `ring`, leaving each sample's V − q in its tap.
     #[inline(never)]
-    fn slide(&mut self, ring: &mut [Tap], main: &mut Lcg, qq: i32) {
+    fn slide(&mut self, ring: &mut [Tap], mut r: u32, qq: i32) -> u32 {
         let (mut pc, mut ps, mut acc) = (self.pc, self.ps, self.acc);
-        let mut r = main.value();
         for tap in ring {
             r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
             let enter = r as i32 >> 31;
@@ -421,33 +491,61 @@ impl Sweep {
             }
             tap.v = acc - (tc * pc + ts * ps);
         }
-        *main = Lcg::new(r);
         (self.pc, self.ps, self.acc) = (pc, ps, acc);
+        r
     }
 
-    /// Quantises the velocities in `ring`, advances X and stores ΔΔX in `out`.
+    /// Quantises the velocities in `ring`, advances X and stores it in
+    /// `out`. Two loops, one while X rises and one while it falls, so that
+    /// the slope's sign is where the code is, not a register.
     #[inline(never)]
     fn store<S: Sample>(&mut self, out: &mut [S], ring: &[Tap], shift: u32) {
-        let Self {
-            mut residue,
-            mut x,
-            mut v_prev,
-            ..
-        } = *self;
-        for (o, tap) in out.iter_mut().zip(ring) {
-            let r = tap.v + residue;
-            let v = r >> shift;
-            residue = r - (v << shift);
-            if (v ^ v_prev) < 0 {
-                // ΔX changes sign: X (before this sample) is a local extreme.
-                self.lo = self.lo.min(x);
-                self.hi = self.hi.max(x);
+        let mask = (1i32 << shift) - 1;
+        let (mut residue, mut x) = (self.residue, self.x);
+        let mut rising = self.rising;
+        let mut samples = out.iter_mut().zip(ring);
+        'sweep: loop {
+            if rising {
+                loop {
+                    let Some((o, tap)) = samples.next() else {
+                        break 'sweep;
+                    };
+                    let v = tap.v + residue;
+                    residue = v & mask;
+                    let v = v >> shift;
+                    if v < 0 {
+                        // X (before this sample) is a local maximum.
+                        self.hi = self.hi.max(x);
+                        x += v;
+                        *o = S::from_scratch(x as i16);
+                        rising = false;
+                        break;
+                    }
+                    x += v;
+                    *o = S::from_scratch(x as i16);
+                }
+            } else {
+                loop {
+                    let Some((o, tap)) = samples.next() else {
+                        break 'sweep;
+                    };
+                    let v = tap.v + residue;
+                    residue = v & mask;
+                    let v = v >> shift;
+                    if v >= 0 {
+                        // X (before this sample) is a local minimum.
+                        self.lo = self.lo.min(x);
+                        x += v;
+                        *o = S::from_scratch(x as i16);
+                        rising = true;
+                        break;
+                    }
+                    x += v;
+                    *o = S::from_scratch(x as i16);
+                }
             }
-            *o = S::from_scratch((v - v_prev) as i16);
-            x += v;
-            v_prev = v;
         }
-        (self.residue, self.x, self.v_prev) = (residue, x, v_prev);
+        (self.residue, self.x, self.rising) = (residue, x, rising);
     }
 
     /// Includes the current X in the extremes (the sweep's end).
@@ -457,6 +555,11 @@ impl Sweep {
     }
 }
 
+/// Fills the tap ring with the initial window (steps k = 0..W−1, drawn from
+/// `main`) and returns its sums Pb꜀, Pbₛ, Q²·Bb and the wrap correction E.
+///
+/// ## The wrap correction E
+///
 /// The part of Σₙ cp(n) that the zero-sum table does not cancel.
 ///
 /// Over the circular sweep (outputs n = W−1..N+W−2) each absolute step index
@@ -473,58 +576,65 @@ impl Sweep {
 ///
 /// (products of 2-vectors are dot products). |S| ≤ Q·W/π + 2Q, so each
 /// product stays below Q²·W/π < 2²⁹; E is summed in `i64`. O(W), once per axis.
-struct WrapCorrection<'t> {
-    table: &'t [(i16, i16)],
-    /// The next early step's index k (only k < W−1 contribute).
-    k: usize,
-    /// (k + N) mod W: the table entry of the step's late copy.
-    late: usize,
-    sa: (i32, i32),
-    sb: (i32, i32),
-    sum: i64,
+///
+/// [`initial_window`] sums it while it fills the window.
+#[inline(never)] // a function of its own: registers of its own
+fn initial_window(
+    table: &[(i16, i16)],
+    n: usize,
+    main: &mut Lcg,
+    qq: i32,
+    ring: &mut heapless::Vec<Tap, { MAX_WINDOW as usize }>,
+) -> (i32, i32, i32, i64) {
+    let w = table.len();
+    // The window's steps and sums.
+    let (mut pc, mut ps, mut bb) = (0i32, 0i32, 0i32);
+    let mut r = main.value();
+    for &e in table {
+        r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
+        let up = r as i32 >> 31;
+        if up != 0 {
+            pc += i32::from(e.0);
+            ps += i32::from(e.1);
+            bb += qq;
+        }
+        // Cannot fail: the table has at most MAX_WINDOW entries.
+        let _ = ring.push(Tap::new(e, up));
+    }
+    *main = Lcg::new(r);
+    // E: the early copies at phases k, then the late ones at (k + N) mod W
+    // (the table from N mod W on, then from 0), for the first W − 1 steps.
+    let early = ring.get(..w - 1).unwrap_or_default();
+    let (late_b, late_a) = table.split_at(n % w);
+    let start_a = table.last().copied().unwrap_or_default();
+    let start_b = table.get((n + w - 1) % w).copied().unwrap_or_default();
+    let sum = wrap_part(early, table, start_a, 1)
+        + wrap_part(early, late_a.iter().chain(late_b), start_b, -1);
+    (pc, ps, bb, sum)
 }
 
-impl<'t> WrapCorrection<'t> {
-    fn new(table: &'t [(i16, i16)], n: usize) -> Self {
-        let w = table.len().max(1);
-        let entry = |i: usize| {
-            table
-                .get(i)
-                .map_or((0, 0), |&(c, s)| (i32::from(c), i32::from(s)))
-        };
-        let (c_last, s_last) = entry(w - 1);
-        let (c_before, s_before) = entry((n + w - 1) % w); // (N−1) mod W
-        Self {
-            table,
-            k: 0,
-            late: n % w,
-            sa: (c_last, s_last),
-            sb: (-c_before, -s_before),
-            sum: 0,
+/// One half of E: Σ over the up-steps k of `taps` of T(k)·S(k), with T(k) the
+/// k-th entry of `phases` and S(k) the running sum that starts at
+/// `sign`·`start` and moves by `sign`·T(k) after each step (SA and SB of the
+/// derivation, SB with the sign folded in: SB = −Σ).
+fn wrap_part<'t>(
+    taps: &[Tap],
+    phases: impl IntoIterator<Item = &'t (i16, i16)>,
+    start: (i16, i16),
+    sign: i32,
+) -> i64 {
+    let (mut sc, mut ss) = (sign * i32::from(start.0), sign * i32::from(start.1));
+    let mut sum = 0i64;
+    for (tap, &(c, s)) in taps.iter().zip(phases) {
+        let (c, s) = (i32::from(c), i32::from(s));
+        if tap.up != 0 {
+            // |T·S| < Q²·W/π < 2²⁹.
+            sum += i64::from(c * sc + s * ss);
         }
+        sc += sign * c;
+        ss += sign * s;
     }
-
-    /// Takes the next step (up or down) of the initial window.
-    fn step(&mut self, up: bool) {
-        let (Some(&(ec, es)), Some(&(lc, ls))) =
-            (self.table.get(self.k), self.table.get(self.late))
-        else {
-            return;
-        };
-        let (ec, es, lc, ls) = (i32::from(ec), i32::from(es), i32::from(lc), i32::from(ls));
-        if up && self.k + 1 < self.table.len() {
-            let early = ec * self.sa.0 + es * self.sa.1;
-            let late = lc * self.sb.0 + ls * self.sb.1;
-            self.sum += i64::from(early) + i64::from(late);
-        }
-        self.sa = (self.sa.0 + ec, self.sa.1 + es);
-        self.sb = (self.sb.0 - lc, self.sb.1 - ls);
-        self.k += 1;
-        self.late += 1;
-        if self.late == self.table.len() {
-            self.late = 0;
-        }
-    }
+    sum
 }
 
 /// Converts the integral X to walk steps δ for [`Trace::smoothed`]
@@ -533,29 +643,31 @@ fn trace_scale(shift: u32, qq: i32, w: usize) -> f32 {
     (1u64 << shift) as f32 / (qq as f32 * w as f32)
 }
 
-/// Walks the stored loop from index 0 (where X = ΔX = `v0`), rebuilding X
-/// from the stored ΔΔX, and returns the first index where X crosses `level`
-/// — the sample nearer the level — with X there. A closed loop that spans the
-/// level always crosses it.
-fn first_crossing<S: Sample>(acc: &[S], v0: i32, level: i32) -> (usize, i32) {
-    let (mut x, mut v) = (v0, v0);
-    for (i, a) in acc.iter().enumerate().skip(1) {
-        v += i32::from(a.to_scratch());
-        let next = x + v;
-        let (dp, dc) = (x - level, next - level);
-        if dp == 0 {
-            return (i - 1, x);
-        }
-        if dc == 0 || (dc ^ dp) < 0 {
-            return if dc.abs() <= dp.abs() {
-                (i, next)
-            } else {
-                (i - 1, x)
-            };
-        }
-        x = next;
+/// Walks the stored loop X from index 0 and returns the first index where
+/// it crosses `level` — the sample nearer the level — with X there, both as
+/// offsets from the lowest sample `low` (exact in `u16`). A closed loop that
+/// spans the level always crosses it.
+fn first_crossing<S: Sample>(xs: &[S], low: i16, level: i32) -> (usize, i32) {
+    let at = |s: &S| i32::from(s.to_scratch().wrapping_sub(low) as u16);
+    let Some(&first) = xs.first() else {
+        return (0, level);
+    };
+    let x0 = at(&first);
+    // Every sample before the crossing lies on the start's side.
+    let found = match x0.cmp(&level) {
+        core::cmp::Ordering::Greater => xs.iter().position(|s| at(s) <= level),
+        core::cmp::Ordering::Less => xs.iter().position(|s| at(s) >= level),
+        core::cmp::Ordering::Equal => return (0, level),
+    };
+    let (Some(i), Some(prev)) = (found, found.and_then(|i| xs.get(i.wrapping_sub(1)))) else {
+        return (0, x0);
+    };
+    let (xc, xp) = (at(&xs[i]), at(prev));
+    if (xc - level).abs() <= (xp - level).abs() {
+        (i, xc)
+    } else {
+        (i - 1, xp)
     }
-    (0, v0)
 }
 
 /// `num/den` (fine units per X unit) as a multiplier `m / 2^shift`, rounded
@@ -569,8 +681,10 @@ fn multiplier(num: i64, den: i64, vmax: i64) -> Option<(i32, u32)> {
     let m_max = ((1u64 << 30) / vmax as u64).max(1);
     // ratio · 2³⁰, exact floor (num < 2²⁴): one division.
     let r = ((num as u64) << 30) / den as u64;
-    let mut drop = 0u32;
-    while drop < 64 && (r >> drop) > m_max {
+    // The fewest dropped bits that bring r to m_max or below: r's length
+    // less m_max's, or one more.
+    let mut drop = (64 - r.leading_zeros()).saturating_sub(64 - m_max.leading_zeros());
+    if r.checked_shr(drop).unwrap_or(0) > m_max {
         drop += 1;
     }
     let m = r.checked_shr(drop).unwrap_or(0);
@@ -621,7 +735,7 @@ fn paper<S: Sample, T: Trace>(
     cfg: &AxisConfig,
     kernel: &HannKernel,
     trace: &mut T,
-) -> Result<LoopInfo, MotionError> {
+) -> Result<(LoopInfo, LoopScale), MotionError> {
     let n = out.len();
     let w = usize::from(cfg.window);
     let table = kernel.table();
@@ -725,12 +839,24 @@ fn paper<S: Sample, T: Trace>(
         .filter(|(_, p)| sign(&p[1]) != sign(&p[0]))
         .nth(pick)
         .map_or(0, |(i, _)| i);
-    Ok(LoopInfo {
+    let info = LoopInfo {
         split: split as u16,
         start: split as u16,
         crossings: crossings as u16,
         up_steps: ones as u16,
-    })
+    };
+    Ok((info, LoopScale::MDEG))
+}
+
+/// Maps samples stored with `scale` to the storage's own units
+/// ([`LoopScale::MDEG`] afterwards); nothing to do if they are already.
+pub(super) fn finalise<S: Sample>(out: &mut [S], scale: &LoopScale) {
+    if *scale == LoopScale::MDEG {
+        return;
+    }
+    for o in out {
+        *o = S::from_fine(scale.fine(o.to_scratch()));
+    }
 }
 
 #[inline]

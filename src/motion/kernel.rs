@@ -25,16 +25,19 @@ pub const MAX_WINDOW: u16 = 511;
 pub struct HannKernel {
     window: u16,
     q: i32,
-    table: [(i16, i16); MAX_WINDOW as usize],
+    /// The entries j = 0..W−1; a vector, so that a kernel is made without
+    /// clearing (or moving) all 2 KiB of its capacity.
+    table: heapless::Vec<(i16, i16), { MAX_WINDOW as usize }>,
 }
 
 /// Integer square root (floor), for the table scale.
-const fn isqrt(v: u32) -> u32 {
+pub(super) const fn isqrt(v: u32) -> u32 {
     let mut lo = 0u32;
     let mut hi = 1u32 << 16;
     while hi - lo > 1 {
         let mid = u32::midpoint(lo, hi);
-        if (mid as u64) * (mid as u64) <= v as u64 {
+        // mid < 2¹⁶, so the square fits u32 (no 64-bit multiply on ARMv6-M).
+        if mid * mid <= v {
             lo = mid;
         } else {
             hi = mid;
@@ -53,13 +56,18 @@ impl HannKernel {
     /// [`MotionError::WindowTooSmall`] below [`MIN_WINDOW`] and
     /// [`MotionError::WindowTooLarge`] above [`MAX_WINDOW`].
     pub fn new(window: u16) -> Result<Self, MotionError> {
-        let mut kernel = Self {
-            window: 0,
-            q: 0,
-            table: [(0, 0); MAX_WINDOW as usize],
-        };
+        let mut kernel = Self::empty();
         kernel.rebuild(window)?;
         Ok(kernel)
+    }
+
+    /// A kernel of no taps, to [`HannKernel::rebuild`] in place.
+    pub(super) const fn empty() -> Self {
+        Self {
+            window: 0,
+            q: 0,
+            table: heapless::Vec::new(),
+        }
     }
 
     /// Rebuilds the table in place for `window` taps (no 2 KiB move).
@@ -86,14 +94,20 @@ impl HannKernel {
         let q = isqrt((1u32 << 29) / u32::from(window)) as i32 - 1;
         // 32-bit phase, 2³² = one turn (idsp's convention: i32::MIN is −π):
         // phase(j) = ⌊j·2³²/W⌋, stepped exactly (Bresenham on the remainder).
-        let step = ((1u64 << 32) / w as u64) as u32;
-        let rem = ((1u64 << 32) % w as u64) as u32;
+        // ⌊2³²/W⌋ and 2³² mod W from (2³² − 1)/W, in 32 bits.
+        let (mut step, mut rem) = (u32::MAX / w as u32, u32::MAX % w as u32 + 1);
+        if rem == w as u32 {
+            (step, rem) = (step + 1, 0);
+        }
         let (mut phase, mut frac) = (0u32, 0u32);
         // Scale from ±2³¹ full scale to ±Q, rounding to nearest:
         // (x >> 15)·Q < 2¹⁶·2¹⁴ fits i32; the dropped bits move the result
         // by less than Q/2¹⁶ < 0.21 LSB.
         let scale = |x: i32| -> i16 { (((x >> 15) * q + (1 << 15)) >> 16) as i16 };
         let mut cos_sum: i32 = 0;
+        self.table.clear();
+        // Cannot fail: w ≤ MAX_WINDOW, the capacity.
+        let _ = self.table.resize(w, (0, 0));
         for j in 0..=w / 2 {
             let (c, s) = idsp::cossin(phase as i32);
             let (tc, mut ts) = (scale(c), scale(s));
@@ -121,7 +135,9 @@ impl HannKernel {
             }
         }
         // Zero-sum cosine column: fold the rounding residue into j = 0.
-        self.table[0].0 = (i32::from(self.table[0].0) - cos_sum) as i16;
+        if let Some(e) = self.table.first_mut() {
+            e.0 = (i32::from(e.0) - cos_sum) as i16;
+        }
         self.window = window;
         self.q = q;
         Ok(())
@@ -142,7 +158,7 @@ impl HannKernel {
     /// The table entries `(Q·cos 2πj/W, Q·sin 2πj/W)` for j = 0..W−1.
     #[must_use]
     pub fn table(&self) -> &[(i16, i16)] {
-        &self.table[..self.window as usize]
+        &self.table
     }
 
     /// The tap weights the table realises, h(m) ≈ ½ − ½·cos(2πm/W), for tests and plots.

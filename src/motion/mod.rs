@@ -24,7 +24,7 @@ mod storage;
 pub use engine::{LoopInfo, Trace};
 pub use kernel::{HannKernel, MAX_WINDOW, MIN_WINDOW};
 pub use lcg::{A as LCG_A, C as LCG_C, Lcg, step_of};
-pub use storage::{FINE_PER_MDEG, Fnv1a, Mdeg16, Sample};
+pub use storage::{FINE_PER_MDEG, Fnv1a, LoopScale, Mdeg16, Q16, Sample};
 
 use crate::axis::Axis;
 use crate::units::{Angle, AngleRange};
@@ -445,6 +445,9 @@ pub struct Trajectory<S: Sample, const N: usize> {
     samples: [S; N],
     /// Where playback starts in `samples` (the loop is stored as a ring).
     start: u16,
+    /// How `samples` map to angles: [`LoopScale::NEUTRAL`] before a loop is
+    /// generated, the loop's own scale for [`Q16`], else [`LoopScale::MDEG`].
+    scale: LoopScale,
 }
 
 impl<S: Sample, const N: usize> Trajectory<S, N> {
@@ -463,6 +466,7 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
         Self {
             samples: [S::ZERO; N],
             start: 0,
+            scale: LoopScale::NEUTRAL,
         }
     }
 
@@ -494,12 +498,19 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
     ) -> Result<LoopInfo, MotionError> {
         // Validate, generate and keep the ring as computed: no rotation.
         self.start = 0;
+        self.scale = LoopScale::NEUTRAL;
         let result = cfg
             .validate(axis, N)
             .and_then(|()| engine::generate(&mut self.samples, cfg, kernel, trace));
         match result {
-            Ok(info) => {
+            Ok((info, scale)) => {
                 self.start = info.start;
+                if S::KEEPS_SCALE {
+                    self.scale = scale;
+                } else {
+                    engine::finalise(&mut self.samples, &scale);
+                    self.scale = LoopScale::MDEG;
+                }
                 Ok(info)
             }
             Err(e) => {
@@ -521,6 +532,14 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
         self.start as usize
     }
 
+    /// How [`Trajectory::samples`] map to angles: the loop's own scale for
+    /// [`Q16`], [`LoopScale::MDEG`] for the other storages
+    /// ([`LoopScale::NEUTRAL`] until a loop is generated).
+    #[must_use]
+    pub const fn scale(&self) -> &LoopScale {
+        &self.scale
+    }
+
     /// The samples in playback order; the first is the neutral pose.
     pub fn playback(&self) -> impl Iterator<Item = &S> + '_ {
         let (head, tail) = self.samples.split_at(self.start().min(N));
@@ -534,7 +553,9 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
         if i >= N {
             i -= N;
         }
-        self.samples.get(i).map_or(Angle::ZERO, |s| s.angle())
+        self.samples
+            .get(i)
+            .map_or(Angle::ZERO, |s| s.angle_in(&self.scale))
     }
 }
 
@@ -574,8 +595,10 @@ pub fn generate_into<S: Sample, T: Trace>(
         .validate(axis, out.len())
         .and_then(|()| engine::generate(out, cfg, kernel, trace));
     match result {
-        Ok(mut info) => {
-            // Slices come back in playback order.
+        Ok((mut info, scale)) => {
+            // Slices come back finalised (a `Q16` holds millidegrees) and in
+            // playback order.
+            engine::finalise(out, &scale);
             out.rotate_left(usize::from(info.start));
             info.start = 0;
             Ok(info)
@@ -610,10 +633,9 @@ impl<S: Sample, const N: usize> HeadTrajectories<S, N> {
     pub fn generate(&mut self, cfg: &HeadConfig) -> Result<[LoopInfo; 3], AxisError> {
         cfg.validate(N)?;
         let mut infos = [LoopInfo::default(); 3];
-        let mut kernel = HannKernel::new(cfg.pitch.window).map_err(|error| AxisError {
-            axis: Axis::Pitch,
-            error,
-        })?;
+        // Built in place, axis by axis (a window equal to the last one's is
+        // kept as it is).
+        let mut kernel = HannKernel::empty();
         for axis in Axis::ALL {
             let c = cfg.axis(axis);
             kernel
@@ -633,7 +655,8 @@ impl<S: Sample, const N: usize> HeadTrajectories<S, N> {
         &self.axes[axis.index()]
     }
 
-    /// FNV-1a over the samples in playback order (little-endian), pitch, roll, yaw.
+    /// FNV-1a over what defines each loop, pitch, roll, yaw: the samples in
+    /// playback order, then the loop's scale (little-endian bytes).
     #[must_use]
     pub fn checksum(&self) -> u32 {
         let mut h = Fnv1a::new();
@@ -641,6 +664,7 @@ impl<S: Sample, const N: usize> HeadTrajectories<S, N> {
             for s in t.playback() {
                 s.hash_into(&mut h);
             }
+            t.scale.hash_into(&mut h);
         }
         h.finish()
     }

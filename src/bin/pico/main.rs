@@ -51,7 +51,7 @@ use embassy_time::{Duration, Instant};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::firmware::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use idle_head::firmware::{self, Flow, Frame, FrameHooks, FrameLoop, LOOP_DURATION};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Mdeg16};
+use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Q16};
 use idle_head::{Axis, Playback};
 use panic_probe as _;
 
@@ -77,7 +77,7 @@ const LOOP_FRAMES: u64 = LOOP_DURATION.0 as u64 * 1000 / CONFIG.frame_period.0 a
 /// quickly (a reset releases the pins: no pulses until the next soft start).
 const WATCHDOG_TIMEOUT: Duration = Duration::from_millis(100);
 
-type Head = HeadTrajectories<Mdeg16, DEFAULT_N>;
+type Head = HeadTrajectories<Q16, DEFAULT_N>;
 
 /// The three loops: 3 · 900 · 2 B = 5400 B, generated once at boot.
 static mut HEAD: Head = Head::new();
