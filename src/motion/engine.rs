@@ -400,6 +400,15 @@ struct Tap {
 }
 
 impl Tap {
+    /// No table entry, no step.
+    const EMPTY: Self = Self::new((0, 0), 0);
+
+    /// The table entry (Q·cos, Q·sin).
+    #[inline]
+    fn parts(&self) -> (i32, i32) {
+        ((self.cs as i32) << 16 >> 16, self.cs as i32 >> 16)
+    }
+
     const fn new((c, s): (i16, i16), up: i32) -> Self {
         Self {
             cs: (c as u16 as u32) | ((s as u16 as u32) << 16),
@@ -587,54 +596,65 @@ fn initial_window(
     ring: &mut heapless::Vec<Tap, { MAX_WINDOW as usize }>,
 ) -> (i32, i32, i32, i64) {
     let w = table.len();
-    // The window's steps and sums.
-    let (mut pc, mut ps, mut bb) = (0i32, 0i32, 0i32);
+    // The window's steps, one tap each.
     let mut r = main.value();
     for &e in table {
         r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
-        let up = r as i32 >> 31;
-        if up != 0 {
-            pc += i32::from(e.0);
-            ps += i32::from(e.1);
-            bb += qq;
-        }
         // Cannot fail: the table has at most MAX_WINDOW entries.
-        let _ = ring.push(Tap::new(e, up));
+        let _ = ring.push(Tap::new(e, r as i32 >> 31));
     }
     *main = Lcg::new(r);
-    // E: the early copies at phases k, then the late ones at (k + N) mod W
-    // (the table from N mod W on, then from 0), for the first W − 1 steps.
-    let early = ring.get(..w - 1).unwrap_or_default();
+    let taps = ring.as_slice();
+    // The window's sums and E's early copies at phases k (SA), in one walk.
+    let (last, early) = taps.split_last().unwrap_or((&Tap::EMPTY, &[]));
+    let (mut pc, mut ps, mut ups) = (0i32, 0i32, 0i32);
+    let (mut sc, mut ss) = last.parts();
+    let mut sum = 0i64;
+    for tap in early {
+        let (c, s) = tap.parts();
+        if tap.up != 0 {
+            pc += c;
+            ps += s;
+            ups += 1;
+            // |T·S| < Q²·W/π < 2²⁹.
+            sum += i64::from(c * sc + s * ss);
+        }
+        sc += c;
+        ss += s;
+    }
+    if last.up != 0 {
+        let (c, s) = last.parts();
+        (pc, ps, ups) = (pc + c, ps + s, ups + 1);
+    }
+    // The late copies at phases (k + N) mod W (SB, sign folded in): the
+    // table from N mod W on, then from 0.
     let (late_b, late_a) = table.split_at(n % w);
-    let start_a = table.last().copied().unwrap_or_default();
-    let start_b = table.get((n + w - 1) % w).copied().unwrap_or_default();
-    let sum = wrap_part(early, table, start_a, 1)
-        + wrap_part(early, late_a.iter().chain(late_b), start_b, -1);
-    (pc, ps, bb, sum)
+    let (c, s) = table.get((n + w - 1) % w).copied().unwrap_or_default();
+    let (early_a, early_b) = early.split_at(late_a.len().min(early.len()));
+    let mut state = (-i32::from(c), -i32::from(s), sum);
+    state = wrap_part(early_a, late_a, state);
+    state = wrap_part(early_b, late_b, state);
+    (pc, ps, ups * qq, state.2)
 }
 
-/// One half of E: Σ over the up-steps k of `taps` of T(k)·S(k), with T(k) the
-/// k-th entry of `phases` and S(k) the running sum that starts at
-/// `sign`·`start` and moves by `sign`·T(k) after each step (SA and SB of the
-/// derivation, SB with the sign folded in: SB = −Σ).
-fn wrap_part<'t>(
+/// Adds to E's sum (`.2`) the terms T(k)·S(k) of the up-steps among `taps`,
+/// T(k) the k-th entry of `phases`, with the running sum S (`.0`, `.1`)
+/// moving by −T(k) after each step (SB of the derivation, sign folded in).
+fn wrap_part(
     taps: &[Tap],
-    phases: impl IntoIterator<Item = &'t (i16, i16)>,
-    start: (i16, i16),
-    sign: i32,
-) -> i64 {
-    let (mut sc, mut ss) = (sign * i32::from(start.0), sign * i32::from(start.1));
-    let mut sum = 0i64;
+    phases: &[(i16, i16)],
+    (mut sc, mut ss, mut sum): (i32, i32, i64),
+) -> (i32, i32, i64) {
     for (tap, &(c, s)) in taps.iter().zip(phases) {
         let (c, s) = (i32::from(c), i32::from(s));
         if tap.up != 0 {
             // |T·S| < Q²·W/π < 2²⁹.
             sum += i64::from(c * sc + s * ss);
         }
-        sc += sign * c;
-        ss += sign * s;
+        sc -= c;
+        ss -= s;
     }
-    sum
+    (sc, ss, sum)
 }
 
 /// Converts the integral X to walk steps δ for [`Trace::smoothed`]
