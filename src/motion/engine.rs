@@ -197,6 +197,33 @@ impl Quantiser {
 // Seamless closure: periodic walk, circular smoothing, start at a crossing.
 // ---------------------------------------------------------------------------
 
+/// What both closures read off the buffer, the configuration and the kernel.
+struct Basics<'k> {
+    /// N, the loop's length.
+    n: usize,
+    /// W, the window's length.
+    w: usize,
+    /// The kernel table, W entries.
+    table: &'k [(i16, i16)],
+    /// The table scale Q.
+    q: i32,
+    /// Q².
+    qq: i32,
+}
+
+impl<'k> Basics<'k> {
+    fn of<S>(out: &[S], cfg: &AxisConfig, kernel: &'k HannKernel) -> Self {
+        let q = kernel.scale();
+        Self {
+            n: out.len(),
+            w: usize::from(cfg.window),
+            table: kernel.table(),
+            q,
+            qq: q * q,
+        }
+    }
+}
+
 /// The seamless loop.
 ///
 /// The circular step sequence is e(k) = ±1 from r(k+1), k = 0..N−1. Removing
@@ -214,11 +241,9 @@ fn seamless<S: Sample, T: Trace>(
     kernel: &HannKernel,
     trace: &mut T,
 ) -> Result<(LoopInfo, LoopScale), MotionError> {
-    let n = out.len();
-    let w = usize::from(cfg.window);
-    let table = kernel.table();
-    let q = kernel.scale();
-    let qq = q * q;
+    let Basics {
+        n, w, table, qq, ..
+    } = Basics::of(out, cfg, kernel);
     let shift = raw_shift(qq, w, n);
 
     // Pass 1: count the up-steps of the whole circular walk.
@@ -756,11 +781,7 @@ fn paper<S: Sample, T: Trace>(
     kernel: &HannKernel,
     trace: &mut T,
 ) -> Result<(LoopInfo, LoopScale), MotionError> {
-    let n = out.len();
-    let w = usize::from(cfg.window);
-    let table = kernel.table();
-    let q = kernel.scale();
-    let qq = q * q;
+    let Basics { n, w, table, q, qq } = Basics::of(out, cfg, kernel);
     let shift = x_shift(q, w, n);
 
     // Pass 2 (causal): steps in {−1, 0, +1}; V = Q²·B − cp = 2Q²·v.
