@@ -498,7 +498,15 @@ impl Sweep {
         shift: u32,
     ) -> u32 {
         let r = self.slide(ring, r, qq);
-        self.store(out, ring, shift);
+        // The step as an immediate where `raw_shift` usually lands (the mask
+        // and shift then take no registers in the loop); any other step runs
+        // the same loop with it in a register.
+        match shift {
+            17 => self.store::<S, 17>(out, ring, shift),
+            18 => self.store::<S, 18>(out, ring, shift),
+            19 => self.store::<S, 19>(out, ring, shift),
+            _ => self.store::<S, 0>(out, ring, shift),
+        }
         r
     }
 
@@ -532,53 +540,66 @@ impl Sweep {
     /// Quantises the velocities in `ring`, advances X and stores it in
     /// `out`. Two loops, one while X rises and one while it falls, so that
     /// the slope's sign is where the code is, not a register.
+    ///
+    /// The step is `2^SHIFT`, a constant, or `2^shift` with `SHIFT = 0`
+    /// (`raw_shift` is at least 15, so 0 never is a step).
     #[inline(never)]
-    fn store<S: Sample>(&mut self, out: &mut [S], ring: &[Tap], shift: u32) {
-        let mask = (1i32 << shift) - 1;
-        let (mut residue, mut x) = (self.residue, self.x);
+    fn store<S: Sample, const SHIFT: u32>(&mut self, out: &mut [S], ring: &[Tap], shift: u32) {
+        let shift = if SHIFT == 0 { shift } else { SHIFT };
+        // The residue v mod 2^shift is carried in the top bits of a word
+        // (`low`): no mask to hold in a register.
+        let up = 32 - shift;
+        let (mut low, mut x) = ((self.residue as u32) << up, self.x);
         let mut rising = self.rising;
-        let mut samples = out.iter_mut().zip(ring);
+        let len = out.len().min(ring.len());
+        let (out, ring) = (&mut out[..len], &ring[..len]);
+        let mut i = 0;
         'sweep: loop {
             if rising {
                 loop {
-                    let Some((o, tap)) = samples.next() else {
+                    if i >= len {
                         break 'sweep;
-                    };
-                    let v = tap.v + residue;
-                    residue = v & mask;
+                    }
+                    let v = ring[i].v + (low >> up) as i32;
+                    low = (v as u32) << up;
                     let v = v >> shift;
                     if v < 0 {
                         // X (before this sample) is a local maximum.
                         self.hi = self.hi.max(x);
                         x += v;
-                        *o = S::from_scratch(x as i16);
+                        out[i] = S::from_scratch(x as i16);
+                        i += 1;
                         rising = false;
                         break;
                     }
                     x += v;
-                    *o = S::from_scratch(x as i16);
+                    out[i] = S::from_scratch(x as i16);
+                    i += 1;
                 }
             } else {
                 loop {
-                    let Some((o, tap)) = samples.next() else {
+                    if i >= len {
                         break 'sweep;
-                    };
-                    let v = tap.v + residue;
-                    residue = v & mask;
+                    }
+                    let v = ring[i].v + (low >> up) as i32;
+                    low = (v as u32) << up;
                     let v = v >> shift;
                     if v >= 0 {
                         // X (before this sample) is a local minimum.
                         self.lo = self.lo.min(x);
                         x += v;
-                        *o = S::from_scratch(x as i16);
+                        out[i] = S::from_scratch(x as i16);
+                        i += 1;
                         rising = true;
                         break;
                     }
                     x += v;
-                    *o = S::from_scratch(x as i16);
+                    out[i] = S::from_scratch(x as i16);
+                    i += 1;
                 }
             }
         }
+        let residue = (low >> up) as i32;
         (self.residue, self.x, self.rising) = (residue, x, rising);
     }
 
