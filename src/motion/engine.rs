@@ -253,7 +253,9 @@ fn seamless<S: Sample, T: Trace>(
     let mut main = Lcg::new(cfg.seed);
     // A heapless vector: stack storage without clearing 4 KiB per axis.
     let mut ring: heapless::Vec<Tap, { MAX_WINDOW as usize }> = heapless::Vec::new();
-    let (pc, ps, bb, wrap_sum) = initial_window(table, n, &mut main, qq, &mut ring);
+    // N mod W, the one division of the sweep's indices (software on ARMv6-M).
+    let n_mod_w = n % w;
+    let (pc, ps, bb, wrap_sum) = initial_window(table, n_mod_w, &mut main, qq, &mut ring);
     let taps = ring.as_mut_slice();
     let total = i64::from(qq * w as i32) * i64::from(ones) - wrap_sum;
     let detrend = total.div_euclid(n as i64) as i32;
@@ -286,7 +288,8 @@ fn seamless<S: Sample, T: Trace>(
     let (head, tail) = out.split_at_mut(wrap_at);
     sweep.run(&mut head[1..], taps, 0, &mut main, qq, shift);
     let mut again = Lcg::new(cfg.seed);
-    sweep.run(tail, taps, (wrap_at - 1) % w, &mut again, qq, shift);
+    // The tail's first residue: (wrap_at − 1) mod W = (N − W) mod W = N mod W.
+    sweep.run(tail, taps, n_mod_w, &mut again, qq, shift);
     sweep.settle();
     debug_assert_eq!(sweep.x, 0, "the seamless loop closes exactly");
     let (mut lo, mut hi, mut x0) = (sweep.lo, sweep.hi, x_first);
@@ -318,7 +321,11 @@ fn seamless<S: Sample, T: Trace>(
     // The first sample, in generation order, where the loop crosses that
     // level: playback starts there (the stored order stays a ring).
     let (start, pivot) = first_crossing(out, low, level as i32);
-    let split = (start + w - 1) % n; // as a loop index
+    // As a loop index: (start + W − 1) mod N, with start + W − 1 < 2N.
+    let split = match start + w - 1 {
+        i if i >= n => i - n,
+        i => i,
+    };
 
     // Scale about the pivot so that it maps to exactly 0 and both extremes
     // stay inside [α1, α2]; the tighter side reaches its bound (less one
@@ -365,11 +372,29 @@ fn seamless<S: Sample, T: Trace>(
 /// stored samples are exact in `i16`, and at least 2N, which makes the
 /// detrend's residue (< N) vanish in the floor: the loop closes exactly.
 fn raw_shift(qq: i32, w: usize, n: usize) -> u32 {
-    // Q²·W/2 · 0.9·√N · 3/2 ≈ Q²·W·√N·0.675; Q²·W < 2²⁹, √N < 2⁷: fits u64.
-    let typical = (qq as u64) * (w as u64) * u64::from(super::kernel::isqrt(n as u32)) * 27 / 40;
-    let by_extent = (64 - typical.leading_zeros()).saturating_sub(16);
+    // Q²·W/2 · 0.9·√N · 3/2 ≈ Q²·W·√N·0.675 = ⌊y/40⌋, y = Q²·W·√N·27;
+    // Q²·W < 2²⁹ and 27·√N < 2²¹ each fit u32, their product u64.
+    let y = u64::from(qq as u32 * w as u32) * u64::from(27 * super::kernel::isqrt(n as u32));
+    let by_extent = bit_len_div40(y).saturating_sub(16);
     let by_len = 64 - ((2 * n as u64 - 1).leading_zeros());
     by_extent.max(by_len).max(15)
+}
+
+/// The bit length of ⌊y/40⌋, without a (software) 64-bit division.
+///
+/// With L the bit length of y, 2^(L−1) ≤ y < 2^L, so ⌊y/40⌋ lies in
+/// [2^(L−6)·0.8, 2^(L−6)·1.6): its bit length is L−5 where y ≥ 40·2^(L−6),
+/// else L−6 (and y ≥ 40·2^(L−6) exactly where ⌊y/2^(L−6)⌋ ≥ 40).
+fn bit_len_div40(y: u64) -> u32 {
+    let len = 64 - y.leading_zeros();
+    if len < 6 {
+        return 0; // y < 32 < 40
+    }
+    if y >> (len - 6) >= 40 {
+        len - 5
+    } else {
+        len - 6
+    }
 }
 
 /// Pass 1: the number of up-steps among the first `n` steps of the walk.
@@ -498,7 +523,15 @@ impl Sweep {
         shift: u32,
     ) -> u32 {
         let r = self.slide(ring, r, qq);
-        self.store(out, ring, shift);
+        // The step as an immediate where `raw_shift` usually lands (the mask
+        // and shift then take no registers in the loop); any other step runs
+        // the same loop with it in a register.
+        match shift {
+            17 => self.store::<S, 17>(out, ring, shift),
+            18 => self.store::<S, 18>(out, ring, shift),
+            19 => self.store::<S, 19>(out, ring, shift),
+            _ => self.store::<S, 0>(out, ring, shift),
+        }
         r
     }
 
@@ -532,53 +565,66 @@ impl Sweep {
     /// Quantises the velocities in `ring`, advances X and stores it in
     /// `out`. Two loops, one while X rises and one while it falls, so that
     /// the slope's sign is where the code is, not a register.
+    ///
+    /// The step is `2^SHIFT`, a constant, or `2^shift` with `SHIFT = 0`
+    /// (`raw_shift` is at least 15, so 0 never is a step).
     #[inline(never)]
-    fn store<S: Sample>(&mut self, out: &mut [S], ring: &[Tap], shift: u32) {
-        let mask = (1i32 << shift) - 1;
-        let (mut residue, mut x) = (self.residue, self.x);
+    fn store<S: Sample, const SHIFT: u32>(&mut self, out: &mut [S], ring: &[Tap], shift: u32) {
+        let shift = if SHIFT == 0 { shift } else { SHIFT };
+        // The residue v mod 2^shift is carried in the top bits of a word
+        // (`low`): no mask to hold in a register.
+        let up = 32 - shift;
+        let (mut low, mut x) = ((self.residue as u32) << up, self.x);
         let mut rising = self.rising;
-        let mut samples = out.iter_mut().zip(ring);
+        let len = out.len().min(ring.len());
+        let (out, ring) = (&mut out[..len], &ring[..len]);
+        let mut i = 0;
         'sweep: loop {
             if rising {
                 loop {
-                    let Some((o, tap)) = samples.next() else {
+                    if i >= len {
                         break 'sweep;
-                    };
-                    let v = tap.v + residue;
-                    residue = v & mask;
+                    }
+                    let v = ring[i].v + (low >> up) as i32;
+                    low = (v as u32) << up;
                     let v = v >> shift;
                     if v < 0 {
                         // X (before this sample) is a local maximum.
                         self.hi = self.hi.max(x);
                         x += v;
-                        *o = S::from_scratch(x as i16);
+                        out[i] = S::from_scratch(x as i16);
+                        i += 1;
                         rising = false;
                         break;
                     }
                     x += v;
-                    *o = S::from_scratch(x as i16);
+                    out[i] = S::from_scratch(x as i16);
+                    i += 1;
                 }
             } else {
                 loop {
-                    let Some((o, tap)) = samples.next() else {
+                    if i >= len {
                         break 'sweep;
-                    };
-                    let v = tap.v + residue;
-                    residue = v & mask;
+                    }
+                    let v = ring[i].v + (low >> up) as i32;
+                    low = (v as u32) << up;
                     let v = v >> shift;
                     if v >= 0 {
                         // X (before this sample) is a local minimum.
                         self.lo = self.lo.min(x);
                         x += v;
-                        *o = S::from_scratch(x as i16);
+                        out[i] = S::from_scratch(x as i16);
+                        i += 1;
                         rising = true;
                         break;
                     }
                     x += v;
-                    *o = S::from_scratch(x as i16);
+                    out[i] = S::from_scratch(x as i16);
+                    i += 1;
                 }
             }
         }
+        let residue = (low >> up) as i32;
         (self.residue, self.x, self.rising) = (residue, x, rising);
     }
 
@@ -590,7 +636,8 @@ impl Sweep {
 }
 
 /// Fills the tap ring with the initial window (steps k = 0..W−1, drawn from
-/// `main`) and returns its sums Pb꜀, Pbₛ, Q²·Bb and the wrap correction E.
+/// `main`) and returns its sums Pb꜀, Pbₛ, Q²·Bb and the wrap correction E
+/// (`n_mod_w` is N mod W).
 ///
 /// ## The wrap correction E
 ///
@@ -615,7 +662,7 @@ impl Sweep {
 #[inline(never)] // a function of its own: registers of its own
 fn initial_window(
     table: &[(i16, i16)],
-    n: usize,
+    n_mod_w: usize,
     main: &mut Lcg,
     qq: i32,
     ring: &mut heapless::Vec<Tap, { MAX_WINDOW as usize }>,
@@ -653,8 +700,12 @@ fn initial_window(
     }
     // The late copies at phases (k + N) mod W (SB, sign folded in): the
     // table from N mod W on, then from 0.
-    let (late_b, late_a) = table.split_at(n % w);
-    let (c, s) = table.get((n + w - 1) % w).copied().unwrap_or_default();
+    let (late_b, late_a) = table.split_at(n_mod_w);
+    // Phase (N + W − 1) mod W = (N mod W) − 1, or W − 1 where N mod W = 0.
+    let (c, s) = table
+        .get(n_mod_w.checked_sub(1).unwrap_or(w - 1))
+        .copied()
+        .unwrap_or_default();
     let (early_a, early_b) = early.split_at(late_a.len().min(early.len()));
     let mut state = (-i32::from(c), -i32::from(s), sum);
     state = wrap_part(early_a, late_a, state);
@@ -723,7 +774,13 @@ fn multiplier(num: i64, den: i64, vmax: i64) -> Option<(i32, u32)> {
     if num <= 0 || den <= 0 || vmax <= 0 {
         return None;
     }
-    let m_max = ((1u64 << 30) / vmax as u64).max(1);
+    // A power of two (the seamless loop's 2¹⁶) divides by a shift.
+    let m_max = if vmax & (vmax - 1) == 0 {
+        (1u64 << 30) >> vmax.trailing_zeros()
+    } else {
+        (1u64 << 30) / vmax as u64
+    }
+    .max(1);
     // ratio · 2³⁰, exact floor (num < 2²⁴): one division.
     let r = ((num as u64) << 30) / den as u64;
     // The fewest dropped bits that bring r to m_max or below: r's length
