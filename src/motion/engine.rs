@@ -539,9 +539,9 @@ impl Sweep {
     #[inline(never)]
     fn slide(&mut self, ring: &mut [Tap], mut r: u32, qq: i32) -> u32 {
         let (mut pc, mut ps, mut acc) = (self.pc, self.ps, self.acc);
-        for tap in ring {
-            r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
-            let enter = r as i32 >> 31;
+        let mut one = |tap: &mut Tap, r: &mut u32| {
+            *r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
+            let enter = *r as i32 >> 31;
             let d = tap.up - enter; // +1: an up-step enters, a down-step leaves
             tap.up = enter;
             let (tc, ts) = ((tap.cs as i32) << 16 >> 16, tap.cs as i32 >> 16);
@@ -557,6 +557,19 @@ impl Sweep {
                 }
             }
             tap.v = acc - (tc * pc + ts * ps);
+        };
+        // Four taps a turn: the loop's spills and branch are paid once per four.
+        let mut pairs = ring.chunks_exact_mut(4);
+        for pair in &mut pairs {
+            if let [a, b, c, e] = pair {
+                one(a, &mut r);
+                one(b, &mut r);
+                one(c, &mut r);
+                one(e, &mut r);
+            }
+        }
+        for tap in pairs.into_remainder() {
+            one(tap, &mut r);
         }
         (self.pc, self.ps, self.acc) = (pc, ps, acc);
         r
