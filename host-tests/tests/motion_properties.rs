@@ -27,14 +27,7 @@ prop_compose! {
         // α1 in [limit min, −0.001°], α2 in [0.001°, limit max].
         let a1 = -1 - ((-lim.min.millidegrees() - 1) as f64 * af) as i32;
         let a2 = 1 + ((lim.max.millidegrees() - 1) as f64 * bf) as i32;
-        let cfg = AxisConfig {
-            seed,
-            window: w,
-            step: Angle::from_millidegrees(step),
-            range: AngleRange { min: Angle::from_millidegrees(a1), max: Angle::from_millidegrees(a2) },
-            closure: if paper { Closure::Paper } else { Closure::Seamless },
-        };
-        (axis, n, cfg)
+        (axis, n, config(seed, w, step, a1, a2, paper))
     }
 }
 
@@ -131,13 +124,7 @@ proptest! {
     fn invalid_configurations_get_errors(axis in axis_strategy(), n in 0usize..10_000, w in any::<u16>(),
                                          seed in any::<u32>(), step in any::<i32>(), a1 in -40_000i32..40_000, a2 in -40_000i32..40_000,
                                          paper in any::<bool>()) {
-        let cfg = AxisConfig {
-            seed,
-            window: w,
-            step: Angle::from_millidegrees(step),
-            range: AngleRange { min: Angle::from_millidegrees(a1), max: Angle::from_millidegrees(a2) },
-            closure: if paper { Closure::Paper } else { Closure::Seamless },
-        };
+        let cfg = config(seed, w, step, a1, a2, paper);
         let verdict = cfg.validate(axis, n);
         let mut buf = vec![Mdeg16(7); n];
         match HannKernel::new(w) {
@@ -177,6 +164,24 @@ proptest! {
             };
             prop_assert!(broken, "{:?} for n={} w={} step={} range {}..{}", e, n, w, step, a1, a2);
         }
+    }
+}
+
+/// A configuration from raw parts (step and range in millidegrees).
+fn config(seed: u32, window: u16, step: i32, a1: i32, a2: i32, paper: bool) -> AxisConfig {
+    AxisConfig {
+        seed,
+        window,
+        step: Angle::from_millidegrees(step),
+        range: AngleRange {
+            min: Angle::from_millidegrees(a1),
+            max: Angle::from_millidegrees(a2),
+        },
+        closure: if paper {
+            Closure::Paper
+        } else {
+            Closure::Seamless
+        },
     }
 }
 

@@ -159,20 +159,22 @@ impl Sample for Q16 {
     fn from_fine(fine: i32) -> Self {
         Q16(Mdeg16::from_fine(fine).0)
     }
+    // Read without its scale (the finalised paper loop, `LoopScale::MDEG`),
+    // a Q16 sample is an `Mdeg16`.
     #[inline]
     fn fine(self) -> i32 {
-        i32::from(self.0) * FINE_PER_MDEG
+        Mdeg16(self.0).fine()
     }
     #[inline]
     fn angle(self) -> Angle {
-        Angle::from_millidegrees(i32::from(self.0))
+        Mdeg16(self.0).angle()
     }
     #[inline]
     fn angle_in(self, scale: &LoopScale) -> Angle {
         scale.angle(self.0)
     }
     fn hash_into(self, h: &mut Fnv1a) {
-        h.write(&self.0.to_le_bytes());
+        Mdeg16(self.0).hash_into(h);
     }
 }
 
