@@ -76,8 +76,8 @@ pub fn paper(seed: u32, n: usize, w: usize, a1: f64, a2: f64) -> RefLoop {
     }
 }
 
-/// The seamless closure: periodic walk, circular smoothing, start at the first
-/// crossing of the zero level, scaled about it.
+/// The seamless closure: periodic walk, circular smoothing, start at a
+/// crossing of the zero level (found as the engine finds it), scaled about it.
 pub fn seamless(seed: u32, n: usize, w: usize, a1: f64, a2: f64) -> RefLoop {
     let mut r = seed;
     let e: Vec<f64> = (0..n)
@@ -105,21 +105,39 @@ pub fn seamless(seed: u32, n: usize, w: usize, a1: f64, a2: f64) -> RefLoop {
     }
     let (lo, hi) = minmax(&j);
     let level = lo + (-a1) * (hi - lo) / (a2 - a1);
-    // The first crossing in generation order, which starts at the first
-    // full window's output, index W−1.
-    let mut split = w - 1;
-    for step in 1..=n {
-        let (a, b) = ((w - 2 + step) % n, (w - 1 + step) % n);
-        let (p, c) = (j[a] - level, j[b] - level);
-        if p == 0.0 {
-            split = a;
-            break;
+    // The crossing the engine picks: generation order starts at the first
+    // full window's output, loop index W−1; the first sample of the grid
+    // 0, 16, 32, … off the start's side brackets it, bisection narrows it
+    // to two neighbours, and the nearer one is the split.
+    let at = |g: usize| j[(w - 1 + g) % n] - level;
+    let x0 = at(0);
+    let before = |x: f64| if x0 > 0.0 { x > 0.0 } else { x < 0.0 };
+    let g = if x0 == 0.0 {
+        0
+    } else {
+        let grid = (1..)
+            .map(|k| 16 * k)
+            .take_while(|&g| g < n)
+            .find(|&g| !before(at(g)));
+        let bracket = grid
+            .map(|g| (g - 16, g))
+            .or_else(|| (1..n).find(|&g| !before(at(g))).map(|g| (g - 1, g)));
+        match bracket {
+            None => 0,
+            Some((mut a, mut b)) => {
+                while b - a > 1 {
+                    let m = a + (b - a) / 2;
+                    if before(at(m)) {
+                        a = m;
+                    } else {
+                        b = m;
+                    }
+                }
+                if at(b).abs() <= at(a).abs() { b } else { a }
+            }
         }
-        if c == 0.0 || (c < 0.0) != (p < 0.0) {
-            split = if c.abs() <= p.abs() { b } else { a };
-            break;
-        }
-    }
+    };
+    let split = (w - 1 + g) % n;
     let normalized: Vec<f64> = j
         .iter()
         .map(|v| a1 + (v - lo) * (a2 - a1) / (hi - lo))
