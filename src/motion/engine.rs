@@ -257,8 +257,7 @@ fn seamless<S: Sample, T: Trace>(
     let n_mod_w = n % w;
     let (pc, ps, bb, wrap_sum) = initial_window(table, n_mod_w, &mut main, qq, &mut ring);
     let taps = ring.as_mut_slice();
-    let total = i64::from(qq * w as i32) * i64::from(ones) - wrap_sum;
-    let detrend = total.div_euclid(n as i64) as i32;
+    let detrend = detrend(qq * w as i32, ones, wrap_sum, n);
 
     // Pass 2: slide the window around the loop, storing X in generation
     // order: out[t] belongs to loop index (W−1+t) mod N.
@@ -358,6 +357,22 @@ fn seamless<S: Sample, T: Trace>(
         up_steps: ones as u16,
     };
     Ok((info, scale))
+}
+
+/// The detrend q = ⌊(Q²·W·ups − E)/N⌋ (see the module docs), with
+/// `qqw` = Q²·W < 2²⁹, `ups` ≤ N ≤ 8192 and |E| < 2²⁴: in 32-bit steps
+/// (two divisions, not a 64-bit one). With Q²·W = a·N + b, b < N, the
+/// quotient is a·ups + ⌊(b·ups − E)/N⌋, where |b·ups − E| < 2²⁶ + 2²⁴.
+fn detrend(qqw: i32, ups: u32, e: i32, n: usize) -> i32 {
+    let (qqw, n) = (qqw as u32, n as u32);
+    let (a, b) = (qqw / n, qqw % n);
+    let y = (b * ups) as i32 - e;
+    let rest = if y >= 0 {
+        (y as u32 / n) as i32
+    } else {
+        -(((-y - 1) as u32 / n) as i32) - 1
+    };
+    (a * ups) as i32 + rest
 }
 
 /// The quantisation step `2^shift` from `V` units to the stored integral X.
@@ -542,11 +557,11 @@ impl Sweep {
         let mut one = |tap: &mut Tap, r: &mut u32| {
             *r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
             let enter = *r as i32 >> 31;
-            let d = tap.up - enter; // +1: an up-step enters, a down-step leaves
-            tap.up = enter;
-            let (tc, ts) = ((tap.cs as i32) << 16 >> 16, tap.cs as i32 >> 16);
-            if d != 0 {
-                if d > 0 {
+            let (tc, ts) = tap.parts();
+            if enter != tap.up {
+                tap.up = enter;
+                if enter != 0 {
+                    // An up-step enters, a down-step leaves.
                     pc += tc;
                     ps += ts;
                     acc += qq;
@@ -668,8 +683,12 @@ impl Sweep {
 /// SA(k) = Σ_{n=W−1}^{k+W−1} T[n mod W],  SB(k) = Σ_{n=k+N}^{N+W−2} T[n mod W]
 /// ```
 ///
-/// (products of 2-vectors are dot products). |S| ≤ Q·W/π + 2Q, so each
-/// product stays below Q²·W/π < 2²⁹; E is summed in `i64`. O(W), once per axis.
+/// (products of 2-vectors are dot products). Each step's two parts cover
+/// the W lags 0..W−1 once, so its term is a sum of W rounding errors of the
+/// table's products, and |E| stays far inside `i32`: below 2²⁴ for every
+/// W ≤ 511 and every N mod W, whatever the steps (`host-tests` checks all
+/// of them). The partial sums may leave `i32`, so they wrap: the final sum
+/// is exact. O(W), once per axis.
 ///
 /// [`initial_window`] sums it while it fills the window.
 #[inline(never)] // a function of its own: registers of its own
@@ -679,14 +698,15 @@ fn initial_window(
     main: &mut Lcg,
     qq: i32,
     ring: &mut heapless::Vec<Tap, { MAX_WINDOW as usize }>,
-) -> (i32, i32, i32, i64) {
+) -> (i32, i32, i32, i32) {
     let w = table.len();
-    // The window's steps, one tap each.
+    // The window's steps, one tap each. Cannot fail: the table has at most
+    // MAX_WINDOW entries.
+    let _ = ring.resize(w, Tap::EMPTY);
     let mut r = main.value();
-    for &e in table {
+    for (tap, &e) in ring.iter_mut().zip(table) {
         r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
-        // Cannot fail: the table has at most MAX_WINDOW entries.
-        let _ = ring.push(Tap::new(e, r as i32 >> 31));
+        *tap = Tap::new(e, r as i32 >> 31);
     }
     *main = Lcg::new(r);
     let taps = ring.as_slice();
@@ -694,15 +714,14 @@ fn initial_window(
     let (last, early) = taps.split_last().unwrap_or((&Tap::EMPTY, &[]));
     let (mut pc, mut ps, mut ups) = (0i32, 0i32, 0i32);
     let (mut sc, mut ss) = last.parts();
-    let mut sum = 0i64;
+    let mut sum = 0i32;
     for tap in early {
         let (c, s) = tap.parts();
         if tap.up != 0 {
             pc += c;
             ps += s;
             ups += 1;
-            // |T·S| < Q²·W/π < 2²⁹.
-            sum += i64::from(c * sc + s * ss);
+            sum = sum.wrapping_add((c * sc).wrapping_add(s * ss));
         }
         sc += c;
         ss += s;
@@ -726,19 +745,19 @@ fn initial_window(
     (pc, ps, ups * qq, state.2)
 }
 
-/// Adds to E's sum (`.2`) the terms T(k)·S(k) of the up-steps among `taps`,
-/// T(k) the k-th entry of `phases`, with the running sum S (`.0`, `.1`)
-/// moving by −T(k) after each step (SB of the derivation, sign folded in).
+/// Adds to E's sum (`.2`, wrapping) the terms T(k)·S(k) of the up-steps
+/// among `taps`, T(k) the k-th entry of `phases`, with the running sum S
+/// (`.0`, `.1`) moving by −T(k) after each step (SB of the derivation, sign
+/// folded in).
 fn wrap_part(
     taps: &[Tap],
     phases: &[(i16, i16)],
-    (mut sc, mut ss, mut sum): (i32, i32, i64),
-) -> (i32, i32, i64) {
+    (mut sc, mut ss, mut sum): (i32, i32, i32),
+) -> (i32, i32, i32) {
     for (tap, &(c, s)) in taps.iter().zip(phases) {
         let (c, s) = (i32::from(c), i32::from(s));
         if tap.up != 0 {
-            // |T·S| < Q²·W/π < 2²⁹.
-            sum += i64::from(c * sc + s * ss);
+            sum = sum.wrapping_add((c * sc).wrapping_add(s * ss));
         }
         sc -= c;
         ss -= s;
