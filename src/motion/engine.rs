@@ -251,7 +251,8 @@ fn seamless<S: Sample, T: Trace>(
     // Initial window: k = 0..W−1, output index W−1. The same steps give the
     // wrap correction E (see `initial_window`) and fill the tap ring.
     let mut main = Lcg::new(cfg.seed);
-    // A heapless vector: stack storage without clearing 4 KiB per axis.
+    // A heapless vector: stack storage (16 B a tap, 8 KiB at most) without
+    // clearing all of it per axis.
     let mut ring: heapless::Vec<Tap, { MAX_WINDOW as usize }> = heapless::Vec::new();
     // N mod W, the one division of the sweep's indices (software on ARMv6-M).
     let n_mod_w = n % w;
@@ -451,14 +452,16 @@ fn requantise<S: Sample>(out: &mut [S], x0: i32, lo: i32, hi: i32) -> u32 {
     k
 }
 
-/// One tap of the sliding window: the kernel table entry of its residue j
-/// and the step currently in the window at that residue (0 for down, −1 for
-/// up). The step leaving the window and the one entering it share the
+/// One tap of the sliding window (16 bytes): the kernel table entry of its
+/// residue j and the step currently in the window at that residue (0 for
+/// down, −1 for up). The step leaving the window and the one entering it share the
 /// residue, so this ring replaces a second, lagging generator.
 #[derive(Clone, Copy)]
 struct Tap {
-    /// (Q·cos, Q·sin) packed as `cos | sin << 16`: one load on ARMv6-M.
-    cs: u32,
+    /// Q·cos, widened: one load and no sign extension on ARMv6-M.
+    c: i32,
+    /// Q·sin, widened.
+    s: i32,
     up: i32,
     /// Scratch: the velocity V − q of the tap's latest sample.
     v: i32,
@@ -471,12 +474,13 @@ impl Tap {
     /// The table entry (Q·cos, Q·sin).
     #[inline]
     fn parts(&self) -> (i32, i32) {
-        ((self.cs as i32) << 16 >> 16, self.cs as i32 >> 16)
+        (self.c, self.s)
     }
 
     const fn new((c, s): (i16, i16), up: i32) -> Self {
         Self {
-            cs: (c as u16 as u32) | ((s as u16 as u32) << 16),
+            c: c as i32,
+            s: s as i32,
             up,
             v: 0,
         }
