@@ -366,7 +366,8 @@ fn seamless<S: Sample, T: Trace>(
 /// quotient is a·ups + ⌊(b·ups − E)/N⌋, where |b·ups − E| < 2²⁶ + 2²⁴.
 fn detrend(qqw: i32, ups: u32, e: i32, n: usize) -> i32 {
     let (qqw, n) = (qqw as u32, n as u32);
-    let (a, b) = (qqw / n, qqw % n);
+    let a = qqw / n;
+    let b = qqw - a * n;
     let y = (b * ups) as i32 - e;
     let rest = if y >= 0 {
         (y as u32 / n) as i32
@@ -390,7 +391,7 @@ fn detrend(qqw: i32, ups: u32, e: i32, n: usize) -> i32 {
 fn raw_shift(qq: i32, w: usize, n: usize) -> u32 {
     // Q²·W/2 · 0.9·√N · 3/2 ≈ Q²·W·√N·0.675 = ⌊y/40⌋, y = Q²·W·√N·27;
     // Q²·W < 2²⁹ and 27·√N < 2²¹ each fit u32, their product u64.
-    let y = u64::from(qq as u32 * w as u32) * u64::from(27 * super::kernel::isqrt(n as u32));
+    let y = u64::from(qq as u32 * w as u32) * u64::from(27 * (n as u32).isqrt());
     let by_extent = bit_len_div40(y).saturating_sub(16);
     let by_len = 64 - ((2 * n as u64 - 1).leading_zeros());
     by_extent.max(by_len).max(15)
@@ -710,7 +711,8 @@ fn initial_window(
     let mut r = main.value();
     for (tap, &e) in ring.iter_mut().zip(table) {
         r = r.wrapping_mul(super::lcg::A).wrapping_add(super::lcg::C);
-        *tap = Tap::new(e, r as i32 >> 31);
+        (tap.c, tap.s) = (i32::from(e.0), i32::from(e.1));
+        tap.up = r as i32 >> 31;
     }
     *main = Lcg::new(r);
     let taps = ring.as_slice();

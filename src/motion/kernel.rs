@@ -30,22 +30,6 @@ pub struct HannKernel {
     table: heapless::Vec<(i16, i16), { MAX_WINDOW as usize }>,
 }
 
-/// Integer square root (floor), for the table scale.
-pub(super) const fn isqrt(v: u32) -> u32 {
-    let mut lo = 0u32;
-    let mut hi = 1u32 << 16;
-    while hi - lo > 1 {
-        let mid = u32::midpoint(lo, hi);
-        // mid < 2¹⁶, so the square fits u32 (no 64-bit multiply on ARMv6-M).
-        if mid * mid <= v {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    lo
-}
-
 impl HannKernel {
     /// Builds the table for a window of `window` taps.
     ///
@@ -91,7 +75,7 @@ impl HannKernel {
             return Ok(());
         }
         let w = usize::from(window);
-        let q = isqrt((1u32 << 29) / u32::from(window)) as i32 - 1;
+        let q = ((1u32 << 29) / u32::from(window)).isqrt() as i32 - 1;
         // 32-bit phase, 2³² = one turn (idsp's convention: i32::MIN is −π):
         // phase(j) = ⌊j·2³²/W⌋, stepped exactly (Bresenham on the remainder).
         // ⌊2³²/W⌋ and 2³² mod W from (2³² − 1)/W, in 32 bits.
