@@ -612,12 +612,9 @@ impl Sweep {
         let len = out.len().min(ring.len());
         let (out, ring) = (&mut out[..len], &ring[..len]);
         let mut i = 0;
-        'sweep: loop {
+        while i < len {
             if rising {
-                loop {
-                    if i >= len {
-                        break 'sweep;
-                    }
+                while i < len {
                     let v = ring[i].v + (low >> up) as i32;
                     low = (v as u32) << up;
                     let v = v >> shift;
@@ -635,10 +632,7 @@ impl Sweep {
                     i += 1;
                 }
             } else {
-                loop {
-                    if i >= len {
-                        break 'sweep;
-                    }
+                while i < len {
                     let v = ring[i].v + (low >> up) as i32;
                     low = (v as u32) << up;
                     let v = v >> shift;
