@@ -48,8 +48,7 @@ Commands:
            motion engine for the default set, for W = 15, 59, 239 (N = 900)
            and N = 450, 900, 1800 (W = 59), next to a direct-form f32
            smoothing, then a verdict. Fails if the default set takes more
-           than its regression ceiling (175,000 instructions;
-           the target is 150,000).
+           than its budget of 150,000 instructions.
   preview  Write the stages of a loop as CSV and PNG (walk, smoothed,
            normalised, final loop with the split point) with its metrics;
            with no options, the three default axes. Options: `preview -h`.
