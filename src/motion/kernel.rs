@@ -92,31 +92,27 @@ impl HannKernel {
         self.table.clear();
         // Cannot fail: w ≤ MAX_WINDOW, the capacity.
         let _ = self.table.resize(w, (0, 0));
-        for j in 0..=w / 2 {
+        // The entries j = 0..=W/2 from the sine/cosine, the rest by symmetry.
+        let (head, tail) = self.table.split_at_mut((w / 2 + 1).min(w));
+        for (j, e) in head.iter_mut().enumerate() {
             let (c, s) = idsp::cossin(phase as i32);
-            let (tc, mut ts) = (scale(c), scale(s));
-            if j == 0 || 2 * j == w {
-                ts = 0; // sin 0 = sin π = 0 exactly
-            }
-            // Mirror: cos(2π(W−j)/W) = cos(2πj/W), sin(2π(W−j)/W) = −sin(2πj/W).
-            let mirror = w - j;
-            if let Some(e) = self.table.get_mut(j) {
-                *e = (tc, ts);
-                cos_sum += i32::from(tc);
-            }
-            if j != 0
-                && mirror != j
-                && let Some(e) = self.table.get_mut(mirror)
-            {
-                *e = (tc, -ts);
-                cos_sum += i32::from(tc);
-            }
+            // sin 0 = sin π = 0 exactly.
+            let ts = if j == 0 || 2 * j == w { 0 } else { scale(s) };
+            *e = (scale(c), ts);
+            cos_sum += i32::from(e.0);
             phase = phase.wrapping_add(step);
             frac += rem;
             if frac >= u32::from(window) {
                 frac -= u32::from(window);
                 phase = phase.wrapping_add(1);
             }
+        }
+        // Mirror: cos(2π(W−j)/W) = cos(2πj/W), sin(2π(W−j)/W) = −sin(2πj/W):
+        // entry W−1 from j = 1, W−2 from j = 2, … (j = W/2 is its own
+        // mirror when W is even).
+        for (e, &(tc, ts)) in tail.iter_mut().rev().zip(head.iter().skip(1)) {
+            *e = (tc, -ts);
+            cos_sum += i32::from(tc);
         }
         // Zero-sum cosine column: fold the rounding residue into j = 0.
         if let Some(e) = self.table.first_mut() {
