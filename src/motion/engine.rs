@@ -292,14 +292,14 @@ fn seamless<S: Sample, T: Trace>(
     sweep.run(tail, taps, n_mod_w, &mut again, qq, shift);
     sweep.settle();
     debug_assert_eq!(sweep.x, 0, "the seamless loop closes exactly");
-    let (mut lo, mut hi, mut x0) = (sweep.lo, sweep.hi, x_first);
+    let (mut lo, mut hi) = (sweep.lo, sweep.hi);
     // X spans at most 65535 raw units, so that its offsets from the lowest
     // sample are exact in `u16`; a wider loop than `raw_shift` expects is
     // quantised again.
     let mut step_log = shift;
     if hi - lo > i32::from(u16::MAX) {
-        let k = requantise(out, x0, lo, hi);
-        (lo, hi, x0, step_log) = (lo >> k, hi >> k, x0 >> k, shift + k);
+        let k = requantise(out, x_first, lo, hi);
+        (lo, hi, step_log) = (lo >> k, hi >> k, shift + k);
     }
     let low = lo as i16;
     let offset = |s: &S| i32::from(s.to_scratch().wrapping_sub(low) as u16);
@@ -310,7 +310,6 @@ fn seamless<S: Sample, T: Trace>(
             trace.smoothed((w - 1 + t) % n, (lo + offset(o)) as f32 * scale);
         }
     }
-    let _ = x0;
     let a1 = i64::from(cfg.range.min.millidegrees()) * i64::from(FINE_PER_MDEG);
     let a2 = i64::from(cfg.range.max.millidegrees()) * i64::from(FINE_PER_MDEG);
     // The level that the range's zero maps to under the paper's
@@ -455,8 +454,8 @@ fn requantise<S: Sample>(out: &mut [S], x0: i32, lo: i32, hi: i32) -> u32 {
 
 /// One tap of the sliding window (16 bytes): the kernel table entry of its
 /// residue j and the step currently in the window at that residue (0 for
-/// down, −1 for up). The step leaving the window and the one entering it share the
-/// residue, so this ring replaces a second, lagging generator.
+/// down, −1 for up). The step leaving the window and the one entering it
+/// share the residue, so this ring replaces a second, lagging generator.
 #[derive(Clone, Copy)]
 struct Tap {
     /// Q·cos, widened: one load and no sign extension on ARMv6-M.
@@ -470,21 +469,17 @@ struct Tap {
 
 impl Tap {
     /// No table entry, no step.
-    const EMPTY: Self = Self::new((0, 0), 0);
+    const EMPTY: Self = Self {
+        c: 0,
+        s: 0,
+        up: 0,
+        v: 0,
+    };
 
     /// The table entry (Q·cos, Q·sin).
     #[inline]
     fn parts(&self) -> (i32, i32) {
         (self.c, self.s)
-    }
-
-    const fn new((c, s): (i16, i16), up: i32) -> Self {
-        Self {
-            c: c as i32,
-            s: s as i32,
-            up,
-            v: 0,
-        }
     }
 }
 

@@ -496,12 +496,21 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
         kernel: &HannKernel,
         trace: &mut T,
     ) -> Result<LoopInfo, MotionError> {
-        // Validate, generate and keep the ring as computed: no rotation.
+        self.generate_checked(cfg.validate(axis, N), cfg, kernel, trace)
+    }
+
+    /// Generates from `cfg` if `checked` (its validation, done by the
+    /// caller) passed, and keeps the ring as computed: no rotation.
+    fn generate_checked<T: Trace>(
+        &mut self,
+        checked: Result<(), MotionError>,
+        cfg: &AxisConfig,
+        kernel: &HannKernel,
+        trace: &mut T,
+    ) -> Result<LoopInfo, MotionError> {
         self.start = 0;
         self.scale = LoopScale::NEUTRAL;
-        let result = cfg
-            .validate(axis, N)
-            .and_then(|()| engine::generate(&mut self.samples, cfg, kernel, trace));
+        let result = checked.and_then(|()| engine::generate(&mut self.samples, cfg, kernel, trace));
         match result {
             Ok((info, scale)) => {
                 self.start = info.start;
@@ -642,8 +651,9 @@ impl<S: Sample, const N: usize> HeadTrajectories<S, N> {
                 .rebuild(c.window)
                 .map_err(|error| AxisError { axis, error })?;
             let i = axis.index();
+            // Validated above, with the other axes.
             infos[i] = self.axes[i]
-                .generate(c, axis, &kernel)
+                .generate_checked(Ok(()), c, &kernel, &mut ())
                 .map_err(|error| AxisError { axis, error })?;
         }
         Ok(infos)
