@@ -17,9 +17,8 @@
 //! assert!((0..DEFAULT_N).all(|i| range.contains(yaw.angle(i))));
 //! ```
 //!
-//! The project's README follows.
-//!
-#![doc = include_str!("../README.md")]
+//! The hardware, the wiring, the commands and how the motion is computed are
+//! in the project's README (`README.md` at the repository root).
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -33,14 +32,24 @@
     clippy::cast_precision_loss
 )]
 
+// A bare `cargo test` builds for the firmware's target, where no test can
+// run: say where the tests are instead of failing on each doc test.
+#[cfg(all(doctest, target_os = "none"))]
+compile_error!("the tests run on the host: `cargo xtask test` (or `cd host-tests && cargo test`)");
+
 pub mod axis;
+pub mod behaviour;
+pub mod command;
+pub mod console;
 pub mod driver;
 #[cfg(feature = "firmware")]
-pub mod firmware;
+pub mod frame_task;
+pub mod idle;
 pub mod metrics;
 pub mod motion;
 pub mod playback;
 pub mod servo;
+pub mod settings;
 pub mod units;
 
 pub use axis::Axis;

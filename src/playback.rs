@@ -1,12 +1,29 @@
 //! Frame playback: which point of the loop a frame shows.
 //!
 //! A loop of `N` samples is played over a configurable duration, independent of
-//! `N` and of the frame rate. The position of frame `k` is computed from `k`
-//! itself (`k · frame_period mod loop_duration`, exact integer arithmetic), so
-//! there is no drift however long the head runs. Between samples the loop is
-//! interpolated with a cyclic Catmull-Rom spline (cubic Hermite with central
-//! difference tangents): continuous in value and velocity everywhere, also
-//! across the seam from sample `N − 1` back to sample 0.
+//! `N` and of the frame rate. The position of frame `k` is
+//! `k · frame_period mod loop_duration` in exact integer arithmetic, so there
+//! is no drift however long the head runs: [`Playback::position`] computes it
+//! from `k`, [`Player`] (the frame path) keeps it from frame to frame with
+//! additions only. Between samples the loop is interpolated with a cyclic
+//! Catmull-Rom spline (cubic Hermite with central difference tangents):
+//! continuous in value and velocity everywhere, also across the seam from
+//! sample `N − 1` back to sample 0.
+//!
+//! # The spline in 32 bits
+//!
+//! With the four samples `p₀..p₃` around a segment and their differences
+//! `d₀ = p₁ − p₀`, `d₁ = p₂ − p₁`, `d₂ = p₃ − p₂`, the segment at `t ∈ [0, 1)` is
+//! `2p(t) = 2p₁ + a₁t + a₂t² + a₃t³` with `a₁ = d₀ + d₁`,
+//! `a₂ = −2d₀ + 3d₁ − d₂`, `a₃ = d₀ − 2d₁ + d₂`, evaluated by Horner's rule with
+//! `t` in Q12 (1.67 frames per sample at the defaults: 4096 steps are far
+//! finer than the frames). When neighbouring samples differ by less than 2¹⁵
+//! m° (32.8°; the idle loops move a fraction of a degree per sample) and lie
+//! within ±2²⁹ m°,
+//! `|a₁| ≤ 2¹⁶`, `|a₂| ≤ 6·2¹⁵`, `|a₃| ≤ 4·2¹⁵` and the Horner sums stay below
+//! `12·2¹⁵·2¹²` < 2³¹: `i32`. Larger steps take the same formula in `i64`.
+//! Each product is rounded down (`>> 12`); the value is `p₁` plus half the
+//! polynomial part, rounded half up.
 //!
 //! ```
 //! use idle_head::playback::{LoopSource, Playback};
@@ -22,7 +39,11 @@
 //! assert_eq!(at(8), 0); // one loop later: back to the start
 //! ```
 
+mod player;
+
 use core::num::{NonZeroU64, NonZeroUsize};
+
+pub use player::{Axes, Cursor, Player};
 
 use crate::units::{Angle, Microseconds, Millis};
 
@@ -74,11 +95,12 @@ pub enum PlaybackError {
     ZeroFramePeriod,
     /// The loop has no samples.
     NoSamples,
+    /// The loop has more than `u32::MAX` samples.
+    TooManySamples,
 }
 
-/// Fraction bits of the interpolation parameter (`t` in Q16, 1.0 = 65 536).
+/// Fraction bits of [`Playback::position`] (Q16, 1.0 = 65 536).
 const FRAC_BITS: u32 = 16;
-const ONE: i64 = 1 << FRAC_BITS;
 
 /// Maps frame indices to loop positions and interpolated offsets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -101,7 +123,8 @@ impl Playback {
     ///
     /// # Errors
     /// [`PlaybackError::ZeroLoopDuration`], [`PlaybackError::ZeroFramePeriod`] or
-    /// [`PlaybackError::NoSamples`] if the respective parameter is zero.
+    /// [`PlaybackError::NoSamples`] if the respective parameter is zero,
+    /// [`PlaybackError::TooManySamples`] above `u32::MAX` samples.
     pub const fn new(
         loop_duration: Millis,
         frame_period: Microseconds,
@@ -116,6 +139,9 @@ impl Playback {
         let Some(samples) = NonZeroUsize::new(samples) else {
             return Err(PlaybackError::NoSamples);
         };
+        if samples.get() as u64 > u32::MAX as u64 {
+            return Err(PlaybackError::TooManySamples);
+        }
         Ok(Self {
             loop_us,
             frame_us: frame_period.0,
@@ -147,56 +173,187 @@ impl Playback {
     /// Exact: time in the loop is `frame · frame_period mod loop_duration`, in µs.
     #[must_use]
     pub const fn position(&self, frame: u64) -> (usize, u32) {
-        // The divisions cannot fail (loop_us ≥ 1); checked forms keep any
-        // panic path out of the frame path.
-        let loop_us = self.loop_us.get() as u128;
-        // frame < 2^64, frame_us < 2^32: the product fits u128.
-        let t = match (frame as u128 * self.frame_us as u128).checked_rem(loop_us) {
-            Some(t) => t,
-            None => 0,
-        };
-        // t < 2^42, samples < 2^64, · 2^16: < 2^122.
-        let pos = match (t * self.samples.get() as u128 * ONE as u128).checked_div(loop_us) {
-            Some(p) => p,
-            None => 0,
-        };
+        let pos = self.locate(frame, FRAC_BITS).0;
         let index = (pos >> FRAC_BITS) as usize; // < samples
-        let frac = (pos & (ONE as u128 - 1)) as u32;
+        let frac = (pos & ((1 << FRAC_BITS) - 1)) as u32;
         (index, frac)
     }
 
+    /// `X = t·n·2^bits` for frame `frame` (`t`: its time in the loop, µs):
+    /// `(⌊X/L⌋, X mod L)`, exactly. `bits ≤ 16`.
+    pub(crate) const fn locate(&self, frame: u64, bits: u32) -> (u64, u64) {
+        let l = self.loop_us.get();
+        let Some(a) = frame.checked_rem(l) else {
+            return (0, 0);
+        };
+        // t = (frame mod L)·F mod L.
+        let t = mul_div_rem(a, self.frame_us as u64, l).1;
+        // n < 2³², so n·2^bits < 2⁴⁸.
+        mul_div_rem(t, (self.samples.get() as u64) << bits, l)
+    }
+
     /// The three offsets (pitch, roll, yaw) of frame `frame`, interpolated
-    /// between samples with a cyclic Catmull-Rom spline.
+    /// between samples with a cyclic Catmull-Rom spline. [`Player`] gives
+    /// the same values frame by frame at a fraction of the cost.
     #[must_use]
     pub fn offsets<L: LoopSource + ?Sized>(&self, frame: u64, loops: [&L; 3]) -> [Angle; 3] {
         let (index, frac) = self.position(frame);
-        loops.map(|l| self.interpolate(l, index, frac))
+        let t = frac >> (FRAC_BITS - T_BITS);
+        let n = self.samples.get();
+        loops.map(|l| {
+            let window = Window::load(l, n, index);
+            Angle::from_millidegrees(window.at(t))
+        })
+    }
+}
+
+/// Fraction bits of the spline parameter `t` (Q12).
+pub(crate) const T_BITS: u32 = 12;
+
+/// Largest difference of neighbouring samples for the 32-bit spline.
+const NARROW_STEP: u32 = 1 << 15;
+
+/// The four samples `p₀..p₃` around a spline segment (from `p₁` to `p₂`),
+/// and up to two after them read ahead (see [`Player`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct Window {
+    p: [i32; 4],
+    ahead: [i32; 2],
+}
+
+impl Window {
+    /// No samples (all zero).
+    pub(crate) const EMPTY: Self = Self {
+        p: [0; 4],
+        ahead: [0; 2],
+    };
+
+    /// The samples `i − 1 ..= i + 2` of `source` (wrapping at `n`; `i < n`).
+    pub(crate) fn load<L: LoopSource + ?Sized>(source: &L, n: usize, i: usize) -> Self {
+        let at = |k: usize| source.angle(k).millidegrees();
+        let before = if i == 0 { n - 1 } else { i - 1 };
+        Self {
+            p: [at(before), at(i), at(wrap(i + 1, n)), at(wrap(i + 2, n))],
+            ahead: [0; 2],
+        }
     }
 
-    fn interpolate<L: LoopSource + ?Sized>(&self, source: &L, i: usize, frac: u32) -> Angle {
-        let n = self.samples.get();
-        // Neighbours i−1, i, i+1, i+2, wrapping at the seam (i < n, so the
-        // successor i + 1 ≤ n cannot overflow).
-        let succ = |k: usize| if k + 1 >= n { 0 } else { k + 1 };
-        let at = |k: usize| source.angle(k).millidegrees() as i64;
-        let p0 = at(if i == 0 { n - 1 } else { i - 1 });
-        let p1 = at(i);
-        if frac == 0 {
-            return Angle::from_millidegrees(p1 as i32);
-        }
-        let p2 = at(succ(i));
-        let p3 = at(succ(succ(i)));
-        let t = frac as i64;
-        // 2·p(t) = 2p1 + (p2 − p0)t + (2p0 − 5p1 + 4p2 − p3)t² + (3p1 − 3p2 + p3 − p0)t³.
-        // |p| < 2^31, so each coefficient < 2^35 and each Horner step < 2^52.
-        let a1 = p2 - p0;
-        let a2 = 2 * p0 - 5 * p1 + 4 * p2 - p3;
-        let a3 = 3 * (p1 - p2) + p3 - p0;
-        let h = ((a3 * t) >> FRAC_BITS) + a2;
-        let h = ((h * t) >> FRAC_BITS) + a1;
-        // Keep one more bit for rounding: (h·t) / 2^16 + 2p1, then halve with rounding.
-        let twice = ((h * t) >> FRAC_BITS) + 2 * p1;
-        let value = (twice + 1).div_euclid(2);
-        Angle::from_millidegrees(value.clamp(i32::MIN as i64, i32::MAX as i64) as i32)
+    /// The window of sample `i` (wrapping at `n`) around its sample `p₁`,
+    /// read from `source` but for `p₁`, which the window holds.
+    pub(crate) fn complete<L: LoopSource + ?Sized>(&mut self, source: &L, n: usize, i: usize) {
+        let at = |k: usize| source.angle(k).millidegrees();
+        let before = if i == 0 { n - 1 } else { i - 1 };
+        self.p = [
+            at(before),
+            self.p[1],
+            at(wrap(i + 1, n)),
+            at(wrap(i + 2, n)),
+        ];
+        self.ahead = [0; 2];
     }
+
+    /// A window of one sample: its value at `t = 0` is that sample.
+    pub(crate) const fn flat(p1: i32) -> Self {
+        Self {
+            p: [p1; 4],
+            ahead: [0; 2],
+        }
+    }
+
+    /// Moves the window on by one sample, `next` being the new last one.
+    #[inline]
+    pub(crate) fn shift(&mut self, next: i32) {
+        let [_, p1, p2, p3] = self.p;
+        self.p = [p1, p2, p3, next];
+    }
+
+    /// Moves the window on by one sample read ahead.
+    #[inline]
+    pub(crate) fn shift_ahead(&mut self) {
+        let [next, later] = self.ahead;
+        self.shift(next);
+        self.ahead = [later, later];
+    }
+
+    /// Keeps `sample` as the read-ahead sample `k` (0 or 1).
+    #[inline]
+    pub(crate) fn set_ahead(&mut self, k: u8, sample: i32) {
+        if let Some(slot) = self.ahead.get_mut(usize::from(k)) {
+            *slot = sample;
+        }
+    }
+
+    /// The segment's value at `t` (Q12, `0..4096`), in m°.
+    ///
+    /// The 32-bit form applies when `|p₁| < 2²⁹` and each difference lies in
+    /// `[−2¹⁵, 2¹⁵)`: then every sample is within 2³⁰, so the wrapping
+    /// differences are the true ones. (Each condition is a biased value
+    /// below 2¹⁶, so one comparison of their bitwise or tests them all.)
+    #[inline]
+    pub(crate) fn at(&self, t: u32) -> i32 {
+        let [p0, p1, p2, p3] = self.p;
+        let (d0, d1, d2) = (
+            p1.wrapping_sub(p0),
+            p2.wrapping_sub(p1),
+            p3.wrapping_sub(p2),
+        );
+        let bias = |d: i32| (d as u32).wrapping_add(NARROW_STEP);
+        let range = (p1 as u32).wrapping_add(1 << 29) >> 14;
+        if range | bias(d0) | bias(d1) | bias(d2) < 2 * NARROW_STEP {
+            let t = t as i32;
+            let a1 = d0 + d1;
+            let a2 = 3 * d1 - 2 * d0 - d2;
+            let a3 = d0 - 2 * d1 + d2;
+            let h = ((a3 * t) >> T_BITS) + a2;
+            let h = ((h * t) >> T_BITS) + a1;
+            let twice = (h * t) >> T_BITS;
+            return p1 + ((twice + 1) >> 1);
+        }
+        self.at_wide(t)
+    }
+
+    /// [`at`](Self::at) in `i64`, for any samples: each coefficient < 2³⁵,
+    /// each Horner sum < 2⁴⁸.
+    #[inline(never)]
+    fn at_wide(&self, t: u32) -> i32 {
+        let [p0, p1, p2, p3] = self.p.map(i64::from);
+        let t = i64::from(t);
+        let (d0, d1, d2) = (p1 - p0, p2 - p1, p3 - p2);
+        let a1 = d0 + d1;
+        let a2 = 3 * d1 - 2 * d0 - d2;
+        let a3 = d0 - 2 * d1 + d2;
+        let h = ((a3 * t) >> T_BITS) + a2;
+        let h = ((h * t) >> T_BITS) + a1;
+        let twice = (h * t) >> T_BITS;
+        let value = p1 + ((twice + 1) >> 1);
+        value.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
+    }
+}
+
+/// `(⌊t·m/l⌋, t·m mod l)` for `t < l < 2⁴⁷` and any `m`, in `u64`: long
+/// multiplication by the 16-bit digits of `m` from the top, reducing modulo
+/// `l` after each (`r·2¹⁶ + t·digit < 2⁶³ + 2⁶³`). The quotient is below `m`.
+pub(crate) const fn mul_div_rem(t: u64, m: u64, l: u64) -> (u64, u64) {
+    let (mut quotient, mut rem) = (0u64, 0u64);
+    // From the highest non-zero digit.
+    let mut shift = (64 - m.leading_zeros()).div_ceil(16) * 16;
+    while shift > 0 {
+        shift -= 16;
+        let partial = (rem << 16) + t * ((m >> shift) & 0xFFFF);
+        let (Some(digit), Some(rest)) = (partial.checked_div(l), partial.checked_rem(l)) else {
+            return (0, 0);
+        };
+        quotient = (quotient << 16) + digit;
+        rem = rest;
+    }
+    (quotient, rem)
+}
+
+/// `k` modulo `n` for `k < 3n`, by subtraction.
+pub(crate) fn wrap(mut k: usize, n: usize) -> usize {
+    while k >= n && n > 0 {
+        k -= n;
+    }
+    k
 }

@@ -20,6 +20,12 @@
 //! assert_eq!(PwmTiming::SERVO_50HZ.duty(Microseconds(1500), 62_500), Duty(4688));
 //! ```
 
+mod map;
+
+use core::fmt;
+
+pub use map::ServoMap;
+
 use crate::axis::Axis;
 use crate::units::{Angle, AngleRange, Microseconds};
 
@@ -78,7 +84,9 @@ pub enum Direction {
     Reversed,
 }
 
-/// A calibration rejected by [`ServoCalibration::validate`], with the rejected values.
+/// A calibration rejected by [`ServoCalibration::validate`], with the rejected
+/// values. Its [`Display`](fmt::Display) says what is wrong in microseconds and
+/// degrees; [`message`](Self::message) names the field for `const` checks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
@@ -94,6 +102,10 @@ pub enum ServoError {
     NeutralOutsidePulseRange {
         /// The rejected neutral pulse.
         neutral: Microseconds,
+        /// The calibration's shortest pulse.
+        min: Microseconds,
+        /// The calibration's longest pulse.
+        max: Microseconds,
     },
     /// `per_degree` is zero: every angle would map to the neutral pulse.
     ZeroPerDegree,
@@ -113,6 +125,10 @@ pub enum ServoError {
         angle: Angle,
         /// The pulse width that angle needs, in microseconds (may be negative).
         needed_us: i64,
+        /// The calibration's shortest pulse.
+        min: Microseconds,
+        /// The calibration's longest pulse.
+        max: Microseconds,
     },
 }
 
@@ -137,6 +153,82 @@ impl ServoError {
             Self::LimitUnreachable { .. } => {
                 "servo calibration: an angle in `limits` needs a pulse outside [`min_pulse`, `max_pulse`]"
             }
+        }
+    }
+}
+
+/// ```
+/// use idle_head::servo::{ServoCalibration, ServoError};
+/// use idle_head::{Axis, Microseconds};
+/// let mut cal = ServoCalibration::hobby(Axis::Roll);
+/// cal.min_pulse = Microseconds(2500);
+/// let err = cal.validate().unwrap_err();
+/// assert_eq!(err.to_string(), "min_pulse 2500 µs must be below max_pulse 2000 µs");
+/// ```
+impl fmt::Display for ServoError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::PulseRangeEmpty { min, max } => write!(
+                f,
+                "min_pulse {} µs must be below max_pulse {} µs",
+                min.0, max.0
+            ),
+            Self::NeutralOutsidePulseRange { neutral, min, max } => write!(
+                f,
+                "neutral {} µs lies outside the pulse range {}..{} µs",
+                neutral.0, min.0, max.0
+            ),
+            Self::ZeroPerDegree => f.write_str("per_degree must be above 0 ns/°"),
+            Self::LimitsInverted { limits } => write!(
+                f,
+                "limits {}..{}: the lower limit lies above the upper one",
+                Degrees(limits.min),
+                Degrees(limits.max)
+            ),
+            Self::NeutralOutsideLimits { limits } => write!(
+                f,
+                "limits {}..{} must contain 0°, the neutral angle the servo starts at",
+                Degrees(limits.min),
+                Degrees(limits.max)
+            ),
+            Self::LimitUnreachable {
+                angle,
+                needed_us,
+                min,
+                max,
+            } => write!(
+                f,
+                "limit {} needs {} µs, outside the pulse range {}..{} µs",
+                Degrees(angle),
+                needed_us,
+                min.0,
+                max.0
+            ),
+        }
+    }
+}
+
+impl core::error::Error for ServoError {}
+
+/// An angle shown in degrees with its sign and up to three decimals
+/// (`+20°`, `-12.5°`, `0°`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Degrees(pub(crate) Angle);
+
+impl fmt::Display for Degrees {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let m = self.0.millidegrees();
+        let sign = match m {
+            0 => "",
+            ..0 => "-",
+            _ => "+",
+        };
+        let (whole, frac) = (m.unsigned_abs() / 1000, m.unsigned_abs() % 1000);
+        match frac {
+            0 => write!(f, "{sign}{whole}°"),
+            _ if frac % 100 == 0 => write!(f, "{sign}{whole}.{}°", frac / 100),
+            _ if frac % 10 == 0 => write!(f, "{sign}{whole}.{:02}°", frac / 10),
+            _ => write!(f, "{sign}{whole}.{frac:03}°"),
         }
     }
 }
@@ -218,10 +310,17 @@ impl ServoCalibration {
     /// use idle_head::{Angle, Axis, Microseconds};
     /// let mut cal = ServoCalibration::hobby(Axis::Pitch);
     /// cal.max_pulse = Microseconds(1700); // +20° needs 1722 µs
+    /// let err = cal.validate().unwrap_err();
     /// assert_eq!(
-    ///     cal.validate(),
-    ///     Err(ServoError::LimitUnreachable { angle: Angle::from_degrees(20), needed_us: 1722 })
+    ///     err,
+    ///     ServoError::LimitUnreachable {
+    ///         angle: Angle::from_degrees(20),
+    ///         needed_us: 1722,
+    ///         min: Microseconds(1000),
+    ///         max: Microseconds(1700),
+    ///     }
     /// );
+    /// assert_eq!(err.to_string(), "limit +20° needs 1722 µs, outside the pulse range 1000..1700 µs");
     /// ```
     pub const fn validate(&self) -> Result<(), ServoError> {
         if self.min_pulse.0 >= self.max_pulse.0 {
@@ -233,6 +332,8 @@ impl ServoCalibration {
         if self.neutral.0 < self.min_pulse.0 || self.neutral.0 > self.max_pulse.0 {
             return Err(ServoError::NeutralOutsidePulseRange {
                 neutral: self.neutral,
+                min: self.min_pulse,
+                max: self.max_pulse,
             });
         }
         if self.per_degree.0 == 0 {
@@ -257,6 +358,8 @@ impl ServoCalibration {
                 return Err(ServoError::LimitUnreachable {
                     angle,
                     needed_us: needed,
+                    min: self.min_pulse,
+                    max: self.max_pulse,
                 });
             }
             i += 1;

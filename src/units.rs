@@ -4,7 +4,11 @@
 //! - [`Angle`]: signed angle in **millidegrees** (1 LSB = 0.001°) held in an `i32`.
 //! - [`Microseconds`]: pulse width or period in **microseconds** held in a `u32`.
 //! - [`Millis`]: duration in **milliseconds** held in a `u32`.
+//!
+//! Angles and ranges display in degrees, as a user writes them: `-23°`,
+//! `4.5°`, `-0.25°`, `-23°..32°` (exact: no float formatting).
 
+use core::fmt;
 use core::ops::{Add, Neg, Sub};
 
 /// A signed angle in millidegrees (1 LSB = 0.001°).
@@ -13,9 +17,9 @@ use core::ops::{Add, Neg, Sub};
 /// use idle_head::Angle;
 /// assert_eq!(Angle::from_degrees(-4).millidegrees(), -4000);
 /// assert_eq!(Angle::from_millidegrees(1500).to_degrees_f32(), 1.5);
+/// assert_eq!(Angle::from_millidegrees(-250).to_string(), "-0.25°");
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Angle(i32);
 
 impl Angle {
@@ -80,6 +84,68 @@ impl Angle {
     }
 }
 
+/// An angle in degrees as it is written: sign, whole degrees and the
+/// significant digits of the millidegrees (`-0.25°` is `("-", 0, 25, 2)`).
+struct Written {
+    sign: &'static str,
+    whole: u32,
+    fraction: u32,
+    digits: usize,
+}
+
+impl Written {
+    const fn of(angle: Angle) -> Self {
+        let abs = angle.0.unsigned_abs();
+        let (mut fraction, mut digits) = (abs % Angle::SCALE as u32, 3);
+        while digits > 0 && fraction % 10 == 0 {
+            fraction /= 10;
+            digits -= 1;
+        }
+        Self {
+            sign: if angle.0 < 0 { "-" } else { "" },
+            whole: abs / Angle::SCALE as u32,
+            fraction,
+            digits,
+        }
+    }
+}
+
+impl fmt::Display for Angle {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let Written {
+            sign,
+            whole,
+            fraction,
+            digits,
+        } = Written::of(*self);
+        if digits == 0 {
+            write!(f, "{sign}{whole}°")
+        } else {
+            write!(f, "{sign}{whole}.{fraction:0digits$}°")
+        }
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Angle {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        let Written {
+            sign,
+            whole,
+            fraction,
+            digits,
+        } = Written::of(*self);
+        // The arms differ in their format strings only (which defmt interns).
+        #[allow(clippy::match_same_arms)]
+        match digits {
+            0 => defmt::write!(f, "{=str}{=u32}°", sign, whole),
+            1 => defmt::write!(f, "{=str}{=u32}.{=u32}°", sign, whole, fraction),
+            2 => defmt::write!(f, "{=str}{=u32}.{=u32:02}°", sign, whole, fraction),
+            _ => defmt::write!(f, "{=str}{=u32}.{=u32:03}°", sign, whole, fraction),
+        }
+    }
+}
+
 impl Add for Angle {
     type Output = Self;
     fn add(self, rhs: Self) -> Self {
@@ -127,9 +193,13 @@ impl Millis {
     }
 }
 
-/// An inclusive angle range `[min, max]`.
+/// An inclusive angle range `[min, max]`, displayed as `min..max`.
+///
+/// ```
+/// use idle_head::AngleRange;
+/// assert_eq!(AngleRange::degrees(-23, 32).to_string(), "-23°..32°");
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AngleRange {
     /// Lower bound (α1 in the paper).
     pub min: Angle,
@@ -163,5 +233,18 @@ impl AngleRange {
     #[must_use]
     pub const fn span_millidegrees(&self) -> i64 {
         self.max.0 as i64 - self.min.0 as i64
+    }
+}
+
+impl fmt::Display for AngleRange {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}..{}", self.min, self.max)
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for AngleRange {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(f, "{}..{}", self.min, self.max);
     }
 }

@@ -1,5 +1,7 @@
 //! Shared helpers for the host tests of the `idle-head` core.
 
+pub mod console;
+
 use embedded_hal_mock::eh1::MockError;
 use embedded_hal_mock::eh1::pwm::{Mock, Transaction};
 use idle_head::Angle;
@@ -119,4 +121,98 @@ pub fn direct_config() -> DriverConfig {
         max_accel: DegreesPerSecondSquared(100_000_000),
     }; 3];
     cfg
+}
+
+/// Proptest strategies for configurations, shared by the test files.
+pub mod strategies {
+    use std::ops::RangeInclusive;
+
+    use idle_head::driver::{
+        DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, MotionLimits,
+    };
+    use idle_head::servo::{Direction, NanosPerDegree, ServoCalibration};
+    use idle_head::{Angle, AngleRange, Microseconds, Millis};
+    use proptest::prelude::*;
+
+    /// A valid calibration with limits within `±limit` m° and `per_degree`
+    /// ns/°: random neutral, scale, direction and limits, with pulse limits
+    /// just wide enough (plus a random margin) to reach the limits.
+    pub fn calibration_in(
+        limit: i32,
+        per_degree: RangeInclusive<u32>,
+    ) -> impl Strategy<Value = ServoCalibration> {
+        (
+            1200u32..=1800,
+            per_degree,
+            any::<bool>(),
+            -limit..=0,
+            0..=limit,
+            0u32..200,
+            0u32..200,
+        )
+            .prop_map(|(neutral, per_degree, reversed, lo, hi, below, above)| {
+                let mut cal = ServoCalibration {
+                    neutral: Microseconds(neutral),
+                    per_degree: NanosPerDegree(per_degree),
+                    direction: if reversed {
+                        Direction::Reversed
+                    } else {
+                        Direction::Normal
+                    },
+                    min_pulse: Microseconds(0),
+                    max_pulse: Microseconds(u32::MAX),
+                    limits: AngleRange {
+                        min: Angle::from_millidegrees(lo),
+                        max: Angle::from_millidegrees(hi),
+                    },
+                };
+                let ends = [
+                    cal.raw_pulse_us(cal.limits.min),
+                    cal.raw_pulse_us(cal.limits.max),
+                ];
+                let (p_lo, p_hi) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
+                cal.min_pulse = Microseconds((p_lo as u32).min(neutral - 1).saturating_sub(below));
+                cal.max_pulse = Microseconds((p_hi as u32).max(neutral + 1) + above);
+                cal
+            })
+    }
+
+    /// A valid calibration of a hobby servo's scale, limits within ±40°.
+    pub fn calibration() -> impl Strategy<Value = ServoCalibration> {
+        calibration_in(40_000, 5000..=20_000)
+    }
+
+    /// Speed and acceleration limits from a crawl to far beyond any servo.
+    pub fn limits() -> impl Strategy<Value = MotionLimits> {
+        (1u32..=400, 1u32..=20_000).prop_map(|(v, a)| MotionLimits {
+            max_speed: DegreesPerSecond(v),
+            max_accel: DegreesPerSecondSquared(a),
+        })
+    }
+
+    prop_compose! {
+        /// A valid driver configuration: random calibrations, limits, neutral
+        /// pose, fade, fault policy and frame period.
+        pub fn config()(
+            servos in [calibration(), calibration(), calibration()],
+            motion in [limits(), limits(), limits()],
+            pose in [0.0f64..=1.0, 0.0f64..=1.0, 0.0f64..=1.0],
+            fade in 0u32..3000,
+            disable_after in 1u16..30,
+            frame_us in prop_oneof![Just(20_000u32), Just(10_000), Just(3_000)],
+        ) -> DriverConfig {
+            let mut cfg = DriverConfig::DEFAULT;
+            cfg.frame_period = Microseconds(frame_us);
+            cfg.servos = servos;
+            cfg.motion = motion;
+            for i in 0..3 {
+                let l = servos[i].limits;
+                let (lo, hi) = (f64::from(l.min.millidegrees()), f64::from(l.max.millidegrees()));
+                cfg.neutral_pose[i] = Angle::from_millidegrees((lo + pose[i] * (hi - lo)).round() as i32);
+            }
+            cfg.fade = Millis(fade);
+            cfg.faults.disable_after = disable_after;
+            cfg
+        }
+    }
 }

@@ -200,12 +200,12 @@ fn wrong_kernel_is_rejected_not_misused() {
     assert!(generate_into(&mut buf, &cfg, Axis::Yaw, &kernel, &mut ()).is_err());
 }
 
-/// The firmware's storage: `Q16` with its loop scale reads exactly the
+/// The firmware's storage: `Integral16` with its loop scale reads exactly the
 /// angles that `Mdeg16` stores, and a fresh trajectory reads neutral.
 #[test]
-fn q16_reads_the_mdeg16_angles() {
-    use idle_head::motion::{LoopScale, Q16, Trajectory};
-    let fresh: Trajectory<Q16, 900> = Trajectory::new();
+fn integral16_reads_the_mdeg16_angles() {
+    use idle_head::motion::{Integral16, LoopScale, Trajectory};
+    let fresh: Trajectory<Integral16, 900> = Trajectory::new();
     assert_eq!(*fresh.scale(), LoopScale::NEUTRAL);
     assert!((0..900).all(|i| fresh.angle(i).millidegrees() == 0));
     for seed in 0..200u32 {
@@ -213,7 +213,7 @@ fn q16_reads_the_mdeg16_angles() {
         for closure in [Closure::Seamless, Closure::Paper] {
             let cfg = AxisConfig::paper_row(seed, 59, -4, 12).with_closure(closure);
             let kernel = HannKernel::new(59).unwrap();
-            let mut q = Box::new(Trajectory::<Q16, 900>::new());
+            let mut q = Box::new(Trajectory::<Integral16, 900>::new());
             let mut m = Box::new(Trajectory::<Mdeg16, 900>::new());
             let iq = q.generate(&cfg, Axis::Pitch, &kernel).unwrap();
             let im = m.generate(&cfg, Axis::Pitch, &kernel).unwrap();

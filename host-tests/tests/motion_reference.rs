@@ -2,7 +2,10 @@
 
 mod reference;
 
-use idle_head::motion::{AxisConfig, Closure, HannKernel, Lcg, Mdeg16, Trajectory};
+use idle_head::motion::{
+    AxisConfig, Closure, DEFAULT_HEAD, DEFAULT_N, Fnv1a, HannKernel, HeadConfig, HeadTrajectories,
+    Integral16, Lcg, Mdeg16, Sample, Trajectory, generate_into,
+};
 use idle_head::{AngleRange, Axis};
 
 fn engine<const N: usize>(
@@ -103,4 +106,68 @@ fn paper_matches_reference() {
 #[test]
 fn range_type_is_used() {
     let _ = AngleRange::degrees(-1, 1);
+}
+
+/// The three default loops, bit for bit: the checksum that the firmware
+/// prints and `qemu/expected.log` records. A change of the engine's
+/// arithmetic that moves any sample or scale shows here, on the host.
+#[test]
+fn default_loops_are_the_recorded_ones() {
+    let mut head = Box::new(HeadTrajectories::<Integral16, DEFAULT_N>::new());
+    head.generate(&DEFAULT_HEAD).unwrap();
+    assert_eq!(head.checksum(), 0x11a5_b828);
+}
+
+/// Loops across lengths, windows, seeds and both closures, bit for bit as
+/// the engine computed them when this test was written (one FNV-1a over
+/// every sample, scale and outcome): the engine's code may be rewritten,
+/// its loops may not move.
+#[test]
+fn loops_across_configurations_are_the_recorded_ones() {
+    let mut h = Fnv1a::new();
+    // Loops of any length, finalised and in playback order.
+    for n in [16, 17, 100, 450, 899, 900, 1800, 4001, 8192] {
+        for w in [3u16, 4, 15, 59, 60, 239, 511] {
+            if usize::from(w) > n / 2 {
+                continue;
+            }
+            let kernel = HannKernel::new(w).unwrap();
+            for seed in [0u32, 1, 127, 259, 8821, 0xdead_beef, u32::MAX] {
+                for closure in [Closure::Seamless, Closure::Paper] {
+                    let cfg = AxisConfig::paper_row(seed, w, -12, 19).with_closure(closure);
+                    let mut out = vec![Integral16::ZERO; n];
+                    match generate_into(&mut out, &cfg, Axis::Roll, &kernel, &mut ()) {
+                        Ok(info) => {
+                            h.write(&info.split.to_le_bytes());
+                            h.write(&info.crossings.to_le_bytes());
+                            h.write(&info.up_steps.to_le_bytes());
+                        }
+                        Err(_) => h.write(b"error"),
+                    }
+                    for s in &out {
+                        s.hash_into(&mut h);
+                    }
+                }
+            }
+        }
+    }
+    // The firmware's form: rings of raw integrals with their loop scales.
+    for w in [3u16, 15, 59, 239, 450] {
+        for seed in [0u32, 127, 0xdead_beef] {
+            for closure in [Closure::Seamless, Closure::Paper] {
+                let head = HeadConfig {
+                    pitch: DEFAULT_HEAD.pitch.with_seed(seed).with_window(w),
+                    roll: DEFAULT_HEAD.roll.with_seed(seed ^ 1).with_window(w),
+                    yaw: DEFAULT_HEAD.yaw.with_seed(seed ^ 2).with_window(w),
+                }
+                .with_closure(closure);
+                let mut loops = Box::new(HeadTrajectories::<Integral16, 900>::new());
+                match loops.generate(&head) {
+                    Ok(_) => h.write(&loops.checksum().to_le_bytes()),
+                    Err(_) => h.write(b"error"),
+                }
+            }
+        }
+    }
+    assert_eq!(h.finish(), 0x472d_c33b, "{:#010x}", h.finish());
 }

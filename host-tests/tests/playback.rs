@@ -1,6 +1,6 @@
 //! Loop playback: exact timing, interpolation, the seam.
 
-use idle_head::playback::{LoopSource, Playback, PlaybackError};
+use idle_head::playback::{LoopSource, Playback, PlaybackError, Player};
 use idle_head::{Angle, Microseconds, Millis};
 use proptest::prelude::*;
 
@@ -29,6 +29,12 @@ fn bad_parameters_are_rejected() {
         Playback::new(Millis(18_000), FRAME, 0),
         Err(PlaybackError::NoSamples)
     );
+    if let Ok(too_many) = usize::try_from(u64::from(u32::MAX) + 1) {
+        assert_eq!(
+            Playback::new(Millis(18_000), FRAME, too_many),
+            Err(PlaybackError::TooManySamples)
+        );
+    }
     let p = Playback::new(Millis(18_000), FRAME, 900).unwrap();
     assert_eq!(
         (p.loop_duration(), p.frame_period(), p.samples()),
@@ -183,5 +189,66 @@ proptest! {
         let (lo, hi) = (*pts.iter().min().unwrap(), *pts.iter().max().unwrap());
         let slack = (hi - lo) / 4 + 1;
         prop_assert!(got >= (lo - slack).max(i64::from(i32::MIN)) && got <= (hi + slack).min(i64::from(i32::MAX)));
+    }
+}
+
+#[test]
+fn the_player_plays_the_default_loop_as_playback_does() {
+    // 900 samples over 30 s at 20 ms frames: 5 frames for 3 samples.
+    let samples: [Vec<Angle>; 3] = [sine(900, 9000.0), sine(900, -5000.0), sine(900, 12_000.0)];
+    let loops = [
+        samples[0].as_slice(),
+        samples[1].as_slice(),
+        samples[2].as_slice(),
+    ];
+    let p = Playback::new(Millis(30_000), FRAME, 900).unwrap();
+    let mut player = Player::new(p, loops);
+    for k in 0..3100u64 {
+        assert_eq!(player.offsets(k), p.offsets(k, loops), "frame {k}");
+    }
+    assert_eq!(player.playback(), &p);
+}
+
+#[test]
+fn the_player_stays_exact_after_years_and_late_frames() {
+    // 900 samples over 60 s; frame index after ten years at 50 Hz.
+    let samples = sine(900, 10_000.0);
+    let loops = [samples.as_slice(); 3];
+    let p = Playback::new(Millis(60_000), FRAME, 900).unwrap();
+    let mut player = Player::new(p, loops);
+    let years = 50 * 3600 * 24 * 365 * 10u64;
+    // Late frames skip ahead, by one frame or by many; then frame by frame.
+    for start in [years, years + 2, years + 1000, u64::MAX - 5000] {
+        for k in start..start + 3000 {
+            assert_eq!(player.offsets(k), p.offsets(k, loops), "frame {k}");
+        }
+    }
+}
+
+proptest! {
+    /// Any playback (loop duration, frame period, sample count) and any
+    /// sequence of frames (the next one, a few skipped, a jump back or far
+    /// ahead, the same again): the player gives exactly `Playback::offsets`.
+    #[test]
+    fn the_player_is_playback_frame_by_frame(
+        values in proptest::collection::vec(-40_000i32..40_000, 1..60),
+        big in proptest::collection::vec(any::<i32>(), 1..8),
+        loop_ms in 1u32..200_000, frame_us in 1u32..100_000,
+        samples in prop_oneof![1usize..100, 100usize..2000, Just(1 << 19), Just(1 << 20)],
+        start: u64,
+        moves in proptest::collection::vec(prop_oneof![
+            8 => Just(1u64), 2 => 0u64..5, 1 => Just(0u64), 1 => any::<u64>()
+        ], 1..300),
+    ) {
+        let a: Vec<Angle> = values.iter().copied().map(Angle::from_millidegrees).collect();
+        let b: Vec<Angle> = big.iter().copied().map(Angle::from_millidegrees).collect();
+        let loops = [a.as_slice(), b.as_slice(), a.as_slice()];
+        let p = Playback::new(Millis(loop_ms), Microseconds(frame_us), samples).unwrap();
+        let mut player = Player::new(p, loops);
+        let mut frame = start;
+        for step in moves {
+            frame = frame.wrapping_add(step);
+            prop_assert_eq!(player.offsets(frame), p.offsets(frame, loops), "frame {}", frame);
+        }
     }
 }

@@ -116,7 +116,9 @@ fn validation_rejects_each_problem_with_the_rejected_value() {
     assert_eq!(
         c.validate(),
         Err(ServoError::NeutralOutsidePulseRange {
-            neutral: Microseconds(2100)
+            neutral: Microseconds(2100),
+            min: Microseconds(1000),
+            max: Microseconds(2000),
         })
     );
 
@@ -145,7 +147,9 @@ fn validation_rejects_each_problem_with_the_rejected_value() {
         c.validate(),
         Err(ServoError::LimitUnreachable {
             angle: Angle::from_degrees(-60),
-            needed_us: 833
+            needed_us: 833,
+            min: Microseconds(1000),
+            max: Microseconds(2000),
         })
     );
 
@@ -156,7 +160,9 @@ fn validation_rejects_each_problem_with_the_rejected_value() {
         c.validate(),
         Err(ServoError::LimitUnreachable {
             angle: Angle::from_degrees(20),
-            needed_us: 1278
+            needed_us: 1278,
+            min: Microseconds(1400),
+            max: Microseconds(2000),
         })
     );
 
@@ -169,6 +175,49 @@ fn validation_rejects_each_problem_with_the_rejected_value() {
         }
         .message()
         .contains("`min_pulse`")
+    );
+}
+
+/// Each error says what is wrong in µs and degrees, with the rejected values.
+#[test]
+fn servo_errors_read_in_the_users_units() {
+    let shown = |edit: &dyn Fn(&mut ServoCalibration)| {
+        let mut c = ServoCalibration::hobby(Axis::Pitch);
+        edit(&mut c);
+        c.validate().unwrap_err().to_string()
+    };
+    assert_eq!(
+        shown(&|c| c.min_pulse = Microseconds(2500)),
+        "min_pulse 2500 µs must be below max_pulse 2000 µs"
+    );
+    assert_eq!(
+        shown(&|c| c.neutral = Microseconds(2100)),
+        "neutral 2100 µs lies outside the pulse range 1000..2000 µs"
+    );
+    assert_eq!(
+        shown(&|c| c.per_degree = NanosPerDegree(0)),
+        "per_degree must be above 0 ns/°"
+    );
+    assert_eq!(
+        shown(&|c| c.limits = AngleRange::degrees(5, -5)),
+        "limits +5°..-5°: the lower limit lies above the upper one"
+    );
+    assert_eq!(
+        shown(&|c| {
+            c.limits = AngleRange {
+                min: Angle::from_millidegrees(2_500),
+                max: Angle::from_millidegrees(12_125),
+            }
+        }),
+        "limits +2.5°..+12.125° must contain 0°, the neutral angle the servo starts at"
+    );
+    assert_eq!(
+        shown(&|c| c.max_pulse = Microseconds(1700)),
+        "limit +20° needs 1722 µs, outside the pulse range 1000..1700 µs"
+    );
+    assert_eq!(
+        shown(&|c| c.limits = AngleRange::degrees(-60, 10)),
+        "limit -60° needs 833 µs, outside the pulse range 1000..2000 µs"
     );
 }
 

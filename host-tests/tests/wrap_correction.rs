@@ -1,13 +1,14 @@
 //! The seamless closure's wrap correction E fits `i32`, for every window and
 //! every loop length.
 //!
-//! The engine sums E (`src/motion/engine.rs`, `initial_window`) in wrapping
-//! `i32` arithmetic and forms the detrend from it in 32-bit steps; both are
-//! exact only if |E| < 2²⁴ (the bound its docs state). E is a sum over the
-//! first W−1 steps of b(k)·term(k), b(k) ∈ {0, 1}, where term(k) depends only
-//! on W and N mod W. This test bounds |E| for every W ≤ 511 and every N mod W
-//! by the worst choice of steps (all positive or all negative terms taken),
-//! computed in `i64` straight from the definition:
+//! The engine sums E (`src/motion/engine/sweep.rs`, `initial_window`) in
+//! wrapping `i32` arithmetic and forms the detrend from it in 32-bit steps
+//! (`seamless.rs`); both are exact only if |E| < 2²⁴ (the bound its docs
+//! state). E is a sum over the first W−1 steps of b(k)·term(k),
+//! b(k) ∈ {0, 1}, where term(k) depends only on W and N mod W. This test
+//! bounds |E| for every W ≤ 511 and every N mod W by the worst choice of
+//! steps (all positive or all negative terms taken), computed in `i64`
+//! straight from the definition:
 //!
 //! ```text
 //! term(k) = T[k]·SA(k) + T[(k+N) mod W]·SB(k)

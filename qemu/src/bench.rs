@@ -15,18 +15,29 @@
 //! `engine` is the whole pipeline (walk, smoothing, scaling, loop closure,
 //! for three axes); `direct` is only the direct-form smoothing
 //! s(n) = Σₘ h(m)·u(n−m) of three walks in f32 (N·W multiply-adds each).
+//!
+//! Then the frame benchmark (`frame_bench.rs`): the instructions of every
+//! frame update of a whole loop with a join, counted exactly, and of
+//! generating the next loop set of the never-repeating stream.
 #![no_std]
 #![no_main]
 
 #[path = "exit.rs"]
 mod exit;
+#[path = "frame_bench.rs"]
+mod frame_bench;
+// The Pico image's PWM clocking (a binary's items cannot be imported).
+#[path = "../../src/bin/pico/rp2040_pwm.rs"]
+#[allow(dead_code)]
+mod rp2040_pwm;
 #[path = "systick.rs"]
 #[allow(dead_code)] // the time driver half is the smoke image's
 mod systick;
 
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
-use idle_head::motion::{DEFAULT_HEAD, HeadConfig, HeadTrajectories, Lcg, Q16};
+use idle_head::motion::{DEFAULT_HEAD, HeadConfig, HeadTrajectories, Integral16, Lcg};
+use static_cell::ConstStaticCell;
 
 /// One row of the table: label, N, W.
 struct Row {
@@ -73,12 +84,15 @@ const ROWS: [Row; 7] = [
     },
 ];
 
-static mut H450: HeadTrajectories<Q16, 450> = HeadTrajectories::new();
-static mut H900: HeadTrajectories<Q16, 900> = HeadTrajectories::new();
-static mut H1800: HeadTrajectories<Q16, 1800> = HeadTrajectories::new();
+static mut H450: HeadTrajectories<Integral16, 450> = HeadTrajectories::new();
+static mut H900: HeadTrajectories<Integral16, 900> = HeadTrajectories::new();
+static mut H1800: HeadTrajectories<Integral16, 1800> = HeadTrajectories::new();
 static mut WALK: [f32; 1800] = [0.0; 1800];
 static mut SMOOTH: [f32; 1800] = [0.0; 1800];
 static mut HANN: [f32; 512] = [0.0; 512];
+/// Loop sets 0 and 1 of the default stream, for the frame benchmark.
+static SETS: ConstStaticCell<[frame_bench::Set; 2]> =
+    ConstStaticCell::new([frame_bench::Set::new(), frame_bench::Set::new()]);
 
 /// The default set with window `w`.
 fn config(w: u16) -> HeadConfig {
@@ -140,6 +154,7 @@ fn main() -> ! {
         )
     };
     let mut ok = true;
+    let mut default_checksum = None;
     for row in &ROWS {
         let cfg = config(row.w);
         let (result, engine) = systick::stopwatch(&mut core.SYST, || match row.n {
@@ -158,6 +173,9 @@ fn main() -> ! {
             }
             check
         });
+        if row.label == "default" {
+            default_checksum = Some(h900.checksum());
+        }
         defmt::info!(
             "bench row={=str} n={=usize} w={=u16} engine={=u64} direct={=u64} ({=f32})",
             row.label,
@@ -168,5 +186,9 @@ fn main() -> ! {
             check
         );
     }
+    // Last: it switches the clock the rows above are counted with. The
+    // default row's checksum is the one loop set 0 must have.
+    let sets = SETS.take();
+    ok &= default_checksum.is_some_and(|sum| frame_bench::run(&mut core.SYST, sets, sum));
     exit::exit(ok)
 }

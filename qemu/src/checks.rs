@@ -3,18 +3,23 @@
 //!
 //! Frame indices below are frames of the time-compressed run, which are the
 //! Pico's 50 Hz frames one for one (see the crate docs): frame 1500 is 30 s
-//! into the loop on the board.
+//! into the loop on the board. The first join blends the next loop set in
+//! over frames 1400..1500.
 
 use core::ops::Range;
 
 use idle_head::driver::{DriverConfig, FrameDriver, FrameTick, Outcome};
-use idle_head::firmware::{Flow, Frame, FrameHooks, RunStats};
+use idle_head::frame_task::{Flow, Frame, FrameHooks, RunStats};
+use idle_head::idle::IdleStats;
 use idle_head::{Angle, Axis};
 
 use crate::pwm::VirtualPwm;
 
 /// Frames per loop: 1.5 s / 1 ms (= 30 s / 20 ms on the Pico).
 pub const LOOP_FRAMES: u64 = crate::LOOP.0 as u64 * 1000 / crate::CONFIG.frame_period.0 as u64;
+/// The first join: the frames where loop set 0 blends into loop set 1.
+const JOIN: Range<u64> =
+    crate::TIMING.period() as u64..(crate::TIMING.period() + crate::TIMING.join_frames) as u64;
 /// Fade-in frames (the soft start).
 const FADE_FRAMES: u64 = crate::PARAMS.fade_frames() as u64;
 /// A trace line every 50 frames (1 s on the Pico) for the host's plot.
@@ -49,11 +54,13 @@ const _: () = {
 const EXPECTED_FAULTS: u32 =
     (BURST.end - BURST.start) as u32 + crate::CONFIG.faults.disable_after as u32;
 
-/// Largest frame-to-frame change of the trajectory offsets, per axis.
+/// Largest frame-to-frame change of the idle offsets (velocity, d1) and
+/// of that change (acceleration, d2), per axis: inside the loops, and over
+/// the join (its frames and the frame after).
 #[derive(Clone, Copy, Default)]
 struct Steps {
-    inside: [u32; 3],
-    seam: [u32; 3],
+    inside: [[u32; 3]; 2],
+    join: [[u32; 3]; 2],
 }
 
 /// Hooks of the smoke run: schedule, frame log, invariants.
@@ -61,6 +68,8 @@ pub struct Checks {
     config: DriverConfig,
     failures: u32,
     previous: Option<Frame>,
+    /// The last frame's offset steps (d1), for d2.
+    last_steps: Option<[i32; 3]>,
     steps: Steps,
     /// Frames after the first fault in which pitch or roll moved.
     others_moved: [u32; 3],
@@ -79,9 +88,10 @@ impl Checks {
             config,
             failures: 0,
             previous: None,
+            last_steps: None,
             steps: Steps {
-                inside: [0; 3],
-                seam: [0; 3],
+                inside: [[0; 3]; 2],
+                join: [[0; 3]; 2],
             },
             others_moved: [0; 3],
             disabled_at: None,
@@ -100,6 +110,7 @@ impl Checks {
     pub fn finish(
         &mut self,
         stats: &RunStats,
+        idle: &IdleStats,
         driver: &mut FrameDriver<VirtualPwm>,
         generated: bool,
     ) -> bool {
@@ -119,16 +130,28 @@ impl Checks {
             );
             self.fail();
         }
+        if idle.joins != 1 || idle.late != 0 || idle.set != 1 {
+            defmt::error!("check: want one join on time, to loop set 1");
+            self.fail();
+        }
+        // The join as smooth as the loops: no larger step than anywhere
+        // inside them, and a change of step within twice theirs (the frames
+        // over the join mix the two loops' accelerations, a few m° per frame
+        // per frame, counted in whole m°). A jump or a kink at the join
+        // would stand out many times over.
         for axis in Axis::ALL {
             let i = axis.index();
+            let [inside, join] = [self.steps.inside, self.steps.join];
             defmt::info!(
-                "{=str}: largest offset step {=u32} mdeg inside the loop, {=u32} mdeg across the seam",
+                "{=str}: largest offset step {=u32} mdeg and change of step {=u32} mdeg inside the loops, {=u32} and {=u32} over the join",
                 axis.name(),
-                self.steps.inside[i],
-                self.steps.seam[i]
+                inside[0][i],
+                inside[1][i],
+                join[0][i],
+                join[1][i]
             );
-            if self.steps.seam[i] > self.steps.inside[i] {
-                defmt::error!("check: {=str} jumps at the loop seam", axis.name());
+            if join[0][i] > inside[0][i] || join[1][i] > 2 * inside[1][i] {
+                defmt::error!("check: {=str} is rougher at the join", axis.name());
                 self.fail();
             }
         }
@@ -242,22 +265,26 @@ impl Checks {
             }
         }
         if let Some(previous) = &self.previous {
-            let seam = index.is_multiple_of(LOOP_FRAMES);
+            let join = usize::from((JOIN.start..=JOIN.end).contains(&index));
             let after_fault = index >= BURST.start;
+            let steps: [i32; 3] = core::array::from_fn(|i| {
+                frame.offsets[i].millidegrees() - previous.offsets[i].millidegrees()
+            });
+            let slots = if join == 1 {
+                &mut self.steps.join
+            } else {
+                &mut self.steps.inside
+            };
             for i in 0..3 {
-                let step = frame.offsets[i]
-                    .millidegrees()
-                    .abs_diff(previous.offsets[i].millidegrees());
-                let slot = if seam {
-                    &mut self.steps.seam[i]
-                } else {
-                    &mut self.steps.inside[i]
-                };
-                *slot = (*slot).max(step);
+                slots[0][i] = slots[0][i].max(steps[i].unsigned_abs());
+                if let Some(last) = self.last_steps {
+                    slots[1][i] = slots[1][i].max(steps[i].abs_diff(last[i]));
+                }
                 if after_fault && frame.report.servos[i].angle != previous.report.servos[i].angle {
                     self.others_moved[i] += 1;
                 }
             }
+            self.last_steps = Some(steps);
         }
     }
 }
@@ -305,9 +332,11 @@ impl FrameHooks<VirtualPwm> for Checks {
             self.disabled_at = Some(index);
         }
         let stopping_now = self.stopped_at.is_none() && driver.is_stopped();
-        let seam = LOOP_FRAMES - 2..=LOOP_FRAMES + 2;
+        let join_start = JOIN.start - 2..=JOIN.start + 2;
+        let join_end = JOIN.end - 2..=JOIN.end + 2;
         if index <= 2
-            || seam.contains(&index)
+            || join_start.contains(&index)
+            || join_end.contains(&index)
             || index.is_multiple_of(TRACE_EVERY)
             || frame.report.failed > 0 && frame.report.should_log
             || index == BURST.end
@@ -316,11 +345,14 @@ impl FrameHooks<VirtualPwm> for Checks {
         {
             log_frame(frame);
         }
-        if index == LOOP_FRAMES {
+        if index == JOIN.start {
             defmt::info!(
-                "frame {=u64}: loop seam (loop position back to sample 0)",
-                index
+                "frame {=u64}: join: the next loop set blends in over {=u64} frames",
+                index,
+                JOIN.end - JOIN.start
             );
+        } else if index == JOIN.end {
+            defmt::info!("frame {=u64}: join done: the new loop set plays on", index);
         }
         if index == STOP_AT {
             defmt::info!("frame {=u64}: fading out", index);

@@ -8,10 +8,12 @@
 //! cargo run --release     # in qemu/: build, run, decode (see run.sh)
 //! ```
 //!
-//! The run generates the three loops (and measures the cost), plays a
-//! little more than one whole loop with a fade-in (soft start), injects PWM
-//! faults on the yaw servo (a short burst it survives, then a persistent
-//! one that gets it switched off), fades out and ends with one line:
+//! The run generates the three loops (and measures the cost), plays the
+//! never-repeating idle with a fade-in (soft start) past its first join (the
+//! next loop set, generated meanwhile by a low-priority task, blended in),
+//! injects PWM faults on the yaw servo (a short burst it survives, then a
+//! persistent one that gets it switched off), fades out and ends with one
+//! line:
 //!
 //! ```text
 //! summary frames=<n> missed=<n> pulse_violations=<n> precompute_insns=<n> checksum=<hex> faults=<n> disabled=<n>
@@ -33,24 +35,45 @@
 //! pulses as frame `k` on the board; only the wall clock between frames is
 //! shorter. The virtual PWM keeps the 50 Hz servo period. The whole run is
 //! about 1.9 s of virtual time.
+//!
+//! # Priorities
+//!
+//! As on the Pico, the frame task runs above the loop generator: in a raw
+//! embassy executor polled from interrupt 0 (GPIO port A on the LM3S6965,
+//! unused here; cortex-m-rt's default vector table sends it to
+//! `DefaultHandler`), while the generator runs in the thread-mode executor
+//! of `main`. The pender pends interrupt 0 for the one and wakes the other
+//! from `WFI`.
 #![no_std]
 #![no_main]
 
 mod checks;
 mod exit;
 mod pwm;
+// The Pico image's PWM clocking, compiled here too (a binary's items cannot be
+// imported): the virtual outputs count as the board's slices do.
+#[path = "../../src/bin/pico/rp2040_pwm.rs"]
+#[allow(dead_code)]
+mod rp2040_pwm;
 mod systick;
 
-use core::sync::atomic::{AtomicBool, Ordering};
+use core::ptr;
+use core::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
 
+use cortex_m::interrupt::InterruptNumber;
+use cortex_m::peripheral::NVIC;
+use cortex_m_rt::exception;
 use defmt_semihosting as _;
 use embassy_executor::raw;
-use embassy_time::Instant;
+use embassy_time::{Duration, Instant};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head::firmware::rp2040_pwm::PICO_SERVO_CLOCK;
-use idle_head::firmware::{self, FrameLoop, LOOP_DURATION};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Q16};
+use idle_head::frame_task::{
+    Exchange, ExchangeSupply, FrameLoop, IDLE_MODE, LOOP_DURATION, SetRef,
+};
+use idle_head::idle::{IdleMode, IdlePlayer, IdleTiming, LoopSet, LoopStream};
+use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N};
 use idle_head::{Axis, Microseconds, Millis, Playback};
+use static_cell::ConstStaticCell;
 
 use crate::checks::Checks;
 use crate::pwm::VirtualPwm;
@@ -69,6 +92,12 @@ const LOOP: Millis = Millis(LOOP_DURATION.0 / SPEEDUP);
 const PLAYBACK: Playback = match Playback::new(LOOP, CONFIG.frame_period, DEFAULT_N) {
     Ok(p) => p,
     Err(_) => panic!("invalid playback parameters"),
+};
+
+/// Loops of 1500 frames joined over 100, as on the Pico.
+const TIMING: IdleTiming = match IdleTiming::new(PLAYBACK) {
+    Ok(t) => t,
+    Err(e) => panic!("{}", e.message()),
 };
 
 /// `config` played `k` times faster: frame period and fade `/ k`, speed
@@ -96,18 +125,65 @@ const _: () = {
     assert!(LOOP.0 * SPEEDUP == LOOP_DURATION.0);
 };
 
-type Head = HeadTrajectories<Q16, DEFAULT_N>;
+/// Duty counts per PWM period of the virtual servo outputs: the Pico's `TOP`
+/// (63 999: 64 000 counts per 20 ms from its 125 MHz clock), so that the duties
+/// written here are the board's.
+const PICO_TOP: u16 = rp2040_pwm::PICO_SERVO_CLOCK.top;
 
-/// The three loops: 3 · 900 · 2 B = 5400 B, generated once at boot.
-static mut HEAD: Head = Head::new();
+type Set = LoopSet<DEFAULT_N>;
 
-/// Set by the executor's pender (a task was woken), cleared by the idle loop.
+/// The two loop set buffers, 2 · 5.4 KB: one plays while the generator
+/// fills the other.
+static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::new()]);
+
+/// The channels the buffers go round through.
+static EXCHANGE: Exchange = Exchange::new();
+
+/// Set by the pender when a thread-mode task was woken, cleared by the idle loop.
 static PENDED: AtomicBool = AtomicBool::new(false);
 
-/// Wake-up hook of the raw executor: just note that there is work to do.
+/// The frame task's executor, polled from [`FrameIrq`] once `main` has set it.
+static FRAME_EXECUTOR: AtomicPtr<raw::Executor> = AtomicPtr::new(ptr::null_mut());
+
+/// The interrupt the frame executor runs in: IRQ 0 (GPIO port A).
+#[derive(Clone, Copy)]
+struct FrameIrq;
+
+// Note(unsafe): 0 is a valid interrupt number of the LM3S6965's NVIC.
+unsafe impl InterruptNumber for FrameIrq {
+    fn number(self) -> u16 {
+        0
+    }
+}
+
+/// The frame executor's pender context (the thread executor's is `usize::MAX`).
+const FRAME_CONTEXT: usize = 0;
+
+/// Wake-up hook of the raw executors: pend the frame interrupt, or note
+/// that thread mode has work.
 #[unsafe(export_name = "__pender")]
-fn pender(_context: *mut ()) {
-    PENDED.store(true, Ordering::Release);
+fn pender(context: *mut ()) {
+    if context as usize == FRAME_CONTEXT {
+        NVIC::pend(FrameIrq);
+    } else {
+        PENDED.store(true, Ordering::Release);
+    }
+}
+
+#[exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    if irqn == FrameIrq.number() as i16 {
+        let executor = FRAME_EXECUTOR.load(Ordering::Acquire);
+        // Note(unsafe): the executor is a `'static` singleton set before the
+        // interrupt is unmasked, and polled from this handler only, which
+        // does not preempt itself.
+        if let Some(executor) = unsafe { executor.as_ref() } {
+            unsafe { executor.poll() };
+        }
+    } else {
+        defmt::error!("unexpected interrupt {=i16}", irqn);
+        exit::exit(false);
+    }
 }
 
 #[cortex_m_rt::entry]
@@ -127,21 +203,18 @@ fn main() -> ! {
     );
     defmt::info!(
         "virtual PWM: {=u16} counts per {=u32} us (the Pico's TOP), pulse limits [{=u32}, {=u32}] us",
-        PICO_SERVO_CLOCK.top,
+        PICO_TOP,
         CONFIG.pwm.period.0,
         CONFIG.servos[0].min_pulse.0,
         CONFIG.servos[0].max_pulse.0
     );
 
-    // Note(unsafe): the only reference ever made to HEAD, here, once, before
-    // any task runs; it is handed on as a shared reference below.
-    let head: &'static mut Head = unsafe { &mut *core::ptr::addr_of_mut!(HEAD) };
+    let [first, spare] = SETS.take();
     // Precompute cost: SysTick counts 12.5 MHz, i.e. 80 instructions per
     // count under `-icount shift=0` (see systick.rs).
-    let (generated, counts) = systick::stopwatch(&mut core.SYST, || head.generate(&DEFAULT_HEAD));
+    let (generated, counts) = systick::stopwatch(&mut core.SYST, || first.generate(&DEFAULT_HEAD));
     let precompute_insns = counts * systick::INSNS_PER_COUNT;
-    let head: &'static Head = head;
-    let checksum = head.checksum();
+    let checksum = first.checksum();
     let generated = match generated {
         Ok(info) => {
             for (axis, info) in Axis::ALL.iter().zip(info.iter()) {
@@ -156,7 +229,11 @@ fn main() -> ! {
             true
         }
         Err(e) => {
-            defmt::error!("trajectory generation failed: {=str}", e.error.message());
+            defmt::error!(
+                "trajectory generation failed: {=str} {=str}",
+                e.axis.name(),
+                e.error.message()
+            );
             false
         }
     };
@@ -166,23 +243,45 @@ fn main() -> ! {
         precompute_insns,
         checksum
     );
+    let mut stream = LoopStream::new(DEFAULT_HEAD, &TIMING);
+    stream.adopt(first);
 
     systick::start_time_driver(&mut core.SYST);
 
-    let Some(executor) =
-        cortex_m::singleton!(: raw::Executor = raw::Executor::new(usize::MAX as *mut ()))
-    else {
+    let (Some(thread), Some(frame_executor)) = (
+        cortex_m::singleton!(: raw::Executor = raw::Executor::new(usize::MAX as *mut ())),
+        cortex_m::singleton!(: raw::Executor = raw::Executor::new(FRAME_CONTEXT as *mut ())),
+    ) else {
         exit::exit(false)
     };
-    let spawner = executor.spawner();
-    match frame_task(head, precompute_insns, checksum, generated) {
-        Ok(token) => spawner.spawn(token),
+    let frame_executor: &'static raw::Executor = frame_executor;
+    match IDLE_MODE {
+        IdleMode::NeverRepeating => {
+            defmt::info!(
+                "idle: never repeating, a new loop set every {=u32} frames, joined over {=u32}",
+                TIMING.period(),
+                TIMING.join_frames
+            );
+            EXCHANGE.give(spare);
+            match generator(stream) {
+                Ok(token) => thread.spawner().spawn(token),
+                Err(_) => exit::exit(false),
+            }
+        }
+        IdleMode::FixedLoop => defmt::info!("idle: the fixed loop, replayed every loop"),
+    }
+    match frame_task(first, precompute_insns, checksum, generated) {
+        Ok(token) => frame_executor.spawner().spawn(token),
         Err(_) => exit::exit(false),
     }
+    FRAME_EXECUTOR.store(ptr::from_ref(frame_executor).cast_mut(), Ordering::Release);
+    // Note(unsafe): the frame executor is published above, before its
+    // interrupt can run.
+    unsafe { NVIC::unmask(FrameIrq) };
     loop {
         // Note(unsafe): `poll` is called from this loop only, never
         // re-entrantly (the pender only sets a flag).
-        unsafe { executor.poll() };
+        unsafe { thread.poll() };
         // Sleep until an interrupt unless a task was woken meanwhile. With
         // interrupts masked, WFI still wakes on a pending interrupt, which
         // then runs right after `free` returns: no wake-up is lost. QEMU
@@ -197,29 +296,69 @@ fn main() -> ! {
     }
 }
 
+/// Generates each next loop set while the frames play (thread mode).
 #[embassy_executor::task]
-async fn frame_task(head: &'static Head, precompute_insns: u64, checksum: u32, generated: bool) {
+async fn generator(mut stream: LoopStream<DEFAULT_N>) {
+    EXCHANGE
+        .generate(&mut stream, |result, ticks| match result {
+            // Virtual time under `-icount shift=0`: 1000 instructions a µs,
+            // the frames that preempt the generator included.
+            Ok(info) => defmt::info!(
+                "loop set {=u32} ready in {=u64} instructions: seeds {:#010x}, entered at {}, join mismatch {} mdeg rms",
+                info.number,
+                Duration::from_ticks(ticks).as_micros() * 1000,
+                info.seeds,
+                info.starts,
+                info.mismatch
+            ),
+            Err(e) => defmt::error!(
+                "loop set failed: {=str} {=str}; trying the next seeds",
+                e.axis.name(),
+                e.error.message()
+            ),
+        })
+        .await
+}
+
+#[embassy_executor::task]
+async fn frame_task(first: SetRef, precompute_insns: u64, checksum: u32, generated: bool) {
     let channels = CONFIG
         .servos
-        .map(|servo| VirtualPwm::new(PICO_SERVO_CLOCK.top, CONFIG.pwm.period, &servo));
+        .map(|servo| VirtualPwm::new(PICO_TOP, CONFIG.pwm.period, &servo));
     let mut driver = FrameDriver::new(channels, PARAMS);
-    let loops = Axis::ALL.map(|axis| head.axis(axis));
+    let idle: IdlePlayer<SetRef, ExchangeSupply> =
+        IdlePlayer::new(first, EXCHANGE.supply(), TIMING, IDLE_MODE);
     let start = Instant::now().as_ticks();
-    let Ok(mut frames) = FrameLoop::new(PLAYBACK, loops, embassy_time::TICK_HZ, start) else {
+    let Ok(mut frames) = FrameLoop::new(idle, CONFIG.frame_period, embassy_time::TICK_HZ, start)
+    else {
         defmt::error!("frame period below one timer tick");
         exit::exit(false)
     };
     let mut checks = Checks::new(CONFIG);
-    let stats = firmware::run(&mut driver, &mut frames, &mut checks).await;
+    let stats = idle_head::frame_task::run(&mut driver, &mut frames, &mut checks).await;
     defmt::info!(
         "frame timing: {=u64} frames, {=u64} missed, wake-up at most {=u64} us after the deadline",
         stats.frames,
         stats.missed,
         embassy_time::Duration::from_ticks(stats.max_lateness).as_micros()
     );
-    let ok = checks.finish(&stats, &mut driver, generated);
+    let idle = frames.idle_mut().stats();
+    defmt::info!(
+        "idle: {=u32} join(s), {=u32} late, playing loop set {=u32}",
+        idle.joins,
+        idle.late,
+        idle.set
+    );
+    let ok = checks.finish(&stats, &idle, &mut driver, generated);
     let logs = driver.channels_mut().each_ref().map(|c| *c.log());
     let violations: u32 = logs.iter().map(|l| l.violations).sum();
+    // The stack was painted before `main` (cortex-m-rt's `paint-stack`): the
+    // bytes that lost their paint are the deepest the stack has been.
+    defmt::info!(
+        "stack: peak stack {=u32} B of {=u32} B",
+        cortex_m_stack::stack_size().saturating_sub(cortex_m_stack::stack_painted()),
+        cortex_m_stack::stack_size()
+    );
     let driver_stats = driver.stats();
     let faults: u32 = driver_stats.faults.iter().sum();
     let disabled = driver_stats.disabled.iter().filter(|&&d| d).count();

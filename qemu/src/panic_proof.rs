@@ -7,12 +7,17 @@
 //! (from the repository root; in qemu/, `cargo build --release --bin frame-path-proof`).
 //!
 //! This image runs the per-frame work of the firmware — [`FrameLoop::next`]
-//! (frame clock) and [`FrameLoop::write`] (playback interpolation, fade,
+//! (frame clock) and [`FrameLoop::write`] (the never-repeating idle: loop
+//! sets taken from and given back to the generator's channels, joins
+//! blended; playback interpolation, fade,
 //! limits, pulse and duty conversion, PWM writes and fault handling in
 //! `FrameDriver::write_frame`) — on inputs the optimiser cannot see
 //! through (`core::hint::black_box`): any time, any loop contents, any PWM
 //! maximum, PWM writes that fail or not, stop and resume requests at any
-//! frame. Its panic handler calls `frame_path_has_a_panic_path`, a function
+//! frame, new motion limits and servo calibrations (any values, valid or
+//! not) between any two frames, and the behaviour: any behaviour parameters
+//! and any command (gestures, looks, `center`, idle changes, stop) applied
+//! between any two frames ([`FrameLoop::apply`]), mixed into every frame. Its panic handler calls `frame_path_has_a_panic_path`, a function
 //! that exists nowhere. If any panic (index, division, overflow check,
 //! `unwrap`, ...) remains reachable after optimisation, the call survives
 //! and the link fails:
@@ -31,10 +36,19 @@
 use core::hint::black_box;
 
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
-use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head::firmware::{FrameLoop, LOOP_DURATION};
-use idle_head::motion::{DEFAULT_N, HeadTrajectories, Q16};
+use idle_head::behaviour::{BehaviourConfig, BehaviourParams};
+use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
+use idle_head::driver::{
+    DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, DriverParams, FrameDriver,
+    MotionLimits,
+};
+use idle_head::frame_task::{Exchange, FrameLoop, IDLE_MODE, LOOP_DURATION};
+use idle_head::idle::{IdlePlayer, IdleTiming, LoopSet};
+use idle_head::motion::DEFAULT_N;
+use idle_head::servo::{Direction, NanosPerDegree, ServoCalibration};
+use idle_head::units::{Angle, AngleRange, Microseconds, Millis};
 use idle_head::{Axis, Playback};
+use static_cell::ConstStaticCell;
 
 const PARAMS: DriverParams = match DriverConfig::DEFAULT.build() {
     Ok(p) => p,
@@ -46,8 +60,19 @@ const PLAYBACK: Playback =
         Err(_) => panic!("invalid playback parameters"),
     };
 
-/// Loops with unknown contents (the optimiser sees them through `black_box`).
-static HEAD: HeadTrajectories<Q16, DEFAULT_N> = HeadTrajectories::new();
+const TIMING: IdleTiming = match IdleTiming::new(PLAYBACK) {
+    Ok(t) => t,
+    Err(e) => panic!("{}", e.message()),
+};
+
+/// Loop sets with unknown contents (the optimiser sees them through
+/// `black_box`).
+static SETS: ConstStaticCell<[LoopSet<DEFAULT_N>; 2]> =
+    ConstStaticCell::new([LoopSet::new(), LoopSet::new()]);
+
+/// The channels to the generator (none runs: whether a set is ready is
+/// unknown to the optimiser).
+static EXCHANGE: Exchange = Exchange::new();
 
 /// A PWM channel whose maximum duty and write results are unknown.
 struct OpaquePwm;
@@ -81,14 +106,60 @@ fn panic(_: &core::panic::PanicInfo<'_>) -> ! {
     unsafe { frame_path_has_a_panic_path() }
 }
 
+/// The built-in behaviour (the proof hides it from the optimiser: any
+/// parameters).
+const BEHAVIOUR: BehaviourParams = match BehaviourConfig::DEFAULT.build(&PARAMS) {
+    Ok(p) => p,
+    Err(e) => panic!("{}", e.message()),
+};
+
+/// Any command, with any values.
+fn any_action() -> Action {
+    let angle = || Angle::from_millidegrees(black_box(0));
+    let millis = || black_box(Some(Millis(black_box(0))));
+    match black_box(0_u8) {
+        0 => Action::Gesture(GestureRequest {
+            kind: match black_box(0_u8) {
+                0 => GestureKind::Nod,
+                1 => GestureKind::Shake,
+                _ => GestureKind::Tilt,
+            },
+            amplitude: black_box(Some(angle())),
+            duration: millis(),
+            cycles: black_box(Some(black_box(0))),
+            intensity: Percent::new(black_box(0)),
+        }),
+        1 => Action::Look(LookRequest {
+            pitch: angle(),
+            yaw: angle(),
+            duration: millis(),
+            hold: match black_box(0_u8) {
+                0 => None,
+                1 => Some(Hold::Stay),
+                _ => Some(Hold::Return(Millis(black_box(0)))),
+            },
+        }),
+        2 => Action::Center { duration: millis() },
+        3 => Action::Idle(black_box(false)),
+        4 => Action::IdleAmp(Percent::new(black_box(0)).unwrap_or(Percent::FULL)),
+        _ => Action::Stop,
+    }
+}
+
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    let head = black_box(&HEAD);
-    let loops = Axis::ALL.map(|axis| head.axis(axis));
+    let Some([first, second]) = black_box(SETS.try_take()) else {
+        loop {
+            cortex_m::asm::wfi();
+        }
+    };
+    EXCHANGE.give(black_box(second));
+    let idle = IdlePlayer::new(first, EXCHANGE.supply(), black_box(TIMING), IDLE_MODE);
     let mut driver = FrameDriver::new([OpaquePwm, OpaquePwm, OpaquePwm], black_box(PARAMS));
-    let Ok(mut frames) = FrameLoop::new(
-        black_box(PLAYBACK),
-        loops,
+    let Ok(mut frames) = FrameLoop::with_behaviour(
+        idle,
+        black_box(PLAYBACK.frame_period()),
+        black_box(BEHAVIOUR),
         black_box(1_000_000),
         black_box(0),
     ) else {
@@ -98,9 +169,38 @@ fn main() -> ! {
         }
     };
     loop {
+        let axis = Axis::ALL[usize::from(black_box(0_u8) % 3)];
         match black_box(0_u8) {
             1 => driver.request_stop(),
             2 => driver.resume(),
+            3 => {
+                let limits = MotionLimits {
+                    max_speed: DegreesPerSecond(black_box(0)),
+                    max_accel: DegreesPerSecondSquared(black_box(0)),
+                };
+                black_box(driver.set_motion_limits(axis, limits)).ok();
+            }
+            4 => {
+                let cal = ServoCalibration {
+                    neutral: Microseconds(black_box(0)),
+                    per_degree: NanosPerDegree(black_box(0)),
+                    direction: if black_box(false) {
+                        Direction::Reversed
+                    } else {
+                        Direction::Normal
+                    },
+                    min_pulse: Microseconds(black_box(0)),
+                    max_pulse: Microseconds(black_box(0)),
+                    limits: AngleRange {
+                        min: Angle::from_millidegrees(black_box(0)),
+                        max: Angle::from_millidegrees(black_box(0)),
+                    },
+                };
+                black_box(driver.set_servo(axis, cal)).ok();
+            }
+            5 => {
+                black_box(frames.apply(&mut driver, &any_action())).ok();
+            }
             _ => {}
         }
         let tick = frames.next(black_box(0));

@@ -1,4 +1,12 @@
 //! Fade envelope: smoothstep gain that fades the idle motion in and out.
+//!
+//! The gain at level `l` of `n` frames is `S(x) = x²(3 − 2x)` at
+//! `x = ⌊l·2¹⁶/n⌋` (Q16), rounded down: one `u32` division while the level
+//! ramps (`l·2¹⁶ < 2³²` for `n ≤ 2¹⁶` frames, 22 minutes at 50 Hz; a longer
+//! fade takes a `u64` one), none at full or zero gain. `S` is formed from
+//! 16-bit halves: `x² = qₕ·2¹⁶ + qₗ`, `c = 3·2¹⁶ − 2x = cₕ·2¹⁶ + cₗ`,
+//! `⌊x²c/2³²⌋ = ⌊(qₕc + qₗcₕ + ⌊qₗcₗ/2¹⁶⌋)/2¹⁶⌋`. Every partial sum is at most
+//! `x²c/2¹⁶ = 2³²·S(x/2¹⁶) < 2³²` for `x < 2¹⁶`: `u32` throughout.
 
 /// Gain scale: Q16, 1.0 = 65 536.
 pub(crate) const UNITY: u32 = 1 << 16;
@@ -25,14 +33,29 @@ impl Envelope {
 
     /// The current gain in Q16 (`0..=65 536`).
     pub(crate) const fn gain(&self) -> u32 {
-        if self.frames == 0 {
-            return if self.stopping { 0 } else { UNITY };
+        if self.level >= self.frames {
+            return if self.frames == 0 && self.stopping {
+                0
+            } else {
+                UNITY
+            };
         }
-        // x = level / frames in Q16; x ≤ 2^16.
-        let x = (self.level as u64 * UNITY as u64) / self.frames as u64;
-        // smoothstep: x²(3 − 2x); x² ≤ 2^32, (3 − 2x) ≤ 3·2^16: product < 2^50.
-        let s = (x * x * (3 * UNITY as u64 - 2 * x)) >> 32;
-        if s > UNITY as u64 { UNITY } else { s as u32 }
+        if self.level == 0 {
+            return 0;
+        }
+        // 0 < level < frames, so 0 < x < 2¹⁶.
+        let x = if self.frames <= UNITY {
+            match (self.level << 16).checked_div(self.frames) {
+                Some(x) => x,
+                None => 0,
+            }
+        } else {
+            match ((self.level as u64) << 16).checked_div(self.frames as u64) {
+                Some(x) => x as u32,
+                None => 0,
+            }
+        };
+        smoothstep(x)
     }
 
     /// Moves one frame along the ramp.
@@ -58,4 +81,13 @@ impl Envelope {
     pub(crate) const fn is_stopping(&self) -> bool {
         self.stopping
     }
+}
+
+/// `⌊x²(3·2¹⁶ − 2x)/2³²⌋` for `x < 2¹⁶` (see the module docs).
+const fn smoothstep(x: u32) -> u32 {
+    let q = x * x;
+    let c = 3 * UNITY - 2 * x;
+    let (qh, ql) = (q >> 16, q & 0xFFFF);
+    let (ch, cl) = (c >> 16, c & 0xFFFF);
+    (qh * c + ql * ch + ((ql * cl) >> 16)) >> 16
 }

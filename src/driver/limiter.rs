@@ -1,25 +1,98 @@
 //! Speed and acceleration limiter on the commanded angle of one axis.
 //!
-//! State in microdegrees (µ°) and µ° per frame so that limits stay exact at
+//! State in microdegrees (µ°) and µ° per frame, so that limits stay exact at
 //! high frame rates; the output is rounded to millidegrees.
+//!
+//! # 32 bits
+//!
+//! Angle limits lie within ±360° ([`MAX_LIMIT_MDEG`]), so every position is
+//! within ±3.6·10⁸ µ° and every distance and speed within [`SPAN`] = 7.2·10⁸
+//! µ°. The per-frame limits are capped without changing any result: a step of
+//! [`SPAN`] already crosses any range (the position clamp gives the same
+//! position), and an acceleration of 2·[`SPAN`] both contains the whole speed
+//! window around any speed and stops any distance in one step (so the braking
+//! speed is the distance itself, as for any larger acceleration). The
+//! largest sum formed is a target speed plus a closing speed, below
+//! 2·[`SPAN`] < 2³¹: `i32` throughout.
+//!
+//! # Exact braking
+//!
+//! The braking speed for a distance `d` at acceleration `a` is the largest `v`
+//! whose steps `v, v − a, v − 2a, …` (the positive ones) sum to at most `d`.
+//! At `v = k·a` the sum is `T(k) = a·k(k+1)/2`; on `v ∈ (k·a, (k+1)·a]` it is
+//! `(k+1)·v − T(k)`. With `k` the largest integer with `T(k) ≤ d` the answer
+//! is `⌊(d + T(k))/(k+1)⌋`, which lies in `[k·a, (k+1)·a)` because
+//! `T(k+1) > d`. `T(k) ≤ d` is `k(k+1)/2 ≤ q` with `q = ⌊d/a⌋`, i.e. `k` is
+//! `r = ⌊√(2q)⌋` or `r − 1` (`k² ≤ 2q < (k+2)²`). With `d ≤ SPAN` every term
+//! fits `u32`: two divisions and a `u32` square root, and only off the
+//! common case, and only when the braking speed can matter: it is at least
+//! `min(d, a)`, and at least `v` when `2·a·d ≥ (v + a)²` (the steps
+//! `v, v − a, …` sum to at most `(v + a)²/2a`), two 64-bit products.
+//!
+//! # Braking for the limits
+//!
+//! The position limits are braked for like a target: a step towards a limit
+//! is at most the braking speed for the distance left to it, so the head
+//! never reaches a limit faster than it can stop there, and the position
+//! clamp never cuts a step short (which would be a deceleration beyond the
+//! limit). The step of a target that moves within the limits is always
+//! within that bound when it is at most one acceleration step: the braking
+//! speed for a distance `d` is at least `min(d, a)`.
+//!
+//! # The common case
+//!
+//! A target that moves within the limits and is tracked exactly (error 0)
+//! is followed as it is: one comparison of its step against the speed and
+//! acceleration limits and of its change against the acceleration limit,
+//! no braking.
 
 use crate::units::Angle;
 
 /// µ° per m°.
-const MICRO_PER_MILLI: i64 = 1000;
+const MICRO_PER_MILLI: i32 = 1000;
 
-/// Limits of one axis in frame units (µ°, µ°/frame, µ°/frame²).
+/// Widest angle limit the limiter takes, either side of neutral: 360° in m°.
+pub(crate) const MAX_LIMIT_MDEG: i32 = 360_000;
+
+/// Largest distance between two positions within the limits: 720° in µ°.
+pub(crate) const SPAN: u32 = 2 * MAX_LIMIT_MDEG as u32 * MICRO_PER_MILLI as u32;
+
+/// Limits of one axis in frame units.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(crate) struct SlewParams {
-    /// Largest step per frame, µ°/frame (≥ 1, ≤ 2^48).
-    pub(crate) max_step: i64,
-    /// Largest change of step per frame, µ°/frame² (≥ 1, ≤ 2^48).
-    pub(crate) max_accel: i64,
-    /// Mechanical limits, µ°.
-    pub(crate) lo: i64,
-    /// Mechanical limits, µ°.
-    pub(crate) hi: i64,
+    /// Largest step per frame, µ°/frame, in `1..=SPAN`.
+    pub(crate) max_step: u32,
+    /// Largest change of step per frame, µ°/frame², in `1..=2·SPAN`.
+    pub(crate) max_accel: u32,
+    /// Mechanical limits, m°, within ±[`MAX_LIMIT_MDEG`].
+    pub(crate) lo: i32,
+    /// Mechanical limits, m°, within ±[`MAX_LIMIT_MDEG`].
+    pub(crate) hi: i32,
+}
+
+impl SlewParams {
+    /// The limits of `step` µ°/frame and `accel` µ°/frame² between `lo` and
+    /// `hi` (m°, validated to lie within ±[`MAX_LIMIT_MDEG`]), capped as the
+    /// module docs explain.
+    pub(crate) const fn new(step: u64, accel: u64, lo: i32, hi: i32) -> Self {
+        let step = if step > SPAN as u64 {
+            SPAN
+        } else {
+            step as u32
+        };
+        let accel = if accel > 2 * SPAN as u64 {
+            2 * SPAN
+        } else {
+            accel as u32
+        };
+        Self {
+            max_step: if step == 0 { 1 } else { step },
+            max_accel: if accel == 0 { 1 } else { accel },
+            lo,
+            hi,
+        }
+    }
 }
 
 /// Follows a target angle within speed, acceleration and position limits.
@@ -27,77 +100,178 @@ pub(crate) struct SlewParams {
 /// It feeds the target's own velocity forward, so a target that already moves
 /// within the limits is followed exactly (no lag); otherwise it accelerates at
 /// most `max_accel`, moves at most `max_step`, and brakes in time to stop on
-/// the target (the braking speed for distance d is the largest v with
-/// v²/2a + v/2 ≤ d, the distance covered by steps v, v − a, v − 2a, ...).
+/// the target and before the position limits. A speed above `max_step`
+/// (after the limit was lowered) comes down by `max_accel` per frame. A
+/// position outside the limits (after a change of calibration) moves back in
+/// and never further out.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(crate) struct Slew {
-    pos: i64,
-    vel: i64,
-    last_target: i64,
+    /// Position, µ°.
+    pos: i32,
+    /// Last step, µ°/frame.
+    vel: i32,
+    /// Last target (clamped to the limits), µ°.
+    last_target: i32,
 }
 
 /// The default is at rest at 0°, where the neutral pulse puts the servo.
 impl Slew {
+    /// At rest at `angle` moving by `vel` µ°/frame, the target there too
+    /// (both clamped to the limiter's range).
+    pub(crate) const fn anchored(angle: Angle, vel: i32) -> Self {
+        let m = angle.millidegrees();
+        let m = if m < -MAX_LIMIT_MDEG {
+            -MAX_LIMIT_MDEG
+        } else if m > MAX_LIMIT_MDEG {
+            MAX_LIMIT_MDEG
+        } else {
+            m
+        };
+        let v = if vel < -(SPAN as i32) {
+            -(SPAN as i32)
+        } else if vel > SPAN as i32 {
+            SPAN as i32
+        } else {
+            vel
+        };
+        Self {
+            pos: m * MICRO_PER_MILLI,
+            vel: v,
+            last_target: m * MICRO_PER_MILLI,
+        }
+    }
+
+    /// The current angle, rounded to m° as [`step`](Self::step) returns it.
+    pub(crate) const fn angle(&self) -> Angle {
+        Angle::from_millidegrees(round_to_mdeg(self.pos))
+    }
+
+    /// The last step, µ°/frame.
+    pub(crate) const fn velocity(&self) -> i32 {
+        self.vel
+    }
+
     /// One frame towards `target`; returns the new angle.
+    #[inline]
     pub(crate) fn step(&mut self, target: Angle, p: &SlewParams) -> Angle {
-        let target = bound(target.millidegrees() as i64 * MICRO_PER_MILLI, p.lo, p.hi);
-        // |target|, |pos| ≤ 2^31 · 1000 < 2^41: differences < 2^42.
+        let mdeg = target.millidegrees().max(p.lo).min(p.hi);
+        let target = mdeg * MICRO_PER_MILLI;
+        // Both within ±MAX_LIMIT: the difference fits.
         let target_vel = target - self.last_target;
+        let speed = target_vel.unsigned_abs();
+        if self.pos == self.last_target
+            && speed <= p.max_step
+            && speed <= p.max_accel
+            && target_vel.abs_diff(self.vel) <= p.max_accel
+        {
+            self.last_target = target;
+            self.pos = target;
+            self.vel = target_vel;
+            return Angle::from_millidegrees(mdeg);
+        }
+        self.limited_step(target, target_vel, p)
+    }
+
+    /// The step when the target is off or moves beyond the limits.
+    #[inline(never)]
+    fn limited_step(&mut self, target: i32, target_vel: i32, p: &SlewParams) -> Angle {
         // Error before this frame's target motion: with perfect tracking it is
         // 0 and the wanted step is exactly the target's step.
         let err = self.last_target - self.pos;
         self.last_target = target;
-        let closing = err
-            .unsigned_abs()
-            .min(brake_speed(err.unsigned_abs(), p.max_accel)) as i64;
-        let wanted = target_vel + err.signum() * closing;
-        // vel ∈ [−max_step, max_step] ⇒ the accel window meets the speed window.
-        let vel = bound(wanted, self.vel - p.max_accel, self.vel + p.max_accel);
-        let vel = bound(vel, -p.max_step, p.max_step);
-        let pos = bound(self.pos + vel, p.lo, p.hi);
+        let v = self.vel;
+        // The speed limit; a speed above it comes down at the acceleration limit.
+        let limit = p.max_step.max(v.unsigned_abs().saturating_sub(p.max_accel));
+        // closing ≤ |err| ≤ SPAN. A closing speed of `limit + |target_vel|`
+        // or more takes the step to the limit whatever it is, so the exact
+        // value is only needed below that.
+        let enough = limit + target_vel.unsigned_abs();
+        let closing = brake_speed_up_to(err.unsigned_abs(), p.max_accel, enough) as i32;
+        let wanted = if err < 0 {
+            target_vel - closing
+        } else {
+            target_vel + closing
+        };
+        // max_accel ≤ 2·SPAN < 2³¹. v ± a is only formed when it lies
+        // between v and `wanted`, so it fits.
+        let a = p.max_accel as i32;
+        let vel = if wanted.abs_diff(v) <= p.max_accel {
+            wanted
+        } else if wanted > v {
+            v + a
+        } else {
+            v - a
+        };
+        let vel = vel.max(-(limit as i32)).min(limit as i32);
+        // Braking for the position limits (a position outside them does not
+        // move further out).
+        let (lo, hi) = (p.lo * MICRO_PER_MILLI, p.hi * MICRO_PER_MILLI);
+        let room =
+            |d: i32, speed: u32| brake_speed_up_to(d.max(0).unsigned_abs(), p.max_accel, speed);
+        let vel = if vel > 0 {
+            room(hi - self.pos, vel.unsigned_abs()) as i32
+        } else {
+            -(room(self.pos - lo, vel.unsigned_abs()) as i32)
+        };
+        // Within the limits, or no further out than the position already is.
+        let (lo, hi) = (lo.min(self.pos), hi.max(self.pos));
+        let pos = (self.pos + vel).max(lo).min(hi);
         self.vel = pos - self.pos;
         self.pos = pos;
-        // Round to the nearest m° (halves up); lo, hi are whole m°, so the
-        // result stays inside the limits.
-        Angle::from_millidegrees((pos + MICRO_PER_MILLI / 2).div_euclid(MICRO_PER_MILLI) as i32)
+        Angle::from_millidegrees(round_to_mdeg(pos))
     }
 }
 
-/// `x` limited to `[lo, hi]` (`hi` wins if `lo > hi`; unlike `Ord::clamp`,
-/// this has no panic path).
-fn bound(x: i64, lo: i64, hi: i64) -> i64 {
-    x.max(lo).min(hi)
+/// `pos` µ° to the nearest m° (halves up), for `|pos| ≤ SPAN/2`; the
+/// limits are whole m°, so a position inside them stays inside.
+///
+/// With `u = pos + 500 + 360 000 000 < 2³⁰`, `⌊u/1000⌋` without a division:
+/// `q₀ = ⌊⌊u/2¹⁶⌋·67 108/2¹⁰⌋` (67 108/1024 = 65.5352 < 2¹⁶/1000) is low by
+/// less than 81, so `r = u − 1000·q₀ < 81 000`, and `⌊r·1049/2²⁰⌋`
+/// (1049/2²⁰ = 1.0004/1000) is `⌊r/1000⌋` or one more, which the last
+/// comparison removes.
+const fn round_to_mdeg(pos: i32) -> i32 {
+    const OFFSET: i32 = MAX_LIMIT_MDEG * MICRO_PER_MILLI;
+    let u = (pos + MICRO_PER_MILLI / 2 + OFFSET) as u32;
+    let q0 = ((u >> 16) * 67_108) >> 10;
+    let r = u - q0 * 1000;
+    let mut q = q0 + ((r * 1049) >> 20);
+    if q * 1000 > u {
+        q -= 1;
+    }
+    q as i32 - MAX_LIMIT_MDEG
+}
+
+/// `min(enough, brake_speed(dist, accel))`, computing the braking speed
+/// only when it may be below `enough`: it is at least `min(dist, accel)`,
+/// and at least `v` when `2·a·dist ≥ (v + a)²` (the steps v, v − a, … sum to
+/// at most `(v + a)²/2a`), which two 64-bit products tell.
+fn brake_speed_up_to(dist: u32, accel: u32, enough: u32) -> u32 {
+    if enough <= dist.min(accel) {
+        return enough;
+    }
+    let reach = u64::from(enough) + u64::from(accel);
+    if 2 * u64::from(dist) * u64::from(accel) >= reach * reach {
+        return enough;
+    }
+    brake_speed(dist, accel).min(enough)
 }
 
 /// Largest step `v` after which the limiter can still stop within `dist`
-/// decelerating by at most `accel` per frame: the steps v, v − a, v − 2a, ...
-/// down to the last positive one must sum to at most `dist`.
-///
-/// With `k` further steps after this one (v ∈ (k·a, (k+1)·a]) the sum is
-/// S(v) = (k+1)·v − a·k(k+1)/2, increasing in v, so on segment `k` the largest
-/// v is min((k+1)·a, ⌊(dist + a·k(k+1)/2) / (k+1)⌋), valid if above k·a. The
-/// continuous estimate k ≈ (√(2·a·d + a²/4) − a/2) / a is within one segment
-/// of the answer; the two segments either side are checked too.
-fn brake_speed(dist: u64, accel: i64) -> u64 {
-    let accel = accel.unsigned_abs().max(1) as u128;
-    let dist = dist as u128;
-    // accel ≤ 2^48, dist < 2^43: the radicand < 2^97, every product below < 2^110.
-    let estimate = (2 * accel * dist + accel * accel / 4)
-        .isqrt()
-        .saturating_sub(accel / 2)
-        / accel;
-    let mut best = 0;
-    let mut segment = estimate.saturating_sub(2);
-    while segment <= estimate + 2 {
-        let steps = segment + 1;
-        let base = accel * segment * steps / 2;
-        let speed = (steps * accel).min((dist + base).checked_div(steps).unwrap_or(0));
-        if speed > segment * accel && speed > best {
-            best = speed;
-        }
-        segment += 1;
+/// decelerating by at most `accel` per frame (see the module docs);
+/// `dist ≤ SPAN`, `accel ≥ 1`.
+fn brake_speed(dist: u32, accel: u32) -> u32 {
+    if dist <= accel {
+        // One step covers it.
+        return dist;
     }
-    // best ≤ (dist + base) / steps ≤ dist + accel < 2^64.
-    best.min(u64::MAX as u128) as u64
+    let q = dist.checked_div(accel).unwrap_or(dist);
+    // 2q ≤ 2·SPAN < 2³¹; r ≤ 37 947, so r(r + 1) fits.
+    let twice = 2 * q;
+    let r = twice.isqrt();
+    let k = if r * (r + 1) <= twice { r } else { r - 1 };
+    // T(k) ≤ a·q ≤ dist.
+    let base = accel * (k * (k + 1) / 2);
+    (dist + base).checked_div(k + 1).unwrap_or(dist)
 }

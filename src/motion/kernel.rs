@@ -7,7 +7,7 @@
 //! `(Q·cos 2πj/W, Q·sin 2πj/W)`, j = 0..W−1, in integers.
 //!
 //! Table scale: `Q = ⌊√(2²⁹ / W)⌋ − 1`, so that `Q²·W < 2²⁹` and every product
-//! of the smoother fits an `i32` (the bound is worked out in `engine.rs`).
+//! of the smoother fits an `i32` (the bound is worked out in `engine/mod.rs`).
 //! The table is made exactly zero-sum (Σcos = Σsin = 0 over a period), which
 //! makes the smoother's loop sums exact; the sine column is odd by
 //! construction and the cosine column absorbs its rounding residue in its

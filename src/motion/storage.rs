@@ -1,7 +1,7 @@
 //! How loop samples are stored.
 //!
 //! Three storage types implement [`Sample`]:
-//! - [`Q16`] (the firmware's): the engine's own `i16` samples of the smoothed
+//! - [`Integral16`] (the firmware's): the engine's own `i16` samples of the smoothed
 //!   integral, 2 bytes a sample, with the loop's [`LoopScale`] (a Q-format
 //!   affine map to angles) kept next to them by
 //!   [`Trajectory`](super::Trajectory). Storing the integral as it is
@@ -13,22 +13,22 @@
 //!
 //! All are filled from the same integer pipeline: the engine maps each value
 //! to *fine* units of 1/256 millidegree with the loop's scale and the storage
-//! type rounds it, so `Mdeg16`, `f32` and `Q16` read through its scale agree
+//! type rounds it, so `Mdeg16`, `f32` and `Integral16` read through its scale agree
 //! within half a millidegree (half an `Mdeg16` LSB) by construction.
 
-use crate::units::Angle;
+use crate::units::{Angle, AngleRange};
 
 mod sealed {
     pub trait Sealed {}
     impl Sealed for super::Mdeg16 {}
-    impl Sealed for super::Q16 {}
+    impl Sealed for super::Integral16 {}
     impl Sealed for f32 {}
 }
 
 /// Fine units per millidegree: the engine's output resolution (1/256 m°).
 pub const FINE_PER_MDEG: i32 = 256;
 
-/// A stored loop sample. Implemented by [`Q16`], [`Mdeg16`] and `f32`; sealed.
+/// A stored loop sample. Implemented by [`Integral16`], [`Mdeg16`] and `f32`; sealed.
 pub trait Sample: Copy + PartialEq + core::fmt::Debug + sealed::Sealed {
     /// The neutral value, for `const` initialisation of static buffers.
     const ZERO: Self;
@@ -54,7 +54,7 @@ pub trait Sample: Copy + PartialEq + core::fmt::Debug + sealed::Sealed {
     /// The stored angle, rounded to the nearest millidegree.
     fn angle(self) -> Angle;
     /// The angle of a sample stored with `scale` (rounded to the nearest
-    /// millidegree). Only [`Q16`] is ever stored with another scale than
+    /// millidegree). Only [`Integral16`] is ever stored with another scale than
     /// [`LoopScale::MDEG`]; the others read as [`Sample::angle`].
     #[inline]
     fn angle_in(self, _scale: &LoopScale) -> Angle {
@@ -131,25 +131,27 @@ impl LoopScale {
     }
 }
 
-/// The engine's raw `i16` sample: the loop's smoothed integral in the units
-/// of its [`LoopScale`], which [`Trajectory`](super::Trajectory) keeps.
+/// The loop's smoothed integral in 16 bits (wrapping `i16`), as the engine
+/// computes it: a raw value that means an angle only through its loop's
+/// [`LoopScale`], which [`Trajectory`](super::Trajectory) keeps next to the
+/// samples (not a fixed-point angle: the scale differs from loop to loop).
 ///
 /// Outside a trajectory (e.g. [`generate_into`](super::generate_into)) the
-/// engine finalises the loop and a `Q16` holds millidegrees, read with
+/// engine finalises the loop and an `Integral16` holds millidegrees, read with
 /// [`LoopScale::MDEG`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[repr(transparent)]
-pub struct Q16(pub i16);
+pub struct Integral16(pub i16);
 
-impl Sample for Q16 {
-    const ZERO: Self = Q16(0);
+impl Sample for Integral16 {
+    const ZERO: Self = Integral16(0);
     const BYTES: usize = 2;
     const KEEPS_SCALE: bool = true;
 
     #[inline]
     fn from_scratch(v: i16) -> Self {
-        Q16(v)
+        Integral16(v)
     }
     #[inline]
     fn to_scratch(self) -> i16 {
@@ -157,10 +159,10 @@ impl Sample for Q16 {
     }
     #[inline]
     fn from_fine(fine: i32) -> Self {
-        Q16(Mdeg16::from_fine(fine).0)
+        Integral16(Mdeg16::from_fine(fine).0)
     }
     // Read without its scale (the finalised paper loop, `LoopScale::MDEG`),
-    // a Q16 sample is an `Mdeg16`.
+    // an Integral16 sample is an `Mdeg16`.
     #[inline]
     fn fine(self) -> i32 {
         Mdeg16(self.0).fine()
@@ -183,6 +185,15 @@ impl Sample for Q16 {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[repr(transparent)]
 pub struct Mdeg16(pub i16);
+
+impl Mdeg16 {
+    /// The angles it holds: ±32.767° (−32.768° is left out, so that the
+    /// range is symmetric).
+    pub const RANGE: AngleRange = AngleRange {
+        min: Angle::from_millidegrees(-(i16::MAX as i32)),
+        max: Angle::from_millidegrees(i16::MAX as i32),
+    };
+}
 
 impl Sample for Mdeg16 {
     const ZERO: Self = Mdeg16(0);

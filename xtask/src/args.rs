@@ -1,61 +1,92 @@
-//! Small helpers for the commands that take their own options
-//! (`preview`, `metrics`): `--flag value` and `--flag=value`.
+//! Options that several commands share, and what the commands that run QEMU
+//! take from them.
 
-use std::str::FromStr;
+use std::time::Duration;
 
-use anyhow::{Context, Result};
+use clap::Args;
+use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N};
 
-/// Splits `--flag=value` into the flag and its inline value.
-pub fn split(arg: &str) -> (&str, Option<&str>) {
-    match arg.split_once('=') {
-        Some((flag, value)) if flag.starts_with("--") => (flag, Some(value)),
-        _ => (arg, None),
+/// Options of the commands that run QEMU.
+#[derive(Debug, Clone, Copy)]
+pub struct Options {
+    /// Re-record the expected QEMU log instead of comparing against it.
+    pub bless: bool,
+    /// Wall-clock limit for one QEMU run.
+    pub timeout: Duration,
+    /// Report the benchmark's instruction budget without failing on it.
+    pub no_budget: bool,
+}
+
+/// The window (W) of the default rows (paper, Table 2), the same for the three axes.
+pub const DEFAULT_WINDOW: u16 = DEFAULT_HEAD.yaw.window;
+const _: () = assert!(
+    DEFAULT_HEAD.pitch.window == DEFAULT_WINDOW && DEFAULT_HEAD.roll.window == DEFAULT_WINDOW
+);
+
+/// `--bless` (qemu, test).
+#[derive(Debug, Clone, Copy, Args)]
+pub struct Bless {
+    /// Re-record qemu/expected.log from this run (the run itself must succeed).
+    #[arg(long)]
+    pub bless: bool,
+}
+
+/// `--timeout` (qemu, test, bench).
+#[derive(Debug, Clone, Copy, Args)]
+pub struct Timeout {
+    /// Stop QEMU after this many seconds of wall time; a run that times out
+    /// fails.
+    // A hung firmware must fail, not stall; a run takes seconds.
+    #[arg(
+        long,
+        value_name = "s",
+        allow_negative_numbers = true,
+        default_value_t = 120,
+        value_parser = at_least_one::<u64>
+    )]
+    pub timeout: u64,
+}
+
+/// A whole number, at least 1.
+pub fn at_least_one<T: std::str::FromStr + From<u8> + PartialOrd>(text: &str) -> Result<T, String> {
+    match text.parse() {
+        Ok(value) if value >= T::from(1) => Ok(value),
+        _ => Err("expected a whole number, at least 1".to_owned()),
     }
 }
 
-/// The value of `flag`: the inline one, or the next argument.
-pub fn value(
-    flag: &str,
-    inline: Option<&str>,
-    args: &mut impl Iterator<Item = String>,
-    what: &str,
-) -> Result<String> {
-    match inline {
-        Some(value) => Ok(value.to_owned()),
-        None => args
-            .next()
-            .with_context(|| format!("`{flag}` needs {what}")),
+/// `--no-budget` (bench, test).
+#[derive(Debug, Clone, Copy, Args)]
+pub struct Budget {
+    /// Report the benchmark's instruction budget without failing on it.
+    #[arg(long)]
+    pub no_budget: bool,
+}
+
+/// `--n` and `--w` (preview, metrics).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Args)]
+pub struct LoopShape {
+    /// Samples per loop [default: 900].
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub n: Option<usize>,
+    /// Hann window taps [default: 59, the default rows'].
+    #[arg(long, value_name = "W", allow_negative_numbers = true)]
+    pub w: Option<u16>,
+}
+
+impl LoopShape {
+    /// Whether either option is given.
+    pub fn given(&self) -> bool {
+        self.n.is_some() || self.w.is_some()
     }
-}
 
-/// Parses `value` of `flag` as a `T`, naming both on failure.
-pub fn parse<T: FromStr>(flag: &str, value: &str, what: &str) -> Result<T>
-where
-    T::Err: std::error::Error + Send + Sync + 'static,
-{
-    value
-        .replace('_', "")
-        .parse()
-        .with_context(|| format!("`{flag} {value}`: expected {what}"))
-}
+    /// Samples per loop.
+    pub fn n(&self) -> usize {
+        self.n.unwrap_or(DEFAULT_N)
+    }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn inline_and_separate_values() {
-        assert_eq!(split("--n=900"), ("--n", Some("900")));
-        assert_eq!(split("--n"), ("--n", None));
-        assert_eq!(split("x=1"), ("x=1", None));
-        let mut rest = ["450".to_owned()].into_iter();
-        assert_eq!(value("--n", None, &mut rest, "N").unwrap(), "450");
-        assert!(value("--n", None, &mut rest, "N").is_err());
-        assert_eq!(value("--n", Some("9"), &mut rest, "N").unwrap(), "9");
-        assert_eq!(
-            parse::<u32>("--seeds", "10_000", "a count").unwrap(),
-            10_000
-        );
-        assert!(parse::<u32>("--seeds", "-1", "a count").is_err());
+    /// Hann window taps.
+    pub fn w(&self) -> u16 {
+        self.w.unwrap_or(DEFAULT_WINDOW)
     }
 }

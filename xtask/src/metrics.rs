@@ -23,92 +23,42 @@
 
 use std::{fmt::Write as _, thread, time::Instant};
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, anyhow};
 use idle_head::{
     Angle, Axis,
     metrics::LoopMetrics,
-    motion::{AxisConfig, Closure, DEFAULT_HEAD, HannKernel, Mdeg16, generate_into},
+    motion::{AxisConfig, AxisError, Closure, DEFAULT_HEAD, HannKernel, Mdeg16, generate_into},
 };
 
-use crate::args;
+use crate::args::LoopShape;
 
 /// The continuity ratio a loop must not exceed (max over P95, both d1 and d2).
 pub const CONTINUITY_LIMIT: f32 = 3.0;
 
-/// `cargo xtask metrics -h`.
-pub const HELP: &str = "\
-Usage: cargo xtask metrics [--seeds <count>] [--n <N>] [--w <W>]
-
-Generates one loop per seed with each closure (seamless, paper) and prints
-the distributions (min, median, p99, max) of the loop metrics of the stored
-loop: max|d1|/P95|d1|, max|d2|/P95|d2|, liveliness, the margins to [α1, α2]
-and the start value; then, per closure, how many seeds break continuity ≤ 3.
-
-Seed i (i = 0..count) is i*2654435761 + 12345 (mod 2^32) and runs on axis
-i mod 3 (pitch, roll, yaw) with that axis' default row (paper, Table 2),
-so each default range gets a third of the seeds.
-
-Options:
-  --seeds <count>  Seeds per closure (default 10000).
-  --n <N>          Samples per loop (default 900).
-  --w <W>          Hann window taps (default 59).
-  -h, --help       Show this text.
-";
-
-/// Options of `cargo xtask metrics`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Options of `cargo xtask metrics` (its help text is in `cli.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::Args)]
 pub struct Args {
     /// Seeds per closure.
+    #[arg(
+        long,
+        value_name = "count",
+        allow_negative_numbers = true,
+        default_value_t = 10_000,
+        value_parser = crate::args::at_least_one::<u32>
+    )]
     pub seeds: u32,
-    /// Samples per loop.
-    pub n: usize,
-    /// Hann window taps.
-    pub w: u16,
-}
-
-impl Default for Args {
-    fn default() -> Self {
-        Self {
-            seeds: 10_000,
-            n: 900,
-            w: 59,
-        }
-    }
+    #[command(flatten)]
+    pub shape: LoopShape,
 }
 
 impl Args {
-    /// Parses the options after `metrics`; `Ok(None)` asks for help.
-    pub fn parse(mut rest: impl Iterator<Item = String>) -> Result<Option<Self>> {
-        let mut parsed = Self::default();
-        while let Some(arg) = rest.next() {
-            let (flag, inline) = args::split(&arg);
-            let mut value =
-                |what: &str| -> Result<String> { args::value(flag, inline, &mut rest, what) };
-            match flag {
-                "-h" | "--help" => return Ok(None),
-                "--seeds" => {
-                    parsed.seeds = args::parse(flag, &value("a count")?, "a count of seeds")?;
-                }
-                "--n" => {
-                    parsed.n = args::parse(flag, &value("a number")?, "a number of samples")?;
-                }
-                "--w" => {
-                    parsed.w = args::parse(flag, &value("a number")?, "a window in taps")?;
-                }
-                other => bail!("unknown metrics option `{other}` (see `cargo xtask help`)"),
-            }
-        }
-        if parsed.seeds == 0 {
-            bail!("`--seeds` must be at least 1");
-        }
-        Ok(Some(parsed))
-    }
-
     /// The command line that reproduces this run.
     pub fn command_line(&self) -> String {
         format!(
             "cargo xtask metrics --seeds {} --n {} --w {}",
-            self.seeds, self.n, self.w
+            self.seeds,
+            self.shape.n(),
+            self.shape.w()
         )
     }
 }
@@ -124,7 +74,7 @@ pub fn config(i: u32, args: Args, closure: Closure) -> (Axis, AxisConfig) {
     let cfg = DEFAULT_HEAD
         .axis(axis)
         .with_seed(seed(i))
-        .with_window(args.w)
+        .with_window(args.shape.w())
         .with_closure(closure);
     (axis, cfg)
 }
@@ -209,9 +159,9 @@ pub struct Results {
 
 /// Generates and measures seeds `range` for `closure`.
 fn measure(range: std::ops::Range<u32>, args: Args, closure: Closure) -> Result<Results> {
-    let kernel = HannKernel::new(args.w).map_err(|error| anyhow!("{error}"))?;
-    let mut buffer = vec![Mdeg16(0); args.n];
-    let mut scratch = vec![0; args.n];
+    let kernel = HannKernel::new(args.shape.w())?;
+    let mut buffer = vec![Mdeg16(0); args.shape.n()];
+    let mut scratch = vec![0; args.shape.n()];
     let mut results = Results::default();
     for i in range {
         let (axis, cfg) = config(i, args, closure);
@@ -316,8 +266,8 @@ pub fn command(args: &Args) -> Result<bool> {
     let args = *args;
     for axis in Axis::ALL {
         let (_, cfg) = config(axis.index() as u32, args, Closure::Seamless);
-        cfg.validate(axis, args.n)
-            .map_err(|error| anyhow!("{}: {error}", axis.name()))?;
+        cfg.validate(axis, args.shape.n())
+            .map_err(|error| AxisError { axis, error })?;
     }
     println!("$ {}", args.command_line());
     println!(
@@ -331,8 +281,8 @@ pub fn command(args: &Args) -> Result<bool> {
         DEFAULT_HEAD.roll.range.max.millidegrees() / 1000,
         DEFAULT_HEAD.yaw.range.min.millidegrees() / 1000,
         DEFAULT_HEAD.yaw.range.max.millidegrees() / 1000,
-        args.n,
-        args.w,
+        args.shape.n(),
+        args.shape.w(),
     );
     println!(
         "metrics of the stored loop x, cyclic: d1(n) = x(n+1) − x(n), d2(n) = d1(n+1) − d1(n); \
@@ -358,28 +308,30 @@ pub fn command(args: &Args) -> Result<bool> {
 mod tests {
     use super::*;
 
+    fn seeds(seeds: u32) -> Args {
+        Args {
+            seeds,
+            shape: LoopShape::default(),
+        }
+    }
+
     #[test]
-    fn parses_options_with_defaults() {
-        let parse = |args: &[&str]| Args::parse(args.iter().map(|s| (*s).to_owned()));
-        assert_eq!(parse(&[]).unwrap().unwrap(), Args::default());
-        let args = parse(&["--seeds", "300", "--n=450", "--w", "15"])
-            .unwrap()
-            .unwrap();
-        assert_eq!(
-            args,
-            Args {
-                seeds: 300,
-                n: 450,
-                w: 15
-            }
-        );
+    fn the_command_line_reproduces_the_run() {
+        let args = Args {
+            seeds: 300,
+            shape: LoopShape {
+                n: Some(450),
+                w: Some(15),
+            },
+        };
         assert_eq!(
             args.command_line(),
             "cargo xtask metrics --seeds 300 --n 450 --w 15"
         );
-        assert!(parse(&["--seeds", "0"]).is_err());
-        assert!(parse(&["--frobnicate"]).is_err());
-        assert!(parse(&["-h"]).unwrap().is_none());
+        assert_eq!(
+            seeds(10_000).command_line(),
+            "cargo xtask metrics --seeds 10000 --n 900 --w 59"
+        );
     }
 
     #[test]
@@ -388,7 +340,7 @@ mod tests {
         assert_eq!(seed(1), 2_654_435_761 + 12_345);
         // Wraps modulo 2^32.
         assert_eq!(seed(2), (2 * 2_654_435_761u64 + 12_345) as u32);
-        let args = Args::default();
+        let args = seeds(1);
         let axes: Vec<Axis> = (0..4).map(|i| config(i, args, Closure::Paper).0).collect();
         assert_eq!(axes, [Axis::Pitch, Axis::Roll, Axis::Yaw, Axis::Pitch]);
         let (_, cfg) = config(2, args, Closure::Paper);
@@ -409,10 +361,7 @@ mod tests {
 
     #[test]
     fn a_few_seeds_measure_and_report() {
-        let args = Args {
-            seeds: 9,
-            ..Args::default()
-        };
+        let args = seeds(9);
         let results: Vec<(Closure, Results)> = [Closure::Seamless, Closure::Paper]
             .into_iter()
             .map(|closure| (closure, run(args, closure).unwrap()))

@@ -1,13 +1,14 @@
-//! Where things are in the repository and how the firmware images are built.
+//! Where things are in the repository, how commands run, and how the firmware
+//! images are built.
 
 use std::{
-    ffi::OsStr,
     fmt::Write as _,
     path::{Path, PathBuf},
-    process::Command,
 };
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, anyhow};
+use cargo_metadata::MetadataCommand;
+use xshell::{Cmd, Shell, cmd};
 
 /// The firmware's compilation target (ARMv6-M: RP2040's Cortex-M0+, QEMU's Cortex-M0).
 pub const TARGET: &str = "thumbv6m-none-eabi";
@@ -16,13 +17,52 @@ pub const TARGET: &str = "thumbv6m-none-eabi";
 /// expected QEMU log on file is recorded at this level.
 pub const DEFMT_LOG: &str = "info";
 
-/// The repository root: the parent of this crate's directory.
+/// The environment of every firmware build: the project's defmt level, over
+/// whatever the caller's environment says.
+pub const FIRMWARE_ENV: &[(&str, &str)] = &[("DEFMT_LOG", DEFMT_LOG)];
+
+/// The repository root: the parent of this crate's directory. Commands run
+/// from any folder of the repository, so every path starts here.
 pub fn root() -> PathBuf {
     let xtask = Path::new(env!("CARGO_MANIFEST_DIR"));
     xtask
         .parent()
         .expect("xtask/ lives inside the repository")
         .to_path_buf()
+}
+
+/// `path` relative to the repository root, for messages.
+pub fn relative(path: &Path) -> PathBuf {
+    path.strip_prefix(root()).unwrap_or(path).to_path_buf()
+}
+
+/// A shell whose commands run in `dir`, relative to the repository root.
+pub fn shell(dir: &str) -> Result<Shell> {
+    let sh = Shell::new()?;
+    sh.change_dir(root().join(dir));
+    Ok(sh)
+}
+
+/// Echoes `cmd` the way a user would type it from the repository root
+/// (`(cd dir && VAR=value program args)`), then runs it with `env` and
+/// inherited output; fails unless it exits with 0.
+pub fn run(sh: &Shell, env: &[(&str, &str)], cmd: Cmd<'_>) -> Result<()> {
+    let mut line = String::new();
+    for (key, value) in env {
+        let _ = write!(line, "{key}={value} ");
+    }
+    let _ = write!(line, "{cmd}");
+    let dir = sh.current_dir();
+    if let Ok(sub) = dir.strip_prefix(root())
+        && !sub.as_os_str().is_empty()
+    {
+        line = format!("(cd {} && {line})", sub.display());
+    }
+    println!("$ {line}");
+    cmd.envs(env.iter().copied())
+        .quiet()
+        .run()
+        .map_err(|error| anyhow!("{error}"))
 }
 
 /// A package of the repository that builds firmware images. Each has its own
@@ -86,22 +126,26 @@ impl Image {
     /// with the project's defmt level. The Pico image is the root package's
     /// only bin, so its command is the one users type.
     pub fn build(&self, root: &Path) -> Result<()> {
-        let mut cargo = cargo(root);
-        cargo
-            .args(["build", "--release"])
-            .args(self.package.manifest_args());
-        if self.package != Package::Root {
-            cargo.args(["--bin", self.bin]);
-        }
-        cargo.env("DEFMT_LOG", DEFMT_LOG);
-        run(&mut cargo)
+        let sh = Shell::new()?;
+        sh.change_dir(root);
+        let manifest = self.package.manifest_args();
+        let bin = match self.package {
+            Package::Root => None,
+            Package::Qemu => Some(["--bin", self.bin]),
+        };
+        let bin = bin.iter().flatten();
+        run(
+            &sh,
+            FIRMWARE_ENV,
+            cmd!(sh, "cargo build --release {manifest...} {bin...}"),
+        )
     }
 }
 
 /// The parts of `cargo metadata` this crate uses.
 #[derive(Debug)]
 pub struct Metadata {
-    /// Where cargo puts build output for the root package.
+    /// Where cargo puts build output for the root workspace.
     pub target_dir: PathBuf,
     /// Where cargo puts build output for the QEMU package (`qemu/target`
     /// unless configured otherwise).
@@ -120,109 +164,27 @@ impl Metadata {
     }
 }
 
-/// Reads `cargo metadata` for both packages (no dependency resolution).
+/// Reads `cargo metadata` for both workspaces (no dependency resolution).
 pub fn metadata(root: &Path) -> Result<Metadata> {
-    let json = cargo_metadata(root, Package::Root)?;
-    let target_dir = target_directory(&json)?;
-    let qemu_target_dir = target_directory(&cargo_metadata(root, Package::Qemu)?)?;
-    let lib_doctests = json["packages"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter(|package| package["name"] == "idle-head")
-        .flat_map(|package| package["targets"].as_array().into_iter().flatten())
-        .any(|target| {
-            target["kind"]
-                .as_array()
-                .is_some_and(|kinds| kinds.iter().any(|kind| kind == "lib"))
-                && target["doctest"] == true
-        });
+    let read = |manifest: &str| {
+        MetadataCommand::new()
+            .current_dir(root)
+            .manifest_path(root.join(manifest))
+            .no_deps()
+            .exec()
+            .with_context(|| format!("running `cargo metadata` for {manifest}"))
+    };
+    let main = read("Cargo.toml")?;
+    let qemu = read("qemu/Cargo.toml")?;
+    let lib_doctests = main
+        .packages
+        .iter()
+        .filter(|package| package.name.as_str() == "idle-head")
+        .flat_map(|package| &package.targets)
+        .any(|target| target.is_lib() && target.doctest);
     Ok(Metadata {
-        target_dir,
-        qemu_target_dir,
+        target_dir: main.target_directory.into(),
+        qemu_target_dir: qemu.target_directory.into(),
         lib_doctests,
     })
-}
-
-/// `cargo metadata --no-deps` of `package`, run in the repository root.
-fn cargo_metadata(root: &Path, package: Package) -> Result<serde_json::Value> {
-    let output = cargo(root)
-        .args(["metadata", "--no-deps", "--format-version", "1"])
-        .args(package.manifest_args())
-        .output()
-        .context("running `cargo metadata`")?;
-    if !output.status.success() {
-        bail!(
-            "`cargo metadata` failed:\n{}",
-            String::from_utf8_lossy(&output.stderr)
-        );
-    }
-    serde_json::from_slice(&output.stdout).context("parsing `cargo metadata` output")
-}
-
-fn target_directory(json: &serde_json::Value) -> Result<PathBuf> {
-    Ok(json["target_directory"]
-        .as_str()
-        .context("`cargo metadata` gave no target_directory")?
-        .into())
-}
-
-/// A `cargo` command running in `dir`.
-pub fn cargo(dir: &Path) -> Command {
-    let mut command = Command::new("cargo");
-    command.current_dir(dir);
-    command
-}
-
-/// Prints a command line the way a user would type it (relative to the root).
-pub fn display(command: &Command) -> String {
-    let mut line = String::new();
-    let root = root();
-    if let Some(dir) = command.get_current_dir()
-        && dir != root
-    {
-        let dir = dir.strip_prefix(&root).unwrap_or(dir);
-        let _ = write!(line, "(cd {} && ", dir.display());
-    }
-    for (key, value) in command.get_envs() {
-        if let Some(value) = value {
-            let _ = write!(
-                line,
-                "{}={} ",
-                key.to_string_lossy(),
-                value.to_string_lossy()
-            );
-        }
-    }
-    line.push_str(&command.get_program().to_string_lossy());
-    for arg in command.get_args() {
-        line.push(' ');
-        line.push_str(&quote(arg));
-    }
-    if command.get_current_dir().is_some_and(|dir| dir != root) {
-        line.push(')');
-    }
-    line
-}
-
-fn quote(arg: &OsStr) -> String {
-    let arg = arg.to_string_lossy();
-    if arg.is_empty() || arg.contains(|c: char| c.is_whitespace() || c == '\'') {
-        format!("'{}'", arg.replace('\'', r"'\''"))
-    } else {
-        arg.into_owned()
-    }
-}
-
-/// Echoes and runs a command with inherited output; fails unless it exits with 0.
-pub fn run(command: &mut Command) -> Result<()> {
-    let line = display(command);
-    println!("$ {line}");
-    let status = command
-        .status()
-        .with_context(|| format!("could not start `{line}`"))?;
-    if !status.success() {
-        bail!("`{line}` failed ({status})");
-    }
-    Ok(())
 }

@@ -1,22 +1,34 @@
 //! Runs the QEMU image and decodes its defmt log; `cargo xtask qemu`.
 
 use std::{
-    io::Read,
+    io::{BufRead, BufReader, Read, Write},
     path::Path,
-    process::{Child, Command, ExitStatus, Stdio},
-    sync::mpsc::{self, RecvTimeoutError},
+    process::{Child, Command, Stdio},
     thread,
     time::{Duration, Instant},
 };
 
-use anyhow::{Context, Result, bail};
-use defmt_decoder::{DecodeError, Frame, Locations, Table};
+use anyhow::{Context, Result, anyhow, bail};
+use defmt_decoder::{DecodeError, Locations, Table};
+use wait_timeout::ChildExt;
+use xshell::{Cmd, Shell, cmd};
 
 use crate::{
-    Options,
+    args::Options,
+    log::{Exit, LogLine, Run},
     project::{self, QEMU},
-    reference, render, setup, snapshot,
+    reference, render,
+    setup::{self, QEMU_BINARY},
+    snapshot,
 };
+
+/// What QEMU 7.2 prints at every start of the `lm3s6965evb` machine, before
+/// the firmware runs: the board's watchdog model starts its timer at reset,
+/// while the system clock that drives it still reads 0 Hz (it is set a moment
+/// later). The watchdog then stays stopped until a program loads it, which
+/// these images never do, so the line says nothing about the run and is not
+/// shown. Later QEMU releases no longer start the watchdog at reset.
+const RESET_NOISE: &str = "Timer with period zero, disabling";
 
 /// `cargo xtask qemu`: build, run, show. `Ok(false)` when the run failed.
 pub fn command(options: Options) -> Result<bool> {
@@ -25,8 +37,7 @@ pub fn command(options: Options) -> Result<bool> {
     setup::ensure_qemu()?;
     let metadata = project::metadata(&root)?;
     QEMU.build(&root)?;
-    let elf = QEMU.elf(&metadata);
-    let run = run(&elf, options.timeout, Echo::All)?;
+    let run = run(&QEMU.elf(&metadata), options.timeout, Echo::All)?;
 
     if let Some(plot) = render::plot(&run.log) {
         println!();
@@ -61,132 +72,23 @@ pub enum Echo {
     Problems,
 }
 
-/// One decoded defmt frame.
-#[derive(Debug, Clone)]
-pub struct LogLine {
-    /// `INFO`, `WARN`, ... (`None` for `println!`-style frames).
-    pub level: Option<String>,
-    /// The formatted message.
-    pub message: String,
-    /// The formatted timestamp, if the firmware has one.
-    pub timestamp: Option<String>,
-    /// `file:line` of the log statement, if the ELF has debug info.
-    pub location: Option<String>,
-}
-
-impl LogLine {
-    fn from_frame(frame: &Frame<'_>, locations: Option<&Locations>, root: &Path) -> Self {
-        let location = locations
-            .and_then(|locations| locations.get(&frame.index()))
-            .map(|location| {
-                let file = location.file.strip_prefix(root).unwrap_or(&location.file);
-                format!("{}:{}", file.display(), location.line)
-            });
-        Self {
-            level: frame.level().map(|level| level.as_str().to_uppercase()),
-            message: frame.display_message().to_string(),
-            timestamp: frame.display_timestamp().map(|t| t.to_string()),
-            location,
-        }
-    }
-
-    fn malformed() -> Self {
-        Self {
-            level: Some("ERROR".to_owned()),
-            message: "(malformed defmt frame: the log stream is corrupt)".to_owned(),
-            timestamp: None,
-            location: None,
-        }
-    }
-
-    /// The line as kept in the expected log: level and message, no timestamp
-    /// or location (those change with unrelated code changes).
-    pub fn snapshot(&self) -> String {
-        match &self.level {
-            Some(level) => format!("{level:<5} {}", self.message),
-            None => self.message.clone(),
-        }
-    }
-
-    /// Whether this is a warning or an error.
-    pub fn is_problem(&self) -> bool {
-        matches!(self.level.as_deref(), Some("WARN" | "ERROR"))
-    }
-
-    fn print(&self) {
-        match &self.timestamp {
-            Some(timestamp) => println!("{timestamp} {}", self.snapshot()),
-            None => println!("{}", self.snapshot()),
-        }
-        if self.is_problem()
-            && let Some(location) = &self.location
-        {
-            println!("      └─ {location}");
-        }
-    }
-}
-
-/// How QEMU ended.
-#[derive(Debug, Clone, Copy)]
-pub enum Exit {
-    /// QEMU exited (semihosting exit code, 0 = success).
-    Status(ExitStatus),
-    /// Killed after the timeout.
-    TimedOut(Duration),
-}
-
-/// The outcome of one QEMU run.
-#[derive(Debug)]
-pub struct Run {
-    /// Decoded log, in order.
-    pub log: Vec<LogLine>,
-    /// How QEMU ended.
-    pub exit: Exit,
-    /// Wall time of the run.
-    pub elapsed: Duration,
-}
-
-impl Run {
-    /// QEMU exited with status 0 before the timeout.
-    pub fn succeeded(&self) -> bool {
-        matches!(self.exit, Exit::Status(status) if status.success())
-    }
-
-    /// One line saying how the run ended.
-    pub fn describe(&self) -> String {
-        let how = match self.exit {
-            Exit::Status(status) if status.success() => "firmware exited with success".to_owned(),
-            Exit::Status(status) => format!("firmware FAILED ({status})"),
-            Exit::TimedOut(limit) => format!(
-                "firmware TIMED OUT: QEMU killed after {} s (raise with --timeout)",
-                limit.as_secs()
-            ),
-        };
-        format!(
-            "qemu: {how}; {} log lines in {:.1} s",
-            self.log.len(),
-            self.elapsed.as_secs_f64()
-        )
-    }
-}
-
 /// QEMU's command line for `elf`. `-icount shift=0` makes one instruction one
 /// nanosecond of virtual time, so timing repeats exactly run after run;
 /// `sleep=off` lets the virtual clock jump over the time the core sleeps
 /// instead of following the wall clock, which would make wake-up times (and
 /// so the log) vary from run to run, and the run slower.
-pub fn qemu_command(elf: &Path) -> Command {
-    let mut command = Command::new(setup::QEMU_BINARY);
-    command
-        .args(["-machine", "lm3s6965evb", "-cpu", "cortex-m0", "-nographic"])
-        .args(["-semihosting-config", "enable=on,target=native"])
-        .args(["-icount", "shift=0,sleep=off"])
-        .arg("-kernel")
-        .arg(elf);
-    command
+pub fn qemu_command<'a>(sh: &'a Shell, elf: &Path) -> Cmd<'a> {
+    cmd!(
+        sh,
+        "{QEMU_BINARY} -machine lm3s6965evb -cpu cortex-m0 -nographic
+            -semihosting-config enable=on,target=native
+            -icount shift=0,sleep=off
+            -kernel {elf}"
+    )
 }
 
-/// Runs `elf` in QEMU, decoding its defmt output as it arrives.
+/// Runs `elf` in QEMU, decoding its defmt output as it arrives; QEMU is
+/// killed after `timeout` of wall time.
 pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
     let root = project::root();
     let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
@@ -195,91 +97,84 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
         .with_context(|| format!("{} has no defmt data", elf.display()))?;
     // Locations need debug info; without them the log still decodes.
     let locations = table.get_locations(&bytes).ok();
-    let mut decoder = table.new_stream_decoder();
 
-    let mut command = qemu_command(elf);
-    command.stdin(Stdio::null()).stdout(Stdio::piped());
-    println!("$ {}", project::display(&command));
+    let sh = project::shell(".")?;
+    let qemu = qemu_command(&sh, elf);
+    println!("$ {qemu}");
+    let mut command = Command::from(qemu);
+    command
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
     let start = Instant::now();
     let mut child = command
         .spawn()
-        .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
+        .with_context(|| format!("could not start {QEMU_BINARY}"))?;
+    let stdout = child.stdout.take().context("QEMU's stdout")?;
+    let stderr = child.stderr.take().context("QEMU's stderr")?;
 
-    // A reader thread feeds stdout through a channel so that the wait for
-    // output can time out.
-    let mut stdout = child.stdout.take().context("QEMU's stdout")?;
-    let (sender, receiver) = mpsc::channel::<Vec<u8>>();
-    let reader = thread::spawn(move || {
-        let mut buffer = [0_u8; 4096];
-        while let Ok(n @ 1..) = stdout.read(&mut buffer) {
-            if sender.send(buffer[..n].to_vec()).is_err() {
-                break;
-            }
-        }
-    });
-
-    let deadline = start + timeout;
-    let mut log = Vec::new();
-    let mut timed_out = false;
-    loop {
-        let left = deadline.saturating_duration_since(Instant::now());
-        match receiver.recv_timeout(left) {
-            Ok(chunk) => {
-                decoder.received(&chunk);
-                loop {
-                    let line = match decoder.decode() {
-                        Ok(frame) => LogLine::from_frame(&frame, locations.as_ref(), &root),
-                        Err(DecodeError::UnexpectedEof) => break,
-                        Err(DecodeError::Malformed) => LogLine::malformed(),
-                    };
-                    if echo == Echo::All || line.is_problem() {
-                        line.print();
-                    }
-                    log.push(line);
-                }
-            }
-            Err(RecvTimeoutError::Timeout) => {
-                timed_out = true;
-                break;
-            }
-            Err(RecvTimeoutError::Disconnected) => break,
-        }
-    }
-
-    let status = if timed_out {
-        None
-    } else {
-        wait_until(&mut child, deadline)?
-    };
-    let exit = if let Some(status) = status {
-        Exit::Status(status)
-    } else {
-        kill(&mut child);
-        Exit::TimedOut(timeout)
-    };
-    let _ = reader.join();
-    Ok(Run {
-        log,
-        exit,
-        elapsed: start.elapsed(),
+    // The log is decoded while QEMU runs; its end is the end of QEMU's
+    // output, which comes when QEMU exits or is killed.
+    thread::scope(|scope| {
+        let decoder = scope.spawn(|| decode(stdout, &table, locations.as_ref(), &root, echo));
+        scope.spawn(|| forward(stderr, &mut std::io::stderr()));
+        let exit = wait_or_kill(&mut child, timeout)?;
+        let log = decoder
+            .join()
+            .map_err(|_| anyhow!("the log decoder panicked"))?;
+        Ok(Run {
+            log,
+            exit,
+            elapsed: start.elapsed(),
+        })
     })
 }
 
-fn wait_until(child: &mut Child, deadline: Instant) -> Result<Option<ExitStatus>> {
-    loop {
-        if let Some(status) = child.try_wait().context("waiting for QEMU")? {
-            return Ok(Some(status));
-        }
-        if Instant::now() >= deadline {
-            return Ok(None);
-        }
-        thread::sleep(Duration::from_millis(20));
+/// Waits for `child` to exit, at most `timeout`; kills it past that.
+fn wait_or_kill(child: &mut Child, timeout: Duration) -> Result<Exit> {
+    if let Some(status) = child.wait_timeout(timeout).context("waiting for QEMU")? {
+        return Ok(Exit::Status(status));
     }
-}
-
-fn kill(child: &mut Child) {
     let _ = child.kill();
     let _ = child.wait();
+    Ok(Exit::TimedOut(timeout))
+}
+
+/// Decodes the defmt stream `output` to its end, echoing lines as they come.
+fn decode(
+    mut output: impl Read,
+    table: &Table,
+    locations: Option<&Locations>,
+    root: &Path,
+    echo: Echo,
+) -> Vec<LogLine> {
+    let mut decoder = table.new_stream_decoder();
+    let mut buffer = [0_u8; 4096];
+    let mut log = Vec::new();
+    while let Ok(n @ 1..) = output.read(&mut buffer) {
+        decoder.received(&buffer[..n]);
+        loop {
+            let line = match decoder.decode() {
+                Ok(frame) => LogLine::from_frame(&frame, locations, root),
+                Err(DecodeError::UnexpectedEof) => break,
+                Err(DecodeError::Malformed) => LogLine::malformed(),
+            };
+            if echo == Echo::All || line.is_problem() {
+                line.print();
+            }
+            log.push(line);
+        }
+    }
+    log
+}
+
+/// Passes QEMU's messages on, all but [`RESET_NOISE`].
+fn forward(stderr: impl Read, to: &mut impl Write) {
+    for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+        if line != RESET_NOISE {
+            let _ = writeln!(to, "{line}");
+        }
+    }
 }
 
 /// The firmware's closing `summary key=value ...` line, as fields.
@@ -362,22 +257,14 @@ pub fn check_summary(log: &[LogLine]) -> Result<String> {
 mod tests {
     use super::*;
 
-    fn line(message: &str) -> LogLine {
-        LogLine {
-            level: Some("INFO".to_owned()),
-            message: message.to_owned(),
-            timestamp: None,
-            location: None,
-        }
-    }
-
     #[test]
     fn reads_the_last_summary_line() {
         let log = [
-            line("frame 0 pitch=0 roll=0 yaw=0"),
-            line("summary frames=10 missed=3"),
-            line("summary frames=900 missed=0 pulse_violations=0, checksum=0x1a2B_3c4d"),
-        ];
+            "frame 0 pitch=0 roll=0 yaw=0",
+            "summary frames=10 missed=3",
+            "summary frames=900 missed=0 pulse_violations=0, checksum=0x1a2B_3c4d",
+        ]
+        .map(|message| LogLine::new("INFO", message));
         let summary = Summary::find(&log).unwrap();
         assert_eq!(summary.number("frames").unwrap(), 900);
         assert_eq!(summary.number("missed").unwrap(), 0);
@@ -387,10 +274,24 @@ mod tests {
     }
 
     #[test]
-    fn snapshot_lines_have_level_and_message_only() {
-        let mut with_extras = line("hello");
-        with_extras.timestamp = Some("1.000000".to_owned());
-        with_extras.location = Some("src/main.rs:3".to_owned());
-        assert_eq!(with_extras.snapshot(), "INFO  hello");
+    fn a_hung_firmware_is_killed_at_the_timeout() {
+        // A program that does not end stands for a hung firmware: the wait
+        // ends at the limit, not with the program.
+        let mut child = Command::new("sleep").arg("30").spawn().unwrap();
+        let start = Instant::now();
+        let exit = wait_or_kill(&mut child, Duration::from_millis(200)).unwrap();
+        assert!(matches!(exit, Exit::TimedOut(limit) if limit.as_millis() == 200));
+        assert!(start.elapsed() < Duration::from_secs(10));
+        let mut child = Command::new("true").spawn().unwrap();
+        let exit = wait_or_kill(&mut child, Duration::from_secs(60)).unwrap();
+        assert!(matches!(exit, Exit::Status(status) if status.success()));
+    }
+
+    #[test]
+    fn only_the_reset_noise_is_dropped() {
+        let stderr = format!("{RESET_NOISE}\nqemu-system-arm: a real problem\n");
+        let mut shown = Vec::new();
+        forward(stderr.as_bytes(), &mut shown);
+        assert_eq!(shown, b"qemu-system-arm: a real problem\n");
     }
 }

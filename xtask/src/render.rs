@@ -1,8 +1,9 @@
-//! A small text plot of the three axes' motion, read back from the QEMU log.
+//! A small text plot of the three axes' motion, from the frame lines of the
+//! QEMU log.
 //!
-//! Frame lines are recognised by their angles, written either as
-//! `pitch=<n> roll=<n> yaw=<n>` (a unit may follow each number) or as a
-//! bracketed triple after a word starting with `angle` (`angles=[p, r, y]`).
+//! The log is the only record of the angles the firmware commanded (the
+//! decoder hands out the formatted text, not the arguments), so the frame
+//! lines are read back: `frame <n>: pitch=<deg> roll=<deg> yaw=<deg> deg, ...`.
 
 // Frame counts and plot rows are small; the float conversions are exact.
 #![allow(
@@ -13,6 +14,8 @@
 
 use std::fmt::Write as _;
 
+use crate::log::LogLine;
+
 /// Columns of the plot.
 const WIDTH: usize = 64;
 /// Rows per axis.
@@ -21,21 +24,16 @@ const AXES: [&str; 3] = ["pitch", "roll", "yaw"];
 
 /// One frame line: its position on the time axis and the three angles.
 struct Sample {
-    /// The frame number (`frame <n>`), or the line's place among the frame lines.
+    /// The frame number.
     x: f64,
     angles: [f64; 3],
 }
 
 /// The plot, or `None` if the log has fewer than two frame lines.
-pub fn plot(log: &[crate::qemu::LogLine]) -> Option<String> {
+pub fn plot(log: &[LogLine]) -> Option<String> {
     let mut samples: Vec<Sample> = log
         .iter()
-        .filter_map(|line| angles(&line.message))
-        .enumerate()
-        .map(|(i, (frame, angles))| Sample {
-            x: frame.unwrap_or(i as f64),
-            angles,
-        })
+        .filter_map(|line| frame_line(&line.message))
         .collect();
     samples.sort_by(|a, b| a.x.total_cmp(&b.x));
     let first = samples.first()?.x;
@@ -100,66 +98,42 @@ pub fn plot(log: &[crate::qemu::LogLine]) -> Option<String> {
     Some(out)
 }
 
-/// The frame number (if given as `frame <n>`) and the three angles of a
-/// frame line, if `message` is one.
-fn angles(message: &str) -> Option<(Option<f64>, [f64; 3])> {
-    let angles = keyed(message).or_else(|| bracketed(message))?;
-    let frame = message
-        .split_once("frame ")
-        .and_then(|(_, rest)| leading_number(rest));
-    Some((frame, angles))
-}
-
-fn keyed(message: &str) -> Option<[f64; 3]> {
-    let mut found = [None; 3];
-    for token in message.split(|c: char| c.is_whitespace() || c == ',') {
-        let Some((key, value)) = token.split_once(['=', ':']) else {
-            continue;
-        };
-        if let Some(axis) = AXES.iter().position(|name| key.eq_ignore_ascii_case(name)) {
-            found[axis] = leading_number(value);
-        }
+/// The frame number and the three angles of a frame line, if `message` is one.
+fn frame_line(message: &str) -> Option<Sample> {
+    let (frame, rest) = message.strip_prefix("frame ")?.split_once(": ")?;
+    let mut words = rest.split_whitespace();
+    let mut angles = [0.0; 3];
+    for (angle, axis) in angles.iter_mut().zip(AXES) {
+        let value = words.next()?.strip_prefix(axis)?.strip_prefix('=')?;
+        *angle = value.parse().ok()?;
     }
-    Some([found[0]?, found[1]?, found[2]?])
-}
-
-fn bracketed(message: &str) -> Option<[f64; 3]> {
-    let at = message.find("angle")?;
-    let rest = &message[at..];
-    let open = rest.find('[')?;
-    let close = rest[open..].find(']')? + open;
-    let values: Vec<f64> = rest[open + 1..close]
-        .split(',')
-        .map(|value| leading_number(value.trim()))
-        .collect::<Option<_>>()?;
-    <[f64; 3]>::try_from(values).ok()
-}
-
-/// The number at the start of `text` (`-12`, `3.5`, `+7mdeg` -> 7).
-fn leading_number(text: &str) -> Option<f64> {
-    let end = text
-        .char_indices()
-        .find(|&(i, c)| !(c.is_ascii_digit() || c == '.' || (i == 0 && (c == '-' || c == '+'))))
-        .map_or(text.len(), |(i, _)| i);
-    text[..end].parse().ok()
+    Some(Sample {
+        x: frame.parse().ok()?,
+        angles,
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::qemu::LogLine;
 
     #[test]
-    fn reads_keyed_and_bracketed_angles() {
-        assert_eq!(
-            angles("frame 3 pitch=-120 roll=45mdeg yaw=+7 pulses=[1500, 1490, 1510]"),
-            Some((Some(3.0), [-120.0, 45.0, 7.0]))
-        );
-        assert_eq!(
-            angles("angles=[1.5, -2, 3] pulses=[1500, 1490, 1510]"),
-            Some((None, [1.5, -2.0, 3.0]))
-        );
-        assert_eq!(angles("summary missed=0"), None);
+    fn reads_frame_lines_only() {
+        let sample = frame_line(
+            "frame 1650: pitch=-2.440 roll=+2.285 yaw=+7.611 deg, pulses 1473 1525 1585 us \
+             (Written Written Failed(Other))",
+        )
+        .unwrap();
+        assert_eq!((sample.x, sample.angles), (1650.0, [-2.44, 2.285, 7.611]));
+        for other in [
+            "frame 1400: join: the next loop set blends in over 100 frames",
+            "frame 1650: injecting PWM write errors on yaw for 10 frames",
+            "frame 7: pitch=+1.000 roll=+2.000 deg",
+            "frame x: pitch=+1.000 roll=+2.000 yaw=+3.000 deg",
+            "summary frames=1903 missed=0",
+        ] {
+            assert!(frame_line(other).is_none(), "{other}");
+        }
     }
 
     #[test]
@@ -167,21 +141,25 @@ mod tests {
         let log: Vec<LogLine> = (0..300)
             .map(|i| {
                 let t = f64::from(i) / 300.0 * std::f64::consts::TAU;
-                LogLine {
-                    level: Some("INFO".to_owned()),
-                    message: format!(
-                        "frame {i} pitch={:.0} roll={:.0} yaw={:.0}",
-                        4000.0 * t.sin(),
-                        2000.0 * (2.0 * t).cos(),
-                        9000.0 * (t / 2.0).sin()
+                LogLine::new(
+                    "INFO",
+                    format!(
+                        "frame {i}: pitch={:+.3} roll={:+.3} yaw={:+.3} deg",
+                        4.0 * t.sin(),
+                        2.0 * (2.0 * t).cos(),
+                        9.0 * (t / 2.0).sin()
                     ),
-                    timestamp: None,
-                    location: None,
-                }
+                )
             })
             .collect();
         let plot = plot(&log).unwrap();
         println!("{plot}");
-        assert_eq!(plot.lines().count(), 1 + 3 * HEIGHT);
+        let lines: Vec<&str> = plot.lines().collect();
+        assert_eq!(lines.len(), 1 + 3 * HEIGHT);
+        assert!(lines[0].contains("300 logged frames, frame 0 to 299"));
+        // Each band is labelled with its axis and its extremes.
+        assert!(lines[1].trim_start().starts_with("pitch") && lines[1].contains(" 4.0 |"));
+        assert!(lines[HEIGHT].contains(" -4.0 |"));
+        assert!(lines[1 + 2 * HEIGHT].trim_start().starts_with("yaw"));
     }
 }

@@ -1,11 +1,9 @@
 //! Installs what the commands need and is missing.
 
-use std::{
-    path::Path,
-    process::{Command, Stdio},
-};
+use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+use xshell::{Shell, cmd};
 
 use crate::project::{self, TARGET};
 
@@ -20,19 +18,28 @@ const COMPONENTS: [&str; 2] = ["rustfmt", "clippy"];
 /// repository uses (the one named by `rust-toolchain.toml`, so rustup runs in
 /// the repository root).
 pub fn ensure_toolchain(root: &Path) -> Result<()> {
-    let Some(targets) = rustup_installed(root, "target") else {
+    let sh = Shell::new()?;
+    sh.change_dir(root);
+    let installed = |what: &str| {
         // No rustup: a toolchain installed some other way must bring these
         // itself; the build says so if it does not.
+        cmd!(sh, "rustup {what} list --installed")
+            .quiet()
+            .read()
+            .ok()
+            .map(|list| {
+                list.lines()
+                    .map(|line| line.trim().to_owned())
+                    .collect::<Vec<_>>()
+            })
+    };
+    let Some(targets) = installed("target") else {
         return Ok(());
     };
     if !targets.iter().any(|target| target == TARGET) {
-        project::run(
-            Command::new("rustup")
-                .args(["target", "add", TARGET])
-                .current_dir(root),
-        )?;
+        project::run(&sh, &[], cmd!(sh, "rustup target add {TARGET}"))?;
     }
-    let components = rustup_installed(root, "component").unwrap_or_default();
+    let components = installed("component").unwrap_or_default();
     let missing: Vec<&str> = COMPONENTS
         .into_iter()
         .filter(|name| {
@@ -42,30 +49,9 @@ pub fn ensure_toolchain(root: &Path) -> Result<()> {
         })
         .collect();
     if !missing.is_empty() {
-        project::run(
-            Command::new("rustup")
-                .args(["component", "add"])
-                .args(&missing)
-                .current_dir(root),
-        )?;
+        project::run(&sh, &[], cmd!(sh, "rustup component add {missing...}"))?;
     }
     Ok(())
-}
-
-/// `rustup <what> list --installed`, one name a line.
-fn rustup_installed(root: &Path, what: &str) -> Option<Vec<String>> {
-    let output = Command::new("rustup")
-        .args([what, "list", "--installed"])
-        .current_dir(root)
-        .stderr(Stdio::inherit())
-        .output()
-        .ok()?;
-    output.status.success().then(|| {
-        String::from_utf8_lossy(&output.stdout)
-            .lines()
-            .map(|line| line.trim().to_owned())
-            .collect()
-    })
 }
 
 /// Makes sure `qemu-system-arm` runs; installs it with apt-get when running as
@@ -74,12 +60,13 @@ pub fn ensure_qemu() -> Result<()> {
     if qemu_version().is_some() {
         return Ok(());
     }
+    let sh = project::shell(".")?;
     let apt = Path::new("/etc/debian_version").exists()
-        && Command::new("apt-get")
-            .arg("--version")
-            .stdout(Stdio::null())
-            .status()
-            .is_ok_and(|status| status.success());
+        && cmd!(sh, "apt-get --version")
+            .quiet()
+            .ignore_stdout()
+            .run()
+            .is_ok();
     if !apt {
         bail!(
             "`{QEMU_BINARY}` was not found; install QEMU's Arm system emulator \
@@ -87,28 +74,23 @@ pub fn ensure_qemu() -> Result<()> {
              `qemu` on Homebrew) and run the command again"
         );
     }
-    if !is_root() {
+    let root = cmd!(sh, "id -u").quiet().read().is_ok_and(|id| id == "0");
+    if !root {
         bail!(
             "`{QEMU_BINARY}` was not found; install it with \
              `sudo apt-get install {QEMU_PACKAGE}` and run the command again"
         );
     }
     println!("{QEMU_BINARY} is missing: installing the `{QEMU_PACKAGE}` package");
+    let env = [("DEBIAN_FRONTEND", "noninteractive")];
+    project::run(&sh, &env, cmd!(sh, "apt-get update -q"))?;
     project::run(
-        Command::new("apt-get")
-            .args(["update", "-q"])
-            .env("DEBIAN_FRONTEND", "noninteractive"),
-    )?;
-    project::run(
-        Command::new("apt-get")
-            .args([
-                "install",
-                "-y",
-                "-q",
-                "--no-install-recommends",
-                QEMU_PACKAGE,
-            ])
-            .env("DEBIAN_FRONTEND", "noninteractive"),
+        &sh,
+        &env,
+        cmd!(
+            sh,
+            "apt-get install -y -q --no-install-recommends {QEMU_PACKAGE}"
+        ),
     )?;
     qemu_version()
         .map(|_| ())
@@ -117,23 +99,7 @@ pub fn ensure_qemu() -> Result<()> {
 
 /// First line of `qemu-system-arm --version`, if it runs.
 pub fn qemu_version() -> Option<String> {
-    let output = Command::new(QEMU_BINARY)
-        .arg("--version")
-        .stdin(Stdio::null())
-        .output()
-        .ok()?;
-    output.status.success().then(|| {
-        String::from_utf8_lossy(&output.stdout)
-            .lines()
-            .next()
-            .unwrap_or_default()
-            .to_owned()
-    })
-}
-
-fn is_root() -> bool {
-    Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|output| output.status.success() && output.stdout.trim_ascii() == b"0")
+    let sh = project::shell(".").ok()?;
+    let version = cmd!(sh, "{QEMU_BINARY} --version").quiet().read().ok()?;
+    Some(version.lines().next().unwrap_or_default().to_owned())
 }

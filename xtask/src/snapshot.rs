@@ -3,21 +3,28 @@
 //! The expected log is the decoded log, one `LEVEL message` line per frame.
 //! Where a line holds a value that changes with unrelated code changes (an
 //! instruction count, a wake-up latency), that part of the line can be
-//! replaced by `[..]` in the file, which matches any text within the line.
-//! Re-recording (`--bless`) keeps such a line as it is while it still matches.
+//! replaced by `[..]` in the file, which matches any text within the line
+//! (snapbox's wildcard). Re-recording (`--bless`) keeps such a line as it is
+//! while it still matches.
+//!
+//! Snapbox pairs the lines of the two logs by position, so a line added or
+//! removed above a wildcard line would cost that line its wildcard on
+//! re-recording. So each line of the run that a wildcard line of the file
+//! matches is first replaced by that wildcard line, wherever it is; snapbox
+//! then compares, shows the difference, or re-records.
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
-use similar::{Algorithm, DiffTag, TextDiff, capture_diff_slices};
+use anyhow::{Context, Result, anyhow, bail};
+use snapbox::{Assert, Data, filter::NormalizeToExpected};
 
-use crate::{project, qemu::Run};
+use crate::{log::Run, project};
 
-/// At most this many diff lines are printed; the full log is written to the
-/// target directory.
+/// At most this many lines of a difference are printed; the full log is
+/// written to the target directory.
 const MAX_DIFF_LINES: usize = 200;
 
-/// Matches any text within one line of the expected log.
+/// Snapbox's wildcard within a line.
 const WILDCARD: &str = "[..]";
 
 /// `qemu/expected.log`.
@@ -25,74 +32,48 @@ pub fn expected_path() -> PathBuf {
     project::root().join("qemu/expected.log")
 }
 
-/// The run's log as it is kept on file.
-pub fn text(run: &Run) -> String {
-    let mut text = String::new();
-    for line in &run.log {
-        text.push_str(&line.snapshot());
-        text.push('\n');
-    }
-    text
-}
-
-/// Re-records the expected log from `run`, keeping the lines with wildcards
-/// that still match.
+/// Re-records the expected log from `run`, keeping the wildcard lines that
+/// still match.
 pub fn bless(run: &Run) -> Result<()> {
     let path = expected_path();
-    let got = text(run);
-    let text = match std::fs::read_to_string(&path) {
-        Ok(want) => project_onto(&want.replace("\r\n", "\n"), &got),
-        Err(_) => got,
-    };
-    std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
-    println!(
-        "re-recorded {} ({} lines)",
-        relative(&path).display(),
-        run.log.len()
-    );
+    let name = project::relative(&path);
+    if record(&path, &run.text())? {
+        println!("re-recorded {} ({} lines)", name.display(), run.log.len());
+    } else {
+        println!(
+            "{} already matches this run ({} lines)",
+            name.display(),
+            run.log.len()
+        );
+    }
     Ok(())
 }
 
-/// Compares `run` with the expected log; prints a unified diff and fails on a
-/// difference. The actual log is also written to `actual` for inspection.
+/// Compares `run` with the expected log; prints the difference and fails on
+/// one. The actual log is also written to `actual` for inspection.
 pub fn compare(run: &Run, actual: &Path) -> Result<()> {
     let path = expected_path();
-    let got = text(run);
+    let expected_name = project::relative(&path).display().to_string();
+    let actual_name = project::relative(actual).display().to_string();
+    let got = run.text();
     if let Some(dir) = actual.parent() {
         std::fs::create_dir_all(dir).ok();
     }
     std::fs::write(actual, &got).with_context(|| format!("writing {}", actual.display()))?;
-    let Ok(want) = std::fs::read_to_string(&path) else {
-        bail!(
-            "no expected log at {}; record one with `cargo xtask test --bless`",
-            relative(&path).display()
-        );
-    };
-    let want = want.replace("\r\n", "\n");
-    let projected = project_onto(&want, &got);
-    if want == projected {
-        println!(
-            "log matches {} ({} lines)",
-            relative(&path).display(),
-            run.log.len()
-        );
-        return Ok(());
+    if !path.exists() {
+        bail!("no expected log at {expected_name}; record one with `cargo xtask test --bless`");
     }
-    let expected_name = relative(&path).display().to_string();
-    let actual_name = relative(actual).display().to_string();
-    let diff = TextDiff::from_lines(&want, &projected);
-    let diff = diff
-        .unified_diff()
-        .context_radius(3)
-        .header(&expected_name, &actual_name)
-        .to_string();
-    let lines: Vec<&str> = diff.lines().collect();
+    let Err(difference) = check(&path, &got) else {
+        println!("log matches {expected_name} ({} lines)", run.log.len());
+        return Ok(());
+    };
+    let lines: Vec<&str> = difference.lines().collect();
     for line in lines.iter().take(MAX_DIFF_LINES) {
         println!("{line}");
     }
     if lines.len() > MAX_DIFF_LINES {
         println!(
-            "... {} more diff lines; see {actual_name}",
+            "... {} more lines of difference; see {actual_name}",
             lines.len() - MAX_DIFF_LINES
         );
     }
@@ -102,59 +83,67 @@ pub fn compare(run: &Run, actual: &Path) -> Result<()> {
     )
 }
 
-/// `got` with each line that an expected line matches through wildcards
-/// replaced by that expected line, so that only real differences remain.
-/// Lines are paired along a line diff, so inserted or removed lines do not
-/// upset the pairing.
-fn project_onto(want: &str, got: &str) -> String {
-    let want: Vec<&str> = want.lines().collect();
-    let mut projected: Vec<&str> = got.lines().collect();
-    let ops = capture_diff_slices(Algorithm::Myers, &want, &projected);
-    for op in ops {
-        let (tag, old, new) = op.as_tag_tuple();
-        if tag != DiffTag::Replace {
-            continue;
-        }
-        // Pair each expected line, in order, with the first later line of the
-        // block that it matches.
-        let mut next = new.start;
-        for old in old {
-            if let Some(at) = (next..new.end).find(|&at| matches(want[old], projected[at])) {
-                projected[at] = want[old];
-                next = at + 1;
-            }
-        }
-    }
-    let mut text = projected.join("\n");
-    if !text.is_empty() {
-        text.push('\n');
-    }
-    text
+/// Snapbox's verdict on the log `got` against the file at `path`: `Err`
+/// holds the difference.
+fn check(path: &Path, got: &str) -> Result<(), String> {
+    let want = std::fs::read_to_string(path).unwrap_or_default();
+    assert()
+        .try_eq(
+            Some(&"this run"),
+            Data::text(with_wildcards(&want, got)),
+            Data::read_from(path, None),
+        )
+        .map_err(|error| error.to_string())
 }
 
-/// Whether `line` matches `pattern`, in which each `[..]` stands for any text.
+/// Writes the log `got` to `path` as snapbox reads it against the file there
+/// (the wildcard lines that match kept), if that differs from the file.
+/// Returns whether it wrote.
+fn record(path: &Path, got: &str) -> Result<bool> {
+    let want = std::fs::read_to_string(path).unwrap_or_default();
+    let (actual, expected) = assert().normalize(
+        Data::text(with_wildcards(&want, got)),
+        Data::read_from(path, None),
+    );
+    if actual == expected {
+        return Ok(false);
+    }
+    actual
+        .write_to_path(path)
+        .map_err(|error| anyhow!("{error}"))?;
+    Ok(true)
+}
+
+/// Snapbox, reading the log as text (no path separators to normalise).
+fn assert() -> Assert {
+    Assert::new().normalize_paths(false)
+}
+
+/// `got` with each line that a wildcard line of `want` matches replaced by
+/// that wildcard line (the first one that matches).
+fn with_wildcards(want: &str, got: &str) -> String {
+    let patterns: Vec<&str> = want
+        .lines()
+        .filter(|line| line.contains(WILDCARD))
+        .collect();
+    got.lines()
+        .map(|line| {
+            patterns
+                .iter()
+                .copied()
+                .find(|pattern| matches(pattern, line))
+                .unwrap_or(line)
+        })
+        .flat_map(|line| [line, "\n"])
+        .collect()
+}
+
+/// Whether snapbox matches `line` against the expected line `pattern`.
 fn matches(pattern: &str, line: &str) -> bool {
-    if !pattern.contains(WILDCARD) {
-        return pattern == line;
-    }
-    let mut parts = pattern.split(WILDCARD);
-    let first = parts.next().unwrap_or_default();
-    let Some(mut rest) = line.strip_prefix(first) else {
-        return false;
-    };
-    let mut parts: Vec<&str> = parts.collect();
-    let last = parts.pop().unwrap_or_default();
-    for part in parts {
-        match rest.find(part) {
-            Some(at) => rest = &rest[at + part.len()..],
-            None => return false,
-        }
-    }
-    rest.len() >= last.len() && rest.ends_with(last)
-}
-
-fn relative(path: &Path) -> &Path {
-    path.strip_prefix(project::root()).unwrap_or(path)
+    let normalized = NormalizeToExpected::new()
+        .redact()
+        .normalize(Data::text(line), &Data::text(pattern));
+    normalized.render().as_deref() == Some(pattern)
 }
 
 #[cfg(test)]
@@ -165,25 +154,85 @@ mod tests {
     fn wildcards_match_within_a_line() {
         assert!(matches("a [..] c", "a b c"));
         assert!(matches("a [..] c", "a  c"));
-        assert!(matches("[..]", ""));
+        assert!(matches("[..]", "anything"));
         assert!(matches("x=[..] y=[..]", "x=1 y=22"));
         assert!(!matches("x=[..] y=[..]", "x=1 z=22"));
         assert!(!matches("a [..] c", "a b d"));
-        assert!(!matches("ab[..]ba", "aba"));
         assert!(!matches("plain", "plain text"));
     }
 
+    /// A scratch copy of an expected log.
+    struct Scratch(PathBuf);
+
+    impl Scratch {
+        fn new(name: &str, text: &str) -> Self {
+            let dir = std::env::temp_dir().join(format!("xtask-snapshot-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            let path = dir.join(name);
+            std::fs::write(&path, text).unwrap();
+            Self(path)
+        }
+
+        fn text(&self) -> String {
+            std::fs::read_to_string(&self.0).unwrap()
+        }
+    }
+
+    impl Drop for Scratch {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_file(&self.0);
+        }
+    }
+
+    const WANT: &str = "INFO  start\n\
+                        INFO  cost [..] insns\n\
+                        INFO  end 1\n\
+                        INFO  timing: at most [..] us late\n";
+
     #[test]
-    fn projection_keeps_matching_wildcard_lines_and_real_differences() {
-        let want = "INFO  start\nINFO  cost [..] insns\nINFO  end 1\n";
-        let got = "INFO  start\nINFO  new line\nINFO  cost 42 insns\nINFO  end 2\n";
+    fn values_under_wildcards_may_change() {
+        let file = Scratch::new("values.log", WANT);
+        let got =
+            "INFO  start\nINFO  cost 42 insns\nINFO  end 1\nINFO  timing: at most 97 us late\n";
+        assert_eq!(check(&file.0, got), Ok(()));
+        let got = got.replace("end 1", "end 2");
+        let difference = check(&file.0, &got).unwrap_err();
+        assert!(difference.contains("end 1") && difference.contains("end 2"));
+        assert!(!difference.contains("cost 42"), "{difference}");
+    }
+
+    #[test]
+    fn blessing_keeps_the_wildcards_that_still_match() {
+        let file = Scratch::new("bless.log", WANT);
+        // A line added above both wildcard lines, one changed between them,
+        // and new values under the wildcards.
+        let got = "INFO  start\n\
+                   INFO  a new line\n\
+                   INFO  cost 7 insns\n\
+                   INFO  end 2\n\
+                   INFO  timing: at most 12 us late\n";
+        assert!(record(&file.0, got).unwrap());
         assert_eq!(
-            project_onto(want, got),
-            "INFO  start\nINFO  new line\nINFO  cost [..] insns\nINFO  end 2\n"
+            file.text(),
+            "INFO  start\n\
+             INFO  a new line\n\
+             INFO  cost [..] insns\n\
+             INFO  end 2\n\
+             INFO  timing: at most [..] us late\n"
         );
+        // The re-recorded file now matches the run, and is left alone.
+        assert_eq!(check(&file.0, got), Ok(()));
+        assert!(!record(&file.0, got).unwrap());
+    }
+
+    #[test]
+    fn blessing_drops_a_wildcard_line_that_no_longer_matches() {
+        let file = Scratch::new("reworded.log", WANT);
+        let got = "INFO  start\nINFO  cost: 7\nINFO  end 1\nINFO  timing: at most 3 us late\n";
+        assert!(record(&file.0, got).unwrap());
         assert_eq!(
-            project_onto(want, "INFO  start\nINFO  cost 7 insns\nINFO  end 1\n"),
-            want
+            file.text(),
+            "INFO  start\nINFO  cost: 7\nINFO  end 1\nINFO  timing: at most [..] us late\n"
         );
     }
 }

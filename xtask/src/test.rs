@@ -5,11 +5,15 @@ use std::{path::Path, time::Instant};
 
 use anyhow::{Result, bail};
 
+use xshell::{Shell, cmd};
+
 use crate::{
-    Options, bench, elf,
-    project::{self, Metadata, PICO, Package, QEMU},
-    qemu::{self, Echo, Run},
-    setup, snapshot,
+    args::Options,
+    bench, elf,
+    log::Run,
+    project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
+    qemu::{self, Echo},
+    setup, sim, snapshot,
 };
 
 /// How a stage ended.
@@ -104,35 +108,36 @@ impl Stages {
 pub fn command(options: Options) -> Result<bool> {
     let start = Instant::now();
     let root = project::root();
-    let host_tests = root.join("host-tests");
-    let qemu_package = root.join("qemu");
-    let xtask = root.join("xtask");
     setup::ensure_toolchain(&root)?;
     let metadata = project::metadata(&root)?;
+    let sh = project::shell(".")?;
+    let host_tests = project::shell("host-tests")?;
+    let xtask = project::shell("xtask")?;
     let mut stages = Stages::new();
 
     // 1. Host tests of the core, and its doc tests once they are switched on.
     stages.run("host tests (host-tests/)", || {
-        project::run(project::cargo(&host_tests).arg("test"))
+        project::run(&host_tests, &[], cmd!(host_tests, "cargo test"))
     });
     stages.run_or_skip("doc tests of the core library (host)", || {
-        doc_tests(&root, &metadata)
+        doc_tests(&sh, &metadata)
     });
     stages.run("xtask unit tests", || {
-        project::run(project::cargo(&xtask).arg("test"))
+        project::run(&xtask, &[], cmd!(xtask, "cargo test --profile xtask"))
     });
 
     // 2. Formatting and lints: firmware (thumb, both packages) and host crates.
     stages.run("rustfmt: core + Pico, qemu/, host-tests, xtask", || {
         let mut failures = Vec::new();
-        for dir in [&root, &qemu_package, &host_tests, &xtask] {
-            if let Err(error) = project::run(project::cargo(dir).args(["fmt", "--check"])) {
+        for dir in [".", "qemu", "host-tests", "xtask"] {
+            let sh = project::shell(dir)?;
+            if let Err(error) = project::run(&sh, &[], cmd!(sh, "cargo fmt --check")) {
                 failures.push(format!("{error:#}"));
             }
         }
         fail_if_any(&failures)
     });
-    clippy_stages(&mut stages, &root, &host_tests, &xtask);
+    clippy_stages(&mut stages, &sh, &host_tests, &xtask);
 
     // 3. The Pico image: placement of the boot stage, memory budgets, no allocator.
     let pico_built = stages.run("Pico build (cargo build --release)", || PICO.build(&root));
@@ -153,9 +158,9 @@ pub fn command(options: Options) -> Result<bool> {
         "Pico calibration image compiles (--features calibrate)",
         || {
             project::run(
-                project::cargo(&root)
-                    .args(["check", "--release", "--features", "calibrate"])
-                    .env("DEFMT_LOG", project::DEFMT_LOG),
+                &sh,
+                FIRMWARE_ENV,
+                cmd!(sh, "cargo check --release --features calibrate"),
             )
         },
     );
@@ -168,7 +173,11 @@ pub fn command(options: Options) -> Result<bool> {
     );
 
     // 4. The QEMU run against the log on file, and the firmware's own verdict.
-    qemu_stages(&mut stages, &root, &metadata, options);
+    let qemu_run = qemu_stages(&mut stages, &root, &metadata, options);
+
+    // The Pico image in the RP2040 emulator, the watchdog drill, and its RAM
+    // with the peak stack measured there.
+    sim_stages(&mut stages, &root, &metadata, pico_built, qemu_run.as_ref());
 
     // 5. The boot-time benchmark in QEMU and the default set's instruction budget.
     stages.run(bench::STAGE, || {
@@ -179,56 +188,92 @@ pub fn command(options: Options) -> Result<bool> {
     Ok(stages.finish(start))
 }
 
-fn clippy_stages(stages: &mut Stages, root: &Path, host_tests: &Path, xtask: &Path) {
+fn clippy_stages(stages: &mut Stages, sh: &Shell, host_tests: &Shell, xtask: &Shell) {
     // `--release` shares build scripts and proc-macros with the release builds below.
-    let lint = ["--", "-D", "warnings"];
     stages.run("clippy: Pico image + core (thumbv6m)", || {
         project::run(
-            project::cargo(root)
-                .args(["clippy", "--release", "--lib", "--bins"])
-                .args(lint)
-                .env("DEFMT_LOG", project::DEFMT_LOG),
+            sh,
+            FIRMWARE_ENV,
+            cmd!(sh, "cargo clippy --release --lib --bins -- -D warnings"),
         )
     });
     stages.run("clippy: QEMU images, qemu/ (thumbv6m)", || {
         project::run(
-            project::cargo(root)
-                .args(["clippy", "--release", "--bins"])
-                .args(Package::Qemu.manifest_args())
-                .args(lint)
-                .env("DEFMT_LOG", project::DEFMT_LOG),
+            sh,
+            FIRMWARE_ENV,
+            cmd!(
+                sh,
+                "cargo clippy --release --bins --manifest-path qemu/Cargo.toml -- -D warnings"
+            ),
         )
     });
     stages.run("clippy: core library (host)", || {
         project::run(
-            project::cargo(root)
-                .args([
-                    "clippy",
-                    "--lib",
-                    "--no-default-features",
-                    "--target",
-                    "host-tuple",
-                ])
-                .args(lint),
+            sh,
+            &[],
+            cmd!(
+                sh,
+                "cargo clippy --lib --no-default-features --target host-tuple -- -D warnings"
+            ),
         )
     });
     stages.run("clippy: host-tests", || {
         project::run(
-            project::cargo(host_tests)
-                .args(["clippy", "--all-targets"])
-                .args(lint),
+            host_tests,
+            &[],
+            cmd!(host_tests, "cargo clippy --all-targets -- -D warnings"),
         )
     });
     stages.run("clippy: xtask", || {
         project::run(
-            project::cargo(xtask)
-                .args(["clippy", "--all-targets"])
-                .args(lint),
+            xtask,
+            &[],
+            cmd!(xtask, "cargo clippy --all-targets -- -D warnings"),
         )
     });
 }
 
-fn qemu_stages(stages: &mut Stages, root: &Path, metadata: &Metadata, options: Options) {
+fn sim_stages(
+    stages: &mut Stages,
+    root: &Path,
+    metadata: &Metadata,
+    pico_built: bool,
+    qemu_run: Option<&Run>,
+) {
+    const MEMORY: &str = "RAM: static + peak stack of the Pico image within its budget";
+    let mut report = None;
+    if pico_built {
+        stages.run(sim::PULSES_STAGE, || {
+            report = Some(sim::test_pulses(root, metadata)?);
+            Ok(())
+        });
+    } else {
+        stages.blocked(sim::PULSES_STAGE, "the Pico build");
+    }
+    stages.run(sim::DRILL_STAGE, || sim::test_drill(root, metadata));
+    stages.run(sim::FAILURES_STAGE, || sim::test_failures(root, metadata));
+    stages.run(MEMORY, || {
+        let peak = |elf: &Path, stack: Option<u64>| -> Result<Option<elf::Peak>> {
+            let Some(stack) = stack else { return Ok(None) };
+            let static_ram = elf::Image::read(elf)?.static_ram();
+            Ok(Some(elf::Peak { static_ram, stack }))
+        };
+        let pico = peak(
+            &PICO.elf(metadata),
+            report.as_ref().and_then(sim::Report::peak_stack),
+        )?;
+        let qemu_peak = qemu_run.and_then(|run| sim::logged_peak_stack(&run.log));
+        let qemu = peak(&QEMU.elf(metadata), qemu_peak)?;
+        elf::check_ram(pico, qemu)
+    });
+}
+
+fn qemu_stages(
+    stages: &mut Stages,
+    root: &Path,
+    metadata: &Metadata,
+    options: Options,
+) -> Option<Run> {
     const BUILD: &str = "QEMU build (LM3S6965 memory map, no allocator linked)";
     const RUN: &str = "QEMU run: firmware exits with success";
     const SNAPSHOT: &str = "QEMU log matches qemu/expected.log";
@@ -243,7 +288,7 @@ fn qemu_stages(stages: &mut Stages, root: &Path, metadata: &Metadata, options: O
         for name in [RUN, SNAPSHOT, SUMMARY] {
             stages.blocked(name, BUILD);
         }
-        return;
+        return None;
     }
     let mut run: Option<Run> = None;
     stages.run(RUN, || {
@@ -262,7 +307,7 @@ fn qemu_stages(stages: &mut Stages, root: &Path, metadata: &Metadata, options: O
         for name in [SNAPSHOT, SUMMARY] {
             stages.blocked(name, RUN);
         }
-        return;
+        return None;
     };
     stages.run(SNAPSHOT, || {
         if options.bless {
@@ -287,21 +332,23 @@ fn qemu_stages(stages: &mut Stages, root: &Path, metadata: &Metadata, options: O
         println!("{verdict}");
         Ok(())
     });
+    Some(run)
 }
 
-fn doc_tests(root: &Path, metadata: &Metadata) -> Result<Option<String>> {
+fn doc_tests(sh: &Shell, metadata: &Metadata) -> Result<Option<String>> {
     if !metadata.lib_doctests {
         return Ok(Some(
             "`doctest = false` in the root Cargo.toml's [lib]".to_owned(),
         ));
     }
-    project::run(project::cargo(root).args([
-        "test",
-        "--doc",
-        "--no-default-features",
-        "--target",
-        "host-tuple",
-    ]))?;
+    project::run(
+        sh,
+        &[],
+        cmd!(
+            sh,
+            "cargo test --doc --no-default-features --target host-tuple"
+        ),
+    )?;
     Ok(None)
 }
 

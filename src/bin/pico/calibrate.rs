@@ -21,7 +21,7 @@
 //! one moves. Limits are the servo calibration's mechanical `limits`.
 
 use idle_head::driver::Outcome;
-use idle_head::firmware::Frame;
+use idle_head::frame_task::Frame;
 use idle_head::{Angle, AngleRange, Axis, LoopSource, Microseconds, Millis, Playback};
 
 /// Samples per second of the sweep timeline (one sample = 100 ms).

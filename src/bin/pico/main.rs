@@ -19,10 +19,18 @@
 //!
 //! # PWM timing
 //!
-//! 125 MHz system clock, 50 Hz: divider 38 + 3/16 = 38.1875, `TOP` = 65 465,
-//! one count = 305.5 ns, period 19 999.86 µs (worked out in
-//! `idle_head::firmware::rp2040_pwm`). A 1000..2000 µs servo range spans
-//! 3273 counts.
+//! 125 MHz system clock, exactly 50 Hz: divider 39 + 1/16 = 39.0625, `TOP` =
+//! 63 999, one count = 312.5 ns, period 20 000 µs (worked out in
+//! `rp2040_pwm.rs`). A 1000..2000 µs servo range spans 3200 counts.
+//!
+//! # Idle motion and priorities
+//!
+//! The head plays the never-repeating idle (`idle_head::idle`; the paper's
+//! fixed loop with `--features fixed-loop`). The frame task runs in an
+//! interrupt executor on `SWI_IRQ_1`, above the thread-mode executor where
+//! the loop generator runs: generating a set takes about 2 ms of CPU, which
+//! frames preempt, so a frame is never delayed by it. Two loop set buffers
+//! change hands through the one-slot channels of [`Exchange`].
 //!
 //! # Watchdog
 //!
@@ -31,6 +39,22 @@
 //! (5 frames). If frames stop, the board resets; the next boot logs that the
 //! last reset came from the watchdog and starts softly again: outputs low,
 //! neutral pulses first, motion faded in.
+//!
+//! # Stack
+//!
+//! cortex-m-rt paints the whole stack region before `main` (feature
+//! `paint-stack`); the first frame's log line and each loop's status line
+//! report the peak stack use since reset, the bytes that lost their paint
+//! (`cortex-m-stack`). The loop generator (at boot and in its task) is the
+//! deepest point, with a frame preempting it on top.
+//!
+//! # Watchdog drill
+//!
+//! `--features watchdog-drill` builds a test image, never shipped: frames
+//! stop after [`DRILL_FRAMES`] frames of every boot, so that the watchdog
+//! resets the board. `cargo xtask test` runs it in the RP2040 emulator and
+//! checks the next boot: the watchdog reset logged, neutral pulses first, the
+//! motion faded in.
 //!
 //! # Calibration
 //!
@@ -42,19 +66,25 @@
 
 #[cfg(feature = "calibrate")]
 mod calibrate;
+mod rp2040_pwm;
 mod servo_pwm;
 
 use defmt_rtt as _;
-use embassy_executor::Spawner;
+use embassy_executor::{InterruptExecutor, Spawner};
+use embassy_rp::interrupt::{self, InterruptExt, Priority};
 use embassy_rp::watchdog::{ResetReason, Watchdog};
 use embassy_time::{Duration, Instant};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head::firmware::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
-use idle_head::firmware::{self, Flow, Frame, FrameHooks, FrameLoop, LOOP_DURATION};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Q16};
+use idle_head::frame_task::{
+    Exchange, Flow, Frame, FrameHooks, FrameLoop, IDLE_MODE, LOOP_DURATION, SetRef,
+};
+use idle_head::idle::{IdleMode, IdleTiming, LoopSet, LoopStream};
+use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N};
 use idle_head::{Axis, Playback};
 use panic_probe as _;
+use static_cell::ConstStaticCell;
 
+use crate::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use crate::servo_pwm::ServoPwm;
 
 /// The frame driver's configuration: 50 Hz frames and PWM, hobby servos on
@@ -65,10 +95,14 @@ const PARAMS: DriverParams = match CONFIG.build() {
     Err(e) => panic!("{}", e.message()),
 };
 /// A 30 s loop at 20 ms frames: 1500 frames per loop.
-#[cfg(not(feature = "calibrate"))]
 const PLAYBACK: Playback = match Playback::new(LOOP_DURATION, CONFIG.frame_period, DEFAULT_N) {
     Ok(p) => p,
     Err(_) => panic!("invalid playback parameters"),
+};
+/// Loops of 1500 frames joined over 100: a join every 1400 frames.
+const TIMING: IdleTiming = match IdleTiming::new(PLAYBACK) {
+    Ok(t) => t,
+    Err(e) => panic!("{}", e.message()),
 };
 const LOOP_FRAMES: u64 = LOOP_DURATION.0 as u64 * 1000 / CONFIG.frame_period.0 as u64;
 
@@ -77,10 +111,29 @@ const LOOP_FRAMES: u64 = LOOP_DURATION.0 as u64 * 1000 / CONFIG.frame_period.0 a
 /// quickly (a reset releases the pins: no pulses until the next soft start).
 const WATCHDOG_TIMEOUT: Duration = Duration::from_millis(100);
 
-type Head = HeadTrajectories<Q16, DEFAULT_N>;
+/// Frames of each boot after which the drill image stops its frames: 3 s,
+/// the 2 s fade-in and a second of motion.
+#[cfg(feature = "watchdog-drill")]
+const DRILL_FRAMES: u64 = 150;
 
-/// The three loops: 3 · 900 · 2 B = 5400 B, generated once at boot.
-static mut HEAD: Head = Head::new();
+type Set = LoopSet<DEFAULT_N>;
+
+/// The two loop set buffers, 2 · 5.4 KB: one plays while the generator
+/// fills the other. All zero (the neutral pose) until generated.
+static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::new()]);
+
+/// The channels the buffers go round through.
+static EXCHANGE: Exchange = Exchange::new();
+
+/// The frame task's executor, above thread mode.
+static FRAME_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
+
+#[embassy_rp::interrupt]
+unsafe fn SWI_IRQ_1() {
+    // Note(unsafe): called from this interrupt only, which `start` below
+    // enables after the executor is set up.
+    unsafe { FRAME_EXECUTOR.on_interrupt() }
+}
 
 #[embassy_executor::main]
 async fn main(spawner: Spawner) {
@@ -131,13 +184,10 @@ async fn main(spawner: Spawner) {
         );
     }
 
-    // Note(unsafe): the only reference ever made to HEAD, here, once, before
-    // the frame task exists; it is handed on as a shared reference below.
-    let head: &'static mut Head = unsafe { &mut *core::ptr::addr_of_mut!(HEAD) };
+    let [first, spare] = SETS.take();
     let start = Instant::now();
-    let generated = head.generate(&DEFAULT_HEAD);
+    let generated = first.generate(&DEFAULT_HEAD);
     let precompute_us = start.elapsed().as_micros();
-    let head: &'static Head = head;
     match generated {
         Ok(info) => {
             for (axis, info) in Axis::ALL.iter().zip(info.iter()) {
@@ -150,45 +200,111 @@ async fn main(spawner: Spawner) {
             }
         }
         // The loop is left at the neutral pose: the servos hold still.
-        Err(e) => defmt::error!("trajectory generation failed: {=str}", e.error.message()),
+        Err(e) => defmt::error!(
+            "trajectory generation failed: {=str} {=str}",
+            e.axis.name(),
+            e.error.message()
+        ),
     }
     defmt::info!(
         "precompute: {=u64} us; checksum {=u32:#010x}",
         precompute_us,
-        head.checksum()
+        first.checksum()
     );
+    let mut stream = LoopStream::new(DEFAULT_HEAD, &TIMING);
+    stream.adopt(first);
+    match IDLE_MODE {
+        IdleMode::NeverRepeating => {
+            defmt::info!(
+                "idle: never repeating, a new loop set every {=u32} frames, joined over {=u32}",
+                TIMING.period(),
+                TIMING.join_frames
+            );
+            EXCHANGE.give(spare);
+            match generator(stream) {
+                Ok(token) => spawner.spawn(token),
+                Err(_) => defmt::error!("generator task already running"),
+            }
+        }
+        IdleMode::FixedLoop => defmt::info!("idle: the fixed loop, replayed every loop"),
+    }
 
     let driver = FrameDriver::new(channels, PARAMS);
-    match frame_task(driver, head, watchdog) {
-        Ok(token) => spawner.spawn(token),
+    // The frame task's interrupt: above thread mode, below the time
+    // driver's alarm (priority 0), which wakes it.
+    interrupt::SWI_IRQ_1.set_priority(Priority::P1);
+    let frames = FRAME_EXECUTOR.start(interrupt::SWI_IRQ_1);
+    match frame_task(driver, first, watchdog) {
+        Ok(token) => frames.spawn(token),
         Err(_) => defmt::error!("frame task already running"),
     }
 }
 
+/// Generates each next loop set while the frames play (thread mode).
 #[embassy_executor::task]
-async fn frame_task(mut driver: FrameDriver<ServoPwm>, head: &'static Head, watchdog: Watchdog) {
+async fn generator(mut stream: LoopStream<DEFAULT_N>) {
+    EXCHANGE
+        .generate(&mut stream, |result, ticks| match result {
+            Ok(info) => defmt::info!(
+                "loop set {=u32} ready in {=u64} us: seeds {:#010x}, entered at {}, join mismatch {} mdeg rms",
+                info.number,
+                Duration::from_ticks(ticks).as_micros(),
+                info.seeds,
+                info.starts,
+                info.mismatch
+            ),
+            Err(e) => defmt::error!(
+                "loop set failed: {=str} {=str}; trying the next seeds",
+                e.axis.name(),
+                e.error.message()
+            ),
+        })
+        .await
+}
+
+/// The idle motion the frame task plays.
+#[cfg(not(feature = "calibrate"))]
+type Idle = idle_head::idle::IdlePlayer<SetRef, idle_head::frame_task::ExchangeSupply>;
+#[cfg(feature = "calibrate")]
+type Idle = idle_head::playback::Player<'static, calibrate::Sweep>;
+
+#[embassy_executor::task]
+async fn frame_task(mut driver: FrameDriver<ServoPwm>, first: SetRef, watchdog: Watchdog) {
     #[cfg(not(feature = "calibrate"))]
-    let (loops, playback) = (Axis::ALL.map(|axis| head.axis(axis)), PLAYBACK);
+    let (idle, playback): (Idle, _) = (
+        idle_head::idle::IdlePlayer::new(first, EXCHANGE.supply(), TIMING, IDLE_MODE),
+        PLAYBACK,
+    );
     #[cfg(feature = "calibrate")]
-    let (sources, playback) = {
-        let _ = head;
+    let (idle, playback): (Idle, _) = {
+        use static_cell::StaticCell;
+        static SWEEPS: StaticCell<[calibrate::Sweep; 3]> = StaticCell::new();
+        let _ = first;
         let sweep = |axis: Axis| calibrate::Sweep::new(axis, CONFIG.servos[axis.index()].limits);
+        let sweeps: &'static [calibrate::Sweep; 3] = SWEEPS.init(Axis::ALL.map(sweep));
+        let playback = calibrate::playback(CONFIG.frame_period);
         (
-            Axis::ALL.map(sweep),
-            calibrate::playback(CONFIG.frame_period),
+            idle_head::playback::Player::new(playback, [&sweeps[0], &sweeps[1], &sweeps[2]]),
+            playback,
         )
     };
-    #[cfg(feature = "calibrate")]
-    let loops = [&sources[0], &sources[1], &sources[2]];
     let start = Instant::now().as_ticks();
-    let Ok(mut frames) = FrameLoop::new(playback, loops, embassy_time::TICK_HZ, start) else {
+    let Ok(mut frames) =
+        FrameLoop::new(idle, playback.frame_period(), embassy_time::TICK_HZ, start)
+    else {
         defmt::error!("frame period below one timer tick");
         return;
     };
     let mut hooks = PicoHooks::new(watchdog, playback);
-    let stats = firmware::run(&mut driver, &mut frames, &mut hooks).await;
-    // `PicoHooks` never stops; if it did, the watchdog would reset the board.
+    let stats = idle_head::frame_task::run(&mut driver, &mut frames, &mut hooks).await;
+    // `PicoHooks` only stops in the watchdog drill; then the watchdog resets
+    // the board.
     defmt::error!("frame task ended: {}", stats);
+    // The drill stalls here, a hung frame task: the PWM keeps sending the
+    // last pulse until the reset (returning would drop the driver, whose
+    // slices switch off at once, mid-pulse).
+    #[cfg(feature = "watchdog-drill")]
+    core::future::pending::<()>().await;
 }
 
 /// Feeds the watchdog after every frame and logs a status line per loop.
@@ -228,11 +344,12 @@ impl FrameHooks<ServoPwm> for PicoHooks {
             self.started = true;
             let [p, r, y] = frame.report.servos;
             defmt::info!(
-                "first frame: neutral pulses {=u32} {=u32} {=u32} us; watchdog armed ({=u64} ms)",
+                "first frame: neutral pulses {=u32} {=u32} {=u32} us; watchdog armed ({=u64} ms); peak stack {=u32} B",
                 p.pulse.0,
                 r.pulse.0,
                 y.pulse.0,
-                WATCHDOG_TIMEOUT.as_millis()
+                WATCHDOG_TIMEOUT.as_millis(),
+                peak_stack()
             );
         }
         self.max_lateness = self
@@ -244,14 +361,29 @@ impl FrameHooks<ServoPwm> for PicoHooks {
         if index > 0 && index.is_multiple_of(self.loop_frames) {
             let stats = driver.stats();
             defmt::info!(
-                "loop {=u64} done: {=u64} frames written, wake-up at most {=u64} us late, faults {}, disabled {}",
+                "loop {=u64} done: {=u64} frames written, wake-up at most {=u64} us late, faults {}, disabled {}, peak stack {=u32} B",
                 index / self.loop_frames,
                 stats.frames,
                 Duration::from_ticks(self.max_lateness).as_micros(),
                 stats.faults,
-                stats.disabled
+                stats.disabled,
+                peak_stack()
             );
+        }
+        #[cfg(feature = "watchdog-drill")]
+        if index == DRILL_FRAMES {
+            defmt::warn!(
+                "watchdog drill: frames stop after frame {=u64}; the watchdog must reset the board",
+                index
+            );
+            return Flow::Stop;
         }
         Flow::Continue
     }
+}
+
+/// Bytes of stack used since reset: the stack region was painted before
+/// `main`, and the deepest write is the lowest word that lost its paint.
+fn peak_stack() -> u32 {
+    cortex_m_stack::stack_size().saturating_sub(cortex_m_stack::stack_painted())
 }

@@ -9,20 +9,29 @@
 //!   its counter at 0 and its compare value at 0, so the output is driven low
 //!   (the output is high only while the counter is below the compare value).
 //! - The first [`SetDutyCycle::set_duty_cycle`] (the frame driver's neutral
-//!   pulse) writes the compare value and only then enables the slice, with the
-//!   counter still at 0: the first period starts at the beginning of a whole
-//!   pulse. (If the compare write only lands at the first wrap, as the
-//!   double-buffered compare register does while running, the first period
-//!   is simply low and the next one a whole pulse.)
+//!   pulse) writes the compare value, sets the counter half a period in
+//!   (above any servo's compare value, so the output stays low) and only
+//!   then enables the slice. The first wrap comes half a period later and
+//!   starts the first pulse: the whole neutral pulse.
 //! - Later writes change the compare value while the slice runs; the RP2040
 //!   latches it at the next wrap, so a pulse is never cut or stretched.
+//!
+//! # One frame, one pulse
+//!
+//! The PWM period is exactly one frame (`rp2040_pwm.rs`) and both come from
+//! the same crystal, so the frames' writes keep the phase the first one set:
+//! each lands half a period before the wrap that latches it, whatever the
+//! frame's wake-up latency or cost (anything below 10 ms). Frame `k` is
+//! latched at wrap `k + 1` and goes out as the `k`-th pulse: no frame is
+//! ever overwritten before it went out, none goes out twice.
 
 use embassy_rp::Peri;
 use embassy_rp::pwm::{ChannelAPin, Config, Pwm, PwmError, Slice};
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use fixed::FixedU16;
 use fixed::types::extra::U4;
-use idle_head::firmware::rp2040_pwm::SliceClock;
+
+use crate::rp2040_pwm::SliceClock;
 
 /// One servo output: channel A of a PWM slice of its own.
 pub struct ServoPwm {
@@ -69,8 +78,10 @@ impl SetDutyCycle for ServoPwm {
         if duty > self.config.top {
             return Err(PwmError::InvalidDutyCycle);
         }
-        // First duty: compare value first, then start the counter from 0.
+        // First duty: compare value, the counter half a period in, then run.
         self.config.compare_a = duty;
+        self.pwm.set_config(&self.config);
+        self.pwm.set_counter(self.config.top / 2 + 1);
         self.config.enable = true;
         self.pwm.set_config(&self.config);
         self.running = true;

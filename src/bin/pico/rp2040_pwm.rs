@@ -6,29 +6,33 @@
 //! channel's compare value, so a pulse is `compare` counts long and the PWM
 //! period is `(TOP + 1) · DIV` system clock cycles.
 //!
-//! For the finest pulse resolution at a given PWM rate the counter should
-//! count as fast as possible, i.e. `DIV` as small as possible such that the
-//! period still fits the 16-bit counter (`TOP + 1 ≤ 65 536`):
+//! The period is made **exactly** one frame (20 ms): the system clock and
+//! the timer that schedules the frames both come from the board's 12 MHz
+//! crystal, so a PWM period of exactly 20 ms never drifts against the frames
+//! and every frame's duty goes out as exactly one pulse (`servo_pwm.rs`
+//! sets the phase). Among the dividers that give a whole number of counts
+//! per period, the smallest one (the finest pulse resolution) that still
+//! fits the 16-bit counter (`TOP + 1 ≤ 65 536`):
 //!
 //! - 125 MHz system clock, 50 Hz: 125 000 000 / 50 = 2 500 000 cycles per
-//!   period; 2 500 000 / 65 536 = 38.15, so `DIV` ≥ 38.15.
-//! - In sixteenths: 2 500 000 · 16 / 65 536 = 610.35 → 611/16 = 38 + 3/16 =
-//!   38.1875 (610/16 = 38.125 would need 65 574 counts, too many).
-//! - Counts per period: 2 500 000 / 38.1875 = 65 466.4 → 65 466, `TOP` = 65 465.
-//! - One count: 38.1875 / 125 MHz = 305.5 ns, the pulse resolution.
-//! - The period: 65 466 · 305.5 ns = 19 999.86 µs (50.0003 Hz, 7 ppm fast):
-//!   a servo decodes the pulse width, not the frame rate, so the rate only
-//!   has to be near 50 Hz.
+//!   period, 40 000 000 in sixteenths of a cycle.
+//! - `DIV` ≥ 2 500 000 / 65 536 = 38.15, i.e. at least 611/16; the first
+//!   sixteenth from there that divides 40 000 000 = 2⁹ · 5⁷ is 625/16 =
+//!   39 + 1/16 = 39.0625.
+//! - Counts per period: 2 500 000 / 39.0625 = 64 000 exactly, `TOP` = 63 999.
+//! - One count: 39.0625 / 125 MHz = 312.5 ns, the pulse resolution (about
+//!   0.03° of a typical servo).
 //!
-//! With a fractional `DIV` the RP2040 spaces the counts 38 or 39 cycles
-//! apart so that they average 38.1875 cycles: a pulse edge moves by at most
-//! one system clock cycle (8 ns), far below a servo's dead band (~1 µs).
+//! With a fractional `DIV` the RP2040 spaces the counts 39 or 40 cycles
+//! apart so that they average 39.0625 cycles (the sixteenths add up to
+//! whole cycles every 16 counts, so the period itself is exact): a pulse
+//! edge moves by at most one system clock cycle (8 ns), far below a servo's
+//! dead band (~1 µs).
 //!
 //! `embedded_hal::pwm::SetDutyCycle::max_duty_cycle` of an embassy-rp output
-//! is `TOP` (65 465). The frame driver maps the servo period (20 000 µs) to
-//! that many counts, so a written pulse is short by at most 20 000 µs ·
-//! (1 − 65 465 · 305.5 ns / 20 000 µs) / 20 000 µs ≈ 22 ppm of its width,
-//! 0.05 µs at 2000 µs: below one count.
+//! is `TOP` (63 999). The frame driver maps the servo period (20 000 µs) to
+//! that many counts, so a written pulse is short by 1/64 000 of its width,
+//! 0.03 µs at 2000 µs: a tenth of a count.
 
 /// Clock settings of one PWM slice.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -54,27 +58,32 @@ const MAX_COUNTS: u64 = 1 << 16;
 
 impl SliceClock {
     /// The smallest divider, and the `TOP` for it, that runs a slice at
-    /// `pwm_hz` from a `sys_hz` system clock (counts per period rounded to
-    /// the nearest whole count).
+    /// exactly `pwm_hz` from a `sys_hz` system clock: a whole number of
+    /// counts per period, of whole sixteenths of a cycle each.
     ///
     /// # Errors
-    /// [`RateUnreachable`] if no divider in 1..256 brings the period into
-    /// the 16-bit counter (or into at least two counts), or a rate is zero.
-    pub const fn finest(sys_hz: u32, pwm_hz: u32) -> Result<Self, RateUnreachable> {
+    /// [`RateUnreachable`] if a rate is zero, the period is not a whole
+    /// number of sixteenths of a cycle, or no divider in 1..256 splits it
+    /// into at most 65 536 (and at least two) whole counts.
+    pub const fn exact(sys_hz: u32, pwm_hz: u32) -> Result<Self, RateUnreachable> {
         if sys_hz == 0 || pwm_hz == 0 {
             return Err(RateUnreachable);
         }
         // Cycles per period in sixteenths: < 2^32 · 16, fits u64.
-        let cycles_16 = sys_hz as u64 * 16 / pwm_hz as u64;
-        // First candidate: ⌈cycles · 16 / 65 536⌉, then step up past rounding.
+        let cycles_16 = sys_hz as u64 * 16;
+        if !cycles_16.is_multiple_of(pwm_hz as u64) {
+            return Err(RateUnreachable);
+        }
+        let cycles_16 = cycles_16 / pwm_hz as u64;
+        // The fewest sixteenths that fit the counter, then up to the first
+        // that divides the period.
         let mut div = cycles_16.div_ceil(MAX_COUNTS);
         if div < MIN_DIVIDER_16THS {
             div = MIN_DIVIDER_16THS;
         }
         while div <= MAX_DIVIDER_16THS {
-            // Nearest whole number of counts per period.
-            let counts = (cycles_16 + div / 2) / div;
-            if counts <= MAX_COUNTS {
+            if cycles_16.is_multiple_of(div) {
+                let counts = cycles_16 / div;
                 if counts < 2 {
                     return Err(RateUnreachable);
                 }
@@ -125,16 +134,17 @@ pub const PICO_SYS_HZ: u32 = 125_000_000;
 /// Servo PWM rate: 50 Hz (a 20 ms period).
 pub const SERVO_PWM_HZ: u32 = 50;
 
-/// Slice clock of the Pico's servo outputs: 125 MHz → 50 Hz.
-pub const PICO_SERVO_CLOCK: SliceClock = match SliceClock::finest(PICO_SYS_HZ, SERVO_PWM_HZ) {
+/// Slice clock of the Pico's servo outputs: 125 MHz → exactly 50 Hz.
+pub const PICO_SERVO_CLOCK: SliceClock = match SliceClock::exact(PICO_SYS_HZ, SERVO_PWM_HZ) {
     Ok(c) => c,
-    Err(_) => panic!("no 8.4 divider runs a 16-bit PWM slice at 50 Hz from 125 MHz"),
+    Err(_) => panic!("no 8.4 divider runs a 16-bit PWM slice at exactly 50 Hz from 125 MHz"),
 };
 
-// The numbers worked out in the module docs.
+// The numbers worked out in the module docs (the QEMU images and the
+// emulator check compile this file too).
 const _: () = {
-    assert!(PICO_SERVO_CLOCK.divider_int() == 38 && PICO_SERVO_CLOCK.divider_frac() == 3);
-    assert!(PICO_SERVO_CLOCK.top == 65_465);
-    assert!(PICO_SERVO_CLOCK.count_ps(PICO_SYS_HZ) == 305_500);
-    assert!(PICO_SERVO_CLOCK.period_ns(PICO_SYS_HZ) == 19_999_863);
+    assert!(PICO_SERVO_CLOCK.divider_int() == 39 && PICO_SERVO_CLOCK.divider_frac() == 1);
+    assert!(PICO_SERVO_CLOCK.top == 63_999);
+    assert!(PICO_SERVO_CLOCK.count_ps(PICO_SYS_HZ) == 312_500);
+    assert!(PICO_SERVO_CLOCK.period_ns(PICO_SYS_HZ) == 20_000_000);
 };

@@ -1,0 +1,504 @@
+//! Commands as text: random commands, their text in the protocol (with
+//! the variations a person or a program may type), and mutations of it.
+
+use std::fmt::Write as _;
+
+use idle_head::command::{
+    Action, Command, GestureKind, GestureRequest, Hold, LookRequest, Percent, SeedChoice,
+    ServoSetting,
+};
+use idle_head::servo::{Direction, NanosPerDegree};
+use idle_head::{Angle, AngleRange, Axis, Microseconds, Millis};
+use proptest::prelude::RngExt as _;
+use proptest::test_runner::TestRng;
+
+/// Every word of the protocol, for random token lines.
+pub const VOCABULARY: &[&str] = &[
+    "help",
+    "status",
+    "save",
+    "load",
+    "defaults",
+    "stop",
+    "nod",
+    "shake",
+    "tilt",
+    "look",
+    "center",
+    "centre",
+    "idle",
+    "seed",
+    "servo",
+    "on",
+    "off",
+    "amp",
+    "random",
+    "pitch",
+    "roll",
+    "yaw",
+    "neutral",
+    "min",
+    "max",
+    "per-degree",
+    "direction",
+    "normal",
+    "reversed",
+    "limits",
+    "stay",
+    "hold=",
+    "cycles=",
+    "intensity=",
+    "hold=stay",
+    "=",
+];
+
+/// Numbers at and past the limits of every field.
+pub const EDGE_NUMBERS: &[&str] = &[
+    "0",
+    "-0",
+    "+0",
+    "1",
+    "-1",
+    "100",
+    "101",
+    "255",
+    "256",
+    "2147483647",
+    "2147483648",
+    "-2147483647",
+    "-2147483648",
+    "-2147483649",
+    "4294967295",
+    "4294967296",
+    "4611686018427387904",
+    "4611686018427387905",
+    "9223372036854775807",
+    "9223372036854775808",
+    "-9223372036854775808",
+    "99999999999999999999999",
+    "000000000000000000000007",
+    "+",
+    "-",
+    "--1",
+    "+-1",
+    "1e3",
+    "0x10",
+    "١٢",
+];
+
+/// A value from `edges` most of the time, else anything in `lo..=hi`.
+fn pick_i64(rng: &mut TestRng, lo: i64, hi: i64, edges: &[i64]) -> i64 {
+    if rng.random_bool(0.3) {
+        let e = edges[rng.random_range(0..edges.len())];
+        return e.clamp(lo, hi);
+    }
+    rng.random_range(lo..=hi)
+}
+
+fn angle(rng: &mut TestRng) -> Angle {
+    let v = pick_i64(
+        rng,
+        i64::from(i32::MIN) + 1,
+        i64::from(i32::MAX),
+        &[i64::from(i32::MIN) + 1, -1, 0, 1, i64::from(i32::MAX)],
+    );
+    if rng.random_bool(0.5) {
+        // Mostly head-sized angles.
+        return Angle::from_millidegrees(rng.random_range(-60_000..=60_000));
+    }
+    Angle::from_millidegrees(v as i32)
+}
+
+fn millis(rng: &mut TestRng, min: u32) -> Millis {
+    let v = pick_i64(
+        rng,
+        i64::from(min),
+        i64::from(u32::MAX),
+        &[i64::from(min), 1, i64::from(u32::MAX)],
+    );
+    Millis(v as u32)
+}
+
+fn u32_any(rng: &mut TestRng) -> u32 {
+    pick_i64(rng, 0, i64::from(u32::MAX), &[0, 1, i64::from(u32::MAX)]) as u32
+}
+
+fn percent(rng: &mut TestRng) -> Percent {
+    Percent::new(rng.random_range(0..=100)).unwrap_or(Percent::FULL)
+}
+
+fn maybe<T>(rng: &mut TestRng, f: impl FnOnce(&mut TestRng) -> T) -> Option<T> {
+    if rng.random_bool(0.5) {
+        Some(f(rng))
+    } else {
+        None
+    }
+}
+
+/// A random command, every field anywhere in its parseable range.
+pub fn random_command(rng: &mut TestRng) -> Command {
+    match rng.random_range(0..12) {
+        0 => Command::Help,
+        1 => Command::Status,
+        2 => Command::Save,
+        3 => Command::Load,
+        4 => Command::Defaults,
+        5 => Command::Act(Action::Stop),
+        6 => {
+            let kind =
+                [GestureKind::Nod, GestureKind::Shake, GestureKind::Tilt][rng.random_range(0..3)];
+            let mut g = GestureRequest::new(kind);
+            g.amplitude = maybe(rng, angle);
+            if g.amplitude.is_some() {
+                g.duration = maybe(rng, |r| millis(r, 1));
+            }
+            if kind != GestureKind::Tilt {
+                g.cycles = maybe(rng, |r| r.random_range(1..=255));
+            }
+            g.intensity = maybe(rng, percent);
+            Command::Act(Action::Gesture(g))
+        }
+        7 => Command::Act(Action::Look(LookRequest {
+            pitch: angle(rng),
+            yaw: angle(rng),
+            duration: maybe(rng, |r| millis(r, 1)),
+            hold: maybe(rng, |r| {
+                if r.random_bool(0.3) {
+                    Hold::Stay
+                } else {
+                    Hold::Return(millis(r, 0))
+                }
+            }),
+        })),
+        8 => Command::Act(Action::Center {
+            duration: maybe(rng, |r| millis(r, 1)),
+        }),
+        9 => Command::Act(match rng.random_range(0..3) {
+            0 => Action::Idle(true),
+            1 => Action::Idle(false),
+            _ => Action::IdleAmp(percent(rng)),
+        }),
+        10 => Command::Seed(if rng.random_bool(0.2) {
+            SeedChoice::Random
+        } else {
+            SeedChoice::Value(u32_any(rng))
+        }),
+        _ => Command::Servo {
+            axis: Axis::ALL[rng.random_range(0..3)],
+            setting: maybe(rng, |r| match r.random_range(0..6) {
+                0 => ServoSetting::Neutral(Microseconds(u32_any(r))),
+                1 => ServoSetting::PerDegree(NanosPerDegree(u32_any(r))),
+                2 => ServoSetting::Direction(if r.random_bool(0.5) {
+                    Direction::Normal
+                } else {
+                    Direction::Reversed
+                }),
+                3 => ServoSetting::MinPulse(Microseconds(u32_any(r))),
+                4 => ServoSetting::MaxPulse(Microseconds(u32_any(r))),
+                _ => ServoSetting::Limits(AngleRange {
+                    min: angle(r),
+                    max: angle(r),
+                }),
+            }),
+        },
+    }
+}
+
+/// How to spell a command: canonical (no generator), or with the
+/// variations the grammar allows (case, blanks, signs, leading zeros,
+/// option order, `centre`).
+struct Style<'r> {
+    rng: Option<&'r mut TestRng>,
+    out: String,
+}
+
+impl Style<'_> {
+    fn chance(&mut self, p: f64) -> bool {
+        self.rng.as_mut().is_some_and(|r| r.random_bool(p))
+    }
+
+    fn word(&mut self, word: &str) {
+        self.blank();
+        for c in word.chars() {
+            let upper = self.chance(0.2);
+            self.out
+                .push(if upper { c.to_ascii_uppercase() } else { c });
+        }
+    }
+
+    fn number(&mut self, v: i64) {
+        self.blank();
+        if v < 0 {
+            self.out.push('-');
+        } else if self.chance(0.1) {
+            self.out.push('+');
+        }
+        while self.chance(0.1) {
+            self.out.push('0');
+        }
+        write!(self.out, "{}", v.unsigned_abs()).unwrap();
+    }
+
+    fn millis(&mut self, m: Millis) {
+        self.number(i64::from(m.0));
+    }
+
+    fn mdeg(&mut self, a: Angle) {
+        self.number(i64::from(a.millidegrees()));
+    }
+
+    fn option(&mut self, name: &str, value: &str) {
+        self.word(name);
+        self.out.push('=');
+        self.out.push_str(value);
+    }
+
+    fn blank(&mut self) {
+        let first = self.out.is_empty();
+        let Some(rng) = self.rng.as_mut() else {
+            if !first {
+                self.out.push(' ');
+            }
+            return;
+        };
+        let n = if first {
+            rng.random_range(0..2)
+        } else {
+            rng.random_range(1..3)
+        };
+        for _ in 0..n {
+            let c = if rng.random_bool(0.8) { ' ' } else { '\t' };
+            self.out.push(c);
+        }
+    }
+}
+
+/// The canonical text of `command`: the parser reads it back as `command`.
+#[must_use]
+pub fn command_text(command: &Command) -> String {
+    let mut style = Style {
+        rng: None,
+        out: String::new(),
+    };
+    write_command(&mut style, command);
+    style.out
+}
+
+/// The text of `command` spelled with random variations of case, blanks,
+/// signs, leading zeros and option order; it still parses as `command`.
+pub fn varied_text(command: &Command, rng: &mut TestRng) -> String {
+    let mut style = Style {
+        rng: Some(rng),
+        out: String::new(),
+    };
+    write_command(&mut style, command);
+    while style.chance(0.3) {
+        style.out.push(' ');
+    }
+    style.out
+}
+
+fn write_command(s: &mut Style<'_>, command: &Command) {
+    match *command {
+        Command::Help => s.word("help"),
+        Command::Status => s.word("status"),
+        Command::Save => s.word("save"),
+        Command::Load => s.word("load"),
+        Command::Defaults => s.word("defaults"),
+        Command::Act(Action::Stop) => s.word("stop"),
+        Command::Act(Action::Gesture(g)) => {
+            s.word(g.kind.name());
+            if let Some(a) = g.amplitude {
+                s.mdeg(a);
+                if let Some(d) = g.duration {
+                    s.millis(d);
+                }
+            }
+            let mut options = Vec::new();
+            if let Some(c) = g.cycles {
+                options.push(("cycles", c.to_string()));
+            }
+            if let Some(i) = g.intensity {
+                options.push(("intensity", i.get().to_string()));
+            }
+            if s.chance(0.5) {
+                options.reverse();
+            }
+            for (name, value) in options {
+                s.option(name, &value);
+            }
+        }
+        Command::Act(Action::Look(l)) => {
+            s.word("look");
+            s.mdeg(l.pitch);
+            s.mdeg(l.yaw);
+            if let Some(d) = l.duration {
+                s.millis(d);
+            }
+            match l.hold {
+                Some(Hold::Stay) => s.option("hold", "stay"),
+                Some(Hold::Return(m)) => s.option("hold", &m.0.to_string()),
+                None => {}
+            }
+        }
+        Command::Act(Action::Center { duration }) => {
+            let word = if s.chance(0.3) { "centre" } else { "center" };
+            s.word(word);
+            if let Some(d) = duration {
+                s.millis(d);
+            }
+        }
+        Command::Act(Action::Idle(on)) => {
+            s.word("idle");
+            s.word(if on { "on" } else { "off" });
+        }
+        Command::Act(Action::IdleAmp(p)) => {
+            s.word("idle");
+            s.word("amp");
+            s.number(i64::from(p.get()));
+        }
+        Command::Seed(SeedChoice::Random) => {
+            s.word("seed");
+            s.word("random");
+        }
+        Command::Seed(SeedChoice::Value(v)) => {
+            s.word("seed");
+            s.number(i64::from(v));
+        }
+        Command::Servo { axis, setting } => {
+            s.word("servo");
+            s.word(axis.name());
+            let Some(setting) = setting else { return };
+            s.word(setting.field());
+            match setting {
+                ServoSetting::Neutral(us)
+                | ServoSetting::MinPulse(us)
+                | ServoSetting::MaxPulse(us) => s.number(i64::from(us.0)),
+                ServoSetting::PerDegree(ns) => s.number(i64::from(ns.0)),
+                ServoSetting::Direction(Direction::Normal) => s.word("normal"),
+                ServoSetting::Direction(Direction::Reversed) => s.word("reversed"),
+                ServoSetting::Limits(r) => {
+                    s.mdeg(r.min);
+                    s.mdeg(r.max);
+                }
+            }
+        }
+    }
+}
+
+/// A byte a mutation inserts: mostly what the grammar is made of.
+fn random_byte(rng: &mut TestRng) -> u8 {
+    const INTERESTING: &[u8] = b" \t=-+0123456789#*aeiouxyz";
+    match rng.random_range(0..4) {
+        0 => INTERESTING[rng.random_range(0..INTERESTING.len())],
+        1 => rng.random_range(0x20..0x7f),
+        _ => rng.random(),
+    }
+}
+
+/// `line` with 1 to 4 random mutations: bytes flipped, replaced, inserted,
+/// deleted or duplicated; words dropped, repeated or swapped; a number
+/// replaced by one at or past a limit; a vocabulary word inserted.
+pub fn mutate(line: &[u8], rng: &mut TestRng) -> Vec<u8> {
+    let mut out = line.to_vec();
+    for _ in 0..rng.random_range(1..=4) {
+        let len = out.len();
+        let at = if len == 0 {
+            0
+        } else {
+            rng.random_range(0..len)
+        };
+        match rng.random_range(0..10) {
+            0 if len > 0 => out[at] ^= 1 << rng.random_range(0..8),
+            1 if len > 0 => out[at] = random_byte(rng),
+            2 => out.insert(at, random_byte(rng)),
+            3 if len > 0 => {
+                out.remove(at);
+            }
+            4 if len > 0 => {
+                let end = rng.random_range(at..=len.min(at + 12));
+                let copy = out[at..end].to_vec();
+                out.splice(end..end, copy);
+            }
+            5 => out = edit_words(&out, rng),
+            6 | 7 => out = replace_number(&out, rng),
+            8 => {
+                let word = VOCABULARY[rng.random_range(0..VOCABULARY.len())];
+                let mut piece = Vec::from(b" ".as_slice());
+                piece.extend_from_slice(word.as_bytes());
+                out.splice(at..at, piece);
+            }
+            _ => out.truncate(at),
+        }
+    }
+    out
+}
+
+fn words(line: &[u8]) -> Vec<Vec<u8>> {
+    line.split(|&b| b == b' ' || b == b'\t')
+        .filter(|w| !w.is_empty())
+        .map(<[u8]>::to_vec)
+        .collect()
+}
+
+fn edit_words(line: &[u8], rng: &mut TestRng) -> Vec<u8> {
+    let mut w = words(line);
+    if w.is_empty() {
+        return line.to_vec();
+    }
+    let i = rng.random_range(0..w.len());
+    let j = rng.random_range(0..w.len());
+    match rng.random_range(0..3) {
+        0 => {
+            w.remove(i);
+        }
+        1 => w.insert(i, w[j].clone()),
+        _ => w.swap(i, j),
+    }
+    w.join(&b' ')
+}
+
+fn replace_number(line: &[u8], rng: &mut TestRng) -> Vec<u8> {
+    let mut w = words(line);
+    let numeric: Vec<usize> = (0..w.len())
+        .filter(|&i| w[i].iter().any(u8::is_ascii_digit))
+        .collect();
+    let edge = EDGE_NUMBERS[rng.random_range(0..EDGE_NUMBERS.len())].as_bytes();
+    if numeric.is_empty() {
+        w.push(edge.to_vec());
+    } else {
+        let i = numeric[rng.random_range(0..numeric.len())];
+        // Keep an option's name: `cycles=` + the new number.
+        let keep = w[i].iter().position(|&b| b == b'=').map_or(0, |p| p + 1);
+        w[i].truncate(keep);
+        w[i].extend_from_slice(edge);
+    }
+    w.join(&b' ')
+}
+
+/// 1 to 8 random words of the vocabulary and edge numbers.
+pub fn token_line(rng: &mut TestRng) -> Vec<u8> {
+    let mut out = Vec::new();
+    for i in 0..rng.random_range(1..=8) {
+        if i > 0 {
+            out.push(b' ');
+        }
+        let word = if rng.random_bool(0.7) {
+            VOCABULARY[rng.random_range(0..VOCABULARY.len())]
+        } else {
+            EDGE_NUMBERS[rng.random_range(0..EDGE_NUMBERS.len())]
+        };
+        out.extend_from_slice(word.as_bytes());
+        if word.ends_with('=') {
+            out.extend_from_slice(EDGE_NUMBERS[rng.random_range(0..EDGE_NUMBERS.len())].as_bytes());
+        }
+    }
+    out
+}
+
+/// Up to `max` random bytes.
+pub fn random_bytes(rng: &mut TestRng, max: usize) -> Vec<u8> {
+    (0..rng.random_range(0..=max))
+        .map(|_| rng.random())
+        .collect()
+}

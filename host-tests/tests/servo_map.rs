@@ -1,0 +1,115 @@
+//! The frame path's servo map against the documented conversions
+//! (`ServoCalibration::pulse`, `PwmTiming::duty`), over every angle.
+
+use host_tests::strategies::calibration;
+use idle_head::servo::{Direction, Duty, NanosPerDegree, PwmTiming, ServoCalibration, ServoMap};
+use idle_head::{Angle, AngleRange, Axis, Microseconds};
+use proptest::prelude::*;
+
+/// Every angle from 2° below the lower limit to 2° above the upper one: the
+/// pulse is the calibration's exactly, the duty `PwmTiming::duty` of it or,
+/// where the true duty lies within a quarter count below a whole count (the
+/// map's documented error), one count more. Returns how many were.
+fn check_every_angle(cal: &ServoCalibration, max_duty: u16) -> Result<usize, TestCaseError> {
+    let timing = PwmTiming::SERVO_50HZ;
+    let map = ServoMap::new(cal, timing, max_duty);
+    let lo = cal.limits.min.millidegrees() - 2000;
+    let hi = cal.limits.max.millidegrees() + 2000;
+    let mut off = 0;
+    for a in lo..=hi {
+        let angle = Angle::from_millidegrees(a);
+        let pulse = cal.pulse(angle);
+        prop_assert_eq!(map.pulse(cal, angle), pulse, "{} m°", a);
+        let want = timing.duty(pulse, max_duty);
+        let (got_pulse, got) = map.pulse_and_duty(cal, angle);
+        prop_assert_eq!(got_pulse, pulse);
+        prop_assert_eq!(map.duty(cal, angle), got);
+        if got != want {
+            // ⌊(p·M + ⌊T/2⌋)/T⌋ is the duty: its fraction, in periods.
+            let (m, t) = (u64::from(max_duty), u64::from(timing.period.0));
+            let below_next = t - (u64::from(pulse.0) * m + t / 2) % t;
+            prop_assert!(
+                got.0 == want.0 + 1 && 4 * below_next <= t,
+                "{} m°: {:?} vs {:?}, {} of {} below the next count",
+                a,
+                got,
+                want,
+                below_next,
+                t
+            );
+            off += 1;
+        }
+    }
+    Ok(off)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// The calibrations of the driver's property tests, on the channels they
+    /// drive and on the Pico's (63 999: 64 000 counts per 20 ms).
+    #[test]
+    fn the_map_agrees_with_the_calibration_over_every_angle(
+        cal in calibration(),
+        max_duty in prop_oneof![Just(20_000u16), Just(62_500), Just(u16::MAX), Just(999), Just(65_465), Just(63_999)],
+    ) {
+        check_every_angle(&cal, max_duty)?;
+    }
+
+    /// The angle a duty maps back to gives that duty.
+    #[test]
+    fn a_duty_maps_back_to_an_angle_that_gives_it(
+        cal in calibration(),
+        max_duty in prop_oneof![Just(20_000u16), Just(62_500), Just(65_465), Just(63_999)],
+        at in 0.0f64..=1.0,
+    ) {
+        let map = ServoMap::new(&cal, PwmTiming::SERVO_50HZ, max_duty);
+        let (lo, hi) = (f64::from(cal.limits.min.millidegrees()), f64::from(cal.limits.max.millidegrees()));
+        let angle = Angle::from_millidegrees((lo + at * (hi - lo)).round() as i32);
+        let duty = map.duty(&cal, angle);
+        let back = map.angle_of_duty(&cal, duty);
+        prop_assert_eq!(map.duty(&cal, back), duty);
+    }
+}
+
+#[test]
+fn the_default_servos_on_the_pico() {
+    for axis in Axis::ALL {
+        let cal = ServoCalibration::hobby(axis);
+        for direction in [Direction::Normal, Direction::Reversed] {
+            let off = check_every_angle(&cal.with_direction(direction), 63_999).unwrap();
+            assert!(off < 10, "{axis:?}: {off}");
+        }
+    }
+}
+
+#[test]
+fn calibrations_beyond_the_32_bit_forms_take_the_documented_conversions() {
+    // Pulses 100..19 000 µs: 17 500 µs from neutral, far beyond ±2100 µs.
+    let wide = ServoCalibration {
+        neutral: Microseconds(1500),
+        per_degree: NanosPerDegree(1_000_000),
+        direction: Direction::Normal,
+        min_pulse: Microseconds(100),
+        max_pulse: Microseconds(19_000),
+        limits: AngleRange::degrees(-1, 17),
+    };
+    assert_eq!(wide.validate(), Ok(()));
+    check_every_angle(&wide, u16::MAX).unwrap();
+    // Far outside the domain, the ends.
+    let map = ServoMap::new(&wide, PwmTiming::SERVO_50HZ, u16::MAX);
+    assert_eq!(
+        map.pulse(&wide, Angle::from_millidegrees(i32::MAX)),
+        Microseconds(19_000)
+    );
+    assert_eq!(
+        map.duty(&wide, Angle::from_millidegrees(i32::MIN)),
+        PwmTiming::SERVO_50HZ.duty(Microseconds(100), u16::MAX)
+    );
+    // A pulse outside the range gets the duty of the nearer end.
+    let hobby = ServoCalibration::hobby(Axis::Yaw);
+    let map = ServoMap::new(&hobby, PwmTiming::SERVO_50HZ, 20_000);
+    assert_eq!(map.pulse_duty(&hobby, Microseconds(5)), Duty(1000));
+    assert_eq!(map.pulse_duty(&hobby, Microseconds(3000)), Duty(2000));
+    assert_eq!(map.max_duty(), 20_000);
+}

@@ -1,0 +1,357 @@
+//! The settings store on sequential-storage's mock flash: round trips,
+//! versions, a power cut at every byte of hundreds of saves in a row, and
+//! random corruption.
+//!
+//! `cargo test --test settings_store -- --nocapture` prints the figures.
+
+use futures::executor::block_on;
+use idle_head::command::Percent;
+use idle_head::servo::{NanosPerDegree, ServoCalibration};
+use idle_head::settings::{
+    DecodeError, EncodeError, LoadError, Record, SaveError, SettingsStore, decode_postcard,
+    encode_postcard,
+};
+use idle_head::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
+use proptest::prelude::RngExt as _;
+use proptest::test_runner::TestRng;
+use sequential_storage::mock_flash::{MockFlashBase, MockFlashError, WriteCountCheck};
+use serde::{Deserialize, Serialize};
+
+/// Four 1 KiB pages of 4-byte words (the RP2040's flash reads in words;
+/// small pages make the store turn pages over often).
+type Flash = MockFlashBase<4, 4, 256>;
+type Store<R> = SettingsStore<Flash, R, 128>;
+
+/// A record like the firmware's settings: three servo calibrations and a
+/// few integers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct ServoSettings {
+    servos: [ServoCalibration; 3],
+    idle_amp: Percent,
+    seed: u32,
+    fade: Millis,
+}
+
+/// The stored layout: plain integers, independent of the in-memory types.
+#[derive(Serialize, Deserialize)]
+struct ServoWire {
+    neutral_us: u32,
+    per_degree_ns: u32,
+    reversed: bool,
+    min_us: u32,
+    max_us: u32,
+    limits_mdeg: [i32; 2],
+}
+
+#[derive(Serialize, Deserialize)]
+struct SettingsWire {
+    servos: [ServoWire; 3],
+    idle_amp: u8,
+    seed: u32,
+    fade_ms: u32,
+}
+
+impl Record for ServoSettings {
+    const VERSION: u16 = 2;
+
+    fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
+        let wire = SettingsWire {
+            servos: self.servos.map(|c| ServoWire {
+                neutral_us: c.neutral.0,
+                per_degree_ns: c.per_degree.0,
+                reversed: c.direction == Direction::Reversed,
+                min_us: c.min_pulse.0,
+                max_us: c.max_pulse.0,
+                limits_mdeg: [c.limits.min.millidegrees(), c.limits.max.millidegrees()],
+            }),
+            idle_amp: self.idle_amp.get(),
+            seed: self.seed,
+            fade_ms: self.fade.0,
+        };
+        encode_postcard(&wire, buf)
+    }
+
+    fn decode(bytes: &[u8]) -> Result<Self, DecodeError> {
+        let wire: SettingsWire = decode_postcard(bytes)?;
+        let servos = wire.servos.map(|w| ServoCalibration {
+            neutral: Microseconds(w.neutral_us),
+            per_degree: NanosPerDegree(w.per_degree_ns),
+            direction: if w.reversed {
+                Direction::Reversed
+            } else {
+                Direction::Normal
+            },
+            min_pulse: Microseconds(w.min_us),
+            max_pulse: Microseconds(w.max_us),
+            limits: AngleRange {
+                min: Angle::from_millidegrees(w.limits_mdeg[0]),
+                max: Angle::from_millidegrees(w.limits_mdeg[1]),
+            },
+        });
+        if servos.iter().any(|c| c.validate().is_err()) {
+            return Err(DecodeError::Invalid);
+        }
+        Ok(Self {
+            servos,
+            idle_amp: Percent::new(wire.idle_amp).ok_or(DecodeError::Invalid)?,
+            seed: wire.seed,
+            fade: Millis(wire.fade_ms),
+        })
+    }
+}
+
+/// Bytes stored under any version, to plant records of other layouts.
+struct Raw<const V: u16>(Vec<u8>);
+
+impl<const V: u16> Record for Raw<V> {
+    const VERSION: u16 = V;
+
+    fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
+        let dst = buf.get_mut(..self.0.len()).ok_or(EncodeError::TooLong)?;
+        dst.copy_from_slice(&self.0);
+        Ok(self.0.len())
+    }
+
+    fn decode(bytes: &[u8]) -> Result<Self, DecodeError> {
+        Ok(Self(bytes.to_vec()))
+    }
+}
+
+/// Valid settings, every field varied.
+fn random_settings(rng: &mut TestRng) -> ServoSettings {
+    let servos = Axis::ALL.map(|axis| {
+        loop {
+            let mut c = ServoCalibration::hobby(axis);
+            c.neutral = Microseconds(rng.random_range(1400..=1600));
+            c.per_degree = NanosPerDegree(rng.random_range(9_000..=13_000));
+            c.min_pulse = Microseconds(rng.random_range(500..=1000));
+            c.max_pulse = Microseconds(rng.random_range(2000..=2500));
+            if rng.random_bool(0.5) {
+                c.direction = Direction::Reversed;
+            }
+            let limits = axis.anatomical_limits();
+            c.limits = AngleRange {
+                min: Angle::from_millidegrees(rng.random_range(limits.min.millidegrees()..=0)),
+                max: Angle::from_millidegrees(rng.random_range(0..=limits.max.millidegrees())),
+            };
+            if c.validate().is_ok() {
+                break c;
+            }
+        }
+    });
+    ServoSettings {
+        servos,
+        idle_amp: Percent::new(rng.random_range(0..=100)).unwrap(),
+        seed: rng.random(),
+        fade: Millis(rng.random_range(0..=5000)),
+    }
+}
+
+fn rng(seed: u64) -> TestRng {
+    host_tests::console::rng(seed)
+}
+
+fn fresh(check: WriteCountCheck) -> Flash {
+    Flash::new(check, None, true)
+}
+
+fn store<R: Record>(flash: Flash) -> Store<R> {
+    Store::new(flash, Flash::FULL_FLASH_RANGE).expect("a valid range")
+}
+
+#[test]
+fn round_trip_and_what_a_load_reports() {
+    let mut rng = rng(1);
+    let mut s = store::<ServoSettings>(fresh(WriteCountCheck::OnceOnly));
+    assert_eq!(block_on(s.load()), Err(LoadError::Empty));
+    for _ in 0..200 {
+        let settings = random_settings(&mut rng);
+        block_on(s.save(&settings)).unwrap();
+        assert_eq!(block_on(s.load()), Ok(settings));
+    }
+    let valid = random_settings(&mut rng);
+    let mut encoded = [0; 128];
+    let len = valid.encode(&mut encoded).unwrap();
+    let encoded = &encoded[..len];
+
+    // Records of other layouts, planted in the same flash.
+    let plant = |flash: Flash, raw: &[u8], version: u16| -> Store<ServoSettings> {
+        let flash = match version {
+            1 => save_raw::<1>(flash, raw),
+            2 => save_raw::<2>(flash, raw),
+            _ => save_raw::<3>(flash, raw),
+        };
+        store(flash)
+    };
+    let mut s = plant(s.into_flash(), encoded, 1);
+    assert_eq!(block_on(s.load()), Err(LoadError::Older { found: 1 }));
+    let mut s = plant(s.into_flash(), encoded, 3);
+    assert_eq!(block_on(s.load()), Err(LoadError::Newer { found: 3 }));
+    let mut s = plant(s.into_flash(), &[0xff, 0xff, 0xff], 2);
+    assert_eq!(block_on(s.load()), Err(LoadError::Corrupt));
+    let mut trailing = encoded.to_vec();
+    trailing.push(0);
+    let mut s = plant(s.into_flash(), &trailing, 2);
+    assert_eq!(block_on(s.load()), Err(LoadError::Corrupt));
+    let mut s = plant(s.into_flash(), &[], 2);
+    assert_eq!(block_on(s.load()), Err(LoadError::Corrupt));
+    let mut invalid = valid;
+    invalid.servos[1].neutral = Microseconds(3000);
+    let mut bytes = [0; 128];
+    let n = invalid.encode(&mut bytes).unwrap();
+    let mut s = plant(s.into_flash(), &bytes[..n], 2);
+    assert_eq!(block_on(s.load()), Err(LoadError::Invalid));
+    // A save puts things right.
+    block_on(s.save(&valid)).unwrap();
+    assert_eq!(block_on(s.load()), Ok(valid));
+    block_on(s.erase()).unwrap();
+    assert_eq!(block_on(s.load()), Err(LoadError::Empty));
+
+    // A record too long for the work buffer is refused, nothing changes.
+    let mut raw = store::<Raw<2>>(fresh(WriteCountCheck::OnceOnly));
+    assert_eq!(
+        block_on(raw.save(&Raw(vec![7; 200]))),
+        Err(SaveError::TooLong)
+    );
+    assert!(matches!(block_on(raw.load()), Err(LoadError::Empty)));
+}
+
+fn save_raw<const V: u16>(flash: Flash, bytes: &[u8]) -> Flash {
+    let mut s = store::<Raw<V>>(flash);
+    block_on(s.save(&Raw(bytes.to_vec()))).unwrap();
+    s.into_flash()
+}
+
+/// Saves in a row, each one cut at every byte it writes or erases.
+const SAVES: usize = 300;
+
+#[test]
+fn a_power_cut_at_every_byte_leaves_the_old_or_the_new_record() {
+    let mut rng = rng(2);
+    let mut flash = fresh(WriteCountCheck::OnceOnly);
+    let mut old: Option<ServoSettings> = None;
+    let (mut cuts, mut kept_old, mut got_new, mut longest) = (0_u64, 0_u64, 0_u64, 0);
+    for i in 0..SAVES {
+        let new = random_settings(&mut rng);
+        // Now and then go on from a state a cut and its repair left.
+        let mut resume: Option<Flash> = None;
+        let mut cut = 0;
+        let done = loop {
+            let mut trial = flash.clone();
+            trial.bytes_until_shutoff = Some(cut);
+            let mut s = store::<ServoSettings>(trial);
+            match block_on(s.save(&new)) {
+                Ok(()) => break s.into_flash(),
+                Err(SaveError::Flash(MockFlashError::EarlyShutoff(..))) => {}
+                Err(e) => panic!("save {i}, cut at byte {cut}: {e:?}"),
+            }
+            // Power back: a new store over what the flash holds.
+            let mut after = s.into_flash();
+            after.bytes_until_shutoff = None;
+            let mut s = store::<ServoSettings>(after);
+            match (block_on(s.load()), old) {
+                (Ok(r), _) if r == new => got_new += 1,
+                (Ok(r), Some(o)) if r == o => kept_old += 1,
+                (Err(LoadError::Empty), None) => kept_old += 1,
+                (other, _) => panic!("save {i}, cut at byte {cut}: loaded {other:?}"),
+            }
+            // The store works on from there.
+            block_on(s.save(&new)).unwrap_or_else(|e| panic!("save {i}, cut {cut}: {e:?}"));
+            assert_eq!(block_on(s.load()), Ok(new), "save {i}, cut {cut}");
+            if rng.random_range(0..=cut) == 0 {
+                resume = Some(s.into_flash());
+            }
+            cut += 1;
+            cuts += 1;
+        };
+        longest = longest.max(cut);
+        flash = match resume {
+            Some(recovered) if i % 5 == 4 => recovered,
+            _ => done,
+        };
+        flash.bytes_until_shutoff = None;
+        old = Some(new);
+    }
+    println!(
+        "power cuts: {SAVES} saves in a row, {cuts} cut points (every byte written or erased; \
+         up to {longest} in one save), {} loads after a cut: {kept_old} old record, \
+         {got_new} new record, 0 other; each followed by a save and a load of the new record",
+        kept_old + got_new
+    );
+    assert_eq!(kept_old + got_new, cuts);
+    assert!(kept_old > 0 && got_new > 0);
+    // Page turnovers (an erase of 1 KiB) were among the cut saves.
+    assert!(longest > 1024);
+}
+
+/// Damaged flash never panics the store and never yields a record that
+/// was not saved; a save afterwards puts it right.
+#[test]
+fn random_corruption_never_panics_nor_invents_a_record() {
+    const TRIALS: usize = 20_000;
+    let mut rng = rng(3);
+    // Real NOR flash: writing over written bits clears them (no mock check).
+    let mut histories = Vec::new();
+    for saves in [1, 3, 20, 60] {
+        let mut s = store::<ServoSettings>(fresh(WriteCountCheck::Disabled));
+        let saved: Vec<ServoSettings> = (0..saves).map(|_| random_settings(&mut rng)).collect();
+        for r in &saved {
+            block_on(s.save(r)).unwrap();
+        }
+        histories.push((s.into_flash(), saved));
+    }
+    let (mut newest, mut older, mut empty, mut corrupt, mut resaved) = (0, 0, 0, 0, 0);
+    for trial in 0..TRIALS {
+        let (base, saved) = &histories[trial % histories.len()];
+        let mut flash = base.clone();
+        corrupt_bytes(flash.as_bytes_mut(), &mut rng);
+        let mut s = store::<ServoSettings>(flash);
+        match block_on(s.load()) {
+            Ok(r) if Some(&r) == saved.last() => newest += 1,
+            Ok(r) if saved.contains(&r) => older += 1,
+            Err(LoadError::Empty) => empty += 1,
+            Err(LoadError::Corrupt) => corrupt += 1,
+            other => panic!("trial {trial}: {other:?}"),
+        }
+        let next = random_settings(&mut rng);
+        let saved_ok = block_on(s.save(&next));
+        let loaded = block_on(s.load());
+        if saved_ok.is_ok() && loaded == Ok(next) {
+            resaved += 1;
+        } else {
+            panic!("trial {trial}: save {saved_ok:?}, then load {loaded:?}");
+        }
+    }
+    println!(
+        "corruption: {TRIALS} damaged flashes: load gave the newest record {newest}, an older \
+         one {older}, empty {empty}, corrupt {corrupt}, a record never saved 0, panics 0; \
+         a save afterwards stored and loaded back in {resaved}"
+    );
+    assert_eq!(newest + older + empty + corrupt, TRIALS);
+    assert!(older > 0 && corrupt + empty > 0);
+}
+
+/// Flips bits, overwrites bytes, clears or erases a run; mostly where
+/// something is written.
+fn corrupt_bytes(bytes: &mut [u8], rng: &mut TestRng) {
+    let written: Vec<usize> = (0..bytes.len()).filter(|&i| bytes[i] != 0xff).collect();
+    for _ in 0..rng.random_range(1..=4) {
+        let at = if rng.random_bool(0.8) {
+            written[rng.random_range(0..written.len())]
+        } else {
+            rng.random_range(0..bytes.len())
+        };
+        match rng.random_range(0..4) {
+            0 => bytes[at] ^= 1 << rng.random_range(0..8),
+            1 => bytes[at] = rng.random(),
+            2 => {
+                let end = (at + rng.random_range(1..64)).min(bytes.len());
+                bytes[at..end].fill(0);
+            }
+            _ => {
+                let end = (at + rng.random_range(1..64)).min(bytes.len());
+                bytes[at..end].fill(0xff);
+            }
+        }
+    }
+}

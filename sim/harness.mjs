@@ -1,0 +1,245 @@
+// Runs a Raspberry Pi Pico flash image in rp2040js and reports what happened
+// as JSON lines on stdout, one event per line. It only reports raw facts;
+// `cargo xtask sim` decodes and checks them.
+//
+//   node harness.mjs '<config as JSON>'
+//
+// config: {
+//   flash:      path of the flash image (binary, loaded at 0x10000000),
+//   vtor:       vector table address (0x10000100 behind a 256-byte boot2),
+//   rtt:        address of `_SEGGER_RTT` (0 = no RTT),
+//   pins:       GPIO numbers whose edges to report,
+//   slices:     PWM slices whose compare writes to report,
+//   probe:      entry address of a function whose cycles to report per call (0 = none),
+//   stack:      [low, high) of the stack region, scanned for paint at the end of a boot,
+//   paint:      the stack paint word,
+//   ns:         virtual time to run, in nanoseconds,
+//   wall_ms:    wall-time limit,
+//   silence_ns: end the run when nothing (log byte, pin edge) happens for this long,
+// }
+//
+// Events ("ns" is virtual time since power-on, across resets):
+//   {"ev":"boot","n":0,"ns":..}                     a boot starts (0 = power-on)
+//   {"ev":"rtt","ns":..,"hex":".."}                 bytes from the RTT up-buffer
+//   {"ev":"edge","pin":16,"high":true,"ns":..}      a pin changed level ("reset":true: by a reset)
+//   {"ev":"cc","slice":0,"value":..,"ns":..}        a PWM compare register write
+//   {"ev":"en","slice":0,"on":true,"ns":..}         a PWM slice enabled or disabled
+//   {"ev":"call","cycles":..,"ns":..}               one call of the probed function
+//   {"ev":"watchdog","ns":..,"reason":1}            the watchdog fired (1 timer, 2 forced)
+//   {"ev":"stack","n":0,"low":..}                   lowest stack address written in boot n
+//   {"ev":"emu","level":"warn","msg":".."}          a complaint of the emulator
+//   {"ev":"end","why":"time|silent|asleep|wall|break|error","ns":..,"instructions":..,"wall_ms":..}
+
+import { readFileSync } from 'node:fs';
+import { RP2040 } from 'rp2040js';
+
+const cfg = JSON.parse(process.argv[2] ?? '{}');
+const FLASH_START = 0x10000000;
+const RAM_START = 0x20000000;
+const NS_PER_CYCLE = 8; // 125 MHz, as rp2040js's own Simulator assumes
+const OP_SEV = 0xbf40;
+const WATCHDOG_BASE = 0x40058;
+const RTT_WRITE = 36; // offsets in `_SEGGER_RTT`: up-buffer 0's write, read, flags
+const RTT_READ = 40;
+const RTT_FLAGS = 44;
+const RTT_BUFFER = 28;
+const RTT_SIZE = 32;
+const RTT_BLOCK_IF_FULL = 2; // what a debugger sets, so that no log byte is dropped
+
+const image = readFileSync(cfg.flash);
+const started = Date.now();
+let out = '';
+const emit = (event) => {
+  out += JSON.stringify(event) + '\n';
+  if (out.length > 1 << 16) flush();
+};
+const flush = () => {
+  if (out) process.stdout.write(out);
+  out = '';
+};
+
+let mcu; // the current boot's chip
+let boot = -1;
+let bootNs = 0; // virtual time at which the current boot started
+let lastActivity = 0; // virtual time of the last log byte or pin edge
+let instructions = 0;
+let watchdogFired = null; // {reason, scratch} once the watchdog fires in this boot
+let stop = null; // why the run ends, once it does
+const level = new Map(cfg.pins.map((pin) => [pin, false]));
+const now = () => bootNs + mcu.clock.nanos;
+
+// A fresh chip, as after power-on or a watchdog reset. The watchdog's REASON
+// and SCRATCH registers survive a watchdog reset; SRAM keeps its contents.
+function powerUp(kept) {
+  const chip = new RP2040();
+  chip.logger = {
+    debug() {},
+    info() {},
+    warn: (name, msg) => emit({ ev: 'emu', level: 'warn', msg: `[${name}] ${msg}` }),
+    error: (name, msg) => emit({ ev: 'emu', level: 'error', msg: `[${name}] ${msg}` }),
+  };
+  chip.onBreak = (code) => {
+    emit({ ev: 'emu', level: 'error', msg: `breakpoint ${code} at ${hex(chip.core.PC)}` });
+    stop = 'break';
+  };
+  chip.flash.set(image);
+  const watchdog = chip.peripherals[WATCHDOG_BASE];
+  if (kept) {
+    chip.sram.set(kept.sram);
+    watchdog.reason = kept.reason;
+    watchdog.scratchData.set(kept.scratch);
+  }
+  // rp2040js leaves the reset to its user. Its watchdog alarm re-arms itself
+  // for the same instant once the counter is at 0, so stop the counter first.
+  watchdog.onWatchdogTrigger = () => {
+    watchdogFired = { reason: watchdog.reason, scratch: watchdog.scratchData.slice() };
+    watchdog.alarm.enable = false;
+    watchdog.timer.enable = false;
+    chip.clock.nextAlarm = null; // the chip is about to be reset: nothing more fires
+  };
+  for (const pin of cfg.pins) {
+    chip.gpio[pin].addListener((state) => edge(pin, state === 1));
+  }
+  for (const slice of cfg.slices) {
+    const channel = chip.pwm.channels[slice];
+    const write = channel.writeRegister.bind(channel);
+    channel.writeRegister = (offset, value) => {
+      const on = channel.csr & 1;
+      write(offset, value);
+      if (offset === 0x0c) emit({ ev: 'cc', slice, value: value >>> 0, ns: now() });
+      if (offset === 0x00 && (channel.csr & 1) !== on) {
+        emit({ ev: 'en', slice, on: !on, ns: now() });
+        // On the chip a channel's output is high while the counter is below
+        // the compare value, also right after the enable; rp2040js only
+        // raises it at the first wrap. Set it here as the chip does (the
+        // compare alarm lowers it as usual).
+        if (!on) channel.setA(channel.timer.counter < channel.alarmA.target);
+      }
+    };
+  }
+  chip.core.VTOR = cfg.vtor;
+  chip.core.reset(); // SP and PC from the vector table, as boot2 hands over
+  return chip;
+}
+
+function edge(pin, high, reset = false) {
+  if (level.get(pin) === high) return;
+  level.set(pin, high);
+  lastActivity = now();
+  emit(reset ? { ev: 'edge', pin, high, ns: lastActivity, reset } : { ev: 'edge', pin, high, ns: lastActivity });
+}
+
+function drainRtt() {
+  const base = cfg.rtt - RAM_START;
+  const view = mcu.sramView;
+  const flags = view.getUint32(base + RTT_FLAGS, true);
+  if ((flags & 3) !== RTT_BLOCK_IF_FULL) {
+    view.setUint32(base + RTT_FLAGS, (flags & ~3) | RTT_BLOCK_IF_FULL, true);
+  }
+  const write = view.getUint32(base + RTT_WRITE, true);
+  let read = view.getUint32(base + RTT_READ, true);
+  if (write === read) return;
+  const buffer = view.getUint32(base + RTT_BUFFER, true) - RAM_START;
+  const size = view.getUint32(base + RTT_SIZE, true);
+  if (buffer < 0 || buffer + size > mcu.sram.length || write >= size || read >= size) return;
+  if (rtt.bytes.length === 0) rtt.ns = now();
+  while (read !== write) {
+    rtt.bytes.push(mcu.sram[buffer + read]);
+    read = (read + 1) % size;
+  }
+  view.setUint32(base + RTT_READ, read, true);
+  lastActivity = now();
+}
+
+// Log bytes go out in batches, stamped with the time of the first.
+const rtt = { bytes: [], ns: 0 };
+function flushRtt() {
+  if (rtt.bytes.length === 0) return;
+  emit({ ev: 'rtt', ns: rtt.ns, hex: Buffer.from(rtt.bytes).toString('hex') });
+  rtt.bytes = [];
+}
+
+// The lowest word of the stack region that no longer holds the paint.
+function stackLow() {
+  const [low, high] = cfg.stack;
+  for (let a = low; a < high; a += 4) {
+    if (mcu.sramView.getUint32(a - RAM_START, true) !== cfg.paint >>> 0) return a;
+  }
+  return high;
+}
+
+function hex(n) {
+  return '0x' + (n >>> 0).toString(16);
+}
+
+function startBoot(kept) {
+  if (mcu) bootNs += mcu.clock.nanos;
+  boot += 1;
+  mcu = powerUp(kept);
+  watchdogFired = null;
+  emit({ ev: 'boot', n: boot, ns: bootNs });
+  for (const pin of cfg.pins) edge(pin, false, true); // a reset releases the pins: low
+}
+
+function endBoot() {
+  if (cfg.stack) emit({ ev: 'stack', n: boot, low: stackLow() });
+}
+
+function run() {
+  startBoot(null);
+  let call = null; // {ret, cycles} while the probed function runs
+  while (!stop) {
+    const { core, clock } = mcu;
+    for (let i = 0; i < 4096 && !stop && !watchdogFired; i++) {
+      if (core.waiting) {
+        const wait = clock.nanosToNextAlarm;
+        if (wait <= 0) {
+          stop = 'asleep';
+          break;
+        }
+        clock.tick(wait);
+        continue;
+      }
+      const pc = core.PC;
+      if (pc === cfg.probe && call === null) call = { ret: core.LR & ~1, cycles: core.cycles };
+      else if (call !== null && pc === call.ret) {
+        emit({ ev: 'call', cycles: core.cycles - call.cycles, ns: now() });
+        call = null;
+      }
+      const cycles = core.executeInstruction();
+      instructions++;
+      clock.tick(cycles * NS_PER_CYCLE);
+      // rp2040js treats SEV as a no-op; on one core it sets the core's own
+      // event register, so that the next WFE returns at once.
+      const inFlash = pc >= FLASH_START && pc < RAM_START;
+      const opcode = inFlash ? mcu.flash16[(pc - FLASH_START) >>> 1] : mcu.readUint16(pc);
+      if (opcode === OP_SEV) core.eventRegistered = true;
+      if ((i & 63) === 0 && cfg.rtt) drainRtt();
+    }
+    if (cfg.rtt) drainRtt();
+    flushRtt();
+    if (watchdogFired) {
+      emit({ ev: 'watchdog', ns: now(), reason: watchdogFired.reason });
+      endBoot();
+      const kept = { sram: mcu.sram.slice(), reason: watchdogFired.reason, scratch: watchdogFired.scratch };
+      call = null;
+      startBoot(kept);
+      continue;
+    }
+    if (stop) break;
+    if (now() >= cfg.ns) stop = 'time';
+    else if (now() - lastActivity > cfg.silence_ns) stop = 'silent';
+    else if (Date.now() - started > cfg.wall_ms) stop = 'wall';
+  }
+  endBoot();
+  emit({ ev: 'end', why: stop, ns: now(), instructions, wall_ms: Date.now() - started });
+  flush();
+}
+
+try {
+  run();
+} catch (error) {
+  emit({ ev: 'end', why: 'error', msg: String(error?.stack ?? error), ns: mcu ? now() : 0, instructions, wall_ms: Date.now() - started });
+  flush();
+  process.exitCode = 1;
+}

@@ -1,0 +1,226 @@
+//! Gaze: where the head's centre is (pitch and yaw), moved by `look` and
+//! `center` along minimum-jerk glides ([`super::glide`]).
+//!
+//! # Durations
+//!
+//! A move takes `base + per_degree · d` (default 300 ms + 8 ms per degree),
+//! `d` the larger of its pitch and yaw distances in degrees, unless a
+//! duration is given. Either way it is lengthened, if need be, until the
+//! profile's peaks fit the axes' gesture limits: a minimum-jerk move of `D`
+//! in `T` peaks at `1.875·D/T` and `5.774·D/T²`. (The default rule never
+//! needs it: its speed stays below 1.875 / 8 ms = 234 °/s and its
+//! acceleration peaks at 601 °/s² for a 37.5° move.)
+//!
+//! # Targets and holds
+//!
+//! Targets are axis angles, like the servo limits; the neutral pose is the
+//! centre. A target outside an axis' limits is clamped to them and the
+//! answer says so. After arriving the head stays for the hold time (default
+//! 3 s), then returns to the centre with the rule's duration, or stays until
+//! told (`hold=stay`). The return is planned when the look is applied, so the
+//! frame path never divides.
+
+use crate::axis::Axis;
+use crate::command::{Hold, LookRequest};
+use crate::units::{Angle, Millis};
+
+use super::config::{BehaviourParams, LimitMode, MAX_HOLD};
+use super::error::BehaviourError;
+use super::glide::{Glide, State};
+
+/// The axes a look moves, in `Gaze`'s order.
+pub(crate) const AXES: [Axis; 2] = [Axis::Pitch, Axis::Yaw];
+
+/// What a look did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LookApplied {
+    /// The target pitch, after clamping.
+    pub pitch: Angle,
+    /// The target yaw, after clamping.
+    pub yaw: Angle,
+    /// Whether the target was clamped to the limits.
+    pub clamped: bool,
+    /// The move's duration.
+    pub duration: Millis,
+    /// What the head does once there.
+    pub hold: Hold,
+}
+
+/// The gaze's centre: a glide per axis and, maybe, the return planned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Gaze {
+    axes: [Glide; 2],
+    back: Option<[Glide; 2]>,
+}
+
+impl Gaze {
+    /// At the centre, at rest.
+    pub(crate) const fn new() -> Self {
+        Self {
+            axes: [Glide::rest(0); 2],
+            back: None,
+        }
+    }
+
+    /// The centre's offsets `[pitch, yaw]` (m°) at frame `now`.
+    #[inline]
+    pub(crate) fn at(&mut self, now: u32) -> [i32; 2] {
+        if self.returns_by(now)
+            && let Some(back) = self.back.take()
+        {
+            self.axes = back;
+        }
+        let [pitch, yaw] = &mut self.axes;
+        [pitch.at(now), yaw.at(now)]
+    }
+
+    /// Whether the planned return starts at or before frame `frame`.
+    pub(crate) fn returns_by(&self, frame: u32) -> bool {
+        self.back
+            .as_ref()
+            .is_some_and(|back| frame.wrapping_sub(back[0].start) as i32 >= 0)
+    }
+
+    /// Whether a return is planned.
+    pub(crate) const fn pending(&self) -> bool {
+        self.back.is_some()
+    }
+
+    /// Whether each axis `[pitch, yaw]` is moving (as of the last `at`).
+    pub(crate) const fn moving(&self) -> [bool; 2] {
+        [self.axes[0].moving(), self.axes[1].moving()]
+    }
+
+    /// Starts a look at frame `next`.
+    pub(crate) fn look(
+        &mut self,
+        params: &BehaviourParams,
+        next: u32,
+        request: &LookRequest,
+    ) -> Result<LookApplied, BehaviourError> {
+        let hold = request.hold.unwrap_or(params.config().gaze.hold);
+        if let Hold::Return(ms) = hold
+            && ms > MAX_HOLD
+        {
+            return Err(BehaviourError::Duration {
+                field: "look hold",
+                duration: ms,
+                min: Millis(0),
+                max: MAX_HOLD,
+            });
+        }
+        check_duration(params, "look duration", request.duration)?;
+        let pose = params.neutral_pose();
+        let mut clamped = false;
+        let targets = [request.pitch, request.yaw];
+        let offsets: [i32; 2] = core::array::from_fn(|i| {
+            let (axis, target) = (AXES[i], targets[i]);
+            let room = params.room(axis);
+            let offset = target.saturating_sub(pose[axis.index()]);
+            let inside = offset.clamp_to(room.min, room.max);
+            clamped |= inside != offset;
+            inside.millidegrees()
+        });
+        let frames = self.move_to(params, next, offsets, request.duration);
+        self.back = match hold {
+            Hold::Stay => None,
+            Hold::Return(ms) => {
+                let at = next
+                    .wrapping_add(frames)
+                    .wrapping_add(params.frames(ms).max(1));
+                let back_frames = duration(params, offsets.map(i32::unsigned_abs), None);
+                Some(offsets.map(|o| Glide::new(at, State::rest(o), 0, back_frames)))
+            }
+        };
+        let absolute =
+            |i: usize| Angle::from_millidegrees(offsets[i]).saturating_add(pose[AXES[i].index()]);
+        Ok(LookApplied {
+            pitch: absolute(0),
+            yaw: absolute(1),
+            clamped,
+            duration: params.millis(frames),
+            hold,
+        })
+    }
+
+    /// Starts a move back to the centre at frame `next`; returns its duration.
+    pub(crate) fn center(
+        &mut self,
+        params: &BehaviourParams,
+        next: u32,
+        given: Option<Millis>,
+    ) -> Result<Millis, BehaviourError> {
+        check_duration(params, "center duration", given)?;
+        let frames = self.move_to(params, next, [0, 0], given);
+        self.back = None;
+        Ok(params.millis(frames))
+    }
+
+    /// Glides both axes from where they are at `next` to `offsets`; returns
+    /// the duration in frames.
+    fn move_to(
+        &mut self,
+        params: &BehaviourParams,
+        next: u32,
+        offsets: [i32; 2],
+        given: Option<Millis>,
+    ) -> u32 {
+        // A return that was due by `next` is under way: start from it.
+        let _ = self.at(next);
+        let from = self.axes.map(|g| g.state(next));
+        let distance: [u32; 2] = core::array::from_fn(|i| offsets[i].abs_diff(from[i].pos));
+        let frames = duration(params, distance, given);
+        self.axes = core::array::from_fn(|i| Glide::new(next, from[i], offsets[i], frames));
+        frames
+    }
+}
+
+/// A given duration must lie in `1..=gaze.longest`.
+fn check_duration(
+    params: &BehaviourParams,
+    field: &'static str,
+    given: Option<Millis>,
+) -> Result<(), BehaviourError> {
+    let longest = params.config().gaze.longest;
+    match given {
+        Some(ms) if ms.0 == 0 || ms > longest => Err(BehaviourError::Duration {
+            field,
+            duration: ms,
+            min: Millis(1),
+            max: longest,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// Frames of a move of `distance` (m°, `[pitch, yaw]`): the given duration or
+/// the rule's, lengthened until it fits the gesture limits.
+fn duration(params: &BehaviourParams, distance: [u32; 2], given: Option<Millis>) -> u32 {
+    let gaze = params.config().gaze;
+    let far = u64::from(distance[0].max(distance[1]));
+    let mut ms = match given {
+        Some(ms) => u64::from(ms.0),
+        None => u64::from(gaze.base.0) + (u64::from(gaze.per_degree.0) * far).div_ceil(1000),
+    };
+    for (i, axis) in AXES.iter().enumerate() {
+        let d = u64::from(distance[i]);
+        let limits = params.limits(*axis, LimitMode::Gesture);
+        let speed = u64::from(limits.max_speed.0.max(1));
+        let accel = u64::from(limits.max_accel.0.max(1));
+        // T ≥ 1.875·D/v and T² ≥ 5.774·D/a (D in m°, T in ms).
+        ms = ms.max((1875 * d).div_ceil(1000 * speed));
+        let squared = (57_735 * d).div_ceil(10 * accel);
+        let root = squared.isqrt();
+        ms = ms.max(if root * root < squared {
+            root + 1
+        } else {
+            root
+        });
+    }
+    // Whole frames, rounded up: never faster than the limits allow.
+    let frame_us = u64::from(params.frame_us().max(1));
+    u32::try_from((ms * 1000).div_ceil(frame_us))
+        .unwrap_or(u32::MAX)
+        .max(2)
+}

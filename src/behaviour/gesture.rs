@@ -1,0 +1,410 @@
+//! Gesture shapes: nod (pitch), shake (yaw), tilt (roll).
+//!
+//! # The shape
+//!
+//! A gesture of amplitude `A`, `n` cycles and duration `D` adds to its axis
+//!
+//! ```text
+//! g(t) = E(φ) · A(φ) · c(φ),      φ = n·t/D ∈ [0, n]  (cycle position)
+//! ```
+//!
+//! - **Carrier** `c`: nod `(1 − cos 2πφ)/2` (each cycle dips towards
+//!   positive pitch and comes back up: a cycle is a down and an up movement
+//!   and its magnitude is the dip, as Mori, Den & Jokinen measure nods);
+//!   shake `sin 2πφ` (to either side of the centre); tilt `1` (a posture).
+//! - **Envelope** `E`: a smootherstep `S(x) = 6x⁵ − 15x⁴ + 10x³` over the
+//!   first and the last half cycle (tilt: third), 1 between. `S` has zero
+//!   first and second derivatives at both ends, so the layer comes in and
+//!   goes out with angle, velocity and acceleration continuous (C2). The
+//!   nod's first downstroke is its ramp and still reaches the full first dip
+//!   at `φ = ½`.
+//! - **Profile** `A(φ)`, for `n ≥ 2`, after the structure Mori, Den & Jokinen
+//!   found in conversational nods (*Structure of nods in conversation*, PLOS
+//!   One 2025, e0323448), applied to shakes too:
+//!   - *declination*: `A(φ) = A·(1 − (φ − ½)/(4n))`, the cycle at position
+//!     `k` peaks at `A·(1 − k/(4n))`, a quarter less over the gesture;
+//!   - *final lowering*: the last cycle is 0.6 times that trend (a
+//!     smootherstep from the middle of the second-last cycle to the middle of
+//!     the last);
+//!   - *anticipatory rising*: a **default** amplitude grows with the number
+//!     of cycles, `× (1 + (n − 1)/20)` up to `× 1.25`; an amplitude that is
+//!     asked for is the first cycle's peak as asked.
+//!
+//!   A default 3-cycle nod dips 1.0, 0.92 and 0.5 times its first peak; a
+//!   2-cycle nod 1.0 and 0.53.
+//! - **Tilt**: up over the first third along `S`, held, down over the last
+//!   third; the amplitude's sign chooses the side.
+//!
+//! # Tempo and intensity
+//!
+//! Fast listener nods run at 2.6–6.5 Hz (Hale et al., *Are you on my
+//! wavelength?*, J. Nonverbal Behav. 2020). The intensity `p` (0–100 %)
+//! sets the cycle frequency `f = slow + (brisk − slow)·p/100` (default nod
+//! 1.5–3.5 Hz, shake 1.2–2.5 Hz; a tilt's "cycle" is its duration, 2.5–1 s)
+//! and scales a default amplitude by `0.75 + p/200` (0.75 to 1.25).
+//! Duration and cycles: both given, as given; only cycles, `n/f`; only a
+//! duration, `round(D·f)` cycles (at least 1); neither, the default cycles
+//! at `f`.
+//!
+//! **Frequency cap** (`max_frequency`, default 4 Hz, at most an eighth of
+//! the frame rate): at 50 Hz a 4 Hz cycle is drawn by 12.5 frames; fewer and
+//! the cycle shows its frame steps. And a hobby servo (about 0.1 s per 60°
+//! plus the lag of its position loop) cannot follow a few-degree
+//! oscillation much faster: beyond a few hertz a nod blurs into a shiver of
+//! reduced amplitude. Cycles faster than the cap are refused
+//! ([`BehaviourError::TooFrequent`]).
+//!
+//! **Speed check.** The shape's peak speed and acceleration are at most
+//! `Kv·ω·a` and `Ka·ω²·a` (`ω = 2πf`; `a = A/2` for the nod's carrier, `A`
+//! otherwise) with `(Kv, Ka)` = (1.45, 1.85) for nods, (1.05, 1.65) for
+//! shakes and (0.9, 1.32) for tilts: measured on the continuous shape over
+//! 1 to 32 cycles and rounded up (the envelope's ramps make the first and the
+//! last half cycle steeper than the bare carrier). A gesture whose bound
+//! exceeds its axis' gesture limits is refused ([`BehaviourError::TooFast`],
+//! [`BehaviourError::TooBrisk`]), so the limiter never flattens one that
+//! plays.
+//!
+//! # Fixed point
+//!
+//! Per frame: `u = t/D` in Q16 from a reciprocal computed when the gesture
+//! starts, `φ = n·u`, the carrier from `idsp::cossin` (32-bit phase
+//! `frac(φ)·2³²`), envelope and profile in Q16: a handful of 32-bit
+//! multiplies, no division.
+
+use crate::command::{GestureKind, GestureRequest, Percent};
+use crate::driver::{DegreesPerSecond, DegreesPerSecondSquared};
+use crate::units::{Angle, AngleRange, Millis};
+
+use super::config::{BehaviourParams, LimitMode, MAX_CYCLES};
+use super::error::BehaviourError;
+use super::fixed::{ONE, inverse, mul, mul_signed, progress, smootherstep};
+
+/// Final lowering: the last cycle loses 0.4 of the trend (Q16).
+const LOWERING: u32 = ONE * 2 / 5;
+
+/// `(Kv, Ka)` of each shape in thousandths (see the module docs).
+const fn peak_factors(kind: GestureKind) -> (u64, u64) {
+    match kind {
+        GestureKind::Nod => (1450, 1850),
+        GestureKind::Shake => (1050, 1650),
+        GestureKind::Tilt => (900, 1320),
+    }
+}
+
+/// A gesture as it plays: what was asked for, resolved, and the constants
+/// of its frame path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GesturePlan {
+    /// Which gesture.
+    pub kind: GestureKind,
+    /// Peak of the first cycle.
+    pub amplitude: Angle,
+    /// Cycles.
+    pub cycles: u8,
+    /// Duration, as played (whole frames).
+    pub duration: Millis,
+    /// Intensity.
+    pub intensity: Percent,
+    /// Frames.
+    pub(crate) frames: u32,
+    inverse: u32,
+    /// Profile at `u = 0` and its fall over the gesture (m°).
+    start: i32,
+    fall: i32,
+    /// Where the final lowering starts (Q16 cycles; `u32::MAX`: none).
+    lower_from: u32,
+    /// 1 / the envelope's ramp in cycles.
+    ramp: u32,
+}
+
+/// Resolves `request` against the defaults and checks it.
+///
+/// # Errors
+/// The first problem found, as a [`BehaviourError`].
+pub(crate) const fn plan(
+    params: &BehaviourParams,
+    request: &GestureRequest,
+) -> Result<GesturePlan, BehaviourError> {
+    let kind = request.kind;
+    let intensity = match request.intensity {
+        Some(p) => p,
+        None => params.config().defaults(kind).intensity,
+    };
+    let (cycles, duration_ms) = match tempo(params, request, intensity) {
+        Ok(t) => t,
+        Err(e) => return Err(e),
+    };
+    let a = match amplitude(params, request, intensity, cycles) {
+        Ok(a) => a,
+        Err(e) => return Err(e),
+    };
+    if let Err(e) = check_peaks(params, kind, a, cycles, duration_ms) {
+        return Err(e);
+    }
+    let frames = params.frames(Millis(duration_ms as u32));
+    let frames = if frames < 2 { 2 } else { frames };
+    // Declination A·(1 − (φ − ½)/(4n)) = A·(1 + 1/(8n)) − (A/4)·u.
+    let (start, fall, lower_from) = if cycles >= 2 {
+        let den = 8 * cycles as i64;
+        let eighth = (a as i64 + (a as i64).signum() * den / 2) / den;
+        (
+            a.saturating_add(eighth as i32),
+            a / 4,
+            (cycles as u32) * ONE - ONE * 3 / 2,
+        )
+    } else {
+        (a, 0, u32::MAX)
+    };
+    Ok(GesturePlan {
+        kind,
+        amplitude: Angle::from_millidegrees(a),
+        cycles: cycles as u8,
+        duration: params.millis(frames),
+        intensity,
+        frames,
+        inverse: inverse(frames),
+        start,
+        fall,
+        lower_from,
+        ramp: match kind {
+            GestureKind::Nod | GestureKind::Shake => 2,
+            GestureKind::Tilt => 3,
+        },
+    })
+}
+
+/// Cycles and duration (ms) of `request` at `intensity`.
+const fn tempo(
+    params: &BehaviourParams,
+    request: &GestureRequest,
+    intensity: Percent,
+) -> Result<(u64, u64), BehaviourError> {
+    let kind = request.kind;
+    let config = params.config();
+    let d = config.defaults(kind);
+    let p = intensity.get() as u64;
+    let f_mhz = d.slow.0 as u64 + (d.brisk.0 as u64).saturating_sub(d.slow.0 as u64) * p / 100;
+    let f_mhz = if f_mhz == 0 { 1 } else { f_mhz };
+    let field = match kind {
+        GestureKind::Nod => "nod duration",
+        GestureKind::Shake => "shake duration",
+        GestureKind::Tilt => "tilt duration",
+    };
+    let longest = config.longest_gesture;
+    let asked = match (kind, request.cycles) {
+        (GestureKind::Tilt, Some(c)) if c != 1 => {
+            return Err(BehaviourError::TiltCycles { cycles: c });
+        }
+        (GestureKind::Tilt, _) => Some(1),
+        (_, Some(c)) if c == 0 || c > MAX_CYCLES => {
+            return Err(BehaviourError::Cycles {
+                kind,
+                cycles: c,
+                max: MAX_CYCLES,
+            });
+        }
+        (_, c) => c,
+    };
+    let (cycles, ms) = if let Some(duration) = request.duration {
+        if duration.0 == 0 || duration.0 > longest.0 {
+            return Err(too_long(field, duration.0 as u64, longest));
+        }
+        let n = if let Some(n) = asked {
+            n as u64
+        } else {
+            let n = (duration.0 as u64 * f_mhz + 500_000) / 1_000_000;
+            if n == 0 {
+                1
+            } else if n > MAX_CYCLES as u64 {
+                MAX_CYCLES as u64
+            } else {
+                n
+            }
+        };
+        (n, duration.0 as u64)
+    } else {
+        let n = if let Some(n) = asked {
+            n as u64
+        } else {
+            d.cycles as u64
+        };
+        let ms = (n * 1_000_000 + f_mhz / 2) / f_mhz;
+        if ms > longest.0 as u64 {
+            return Err(too_long(field, ms, longest));
+        }
+        (n, ms)
+    };
+    // n cycles in D ms at most at the cap: n·10⁶ ≤ cap·D.
+    if cycles * 1_000_000 > config.max_frequency.0 as u64 * ms {
+        return Err(BehaviourError::TooFrequent {
+            kind,
+            cycles: cycles as u8,
+            duration: Millis(ms as u32),
+            max: config.max_frequency,
+        });
+    }
+    Ok((cycles, ms))
+}
+
+/// The first cycle's peak (m°): as asked, or the default at `intensity`
+/// rising with `cycles`; checked against the axis' room.
+const fn amplitude(
+    params: &BehaviourParams,
+    request: &GestureRequest,
+    intensity: Percent,
+    cycles: u64,
+) -> Result<i32, BehaviourError> {
+    let kind = request.kind;
+    let amplitude = if let Some(a) = request.amplitude {
+        a.millidegrees() as i64
+    } else {
+        // × (0.75 + p/200) × (1 + (min(n, 6) − 1)/20), rounded.
+        let d = params.config().defaults(kind);
+        let rising = if cycles > 6 { 6 } else { cycles };
+        let num = d.amplitude.millidegrees() as i64
+            * (150 + intensity.get() as i64)
+            * (19 + rising as i64);
+        let den = 200 * 20;
+        (num + num.signum() * den / 2) / den
+    };
+    let room = params.room(kind.axis());
+    let allowed = match kind {
+        GestureKind::Nod => AngleRange {
+            min: Angle::from_millidegrees(1),
+            max: room.max,
+        },
+        GestureKind::Shake => {
+            // Both sides: the nearer limit.
+            let other = room.min.millidegrees().saturating_neg();
+            AngleRange {
+                min: Angle::from_millidegrees(1),
+                max: if room.max.millidegrees() < other {
+                    room.max
+                } else {
+                    Angle::from_millidegrees(other)
+                },
+            }
+        }
+        GestureKind::Tilt => room,
+    };
+    if amplitude < allowed.min.millidegrees() as i64
+        || amplitude > allowed.max.millidegrees() as i64
+    {
+        return Err(BehaviourError::Amplitude {
+            kind,
+            amplitude: Angle::from_millidegrees(if amplitude < i32::MIN as i64 {
+                i32::MIN
+            } else if amplitude > i32::MAX as i64 {
+                i32::MAX
+            } else {
+                amplitude as i32
+            }),
+            allowed,
+        });
+    }
+    Ok(amplitude as i32)
+}
+
+/// The shape's peak speed and acceleration against the axis' gesture
+/// limits (m°/s, m°/s²; see the module docs).
+const fn check_peaks(
+    params: &BehaviourParams,
+    kind: GestureKind,
+    amplitude: i32,
+    cycles: u64,
+    ms: u64,
+) -> Result<(), BehaviourError> {
+    let axis = kind.axis();
+    let limits = params.limits(axis, LimitMode::Gesture);
+    let (kv, ka) = peak_factors(kind);
+    // The amplitude lies within the axis' room (the driver keeps limits
+    // within ±2¹⁸ m°): capped at 2²⁰, with n ≤ 32 every product fits u64.
+    let carrier = match kind {
+        GestureKind::Nod => amplitude.unsigned_abs() as u64 / 2,
+        GestureKind::Shake | GestureKind::Tilt => amplitude.unsigned_abs() as u64,
+    };
+    let carrier = if carrier > 1 << 20 { 1 << 20 } else { carrier };
+    let (n, ms) = (cycles, if ms == 0 { 1 } else { ms });
+    // Kv·a·2π·n/D with 2π·1000 = 6283; Ka·a·(2π·n/D)² with 4π²·1000 = 39 478.
+    let speed = (kv * carrier * 6283 * n).div_ceil(1000 * ms);
+    let accel = (ka * carrier * 39_478 * n * n).div_ceil(ms.saturating_mul(ms));
+    if speed > limits.max_speed.0 as u64 * 1000 {
+        return Err(BehaviourError::TooFast {
+            kind,
+            axis,
+            needed: DegreesPerSecond(clamp_u32(speed.div_ceil(1000))),
+            max: limits.max_speed,
+        });
+    }
+    if accel > limits.max_accel.0 as u64 * 1000 {
+        return Err(BehaviourError::TooBrisk {
+            kind,
+            axis,
+            needed: DegreesPerSecondSquared(clamp_u32(accel.div_ceil(1000))),
+            max: limits.max_accel,
+        });
+    }
+    Ok(())
+}
+
+/// A duration outside `1..=longest`.
+const fn too_long(field: &'static str, ms: u64, longest: Millis) -> BehaviourError {
+    BehaviourError::Duration {
+        field,
+        duration: Millis(clamp_u32(ms)),
+        min: Millis(1),
+        max: longest,
+    }
+}
+
+const fn clamp_u32(v: u64) -> u32 {
+    if v > u32::MAX as u64 {
+        u32::MAX
+    } else {
+        v as u32
+    }
+}
+
+impl GesturePlan {
+    /// The layer at `t` frames after the start: its offset (m°) and its
+    /// envelope `E` (Q16), or `None` once it has ended.
+    #[inline]
+    pub(crate) fn at(&self, t: u32) -> Option<(i32, u32)> {
+        if t >= self.frames {
+            return None;
+        }
+        let u = progress(t, self.inverse);
+        let n = self.cycles as u32;
+        // φ < n: u < 1.
+        let phi = n * u;
+        let tail = n * ONE - phi;
+        let envelope = if phi * self.ramp < ONE {
+            smootherstep(phi * self.ramp)
+        } else if tail * self.ramp < ONE {
+            smootherstep(tail * self.ramp)
+        } else {
+            ONE
+        };
+        let mut amplitude = self.start - mul(self.fall, u);
+        if phi > self.lower_from {
+            let lowering = mul(LOWERING as i32, smootherstep(phi - self.lower_from));
+            amplitude -= mul(amplitude, lowering as u32);
+        }
+        let scaled = mul(amplitude, envelope);
+        let value = match self.kind {
+            GestureKind::Tilt => scaled,
+            GestureKind::Nod | GestureKind::Shake => {
+                // frac(φ) as a 32-bit phase (2³² = one turn).
+                let (cos, sin) = idsp::cossin((phi << 16) as i32);
+                if self.kind == GestureKind::Nod {
+                    // (1 − cos)/2 in Q16: cos in Q31 → Q17 halves it.
+                    mul(scaled, (ONE as i32 - (cos >> 15)) as u32 >> 1)
+                } else {
+                    mul_signed(scaled, sin >> 15)
+                }
+            }
+        };
+        Some((value, envelope))
+    }
+}

@@ -1,0 +1,163 @@
+//! Minimum-jerk moves that start from any state: the gaze's centre and the
+//! idle gain.
+//!
+//! From rest, a move of distance `D` over `T` is the minimum-jerk profile
+//! `p(τ) = p₀ + D·(10τ³ − 15τ⁴ + 6τ⁵)`, `τ = t/T`. A new move that starts
+//! while another one plays starts from where the value is *and* from its
+//! velocity and acceleration, so neither jumps: the quintic with those ends
+//! (position `p₀`, velocity `v`, acceleration `a` at `τ = 0`, in units of the
+//! move: `v = dp/dτ`, `a = d²p/dτ²`; the target at rest at `τ = 1`), which
+//! is the minimum-jerk path between those states.
+//!
+//! Written around the target, with `s = 1 − τ`, it reads
+//!
+//! ```text
+//! p = target − s³·(r₀ + r₁·s + r₂·s²)
+//! r₀ = 10D − 4v − a/2,   r₁ = −15D + 7v + a,   r₂ = 6D − 3v − a/2
+//! ```
+//!
+//! (at `s = 1`: `r₀ + r₁ + r₂ = D`, `h′ = 3r₀ + 4r₁ + 5r₂ = v`,
+//! `−h″ = −(6r₀ + 12r₁ + 20r₂) = a`; from rest this is the profile above).
+//! Per frame: `s` in Q16 from a precomputed reciprocal and five rounded
+//! Q16 multiplies (Horner for the quadratic, then `· s` three times): within
+//! 2.5 m° of the polynomial whatever the distance, and the start and the end
+//! are exact.
+
+use super::fixed::{MAX_FRAMES, ONE, inverse, mul, progress};
+
+/// Where a value is and how it moves, at one frame: the position and the
+/// first two derivatives in units of the move it comes from (`dp/dτ`,
+/// `d²p/dτ²` over that move's `frames`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct State {
+    /// The value (as the frame path computes it).
+    pub(crate) pos: i32,
+    slope: i64,
+    curve: i64,
+    frames: u32,
+}
+
+impl State {
+    /// At rest at `pos`.
+    pub(crate) const fn rest(pos: i32) -> Self {
+        Self {
+            pos,
+            slope: 0,
+            curve: 0,
+            frames: 1,
+        }
+    }
+}
+
+/// Bound of the coefficients: sums of two stay inside `i32`.
+const BOUND: i64 = 1 << 29;
+/// Velocities and accelerations beyond this give coefficients past the bound.
+const FAR: i64 = 1 << 40;
+
+/// One value moving to a target; see the [module docs](self).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct Glide {
+    /// Frame of `τ = 0`.
+    pub(crate) start: u32,
+    /// `T` in frames; 0 once arrived.
+    frames: u32,
+    inverse: u32,
+    target: i32,
+    r: [i32; 3],
+}
+
+impl Glide {
+    /// At rest at `value`.
+    pub(crate) const fn rest(value: i32) -> Self {
+        Self {
+            start: 0,
+            frames: 0,
+            inverse: 0,
+            target: value,
+            r: [0; 3],
+        }
+    }
+
+    /// A move from `from` at frame `start` to `target`, arriving `frames`
+    /// frames later (`2..=MAX_FRAMES`).
+    pub(crate) fn new(start: u32, from: State, target: i32, frames: u32) -> Self {
+        let frames = frames.clamp(2, MAX_FRAMES);
+        let (span, old) = (i64::from(frames), i64::from(from.frames.max(1)));
+        let dist = i64::from(target) - i64::from(from.pos);
+        // Velocity and acceleration in units of this move (saturating: a
+        // coefficient past the bound is clamped anyway).
+        let vel = from.slope.saturating_mul(span) / old;
+        let acc = (from.curve.saturating_mul(span) / old).saturating_mul(span) / old;
+        // Far past the bound either way; below it the sums stay exact.
+        let (vel, acc) = (vel.clamp(-FAR, FAR), acc.clamp(-FAR, FAR));
+        let r = [
+            10 * dist - 4 * vel - acc / 2,
+            -15 * dist + 7 * vel + acc,
+            6 * dist - 3 * vel - acc / 2,
+        ]
+        .map(|c| c.clamp(-BOUND, BOUND) as i32);
+        Self {
+            start,
+            frames,
+            inverse: inverse(frames),
+            target,
+            r,
+        }
+    }
+
+    /// The target.
+    pub(crate) const fn target(&self) -> i32 {
+        self.target
+    }
+
+    /// Whether the move is still under way (as of the last [`at`](Self::at)).
+    pub(crate) const fn moving(&self) -> bool {
+        self.frames != 0
+    }
+
+    /// The value at frame `now` (not before `start`). Once arrived the glide
+    /// rests at its target for good.
+    #[inline]
+    pub(crate) fn at(&mut self, now: u32) -> i32 {
+        let t = now.wrapping_sub(self.start);
+        if t >= self.frames {
+            self.frames = 0;
+            return self.target;
+        }
+        let [r0, r1, r2] = self.r;
+        if t == 0 {
+            return self.target - (r0 + r1 + r2);
+        }
+        // 1 ≤ t < T: 0 < s < 1. Each multiply rounds to the unit: the
+        // value is within 2.5 units of the exact polynomial at this s.
+        let s = ONE - progress(t, self.inverse);
+        let q = mul(mul(r2, s) + r1, s) + r0;
+        self.target - mul(mul(mul(q, s), s), s)
+    }
+
+    /// The state at frame `now`: the position exactly as [`at`](Self::at)
+    /// gives it, velocity and acceleration from the derivatives (for a new
+    /// move to start from).
+    pub(crate) fn state(&self, now: u32) -> State {
+        let mut copy = *self;
+        let pos = copy.at(now);
+        let t = now.wrapping_sub(self.start);
+        if t >= self.frames {
+            return State::rest(pos);
+        }
+        let s = i64::from(ONE - progress(t, self.inverse));
+        let [r0, r1, r2] = self.r.map(i64::from);
+        // Horner in Q16 steps (|r| ≤ 2²⁹: every product below 2⁵²):
+        // h′(s) = s²·(3r₀ + s·(4r₁ + s·5r₂)), h″(s) = s·(6r₀ + s·(12r₁ + s·20r₂)).
+        let q = |x: i64| (x * s) >> 16;
+        let slope = q(q(3 * r0 + q(4 * r1 + q(5 * r2))));
+        let curve = -q(6 * r0 + q(12 * r1 + q(20 * r2)));
+        State {
+            pos,
+            slope,
+            curve,
+            frames: self.frames,
+        }
+    }
+}

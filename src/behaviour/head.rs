@@ -1,0 +1,150 @@
+//! The frame engine: idle source, mixer and frame driver, one call per frame.
+//!
+//! The embassy frame task and the host trace both call [`Head::frame`]
+//! (after [`Head::drain`] for queued commands): the same code, the same
+//! numbers. The driver stays the caller's (the board hooks get it between
+//! frames); the head borrows it for each call.
+//!
+//! Between frames ([`Head::sync`], also part of [`Head::apply`] and
+//! [`Head::drain`]) the head switches each axis' speed and acceleration
+//! limits between the idle mode (the driver's configured limits, which the
+//! parameters were built with) and the gesture mode, as the mixer asks
+//! ([`LimitMode`]): the gesture limits as soon as a motion is applied (or a
+//! planned return is due next frame), the idle limits back once the axis has
+//! settled. Like any change of the driver's limits, a switch is made between
+//! two frames, not during one.
+
+use embedded_hal::pwm::SetDutyCycle;
+
+use crate::axis::Axis;
+use crate::command::Action;
+use crate::driver::{FrameDriver, FrameReport};
+use crate::units::Angle;
+
+use super::config::{BehaviourParams, LimitMode};
+use super::error::BehaviourError;
+use super::idle::IdleSource;
+use super::mixer::{Applied, Mixer};
+use super::queue::{CommandQueue, PER_FRAME};
+
+/// What one frame did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct HeadFrame {
+    /// The mixer's offsets `[pitch, roll, yaw]`: what the driver got.
+    pub offsets: [Angle; 3],
+    /// What the driver wrote.
+    pub report: FrameReport,
+}
+
+/// The frame engine; see the [module docs](self).
+#[derive(Clone, Debug)]
+pub struct Head<I> {
+    idle: I,
+    mixer: Mixer,
+    /// The limit mode the driver has, per axis.
+    modes: [LimitMode; 3],
+}
+
+impl<I> Head<I> {
+    /// A head playing `idle` with the behaviour `params`.
+    pub const fn new(idle: I, params: BehaviourParams) -> Self {
+        Self {
+            idle,
+            mixer: Mixer::new(params),
+            modes: [LimitMode::Idle; 3],
+        }
+    }
+}
+
+impl<I: IdleSource> Head<I> {
+    /// The mixer.
+    pub fn mixer(&self) -> &Mixer {
+        &self.mixer
+    }
+
+    /// The idle source.
+    pub fn idle_mut(&mut self) -> &mut I {
+        &mut self.idle
+    }
+
+    /// Applies `action` from the next frame on. `Stop` fades the driver out;
+    /// a gesture, a look, `idle on` or `idle amp` after a stop fades it in
+    /// again. An axis that starts moving gets its gesture limits at once.
+    ///
+    /// # Errors
+    /// A [`BehaviourError`] for bad parameters; nothing changes then.
+    pub fn apply<P: SetDutyCycle>(
+        &mut self,
+        driver: &mut FrameDriver<P>,
+        action: &Action,
+    ) -> Result<Applied, BehaviourError> {
+        let applied = self.mixer.apply(action)?;
+        match action {
+            Action::Stop => driver.request_stop(),
+            Action::Gesture(_) | Action::Look(_) | Action::Idle(true) | Action::IdleAmp(_) => {
+                driver.resume();
+            }
+            Action::Center { .. } | Action::Idle(false) => {}
+        }
+        self.sync(driver);
+        Ok(applied)
+    }
+
+    /// Between frames: gives the driver the limits of the modes the mixer
+    /// asks for from the next frame on (see the [module docs](self)).
+    pub fn sync<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>) {
+        let wanted = self.mixer.modes();
+        if !LimitMode::same(wanted, self.modes) {
+            self.switch(driver, wanted);
+        }
+    }
+
+    /// Between frames: [`sync`](Self::sync), then up to [`PER_FRAME`]
+    /// queued actions, telling `done` each action and its outcome; returns
+    /// how many.
+    pub fn drain<P: SetDutyCycle, const N: usize>(
+        &mut self,
+        driver: &mut FrameDriver<P>,
+        queue: &CommandQueue<N>,
+        mut done: impl FnMut(&Action, &Result<Applied, BehaviourError>),
+    ) -> usize {
+        self.sync(driver);
+        let mut count = 0;
+        while count < PER_FRAME {
+            let Some(action) = queue.take() else { break };
+            let outcome = self.apply(driver, &action);
+            done(&action, &outcome);
+            count += 1;
+        }
+        count
+    }
+
+    /// Plays frame `frame`: idle offsets, mixed, through `driver` (which
+    /// starts with neutral pulses on its first frame).
+    pub fn frame<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, frame: u64) -> HeadFrame {
+        let idle = self.idle.offsets(frame);
+        let offsets = self.mixer.frame(frame, idle);
+        HeadFrame {
+            offsets,
+            report: driver.write_frame(offsets),
+        }
+    }
+
+    /// Gives the driver the limits of `modes` where they changed. (They were
+    /// validated with the parameters; should the driver refuse them, the
+    /// axis keeps its limits and the switch is tried again next frame.)
+    #[inline(never)]
+    fn switch<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, modes: [LimitMode; 3]) {
+        let params = self.mixer.params();
+        for ((axis, &wanted), mode) in Axis::ALL.iter().zip(&modes).zip(&mut self.modes) {
+            if wanted != *mode
+                && driver
+                    .set_motion_limits(*axis, params.limits(*axis, wanted))
+                    .is_ok()
+            {
+                *mode = wanted;
+            }
+        }
+    }
+}

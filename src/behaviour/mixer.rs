@@ -1,0 +1,334 @@
+//! The one place where the layers meet.
+//!
+//! Per axis and frame:
+//!
+//! ```text
+//! offset = centre + idle · gain · Π(1 − duck·Eᵢ) + Σ gestureᵢ
+//! ```
+//!
+//! - `centre`: the gaze (pitch and yaw; roll stays 0), [`super::gaze`];
+//! - `idle`: the idle source's offset, scaled by the idle gain (`idle on|off`,
+//!   `idle amp`, a minimum-jerk glide over `idle.fade`) and ducked under each
+//!   gesture on the axis by its envelope `Eᵢ` (so the duck is as smooth as the
+//!   gesture's own ramps);
+//! - `gestureᵢ`: up to [`LAYERS`] gesture layers, [`super::gesture`]. A new
+//!   gesture takes a free layer and every older one fades out under it
+//!   along `1 − S(t/blend)` (a smootherstep, C2), still playing: never a jump.
+//!
+//! The mixer also says which limit mode each axis needs from the next frame
+//! on ([`Mixer::modes`]: [`LimitMode::Gesture`] while a gesture or a gaze
+//! move plays on it and for `settle` after).
+
+use crate::command::{Action, GestureRequest, Percent};
+use crate::units::{Angle, Millis};
+
+use super::config::{BehaviourParams, LimitMode};
+use super::error::BehaviourError;
+use super::fixed::{ONE, mul, progress, smootherstep};
+use super::gaze::{Gaze, LookApplied};
+use super::gesture::{self, GesturePlan};
+use super::glide::Glide;
+
+/// Gesture layers: one playing and up to two fading out under it.
+pub const LAYERS: usize = 3;
+
+/// What an action did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Applied {
+    /// A gesture started, as resolved.
+    Gesture(GesturePlan),
+    /// A look started.
+    Look(LookApplied),
+    /// The move back to the centre started; it takes this long.
+    Center(Millis),
+    /// The idle gain glides to this.
+    Idle(Percent),
+    /// Stop: the driver fades everything out (not the mixer's to do).
+    Stop,
+}
+
+/// A gesture layer: its plan, start, and the start of its fade-out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Layer {
+    plan: GesturePlan,
+    start: u32,
+    release: Option<u32>,
+}
+
+/// Idle, gestures and gaze mixed into one set of offsets; see the
+/// [module docs](self).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Mixer {
+    params: BehaviourParams,
+    layers: [Option<Layer>; LAYERS],
+    gaze: Gaze,
+    /// Idle gain, Q16.
+    idle_gain: Glide,
+    idle_on: bool,
+    idle_amp: Percent,
+    /// Frames each axis stays in gesture mode.
+    gesture_left: [u32; 3],
+    /// The limit modes from the next frame on.
+    modes: [LimitMode; 3],
+    /// Nothing moves but the idle, at `rest_gain` around `rest_centre`.
+    quiet: bool,
+    rest_gain: u32,
+    rest_centre: [i32; 2],
+    /// The last frame mixed, and the frame actions start at.
+    now: u32,
+    next: u32,
+}
+
+impl Mixer {
+    /// A mixer at rest: idle at the configured amplitude, centre at the
+    /// neutral pose, no gesture.
+    #[must_use]
+    pub const fn new(params: BehaviourParams) -> Self {
+        let amp = params.config().idle.amplitude;
+        Self {
+            params,
+            layers: [None; LAYERS],
+            gaze: Gaze::new(),
+            idle_gain: Glide::rest(gain_of(amp)),
+            idle_on: true,
+            idle_amp: amp,
+            gesture_left: [0; 3],
+            modes: [LimitMode::Idle; 3],
+            quiet: true,
+            rest_gain: gain_of(amp) as u32,
+            rest_centre: [0; 2],
+            now: 0,
+            next: 0,
+        }
+    }
+
+    /// The parameters in use.
+    #[must_use]
+    pub const fn params(&self) -> &BehaviourParams {
+        &self.params
+    }
+
+    /// Applies `action` from the next frame on.
+    ///
+    /// `Stop` changes nothing here and answers [`Applied::Stop`]: stopping
+    /// is the driver's fade (see [`Head`](super::Head)).
+    ///
+    /// # Errors
+    /// A [`BehaviourError`] for bad parameters (nothing changes then).
+    pub fn apply(&mut self, action: &Action) -> Result<Applied, BehaviourError> {
+        let next = self.next;
+        let applied = match action {
+            Action::Gesture(request) => {
+                let plan = self.gesture(request)?;
+                self.modes[request.kind.axis().index()] = LimitMode::Gesture;
+                Applied::Gesture(plan)
+            }
+            Action::Look(request) => {
+                let applied = self.gaze.look(&self.params, next, request)?;
+                self.gazing();
+                Applied::Look(applied)
+            }
+            Action::Center { duration } => {
+                let applied = self.gaze.center(&self.params, next, *duration)?;
+                self.gazing();
+                Applied::Center(applied)
+            }
+            Action::Idle(on) => {
+                self.idle_on = *on;
+                Applied::Idle(self.glide_idle())
+            }
+            Action::IdleAmp(amp) => {
+                self.idle_amp = *amp;
+                Applied::Idle(self.glide_idle())
+            }
+            Action::Stop => return Ok(Applied::Stop),
+        };
+        self.quiet = false;
+        Ok(applied)
+    }
+
+    /// A gaze move starts: pitch and yaw in gesture mode.
+    fn gazing(&mut self) {
+        for axis in [crate::axis::Axis::Pitch, crate::axis::Axis::Yaw] {
+            if let Some(mode) = self.modes.get_mut(axis.index()) {
+                *mode = LimitMode::Gesture;
+            }
+        }
+    }
+
+    fn gesture(&mut self, request: &GestureRequest) -> Result<GesturePlan, BehaviourError> {
+        let plan = gesture::plan(&self.params, request)?;
+        let next = self.next;
+        let Some(free) = self.layers.iter().position(Option::is_none) else {
+            // Every layer plays: the one that ends first frees first.
+            let blend = self.params.blend;
+            let left = self
+                .layers
+                .iter()
+                .flatten()
+                .map(|l| match l.release {
+                    Some(r) => blend.saturating_sub(next.wrapping_sub(r)),
+                    None => l.plan.frames.saturating_sub(next.wrapping_sub(l.start)),
+                })
+                .min()
+                .unwrap_or(0);
+            // The layer is cleared while mixing the frame it ends at.
+            return Err(BehaviourError::Busy {
+                retry_in: self.params.millis(left + 1),
+            });
+        };
+        for layer in self.layers.iter_mut().flatten() {
+            layer.release.get_or_insert(next);
+        }
+        if let Some(slot) = self.layers.get_mut(free) {
+            *slot = Some(Layer {
+                plan,
+                start: next,
+                release: None,
+            });
+        }
+        Ok(plan)
+    }
+
+    /// Glides the idle gain to its new target; returns the target.
+    fn glide_idle(&mut self) -> Percent {
+        let target = if self.idle_on {
+            self.idle_amp
+        } else {
+            Percent::ZERO
+        };
+        let from = self.idle_gain.state(self.next);
+        self.idle_gain = Glide::new(self.next, from, gain_of(target), self.params.idle_fade);
+        target
+    }
+
+    /// The offsets of frame `frame` for the driver, `[pitch, roll, yaw]`,
+    /// over `idle` (the idle source's offsets of that frame).
+    #[inline]
+    pub fn frame(&mut self, frame: u64, idle: [Angle; 3]) -> [Angle; 3] {
+        let now = frame as u32;
+        if !self.quiet {
+            return self.mix(now, idle);
+        }
+        // Nothing moves but the idle: at its resting gain, around the resting
+        // centre (within the limits: no overflow).
+        self.now = now;
+        self.next = now.wrapping_add(1);
+        let [pitch, roll, yaw] = idle.map(Angle::millidegrees);
+        let [centre_pitch, centre_yaw] = self.rest_centre;
+        let gain = self.rest_gain;
+        let [pitch, roll, yaw] = if gain == ONE {
+            [pitch, roll, yaw]
+        } else {
+            [mul(pitch, gain), mul(roll, gain), mul(yaw, gain)]
+        };
+        [pitch + centre_pitch, roll, yaw + centre_yaw].map(Angle::from_millidegrees)
+    }
+
+    /// [`frame`](Self::frame) while anything but the idle moves.
+    #[inline(never)]
+    fn mix(&mut self, now: u32, idle: [Angle; 3]) -> [Angle; 3] {
+        let elapsed = now.wrapping_sub(self.now).max(1);
+        self.now = now;
+        self.next = now.wrapping_add(1);
+        let mut add = [0_i32; 3];
+        let mut duck = [ONE; 3];
+        let mut active = [false; 3];
+        let params = &self.params;
+        for slot in &mut self.layers {
+            let Some(layer) = slot else { continue };
+            let Some((mut value, mut strength)) = layer.plan.at(now.wrapping_sub(layer.start))
+            else {
+                *slot = None;
+                continue;
+            };
+            if let Some(release) = layer.release {
+                let t = now.wrapping_sub(release);
+                if t >= params.blend {
+                    *slot = None;
+                    continue;
+                }
+                let fade = ONE - smootherstep(progress(t, params.blend_inverse));
+                value = mul(value, fade);
+                strength = mul(strength as i32, fade) as u32;
+            }
+            let i = layer.plan.kind.axis().index();
+            if let (Some(a), Some(d), Some(on)) =
+                (add.get_mut(i), duck.get_mut(i), active.get_mut(i))
+            {
+                *a += value;
+                *d = mul(*d as i32, ONE - mul(params.duck as i32, strength) as u32) as u32;
+                *on = true;
+            }
+        }
+
+        let centre = self.gaze.at(now);
+        let moving = self.gaze.moving();
+        let returning = self.gaze.returns_by(self.next);
+        let gain = if self.idle_gain.moving() {
+            self.idle_gain.at(now).clamp(0, ONE as i32) as u32
+        } else {
+            self.idle_gain.target() as u32
+        };
+        let mut offsets = idle.map(Angle::millidegrees);
+        for ((value, &d), &a) in offsets.iter_mut().zip(&duck).zip(&add) {
+            if gain != ONE {
+                *value = mul(*value, gain);
+            }
+            if d != ONE {
+                *value = mul(*value, d);
+            }
+            // Within the limits: no overflow.
+            *value += a;
+        }
+        offsets[0] += centre[0];
+        offsets[2] += centre[1];
+        active[0] |= moving[0];
+        active[2] |= moving[1];
+
+        // The modes from the next frame on: gesture while anything plays on
+        // the axis (or the return starts) and `settle` after.
+        let soon = [returning, false, returning];
+        for (((mode, left), &on), &soon) in self
+            .modes
+            .iter_mut()
+            .zip(&mut self.gesture_left)
+            .zip(&active)
+            .zip(&soon)
+        {
+            *left = if on {
+                self.params.settle
+            } else {
+                left.saturating_sub(elapsed)
+            };
+            *mode = if on || soon || *left > 0 {
+                LimitMode::Gesture
+            } else {
+                LimitMode::Idle
+            };
+        }
+        if LimitMode::same(self.modes, [LimitMode::Idle; 3])
+            && self.layers.iter().all(Option::is_none)
+            && !self.gaze.pending()
+            && !self.idle_gain.moving()
+        {
+            self.quiet = true;
+            self.rest_centre = centre;
+            self.rest_gain = gain;
+        }
+        offsets.map(Angle::from_millidegrees)
+    }
+
+    /// The limit modes from the next frame on, `[pitch, roll, yaw]`: the
+    /// driver should have them before the next frame is mixed.
+    #[must_use]
+    pub const fn modes(&self) -> [LimitMode; 3] {
+        self.modes
+    }
+}
+
+/// A percentage as a Q16 gain.
+const fn gain_of(p: Percent) -> i32 {
+    (p.get() as u32 * ONE / 100) as i32
+}

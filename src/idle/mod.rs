@@ -1,0 +1,67 @@
+//! Never-repeating idle motion: a fresh loop per axis whenever the last one
+//! ends, joined to it as smoothly as a loop's interior.
+//!
+//! # The stream
+//!
+//! Set 0 is the configuration's own loops ([`LoopSet::generate`], the boot
+//! loops, each entered at its neutral crossing). Set k+1 is generated with
+//! the same configuration except the seeds: **each axis' next seed r(0) is
+//! the last LCG value its previous loop drew**, r(N) (both closures draw
+//! r(1)..r(N): the seamless one N walk steps, the paper's N − 1 steps and
+//! its split). The LCG stream of an axis therefore goes on unbroken from
+//! loop to loop, and the whole sequence follows from the three seeds of
+//! the configuration ([`after_loop`] computes r(N) by squaring the LCG's
+//! affine map).
+//!
+//! # The join
+//!
+//! Every loop is played once through, N samples in `L` frames (1500 at the
+//! defaults), and its first and last `J` frames ([`JOIN_FRAMES`] = 100,
+//! 2 s) overlap the loops before and after it: over a join the outgoing
+//! loop plays its last `J` frames, the incoming loop its first `J`, and the
+//! frame shows
+//!
+//! ```text
+//! out + s(j/J)·(in − out),   s(u) = 10u³ − 15u⁴ + 6u⁵,   j = 0..J−1
+//! ```
+//!
+//! a convex combination (the angle stays inside both loops' ranges, so
+//! inside [α1, α2]) whose weight has zero first and second derivatives at
+//! both ends, so velocity and acceleration stay continuous. Joins come
+//! every `L − J` frames (1400: 28 s). No sample of a loop is played
+//! twice, so no part of a loop returns at the next join.
+//!
+//! The blend has little to hide because the incoming loop is entered where
+//! it already resembles the outgoing one: each loop is a ring (seamless, so
+//! it can be entered at any sample), and the generator chooses the entry s
+//! that minimises the squared difference between the incoming loop's samples
+//! s, s+3, …, s+J and the outgoing loop's exit (its samples over the join,
+//! `J·N/L` = 60 at the defaults), which matches value, slope and curvature
+//! together ([`SetInfo::mismatch`] reports what is left). Only set 0 starts
+//! at the neutral pose.
+//!
+//! # Generation and hand-over
+//!
+//! [`LoopStream`] generates each set (about 150,000 instructions for the
+//! loops and the entry search on a Cortex-M0+) into a [`LoopSet`] buffer;
+//! [`IdlePlayer`] plays the sets frame by frame and takes the next one
+//! through a [`LoopSupply`] on the frame its join is due. The firmware
+//! generates in a low-priority task and passes `&'static mut` buffers
+//! through channels (`frame_task`); the host calls the generator on the
+//! spot. Both play the same frames. Should a set not be ready in time, the
+//! current one plays once more (it is seamless) and the join is tried a
+//! loop later, on the same samples.
+//!
+//! # The fixed loop
+//!
+//! [`IdleMode::FixedLoop`] plays set 0 for ever: the paper's behaviour,
+//! one loop per axis replayed every `L` frames.
+
+mod join;
+mod source;
+mod stream;
+
+pub use crate::behaviour::IdleSource;
+pub use join::{IdleError, IdleTiming, JOIN_FRAMES, MAX_JOIN_SAMPLES, join_weight};
+pub use source::{IdleMode, IdlePlayer, IdleStats, LoopSupply, NoSupply};
+pub use stream::{GenerateOnTake, LoopSet, LoopStream, MATCH_STRIDE, SetInfo, SetView, after_loop};

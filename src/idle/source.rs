@@ -1,0 +1,232 @@
+//! The idle source the frame task plays: one loop set after another,
+//! each entered through its join, or one set for ever.
+
+use core::ops::Deref;
+
+use crate::behaviour::IdleSource;
+use crate::playback::Cursor;
+use crate::units::Angle;
+
+use super::join::IdleTiming;
+use super::stream::LoopSet;
+
+/// Where the frame task gets its next loop set and leaves the one it has
+/// played: the firmware's one-slot channels to the generator task, or a
+/// generator called on the spot (host).
+pub trait LoopSupply<H> {
+    /// The next set, if it is ready. Called once per join, on the frame
+    /// where the join is due.
+    fn take(&mut self) -> Option<H>;
+    /// A set the frame task no longer reads, for the generator to fill.
+    fn give_back(&mut self, set: H);
+}
+
+/// No supply: the fixed-loop mode, or a stream that never gets a set.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoSupply;
+
+impl<H> LoopSupply<H> for NoSupply {
+    fn take(&mut self) -> Option<H> {
+        None
+    }
+
+    fn give_back(&mut self, set: H) {
+        drop(set);
+    }
+}
+
+/// Which idle motion the head plays.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum IdleMode {
+    /// A new loop set every loop, joined to the last: the head never repeats.
+    #[default]
+    NeverRepeating,
+    /// The first set replayed for ever: the paper's fixed loop.
+    FixedLoop,
+}
+
+/// What an [`IdlePlayer`] has done so far.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct IdleStats {
+    /// Joins begun (sets taken over).
+    pub joins: u32,
+    /// Joins that found no set ready: the current set played once more.
+    pub late: u32,
+    /// The number of the set playing.
+    pub set: u32,
+}
+
+/// Plays loop sets (`H` derefs to a [`LoopSet`]) frame by frame: in
+/// [`IdleMode::NeverRepeating`] each set is followed by the next from
+/// `supply`, entered through its join; in [`IdleMode::FixedLoop`] the first
+/// set plays for ever. See the [module docs](super).
+#[derive(Clone, Debug)]
+// The fields every frame reads first, at small offsets (cheaper to address
+// on the Cortex-M0).
+#[repr(C)]
+pub struct IdlePlayer<H, S> {
+    /// The frame from which on [`on_event`](Self::on_event) plays the
+    /// frames: every frame of a join, else the next join (`u64::MAX`: never).
+    slow_from: u64,
+    /// The frame of `current`'s first frame (its local frame 0).
+    origin: u64,
+    current: H,
+    /// Whether `current` is still playing its join.
+    joining: bool,
+    /// The local frame of the next event: the join's end (while `joining`),
+    /// else the next join (`u64::MAX`: never).
+    event: u64,
+    cursor: Cursor,
+    /// A cursor at frame 0 with nothing read, for each new set (made once:
+    /// making one divides in 64 bits).
+    fresh: Cursor,
+    supply: S,
+    timing: IdleTiming,
+    /// Whether sets follow each other.
+    stream: bool,
+    stats: IdleStats,
+}
+
+impl<H, S> IdlePlayer<H, S> {
+    /// What the player has done so far.
+    #[must_use]
+    pub const fn stats(&self) -> IdleStats {
+        self.stats
+    }
+
+    /// The timing of the loops.
+    #[must_use]
+    pub const fn timing(&self) -> &IdleTiming {
+        &self.timing
+    }
+
+    /// Whether a join is under way.
+    #[must_use]
+    pub const fn in_join(&self) -> bool {
+        self.joining
+    }
+
+    /// The set playing.
+    #[must_use]
+    pub const fn current(&self) -> &H {
+        &self.current
+    }
+}
+
+impl<H, S, const N: usize> IdlePlayer<H, S>
+where
+    H: Deref<Target = LoopSet<N>>,
+    S: LoopSupply<H>,
+{
+    /// Plays `first` from frame 0, then (in [`IdleMode::NeverRepeating`])
+    /// the sets of `supply`.
+    #[must_use]
+    pub const fn new(first: H, supply: S, timing: IdleTiming, mode: IdleMode) -> Self {
+        let stream = matches!(mode, IdleMode::NeverRepeating);
+        let fresh = Cursor::new(timing.playback);
+        let event = if stream {
+            timing.period() as u64
+        } else {
+            u64::MAX
+        };
+        Self {
+            slow_from: event,
+            origin: 0,
+            current: first,
+            joining: false,
+            event,
+            cursor: fresh,
+            fresh,
+            supply,
+            timing,
+            stream,
+            stats: IdleStats {
+                joins: 0,
+                late: 0,
+                set: 0,
+            },
+        }
+    }
+
+    /// The idle offsets of frame `frame`.
+    #[inline]
+    pub fn offsets(&mut self, frame: u64) -> [Angle; 3] {
+        if frame >= self.slow_from {
+            return self.slow(frame);
+        }
+        self.cursor.offsets(frame, &*self.current)
+    }
+
+    /// A frame of a join, or one at or past an event.
+    #[inline(never)]
+    fn slow(&mut self, frame: u64) -> [Angle; 3] {
+        let local = frame.wrapping_sub(self.origin);
+        if local >= self.event {
+            self.on_event(local);
+        }
+        // Every frame of a join comes here; after it, the next join.
+        self.slow_from = if self.joining {
+            frame.wrapping_add(1)
+        } else {
+            self.origin.saturating_add(self.event)
+        };
+        if self.joining {
+            return self.cursor.offsets(frame, &self.current.views());
+        }
+        self.cursor.offsets(frame, &*self.current)
+    }
+
+    /// A frame at or past an event: the end of a join (the set plays on
+    /// alone), or a join due (the next set taken, its join begins).
+    fn on_event(&mut self, local: u64) {
+        if self.joining {
+            // Its join played (and no spline window reaches back into it),
+            // the set reads its own samples from now on: from the join's
+            // last sample on they are the same.
+            self.joining = false;
+            self.event = u64::from(self.timing.period());
+            return;
+        }
+        if !self.stream {
+            self.event = u64::MAX;
+            return;
+        }
+        let Some(set) = self.supply.take() else {
+            // Not ready: the current set is seamless and plays once more;
+            // its join out falls on the same samples a loop later.
+            self.stats.late = self.stats.late.saturating_add(1);
+            self.event = self
+                .event
+                .saturating_add(u64::from(self.timing.loop_frames));
+            return;
+        };
+        // The outgoing set's exit is in the new set's join: it is read no more.
+        let outgoing = core::mem::replace(&mut self.current, set);
+        self.supply.give_back(outgoing);
+        self.origin = self.origin.wrapping_add(self.event);
+        let local = local - self.event;
+        self.cursor = self.fresh;
+        self.cursor.restart_at(self.origin);
+        self.joining = true;
+        self.event = u64::from(self.timing.join_read_frames());
+        self.stats.joins = self.stats.joins.saturating_add(1);
+        self.stats.set = self.current.number();
+        if local >= self.event {
+            // Skipped past the whole join.
+            self.on_event(local);
+        }
+    }
+}
+
+impl<H, S, const N: usize> IdleSource for IdlePlayer<H, S>
+where
+    H: Deref<Target = LoopSet<N>>,
+    S: LoopSupply<H>,
+{
+    #[inline]
+    fn offsets(&mut self, frame: u64) -> [Angle; 3] {
+        IdlePlayer::offsets(self, frame)
+    }
+}

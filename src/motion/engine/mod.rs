@@ -1,0 +1,180 @@
+//! The integer pipeline: walk → Hann smoothing → scaling → loop closure.
+//!
+//! # Smoothing in O(N), independent of W
+//!
+//! Smoothing the walk u with the Hann kernel h equals smoothing its steps
+//! e(k) = u(k) − u(k−1) ∈ {−1, 0, +1} and integrating, because convolution
+//! commutes with summation. With h(m) = ½ − ½·cos(ωm), ω = 2π/W, the smoothed
+//! velocity at n is
+//!
+//! ```text
+//! v(n) = Σₘ h(m)·e(n−m) = ½·B(n) − ½·Σₖ e(k)·cos(ω(n−k))          (k over the window)
+//!      = ½·B(n) − ½·[cos ωn · Σₖ e(k) cos ωk  +  sin ωn · Σₖ e(k) sin ωk]
+//! ```
+//!
+//! where B(n) is the plain window sum. B and the two phasor sums P꜀, Pₛ are
+//! *sliding sums over absolute time*: when the window moves by one sample the
+//! entering and the leaving step share the same residue n mod W, so each sum
+//! changes by (`e_new` − `e_old`)·T[n mod W] — one table entry, no rotation, no
+//! rounding. The sums are therefore exact integers at every n: there is no
+//! drift to re-anchor. Only the table rounding (≈ 1/Q per tap) separates the
+//! result from the real-valued Hann smoothing; `host-tests` measures it against
+//! a direct-form f64 convolution.
+//!
+//! # What the buffer holds
+//!
+//! The smoothed velocity V is quantised to a step 2^shift by an
+//! error-feedback [`Quantiser`], so the integral X of the quantised velocity
+//! equals ⌊(exact integral)/2^shift⌋ at every sample: no drift.
+//!
+//! - Seamless closure: the buffer receives X itself, wrapping in 16 bits,
+//!   with a step (`raw_shift` in `seamless.rs`) that makes a typical loop span 2¹⁵..2¹⁶
+//!   units (a wider one is quantised again); a [`LoopScale`] maps it to
+//!   angles about the loop's start. [`Integral16`](super::Integral16) storage keeps it as
+//!   it is: no pass after the sweep touches every sample.
+//! - Paper closure (taper and split need the angles): the buffer holds the
+//!   *second difference* ΔΔX as `i16` (see `x_shift` in `paper.rs`) and a scaling pass
+//!   integrates it twice into angles.
+//!
+//! No scratch memory beyond the output buffer and the W-tap ring.
+//!
+//! # Magnitudes (all fit `i32`)
+//!
+//! With table scale Q (Q²·W < 2²⁹) and bits b ∈ {0,1} of the steps:
+//! - `Pb = Σ b(k)·T[k mod W]` is a 2-vector of length ≤ W·(Q+1);
+//! - `cp = T꜀[j]·Pb꜀ + Tₛ[j]·Pbₛ` ≤ (Q+1)²·W (Cauchy–Schwarz) < 2²⁹·(1 + 3/Q);
+//! - `V = Q²·Bb − cp` = 2Q²·Σ h·b ∈ [0, Q²W] up to rounding, |V| < 2³⁰;
+//! - `V − q` with the detrend q ≤ Q²W, plus the quantiser's residue: < 2³¹;
+//! - ΔX = (V − q)/2^shift with 2^shift ≥ 2N, so |X| < 2³⁰ over the loop;
+//! - seamless: 2^shift ≥ 2¹⁵, so |ΔX| < 2¹⁵ and neighbouring samples differ
+//!   by an exact `i16`; the scale multiplies offsets < 2¹⁶ by m < 2¹⁵;
+//! - paper: |ΔΔX| < 2¹⁴ (see `x_shift` in `paper.rs`), stored as `i16`; the scaling pass
+//!   forms ΔX·m with m sized by the largest |ΔX|: < 2³¹.
+#![allow(clippy::many_single_char_names)] // the notation of the derivation above
+
+mod paper;
+mod scale;
+mod seamless;
+mod sweep;
+
+pub(super) use scale::finalise;
+
+use super::kernel::HannKernel;
+use super::storage::{LoopScale, Sample};
+use super::{AxisConfig, Closure, MotionError};
+
+/// What the engine decided for one loop.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LoopInfo {
+    /// The index, in generation order, of the sample of the smoothed, scaled
+    /// loop where playback starts (the split point p of the paper's Figure 6).
+    pub split: u16,
+    /// Where playback starts in the stored buffer: the loop is kept as a ring
+    /// (exchanging the two halves is a matter of where reading starts).
+    pub start: u16,
+    /// How many zero crossings were candidates for the split.
+    pub crossings: u16,
+    /// Up-steps (+δ) among the walk's steps.
+    pub up_steps: u16,
+}
+
+/// Observer of intermediate stages, for previews and tests.
+///
+/// All methods default to doing nothing; `()` implements it as a no-op that
+/// compiles away.
+pub trait Trace {
+    /// Whether the observer wants the stages at all (`()` does not: the
+    /// engine then skips the work of rebuilding them).
+    const ENABLED: bool = true;
+
+    /// The smoothed walk before scaling, at loop index `n` (generation order),
+    /// in units of the walk step δ (up to an additive constant).
+    fn smoothed(&mut self, _n: usize, _walk_steps: f32) {}
+    /// The scaled loop before closure at index `n` (generation order), in fine
+    /// units of 1/256 millidegree.
+    fn normalized(&mut self, _n: usize, _fine: i32) {}
+}
+
+impl Trace for () {
+    const ENABLED: bool = false;
+}
+
+/// Runs the pipeline for one axis into `out` (length N, validated by the
+/// caller); the samples map to angles with the returned scale.
+pub(super) fn generate<S: Sample, T: Trace>(
+    out: &mut [S],
+    cfg: &AxisConfig,
+    kernel: &HannKernel,
+    trace: &mut T,
+) -> Result<(LoopInfo, LoopScale), MotionError> {
+    if kernel.window() != cfg.window || out.len() < 2 * usize::from(cfg.window) {
+        // Callers validate first; this keeps the function total on its own.
+        return Err(MotionError::WindowTooLarge {
+            window: cfg.window,
+            max: (out.len() / 2) as u16,
+        });
+    }
+    match cfg.closure {
+        Closure::Seamless => seamless::seamless(out, cfg, kernel, trace),
+        Closure::Paper => paper::paper(out, cfg, kernel, trace),
+    }
+}
+
+/// What both closures read off the buffer, the configuration and the kernel.
+#[derive(Clone, Copy)]
+pub(super) struct Basics<'k> {
+    /// N, the loop's length.
+    n: usize,
+    /// W, the window's length.
+    w: usize,
+    /// The kernel table, W entries.
+    table: &'k [(i16, i16)],
+    /// The table scale Q.
+    q: i32,
+    /// Q².
+    qq: i32,
+}
+
+impl<'k> Basics<'k> {
+    fn of<S>(out: &[S], cfg: &AxisConfig, kernel: &'k HannKernel) -> Self {
+        let q = kernel.scale();
+        Self {
+            n: out.len(),
+            w: usize::from(cfg.window),
+            table: kernel.table(),
+            q,
+            qq: q * q,
+        }
+    }
+}
+
+/// Error-feedback quantisation by 2^shift (0 ≤ shift ≤ 30): after each
+/// push, the outputs so far sum to exactly ⌊(r₀ + the inputs so far)/2^shift⌋,
+/// r₀ the starting residue, so an integral of the outputs never drifts from
+/// the exact one.
+#[derive(Clone, Copy)]
+pub(super) struct Quantiser {
+    /// The inputs' sum so far, modulo 2^shift.
+    residue: i32,
+    shift: u32,
+}
+
+impl Quantiser {
+    /// A quantiser by 2^`shift` with nothing carried over.
+    pub(super) const fn new(shift: u32) -> Self {
+        Self::with_residue(shift, 0)
+    }
+
+    /// A quantiser by 2^`shift` that carries `residue` (< 2^shift) over.
+    pub(super) const fn with_residue(shift: u32, residue: i32) -> Self {
+        Self { residue, shift }
+    }
+
+    /// Quantises the next input.
+    pub(super) fn push(&mut self, v: i32) -> i32 {
+        let total = v + self.residue;
+        self.residue = total & ((1 << self.shift) - 1);
+        total >> self.shift
+    }
+}

@@ -1,0 +1,146 @@
+//! The decoded log of one QEMU run: the types that running, plotting,
+//! snapshotting and benchmarking share.
+
+use std::{path::Path, process::ExitStatus, time::Duration};
+
+use defmt_decoder::{Frame, Locations};
+
+/// One decoded defmt frame.
+#[derive(Debug, Clone)]
+pub struct LogLine {
+    /// `INFO`, `WARN`, ... (`None` for `println!`-style frames).
+    pub level: Option<String>,
+    /// The formatted message.
+    pub message: String,
+    /// The formatted timestamp, if the firmware has one.
+    pub timestamp: Option<String>,
+    /// `file:line` of the log statement, if the ELF has debug info.
+    pub location: Option<String>,
+}
+
+impl LogLine {
+    /// A line with a level and a message only.
+    pub fn new(level: &str, message: impl Into<String>) -> Self {
+        Self {
+            level: Some(level.to_owned()),
+            message: message.into(),
+            timestamp: None,
+            location: None,
+        }
+    }
+
+    /// The line of a decoded frame; locations are shown relative to `root`.
+    pub fn from_frame(frame: &Frame<'_>, locations: Option<&Locations>, root: &Path) -> Self {
+        let location = locations
+            .and_then(|locations| locations.get(&frame.index()))
+            .map(|location| {
+                let file = location.file.strip_prefix(root).unwrap_or(&location.file);
+                format!("{}:{}", file.display(), location.line)
+            });
+        Self {
+            level: frame.level().map(|level| level.as_str().to_uppercase()),
+            message: frame.display_message().to_string(),
+            timestamp: frame.display_timestamp().map(|t| t.to_string()),
+            location,
+        }
+    }
+
+    /// Stands for bytes that do not decode.
+    pub fn malformed() -> Self {
+        Self::new(
+            "ERROR",
+            "(malformed defmt frame: the log stream is corrupt)",
+        )
+    }
+
+    /// The line as kept in the expected log: level and message, no timestamp
+    /// or location (those change with unrelated code changes).
+    pub fn snapshot(&self) -> String {
+        match &self.level {
+            Some(level) => format!("{level:<5} {}", self.message),
+            None => self.message.clone(),
+        }
+    }
+
+    /// Whether this is a warning or an error.
+    pub fn is_problem(&self) -> bool {
+        matches!(self.level.as_deref(), Some("WARN" | "ERROR"))
+    }
+
+    /// Prints the line with its timestamp, and the location of a problem.
+    pub fn print(&self) {
+        match &self.timestamp {
+            Some(timestamp) => println!("{timestamp} {}", self.snapshot()),
+            None => println!("{}", self.snapshot()),
+        }
+        if self.is_problem()
+            && let Some(location) = &self.location
+        {
+            println!("      └─ {location}");
+        }
+    }
+}
+
+/// How QEMU ended.
+#[derive(Debug, Clone, Copy)]
+pub enum Exit {
+    /// QEMU exited (semihosting exit code, 0 = success).
+    Status(ExitStatus),
+    /// Killed after the timeout.
+    TimedOut(Duration),
+}
+
+/// The outcome of one QEMU run.
+#[derive(Debug)]
+pub struct Run {
+    /// Decoded log, in order.
+    pub log: Vec<LogLine>,
+    /// How QEMU ended.
+    pub exit: Exit,
+    /// Wall time of the run.
+    pub elapsed: Duration,
+}
+
+impl Run {
+    /// QEMU exited with status 0 before the timeout.
+    pub fn succeeded(&self) -> bool {
+        matches!(self.exit, Exit::Status(status) if status.success())
+    }
+
+    /// One line saying how the run ended.
+    pub fn describe(&self) -> String {
+        let how = match self.exit {
+            Exit::Status(status) if status.success() => "firmware exited with success".to_owned(),
+            Exit::Status(status) => format!("firmware FAILED ({status})"),
+            Exit::TimedOut(limit) => format!(
+                "firmware TIMED OUT: QEMU killed after {} s (raise with --timeout)",
+                limit.as_secs()
+            ),
+        };
+        format!(
+            "qemu: {how}; {} log lines in {:.1} s",
+            self.log.len(),
+            self.elapsed.as_secs_f64()
+        )
+    }
+
+    /// The log as kept on file: one [`LogLine::snapshot`] a line.
+    pub fn text(&self) -> String {
+        self.log.iter().map(|line| line.snapshot() + "\n").collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn snapshot_lines_have_level_and_message_only() {
+        let mut line = LogLine::new("INFO", "hello");
+        line.timestamp = Some("1.000000".to_owned());
+        line.location = Some("src/main.rs:3".to_owned());
+        assert_eq!(line.snapshot(), "INFO  hello");
+        assert!(!line.is_problem());
+        assert!(LogLine::malformed().is_problem());
+    }
+}

@@ -1,0 +1,478 @@
+//! The stages of one loop in f64 degrees, from the engine's own trace: walk,
+//! smoothed, normalised, final (see the module docs of `preview` for what
+//! each column is), with the loop's metrics and a check of the split point.
+
+// Sample indices (< 2^13) and angles are small: float conversions are exact
+// or far below the printed resolution.
+#![allow(clippy::cast_precision_loss)]
+
+use std::fmt::Write as _;
+
+use anyhow::{Context, Result};
+use idle_head::{
+    Angle, Axis,
+    metrics::LoopMetrics,
+    motion::{
+        AxisConfig, AxisError, Closure, FINE_PER_MDEG, HannKernel, Lcg, LoopInfo, Mdeg16, Trace,
+        generate_into, step_of,
+    },
+};
+
+/// One loop to preview.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoopSpec {
+    /// The axis (anatomical limits).
+    pub axis: Axis,
+    /// Samples per loop.
+    pub n: usize,
+    /// Seed, window, step, range and closure.
+    pub cfg: AxisConfig,
+}
+
+/// An [`Angle`] in degrees.
+pub fn deg(angle: Angle) -> f64 {
+    f64::from(angle.millidegrees()) / f64::from(Angle::SCALE)
+}
+
+/// The paper closure's open walk in degrees: u(0) = 0, u(n) = u(n−1) ± δ with
+/// the sign of r(n).
+pub fn paper_walk(seed: u32, n: usize, delta: f64) -> Vec<f64> {
+    let mut lcg = Lcg::new(seed);
+    let mut u = 0.0;
+    (0..n)
+        .map(|i| {
+            if i > 0 {
+                u += f64::from(step_of(lcg.next_value())) * delta;
+            }
+            u
+        })
+        .collect()
+}
+
+/// The seamless closure's periodic walk in degrees: e(k) = ±1 from r(k+1),
+/// walk(n) = δ·Σ_{k≤n} (e(k) − D/N) with D = Σ e; walk(N−1) = 0.
+pub fn seamless_walk(seed: u32, n: usize, delta: f64) -> Vec<f64> {
+    let mut lcg = Lcg::new(seed);
+    let steps: Vec<f64> = (0..n)
+        .map(|_| f64::from(step_of(lcg.next_value())))
+        .collect();
+    let drift = steps.iter().sum::<f64>() / n as f64;
+    let mut u = 0.0;
+    steps
+        .iter()
+        .map(|e| {
+            u += (e - drift) * delta;
+            u
+        })
+        .collect()
+}
+
+/// The paper's normalisation into [a1, a2]: a1 + (s − min)(a2 − a1)/(max − min).
+pub fn normalize(values: &[f64], a1: f64, a2: f64) -> Vec<f64> {
+    let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let span = max - min;
+    values
+        .iter()
+        .map(|&s| {
+            if span > 0.0 {
+                a1 + (s - min) * (a2 - a1) / span
+            } else {
+                a1
+            }
+        })
+        .collect()
+}
+
+/// The length-N Hann taper of the paper closure: ½ − ½·cos(2πn/(N−1)).
+pub fn taper(n: usize) -> Vec<f64> {
+    let span = (n.max(2) - 1) as f64;
+    (0..n)
+        .map(|i| 0.5 - 0.5 * (std::f64::consts::TAU * i as f64 / span).cos())
+        .collect()
+}
+
+fn mean(values: &[f64]) -> f64 {
+    values.iter().sum::<f64>() / values.len().max(1) as f64
+}
+
+/// Records the engine's intermediate stages (generation order).
+struct Recorder {
+    /// The smoothed walk in walk steps δ.
+    smoothed: Vec<f64>,
+    /// The scaled loop before closure, fine units (1/256 m°).
+    scaled: Vec<i32>,
+}
+
+impl Trace for Recorder {
+    fn smoothed(&mut self, n: usize, walk_steps: f32) {
+        if let Some(slot) = self.smoothed.get_mut(n) {
+            *slot = f64::from(walk_steps);
+        }
+    }
+
+    fn normalized(&mut self, n: usize, fine: i32) {
+        if let Some(slot) = self.scaled.get_mut(n) {
+            *slot = fine;
+        }
+    }
+}
+
+/// What the data say about the split point p.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SplitCheck {
+    /// max |final(i) − last(i + p mod N)| over i, degrees: ≈ 0 if index 0 of
+    /// the stored loop is sample p of the closure's last stage.
+    pub forward: f64,
+    /// The same for the other reading, final(i) = last(i − p mod N).
+    pub backward: f64,
+    /// Where the closure's split stage crosses zero: p with the stage's
+    /// value there (degrees), and p's neighbour across zero with its value,
+    /// if one is. Paper closure: the tapered loop as stored, whose sign
+    /// changes from p to p + 1. Seamless closure: the normalised loop, whose
+    /// zero is the level the engine splits at; p is the sample the engine
+    /// found nearer to that level.
+    pub crossing: ((usize, f64), Option<(usize, f64)>),
+    /// max |normalized − the engine's own scaled stage|, degrees (≈ 0 for
+    /// the paper closure, whose engine normalises exactly so).
+    pub formula_vs_engine: f64,
+}
+
+/// All stages of one loop.
+#[derive(Debug, Clone)]
+pub struct Stages {
+    /// What was generated.
+    pub spec: LoopSpec,
+    /// The engine's decisions.
+    pub info: LoopInfo,
+    /// Walk, degrees, generation order.
+    pub walk: Vec<f64>,
+    /// Smoothed walk, degrees, generation order.
+    pub smoothed: Vec<f64>,
+    /// Normalised into [α1, α2], degrees, generation order.
+    pub normalized: Vec<f64>,
+    /// Paper closure only: the Hann taper and the tapered loop (degrees).
+    pub tapered: Option<(Vec<f64>, Vec<f64>)>,
+    /// The stored loop, degrees, playback order.
+    pub final_loop: Vec<f64>,
+    /// Metrics of the stored loop.
+    pub metrics: LoopMetrics,
+    /// The split point, checked against the data.
+    pub split: SplitCheck,
+}
+
+impl Stages {
+    /// Runs the engine for `spec` and derives every stage.
+    pub fn compute(spec: LoopSpec) -> Result<Self> {
+        let LoopSpec { axis, n, cfg } = spec;
+        let kernel = HannKernel::new(cfg.window).map_err(|error| AxisError { axis, error })?;
+        let mut stored = vec![Mdeg16(0); n];
+        let mut recorder = Recorder {
+            smoothed: vec![0.0; n],
+            scaled: vec![0; n],
+        };
+        let info = generate_into(&mut stored, &cfg, axis, &kernel, &mut recorder)
+            .map_err(|error| AxisError { axis, error })?;
+
+        let delta = deg(cfg.step);
+        let walk = match cfg.closure {
+            Closure::Paper => paper_walk(cfg.seed, n, delta),
+            Closure::Seamless => seamless_walk(cfg.seed, n, delta),
+        };
+        let mut smoothed: Vec<f64> = recorder.smoothed.iter().map(|s| s * delta).collect();
+        let shift = mean(&walk) - mean(&smoothed);
+        for s in &mut smoothed {
+            *s += shift;
+        }
+        let (a1, a2) = (deg(cfg.range.min), deg(cfg.range.max));
+        let normalized = normalize(&smoothed, a1, a2);
+        let final_loop: Vec<f64> = stored.iter().map(|s| f64::from(s.0) / 1000.0).collect();
+
+        // The closure's last stage before the exchange, from the engine's own
+        // scaled values (fine units), in degrees.
+        let fine_to_deg = |fine: i32| f64::from(fine) / f64::from(FINE_PER_MDEG * Angle::SCALE);
+        let scaled: Vec<f64> = recorder.scaled.iter().map(|&f| fine_to_deg(f)).collect();
+        let (last, tapered) = match cfg.closure {
+            Closure::Paper => {
+                let h = taper(n);
+                let last: Vec<f64> = scaled.iter().zip(&h).map(|(x, h)| x * h).collect();
+                let mine: Vec<f64> = normalized.iter().zip(&h).map(|(x, h)| x * h).collect();
+                (last, Some((h, mine)))
+            }
+            Closure::Seamless => (scaled.clone(), None),
+        };
+        let p = usize::from(info.split);
+        let distance = |offset: usize| {
+            final_loop
+                .iter()
+                .enumerate()
+                .map(|(i, f)| (f - last[(i + offset) % n]).abs())
+                .fold(0.0, f64::max)
+        };
+        let split = SplitCheck {
+            forward: distance(p),
+            backward: distance((n - p % n) % n),
+            crossing: match cfg.closure {
+                Closure::Paper => ((p, final_loop[0]), Some(((p + 1) % n, final_loop[1 % n]))),
+                Closure::Seamless => ((p, normalized[p]), across_zero(&normalized, p)),
+            },
+            formula_vs_engine: normalized
+                .iter()
+                .zip(&scaled)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max),
+        };
+
+        let mut scratch = vec![0; n];
+        let metrics = LoopMetrics::measure(&stored, &mut scratch)
+            .context("the loop is too short to measure")?;
+        Ok(Self {
+            spec,
+            info,
+            walk,
+            smoothed,
+            normalized,
+            tapered,
+            final_loop,
+            metrics,
+            split,
+        })
+    }
+
+    /// The CSV text: header `n,walk,smoothed,normalized,final`, degrees.
+    pub fn csv(&self) -> String {
+        let mut out = String::from("n,walk,smoothed,normalized,final\n");
+        for i in 0..self.spec.n {
+            let _ = writeln!(
+                out,
+                "{i},{:.4},{:.4},{:.4},{:.3}",
+                self.walk[i], self.smoothed[i], self.normalized[i], self.final_loop[i]
+            );
+        }
+        out
+    }
+
+    /// One line naming the loop.
+    pub fn title(&self) -> String {
+        let LoopSpec { axis, n, cfg } = self.spec;
+        format!(
+            "{}: seed r(0) = {}, N = {n}, W = {}, δ = {}°, range [α1, α2] = [{}°, {}°], {} closure",
+            axis.name(),
+            cfg.seed,
+            cfg.window,
+            deg(cfg.step),
+            deg(cfg.range.min),
+            deg(cfg.range.max),
+            closure_name(cfg.closure),
+        )
+    }
+
+    /// The metrics as short lines (the PNG's text box and the terminal).
+    pub fn metric_lines(&self) -> Vec<String> {
+        let m = &self.metrics;
+        let LoopSpec { cfg, .. } = self.spec;
+        let inside = cfg.range.contains(m.min) && cfg.range.contains(m.max);
+        vec![
+            format!(
+                "continuity: max|d1|/P95|d1| = {:.2}, max|d2|/P95|d2| = {:.2}",
+                m.velocity_ratio, m.acceleration_ratio
+            ),
+            format!(
+                "liveliness (min over 10 segments of mean|d1| / mean|d1|) = {:.2}",
+                m.liveliness
+            ),
+            format!(
+                "range: min = {:.3}°, max = {:.3}° ({} [{}°, {}°]); start x(0) = {:.3}°",
+                deg(m.min),
+                deg(m.max),
+                if inside { "inside" } else { "OUTSIDE" },
+                deg(cfg.range.min),
+                deg(cfg.range.max),
+                deg(m.start),
+            ),
+            match cfg.closure {
+                Closure::Paper => format!(
+                    "split p = {} (drawn from {} zero crossings); {} up-steps in the walk",
+                    self.info.split, self.info.crossings, self.info.up_steps
+                ),
+                Closure::Seamless => format!(
+                    "split p = {} (where the smoothed loop crosses the level that maps to 0°); \
+                     {} up-steps in the walk",
+                    self.info.split, self.info.up_steps
+                ),
+            },
+        ]
+    }
+
+    /// What the split check found, in words.
+    pub fn split_lines(&self) -> Vec<String> {
+        let s = &self.split;
+        let ((p, at_p), across) = s.crossing;
+        let paper = self.spec.cfg.closure == Closure::Paper;
+        let (stage, split_stage) = if paper {
+            ("the tapered loop", "tapered")
+        } else {
+            ("the engine's scaled loop", "normalized")
+        };
+        let crossing = match across {
+            Some((q, at_q)) => {
+                // In sample order, p first where the sign changes after it.
+                let (first, second) = if q == (p + 1) % self.spec.n {
+                    ((p, at_p), (q, at_q))
+                } else {
+                    ((q, at_q), (p, at_p))
+                };
+                let nearer = !paper && at_p.abs() <= at_q.abs();
+                format!(
+                    "{split_stage} changes sign between samples {} and {} ({:+.4}° and {:+.4}°), \
+                     p = {p}{}",
+                    first.0,
+                    second.0,
+                    first.1,
+                    second.1,
+                    if nearer { ", the one nearer 0°" } else { "" }
+                )
+            }
+            None => format!("{split_stage}(p = {p}) = {at_p:+.4}°, no neighbour across 0°"),
+        };
+        let scaling = if paper {
+            "paper formula vs the engine's normalisation"
+        } else {
+            "the engine scales about p (played from exactly 0°), the paper formula min to max"
+        };
+        vec![
+            format!(
+                "split check: final(i) = {stage}((i + p) mod N) within {:.4}° \
+                 (the reading (i − p) mod N is off by up to {:.3}°)",
+                s.forward, s.backward
+            ),
+            format!(
+                "             {crossing}; {scaling}: max diff {:.4}°",
+                s.formula_vs_engine
+            ),
+        ]
+    }
+}
+
+/// The neighbour of sample `p` (cyclic) on the other side of zero, with its
+/// value: the one before if that is across, else the one after if that is.
+fn across_zero(values: &[f64], p: usize) -> Option<(usize, f64)> {
+    let n = values.len();
+    let sign = |i: usize| values[i] > 0.0;
+    [(p + n - 1) % n, (p + 1) % n]
+        .into_iter()
+        .find(|&q| sign(q) != sign(p))
+        .map(|q| (q, values[q]))
+}
+
+pub fn closure_name(closure: Closure) -> &'static str {
+    match closure {
+        Closure::Paper => "paper",
+        Closure::Seamless => "seamless",
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::float_cmp)] // exact values by construction
+mod tests {
+    use idle_head::{
+        Axis,
+        motion::{DEFAULT_HEAD, DEFAULT_N},
+    };
+
+    use super::*;
+
+    #[test]
+    fn paper_walk_steps_by_the_top_bit_of_r_n() {
+        let walk = paper_walk(127, 6, 0.5);
+        assert_eq!(walk[0], 0.0);
+        let mut lcg = Lcg::new(127);
+        for i in 1..6 {
+            let r = lcg.next_value();
+            let step = if r >= 1 << 31 { 0.5 } else { -0.5 };
+            assert_eq!(walk[i] - walk[i - 1], step);
+        }
+    }
+
+    #[test]
+    fn seamless_walk_is_periodic() {
+        let walk = seamless_walk(8821, 900, 1.0);
+        assert!(walk[899].abs() < 1e-9, "ends at zero: {}", walk[899]);
+        // The first step is e(0) − D/N, with e(0) from r(1).
+        let mut lcg = Lcg::new(8821);
+        let e0 = f64::from(step_of(lcg.next_value()));
+        assert!((walk[0] - e0).abs() < 1.0);
+    }
+
+    #[test]
+    fn normalisation_and_taper() {
+        assert_eq!(normalize(&[2.0, 4.0, 3.0], -4.0, 12.0), [-4.0, 12.0, 4.0]);
+        assert_eq!(normalize(&[1.0, 1.0], -1.0, 1.0), [-1.0, -1.0]);
+        let h = taper(5);
+        assert!(h[0].abs() < 1e-12 && h[4].abs() < 1e-12);
+        assert!((h[2] - 1.0).abs() < 1e-12);
+        assert!((h[1] - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn stages_of_a_default_axis() {
+        for closure in [Closure::Paper, Closure::Seamless] {
+            let spec = LoopSpec {
+                axis: Axis::Pitch,
+                n: DEFAULT_N,
+                cfg: DEFAULT_HEAD.pitch.with_closure(closure),
+            };
+            let stages = Stages::compute(spec).unwrap();
+            // Playback starts at the split point of the last stage.
+            assert!(stages.split.forward <= 0.001, "{:?}", stages.split);
+            // p and its neighbour lie on either side of zero.
+            let ((_, at_p), across) = stages.split.crossing;
+            let (_, at_q) = across.unwrap();
+            assert!((at_p > 0.0) != (at_q > 0.0), "{:?}", stages.split);
+            let (lo, hi) = stages
+                .normalized
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+            assert!((lo + 4.0).abs() < 1e-9 && (hi - 12.0).abs() < 1e-9);
+            if closure == Closure::Paper {
+                assert!(stages.split.formula_vs_engine < 0.01, "{:?}", stages.split);
+            }
+            let csv = stages.csv();
+            let mut lines = csv.lines();
+            assert_eq!(lines.next(), Some("n,walk,smoothed,normalized,final"));
+            assert_eq!(lines.count(), DEFAULT_N);
+            let smoothed_mean = mean(&stages.smoothed);
+            assert!((smoothed_mean - mean(&stages.walk)).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn a_coarse_loop_is_split_beside_its_crossing() {
+        // 17 samples, W = 3: steps of several degrees, so p is a whole
+        // sample away from where the loop crosses 0°.
+        let spec = LoopSpec {
+            axis: Axis::Yaw,
+            n: 17,
+            cfg: DEFAULT_HEAD.yaw.with_window(3),
+        };
+        let stages = Stages::compute(spec).unwrap();
+        let ((p, at_p), across) = stages.split.crossing;
+        let (q, at_q) = across.unwrap();
+        assert_eq!(p, usize::from(stages.info.split));
+        assert!(q == (p + 1) % 17 || p == (q + 1) % 17);
+        assert!((at_p > 0.0) != (at_q > 0.0));
+        // The engine picks the sample nearer the crossing, and plays it as 0°.
+        assert!(at_p.abs() <= at_q.abs());
+        assert_eq!(stages.final_loop[0], 0.0);
+        let lines = stages.split_lines().join("\n");
+        assert_eq!((p, q), (9, 8));
+        assert!(
+            lines.contains(
+                "normalized changes sign between samples 8 and 9 (+2.7859° and -1.5000°), \
+                 p = 9, the one nearer 0°"
+            ),
+            "{lines}"
+        );
+        assert!(!lines.contains("sits at"), "{lines}");
+    }
+}

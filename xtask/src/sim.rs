@@ -1,0 +1,304 @@
+//! `cargo xtask sim`: the Pico image, exactly as `cargo run --release`
+//! flashes it, in the RP2040 emulator rp2040js (Node.js, `sim/`).
+//!
+//! The harness (`sim/harness.mjs`) boots the flash image the way boot2
+//! hands over, bridges the emulator's one gap (SEV), performs watchdog resets
+//! and reports raw facts as JSON lines: RTT bytes, pin edges, PWM compare
+//! writes, the cycles of each frame update. This module decodes the log with
+//! the ELF's defmt table, rebuilds the pulse trains and checks them against
+//! the duties the host computes with the same core (`pulses.rs` explains how
+//! PWM periods map to frames).
+
+mod expect;
+mod image;
+// The Pico image's own PWM clocking (divider, TOP, count length), compiled
+// here too, so the host's expectation uses exactly the firmware's numbers.
+mod node;
+mod pulses;
+#[path = "../../src/bin/pico/rp2040_pwm.rs"]
+#[allow(dead_code, clippy::pedantic)]
+pub(crate) mod rp2040_pwm;
+mod run;
+mod stages;
+
+use std::{fmt::Write as _, time::Duration};
+
+use anyhow::Result;
+
+pub use run::{Report, logged_peak_stack};
+pub use stages::{
+    DRILL_STAGE, FAILURES_STAGE, PULSES_STAGE, test_drill, test_failures, test_pulses,
+};
+
+use crate::project::{self, PICO};
+use crate::setup;
+
+/// Options of `cargo xtask sim`.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct Args {
+    /// Virtual time to run, in seconds (default: a 30 s loop, the 2 s
+    /// fade-in and half a second of boot).
+    #[arg(long = "seconds", value_name = "S", default_value = "32.5", value_parser = virtual_seconds)]
+    pub virtual_time: Duration,
+    /// Wall-time limit in seconds.
+    #[arg(long, value_name = "S", default_value = "120", value_parser = wall_seconds)]
+    pub timeout: Duration,
+    /// The watchdog drill instead: build the test image (`--features
+    /// watchdog-drill`, in target/watchdog-drill), whose frames stop after
+    /// 3 s, and check that the watchdog resets it and the next boot starts
+    /// softly again.
+    #[arg(long)]
+    pub drill: bool,
+}
+
+/// One loop (30 s), the fade-in (2 s) and half a second for the boot.
+pub const DEFAULT_TIME: Duration = Duration::from_millis(32_500);
+
+fn virtual_seconds(value: &str) -> Result<Duration, String> {
+    seconds(value, 3600.0)
+}
+
+fn wall_seconds(value: &str) -> Result<Duration, String> {
+    seconds(value, 86_400.0)
+}
+
+fn seconds(value: &str, max: f64) -> Result<Duration, String> {
+    let seconds: f64 = value
+        .parse()
+        .map_err(|_| format!("`{value}`: expected seconds"))?;
+    if !(seconds > 0.0 && seconds <= max) {
+        return Err(format!("must be above 0 and at most {max} s"));
+    }
+    Ok(Duration::from_secs_f64(seconds))
+}
+
+/// `cargo xtask sim`. `Ok(false)` when a check failed.
+pub fn command(args: &Args) -> Result<bool> {
+    let root = project::root();
+    setup::ensure_toolchain(&root)?;
+    let metadata = project::metadata(&root)?;
+    if args.drill {
+        return match stages::test_drill(&root, &metadata) {
+            Ok(()) => Ok(true),
+            Err(error) => {
+                println!("watchdog drill FAILED: {error:#}");
+                Ok(false)
+            }
+        };
+    }
+    PICO.build(&root)?;
+    let report = run::simulate(&root, &PICO.elf(&metadata), args.virtual_time, args.timeout)?;
+    print!("{}", report.log_text());
+    print!("{}", report.table());
+    println!("{}", report.verdict());
+    println!("{}", report.summary());
+    Ok(report.problems.is_empty())
+}
+
+impl Report {
+    /// Frames that went out as their own pulse, on every servo, all boots.
+    pub fn frames(&self) -> usize {
+        self.boots
+            .iter()
+            .map(|boot| boot.servos.iter().map(|s| s.fresh).min().unwrap_or(0))
+            .sum()
+    }
+
+    /// Watchdog resets during the run.
+    pub fn watchdog_resets(&self) -> usize {
+        self.boots.iter().filter(|boot| boot.watchdog).count()
+    }
+
+    /// The peak stack: the larger of what the firmware logged and what the
+    /// emulated RAM shows at the end of each boot.
+    pub fn peak_stack(&self) -> Option<u64> {
+        let logged = self
+            .boots
+            .iter()
+            .filter_map(|boot| run::logged_peak_stack(boot.log.iter().map(|(_, line)| line)));
+        let ram = self.boots.iter().filter_map(|boot| boot.stack_peak);
+        logged.chain(ram).max()
+    }
+
+    /// The decoded log with virtual times, boots and resets marked.
+    pub fn log_text(&self) -> String {
+        let mut text = String::new();
+        for (b, boot) in self.boots.iter().enumerate() {
+            let how = if b == 0 {
+                "power-on"
+            } else {
+                "after a watchdog reset"
+            };
+            let _ = writeln!(text, "[boot {b} at {:.6} s, {how}]", boot.start / 1e9);
+            for (ns, line) in &boot.log {
+                let _ = writeln!(text, "{:>11.6} {}", ns / 1e9, line.snapshot());
+                if line.is_problem()
+                    && let Some(location) = &line.location
+                {
+                    let _ = writeln!(text, "            └─ {location}");
+                }
+            }
+            if boot.watchdog {
+                let _ = writeln!(text, "[watchdog reset at {:.6} s]", boot.end / 1e9);
+            }
+        }
+        for (message, count) in &self.emulator {
+            let _ = writeln!(text, "emulator: {message} ({count}x)");
+        }
+        text
+    }
+
+    /// Per boot and servo: pulses, frames, widths, periods; then the frame
+    /// update's cycles and the stack.
+    pub fn table(&self) -> String {
+        let timing = run::timing();
+        let us = |counts: u32| f64::from(counts) * timing.count_ns / 1e3;
+        let mut text = String::new();
+        for (b, boot) in self.boots.iter().enumerate() {
+            let _ = writeln!(
+                text,
+                "\nboot {b}, {:.3} s to {:.3} s:\n  {:<6} {:<5} {:>7} {:>7} {:>5} {:>9} {:>9} {:>9}  {:<21} {:>10}",
+                boot.start / 1e9,
+                boot.end / 1e9,
+                "servo",
+                "pin",
+                "pulses",
+                "frames",
+                "held",
+                "first µs",
+                "min µs",
+                "max µs",
+                "period ns",
+                "mismatches"
+            );
+            for ((name, pin, _), check) in run::SERVOS.iter().zip(&boot.servos) {
+                let widths = check.pulses.iter().map(|p| p.counts);
+                let first = check.pulses.first().map_or(0, |p| p.counts);
+                let period = check
+                    .periods
+                    .map_or("-".to_owned(), |(low, high)| format!("{low:.0}..{high:.0}"));
+                let _ = writeln!(
+                    text,
+                    "  {name:<6} GP{pin:<3} {:>7} {:>7} {:>5} {:>9.1} {:>9.1} {:>9.1}  {period:<21} {:>10}",
+                    check.pulses.len(),
+                    check.fresh,
+                    check.held,
+                    us(first),
+                    us(widths.clone().min().unwrap_or(0)),
+                    us(widths.max().unwrap_or(0)),
+                    check.mismatches
+                );
+            }
+        }
+        let _ = writeln!(text, "\n{}", self.frame_cycles());
+        let logged = self
+            .boots
+            .iter()
+            .filter_map(|boot| run::logged_peak_stack(boot.log.iter().map(|(_, line)| line)))
+            .max();
+        let ram = self.boots.iter().filter_map(|boot| boot.stack_peak).max();
+        let bytes = |b: Option<u64>| b.map_or("-".to_owned(), |b| format!("{b} B"));
+        let _ = writeln!(
+            text,
+            "peak stack: {} as the firmware logged it, {} in the emulated RAM at the end",
+            bytes(logged),
+            bytes(ram)
+        );
+        let _ = writeln!(
+            text,
+            "run: {:.3} s of virtual time, {} instructions, {:.1} s of wall time",
+            self.end.ns / 1e9,
+            self.end.instructions,
+            Duration::from_millis(self.end.wall_ms).as_secs_f64()
+        );
+        text
+    }
+
+    /// `frame update: ...` with min, median and max cycles.
+    pub fn frame_cycles(&self) -> String {
+        // Each boot's first call is the start frame (neutral pulses only).
+        let starts: Vec<u64> = self
+            .boots
+            .iter()
+            .filter_map(|b| b.frame_cycles.first().copied())
+            .collect();
+        let mut cycles: Vec<u64> = self
+            .boots
+            .iter()
+            .flat_map(|b| b.frame_cycles.iter().skip(1).copied())
+            .collect();
+        cycles.sort_unstable();
+        match (cycles.first(), cycles.last()) {
+            (Some(min), Some(max)) => format!(
+                "frame update (FrameLoop::write), RP2040 cycles as rp2040js counts them: min {min}, \
+                 median {}, max {max} over {} frames (start frame {})",
+                cycles[cycles.len() / 2],
+                cycles.len(),
+                starts.first().copied().unwrap_or(0)
+            ),
+            _ => "frame update: no call seen".to_owned(),
+        }
+    }
+
+    /// `sim: ok ...` or the problems.
+    pub fn verdict(&self) -> String {
+        if self.problems.is_empty() {
+            format!(
+                "sim: ok: {} frames, every pulse the host's duty within one count, periods within one count",
+                self.frames()
+            )
+        } else {
+            let mut text = format!("sim: FAILED ({} problems):", self.problems.len());
+            for problem in &self.problems {
+                let _ = write!(text, "\n  {problem}");
+            }
+            text
+        }
+    }
+
+    /// The closing `sim summary ...` line.
+    pub fn summary(&self) -> String {
+        let timing = run::timing();
+        let pulses: usize = self
+            .boots
+            .iter()
+            .flat_map(|b| &b.servos)
+            .map(|s| s.pulses.len())
+            .sum();
+        let mismatches: usize = self
+            .boots
+            .iter()
+            .flat_map(|b| &b.servos)
+            .map(|s| s.mismatches)
+            .sum();
+        let periods = self
+            .boots
+            .iter()
+            .flat_map(|b| &b.servos)
+            .filter_map(|s| s.periods);
+        let (low, high) = periods.fold((f64::INFINITY, 0.0_f64), |(l, h), (a, b)| {
+            (l.min(a), h.max(b))
+        });
+        let period = if low.is_finite() {
+            format!("{low:.0}..{high:.0}")
+        } else {
+            "-".to_owned()
+        };
+        let first: Vec<String> = self.boots.first().map_or_else(Vec::new, |boot| {
+            boot.servos
+                .iter()
+                .map(|s| {
+                    s.pulses.first().map_or("-".to_owned(), |p| {
+                        format!("{:.0}", f64::from(p.counts) * timing.count_ns / 1e3)
+                    })
+                })
+                .collect()
+        });
+        format!(
+            "sim summary frames={} pulses={pulses} mismatches={mismatches} period_ns={period} first_us={} watchdog_resets={}",
+            self.frames(),
+            first.join(","),
+            self.watchdog_resets()
+        )
+    }
+}

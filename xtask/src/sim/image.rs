@@ -1,0 +1,154 @@
+//! What the emulator needs from the Pico ELF: the flash contents and the
+//! addresses of a few symbols.
+//!
+//! The flash image is what `arm-none-eabi-objcopy -O binary` of the stored
+//! sections (`.boot2 .vector_table .text .rodata .data`) gives: every
+//! loadable segment placed at its load address (`p_paddr`; `.data` runs in
+//! RAM but is stored in flash behind `.rodata`), gaps filled with the erased
+//! value 0xff. It is read with the `object` crate the xtask already uses for
+//! the memory budgets, so the emulator needs no binutils.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use object::read::elf::{ElfFile32, ProgramHeader};
+use object::{Endianness, Object, ObjectSymbol, elf};
+
+/// Where the RP2040 maps its QSPI flash (XIP).
+pub const FLASH_START: u64 = 0x1000_0000;
+/// The window of the XIP address space a 16 MiB flash can occupy.
+const FLASH_END: u64 = 0x1100_0000;
+/// Where boot2 leaves the vector table: right behind its own 256 bytes.
+pub const VECTOR_TABLE: u64 = FLASH_START + 0x100;
+/// What cortex-m-rt's `paint-stack` fills the stack with before `main`.
+pub const STACK_PAINT: u32 = 0xcccc_cccc;
+
+/// The parts of a Pico ELF the emulator run uses.
+#[derive(Debug)]
+pub struct PicoImage {
+    /// Flash contents from `FLASH_START` on.
+    pub flash: Vec<u8>,
+    /// Address of the RTT control block `_SEGGER_RTT`.
+    pub rtt: u64,
+    /// The stack region `[_stack_end, _stack_start)`.
+    pub stack: (u64, u64),
+    /// Entry of the frame update `FrameLoop::write`, if it is a function of
+    /// its own (it is `#[inline(never)]`).
+    pub frame_update: Option<u64>,
+}
+
+impl PicoImage {
+    /// Reads `path`; a file that is not a Pico image gets an error saying why.
+    pub fn read(path: &Path) -> Result<Self> {
+        let data = std::fs::read(path).with_context(|| {
+            format!(
+                "the Pico ELF {} is missing (build it with `cargo build --release`)",
+                path.display()
+            )
+        })?;
+        Self::parse(&data).with_context(|| format!("{} is not a Pico image", path.display()))
+    }
+
+    fn parse(data: &[u8]) -> Result<Self> {
+        let file = ElfFile32::<Endianness>::parse(data)
+            .context("not a 32-bit ELF file (the Pico image is a thumbv6m-none-eabi ELF)")?;
+        if file.elf_header().e_machine.get(file.endian()) != elf::EM_ARM {
+            bail!("not an Arm ELF file");
+        }
+        if file.section_by_name(".boot2").is_none() {
+            bail!("no `.boot2` section (an image for another board?)");
+        }
+        let flash = flash_image(&file, data)?;
+        let symbol = |name: &str| {
+            file.symbols()
+                .find(|symbol| symbol.name() == Ok(name))
+                .map(|symbol| symbol.address())
+        };
+        let rtt =
+            symbol("_SEGGER_RTT").context("no `_SEGGER_RTT` symbol: the image has no RTT log")?;
+        let stack = (
+            symbol("_stack_end").context("no `_stack_end` symbol")?,
+            symbol("_stack_start").context("no `_stack_start` symbol")?,
+        );
+        let frame_update = file
+            .symbols()
+            .filter(|symbol| symbol.kind() == object::SymbolKind::Text)
+            .find(|symbol| {
+                symbol.name().is_ok_and(|name| {
+                    let name = format!("{:#}", rustc_demangle::demangle(name));
+                    name.contains("FrameLoop") && name.ends_with("::write")
+                })
+            })
+            // Thumb: the low bit of a function symbol is the mode bit.
+            .map(|symbol| symbol.address() & !1);
+        Ok(Self {
+            flash,
+            rtt,
+            stack,
+            frame_update,
+        })
+    }
+}
+
+/// Every loadable segment at its load address, as `objcopy -O binary` lays
+/// out the flash; checks that the vector table is where boot2 jumps to.
+fn flash_image(file: &ElfFile32<Endianness>, data: &[u8]) -> Result<Vec<u8>> {
+    let endian = file.endian();
+    let mut flash = Vec::new();
+    for header in file.elf_program_headers() {
+        if header.p_type(endian) != elf::PT_LOAD || header.p_filesz(endian) == 0 {
+            continue;
+        }
+        let address = u64::from(header.p_paddr(endian));
+        if !(FLASH_START..FLASH_END).contains(&address) {
+            continue;
+        }
+        let bytes = header
+            .data(endian, data)
+            .map_err(|()| anyhow::anyhow!("a segment lies outside the file"))?;
+        let start = usize::try_from(address - FLASH_START)?;
+        let end = start + bytes.len();
+        if flash.len() < end {
+            flash.resize(end, 0xff);
+        }
+        flash[start..end].copy_from_slice(bytes);
+    }
+    let vectors = usize::try_from(VECTOR_TABLE - FLASH_START)?;
+    let word = |at: usize| {
+        flash
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
+    match (word(vectors), word(vectors + 4)) {
+        (Some(sp), Some(reset)) if sp >> 28 == 2 && u64::from(reset) >> 24 == FLASH_START >> 24 => {
+            Ok(flash)
+        }
+        _ => bail!(
+            "no vector table at {VECTOR_TABLE:#010x} (initial stack pointer in RAM, reset \
+             handler in flash), where boot2 hands over"
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_host_binary_is_not_a_pico_image() {
+        let error = PicoImage::read(&std::env::current_exe().unwrap()).unwrap_err();
+        assert!(
+            format!("{error:#}").contains("is not a Pico image"),
+            "{error:#}"
+        );
+    }
+
+    #[test]
+    fn a_missing_file_says_how_to_build_it() {
+        let error = PicoImage::read(Path::new("/nonexistent/pico")).unwrap_err();
+        assert!(
+            format!("{error:#}").contains("cargo build --release"),
+            "{error:#}"
+        );
+    }
+}

@@ -1,0 +1,242 @@
+//! Node, the emulator package and one run of `sim/harness.mjs`.
+
+use std::{
+    io::{BufRead, BufReader},
+    path::{Path, PathBuf},
+    process::{Command, Stdio},
+    sync::mpsc::{self, RecvTimeoutError},
+    thread,
+    time::{Duration, Instant},
+};
+
+use anyhow::{Context, Result, bail};
+use serde_json::{Value, json};
+
+use crate::project;
+use xshell::cmd;
+
+/// The Debian/Ubuntu packages that bring `node` and `npm`.
+const PACKAGES: [&str; 2] = ["nodejs", "npm"];
+
+/// The folder with the harness and its `package.json`.
+pub fn folder(root: &Path) -> PathBuf {
+    root.join("sim")
+}
+
+/// Makes sure `node` and `npm` run (installing them with apt-get when root on
+/// Debian or Ubuntu) and that the pinned emulator is installed (`npm ci`).
+pub fn ensure(root: &Path) -> Result<()> {
+    if version("node").is_none() || version("npm").is_none() {
+        install_node()?;
+    }
+    let sim = folder(root);
+    let read = |path: PathBuf| -> Option<Value> {
+        serde_json::from_slice(&std::fs::read(path).ok()?).ok()
+    };
+    let pinned = read(sim.join("package-lock.json"))
+        .context("sim/package-lock.json is missing or not JSON")?["packages"]
+        ["node_modules/rp2040js"]["version"]
+        .clone();
+    let installed = read(sim.join("node_modules/rp2040js/package.json"))
+        .map_or(Value::Null, |package| package["version"].clone());
+    if pinned.is_null() || installed != pinned {
+        let sh = project::shell(".")?;
+        sh.change_dir(&sim);
+        project::run(&sh, &[], cmd!(sh, "npm ci --no-audit --no-fund"))
+            .context("installing the emulator (rp2040js) with `npm ci` in sim/")?;
+    }
+    Ok(())
+}
+
+/// First line of `<program> --version`, if it runs.
+pub fn version(program: &str) -> Option<String> {
+    let output = Command::new(program)
+        .arg("--version")
+        .stdin(Stdio::null())
+        .output()
+        .ok()?;
+    output.status.success().then(|| {
+        String::from_utf8_lossy(&output.stdout)
+            .lines()
+            .next()
+            .unwrap_or_default()
+            .trim()
+            .to_owned()
+    })
+}
+
+/// Why Node.js cannot be installed here, if it cannot: no apt-get, or not root.
+fn cannot_install(apt: bool, root: bool) -> Option<String> {
+    let packages = PACKAGES.join(" ");
+    if !apt {
+        Some(format!(
+            "Node.js was not found: install `node` (18 or newer) and `npm` \
+             (packages `{packages}` on Debian/Ubuntu) and run the command again"
+        ))
+    } else if !root {
+        Some(format!(
+            "Node.js was not found: install it with `sudo apt-get install {packages}` \
+             and run the command again"
+        ))
+    } else {
+        None
+    }
+}
+
+fn install_node() -> Result<()> {
+    let packages = PACKAGES.join(" ");
+    let apt = Path::new("/etc/debian_version").exists() && version("apt-get").is_some();
+    if let Some(message) = cannot_install(apt, is_root()) {
+        bail!("{message}");
+    }
+    println!("node/npm are missing: installing the packages {packages}");
+    let sh = project::shell(".")?;
+    let env = [("DEBIAN_FRONTEND", "noninteractive")];
+    project::run(&sh, &env, cmd!(sh, "apt-get update -q"))?;
+    project::run(
+        &sh,
+        &env,
+        cmd!(
+            sh,
+            "apt-get install -y -q --no-install-recommends {PACKAGES...}"
+        ),
+    )?;
+    if version("node").is_none() || version("npm").is_none() {
+        bail!("`node` or `npm` still does not run after installing {packages}");
+    }
+    Ok(())
+}
+
+fn is_root() -> bool {
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|output| output.status.success() && output.stdout.trim_ascii() == b"0")
+}
+
+/// What the harness is asked to run.
+#[derive(Debug, Clone)]
+pub struct Config {
+    /// The flash image file.
+    pub flash: PathBuf,
+    /// Vector table address.
+    pub vtor: u64,
+    /// `_SEGGER_RTT`, or 0.
+    pub rtt: u64,
+    /// GPIOs to watch.
+    pub pins: Vec<u8>,
+    /// PWM slices whose compare writes to report.
+    pub slices: Vec<u8>,
+    /// Function whose cycles to report per call, or 0.
+    pub probe: u64,
+    /// Stack region to scan for paint, if painted.
+    pub stack: Option<(u64, u64)>,
+    /// Virtual time to run.
+    pub virtual_time: Duration,
+    /// Wall time allowed.
+    pub wall: Duration,
+    /// Virtual time without a log byte or a pin edge after which the run ends.
+    pub silence: Duration,
+}
+
+impl Config {
+    fn json(&self) -> Value {
+        json!({
+            "flash": self.flash,
+            "vtor": self.vtor,
+            "rtt": self.rtt,
+            "pins": self.pins,
+            "slices": self.slices,
+            "probe": self.probe,
+            "stack": self.stack.map(|(low, high)| [low, high]),
+            "paint": super::image::STACK_PAINT,
+            "ns": nanos(self.virtual_time),
+            "wall_ms": self.wall.as_millis(),
+            "silence_ns": nanos(self.silence),
+        })
+    }
+}
+
+fn nanos(duration: Duration) -> u64 {
+    u64::try_from(duration.as_nanos()).unwrap_or(u64::MAX)
+}
+
+/// Runs the harness; returns its events, in order. Fails if node cannot be
+/// started, exits with an error, or outlives the wall time (plus a grace).
+pub fn run(root: &Path, config: &Config) -> Result<Vec<Value>> {
+    let mut command = Command::new("node");
+    command
+        .arg("harness.mjs")
+        .arg(config.json().to_string())
+        .current_dir(folder(root))
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    let mut child = command
+        .spawn()
+        .context("could not start `node` (is Node.js installed?)")?;
+    let stdout = child.stdout.take().context("node's stdout")?;
+    let stderr = child.stderr.take().context("node's stderr")?;
+    let (sender, receiver) = mpsc::channel::<String>();
+    let reader = thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if sender.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let errors = thread::spawn(move || {
+        let mut text = String::new();
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            text.push_str(&line);
+            text.push('\n');
+        }
+        text
+    });
+    // The harness stops itself at `wall`; the grace covers node's start-up.
+    let deadline = Instant::now() + config.wall + Duration::from_secs(15);
+    let mut events: Vec<Value> = Vec::new();
+    loop {
+        match receiver.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+            Ok(line) => {
+                events.push(serde_json::from_str(&line).with_context(|| {
+                    format!("the harness printed a line that is not JSON: {line}")
+                })?);
+            }
+            Err(RecvTimeoutError::Disconnected) => break,
+            Err(RecvTimeoutError::Timeout) => {
+                let _ = child.kill();
+                let _ = child.wait();
+                bail!(
+                    "the emulator made no progress: node was killed after {} s of wall time",
+                    config.wall.as_secs() + 15
+                );
+            }
+        }
+    }
+    let status = child.wait().context("waiting for node")?;
+    let _ = reader.join();
+    let stderr = errors.join().unwrap_or_default();
+    if !status.success() && events.last().is_none_or(|e| e["ev"] != "end") {
+        bail!(
+            "the emulator harness failed ({status}):\n{}",
+            stderr.trim_end()
+        );
+    }
+    Ok(events)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_missing_node_names_the_packages_to_install() {
+        assert!(version("idle-head-no-such-program").is_none());
+        for (apt, root) in [(false, false), (false, true), (true, false)] {
+            let message = cannot_install(apt, root).unwrap();
+            assert!(message.contains("nodejs npm"), "{message}");
+        }
+        assert!(cannot_install(true, true).is_none());
+    }
+}

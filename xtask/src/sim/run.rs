@@ -1,0 +1,388 @@
+//! One emulator run of a Pico image: the harness's events sorted into boots,
+//! the RTT log decoded, every servo's pulses checked against the host.
+
+use std::{path::Path, time::Duration};
+
+use super::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
+use anyhow::{Context, Result, bail};
+use defmt_decoder::{DecodeError, Locations, StreamDecoder, Table};
+use idle_head::driver::DriverConfig;
+use serde_json::Value;
+
+use super::{
+    expect,
+    image::{PicoImage, VECTOR_TABLE},
+    node,
+    pulses::{self, Limits, ServoCheck, Timing, Train},
+};
+use crate::log::LogLine;
+
+/// The servos as wired on the Pico (`src/bin/pico/main.rs`): name, GPIO,
+/// PWM slice (channel A).
+pub const SERVOS: [(&str, u8, u8); 3] = [("pitch", 16, 0), ("roll", 18, 1), ("yaw", 20, 2)];
+
+/// Virtual time without a log byte or a pin edge after which a run is
+/// declared stuck: 50 frames.
+const SILENCE: Duration = Duration::from_secs(1);
+
+/// One boot: from power-on or a reset to the next reset or the end.
+#[derive(Debug, Default)]
+pub struct Boot {
+    /// When it started and ended, ns of virtual time since power-on.
+    pub start: f64,
+    /// See `start`.
+    pub end: f64,
+    /// Whether the watchdog ended it.
+    pub watchdog: bool,
+    /// The decoded log, each line with the time its last byte left.
+    pub log: Vec<(f64, LogLine)>,
+    /// Per servo, what the emulator reported.
+    pub trains: [Train; 3],
+    /// Per servo, the verdict.
+    pub servos: [ServoCheck; 3],
+    /// Cycles of each frame update, in order.
+    pub frame_cycles: Vec<u64>,
+    /// Lowest stack address written, from the emulated RAM at the end.
+    pub stack_low: Option<u64>,
+    /// Peak stack use, bytes, from `stack_low`.
+    pub stack_peak: Option<u64>,
+}
+
+/// How the harness ended.
+#[derive(Debug, Default)]
+pub struct End {
+    /// `time` when it ran the whole virtual time.
+    pub why: String,
+    /// Virtual time reached, ns.
+    pub ns: f64,
+    /// Instructions executed.
+    pub instructions: u64,
+    /// Wall time, ms.
+    pub wall_ms: u64,
+    /// The harness's error, if it failed.
+    pub error: Option<String>,
+}
+
+impl End {
+    /// Why the run did not reach its virtual time, if it did not.
+    pub fn problem(&self, silence: Duration) -> Option<String> {
+        let at = self.ns / 1e9;
+        match self.why.as_str() {
+            "time" => None,
+            "silent" => Some(format!(
+                "the emulator made no progress: no log byte and no pin edge for {} s of virtual \
+                 time (stopped at {at:.3} s)",
+                silence.as_secs_f64()
+            )),
+            "asleep" => Some(format!(
+                "the emulator made no progress: the core sleeps with nothing left to wake it \
+                 (at {at:.3} s)"
+            )),
+            "wall" => Some(format!(
+                "the emulator made no progress in time: stopped after {:.1} s of wall time at \
+                 {at:.3} s of virtual time (raise with --timeout)",
+                Duration::from_millis(self.wall_ms).as_secs_f64()
+            )),
+            "break" => Some(format!("the firmware hit a breakpoint at {at:.3} s")),
+            other => Some(format!(
+                "the emulator stopped ({other}) at {at:.3} s: {}",
+                self.error.as_deref().unwrap_or("no reason given")
+            )),
+        }
+    }
+}
+
+/// Everything one run produced.
+#[derive(Debug, Default)]
+pub struct Report {
+    /// The boots, in order.
+    pub boots: Vec<Boot>,
+    /// How it ended.
+    pub end: End,
+    /// The emulator's complaints, each with how often it came.
+    pub emulator: Vec<(String, usize)>,
+    /// Problems with the run itself (it stopped early, a frame is missing...).
+    pub problems: Vec<String>,
+}
+
+/// Runs `elf` for `virtual_time` (at most `wall` of wall time) and checks it.
+pub fn simulate(root: &Path, elf: &Path, virtual_time: Duration, wall: Duration) -> Result<Report> {
+    let image = PicoImage::read(elf)?;
+    let bytes = std::fs::read(elf)?;
+    let table = Table::parse(&bytes)
+        .with_context(|| format!("reading the defmt table of {}", elf.display()))?
+        .with_context(|| format!("{} has no defmt data", elf.display()))?;
+    let locations = table.get_locations(&bytes).ok();
+    node::ensure(root)?;
+    let flash = elf.with_extension("flash.bin");
+    std::fs::write(&flash, &image.flash).with_context(|| format!("writing {}", flash.display()))?;
+    let config = node::Config {
+        flash,
+        vtor: VECTOR_TABLE,
+        rtt: image.rtt,
+        pins: SERVOS.iter().map(|s| s.1).collect(),
+        slices: SERVOS.iter().map(|s| s.2).collect(),
+        probe: image.frame_update.unwrap_or(0),
+        stack: Some(image.stack),
+        virtual_time,
+        wall,
+        silence: SILENCE,
+    };
+    println!(
+        "$ (cd sim && node harness.mjs ...)  # {} of flash, {:.1} s of virtual time",
+        image.flash.len(),
+        virtual_time.as_secs_f64()
+    );
+    let events = node::run(root, &config)?;
+    let mut report = sort(&events, &table, locations.as_ref(), root)?;
+    for boot in &mut report.boots {
+        boot.stack_peak = boot.stack_low.map(|low| image.stack.1.saturating_sub(low));
+    }
+    if image.frame_update.is_none() {
+        report
+            .problems
+            .push("no `FrameLoop::write` symbol: the frame update was inlined".to_owned());
+    }
+    // An instruction rp2040js does not know runs as a no-op: nothing after
+    // it can be trusted.
+    for (message, count) in &report.emulator {
+        if message.contains("not implemented") {
+            report.problems.push(format!(
+                "the emulator skipped an instruction ({count}x): {message}"
+            ));
+        }
+    }
+    if let Some(problem) = report.end.problem(SILENCE) {
+        report.problems.push(problem);
+    }
+    check(&mut report)?;
+    Ok(report)
+}
+
+fn number(event: &Value, key: &str) -> Result<f64> {
+    event[key]
+        .as_f64()
+        .with_context(|| format!("harness event without `{key}`: {event}"))
+}
+
+#[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // counts and addresses < 2^53
+fn integer(event: &Value, key: &str) -> Result<u64> {
+    number(event, key).map(|n| n as u64)
+}
+
+/// Sorts the events into boots and decodes each boot's log.
+fn sort(
+    events: &[Value],
+    table: &Table,
+    locations: Option<&Locations>,
+    root: &Path,
+) -> Result<Report> {
+    let mut report = Report::default();
+    let mut decoder: Option<Box<dyn StreamDecoder + '_>> = None;
+    let servo = |key: &str, event: &Value| -> Result<Option<usize>> {
+        let n = integer(event, key)?;
+        Ok(SERVOS
+            .iter()
+            .position(|s| u64::from(if key == "pin" { s.1 } else { s.2 }) == n))
+    };
+    for event in events {
+        let kind = event["ev"].as_str().unwrap_or_default();
+        if kind == "boot" {
+            let start = number(event, "ns")?;
+            if let Some(last) = report.boots.last_mut() {
+                last.end = start;
+            }
+            report.boots.push(Boot {
+                start,
+                ..Boot::default()
+            });
+            decoder = Some(table.new_stream_decoder());
+            continue;
+        }
+        if kind == "emu" {
+            let message = event["msg"].as_str().unwrap_or_default().to_owned();
+            match report.emulator.iter_mut().find(|(m, _)| *m == message) {
+                Some((_, count)) => *count += 1,
+                None => report.emulator.push((message, 1)),
+            }
+            continue;
+        }
+        if kind == "end" {
+            report.end = end(event)?;
+            continue;
+        }
+        let Some(boot) = report.boots.last_mut() else {
+            bail!("harness event before the first boot: {event}");
+        };
+        match kind {
+            "rtt" => {
+                let ns = number(event, "ns")?;
+                let bytes = hex(event["hex"].as_str().unwrap_or_default())?;
+                let Some(decoder) = decoder.as_mut() else {
+                    continue;
+                };
+                decoder.received(&bytes);
+                loop {
+                    let line = match decoder.decode() {
+                        Ok(frame) => line(&frame, locations, root),
+                        Err(DecodeError::UnexpectedEof) => break,
+                        Err(DecodeError::Malformed) => LogLine {
+                            level: Some("ERROR".to_owned()),
+                            message: "(malformed defmt frame: the log stream is corrupt)"
+                                .to_owned(),
+                            timestamp: None,
+                            location: None,
+                        },
+                    };
+                    boot.log.push((ns, line));
+                }
+            }
+            "edge" if event["reset"] != true => {
+                if let Some(i) = servo("pin", event)? {
+                    boot.trains[i]
+                        .edges
+                        .push((number(event, "ns")?, event["high"] == true));
+                }
+            }
+            "cc" => {
+                if let Some(i) = servo("slice", event)? {
+                    // Channel A is the low half of the compare register.
+                    let value = (integer(event, "value")? & 0xffff) as u16;
+                    boot.trains[i].writes.push((number(event, "ns")?, value));
+                }
+            }
+            "en" if event["on"] == true => {
+                if let Some(i) = servo("slice", event)? {
+                    let train = &mut boot.trains[i];
+                    train.enabled = train.enabled.or(Some(number(event, "ns")?));
+                }
+            }
+            "call" => boot.frame_cycles.push(integer(event, "cycles")?),
+            "watchdog" => boot.watchdog = true,
+            "stack" => boot.stack_low = Some(integer(event, "low")?),
+            _ => {}
+        }
+    }
+    if report.end.why.is_empty() {
+        bail!("the emulator harness ended without saying how");
+    }
+    if let Some(last) = report.boots.last_mut() {
+        last.end = report.end.ns;
+    }
+    Ok(report)
+}
+
+fn end(event: &Value) -> Result<End> {
+    Ok(End {
+        why: event["why"].as_str().unwrap_or("?").to_owned(),
+        ns: number(event, "ns")?,
+        instructions: integer(event, "instructions")?,
+        wall_ms: integer(event, "wall_ms")?,
+        error: event["msg"].as_str().map(str::to_owned),
+    })
+}
+
+/// How a run ended, from its events.
+pub fn end_of(events: &[Value]) -> Result<End> {
+    let event = events
+        .iter()
+        .rfind(|event| event["ev"] == "end")
+        .context("the emulator harness ended without saying how")?;
+    end(event)
+}
+
+fn line(frame: &defmt_decoder::Frame<'_>, locations: Option<&Locations>, root: &Path) -> LogLine {
+    let location = locations
+        .and_then(|locations| locations.get(&frame.index()))
+        .map(|location| {
+            let file = location.file.strip_prefix(root).unwrap_or(&location.file);
+            format!("{}:{}", file.display(), location.line)
+        });
+    LogLine {
+        level: frame.level().map(|level| level.as_str().to_uppercase()),
+        message: frame.display_message().to_string(),
+        timestamp: None,
+        location,
+    }
+}
+
+fn hex(text: &str) -> Result<Vec<u8>> {
+    (0..text.len())
+        .step_by(2)
+        .map(|i| {
+            text.get(i..i + 2)
+                .and_then(|pair| u8::from_str_radix(pair, 16).ok())
+                .with_context(|| format!("bad hex in an RTT event: {text}"))
+        })
+        .collect()
+}
+
+/// The PWM timing of the Pico's servo slices.
+#[allow(clippy::cast_precision_loss)] // 312 500 ps
+pub fn timing() -> Timing {
+    Timing {
+        count_ns: PICO_SERVO_CLOCK.count_ps(PICO_SYS_HZ) as f64 / 1e3,
+        period_counts: u32::from(PICO_SERVO_CLOCK.top) + 1,
+        frame_ns: f64::from(DriverConfig::DEFAULT.frame_period.0) * 1e3,
+    }
+}
+
+/// Neutral, shortest and longest pulse of each servo, in counts.
+fn limits() -> [Limits; 3] {
+    let config = DriverConfig::DEFAULT;
+    let top = PICO_SERVO_CLOCK.top;
+    config.servos.map(|servo| Limits {
+        neutral: config.pwm.duty(servo.neutral, top).0,
+        min: config.pwm.duty(servo.min_pulse, top).0,
+        max: config.pwm.duty(servo.max_pulse, top).0,
+    })
+}
+
+/// Checks every boot's pulses against the host's duties.
+fn check(report: &mut Report) -> Result<()> {
+    let frames = report
+        .boots
+        .iter()
+        .flat_map(|boot| boot.trains.iter().map(|train| train.writes.len()))
+        .max()
+        .unwrap_or(0);
+    let expected = expect::pico_duties(frames)?;
+    let (timing, limits) = (timing(), limits());
+    let boots = report.boots.len();
+    for (b, boot) in report.boots.iter_mut().enumerate() {
+        for (i, train) in boot.trains.iter_mut().enumerate() {
+            train.end = boot.end;
+            train.reset = boot.watchdog;
+            let duties: Vec<u16> = expected.iter().map(|frame| frame[i]).collect();
+            let verdict = pulses::check(train, &duties, &timing, limits[i]);
+            let name = SERVOS[i].0;
+            let prefix = if boots > 1 {
+                format!("boot {b}, {name}")
+            } else {
+                name.to_owned()
+            };
+            report
+                .problems
+                .extend(verdict.problems.iter().map(|p| format!("{prefix}: {p}")));
+            if verdict.held > 0 && !boot.watchdog {
+                report.problems.push(format!(
+                    "{prefix}: {} pulses repeated the last frame: frames stopped",
+                    verdict.held
+                ));
+            }
+            boot.servos[i] = verdict;
+        }
+    }
+    Ok(())
+}
+
+/// The largest `peak stack <n> B` the firmware logged.
+pub fn logged_peak_stack<'a>(lines: impl IntoIterator<Item = &'a LogLine>) -> Option<u64> {
+    lines
+        .into_iter()
+        .filter_map(|line| {
+            let (_, rest) = line.message.split_once("peak stack ")?;
+            rest.split_whitespace().next()?.parse().ok()
+        })
+        .max()
+}

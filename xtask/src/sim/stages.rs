@@ -1,0 +1,245 @@
+//! The emulator's stages of `cargo xtask test`.
+
+use std::{path::Path, time::Duration};
+
+use anyhow::{Context, Result, bail};
+
+use super::{
+    DEFAULT_TIME,
+    image::{FLASH_START, PicoImage, VECTOR_TABLE},
+    node,
+    run::{self, Report},
+};
+use xshell::cmd;
+
+use crate::{
+    project::{self, Metadata, PICO, TARGET},
+    reference,
+};
+
+/// Stage names.
+pub const PULSES_STAGE: &str =
+    "Pico image in the RP2040 emulator: every pulse the host's duty, frame for frame";
+/// See [`PULSES_STAGE`].
+pub const DRILL_STAGE: &str =
+    "watchdog drill in the RP2040 emulator: reset, logged, soft start again";
+/// See [`PULSES_STAGE`].
+pub const FAILURES_STAGE: &str =
+    "RP2040 emulator: a hung, a sleeping and a wrong image each fail clearly";
+
+/// Frames the pulse check must cover: a whole loop (1500) and then some.
+const MIN_FRAMES: usize = 1600;
+/// Wall-time limit of one emulator run.
+const WALL: Duration = Duration::from_secs(120);
+/// The drill image stops its frames after this many frames of each boot
+/// (`DRILL_FRAMES` in `src/bin/pico/main.rs`).
+const DRILL_FRAMES: usize = 150;
+/// The Pico's watchdog timeout (`WATCHDOG_TIMEOUT` in `src/bin/pico/main.rs`).
+const WATCHDOG_MS: f64 = 100.0;
+/// Two drill boots: each 3 s of frames and the 100 ms timeout.
+const DRILL_TIME: Duration = Duration::from_millis(6_500);
+
+/// The shipped Pico image (already built) for [`DEFAULT_TIME`]; fails unless
+/// every check passes over at least [`MIN_FRAMES`] frames and the loops'
+/// checksum is the host's. Returns the run for the memory stage.
+pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
+    let report = run::simulate(root, &PICO.elf(metadata), DEFAULT_TIME, WALL)?;
+    print!("{}", report.log_text());
+    print!("{}", report.table());
+    println!("{}", report.verdict());
+    println!("{}", report.summary());
+    let mut problems = report.problems.clone();
+    if report.frames() < MIN_FRAMES {
+        problems.push(format!(
+            "{} frames checked, fewer than {MIN_FRAMES}",
+            report.frames()
+        ));
+    }
+    if report.watchdog_resets() > 0 {
+        problems.push("the watchdog reset the shipped image".to_owned());
+    }
+    let host = reference::checksum()?;
+    let want = format!("checksum {host:#010x}");
+    let logged = report
+        .boots
+        .iter()
+        .flat_map(|b| &b.log)
+        .any(|(_, l)| l.message.contains(&want));
+    if !logged {
+        problems.push(format!(
+            "no `precompute: ...; {want}` line, the host's checksum"
+        ));
+    }
+    fail_if_any(&problems)?;
+    Ok(report)
+}
+
+/// Builds the drill image (`--features watchdog-drill`, in a target
+/// directory of its own so that the shipped ELF is never overwritten), runs
+/// two of its boots and checks the reset and the soft start after it.
+pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
+    let target = metadata.target_dir.join("watchdog-drill");
+    let sh = project::shell(".")?;
+    sh.change_dir(root);
+    project::run(
+        &sh,
+        project::FIRMWARE_ENV,
+        cmd!(
+            sh,
+            "cargo build --release --features watchdog-drill --target-dir {target}"
+        ),
+    )?;
+    let elf = target.join(TARGET).join("release").join(PICO.bin);
+    let report = run::simulate(root, &elf, DRILL_TIME, WALL)?;
+    print!("{}", report.log_text());
+    print!("{}", report.table());
+    println!("{}", report.verdict());
+    println!("{}", report.summary());
+
+    let mut problems = report.problems.clone();
+    let says = |boot: usize, text: &str| {
+        report
+            .boots
+            .get(boot)
+            .is_some_and(|b| b.log.iter().any(|(_, l)| l.message.contains(text)))
+    };
+    let first = report.boots.first().context("no boot at all")?;
+    if !first.watchdog {
+        problems.push("the watchdog did not reset the board after the frames stopped".to_owned());
+    }
+    if !says(0, "boot: power-on") || !says(0, &format!("frames stop after frame {DRILL_FRAMES}")) {
+        problems.push("boot 0 did not log a power-on boot and the drill's stop".to_owned());
+    }
+    if !says(1, "last reset by the WATCHDOG") {
+        problems.push("boot 1 did not log the watchdog reset".to_owned());
+    }
+    if !says(1, "first frame: neutral pulses 1500 1500 1500 us") {
+        problems.push("boot 1 did not log neutral first pulses".to_owned());
+    }
+    for (b, boot) in report
+        .boots
+        .iter()
+        .enumerate()
+        .filter(|(_, boot)| boot.watchdog)
+    {
+        for (check, (name, ..)) in boot.servos.iter().zip(run::SERVOS) {
+            // Frames 0..=DRILL_FRAMES, each its own pulse: neutral first and
+            // the 2 s fade-in (checked against the host) before the stop.
+            if check.fresh != DRILL_FRAMES + 1 {
+                problems.push(format!(
+                    "boot {b}, {name}: {} frames went out, not {}",
+                    check.fresh,
+                    DRILL_FRAMES + 1
+                ));
+            }
+            // The last duty is held until the reset, 100 ms: 5 periods.
+            if check.held > 6 {
+                problems.push(format!(
+                    "boot {b}, {name}: {} pulses held before the reset",
+                    check.held
+                ));
+            }
+        }
+        let last_write = boot.trains[0].writes.last().map_or(boot.start, |w| w.0);
+        let after = (boot.end - last_write) / 1e6;
+        println!("boot {b}: watchdog reset {after:.3} ms after the last frame");
+        if !(WATCHDOG_MS - 20.0..=WATCHDOG_MS + 1.0).contains(&after) {
+            problems.push(format!(
+                "boot {b}: the watchdog reset came {after:.3} ms after the last frame, not {WATCHDOG_MS} ms"
+            ));
+        }
+    }
+    fail_if_any(&problems)
+}
+
+/// A hung image, an image that sleeps for ever, a run out of wall time and
+/// files that are not Pico images: each ends with its own clear message.
+pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
+    node::ensure(root)?;
+    let dir = metadata.target_dir.join("sim-failures");
+    std::fs::create_dir_all(&dir)?;
+    let cases: [(&str, &[u16], Duration, &str); 3] = [
+        ("hung", &[B_SELF], WALL, "no log byte and no pin edge"),
+        (
+            "asleep",
+            &[WFI, B_SELF],
+            WALL,
+            "sleeps with nothing left to wake it",
+        ),
+        (
+            "slow",
+            &[B_SELF],
+            Duration::from_millis(200),
+            "stopped after",
+        ),
+    ];
+    let mut problems = Vec::new();
+    for (name, code, wall, want) in cases {
+        let flash = dir.join(format!("{name}.bin"));
+        std::fs::write(&flash, synthetic(code))?;
+        let silence = if name == "slow" {
+            Duration::from_secs(3600)
+        } else {
+            Duration::from_millis(50)
+        };
+        let config = node::Config {
+            flash,
+            vtor: VECTOR_TABLE,
+            rtt: 0,
+            pins: Vec::new(),
+            slices: Vec::new(),
+            probe: 0,
+            stack: None,
+            virtual_time: Duration::from_secs(if name == "slow" { 3600 } else { 2 }),
+            wall,
+            silence,
+        };
+        let events = node::run(root, &config)?;
+        let end = run::end_of(&events)?;
+        match end.problem(silence) {
+            Some(message) if message.contains(want) => println!("{name}: {message}"),
+            other => problems.push(format!("{name}: expected `{want}`, got {other:?}")),
+        }
+    }
+    let missing = dir.join("no-such-elf");
+    for (path, want) in [
+        (missing.as_path(), "cargo build --release"),
+        (&std::env::current_exe()?, "is not a Pico image"),
+    ] {
+        match PicoImage::read(path) {
+            Err(error) if format!("{error:#}").contains(want) => {
+                println!("{}: {error:#}", path.display());
+            }
+            other => problems.push(format!(
+                "{}: expected `{want}`, got {other:?}",
+                path.display()
+            )),
+        }
+    }
+    fail_if_any(&problems)
+}
+
+/// Thumb `b .`: a loop on itself.
+const B_SELF: u16 = 0xe7fe;
+/// Thumb `wfi`.
+const WFI: u16 = 0xbf30;
+
+/// A flash image: 256 bytes where boot2 would be, a vector table (stack at
+/// the top of RAM, reset handler right behind it) and `code`.
+fn synthetic(code: &[u16]) -> Vec<u8> {
+    let mut flash = vec![0xff; usize::try_from(VECTOR_TABLE - FLASH_START).unwrap_or(0x100)];
+    #[allow(clippy::cast_possible_truncation)] // addresses of the RP2040, 32 bits
+    let reset = (VECTOR_TABLE + 8) as u32 | 1;
+    flash.extend(0x2004_0000_u32.to_le_bytes());
+    flash.extend(reset.to_le_bytes());
+    flash.extend(code.iter().flat_map(|half| half.to_le_bytes()));
+    flash
+}
+
+fn fail_if_any(problems: &[String]) -> Result<()> {
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        bail!("{}", problems.join("; "))
+    }
+}

@@ -1,0 +1,180 @@
+//! Trace scripts: `<seconds> <command>` per line, the command in the
+//! console's words (parsed by the core's `console::parse`).
+
+use std::fmt::Write as _;
+
+use anyhow::{Result, bail};
+use idle_head::behaviour::BehaviourParams;
+use idle_head::command::{Action, Command};
+use idle_head::console;
+
+/// One scripted command.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Event {
+    /// Its line in the script (from 1).
+    pub line: usize,
+    /// When, in µs from the first frame.
+    pub at_us: u64,
+    /// The command as written.
+    pub text: String,
+    /// The command.
+    pub action: Action,
+}
+
+/// The commands a script may give.
+const ALLOWED: &str = "nod, shake, tilt, look, center, idle on|off, idle amp, stop";
+
+/// `text` as seconds (`2`, `2.5`, `0.125`; at most µs), in µs.
+pub fn seconds(text: &str) -> Result<u64> {
+    let (whole, fraction) = text.split_once('.').unwrap_or((text, "0"));
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    if !digits(whole) || !digits(fraction) || fraction.len() > 6 {
+        bail!("`{text}`: expected seconds such as 2 or 2.5 (at most 6 decimals)");
+    }
+    let whole: u64 = whole
+        .parse()
+        .ok()
+        .filter(|&s| s <= 1_000_000)
+        .ok_or_else(|| anyhow::anyhow!("`{text}`: at most 1000000 seconds"))?;
+    let micros: u64 = format!("{fraction:0<6}").parse().unwrap_or(0);
+    Ok(whole * 1_000_000 + micros)
+}
+
+/// `us` as decimal seconds without trailing zeros.
+pub fn show_seconds(us: u64) -> String {
+    let mut text = format!("{}", us / 1_000_000);
+    let fraction = us % 1_000_000;
+    if fraction != 0 {
+        let digits = format!("{fraction:06}");
+        let _ = write!(text, ".{}", digits.trim_end_matches('0'));
+    }
+    text
+}
+
+/// Parses a script; the events sorted by time (in line order at equal
+/// times). Every bad line is reported, each with its number and reason,
+/// and then none runs.
+pub fn parse(script: &str, params: &BehaviourParams) -> Result<Vec<Event>> {
+    let mut events = Vec::new();
+    let mut errors = Vec::new();
+    for (index, raw) in script.lines().enumerate() {
+        let line = index + 1;
+        let text = raw.split_once('#').map_or(raw, |(before, _)| before).trim();
+        if text.is_empty() {
+            continue;
+        }
+        match event(line, text, params) {
+            Ok(event) => events.push(event),
+            Err(reason) => errors.push(format!("line {line}: {reason}")),
+        }
+    }
+    if !errors.is_empty() {
+        bail!("{}", errors.join("\n"));
+    }
+    events.sort_by_key(|e| e.at_us);
+    Ok(events)
+}
+
+fn event(line: usize, text: &str, params: &BehaviourParams) -> Result<Event, String> {
+    let (time, command) = text
+        .split_once(char::is_whitespace)
+        .map(|(t, c)| (t, c.trim()))
+        .ok_or_else(|| format!("`{text}`: expected `<seconds> <command>`"))?;
+    let at_us = seconds(time).map_err(|e| e.to_string())?;
+    let action = match console::parse(command.as_bytes()) {
+        Ok(Command::Act(action)) => action,
+        Ok(_) => {
+            let word = command.split_whitespace().next().unwrap_or("");
+            return Err(format!("`{word}` cannot be scripted (commands: {ALLOWED})"));
+        }
+        Err(e) => return Err(e.describe(command.as_bytes()).to_string()),
+    };
+    params.check(&action).map_err(|e| e.to_string())?;
+    Ok(Event {
+        line,
+        at_us,
+        text: command.to_owned(),
+        action,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use idle_head::behaviour::BehaviourConfig;
+    use idle_head::command::GestureKind;
+    use idle_head::driver::DriverConfig;
+
+    fn params() -> BehaviourParams {
+        BehaviourConfig::DEFAULT
+            .build(&DriverConfig::DEFAULT.build().unwrap())
+            .unwrap()
+    }
+
+    #[test]
+    fn times() {
+        assert_eq!(seconds("2").unwrap(), 2_000_000);
+        assert_eq!(seconds("2.5").unwrap(), 2_500_000);
+        assert_eq!(seconds("0.000001").unwrap(), 1);
+        for bad in ["", "-1", "2,5", ".5", "1.", "1.0000001", "x"] {
+            assert!(seconds(bad).is_err(), "{bad}");
+        }
+        assert_eq!(show_seconds(2_500_000), "2.5");
+        assert_eq!(show_seconds(3_000_000), "3");
+    }
+
+    #[test]
+    fn a_script_in_time_order() {
+        let script = "\
+# a nod, then a shake interrupted by a tilt
+2.5 nod 6000 900
+
+1 look 5000 -10000 hold=stay   # first
+4 shake
+4.4 tilt -8000
+6 center
+7 idle amp 50
+8 stop
+";
+        let events = parse(script, &params()).unwrap();
+        let lines: Vec<(usize, u64)> = events.iter().map(|e| (e.line, e.at_us)).collect();
+        assert_eq!(
+            lines,
+            [
+                (4, 1_000_000),
+                (2, 2_500_000),
+                (5, 4_000_000),
+                (6, 4_400_000),
+                (7, 6_000_000),
+                (8, 7_000_000),
+                (9, 8_000_000),
+            ]
+        );
+        assert!(matches!(events[1].action, Action::Gesture(g) if g.kind == GestureKind::Nod));
+    }
+
+    #[test]
+    fn every_bad_line_is_named_and_nothing_runs() {
+        let script = "\
+1 nod six
+2 wave
+3 servo pitch neutral 1500
+x nod
+5 nod 30000
+6 look 0
+7
+";
+        let err = parse(script, &params()).unwrap_err().to_string();
+        assert_eq!(
+            err,
+            "\
+line 1: `six`: amplitude in mdeg must be a whole number
+line 2: unknown command `wave` (try `help`)
+line 3: `servo` cannot be scripted (commands: nod, shake, tilt, look, center, idle on|off, idle amp, stop)
+line 4: `x`: expected seconds such as 2 or 2.5 (at most 6 decimals)
+line 5: nod amplitude 30°: must be in 0.001°..20° (pitch's limits around its neutral pose)
+line 6: missing yaw in mdeg
+line 7: `7`: expected `<seconds> <command>`"
+        );
+    }
+}
