@@ -4,7 +4,8 @@
 use std::{fmt::Write as _, path::Path};
 
 use anyhow::{Context, Result, bail};
-use object::{Object, ObjectSection, ObjectSymbol, SectionFlags, SectionKind, elf};
+use object::read::elf::{ElfFile32, ProgramHeader};
+use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, SectionKind, elf};
 
 /// RAM budget of the Pico image: static RAM (`.data + .bss + .uninit`) plus
 /// the peak stack measured in the RP2040 emulator (the boot precompute's
@@ -18,6 +19,13 @@ pub const FLASH_BUDGET: u64 = 64 * 1024;
 pub const BOOT2_ADDRESS: u64 = 0x1000_0000;
 /// Size of the second stage: 252 bytes of code plus a 4-byte CRC32.
 pub const BOOT2_SIZE: u64 = 256;
+/// The Pico's settings store: the last four 4 KiB erase sectors of its
+/// 2 MiB flash (`SETTINGS` in memory.x, `SETTINGS_RANGE` in
+/// `src/bin/pico/settings.rs`). Nothing may be linked there.
+pub const SETTINGS_REGION: std::ops::Range<u64> = 0x101f_c000..0x1020_0000;
+/// Where the RP2040 maps its QSPI flash (XIP), and the end of the window a
+/// 16 MiB flash can occupy.
+const XIP: std::ops::Range<u64> = 0x1000_0000..0x1100_0000;
 /// Where the emulated LM3S6965 reads its vector table at reset: the start of
 /// its flash (`FLASH` in qemu/memory.x). An image linked with another board's
 /// memory map (the Pico's flash starts at `0x1000_0000`) does not start.
@@ -56,6 +64,13 @@ pub struct Image {
     pub sections: Vec<Section>,
     /// Allocator symbols found (there should be none).
     pub allocator_symbols: Vec<String>,
+    /// `[__settings_start, __settings_end)` from the linker script, if
+    /// the image has them (the Pico image does).
+    pub settings: Option<std::ops::Range<u64>>,
+    /// End of the bytes stored in the XIP flash window: the highest load
+    /// address (`p_paddr + p_filesz`) of a loadable segment there, so
+    /// `.data`'s initial values count where they are stored.
+    pub flash_end: u64,
 }
 
 impl Image {
@@ -90,9 +105,20 @@ impl Image {
             .collect();
         allocator_symbols.sort();
         allocator_symbols.dedup();
+        let symbol = |name: &str| {
+            file.symbols()
+                .find(|symbol| symbol.name() == Ok(name))
+                .map(|symbol| symbol.address())
+        };
+        let settings = symbol("__settings_start")
+            .zip(symbol("__settings_end"))
+            .map(|(start, end)| start..end);
+        let flash_end = stored_end(&data);
         Ok(Self {
             sections,
             allocator_symbols,
+            settings,
+            flash_end,
         })
     }
 
@@ -155,7 +181,8 @@ impl Image {
 }
 
 /// Prints the Pico image's sections and budgets; fails if `.boot2` is misplaced,
-/// a budget is exceeded or an allocator is linked.
+/// a budget is exceeded, an allocator is linked or the image reaches into
+/// the settings region.
 pub fn check_pico(path: &Path) -> Result<()> {
     let image = Image::read(path)?;
     println!("{}", path.display());
@@ -205,6 +232,9 @@ pub fn check_pico(path: &Path) -> Result<()> {
         problems.push(error.to_string());
     } else {
         println!("  no allocator linked");
+    }
+    if let Err(error) = check_settings_region(&image) {
+        problems.push(error.to_string());
     }
 
     if problems.is_empty() {
@@ -284,6 +314,63 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
     Ok(())
 }
 
+/// The highest load address (`p_paddr + p_filesz`) of a loadable segment
+/// in the XIP flash window of a 32-bit Arm ELF; 0 for anything else.
+fn stored_end(data: &[u8]) -> u64 {
+    let Ok(file) = ElfFile32::<Endianness>::parse(data) else {
+        return 0;
+    };
+    let endian = file.endian();
+    file.elf_program_headers()
+        .iter()
+        .filter(|header| header.p_type(endian) == elf::PT_LOAD)
+        .map(|header| {
+            let start = u64::from(header.p_paddr(endian));
+            (start, start + u64::from(header.p_filesz(endian)))
+        })
+        .filter(|&(start, end)| end > start && XIP.contains(&start))
+        .map(|(_, end)| end)
+        .max()
+        .unwrap_or(0)
+}
+
+/// Fails unless the image names the settings region of memory.x, it is
+/// [`SETTINGS_REGION`], and nothing stored in flash reaches into it.
+fn check_settings_region(image: &Image) -> Result<()> {
+    let Some(region) = image.settings.clone() else {
+        bail!(
+            "no `__settings_start`/`__settings_end` symbols: memory.x must reserve the settings \
+             region"
+        );
+    };
+    if region != SETTINGS_REGION {
+        bail!(
+            "the settings region is {:#010x}..{:#010x} in memory.x, but the firmware's store \
+             uses {:#010x}..{:#010x}",
+            region.start,
+            region.end,
+            SETTINGS_REGION.start,
+            SETTINGS_REGION.end
+        );
+    }
+    if image.flash_end > region.start {
+        bail!(
+            "the image's flash contents end at {:#010x}, inside the settings region at \
+             {:#010x}",
+            image.flash_end,
+            region.start
+        );
+    }
+    println!(
+        "  settings region {:#010x}..{:#010x} ({} KiB) clear: the image ends at {:#010x}",
+        region.start,
+        region.end,
+        (region.end - region.start) / 1024,
+        image.flash_end
+    );
+    Ok(())
+}
+
 fn stored_names(image: &Image) -> String {
     image
         .sections
@@ -310,5 +397,28 @@ mod tests {
         assert!(image.check_no_allocator().is_err());
         assert!(image.section(".text").is_some_and(|text| text.size > 0));
         assert!(image.flash() > 0);
+    }
+
+    fn image(settings: Option<std::ops::Range<u64>>, flash_end: u64) -> Image {
+        Image {
+            sections: Vec::new(),
+            allocator_symbols: Vec::new(),
+            settings,
+            flash_end,
+        }
+    }
+
+    #[test]
+    fn the_settings_region_must_be_reserved_and_clear() {
+        assert!(check_settings_region(&image(Some(SETTINGS_REGION), 0x1000_c000)).is_ok());
+        assert!(
+            check_settings_region(&image(Some(SETTINGS_REGION), SETTINGS_REGION.start)).is_ok()
+        );
+        let into = check_settings_region(&image(Some(SETTINGS_REGION), SETTINGS_REGION.start + 4));
+        assert!(format!("{:#}", into.unwrap_err()).contains("inside the settings region"));
+        let moved = check_settings_region(&image(Some(0x1010_0000..0x1010_4000), 0x1000_c000));
+        assert!(format!("{:#}", moved.unwrap_err()).contains("the firmware's store uses"));
+        let missing = check_settings_region(&image(None, 0x1000_c000));
+        assert!(format!("{:#}", missing.unwrap_err()).contains("must reserve"));
     }
 }

@@ -66,12 +66,17 @@
 
 #[cfg(feature = "calibrate")]
 mod calibrate;
+mod console;
+mod handler;
 mod rp2040_pwm;
 mod servo_pwm;
+mod settings;
 
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_rp::interrupt::{self, InterruptExt, Priority};
+use embassy_rp::peripherals::UART0;
+use embassy_rp::uart::{self, BufferedInterruptHandler, BufferedUart};
 use embassy_rp::watchdog::{ResetReason, Watchdog};
 use embassy_time::{Duration, Instant};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
@@ -84,6 +89,7 @@ use idle_head::{Axis, Playback};
 use panic_probe as _;
 use static_cell::ConstStaticCell;
 
+use crate::console::{PORT_PRIORITY, PicoSession, Queue, QueueHandler, UART_BAUD};
 use crate::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use crate::servo_pwm::ServoPwm;
 
@@ -124,6 +130,19 @@ static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::
 
 /// The channels the buffers go round through.
 static EXCHANGE: Exchange = Exchange::new();
+
+/// Actions from the console ports to the frame task.
+static COMMANDS: Queue = Queue::new();
+
+/// The UART console's buffers: a reply line fits the transmit buffer; the
+/// receive buffer holds a line while the loop generator keeps thread mode
+/// busy (about 2 ms, 23 bytes at 115200 baud).
+static UART_TX: ConstStaticCell<[u8; 128]> = ConstStaticCell::new([0; 128]);
+static UART_RX: ConstStaticCell<[u8; 64]> = ConstStaticCell::new([0; 64]);
+
+embassy_rp::bind_interrupts!(struct Irqs {
+    UART0_IRQ => BufferedInterruptHandler<UART0>;
+});
 
 /// The frame task's executor, above thread mode.
 static FRAME_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
@@ -184,6 +203,11 @@ async fn main(spawner: Spawner) {
         );
     }
 
+    // Before the first frame: nothing else runs yet while the store is read.
+    if let Some(mut store) = settings::open::<settings::Probe>(p.FLASH) {
+        settings::probe(&mut store).await;
+    }
+
     let [first, spare] = SETS.take();
     let start = Instant::now();
     let generated = first.generate(&DEFAULT_HEAD);
@@ -238,6 +262,36 @@ async fn main(spawner: Spawner) {
         Ok(token) => frames.spawn(token),
         Err(_) => defmt::error!("frame task already running"),
     }
+
+    let mut uart_config = uart::Config::default();
+    uart_config.baudrate = UART_BAUD;
+    let uart = BufferedUart::new(
+        p.UART0,
+        p.PIN_0,
+        p.PIN_1,
+        Irqs,
+        UART_TX.take(),
+        UART_RX.take(),
+        uart_config,
+    );
+    interrupt::UART0_IRQ.set_priority(PORT_PRIORITY);
+    match uart_console(uart) {
+        Ok(token) => {
+            spawner.spawn(token);
+            defmt::info!("console: UART0 GP0 TX, GP1 RX, {=u32} 8N1", UART_BAUD);
+        }
+        Err(_) => defmt::error!("uart console task already running"),
+    }
+}
+
+/// The console on UART0, for as long as the board runs.
+#[embassy_executor::task]
+async fn uart_console(mut uart: BufferedUart) {
+    let mut session = PicoSession::new();
+    let mut handler = QueueHandler::new(&COMMANDS);
+    // A UART never goes away: `serve` only returns if it did.
+    let gone = console::serve(&mut uart, &mut session, &mut handler).await;
+    defmt::error!("console uart ended: {}", gone);
 }
 
 /// Generates each next loop set while the frames play (thread mode).
@@ -289,12 +343,12 @@ async fn frame_task(mut driver: FrameDriver<ServoPwm>, first: SetRef, watchdog: 
         )
     };
     let start = Instant::now().as_ticks();
-    let Ok(mut frames) =
-        FrameLoop::new(idle, playback.frame_period(), embassy_time::TICK_HZ, start)
+    let Ok(frames) = FrameLoop::new(idle, playback.frame_period(), embassy_time::TICK_HZ, start)
     else {
         defmt::error!("frame period below one timer tick");
         return;
     };
+    let mut frames = frames.with_commands(&COMMANDS);
     let mut hooks = PicoHooks::new(watchdog, playback);
     let stats = idle_head::frame_task::run(&mut driver, &mut frames, &mut hooks).await;
     // `PicoHooks` only stops in the watchdog drill; then the watchdog resets
