@@ -71,11 +71,12 @@ mod handler;
 mod rp2040_pwm;
 mod servo_pwm;
 mod settings;
+mod usb;
 
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_rp::interrupt::{self, InterruptExt, Priority};
-use embassy_rp::peripherals::UART0;
+use embassy_rp::peripherals::{UART0, USB};
 use embassy_rp::uart::{self, BufferedInterruptHandler, BufferedUart};
 use embassy_rp::watchdog::{ResetReason, Watchdog};
 use embassy_time::{Duration, Instant};
@@ -142,6 +143,7 @@ static UART_RX: ConstStaticCell<[u8; 64]> = ConstStaticCell::new([0; 64]);
 
 embassy_rp::bind_interrupts!(struct Irqs {
     UART0_IRQ => BufferedInterruptHandler<UART0>;
+    USBCTRL_IRQ => embassy_rp::usb::InterruptHandler<USB>;
 });
 
 /// The frame task's executor, above thread mode.
@@ -281,6 +283,42 @@ async fn main(spawner: Spawner) {
             defmt::info!("console: UART0 GP0 TX, GP1 RX, {=u32} 8N1", UART_BAUD);
         }
         Err(_) => defmt::error!("uart console task already running"),
+    }
+
+    let (device, serial) = usb::build(embassy_rp::usb::Driver::new(p.USB, Irqs));
+    interrupt::USBCTRL_IRQ.set_priority(PORT_PRIORITY);
+    match (usb_device(device), usb_console(serial)) {
+        (Ok(device), Ok(console)) => {
+            spawner.spawn(device);
+            spawner.spawn(console);
+            defmt::info!(
+                "console: USB CDC-ACM {=u16:04x}:{=u16:04x}",
+                usb::VID,
+                usb::PID
+            );
+        }
+        _ => defmt::error!("usb tasks already running"),
+    }
+}
+
+/// The USB device: enumeration, control requests, bus resets.
+#[embassy_executor::task]
+async fn usb_device(mut device: usb::Device) {
+    device.run().await
+}
+
+/// The console on the USB serial port: one session per connection.
+#[embassy_executor::task]
+async fn usb_console(mut serial: usb::Serial) {
+    let mut session = PicoSession::new();
+    let mut handler = QueueHandler::new(&COMMANDS);
+    loop {
+        serial.wait_connection().await;
+        session.reset();
+        let mut port = usb::UsbPort {
+            serial: &mut serial,
+        };
+        console::serve(&mut port, &mut session, &mut handler).await;
     }
 }
 
