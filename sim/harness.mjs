@@ -16,6 +16,10 @@
 //   ns:         virtual time to run, in nanoseconds,
 //   wall_ms:    wall-time limit,
 //   silence_ns: end the run when nothing (log byte, pin edge) happens for this long,
+//   uart:       optional, bytes for UART0's RX line: {hex, at_ns, byte_ns}: from virtual
+//               time at_ns on, one byte every byte_ns (the line rate); boot 0 only,
+//   usb:        optional, bytes for the USB serial port: {hex, at_ns}: rp2040js's CDC-ACM
+//               host enumerates the device, and from at_ns on sends the bytes; boot 0 only,
 // }
 //
 // Events ("ns" is virtual time since power-on, across resets):
@@ -27,11 +31,16 @@
 //   {"ev":"call","cycles":..,"ns":..}               one call of the probed function
 //   {"ev":"watchdog","ns":..,"reason":1}            the watchdog fired (1 timer, 2 forced)
 //   {"ev":"stack","n":0,"low":..}                   lowest stack address written in boot n
+//   {"ev":"uart","ns":..,"hex":".."}                bytes UART0 sent (TX), stamped with the first
+//   {"ev":"uart_rx","ns":..,"n":..}                  the last scripted byte went onto the RX line
+//   {"ev":"uart_overrun","ns":..}                   a scripted byte found UART0's RX FIFO full
+//   {"ev":"usb_connected","ns":..}                  the CDC-ACM host configured the device
+//   {"ev":"usb","ns":..,"hex":".."}                 bytes the device sent on its CDC-ACM IN endpoint
 //   {"ev":"emu","level":"warn","msg":".."}          a complaint of the emulator
 //   {"ev":"end","why":"time|silent|asleep|wall|break|error","ns":..,"instructions":..,"wall_ms":..}
 
 import { readFileSync } from 'node:fs';
-import { RP2040 } from 'rp2040js';
+import { RP2040, USBCDC } from 'rp2040js';
 
 const cfg = JSON.parse(process.argv[2] ?? '{}');
 const FLASH_START = 0x10000000;
@@ -45,6 +54,9 @@ const RTT_FLAGS = 44;
 const RTT_BUFFER = 28;
 const RTT_SIZE = 32;
 const RTT_BLOCK_IF_FULL = 2; // what a debugger sets, so that no log byte is dropped
+const UARTDR = 0x00;
+const UARTDMACR = 0x48;
+const UART_TXINTR = 1 << 5;
 
 const image = readFileSync(cfg.flash);
 const started = Date.now();
@@ -100,6 +112,13 @@ function powerUp(kept) {
   for (const pin of cfg.pins) {
     chip.gpio[pin].addListener((state) => edge(pin, state === 1));
   }
+  uartAsOnTheChip(chip.uart[0]);
+  if (cfg.usb && !kept) usbHost(chip);
+  chip.uart[0].onByte = (byte) => {
+    if (uartTx.bytes.length === 0) uartTx.ns = now();
+    uartTx.bytes.push(byte);
+    lastActivity = now();
+  };
   for (const slice of cfg.slices) {
     const channel = chip.pwm.channels[slice];
     const write = channel.writeRegister.bind(channel);
@@ -120,6 +139,129 @@ function powerUp(kept) {
   chip.core.VTOR = cfg.vtor;
   chip.core.reset(); // SP and PC from the vector table, as boot2 hands over
   return chip;
+}
+
+// Two gaps of rp2040js's UART, bridged as the PL011 behaves:
+// - It has no DMA control register (UARTDMACR): a read gives 0xffffffff, as
+//   for any register it lacks, so a driver that checks for DMA first
+//   (embassy-rp's buffered UART) returns from every interrupt without
+//   serving it, and the interrupt never ends. Here it reads back what was
+//   written, 0 after reset.
+// - It raises the transmit interrupt again on every interrupt check, so once
+//   the firmware unmasks it (embassy-rp's buffered UART keeps it unmasked)
+//   it never clears. The PL011 raises it when its transmit FIFO falls to the
+//   trigger level; the emulator sends each byte at once, so here it is
+//   raised once per byte written, and stays cleared when the firmware
+//   clears it.
+function uartAsOnTheChip(uart) {
+  let dmacr = 0;
+  uart.checkInterrupts = function () {
+    this.rp2040.setInterrupt(this.irq, !!(this.interruptStatus & this.interruptMask));
+  };
+  const read = uart.readUint32.bind(uart);
+  uart.readUint32 = (offset) => (offset === UARTDMACR ? dmacr : read(offset));
+  const write = uart.writeUint32.bind(uart);
+  uart.writeUint32 = (offset, value) => {
+    if (offset === UARTDMACR) {
+      dmacr = value & 0x7;
+      return;
+    }
+    write(offset, value);
+    if (offset === UARTDR && uart.enabled) {
+      uart.interruptStatus |= UART_TXINTR;
+      uart.checkInterrupts();
+    }
+  };
+}
+
+// Two gaps of rp2040js's USB device controller and its CDC-ACM host, bridged
+// as the chip and a real host behave:
+// - The controller clears an OUT buffer's AVAILABLE bit as soon as the
+//   firmware sets it, before any packet has arrived. On the chip it stays
+//   set until a packet is in the buffer. embassy-rp waits for the bit to
+//   clear and then reads the buffer with the length it wrote itself (64), so
+//   it reads stale bytes as a packet. Here the bit stays set until the host's
+//   packet is written into the buffer.
+// - The host answers every OUT transfer at once, with a zero-length packet
+//   when it has nothing to send. A real host sends nothing (the device NAKs)
+//   until it has data. Here a transfer waits until there are bytes.
+const EP0_IN_BUFFER_CONTROL = 0x80;
+const EP15_OUT_BUFFER_CONTROL = 0xfc;
+const USB_BUF_CTRL_FULL = 1 << 15;
+const USB_BUF_CTRL_AVAILABLE = 1 << 10;
+function usbHost(chip) {
+  const usb = chip.usbCtrl;
+  const view = chip.usbDPRAMView;
+  const cdc = new USBCDC(usb);
+  const updated = usb.DPRAMUpdated.bind(usb);
+  usb.DPRAMUpdated = (offset, value) => {
+    updated(offset, value);
+    const out = (offset & 4) !== 0;
+    const endpoint = (offset - EP0_IN_BUFFER_CONTROL) >> 3;
+    if (out && endpoint !== 0 && value & USB_BUF_CTRL_AVAILABLE) {
+      if (offset >= EP0_IN_BUFFER_CONTROL && offset <= EP15_OUT_BUFFER_CONTROL) {
+        const now = view.getUint32(offset, true);
+        if (!(now & USB_BUF_CTRL_FULL)) view.setUint32(offset, now | USB_BUF_CTRL_AVAILABLE, true);
+      }
+    }
+  };
+  const finish = usb.finishRead.bind(usb);
+  usb.finishRead = (endpoint, buffer) => {
+    finish(endpoint, buffer);
+    const offset = EP0_IN_BUFFER_CONTROL + endpoint * 8 + 4;
+    view.setUint32(offset, view.getUint32(offset, true) & ~USB_BUF_CTRL_AVAILABLE, true);
+  };
+  const read = usb.onEndpointRead;
+  let waiting = null; // an OUT transfer the host has not answered yet
+  usb.onEndpointRead = (endpoint, size) => {
+    if (endpoint === cdc.outEndpoint && cdc.txFIFO.empty) waiting = { endpoint, size };
+    else read(endpoint, size);
+  };
+  cdc.onDeviceConnected = () => {
+    emit({ ev: 'usb_connected', ns: now() });
+    usbSend = () => {
+      for (const byte of Buffer.from(cfg.usb.hex, 'hex')) cdc.sendSerialByte(byte);
+      if (waiting) {
+        const { endpoint, size } = waiting;
+        waiting = null;
+        read(endpoint, size);
+      }
+    };
+  };
+  cdc.onSerialData = (bytes) => {
+    emit({ ev: 'usb', ns: now(), hex: Buffer.from(bytes).toString('hex') });
+    lastActivity = now();
+  };
+}
+let usbSend = null; // sends the USB script, once the device is configured
+function feedUsb() {
+  if (usbSend && now() >= cfg.usb.at_ns) {
+    usbSend();
+    usbSend = null;
+  }
+}
+
+// UART0's scripted RX line (boot 0) and the bytes it sent.
+const script = cfg.uart ? Buffer.from(cfg.uart.hex, 'hex') : Buffer.alloc(0);
+let scriptAt = 0;
+const uartTx = { bytes: [], ns: 0 };
+function uartDue() {
+  if (boot !== 0 || scriptAt >= script.length) return Infinity;
+  return cfg.uart.at_ns + scriptAt * cfg.uart.byte_ns;
+}
+function feedUart() {
+  if (now() < uartDue()) return;
+  const uart = mcu.uart[0];
+  if (uart.rxFIFO.full) emit({ ev: 'uart_overrun', ns: now() });
+  else uart.feedByte(script[scriptAt]);
+  scriptAt += 1;
+  lastActivity = now();
+  if (scriptAt === script.length) emit({ ev: 'uart_rx', ns: now(), n: scriptAt });
+}
+function flushUart() {
+  if (uartTx.bytes.length === 0) return;
+  emit({ ev: 'uart', ns: uartTx.ns, hex: Buffer.from(uartTx.bytes).toString('hex') });
+  uartTx.bytes = [];
 }
 
 function edge(pin, high, reset = false) {
@@ -192,7 +334,13 @@ function run() {
     const { core, clock } = mcu;
     for (let i = 0; i < 4096 && !stop && !watchdogFired; i++) {
       if (core.waiting) {
-        const wait = clock.nanosToNextAlarm;
+        let wait = clock.nanosToNextAlarm;
+        const due = uartDue() - now(); // asleep until the next scripted byte at the latest
+        if (due <= 0) {
+          feedUart();
+          continue;
+        }
+        if (due !== Infinity && (wait <= 0 || due < wait)) wait = due;
         if (wait <= 0) {
           stop = 'asleep';
           break;
@@ -215,9 +363,12 @@ function run() {
       const opcode = inFlash ? mcu.flash16[(pc - FLASH_START) >>> 1] : mcu.readUint16(pc);
       if (opcode === OP_SEV) core.eventRegistered = true;
       if ((i & 63) === 0 && cfg.rtt) drainRtt();
+      if ((i & 15) === 0 && cfg.uart) feedUart();
+      if ((i & 255) === 0 && usbSend) feedUsb();
     }
     if (cfg.rtt) drainRtt();
     flushRtt();
+    flushUart();
     if (watchdogFired) {
       emit({ ev: 'watchdog', ns: now(), reason: watchdogFired.reason });
       endBoot();

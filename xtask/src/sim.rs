@@ -9,11 +9,17 @@
 //! the duties the host computes with the same core (`pulses.rs` explains how
 //! PWM periods map to frames).
 
+mod exchange;
 mod expect;
 mod image;
 // The Pico image's own PWM clocking (divider, TOP, count length), compiled
 // here too, so the host's expectation uses exactly the firmware's numbers.
 mod node;
+// The Pico console's handler, compiled here too, for the replies the UART
+// exchange must bring back.
+#[path = "../../src/bin/pico/handler.rs"]
+#[allow(dead_code)]
+pub(crate) mod pico_handler;
 mod pulses;
 #[path = "../../src/bin/pico/rp2040_pwm.rs"]
 #[allow(dead_code, clippy::pedantic)]
@@ -87,8 +93,15 @@ pub fn command(args: &Args) -> Result<bool> {
         };
     }
     PICO.build(&root)?;
-    let report = run::simulate(&root, &PICO.elf(&metadata), args.virtual_time, args.timeout)?;
+    let report = run::simulate(
+        &root,
+        &PICO.elf(&metadata),
+        args.virtual_time,
+        args.timeout,
+        args.virtual_time > exchange::START + Duration::from_secs(1),
+    )?;
     print!("{}", report.log_text());
+    print!("{}", report.exchange.as_deref().unwrap_or_default());
     print!("{}", report.table());
     println!("{}", report.verdict());
     println!("{}", report.summary());

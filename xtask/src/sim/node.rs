@@ -137,6 +137,22 @@ pub struct Config {
     pub wall: Duration,
     /// Virtual time without a log byte or a pin edge after which the run ends.
     pub silence: Duration,
+    /// Bytes for UART0's RX line, if any.
+    pub uart: Option<UartScript>,
+    /// Bytes for the USB serial port (CDC-ACM), if any, and when to send
+    /// them.
+    pub usb: Option<(Vec<u8>, Duration)>,
+}
+
+/// Bytes the harness puts on UART0's RX line in boot 0.
+#[derive(Debug, Clone)]
+pub struct UartScript {
+    /// The bytes.
+    pub bytes: Vec<u8>,
+    /// Virtual time of the first.
+    pub start: Duration,
+    /// Time per byte (the line rate).
+    pub byte_time: Duration,
 }
 
 impl Config {
@@ -153,6 +169,15 @@ impl Config {
             "ns": nanos(self.virtual_time),
             "wall_ms": self.wall.as_millis(),
             "silence_ns": nanos(self.silence),
+            "uart": self.uart.as_ref().map(|uart| json!({
+                "hex": uart.bytes.iter().map(|b| format!("{b:02x}")).collect::<String>(),
+                "at_ns": nanos(uart.start),
+                "byte_ns": nanos(uart.byte_time),
+            })),
+            "usb": self.usb.as_ref().map(|(bytes, at)| json!({
+                "hex": bytes.iter().map(|b| format!("{b:02x}")).collect::<String>(),
+                "at_ns": nanos(*at),
+            })),
         })
     }
 }

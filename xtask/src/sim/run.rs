@@ -1,7 +1,7 @@
 //! One emulator run of a Pico image: the harness's events sorted into boots,
 //! the RTT log decoded, every servo's pulses checked against the host.
 
-use std::{path::Path, time::Duration};
+use std::{fmt::Write as _, path::Path, time::Duration};
 
 use super::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use anyhow::{Context, Result, bail};
@@ -10,7 +10,7 @@ use idle_head::driver::DriverConfig;
 use serde_json::Value;
 
 use super::{
-    expect,
+    exchange, expect,
     image::{PicoImage, VECTOR_TABLE},
     node,
     pulses::{self, Limits, ServoCheck, Timing, Train},
@@ -46,6 +46,16 @@ pub struct Boot {
     pub stack_low: Option<u64>,
     /// Peak stack use, bytes, from `stack_low`.
     pub stack_peak: Option<u64>,
+    /// Bytes UART0 sent.
+    pub uart: Vec<u8>,
+    /// Scripted bytes that found UART0's receive FIFO full.
+    pub uart_overruns: usize,
+    /// When the last scripted byte went onto the RX line, ns.
+    pub uart_sent: Option<f64>,
+    /// When the emulator's USB host had configured the device, ns.
+    pub usb_connected: Option<f64>,
+    /// Bytes the device sent on its CDC-ACM port.
+    pub usb: Vec<u8>,
 }
 
 /// How the harness ended.
@@ -103,10 +113,20 @@ pub struct Report {
     pub emulator: Vec<(String, usize)>,
     /// Problems with the run itself (it stopped early, a frame is missing...).
     pub problems: Vec<String>,
+    /// The UART exchange as a transcript, if the run had one.
+    pub exchange: Option<String>,
 }
 
-/// Runs `elf` for `virtual_time` (at most `wall` of wall time) and checks it.
-pub fn simulate(root: &Path, elf: &Path, virtual_time: Duration, wall: Duration) -> Result<Report> {
+/// Runs `elf` for `virtual_time` (at most `wall` of wall time) and checks
+/// it; with `exchange`, also the console exchange over UART0
+/// ([`exchange`]).
+pub fn simulate(
+    root: &Path,
+    elf: &Path,
+    virtual_time: Duration,
+    wall: Duration,
+    exchange: bool,
+) -> Result<Report> {
     let image = PicoImage::read(elf)?;
     let bytes = std::fs::read(elf)?;
     let table = Table::parse(&bytes)
@@ -127,6 +147,12 @@ pub fn simulate(root: &Path, elf: &Path, virtual_time: Duration, wall: Duration)
         virtual_time,
         wall,
         silence: SILENCE,
+        uart: exchange.then(|| node::UartScript {
+            bytes: exchange::script(),
+            start: exchange::START,
+            byte_time: exchange::BYTE_TIME,
+        }),
+        usb: exchange.then(|| (exchange::script(), exchange::USB_START)),
     };
     println!(
         "$ (cd sim && node harness.mjs ...)  # {} of flash, {:.1} s of virtual time",
@@ -156,7 +182,70 @@ pub fn simulate(root: &Path, elf: &Path, virtual_time: Duration, wall: Duration)
         report.problems.push(problem);
     }
     check(&mut report)?;
+    if exchange {
+        check_exchange(&mut report);
+    }
     Ok(report)
+}
+
+/// The UART exchange of boot 0 against the host's replies.
+fn check_exchange(report: &mut Report) {
+    let Some(boot) = report.boots.first() else {
+        return;
+    };
+    let script = exchange::script();
+    let (transcript, problems) = exchange::check(&script, &boot.uart);
+    let mut text = format!(
+        "UART0 exchange ({} bytes in from {:.1} s at 115200 baud, {} bytes out):\n{transcript}",
+        script.len(),
+        exchange::START.as_secs_f64(),
+        boot.uart.len()
+    );
+    match boot.uart_sent {
+        Some(ns) => {
+            let _ = writeln!(text, "  (last byte in at {:.4} s)", ns / 1e9);
+        }
+        None => report
+            .problems
+            .push("the harness did not send the whole UART script".to_owned()),
+    }
+    if boot.uart_overruns > 0 {
+        report.problems.push(format!(
+            "{} UART bytes found the receive FIFO full (the firmware did not read in time)",
+            boot.uart_overruns
+        ));
+    }
+    let (usb, usb_problems) = exchange::check(&script, &boot.usb);
+    match boot.usb_connected {
+        Some(ns) => {
+            let _ = write!(
+                text,
+                "USB CDC-ACM exchange (enumerated and configured at {:.4} s; {} bytes in at {:.1} s, {} bytes out):\n{usb}",
+                ns / 1e9,
+                script.len(),
+                exchange::USB_START.as_secs_f64(),
+                boot.usb.len()
+            );
+            report.problems.extend(usb_problems.into_iter().map(|p| format!("USB: {p}")));
+        }
+        None => report
+            .problems
+            .push("the emulator's USB host did not configure the device".to_owned()),
+    }
+    // The script's `center` went through the queue to the frame task, which
+    // logs each action it applies with its answer.
+    let applied = boot
+        .log
+        .iter()
+        .any(|(_, line)| line.message.contains("Center") && line.message.contains(": ok "));
+    if !applied {
+        report.problems.push(
+            "the frame task did not log the UART's `center` as applied (`frame <n>: Center ...: ok`)"
+                .to_owned(),
+        );
+    }
+    report.problems.extend(problems);
+    report.exchange = Some(text);
 }
 
 fn number(event: &Value, key: &str) -> Result<f64> {
@@ -258,6 +347,15 @@ fn sort(
                 }
             }
             "call" => boot.frame_cycles.push(integer(event, "cycles")?),
+            "uart" => boot
+                .uart
+                .extend(hex(event["hex"].as_str().unwrap_or_default())?),
+            "uart_overrun" => boot.uart_overruns += 1,
+            "uart_rx" => boot.uart_sent = Some(number(event, "ns")?),
+            "usb_connected" => boot.usb_connected = Some(number(event, "ns")?),
+            "usb" => boot
+                .usb
+                .extend(hex(event["hex"].as_str().unwrap_or_default())?),
             "watchdog" => boot.watchdog = true,
             "stack" => boot.stack_low = Some(integer(event, "low")?),
             _ => {}

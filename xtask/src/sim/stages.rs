@@ -43,8 +43,9 @@ const DRILL_TIME: Duration = Duration::from_millis(6_500);
 /// every check passes over at least [`MIN_FRAMES`] frames and the loops'
 /// checksum is the host's. Returns the run for the memory stage.
 pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
-    let report = run::simulate(root, &PICO.elf(metadata), DEFAULT_TIME, WALL)?;
+    let report = run::simulate(root, &PICO.elf(metadata), DEFAULT_TIME, WALL, true)?;
     print!("{}", report.log_text());
+    print!("{}", report.exchange.as_deref().unwrap_or_default());
     print!("{}", report.table());
     println!("{}", report.verdict());
     println!("{}", report.summary());
@@ -90,7 +91,7 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
         ),
     )?;
     let elf = target.join(TARGET).join("release").join(PICO.bin);
-    let report = run::simulate(root, &elf, DRILL_TIME, WALL)?;
+    let report = run::simulate(root, &elf, DRILL_TIME, WALL, false)?;
     print!("{}", report.log_text());
     print!("{}", report.table());
     println!("{}", report.verdict());
@@ -193,6 +194,8 @@ pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
             virtual_time: Duration::from_secs(if name == "slow" { 3600 } else { 2 }),
             wall,
             silence,
+            uart: None,
+            usb: None,
         };
         let events = node::run(root, &config)?;
         let end = run::end_of(&events)?;
