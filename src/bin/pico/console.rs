@@ -20,7 +20,7 @@ use embassy_rp::interrupt::Priority;
 use embassy_rp::uart::BufferedUart;
 use idle_head::console::{Handler, Session};
 
-pub use crate::handler::{Queue, QueueHandler};
+pub use crate::handler::{PicoSession, Queue, QueueHandler};
 
 /// The ports' interrupt priority: below the frame task's (`P1`), above
 /// thread mode, where the console tasks run.
@@ -28,10 +28,6 @@ pub const PORT_PRIORITY: Priority = Priority::P2;
 
 /// The UART's baud rate (8 data bits, no parity, 1 stop bit).
 pub const UART_BAUD: u32 = 115_200;
-
-/// A console session on the Pico: lines up to 80 bytes (a terminal's
-/// width), replies up to 128 bytes.
-pub type PicoSession = Session<80, 128>;
 
 /// Bytes [`serve`] reads at once: a full-speed USB packet.
 pub const READ_CHUNK: usize = 64;

@@ -10,7 +10,11 @@ use core::fmt::Write as _;
 
 use idle_head::behaviour::CommandQueue;
 use idle_head::command::Command;
-use idle_head::console::{ErrorCode, HELP, Handler, Reply};
+use idle_head::console::{ErrorCode, HELP, Handler, Reply, Session};
+
+/// A console session on the Pico: lines up to 96 bytes, replies up to 160,
+/// as `docs/protocol.md` promises.
+pub type PicoSession = Session<96, 160>;
 
 /// The console's command queue, drained by the frame task.
 pub type Queue = CommandQueue;

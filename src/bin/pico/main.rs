@@ -135,10 +135,11 @@ static EXCHANGE: Exchange = Exchange::new();
 /// Actions from the console ports to the frame task.
 static COMMANDS: Queue = Queue::new();
 
-/// The UART console's buffers: a reply line fits the transmit buffer; the
-/// receive buffer holds a line while the loop generator keeps thread mode
-/// busy (about 2 ms, 23 bytes at 115200 baud).
-static UART_TX: ConstStaticCell<[u8; 128]> = ConstStaticCell::new([0; 128]);
+/// The UART console's buffers: the console task waits while a reply
+/// drains from the transmit buffer; the receive buffer holds what arrives
+/// while the loop generator keeps thread mode busy (about 2 ms, 23 bytes
+/// at 115200 baud).
+static UART_TX: ConstStaticCell<[u8; 64]> = ConstStaticCell::new([0; 64]);
 static UART_RX: ConstStaticCell<[u8; 64]> = ConstStaticCell::new([0; 64]);
 
 embassy_rp::bind_interrupts!(struct Irqs {
@@ -206,9 +207,7 @@ async fn main(spawner: Spawner) {
     }
 
     // Before the first frame: nothing else runs yet while the store is read.
-    if let Some(mut store) = settings::open::<settings::Probe>(p.FLASH) {
-        settings::probe(&mut store).await;
-    }
+    settings::probe(p.FLASH);
 
     let [first, spare] = SETS.take();
     let start = Instant::now();

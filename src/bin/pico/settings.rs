@@ -16,7 +16,10 @@
 //! type; until then [`Probe`] stands in for it, a record that decodes
 //! nothing.
 
+use core::future::Future;
 use core::ops::Range;
+use core::pin::pin;
+use core::task::{Context, Poll, Waker};
 
 use embassy_embedded_hal::adapter::BlockingAsync;
 use embassy_rp::Peri;
@@ -37,6 +40,9 @@ pub const SETTINGS_RANGE: Range<u32> = {
 };
 /// Where the region appears in the address space (XIP base + offset).
 pub const SETTINGS_ADDRESS: u32 = 0x1000_0000 + SETTINGS_RANGE.start;
+// memory.x reserves the same sectors (`SETTINGS`); `cargo xtask test`
+// checks that no code is linked there.
+const _: () = assert!(SETTINGS_ADDRESS == 0x101f_c000);
 
 /// The flash driver the store runs on.
 pub type PicoFlash = BlockingAsync<Flash<'static, FLASH, Blocking, FLASH_SIZE>>;
@@ -64,7 +70,7 @@ impl Record for Probe {
 
 /// Opens the store on the flash peripheral. `None` (logged) if the region
 /// is not a valid store range, which `SETTINGS_RANGE` rules out.
-pub fn open<R: Record>(flash: Peri<'static, FLASH>) -> Option<Store<R>> {
+fn open<R: Record>(flash: Peri<'static, FLASH>) -> Option<Store<R>> {
     let flash = BlockingAsync::new(Flash::new_blocking(flash));
     match Store::new(flash, SETTINGS_RANGE) {
         Ok(store) => Some(store),
@@ -75,11 +81,34 @@ pub fn open<R: Record>(flash: Peri<'static, FLASH>) -> Option<Store<R>> {
     }
 }
 
-/// Reads what the store holds and logs it: the head runs on its built-in
-/// settings whatever it finds.
-pub async fn probe(store: &mut Store<Probe>) {
+/// Opens the store on the flash peripheral, reads what it holds and logs
+/// it: the head runs on its built-in settings whatever it finds.
+///
+/// The store and its buffer live on the stack for this call only (at boot,
+/// before the loop generator's deeper stack), not in the main task's
+/// static state.
+pub fn probe(flash: Peri<'static, FLASH>) {
+    let Some(mut store) = open::<Probe>(flash) else {
+        return;
+    };
+    match at_once(store.load()) {
+        Some(loaded) => log(loaded),
+        None => defmt::error!("settings: the blocking flash driver waited"),
+    }
+}
+
+/// Polls `future` once: every flash operation of [`PicoFlash`] is blocking
+/// underneath, so the store's futures complete on their first poll.
+fn at_once<F: Future>(future: F) -> Option<F::Output> {
+    match pin!(future).poll(&mut Context::from_waker(Waker::noop())) {
+        Poll::Ready(output) => Some(output),
+        Poll::Pending => None,
+    }
+}
+
+fn log(loaded: Result<Probe, LoadError<FlashError>>) {
     let at = SETTINGS_ADDRESS;
-    match store.load().await {
+    match loaded {
         Err(LoadError::Empty) => {
             defmt::info!("settings: defaults (empty store at {=u32:#010x})", at);
         }

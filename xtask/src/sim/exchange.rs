@@ -45,8 +45,8 @@ const SCRIPT: &[&[u8]] = &[
 /// The bytes of the whole script.
 pub fn script() -> Vec<u8> {
     let mut bytes: Vec<u8> = SCRIPT.concat();
-    // An overlong line: one byte past the Pico's 80.
-    bytes.extend(std::iter::repeat_n(b'a', 81));
+    // An overlong line: one byte past the protocol's 96.
+    bytes.extend(std::iter::repeat_n(b'a', 97));
     bytes.extend(b"\r\n");
     // Machine mode: `#<seq> <command> *<crc>`.
     let body = "#7 help";
