@@ -79,7 +79,7 @@ pub fn check(script: &[u8], sent: &[u8]) -> (String, Vec<String>) {
     let mut problems = Vec::new();
     let lines: Vec<&[u8]> = script
         .split_inclusive(|&b| b == b'\n' || b == b'\r')
-        .filter(|line| line.len() > 1 || !matches!(line, [b'\n'] | [b'\r']))
+        .filter(|line| !matches!(line, [b'\n' | b'\r']))
         .collect();
     for (i, want) in want.iter().enumerate() {
         let line = lines.get(i).map_or_else(String::new, |l| printable(l));

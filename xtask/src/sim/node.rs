@@ -1,6 +1,7 @@
 //! Node, the emulator package and one run of `sim/harness.mjs`.
 
 use std::{
+    fmt::Write as _,
     io::{BufRead, BufReader},
     path::{Path, PathBuf},
     process::{Command, Stdio},
@@ -170,16 +171,24 @@ impl Config {
             "wall_ms": self.wall.as_millis(),
             "silence_ns": nanos(self.silence),
             "uart": self.uart.as_ref().map(|uart| json!({
-                "hex": uart.bytes.iter().map(|b| format!("{b:02x}")).collect::<String>(),
+                "hex": hex(&uart.bytes),
                 "at_ns": nanos(uart.start),
                 "byte_ns": nanos(uart.byte_time),
             })),
             "usb": self.usb.as_ref().map(|(bytes, at)| json!({
-                "hex": bytes.iter().map(|b| format!("{b:02x}")).collect::<String>(),
+                "hex": hex(bytes),
                 "at_ns": nanos(*at),
             })),
         })
     }
+}
+
+/// `bytes` as lower-case hex digits, as the harness reads them.
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().fold(String::new(), |mut text, byte| {
+        let _ = write!(text, "{byte:02x}");
+        text
+    })
 }
 
 fn nanos(duration: Duration) -> u64 {

@@ -226,7 +226,9 @@ fn check_exchange(report: &mut Report) {
                 exchange::USB_START.as_secs_f64(),
                 boot.usb.len()
             );
-            report.problems.extend(usb_problems.into_iter().map(|p| format!("USB: {p}")));
+            report
+                .problems
+                .extend(usb_problems.into_iter().map(|p| format!("USB: {p}")));
         }
         None => report
             .problems
@@ -347,15 +349,18 @@ fn sort(
                 }
             }
             "call" => boot.frame_cycles.push(integer(event, "cycles")?),
-            "uart" => boot
-                .uart
-                .extend(hex(event["hex"].as_str().unwrap_or_default())?),
+            "uart" | "usb" => {
+                let bytes = hex(event["hex"].as_str().unwrap_or_default())?;
+                let port = if kind == "uart" {
+                    &mut boot.uart
+                } else {
+                    &mut boot.usb
+                };
+                port.extend(bytes);
+            }
             "uart_overrun" => boot.uart_overruns += 1,
             "uart_rx" => boot.uart_sent = Some(number(event, "ns")?),
             "usb_connected" => boot.usb_connected = Some(number(event, "ns")?),
-            "usb" => boot
-                .usb
-                .extend(hex(event["hex"].as_str().unwrap_or_default())?),
             "watchdog" => boot.watchdog = true,
             "stack" => boot.stack_low = Some(integer(event, "low")?),
             _ => {}
