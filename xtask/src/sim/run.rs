@@ -349,21 +349,9 @@ fn sort(
                 }
             }
             "call" => boot.frame_cycles.push(integer(event, "cycles")?),
-            "uart" | "usb" => {
-                let bytes = hex(event["hex"].as_str().unwrap_or_default())?;
-                let port = if kind == "uart" {
-                    &mut boot.uart
-                } else {
-                    &mut boot.usb
-                };
-                port.extend(bytes);
-            }
-            "uart_overrun" => boot.uart_overruns += 1,
-            "uart_rx" => boot.uart_sent = Some(number(event, "ns")?),
-            "usb_connected" => boot.usb_connected = Some(number(event, "ns")?),
             "watchdog" => boot.watchdog = true,
             "stack" => boot.stack_low = Some(integer(event, "low")?),
-            _ => {}
+            _ => port_event(boot, kind, event)?,
         }
     }
     if report.end.why.is_empty() {
@@ -373,6 +361,24 @@ fn sort(
         last.end = report.end.ns;
     }
     Ok(report)
+}
+
+/// An event of the console ports (UART0, USB) into `boot`; others are
+/// ignored.
+fn port_event(boot: &mut Boot, kind: &str, event: &Value) -> Result<()> {
+    match kind {
+        "uart" => boot
+            .uart
+            .extend(hex(event["hex"].as_str().unwrap_or_default())?),
+        "usb" => boot
+            .usb
+            .extend(hex(event["hex"].as_str().unwrap_or_default())?),
+        "uart_overrun" => boot.uart_overruns += 1,
+        "uart_rx" => boot.uart_sent = Some(number(event, "ns")?),
+        "usb_connected" => boot.usb_connected = Some(number(event, "ns")?),
+        _ => {}
+    }
+    Ok(())
 }
 
 fn end(event: &Value) -> Result<End> {
