@@ -56,6 +56,21 @@
 //! checks the next boot: the watchdog reset logged, neutral pulses first, the
 //! motion faded in.
 //!
+//! # Console
+//!
+//! The command protocol of `docs/protocol.md` on two ports at once, each
+//! with its own session (`console.rs`): UART0 on GP0 (TX, pin 1) and GP1
+//! (RX, pin 2) at 115200 8N1, 3.3 V levels; and the board's USB port as a
+//! CDC-ACM serial port, `16c0:27dd` (`usb.rs`). Both tasks run in thread
+//! mode and hand actions to the frame task through [`COMMANDS`], which it
+//! drains between frames; the ports' interrupts sit below the frame task's.
+//!
+//! # Settings
+//!
+//! The last four 4 KiB flash sectors, `0x101f_c000..0x1020_0000`, hold the
+//! settings store (reserved in memory.x); it is opened and read at boot,
+//! before the first frame, and the log says what it holds (`settings.rs`).
+//!
 //! # Calibration
 //!
 //! `cargo run --release --features calibrate` plays a slow sweep of each
