@@ -446,14 +446,16 @@ struct Started<'a>(&'a Applied);
 impl defmt::Format for Started<'_> {
     fn format(&self, f: defmt::Formatter<'_>) {
         match self.0 {
-            Applied::Gesture(plan) => defmt::write!(
-                f,
-                "{=u8} cycle(s) of {} in {=u32} ms, intensity {=u8} %",
-                plan.cycles,
-                plan.amplitude,
-                plan.duration.0,
-                plan.intensity.get()
-            ),
+            Applied::Gesture(plan) => {
+                defmt::write!(
+                    f,
+                    "{=u8} cycle(s) of {} in {=u32} ms, intensity {=u8} %",
+                    plan.cycles,
+                    plan.amplitude,
+                    plan.duration.0,
+                    plan.intensity.get()
+                );
+            }
             Applied::Look(look) => {
                 defmt::write!(
                     f,
@@ -471,10 +473,14 @@ impl defmt::Format for Started<'_> {
                 }
             }
             Applied::Center(duration) => {
-                defmt::write!(f, "back to centre in {=u32} ms", duration.0)
+                defmt::write!(f, "back to centre in {=u32} ms", duration.0);
             }
-            Applied::Idle(gain) => defmt::write!(f, "idle to {=u8} %", gain.get()),
-            Applied::Stop => defmt::write!(f, "fading out"),
+            Applied::Idle(gain) => {
+                defmt::write!(f, "idle to {=u8} %", gain.get());
+            }
+            Applied::Stop => {
+                defmt::write!(f, "fading out");
+            }
         }
     }
 }
