@@ -7,9 +7,12 @@
 
 use std::{env, fs, path::PathBuf};
 
+/// The Pico's memory map: flash, the boot stage and RAM.
+const MEMORY_X: &str = "src/bin/pico/memory.x";
+
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
-    println!("cargo:rerun-if-changed=memory.x");
+    println!("cargo:rerun-if-changed={MEMORY_X}");
 
     if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none")
         || env::var_os("CARGO_FEATURE_PICO").is_none()
@@ -17,14 +20,15 @@ fn main() {
         return;
     }
 
-    // cortex-m-rt's link.x includes `memory.x`. The linker runs in the
-    // workspace root, this directory, and finds the top-level memory.x (the
-    // Pico's) there; the copy on the search path serves a build inside a larger
-    // workspace, where it runs elsewhere. Only the Pico build adds the path: a
-    // dependent package inherits its dependencies' search paths, and the QEMU
-    // images must link with their own memory map.
+    // cortex-m-rt's link.x includes `memory.x`, which the linker looks for
+    // in the workspace root (where it runs, and where none lies: the
+    // workspace also holds the QEMU images) and then on the search path. The
+    // Pico's memory map goes there, from next to the Pico binary. Only the
+    // Pico build adds the path: a dependent package inherits its
+    // dependencies' search paths, and the QEMU images must link with their
+    // own memory map.
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
-    fs::copy("memory.x", out.join("memory.x")).unwrap();
+    fs::copy(MEMORY_X, out.join("memory.x")).unwrap();
     println!("cargo:rustc-link-search={}", out.display());
 
     // No page alignment of sections: it would only waste flash.

@@ -1,8 +1,8 @@
 //! Linker setup for the QEMU images (`lm3s6965evb`).
 //!
-//! The memory map is `memory.x` in this directory: the linker runs here (this
-//! package is its own workspace) and cortex-m-rt's link.x includes it from
-//! here. It is also copied to the search path, as for the Pico image.
+//! The memory map is `memory.x` in this directory. The linker runs in the
+//! workspace root, where no `memory.x` lies, so cortex-m-rt's link.x finds
+//! this one on the search path, where it is copied (as the Pico image's is).
 
 use std::{env, fs, path::PathBuf};
 

@@ -3,7 +3,7 @@
 # runner of `cargo run` in this directory (see .cargo/config.toml) and works
 # on its own too:
 #
-#     qemu/run.sh qemu/target/thumbv6m-none-eabi/release/qemu
+#     qemu/run.sh target/thumbv6m-none-eabi/release/qemu
 #
 # Needs qemu-system-arm and defmt-print (`cargo install defmt-print`). The exit
 # status is the firmware's (semihosting exit: 0 = every check passed).

@@ -53,7 +53,7 @@ use crate::behaviour::{
     Applied, BehaviourConfig, BehaviourError, BehaviourParams, CommandQueue, Head, HeadFrame,
     IdleSource,
 };
-use crate::command::Action;
+use crate::command::{Action, GestureKind, Hold};
 use crate::driver::{DriverConfig, FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod};
 use crate::idle::{IdleMode, LoopSet, LoopStream, LoopSupply, SetInfo};
 use crate::motion::{AxisError, DEFAULT_N};
@@ -313,9 +313,16 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
                 self.head
                     .drain(driver, queue, |action, outcome| match outcome {
                         Ok(applied) => {
-                            defmt::info!("frame {=u64}: {}: ok {}", tick.frame, action, applied);
+                            defmt::info!(
+                                "frame {=u64}: {=str}: ok {}",
+                                tick.frame,
+                                word(action),
+                                Started(applied)
+                            );
                         }
-                        Err(e) => defmt::warn!("frame {=u64}: {}: {}", tick.frame, action, e),
+                        Err(e) => {
+                            defmt::warn!("frame {=u64}: {=str}: {}", tick.frame, word(action), e);
+                        }
                     });
             }
             None => self.head.sync(driver),
@@ -411,6 +418,69 @@ fn log_faults(report: &FrameReport) {
                 kind
             ),
             Outcome::Written | Outcome::Off => {}
+        }
+    }
+}
+
+/// The command word of `action`, as the console spells it.
+const fn word(action: &Action) -> &'static str {
+    match action {
+        Action::Gesture(request) => match request.kind {
+            GestureKind::Nod => "nod",
+            GestureKind::Shake => "shake",
+            GestureKind::Tilt => "tilt",
+        },
+        Action::Look(_) => "look",
+        Action::Center { .. } => "center",
+        Action::Idle(true) => "idle on",
+        Action::Idle(false) => "idle off",
+        Action::IdleAmp(_) => "idle amp",
+        Action::Stop => "stop",
+    }
+}
+
+/// What an action started, for the log: the resolved figures in the
+/// user's units (the frame path's own fields left out).
+struct Started<'a>(&'a Applied);
+
+impl defmt::Format for Started<'_> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        match self.0 {
+            Applied::Gesture(plan) => {
+                defmt::write!(
+                    f,
+                    "{=u8} cycle(s) of {} in {=u32} ms, intensity {=u8} %",
+                    plan.cycles,
+                    plan.amplitude,
+                    plan.duration.0,
+                    plan.intensity.get()
+                );
+            }
+            Applied::Look(look) => {
+                defmt::write!(
+                    f,
+                    "to pitch {} yaw {} in {=u32} ms",
+                    look.pitch,
+                    look.yaw,
+                    look.duration.0
+                );
+                match look.hold {
+                    Hold::Return(after) => defmt::write!(f, ", back after {=u32} ms", after.0),
+                    Hold::Stay => defmt::write!(f, ", staying"),
+                }
+                if look.clamped {
+                    defmt::write!(f, " (clamped to the limits)");
+                }
+            }
+            Applied::Center(duration) => {
+                defmt::write!(f, "back to centre in {=u32} ms", duration.0);
+            }
+            Applied::Idle(gain) => {
+                defmt::write!(f, "idle to {=u8} %", gain.get());
+            }
+            Applied::Stop => {
+                defmt::write!(f, "fading out");
+            }
         }
     }
 }

@@ -136,12 +136,18 @@ impl defmt::Format for Angle {
             digits,
         } = Written::of(*self);
         // The arms differ in their format strings only (which defmt interns).
+        // The sign is part of the format string, not a `{=str}` argument,
+        // which a `{:?}` around the angle (a derived `Format`) would quote.
         #[allow(clippy::match_same_arms)]
-        match digits {
-            0 => defmt::write!(f, "{=str}{=u32}°", sign, whole),
-            1 => defmt::write!(f, "{=str}{=u32}.{=u32}°", sign, whole, fraction),
-            2 => defmt::write!(f, "{=str}{=u32}.{=u32:02}°", sign, whole, fraction),
-            _ => defmt::write!(f, "{=str}{=u32}.{=u32:03}°", sign, whole, fraction),
+        match (sign.is_empty(), digits) {
+            (true, 0) => defmt::write!(f, "{=u32}°", whole),
+            (true, 1) => defmt::write!(f, "{=u32}.{=u32}°", whole, fraction),
+            (true, 2) => defmt::write!(f, "{=u32}.{=u32:02}°", whole, fraction),
+            (true, _) => defmt::write!(f, "{=u32}.{=u32:03}°", whole, fraction),
+            (false, 0) => defmt::write!(f, "-{=u32}°", whole),
+            (false, 1) => defmt::write!(f, "-{=u32}.{=u32}°", whole, fraction),
+            (false, 2) => defmt::write!(f, "-{=u32}.{=u32:02}°", whole, fraction),
+            (false, _) => defmt::write!(f, "-{=u32}.{=u32:03}°", whole, fraction),
         }
     }
 }

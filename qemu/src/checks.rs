@@ -8,15 +8,17 @@
 
 use core::ops::Range;
 
+use idle_head::behaviour::CommandQueue;
 use idle_head::driver::{DriverConfig, FrameDriver, FrameTick, Outcome};
 use idle_head::frame_task::{Flow, Frame, FrameHooks, RunStats};
 use idle_head::idle::IdleStats;
 use idle_head::{Angle, Axis};
 
 use crate::pwm::VirtualPwm;
+use crate::script;
 
 /// Frames per loop: 1.5 s / 1 ms (= 30 s / 20 ms on the Pico).
-pub const LOOP_FRAMES: u64 = crate::LOOP.0 as u64 * 1000 / crate::CONFIG.frame_period.0 as u64;
+pub const LOOP_FRAMES: u64 = crate::LOOP.0 as u64 * 1000 / crate::FRAME_PERIOD.0 as u64;
 /// The first join: the frames where loop set 0 blends into loop set 1.
 const JOIN: Range<u64> =
     crate::TIMING.period() as u64..(crate::TIMING.period() + crate::TIMING.join_frames) as u64;
@@ -47,6 +49,10 @@ const _: () = {
     assert!(((BURST.end - BURST.start) as u16) < crate::CONFIG.faults.disable_after);
     assert!(BURST.end < PERSISTENT_FROM);
     assert!(PERSISTENT_FROM + (crate::CONFIG.faults.disable_after as u64) < STOP_AT);
+    assert!(
+        script::QUIET_FROM <= JOIN.start,
+        "the script's motion ends before the join"
+    );
 };
 
 /// Faults the schedule injects: the burst, then the failed frames up to the
@@ -54,18 +60,23 @@ const _: () = {
 const EXPECTED_FAULTS: u32 =
     (BURST.end - BURST.start) as u32 + crate::CONFIG.faults.disable_after as u32;
 
-/// Largest frame-to-frame change of the idle offsets (velocity, d1) and
-/// of that change (acceleration, d2), per axis: inside the loops, and over
-/// the join (its frames and the frame after).
+/// Largest frame-to-frame change of the offsets (velocity, d1) and of that
+/// change (acceleration, d2), per axis: inside the loops (the script's frames
+/// left out), over the join (its frames and the frame after), and while the
+/// script plays.
 #[derive(Clone, Copy, Default)]
 struct Steps {
     inside: [[u32; 3]; 2],
     join: [[u32; 3]; 2],
+    /// While the script plays (not compared).
+    scripted: [[u32; 3]; 2],
 }
 
 /// Hooks of the smoke run: schedule, frame log, invariants.
 pub struct Checks {
     config: DriverConfig,
+    /// Where the script's commands go (the frame loop drains it).
+    commands: &'static CommandQueue,
     failures: u32,
     previous: Option<Frame>,
     /// The last frame's offset steps (d1), for d2.
@@ -83,15 +94,17 @@ pub struct Checks {
 }
 
 impl Checks {
-    pub const fn new(config: DriverConfig) -> Self {
+    pub const fn new(config: DriverConfig, commands: &'static CommandQueue) -> Self {
         Self {
             config,
+            commands,
             failures: 0,
             previous: None,
             last_steps: None,
             steps: Steps {
                 inside: [[0; 3]; 2],
                 join: [[0; 3]; 2],
+                scripted: [[0; 3]; 2],
             },
             others_moved: [0; 3],
             disabled_at: None,
@@ -141,14 +154,17 @@ impl Checks {
         // would stand out many times over.
         for axis in Axis::ALL {
             let i = axis.index();
-            let [inside, join] = [self.steps.inside, self.steps.join];
+            let [inside, join, scripted] =
+                [self.steps.inside, self.steps.join, self.steps.scripted];
             defmt::info!(
-                "{=str}: largest offset step {=u32} mdeg and change of step {=u32} mdeg inside the loops, {=u32} and {=u32} over the join",
+                "{=str}: largest offset step {=u32} mdeg and change of step {=u32} mdeg inside the loops, {=u32} and {=u32} over the join, {=u32} and {=u32} under the script",
                 axis.name(),
                 inside[0][i],
                 inside[1][i],
                 join[0][i],
-                join[1][i]
+                join[1][i],
+                scripted[0][i],
+                scripted[1][i]
             );
             if join[0][i] > inside[0][i] || join[1][i] > 2 * inside[1][i] {
                 defmt::error!("check: {=str} is rougher at the join", axis.name());
@@ -270,8 +286,13 @@ impl Checks {
             let steps: [i32; 3] = core::array::from_fn(|i| {
                 frame.offsets[i].millidegrees() - previous.offsets[i].millidegrees()
             });
+            // The script's gestures and look are not the idle's steps: the
+            // loops' own are measured outside them.
+            let scripted = (script::SCRIPT[0].frame..script::QUIET_FROM).contains(&index);
             let slots = if join == 1 {
                 &mut self.steps.join
+            } else if scripted {
+                &mut self.steps.scripted
             } else {
                 &mut self.steps.inside
             };
@@ -315,6 +336,10 @@ impl FrameHooks<VirtualPwm> for Checks {
         }
         if let Some(channel) = driver.channels_mut().get_mut(index) {
             channel.inject_faults(inject);
+        }
+        if let Err(full) = script::submit(tick.frame, self.commands) {
+            defmt::error!("check: frame {=u64}: {}", tick.frame, full.0);
+            self.fail();
         }
         self.write_started = crate::systick::now_counts();
     }

@@ -11,7 +11,8 @@
 //! The run generates the three loops (and measures the cost), plays the
 //! never-repeating idle with a fade-in (soft start) past its first join (the
 //! next loop set, generated meanwhile by a low-priority task, blended in),
-//! injects PWM faults on the yaw servo (a short burst it survives, then a
+//! plays a script over it (a nod, a shake interrupted by a tilt, a look and
+//! its return, see script.rs), injects PWM faults on the yaw servo (a short burst it survives, then a
 //! persistent one that gets it switched off), fades out and ends with one
 //! line:
 //!
@@ -27,13 +28,14 @@
 //! Idle time is not free under `-icount shift=0`: QEMU either lets the
 //! virtual clock follow the wall clock while the core sleeps (the default,
 //! `sleep=on`) or jumps it (`sleep=off`). To keep the run short either way
-//! the smoke build plays the Pico's configuration [`SPEEDUP`] = 20 times
-//! faster: 1 ms frames instead of 20 ms, a 1.5 s loop instead of 30 s, and
-//! speed and acceleration limits 20 and 20² times higher. Every per-frame
-//! quantity (loop position, fade gain, step and acceleration limits, fault
-//! counts) is then exactly the Pico's, so frame `k` here writes the same
-//! pulses as frame `k` on the board; only the wall clock between frames is
-//! shorter. The virtual PWM keeps the 50 Hz servo period. The whole run is
+//! the smoke build plays its frames [`SPEEDUP`] = 20 times faster: one every
+//! 1 ms instead of 20 ms, a 1.5 s loop instead of 30 s. Everything else is
+//! the Pico's configuration as it is, driver and behaviour alike, whose
+//! per-frame quantities (loop position, fade gain, step and acceleration
+//! limits of the idle and gesture modes, gesture and gaze timing, fault
+//! counts) all derive from the Pico's 20 ms frame period: frame `k` here
+//! writes the same pulses as frame `k` on the board, and only the wall clock
+//! between frames is shorter. The virtual PWM keeps the 50 Hz servo period. The whole run is
 //! about 1.9 s of virtual time.
 //!
 //! # Priorities
@@ -50,6 +52,7 @@
 mod checks;
 mod exit;
 mod pwm;
+mod script;
 // The Pico image's PWM clocking, compiled here too (a binary's items cannot be
 // imported): the virtual outputs count as the board's slices do.
 #[path = "../../src/bin/pico/rp2040_pwm.rs"]
@@ -66,6 +69,7 @@ use cortex_m_rt::exception;
 use defmt_semihosting as _;
 use embassy_executor::raw;
 use embassy_time::{Duration, Instant};
+use idle_head::behaviour::CommandQueue;
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::frame_task::{
     Exchange, ExchangeSupply, FrameLoop, IDLE_MODE, LOOP_DURATION, SetRef,
@@ -81,15 +85,17 @@ use crate::pwm::VirtualPwm;
 /// How much faster than the Pico the smoke run plays (see the crate docs).
 const SPEEDUP: u32 = 20;
 
-/// The Pico's configuration, time-compressed by [`SPEEDUP`].
-const CONFIG: DriverConfig = compress(DriverConfig::DEFAULT, SPEEDUP);
+/// The Pico's configuration: every per-frame quantity as on the board.
+const CONFIG: DriverConfig = DriverConfig::DEFAULT;
+/// The time between frames here: the Pico's, [`SPEEDUP`] times shorter.
+const FRAME_PERIOD: Microseconds = Microseconds(CONFIG.frame_period.0 / SPEEDUP);
 const PARAMS: DriverParams = match CONFIG.build() {
     Ok(p) => p,
     Err(e) => panic!("{}", e.message()),
 };
 /// 30 s / 20 = 1.5 s per loop: 1500 frames of 1 ms.
 const LOOP: Millis = Millis(LOOP_DURATION.0 / SPEEDUP);
-const PLAYBACK: Playback = match Playback::new(LOOP, CONFIG.frame_period, DEFAULT_N) {
+const PLAYBACK: Playback = match Playback::new(LOOP, FRAME_PERIOD, DEFAULT_N) {
     Ok(p) => p,
     Err(_) => panic!("invalid playback parameters"),
 };
@@ -100,28 +106,9 @@ const TIMING: IdleTiming = match IdleTiming::new(PLAYBACK) {
     Err(e) => panic!("{}", e.message()),
 };
 
-/// `config` played `k` times faster: frame period and fade `/ k`, speed
-/// limit `· k`, acceleration limit `· k²`, fault log interval `/ k`. The
-/// driver's per-frame step (speed · frame period) and per-frame² change
-/// (acceleration · frame period²) stay the same. The PWM period is kept.
-const fn compress(mut config: DriverConfig, k: u32) -> DriverConfig {
-    config.frame_period = Microseconds(config.frame_period.0 / k);
-    config.fade = Millis(config.fade.0 / k);
-    config.faults.log_interval = Millis(config.faults.log_interval.0 / k);
-    let mut i = 0;
-    while i < 3 {
-        config.motion[i].max_speed.0 *= k;
-        config.motion[i].max_accel.0 *= k * k;
-        i += 1;
-    }
-    config
-}
-
-// The compression is exact: whole µs and ms.
+// The compression is exact: whole µs and ms, as many frames a loop.
 const _: () = {
-    let pico = DriverConfig::DEFAULT;
-    assert!(CONFIG.frame_period.0 * SPEEDUP == pico.frame_period.0);
-    assert!(CONFIG.fade.0 * SPEEDUP == pico.fade.0);
+    assert!(FRAME_PERIOD.0 * SPEEDUP == CONFIG.frame_period.0);
     assert!(LOOP.0 * SPEEDUP == LOOP_DURATION.0);
 };
 
@@ -138,6 +125,9 @@ static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::
 
 /// The channels the buffers go round through.
 static EXCHANGE: Exchange = Exchange::new();
+
+/// Commands for the frame task (the script's, see script.rs).
+static COMMANDS: CommandQueue = CommandQueue::new();
 
 /// Set by the pender when a thread-mode task was woken, cleared by the idle loop.
 static PENDED: AtomicBool = AtomicBool::new(false);
@@ -194,7 +184,7 @@ fn main() -> ! {
     defmt::info!(
         "idle-head QEMU smoke run: {=u32}x time compression, frame period {=u32} us, loop {=u32} ms = {=u64} frames, N = {=usize}, fade {=u32} frames, disable after {=u16} failed frames",
         SPEEDUP,
-        CONFIG.frame_period.0,
+        FRAME_PERIOD.0,
         LOOP.0,
         checks::LOOP_FRAMES,
         DEFAULT_N,
@@ -329,12 +319,12 @@ async fn frame_task(first: SetRef, precompute_insns: u64, checksum: u32, generat
     let idle: IdlePlayer<SetRef, ExchangeSupply> =
         IdlePlayer::new(first, EXCHANGE.supply(), TIMING, IDLE_MODE);
     let start = Instant::now().as_ticks();
-    let Ok(mut frames) = FrameLoop::new(idle, CONFIG.frame_period, embassy_time::TICK_HZ, start)
-    else {
+    let Ok(frames) = FrameLoop::new(idle, FRAME_PERIOD, embassy_time::TICK_HZ, start) else {
         defmt::error!("frame period below one timer tick");
         exit::exit(false)
     };
-    let mut checks = Checks::new(CONFIG);
+    let mut frames = frames.with_commands(&COMMANDS);
+    let mut checks = Checks::new(CONFIG, &COMMANDS);
     let stats = idle_head::frame_task::run(&mut driver, &mut frames, &mut checks).await;
     defmt::info!(
         "frame timing: {=u64} frames, {=u64} missed, wake-up at most {=u64} us after the deadline",

@@ -24,6 +24,7 @@ mod args;
 mod bench;
 mod cli;
 mod elf;
+mod fonts;
 mod log;
 mod metrics;
 mod preview;

@@ -65,8 +65,8 @@ pub fn run(sh: &Shell, env: &[(&str, &str)], cmd: Cmd<'_>) -> Result<()> {
         .map_err(|error| anyhow!("{error}"))
 }
 
-/// A package of the repository that builds firmware images. Each has its own
-/// workspace, memory map (`memory.x`) and target directory.
+/// A package of the repository that builds firmware images, each with its
+/// own memory map (`memory.x`), in the one workspace and target directory.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Package {
     /// The root package `idle-head`: the core library and the Pico image.
@@ -81,7 +81,7 @@ impl Package {
     pub fn manifest_args(self) -> &'static [&'static str] {
         match self {
             Self::Root => &[],
-            Self::Qemu => &["--manifest-path", "qemu/Cargo.toml"],
+            Self::Qemu => &["--package", "idle-head-qemu"],
         }
     }
 }
@@ -113,10 +113,10 @@ impl Image {
         }
     }
 
-    /// Release ELF of this image in its package's target directory.
+    /// Release ELF of this image in the target directory.
     pub fn elf(&self, metadata: &Metadata) -> PathBuf {
         metadata
-            .target_dir(self.package)
+            .target_dir
             .join(TARGET)
             .join("release")
             .join(self.bin)
@@ -145,37 +145,20 @@ impl Image {
 /// The parts of `cargo metadata` this crate uses.
 #[derive(Debug)]
 pub struct Metadata {
-    /// Where cargo puts build output for the root workspace.
+    /// Where cargo puts build output (`target/` unless configured otherwise).
     pub target_dir: PathBuf,
-    /// Where cargo puts build output for the QEMU package (`qemu/target`
-    /// unless configured otherwise).
-    pub qemu_target_dir: PathBuf,
     /// Whether the core library's doc tests are switched on (`[lib] doctest`).
     pub lib_doctests: bool,
 }
 
-impl Metadata {
-    /// The target directory of `package`.
-    pub fn target_dir(&self, package: Package) -> &Path {
-        match package {
-            Package::Root => &self.target_dir,
-            Package::Qemu => &self.qemu_target_dir,
-        }
-    }
-}
-
-/// Reads `cargo metadata` for both workspaces (no dependency resolution).
+/// Reads `cargo metadata` for the workspace (no dependency resolution).
 pub fn metadata(root: &Path) -> Result<Metadata> {
-    let read = |manifest: &str| {
-        MetadataCommand::new()
-            .current_dir(root)
-            .manifest_path(root.join(manifest))
-            .no_deps()
-            .exec()
-            .with_context(|| format!("running `cargo metadata` for {manifest}"))
-    };
-    let main = read("Cargo.toml")?;
-    let qemu = read("qemu/Cargo.toml")?;
+    let main = MetadataCommand::new()
+        .current_dir(root)
+        .manifest_path(root.join("Cargo.toml"))
+        .no_deps()
+        .exec()
+        .context("running `cargo metadata`")?;
     let lib_doctests = main
         .packages
         .iter()
@@ -184,7 +167,6 @@ pub fn metadata(root: &Path) -> Result<Metadata> {
         .any(|target| target.is_lib() && target.doctest);
     Ok(Metadata {
         target_dir: main.target_directory.into(),
-        qemu_target_dir: qemu.target_directory.into(),
         lib_doctests,
     })
 }

@@ -128,14 +128,7 @@ pub fn command(options: Options) -> Result<bool> {
 
     // 2. Formatting and lints: firmware (thumb, both packages) and host crates.
     stages.run("rustfmt: core + Pico, qemu/, host-tests, xtask", || {
-        let mut failures = Vec::new();
-        for dir in [".", "qemu", "host-tests", "xtask"] {
-            let sh = project::shell(dir)?;
-            if let Err(error) = project::run(&sh, &[], cmd!(sh, "cargo fmt --check")) {
-                failures.push(format!("{error:#}"));
-            }
-        }
-        fail_if_any(&failures)
+        project::run(&sh, &[], cmd!(sh, "cargo fmt --all --check"))
     });
     clippy_stages(&mut stages, &sh, &host_tests, &xtask);
 
@@ -203,7 +196,7 @@ fn clippy_stages(stages: &mut Stages, sh: &Shell, host_tests: &Shell, xtask: &Sh
             FIRMWARE_ENV,
             cmd!(
                 sh,
-                "cargo clippy --release --bins --manifest-path qemu/Cargo.toml -- -D warnings"
+                "cargo clippy --release --bins --package idle-head-qemu -- -D warnings"
             ),
         )
     });
@@ -316,7 +309,7 @@ fn qemu_stages(
             }
             snapshot::bless(&run)
         } else {
-            snapshot::compare(&run, &metadata.qemu_target_dir.join("qemu-actual.log"))
+            snapshot::compare(&run, &metadata.target_dir.join("qemu-actual.log"))
         }
     });
     stages.run(SUMMARY, || {
@@ -350,12 +343,4 @@ fn doc_tests(sh: &Shell, metadata: &Metadata) -> Result<Option<String>> {
         ),
     )?;
     Ok(None)
-}
-
-fn fail_if_any(failures: &[String]) -> Result<()> {
-    if failures.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", failures.join("; "))
-    }
 }

@@ -11,7 +11,7 @@
     clippy::cast_possible_wrap
 )]
 
-use std::{path::Path, sync::Once};
+use std::path::Path;
 
 use anyhow::{Result, anyhow};
 use idle_head::motion::Closure;
@@ -19,36 +19,19 @@ use plotters::{
     coord::Shift,
     prelude::*,
     style::{
-        FontStyle, register_font,
+        FontStyle,
         text_anchor::{HPos, Pos, VPos},
     },
 };
 
 use super::stages::{LoopSpec, Stages, deg};
+use crate::fonts::{self, FONT};
 
 const WIDTH: u32 = 1400;
 const HEADER: u32 = 150;
 const PANEL: u32 = 240;
 /// Width of the legend column right of each panel.
 const LEGEND: u32 = 270;
-const FONT: &str = "sans-serif";
-
-/// Registers `DejaVu Sans` as the plots' `sans-serif` font, once.
-fn register_fonts() -> Result<()> {
-    static ONCE: Once = Once::new();
-    let mut result = Ok(());
-    ONCE.call_once(|| {
-        for (style, bytes) in [
-            (FontStyle::Normal, dejavu::sans::regular()),
-            (FontStyle::Bold, dejavu::sans::bold()),
-        ] {
-            if register_font(FONT, style, bytes).is_err() {
-                result = Err(anyhow!("the DejaVu Sans font did not load"));
-            }
-        }
-    });
-    result
-}
 
 /// One curve of a panel.
 struct Curve<'a> {
@@ -190,7 +173,7 @@ fn panels(stages: &Stages) -> Vec<Panel<'_>> {
 
 /// Draws the figure to `path` (PNG).
 pub fn plot(stages: &Stages, path: &Path) -> Result<()> {
-    register_fonts()?;
+    fonts::register()?;
     let panels = panels(stages);
     let height = HEADER + PANEL * panels.len() as u32;
     let root = BitMapBackend::new(path, (WIDTH, height)).into_drawing_area();

@@ -4,22 +4,19 @@
 // Frame counts and angles are far below f64's exact range.
 #![allow(clippy::cast_precision_loss)]
 
-use std::{path::Path, sync::Once};
+use std::path::Path;
 
 use anyhow::{Result, anyhow};
 use idle_head::Axis;
-use plotters::{
-    prelude::*,
-    style::{FontStyle, register_font},
-};
+use plotters::{prelude::*, style::FontStyle};
 
 use super::{Mark, Trace};
+use crate::fonts::{self, FONT};
 
 const WIDTH: u32 = 1400;
 const HEADER: u32 = 70;
 const PANEL: u32 = 260;
 /// Registered under a name of its own (the other pictures register theirs).
-const FONT: &str = "trace-sans";
 
 const BLUE: RGBColor = RGBColor(31, 119, 180);
 const ORANGE: RGBColor = RGBColor(255, 127, 14);
@@ -28,25 +25,9 @@ const GREY: RGBColor = RGBColor(110, 110, 110);
 const SHADE: RGBColor = RGBColor(255, 228, 196);
 const REFUSED: RGBColor = RGBColor(214, 39, 40);
 
-fn register_fonts() -> Result<()> {
-    static ONCE: Once = Once::new();
-    let mut result = Ok(());
-    ONCE.call_once(|| {
-        for (style, bytes) in [
-            (FontStyle::Normal, dejavu::sans::regular()),
-            (FontStyle::Bold, dejavu::sans::bold()),
-        ] {
-            if register_font(FONT, style, bytes).is_err() {
-                result = Err(anyhow!("the DejaVu Sans font did not load"));
-            }
-        }
-    });
-    result
-}
-
 /// Draws `trace` to `path`.
 pub fn draw(trace: &Trace, seed: Option<u32>, path: &Path) -> Result<()> {
-    register_fonts()?;
+    fonts::register()?;
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
     }

@@ -1,0 +1,288 @@
+//! One line of the console protocol → a [`Command`].
+//!
+//! Words are separated by spaces or tabs and compared without regard to
+//! ASCII case. Numbers are decimal integers with an optional sign, in the
+//! project's units. Optional trailing options are `name=value` words, in
+//! any order after the positional arguments.
+//!
+//! ```text
+//! help | status | save | load | defaults | stop
+//! nod   [amp_mdeg] [ms] [cycles=N] [intensity=PCT]
+//! shake [amp_mdeg] [ms] [cycles=N] [intensity=PCT]
+//! tilt  [amp_mdeg] [ms] [intensity=PCT]
+//! look <pitch_mdeg> <yaw_mdeg> [ms] [hold=MS|hold=stay]
+//! center [ms]
+//! idle on | idle off | idle amp <percent>
+//! seed <n> | seed random
+//! servo <pitch|roll|yaw> [neutral <us> | per-degree <ns> | direction <normal|reversed>
+//!                        | min <us> | max <us> | limits <min_mdeg> <max_mdeg>]
+//! ```
+//!
+//! The parser checks the syntax and that each number fits its type
+//! (a percentage is at most 100, a duration is positive); whether a value
+//! suits the head (an amplitude inside the axis' limits, a calibration
+//! that validates) is for the behaviour and the settings to decide. It
+//! never panics and allocates nothing.
+//!
+//! ```
+//! use idle_head::command::{Action, Command, GestureKind};
+//! use idle_head::console::parse;
+//! use idle_head::{Angle, Millis};
+//!
+//! let Ok(Command::Act(Action::Gesture(nod))) = parse(b"nod 6000 900 cycles=3") else {
+//!     panic!("a nod")
+//! };
+//! assert_eq!(nod.kind, GestureKind::Nod);
+//! assert_eq!(nod.amplitude, Some(Angle::from_degrees(6)));
+//! assert_eq!(nod.duration, Some(Millis(900)));
+//! assert_eq!(nod.cycles, Some(3));
+//!
+//! let err = parse(b"nod six").unwrap_err();
+//! assert_eq!(err.describe(b"nod six").to_string(), "`six`: amplitude in mdeg must be a whole number");
+//! ```
+
+use crate::axis::Axis;
+use crate::command::{
+    Action, Command, GestureKind, GestureRequest, Hold, LookRequest, Percent, SeedChoice,
+    ServoSetting,
+};
+use crate::servo::{Direction, NanosPerDegree};
+use crate::units::{Angle, AngleRange, Microseconds, Millis};
+
+mod error;
+mod words;
+
+pub use error::{ParseError, ParseErrorKind, Span};
+use words::{Word, Words, once};
+
+/// Parses one line (without its line ending); the grammar is in this
+/// module's source and, for users, in `docs/protocol.md`.
+///
+/// # Errors
+/// A [`ParseError`] naming the first problem and the word it is in.
+pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
+    let mut words = Words::new(line);
+    let Some(first) = words.next() else {
+        return Err(words.error_here(ParseErrorKind::Empty));
+    };
+    let command = match first.lower() {
+        Word::Is("help") => Command::Help,
+        Word::Is("status") => Command::Status,
+        Word::Is("save") => Command::Save,
+        Word::Is("load") => Command::Load,
+        Word::Is("defaults") => Command::Defaults,
+        Word::Is("stop") => Command::Act(Action::Stop),
+        Word::Is("nod") => gesture(&mut words, GestureKind::Nod)?,
+        Word::Is("shake") => gesture(&mut words, GestureKind::Shake)?,
+        Word::Is("tilt") => gesture(&mut words, GestureKind::Tilt)?,
+        Word::Is("look") => look(&mut words)?,
+        Word::Is("center" | "centre") => Command::Act(Action::Center {
+            duration: words.optional_number(DURATION)?.map(to_millis),
+        }),
+        Word::Is("idle") => idle(&mut words)?,
+        Word::Is("seed") => seed(&mut words)?,
+        Word::Is("servo") => servo(&mut words)?,
+        _ => return Err(first.error(ParseErrorKind::UnknownCommand)),
+    };
+    words.end()?;
+    Ok(command)
+}
+
+/// A numeric field: its name and range.
+#[derive(Clone, Copy)]
+struct Field {
+    what: &'static str,
+    min: i64,
+    max: i64,
+}
+
+const AMPLITUDE: Field = Field {
+    what: "amplitude in mdeg",
+    min: i32::MIN as i64 + 1,
+    max: i32::MAX as i64,
+};
+const ANGLE: Field = Field {
+    what: "angle in mdeg",
+    ..AMPLITUDE
+};
+const DURATION: Field = Field {
+    what: "duration in ms",
+    min: 1,
+    max: u32::MAX as i64,
+};
+const HOLD: Field = Field {
+    what: "hold in ms",
+    min: 0,
+    max: u32::MAX as i64,
+};
+const CYCLES: Field = Field {
+    what: "cycles",
+    min: 1,
+    max: u8::MAX as i64,
+};
+const PERCENT: Field = Field {
+    what: "percentage",
+    min: 0,
+    max: 100,
+};
+const SEED: Field = Field {
+    what: "seed",
+    min: 0,
+    max: u32::MAX as i64,
+};
+const PULSE: Field = Field {
+    what: "pulse in us",
+    min: 0,
+    max: u32::MAX as i64,
+};
+const PER_DEGREE: Field = Field {
+    what: "ns per degree",
+    min: 0,
+    max: u32::MAX as i64,
+};
+
+fn to_angle(v: i64) -> Angle {
+    Angle::from_millidegrees(v as i32)
+}
+
+fn to_millis(v: i64) -> Millis {
+    Millis(v as u32)
+}
+
+fn to_percent(v: i64) -> Percent {
+    Percent::new(v as u8).unwrap_or(Percent::FULL)
+}
+
+/// `nod|shake|tilt [amp] [ms] [cycles=N] [intensity=P]`.
+fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Command, ParseError> {
+    let mut request = GestureRequest::new(kind);
+    request.amplitude = words.optional_number(AMPLITUDE)?.map(to_angle);
+    request.duration = words.optional_number(DURATION)?.map(to_millis);
+    let allowed = match kind {
+        GestureKind::Tilt => "intensity",
+        GestureKind::Nod | GestureKind::Shake => "cycles, intensity",
+    };
+    while let Some((name, value, word)) = words.option()? {
+        match (name, kind) {
+            ("cycles", GestureKind::Nod | GestureKind::Shake) => {
+                once(request.cycles.is_some(), word)?;
+                request.cycles = Some(value.number(CYCLES)? as u8);
+            }
+            ("intensity", _) => {
+                once(request.intensity.is_some(), word)?;
+                request.intensity = Some(to_percent(value.number(PERCENT)?));
+            }
+            _ => return Err(word.error(ParseErrorKind::UnknownOption { allowed })),
+        }
+    }
+    Ok(Command::Act(Action::Gesture(request)))
+}
+
+/// `look <pitch> <yaw> [ms] [hold=MS|hold=stay]`.
+fn look(words: &mut Words<'_>) -> Result<Command, ParseError> {
+    let pitch = to_angle(words.number("pitch in mdeg", ANGLE)?);
+    let yaw = to_angle(words.number("yaw in mdeg", ANGLE)?);
+    let duration = words.optional_number(DURATION)?.map(to_millis);
+    let mut hold = None;
+    while let Some((name, value, word)) = words.option()? {
+        if name != "hold" {
+            return Err(word.error(ParseErrorKind::UnknownOption { allowed: "hold" }));
+        }
+        once(hold.is_some(), word)?;
+        hold = Some(if value.lower() == Word::Is("stay") {
+            Hold::Stay
+        } else {
+            Hold::Return(to_millis(value.number(HOLD)?))
+        });
+    }
+    Ok(Command::Act(Action::Look(LookRequest {
+        pitch,
+        yaw,
+        duration,
+        hold,
+    })))
+}
+
+/// `idle on|off|amp <percent>`.
+fn idle(words: &mut Words<'_>) -> Result<Command, ParseError> {
+    const EXPECTED: &str = "`on`, `off` or `amp`";
+    let Some(word) = words.next() else {
+        return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
+    };
+    let action = match word.lower() {
+        Word::Is("on") => Action::Idle(true),
+        Word::Is("off") => Action::Idle(false),
+        Word::Is("amp") => Action::IdleAmp(to_percent(words.number("percentage", PERCENT)?)),
+        _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: EXPECTED })),
+    };
+    Ok(Command::Act(action))
+}
+
+/// `seed <n>|random`.
+fn seed(words: &mut Words<'_>) -> Result<Command, ParseError> {
+    const EXPECTED: &str = "a seed or `random`";
+    let Some(word) = words.next() else {
+        return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
+    };
+    if word.lower() == Word::Is("random") {
+        return Ok(Command::Seed(SeedChoice::Random));
+    }
+    Ok(Command::Seed(SeedChoice::Value(word.number(SEED)? as u32)))
+}
+
+/// `servo <axis> [<field> <value>...]`.
+fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
+    const AXES: &str = "`pitch`, `roll` or `yaw`";
+    const FIELDS: &str = "`neutral`, `per-degree`, `direction`, `min`, `max` or `limits`";
+    let Some(word) = words.next() else {
+        return Err(words.error_here(ParseErrorKind::Missing(AXES)));
+    };
+    let axis = match word.lower() {
+        Word::Is("pitch") => Axis::Pitch,
+        Word::Is("roll") => Axis::Roll,
+        Word::Is("yaw") => Axis::Yaw,
+        _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: AXES })),
+    };
+    let Some(field) = words.next() else {
+        return Ok(Command::Servo {
+            axis,
+            setting: None,
+        });
+    };
+    let pulse = |words: &mut Words<'_>| -> Result<Microseconds, ParseError> {
+        Ok(Microseconds(words.number("pulse in us", PULSE)? as u32))
+    };
+    let setting = match field.lower() {
+        Word::Is("neutral") => ServoSetting::Neutral(pulse(words)?),
+        Word::Is("min") => ServoSetting::MinPulse(pulse(words)?),
+        Word::Is("max") => ServoSetting::MaxPulse(pulse(words)?),
+        Word::Is("per-degree") => ServoSetting::PerDegree(NanosPerDegree(
+            words.number("ns per degree", PER_DEGREE)? as u32,
+        )),
+        Word::Is("direction") => {
+            const DIRECTIONS: &str = "`normal` or `reversed`";
+            let Some(word) = words.next() else {
+                return Err(words.error_here(ParseErrorKind::Missing(DIRECTIONS)));
+            };
+            ServoSetting::Direction(match word.lower() {
+                Word::Is("normal") => Direction::Normal,
+                Word::Is("reversed") => Direction::Reversed,
+                _ => {
+                    return Err(word.error(ParseErrorKind::UnknownWord {
+                        expected: DIRECTIONS,
+                    }));
+                }
+            })
+        }
+        Word::Is("limits") => {
+            let min = to_angle(words.number("lower limit in mdeg", ANGLE)?);
+            let max = to_angle(words.number("upper limit in mdeg", ANGLE)?);
+            ServoSetting::Limits(AngleRange { min, max })
+        }
+        _ => return Err(field.error(ParseErrorKind::UnknownWord { expected: FIELDS })),
+    };
+    Ok(Command::Servo {
+        axis,
+        setting: Some(setting),
+    })
+}

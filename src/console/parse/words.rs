@@ -1,0 +1,249 @@
+//! The words of a line: tokens with their positions, keywords, numbers.
+
+use super::Field;
+use super::error::{ParseError, ParseErrorKind, Span};
+
+/// An error for an option seen before.
+pub(super) fn once(seen: bool, word: Token<'_>) -> Result<(), ParseError> {
+    if seen {
+        Err(word.error(ParseErrorKind::DuplicateOption))
+    } else {
+        Ok(())
+    }
+}
+
+/// A word of the line with its position.
+#[derive(Clone, Copy)]
+pub(super) struct Token<'a> {
+    text: &'a [u8],
+    start: usize,
+}
+
+/// A word compared without regard to ASCII case (`Other` if it matches
+/// none of the names the parser asks about).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Word {
+    Is(&'static str),
+    Other,
+}
+
+/// Every word the protocol has, lower case.
+const KEYWORDS: [&str; 34] = [
+    "help",
+    "status",
+    "save",
+    "load",
+    "defaults",
+    "stop",
+    "nod",
+    "shake",
+    "tilt",
+    "look",
+    "center",
+    "centre",
+    "idle",
+    "seed",
+    "servo",
+    "on",
+    "off",
+    "amp",
+    "random",
+    "pitch",
+    "roll",
+    "yaw",
+    "neutral",
+    "min",
+    "max",
+    "per-degree",
+    "direction",
+    "normal",
+    "reversed",
+    "limits",
+    "stay",
+    "hold",
+    "cycles",
+    "intensity",
+];
+
+impl<'a> Token<'a> {
+    pub(super) fn span(&self) -> Span {
+        Span {
+            start: clamp_u16(self.start),
+            end: clamp_u16(self.start + self.text.len()),
+        }
+    }
+
+    pub(super) fn error(&self, kind: ParseErrorKind) -> ParseError {
+        ParseError {
+            kind,
+            at: self.span(),
+        }
+    }
+
+    /// The keyword this word is, ignoring ASCII case.
+    pub(super) fn lower(&self) -> Word {
+        KEYWORDS
+            .iter()
+            .find(|k| k.as_bytes().eq_ignore_ascii_case(self.text))
+            .map_or(Word::Other, |k| Word::Is(k))
+    }
+
+    /// The word as a whole number in `field`'s range.
+    pub(super) fn number(&self, field: Field) -> Result<i64, ParseError> {
+        let value = integer(self.text).ok_or(self.error(ParseErrorKind::NotANumber(field.what)))?;
+        if value < field.min || value > field.max {
+            return Err(self.error(ParseErrorKind::OutOfRange {
+                what: field.what,
+                min: field.min,
+                max: field.max,
+            }));
+        }
+        Ok(value)
+    }
+
+    /// `name=value` split at the first `=`, the name lower-cased.
+    pub(super) fn split_option(&self) -> Option<(&'static str, Token<'a>)> {
+        let eq = self.text.iter().position(|&b| b == b'=')?;
+        let (name, rest) = self.text.split_at(eq);
+        let value = Token {
+            text: rest.get(1..).unwrap_or_default(),
+            start: self.start + eq + 1,
+        };
+        let name = Token {
+            text: name,
+            start: self.start,
+        };
+        Some((
+            match name.lower() {
+                Word::Is(k) => k,
+                Word::Other => "",
+            },
+            value,
+        ))
+    }
+}
+
+const fn clamp_u16(v: usize) -> u16 {
+    if v > u16::MAX as usize {
+        u16::MAX
+    } else {
+        v as u16
+    }
+}
+
+/// A decimal integer with an optional sign; `None` if not one or beyond ±2⁶².
+fn integer(text: &[u8]) -> Option<i64> {
+    let (negative, digits) = match text.split_first() {
+        Some((b'-', rest)) => (true, rest),
+        Some((b'+', rest)) => (false, rest),
+        _ => (false, text),
+    };
+    if digits.is_empty() {
+        return None;
+    }
+    let mut value: i64 = 0;
+    for &d in digits {
+        if !d.is_ascii_digit() {
+            return None;
+        }
+        value = value.checked_mul(10)?.checked_add(i64::from(d - b'0'))?;
+        if value > 1 << 62 {
+            return None;
+        }
+    }
+    Some(if negative { -value } else { value })
+}
+
+/// The words of a line, separated by spaces and tabs.
+pub(super) struct Words<'a> {
+    line: &'a [u8],
+    pos: usize,
+}
+
+impl<'a> Words<'a> {
+    pub(super) fn new(line: &'a [u8]) -> Self {
+        Self { line, pos: 0 }
+    }
+
+    /// An error at the end of the line (or at the current position).
+    pub(super) fn error_here(&self, kind: ParseErrorKind) -> ParseError {
+        let at = clamp_u16(self.line.len());
+        ParseError {
+            kind,
+            at: Span { start: at, end: at },
+        }
+    }
+
+    pub(super) fn skip_blanks(&mut self) {
+        while let Some(&b) = self.line.get(self.pos) {
+            if b != b' ' && b != b'\t' {
+                break;
+            }
+            self.pos += 1;
+        }
+    }
+
+    pub(super) fn peek(&mut self) -> Option<Token<'a>> {
+        self.skip_blanks();
+        let start = self.pos;
+        let rest = self.line.get(start..).unwrap_or_default();
+        let len = rest
+            .iter()
+            .position(|&b| b == b' ' || b == b'\t')
+            .unwrap_or(rest.len());
+        if len == 0 {
+            return None;
+        }
+        Some(Token {
+            text: rest.get(..len).unwrap_or_default(),
+            start,
+        })
+    }
+
+    pub(super) fn next(&mut self) -> Option<Token<'a>> {
+        let token = self.peek()?;
+        self.pos = token.start + token.text.len();
+        Some(token)
+    }
+
+    /// A required number.
+    pub(super) fn number(&mut self, what: &'static str, field: Field) -> Result<i64, ParseError> {
+        match self.next() {
+            Some(token) => token.number(Field { what, ..field }),
+            None => Err(self.error_here(ParseErrorKind::Missing(what))),
+        }
+    }
+
+    /// An optional positional number: absent at the end of the line or
+    /// where the options (`name=value`) begin.
+    pub(super) fn optional_number(&mut self, field: Field) -> Result<Option<i64>, ParseError> {
+        match self.peek() {
+            Some(token) if !token.text.contains(&b'=') => {
+                self.next();
+                token.number(field).map(Some)
+            }
+            _ => Ok(None),
+        }
+    }
+
+    /// The next `name=value` option, if any.
+    pub(super) fn option(
+        &mut self,
+    ) -> Result<Option<(&'static str, Token<'a>, Token<'a>)>, ParseError> {
+        let Some(token) = self.next() else {
+            return Ok(None);
+        };
+        match token.split_option() {
+            Some((name, value)) => Ok(Some((name, value, token))),
+            None => Err(token.error(ParseErrorKind::Unexpected)),
+        }
+    }
+
+    /// Nothing may follow.
+    pub(super) fn end(&mut self) -> Result<(), ParseError> {
+        match self.next() {
+            Some(token) => Err(token.error(ParseErrorKind::Unexpected)),
+            None => Ok(()),
+        }
+    }
+}
