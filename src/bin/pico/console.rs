@@ -16,11 +16,16 @@
 //! servo calibration and saved settings need the settings service, which
 //! takes its place.
 
-use embassy_rp::interrupt::Priority;
-use embassy_rp::uart::BufferedUart;
+use embassy_executor::Spawner;
+use embassy_rp::Peri;
+use embassy_rp::interrupt::{self, InterruptExt, Priority};
+use embassy_rp::peripherals::{PIN_0, PIN_1, UART0, USB};
+use embassy_rp::uart::{self, BufferedInterruptHandler, BufferedUart};
 use idle_head::console::{Handler, Session};
+use static_cell::ConstStaticCell;
 
-pub use crate::handler::{PicoSession, Queue, QueueHandler};
+use crate::handler::{PicoSession, Queue, QueueHandler};
+use crate::usb;
 
 /// The ports' interrupt priority: below the frame task's (`P1`), above
 /// thread mode, where the console tasks run.
@@ -88,4 +93,95 @@ impl Port for BufferedUart {
             .await
             .map_err(|_| Gone)
     }
+}
+
+/// The UART console's buffers: the console task waits while a reply
+/// drains from the transmit buffer; the receive buffer holds what arrives
+/// while the loop generator keeps thread mode busy (about 2 ms, 23 bytes
+/// at 115200 baud).
+static UART_TX: ConstStaticCell<[u8; 64]> = ConstStaticCell::new([0; 64]);
+static UART_RX: ConstStaticCell<[u8; 64]> = ConstStaticCell::new([0; 64]);
+
+embassy_rp::bind_interrupts!(struct Irqs {
+    UART0_IRQ => BufferedInterruptHandler<UART0>;
+    USBCTRL_IRQ => embassy_rp::usb::InterruptHandler<USB>;
+});
+
+/// The peripherals the console takes: UART0 on GP0 (TX) and GP1 (RX), and
+/// the USB controller.
+pub struct Ports {
+    pub uart: Peri<'static, UART0>,
+    pub tx: Peri<'static, PIN_0>,
+    pub rx: Peri<'static, PIN_1>,
+    pub usb: Peri<'static, USB>,
+}
+
+/// Starts the console on both ports, in thread mode (`spawner`), handing
+/// actions to the frame task through `commands`. Call once.
+pub fn start(spawner: Spawner, ports: Ports, commands: &'static Queue) {
+    let mut uart_config = uart::Config::default();
+    uart_config.baudrate = UART_BAUD;
+    let uart = BufferedUart::new(
+        ports.uart,
+        ports.tx,
+        ports.rx,
+        Irqs,
+        UART_TX.take(),
+        UART_RX.take(),
+        uart_config,
+    );
+    interrupt::UART0_IRQ.set_priority(PORT_PRIORITY);
+    match uart_console(uart, commands) {
+        Ok(token) => {
+            spawner.spawn(token);
+            defmt::info!("console: UART0 GP0 TX, GP1 RX, {=u32} 8N1", UART_BAUD);
+        }
+        Err(_) => defmt::error!("uart console task already running"),
+    }
+
+    let (device, serial) = usb::build(embassy_rp::usb::Driver::new(ports.usb, Irqs));
+    interrupt::USBCTRL_IRQ.set_priority(PORT_PRIORITY);
+    match (usb_device(device), usb_console(serial, commands)) {
+        (Ok(device), Ok(console)) => {
+            spawner.spawn(device);
+            spawner.spawn(console);
+            defmt::info!(
+                "console: USB CDC-ACM {=u16:04x}:{=u16:04x}",
+                usb::VID,
+                usb::PID
+            );
+        }
+        _ => defmt::error!("usb tasks already running"),
+    }
+}
+
+/// The USB device: enumeration, control requests, bus resets.
+#[embassy_executor::task]
+async fn usb_device(mut device: usb::Device) {
+    device.run().await
+}
+
+/// The console on the USB serial port: one session per connection.
+#[embassy_executor::task]
+async fn usb_console(mut serial: usb::Serial, commands: &'static Queue) {
+    let mut session = PicoSession::new();
+    let mut handler = QueueHandler::new(commands);
+    loop {
+        serial.wait_connection().await;
+        session.reset();
+        let mut port = usb::UsbPort {
+            serial: &mut serial,
+        };
+        serve(&mut port, &mut session, &mut handler).await;
+    }
+}
+
+/// The console on UART0, for as long as the board runs.
+#[embassy_executor::task]
+async fn uart_console(mut uart: BufferedUart, commands: &'static Queue) {
+    let mut session = PicoSession::new();
+    let mut handler = QueueHandler::new(commands);
+    // A UART never goes away: `serve` only returns if it did.
+    let gone = serve(&mut uart, &mut session, &mut handler).await;
+    defmt::error!("console uart ended: {}", gone);
 }

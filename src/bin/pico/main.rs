@@ -56,9 +56,10 @@
 //! checks the next boot: the watchdog reset logged, neutral pulses first, the
 //! motion faded in.
 //!
-//! # Console
+//! # Console (feature `console`)
 //!
-//! The command protocol of `docs/protocol.md` on two ports at once, each
+//! `--features console` adds the command protocol of `docs/protocol.md` on
+//! two ports at once, each
 //! with its own session (`console.rs`): UART0 on GP0 (TX, pin 1) and GP1
 //! (RX, pin 2) at 115200 8N1, 3.3 V levels; and the board's USB port as a
 //! CDC-ACM serial port, `16c0:27dd` (`usb.rs`). Both tasks run in thread
@@ -68,8 +69,9 @@
 //! # Settings
 //!
 //! The last four 4 KiB flash sectors, `0x101f_c000..0x1020_0000`, hold the
-//! settings store (reserved in memory.x); it is opened and read at boot,
-//! before the first frame, and the log says what it holds (`settings.rs`).
+//! settings store; memory.x reserves them in every image. With the
+//! `console` feature the store is opened and read at boot, before the first
+//! frame, and the log says what it holds (`settings.rs`).
 //!
 //! # Calibration
 //!
@@ -81,20 +83,23 @@
 
 #[cfg(feature = "calibrate")]
 mod calibrate;
+#[cfg(feature = "console")]
 mod console;
+#[cfg(feature = "console")]
 mod handler;
 mod rp2040_pwm;
 mod servo_pwm;
+#[cfg(feature = "console")]
 mod settings;
+#[cfg(feature = "console")]
 mod usb;
 
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_rp::interrupt::{self, InterruptExt, Priority};
-use embassy_rp::peripherals::{UART0, USB};
-use embassy_rp::uart::{self, BufferedInterruptHandler, BufferedUart};
 use embassy_rp::watchdog::{ResetReason, Watchdog};
 use embassy_time::{Duration, Instant};
+use idle_head::behaviour::CommandQueue;
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::frame_task::{
     Exchange, Flow, Frame, FrameHooks, FrameLoop, IDLE_MODE, LOOP_DURATION, SetRef,
@@ -105,7 +110,6 @@ use idle_head::{Axis, Playback};
 use panic_probe as _;
 use static_cell::ConstStaticCell;
 
-use crate::console::{PORT_PRIORITY, PicoSession, Queue, QueueHandler, UART_BAUD};
 use crate::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use crate::servo_pwm::ServoPwm;
 
@@ -147,20 +151,9 @@ static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::
 /// The channels the buffers go round through.
 static EXCHANGE: Exchange = Exchange::new();
 
-/// Actions from the console ports to the frame task.
-static COMMANDS: Queue = Queue::new();
-
-/// The UART console's buffers: the console task waits while a reply
-/// drains from the transmit buffer; the receive buffer holds what arrives
-/// while the loop generator keeps thread mode busy (about 2 ms, 23 bytes
-/// at 115200 baud).
-static UART_TX: ConstStaticCell<[u8; 64]> = ConstStaticCell::new([0; 64]);
-static UART_RX: ConstStaticCell<[u8; 64]> = ConstStaticCell::new([0; 64]);
-
-embassy_rp::bind_interrupts!(struct Irqs {
-    UART0_IRQ => BufferedInterruptHandler<UART0>;
-    USBCTRL_IRQ => embassy_rp::usb::InterruptHandler<USB>;
-});
+/// Actions for the frame task, which it drains between frames: from the
+/// console ports with the `console` feature, empty without.
+static COMMANDS: CommandQueue = CommandQueue::new();
 
 /// The frame task's executor, above thread mode.
 static FRAME_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
@@ -222,6 +215,7 @@ async fn main(spawner: Spawner) {
     }
 
     // Before the first frame: nothing else runs yet while the store is read.
+    #[cfg(feature = "console")]
     settings::probe(p.FLASH);
 
     let [first, spare] = SETS.take();
@@ -279,71 +273,17 @@ async fn main(spawner: Spawner) {
         Err(_) => defmt::error!("frame task already running"),
     }
 
-    let mut uart_config = uart::Config::default();
-    uart_config.baudrate = UART_BAUD;
-    let uart = BufferedUart::new(
-        p.UART0,
-        p.PIN_0,
-        p.PIN_1,
-        Irqs,
-        UART_TX.take(),
-        UART_RX.take(),
-        uart_config,
+    #[cfg(feature = "console")]
+    console::start(
+        spawner,
+        console::Ports {
+            uart: p.UART0,
+            tx: p.PIN_0,
+            rx: p.PIN_1,
+            usb: p.USB,
+        },
+        &COMMANDS,
     );
-    interrupt::UART0_IRQ.set_priority(PORT_PRIORITY);
-    match uart_console(uart) {
-        Ok(token) => {
-            spawner.spawn(token);
-            defmt::info!("console: UART0 GP0 TX, GP1 RX, {=u32} 8N1", UART_BAUD);
-        }
-        Err(_) => defmt::error!("uart console task already running"),
-    }
-
-    let (device, serial) = usb::build(embassy_rp::usb::Driver::new(p.USB, Irqs));
-    interrupt::USBCTRL_IRQ.set_priority(PORT_PRIORITY);
-    match (usb_device(device), usb_console(serial)) {
-        (Ok(device), Ok(console)) => {
-            spawner.spawn(device);
-            spawner.spawn(console);
-            defmt::info!(
-                "console: USB CDC-ACM {=u16:04x}:{=u16:04x}",
-                usb::VID,
-                usb::PID
-            );
-        }
-        _ => defmt::error!("usb tasks already running"),
-    }
-}
-
-/// The USB device: enumeration, control requests, bus resets.
-#[embassy_executor::task]
-async fn usb_device(mut device: usb::Device) {
-    device.run().await
-}
-
-/// The console on the USB serial port: one session per connection.
-#[embassy_executor::task]
-async fn usb_console(mut serial: usb::Serial) {
-    let mut session = PicoSession::new();
-    let mut handler = QueueHandler::new(&COMMANDS);
-    loop {
-        serial.wait_connection().await;
-        session.reset();
-        let mut port = usb::UsbPort {
-            serial: &mut serial,
-        };
-        console::serve(&mut port, &mut session, &mut handler).await;
-    }
-}
-
-/// The console on UART0, for as long as the board runs.
-#[embassy_executor::task]
-async fn uart_console(mut uart: BufferedUart) {
-    let mut session = PicoSession::new();
-    let mut handler = QueueHandler::new(&COMMANDS);
-    // A UART never goes away: `serve` only returns if it did.
-    let gone = console::serve(&mut uart, &mut session, &mut handler).await;
-    defmt::error!("console uart ended: {}", gone);
 }
 
 /// Generates each next loop set while the frames play (thread mode).
