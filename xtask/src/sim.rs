@@ -33,7 +33,8 @@ use anyhow::Result;
 
 pub use run::{Report, logged_peak_stack};
 pub use stages::{
-    DRILL_STAGE, FAILURES_STAGE, PULSES_STAGE, test_drill, test_failures, test_pulses,
+    CONSOLE_STAGE, CONSOLE_TIME, DRILL_STAGE, FAILURES_STAGE, PULSES_STAGE, WALL, test_console,
+    test_drill, test_failures, test_pulses,
 };
 
 use crate::project::{self, PICO};
@@ -42,10 +43,10 @@ use crate::setup;
 /// Options of `cargo xtask sim`.
 #[derive(Debug, Clone, Copy, clap::Args)]
 pub struct Args {
-    /// Virtual time to run, in seconds (default: a 30 s loop, the 2 s
-    /// fade-in and half a second of boot).
-    #[arg(long = "seconds", value_name = "S", default_value = "32.5", value_parser = virtual_seconds)]
-    pub virtual_time: Duration,
+    /// Virtual time to run, in seconds (default: 32.5, a 30 s loop, the
+    /// 2 s fade-in and half a second of boot; with `--console`, 6).
+    #[arg(long = "seconds", value_name = "S", value_parser = virtual_seconds)]
+    pub virtual_time: Option<Duration>,
     /// Wall-time limit in seconds.
     #[arg(long, value_name = "S", default_value = "120", value_parser = wall_seconds)]
     pub timeout: Duration,
@@ -53,8 +54,14 @@ pub struct Args {
     /// watchdog-drill`, in target/watchdog-drill), whose frames stop after
     /// 3 s, and check that the watchdog resets it and the next boot starts
     /// softly again.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "console")]
     pub drill: bool,
+    /// The console image instead (`--features console`, in target/console):
+    /// its memory against the budgets (not enforced), and a scripted
+    /// exchange over UART0 and then over USB CDC-ACM, every reply checked.
+    /// Without `--seconds`, 6 s: both scripts and their replies.
+    #[arg(long)]
+    pub console: bool,
 }
 
 /// One loop (30 s), the fade-in (2 s) and half a second for the boot.
@@ -92,17 +99,33 @@ pub fn command(args: &Args) -> Result<bool> {
             }
         };
     }
+    if args.console {
+        let time = args.virtual_time.unwrap_or(CONSOLE_TIME);
+        if time < exchange::USB_START + Duration::from_secs(1) {
+            println!(
+                "console: the USB script starts at {} s; run at least {} s",
+                exchange::USB_START.as_secs(),
+                exchange::USB_START.as_secs() + 1
+            );
+            return Ok(false);
+        }
+        return match stages::test_console(&root, &metadata, time, args.timeout) {
+            Ok(()) => Ok(true),
+            Err(error) => {
+                println!("console FAILED: {error:#}");
+                Ok(false)
+            }
+        };
+    }
     PICO.build(&root)?;
     let report = run::simulate(
         &root,
         &PICO.elf(&metadata),
-        args.virtual_time,
+        args.virtual_time.unwrap_or(DEFAULT_TIME),
         args.timeout,
-        // The console exchange when the run lasts past both scripts.
-        args.virtual_time >= exchange::USB_START + Duration::from_secs(1),
+        false,
     )?;
     print!("{}", report.log_text());
-    print!("{}", report.exchange.as_deref().unwrap_or_default());
     print!("{}", report.table());
     println!("{}", report.verdict());
     println!("{}", report.summary());

@@ -137,7 +137,7 @@ pub fn command(options: Options) -> Result<bool> {
     if pico_built {
         stages.run(
             "Pico image: .boot2 placement, memory budgets, no allocator",
-            || elf::check_pico(&PICO.elf(&metadata)),
+            || elf::check_pico(&PICO.elf(&metadata), elf::Budgets::Enforce),
         );
     } else {
         stages.blocked(
@@ -244,6 +244,9 @@ fn sim_stages(
         stages.blocked(sim::PULSES_STAGE, "the Pico build");
     }
     stages.run(sim::DRILL_STAGE, || sim::test_drill(root, metadata));
+    stages.run(sim::CONSOLE_STAGE, || {
+        sim::test_console(root, metadata, sim::CONSOLE_TIME, sim::WALL)
+    });
     stages.run(sim::FAILURES_STAGE, || sim::test_failures(root, metadata));
     stages.run(MEMORY, || {
         let peak = |elf: &Path, stack: Option<u64>| -> Result<Option<elf::Peak>> {

@@ -239,10 +239,10 @@ fn check_exchange(report: &mut Report) {
     let applied = boot
         .log
         .iter()
-        .any(|(_, line)| line.message.contains("Center") && line.message.contains(": ok "));
+        .any(|(_, line)| line.message.contains(": center: ok"));
     if !applied {
         report.problems.push(
-            "the frame task did not log the UART's `center` as applied (`frame <n>: Center ...: ok`)"
+            "the frame task did not log the UART's `center` as applied (`frame <n>: center: ok ...`)"
                 .to_owned(),
         );
     }

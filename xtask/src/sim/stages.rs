@@ -1,6 +1,9 @@
 //! The emulator's stages of `cargo xtask test`.
 
-use std::{path::Path, time::Duration};
+use std::{
+    path::{Path, PathBuf},
+    time::Duration,
+};
 
 use anyhow::{Context, Result, bail};
 
@@ -13,6 +16,7 @@ use super::{
 use xshell::cmd;
 
 use crate::{
+    elf::{self, Budgets},
     project::{self, Metadata, PICO, TARGET},
     reference,
 };
@@ -24,13 +28,16 @@ pub const PULSES_STAGE: &str =
 pub const DRILL_STAGE: &str =
     "watchdog drill in the RP2040 emulator: reset, logged, soft start again";
 /// See [`PULSES_STAGE`].
+pub const CONSOLE_STAGE: &str = "console image (--features console) in the RP2040 emulator: \
+     the UART and USB exchanges; its memory figures (budgets not enforced)";
+/// See [`PULSES_STAGE`].
 pub const FAILURES_STAGE: &str =
     "RP2040 emulator: a hung, a sleeping and a wrong image each fail clearly";
 
 /// Frames the pulse check must cover: a whole loop (1500) and then some.
 const MIN_FRAMES: usize = 1600;
 /// Wall-time limit of one emulator run.
-const WALL: Duration = Duration::from_secs(120);
+pub const WALL: Duration = Duration::from_secs(120);
 /// The drill image stops its frames after this many frames of each boot
 /// (`DRILL_FRAMES` in `src/bin/pico/main.rs`).
 const DRILL_FRAMES: usize = 150;
@@ -38,14 +45,16 @@ const DRILL_FRAMES: usize = 150;
 const WATCHDOG_MS: f64 = 100.0;
 /// Two drill boots: each 3 s of frames and the 100 ms timeout.
 const DRILL_TIME: Duration = Duration::from_millis(6_500);
+/// The console run: both scripts (UART at 3 s, USB at 4 s) and a second
+/// for the last replies.
+pub const CONSOLE_TIME: Duration = Duration::from_secs(6);
 
 /// The shipped Pico image (already built) for [`DEFAULT_TIME`]; fails unless
 /// every check passes over at least [`MIN_FRAMES`] frames and the loops'
 /// checksum is the host's. Returns the run for the memory stage.
 pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
-    let report = run::simulate(root, &PICO.elf(metadata), DEFAULT_TIME, WALL, true)?;
+    let report = run::simulate(root, &PICO.elf(metadata), DEFAULT_TIME, WALL, false)?;
     print!("{}", report.log_text());
-    print!("{}", report.exchange.as_deref().unwrap_or_default());
     print!("{}", report.table());
     println!("{}", report.verdict());
     println!("{}", report.summary());
@@ -79,18 +88,7 @@ pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
 /// directory of its own so that the shipped ELF is never overwritten), runs
 /// two of its boots and checks the reset and the soft start after it.
 pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
-    let target = metadata.target_dir.join("watchdog-drill");
-    let sh = project::shell(".")?;
-    sh.change_dir(root);
-    project::run(
-        &sh,
-        project::FIRMWARE_ENV,
-        cmd!(
-            sh,
-            "cargo build --release --features watchdog-drill --target-dir {target}"
-        ),
-    )?;
-    let elf = target.join(TARGET).join("release").join(PICO.bin);
+    let elf = build_variant(root, metadata, "watchdog-drill")?;
     let report = run::simulate(root, &elf, DRILL_TIME, WALL, false)?;
     print!("{}", report.log_text());
     print!("{}", report.table());
@@ -151,6 +149,54 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
         }
     }
     fail_if_any(&problems)
+}
+
+/// Builds the Pico image with `feature` in a target directory of its own
+/// (`target/<feature>`), so that the shipped ELF is never overwritten;
+/// returns its ELF.
+pub fn build_variant(root: &Path, metadata: &Metadata, feature: &str) -> Result<PathBuf> {
+    let target = metadata.target_dir.join(feature);
+    let sh = project::shell(".")?;
+    sh.change_dir(root);
+    project::run(
+        &sh,
+        project::FIRMWARE_ENV,
+        cmd!(
+            sh,
+            "cargo build --release --features {feature} --target-dir {target}"
+        ),
+    )?;
+    Ok(target.join(TARGET).join("release").join(PICO.bin))
+}
+
+/// Builds the console image (`--features console`, in target/console),
+/// prints its sections and memory against the budgets without enforcing
+/// them, and runs it with the UART and USB exchanges: fails if a reply,
+/// a pulse or the run itself is wrong.
+pub fn test_console(
+    root: &Path,
+    metadata: &Metadata,
+    virtual_time: Duration,
+    wall: Duration,
+) -> Result<()> {
+    let elf = build_variant(root, metadata, "console")?;
+    elf::check_pico(&elf, Budgets::Report)?;
+    let report = run::simulate(root, &elf, virtual_time, wall, true)?;
+    print!("{}", report.log_text());
+    print!("{}", report.exchange.as_deref().unwrap_or_default());
+    print!("{}", report.table());
+    println!("{}", report.verdict());
+    println!("{}", report.summary());
+    let static_ram = elf::Image::read(&elf)?.static_ram();
+    match report.peak_stack() {
+        Some(stack) => println!(
+            "console image RAM: {static_ram} B static + {stack} B peak stack = {} B of the {} B budget (reported, not enforced)",
+            static_ram + stack,
+            elf::RAM_BUDGET
+        ),
+        None => println!("console image RAM: {static_ram} B static, peak stack not measured"),
+    }
+    fail_if_any(&report.problems)
 }
 
 /// A hung image, an image that sleeps for ever, a run out of wall time and
