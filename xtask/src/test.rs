@@ -190,6 +190,19 @@ fn clippy_stages(stages: &mut Stages, sh: &Shell, host_tests: &Shell, xtask: &Sh
             cmd!(sh, "cargo clippy --release --lib --bins -- -D warnings"),
         )
     });
+    stages.run(
+        "clippy: Pico console image (thumbv6m, --features console)",
+        || {
+            project::run(
+                sh,
+                FIRMWARE_ENV,
+                cmd!(
+                    sh,
+                    "cargo clippy --release --bins --features console -- -D warnings"
+                ),
+            )
+        },
+    );
     stages.run("clippy: QEMU images, qemu/ (thumbv6m)", || {
         project::run(
             sh,

@@ -63,7 +63,7 @@
 //! with its own session (`console.rs`): UART0 on GP0 (TX, pin 1) and GP1
 //! (RX, pin 2) at 115200 8N1, 3.3 V levels; and the board's USB port as a
 //! CDC-ACM serial port, `16c0:27dd` (`usb.rs`). Both tasks run in thread
-//! mode and hand actions to the frame task through [`COMMANDS`], which it
+//! mode and hand actions to the frame task through the command queue, which it
 //! drains between frames; the ports' interrupts sit below the frame task's.
 //!
 //! # Settings
@@ -99,6 +99,7 @@ use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_rp::interrupt::{self, InterruptExt, Priority};
 use embassy_rp::watchdog::{ResetReason, Watchdog};
 use embassy_time::{Duration, Instant};
+#[cfg(feature = "console")]
 use idle_head::behaviour::CommandQueue;
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::frame_task::{
@@ -151,8 +152,9 @@ static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::
 /// The channels the buffers go round through.
 static EXCHANGE: Exchange = Exchange::new();
 
-/// Actions for the frame task, which it drains between frames: from the
-/// console ports with the `console` feature, empty without.
+/// Actions from the console ports to the frame task, which it drains
+/// between frames.
+#[cfg(feature = "console")]
 static COMMANDS: CommandQueue = CommandQueue::new();
 
 /// The frame task's executor, above thread mode.
@@ -340,7 +342,9 @@ async fn frame_task(mut driver: FrameDriver<ServoPwm>, first: SetRef, watchdog: 
         defmt::error!("frame period below one timer tick");
         return;
     };
-    let mut frames = frames.with_commands(&COMMANDS);
+    #[cfg(feature = "console")]
+    let frames = frames.with_commands(&COMMANDS);
+    let mut frames = frames;
     let mut hooks = PicoHooks::new(watchdog, playback);
     let stats = idle_head::frame_task::run(&mut driver, &mut frames, &mut hooks).await;
     // `PicoHooks` only stops in the watchdog drill; then the watchdog resets
