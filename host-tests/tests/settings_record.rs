@@ -14,6 +14,9 @@ use idle_head::settings::{
 use idle_head::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
 
+/// A change to the built-in settings.
+type Edit = fn(&mut Settings);
+
 fn encode(s: &Settings) -> Vec<u8> {
     let mut buf = [0; 512];
     let n = s.encode(&mut buf).unwrap();
@@ -128,7 +131,7 @@ fn every_field_has_its_validation_error() {
         SettingsError::Behaviour(b) => b,
         other => panic!("{other:?}"),
     };
-    let cases: [(&str, fn(&mut Settings)); 12] = [
+    let cases: [(&str, Edit); 12] = [
         ("nod.amplitude", |s| {
             s.behaviour.nod.amplitude = Angle::from_degrees(80)
         }),

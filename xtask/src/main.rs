@@ -23,6 +23,7 @@
 mod args;
 mod bench;
 mod cli;
+mod console;
 mod elf;
 mod log;
 mod metrics;
@@ -65,6 +66,7 @@ fn main() -> ExitCode {
         Some(Command::Metrics(args)) => metrics::command(&args),
         Some(Command::Sim(args)) => sim::command(&args),
         Some(Command::Trace(args)) => trace::command(&args),
+        Some(Command::Console(args)) => console::command(&args),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

@@ -131,7 +131,7 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
 }
 
 /// Waits for `child` to exit, at most `timeout`; kills it past that.
-fn wait_or_kill(child: &mut Child, timeout: Duration) -> Result<Exit> {
+pub(crate) fn wait_or_kill(child: &mut Child, timeout: Duration) -> Result<Exit> {
     if let Some(status) = child.wait_timeout(timeout).context("waiting for QEMU")? {
         return Ok(Exit::Status(status));
     }
@@ -141,7 +141,7 @@ fn wait_or_kill(child: &mut Child, timeout: Duration) -> Result<Exit> {
 }
 
 /// Decodes the defmt stream `output` to its end, echoing lines as they come.
-fn decode(
+pub(crate) fn decode(
     mut output: impl Read,
     table: &Table,
     locations: Option<&Locations>,
@@ -169,7 +169,7 @@ fn decode(
 }
 
 /// Passes QEMU's messages on, all but [`RESET_NOISE`].
-fn forward(stderr: impl Read, to: &mut impl Write) {
+pub(crate) fn forward(stderr: impl Read, to: &mut impl Write) {
     for line in BufReader::new(stderr).lines().map_while(Result::ok) {
         if line != RESET_NOISE {
             let _ = writeln!(to, "{line}");
