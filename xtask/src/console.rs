@@ -62,8 +62,14 @@ pub fn command(args: &Args) -> Result<bool> {
                 let _ = stdout.flush();
             },
             Pace::RealTime,
+            Echo::Quiet,
             wait,
         )?;
+        // The firmware's warnings and errors on stderr: stdout has the
+        // replies and the summary only.
+        for line in session.run.log.iter().filter(|l| l.is_problem()) {
+            eprintln!("{}", line.snapshot());
+        }
         match session.summary() {
             Some(line) => println!("{line}"),
             None => println!("no summary line: {}", session.run.describe()),
@@ -216,6 +222,7 @@ pub fn qemu_session(
     lines: impl Iterator<Item = String>,
     mut on_reply: impl FnMut(&str) + Send,
     pace: Pace,
+    echo: Echo,
     wait: Duration,
 ) -> Result<QemuSession> {
     let root = project::root();
@@ -262,8 +269,7 @@ pub fn qemu_session(
     let stderr = child.stderr.take().context("QEMU's stderr")?;
     let start = Instant::now();
     thread::scope(|scope| {
-        let decoder =
-            scope.spawn(|| qemu::decode(stdout, &table, locations.as_ref(), &root, Echo::Problems));
+        let decoder = scope.spawn(|| qemu::decode(stdout, &table, locations.as_ref(), &root, echo));
         scope.spawn(|| qemu::forward(stderr, &mut std::io::stderr()));
         let talked = talk(&uart0, &uart1, lines, &mut on_reply, wait);
         let exit = qemu::wait_or_kill(&mut child, Duration::from_secs(120))?;
@@ -420,6 +426,7 @@ pub fn flood(elf: &Path) -> Result<String> {
         lines.into_iter().map(|(line, _)| line),
         |reply| replies.push(reply.to_owned()),
         Pace::Fast,
+        Echo::Problems,
         Duration::from_secs(60),
     )?;
     let summary = session.summary().unwrap_or_default();

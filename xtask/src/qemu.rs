@@ -70,6 +70,8 @@ pub enum Echo {
     All,
     /// Warnings and errors only (with their source location).
     Problems,
+    /// Nothing (the caller shows what it wants once QEMU is done).
+    Quiet,
 }
 
 /// QEMU's command line for `elf`. `-icount shift=0` makes one instruction one
@@ -159,7 +161,7 @@ pub(crate) fn decode(
                 Err(DecodeError::UnexpectedEof) => break,
                 Err(DecodeError::Malformed) => LogLine::malformed(),
             };
-            if echo == Echo::All || line.is_problem() {
+            if echo == Echo::All || (echo == Echo::Problems && line.is_problem()) {
                 line.print();
             }
             log.push(line);
