@@ -74,7 +74,11 @@ pub async fn console(mut service: Service) {
         UART1.listen();
         RX_READY.wait().await;
     }
-    defmt::info!("console: the host hung up after {=u32} lines", lines);
+    defmt::info!(
+        "console: the host hung up after {=u32} lines, at frame {=u64}",
+        lines,
+        LINK.status().frame
+    );
     // The queued commands are played before the run fades out.
     while !QUEUE.is_empty() || LINK.servos_pending() {
         YieldNow(false).await;

@@ -444,6 +444,14 @@ pub fn flood(elf: &Path) -> Result<String> {
         }
     }
     let verdict = qemu::check_summary(&session.run.log)?;
+    if let Some(line) = session
+        .run
+        .log
+        .iter()
+        .find(|l| l.message.starts_with("console: the host hung up"))
+    {
+        println!("{}", line.message);
+    }
     let frames = summary
         .split_whitespace()
         .find_map(|w| w.strip_prefix("frames="))
