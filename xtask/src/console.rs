@@ -4,7 +4,7 @@
 //! found by its USB VID:PID. Also the flood and console stages of `cargo
 //! xtask test`.
 
-use std::io::{BufRead, Read, Write};
+use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::net::UnixStream;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -270,7 +270,15 @@ pub fn qemu_session(
     let start = Instant::now();
     thread::scope(|scope| {
         let decoder = scope.spawn(|| qemu::decode(stdout, &table, locations.as_ref(), &root, echo));
-        scope.spawn(|| qemu::forward(stderr, &mut std::io::stderr()));
+        scope.spawn(|| {
+            // QEMU says it waits for each socket's connection: not news here.
+            let mut to = std::io::stderr();
+            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+                if !line.contains("QEMU waiting for connection") && !qemu::is_reset_noise(&line) {
+                    let _ = writeln!(to, "{line}");
+                }
+            }
+        });
         let talked = talk(&uart0, &uart1, lines, &mut on_reply, wait);
         let exit = qemu::wait_or_kill(&mut child, Duration::from_secs(120))?;
         let log = decoder

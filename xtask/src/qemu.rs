@@ -170,8 +170,13 @@ pub(crate) fn decode(
     log
 }
 
+/// Whether `line` is QEMU's [`RESET_NOISE`].
+pub(crate) fn is_reset_noise(line: &str) -> bool {
+    line == RESET_NOISE
+}
+
 /// Passes QEMU's messages on, all but [`RESET_NOISE`].
-pub(crate) fn forward(stderr: impl Read, to: &mut impl Write) {
+fn forward(stderr: impl Read, to: &mut impl Write) {
     for line in BufReader::new(stderr).lines().map_while(Result::ok) {
         if line != RESET_NOISE {
             let _ = writeln!(to, "{line}");
