@@ -479,7 +479,7 @@ pub fn flood(elf: &Path) -> Result<String> {
 pub fn piped_script() -> Result<String> {
     const SCRIPT: &str = "help\nstatus\nservo yaw\nservo yaw neutral 1520\nservo yaw\n\
                           idle amp 60\nseed 42\nsave\ndefaults\nload\nservo yaw\nnodd\n\
-                          servo yaw max 9000\nstatus\n";
+                          servo yaw min 2600\nstatus\n";
     const WANT: [&str; 14] = [
         "ok commands:",
         "ok mode=running",
