@@ -202,7 +202,10 @@ impl<P: SetDutyCycle> FrameDriver<P> {
     /// An axis moving faster than a lowered speed limit slows down at the
     /// acceleration limit; braking onto the target stays exact. (An axis
     /// braking when its acceleration limit is lowered may no longer stop in
-    /// time: it overshoots within the new limits and comes back.)
+    /// time: it overshoots within the new limits and comes back.) The angle
+    /// limits are never passed: an axis that can no longer stop before one
+    /// at the lowered acceleration brakes harder than it allows. To switch
+    /// without that, ask [`can_take_limits`](Self::can_take_limits) first.
     ///
     /// # Errors
     /// [`ConfigError::ZeroSpeedLimit`] or [`ConfigError::AccelBelowResolution`];
@@ -224,6 +227,24 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         servo.limits = slew_params(axis, limits, config.frame_period, cal.limits)?;
         *motion = limits;
         Ok(())
+    }
+
+    /// Whether `axis` can take `limits` from the next frame on with no step
+    /// beyond them: it moves no faster than their speed limit and, at their
+    /// acceleration limit, can still stop before the angle limit it moves
+    /// towards. `false` for limits that
+    /// [`set_motion_limits`](Self::set_motion_limits) would refuse.
+    #[must_use]
+    pub fn can_take_limits(&self, axis: Axis, limits: MotionLimits) -> bool {
+        let config = &self.params.config;
+        let (Some(cal), Some(servo)) = (
+            config.servos.get(axis.index()),
+            self.servos.get(axis.index()),
+        ) else {
+            return false;
+        };
+        slew_params(axis, limits, config.frame_period, cal.limits)
+            .is_ok_and(|p| servo.slew.can_take(&p))
     }
 
     /// A new calibration for `axis`' servo from the next frame on, validated

@@ -152,6 +152,28 @@ impl Slew {
         self.vel
     }
 
+    /// Whether the limits `p` can take over from the next frame on without a
+    /// step beyond them: the speed is within `p`'s and, decelerating at `p`'s
+    /// acceleration, the axis can still stop before the angle limit it moves
+    /// towards. (Otherwise the next step would have to brake harder than
+    /// `p` allows, or pass the angle limit: the limits in use must stay until
+    /// the axis has slowed down.)
+    pub(crate) fn can_take(&self, p: &SlewParams) -> bool {
+        let speed = self.vel.unsigned_abs();
+        if speed > p.max_step {
+            return false;
+        }
+        // Both within ±MAX_LIMIT: the differences fit.
+        let room = match self.vel {
+            0 => return true,
+            v if v > 0 => p.hi * MICRO_PER_MILLI - self.pos,
+            _ => self.pos - p.lo * MICRO_PER_MILLI,
+        };
+        // The next step is at least `speed − a` towards the limit, and the
+        // braking speed for the room left now is the most it may be.
+        speed.saturating_sub(p.max_accel) <= brake_speed(room.max(0).unsigned_abs(), p.max_accel)
+    }
+
     /// One frame towards `target`; returns the new angle.
     #[inline]
     pub(crate) fn step(&mut self, target: Angle, p: &SlewParams) -> Angle {
