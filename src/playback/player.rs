@@ -30,7 +30,7 @@
 //! a sample (such as frame 0) needs only that sample, and the next frame
 //! reads the other three.
 
-use crate::playback::{LoopSource, Playback, T_BITS, Window, mul_div_rem, wrap};
+use crate::playback::{LoopSource, Playback, T_BITS, Weights, Window, mul_div_rem, wrap};
 use crate::units::Angle;
 
 /// Plays three loops frame by frame; the same offsets as
@@ -195,8 +195,10 @@ impl Cursor {
             self.seek(frame, loops);
         }
         let t = self.pos & ((1 << T_BITS) - 1);
+        // One set of weights for the three axes.
+        let w = Weights::at(t);
         let [p, r, y] = &self.windows;
-        [p.at(t), r.at(t), y.at(t)].map(Angle::from_millidegrees)
+        [p.at_weights(&w), r.at_weights(&w), y.at_weights(&w)].map(Angle::from_millidegrees)
     }
 
     /// One frame on (see the module docs).
