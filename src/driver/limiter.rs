@@ -65,6 +65,9 @@ pub(crate) struct SlewParams {
     pub(crate) max_step: u32,
     /// Largest change of step per frame, µ°/frame², in `1..=2·SPAN`.
     pub(crate) max_accel: u32,
+    /// `min(max_step, max_accel)`: the largest target step followed as it is
+    /// (see the module docs' common case).
+    follow: u32,
     /// Mechanical limits, m°, within ±[`MAX_LIMIT_MDEG`].
     pub(crate) lo: i32,
     /// Mechanical limits, m°, within ±[`MAX_LIMIT_MDEG`].
@@ -86,9 +89,16 @@ impl SlewParams {
         } else {
             accel as u32
         };
+        let max_step = if step == 0 { 1 } else { step };
+        let max_accel = if accel == 0 { 1 } else { accel };
         Self {
-            max_step: if step == 0 { 1 } else { step },
-            max_accel: if accel == 0 { 1 } else { accel },
+            max_step,
+            max_accel,
+            follow: if max_step < max_accel {
+                max_step
+            } else {
+                max_accel
+            },
             lo,
             hi,
         }
@@ -183,8 +193,7 @@ impl Slew {
         let target_vel = target - self.last_target;
         let speed = target_vel.unsigned_abs();
         if self.pos == self.last_target
-            && speed <= p.max_step
-            && speed <= p.max_accel
+            && speed <= p.follow
             && target_vel.abs_diff(self.vel) <= p.max_accel
         {
             self.last_target = target;
