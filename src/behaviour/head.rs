@@ -13,7 +13,7 @@
 //! planned return is due next frame), the idle limits back once the axis has
 //! settled. Like any change of the driver's limits, a switch is made between
 //! two frames, not during one, and only once the driver's axis can take the
-//! new limits ([`FrameDriver::can_take_limits`]): an axis still moving
+//! new limits ([`FrameDriver::set_motion_limits_when_safe`]): an axis still moving
 //! faster than the idle limits allow, or too fast to stop before an angle
 //! limit at the idle acceleration (the driver's fade after a stop moves the
 //! target too, which the mixer does not see), keeps its gesture limits until
@@ -151,10 +151,7 @@ impl<I: IdleSource> Head<I> {
         let params = self.mixer.params();
         for ((axis, &wanted), mode) in Axis::ALL.iter().zip(&modes).zip(&mut self.modes) {
             let limits = params.limits(*axis, wanted);
-            if wanted != *mode
-                && driver.can_take_limits(*axis, limits)
-                && driver.set_motion_limits(*axis, limits).is_ok()
-            {
+            if wanted != *mode && driver.set_motion_limits_when_safe(*axis, limits) == Ok(true) {
                 *mode = wanted;
             }
         }

@@ -205,7 +205,7 @@ impl<P: SetDutyCycle> FrameDriver<P> {
     /// time: it overshoots within the new limits and comes back.) The angle
     /// limits are never passed: an axis that can no longer stop before one
     /// at the lowered acceleration brakes harder than it allows. To switch
-    /// without that, ask [`can_take_limits`](Self::can_take_limits) first.
+    /// without that, use [`set_motion_limits_when_safe`](Self::set_motion_limits_when_safe).
     ///
     /// # Errors
     /// [`ConfigError::ZeroSpeedLimit`] or [`ConfigError::AccelBelowResolution`];
@@ -229,22 +229,35 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         Ok(())
     }
 
-    /// Whether `axis` can take `limits` from the next frame on with no step
-    /// beyond them: it moves no faster than their speed limit and, at their
+    /// As [`set_motion_limits`](Self::set_motion_limits), but only if
+    /// `axis` can take `limits` from the next frame on with no step beyond
+    /// them: it moves no faster than their speed limit and, at their
     /// acceleration limit, can still stop before the angle limit it moves
-    /// towards. `false` for limits that
-    /// [`set_motion_limits`](Self::set_motion_limits) would refuse.
-    #[must_use]
-    pub fn can_take_limits(&self, axis: Axis, limits: MotionLimits) -> bool {
-        let config = &self.params.config;
-        let (Some(cal), Some(servo)) = (
-            config.servos.get(axis.index()),
-            self.servos.get(axis.index()),
+    /// towards. `Ok(false)` (the limits in use unchanged) if it cannot yet.
+    ///
+    /// # Errors
+    /// As [`set_motion_limits`](Self::set_motion_limits).
+    pub fn set_motion_limits_when_safe(
+        &mut self,
+        axis: Axis,
+        limits: MotionLimits,
+    ) -> Result<bool, ConfigError> {
+        let i = axis.index();
+        let config = &mut self.params.config;
+        let (Some(cal), Some(motion), Some(servo)) = (
+            config.servos.get(i),
+            config.motion.get_mut(i),
+            self.servos.get_mut(i),
         ) else {
-            return false;
+            return Ok(false);
         };
-        slew_params(axis, limits, config.frame_period, cal.limits)
-            .is_ok_and(|p| servo.slew.can_take(&p))
+        let params = slew_params(axis, limits, config.frame_period, cal.limits)?;
+        if !servo.slew.can_take(&params) {
+            return Ok(false);
+        }
+        servo.limits = params;
+        *motion = limits;
+        Ok(true)
     }
 
     /// A new calibration for `axis`' servo from the next frame on, validated
