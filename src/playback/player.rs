@@ -196,9 +196,14 @@ impl Cursor {
         }
         let t = self.pos & ((1 << T_BITS) - 1);
         // One set of weights for the three axes.
-        let w = Weights::at(t);
-        let [p, r, y] = &self.windows;
-        [p.at_weights(&w), r.at_weights(&w), y.at_weights(&w)].map(Angle::from_millidegrees)
+        let weights = Weights::at(t);
+        let [pitch, roll, yaw] = &self.windows;
+        [
+            pitch.at_weights(&weights),
+            roll.at_weights(&weights),
+            yaw.at_weights(&weights),
+        ]
+        .map(Angle::from_millidegrees)
     }
 
     /// One frame on (see the module docs).
