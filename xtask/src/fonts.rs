@@ -1,4 +1,4 @@
-//! The one font of the PNG plots (`preview`, `trace`): DejaVu Sans, built
+//! The one font of the PNG plots (`preview`, `trace`): `DejaVu Sans`, built
 //! in, so that a plot looks the same on every machine.
 
 use std::sync::Once;
@@ -9,7 +9,7 @@ use plotters::style::{FontStyle, register_font};
 /// The family name the plots ask for.
 pub const FONT: &str = "sans-serif";
 
-/// Registers DejaVu Sans (regular and bold) as [`FONT`], once per process.
+/// Registers `DejaVu Sans` (regular and bold) as [`FONT`], once per process.
 pub fn register() -> Result<()> {
     static ONCE: Once = Once::new();
     let mut result = Ok(());

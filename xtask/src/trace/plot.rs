@@ -16,8 +16,6 @@ use crate::fonts::{self, FONT};
 const WIDTH: u32 = 1400;
 const HEADER: u32 = 70;
 const PANEL: u32 = 260;
-/// Registered under a name of its own (the other pictures register theirs).
-
 const BLUE: RGBColor = RGBColor(31, 119, 180);
 const ORANGE: RGBColor = RGBColor(255, 127, 14);
 const GREEN: RGBColor = RGBColor(44, 160, 44);
