@@ -54,6 +54,7 @@ use crate::behaviour::{
     IdleSource,
 };
 use crate::command::{Action, GestureKind, Hold};
+use crate::console::{ConsoleLink, HeadMode, HeadStatus};
 use crate::driver::{DriverConfig, FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod};
 use crate::idle::{IdleMode, LoopSet, LoopStream, LoopSupply, SetInfo};
 use crate::motion::{AxisError, DEFAULT_N};
@@ -121,10 +122,25 @@ impl Exchange {
     pub async fn generate(
         &self,
         stream: &mut LoopStream<DEFAULT_N>,
+        done: impl FnMut(&Result<SetInfo, AxisError>, u64),
+    ) -> ! {
+        self.generate_seeded(stream, None, done).await
+    }
+
+    /// As [`generate`](Self::generate), taking new seeds from `link`
+    /// (the console's `seed`) before each set: the set after a reseed is
+    /// generated from them and joined in as any set is.
+    pub async fn generate_seeded(
+        &self,
+        stream: &mut LoopStream<DEFAULT_N>,
+        link: Option<&ConsoleLink>,
         mut done: impl FnMut(&Result<SetInfo, AxisError>, u64),
     ) -> ! {
         loop {
             let set = self.free.wait().await;
+            if let Some(seeds) = link.and_then(ConsoleLink::take_seeds) {
+                stream.reseed(seeds);
+            }
             loop {
                 let start = Instant::now();
                 let result = stream.next_into(set);
@@ -217,6 +233,7 @@ pub struct FrameLoop<'a, I> {
     head: Head<I>,
     clock: FrameClock,
     commands: Option<&'a CommandQueue>,
+    link: Option<&'a ConsoleLink>,
 }
 
 impl<'a, I: IdleSource> FrameLoop<'a, I> {
@@ -255,6 +272,7 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
             head: Head::new(idle, params),
             clock,
             commands: None,
+            link: None,
         })
     }
 
@@ -262,6 +280,16 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
     #[must_use]
     pub const fn with_commands(mut self, queue: &'a CommandQueue) -> Self {
         self.commands = Some(queue);
+        self
+    }
+
+    /// Shares status and servo calibrations with the console through
+    /// `link`: calibrations are applied before a frame
+    /// ([`drain`](Self::drain)), the status published after it
+    /// ([`publish`](Self::publish)).
+    #[must_use]
+    pub const fn with_link(mut self, link: &'a ConsoleLink) -> Self {
+        self.link = Some(link);
         self
     }
 
@@ -308,6 +336,24 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
     /// Before frame `tick`: the limit modes the behaviour asks for, then the
     /// queued commands (at most two), each logged with its answer.
     pub fn drain<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, tick: FrameTick) {
+        if let Some(link) = self.link {
+            for (axis, cal) in crate::Axis::ALL.iter().zip(link.take_servos()) {
+                let Some(cal) = cal else { continue };
+                match driver.set_servo(*axis, cal) {
+                    Ok(()) => defmt::info!(
+                        "frame {=u64}: {=str} servo calibration changed",
+                        tick.frame,
+                        axis.name()
+                    ),
+                    Err(e) => defmt::warn!(
+                        "frame {=u64}: {=str} servo calibration refused: {=str}",
+                        tick.frame,
+                        axis.name(),
+                        e.message()
+                    ),
+                }
+            }
+        }
         match self.commands {
             Some(queue) => {
                 self.head
@@ -326,6 +372,21 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
                     });
             }
             None => self.head.sync(driver),
+        }
+    }
+
+    /// After a frame that wrote `report`: the head's status for the
+    /// console, if linked.
+    pub fn publish<P: SetDutyCycle>(&self, driver: &FrameDriver<P>, report: &FrameReport) {
+        if let Some(link) = self.link {
+            let mode = if driver.is_stopped() {
+                HeadMode::Stopped
+            } else if driver.is_stopping() {
+                HeadMode::Stopping
+            } else {
+                HeadMode::Running
+            };
+            link.publish(HeadStatus::of(report, driver.stats(), mode));
         }
     }
 
@@ -380,6 +441,7 @@ where
         hooks.before_frame(&tick, driver);
         frames.drain(driver, tick);
         let HeadFrame { offsets, report } = frames.write(driver, tick);
+        frames.publish(driver, &report);
         if report.should_log {
             log_faults(&report);
         }

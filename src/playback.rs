@@ -15,15 +15,18 @@
 //! With the four samples `p₀..p₃` around a segment and their differences
 //! `d₀ = p₁ − p₀`, `d₁ = p₂ − p₁`, `d₂ = p₃ − p₂`, the segment at `t ∈ [0, 1)` is
 //! `2p(t) = 2p₁ + a₁t + a₂t² + a₃t³` with `a₁ = d₀ + d₁`,
-//! `a₂ = −2d₀ + 3d₁ − d₂`, `a₃ = d₀ − 2d₁ + d₂`, evaluated by Horner's rule with
-//! `t` in Q12 (1.67 frames per sample at the defaults: 4096 steps are far
-//! finer than the frames). When neighbouring samples differ by less than 2¹⁵
-//! m° (32.8°; the idle loops move a fraction of a degree per sample) and lie
-//! within ±2²⁹ m°,
-//! `|a₁| ≤ 2¹⁶`, `|a₂| ≤ 6·2¹⁵`, `|a₃| ≤ 4·2¹⁵` and the Horner sums stay below
-//! `12·2¹⁵·2¹²` < 2³¹: `i32`. Larger steps take the same formula in `i64`.
-//! Each product is rounded down (`>> 12`); the value is `p₁` plus half the
-//! polynomial part, rounded half up.
+//! `a₂ = −2d₀ + 3d₁ − d₂`, `a₃ = d₀ − 2d₁ + d₂`, that is
+//! `2p(t) = 2p₁ + w₀(t)·d₀ + w₁(t)·d₁ + w₂(t)·d₂` with the weights
+//! `w₀ = t − 2t² + t³`, `w₁ = t + 3t² − 2t³`, `w₂ = t³ − t²`. The weights
+//! depend on `t` alone, which the three axes share: a frame works them out
+//! once ([`Weights`], `t` in Q12, `t²` and `t³` rounded down to Q12) and each
+//! axis then takes three products (1.67 frames per sample at the defaults:
+//! 4096 steps are far finer than the frames). `|w₀|, |w₂| < 0.15` and
+//! `0 ≤ w₁ ≤ 2`: when neighbouring samples differ by less than 2¹⁵ m° (32.8°;
+//! the idle loops move a fraction of a degree per sample) and lie within
+//! ±2²⁹ m°, the sum stays below `2.3·2¹²·2¹⁵` < 2³¹: `i32`. Larger steps
+//! take the same formula in `i64`. The sum is rounded down (`>> 12`); the
+//! value is `p₁` plus half of it, rounded half up.
 //!
 //! ```
 //! use idle_head::playback::{LoopSource, Playback};
@@ -285,13 +288,19 @@ impl Window {
     }
 
     /// The segment's value at `t` (Q12, `0..4096`), in m°.
+    #[inline]
+    pub(crate) fn at(&self, t: u32) -> i32 {
+        self.at_weights(&Weights::at(t))
+    }
+
+    /// The segment's value at the `t` of `w`, in m° (see the module docs).
     ///
     /// The 32-bit form applies when `|p₁| < 2²⁹` and each difference lies in
     /// `[−2¹⁵, 2¹⁵)`: then every sample is within 2³⁰, so the wrapping
     /// differences are the true ones. (Each condition is a biased value
     /// below 2¹⁶, so one comparison of their bitwise or tests them all.)
     #[inline]
-    pub(crate) fn at(&self, t: u32) -> i32 {
+    pub(crate) fn at_weights(&self, w: &Weights) -> i32 {
         let [p0, p1, p2, p3] = self.p;
         let (d0, d1, d2) = (
             p1.wrapping_sub(p0),
@@ -301,33 +310,36 @@ impl Window {
         let bias = |d: i32| (d as u32).wrapping_add(NARROW_STEP);
         let range = (p1 as u32).wrapping_add(1 << 29) >> 14;
         if range | bias(d0) | bias(d1) | bias(d2) < 2 * NARROW_STEP {
-            let t = t as i32;
-            let a1 = d0 + d1;
-            let a2 = 3 * d1 - 2 * d0 - d2;
-            let a3 = d0 - 2 * d1 + d2;
-            let h = ((a3 * t) >> T_BITS) + a2;
-            let h = ((h * t) >> T_BITS) + a1;
-            let twice = (h * t) >> T_BITS;
+            let [w0, w1, w2] = w.0;
+            let twice = (w0 * d0 + w1 * d1 + w2 * d2) >> T_BITS;
             return p1 + ((twice + 1) >> 1);
         }
-        self.at_wide(t)
+        self.at_wide(w)
     }
 
-    /// [`at`](Self::at) in `i64`, for any samples: each coefficient < 2³⁵,
-    /// each Horner sum < 2⁴⁸.
+    /// [`at_weights`](Self::at_weights) in `i64`, for any samples.
     #[inline(never)]
-    fn at_wide(&self, t: u32) -> i32 {
+    fn at_wide(&self, w: &Weights) -> i32 {
         let [p0, p1, p2, p3] = self.p.map(i64::from);
-        let t = i64::from(t);
-        let (d0, d1, d2) = (p1 - p0, p2 - p1, p3 - p2);
-        let a1 = d0 + d1;
-        let a2 = 3 * d1 - 2 * d0 - d2;
-        let a3 = d0 - 2 * d1 + d2;
-        let h = ((a3 * t) >> T_BITS) + a2;
-        let h = ((h * t) >> T_BITS) + a1;
-        let twice = (h * t) >> T_BITS;
+        let [w0, w1, w2] = w.0.map(i64::from);
+        let twice = (w0 * (p1 - p0) + w1 * (p2 - p1) + w2 * (p3 - p2)) >> T_BITS;
         let value = p1 + ((twice + 1) >> 1);
         value.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
+    }
+}
+
+/// The spline weights `[w₀, w₁, w₂]` at one `t`, Q12 (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Weights([i32; 3]);
+
+impl Weights {
+    /// The weights at `t` (Q12, `0..4096`).
+    #[inline]
+    pub(crate) const fn at(t: u32) -> Self {
+        let t = (t & ((1 << T_BITS) - 1)) as i32;
+        let t2 = (t * t) >> T_BITS;
+        let t3 = (t2 * t) >> T_BITS;
+        Self([t - 2 * t2 + t3, t + 3 * t2 - 2 * t3, t3 - t2])
     }
 }
 

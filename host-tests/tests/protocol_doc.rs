@@ -1,20 +1,19 @@
 //! The exchanges in `docs/protocol.md` are what the console does: every
-//! `> line` of an example, sent to a session whose handler answers `help`
-//! with the help line and any other command with a bare `ok`, gets the
-//! `< reply` written under it, byte for byte.
+//! `> line` of an example, sent to the firmware's console service on a
+//! simulated head (built-in settings, one frame played after each line,
+//! the examples in the order of the document), gets the `< reply` written
+//! under it, byte for byte.
 
-use idle_head::command::Command;
-use idle_head::console::{HELP, Reply, Session};
+use host_tests::console::head::{SimFrames, service, shared};
+use idle_head::console::Session;
 
 #[test]
 fn the_examples_in_the_protocol_document_hold() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/protocol.md");
     let doc = std::fs::read_to_string(path).expect("docs/protocol.md");
-    let mut handler = |command: Command, reply: &mut Reply<'_>| {
-        if command == Command::Help {
-            std::fmt::Write::write_str(reply.ok(), HELP).unwrap();
-        }
-    };
+    let (queue, link) = shared();
+    let mut frames = SimFrames::new();
+    let mut handler = service(queue, link);
     let mut session = Session::<96, 160>::new();
     let mut exchanges = 0;
     let mut lines = doc.lines().peekable();
@@ -30,6 +29,7 @@ fn the_examples_in_the_protocol_document_hold() {
         session.feed(format!("{sent}\r\n").as_bytes(), &mut handler, |r| {
             got.push(String::from_utf8(r.to_vec()).unwrap());
         });
+        frames.frame(queue, link);
         assert_eq!(got, [format!("{want}\r\n")], "`> {sent}`");
         exchanges += 1;
     }

@@ -1,6 +1,6 @@
 //! The settings store on sequential-storage's mock flash: round trips,
-//! versions, a power cut at every byte of hundreds of saves in a row, and
-//! random corruption.
+//! versions, a power cut at every byte of hundreds of saves in a row of the
+//! firmware's own [`Settings`] record, and random corruption.
 //!
 //! `cargo test --test settings_store -- --nocapture` prints the figures.
 
@@ -8,8 +8,8 @@ use futures::executor::block_on;
 use idle_head::command::Percent;
 use idle_head::servo::{NanosPerDegree, ServoCalibration};
 use idle_head::settings::{
-    DecodeError, EncodeError, LoadError, Record, SaveError, SettingsStore, decode_postcard,
-    encode_postcard,
+    DecodeError, EncodeError, LoadError, Record, SaveError, Settings, SettingsStore,
+    decode_postcard, encode_postcard,
 };
 use idle_head::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 /// Four 1 KiB pages of 4-byte words (the RP2040's flash reads in words;
 /// small pages make the store turn pages over often).
 type Flash = MockFlashBase<4, 4, 256>;
-type Store<R> = SettingsStore<Flash, R, 128>;
+type Store<R> = SettingsStore<Flash, R, 256>;
 
 /// A record like the firmware's settings: three servo calibrations and a
 /// few integers.
@@ -147,6 +147,31 @@ fn random_settings(rng: &mut TestRng) -> ServoSettings {
     }
 }
 
+/// The firmware's own settings record, servos, idle amplitude, gaze and
+/// seeds varied (valid by construction, checked).
+fn random_real(rng: &mut TestRng) -> Settings {
+    loop {
+        let s = random_real_candidate(rng);
+        // Narrow random limits can leave no room for the default gestures.
+        if s.validate(&idle_head::DriverConfig::DEFAULT).is_ok() {
+            return s;
+        }
+    }
+}
+
+fn random_real_candidate(rng: &mut TestRng) -> Settings {
+    let servos = random_settings(rng).servos;
+    let mut s = Settings {
+        servos,
+        ..Settings::DEFAULT
+    };
+    s.behaviour.idle.amplitude = Percent::new(rng.random_range(0..=100)).unwrap();
+    s.behaviour.gaze.base = Millis(rng.random_range(0..=5000));
+    s.behaviour.nod.intensity = Percent::new(rng.random_range(0..=100)).unwrap();
+    s.seeds = [rng.random(), rng.random(), rng.random()];
+    s
+}
+
 fn rng(seed: u64) -> TestRng {
     host_tests::console::rng(seed)
 }
@@ -210,7 +235,7 @@ fn round_trip_and_what_a_load_reports() {
     // A record too long for the work buffer is refused, nothing changes.
     let mut raw = store::<Raw<2>>(fresh(WriteCountCheck::OnceOnly));
     assert_eq!(
-        block_on(raw.save(&Raw(vec![7; 200]))),
+        block_on(raw.save(&Raw(vec![7; 300]))),
         Err(SaveError::TooLong)
     );
     assert!(matches!(block_on(raw.load()), Err(LoadError::Empty)));
@@ -229,17 +254,17 @@ const SAVES: usize = 300;
 fn a_power_cut_at_every_byte_leaves_the_old_or_the_new_record() {
     let mut rng = rng(2);
     let mut flash = fresh(WriteCountCheck::OnceOnly);
-    let mut old: Option<ServoSettings> = None;
+    let mut old: Option<Settings> = None;
     let (mut cuts, mut kept_old, mut got_new, mut longest) = (0_u64, 0_u64, 0_u64, 0);
     for i in 0..SAVES {
-        let new = random_settings(&mut rng);
+        let new = random_real(&mut rng);
         // Now and then go on from a state a cut and its repair left.
         let mut resume: Option<Flash> = None;
         let mut cut = 0;
         let done = loop {
             let mut trial = flash.clone();
             trial.bytes_until_shutoff = Some(cut);
-            let mut s = store::<ServoSettings>(trial);
+            let mut s = store::<Settings>(trial);
             match block_on(s.save(&new)) {
                 Ok(()) => break s.into_flash(),
                 Err(SaveError::Flash(MockFlashError::EarlyShutoff(..))) => {}
@@ -248,7 +273,7 @@ fn a_power_cut_at_every_byte_leaves_the_old_or_the_new_record() {
             // Power back: a new store over what the flash holds.
             let mut after = s.into_flash();
             after.bytes_until_shutoff = None;
-            let mut s = store::<ServoSettings>(after);
+            let mut s = store::<Settings>(after);
             match (block_on(s.load()), old) {
                 (Ok(r), _) if r == new => got_new += 1,
                 (Ok(r), Some(o)) if r == o => kept_old += 1,
@@ -293,8 +318,8 @@ fn random_corruption_never_panics_nor_invents_a_record() {
     // Real NOR flash: writing over written bits clears them (no mock check).
     let mut histories = Vec::new();
     for saves in [1, 3, 20, 60] {
-        let mut s = store::<ServoSettings>(fresh(WriteCountCheck::Disabled));
-        let saved: Vec<ServoSettings> = (0..saves).map(|_| random_settings(&mut rng)).collect();
+        let mut s = store::<Settings>(fresh(WriteCountCheck::Disabled));
+        let saved: Vec<Settings> = (0..saves).map(|_| random_real(&mut rng)).collect();
         for r in &saved {
             block_on(s.save(r)).unwrap();
         }
@@ -305,7 +330,7 @@ fn random_corruption_never_panics_nor_invents_a_record() {
         let (base, saved) = &histories[trial % histories.len()];
         let mut flash = base.clone();
         corrupt_bytes(flash.as_bytes_mut(), &mut rng);
-        let mut s = store::<ServoSettings>(flash);
+        let mut s = store::<Settings>(flash);
         match block_on(s.load()) {
             Ok(r) if Some(&r) == saved.last() => newest += 1,
             Ok(r) if saved.contains(&r) => older += 1,
@@ -313,7 +338,7 @@ fn random_corruption_never_panics_nor_invents_a_record() {
             Err(LoadError::Corrupt) => corrupt += 1,
             other => panic!("trial {trial}: {other:?}"),
         }
-        let next = random_settings(&mut rng);
+        let next = random_real(&mut rng);
         let saved_ok = block_on(s.save(&next));
         let loaded = block_on(s.load());
         if saved_ok.is_ok() && loaded == Ok(next) {

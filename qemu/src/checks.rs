@@ -7,6 +7,7 @@
 //! over frames 1400..1500.
 
 use core::ops::Range;
+use core::sync::atomic::Ordering;
 
 use idle_head::behaviour::CommandQueue;
 use idle_head::driver::{DriverConfig, FrameDriver, FrameTick, Outcome};
@@ -77,6 +78,8 @@ pub struct Checks {
     config: DriverConfig,
     /// Where the script's commands go (the frame loop drains it).
     commands: &'static CommandQueue,
+    /// The fade-out waits for the console's host to hang up.
+    hold: bool,
     failures: u32,
     previous: Option<Frame>,
     /// The last frame's offset steps (d1), for d2.
@@ -86,6 +89,7 @@ pub struct Checks {
     others_moved: [u32; 3],
     disabled_at: Option<u64>,
     stopped_at: Option<u64>,
+    stop_requested: bool,
     last: u64,
     /// SysTick count when the current frame's write began.
     write_started: u64,
@@ -94,10 +98,11 @@ pub struct Checks {
 }
 
 impl Checks {
-    pub const fn new(config: DriverConfig, commands: &'static CommandQueue) -> Self {
+    pub const fn new(config: DriverConfig, commands: &'static CommandQueue, hold: bool) -> Self {
         Self {
             config,
             commands,
+            hold,
             failures: 0,
             previous: None,
             last_steps: None,
@@ -109,6 +114,7 @@ impl Checks {
             others_moved: [0; 3],
             disabled_at: None,
             stopped_at: None,
+            stop_requested: false,
             last: 0,
             write_started: 0,
             write_counts: (0, 0),
@@ -143,7 +149,13 @@ impl Checks {
             );
             self.fail();
         }
-        if idle.joins != 1 || idle.late != 0 || idle.set != 1 {
+        // A held run plays on past the first join.
+        let joins_ok = if self.hold {
+            idle.joins >= 1 && idle.set == idle.joins
+        } else {
+            idle.joins == 1 && idle.set == 1
+        };
+        if !joins_ok || idle.late != 0 {
             defmt::error!("check: want one join on time, to loop set 1");
             self.fail();
         }
@@ -379,9 +391,11 @@ impl FrameHooks<VirtualPwm> for Checks {
         } else if index == JOIN.end {
             defmt::info!("frame {=u64}: join done: the new loop set plays on", index);
         }
-        if index == STOP_AT {
+        let released = !self.hold || crate::console::HUNG_UP.load(Ordering::Acquire);
+        if index >= STOP_AT && released && !self.stop_requested {
             defmt::info!("frame {=u64}: fading out", index);
             driver.request_stop();
+            self.stop_requested = true;
         }
         if stopping_now {
             defmt::info!("frame {=u64}: fade-out done, at the neutral pose", index);

@@ -50,6 +50,7 @@
 #![no_main]
 
 mod checks;
+mod console;
 mod exit;
 mod pwm;
 mod script;
@@ -59,6 +60,7 @@ mod script;
 #[allow(dead_code)]
 mod rp2040_pwm;
 mod systick;
+mod uart;
 
 use core::ptr;
 use core::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
@@ -69,13 +71,14 @@ use cortex_m_rt::exception;
 use defmt_semihosting as _;
 use embassy_executor::raw;
 use embassy_time::{Duration, Instant};
-use idle_head::behaviour::CommandQueue;
+use idle_head::console::ConsoleService;
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::frame_task::{
     Exchange, ExchangeSupply, FrameLoop, IDLE_MODE, LOOP_DURATION, SetRef,
 };
 use idle_head::idle::{IdleMode, IdlePlayer, IdleTiming, LoopSet, LoopStream};
 use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N};
+use idle_head::settings::{RamStorage, Settings, SettingsSource};
 use idle_head::{Axis, Microseconds, Millis, Playback};
 use static_cell::ConstStaticCell;
 
@@ -126,9 +129,6 @@ static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::
 /// The channels the buffers go round through.
 static EXCHANGE: Exchange = Exchange::new();
 
-/// Commands for the frame task (the script's, see script.rs).
-static COMMANDS: CommandQueue = CommandQueue::new();
-
 /// Set by the pender when a thread-mode task was woken, cleared by the idle loop.
 static PENDED: AtomicBool = AtomicBool::new(false);
 
@@ -160,9 +160,25 @@ fn pender(context: *mut ()) {
     }
 }
 
+/// A UART's interrupt line, for the NVIC.
+#[derive(Clone, Copy)]
+struct UartIrq(u16);
+
+// Note(unsafe): 5 and 6 are UART0's and UART1's interrupt numbers on the
+// LM3S6965.
+unsafe impl InterruptNumber for UartIrq {
+    fn number(self) -> u16 {
+        self.0
+    }
+}
+
 #[exception]
 unsafe fn DefaultHandler(irqn: i16) {
-    if irqn == FrameIrq.number() as i16 {
+    if irqn == uart::UART0_IRQ as i16 {
+        uart::UART0.on_interrupt();
+    } else if irqn == uart::UART1_IRQ as i16 {
+        uart::UART1.on_interrupt();
+    } else if irqn == FrameIrq.number() as i16 {
         let executor = FRAME_EXECUTOR.load(Ordering::Acquire);
         // Note(unsafe): the executor is a `'static` singleton set before the
         // interrupt is unmasked, and polled from this handler only, which
@@ -233,6 +249,11 @@ fn main() -> ! {
         precompute_insns,
         checksum
     );
+    let hold = console::held_by_host();
+    console::HOLD.store(hold, Ordering::Relaxed);
+    if hold {
+        defmt::info!("console: the run lasts until the host hangs up (UART1)");
+    }
     let mut stream = LoopStream::new(DEFAULT_HEAD, &TIMING);
     stream.adopt(first);
 
@@ -260,6 +281,25 @@ fn main() -> ! {
         }
         IdleMode::FixedLoop => defmt::info!("idle: the fixed loop, replayed every loop"),
     }
+    // Settings in Pico units (the frame task's behaviour is built for
+    // them too); status reports Pico time (frames of 20 ms).
+    match ConsoleService::new(
+        &console::QUEUE,
+        &console::LINK,
+        RamStorage::new(),
+        DriverConfig::DEFAULT,
+        Settings::DEFAULT,
+        SettingsSource::Defaults,
+    ) {
+        Ok(mut service) => {
+            service.add_entropy(checksum);
+            match console::console(service) {
+                Ok(token) => thread.spawner().spawn(token),
+                Err(_) => exit::exit(false),
+            }
+        }
+        Err(_) => exit::exit(false),
+    }
     match frame_task(first, precompute_insns, checksum, generated) {
         Ok(token) => frame_executor.spawner().spawn(token),
         Err(_) => exit::exit(false),
@@ -268,6 +308,17 @@ fn main() -> ! {
     // Note(unsafe): the frame executor is published above, before its
     // interrupt can run.
     unsafe { NVIC::unmask(FrameIrq) };
+    // The UARTs below the frame interrupt (priority 0): a frame preempts
+    // their (short) handler, never the other way round.
+    for irq in [uart::UART0_IRQ, uart::UART1_IRQ] {
+        // Note(unsafe): priorities are set before the interrupts are
+        // unmasked; their handlers share no state with a priority-based
+        // critical section.
+        unsafe {
+            core.NVIC.set_priority(UartIrq(irq), 0x80);
+            NVIC::unmask(UartIrq(irq));
+        }
+    }
     loop {
         // Note(unsafe): `poll` is called from this loop only, never
         // re-entrantly (the pender only sets a flag).
@@ -290,7 +341,7 @@ fn main() -> ! {
 #[embassy_executor::task]
 async fn generator(mut stream: LoopStream<DEFAULT_N>) {
     EXCHANGE
-        .generate(&mut stream, |result, ticks| match result {
+        .generate_seeded(&mut stream, Some(&console::LINK), |result, ticks| match result {
             // Virtual time under `-icount shift=0`: 1000 instructions a µs,
             // the frames that preempt the generator included.
             Ok(info) => defmt::info!(
@@ -319,12 +370,22 @@ async fn frame_task(first: SetRef, precompute_insns: u64, checksum: u32, generat
     let idle: IdlePlayer<SetRef, ExchangeSupply> =
         IdlePlayer::new(first, EXCHANGE.supply(), TIMING, IDLE_MODE);
     let start = Instant::now().as_ticks();
-    let Ok(frames) = FrameLoop::new(idle, FRAME_PERIOD, embassy_time::TICK_HZ, start) else {
+    let Ok(mut frames) =
+        FrameLoop::new(idle, FRAME_PERIOD, embassy_time::TICK_HZ, start).map(|frames| {
+            frames
+                .with_commands(&console::QUEUE)
+                .with_link(&console::LINK)
+        })
+    else {
         defmt::error!("frame period below one timer tick");
         exit::exit(false)
     };
-    let mut frames = frames.with_commands(&COMMANDS);
-    let mut checks = Checks::new(CONFIG, &COMMANDS);
+    // The script's commands share the console's queue, as a board's would.
+    let mut checks = Checks::new(
+        CONFIG,
+        &console::QUEUE,
+        console::HOLD.load(Ordering::Relaxed),
+    );
     let stats = idle_head::frame_task::run(&mut driver, &mut frames, &mut checks).await;
     defmt::info!(
         "frame timing: {=u64} frames, {=u64} missed, wake-up at most {=u64} us after the deadline",

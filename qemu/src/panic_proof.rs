@@ -17,7 +17,10 @@
 //! frame, new motion limits and servo calibrations (any values, valid or
 //! not) between any two frames, and the behaviour: any behaviour parameters
 //! and any command (gestures, looks, `center`, idle changes, stop) applied
-//! between any two frames ([`FrameLoop::apply`]), mixed into every frame. Its panic handler calls `frame_path_has_a_panic_path`, a function
+//! between any two frames ([`FrameLoop::apply`]), mixed into every frame,
+//! servo calibrations from the console's link, the status published for
+//! it after every frame ([`FrameLoop::publish`]), and the console's
+//! parser (`idle_head::console::parse`) on any line. Its panic handler calls `frame_path_has_a_panic_path`, a function
 //! that exists nowhere. If any panic (index, division, overflow check,
 //! `unwrap`, ...) remains reachable after optimisation, the call survives
 //! and the link fails:
@@ -38,6 +41,7 @@ use core::hint::black_box;
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
 use idle_head::behaviour::{BehaviourConfig, BehaviourParams};
 use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
+use idle_head::console::{ConsoleLink, parse};
 use idle_head::driver::{
     DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, DriverParams, FrameDriver,
     MotionLimits,
@@ -73,6 +77,9 @@ static SETS: ConstStaticCell<[LoopSet<DEFAULT_N>; 2]> =
 /// The channels to the generator (none runs: whether a set is ready is
 /// unknown to the optimiser).
 static EXCHANGE: Exchange = Exchange::new();
+
+/// What the console shares with the frame task: calibrations in, status out.
+static LINK: ConsoleLink = ConsoleLink::new();
 
 /// A PWM channel whose maximum duty and write results are unknown.
 struct OpaquePwm;
@@ -162,7 +169,8 @@ fn main() -> ! {
         black_box(BEHAVIOUR),
         black_box(1_000_000),
         black_box(0),
-    ) else {
+    )
+    .map(|frames| frames.with_link(&LINK)) else {
         // Not reached with the built-in playback; no panic either way.
         loop {
             cortex_m::asm::wfi();
@@ -201,10 +209,25 @@ fn main() -> ! {
             5 => {
                 black_box(frames.apply(&mut driver, &any_action())).ok();
             }
+            6 => {
+                // Calibrations the console sent, as `FrameLoop::drain` applies them.
+                for (axis, cal) in Axis::ALL.iter().zip(LINK.take_servos()) {
+                    if let Some(cal) = cal {
+                        black_box(driver.set_servo(*axis, cal)).ok();
+                    }
+                }
+            }
+            7 => {
+                // The console's parser, on any line of up to 96 bytes.
+                let line = black_box([0_u8; 96]);
+                let len = usize::from(black_box(0_u8)) % (line.len() + 1);
+                black_box(parse(line.get(..len).unwrap_or_default())).ok();
+            }
             _ => {}
         }
         let tick = frames.next(black_box(0));
         let written = frames.write(&mut driver, tick);
+        frames.publish(&driver, &written.report);
         black_box((written, driver.is_stopped(), driver.stats()));
     }
 }

@@ -12,7 +12,12 @@
 //! ([`LimitMode`]): the gesture limits as soon as a motion is applied (or a
 //! planned return is due next frame), the idle limits back once the axis has
 //! settled. Like any change of the driver's limits, a switch is made between
-//! two frames, not during one.
+//! two frames, not during one, and only once the driver's axis can take the
+//! new limits ([`FrameDriver::set_motion_limits_when_safe`]): an axis still moving
+//! faster than the idle limits allow, or too fast to stop before an angle
+//! limit at the idle acceleration (the driver's fade after a stop moves the
+//! target too, which the mixer does not see), keeps its gesture limits until
+//! it can.
 
 use embedded_hal::pwm::SetDutyCycle;
 
@@ -61,6 +66,12 @@ impl<I: IdleSource> Head<I> {
     /// The mixer.
     pub fn mixer(&self) -> &Mixer {
         &self.mixer
+    }
+
+    /// The limit modes the driver has, `[pitch, roll, yaw]` (the mixer's
+    /// [`modes`](Mixer::modes) once each switch was made).
+    pub const fn limit_modes(&self) -> [LimitMode; 3] {
+        self.modes
     }
 
     /// The idle source.
@@ -132,17 +143,15 @@ impl<I: IdleSource> Head<I> {
     }
 
     /// Gives the driver the limits of `modes` where they changed. (They were
-    /// validated with the parameters; should the driver refuse them, the
-    /// axis keeps its limits and the switch is tried again next frame.)
+    /// validated with the parameters. Should the axis not be able to take
+    /// them yet, or the driver refuse them, the axis keeps its limits and the
+    /// switch is tried again next frame.)
     #[inline(never)]
     fn switch<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, modes: [LimitMode; 3]) {
         let params = self.mixer.params();
         for ((axis, &wanted), mode) in Axis::ALL.iter().zip(&modes).zip(&mut self.modes) {
-            if wanted != *mode
-                && driver
-                    .set_motion_limits(*axis, params.limits(*axis, wanted))
-                    .is_ok()
-            {
+            let limits = params.limits(*axis, wanted);
+            if wanted != *mode && driver.set_motion_limits_when_safe(*axis, limits) == Ok(true) {
                 *mode = wanted;
             }
         }

@@ -202,7 +202,10 @@ impl<P: SetDutyCycle> FrameDriver<P> {
     /// An axis moving faster than a lowered speed limit slows down at the
     /// acceleration limit; braking onto the target stays exact. (An axis
     /// braking when its acceleration limit is lowered may no longer stop in
-    /// time: it overshoots within the new limits and comes back.)
+    /// time: it overshoots within the new limits and comes back.) The angle
+    /// limits are never passed: an axis that can no longer stop before one
+    /// at the lowered acceleration brakes harder than it allows. To switch
+    /// without that, use [`set_motion_limits_when_safe`](Self::set_motion_limits_when_safe).
     ///
     /// # Errors
     /// [`ConfigError::ZeroSpeedLimit`] or [`ConfigError::AccelBelowResolution`];
@@ -224,6 +227,37 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         servo.limits = slew_params(axis, limits, config.frame_period, cal.limits)?;
         *motion = limits;
         Ok(())
+    }
+
+    /// As [`set_motion_limits`](Self::set_motion_limits), but only if
+    /// `axis` can take `limits` from the next frame on with no step beyond
+    /// them: it moves no faster than their speed limit and, at their
+    /// acceleration limit, can still stop before the angle limit it moves
+    /// towards. `Ok(false)` (the limits in use unchanged) if it cannot yet.
+    ///
+    /// # Errors
+    /// As [`set_motion_limits`](Self::set_motion_limits).
+    pub fn set_motion_limits_when_safe(
+        &mut self,
+        axis: Axis,
+        limits: MotionLimits,
+    ) -> Result<bool, ConfigError> {
+        let i = axis.index();
+        let config = &mut self.params.config;
+        let (Some(cal), Some(motion), Some(servo)) = (
+            config.servos.get(i),
+            config.motion.get_mut(i),
+            self.servos.get_mut(i),
+        ) else {
+            return Ok(false);
+        };
+        let params = slew_params(axis, limits, config.frame_period, cal.limits)?;
+        if !servo.slew.can_take(&params) {
+            return Ok(false);
+        }
+        servo.limits = params;
+        *motion = limits;
+        Ok(true)
     }
 
     /// A new calibration for `axis`' servo from the next frame on, validated
@@ -315,7 +349,12 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         let report = &mut self.last;
         report.frame = self.stats.frames;
         report.should_log = false;
-        if report.servos.iter().all(|s| s.outcome == Outcome::Written) {
+        let [a, b, c] = &report.servos;
+        // Unrolled: the loop's counter costs as much as the comparisons.
+        if a.outcome == Outcome::Written
+            && b.outcome == Outcome::Written
+            && c.outcome == Outcome::Written
+        {
             report.written = 3;
             report.failed = 0;
             report.disabled = 0;

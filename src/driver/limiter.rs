@@ -65,6 +65,9 @@ pub(crate) struct SlewParams {
     pub(crate) max_step: u32,
     /// Largest change of step per frame, µ°/frame², in `1..=2·SPAN`.
     pub(crate) max_accel: u32,
+    /// `min(max_step, max_accel)`: the largest target step followed as it is
+    /// (see the module docs' common case).
+    follow: u32,
     /// Mechanical limits, m°, within ±[`MAX_LIMIT_MDEG`].
     pub(crate) lo: i32,
     /// Mechanical limits, m°, within ±[`MAX_LIMIT_MDEG`].
@@ -86,9 +89,16 @@ impl SlewParams {
         } else {
             accel as u32
         };
+        let max_step = if step == 0 { 1 } else { step };
+        let max_accel = if accel == 0 { 1 } else { accel };
         Self {
-            max_step: if step == 0 { 1 } else { step },
-            max_accel: if accel == 0 { 1 } else { accel },
+            max_step,
+            max_accel,
+            follow: if max_step < max_accel {
+                max_step
+            } else {
+                max_accel
+            },
             lo,
             hi,
         }
@@ -152,6 +162,28 @@ impl Slew {
         self.vel
     }
 
+    /// Whether the limits `p` can take over from the next frame on without a
+    /// step beyond them: the speed is within `p`'s and, decelerating at `p`'s
+    /// acceleration, the axis can still stop before the angle limit it moves
+    /// towards. (Otherwise the next step would have to brake harder than
+    /// `p` allows, or pass the angle limit: the limits in use must stay until
+    /// the axis has slowed down.)
+    pub(crate) fn can_take(&self, p: &SlewParams) -> bool {
+        let speed = self.vel.unsigned_abs();
+        if speed > p.max_step {
+            return false;
+        }
+        // Both within ±MAX_LIMIT: the differences fit.
+        let room = match self.vel {
+            0 => return true,
+            v if v > 0 => p.hi * MICRO_PER_MILLI - self.pos,
+            _ => self.pos - p.lo * MICRO_PER_MILLI,
+        };
+        // The next step is at least `speed − a` towards the limit, and the
+        // braking speed for the room left now is the most it may be.
+        speed.saturating_sub(p.max_accel) <= brake_speed(room.max(0).unsigned_abs(), p.max_accel)
+    }
+
     /// One frame towards `target`; returns the new angle.
     #[inline]
     pub(crate) fn step(&mut self, target: Angle, p: &SlewParams) -> Angle {
@@ -161,8 +193,7 @@ impl Slew {
         let target_vel = target - self.last_target;
         let speed = target_vel.unsigned_abs();
         if self.pos == self.last_target
-            && speed <= p.max_step
-            && speed <= p.max_accel
+            && speed <= p.follow
             && target_vel.abs_diff(self.vel) <= p.max_accel
         {
             self.last_target = target;

@@ -250,6 +250,12 @@ impl<const N: usize> LoopStream<N> {
         self.seeds
     }
 
+    /// Draws the next set from `seeds` instead of where the streams
+    /// stopped (the console's `seed`); the streams run on from there.
+    pub fn reseed(&mut self, seeds: [u32; 3]) {
+        self.seeds = seeds;
+    }
+
     /// Generates the next set into `set`: set 0 is the configuration's own
     /// loops; every later one continues the LCG streams and is entered where
     /// it joins the last set best.

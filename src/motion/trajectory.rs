@@ -136,8 +136,13 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
     /// Sample `index` of the loop in playback order (taken modulo N) as an angle.
     #[must_use]
     pub fn angle(&self, index: usize) -> Angle {
-        // Playback reads indices below N: no division for them.
-        let index = if index < N { index } else { index % N };
+        // Playback reads indices below N: no division for them (out of
+        // line, or the compiler divides before it compares).
+        let index = if index < N {
+            index
+        } else {
+            wrap_index::<N>(index)
+        };
         let mut i = self.start() + index;
         if i >= N {
             i -= N;
@@ -145,6 +150,16 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
         self.samples
             .get(i)
             .map_or(Angle::ZERO, |s| s.angle_in(&self.scale))
+    }
+}
+
+/// `index mod N`, for the indices past the loop.
+#[cold]
+#[inline(never)]
+const fn wrap_index<const N: usize>(index: usize) -> usize {
+    match index.checked_rem(N) {
+        Some(i) => i,
+        None => 0,
     }
 }
 

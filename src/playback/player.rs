@@ -30,7 +30,7 @@
 //! a sample (such as frame 0) needs only that sample, and the next frame
 //! reads the other three.
 
-use crate::playback::{LoopSource, Playback, T_BITS, Window, mul_div_rem, wrap};
+use crate::playback::{LoopSource, Playback, T_BITS, Weights, Window, mul_div_rem, wrap};
 use crate::units::Angle;
 
 /// Plays three loops frame by frame; the same offsets as
@@ -195,8 +195,15 @@ impl Cursor {
             self.seek(frame, loops);
         }
         let t = self.pos & ((1 << T_BITS) - 1);
-        let [p, r, y] = &self.windows;
-        [p.at(t), r.at(t), y.at(t)].map(Angle::from_millidegrees)
+        // One set of weights for the three axes.
+        let weights = Weights::at(t);
+        let [pitch, roll, yaw] = &self.windows;
+        [
+            pitch.at_weights(&weights),
+            roll.at_weights(&weights),
+            yaw.at_weights(&weights),
+        ]
+        .map(Angle::from_millidegrees)
     }
 
     /// One frame on (see the module docs).

@@ -4,6 +4,11 @@
 //! - [`Record`]: how a settings type turns into bytes and back, with the
 //!   version of that layout. With the `postcard` feature,
 //!   [`encode_postcard`] and [`decode_postcard`] do it for any serde type.
+//! - [`Settings`]: the head's settings (servos, behaviour, seeds), one
+//!   validated record of version 1 ([`Settings::DEFAULT`]: the built-in
+//!   configuration).
+//! - [`SettingsStorage`]: what the console's `save` and `load` call, a
+//!   trait each board implements; [`RamStorage`] keeps the record in RAM.
 //! - [`SettingsStore`]: the record in a range of NOR flash (anything that
 //!   implements `embedded_storage_async::nor_flash::NorFlash`, such as
 //!   embassy-rp's flash driver), kept by `sequential-storage`'s map.
@@ -28,11 +33,17 @@
 //! saving are not free of panic paths; they run at boot and on `save` or
 //! `load`, never on the frame path.
 
+mod codec;
 mod record;
+mod storage;
 mod store;
+mod values;
 
+pub use codec::SETTINGS_LEN;
 pub use record::{DecodeError, EncodeError, Record};
 #[cfg(feature = "postcard")]
 pub use record::{decode_postcard, encode_postcard};
 pub use sequential_storage::map::MapConfigError;
+pub use storage::{RamStorage, SettingsStorage, StorageError};
 pub use store::{LoadError, SaveError, SettingsStore};
+pub use values::{Settings, SettingsError, SettingsSource, Validated};

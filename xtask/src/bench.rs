@@ -19,8 +19,11 @@
 //! ```
 //!
 //! This module decodes that log, prints the table and the `frame` row,
-//! reports the `default` row against its [`BUDGET`] and the frame row against
-//! [`FRAME_MEDIAN_BUDGET`] and [`FRAME_MAX_BUDGET`], and fails past any.
+//! reports the `default` row against its [`BUDGET`] and both frame rows (idle,
+//! and with a gesture and a look) against [`FRAME_MEDIAN_BUDGET`] and
+//! [`FRAME_MAX_BUDGET`], and fails past the default's budget or the idle
+//! frame row's, naming the row (the gesture row is reported, not yet held
+//! to its budget: see `frame.rs`).
 
 // Instruction counts are far below 2^52 and positive: the float conversions are exact.
 #![allow(
@@ -32,6 +35,11 @@
 use std::{fmt::Write as _, path::Path};
 
 use anyhow::{Context, Result, bail};
+
+mod frame;
+
+pub use frame::FrameRow;
+use frame::frames_over_budget;
 
 use crate::{
     args::Options,
@@ -60,7 +68,7 @@ pub const FRAME_MAX_BUDGET: u64 = 2000;
 
 /// The name of the benchmark's stage in `cargo xtask test`.
 pub const STAGE: &str = "QEMU bench: default set within its 150,000-instruction budget, \
-                         frame median within 1,000, max within 2,000";
+                         idle frame median within 1,000, max within 2,000";
 
 /// RP2040 system clock (Hz) the time column assumes: 125 MHz, the Pico's default.
 const RP2040_HZ: f64 = 125e6;
@@ -140,123 +148,6 @@ impl Row {
     /// every Cortex-M0+ instruction takes at least one cycle.
     pub fn rp2040_us(&self) -> f64 {
         self.engine as f64 / RP2040_HZ * 1e6
-    }
-}
-
-/// The `frame bench ...` line: instructions per frame update over a loop.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct FrameRow {
-    /// What plays besides the idle loops (`gesture+look`), if anything.
-    pub scenario: Option<String>,
-    /// Frames measured.
-    pub frames: u64,
-    /// Fewest instructions of a frame.
-    pub min: u64,
-    /// Median over the frames.
-    pub median: u64,
-    /// Most instructions of a frame.
-    pub max: u64,
-    /// The frame that took `max`.
-    pub max_at: u64,
-    /// Mean over the frames.
-    pub mean: u64,
-}
-
-impl FrameRow {
-    /// Parses a `frame bench frames=... min=... median=... max=... max_at=...
-    /// mean=...` message; `None` for any other message, an error for a
-    /// malformed one.
-    pub fn parse(message: &str) -> Result<Option<Self>> {
-        let Some(rest) = message.trim_start().strip_prefix("frame bench ") else {
-            return Ok(None);
-        };
-        let number = |key: &str| -> Result<u64> {
-            let value = rest
-                .split_whitespace()
-                .find_map(|token| token.strip_prefix(key)?.strip_prefix('='))
-                .with_context(|| format!("`{message}` has no `{key}=`"))?;
-            value
-                .parse()
-                .with_context(|| format!("`{key}={value}` in `{message}` is not a whole number"))
-        };
-        let scenario = rest
-            .split_whitespace()
-            .find_map(|token| token.strip_prefix("scenario="))
-            .map(str::to_owned);
-        Ok(Some(Self {
-            scenario,
-            frames: number("frames")?,
-            min: number("min")?,
-            median: number("median")?,
-            max: number("max")?,
-            max_at: number("max_at")?,
-            mean: number("mean")?,
-        }))
-    }
-
-    /// The frame rows of a benchmark log (idle, then with a gesture and a
-    /// look); fails if one is missing or malformed.
-    pub fn all(log: &[LogLine]) -> Result<Vec<Self>> {
-        let rows: Vec<Self> = log
-            .iter()
-            .filter_map(|line| FrameRow::parse(&line.message).transpose())
-            .collect::<Result<_>>()?;
-        for scenario in [None, Some("gesture+look")] {
-            if !rows.iter().any(|row| row.scenario.as_deref() == scenario) {
-                bail!(
-                    "the benchmark reported no `frame bench{}` line",
-                    scenario.map_or(String::new(), |s| format!(" scenario={s}"))
-                );
-            }
-        }
-        Ok(rows)
-    }
-
-    /// The median and the max within their budgets.
-    pub fn within_budget(&self) -> bool {
-        self.median <= FRAME_MEDIAN_BUDGET && self.max <= FRAME_MAX_BUDGET
-    }
-
-    /// The row, its header and the budget line, ready to print.
-    pub fn lines(&self) -> String {
-        let mark = |value: u64, budget: u64| if value <= budget { "ok" } else { "OVER" };
-        let (label, what) = match &self.scenario {
-            None => ("frame".to_owned(), "idle loops only".to_owned()),
-            Some(s) => (
-                format!("frame ({})", s.replace('+', " + ")),
-                "a gesture and a gaze move playing at every frame".to_owned(),
-            ),
-        };
-        format!(
-            "{:<22} {:>6} {:>6} {:>7} {:>6} {:>6} {:>9}\n\
-             {:<22} {:>6} {:>6} {:>7} {:>6} {:>6} {:>9}\n\
-             {label}: instructions of one frame update (3 servos: playback, mixer, fade, \
-             limits, mapping, PWM writes; {what}) over frames 0..{} (fade-in, a join); \
-             max at frame {}.\n\
-             \x20 budget: median {} against {}: {}; max {} against {}: {}\n",
-            "row",
-            "frames",
-            "min",
-            "median",
-            "max",
-            "mean",
-            "RP2040 µs",
-            label,
-            self.frames,
-            thousands(self.min),
-            thousands(self.median),
-            thousands(self.max),
-            thousands(self.mean),
-            format!("{:.1}", self.max as f64 / RP2040_HZ * 1e6),
-            self.frames.saturating_sub(1),
-            self.max_at,
-            thousands(self.median),
-            thousands(FRAME_MEDIAN_BUDGET),
-            mark(self.median, FRAME_MEDIAN_BUDGET),
-            thousands(self.max),
-            thousands(FRAME_MAX_BUDGET),
-            mark(self.max, FRAME_MAX_BUDGET),
-        )
     }
 }
 
@@ -401,9 +292,8 @@ fn thousands(value: u64) -> String {
     out
 }
 
-/// Builds and runs the benchmark image, prints the table and the verdict.
 /// Fails if the run or the log is broken, or (unless `no_budget`) if the
-/// default row is over the [`BUDGET`].
+/// default row or a frame row is over its budget.
 pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Result<()> {
     BENCH.build(root)?;
     let elf = BENCH.elf(metadata);
@@ -424,30 +314,16 @@ pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Resu
     print!("{}", table(&rows));
     let verdict = Verdict::of(&rows)?;
     print!("{}", verdict.lines());
-    for frame in FrameRow::all(&run.log)? {
+    let frames = FrameRow::all(&run.log)?;
+    for frame in &frames {
         println!();
         print!("{}", frame.lines());
-        if frame.scenario.is_some() {
-            // Reported: with a gesture and a gaze move the mixer's share
-            // does not fit next to today's playback and driver.
-            if !frame.within_budget() {
-                println!("(with motion playing the frame budget is reported, not enforced)");
-            }
-            continue;
-        }
-        if !frame.within_budget() {
-            if options.no_budget {
-                println!("(--no-budget: the frame budget is reported, not enforced)");
-            } else {
-                bail!(
-                    "a frame update takes {} instructions at the median and {} at most, over its \
-                     budget of {} and {} (pass --no-budget to report without failing)",
-                    thousands(frame.median),
-                    thousands(frame.max),
-                    thousands(FRAME_MEDIAN_BUDGET),
-                    thousands(FRAME_MAX_BUDGET)
-                );
-            }
+    }
+    if let Some(over) = frames_over_budget(&frames) {
+        if options.no_budget {
+            println!("(--no-budget: the frame budget is reported, not enforced)");
+        } else {
+            bail!("{over} (pass --no-budget to report without failing)");
         }
     }
     if !verdict.within_budget() {
@@ -608,6 +484,34 @@ mod tests {
         let active = FrameRow::parse(active).unwrap().unwrap();
         assert_eq!(active.scenario.as_deref(), Some("gesture+look"));
         assert!(active.lines().contains("frame (gesture + look)   1601"));
+    }
+
+    #[test]
+    fn the_idle_frame_row_is_held_to_the_budget_and_named() {
+        let idle = FrameRow::parse(
+            "frame bench frames=1601 min=880 median=890 max=1500 max_at=1 mean=950",
+        )
+        .unwrap()
+        .unwrap();
+        let busy = FrameRow::parse(
+            "frame bench scenario=gesture+look frames=1601 min=900 median=980 max=1900 max_at=9 mean=990",
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!(frames_over_budget(&[idle.clone(), busy.clone()]), None);
+        // The gesture row over its budget is reported, not failed on.
+        let slow_busy = FrameRow {
+            median: 1001,
+            ..busy.clone()
+        };
+        assert!(!slow_busy.held_to_budget());
+        assert!(slow_busy.lines().contains("OVER"));
+        assert!(slow_busy.lines().contains("not yet held"));
+        assert_eq!(frames_over_budget(&[idle.clone(), slow_busy]), None);
+        let spiky_idle = FrameRow { max: 2001, ..idle };
+        let message = frames_over_budget(&[spiky_idle, busy]).unwrap();
+        assert!(message.contains("`frame` takes 890 instructions at the median and 2,001"));
+        assert!(!message.contains("gesture"), "{message}");
     }
 
     #[test]

@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 
 use crate::{
     args::{Bless, Budget, Options, Timeout},
-    metrics, preview, sim, trace,
+    console, metrics, preview, sim, trace,
 };
 
 /// Project commands of idle-head: build and run the firmware in QEMU, test,
@@ -117,6 +117,13 @@ pub enum Command {
     /// `#` comments are ignored; any bad line is an error naming it, and then
     /// nothing runs.
     Trace(trace::Args),
+    /// Talk to a head: lines from stdin, replies to stdout, one per line.
+    ///
+    /// With --qemu the firmware runs in QEMU and its UART0 carries the
+    /// console; when stdin closes, the firmware is stopped and its summary
+    /// line printed. With --port <dev> that serial port is opened (115200
+    /// 8N1); with neither, the Pico is found by its USB VID:PID 16c0:27dd.
+    Console(console::Args),
 }
 
 impl Command {

@@ -23,6 +23,7 @@
 mod args;
 mod bench;
 mod cli;
+mod console;
 mod elf;
 mod fonts;
 mod log;
@@ -66,6 +67,7 @@ fn main() -> ExitCode {
         Some(Command::Metrics(args)) => metrics::command(&args),
         Some(Command::Sim(args)) => sim::command(&args),
         Some(Command::Trace(args)) => trace::command(&args),
+        Some(Command::Console(args)) => console::command(&args),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

@@ -58,7 +58,9 @@ pub fn run(sh: &Shell, env: &[(&str, &str)], cmd: Cmd<'_>) -> Result<()> {
     {
         line = format!("(cd {} && {line})", sub.display());
     }
-    println!("$ {line}");
+    // On stderr: stdout is for results (`cargo xtask console` prints only
+    // the head's replies there).
+    eprintln!("$ {line}");
     cmd.envs(env.iter().copied())
         .quiet()
         .run()

@@ -70,6 +70,8 @@ pub enum Echo {
     All,
     /// Warnings and errors only (with their source location).
     Problems,
+    /// Nothing (the caller shows what it wants once QEMU is done).
+    Quiet,
 }
 
 /// QEMU's command line for `elf`. `-icount shift=0` makes one instruction one
@@ -131,7 +133,7 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
 }
 
 /// Waits for `child` to exit, at most `timeout`; kills it past that.
-fn wait_or_kill(child: &mut Child, timeout: Duration) -> Result<Exit> {
+pub(crate) fn wait_or_kill(child: &mut Child, timeout: Duration) -> Result<Exit> {
     if let Some(status) = child.wait_timeout(timeout).context("waiting for QEMU")? {
         return Ok(Exit::Status(status));
     }
@@ -141,7 +143,7 @@ fn wait_or_kill(child: &mut Child, timeout: Duration) -> Result<Exit> {
 }
 
 /// Decodes the defmt stream `output` to its end, echoing lines as they come.
-fn decode(
+pub(crate) fn decode(
     mut output: impl Read,
     table: &Table,
     locations: Option<&Locations>,
@@ -159,13 +161,18 @@ fn decode(
                 Err(DecodeError::UnexpectedEof) => break,
                 Err(DecodeError::Malformed) => LogLine::malformed(),
             };
-            if echo == Echo::All || line.is_problem() {
+            if echo == Echo::All || (echo == Echo::Problems && line.is_problem()) {
                 line.print();
             }
             log.push(line);
         }
     }
     log
+}
+
+/// Whether `line` is QEMU's [`RESET_NOISE`].
+pub(crate) fn is_reset_noise(line: &str) -> bool {
+    line == RESET_NOISE
 }
 
 /// Passes QEMU's messages on, all but [`RESET_NOISE`].

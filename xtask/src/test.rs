@@ -9,7 +9,7 @@ use xshell::{Shell, cmd};
 
 use crate::{
     args::Options,
-    bench, elf,
+    bench, console, elf,
     log::Run,
     project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
     qemu::{self, Echo},
@@ -287,6 +287,8 @@ fn qemu_stages(
     const RUN: &str = "QEMU run: firmware exits with success";
     const SNAPSHOT: &str = "QEMU log matches qemu/expected.log";
     const SUMMARY: &str = "QEMU summary: missed=0 pulse_violations=0, checksum = host's";
+    const FLOOD: &str = "QEMU flood: 10,000 console lines during a run, one reply each, missed=0";
+    const CONSOLE: &str = "cargo xtask console --qemu with a piped script";
 
     let built = stages.run(BUILD, || {
         setup::ensure_qemu()?;
@@ -327,6 +329,14 @@ fn qemu_stages(
         } else {
             snapshot::compare(&run, &metadata.target_dir.join("qemu-actual.log"))
         }
+    });
+    stages.run(FLOOD, || {
+        println!("{}", console::flood(&QEMU.elf(metadata))?);
+        Ok(())
+    });
+    stages.run(CONSOLE, || {
+        println!("{}", console::piped_script()?);
+        Ok(())
     });
     stages.run(SUMMARY, || {
         if let Some(line) = run

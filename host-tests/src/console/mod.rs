@@ -4,6 +4,7 @@
 //! [`run_stream`] and checks the replies with [`check_replies`]; a handler
 //! that drives a simulated head plugs in the same way.
 
+pub mod head;
 mod model;
 mod text;
 

@@ -16,7 +16,6 @@ use crate::fonts::{self, FONT};
 const WIDTH: u32 = 1400;
 const HEADER: u32 = 70;
 const PANEL: u32 = 260;
-
 const BLUE: RGBColor = RGBColor(31, 119, 180);
 const ORANGE: RGBColor = RGBColor(255, 127, 14);
 const GREEN: RGBColor = RGBColor(44, 160, 44);

@@ -1,0 +1,198 @@
+//! A simulated head behind the console service: the frame task's code
+//! (queue drain, servo calibrations from the link, frame, status) on the
+//! host, with PWM channels that keep the last duty, and a check of every
+//! frame against the servos' limits as they are at that frame.
+
+use std::convert::Infallible;
+
+use embedded_hal::pwm::{ErrorType, SetDutyCycle};
+use idle_head::behaviour::{BehaviourConfig, CommandQueue, Head, LOOP_DURATION};
+use idle_head::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
+use idle_head::driver::{DriverConfig, FrameDriver};
+use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16, Trajectory};
+use idle_head::playback::Player;
+use idle_head::settings::{RamStorage, Settings, SettingsSource};
+use idle_head::{Axis, Playback};
+
+/// A PWM channel that keeps the last duty (1 µs per count at 50 Hz).
+#[derive(Debug, Default)]
+pub struct LastDuty(pub u16);
+
+impl ErrorType for LastDuty {
+    type Error = Infallible;
+}
+
+impl SetDutyCycle for LastDuty {
+    fn max_duty_cycle(&self) -> u16 {
+        20_000
+    }
+
+    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Infallible> {
+        self.0 = duty;
+        Ok(())
+    }
+}
+
+/// Frames a servo left outside new angle limits may take to come back:
+/// the widest span (720°) at the slowest limiter (60 °/s, 600 °/s²) is
+/// 12 s; 50 Hz frames.
+pub const RETURN_FRAMES: u64 = 13 * 50;
+
+type Idle = Player<'static, Trajectory<Integral16, DEFAULT_N>>;
+
+/// The Table 2 loops, generated once.
+fn loops() -> &'static HeadTrajectories<Integral16, DEFAULT_N> {
+    use std::sync::OnceLock;
+    static LOOPS: OnceLock<Box<HeadTrajectories<Integral16, DEFAULT_N>>> = OnceLock::new();
+    LOOPS.get_or_init(|| {
+        let mut head = Box::new(HeadTrajectories::new());
+        head.generate(&DEFAULT_HEAD).expect("the default loops");
+        head
+    })
+}
+
+/// The frame side of a simulated head: what the frame task owns.
+pub struct SimFrames {
+    head: Head<Idle>,
+    driver: FrameDriver<LastDuty>,
+    frame: u64,
+    /// Frames played.
+    pub frames: u64,
+    /// Frames with a pulse or an angle outside the servo's limits.
+    pub violations: u64,
+    /// Calibrations the driver applied.
+    pub calibrations: u64,
+    /// Of the violations, angles outside the limits past the return time.
+    pub outside_after_return: u64,
+    /// The frame of each servo's last calibration change.
+    changed: [Option<u64>; 3],
+    /// Actions the mixer took, and refused.
+    pub applied: u64,
+    /// Actions the mixer refused when they came to be played.
+    pub refused: u64,
+}
+
+impl SimFrames {
+    /// A head on the built-in configuration.
+    #[must_use]
+    pub fn new() -> Self {
+        let config = DriverConfig::DEFAULT;
+        let params = config.build().expect("the default driver");
+        let playback =
+            Playback::new(LOOP_DURATION, config.frame_period, DEFAULT_N).expect("playback");
+        let idle = Player::new(playback, Axis::ALL.map(|axis| loops().axis(axis)));
+        let behaviour = BehaviourConfig::DEFAULT
+            .build(&params)
+            .expect("the default behaviour");
+        Self {
+            head: Head::new(idle, behaviour),
+            driver: FrameDriver::new(
+                [
+                    LastDuty::default(),
+                    LastDuty::default(),
+                    LastDuty::default(),
+                ],
+                params,
+            ),
+            frame: 0,
+            frames: 0,
+            violations: 0,
+            calibrations: 0,
+            outside_after_return: 0,
+            changed: [None; 3],
+            applied: 0,
+            refused: 0,
+        }
+    }
+
+    /// Plays one frame as the frame task does: calibrations from `link`,
+    /// queued actions, the frame, the status published.
+    pub fn frame<const N: usize>(&mut self, queue: &CommandQueue<N>, link: &ConsoleLink) {
+        for (axis, cal) in Axis::ALL.iter().zip(link.take_servos()) {
+            if let Some(cal) = cal {
+                self.driver
+                    .set_servo(*axis, cal)
+                    .expect("the service sends only valid calibrations");
+                self.calibrations += 1;
+                if let Some(at) = self.changed.get_mut(axis.index()) {
+                    *at = Some(self.frame);
+                }
+            }
+        }
+        let (mut applied, mut refused) = (0, 0);
+        self.head
+            .drain(&mut self.driver, queue, |_, outcome| match outcome {
+                Ok(_) => applied += 1,
+                Err(_) => refused += 1,
+            });
+        self.applied += applied;
+        self.refused += refused;
+        let report = self.head.frame(&mut self.driver, self.frame).report;
+        let servos = self.driver.params().config().servos;
+        for ((s, cal), changed) in report.servos.iter().zip(&servos).zip(&self.changed) {
+            // Pulse limits are hard. A new calibration may leave a servo
+            // outside its new angle limits: the driver brings it back in
+            // through the limiter, within `RETURN_FRAMES`.
+            let returning = changed.is_some_and(|at| self.frame <= at + RETURN_FRAMES);
+            if (!cal.limits.contains(s.angle) && !returning)
+                || s.pulse.0 < cal.min_pulse.0
+                || s.pulse.0 > cal.max_pulse.0
+            {
+                if !cal.limits.contains(s.angle) {
+                    self.outside_after_return += 1;
+                }
+                self.violations += 1;
+            }
+        }
+        let mode = if self.driver.is_stopped() {
+            HeadMode::Stopped
+        } else if self.driver.is_stopping() {
+            HeadMode::Stopping
+        } else {
+            HeadMode::Running
+        };
+        link.publish(HeadStatus::of(&report, self.driver.stats(), mode));
+        self.frame += 1;
+        self.frames += 1;
+    }
+
+    /// The driver's current configuration.
+    #[must_use]
+    pub fn config(&self) -> &DriverConfig {
+        self.driver.params().config()
+    }
+}
+
+impl Default for SimFrames {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// The shared state of a simulated head, leaked for `'static` as the
+/// firmware's statics are.
+#[must_use]
+pub fn shared() -> (&'static CommandQueue, &'static ConsoleLink) {
+    (
+        Box::leak(Box::new(CommandQueue::new())),
+        Box::leak(Box::new(ConsoleLink::new())),
+    )
+}
+
+/// A console service for a simulated head on the built-in settings, with
+/// a RAM store.
+#[must_use]
+pub fn service(
+    queue: &'static CommandQueue,
+    link: &'static ConsoleLink,
+) -> ConsoleService<'static, RamStorage<256>> {
+    ConsoleService::new(
+        queue,
+        link,
+        RamStorage::new(),
+        DriverConfig::DEFAULT,
+        Settings::DEFAULT,
+        SettingsSource::Defaults,
+    )
+    .expect("the built-in settings")
+}

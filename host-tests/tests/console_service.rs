@@ -1,0 +1,309 @@
+//! The console service on a simulated head: what each command does, and
+//! the fuzz: over a million random and mutated lines, and random byte
+//! streams, through the service into a head that plays a frame between
+//! lines. Exactly one reply per line, no panic, and the head never leaves
+//! the limits its calibration has at that frame.
+//!
+//! `cargo test --release --test console_service -- --nocapture` prints
+//! the figures.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+use host_tests::console::head::{SimFrames, service, shared};
+use host_tests::console::{LINE, REPLY, count_line_ends, random_line, random_stream, rng};
+use idle_head::console::{ErrorCode, Handler, Session, parse, respond};
+use idle_head::settings::{SettingsStorage, StorageError};
+use proptest::prelude::RngExt as _;
+
+/// Feeds `text` (lines) to the service, a frame after each line; the replies.
+fn talk<H: Handler>(
+    service: &mut H,
+    frames: &mut SimFrames,
+    queue: &idle_head::behaviour::CommandQueue,
+    link: &idle_head::console::ConsoleLink,
+    text: &str,
+) -> Vec<String> {
+    let mut session = Session::<LINE, REPLY>::new();
+    let mut replies = Vec::new();
+    for line in text.lines() {
+        session.feed(line.as_bytes(), service, |_| {
+            panic!("reply before the line end")
+        });
+        session.feed(b"\n", service, |r| {
+            replies.push(String::from_utf8(r.to_vec()).unwrap().trim_end().to_owned());
+        });
+        frames.frame(queue, link);
+    }
+    replies
+}
+
+#[test]
+fn every_command_does_what_it_says() {
+    let (queue, link) = shared();
+    let mut frames = SimFrames::new();
+    let mut svc = service(queue, link);
+    macro_rules! say {
+        ($text:expr) => {
+            talk(&mut svc, &mut frames, queue, link, $text)
+        };
+    }
+
+    let r = say!("help\nstatus");
+    assert!(r[0].starts_with("ok commands: help status"), "{r:?}");
+    assert!(
+        r[1].starts_with("ok mode=running mdeg=")
+            && r[1].contains(" us=")
+            && r[1].contains(" faults=0,0,0 off=0 uptime_ms=0 fw=0.1.0 settings=defaults"),
+        "{}",
+        r[1]
+    );
+    // Motion goes through the queue; a refused one says why.
+    let r = say!("nod\nlook 5000 -12000\nnod 90000\ncenter");
+    assert_eq!(r[..2], ["ok", "ok"]);
+    assert!(r[2].starts_with("err limit "), "{}", r[2]);
+    assert_eq!(r[3], "ok");
+    // Servo: show, change, invalid, past the limits.
+    let r = say!(
+        "servo yaw\nservo yaw neutral 1520\nservo yaw min 2600\nservo pitch limits -1000 1000"
+    );
+    assert_eq!(
+        r[0],
+        "ok yaw neutral=1500 per-degree=11111 direction=normal min=1000 max=2000 limits=-9000,9000"
+            .replace("limits=-9000,9000", &r[0][r[0].find("limits=").unwrap()..])
+    );
+    assert_eq!(r[1], "ok");
+    assert!(
+        r[2].starts_with("err invalid yaw servo: min_pulse 2600"),
+        "{}",
+        r[2]
+    );
+    assert!(
+        r[3].starts_with("err limit the head would go past the new limits"),
+        "{}",
+        r[3]
+    );
+    assert_eq!(frames.calibrations, 1);
+    assert_eq!(frames.config().servos[2].neutral.0, 1520);
+    let r = say!("status");
+    assert!(r[0].ends_with("settings=changed"), "{}", r[0]);
+    // Seeds.
+    let r = say!("seed 42\nseed random");
+    assert_eq!(r[0], "ok seed=42");
+    assert!(r[1].starts_with("ok seed="));
+    assert!(link.take_seeds().is_some());
+    // Save, change, load, defaults.
+    let r =
+        say!("save\nstatus\nservo yaw neutral 1480\nload\nservo yaw\ndefaults\nservo yaw\nstatus");
+    assert_eq!(r[0], "ok");
+    assert!(r[1].ends_with("settings=flash"), "{}", r[1]);
+    assert_eq!(r[3], "ok");
+    assert!(r[4].contains("neutral=1520"), "{}", r[4]);
+    assert!(r[6].contains("neutral=1500"), "{}", r[6]);
+    assert!(r[7].ends_with("settings=defaults"), "{}", r[7]);
+    assert_eq!(frames.config().servos[2].neutral.0, 1500);
+    // Stop, and status says so (after the fade).
+    say!("stop");
+    for _ in 0..200 {
+        frames.frame(queue, link);
+    }
+    assert!(say!("status")[0].starts_with("ok mode=stopped"));
+    assert_eq!(frames.violations, 0);
+}
+
+#[test]
+fn a_full_queue_is_busy_and_nothing_is_dropped() {
+    let (queue, link) = shared();
+    let mut frames = SimFrames::new();
+    let mut svc = service(queue, link);
+    let mut out = [0; REPLY];
+    let (mut ok, mut busy) = (0, 0);
+    for _ in 0..20 {
+        let reply = respond(Ok(b"idle amp 50"), &mut svc, &mut out);
+        match reply {
+            b"ok\r\n" => ok += 1,
+            r if r.starts_with(b"err busy ") => busy += 1,
+            r => panic!("{}", String::from_utf8_lossy(r)),
+        }
+    }
+    assert_eq!((ok, busy), (8, 12), "the queue holds 8");
+    for _ in 0..4 {
+        frames.frame(queue, link);
+    }
+    assert_eq!(frames.applied, 8, "every accepted action was played");
+    assert!(queue.is_empty());
+}
+
+#[test]
+fn storage_errors_are_replies() {
+    struct Broken;
+    impl SettingsStorage for Broken {
+        fn save(&mut self, _: &idle_head::settings::Settings) -> Result<(), StorageError> {
+            Err(StorageError::Device)
+        }
+        fn load(&mut self) -> Result<idle_head::settings::Settings, StorageError> {
+            Err(StorageError::Older { found: 0 })
+        }
+    }
+    let (queue, link) = shared();
+    let mut svc = idle_head::console::ConsoleService::new(
+        queue,
+        link,
+        Broken,
+        idle_head::DriverConfig::DEFAULT,
+        idle_head::settings::Settings::DEFAULT,
+        idle_head::settings::SettingsSource::Defaults,
+    )
+    .unwrap();
+    let mut out = [0; REPLY];
+    assert_eq!(
+        respond(Ok(b"save"), &mut svc, &mut out),
+        b"err storage save: the flash failed\r\n"
+    );
+    assert_eq!(
+        respond(Ok(b"load"), &mut svc, &mut out),
+        b"err storage load: stored settings are of older version 0\r\n"
+    );
+    let mut ram = service(queue, link);
+    assert_eq!(
+        respond(Ok(b"load"), &mut ram, &mut out),
+        b"err storage load: no settings saved\r\n"
+    );
+}
+
+/// Lines straight to the service (as a session hands them over), with
+/// 0 to 2 frames after each.
+const LINES: usize = 1_100_000;
+const STREAMS: u64 = 8;
+const STREAM_BYTES: usize = 128 * 1024;
+
+/// Codes a command the parser accepted may still get.
+const AFTER_PARSE: [ErrorCode; 5] = [
+    ErrorCode::Busy,
+    ErrorCode::Limit,
+    ErrorCode::Invalid,
+    ErrorCode::Range,
+    ErrorCode::Storage,
+];
+
+#[test]
+fn a_million_lines_drive_a_head_that_stays_within_its_limits() {
+    let (queue, link) = shared();
+    let mut frames = SimFrames::new();
+    let mut svc = service(queue, link);
+    let mut rng = rng(0x5e41_11ce);
+    let mut out = [0; REPLY];
+    let (mut ok, mut err, mut refused_after_parse, mut panics) = (0_usize, 0_usize, 0_usize, 0);
+    for _ in 0..LINES {
+        let (_, line) = random_line(&mut rng);
+        // A line holds no line end (the framer splits there).
+        let line: Vec<u8> = line
+            .into_iter()
+            .filter(|b| *b != b'\n' && *b != b'\r')
+            .collect();
+        let run = catch_unwind(AssertUnwindSafe(|| {
+            let reply = respond(Ok(&line), &mut svc, &mut out).to_vec();
+            check_verdict(&line, &reply)
+        }));
+        match run {
+            Ok(Verdict::Ok) => ok += 1,
+            Ok(Verdict::Err) => err += 1,
+            Ok(Verdict::Refused) => {
+                err += 1;
+                refused_after_parse += 1;
+            }
+            Err(_) => {
+                panics += 1;
+                eprintln!("panic on {:?}", String::from_utf8_lossy(&line));
+            }
+        }
+        for _ in 0..rng.random_range(0..3) {
+            frames.frame(queue, link);
+        }
+    }
+    println!(
+        "service: {LINES} lines, {ok} ok, {err} err ({refused_after_parse} parsed but refused: \
+         busy, limit, invalid, range, storage), panics = {panics}; head: {} frames, {} actions \
+         played, {} refused by the mixer, {} calibrations applied, {} limit violations",
+        frames.frames, frames.applied, frames.refused, frames.calibrations, frames.violations
+    );
+    assert_eq!(panics, 0);
+    assert_eq!(ok + err, LINES, "one reply per line");
+    assert_eq!(frames.violations, 0);
+    assert!(frames.applied > 10_000 && frames.calibrations > 100 && refused_after_parse > 1000);
+}
+
+#[test]
+fn random_streams_through_a_session_into_the_head() {
+    let (queue, link) = shared();
+    let mut frames = SimFrames::new();
+    let mut svc = service(queue, link);
+    let (mut lines, mut replies, mut bytes) = (0, 0, 0);
+    for seed in 0..STREAMS {
+        let mut rng = rng(0x0005_7ea0 + seed);
+        let stream = random_stream(&mut rng, STREAM_BYTES);
+        bytes += stream.len();
+        let mut session = Session::<LINE, REPLY>::new();
+        let mut got = 0;
+        let mut rest = &stream[..];
+        while !rest.is_empty() {
+            let n = rng.random_range(1..=rest.len().min(64));
+            let (chunk, tail) = rest.split_at(n);
+            session.feed(chunk, &mut svc, |r| {
+                assert!(r.ends_with(b"\r\n") && r.len() <= REPLY);
+                got += 1;
+            });
+            frames.frame(queue, link);
+            rest = tail;
+        }
+        assert_eq!(got, count_line_ends(&stream), "stream {seed}");
+        lines += count_line_ends(&stream);
+        replies += got;
+    }
+    println!(
+        "service streams: {STREAMS} streams, {bytes} bytes, {lines} lines, {replies} replies; \
+         {} frames, {} limit violations",
+        frames.frames, frames.violations
+    );
+    assert_eq!(lines, replies);
+    assert_eq!(frames.violations, 0);
+}
+
+enum Verdict {
+    Ok,
+    Err,
+    /// Parsed, then refused by the service.
+    Refused,
+}
+
+/// The reply agrees with the parser: a parse error gets its code; a
+/// command gets `ok` or one of the service's codes.
+fn check_verdict(line: &[u8], reply: &[u8]) -> Verdict {
+    let text = std::str::from_utf8(reply).expect("UTF-8 reply");
+    let body = text.strip_suffix("\r\n").expect("CR LF");
+    assert!(!body.contains(['\r', '\n']), "{body:?}");
+    if line.first() == Some(&b'#') {
+        // Machine mode: the session's envelope (tested in console_fuzz).
+        return if body.starts_with("err line ") {
+            Verdict::Err
+        } else {
+            assert!(body.starts_with('#'), "{body:?}");
+            Verdict::Ok
+        };
+    }
+    match parse(line) {
+        Err(e) => {
+            assert!(body.starts_with(&format!("err {} ", e.code())), "{body:?}");
+            Verdict::Err
+        }
+        Ok(_) if body == "ok" || body.starts_with("ok ") => Verdict::Ok,
+        Ok(command) => {
+            assert!(
+                AFTER_PARSE
+                    .iter()
+                    .any(|c| body.starts_with(&format!("err {} ", c.as_str()))),
+                "{command:?} → {body:?}"
+            );
+            Verdict::Refused
+        }
+    }
+}

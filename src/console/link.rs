@@ -1,0 +1,164 @@
+//! What the console task and the frame task share, besides the command
+//! queue: the head's status (frame task → console), servo calibrations
+//! to apply (console → frame task) and new idle seeds (console → loop
+//! generator).
+//!
+//! Each is an embassy-sync blocking `Mutex` over a `Cell`, or a `Signal`
+//! (whose state is a `Cell` too): a critical section around a copy, no
+//! `RefCell` borrow, so nothing here puts a panic path on the frame path.
+
+use core::cell::Cell;
+
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::signal::Signal;
+
+use crate::axis::Axis;
+use crate::driver::{DriverStats, FrameReport};
+use crate::servo::ServoCalibration;
+use crate::units::{Angle, Microseconds};
+
+/// What the driver is doing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum HeadMode {
+    /// No frame written yet.
+    #[default]
+    Starting,
+    /// Playing (fading in or at full strength).
+    Running,
+    /// Fading out after `stop`.
+    Stopping,
+    /// Holding the neutral pose after `stop`.
+    Stopped,
+}
+
+impl HeadMode {
+    /// The word in `status`.
+    #[must_use]
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::Starting => "starting",
+            Self::Running => "running",
+            Self::Stopping => "stopping",
+            Self::Stopped => "stopped",
+        }
+    }
+}
+
+/// The head as the last frame left it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct HeadStatus {
+    /// The driver's frame count.
+    pub frame: u64,
+    /// What the driver is doing.
+    pub mode: HeadMode,
+    /// Commanded angles `[pitch, roll, yaw]`.
+    pub angles: [Angle; 3],
+    /// Pulses written `[pitch, roll, yaw]`.
+    pub pulses: [Microseconds; 3],
+    /// Write errors per servo so far.
+    pub faults: [u32; 3],
+    /// Servos switched off.
+    pub disabled: [bool; 3],
+}
+
+impl HeadStatus {
+    /// The status after a frame that wrote `report`.
+    #[must_use]
+    pub fn of(report: &FrameReport, stats: &DriverStats, mode: HeadMode) -> Self {
+        Self {
+            frame: report.frame,
+            mode,
+            angles: report.servos.map(|s| s.angle),
+            pulses: report.servos.map(|s| s.pulse),
+            faults: stats.faults,
+            disabled: stats.disabled,
+        }
+    }
+}
+
+/// The shared state; see the [module docs](self). Lives in a `static`.
+pub struct ConsoleLink {
+    status: Mutex<CriticalSectionRawMutex, Cell<HeadStatus>>,
+    servos: Mutex<CriticalSectionRawMutex, Cell<[Option<ServoCalibration>; 3]>>,
+    seeds: Signal<CriticalSectionRawMutex, [u32; 3]>,
+}
+
+impl ConsoleLink {
+    /// Nothing published, nothing pending.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self {
+            status: Mutex::new(Cell::new(HeadStatus {
+                frame: 0,
+                mode: HeadMode::Starting,
+                angles: [Angle::ZERO; 3],
+                pulses: [Microseconds(0); 3],
+                faults: [0; 3],
+                disabled: [false; 3],
+            })),
+            servos: Mutex::new(Cell::new([None; 3])),
+            seeds: Signal::new(),
+        }
+    }
+
+    /// The frame task: the head after the last frame.
+    pub fn publish(&self, status: HeadStatus) {
+        self.status.lock(|cell| cell.set(status));
+    }
+
+    /// The console: the head after the last frame.
+    pub fn status(&self) -> HeadStatus {
+        self.status.lock(Cell::get)
+    }
+
+    /// The console: `cal` for `axis`' servo from the next frame on. A
+    /// calibration not yet applied is replaced (each is a whole
+    /// calibration: the newest is the one asked for).
+    pub fn set_servo(&self, axis: Axis, cal: ServoCalibration) {
+        self.servos.lock(|cell| {
+            let mut pending = cell.get();
+            if let Some(slot) = pending.get_mut(axis.index()) {
+                *slot = Some(cal);
+            }
+            cell.set(pending);
+        });
+    }
+
+    /// The frame task: the calibrations to apply, `[pitch, roll, yaw]`.
+    pub fn take_servos(&self) -> [Option<ServoCalibration>; 3] {
+        self.servos.lock(|cell| cell.replace([None; 3]))
+    }
+
+    /// Whether calibrations wait for the frame task.
+    pub fn servos_pending(&self) -> bool {
+        self.servos
+            .lock(|cell| cell.get().iter().any(Option::is_some))
+    }
+
+    /// The console: generate the next loop set from `seeds`.
+    pub fn reseed(&self, seeds: [u32; 3]) {
+        self.seeds.signal(seeds);
+    }
+
+    /// The loop generator: new seeds, if asked for since the last call.
+    pub fn take_seeds(&self) -> Option<[u32; 3]> {
+        self.seeds.try_take()
+    }
+}
+
+impl Default for ConsoleLink {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl core::fmt::Debug for ConsoleLink {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("ConsoleLink")
+            .field("status", &self.status())
+            .finish_non_exhaustive()
+    }
+}

@@ -1,0 +1,349 @@
+//! The console service: the [`Handler`] that carries out every command.
+//!
+//! Board-neutral: a board gives it the frame task's [`CommandQueue`], the
+//! [`ConsoleLink`] shared with the frame task and the loop generator, its
+//! [`SettingsStorage`] and its base driver configuration, and runs a
+//! [`Session`](super::Session) over its transport with the service as
+//! handler:
+//!
+//! ```
+//! use idle_head::behaviour::CommandQueue;
+//! use idle_head::console::{ConsoleLink, ConsoleService, Session};
+//! use idle_head::driver::DriverConfig;
+//! use idle_head::settings::{RamStorage, Settings, SettingsSource};
+//!
+//! static QUEUE: CommandQueue = CommandQueue::new();
+//! static LINK: ConsoleLink = ConsoleLink::new();
+//! let mut service = ConsoleService::new(
+//!     &QUEUE, &LINK, RamStorage::<256>::new(), DriverConfig::DEFAULT,
+//!     Settings::DEFAULT, SettingsSource::Defaults,
+//! ).unwrap();
+//! let mut session = Session::<96, 160>::new();
+//! let mut replies = Vec::new();
+//! session.feed(b"nod\nservo yaw min 2600\nsave\n", &mut service, |r| replies.push(r.to_vec()));
+//! assert_eq!(replies[0], b"ok\r\n");
+//! assert!(replies[1].starts_with(b"err invalid "));
+//! assert_eq!(replies[2], b"ok\r\n");
+//! ```
+//!
+//! What each command does:
+//!
+//! - motion (`nod`, `look`, `stop`, `idle …`): checked as the mixer
+//!   would ([`BehaviourParams::check`]) and queued for the frame task;
+//!   a full queue is `err busy` (nothing queued, send it again);
+//! - `status`: the head as the last frame left it ([`HeadStatus`]),
+//!   uptime, firmware version, where the settings came from;
+//! - `servo <axis> <field> <value>`: the settings with that field
+//!   changed are validated as the typed configuration is
+//!   ([`Settings::validate`]); `err invalid` for a calibration the
+//!   driver refuses, `err limit` if the behaviour would then drive the
+//!   servo past its new limits; otherwise the frame task applies it
+//!   between two frames through the limiter ([`FrameDriver::set_servo`]);
+//! - `seed`: the next loop set is generated from the new seeds and
+//!   joined in as any set is (no jump);
+//! - `save`, `load`, `defaults`: the [`SettingsStorage`]; a loaded or
+//!   default set is applied as `servo` and `seed` are, and its idle
+//!   amplitude through the queue. (Gesture and gaze defaults take effect
+//!   at the next boot: the frame task's behaviour is built once.)
+//!
+//! [`FrameDriver::set_servo`]: crate::driver::FrameDriver::set_servo
+
+use core::fmt::Write as _;
+
+use super::HELP;
+use super::link::{ConsoleLink, HeadStatus};
+use super::reply::{ErrorCode, Reply};
+use super::session::Handler;
+use crate::axis::Axis;
+use crate::behaviour::{BehaviourError, BehaviourParams, CommandQueue};
+use crate::command::{Action, Command, SeedChoice, ServoSetting};
+use crate::driver::DriverConfig;
+use crate::servo::{Direction, ServoCalibration};
+use crate::settings::{Settings, SettingsError, SettingsSource, SettingsStorage, StorageError};
+
+/// The firmware version `status` reports.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// The console service; see the [module docs](self).
+pub struct ConsoleService<'a, S, const N: usize = { crate::behaviour::queue::CAPACITY }> {
+    queue: &'a CommandQueue<N>,
+    link: &'a ConsoleLink,
+    storage: S,
+    base: DriverConfig,
+    settings: Settings,
+    behaviour: BehaviourParams,
+    source: SettingsSource,
+    /// xorshift32 state for `seed random`.
+    entropy: u32,
+}
+
+impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
+    /// A service for a head that runs `settings` (from `source`) on the
+    /// board's driver configuration `base`.
+    ///
+    /// # Errors
+    /// The [`SettingsError`] if `settings` are not valid with `base`.
+    pub fn new(
+        queue: &'a CommandQueue<N>,
+        link: &'a ConsoleLink,
+        storage: S,
+        base: DriverConfig,
+        settings: Settings,
+        source: SettingsSource,
+    ) -> Result<Self, SettingsError> {
+        let valid = settings.validate(&base)?;
+        Ok(Self {
+            queue,
+            link,
+            storage,
+            base,
+            settings,
+            behaviour: valid.behaviour,
+            source,
+            entropy: 0x9e37_79b9,
+        })
+    }
+
+    /// Mixes `bits` from the board's entropy source into `seed random`.
+    pub fn add_entropy(&mut self, bits: u32) {
+        self.entropy = (self.entropy ^ bits) | 1;
+    }
+
+    /// The settings in effect (as the console last set them).
+    #[must_use]
+    pub const fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Where they came from.
+    #[must_use]
+    pub const fn source(&self) -> SettingsSource {
+        self.source
+    }
+
+    /// The board's store.
+    pub fn storage_mut(&mut self) -> &mut S {
+        &mut self.storage
+    }
+
+    fn act(&mut self, action: Action, reply: &mut Reply<'_>) {
+        if let Err(e) = self.behaviour.check(&action) {
+            write!(reply.err(behaviour_code(&e)), "{e}").ok();
+            return;
+        }
+        if let Err(full) = self.queue.try_submit(action) {
+            write!(reply.err(ErrorCode::Busy), "{full}").ok();
+        }
+    }
+
+    fn status(&self, reply: &mut Reply<'_>) {
+        let s: HeadStatus = self.link.status();
+        let [p, r, y] = s.angles.map(crate::units::Angle::millidegrees);
+        let [pp, pr, py] = s.pulses.map(|us| us.0);
+        let [fp, fr, fy] = s.faults;
+        let off = s.disabled.iter().filter(|&&d| d).count();
+        // Frames since start × frame period, in ms.
+        let uptime = s.frame * u64::from(self.base.frame_period.0) / 1000;
+        write!(
+            reply.ok(),
+            "mode={} mdeg={p},{r},{y} us={pp},{pr},{py} faults={fp},{fr},{fy} off={off} \
+             uptime_ms={uptime} fw={VERSION} settings={}",
+            s.mode.as_str(),
+            self.source.as_str()
+        )
+        .ok();
+    }
+
+    fn show_servo(&self, axis: Axis, reply: &mut Reply<'_>) {
+        let c = self.settings.servo(axis);
+        write!(
+            reply.ok(),
+            "{} neutral={} per-degree={} direction={} min={} max={} limits={},{}",
+            axis.name(),
+            c.neutral.0,
+            c.per_degree.0,
+            match c.direction {
+                Direction::Normal => "normal",
+                Direction::Reversed => "reversed",
+            },
+            c.min_pulse.0,
+            c.max_pulse.0,
+            c.limits.min.millidegrees(),
+            c.limits.max.millidegrees()
+        )
+        .ok();
+    }
+
+    fn set_servo(&mut self, axis: Axis, setting: ServoSetting, reply: &mut Reply<'_>) {
+        let mut next = self.settings;
+        let Some(cal) = next.servos.get_mut(axis.index()) else {
+            return;
+        };
+        change(cal, setting);
+        let cal = *cal;
+        if let ServoSetting::Limits(limits) = setting {
+            let at = self.link.status().angles[axis.index()];
+            if !limits.contains(at) {
+                write!(
+                    reply.err(ErrorCode::Limit),
+                    "the {} servo stands at {} mdeg, outside {}..{}: move it in first",
+                    axis.name(),
+                    at.millidegrees(),
+                    limits.min.millidegrees(),
+                    limits.max.millidegrees()
+                )
+                .ok();
+                return;
+            }
+        }
+        match next.validate(&self.base) {
+            Ok(valid) => {
+                self.link.set_servo(axis, cal);
+                self.settings = next;
+                self.behaviour = valid.behaviour;
+                self.source = SettingsSource::Changed;
+            }
+            Err(SettingsError::Driver(e)) => {
+                write!(reply.err(ErrorCode::Invalid), "{e}").ok();
+            }
+            Err(SettingsError::Behaviour(e)) => {
+                write!(
+                    reply.err(ErrorCode::Limit),
+                    "the head would go past the new limits: {e}"
+                )
+                .ok();
+            }
+        }
+    }
+
+    fn seed(&mut self, choice: SeedChoice, reply: &mut Reply<'_>) {
+        let n = match choice {
+            SeedChoice::Value(n) => n,
+            SeedChoice::Random => {
+                // xorshift32, stirred with the frame count.
+                let mut x = self.entropy ^ (self.link.status().frame as u32);
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                self.entropy = x | 1;
+                x
+            }
+        };
+        let seeds = Settings::seeds_from(n);
+        self.link.reseed(seeds);
+        self.settings.seeds = seeds;
+        self.source = SettingsSource::Changed;
+        write!(reply.ok(), "seed={n}").ok();
+    }
+
+    /// Puts `settings` in effect: idle amplitude through the queue (so a
+    /// full queue changes nothing), servos and seeds through the link.
+    fn adopt(&mut self, settings: Settings, source: SettingsSource, reply: &mut Reply<'_>) -> bool {
+        let valid = match settings.validate(&self.base) {
+            Ok(valid) => valid,
+            Err(e) => {
+                write!(reply.err(ErrorCode::Invalid), "{e}").ok();
+                return false;
+            }
+        };
+        let amp = settings.behaviour.idle.amplitude;
+        if amp != self.settings.behaviour.idle.amplitude
+            && let Err(full) = self.queue.try_submit(Action::IdleAmp(amp))
+        {
+            write!(reply.err(ErrorCode::Busy), "{full}").ok();
+            return false;
+        }
+        for (axis, (new, old)) in Axis::ALL
+            .iter()
+            .zip(settings.servos.iter().zip(&self.settings.servos))
+        {
+            if new != old {
+                self.link.set_servo(*axis, *new);
+            }
+        }
+        if settings.seeds != self.settings.seeds {
+            self.link.reseed(settings.seeds);
+        }
+        self.settings = settings;
+        self.behaviour = valid.behaviour;
+        self.source = source;
+        true
+    }
+
+    fn load(&mut self, reply: &mut Reply<'_>) {
+        match self.storage.load() {
+            Ok(settings) => {
+                self.adopt(settings, SettingsSource::Flash, reply);
+            }
+            Err(e) => storage_error(e, "load", reply),
+        }
+    }
+
+    fn save(&mut self, reply: &mut Reply<'_>) {
+        match self.storage.save(&self.settings) {
+            Ok(()) => self.source = SettingsSource::Flash,
+            Err(e) => storage_error(e, "save", reply),
+        }
+    }
+}
+
+impl<S: SettingsStorage, const N: usize> Handler for ConsoleService<'_, S, N> {
+    fn command(&mut self, command: Command, reply: &mut Reply<'_>) {
+        match command {
+            Command::Help => {
+                reply.ok().write_str(HELP).ok();
+            }
+            Command::Status => self.status(reply),
+            Command::Act(action) => self.act(action, reply),
+            Command::Seed(choice) => self.seed(choice, reply),
+            Command::Servo {
+                axis,
+                setting: None,
+            } => self.show_servo(axis, reply),
+            Command::Servo {
+                axis,
+                setting: Some(setting),
+            } => self.set_servo(axis, setting, reply),
+            Command::Save => self.save(reply),
+            Command::Load => self.load(reply),
+            Command::Defaults => {
+                self.adopt(Settings::DEFAULT, SettingsSource::Defaults, reply);
+            }
+        }
+    }
+}
+
+impl<S, const N: usize> core::fmt::Debug for ConsoleService<'_, S, N> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("ConsoleService")
+            .field("settings", &self.settings)
+            .field("source", &self.source)
+            .finish_non_exhaustive()
+    }
+}
+
+/// `cal` with `setting` applied.
+fn change(cal: &mut ServoCalibration, setting: ServoSetting) {
+    match setting {
+        ServoSetting::Neutral(us) => cal.neutral = us,
+        ServoSetting::PerDegree(ns) => cal.per_degree = ns,
+        ServoSetting::Direction(d) => cal.direction = d,
+        ServoSetting::MinPulse(us) => cal.min_pulse = us,
+        ServoSetting::MaxPulse(us) => cal.max_pulse = us,
+        ServoSetting::Limits(range) => cal.limits = range,
+    }
+}
+
+/// The reply code of a refused motion.
+const fn behaviour_code(e: &BehaviourError) -> ErrorCode {
+    match e {
+        BehaviourError::Busy { .. } => ErrorCode::Busy,
+        BehaviourError::Amplitude { .. } => ErrorCode::Limit,
+        BehaviourError::Config { .. } => ErrorCode::Invalid,
+        _ => ErrorCode::Range,
+    }
+}
+
+fn storage_error(e: StorageError, what: &str, reply: &mut Reply<'_>) {
+    write!(reply.err(ErrorCode::Storage), "{what}: {e}").ok();
+}

@@ -1,0 +1,173 @@
+//! Where the console's `save` and `load` go: a small trait each board
+//! implements ([`SettingsStorage`]), and [`RamStorage`], a record kept in
+//! RAM (the QEMU image's store; tests).
+
+use core::fmt;
+
+use super::record::{DecodeError, Record};
+use super::store::{LoadError, SaveError};
+use super::values::Settings;
+
+/// Why `save` or `load` failed: the board-neutral form of the store's
+/// errors, for the console's `err storage` reply.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum StorageError {
+    /// Nothing saved yet.
+    Empty,
+    /// The stored bytes are damaged or not a record.
+    Corrupt,
+    /// A record of an older layout version.
+    Older {
+        /// Its version.
+        found: u16,
+    },
+    /// A record of a newer layout version.
+    Newer {
+        /// Its version.
+        found: u16,
+    },
+    /// A record that fails validation.
+    Invalid,
+    /// The record does not fit the store.
+    TooLong,
+    /// The flash (or whatever holds the record) failed.
+    Device,
+}
+
+impl fmt::Display for StorageError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::Empty => f.write_str("no settings saved"),
+            Self::Corrupt => f.write_str("stored settings are damaged"),
+            Self::Older { found } => write!(f, "stored settings are of older version {found}"),
+            Self::Newer { found } => write!(f, "stored settings are of newer version {found}"),
+            Self::Invalid => f.write_str("stored settings fail validation"),
+            Self::TooLong => f.write_str("settings do not fit the store"),
+            Self::Device => f.write_str("the flash failed"),
+        }
+    }
+}
+
+impl<E> From<LoadError<E>> for StorageError {
+    fn from(e: LoadError<E>) -> Self {
+        match e {
+            LoadError::Empty => Self::Empty,
+            LoadError::Corrupt => Self::Corrupt,
+            LoadError::Older { found } => Self::Older { found },
+            LoadError::Newer { found } => Self::Newer { found },
+            LoadError::Invalid => Self::Invalid,
+            LoadError::Flash(_) => Self::Device,
+        }
+    }
+}
+
+impl<E> From<SaveError<E>> for StorageError {
+    fn from(e: SaveError<E>) -> Self {
+        match e {
+            SaveError::TooLong | SaveError::Encode => Self::TooLong,
+            SaveError::Corrupt => Self::Corrupt,
+            SaveError::Flash(_) => Self::Device,
+        }
+    }
+}
+
+/// The board's settings store, as the console service uses it.
+///
+/// Called from the console task only (never from the frame path), once
+/// per `save` or `load` command; a call may block for as long as a flash
+/// write takes (the frame task runs at a higher priority meanwhile). On
+/// the Pico it wraps a [`SettingsStore`](super::SettingsStore) over the
+/// flash driver (e.g. with `embassy_futures::block_on`).
+pub trait SettingsStorage {
+    /// Stores `settings` (a power cut leaves the old or the new ones).
+    ///
+    /// # Errors
+    /// Why nothing new was stored.
+    fn save(&mut self, settings: &Settings) -> Result<(), StorageError>;
+
+    /// The settings stored last.
+    ///
+    /// # Errors
+    /// Why none could be loaded (the caller keeps its settings).
+    fn load(&mut self) -> Result<Settings, StorageError>;
+}
+
+/// One record kept in RAM as the flash store keeps it (version, then the
+/// record's bytes), `N` bytes at most: lost at reset.
+#[derive(Clone, Debug)]
+pub struct RamStorage<const N: usize = 256> {
+    bytes: [u8; N],
+    /// Bytes used (0: nothing saved).
+    len: usize,
+}
+
+impl<const N: usize> RamStorage<N> {
+    /// An empty store.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self {
+            bytes: [0; N],
+            len: 0,
+        }
+    }
+
+    /// The stored bytes: the version (little-endian `u16`), then the record.
+    #[must_use]
+    pub fn raw(&self) -> &[u8] {
+        self.bytes.get(..self.len).unwrap_or_default()
+    }
+
+    /// Replaces the stored bytes (a test's damaged or old record).
+    ///
+    /// # Errors
+    /// [`StorageError::TooLong`] if they do not fit.
+    pub fn set_raw(&mut self, raw: &[u8]) -> Result<(), StorageError> {
+        let slot = self
+            .bytes
+            .get_mut(..raw.len())
+            .ok_or(StorageError::TooLong)?;
+        slot.copy_from_slice(raw);
+        self.len = raw.len();
+        Ok(())
+    }
+}
+
+impl<const N: usize> Default for RamStorage<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> SettingsStorage for RamStorage<N> {
+    fn save(&mut self, settings: &Settings) -> Result<(), StorageError> {
+        let (version, body) = self
+            .bytes
+            .split_at_mut_checked(2)
+            .ok_or(StorageError::TooLong)?;
+        let used = settings.encode(body).map_err(|_| StorageError::TooLong)?;
+        version.copy_from_slice(&Settings::VERSION.to_le_bytes());
+        self.len = 2 + used;
+        Ok(())
+    }
+
+    fn load(&mut self) -> Result<Settings, StorageError> {
+        let raw = self.raw();
+        let Some((version, body)) = raw.split_first_chunk::<2>() else {
+            return Err(if raw.is_empty() {
+                StorageError::Empty
+            } else {
+                StorageError::Corrupt
+            });
+        };
+        let found = u16::from_le_bytes(*version);
+        match found.cmp(&Settings::VERSION) {
+            core::cmp::Ordering::Less => Err(StorageError::Older { found }),
+            core::cmp::Ordering::Greater => Err(StorageError::Newer { found }),
+            core::cmp::Ordering::Equal => Settings::decode(body).map_err(|e| match e {
+                DecodeError::Malformed => StorageError::Corrupt,
+                DecodeError::Invalid => StorageError::Invalid,
+            }),
+        }
+    }
+}

@@ -1,0 +1,152 @@
+//! The head's settings: one versioned, validated structure.
+//!
+//! [`Settings`] holds what a person may change at run time and keep in
+//! flash: the calibration and limits of the three servos, the behaviour
+//! (idle amplitude, gesture and gaze parameters) and the idle motion's
+//! seeds. [`Settings::DEFAULT`] is the built-in configuration.
+//! [`Settings::validate`] checks them exactly as the typed
+//! configurations are checked ([`DriverConfig::build`],
+//! [`BehaviourConfig::build`]), against a board's base driver
+//! configuration (its frame period, PWM and speed limits).
+
+use core::fmt;
+
+use crate::axis::Axis;
+use crate::behaviour::{BehaviourConfig, BehaviourError, BehaviourParams};
+use crate::driver::{ConfigError, DriverConfig, DriverParams};
+use crate::motion::DEFAULT_HEAD;
+use crate::servo::ServoCalibration;
+
+/// Everything a person may change and save; see the [module docs](self).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Settings {
+    /// Calibration and angle limits per servo, `[pitch, roll, yaw]`.
+    pub servos: [ServoCalibration; 3],
+    /// Gesture, gaze and idle parameters.
+    pub behaviour: BehaviourConfig,
+    /// Seeds r(0) of the idle motion's random streams, `[pitch, roll, yaw]`.
+    pub seeds: [u32; 3],
+}
+
+/// Why settings are not valid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SettingsError {
+    /// A servo calibration the driver rejects.
+    Driver(ConfigError),
+    /// Behaviour parameters that do not hold with these servos.
+    Behaviour(BehaviourError),
+}
+
+impl fmt::Display for SettingsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Driver(e) => e.fmt(f),
+            Self::Behaviour(e) => e.fmt(f),
+        }
+    }
+}
+
+impl core::error::Error for SettingsError {}
+
+/// Settings checked against a board's driver configuration: the
+/// parameters the frame path uses.
+#[derive(Clone, Copy, Debug)]
+pub struct Validated {
+    /// The driver's parameters with these servos.
+    pub driver: DriverParams,
+    /// The behaviour's parameters for that driver.
+    pub behaviour: BehaviourParams,
+}
+
+impl Settings {
+    /// The built-in configuration: the hobby servos of
+    /// [`DriverConfig::DEFAULT`], [`BehaviourConfig::DEFAULT`] and the
+    /// seeds of the paper's Table 2 ([`DEFAULT_HEAD`]).
+    pub const DEFAULT: Self = Self {
+        servos: DriverConfig::DEFAULT.servos,
+        behaviour: BehaviourConfig::DEFAULT,
+        seeds: [
+            DEFAULT_HEAD.pitch.seed,
+            DEFAULT_HEAD.roll.seed,
+            DEFAULT_HEAD.yaw.seed,
+        ],
+    };
+
+    /// `base` with these settings' servos.
+    #[must_use]
+    pub const fn driver_config(&self, base: &DriverConfig) -> DriverConfig {
+        let mut config = *base;
+        config.servos = self.servos;
+        config
+    }
+
+    /// Checks the settings with `base`'s frame period, PWM, neutral pose
+    /// and speed limits, as the typed configurations are checked.
+    ///
+    /// # Errors
+    /// The first problem found: [`SettingsError::Driver`] for a servo,
+    /// [`SettingsError::Behaviour`] for the behaviour parameters (which
+    /// also must fit the servos' limits).
+    pub const fn validate(&self, base: &DriverConfig) -> Result<Validated, SettingsError> {
+        let driver = match self.driver_config(base).build() {
+            Ok(driver) => driver,
+            Err(e) => return Err(SettingsError::Driver(e)),
+        };
+        match self.behaviour.build(&driver) {
+            Ok(behaviour) => Ok(Validated { driver, behaviour }),
+            Err(e) => Err(SettingsError::Behaviour(e)),
+        }
+    }
+
+    /// The calibration of `axis`' servo.
+    #[must_use]
+    pub const fn servo(&self, axis: Axis) -> &ServoCalibration {
+        &self.servos[axis.index()]
+    }
+
+    /// The three seeds that `seed <n>` gives: `n` for pitch, then two
+    /// more drawn from it (the same `n`, the same motion).
+    #[must_use]
+    pub const fn seeds_from(n: u32) -> [u32; 3] {
+        // Two steps of a 32-bit LCG (Numerical Recipes' constants), so
+        // that the axes' streams differ.
+        let roll = n.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        let yaw = roll.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        [n, roll, yaw]
+    }
+}
+
+/// Where the settings in effect came from (`status`'s `settings=`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SettingsSource {
+    /// The built-in settings.
+    Defaults,
+    /// Loaded from (or just saved to) flash.
+    Flash,
+    /// Changed since, not saved.
+    Changed,
+}
+
+impl SettingsSource {
+    /// The word in `status`.
+    #[must_use]
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::Defaults => "defaults",
+            Self::Flash => "flash",
+            Self::Changed => "changed",
+        }
+    }
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+// The built-in settings are valid with the built-in driver.
+const _: () = assert!(Settings::DEFAULT.validate(&DriverConfig::DEFAULT).is_ok());
