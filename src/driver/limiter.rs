@@ -44,7 +44,14 @@
 //! A target that moves within the limits and is tracked exactly (error 0)
 //! is followed as it is: one comparison of its step against the speed and
 //! acceleration limits and of its change against the acceleration limit,
-//! no braking.
+//! no braking. A faster step (up to the speed limit) is followed as it is
+//! too while the position lies in the *clear band*, at least the braking
+//! distance of the fastest step, `⌈(max_step + a)²/2a⌉`, from both position
+//! limits (computed with the limits): there the braking speed for either
+//! limit is at least the step (and the step stays inside them), so the full
+//! path would give the same step. Fast gestures and gaze moves, whose steps
+//! exceed one acceleration step, stay on the common case away from the
+//! limits.
 
 use crate::units::Angle;
 
@@ -68,6 +75,11 @@ pub(crate) struct SlewParams {
     /// `min(max_step, max_accel)`: the largest target step followed as it is
     /// (see the module docs' common case).
     follow: u32,
+    /// The clear band, µ°: from a position within it (`clear_lo ≤ pos ≤
+    /// clear_hi`) any step up to `max_step` is within the braking speed for
+    /// both position limits (empty when the limits are too close for that).
+    clear_lo: i32,
+    clear_hi: i32,
     /// Mechanical limits, m°, within ±[`MAX_LIMIT_MDEG`].
     pub(crate) lo: i32,
     /// Mechanical limits, m°, within ±[`MAX_LIMIT_MDEG`].
@@ -91,6 +103,25 @@ impl SlewParams {
         };
         let max_step = if step == 0 { 1 } else { step };
         let max_accel = if accel == 0 { 1 } else { accel };
+        // The braking distance of the fastest step: a step `v ≤ max_step`
+        // is within the braking speed for a distance `d` when
+        // `2·a·d ≥ (v + a)²` (module docs), so for every `d ≥ reach`.
+        // max_step + max_accel ≤ 3·SPAN < 2³²: the square fits u64.
+        let sum = max_step as u64 + max_accel as u64;
+        let reach = (sum * sum).div_ceil(2 * max_accel as u64);
+        let reach = if reach > SPAN as u64 {
+            SPAN as i64
+        } else {
+            reach as i64
+        };
+        // Limits within ±MAX_LIMIT: every term fits i64, the band's ends i32.
+        let clear_lo = lo as i64 * MICRO_PER_MILLI as i64 + reach;
+        let clear_hi = hi as i64 * MICRO_PER_MILLI as i64 - reach;
+        let (clear_lo, clear_hi) = if clear_lo > clear_hi {
+            (i32::MAX, i32::MIN)
+        } else {
+            (clear_lo as i32, clear_hi as i32)
+        };
         Self {
             max_step,
             max_accel,
@@ -99,6 +130,8 @@ impl SlewParams {
             } else {
                 max_accel
             },
+            clear_lo,
+            clear_hi,
             lo,
             hi,
         }
@@ -207,6 +240,18 @@ impl Slew {
     /// The step when the target is off or moves beyond the limits.
     #[inline(never)]
     fn limited_step(&mut self, target: i32, target_vel: i32, p: &SlewParams) -> Angle {
+        // The common case's faster steps, in the clear band (module docs).
+        if self.pos == self.last_target
+            && target_vel.unsigned_abs() <= p.max_step
+            && target_vel.abs_diff(self.vel) <= p.max_accel
+            && self.pos >= p.clear_lo
+            && self.pos <= p.clear_hi
+        {
+            self.last_target = target;
+            self.pos = target;
+            self.vel = target_vel;
+            return Angle::from_millidegrees(round_to_mdeg(target));
+        }
         // Error before this frame's target motion: with perfect tracking it is
         // 0 and the wanted step is exactly the target's step.
         let err = self.last_target - self.pos;
