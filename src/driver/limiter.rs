@@ -86,11 +86,22 @@ pub(crate) struct SlewParams {
     pub(crate) hi: i32,
 }
 
-impl SlewParams {
-    /// The limits of `step` µ°/frame and `accel` µ°/frame² between `lo` and
-    /// `hi` (m°, validated to lie within ±[`MAX_LIMIT_MDEG`]), capped as the
-    /// module docs explain.
-    pub(crate) const fn new(step: u64, accel: u64, lo: i32, hi: i32) -> Self {
+/// The per-frame rates of one axis' motion limits, without its angle
+/// limits: what a change of motion limits computes (its divisions), so that
+/// limits used again and again (the behaviour's modes) are computed once.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct SlewRates {
+    max_step: u32,
+    max_accel: u32,
+    /// The braking distance of the fastest step, µ°, at most [`SPAN`].
+    reach: i32,
+}
+
+impl SlewRates {
+    /// `step` µ°/frame and `accel` µ°/frame², capped as the module docs
+    /// explain.
+    pub(crate) const fn new(step: u64, accel: u64) -> Self {
         let step = if step > SPAN as u64 {
             SPAN
         } else {
@@ -109,18 +120,43 @@ impl SlewParams {
         // max_step + max_accel ≤ 3·SPAN < 2³²: the square fits u64.
         let sum = max_step as u64 + max_accel as u64;
         let reach = (sum * sum).div_ceil(2 * max_accel as u64);
-        let reach = if reach > SPAN as u64 {
-            SPAN as i64
-        } else {
-            reach as i64
-        };
-        // Limits within ±MAX_LIMIT: every term fits i64, the band's ends i32.
-        let clear_lo = lo as i64 * MICRO_PER_MILLI as i64 + reach;
-        let clear_hi = hi as i64 * MICRO_PER_MILLI as i64 - reach;
+        Self {
+            max_step,
+            max_accel,
+            reach: if reach > SPAN as u64 {
+                SPAN as i32
+            } else {
+                reach as i32
+            },
+        }
+    }
+}
+
+impl SlewParams {
+    /// The limits of `step` µ°/frame and `accel` µ°/frame² between `lo` and
+    /// `hi` (m°, validated to lie within ±[`MAX_LIMIT_MDEG`]), capped as the
+    /// module docs explain.
+    pub(crate) const fn new(step: u64, accel: u64, lo: i32, hi: i32) -> Self {
+        Self::with_rates(SlewRates::new(step, accel), lo, hi)
+    }
+
+    /// The limits of `rates` between `lo` and `hi` (m°, validated to lie
+    /// within ±[`MAX_LIMIT_MDEG`]). No division: a switch between rates
+    /// computed before is a few additions.
+    pub(crate) const fn with_rates(rates: SlewRates, lo: i32, hi: i32) -> Self {
+        let SlewRates {
+            max_step,
+            max_accel,
+            reach,
+        } = rates;
+        // |lo|, |hi| ≤ MAX_LIMIT and reach ≤ SPAN: the band's ends are
+        // within ±1.08·10⁹ µ°, inside i32.
+        let clear_lo = lo * MICRO_PER_MILLI + reach;
+        let clear_hi = hi * MICRO_PER_MILLI - reach;
         let (clear_lo, clear_hi) = if clear_lo > clear_hi {
             (i32::MAX, i32::MIN)
         } else {
-            (clear_lo as i32, clear_hi as i32)
+            (clear_lo, clear_hi)
         };
         Self {
             max_step,
