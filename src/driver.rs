@@ -47,3 +47,6 @@ pub use config::{
 pub use error::ConfigError;
 pub use frame::FrameDriver;
 pub use report::{DriverStats, FrameReport, Outcome, ServoReport};
+
+pub(crate) use config::slew_rates;
+pub(crate) use limiter::SlewRates;

@@ -22,7 +22,9 @@ use const_format::concatcp;
 
 use crate::axis::Axis;
 use crate::command::{GestureKind, GestureRequest, Hold, Percent};
-use crate::driver::{DegreesPerSecond, DegreesPerSecondSquared, DriverParams, MotionLimits};
+use crate::driver::{
+    DegreesPerSecond, DegreesPerSecondSquared, DriverParams, MotionLimits, SlewRates, slew_rates,
+};
 use crate::units::{Angle, AngleRange, Millis};
 
 use super::error::BehaviourError;
@@ -365,6 +367,7 @@ impl BehaviourConfig {
             frame_us,
             room,
             idle_limits: cfg.motion,
+            rates: [[None; 2]; 3],
             blend: 0,
             blend_inverse: 0,
             settle: 0,
@@ -372,6 +375,7 @@ impl BehaviourConfig {
             duck: (self.idle.duck.get() as u32 * ONE) / 100,
             pose: cfg.neutral_pose,
         };
+        params.rates = mode_rates(cfg, &self.gesture_limits);
         params.blend = params.frames(self.blend);
         params.blend_inverse = inverse(params.blend);
         params.settle = params.frames(self.settle);
@@ -409,6 +413,32 @@ const _: () = match crate::driver::DriverConfig::DEFAULT.build() {
     Err(e) => panic!("{}", e.message()),
 };
 
+/// The per-frame rates of both modes' limits, `[idle, gesture]` per axis,
+/// at the driver's frame period (`None` where the driver refuses them).
+const fn mode_rates(
+    cfg: &crate::driver::DriverConfig,
+    gesture: &[MotionLimits; 3],
+) -> [[Option<SlewRates>; 2]; 3] {
+    let mut rates = [[None; 2]; 3];
+    let mut i = 0;
+    while i < 3 {
+        let axis = Axis::ALL[i];
+        let period = cfg.frame_period;
+        rates[i] = [
+            match slew_rates(axis, cfg.motion[i], period) {
+                Ok(r) => Some(r),
+                Err(_) => None,
+            },
+            match slew_rates(axis, gesture[i], period) {
+                Ok(r) => Some(r),
+                Err(_) => None,
+            },
+        ];
+        i += 1;
+    }
+    rates
+}
+
 /// A validated [`BehaviourConfig`] in the integer form the frame path uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -419,6 +449,10 @@ pub struct BehaviourParams {
     room: [AngleRange; 3],
     /// The driver's configured limits: the idle mode.
     idle_limits: [MotionLimits; 3],
+    /// The per-frame rates of both modes' limits (`[idle, gesture]` per
+    /// axis) at `frame_us`, computed here so that a switch between the modes
+    /// divides nothing (`None`: the driver refuses those limits).
+    rates: [[Option<SlewRates>; 2]; 3],
     /// Frames of a gesture's fade-out under a newer one, and its reciprocal.
     pub(crate) blend: u32,
     pub(crate) blend_inverse: u32,
@@ -482,6 +516,12 @@ impl BehaviourParams {
             LimitMode::Idle => self.idle_limits[axis.index()],
             LimitMode::Gesture => self.config.gesture_limits[axis.index()],
         }
+    }
+
+    /// The per-frame rates of [`limits`](Self::limits)`(axis, mode)` at
+    /// [`frame_us`](Self::frame_us), if the driver takes those limits.
+    pub(crate) const fn rates(&self, axis: Axis, mode: LimitMode) -> Option<SlewRates> {
+        self.rates[axis.index()][mode as usize]
     }
 
     /// Checks `action` as [`Mixer::apply`](super::Mixer::apply) would on a

@@ -151,7 +151,14 @@ impl<I: IdleSource> Head<I> {
         let params = self.mixer.params();
         for ((axis, &wanted), mode) in Axis::ALL.iter().zip(&modes).zip(&mut self.modes) {
             let limits = params.limits(*axis, wanted);
-            if wanted != *mode && driver.set_motion_limits_when_safe(*axis, limits) == Ok(true) {
+            if wanted != *mode
+                && driver.set_rates_when_safe(
+                    *axis,
+                    limits,
+                    params.rates(*axis, wanted),
+                    params.frame_us(),
+                ) == Ok(true)
+            {
                 *mode = wanted;
             }
         }

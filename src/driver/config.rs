@@ -6,7 +6,7 @@ use crate::servo::{PwmTiming, ServoCalibration};
 use crate::units::{Angle, AngleRange, Microseconds, Millis};
 
 use super::ConfigError;
-use super::limiter::{MAX_LIMIT_MDEG, SlewParams};
+use super::limiter::{MAX_LIMIT_MDEG, SlewParams, SlewRates};
 
 /// Angular speed in whole degrees per second.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -248,6 +248,22 @@ pub(crate) const fn slew_params(
     frame_period: Microseconds,
     limits: AngleRange,
 ) -> Result<SlewParams, ConfigError> {
+    match slew_rates(axis, motion, frame_period) {
+        Ok(rates) => Ok(SlewParams::with_rates(
+            rates,
+            limits.min.millidegrees(),
+            limits.max.millidegrees(),
+        )),
+        Err(e) => Err(e),
+    }
+}
+
+/// The per-frame rates of `motion` at `frame_period`.
+pub(crate) const fn slew_rates(
+    axis: Axis,
+    motion: MotionLimits,
+    frame_period: Microseconds,
+) -> Result<SlewRates, ConfigError> {
     const US_PER_S: u64 = 1_000_000;
     let frame_us = frame_period.0 as u64;
     // deg/s · 10^6 µ°/° · frame_us / 10^6 µs/s = µ° per frame.
@@ -269,12 +285,7 @@ pub(crate) const fn slew_params(
     } else {
         accel as u64
     };
-    Ok(SlewParams::new(
-        step,
-        accel,
-        limits.min.millidegrees(),
-        limits.max.millidegrees(),
-    ))
+    Ok(SlewRates::new(step, accel))
 }
 
 /// Whole frames in `us` microseconds, rounded up, saturating at `u32::MAX`.

@@ -8,7 +8,7 @@ use crate::units::{Angle, Microseconds};
 
 use super::config::{check_servo, slew_params};
 use super::envelope::{Envelope, UNITY};
-use super::limiter::{Slew, SlewParams};
+use super::limiter::{Slew, SlewParams, SlewRates};
 use super::{
     ConfigError, DriverParams, DriverStats, FrameReport, MotionLimits, Outcome, ServoReport,
 };
@@ -252,6 +252,46 @@ impl<P: SetDutyCycle> FrameDriver<P> {
             return Ok(false);
         };
         let params = slew_params(axis, limits, config.frame_period, cal.limits)?;
+        if !servo.slew.can_take(&params) {
+            return Ok(false);
+        }
+        servo.limits = params;
+        *motion = limits;
+        Ok(true)
+    }
+
+    /// As [`set_motion_limits_when_safe`](Self::set_motion_limits_when_safe),
+    /// with `limits`' per-frame rates computed before for a frame period of
+    /// `frame_us` (a switch between two sets of limits used again and again
+    /// is then a copy and a few additions: no division). Without rates, or
+    /// for another frame period than the driver's, they are computed here.
+    ///
+    /// # Errors
+    /// As [`set_motion_limits`](Self::set_motion_limits).
+    pub(crate) fn set_rates_when_safe(
+        &mut self,
+        axis: Axis,
+        limits: MotionLimits,
+        rates: Option<SlewRates>,
+        frame_us: u32,
+    ) -> Result<bool, ConfigError> {
+        let i = axis.index();
+        let config = &mut self.params.config;
+        let Some(rates) = rates.filter(|_| config.frame_period.0 == frame_us) else {
+            return self.set_motion_limits_when_safe(axis, limits);
+        };
+        let (Some(cal), Some(motion), Some(servo)) = (
+            config.servos.get(i),
+            config.motion.get_mut(i),
+            self.servos.get_mut(i),
+        ) else {
+            return Ok(false);
+        };
+        let params = SlewParams::with_rates(
+            rates,
+            cal.limits.min.millidegrees(),
+            cal.limits.max.millidegrees(),
+        );
         if !servo.slew.can_take(&params) {
             return Ok(false);
         }

@@ -44,7 +44,14 @@
 //! A target that moves within the limits and is tracked exactly (error 0)
 //! is followed as it is: one comparison of its step against the speed and
 //! acceleration limits and of its change against the acceleration limit,
-//! no braking.
+//! no braking. A faster step (up to the speed limit) is followed as it is
+//! too while the position lies in the *clear band*, at least the braking
+//! distance of the fastest step, `⌈(max_step + a)²/2a⌉`, from both position
+//! limits (computed with the limits): there the braking speed for either
+//! limit is at least the step (and the step stays inside them), so the full
+//! path would give the same step. Fast gestures and gaze moves, whose steps
+//! exceed one acceleration step, stay on the common case away from the
+//! limits.
 
 use crate::units::Angle;
 
@@ -68,17 +75,33 @@ pub(crate) struct SlewParams {
     /// `min(max_step, max_accel)`: the largest target step followed as it is
     /// (see the module docs' common case).
     follow: u32,
+    /// The clear band, µ°: from a position within it (`clear_lo ≤ pos ≤
+    /// clear_hi`) any step up to `max_step` is within the braking speed for
+    /// both position limits (empty when the limits are too close for that).
+    clear_lo: i32,
+    clear_hi: i32,
     /// Mechanical limits, m°, within ±[`MAX_LIMIT_MDEG`].
     pub(crate) lo: i32,
     /// Mechanical limits, m°, within ±[`MAX_LIMIT_MDEG`].
     pub(crate) hi: i32,
 }
 
-impl SlewParams {
-    /// The limits of `step` µ°/frame and `accel` µ°/frame² between `lo` and
-    /// `hi` (m°, validated to lie within ±[`MAX_LIMIT_MDEG`]), capped as the
-    /// module docs explain.
-    pub(crate) const fn new(step: u64, accel: u64, lo: i32, hi: i32) -> Self {
+/// The per-frame rates of one axis' motion limits, without its angle
+/// limits: what a change of motion limits computes (its divisions), so that
+/// limits used again and again (the behaviour's modes) are computed once.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct SlewRates {
+    max_step: u32,
+    max_accel: u32,
+    /// The braking distance of the fastest step, µ°, at most [`SPAN`].
+    reach: i32,
+}
+
+impl SlewRates {
+    /// `step` µ°/frame and `accel` µ°/frame², capped as the module docs
+    /// explain.
+    pub(crate) const fn new(step: u64, accel: u64) -> Self {
         let step = if step > SPAN as u64 {
             SPAN
         } else {
@@ -91,6 +114,50 @@ impl SlewParams {
         };
         let max_step = if step == 0 { 1 } else { step };
         let max_accel = if accel == 0 { 1 } else { accel };
+        // The braking distance of the fastest step: a step `v ≤ max_step`
+        // is within the braking speed for a distance `d` when
+        // `2·a·d ≥ (v + a)²` (module docs), so for every `d ≥ reach`.
+        // max_step + max_accel ≤ 3·SPAN < 2³²: the square fits u64.
+        let sum = max_step as u64 + max_accel as u64;
+        let reach = (sum * sum).div_ceil(2 * max_accel as u64);
+        Self {
+            max_step,
+            max_accel,
+            reach: if reach > SPAN as u64 {
+                SPAN as i32
+            } else {
+                reach as i32
+            },
+        }
+    }
+}
+
+impl SlewParams {
+    /// The limits of `step` µ°/frame and `accel` µ°/frame² between `lo` and
+    /// `hi` (m°, validated to lie within ±[`MAX_LIMIT_MDEG`]), capped as the
+    /// module docs explain.
+    pub(crate) const fn new(step: u64, accel: u64, lo: i32, hi: i32) -> Self {
+        Self::with_rates(SlewRates::new(step, accel), lo, hi)
+    }
+
+    /// The limits of `rates` between `lo` and `hi` (m°, validated to lie
+    /// within ±[`MAX_LIMIT_MDEG`]). No division: a switch between rates
+    /// computed before is a few additions.
+    pub(crate) const fn with_rates(rates: SlewRates, lo: i32, hi: i32) -> Self {
+        let SlewRates {
+            max_step,
+            max_accel,
+            reach,
+        } = rates;
+        // |lo|, |hi| ≤ MAX_LIMIT and reach ≤ SPAN: the band's ends are
+        // within ±1.08·10⁹ µ°, inside i32.
+        let clear_lo = lo * MICRO_PER_MILLI + reach;
+        let clear_hi = hi * MICRO_PER_MILLI - reach;
+        let (clear_lo, clear_hi) = if clear_lo > clear_hi {
+            (i32::MAX, i32::MIN)
+        } else {
+            (clear_lo, clear_hi)
+        };
         Self {
             max_step,
             max_accel,
@@ -99,6 +166,8 @@ impl SlewParams {
             } else {
                 max_accel
             },
+            clear_lo,
+            clear_hi,
             lo,
             hi,
         }
@@ -207,6 +276,18 @@ impl Slew {
     /// The step when the target is off or moves beyond the limits.
     #[inline(never)]
     fn limited_step(&mut self, target: i32, target_vel: i32, p: &SlewParams) -> Angle {
+        // The common case's faster steps, in the clear band (module docs).
+        if self.pos == self.last_target
+            && target_vel.unsigned_abs() <= p.max_step
+            && target_vel.abs_diff(self.vel) <= p.max_accel
+            && self.pos >= p.clear_lo
+            && self.pos <= p.clear_hi
+        {
+            self.last_target = target;
+            self.pos = target;
+            self.vel = target_vel;
+            return Angle::from_millidegrees(round_to_mdeg(target));
+        }
         // Error before this frame's target motion: with perfect tracking it is
         // 0 and the wanted step is exactly the target's step.
         let err = self.last_target - self.pos;
