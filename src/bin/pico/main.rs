@@ -63,15 +63,20 @@
 //! with its own session (`console.rs`): UART0 on GP0 (TX, pin 1) and GP1
 //! (RX, pin 2) at 115200 8N1, 3.3 V levels; and the board's USB port as a
 //! CDC-ACM serial port, `16c0:27dd` (`usb.rs`). Both tasks run in thread
-//! mode and hand actions to the frame task through the command queue, which it
-//! drains between frames; the ports' interrupts sit below the frame task's.
+//! mode and share one `ConsoleService` (`handler.rs`), which hands actions to
+//! the frame task through the command queue, which it drains between frames,
+//! and servo calibrations, seeds and the head's status through the
+//! `ConsoleLink`; the ports' interrupts sit below the frame task's.
 //!
 //! # Settings
 //!
 //! The last four 4 KiB flash sectors, `0x101f_c000..0x1020_0000`, hold the
 //! settings store; memory.x reserves them in every image. With the
-//! `console` feature the store is opened and read at boot, before the first
-//! frame, and the log says what it holds (`settings.rs`).
+//! `console` feature the store is read at boot, before the first frame:
+//! stored settings are put in effect (servo calibrations, behaviour, idle
+//! seeds), else the built-in ones, and the log says which (`settings.rs`).
+//! While `save` or `load` uses the flash, the frames feed the watchdog with
+//! a longer timeout: a sector erase keeps interrupts off for up to 400 ms.
 //!
 //! # Calibration
 //!
