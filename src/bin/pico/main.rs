@@ -246,13 +246,15 @@ async fn main(spawner: Spawner) {
     #[cfg(feature = "console")]
     let boot = settings::boot(p.FLASH, &CONFIG, DEFAULT_SETTINGS, &LINK);
     #[cfg(feature = "console")]
-    let (head, params, behaviour) = (boot.head(), boot.valid.driver, boot.valid.behaviour);
+    let (boot_head, params, behaviour) = (boot.head(), boot.valid.driver, boot.valid.behaviour);
+    #[cfg(feature = "console")]
+    let head = &boot_head;
     #[cfg(not(feature = "console"))]
-    let (head, params) = (DEFAULT_HEAD, PARAMS);
+    let (head, params) = (&DEFAULT_HEAD, PARAMS);
 
     let [first, spare] = SETS.take();
     let start = Instant::now();
-    let generated = first.generate(&head);
+    let generated = first.generate(head);
     let precompute_us = start.elapsed().as_micros();
     match generated {
         Ok(info) => {
@@ -277,7 +279,7 @@ async fn main(spawner: Spawner) {
         precompute_us,
         first.checksum()
     );
-    let mut stream = LoopStream::new(head, &TIMING);
+    let mut stream = LoopStream::new(*head, &TIMING);
     stream.adopt(first);
     match IDLE_MODE {
         IdleMode::NeverRepeating => {
