@@ -5,16 +5,18 @@
 //! [`Session`]: bytes in, one reply line out per input line. The commands
 //! are carried out by a [`Handler`], the one generic parameter of
 //! [`serve`]; actions reach the frame task only through its
-//! [`CommandQueue`], which it drains between frames. The frame task runs in
+//! [`CommandQueue`], which it drains between frames, and servo
+//! calibrations, seeds and the head's status through the
+//! [`ConsoleLink`](idle_head::console::ConsoleLink). The frame task runs in
 //! the interrupt executor above both console tasks, and the ports'
 //! interrupts sit below it ([`PORT_PRIORITY`]): a flood of bytes on either
 //! port never delays a frame.
 //!
-//! The handler for now, [`QueueHandler`] (`handler.rs`), answers `help`, queues the motion
-//! commands (`nod`, `look`, `stop`, ...; a full queue is `err busy`) and
-//! answers every other command `err state not available yet`: status,
-//! servo calibration and saved settings need the settings service, which
-//! takes its place.
+//! The handler is the core's `ConsoleService`, one for both ports
+//! ([`Shared`], `handler.rs`), with the settings store in flash
+//! (`settings.rs`): a servo changed on one port shows on the other.
+//!
+//! [`CommandQueue`]: idle_head::behaviour::CommandQueue
 
 use embassy_executor::Spawner;
 use embassy_rp::Peri;
@@ -24,8 +26,12 @@ use embassy_rp::uart::{self, BufferedInterruptHandler, BufferedUart};
 use idle_head::console::{Handler, Session};
 use static_cell::ConstStaticCell;
 
-use crate::handler::{PicoSession, Queue, QueueHandler};
+use crate::handler::{PicoSession, Shared, SharedService};
+use crate::settings::PicoStorage;
 use crate::usb;
+
+/// The service both ports share.
+pub type Service = SharedService<PicoStorage>;
 
 /// The ports' interrupt priority: below the frame task's (`P1`), above
 /// thread mode, where the console tasks run.
@@ -117,8 +123,8 @@ pub struct Ports {
 }
 
 /// Starts the console on both ports, in thread mode (`spawner`), handing
-/// actions to the frame task through `commands`. Call once.
-pub fn start(spawner: Spawner, ports: Ports, commands: &'static Queue) {
+/// commands to `service`. Call once.
+pub fn start(spawner: Spawner, ports: Ports, service: &'static Service) {
     let mut uart_config = uart::Config::default();
     uart_config.baudrate = UART_BAUD;
     let uart = BufferedUart::new(
@@ -131,7 +137,7 @@ pub fn start(spawner: Spawner, ports: Ports, commands: &'static Queue) {
         uart_config,
     );
     interrupt::UART0_IRQ.set_priority(PORT_PRIORITY);
-    match uart_console(uart, commands) {
+    match uart_console(uart, service) {
         Ok(token) => {
             spawner.spawn(token);
             defmt::info!("console: UART0 GP0 TX, GP1 RX, {=u32} 8N1", UART_BAUD);
@@ -141,7 +147,7 @@ pub fn start(spawner: Spawner, ports: Ports, commands: &'static Queue) {
 
     let (device, serial) = usb::build(embassy_rp::usb::Driver::new(ports.usb, Irqs));
     interrupt::USBCTRL_IRQ.set_priority(PORT_PRIORITY);
-    match (usb_device(device), usb_console(serial, commands)) {
+    match (usb_device(device), usb_console(serial, service)) {
         (Ok(device), Ok(console)) => {
             spawner.spawn(device);
             spawner.spawn(console);
@@ -163,9 +169,9 @@ async fn usb_device(mut device: usb::Device) {
 
 /// The console on the USB serial port: one session per connection.
 #[embassy_executor::task]
-async fn usb_console(mut serial: usb::Serial, commands: &'static Queue) {
+async fn usb_console(mut serial: usb::Serial, service: &'static Service) {
     let mut session = PicoSession::new();
-    let mut handler = QueueHandler::new(commands);
+    let mut handler = Shared::new(service);
     loop {
         serial.wait_connection().await;
         session.reset();
@@ -178,9 +184,9 @@ async fn usb_console(mut serial: usb::Serial, commands: &'static Queue) {
 
 /// The console on UART0, for as long as the board runs.
 #[embassy_executor::task]
-async fn uart_console(mut uart: BufferedUart, commands: &'static Queue) {
+async fn uart_console(mut uart: BufferedUart, service: &'static Service) {
     let mut session = PicoSession::new();
-    let mut handler = QueueHandler::new(commands);
+    let mut handler = Shared::new(service);
     // A UART never goes away: `serve` only returns if it did.
     let gone = serve(&mut uart, &mut session, &mut handler).await;
     defmt::error!("console uart ended: {}", gone);

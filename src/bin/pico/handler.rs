@@ -1,59 +1,57 @@
-//! The console's handler until the settings service takes its place.
+//! The console's handler on the Pico: the core's [`ConsoleService`],
+//! one for both ports, behind a blocking mutex ([`Shared`]).
 //!
-//! `help`, the motion commands into the frame task's queue (a full queue is
-//! `err busy`, the command not taken), `err state not available yet` for
-//! the commands that need the settings service. Free of the board: the
-//! emulator check (`cargo xtask sim`) compiles this file on the host and
-//! computes the replies it expects with it.
+//! Both console tasks run in the thread-mode executor and a command is
+//! carried out without an `.await`, so the two never want the service at
+//! once; the `RefCell` (borrowed with `try_borrow_mut`, never a panic) is
+//! in the console tasks only, never on the frame path, which reaches the
+//! service's state through the queue and the [`ConsoleLink`] alone.
+//!
+//! Free of the board: the emulator check (`cargo xtask sim`) compiles this
+//! file on the host and computes the replies it expects with it, over a
+//! `RamStorage`.
+//!
+//! [`ConsoleLink`]: idle_head::console::ConsoleLink
 
+use core::cell::RefCell;
 use core::fmt::Write as _;
 
-use idle_head::behaviour::CommandQueue;
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use idle_head::command::Command;
-use idle_head::console::{ErrorCode, HELP, Handler, Reply, Session};
+use idle_head::console::{ConsoleService, ErrorCode, Handler, Reply, Session};
+use idle_head::settings::SettingsStorage;
 
 /// A console session on the Pico: lines up to 96 bytes, replies up to 160,
 /// as `docs/protocol.md` promises.
 pub type PicoSession = Session<96, 160>;
 
-/// The console's command queue, drained by the frame task.
-pub type Queue = CommandQueue;
+/// One service for both ports, in thread mode.
+pub type SharedService<S> = Mutex<NoopRawMutex, RefCell<ConsoleService<'static, S>>>;
 
-/// The console's handler until the settings service takes over: `help`,
-/// motion commands into the frame task's queue, `err state` for the rest.
-pub struct QueueHandler {
-    queue: &'static Queue,
+/// A port's handle on the shared service.
+pub struct Shared<S: 'static> {
+    service: &'static SharedService<S>,
 }
 
-impl QueueHandler {
-    /// A handler queueing actions into `queue`.
-    pub const fn new(queue: &'static Queue) -> Self {
-        Self { queue }
+impl<S: SettingsStorage> Shared<S> {
+    /// A handle on `service`.
+    pub const fn new(service: &'static SharedService<S>) -> Self {
+        Self { service }
     }
 }
 
-impl Handler for QueueHandler {
+impl<S: SettingsStorage> Handler for Shared<S> {
     fn command(&mut self, command: Command, reply: &mut Reply<'_>) {
-        match command {
-            Command::Help => {
-                reply.ok().write_str(HELP).ok();
-            }
-            Command::Act(action) => {
-                if let Err(full) = self.queue.try_submit(action) {
-                    write!(reply.err(ErrorCode::Busy), "{full}").ok();
-                }
-            }
-            Command::Status
-            | Command::Seed(_)
-            | Command::Servo { .. }
-            | Command::Save
-            | Command::Load
-            | Command::Defaults => {
+        self.service.lock(|cell| match cell.try_borrow_mut() {
+            Ok(mut service) => service.command(command, reply),
+            // Cannot happen (see the module docs); an answer all the same.
+            Err(_) => {
                 reply
-                    .err(ErrorCode::State)
-                    .write_str("not available yet")
+                    .err(ErrorCode::Busy)
+                    .write_str("the other port's command is running")
                     .ok();
             }
-        }
+        });
     }
 }

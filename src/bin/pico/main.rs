@@ -63,15 +63,20 @@
 //! with its own session (`console.rs`): UART0 on GP0 (TX, pin 1) and GP1
 //! (RX, pin 2) at 115200 8N1, 3.3 V levels; and the board's USB port as a
 //! CDC-ACM serial port, `16c0:27dd` (`usb.rs`). Both tasks run in thread
-//! mode and hand actions to the frame task through the command queue, which it
-//! drains between frames; the ports' interrupts sit below the frame task's.
+//! mode and share one `ConsoleService` (`handler.rs`), which hands actions to
+//! the frame task through the command queue, which it drains between frames,
+//! and servo calibrations, seeds and the head's status through the
+//! `ConsoleLink`; the ports' interrupts sit below the frame task's.
 //!
 //! # Settings
 //!
 //! The last four 4 KiB flash sectors, `0x101f_c000..0x1020_0000`, hold the
 //! settings store; memory.x reserves them in every image. With the
-//! `console` feature the store is opened and read at boot, before the first
-//! frame, and the log says what it holds (`settings.rs`).
+//! `console` feature the store is read at boot, before the first frame:
+//! stored settings are put in effect (servo calibrations, behaviour, idle
+//! seeds), else the built-in ones, and the log says which (`settings.rs`).
+//! While `save` or `load` uses the flash, the frames feed the watchdog with
+//! a longer timeout: a sector erase keeps interrupts off for up to 400 ms.
 //!
 //! # Calibration
 //!
@@ -101,12 +106,16 @@ use embassy_rp::watchdog::{ResetReason, Watchdog};
 use embassy_time::{Duration, Instant};
 #[cfg(feature = "console")]
 use idle_head::behaviour::CommandQueue;
+#[cfg(feature = "console")]
+use idle_head::console::{ConsoleLink, ConsoleService};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::frame_task::{
     Exchange, Flow, Frame, FrameHooks, FrameLoop, IDLE_MODE, LOOP_DURATION, SetRef,
 };
 use idle_head::idle::{IdleMode, IdleTiming, LoopSet, LoopStream};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N};
+#[cfg(not(feature = "console"))]
+use idle_head::motion::DEFAULT_HEAD;
+use idle_head::motion::DEFAULT_N;
 use idle_head::{Axis, Playback};
 use panic_probe as _;
 use static_cell::ConstStaticCell;
@@ -156,6 +165,23 @@ static EXCHANGE: Exchange = Exchange::new();
 /// between frames.
 #[cfg(feature = "console")]
 static COMMANDS: CommandQueue = CommandQueue::new();
+
+/// Status, servo calibrations and seeds between the console and the frame
+/// task (and the loop generator).
+#[cfg(feature = "console")]
+static LINK: ConsoleLink = ConsoleLink::new();
+
+/// The built-in settings, checked with [`CONFIG`] at compile time.
+#[cfg(feature = "console")]
+const DEFAULT_SETTINGS: idle_head::settings::Validated =
+    match idle_head::settings::Settings::DEFAULT.validate(&CONFIG) {
+        Ok(v) => v,
+        Err(_) => panic!("the built-in settings fail validation"),
+    };
+
+/// The console service, shared by the two ports (thread mode only).
+#[cfg(feature = "console")]
+static SERVICE: static_cell::StaticCell<console::Service> = static_cell::StaticCell::new();
 
 /// The frame task's executor, above thread mode.
 static FRAME_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
@@ -218,11 +244,17 @@ async fn main(spawner: Spawner) {
 
     // Before the first frame: nothing else runs yet while the store is read.
     #[cfg(feature = "console")]
-    settings::probe(p.FLASH);
+    let boot = settings::boot(p.FLASH, &CONFIG, DEFAULT_SETTINGS, &LINK);
+    #[cfg(feature = "console")]
+    let (boot_head, params, behaviour) = (boot.head(), boot.valid.driver, boot.valid.behaviour);
+    #[cfg(feature = "console")]
+    let head = &boot_head;
+    #[cfg(not(feature = "console"))]
+    let (head, params) = (&DEFAULT_HEAD, PARAMS);
 
     let [first, spare] = SETS.take();
     let start = Instant::now();
-    let generated = first.generate(&DEFAULT_HEAD);
+    let generated = first.generate(head);
     let precompute_us = start.elapsed().as_micros();
     match generated {
         Ok(info) => {
@@ -247,7 +279,7 @@ async fn main(spawner: Spawner) {
         precompute_us,
         first.checksum()
     );
-    let mut stream = LoopStream::new(DEFAULT_HEAD, &TIMING);
+    let mut stream = LoopStream::new(*head, &TIMING);
     stream.adopt(first);
     match IDLE_MODE {
         IdleMode::NeverRepeating => {
@@ -265,49 +297,80 @@ async fn main(spawner: Spawner) {
         IdleMode::FixedLoop => defmt::info!("idle: the fixed loop, replayed every loop"),
     }
 
-    let driver = FrameDriver::new(channels, PARAMS);
+    let driver = FrameDriver::new(channels, params);
     // The frame task's interrupt: above thread mode, below the time
     // driver's alarm (priority 0), which wakes it.
     interrupt::SWI_IRQ_1.set_priority(Priority::P1);
     let frames = FRAME_EXECUTOR.start(interrupt::SWI_IRQ_1);
-    match frame_task(driver, first, watchdog) {
+    #[cfg(feature = "console")]
+    let checksum = first.checksum();
+    #[cfg(feature = "console")]
+    let task = frame_task(driver, first, watchdog, behaviour);
+    #[cfg(not(feature = "console"))]
+    let task = frame_task(driver, first, watchdog);
+    match task {
         Ok(token) => frames.spawn(token),
         Err(_) => defmt::error!("frame task already running"),
     }
 
     #[cfg(feature = "console")]
-    console::start(
-        spawner,
-        console::Ports {
-            uart: p.UART0,
-            tx: p.PIN_0,
-            rx: p.PIN_1,
-            usb: p.USB,
-        },
-        &COMMANDS,
-    );
+    {
+        let settings::Boot {
+            storage,
+            settings,
+            source,
+            ..
+        } = boot;
+        match ConsoleService::new(&COMMANDS, &LINK, storage, CONFIG, settings, source) {
+            Ok(mut service) => {
+                // `seed random` mixes the loop checksum and the boot time in.
+                service.add_entropy(checksum ^ Instant::now().as_ticks() as u32);
+                let service = SERVICE.init(embassy_sync::blocking_mutex::Mutex::new(
+                    core::cell::RefCell::new(service),
+                ));
+                console::start(
+                    spawner,
+                    console::Ports {
+                        uart: p.UART0,
+                        tx: p.PIN_0,
+                        rx: p.PIN_1,
+                        usb: p.USB,
+                    },
+                    service,
+                );
+            }
+            Err(e) => defmt::error!("console: no service: {}", e),
+        }
+    }
 }
 
 /// Generates each next loop set while the frames play (thread mode).
 #[embassy_executor::task]
 async fn generator(mut stream: LoopStream<DEFAULT_N>) {
-    EXCHANGE
-        .generate(&mut stream, |result, ticks| match result {
-            Ok(info) => defmt::info!(
-                "loop set {=u32} ready in {=u64} us: seeds {:#010x}, entered at {}, join mismatch {} mdeg rms",
-                info.number,
-                Duration::from_ticks(ticks).as_micros(),
-                info.seeds,
-                info.starts,
-                info.mismatch
-            ),
-            Err(e) => defmt::error!(
-                "loop set failed: {=str} {=str}; trying the next seeds",
-                e.axis.name(),
-                e.error.message()
-            ),
-        })
-        .await
+    #[cfg(feature = "console")]
+    let generated = EXCHANGE.generate_seeded(&mut stream, Some(&LINK), log_set);
+    #[cfg(not(feature = "console"))]
+    let generated = EXCHANGE.generate(&mut stream, log_set);
+    generated.await
+}
+
+/// Logs a loop set the generator made.
+fn log_set(result: &Result<idle_head::idle::SetInfo, idle_head::motion::AxisError>, ticks: u64) {
+    match result {
+        Ok(info) => defmt::info!(
+            "loop set {=u32} ready in {=u64} us: seeds {:#010x}, entered at {}, join mismatch {} mdeg rms",
+            info.number,
+            Duration::from_ticks(ticks).as_micros(),
+            info.seeds,
+            info.starts,
+            info.mismatch
+        ),
+        Err(e) => defmt::error!(
+            "loop set failed: {=str} {=str}; trying the next seeds",
+            e.axis.name(),
+            e.error.message()
+        ),
+    }
 }
 
 /// The idle motion the frame task plays.
@@ -317,7 +380,12 @@ type Idle = idle_head::idle::IdlePlayer<SetRef, idle_head::frame_task::ExchangeS
 type Idle = idle_head::playback::Player<'static, calibrate::Sweep>;
 
 #[embassy_executor::task]
-async fn frame_task(mut driver: FrameDriver<ServoPwm>, first: SetRef, watchdog: Watchdog) {
+async fn frame_task(
+    mut driver: FrameDriver<ServoPwm>,
+    first: SetRef,
+    watchdog: Watchdog,
+    #[cfg(feature = "console")] behaviour: idle_head::behaviour::BehaviourParams,
+) {
     #[cfg(not(feature = "calibrate"))]
     let (idle, playback): (Idle, _) = (
         idle_head::idle::IdlePlayer::new(first, EXCHANGE.supply(), TIMING, IDLE_MODE),
@@ -337,13 +405,23 @@ async fn frame_task(mut driver: FrameDriver<ServoPwm>, first: SetRef, watchdog: 
         )
     };
     let start = Instant::now().as_ticks();
-    let Ok(frames) = FrameLoop::new(idle, playback.frame_period(), embassy_time::TICK_HZ, start)
-    else {
+    // The console image: the behaviour of the settings the board booted with.
+    #[cfg(feature = "console")]
+    let frames = FrameLoop::with_behaviour(
+        idle,
+        playback.frame_period(),
+        behaviour,
+        embassy_time::TICK_HZ,
+        start,
+    );
+    #[cfg(not(feature = "console"))]
+    let frames = FrameLoop::new(idle, playback.frame_period(), embassy_time::TICK_HZ, start);
+    let Ok(frames) = frames else {
         defmt::error!("frame period below one timer tick");
         return;
     };
     #[cfg(feature = "console")]
-    let frames = frames.with_commands(&COMMANDS);
+    let frames = frames.with_commands(&COMMANDS).with_link(&LINK);
     let mut frames = frames;
     let mut hooks = PicoHooks::new(watchdog, playback);
     let stats = idle_head::frame_task::run(&mut driver, &mut frames, &mut hooks).await;
@@ -386,7 +464,7 @@ impl PicoHooks {
 impl FrameHooks<ServoPwm> for PicoHooks {
     fn after_frame(&mut self, frame: &Frame, driver: &mut FrameDriver<ServoPwm>) -> Flow {
         if self.started {
-            self.watchdog.feed(WATCHDOG_TIMEOUT);
+            self.watchdog.feed(watchdog_timeout());
         } else {
             // The first frame (neutral pulses) is out: from now on frames
             // must keep coming.
@@ -430,6 +508,22 @@ impl FrameHooks<ServoPwm> for PicoHooks {
         }
         Flow::Continue
     }
+}
+
+/// The watchdog timeout the frame task feeds: [`WATCHDOG_TIMEOUT`], or
+/// longer while the console's `save` or `load` uses the flash (see
+/// `settings.rs`).
+#[cfg(feature = "console")]
+fn watchdog_timeout() -> Duration {
+    if settings::FLASH_BUSY.load(core::sync::atomic::Ordering::Acquire) {
+        Duration::from_millis(settings::FLASH_WATCHDOG_MS)
+    } else {
+        WATCHDOG_TIMEOUT
+    }
+}
+#[cfg(not(feature = "console"))]
+const fn watchdog_timeout() -> Duration {
+    WATCHDOG_TIMEOUT
 }
 
 /// Bytes of stack used since reset: the stack region was painted before

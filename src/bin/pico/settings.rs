@@ -6,26 +6,47 @@
 //! The flash driver is embassy-rp's in blocking mode, made async by
 //! [`BlockingAsync`]: reads are plain reads of the memory-mapped flash, and
 //! an erase or a write runs from RAM with interrupts off, as the flash
-//! cannot be read (nor code run from it) meanwhile. A sector erase takes
-//! 45 ms typically (W25Q16JV, up to 400 ms), two frames or more: only the
-//! boot probe touches the store today, before the first frame.
+//! cannot be read (nor code run from it) meanwhile.
 //!
-//! At boot the store is opened and its record probed ([`probe`]); the
-//! head runs on its built-in settings and the log says what the store
-//! holds. Reading the record into the settings arrives with the settings
-//! type; until then [`Probe`] stands in for it, a record that decodes
-//! nothing.
+//! At boot ([`boot`]) the store is read before the first frame: stored
+//! settings of the current version are put in effect (servo calibrations,
+//! behaviour, seeds) and logged with their version; an empty store gives
+//! the built-in settings; a damaged store, or one of another version,
+//! gives the built-in settings with a warning. The console's `save` and
+//! `load` go through [`PicoStorage`].
+//!
+//! # `save` and the watchdog
+//!
+//! A sector erase takes 45 ms typically (W25Q16JV), up to 400 ms, with
+//! interrupts off: no frame runs meanwhile, and the watchdog (100 ms) would
+//! reset the board. So around every flash operation of `save` and `load`
+//! [`PicoStorage`] sets [`FLASH_BUSY`] and waits (at most
+//! [`FRAME_WAIT_MS`]) for one frame: that frame, and every frame until the
+//! operation ends, feeds the watchdog with [`FLASH_WATCHDOG_MS`] instead of
+//! 100 ms. Afterwards the next frame feeds it with 100 ms again. While the
+//! interrupts are off the PWM hardware keeps sending the last pulses, so
+//! the servos hold their pose; the frames due meanwhile are missed (the
+//! frame task's lateness shows it), and the head resumes where its clock
+//! stands.
 
 use core::future::Future;
 use core::ops::Range;
 use core::pin::pin;
+use core::sync::atomic::{AtomicBool, Ordering};
 use core::task::{Context, Poll, Waker};
 
 use embassy_embedded_hal::adapter::BlockingAsync;
 use embassy_rp::Peri;
 use embassy_rp::flash::{Blocking, ERASE_SIZE, Error as FlashError, Flash};
 use embassy_rp::peripherals::FLASH;
-use idle_head::settings::{DecodeError, EncodeError, LoadError, Record, SettingsStore};
+use embassy_time::{Duration, Instant};
+use idle_head::console::ConsoleLink;
+use idle_head::driver::DriverConfig;
+use idle_head::motion::{DEFAULT_HEAD, HeadConfig};
+use idle_head::settings::{
+    LoadError, Record, Settings, SettingsSource, SettingsStorage, SettingsStore, StorageError,
+    Validated,
+};
 
 /// The Pico's flash: 2 MiB (W25Q16JV).
 pub const FLASH_SIZE: usize = 2 * 1024 * 1024;
@@ -44,33 +65,135 @@ pub const SETTINGS_ADDRESS: u32 = 0x1000_0000 + SETTINGS_RANGE.start;
 // checks that no code is linked there.
 const _: () = assert!(SETTINGS_ADDRESS == 0x101f_c000);
 
+/// The watchdog timeout the frames feed while a flash operation is under
+/// way: a 400 ms sector erase, with a wide margin.
+pub const FLASH_WATCHDOG_MS: u64 = 1000;
+/// How long a flash operation waits for the frame that feeds the watchdog
+/// with [`FLASH_WATCHDOG_MS`]: more than a frame (20 ms).
+pub const FRAME_WAIT_MS: u64 = 50;
+
+/// Set while `save` or `load` uses the flash: the frames feed the watchdog
+/// with [`FLASH_WATCHDOG_MS`] (see the [module docs](self)).
+pub static FLASH_BUSY: AtomicBool = AtomicBool::new(false);
+
 /// The flash driver the store runs on.
 pub type PicoFlash = BlockingAsync<Flash<'static, FLASH, Blocking, FLASH_SIZE>>;
 
 /// The store, with a record of up to 125 bytes.
-pub type Store<R> = SettingsStore<PicoFlash, R, 128>;
+pub type Store = SettingsStore<PicoFlash, Settings, 128>;
 
-/// A stand-in record that reads nothing: any record saved by a firmware
-/// with settings has a lower version, so a probe tells an empty store
-/// from a damaged one and finds the stored version, without a settings
-/// type.
-pub struct Probe;
+/// The console's `save` and `load` on the flash store.
+pub struct PicoStorage {
+    /// `None` if the store could not be opened (logged at boot).
+    store: Option<Store>,
+    /// The frame task's status, to see a frame pass.
+    link: &'static ConsoleLink,
+}
 
-impl Record for Probe {
-    const VERSION: u16 = u16::MAX;
-
-    fn encode(&self, _: &mut [u8]) -> Result<usize, EncodeError> {
-        Err(EncodeError::Unsupported)
-    }
-
-    fn decode(_: &[u8]) -> Result<Self, DecodeError> {
-        Err(DecodeError::Malformed)
+impl PicoStorage {
+    /// Runs `op` on the store with the watchdog's flash timeout in force.
+    fn guarded<T>(
+        &mut self,
+        op: impl FnOnce(&mut Store) -> Result<T, StorageError>,
+    ) -> Result<T, StorageError> {
+        let store = self.store.as_mut().ok_or(StorageError::Device)?;
+        FLASH_BUSY.store(true, Ordering::Release);
+        // The frame task runs above this task: once the frame count moves,
+        // that frame has fed the watchdog with the long timeout. If no frame
+        // comes (the watchdog is not running yet), go on.
+        let frame = self.link.status().frame;
+        let since = Instant::now();
+        while self.link.status().frame == frame
+            && since.elapsed() < Duration::from_millis(FRAME_WAIT_MS)
+        {
+            core::hint::spin_loop();
+        }
+        let result = op(store);
+        FLASH_BUSY.store(false, Ordering::Release);
+        result
     }
 }
 
-/// Opens the store on the flash peripheral. `None` (logged) if the region
-/// is not a valid store range, which `SETTINGS_RANGE` rules out.
-fn open<R: Record>(flash: Peri<'static, FLASH>) -> Option<Store<R>> {
+impl SettingsStorage for PicoStorage {
+    fn save(&mut self, settings: &Settings) -> Result<(), StorageError> {
+        self.guarded(|store| match at_once(store.save(settings)) {
+            Some(result) => result.map_err(StorageError::from),
+            None => Err(StorageError::Device),
+        })
+    }
+
+    fn load(&mut self) -> Result<Settings, StorageError> {
+        self.guarded(|store| match at_once(store.load()) {
+            Some(result) => result.map_err(StorageError::from),
+            None => Err(StorageError::Device),
+        })
+    }
+}
+
+/// The settings the board boots with.
+pub struct Boot {
+    /// The console's store.
+    pub storage: PicoStorage,
+    /// The settings in effect.
+    pub settings: Settings,
+    /// Where they came from.
+    pub source: SettingsSource,
+    /// Their parameters for the driver and the behaviour.
+    pub valid: Validated,
+}
+
+impl Boot {
+    /// The idle motion's configuration with these settings' seeds.
+    pub const fn head(&self) -> HeadConfig {
+        let mut head = DEFAULT_HEAD;
+        head.pitch.seed = self.settings.seeds[0];
+        head.roll.seed = self.settings.seeds[1];
+        head.yaw.seed = self.settings.seeds[2];
+        head
+    }
+}
+
+/// Opens the store on the flash peripheral and reads the settings in it
+/// (before the first frame: no watchdog, no frames yet), checked against
+/// `base`; the built-in settings (`defaults`, checked with `base` at compile
+/// time) if there are none or they are not usable. The log says which.
+pub fn boot(
+    flash: Peri<'static, FLASH>,
+    base: &DriverConfig,
+    defaults: Validated,
+    link: &'static ConsoleLink,
+) -> Boot {
+    let mut store = open(flash);
+    let loaded = match store.as_mut() {
+        Some(store) => match at_once(store.load()) {
+            Some(loaded) => loaded_settings(loaded, base),
+            None => {
+                defmt::error!("settings: defaults; the blocking flash driver waited");
+                None
+            }
+        },
+        None => None,
+    };
+    let storage = PicoStorage { store, link };
+    match loaded {
+        Some((settings, valid)) => Boot {
+            storage,
+            settings,
+            source: SettingsSource::Flash,
+            valid,
+        },
+        None => Boot {
+            storage,
+            settings: Settings::DEFAULT,
+            source: SettingsSource::Defaults,
+            valid: defaults,
+        },
+    }
+}
+
+/// Opens the store. `None` (logged) if the region is not a valid store
+/// range, which `SETTINGS_RANGE` rules out.
+fn open(flash: Peri<'static, FLASH>) -> Option<Store> {
     let flash = BlockingAsync::new(Flash::new_blocking(flash));
     match Store::new(flash, SETTINGS_RANGE) {
         Ok(store) => Some(store),
@@ -78,22 +201,6 @@ fn open<R: Record>(flash: Peri<'static, FLASH>) -> Option<Store<R>> {
             defmt::error!("settings: no store: the region is not whole erase sectors");
             None
         }
-    }
-}
-
-/// Opens the store on the flash peripheral, reads what it holds and logs
-/// it: the head runs on its built-in settings whatever it finds.
-///
-/// The store and its buffer live on the stack for this call only (at boot,
-/// before the loop generator's deeper stack), not in the main task's
-/// static state.
-pub fn probe(flash: Peri<'static, FLASH>) {
-    let Some(mut store) = open::<Probe>(flash) else {
-        return;
-    };
-    match at_once(store.load()) {
-        Some(loaded) => log(loaded),
-        None => defmt::error!("settings: the blocking flash driver waited"),
     }
 }
 
@@ -106,31 +213,45 @@ fn at_once<F: Future>(future: F) -> Option<F::Output> {
     }
 }
 
-fn log(loaded: Result<Probe, LoadError<FlashError>>) {
+/// The stored settings if they can be used with `base`, logged either way.
+fn loaded_settings(
+    loaded: Result<Settings, LoadError<FlashError>>,
+    base: &DriverConfig,
+) -> Option<(Settings, Validated)> {
     let at = SETTINGS_ADDRESS;
     match loaded {
+        Ok(settings) => match settings.validate(base) {
+            Ok(valid) => {
+                defmt::info!(
+                    "settings: loaded from flash (version {=u16}) at {=u32:#010x}",
+                    Settings::VERSION,
+                    at
+                );
+                return Some((settings, valid));
+            }
+            Err(e) => defmt::warn!(
+                "settings: defaults; the stored settings fail validation: {}",
+                e
+            ),
+        },
         Err(LoadError::Empty) => {
             defmt::info!("settings: defaults (empty store at {=u32:#010x})", at);
         }
-        Err(LoadError::Older { found }) => defmt::info!(
-            "settings: defaults; the store at {=u32:#010x} holds a record of version {=u16}, read once the settings service is in",
+        Err(LoadError::Older { found } | LoadError::Newer { found }) => defmt::warn!(
+            "settings: defaults; the store at {=u32:#010x} holds settings of version {=u16}, not {=u16}",
             at,
-            found
+            found,
+            Settings::VERSION
         ),
-        Err(LoadError::Flash(e)) => warn_flash(at, e),
-        Err(LoadError::Corrupt | LoadError::Newer { .. } | LoadError::Invalid) | Ok(Probe) => {
-            defmt::warn!(
-                "settings: defaults; the store at {=u32:#010x} is damaged",
-                at
-            );
-        }
+        Err(LoadError::Flash(e)) => defmt::warn!(
+            "settings: defaults; reading the store at {=u32:#010x} failed: {}",
+            at,
+            e
+        ),
+        Err(LoadError::Corrupt | LoadError::Invalid) => defmt::warn!(
+            "settings: defaults; the store at {=u32:#010x} is damaged",
+            at
+        ),
     }
-}
-
-fn warn_flash(at: u32, e: FlashError) {
-    defmt::warn!(
-        "settings: defaults; reading the store at {=u32:#010x} failed: {}",
-        at,
-        e
-    );
+    None
 }

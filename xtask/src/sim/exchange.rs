@@ -8,17 +8,45 @@
 //! USB. Every byte sent back is recorded. The check, for each port:
 //! exactly one reply line per script line, each the reply the host
 //! computes with the same core `Session` and the firmware's own handler
-//! (`src/bin/pico/handler.rs`, compiled here too), in order. The frames
-//! are checked as always, so the exchange must not change a pulse: the
-//! script's one motion command, `center`, asks for the pose the head
-//! already holds.
+//! (`src/bin/pico/handler.rs`, compiled here too: the core's
+//! `ConsoleService`, shared by both ports, here over a `RamStorage`), in
+//! order. The two ports share one service on the board as here: the USB
+//! run's replies follow the UART run's changes (`status` then says
+//! `settings=changed`).
+//!
+//! The frames are checked as always, so the exchange must not change a
+//! pulse: the script's one motion command, `center`, asks for the pose the
+//! head already holds; `servo yaw neutral 1500` sets the neutral the yaw
+//! servo already has; `seed 7` takes effect with the next loop set, which
+//! is generated after the first join (28 s), past the run's end.
+//!
+//! `status` reports the head as the last frame left it: `mode`, `faults`,
+//! `off`, `fw` and `settings` are compared exactly (the host's link says
+//! `running`, as the head is after its fade-in), while the angles, the
+//! pulses and the uptime depend on the frame at which the line arrives:
+//! for them the check accepts any value of the right form (a
+//! comma-separated list of integers), a wildcard written `*` in the
+//! transcript's expectations ([`mask`]).
+//!
+//! `save` is not in the script: it erases and programs flash through the
+//! RP2040's boot ROM, which the emulator does not have. `load` is, as it
+//! only reads the memory-mapped flash: the emulator's store is empty, so
+//! it answers `err storage load: no settings saved`.
 
 use std::fmt::Write as _;
 use std::time::Duration;
 
 use idle_head::console::checksum;
 
-use super::pico_handler::{PicoSession, Queue, QueueHandler};
+use std::cell::RefCell;
+
+use embassy_sync::blocking_mutex::Mutex;
+use idle_head::behaviour::CommandQueue;
+use idle_head::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
+use idle_head::driver::DriverConfig;
+use idle_head::settings::{RamStorage, Settings, SettingsSource};
+
+use super::pico_handler::{PicoSession, Shared, SharedService};
 
 /// When the first byte goes out: 3 s, after the 2 s fade-in.
 pub const START: Duration = Duration::from_secs(3);
@@ -34,10 +62,14 @@ const SCRIPT: &[&[u8]] = &[
     b"help\r\n",
     b"status\n",
     b"nodd\r\n",
+    b"servo yaw\r\n",
     b"servo yaw neutral 1500\r",
     b"center\r\n",
     b"look 10 up\n",
-    b"save\r\n",
+    b"seed 7\n",
+    b"load\r\n",
+    b"status\r\n",
+    b"servo yaw min 400\n",
     b"nod\x07\r\n",
     b"seed 4294967296\n",
 ];
@@ -55,25 +87,80 @@ pub fn script() -> Vec<u8> {
     bytes
 }
 
-/// The replies the firmware must send for `script`, one per line.
-pub fn expected(script: &[u8]) -> Vec<Vec<u8>> {
+/// The replies the firmware must send for `script`, one per line: first
+/// on the UART, then on the USB port, with one service as on the board.
+pub fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
     // The firmware's frame task drains its queue; the script holds fewer
-    // actions than the queue holds, so here it never needs draining.
-    static QUEUE: Queue = Queue::new();
-    let mut session = PicoSession::new();
-    let mut handler = QueueHandler::new(&QUEUE);
-    let mut replies = Vec::new();
-    session.feed(script, &mut handler, |reply| replies.push(reply.to_vec()));
-    replies
+    // actions than the queue holds (twice over), so here it never needs
+    // draining.
+    let queue: &'static CommandQueue = Box::leak(Box::new(CommandQueue::new()));
+    let link: &'static ConsoleLink = Box::leak(Box::new(ConsoleLink::new()));
+    // As on the board from its fade-in on; the rest is masked ([`mask`]).
+    link.publish(HeadStatus {
+        mode: HeadMode::Running,
+        ..HeadStatus::default()
+    });
+    let service = ConsoleService::new(
+        queue,
+        link,
+        RamStorage::<256>::new(),
+        DriverConfig::DEFAULT,
+        Settings::DEFAULT,
+        SettingsSource::Defaults,
+    )
+    .expect("the built-in settings are valid");
+    let service: &'static SharedService<RamStorage<256>> =
+        Box::leak(Box::new(Mutex::new(RefCell::new(service))));
+    [(), ()].map(|()| {
+        let mut session = PicoSession::new();
+        let mut handler = Shared::new(service);
+        let mut replies = Vec::new();
+        session.feed(script, &mut handler, |reply| replies.push(mask(reply)));
+        replies
+    })
 }
 
-/// What UART0 sent against what it should have; the transcript and the
-/// problems found.
-pub fn check(script: &[u8], sent: &[u8]) -> (String, Vec<String>) {
-    let want = expected(script);
-    let got: Vec<&[u8]> = sent
+/// `reply` with the values that depend on the frame it was answered at
+/// (the angles, pulses and uptime of `status`) replaced by `*`, if they
+/// have their form: a comma-separated list of integers.
+pub fn mask(reply: &[u8]) -> Vec<u8> {
+    if !reply.starts_with(b"ok mode=") {
+        return reply.to_vec();
+    }
+    let mut out = Vec::with_capacity(reply.len());
+    for (i, word) in reply.split(|&b| b == b' ').enumerate() {
+        if i > 0 {
+            out.push(b' ');
+        }
+        let masked = ["mdeg=", "us=", "uptime_ms="].iter().find_map(|key| {
+            let value = word.strip_prefix(key.as_bytes())?;
+            let numbers = value.split(|&b| b == b',').all(|n| {
+                !n.is_empty()
+                    && n.strip_prefix(b"-")
+                        .unwrap_or(n)
+                        .iter()
+                        .all(u8::is_ascii_digit)
+            });
+            numbers.then_some(key)
+        });
+        match masked {
+            Some(key) => {
+                out.extend(key.as_bytes());
+                out.push(b'*');
+            }
+            None => out.extend(word),
+        }
+    }
+    out
+}
+
+/// What a port sent against `want` (from [`expected`]); the transcript
+/// and the problems found.
+pub fn check(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>) {
+    let got: Vec<Vec<u8>> = sent
         .split_inclusive(|&b| b == b'\n')
         .filter(|line| !line.is_empty())
+        .map(mask)
         .collect();
     let mut transcript = String::new();
     let mut problems = Vec::new();
@@ -89,7 +176,7 @@ pub fn check(script: &[u8], sent: &[u8]) -> (String, Vec<String>) {
                 let _ = writeln!(transcript, "  < {}", printable(reply));
                 if reply != want {
                     problems.push(format!(
-                        "UART reply {} is `{}`, not `{}`",
+                        "reply {} is `{}`, not `{}`",
                         i + 1,
                         printable(reply),
                         printable(want)
@@ -103,13 +190,13 @@ pub fn check(script: &[u8], sent: &[u8]) -> (String, Vec<String>) {
     }
     if got.len() != want.len() {
         problems.push(format!(
-            "{} reply lines over the UART for {} lines sent",
+            "{} reply lines for {} lines sent",
             got.len(),
             want.len()
         ));
     }
     if got.last().is_some_and(|l| !l.ends_with(b"\r\n")) {
-        problems.push("the last UART reply does not end in CR LF".to_owned());
+        problems.push("the last reply does not end in CR LF".to_owned());
     }
     (transcript, problems)
 }
@@ -143,23 +230,58 @@ mod tests {
     #[test]
     fn one_expected_reply_per_script_line() {
         let script = script();
-        let want = expected(&script);
-        assert_eq!(want.len(), SCRIPT.len() + 2);
-        assert!(want[0].starts_with(b"ok commands: help"));
-        assert_eq!(want[1], b"err state not available yet\r\n");
-        assert!(want.iter().all(|r| r.ends_with(b"\r\n")));
+        let [uart, usb] = expected(&script);
+        for want in [&uart, &usb] {
+            assert_eq!(want.len(), SCRIPT.len() + 2);
+            assert!(want[0].starts_with(b"ok commands: help"));
+            assert!(want.iter().all(|r| r.ends_with(b"\r\n")));
+        }
+        let text = |r: &Vec<u8>| String::from_utf8_lossy(r).into_owned();
+        assert!(
+            text(&uart[1])
+                .starts_with("ok mode=running mdeg=* us=* faults=0,0,0 off=0 uptime_ms=* fw=")
+                && text(&uart[1]).ends_with(" settings=defaults\r\n"),
+            "{}",
+            text(&uart[1])
+        );
+        assert!(
+            text(&uart[3]).starts_with("ok yaw neutral=1500 "),
+            "{}",
+            text(&uart[3])
+        );
+        assert_eq!(text(&uart[7]), "ok seed=7\r\n");
+        assert_eq!(text(&uart[8]), "err storage load: no settings saved\r\n");
+        assert!(text(&uart[9]).ends_with(" settings=changed\r\n"));
+        // The USB run finds the settings the UART run changed.
+        assert!(text(&usb[1]).ends_with(" settings=changed\r\n"));
+    }
+
+    #[test]
+    fn status_masks_only_numbers() {
+        let masked = mask(b"ok mode=running mdeg=1,-2,3 us=1500,1500,1500 faults=0,0,0 uptime_ms=3020 settings=flash\r\n");
+        assert_eq!(
+            masked,
+            b"ok mode=running mdeg=* us=* faults=0,0,0 uptime_ms=* settings=flash\r\n"
+        );
+        assert_eq!(
+            mask(b"ok mode=running mdeg=x,1"),
+            b"ok mode=running mdeg=x,1"
+        );
+        assert_eq!(mask(b"ok mode=running us="), b"ok mode=running us=");
+        assert_eq!(mask(b"ok yaw us=1"), b"ok yaw us=1");
     }
 
     #[test]
     fn a_missing_or_wrong_reply_is_a_problem() {
         let script = script();
-        let all: Vec<u8> = expected(&script).concat();
-        assert!(check(&script, &all).1.is_empty());
+        let [want, _] = expected(&script);
+        let all: Vec<u8> = want.concat();
+        assert!(check(&script, &want, &all).1.is_empty());
         let short = &all[..all.len() - 3];
-        assert!(!check(&script, short).1.is_empty());
+        assert!(!check(&script, &want, short).1.is_empty());
         let mut wrong = all.clone();
         wrong[0] = b'x';
-        assert!(!check(&script, &wrong).1.is_empty());
-        assert!(!check(&script, &[]).1.is_empty());
+        assert!(!check(&script, &want, &wrong).1.is_empty());
+        assert!(!check(&script, &want, &[]).1.is_empty());
     }
 }

@@ -194,7 +194,8 @@ fn check_exchange(report: &mut Report) {
         return;
     };
     let script = exchange::script();
-    let (transcript, problems) = exchange::check(&script, &boot.uart);
+    let [uart_want, usb_want] = exchange::expected(&script);
+    let (transcript, problems) = exchange::check(&script, &uart_want, &boot.uart);
     let mut text = format!(
         "UART0 exchange ({} bytes in from {:.1} s at 115200 baud, {} bytes out):\n{transcript}",
         script.len(),
@@ -215,7 +216,7 @@ fn check_exchange(report: &mut Report) {
             boot.uart_overruns
         ));
     }
-    let (usb, usb_problems) = exchange::check(&script, &boot.usb);
+    let (usb, usb_problems) = exchange::check(&script, &usb_want, &boot.usb);
     match boot.usb_connected {
         Some(ns) => {
             let _ = write!(
@@ -246,7 +247,9 @@ fn check_exchange(report: &mut Report) {
                 .to_owned(),
         );
     }
-    report.problems.extend(problems);
+    report
+        .problems
+        .extend(problems.into_iter().map(|p| format!("UART: {p}")));
     report.exchange = Some(text);
 }
 
