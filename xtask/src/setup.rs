@@ -82,6 +82,16 @@ pub fn ensure_qemu() -> Result<()> {
         );
     }
     println!("{QEMU_BINARY} is missing: installing the `{QEMU_PACKAGE}` package");
+    apt_install(&[QEMU_PACKAGE])?;
+    qemu_version()
+        .map(|_| ())
+        .with_context(|| format!("`{QEMU_BINARY}` still does not run after installing it"))
+}
+
+/// Installs `packages` with apt-get, non-interactively (the caller has
+/// checked that apt-get exists and that this runs as root).
+pub fn apt_install(packages: &[&str]) -> Result<()> {
+    let sh = project::shell(".")?;
     let env = [("DEBIAN_FRONTEND", "noninteractive")];
     project::run(&sh, &env, cmd!(sh, "apt-get update -q"))?;
     project::run(
@@ -89,12 +99,9 @@ pub fn ensure_qemu() -> Result<()> {
         &env,
         cmd!(
             sh,
-            "apt-get install -y -q --no-install-recommends {QEMU_PACKAGE}"
+            "apt-get install -y -q --no-install-recommends {packages...}"
         ),
-    )?;
-    qemu_version()
-        .map(|_| ())
-        .with_context(|| format!("`{QEMU_BINARY}` still does not run after installing it"))
+    )
 }
 
 /// First line of `qemu-system-arm --version`, if it runs.

@@ -13,7 +13,7 @@ use std::{
 use anyhow::{Context, Result, bail};
 use serde_json::{Value, json};
 
-use crate::project;
+use crate::{project, setup};
 use xshell::cmd;
 
 /// The Debian/Ubuntu packages that bring `node` and `npm`.
@@ -91,17 +91,7 @@ fn install_node() -> Result<()> {
         bail!("{message}");
     }
     println!("node/npm are missing: installing the packages {packages}");
-    let sh = project::shell(".")?;
-    let env = [("DEBIAN_FRONTEND", "noninteractive")];
-    project::run(&sh, &env, cmd!(sh, "apt-get update -q"))?;
-    project::run(
-        &sh,
-        &env,
-        cmd!(
-            sh,
-            "apt-get install -y -q --no-install-recommends {PACKAGES...}"
-        ),
-    )?;
+    setup::apt_install(&PACKAGES)?;
     if version("node").is_none() || version("npm").is_none() {
         bail!("`node` or `npm` still does not run after installing {packages}");
     }
