@@ -57,7 +57,7 @@ use crate::command::{Action, GestureKind, Hold};
 use crate::console::{ConsoleLink, HeadMode, HeadStatus};
 use crate::driver::{DriverConfig, FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod};
 use crate::idle::{IdleMode, LoopSet, LoopStream, LoopSupply, SetInfo};
-use crate::motion::{AxisError, DEFAULT_N};
+use crate::motion::{AxisError, DEFAULT_N, DEFAULT_WINDOW_CAP};
 use crate::{Angle, Microseconds};
 
 pub use crate::behaviour::LOOP_DURATION;
@@ -79,8 +79,12 @@ pub const IDLE_MODE: IdleMode = if cfg!(feature = "fixed-loop") {
     IdleMode::NeverRepeating
 };
 
+/// A loop set as the boards keep it: the default length, and a kernel
+/// capacity of the default windows ([`DEFAULT_WINDOW_CAP`]).
+pub type Set = LoopSet<DEFAULT_N, DEFAULT_WINDOW_CAP>;
+
 /// A loop set buffer as the boards pass it between the tasks.
-pub type SetRef = &'static mut LoopSet<DEFAULT_N>;
+pub type SetRef = &'static mut Set;
 
 /// The two one-slot channels the loop set buffers go round through: `free`
 /// (a set the frame task no longer reads) and `ready` (a set generated,

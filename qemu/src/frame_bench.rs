@@ -59,7 +59,7 @@ use idle_head::behaviour::Applied;
 use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver, FrameTick};
 use idle_head::frame_task::{FrameLoop, LOOP_DURATION};
-use idle_head::idle::{IdleMode, IdlePlayer, IdleTiming, LoopSet, LoopStream, LoopSupply};
+use idle_head::idle::{IdleMode, IdlePlayer, IdleTiming, LoopStream, LoopSupply};
 use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N};
 use idle_head::units::Angle;
 
@@ -100,7 +100,7 @@ const TIMING: IdleTiming = match IdleTiming::new(PLAYBACK) {
 };
 
 /// A loop set of the default length.
-pub type Set = LoopSet<DEFAULT_N>;
+pub use idle_head::frame_task::Set;
 
 /// Hands loop set 1 over when its join is due; a set given back is dropped.
 #[derive(Clone, Copy)]

@@ -76,7 +76,7 @@ use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::frame_task::{
     Exchange, ExchangeSupply, FrameLoop, IDLE_MODE, LOOP_DURATION, SetRef,
 };
-use idle_head::idle::{IdleMode, IdlePlayer, IdleTiming, LoopSet, LoopStream};
+use idle_head::idle::{IdleMode, IdlePlayer, IdleTiming, LoopStream};
 use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N};
 use idle_head::settings::{RamStorage, Settings, SettingsSource};
 use idle_head::{Axis, Microseconds, Millis, Playback};
@@ -120,7 +120,7 @@ const _: () = {
 /// written here are the board's.
 const PICO_TOP: u16 = rp2040_pwm::PICO_SERVO_CLOCK.top;
 
-type Set = LoopSet<DEFAULT_N>;
+use idle_head::frame_task::Set;
 
 /// The two loop set buffers, 2 · 5.4 KB: one plays while the generator
 /// fills the other.

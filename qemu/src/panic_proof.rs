@@ -46,8 +46,9 @@ use idle_head::driver::{
     DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, DriverParams, FrameDriver,
     MotionLimits,
 };
+use idle_head::frame_task::Set;
 use idle_head::frame_task::{Exchange, FrameLoop, IDLE_MODE, LOOP_DURATION};
-use idle_head::idle::{IdlePlayer, IdleTiming, LoopSet};
+use idle_head::idle::{IdlePlayer, IdleTiming};
 use idle_head::motion::DEFAULT_N;
 use idle_head::servo::{Direction, NanosPerDegree, ServoCalibration};
 use idle_head::units::{Angle, AngleRange, Microseconds, Millis};
@@ -71,8 +72,7 @@ const TIMING: IdleTiming = match IdleTiming::new(PLAYBACK) {
 
 /// Loop sets with unknown contents (the optimiser sees them through
 /// `black_box`).
-static SETS: ConstStaticCell<[LoopSet<DEFAULT_N>; 2]> =
-    ConstStaticCell::new([LoopSet::new(), LoopSet::new()]);
+static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::new()]);
 
 /// The channels to the generator (none runs: whether a set is ready is
 /// unknown to the optimiser).

@@ -115,9 +115,9 @@ impl<H, S> IdlePlayer<H, S> {
     }
 }
 
-impl<H, S, const N: usize> IdlePlayer<H, S>
+impl<H, S, const N: usize, const CAP: usize> IdlePlayer<H, S>
 where
-    H: Deref<Target = LoopSet<N>>,
+    H: Deref<Target = LoopSet<N, CAP>>,
     S: LoopSupply<H>,
 {
     /// Plays `first` from frame 0, then (in [`IdleMode::NeverRepeating`])
@@ -220,9 +220,9 @@ where
     }
 }
 
-impl<H, S, const N: usize> IdleSource for IdlePlayer<H, S>
+impl<H, S, const N: usize, const CAP: usize> IdleSource for IdlePlayer<H, S>
 where
-    H: Deref<Target = LoopSet<N>>,
+    H: Deref<Target = LoopSet<N, CAP>>,
     S: LoopSupply<H>,
 {
     #[inline]

@@ -3,7 +3,8 @@
 
 use crate::axis::Axis;
 use crate::motion::{
-    AxisError, HeadConfig, HeadTrajectories, Integral16, LCG_A, LCG_C, LoopInfo, Sample, Trajectory,
+    AxisError, HeadConfig, HeadTrajectories, Integral16, LCG_A, LCG_C, LoopInfo, MAX_WINDOW,
+    Sample, Trajectory,
 };
 
 use super::join::{IdleTiming, MAX_JOIN_SAMPLES, blend, join_weight};
@@ -21,9 +22,11 @@ const KEPT: usize = MAX_JOIN_SAMPLES + 2;
 /// `0..=J` the outgoing loop's exit blended into this loop's entry. Read
 /// through [`SetView`]s, a set plays its join and then its own loop, with
 /// one player and no second loop to read.
+///
+/// `CAP` bounds the window W of the loops ([`HeadTrajectories`]).
 #[derive(Clone, Debug)]
-pub struct LoopSet<const N: usize> {
-    loops: HeadTrajectories<Integral16, N>,
+pub struct LoopSet<const N: usize, const CAP: usize = { MAX_WINDOW as usize }> {
+    loops: HeadTrajectories<Integral16, N, CAP>,
     /// The join's samples per axis, `join[axis][m]` for playback index `m − 1`.
     join: [[i16; KEPT]; 3],
     /// How many of them there are: `J + 2`, or 0 (set 0: no join).
@@ -34,7 +37,7 @@ pub struct LoopSet<const N: usize> {
     number: u32,
 }
 
-impl<const N: usize> LoopSet<N> {
+impl<const N: usize, const CAP: usize> LoopSet<N, CAP> {
     /// Three all-zero loops (the neutral pose).
     #[must_use]
     pub const fn new() -> Self {
@@ -61,7 +64,7 @@ impl<const N: usize> LoopSet<N> {
 
     /// The three loops.
     #[must_use]
-    pub const fn trajectories(&self) -> &HeadTrajectories<Integral16, N> {
+    pub const fn trajectories(&self) -> &HeadTrajectories<Integral16, N, CAP> {
         &self.loops
     }
 
@@ -131,7 +134,7 @@ impl<const N: usize> LoopSet<N> {
     }
 }
 
-impl<const N: usize> Default for LoopSet<N> {
+impl<const N: usize, const CAP: usize> Default for LoopSet<N, CAP> {
     fn default() -> Self {
         Self::new()
     }
@@ -162,7 +165,7 @@ impl<const N: usize> crate::playback::LoopSource for SetView<'_, N> {
     }
 }
 
-impl<const N: usize> crate::playback::Axes for LoopSet<N> {
+impl<const N: usize, const CAP: usize> crate::playback::Axes for LoopSet<N, CAP> {
     type Loop = Trajectory<Integral16, N>;
 
     #[inline]
@@ -264,7 +267,10 @@ impl<const N: usize> LoopStream<N> {
     /// The axis whose loop could not be generated (a seed whose walk is
     /// degenerate); `set` is then neutral on that axis, and the stream has
     /// moved past those seeds, so the next call tries new ones.
-    pub fn next_into(&mut self, set: &mut LoopSet<N>) -> Result<SetInfo, AxisError> {
+    pub fn next_into<const CAP: usize>(
+        &mut self,
+        set: &mut LoopSet<N, CAP>,
+    ) -> Result<SetInfo, AxisError> {
         if self.next == 0 {
             set.generate(&self.config)?;
             self.adopt(set);
@@ -319,7 +325,7 @@ impl<const N: usize> LoopStream<N> {
     /// configuration, as the stream's first set (the boot set, generated
     /// and timed on its own): the next call of [`next_into`](Self::next_into)
     /// makes set 1.
-    pub fn adopt(&mut self, set: &LoopSet<N>) {
+    pub fn adopt<const CAP: usize>(&mut self, set: &LoopSet<N, CAP>) {
         self.seeds = set.seeds.map(|seed| after_loop(seed, N));
         self.next = set.number + 1;
         self.capture(set);
@@ -327,7 +333,7 @@ impl<const N: usize> LoopStream<N> {
 
     /// Keeps the exit segment of `set`: the samples its join out plays,
     /// and the one before.
-    fn capture(&mut self, set: &LoopSet<N>) {
+    fn capture<const CAP: usize>(&mut self, set: &LoopSet<N, CAP>) {
         let j = self.join_samples;
         for (axis, exit) in Axis::ALL.iter().zip(self.exit.iter_mut()) {
             let t = set.loops.axis(*axis);
@@ -440,9 +446,9 @@ pub struct GenerateOnTake<H, const N: usize> {
     failures: u32,
 }
 
-impl<H, const N: usize> GenerateOnTake<H, N>
+impl<H, const N: usize, const CAP: usize> GenerateOnTake<H, N>
 where
-    H: core::ops::DerefMut<Target = LoopSet<N>>,
+    H: core::ops::DerefMut<Target = LoopSet<N, CAP>>,
 {
     /// Generates `stream`'s sets into `spare` (and then into each set given
     /// back).
@@ -465,9 +471,9 @@ where
     }
 }
 
-impl<H, const N: usize> super::LoopSupply<H> for GenerateOnTake<H, N>
+impl<H, const N: usize, const CAP: usize> super::LoopSupply<H> for GenerateOnTake<H, N>
 where
-    H: core::ops::DerefMut<Target = LoopSet<N>>,
+    H: core::ops::DerefMut<Target = LoopSet<N, CAP>>,
 {
     fn take(&mut self) -> Option<H> {
         let mut set = self.spare.take()?;

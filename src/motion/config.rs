@@ -181,6 +181,15 @@ impl HeadConfig {
         self
     }
 
+    /// The longest of the three windows W: the kernel capacity that
+    /// generates this configuration ([`HeadTrajectories`](super::HeadTrajectories)).
+    #[must_use]
+    pub const fn longest_window(&self) -> u16 {
+        let (p, r, y) = (self.pitch.window, self.roll.window, self.yaw.window);
+        let pr = if p > r { p } else { r };
+        if pr > y { pr } else { y }
+    }
+
     /// Checks all three axes for loops of `n` samples.
     ///
     /// # Errors
@@ -224,3 +233,9 @@ pub const DEFAULT_HEAD: HeadConfig = HeadConfig {
     yaw: AxisConfig::paper_row(8821, 59, -9, 9),
 };
 const _: () = DEFAULT_HEAD.assert_valid(DEFAULT_N);
+
+/// The kernel capacity of the firmware's loops: [`DEFAULT_HEAD`]'s longest
+/// window (59 taps). The console changes seeds, never windows, so every
+/// loop set the firmware generates fits it; it keeps 9 KB of stack free
+/// against [`MAX_WINDOW`](super::MAX_WINDOW).
+pub const DEFAULT_WINDOW_CAP: usize = DEFAULT_HEAD.longest_window() as usize;

@@ -20,14 +20,22 @@ pub const MIN_WINDOW: u16 = 3;
 /// Largest supported window (taps); bounds the table (4 bytes a tap).
 pub const MAX_WINDOW: u16 = 511;
 
-/// The kernel table for one window length `W`.
+/// The kernel table for one window length `W`, of at most `CAP` taps.
+///
+/// `CAP` is the largest window the kernel can be built for, [`MAX_WINDOW`]
+/// unless told otherwise. It sizes the table, and the smoother's ring of
+/// taps on the stack while a loop is computed (16 bytes a tap): an image
+/// whose windows are all short sets it to its longest window and keeps
+/// 10 KB of stack for other things (see [`HeadTrajectories`]).
+///
+/// [`HeadTrajectories`]: super::HeadTrajectories
 #[derive(Clone, Debug)]
-pub struct HannKernel {
+pub struct HannKernel<const CAP: usize = { MAX_WINDOW as usize }> {
     window: u16,
     q: i32,
     /// The entries j = 0..W−1; a vector, so that a kernel is made without
-    /// clearing (or moving) all 2 KiB of its capacity.
-    table: heapless::Vec<(i16, i16), { MAX_WINDOW as usize }>,
+    /// clearing (or moving) all of its capacity.
+    table: heapless::Vec<(i16, i16), CAP>,
 }
 
 impl HannKernel {
@@ -44,9 +52,22 @@ impl HannKernel {
         kernel.rebuild(window)?;
         Ok(kernel)
     }
+}
+
+impl<const CAP: usize> HannKernel<CAP> {
+    /// The longest window this kernel takes: `CAP`, which must lie in
+    /// `MIN_WINDOW..=MAX_WINDOW` (checked when the type is used).
+    pub const CAPACITY: u16 = {
+        assert!(
+            CAP >= MIN_WINDOW as usize && CAP <= MAX_WINDOW as usize,
+            "a kernel's capacity lies in MIN_WINDOW..=MAX_WINDOW"
+        );
+        CAP as u16
+    };
 
     /// A kernel of no taps, to [`HannKernel::rebuild`] in place.
-    pub(super) const fn empty() -> Self {
+    #[must_use]
+    pub const fn empty() -> Self {
         Self {
             window: 0,
             q: 0,
@@ -57,7 +78,8 @@ impl HannKernel {
     /// Rebuilds the table in place for `window` taps (no 2 KiB move).
     ///
     /// # Errors
-    /// As [`HannKernel::new`]; the kernel is left unchanged on error.
+    /// As [`HannKernel::new`], with [`HannKernel::CAPACITY`] in place of
+    /// [`MAX_WINDOW`]; the kernel is left unchanged on error.
     pub fn rebuild(&mut self, window: u16) -> Result<(), MotionError> {
         if window < MIN_WINDOW {
             return Err(MotionError::WindowTooSmall {
@@ -65,10 +87,10 @@ impl HannKernel {
                 min: MIN_WINDOW,
             });
         }
-        if window > MAX_WINDOW {
+        if window > Self::CAPACITY {
             return Err(MotionError::WindowTooLarge {
                 window,
-                max: MAX_WINDOW,
+                max: Self::CAPACITY,
             });
         }
         if window == self.window {
@@ -90,7 +112,7 @@ impl HannKernel {
         let scale = |x: i32| -> i16 { (((x >> 15) * q + (1 << 15)) >> 16) as i16 };
         let mut cos_sum: i32 = 0;
         self.table.clear();
-        // Cannot fail: w ≤ MAX_WINDOW, the capacity.
+        // Cannot fail: w ≤ CAP, the capacity.
         let _ = self.table.resize(w, (0, 0));
         // The entries j = 0..=W/2 from the sine/cosine, the rest by symmetry.
         let (head, tail) = self.table.split_at_mut((w / 2 + 1).min(w));

@@ -25,7 +25,8 @@ mod storage;
 mod trajectory;
 
 pub use config::{
-    AxisConfig, Closure, DEFAULT_HEAD, DEFAULT_N, HeadConfig, MAX_N, MAX_STEP, MIN_N,
+    AxisConfig, Closure, DEFAULT_HEAD, DEFAULT_N, DEFAULT_WINDOW_CAP, HeadConfig, MAX_N, MAX_STEP,
+    MIN_N,
 };
 pub use engine::{LoopInfo, Trace};
 pub use error::{AxisError, MotionError};

@@ -3,7 +3,7 @@
 //! time ([`generate_into`]).
 
 use super::engine::{self, LoopInfo, Trace};
-use super::kernel::HannKernel;
+use super::kernel::{HannKernel, MAX_WINDOW};
 use super::storage::{Fnv1a, LoopScale, Sample};
 use super::{AxisConfig, AxisError, HeadConfig, MAX_N, MIN_N, MotionError};
 use crate::axis::Axis;
@@ -45,11 +45,11 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
     /// # Errors
     /// Any [`MotionError`] of [`AxisConfig::validate`], or [`MotionError::Degenerate`].
     /// On error the loop is left all zero (the neutral pose).
-    pub fn generate(
+    pub fn generate<const CAP: usize>(
         &mut self,
         cfg: &AxisConfig,
         axis: Axis,
-        kernel: &HannKernel,
+        kernel: &HannKernel<CAP>,
     ) -> Result<LoopInfo, MotionError> {
         self.generate_traced(cfg, axis, kernel, &mut ())
     }
@@ -59,11 +59,11 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
     ///
     /// # Errors
     /// As [`Trajectory::generate`].
-    pub fn generate_traced<T: Trace>(
+    pub fn generate_traced<T: Trace, const CAP: usize>(
         &mut self,
         cfg: &AxisConfig,
         axis: Axis,
-        kernel: &HannKernel,
+        kernel: &HannKernel<CAP>,
         trace: &mut T,
     ) -> Result<LoopInfo, MotionError> {
         self.generate_checked(cfg.validate(axis, N), cfg, kernel, trace)
@@ -71,11 +71,11 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
 
     /// Generates from `cfg` if `checked` (its validation, done by the
     /// caller) passed, and keeps the ring as computed: no rotation.
-    fn generate_checked<T: Trace>(
+    fn generate_checked<T: Trace, const CAP: usize>(
         &mut self,
         checked: Result<(), MotionError>,
         cfg: &AxisConfig,
-        kernel: &HannKernel,
+        kernel: &HannKernel<CAP>,
         trace: &mut T,
     ) -> Result<LoopInfo, MotionError> {
         self.start = 0;
@@ -188,11 +188,11 @@ impl<S: Sample, const N: usize> Default for Trajectory<S, N> {
 /// Any [`MotionError`] of [`AxisConfig::validate`], a kernel built for another
 /// window ([`MotionError::WindowTooLarge`]), or [`MotionError::Degenerate`].
 /// On error `out` is left all zero (the neutral pose).
-pub fn generate_into<S: Sample, T: Trace>(
+pub fn generate_into<S: Sample, T: Trace, const CAP: usize>(
     out: &mut [S],
     cfg: &AxisConfig,
     axis: Axis,
-    kernel: &HannKernel,
+    kernel: &HannKernel<CAP>,
     trace: &mut T,
 ) -> Result<LoopInfo, MotionError> {
     let result = cfg
@@ -215,12 +215,19 @@ pub fn generate_into<S: Sample, T: Trace>(
 }
 
 /// The three loops of a head (pitch, roll, yaw), usable in a `static`.
+///
+/// `CAP` is the longest window (W) [`HeadTrajectories::generate`] takes,
+/// [`MAX_WINDOW`] unless told otherwise; a longer one is
+/// [`MotionError::WindowTooLarge`]. It costs no RAM of its own, but while
+/// the loops are computed the smoother keeps `20·CAP` bytes on the stack
+/// (its kernel table and tap ring, [`HannKernel`]): about 10 KB for
+/// [`MAX_WINDOW`], 1.2 KB for the default set's W = 59.
 #[derive(Clone, Debug)]
-pub struct HeadTrajectories<S: Sample, const N: usize> {
+pub struct HeadTrajectories<S: Sample, const N: usize, const CAP: usize = { MAX_WINDOW as usize }> {
     axes: [Trajectory<S, N>; 3],
 }
 
-impl<S: Sample, const N: usize> HeadTrajectories<S, N> {
+impl<S: Sample, const N: usize, const CAP: usize> HeadTrajectories<S, N, CAP> {
     /// Three all-zero loops.
     #[must_use]
     pub const fn new() -> Self {
@@ -232,14 +239,14 @@ impl<S: Sample, const N: usize> HeadTrajectories<S, N> {
     /// Computes all three loops; one kernel table is shared by axes with equal W.
     ///
     /// # Errors
-    /// The first axis whose configuration is rejected; that axis and the ones
-    /// after it are left all zero.
+    /// The first axis whose configuration is rejected, or whose window is
+    /// longer than `CAP`; that axis and the ones after it are left all zero.
     pub fn generate(&mut self, cfg: &HeadConfig) -> Result<[LoopInfo; 3], AxisError> {
         cfg.validate(N)?;
         let mut infos = [LoopInfo::default(); 3];
         // Built in place, axis by axis (a window equal to the last one's is
         // kept as it is).
-        let mut kernel = HannKernel::empty();
+        let mut kernel = HannKernel::<CAP>::empty();
         for axis in Axis::ALL {
             let c = cfg.axis(axis);
             kernel
@@ -286,7 +293,7 @@ impl<S: Sample, const N: usize> HeadTrajectories<S, N> {
     }
 }
 
-impl<S: Sample, const N: usize> Default for HeadTrajectories<S, N> {
+impl<S: Sample, const N: usize, const CAP: usize> Default for HeadTrajectories<S, N, CAP> {
     fn default() -> Self {
         Self::new()
     }

@@ -112,7 +112,7 @@ use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::frame_task::{
     Exchange, Flow, Frame, FrameHooks, FrameLoop, IDLE_MODE, LOOP_DURATION, SetRef,
 };
-use idle_head::idle::{IdleMode, IdleTiming, LoopSet, LoopStream};
+use idle_head::idle::{IdleMode, IdleTiming, LoopStream};
 #[cfg(not(feature = "console"))]
 use idle_head::motion::DEFAULT_HEAD;
 use idle_head::motion::DEFAULT_N;
@@ -152,7 +152,7 @@ const WATCHDOG_TIMEOUT: Duration = Duration::from_millis(100);
 #[cfg(feature = "watchdog-drill")]
 const DRILL_FRAMES: u64 = 150;
 
-type Set = LoopSet<DEFAULT_N>;
+use idle_head::frame_task::Set;
 
 /// The two loop set buffers, 2 · 5.4 KB: one plays while the generator
 /// fills the other. All zero (the neutral pose) until generated.

@@ -102,10 +102,10 @@ impl Trace for () {
 
 /// Runs the pipeline for one axis into `out` (length N, validated by the
 /// caller); the samples map to angles with the returned scale.
-pub(super) fn generate<S: Sample, T: Trace>(
+pub(super) fn generate<S: Sample, T: Trace, const CAP: usize>(
     out: &mut [S],
     cfg: &AxisConfig,
-    kernel: &HannKernel,
+    kernel: &HannKernel<CAP>,
     trace: &mut T,
 ) -> Result<(LoopInfo, LoopScale), MotionError> {
     if kernel.window() != cfg.window || out.len() < 2 * usize::from(cfg.window) {
@@ -137,7 +137,7 @@ pub(super) struct Basics<'k> {
 }
 
 impl<'k> Basics<'k> {
-    fn of<S>(out: &[S], cfg: &AxisConfig, kernel: &'k HannKernel) -> Self {
+    fn of<S, const CAP: usize>(out: &[S], cfg: &AxisConfig, kernel: &'k HannKernel<CAP>) -> Self {
         let q = kernel.scale();
         Self {
             n: out.len(),

@@ -12,10 +12,10 @@ use crate::motion::{AxisConfig, MotionError};
 ///
 /// The open walk has u(0) = 0 and steps e(k) = ±1 from r(k), k = 1..N−1
 /// (e(0) = 0 and e(k) = 0 before the start: the paper's u(n−m) = 0 for n−m < 0).
-pub(super) fn paper<S: Sample, T: Trace>(
+pub(super) fn paper<S: Sample, T: Trace, const CAP: usize>(
     out: &mut [S],
     cfg: &AxisConfig,
-    kernel: &HannKernel,
+    kernel: &HannKernel<CAP>,
     trace: &mut T,
 ) -> Result<(LoopInfo, LoopScale), MotionError> {
     let Basics { n, w, table, q, qq } = Basics::of(out, cfg, kernel);

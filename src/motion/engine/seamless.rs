@@ -28,10 +28,10 @@ use crate::motion::{AxisConfig, MotionError};
 /// The buffer receives the quantised integral X itself (wrapping `i16`, see
 /// [`raw_shift`]); the returned [`LoopScale`] maps it to angles about the
 /// loop's start.
-pub(super) fn seamless<S: Sample, T: Trace>(
+pub(super) fn seamless<S: Sample, T: Trace, const CAP: usize>(
     out: &mut [S],
     cfg: &AxisConfig,
-    kernel: &HannKernel,
+    kernel: &HannKernel<CAP>,
     trace: &mut T,
 ) -> Result<(LoopInfo, LoopScale), MotionError> {
     let basics = Basics::of(out, cfg, kernel);
@@ -42,7 +42,7 @@ pub(super) fn seamless<S: Sample, T: Trace>(
         first,
         mut lo,
         mut hi,
-    } = smooth(out, cfg.seed, &basics, shift);
+    } = smooth::<S, CAP>(out, cfg.seed, &basics, shift);
     // X spans at most 65535 raw units, so that its offsets from the lowest
     // sample are exact in `u16`; a wider loop than `raw_shift` expects is
     // quantised again.
@@ -120,7 +120,12 @@ struct Smoothed {
 /// Passes 1 and 2: the circular walk of `seed` smoothed and detrended, its
 /// quantised integral X stored in `out` in generation order: `out[t]`
 /// belongs to loop index (W−1+t) mod N.
-fn smooth<S: Sample>(out: &mut [S], seed: u32, basics: &Basics, shift: u32) -> Smoothed {
+fn smooth<S: Sample, const CAP: usize>(
+    out: &mut [S],
+    seed: u32,
+    basics: &Basics,
+    shift: u32,
+) -> Smoothed {
     let Basics {
         n, w, table, qq, ..
     } = *basics;
@@ -129,7 +134,7 @@ fn smooth<S: Sample>(out: &mut [S], seed: u32, basics: &Basics, shift: u32) -> S
     // The initial window, steps k = 0..W−1 (output n = W−1), fills the tap
     // ring and gives the wrap correction E for the detrend.
     let mut walk = Lcg::new(seed);
-    let mut ring = Ring::new();
+    let mut ring = Ring::<CAP>::new();
     let n_mod_w = n % w;
     let window = initial_window(table, n_mod_w, &mut walk, qq, &mut ring);
     let taps = ring.as_mut_slice();

@@ -30,13 +30,13 @@
 //! is exact. O(W), once per axis, summed by [`initial_window`] while it
 //! fills the window.
 
-use crate::motion::kernel::MAX_WINDOW;
 use crate::motion::lcg::Lcg;
 use crate::motion::storage::Sample;
 
-/// The taps of the sliding window: at most [`MAX_WINDOW`] on the stack
-/// (16 bytes each), without clearing all of them per axis.
-pub(super) type Ring = heapless::Vec<Tap, { MAX_WINDOW as usize }>;
+/// The taps of the sliding window: at most the kernel's capacity `CAP`
+/// ≤ [`MAX_WINDOW`](crate::motion::MAX_WINDOW) on the stack (16 bytes each), without clearing all of
+/// them per axis.
+pub(super) type Ring<const CAP: usize> = heapless::Vec<Tap, CAP>;
 
 /// One tap of the sliding window: the kernel table entry of its residue j
 /// and the step currently in the window at that residue. The step leaving
@@ -282,16 +282,16 @@ impl Sweep {
 /// `walk`) and returns its sums and the wrap correction E (see the module
 /// docs); `n_mod_w` is N mod W.
 #[inline(never)] // 1,120 instructions fewer for the default set
-pub(super) fn initial_window(
+pub(super) fn initial_window<const CAP: usize>(
     table: &[(i16, i16)],
     n_mod_w: usize,
     walk: &mut Lcg,
     qq: i32,
-    ring: &mut Ring,
+    ring: &mut Ring<CAP>,
 ) -> Window {
     let w = table.len();
-    // The window's steps, one tap each. Cannot fail: the table has at most
-    // MAX_WINDOW entries.
+    // The window's steps, one tap each. Cannot fail: the table comes from a
+    // kernel of the same capacity.
     let _ = ring.resize(w, Tap::EMPTY);
     let mut lcg = *walk;
     for (tap, &(c, s)) in ring.iter_mut().zip(table) {
