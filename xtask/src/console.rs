@@ -538,3 +538,6 @@ pub fn piped_script() -> Result<String> {
         WANT.len()
     ))
 }
+
+#[cfg(test)]
+mod port_tests;
