@@ -83,23 +83,66 @@ pub fn command(args: &Args) -> Result<bool> {
     serial_session(&port, stdin, &mut stdout, wait)
 }
 
-/// The Pico's port: the USB serial device with [`PICO_USB_ID`].
+/// The product string the head's USB port reports (`src/bin/pico/usb.rs`).
+pub const PICO_PRODUCT: &str = "idle-head console";
+
+/// The Pico's port: the USB serial device with [`PICO_USB_ID`] and
+/// [`PICO_PRODUCT`] (see [`pick_pico`]).
 fn find_pico() -> Result<PathBuf> {
     let ports = serialport::available_ports().context("listing serial ports")?;
-    ports
-        .into_iter()
-        .find(|p| {
-            matches!(&p.port_type, serialport::SerialPortType::UsbPort(usb)
-                if (usb.vid, usb.pid) == PICO_USB_ID)
+    pick_pico(&ports)
+}
+
+/// The head among `ports`. Other hobby devices share [`PICO_USB_ID`], so
+/// the product string decides: the one port with [`PICO_USB_ID`] and
+/// [`PICO_PRODUCT`]; failing that, the one port with [`PICO_USB_ID`] whose
+/// strings the system does not show. None, or more than one, is an error
+/// that lists what was found and asks for `--port`.
+fn pick_pico(ports: &[serialport::SerialPortInfo]) -> Result<PathBuf> {
+    let shared: Vec<(&str, Option<&str>)> = ports
+        .iter()
+        .filter_map(|p| match &p.port_type {
+            serialport::SerialPortType::UsbPort(usb) if (usb.vid, usb.pid) == PICO_USB_ID => {
+                Some((p.port_name.as_str(), usb.product.as_deref()))
+            }
+            _ => None,
         })
-        .map(|p| PathBuf::from(p.port_name))
-        .with_context(|| {
-            format!(
-                "no USB serial device {:04x}:{:04x} found; is the head plugged in? \
-                 (or give --port <dev>)",
-                PICO_USB_ID.0, PICO_USB_ID.1
-            )
-        })
+        .collect();
+    let heads: Vec<&str> = shared
+        .iter()
+        .filter(|(_, product)| *product == Some(PICO_PRODUCT))
+        .map(|(name, _)| *name)
+        .collect();
+    let unnamed: Vec<&str> = shared
+        .iter()
+        .filter(|(_, product)| product.is_none())
+        .map(|(name, _)| *name)
+        .collect();
+    let (vid, pid) = PICO_USB_ID;
+    match (heads.as_slice(), unnamed.as_slice()) {
+        ([one], _) | ([], [one]) => Ok(PathBuf::from(one)),
+        ([], []) if shared.is_empty() => bail!(
+            "no USB serial device {vid:04x}:{pid:04x} found; is the head plugged in, \
+             running the console image (--features console)? (or give --port <dev>)"
+        ),
+        ([], []) => bail!(
+            "no head among the USB serial devices {vid:04x}:{pid:04x}: {}; give --port <dev>",
+            shared
+                .iter()
+                .map(|(name, product)| format!("{name} (\"{}\")", product.unwrap_or_default()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        (several, _) if several.len() > 1 => bail!(
+            "several heads ({vid:04x}:{pid:04x} \"{PICO_PRODUCT}\"): {}; give --port <dev>",
+            several.join(", ")
+        ),
+        (_, several) => bail!(
+            "several USB serial devices {vid:04x}:{pid:04x} without a product string: {}; \
+             give --port <dev>",
+            several.join(", ")
+        ),
+    }
 }
 
 /// Lines from `input` to the port, replies to `out`, one per line.

@@ -1,6 +1,7 @@
 //! `--port`: the session over a real tty, a pseudo-terminal whose other
 //! side is a simulated head running the firmware's own console (session,
-//! parser and service) on the host.
+//! parser and service) on the host; and without `--port`, which USB serial
+//! device is taken for the head.
 
 use std::os::fd::RawFd;
 use std::path::PathBuf;
@@ -100,4 +101,81 @@ fn a_line_without_a_reply_fails_the_session_after_the_wait() {
     assert!(!ok, "a reply was missing: {out}");
     assert_eq!(out.lines().count(), 2, "{out}");
     assert!(out.starts_with("ok mode=starting"), "{out}");
+}
+
+/// A USB serial port as the system lists it.
+fn usb(name: &str, vid: u16, pid: u16, product: Option<&str>) -> serialport::SerialPortInfo {
+    serialport::SerialPortInfo {
+        port_name: name.to_owned(),
+        port_type: serialport::SerialPortType::UsbPort(serialport::UsbPortInfo {
+            vid,
+            pid,
+            serial_number: None,
+            manufacturer: None,
+            product: product.map(str::to_owned),
+        }),
+    }
+}
+
+#[test]
+fn the_head_is_found_by_its_id_and_product_among_other_devices() {
+    let (vid, pid) = super::PICO_USB_ID;
+    let other = usb("/dev/ttyACM0", vid, pid, Some("some other gadget"));
+    let head = usb("/dev/ttyACM1", vid, pid, Some(super::PICO_PRODUCT));
+    let arduino = usb("/dev/ttyACM2", 0x2341, 0x0043, Some(super::PICO_PRODUCT));
+    let pty = serialport::SerialPortInfo {
+        port_name: "/dev/pts/3".to_owned(),
+        port_type: serialport::SerialPortType::Unknown,
+    };
+    let found = super::pick_pico(&[other.clone(), arduino.clone(), head, pty.clone()]);
+    assert_eq!(found.unwrap(), PathBuf::from("/dev/ttyACM1"));
+
+    // The shared ID alone is not enough when the product says otherwise.
+    let err = super::pick_pico(&[other.clone(), arduino.clone(), pty]).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("/dev/ttyACM0 (\"some other gadget\")"),
+        "{err}"
+    );
+    let err = super::pick_pico(&[arduino]).unwrap_err();
+    assert!(err.to_string().contains("is the head plugged in"), "{err}");
+
+    // Without product strings, one device of the ID is taken; two are not.
+    let bare = usb("/dev/ttyACM4", vid, pid, None);
+    assert_eq!(
+        super::pick_pico(&[other, bare.clone()]).unwrap(),
+        PathBuf::from("/dev/ttyACM4")
+    );
+    let bare2 = usb("/dev/ttyACM5", vid, pid, None);
+    let err = super::pick_pico(&[bare, bare2]).unwrap_err();
+    assert!(
+        err.to_string().contains("without a product string"),
+        "{err}"
+    );
+}
+
+#[test]
+fn two_heads_need_a_port() {
+    let (vid, pid) = super::PICO_USB_ID;
+    let a = usb("/dev/ttyACM0", vid, pid, Some(super::PICO_PRODUCT));
+    let b = usb("/dev/ttyACM1", vid, pid, Some(super::PICO_PRODUCT));
+    let err = super::pick_pico(&[a, b]).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("/dev/ttyACM0, /dev/ttyACM1; give --port"),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_product_looked_for_is_the_one_the_firmware_reports() {
+    let usb = include_str!("../../../src/bin/pico/usb.rs");
+    let (vid, pid) = super::PICO_USB_ID;
+    for line in [
+        format!("pub const PRODUCT: &str = \"{}\";", super::PICO_PRODUCT),
+        format!("pub const VID: u16 = 0x{vid:04x};"),
+        format!("pub const PID: u16 = 0x{pid:04x};"),
+    ] {
+        assert!(usb.contains(&line), "src/bin/pico/usb.rs lacks `{line}`");
+    }
 }
