@@ -55,19 +55,41 @@ use crate::behaviour::{
 };
 use crate::command::{Action, GestureKind, Hold};
 use crate::console::{ConsoleLink, HeadMode, HeadStatus};
-use crate::driver::{DriverConfig, FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod};
-use crate::idle::{IdleMode, LoopSet, LoopStream, LoopSupply, SetInfo};
+use crate::driver::{
+    DriverConfig, DriverParams, FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod,
+};
+use crate::idle::{IdleMode, IdleTiming, LoopSet, LoopStream, LoopSupply, SetInfo};
 use crate::motion::{AxisError, DEFAULT_N, DEFAULT_WINDOW_CAP};
+use crate::playback::Playback;
 use crate::{Angle, Microseconds};
 
 pub use crate::behaviour::LOOP_DURATION;
 
+/// The built-in driver configuration's parameters ([`DriverConfig::DEFAULT`]:
+/// 50 Hz frames and PWM, hobby servos on the anatomical limits, a 2 s fade),
+/// checked at compile time.
+pub const DEFAULT_PARAMS: DriverParams = match DriverConfig::DEFAULT.build() {
+    Ok(p) => p,
+    Err(e) => panic!("{}", e.message()),
+};
+
+/// The default loops played at the default frame period: a 30 s loop of 20
+/// ms frames, 1500 frames a loop.
+pub const DEFAULT_PLAYBACK: Playback =
+    match Playback::new(LOOP_DURATION, DriverConfig::DEFAULT.frame_period, DEFAULT_N) {
+        Ok(p) => p,
+        Err(_) => panic!("invalid playback parameters"),
+    };
+
+/// [`DEFAULT_PLAYBACK`]'s loops joined over 100 frames: a join every 1400.
+pub const DEFAULT_TIMING: IdleTiming = match IdleTiming::new(DEFAULT_PLAYBACK) {
+    Ok(t) => t,
+    Err(e) => panic!("{}", e.message()),
+};
+
 /// The built-in behaviour for the built-in driver configuration.
-const DEFAULT_BEHAVIOUR: BehaviourParams = match DriverConfig::DEFAULT.build() {
-    Ok(driver) => match BehaviourConfig::DEFAULT.build(&driver) {
-        Ok(params) => params,
-        Err(e) => panic!("{}", e.message()),
-    },
+const DEFAULT_BEHAVIOUR: BehaviourParams = match BehaviourConfig::DEFAULT.build(&DEFAULT_PARAMS) {
+    Ok(params) => params,
     Err(e) => panic!("{}", e.message()),
 };
 

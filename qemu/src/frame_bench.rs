@@ -58,9 +58,9 @@ use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use idle_head::behaviour::Applied;
 use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver, FrameTick};
-use idle_head::frame_task::{FrameLoop, LOOP_DURATION};
+use idle_head::frame_task::{DEFAULT_PARAMS, DEFAULT_PLAYBACK, DEFAULT_TIMING, FrameLoop};
 use idle_head::idle::{IdleMode, IdlePlayer, IdleTiming, LoopStream, LoopSupply};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N};
+use idle_head::motion::DEFAULT_HEAD;
 use idle_head::units::Angle;
 
 use crate::rp2040_pwm::PICO_SERVO_CLOCK;
@@ -84,20 +84,9 @@ const INSNS_PER_FAST_COUNT: u64 = 5;
 const SYSCTL_RCC: *mut u32 = 0x400F_E060 as *mut u32;
 const RCC_SYSDIV: u32 = 0xF << 23;
 
-const PARAMS: DriverParams = match DriverConfig::DEFAULT.build() {
-    Ok(p) => p,
-    Err(e) => panic!("{}", e.message()),
-};
-const PLAYBACK: Playback =
-    match Playback::new(LOOP_DURATION, DriverConfig::DEFAULT.frame_period, DEFAULT_N) {
-        Ok(p) => p,
-        Err(_) => panic!("invalid playback parameters"),
-    };
-
-const TIMING: IdleTiming = match IdleTiming::new(PLAYBACK) {
-    Ok(t) => t,
-    Err(e) => panic!("{}", e.message()),
-};
+const PARAMS: DriverParams = DEFAULT_PARAMS;
+const PLAYBACK: Playback = DEFAULT_PLAYBACK;
+const TIMING: IdleTiming = DEFAULT_TIMING;
 
 /// A loop set of the default length.
 pub use idle_head::frame_task::Set;

@@ -43,32 +43,20 @@ use idle_head::behaviour::{BehaviourConfig, BehaviourParams};
 use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
 use idle_head::console::{ConsoleLink, parse};
 use idle_head::driver::{
-    DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, DriverParams, FrameDriver,
-    MotionLimits,
+    DegreesPerSecond, DegreesPerSecondSquared, DriverParams, FrameDriver, MotionLimits,
 };
-use idle_head::frame_task::Set;
-use idle_head::frame_task::{Exchange, FrameLoop, IDLE_MODE, LOOP_DURATION};
+use idle_head::frame_task::{
+    DEFAULT_PARAMS, DEFAULT_PLAYBACK, DEFAULT_TIMING, Exchange, FrameLoop, IDLE_MODE, Set,
+};
 use idle_head::idle::{IdlePlayer, IdleTiming};
-use idle_head::motion::DEFAULT_N;
 use idle_head::servo::{Direction, NanosPerDegree, ServoCalibration};
 use idle_head::units::{Angle, AngleRange, Microseconds, Millis};
 use idle_head::{Axis, Playback};
 use static_cell::ConstStaticCell;
 
-const PARAMS: DriverParams = match DriverConfig::DEFAULT.build() {
-    Ok(p) => p,
-    Err(e) => panic!("{}", e.message()),
-};
-const PLAYBACK: Playback =
-    match Playback::new(LOOP_DURATION, DriverConfig::DEFAULT.frame_period, DEFAULT_N) {
-        Ok(p) => p,
-        Err(_) => panic!("invalid playback parameters"),
-    };
-
-const TIMING: IdleTiming = match IdleTiming::new(PLAYBACK) {
-    Ok(t) => t,
-    Err(e) => panic!("{}", e.message()),
-};
+const PARAMS: DriverParams = DEFAULT_PARAMS;
+const PLAYBACK: Playback = DEFAULT_PLAYBACK;
+const TIMING: IdleTiming = DEFAULT_TIMING;
 
 /// Loop sets with unknown contents (the optimiser sees them through
 /// `black_box`).

@@ -110,7 +110,8 @@ use idle_head::behaviour::CommandQueue;
 use idle_head::console::{ConsoleLink, ConsoleService};
 use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head::frame_task::{
-    Exchange, Flow, Frame, FrameHooks, FrameLoop, IDLE_MODE, LOOP_DURATION, SetRef,
+    DEFAULT_PARAMS, DEFAULT_TIMING, Exchange, Flow, Frame, FrameHooks, FrameLoop, IDLE_MODE,
+    LOOP_DURATION, Set, SetRef,
 };
 use idle_head::idle::{IdleMode, IdleTiming, LoopStream};
 #[cfg(not(feature = "console"))]
@@ -126,20 +127,9 @@ use crate::servo_pwm::ServoPwm;
 /// The frame driver's configuration: 50 Hz frames and PWM, hobby servos on
 /// the anatomical limits, a 2 s fade (see `DriverConfig::DEFAULT`).
 const CONFIG: DriverConfig = DriverConfig::DEFAULT;
-const PARAMS: DriverParams = match CONFIG.build() {
-    Ok(p) => p,
-    Err(e) => panic!("{}", e.message()),
-};
-/// A 30 s loop at 20 ms frames: 1500 frames per loop.
-const PLAYBACK: Playback = match Playback::new(LOOP_DURATION, CONFIG.frame_period, DEFAULT_N) {
-    Ok(p) => p,
-    Err(_) => panic!("invalid playback parameters"),
-};
+const PARAMS: DriverParams = DEFAULT_PARAMS;
 /// Loops of 1500 frames joined over 100: a join every 1400 frames.
-const TIMING: IdleTiming = match IdleTiming::new(PLAYBACK) {
-    Ok(t) => t,
-    Err(e) => panic!("{}", e.message()),
-};
+const TIMING: IdleTiming = DEFAULT_TIMING;
 const LOOP_FRAMES: u64 = LOOP_DURATION.0 as u64 * 1000 / CONFIG.frame_period.0 as u64;
 
 /// Watchdog timeout: 100 ms = 5 frames of 20 ms. Long enough for a frame
@@ -151,8 +141,6 @@ const WATCHDOG_TIMEOUT: Duration = Duration::from_millis(100);
 /// the 2 s fade-in and a second of motion.
 #[cfg(feature = "watchdog-drill")]
 const DRILL_FRAMES: u64 = 150;
-
-use idle_head::frame_task::Set;
 
 /// The two loop set buffers, 2 · 5.4 KB: one plays while the generator
 /// fills the other. All zero (the neutral pose) until generated.
@@ -389,7 +377,8 @@ async fn frame_task(
     #[cfg(not(feature = "calibrate"))]
     let (idle, playback): (Idle, _) = (
         idle_head::idle::IdlePlayer::new(first, EXCHANGE.supply(), TIMING, IDLE_MODE),
-        PLAYBACK,
+        // A 30 s loop at 20 ms frames: 1500 frames per loop.
+        idle_head::frame_task::DEFAULT_PLAYBACK,
     );
     #[cfg(feature = "calibrate")]
     let (idle, playback): (Idle, _) = {
