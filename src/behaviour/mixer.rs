@@ -259,15 +259,15 @@ impl Mixer {
         let [pitch_mode, roll_mode, yaw_mode] = &mut self.modes;
         *pitch_mode = settle_mode(
             pitch_left,
-            sums.active[0] || moving[0],
+            sums.active & 1 != 0 || moving[0],
             returning,
             settle,
             elapsed,
         );
-        *roll_mode = settle_mode(roll_left, sums.active[1], false, settle, elapsed);
+        *roll_mode = settle_mode(roll_left, sums.active & 2 != 0, false, settle, elapsed);
         *yaw_mode = settle_mode(
             yaw_left,
-            sums.active[2] || moving[1],
+            sums.active & 4 != 0 || moving[1],
             returning,
             settle,
             elapsed,
@@ -291,7 +291,7 @@ impl Mixer {
         let mut sums = Sums {
             add: [0; 3],
             duck: [ONE; 3],
-            active: [false; 3],
+            active: 0,
         };
         let params = &self.params;
         for slot in &mut self.layers {
@@ -312,14 +312,10 @@ impl Mixer {
                 strength = mul(strength as i32, fade) as u32;
             }
             let i = layer.plan.kind.axis().index();
-            if let (Some(a), Some(d), Some(on)) = (
-                sums.add.get_mut(i),
-                sums.duck.get_mut(i),
-                sums.active.get_mut(i),
-            ) {
+            if let (Some(a), Some(d)) = (sums.add.get_mut(i), sums.duck.get_mut(i)) {
                 *a += value;
                 *d = mul(*d as i32, ONE - mul(params.duck as i32, strength) as u32) as u32;
-                *on = true;
+                sums.active |= 1 << i;
             }
         }
         sums
@@ -339,8 +335,8 @@ struct Sums {
     add: [i32; 3],
     /// The idle's duck, Q16.
     duck: [u32; 3],
-    /// Whether a gesture plays on the axis.
-    active: [bool; 3],
+    /// Bit `i`: a gesture plays on axis `i`.
+    active: u8,
 }
 
 /// `idle · gain · duck` (Q16 each; a factor of 1 skipped: `mul` by 1 is
