@@ -314,7 +314,17 @@ impl Mixer {
             let i = layer.plan.kind.axis().index();
             if let (Some(a), Some(d)) = (sums.add.get_mut(i), sums.duck.get_mut(i)) {
                 *a += value;
-                *d = mul(*d as i32, ONE - mul(params.duck as i32, strength) as u32) as u32;
+                // (`mul` by 1 is exact: the factors of 1 are skipped.)
+                let lowered = if strength == ONE {
+                    params.duck
+                } else {
+                    mul(params.duck as i32, strength) as u32
+                };
+                *d = if *d == ONE {
+                    ONE - lowered
+                } else {
+                    mul(*d as i32, ONE - lowered) as u32
+                };
                 sums.active |= 1 << i;
             }
         }
