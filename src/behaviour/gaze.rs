@@ -71,8 +71,7 @@ impl Gaze {
         {
             self.axes = back;
         }
-        let [pitch, yaw] = &mut self.axes;
-        [pitch.at(now), yaw.at(now)]
+        Glide::pair_at(&mut self.axes, now)
     }
 
     /// Whether the planned return starts at or before frame `frame`.

@@ -391,7 +391,12 @@ impl GesturePlan {
             let lowering = mul(LOWERING as i32, smootherstep(phi - self.lower_from));
             amplitude -= mul(amplitude, lowering as u32);
         }
-        let scaled = mul(amplitude, envelope);
+        // Between the ramps the envelope is 1 (and `mul` by 1 exact).
+        let scaled = if envelope == ONE {
+            amplitude
+        } else {
+            mul(amplitude, envelope)
+        };
         let value = match self.kind {
             GestureKind::Tilt => scaled,
             GestureKind::Nod | GestureKind::Shake => {

@@ -129,9 +129,38 @@ impl Glide {
         if t == 0 {
             return self.target - (r0 + r1 + r2);
         }
-        // 1 ≤ t < T: 0 < s < 1. Each multiply rounds to the unit: the
-        // value is within 2.5 units of the exact polynomial at this s.
-        let s = ONE - progress(t, self.inverse);
+        // 1 ≤ t < T: 0 < s < 1.
+        self.at_s(ONE - progress(t, self.inverse))
+    }
+
+    /// The values of two glides at frame `now`, each as [`at`](Self::at)
+    /// gives it. Glides that share their clock (the same start and
+    /// duration, as the gaze's two axes always do) work out `s` once.
+    #[inline]
+    pub(crate) fn pair_at(pair: &mut [Self; 2], now: u32) -> [i32; 2] {
+        let [a, b] = pair;
+        if a.start != b.start || a.frames != b.frames {
+            return [a.at(now), b.at(now)];
+        }
+        let t = now.wrapping_sub(a.start);
+        if t >= a.frames {
+            (a.frames, b.frames) = (0, 0);
+            return [a.target, b.target];
+        }
+        if t == 0 {
+            return [a.at(now), b.at(now)];
+        }
+        // The same frames, the same reciprocal.
+        let s = ONE - progress(t, a.inverse);
+        [a.at_s(s), b.at_s(s)]
+    }
+
+    /// The value at `s = 1 − τ` (Q16, `0 < s < 1`). Each multiply rounds to
+    /// the unit: the value is within 2.5 units of the exact polynomial at
+    /// this `s`.
+    #[inline]
+    fn at_s(&self, s: u32) -> i32 {
+        let [r0, r1, r2] = self.r;
         let q = mul(mul(r2, s) + r1, s) + r0;
         self.target - mul(mul(mul(q, s), s), s)
     }

@@ -227,14 +227,72 @@ impl Mixer {
     }
 
     /// [`frame`](Self::frame) while anything but the idle moves.
+    ///
+    /// Written per axis rather than over arrays: on a Cortex-M0 the loops
+    /// over `[_; 3]` cost more in spilled counters and pointers than their
+    /// bodies (see [`Sums`]).
     #[inline(never)]
     fn mix(&mut self, now: u32, idle: [Angle; 3]) -> [Angle; 3] {
         let elapsed = now.wrapping_sub(self.now).max(1);
         self.now = now;
         self.next = now.wrapping_add(1);
-        let mut add = [0_i32; 3];
-        let mut duck = [ONE; 3];
-        let mut active = [false; 3];
+        let sums = self.layers(now);
+
+        let centre = self.gaze.at(now);
+        let gain = if self.idle_gain.moving() {
+            self.idle_gain.at(now).clamp(0, ONE as i32) as u32
+        } else {
+            self.idle_gain.target() as u32
+        };
+        let [pitch, roll, yaw] = idle.map(Angle::millidegrees);
+        // Within the limits: no overflow.
+        let pitch = idle_part(pitch, gain, sums.duck[0]) + sums.add[0] + centre[0];
+        let roll = idle_part(roll, gain, sums.duck[1]) + sums.add[1];
+        let yaw = idle_part(yaw, gain, sums.duck[2]) + sums.add[2] + centre[1];
+
+        // The modes from the next frame on: gesture while anything plays on
+        // the axis (or the return starts) and `settle` after.
+        let moving = self.gaze.moving();
+        let returning = self.gaze.returns_by(self.next);
+        let settle = self.params.settle;
+        let [pitch_left, roll_left, yaw_left] = &mut self.gesture_left;
+        let [pitch_mode, roll_mode, yaw_mode] = &mut self.modes;
+        *pitch_mode = settle_mode(
+            pitch_left,
+            sums.active & 1 != 0 || moving[0],
+            returning,
+            settle,
+            elapsed,
+        );
+        *roll_mode = settle_mode(roll_left, sums.active & 2 != 0, false, settle, elapsed);
+        *yaw_mode = settle_mode(
+            yaw_left,
+            sums.active & 4 != 0 || moving[1],
+            returning,
+            settle,
+            elapsed,
+        );
+        if LimitMode::same(self.modes, [LimitMode::Idle; 3])
+            && self.layers.iter().all(Option::is_none)
+            && !self.gaze.pending()
+            && !self.idle_gain.moving()
+        {
+            self.quiet = true;
+            self.rest_centre = centre;
+            self.rest_gain = gain;
+        }
+        [pitch, roll, yaw].map(Angle::from_millidegrees)
+    }
+
+    /// The gesture layers at frame `now`, summed per axis; clears the
+    /// layers that have ended.
+    #[inline]
+    fn layers(&mut self, now: u32) -> Sums {
+        let mut sums = Sums {
+            add: [0; 3],
+            duck: [ONE; 3],
+            active: 0,
+        };
         let params = &self.params;
         for slot in &mut self.layers {
             let Some(layer) = slot else { continue };
@@ -254,70 +312,23 @@ impl Mixer {
                 strength = mul(strength as i32, fade) as u32;
             }
             let i = layer.plan.kind.axis().index();
-            if let (Some(a), Some(d), Some(on)) =
-                (add.get_mut(i), duck.get_mut(i), active.get_mut(i))
-            {
+            if let (Some(a), Some(d)) = (sums.add.get_mut(i), sums.duck.get_mut(i)) {
                 *a += value;
-                *d = mul(*d as i32, ONE - mul(params.duck as i32, strength) as u32) as u32;
-                *on = true;
+                // (`mul` by 1 is exact: the factors of 1 are skipped.)
+                let lowered = if strength == ONE {
+                    params.duck
+                } else {
+                    mul(params.duck as i32, strength) as u32
+                };
+                *d = if *d == ONE {
+                    ONE - lowered
+                } else {
+                    mul(*d as i32, ONE - lowered) as u32
+                };
+                sums.active |= 1 << i;
             }
         }
-
-        let centre = self.gaze.at(now);
-        let moving = self.gaze.moving();
-        let returning = self.gaze.returns_by(self.next);
-        let gain = if self.idle_gain.moving() {
-            self.idle_gain.at(now).clamp(0, ONE as i32) as u32
-        } else {
-            self.idle_gain.target() as u32
-        };
-        let mut offsets = idle.map(Angle::millidegrees);
-        for ((value, &d), &a) in offsets.iter_mut().zip(&duck).zip(&add) {
-            if gain != ONE {
-                *value = mul(*value, gain);
-            }
-            if d != ONE {
-                *value = mul(*value, d);
-            }
-            // Within the limits: no overflow.
-            *value += a;
-        }
-        offsets[0] += centre[0];
-        offsets[2] += centre[1];
-        active[0] |= moving[0];
-        active[2] |= moving[1];
-
-        // The modes from the next frame on: gesture while anything plays on
-        // the axis (or the return starts) and `settle` after.
-        let soon = [returning, false, returning];
-        for (((mode, left), &on), &soon) in self
-            .modes
-            .iter_mut()
-            .zip(&mut self.gesture_left)
-            .zip(&active)
-            .zip(&soon)
-        {
-            *left = if on {
-                self.params.settle
-            } else {
-                left.saturating_sub(elapsed)
-            };
-            *mode = if on || soon || *left > 0 {
-                LimitMode::Gesture
-            } else {
-                LimitMode::Idle
-            };
-        }
-        if LimitMode::same(self.modes, [LimitMode::Idle; 3])
-            && self.layers.iter().all(Option::is_none)
-            && !self.gaze.pending()
-            && !self.idle_gain.moving()
-        {
-            self.quiet = true;
-            self.rest_centre = centre;
-            self.rest_gain = gain;
-        }
-        offsets.map(Angle::from_millidegrees)
+        sums
     }
 
     /// The limit modes from the next frame on, `[pitch, roll, yaw]`: the
@@ -325,6 +336,41 @@ impl Mixer {
     #[must_use]
     pub const fn modes(&self) -> [LimitMode; 3] {
         self.modes
+    }
+}
+
+/// The gesture layers of one frame, per axis `[pitch, roll, yaw]`.
+struct Sums {
+    /// The gestures' offsets, m°.
+    add: [i32; 3],
+    /// The idle's duck, Q16.
+    duck: [u32; 3],
+    /// Bit `i`: a gesture plays on axis `i`.
+    active: u8,
+}
+
+/// `idle · gain · duck` (Q16 each; a factor of 1 skipped: `mul` by 1 is
+/// exact).
+#[inline]
+const fn idle_part(idle: i32, gain: u32, duck: u32) -> i32 {
+    let value = if gain == ONE { idle } else { mul(idle, gain) };
+    if duck == ONE { value } else { mul(value, duck) }
+}
+
+/// One axis' limit mode from the next frame on, its frames `left` in
+/// gesture mode updated: gesture while `on` (and `settle` frames after) or
+/// when a return starts (`soon`).
+#[inline]
+const fn settle_mode(left: &mut u32, on: bool, soon: bool, settle: u32, elapsed: u32) -> LimitMode {
+    *left = if on {
+        settle
+    } else {
+        left.saturating_sub(elapsed)
+    };
+    if on || soon || *left > 0 {
+        LimitMode::Gesture
+    } else {
+        LimitMode::Idle
     }
 }
 

@@ -1,12 +1,13 @@
 //! Fade envelope: smoothstep gain that fades the idle motion in and out.
 //!
 //! The gain at level `l` of `n` frames is `S(x) = x²(3 − 2x)` at
-//! `x = ⌊l·2¹⁶/n⌋` (Q16), rounded down: one `u32` division while the level
-//! ramps (`l·2¹⁶ < 2³²` for `n ≤ 2¹⁶` frames, 22 minutes at 50 Hz; a longer
-//! fade takes a `u64` one), none at full or zero gain. `S` is formed from
-//! 16-bit halves: `x² = qₕ·2¹⁶ + qₗ`, `c = 3·2¹⁶ − 2x = cₕ·2¹⁶ + cₗ`,
-//! `⌊x²c/2³²⌋ = ⌊(qₕc + qₗcₕ + ⌊qₗcₗ/2¹⁶⌋)/2¹⁶⌋`. Every partial sum is at most
-//! `x²c/2¹⁶ = 2³²·S(x/2¹⁶) < 2³²` for `x < 2¹⁶`: `u32` throughout.
+//! `x = ⌊l·2¹⁶/n⌋` (Q16), rounded down. The envelope keeps `x` and the
+//! remainder `l·2¹⁶ mod n` as the level moves by one a frame, adding or
+//! taking away `⌊2¹⁶/n⌋` and `2¹⁶ mod n` (worked out with the envelope) with
+//! a carry: exactly the quotient, and no division on the frame path. `S` is
+//! formed from 16-bit halves: `x² = qₕ·2¹⁶ + qₗ`, `c = 3·2¹⁶ − 2x = cₕ·2¹⁶ +
+//! cₗ`, `⌊x²c/2³²⌋ = ⌊(qₕc + qₗcₕ + ⌊qₗcₗ/2¹⁶⌋)/2¹⁶⌋`. Every partial sum is at
+//! most `x²c/2¹⁶ = 2³²·S(x/2¹⁶) < 2³²` for `x < 2¹⁶`: `u32` throughout.
 
 /// Gain scale: Q16, 1.0 = 65 536.
 pub(crate) const UNITY: u32 = 1 << 16;
@@ -19,15 +20,30 @@ pub(crate) struct Envelope {
     frames: u32,
     level: u32,
     stopping: bool,
+    /// `⌊level·2¹⁶/frames⌋` and `level·2¹⁶ mod frames` (0 and 0 when
+    /// `frames` is 0).
+    x: u32,
+    rem: u32,
+    /// `⌊2¹⁶/frames⌋` and `2¹⁶ mod frames`: what one level adds.
+    step: u32,
+    step_rem: u32,
 }
 
 impl Envelope {
     /// An envelope at zero gain, about to fade in over `frames` frames.
     pub(crate) const fn new(frames: u32) -> Self {
+        let (step, step_rem) = match (UNITY.checked_div(frames), UNITY.checked_rem(frames)) {
+            (Some(q), Some(r)) => (q, r),
+            _ => (0, 0),
+        };
         Self {
             frames,
             level: 0,
             stopping: false,
+            x: 0,
+            rem: 0,
+            step,
+            step_rem,
         }
     }
 
@@ -44,29 +60,37 @@ impl Envelope {
             return 0;
         }
         // 0 < level < frames, so 0 < x < 2¹⁶.
-        let x = if self.frames <= UNITY {
-            match (self.level << 16).checked_div(self.frames) {
-                Some(x) => x,
-                None => 0,
-            }
-        } else {
-            match ((self.level as u64) << 16).checked_div(self.frames as u64) {
-                Some(x) => x as u32,
-                None => 0,
-            }
-        };
-        smoothstep(x)
+        smoothstep(self.x)
     }
 
-    /// Moves one frame along the ramp.
+    /// Moves the level one frame on (towards zero while stopping).
     pub(crate) const fn advance(&mut self) {
         if self.stopping {
-            self.level = self.level.saturating_sub(1);
+            if self.level > 0 {
+                self.level -= 1;
+                // (x, rem) − (step, step_rem), borrowing `frames` from x;
+                // the result is level·2¹⁶ ≥ 0 divided by frames.
+                if self.rem < self.step_rem {
+                    self.rem += self.frames - self.step_rem;
+                    self.x -= self.step + 1;
+                } else {
+                    self.rem -= self.step_rem;
+                    self.x -= self.step;
+                }
+            }
         } else if self.level < self.frames {
             self.level += 1;
+            // (x, rem) + (step, step_rem), carrying when rem reaches
+            // frames (both below it: no overflow as written).
+            if self.rem >= self.frames - self.step_rem {
+                self.rem -= self.frames - self.step_rem;
+                self.x += self.step + 1;
+            } else {
+                self.rem += self.step_rem;
+                self.x += self.step;
+            }
         }
     }
-
     /// Fade out (`true`) or in (`false`) from the current gain.
     pub(crate) const fn set_stopping(&mut self, stopping: bool) {
         self.stopping = stopping;

@@ -84,6 +84,10 @@ pub struct IdlePlayer<H, S> {
     fresh: Cursor,
     supply: S,
     timing: IdleTiming,
+    /// [`IdleTiming::join_read_frames`], worked out once (it divides in 64
+    /// bits, which would otherwise cost the frame a join starts at some
+    /// 300 instructions).
+    join_read: u32,
     /// Whether sets follow each other.
     stream: bool,
     stats: IdleStats,
@@ -141,6 +145,7 @@ where
             fresh,
             supply,
             timing,
+            join_read: timing.join_read_frames(),
             stream,
             stats: IdleStats {
                 joins: 0,
@@ -210,7 +215,7 @@ where
         self.cursor = self.fresh;
         self.cursor.restart_at(self.origin);
         self.joining = true;
-        self.event = u64::from(self.timing.join_read_frames());
+        self.event = u64::from(self.join_read);
         self.stats.joins = self.stats.joins.saturating_add(1);
         self.stats.set = self.current.number();
         if local >= self.event {

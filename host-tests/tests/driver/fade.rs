@@ -116,3 +116,38 @@ fn the_fade_is_the_specified_smoothstep_exactly() {
         }
     }
 }
+
+#[test]
+fn the_fade_stays_exact_when_it_reverses() {
+    // Fades of 7, 100 and 70 001 frames, turned back twice on the way.
+    for frames in [7u64, 100, 70_001] {
+        let mut cfg = direct_config();
+        cfg.fade = Millis((frames * 20) as u32);
+        let mut d = FrameDriver::new(recorders(), params(&cfg));
+        d.start();
+        let offsets = [19_999, -13_999, -1];
+        let check = |d: &mut FrameDriver<host_tests::Recorder>, level: u64| {
+            let r = d.write_frame(mdeg(offsets));
+            for (i, &o) in offsets.iter().enumerate() {
+                let want = (i64::from(o) * gain(level, frames) as i64 + (1 << 15)) >> 16;
+                assert_eq!(
+                    i64::from(r.servos[i].angle.millidegrees()),
+                    want,
+                    "{frames}: level {level}"
+                );
+            }
+        };
+        let (up, down) = (frames * 3 / 5, frames / 5);
+        for level in 0..=up {
+            check(&mut d, level);
+        }
+        d.request_stop();
+        for level in (down..=up + 1).rev() {
+            check(&mut d, level);
+        }
+        d.resume();
+        for level in down - 1..=frames {
+            check(&mut d, level);
+        }
+    }
+}
