@@ -10,7 +10,7 @@ use std::thread;
 
 use idle_head::idle::{
     GenerateOnTake, IdleMode, IdlePlayer, IdleTiming, JOIN_FRAMES, LoopSet, LoopStream, LoopSupply,
-    NoSupply, after_loop, join_weight,
+    MAX_DRAWS, NoSupply, after_loop, join_weight,
 };
 use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
 use idle_head::{Axis, Microseconds, Millis, Playback};
@@ -52,7 +52,8 @@ fn config_for(index: u64) -> HeadConfig {
     if index == 0 {
         return c;
     }
-    let mut z = index.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    // Three fresh values per index: no two indices share a seed.
+    let mut z = index.wrapping_mul(3).wrapping_mul(0x9E37_79B9_7F4A_7C15);
     let mut next = || {
         z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut x = z;
@@ -80,14 +81,23 @@ fn each_seed_is_the_last_value_the_previous_loop_drew() {
     let mut stream = Stream::new(DEFAULT_HEAD, &t);
     let mut set = Set::new();
     let mut seeds = [127, 259, 8821];
-    for number in 0..5 {
+    let mut discarded = 0;
+    for number in 0..20 {
         let info = stream.next_into(&mut set).unwrap();
         assert_eq!(info.number, number);
-        assert_eq!(info.seeds, seeds);
-        assert_eq!(set.seeds(), seeds);
-        seeds = seeds.map(|s| after_loop(s, DEFAULT_N));
+        // A loop discarded for its pace is skipped: the next is drawn from
+        // where its stream stopped.
+        let kept: [u32; 3] = std::array::from_fn(|a| {
+            (0..info.discarded[a]).fold(seeds[a], |s, _| after_loop(s, DEFAULT_N))
+        });
+        assert_eq!(info.seeds, kept);
+        assert_eq!(set.seeds(), kept);
+        seeds = kept.map(|s| after_loop(s, DEFAULT_N));
         assert_eq!(stream.seeds(), seeds);
+        discarded += info.discarded.iter().map(|&d| u32::from(d)).sum::<u32>();
     }
+    // The default stream discards some: the rule is exercised here.
+    assert!(discarded > 0);
 }
 
 #[test]
@@ -265,6 +275,13 @@ struct Smoothness {
     alone: [Worst; 4],
     join_values: [Vec<f64>; 4],
     alone_values: [Vec<f64>; 4],
+    /// Loops drawn, and discarded for their pace, over all axes; the most
+    /// discarded for one loop.
+    drawn: u64,
+    discarded: u64,
+    most_discarded: u8,
+    /// Loops kept after [`MAX_DRAWS`] draws, none within the bounds.
+    fallbacks: u64,
 }
 
 impl Smoothness {
@@ -275,6 +292,10 @@ impl Smoothness {
             self.join_values[i].extend_from_slice(&other.join_values[i]);
             self.alone_values[i].extend_from_slice(&other.alone_values[i]);
         }
+        self.drawn += other.drawn;
+        self.discarded += other.discarded;
+        self.most_discarded = self.most_discarded.max(other.most_discarded);
+        self.fallbacks += other.fallbacks;
     }
 }
 
@@ -285,14 +306,26 @@ const JOINS: usize = 50;
 const MARGIN: usize = 10;
 
 /// The first `loops` sets of `config`'s stream, each played alone for one
-/// loop (from its entry, `loop_frames` frames each): their interiors.
-fn each_loop_alone(config: HeadConfig, loops: usize, loop_frames: usize) -> Vec<[i32; 3]> {
+/// loop (from its entry, `loop_frames` frames each): their interiors; with
+/// what the sets discarded (into `s`).
+fn each_loop_alone(
+    config: HeadConfig,
+    loops: usize,
+    loop_frames: usize,
+    s: &mut Smoothness,
+) -> Vec<[i32; 3]> {
     let t = timing();
     let mut stream = Stream::new(config, &t);
     let mut set = Set::new();
     let mut frames = Vec::with_capacity(loops * loop_frames);
     for _ in 0..loops {
-        stream.next_into(&mut set).unwrap();
+        let info = stream.next_into(&mut set).unwrap();
+        for d in info.discarded {
+            s.drawn += 1 + u64::from(d);
+            s.discarded += u64::from(d);
+            s.most_discarded = s.most_discarded.max(d);
+            s.fallbacks += u64::from(d + 1 == MAX_DRAWS);
+        }
         let mut p = IdlePlayer::new(&set, NoSupply, t, IdleMode::FixedLoop);
         frames.extend((0..loop_frames as u64).map(|k| p.offsets(k).map(|a| a.millidegrees())));
     }
@@ -314,7 +347,7 @@ fn measure(from: u64, to: u64) -> Smoothness {
     for seed in from..to {
         let config = config_for(seed);
         let stream = play(config, IdleMode::NeverRepeating, frames);
-        let alone = each_loop_alone(config, JOINS + 1, loop_frames);
+        let alone = each_loop_alone(config, JOINS + 1, loop_frames, &mut s);
         for k in 1..=JOINS {
             let centre = k * period + join / 2;
             let around_join = centre - loop_frames / 2..centre + loop_frames / 2;
@@ -392,26 +425,22 @@ fn joins_are_as_smooth_as_a_loops_interior_over_1000_seeds_and_50_joins() {
             a.value,
         );
     }
-    // The join itself: its frames against the window's P95, at most 3 for
-    // every join, axis and seed.
-    for i in 2..4 {
+    println!(
+        "  loops drawn {}, discarded {} ({:.2}%), at most {} for one loop (of {MAX_DRAWS} draws); {} kept the closest",
+        all.drawn,
+        all.discarded,
+        100.0 * all.discarded as f64 / all.drawn as f64,
+        all.most_discarded,
+        all.fallbacks
+    );
+    // Every stretch holding a join, and the join itself against it: at
+    // most 3 for every join, axis and seed.
+    for i in 0..4 {
         assert!(
             all.join[i].value <= 3.0,
-            "{}: worst {:?}",
+            "{}: {} windows above 3, worst {:?}",
             names[i],
-            all.join[i]
-        );
-    }
-    // The whole window reaches past 3 only in the far tail, where a
-    // loop-length window mixes a lively loop with a quiet one (its maximum
-    // then lies away from the join, which the assertion above bounds): at
-    // most 1 in 10,000 windows, and never by more than a sixth.
-    for i in 0..2 {
-        let above = all.join_values[i].iter().filter(|&&v| v > 3.0).count();
-        assert!(
-            above * 10_000 <= all.join_values[i].len() && all.join[i].value <= 3.5,
-            "{}: {above} windows above 3, worst {:?}",
-            names[i],
+            all.join_values[i].iter().filter(|&&v| v > 3.0).count(),
             all.join[i]
         );
     }

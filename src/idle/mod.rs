@@ -58,10 +58,12 @@
 //! one loop per axis replayed every `L` frames.
 
 mod join;
+mod pace;
 mod source;
 mod stream;
 
 pub use crate::behaviour::IdleSource;
 pub use join::{IdleError, IdleTiming, JOIN_FRAMES, MAX_JOIN_SAMPLES, join_weight};
+pub use pace::{MAX_DRAWS, MAX_JOIN_TURN_RATIO, MAX_SPEED_RATIO, MAX_TURN_RATIO, Pace, Spread};
 pub use source::{IdleMode, IdlePlayer, IdleStats, LoopSupply, NoSupply};
 pub use stream::{GenerateOnTake, LoopSet, LoopStream, MATCH_STRIDE, SetInfo, SetView, after_loop};

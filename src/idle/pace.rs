@@ -1,0 +1,186 @@
+//! How fast and how sharply a loop moves, so that consecutive loops of an
+//! axis stay comparable: a stretch holding the end of a lively loop and the
+//! start of a calm one would otherwise measure the lively part against the
+//! calm part's P95 and exceed the smoothness bound, join or no join.
+//!
+//! Measured on the loop's samples in m° (cyclic), per sample: the P95
+//! (nearest-rank, as [`crate::metrics`]) and the maximum of |d1| and of
+//! |d2|. The bounds are below the frames' bound of 3 where the samples
+//! predict the frames less well (see the module docs of [`super`]).
+
+use crate::motion::{Integral16, Sample, Trajectory};
+
+/// Q8 ratios: 256 is 1.
+const ONE: u32 = 256;
+
+/// The largest |d1| of either of two consecutive loops over the other's
+/// P95|d1|, Q8: 2.5.
+pub const MAX_SPEED_RATIO: u32 = 576;
+
+/// The largest |d2| of either of two consecutive loops over the other's
+/// P95|d2|, Q8: 3.
+pub const MAX_TURN_RATIO: u32 = 640;
+
+/// The largest |d2| over the join's samples over the smaller P95|d2| of
+/// the two loops, Q8: 3.
+pub const MAX_JOIN_TURN_RATIO: u32 = 768;
+
+/// Loops an axis may draw for one set: the first, and up to 15 more while
+/// the last drawn breaks a bound.
+pub const MAX_DRAWS: u8 = 16;
+
+/// The P95 and the maximum of |d1| or |d2| over a loop, m° per sample (or
+/// per sample²).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Spread {
+    /// P95, nearest-rank.
+    pub p95: u16,
+    /// Maximum.
+    pub max: u16,
+}
+
+impl Spread {
+    /// The spread of the `n` values `values()` yields (called again for
+    /// each pass): the maximum, then the P95 by bisection over 0..=max (at
+    /// most 16 passes, no sorting and no buffer).
+    fn of<I: Iterator<Item = u16>>(n: usize, values: impl Fn() -> I) -> Self {
+        let max = values().max().unwrap_or(0);
+        // Nearest rank: the smallest v with at least ⌈0.95·n⌉ values ≤ v.
+        let rank = (n * 95).div_ceil(100);
+        let (mut lo, mut hi) = (0u16, max);
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            if values().filter(|&d| d <= mid).count() >= rank {
+                hi = mid;
+            } else {
+                lo = mid + 1;
+            }
+        }
+        Self { p95: lo, max }
+    }
+
+    /// The larger of `self.max / other.p95` and `other.max / self.p95`,
+    /// Q8, rounded up (`u32::MAX` if a P95 is 0).
+    const fn cross(self, other: Self) -> u32 {
+        let a = ratio(self.max, other.p95);
+        let b = ratio(other.max, self.p95);
+        if a > b { a } else { b }
+    }
+}
+
+/// `max / p95` in Q8, rounded up; `u32::MAX` when `p95` is 0.
+const fn ratio(max: u16, p95: u16) -> u32 {
+    if p95 == 0 {
+        return u32::MAX;
+    }
+    ((max as u32) << 8).div_ceil(p95 as u32)
+}
+
+/// `value` Q8 scaled so that `bound` maps to [`ONE`] (saturating).
+const fn against(value: u32, bound: u32) -> u32 {
+    if value == u32::MAX || bound == 0 {
+        return u32::MAX;
+    }
+    let scaled = (value as u64 * ONE as u64).div_ceil(bound as u64);
+    if scaled > u32::MAX as u64 {
+        u32::MAX
+    } else {
+        scaled as u32
+    }
+}
+
+/// How a loop moves: the spread of its |d1| (speed) and |d2| (turns).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Pace {
+    /// |d1|, m° per sample.
+    pub speed: Spread,
+    /// |d2|, m° per sample².
+    pub turn: Spread,
+}
+
+impl Pace {
+    /// The pace of `angles`, one loop in m° taken cyclically; all zero for
+    /// fewer than three samples.
+    #[must_use]
+    pub fn of(angles: &[i16]) -> Self {
+        let n = angles.len();
+        if n < 3 {
+            return Self::default();
+        }
+        // Sample i and the two after it, cyclically.
+        let triples = || {
+            let next = angles.iter().cycle().skip(1);
+            let after = angles.iter().cycle().skip(2);
+            angles
+                .iter()
+                .zip(next)
+                .zip(after)
+                .map(|((a, b), c)| (i32::from(*a), i32::from(*b), i32::from(*c)))
+        };
+        let clamp = |v: i32| v.unsigned_abs().min(0xFFFF) as u16;
+        Self {
+            speed: Spread::of(n, || triples().map(|(a, b, _)| clamp(b - a))),
+            turn: Spread::of(n, || triples().map(|(a, b, c)| clamp(c - 2 * b + a))),
+        }
+    }
+
+    /// The pace of `loop_` (the ring: the same from any start).
+    #[must_use]
+    pub fn of_loop<const N: usize>(loop_: &Trajectory<Integral16, N>) -> Self {
+        // 1.8 KB of stack, freed before the entry search takes its own.
+        let scale = loop_.scale();
+        let mut angles = [0i16; N];
+        for (a, s) in angles.iter_mut().zip(loop_.samples()) {
+            // Inside the axis' range, which the configuration keeps within
+            // ±32.767° (an i16 of m°).
+            *a = scale.angle(s.to_scratch()).millidegrees() as i16;
+        }
+        Self::of(&angles)
+    }
+
+    /// How far `self` and the outgoing loop's pace `out` are from keeping
+    /// pace, Q8: the largest of the speed and turn ratios
+    /// ([`Spread::cross`]), each divided by its bound. At most 256: within
+    /// both bounds.
+    #[must_use]
+    pub const fn score(self, out: Self) -> u32 {
+        let speed = against(self.speed.cross(out.speed), MAX_SPEED_RATIO);
+        let turn = against(self.turn.cross(out.turn), MAX_TURN_RATIO);
+        if speed > turn { speed } else { turn }
+    }
+
+    /// How far the join's largest |d2| (`join_turn`, m° per sample²) is from
+    /// its bound against the smaller P95|d2| of `self` and `out`, Q8 (at
+    /// most 256: within it).
+    #[must_use]
+    pub const fn join_score(self, out: Self, join_turn: u16) -> u32 {
+        let p95 = if self.turn.p95 < out.turn.p95 {
+            self.turn.p95
+        } else {
+            out.turn.p95
+        };
+        against(ratio(join_turn, p95), MAX_JOIN_TURN_RATIO)
+    }
+
+    /// Whether a score of [`score`](Self::score) or
+    /// [`join_score`](Self::join_score) is within its bounds.
+    #[must_use]
+    pub const fn within(score: u32) -> bool {
+        score <= ONE
+    }
+}
+
+/// The largest |d2| of the samples `values` yields, m° per sample².
+pub(super) fn max_turn(values: impl Iterator<Item = i32>) -> u16 {
+    let (mut a, mut b) = (None::<i32>, None::<i32>);
+    let mut max = 0u16;
+    for c in values {
+        if let (Some(a), Some(b)) = (a, b) {
+            max = max.max((c - 2 * b + a).unsigned_abs().min(0xFFFF) as u16);
+        }
+        (a, b) = (b, Some(c));
+    }
+    max
+}
