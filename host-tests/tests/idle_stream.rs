@@ -10,7 +10,7 @@ use std::thread;
 
 use idle_head::idle::{
     GenerateOnTake, IdleMode, IdlePlayer, IdleTiming, JOIN_FRAMES, LoopSet, LoopStream, LoopSupply,
-    MAX_DRAWS, NoSupply, after_loop, join_weight,
+    MAX_DRAWS, NoSupply, Pace, after_loop, join_weight,
 };
 use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
 use idle_head::{Axis, Microseconds, Millis, Playback};
@@ -172,6 +172,42 @@ fn a_frame_does_not_depend_on_the_frames_skipped_before_it() {
         );
         // Skip 0 to 6 frames, through joins too.
         k += 1 + (k * 7 + 3) % 7;
+    }
+}
+
+#[test]
+fn a_loops_pace_is_the_p95_and_maximum_of_its_cyclic_differences() {
+    // Nearest-rank P95 and maximum by sorting, as `ratios` measures frames.
+    let reference = |x: &[i16], order: usize| {
+        let n = x.len();
+        let v = |i: usize| i64::from(x[i % n]);
+        let mut d: Vec<i64> = (0..n)
+            .map(|i| match order {
+                1 => (v(i + 1) - v(i)).abs(),
+                _ => (v(i + 2) - 2 * v(i + 1) + v(i)).abs(),
+            })
+            .collect();
+        d.sort_unstable();
+        (d[(n * 95).div_ceil(100) - 1] as u16, d[n - 1] as u16)
+    };
+    let mut lcg = Lcg::new(7);
+    for n in [3, 4, 20, 101, DEFAULT_N] {
+        for _ in 0..20 {
+            // A bounded random walk, in m°.
+            let mut x = 0i32;
+            let angles: Vec<i16> = (0..n)
+                .map(|_| {
+                    x = (x + (lcg.next_value() >> 20) as i32 - 2048).clamp(-30_000, 30_000);
+                    x as i16
+                })
+                .collect();
+            let mut scratch = angles.clone();
+            let pace = Pace::of(&mut scratch, |a| a.copy_from_slice(&angles));
+            let (p1, m1) = reference(&angles, 1);
+            let (p2, m2) = reference(&angles, 2);
+            assert_eq!((pace.speed.p95, pace.speed.max), (p1, m1), "n {n}");
+            assert_eq!((pace.turn.p95, pace.turn.max), (p2, m2), "n {n}");
+        }
     }
 }
 

@@ -41,23 +41,25 @@ pub struct Spread {
 }
 
 impl Spread {
-    /// The spread of the `n` values `values()` yields (called again for
-    /// each pass): the maximum, then the P95 by bisection over 0..=max (at
-    /// most 16 passes, no sorting and no buffer).
-    fn of<I: Iterator<Item = u16>>(n: usize, values: impl Fn() -> I) -> Self {
-        let max = values().max().unwrap_or(0);
+    /// The spread of `values` (all ≥ 0): the maximum, then the P95 by
+    /// bisection over 0..=max (at most 15 passes, no sorting).
+    fn of(values: &[i16]) -> Self {
+        let max = values.iter().copied().max().unwrap_or(0).max(0);
         // Nearest rank: the smallest v with at least ⌈0.95·n⌉ values ≤ v.
-        let rank = (n * 95).div_ceil(100);
-        let (mut lo, mut hi) = (0u16, max);
+        let rank = (values.len() * 95).div_ceil(100);
+        let (mut lo, mut hi) = (0i16, max);
         while lo < hi {
             let mid = lo + (hi - lo) / 2;
-            if values().filter(|&d| d <= mid).count() >= rank {
+            if values.iter().filter(|&&d| d <= mid).count() >= rank {
                 hi = mid;
             } else {
                 lo = mid + 1;
             }
         }
-        Self { p95: lo, max }
+        Self {
+            p95: lo as u16,
+            max: max as u16,
+        }
     }
 
     /// The larger of `self.max / other.p95` and `other.max / self.p95`,
@@ -102,27 +104,41 @@ pub struct Pace {
 
 impl Pace {
     /// The pace of `angles`, one loop in m° taken cyclically; all zero for
-    /// fewer than three samples.
+    /// fewer than three samples. Uses `angles` as scratch: it holds |d1|
+    /// afterwards.
     #[must_use]
-    pub fn of(angles: &[i16]) -> Self {
+    pub fn of(angles: &mut [i16], refill: impl Fn(&mut [i16])) -> Self {
         let n = angles.len();
         if n < 3 {
             return Self::default();
         }
-        // Sample i and the two after it, cyclically.
-        let triples = || {
-            let next = angles.iter().cycle().skip(1);
-            let after = angles.iter().cycle().skip(2);
-            angles
-                .iter()
-                .zip(next)
-                .zip(after)
-                .map(|((a, b), c)| (i32::from(*a), i32::from(*b), i32::from(*c)))
-        };
-        let clamp = |v: i32| v.unsigned_abs().min(0xFFFF) as u16;
+        // |d2| in place, front to back: sample i is read only by the
+        // differences i − 2, i − 1 and i, so the first two are kept for
+        // the wrap.
+        let (first, second) = (angles[0], angles[1]);
+        let clamp = |v: i32| v.unsigned_abs().min(0x7FFF) as i16;
+        for i in 0..n {
+            let b = angles
+                .get(i + 1)
+                .copied()
+                .unwrap_or(if i + 1 == n { first } else { second });
+            let c = angles
+                .get(i + 2)
+                .copied()
+                .unwrap_or(if i + 2 == n { first } else { second });
+            let a = angles[i];
+            angles[i] = clamp(i32::from(c) - 2 * i32::from(b) + i32::from(a));
+        }
+        let turn = Spread::of(angles);
+        refill(angles);
+        let first = angles[0];
+        for i in 0..n {
+            let b = angles.get(i + 1).copied().unwrap_or(first);
+            angles[i] = clamp(i32::from(b) - i32::from(angles[i]));
+        }
         Self {
-            speed: Spread::of(n, || triples().map(|(a, b, _)| clamp(b - a))),
-            turn: Spread::of(n, || triples().map(|(a, b, c)| clamp(c - 2 * b + a))),
+            speed: Spread::of(angles),
+            turn,
         }
     }
 
@@ -130,14 +146,17 @@ impl Pace {
     #[must_use]
     pub fn of_loop<const N: usize>(loop_: &Trajectory<Integral16, N>) -> Self {
         // 1.8 KB of stack, freed before the entry search takes its own.
-        let scale = loop_.scale();
         let mut angles = [0i16; N];
-        for (a, s) in angles.iter_mut().zip(loop_.samples()) {
-            // Inside the axis' range, which the configuration keeps within
-            // ±32.767° (an i16 of m°).
-            *a = scale.angle(s.to_scratch()).millidegrees() as i16;
-        }
-        Self::of(&angles)
+        let fill = |angles: &mut [i16]| {
+            let scale = loop_.scale();
+            for (a, s) in angles.iter_mut().zip(loop_.samples()) {
+                // Inside the axis' range, which the configuration keeps
+                // within ±32.767° (an i16 of m°).
+                *a = scale.angle(s.to_scratch()).millidegrees() as i16;
+            }
+        };
+        fill(&mut angles);
+        Self::of(&mut angles, fill)
     }
 
     /// How far `self` and the outgoing loop's pace `out` are from keeping
