@@ -70,8 +70,9 @@
 //!
 //! # Generation and hand-over
 //!
-//! [`LoopStream`] generates each set (about 150,000 instructions for the
-//! loops and the entry search on a Cortex-M0+) into a [`LoopSet`] buffer;
+//! [`LoopStream`] generates each set (about 2 million instructions for the
+//! loops, their pace and the entry search on a Cortex-M0+, see the README)
+//! into a [`LoopSet`] buffer;
 //! [`IdlePlayer`] plays the sets frame by frame and takes the next one
 //! through a [`LoopSupply`] on the frame its join is due. The firmware
 //! generates in a low-priority task and passes `&'static mut` buffers

@@ -14,11 +14,11 @@ use crate::motion::{Integral16, Sample, Trajectory};
 const ONE: u32 = 256;
 
 /// The largest |d1| of either of two consecutive loops over the other's
-/// P95|d1|, Q8: 2.5.
+/// P95|d1|, Q8: 2.25.
 pub const MAX_SPEED_RATIO: u32 = 576;
 
 /// The largest |d2| of either of two consecutive loops over the other's
-/// P95|d2|, Q8: 3.
+/// P95|d2|, Q8: 2.5.
 pub const MAX_TURN_RATIO: u32 = 640;
 
 /// The largest |d2| over the join's samples over the smaller P95|d2| of
@@ -41,24 +41,62 @@ pub struct Spread {
 }
 
 impl Spread {
-    /// The spread of `values` (all ≥ 0): the maximum, then the P95 by
-    /// bisection over 0..=max (at most 15 passes, no sorting).
-    fn of(values: &[i16]) -> Self {
-        let max = values.iter().copied().max().unwrap_or(0).max(0);
-        // Nearest rank: the smallest v with at least ⌈0.95·n⌉ values ≤ v.
-        let rank = (values.len() * 95).div_ceil(100);
-        let (mut lo, mut hi) = (0i16, max);
-        while lo < hi {
-            let mid = lo + (hi - lo) / 2;
-            if values.iter().filter(|&&d| d <= mid).count() >= rank {
-                hi = mid;
+    /// The spread of |d1| (`TURN` false) or |d2| (`TURN` true) of a loop
+    /// given by its d1 (cyclic): the maximum, then the P95 by histograms
+    /// of 64 buckets, each pass narrowing to the bucket that holds it (3
+    /// passes for values below 4096, no sorting and no buffer).
+    fn of<const TURN: bool>(d1: &[i16]) -> Self {
+        const BUCKETS: u32 = 64;
+        let n = d1.len();
+        let last = d1.last().copied().unwrap_or(0);
+        let value = |v: i16, prev: i16| {
+            if TURN {
+                (i32::from(v) - i32::from(prev)).unsigned_abs()
             } else {
-                lo = mid + 1;
+                i32::from(v).unsigned_abs()
             }
+        };
+        let (mut max, mut prev) = (0, last);
+        for &v in d1 {
+            max = max.max(value(v, prev));
+            prev = v;
         }
-        Self {
-            p95: lo as u16,
-            max: max as u16,
+        // Nearest rank: the smallest v with at least ⌈0.95·n⌉ values ≤ v.
+        let rank = (n * 95).div_ceil(100) as u32;
+        // The P95 lies in base..base + width; `below` values lie under base.
+        let (mut base, mut width, mut below) = (0u32, max + 1, 0u32);
+        let mut shift = 0u32;
+        while (width - 1) >> shift >= BUCKETS {
+            shift += 1;
+        }
+        loop {
+            let mut counts = [0u32; BUCKETS as usize];
+            let mut prev = last;
+            for &v in d1 {
+                let offset = value(v, prev).wrapping_sub(base);
+                prev = v;
+                if offset < width {
+                    // Below 64 (width ≤ 64 << shift); the mask spares a check.
+                    counts[(offset >> shift) as usize & (BUCKETS as usize - 1)] += 1;
+                }
+            }
+            let mut bucket = 0;
+            for (k, &c) in counts.iter().enumerate() {
+                bucket = k as u32;
+                if below + c >= rank {
+                    break;
+                }
+                below += c;
+            }
+            base += bucket << shift;
+            if shift == 0 {
+                return Self {
+                    p95: base.min(0xFFFF) as u16,
+                    max: max.min(0xFFFF) as u16,
+                };
+            }
+            width = width.saturating_sub(bucket << shift).min(1 << shift);
+            shift = shift.saturating_sub(6);
         }
     }
 
@@ -104,41 +142,27 @@ pub struct Pace {
 
 impl Pace {
     /// The pace of `angles`, one loop in m° taken cyclically; all zero for
-    /// fewer than three samples. Uses `angles` as scratch: it holds |d1|
+    /// fewer than three samples. Uses `angles` as scratch: it holds d1
     /// afterwards.
     #[must_use]
-    pub fn of(angles: &mut [i16], refill: impl Fn(&mut [i16])) -> Self {
+    pub fn of(angles: &mut [i16]) -> Self {
         let n = angles.len();
+        let Some(&first) = angles.first() else {
+            return Self::default();
+        };
         if n < 3 {
             return Self::default();
         }
-        // |d2| in place, front to back: sample i is read only by the
-        // differences i − 2, i − 1 and i, so the first two are kept for
-        // the wrap.
-        let (first, second) = (angles[0], angles[1]);
-        let clamp = |v: i32| v.unsigned_abs().min(0x7FFF) as i16;
+        // d1 in place, front to back (sample i + 1 is still unread).
         for i in 0..n {
-            let b = angles
-                .get(i + 1)
-                .copied()
-                .unwrap_or(if i + 1 == n { first } else { second });
-            let c = angles
-                .get(i + 2)
-                .copied()
-                .unwrap_or(if i + 2 == n { first } else { second });
-            let a = angles[i];
-            angles[i] = clamp(i32::from(c) - 2 * i32::from(b) + i32::from(a));
-        }
-        let turn = Spread::of(angles);
-        refill(angles);
-        let first = angles[0];
-        for i in 0..n {
-            let b = angles.get(i + 1).copied().unwrap_or(first);
-            angles[i] = clamp(i32::from(b) - i32::from(angles[i]));
+            let next = angles.get(i + 1).copied().unwrap_or(first);
+            if let Some(a) = angles.get_mut(i) {
+                *a = (i32::from(next) - i32::from(*a)).clamp(-0x7FFF, 0x7FFF) as i16;
+            }
         }
         Self {
-            speed: Spread::of(angles),
-            turn,
+            speed: Spread::of::<false>(angles),
+            turn: Spread::of::<true>(angles),
         }
     }
 
@@ -146,17 +170,14 @@ impl Pace {
     #[must_use]
     pub fn of_loop<const N: usize>(loop_: &Trajectory<Integral16, N>) -> Self {
         // 1.8 KB of stack, freed before the entry search takes its own.
+        let scale = loop_.scale();
         let mut angles = [0i16; N];
-        let fill = |angles: &mut [i16]| {
-            let scale = loop_.scale();
-            for (a, s) in angles.iter_mut().zip(loop_.samples()) {
-                // Inside the axis' range, which the configuration keeps
-                // within ±32.767° (an i16 of m°).
-                *a = scale.angle(s.to_scratch()).millidegrees() as i16;
-            }
-        };
-        fill(&mut angles);
-        Self::of(&mut angles, fill)
+        for (a, s) in angles.iter_mut().zip(loop_.samples()) {
+            // Inside the axis' range, which the configuration keeps within
+            // ±32.767° (an i16 of m°).
+            *a = scale.angle(s.to_scratch()).millidegrees() as i16;
+        }
+        Self::of(&mut angles)
     }
 
     /// How far `self` and the outgoing loop's pace `out` are from keeping
