@@ -25,9 +25,9 @@
 //! axis draws its next loop until it keeps pace with the outgoing loop,
 //! measured on the loops' samples in m° ([`Pace`], cyclic, per sample):
 //!
-//! - the largest |d1| of either loop is at most [`MAX_SPEED_RATIO`] (2.25)
+//! - the largest |d1| of either loop is at most [`MAX_SPEED_RATIO`] (2)
 //!   times the other's P95|d1|, and the largest |d2| at most
-//!   [`MAX_TURN_RATIO`] (2.5) times the other's P95|d2|;
+//!   [`MAX_TURN_RATIO`] (2.25) times the other's P95|d2|;
 //! - once entered and blended, the largest |d2| over the join's samples is
 //!   at most [`MAX_JOIN_TURN_RATIO`] (3) times the smaller P95|d2|.
 //!

@@ -14,12 +14,12 @@ use crate::motion::{Integral16, Sample, Trajectory};
 const ONE: u32 = 256;
 
 /// The largest |d1| of either of two consecutive loops over the other's
-/// P95|d1|, Q8: 2.25.
-pub const MAX_SPEED_RATIO: u32 = 576;
+/// P95|d1|, Q8: 2.
+pub const MAX_SPEED_RATIO: u32 = 512;
 
 /// The largest |d2| of either of two consecutive loops over the other's
-/// P95|d2|, Q8: 2.5.
-pub const MAX_TURN_RATIO: u32 = 640;
+/// P95|d2|, Q8: 2.25.
+pub const MAX_TURN_RATIO: u32 = 576;
 
 /// The largest |d2| over the join's samples over the smaller P95|d2| of
 /// the two loops, Q8: 3.
