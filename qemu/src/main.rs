@@ -345,10 +345,11 @@ async fn generator(mut stream: LoopStream<DEFAULT_N>) {
             // Virtual time under `-icount shift=0`: 1000 instructions a µs,
             // the frames that preempt the generator included.
             Ok(info) => defmt::info!(
-                "loop set {=u32} ready in {=u64} instructions: seeds {:#010x}, entered at {}, join mismatch {} mdeg rms",
+                "loop set {=u32} ready in {=u64} instructions: seeds {:#010x} ({} discarded), entered at {}, join mismatch {} mdeg rms",
                 info.number,
                 Duration::from_ticks(ticks).as_micros() * 1000,
                 info.seeds,
+                info.discarded,
                 info.starts,
                 info.mismatch
             ),

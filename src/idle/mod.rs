@@ -11,7 +11,35 @@
 //! its split). The LCG stream of an axis therefore goes on unbroken from
 //! loop to loop, and the whole sequence follows from the three seeds of
 //! the configuration ([`after_loop`] computes r(N) by squaring the LCG's
-//! affine map).
+//! affine map). A loop the stream discards (below, "Keeping pace") is
+//! skipped the same way: the next draw's seed is the last value the
+//! discarded loop drew.
+//!
+//! # Keeping pace
+//!
+//! A stretch of frames around a join holds the end of one loop and the
+//! start of the next. If one is lively and the other calm, the calm one
+//! lowers the stretch's P95 and the lively one's fastest moments stand out
+//! (max|d1|/P95|d1| reached 3.13 while every loop alone stays below 2.75),
+//! and a join between loops that match badly can turn sharply. So each
+//! axis draws its next loop until it keeps pace with the outgoing loop,
+//! measured on the loops' samples in m° ([`Pace`], cyclic, per sample):
+//!
+//! - the largest |d1| of either loop is at most [`MAX_SPEED_RATIO`] (2)
+//!   times the other's P95|d1|, and the largest |d2| at most
+//!   [`MAX_TURN_RATIO`] (2.25) times the other's P95|d2|;
+//! - once entered and blended, the largest |d2| over the join's samples is
+//!   at most [`MAX_JOIN_TURN_RATIO`] (3) times the smaller P95|d2|.
+//!
+//! A loop that breaks a bound is discarded and the axis draws the next
+//! one, from the seed after it; after [`MAX_DRAWS`] (16) draws the one
+//! closest to the bounds is kept (generated again from its seed; the
+//! stream goes on after the last draw). The bounds are tighter than the
+//! frames' 3 because the samples do not see all the frames do (the spline
+//! between samples, the m° rounding of each frame, a stretch holding only
+//! part of each loop). A loop's own interior is never judged, only the
+//! difference between neighbours: "as smooth as a loop's interior". Set 0
+//! is the configuration's own and never discarded.
 //!
 //! # The join
 //!
@@ -42,8 +70,9 @@
 //!
 //! # Generation and hand-over
 //!
-//! [`LoopStream`] generates each set (about 150,000 instructions for the
-//! loops and the entry search on a Cortex-M0+) into a [`LoopSet`] buffer;
+//! [`LoopStream`] generates each set (about 2 million instructions for the
+//! loops, their pace and the entry search on a Cortex-M0+, see the README)
+//! into a [`LoopSet`] buffer;
 //! [`IdlePlayer`] plays the sets frame by frame and takes the next one
 //! through a [`LoopSupply`] on the frame its join is due. The firmware
 //! generates in a low-priority task and passes `&'static mut` buffers
@@ -58,10 +87,12 @@
 //! one loop per axis replayed every `L` frames.
 
 mod join;
+mod pace;
 mod source;
 mod stream;
 
 pub use crate::behaviour::IdleSource;
 pub use join::{IdleError, IdleTiming, JOIN_FRAMES, MAX_JOIN_SAMPLES, join_weight};
+pub use pace::{MAX_DRAWS, MAX_JOIN_TURN_RATIO, MAX_SPEED_RATIO, MAX_TURN_RATIO, Pace, Spread};
 pub use source::{IdleMode, IdlePlayer, IdleStats, LoopSupply, NoSupply};
 pub use stream::{GenerateOnTake, LoopSet, LoopStream, MATCH_STRIDE, SetInfo, SetView, after_loop};

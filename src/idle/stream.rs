@@ -8,6 +8,7 @@ use crate::motion::{
 };
 
 use super::join::{IdleTiming, MAX_JOIN_SAMPLES, blend, join_weight};
+use super::pace::{MAX_DRAWS, Pace, Spread, max_turn};
 
 /// Samples of a join kept per axis: the one before it, and the join's
 /// `J + 1` (see [`LoopSet`]).
@@ -193,6 +194,12 @@ impl<'a, const N: usize> crate::playback::Axes for [SetView<'a, N>; 3] {
     }
 }
 
+/// The pace of a stream with no set yet (`Pace::default`, in a `const`).
+const PACE_ZERO: Pace = Pace {
+    speed: Spread { p95: 0, max: 0 },
+    turn: Spread { p95: 0, max: 0 },
+};
+
 /// What [`LoopStream::next_into`] made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -207,6 +214,10 @@ pub struct SetInfo {
     /// and the incoming loop over the join (sampled every
     /// [`MATCH_STRIDE`] samples): what the blend has to hide.
     pub mismatch: [u32; 3],
+    /// Per axis, the loops drawn and discarded before the one kept, for
+    /// not keeping pace with the outgoing loop or joining it too sharply
+    /// ([`Pace`]).
+    pub discarded: [u8; 3],
 }
 
 /// Every how many samples of the join the entry search compares.
@@ -226,6 +237,8 @@ pub struct LoopStream<const N: usize> {
     /// The last set's samples at playback indices `N − J − 1 ..= N` per
     /// axis, in m°: the one before its join out, and what it plays.
     exit: [[i16; KEPT]; 3],
+    /// The last set's pace per axis, which the next set's loops must keep.
+    pace: [Pace; 3],
 }
 
 impl<const N: usize> LoopStream<N> {
@@ -244,6 +257,7 @@ impl<const N: usize> LoopStream<N> {
             seeds: [config.pitch.seed, config.roll.seed, config.yaw.seed],
             next: 0,
             exit: [[0; KEPT]; 3],
+            pace: [PACE_ZERO; 3],
         }
     }
 
@@ -279,6 +293,7 @@ impl<const N: usize> LoopStream<N> {
                 seeds: set.seeds,
                 starts: set.starts(),
                 mismatch: [0; 3],
+                discarded: [0; 3],
             });
         }
         let mut config = self.config;
@@ -293,32 +308,113 @@ impl<const N: usize> LoopStream<N> {
         self.next += 1;
         generated?;
         let mut mismatch = [0; 3];
-        let j = self.join_samples;
+        let mut discarded = [0; 3];
         for axis in Axis::ALL {
             let a = axis.index();
-            let (start, cost) = best_entry(set.loops.axis(axis), &self.exit[a], j);
-            set.loops.set_start(axis, start);
-            mismatch[a] = rms(cost, j);
-            // The join: the outgoing exit blended into the entry.
-            let t = set.loops.axis(axis);
-            let (exit, join) = (&self.exit[a], &mut set.join[a]);
-            for (m, (kept, out)) in join.iter_mut().zip(exit.iter()).take(j + 2).enumerate() {
-                let out = i32::from(*out);
-                // Between two samples of the axis' range: an i16 of m°.
-                *kept = match m.checked_sub(1) {
-                    Some(i) => blend(out, t.angle(i).millidegrees(), join_weight(i, j)),
-                    None => out,
-                } as i16;
-            }
+            let (drawn, cost) = self.draw(set, &mut config, axis);
+            discarded[a] = drawn - 1;
+            mismatch[a] = rms(cost, self.join_samples);
         }
-        set.join_len = (j + 2) as u8;
+        set.join_len = (self.join_samples + 2) as u8;
         self.capture(set);
         Ok(SetInfo {
             number: set.number,
             seeds: set.seeds,
             starts: set.starts(),
             mismatch,
+            discarded,
         })
+    }
+
+    /// Draws the loop of `axis` into `set` until one keeps pace with the
+    /// outgoing loop and joins it within the bounds ([`Pace`]), each from
+    /// where the last drawn one's LCG stream stopped; after [`MAX_DRAWS`]
+    /// the one closest to the bounds is kept (generated again from its
+    /// seed). `set` holds the first draw, generated from `set.seeds`, and
+    /// the stream's seeds are already past it. Returns the loops drawn and
+    /// the kept entry's cost.
+    fn draw<const CAP: usize>(
+        &mut self,
+        set: &mut LoopSet<N, CAP>,
+        config: &mut HeadConfig,
+        axis: Axis,
+    ) -> (u8, u64) {
+        let a = axis.index();
+        let mut generated = true;
+        let mut draws = 1;
+        // (score, seed) of the closest loop drawn.
+        let mut best = (u32::MAX, set.seeds[a]);
+        loop {
+            if generated {
+                let (score, pace, cost) = self.enter(set, axis, false);
+                if Pace::within(score) {
+                    self.pace[a] = pace;
+                    return (draws, cost);
+                }
+                if score < best.0 {
+                    best = (score, set.seeds[a]);
+                }
+            }
+            if draws >= MAX_DRAWS {
+                break;
+            }
+            let seed = self.seeds[a];
+            self.seeds[a] = after_loop(seed, N);
+            draws += 1;
+            config.axis_mut(axis).seed = seed;
+            set.seeds[a] = seed;
+            // A degenerate walk counts as a discarded loop.
+            generated = set.loops.generate_axis(config, axis).is_ok();
+        }
+        if !generated || set.seeds[a] != best.1 {
+            config.axis_mut(axis).seed = best.1;
+            set.seeds[a] = best.1;
+            // Generated once already (if every draw was degenerate, the
+            // axis stays neutral).
+            let _ = set.loops.generate_axis(config, axis);
+        }
+        let (_, pace, cost) = self.enter(set, axis, true);
+        self.pace[a] = pace;
+        (draws, cost)
+    }
+
+    /// Measures the loop of `axis` in `set` against the outgoing one and,
+    /// if it keeps pace (or `always`), enters it where it joins the exit
+    /// best and blends the join. Returns its score ([`Pace::score`], then
+    /// the larger of that and [`Pace::join_score`] once joined), its pace
+    /// and its entry's cost (`u64::MAX`: not entered).
+    fn enter<const CAP: usize>(
+        &self,
+        set: &mut LoopSet<N, CAP>,
+        axis: Axis,
+        always: bool,
+    ) -> (u32, Pace, u64) {
+        let a = axis.index();
+        let out = self.pace[a];
+        let pace = Pace::of_loop(set.loops.axis(axis));
+        let score = pace.score(out);
+        if !Pace::within(score) && !always {
+            return (score, pace, u64::MAX);
+        }
+        let j = self.join_samples;
+        let (start, cost) = best_entry(set.loops.axis(axis), &self.exit[a], j);
+        set.loops.set_start(axis, start);
+        // The join: the outgoing exit blended into the entry.
+        let t = set.loops.axis(axis);
+        let (exit, join) = (&self.exit[a], &mut set.join[a]);
+        for (m, (kept, out)) in join.iter_mut().zip(exit.iter()).take(j + 2).enumerate() {
+            let out = i32::from(*out);
+            // Between two samples of the axis' range: an i16 of m°.
+            *kept = match m.checked_sub(1) {
+                Some(i) => blend(out, t.angle(i).millidegrees(), join_weight(i, j)),
+                None => out,
+            } as i16;
+        }
+        // Its turns: playback −1..=J, then the loop's own J + 1 and J + 2.
+        let after = [j + 1, j + 2].map(|i| t.angle(i).millidegrees());
+        let samples = join.iter().take(j + 2).map(|&v| i32::from(v));
+        let turn = max_turn(samples.chain(after));
+        (score.max(pace.join_score(out, turn)), pace, cost)
     }
 
     /// Takes `set`, generated by [`LoopSet::generate`] from this stream's
@@ -329,6 +425,9 @@ impl<const N: usize> LoopStream<N> {
         self.seeds = set.seeds.map(|seed| after_loop(seed, N));
         self.next = set.number + 1;
         self.capture(set);
+        for (axis, pace) in Axis::ALL.iter().zip(self.pace.iter_mut()) {
+            *pace = Pace::of_loop(set.loops.axis(*axis));
+        }
     }
 
     /// Keeps the exit segment of `set`: the samples its join out plays,

@@ -172,6 +172,15 @@ impl HeadConfig {
         }
     }
 
+    /// The configuration of `axis`, to change.
+    pub const fn axis_mut(&mut self, axis: Axis) -> &mut AxisConfig {
+        match axis {
+            Axis::Pitch => &mut self.pitch,
+            Axis::Roll => &mut self.roll,
+            Axis::Yaw => &mut self.yaw,
+        }
+    }
+
     /// The same configuration with every axis on `closure`.
     #[must_use]
     pub const fn with_closure(mut self, closure: Closure) -> Self {

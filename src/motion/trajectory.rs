@@ -261,6 +261,21 @@ impl<S: Sample, const N: usize, const CAP: usize> HeadTrajectories<S, N, CAP> {
         Ok(infos)
     }
 
+    /// Computes the loop of `axis` alone from `cfg` (the other axes are left
+    /// as they are).
+    ///
+    /// # Errors
+    /// As [`HeadTrajectories::generate`], for this axis; the axis is then
+    /// left all zero.
+    pub fn generate_axis(&mut self, cfg: &HeadConfig, axis: Axis) -> Result<LoopInfo, AxisError> {
+        let c = cfg.axis(axis);
+        let mut kernel = HannKernel::<CAP>::empty();
+        let checked = c.validate(axis, N).and_then(|()| kernel.rebuild(c.window));
+        self.axes[axis.index()]
+            .generate_checked(checked, c, &kernel, &mut ())
+            .map_err(|error| AxisError { axis, error })
+    }
+
     /// The loop of `axis`.
     #[must_use]
     pub const fn axis(&self, axis: Axis) -> &Trajectory<S, N> {

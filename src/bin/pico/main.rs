@@ -346,10 +346,11 @@ async fn generator(mut stream: LoopStream<DEFAULT_N>) {
 fn log_set(result: &Result<idle_head::idle::SetInfo, idle_head::motion::AxisError>, ticks: u64) {
     match result {
         Ok(info) => defmt::info!(
-            "loop set {=u32} ready in {=u64} us: seeds {:#010x}, entered at {}, join mismatch {} mdeg rms",
+            "loop set {=u32} ready in {=u64} us: seeds {:#010x} ({} discarded), entered at {}, join mismatch {} mdeg rms",
             info.number,
             Duration::from_ticks(ticks).as_micros(),
             info.seeds,
+            info.discarded,
             info.starts,
             info.mismatch
         ),
