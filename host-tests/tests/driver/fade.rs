@@ -90,17 +90,8 @@ fn the_fade_is_the_specified_smoothstep_exactly() {
         assert_eq!(u64::from(p.fade_frames()), frames);
         let mut d = FrameDriver::new(recorders(), p);
         d.start();
-        let offsets = [19_999, -13_999, -1];
         let check = |d: &mut FrameDriver<host_tests::Recorder>, level: u64| {
-            let r = d.write_frame(mdeg(offsets));
-            for (i, &o) in offsets.iter().enumerate() {
-                let want = (i64::from(o) * gain(level, frames) as i64 + (1 << 15)) >> 16;
-                assert_eq!(
-                    i64::from(r.servos[i].angle.millidegrees()),
-                    want,
-                    "{frames}: level {level}"
-                );
-            }
+            check_level(d, frames, level);
         };
         let top = frames.min(1200);
         for level in 0..=top {
@@ -117,6 +108,23 @@ fn the_fade_is_the_specified_smoothstep_exactly() {
     }
 }
 
+/// Writes one frame of [`FADE_OFFSETS`] and checks each servo's angle is
+/// the offset at fade `level` of `frames`, rounded to the nearest m°.
+fn check_level(d: &mut FrameDriver<host_tests::Recorder>, frames: u64, level: u64) {
+    let r = d.write_frame(mdeg(FADE_OFFSETS));
+    for (i, &o) in FADE_OFFSETS.iter().enumerate() {
+        let want = (i64::from(o) * gain(level, frames) as i64 + (1 << 15)) >> 16;
+        assert_eq!(
+            i64::from(r.servos[i].angle.millidegrees()),
+            want,
+            "{frames}: level {level}"
+        );
+    }
+}
+
+/// Offsets (m°) the exact fade tests play: large, negative and tiny.
+const FADE_OFFSETS: [i32; 3] = [19_999, -13_999, -1];
+
 #[test]
 fn the_fade_stays_exact_when_it_reverses() {
     // Fades of 7, 100 and 70 001 frames, turned back twice on the way.
@@ -125,17 +133,8 @@ fn the_fade_stays_exact_when_it_reverses() {
         cfg.fade = Millis((frames * 20) as u32);
         let mut d = FrameDriver::new(recorders(), params(&cfg));
         d.start();
-        let offsets = [19_999, -13_999, -1];
         let check = |d: &mut FrameDriver<host_tests::Recorder>, level: u64| {
-            let r = d.write_frame(mdeg(offsets));
-            for (i, &o) in offsets.iter().enumerate() {
-                let want = (i64::from(o) * gain(level, frames) as i64 + (1 << 15)) >> 16;
-                assert_eq!(
-                    i64::from(r.servos[i].angle.millidegrees()),
-                    want,
-                    "{frames}: level {level}"
-                );
-            }
+            check_level(d, frames, level);
         };
         let (up, down) = (frames * 3 / 5, frames / 5);
         for level in 0..=up {
