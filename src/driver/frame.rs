@@ -215,17 +215,10 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         axis: Axis,
         limits: MotionLimits,
     ) -> Result<(), ConfigError> {
-        let i = axis.index();
-        let config = &mut self.params.config;
-        let (Some(cal), Some(motion), Some(servo)) = (
-            config.servos.get(i),
-            config.motion.get_mut(i),
-            self.servos.get_mut(i),
-        ) else {
-            return Ok(());
-        };
-        servo.limits = slew_params(axis, limits, config.frame_period, cal.limits)?;
-        *motion = limits;
+        if let Some((params, motion, servo)) = self.motion_slots(axis, limits)? {
+            servo.limits = params;
+            *motion = limits;
+        }
         Ok(())
     }
 
@@ -242,6 +235,24 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         axis: Axis,
         limits: MotionLimits,
     ) -> Result<bool, ConfigError> {
+        let Some((params, motion, servo)) = self.motion_slots(axis, limits)? else {
+            return Ok(false);
+        };
+        if !servo.slew.can_take(&params) {
+            return Ok(false);
+        }
+        servo.limits = params;
+        *motion = limits;
+        Ok(true)
+    }
+
+    /// `axis`' per-frame limits for `limits`, with the configuration's and
+    /// the servo's slots they go in (`None` for no such servo).
+    fn motion_slots(
+        &mut self,
+        axis: Axis,
+        limits: MotionLimits,
+    ) -> Result<Option<(SlewParams, &mut MotionLimits, &mut ServoState)>, ConfigError> {
         let i = axis.index();
         let config = &mut self.params.config;
         let (Some(cal), Some(motion), Some(servo)) = (
@@ -249,15 +260,10 @@ impl<P: SetDutyCycle> FrameDriver<P> {
             config.motion.get_mut(i),
             self.servos.get_mut(i),
         ) else {
-            return Ok(false);
+            return Ok(None);
         };
         let params = slew_params(axis, limits, config.frame_period, cal.limits)?;
-        if !servo.slew.can_take(&params) {
-            return Ok(false);
-        }
-        servo.limits = params;
-        *motion = limits;
-        Ok(true)
+        Ok(Some((params, motion, servo)))
     }
 
     /// As [`set_motion_limits_when_safe`](Self::set_motion_limits_when_safe),
