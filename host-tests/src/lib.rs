@@ -1,5 +1,6 @@
 //! Shared helpers for the host tests of the `idle-head` core.
 
+pub mod behaviour;
 pub mod console;
 
 use embedded_hal_mock::eh1::MockError;

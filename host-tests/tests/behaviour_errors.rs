@@ -3,28 +3,16 @@
 
 use idle_head::Angle;
 use idle_head::behaviour::{
-    BehaviourConfig, BehaviourError, BehaviourParams, CommandQueue, MilliHertz, Mixer, QueueFull,
+    BehaviourConfig, BehaviourError, CommandQueue, MilliHertz, Mixer, QueueFull,
 };
 use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
 use idle_head::driver::{DegreesPerSecond, DriverConfig, DriverParams};
 use idle_head::units::Millis;
 
+use host_tests::behaviour::{default_params as params, gesture};
+
 fn driver() -> DriverParams {
     DriverConfig::DEFAULT.build().unwrap()
-}
-
-fn params() -> BehaviourParams {
-    BehaviourConfig::DEFAULT.build(&driver()).unwrap()
-}
-
-fn gesture(kind: GestureKind, amp: Option<i32>, ms: Option<u32>, cycles: Option<u8>) -> Action {
-    Action::Gesture(GestureRequest {
-        kind,
-        amplitude: amp.map(Angle::from_millidegrees),
-        duration: ms.map(Millis),
-        cycles,
-        intensity: None,
-    })
 }
 
 /// The error `action` gets, and that the mixer is unchanged after it.

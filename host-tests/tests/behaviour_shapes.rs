@@ -5,27 +5,11 @@
 use std::f64::consts::TAU;
 
 use idle_head::Angle;
-use idle_head::behaviour::{
-    Applied, BehaviourConfig, BehaviourParams, GesturePlan, LimitMode, LookApplied, Mixer,
-};
+use idle_head::behaviour::{Applied, GesturePlan, LimitMode, LookApplied, Mixer};
 use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
-use idle_head::driver::DriverConfig;
 use idle_head::units::Millis;
 
-fn params() -> BehaviourParams {
-    let driver = DriverConfig::DEFAULT.build().unwrap();
-    BehaviourConfig::DEFAULT.build(&driver).unwrap()
-}
-
-fn gesture(kind: GestureKind, amp: Option<i32>, ms: Option<u32>, cycles: Option<u8>) -> Action {
-    Action::Gesture(GestureRequest {
-        kind,
-        amplitude: amp.map(Angle::from_millidegrees),
-        duration: ms.map(Millis),
-        cycles,
-        intensity: None,
-    })
-}
+use host_tests::behaviour::{default_params as params, gesture};
 
 fn plan_of(applied: Applied) -> GesturePlan {
     match applied {

@@ -1,0 +1,28 @@
+//! Shared helpers for the behaviour tests.
+
+use idle_head::Angle;
+use idle_head::behaviour::{BehaviourConfig, BehaviourParams};
+use idle_head::command::{Action, GestureKind, GestureRequest};
+use idle_head::driver::DriverConfig;
+use idle_head::units::Millis;
+
+/// The built-in behaviour on the built-in driver configuration (panics if
+/// either is invalid: tests only).
+#[must_use]
+pub fn default_params() -> BehaviourParams {
+    let driver = DriverConfig::DEFAULT.build().unwrap();
+    BehaviourConfig::DEFAULT.build(&driver).unwrap()
+}
+
+/// A gesture request of `kind`: amplitude in m°, duration in ms and cycles
+/// as given (`None`: the default), at the default intensity.
+#[must_use]
+pub fn gesture(kind: GestureKind, amp: Option<i32>, ms: Option<u32>, cycles: Option<u8>) -> Action {
+    Action::Gesture(GestureRequest {
+        kind,
+        amplitude: amp.map(Angle::from_millidegrees),
+        duration: ms.map(Millis),
+        cycles,
+        intensity: None,
+    })
+}
