@@ -327,13 +327,11 @@ struct Smoothness {
 }
 
 /// Other stretches holding a join, beside the loop-length window centred
-/// on it: (frames, frames before the join's start, asserted). One loop
-/// length with the join a quarter and three quarters in (asserted), and
-/// two loop lengths from just before one join to past the next, three
-/// loops (reported only: the rule compares neighbours, so the first and
-/// third loop may differ more; seeds 1000 to 1999 reach 3.25 for d2).
-const STRETCHES: [(usize, usize, bool); 3] =
-    [(1500, 375, true), (1500, 1025, true), (3000, 1450, false)];
+/// on it: (frames, frames before the join's start). One loop length with
+/// the join a quarter and three quarters in, and two loop lengths from
+/// just before one join to past the next: three loops, which is why a loop
+/// must keep pace with the loop two back as well as with the one it joins.
+const STRETCHES: [(usize, usize); 3] = [(1500, 375), (1500, 1025), (3000, 1450)];
 
 impl Smoothness {
     fn add(&mut self, other: &Self) {
@@ -356,6 +354,8 @@ impl Smoothness {
     }
 }
 
+/// The seeds the bounds were chosen on; [`SEEDS_UNSEEN`] checks them on
+/// others.
 const SEEDS: u64 = 1000;
 const JOINS: usize = 50;
 
@@ -438,7 +438,7 @@ fn measure(from: u64, to: u64) -> Smoothness {
                         values[i].push(value);
                     }
                 }
-                for (&(len, before, _), found) in STRETCHES.iter().zip(&mut s.stretches) {
+                for (&(len, before), found) in STRETCHES.iter().zip(&mut s.stretches) {
                     let Some(start) = (k * period).checked_sub(before) else {
                         continue;
                     };
@@ -464,12 +464,32 @@ fn median(v: &mut [f64]) -> f64 {
     v[v.len() / 2]
 }
 
+/// Seeds 1000 to 1999, never used to choose the bounds.
+const SEEDS_UNSEEN: std::ops::Range<u64> = SEEDS..2 * SEEDS;
+
 #[test]
-#[allow(clippy::needless_range_loop)] // four measures, indexed in parallel arrays
 fn joins_are_as_smooth_as_a_loops_interior_over_1000_seeds_and_50_joins() {
-    let half = SEEDS / 2;
-    let other = thread::spawn(move || measure(0, half));
-    let mut all = measure(half, SEEDS);
+    smooth_over(0..SEEDS, true);
+}
+
+/// The same figures on seeds the bounds were not chosen on, printed and
+/// not asserted (one 1500-frame stretch in 150,000 reaches 10/3 for d2:
+/// see [`idle_head::idle::MAX_JOIN_TURN_RATIO`]). As long again, so run on
+/// request: `cargo test --release --test idle_stream -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn joins_on_other_seeds_measured() {
+    smooth_over(SEEDS_UNSEEN, false);
+}
+
+/// Measures `seeds` ([`measure`], on two threads), prints the figures and,
+/// if `check`, asserts every ratio and stretch at most 3.
+#[allow(clippy::needless_range_loop)] // four measures, indexed in parallel arrays
+fn smooth_over(seeds: std::ops::Range<u64>, check: bool) {
+    let (from, to) = (seeds.start, seeds.end);
+    let half = from + (to - from) / 2;
+    let other = thread::spawn(move || measure(from, half));
+    let mut all = measure(half, to);
     all.add(&other.join().unwrap());
     let names = [
         "max|d1|/P95|d1|, whole window",
@@ -478,8 +498,9 @@ fn joins_are_as_smooth_as_a_loops_interior_over_1000_seeds_and_50_joins() {
         "max|d2|/P95|d2|, join region ",
     ];
     println!(
-        "{SEEDS} seeds x {JOINS} joins x 3 axes; frames in m°, 1500-frame windows centred on each join \
+        "seeds {from} to {} x {JOINS} joins x 3 axes; frames in m°, 1500-frame windows centred on each join \
          (join region: its {} frames and {MARGIN} either side); each loop alone: one loop, region in its middle",
+        to - 1,
         JOIN_FRAMES
     );
     for i in 0..4 {
@@ -506,7 +527,7 @@ fn joins_are_as_smooth_as_a_loops_interior_over_1000_seeds_and_50_joins() {
         all.most_discarded,
         all.fallbacks
     );
-    for (&(len, before, asserted), found) in STRETCHES.iter().zip(&all.stretches) {
+    for (&(len, before), found) in STRETCHES.iter().zip(&all.stretches) {
         println!(
             "  {len} frames, the join {before} frames in: max|d1|/P95|d1| worst {:.2} (seed {}, join {}, {}), max|d2|/P95|d2| worst {:.2} (seed {}, join {}, {}); {} and {} above 3",
             found[0].0.value,
@@ -520,9 +541,15 @@ fn joins_are_as_smooth_as_a_loops_interior_over_1000_seeds_and_50_joins() {
             found[0].1,
             found[1].1,
         );
+    }
+    if !check {
+        return;
+    }
+    // Every stretch holding one or two joins: at most 3.
+    for (&(len, before), found) in STRETCHES.iter().zip(&all.stretches) {
         for (i, (worst, above)) in found.iter().enumerate() {
             assert!(
-                !asserted || worst.value <= 3.0,
+                worst.value <= 3.0,
                 "{len}-frame stretch, join {before} in, d{}: {above} above 3, worst {worst:?}",
                 i + 1
             );

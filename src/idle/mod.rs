@@ -93,6 +93,8 @@ mod stream;
 
 pub use crate::behaviour::IdleSource;
 pub use join::{IdleError, IdleTiming, JOIN_FRAMES, MAX_JOIN_SAMPLES, join_weight};
-pub use pace::{MAX_DRAWS, MAX_JOIN_TURN_RATIO, MAX_SPEED_RATIO, MAX_TURN_RATIO, Pace, Spread};
+pub use pace::{
+    MAX_DRAWS, MAX_JOIN_TURN_RATIO, MAX_SPEED_RATIO, MAX_TURN_RATIO, Pace, Paces, Spread,
+};
 pub use source::{IdleMode, IdlePlayer, IdleStats, LoopSupply, NoSupply};
 pub use stream::{GenerateOnTake, LoopSet, LoopStream, MATCH_STRIDE, SetInfo, SetView, after_loop};
