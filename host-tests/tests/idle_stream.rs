@@ -328,9 +328,10 @@ struct Smoothness {
 
 /// Other stretches holding a join, beside the loop-length window centred
 /// on it: (frames, frames before the join's start). One loop length with
-/// the join a quarter and three quarters in, and two loop lengths from
-/// just before one join to past the next: three loops, which is why a loop
-/// must keep pace with the loop two back as well as with the one it joins.
+/// the join a quarter and three quarters in, and two loop lengths with
+/// joins 50, 1450 and 2850 frames in (two loops whole, and 150 frames of
+/// each loop either side), which is why a loop must keep pace with the
+/// loop two back as well as with the one it joins.
 const STRETCHES: [(usize, usize); 3] = [(1500, 375), (1500, 1025), (3000, 1450)];
 
 impl Smoothness {

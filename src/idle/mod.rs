@@ -22,8 +22,8 @@
 //! lowers the stretch's P95 and the lively one's fastest moments stand out
 //! (max|d1|/P95|d1| reached 3.13 while every loop alone stays below 2.75),
 //! and a join between loops that match badly can turn sharply. A stretch of
-//! two loop lengths holds three loops and two joins, so the first and the
-//! third loop meet in one P95 too. So each axis draws its next loop until
+//! two loop lengths holds two loops whole and the ends of the loops either
+//! side, so loops two apart meet in one P95 too. So each axis draws its next loop until
 //! it keeps pace with the axis' last two loops ([`Paces`]), measured on the
 //! loops' samples in m° ([`Pace`], cyclic, per sample):
 //!
@@ -39,7 +39,7 @@
 //!
 //! Each loop is thus measured against the loops up to two away, and each
 //! join against the two loops before it, the one it enters and the one
-//! after it: everything a stretch of two loop lengths can hold with it.
+//! after it.
 //! A loop that breaks a bound is discarded and the axis draws the next
 //! one, from the seed after it; after [`MAX_DRAWS`] (16) draws the one
 //! closest to the bounds is kept (generated again from its seed; the

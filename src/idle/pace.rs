@@ -21,11 +21,11 @@ pub const MAX_SPEED_RATIO: u32 = 512;
 /// P95|d2|, Q8: 2.25.
 pub const MAX_TURN_RATIO: u32 = 576;
 
-/// The largest |d2| over a join's samples over the P95|d2| of each loop a
-/// stretch holding the join can hold (the loop it enters, the two before
-/// and the one after), Q8: 2.75. With 3, seed 437 of the test's 1,000 (a
-/// join at exactly 3 times the P95) reached 10/3 over three loops' frames:
-/// their |d2| are a few m° per frame², so one m° more is a tenth more.
+/// The largest |d2| over a join's samples over the P95|d2| of the loop it
+/// enters, of the two before and of the one after, Q8: 2.75. Below 3
+/// because the frames' |d2| are a few m° per frame², so one m° more is a
+/// tenth more: a join at exactly 3 times a P95|d2| of 9 m°/sample²
+/// measured 10/3 over 3000 frames.
 pub const MAX_JOIN_TURN_RATIO: u32 = 704;
 
 /// Loops an axis may draw for one set: the first, and up to 15 more while
@@ -203,9 +203,10 @@ impl Pace {
 }
 
 /// What an axis' next loop must keep pace with: its last two loops and
-/// the join into the last (20 bytes). A stretch of frames can hold three
-/// loops and two joins, so each loop and each join is measured against
-/// every loop such a stretch can hold with it.
+/// the join into the last (18 bytes). A stretch of two loop lengths holds
+/// two loops whole and the ends of those either side, so each loop is
+/// measured against the loops up to two away, and each join against the
+/// two loops before it, the one it enters and the one after.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Paces {
@@ -260,10 +261,12 @@ impl Paces {
     }
 }
 
+/// The larger of two scores (`u32::max` is not `const`).
 const fn max(a: u32, b: u32) -> u32 {
     if a > b { a } else { b }
 }
 
+/// The smaller of two P95s.
 const fn min(a: u16, b: u16) -> u16 {
     if a < b { a } else { b }
 }

@@ -199,6 +199,7 @@ const PACE_ZERO: Pace = Pace {
     speed: Spread { p95: 0, max: 0 },
     turn: Spread { p95: 0, max: 0 },
 };
+/// The same for both loops a new one is measured against.
 const PACES_ZERO: Paces = Paces::new(PACE_ZERO);
 
 /// What [`LoopStream::next_into`] made.
@@ -328,13 +329,13 @@ impl<const N: usize> LoopStream<N> {
         })
     }
 
-    /// Draws the loop of `axis` into `set` until one keeps pace with the
-    /// axis' last two loops and its join within the bounds ([`Paces`]),
-    /// each from where the last drawn one's LCG stream stopped; after [`MAX_DRAWS`]
-    /// the one closest to the bounds is kept (generated again from its
-    /// seed). `set` holds the first draw, generated from `set.seeds`, and
-    /// the stream's seeds are already past it. Returns the loops drawn and
-    /// the kept entry's cost.
+    /// Draws the loop of `axis` into `set` until it keeps pace with the
+    /// axis' last two loops and its join is within the bounds ([`Paces`]),
+    /// each draw from where the last one's LCG stream stopped; after
+    /// [`MAX_DRAWS`] the one closest to the bounds is kept (generated again
+    /// from its seed). `set` holds the first draw, generated from
+    /// `set.seeds`, and the stream's seeds are already past it. Returns the
+    /// loops drawn and the kept entry's cost.
     fn draw<const CAP: usize>(
         &mut self,
         set: &mut LoopSet<N, CAP>,
