@@ -10,7 +10,7 @@ use std::thread;
 
 use idle_head::idle::{
     GenerateOnTake, IdleMode, IdlePlayer, IdleTiming, JOIN_FRAMES, LoopSet, LoopStream, LoopSupply,
-    MAX_DRAWS, NoSupply, Pace, after_loop, join_weight,
+    MAX_DRAWS, NoSupply, Pace, Paces, Spread, after_loop, join_weight,
 };
 use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
 use idle_head::{Axis, Microseconds, Millis, Playback};
@@ -211,6 +211,40 @@ fn a_loops_pace_is_the_p95_and_maximum_of_its_cyclic_differences() {
             assert_eq!((pace.turn.p95, pace.turn.max), (p2, m2), "n {n}");
         }
     }
+}
+
+#[test]
+fn a_loop_keeps_pace_with_the_last_two_loops_and_the_join_into_the_last() {
+    let pace = |p1, m1, p2, m2| Pace {
+        speed: Spread { p95: p1, max: m1 },
+        turn: Spread { p95: p2, max: m2 },
+    };
+    let calm = pace(100, 150, 10, 15);
+    let mid = pace(140, 190, 13, 20);
+    let lively = pace(190, 260, 17, 27);
+    // Neighbours keep pace (260 ≤ 2 · 140, 27 ≤ 2.25 · 13, ...), but the
+    // lively loop not with the calm one (260 > 2 · 100).
+    assert!(Pace::within(lively.score(mid)) && Pace::within(mid.score(calm)));
+    assert!(!Pace::within(lively.score(calm)));
+    let mut history = Paces::new(calm);
+    assert!(Pace::within(history.score(mid)));
+    history.push(mid, 0);
+    // The calm loop two back still counts; once it is three back, not.
+    assert!(!Pace::within(history.score(lively)));
+    history.push(mid, 0);
+    assert!(Pace::within(history.score(lively)));
+    // The join into the last loop against the next loop's P95|d2| (13):
+    // at most 2.75 times it.
+    history.push(mid, 35);
+    assert!(Pace::within(history.score(mid)));
+    history.push(mid, 36);
+    assert!(!Pace::within(history.score(mid)));
+    // A new join against the smallest P95|d2| of its loop and the last two
+    // (10, two back): at most 27.
+    let mut history = Paces::new(calm);
+    history.push(mid, 0);
+    assert!(Pace::within(history.join_score(mid, 27)));
+    assert!(!Pace::within(history.join_score(mid, 28)));
 }
 
 /// A supply that is not ready for its first `late` joins.
