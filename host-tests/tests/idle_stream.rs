@@ -10,7 +10,7 @@ use std::thread;
 
 use idle_head::idle::{
     GenerateOnTake, IdleMode, IdlePlayer, IdleTiming, JOIN_FRAMES, LoopSet, LoopStream, LoopSupply,
-    MAX_DRAWS, NoSupply, Pace, after_loop, join_weight,
+    MAX_DRAWS, NoSupply, Pace, Paces, Spread, after_loop, join_weight,
 };
 use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
 use idle_head::{Axis, Microseconds, Millis, Playback};
@@ -213,6 +213,40 @@ fn a_loops_pace_is_the_p95_and_maximum_of_its_cyclic_differences() {
     }
 }
 
+#[test]
+fn a_loop_keeps_pace_with_the_last_two_loops_and_the_join_into_the_last() {
+    let pace = |p1, m1, p2, m2| Pace {
+        speed: Spread { p95: p1, max: m1 },
+        turn: Spread { p95: p2, max: m2 },
+    };
+    let calm = pace(100, 150, 10, 15);
+    let mid = pace(140, 190, 13, 20);
+    let lively = pace(190, 260, 17, 27);
+    // Neighbours keep pace (260 ≤ 2 · 140, 27 ≤ 2.25 · 13, ...), but the
+    // lively loop not with the calm one (260 > 2 · 100).
+    assert!(Pace::within(lively.score(mid)) && Pace::within(mid.score(calm)));
+    assert!(!Pace::within(lively.score(calm)));
+    let mut history = Paces::new(calm);
+    assert!(Pace::within(history.score(mid)));
+    history.push(mid, 0);
+    // The calm loop two back still counts; once it is three back, not.
+    assert!(!Pace::within(history.score(lively)));
+    history.push(mid, 0);
+    assert!(Pace::within(history.score(lively)));
+    // The join into the last loop against the next loop's P95|d2| (13):
+    // at most 2.75 times it.
+    history.push(mid, 35);
+    assert!(Pace::within(history.score(mid)));
+    history.push(mid, 36);
+    assert!(!Pace::within(history.score(mid)));
+    // A new join against the smallest P95|d2| of its loop and the last two
+    // (10, two back): at most 27.
+    let mut history = Paces::new(calm);
+    history.push(mid, 0);
+    assert!(Pace::within(history.join_score(mid, 27)));
+    assert!(!Pace::within(history.join_score(mid, 28)));
+}
+
 /// A supply that is not ready for its first `late` joins.
 struct Late {
     inner: GenerateOnTake<Box<Set>, DEFAULT_N>,
@@ -327,13 +361,12 @@ struct Smoothness {
 }
 
 /// Other stretches holding a join, beside the loop-length window centred
-/// on it: (frames, frames before the join's start, asserted). One loop
-/// length with the join a quarter and three quarters in (asserted), and
-/// two loop lengths from just before one join to past the next, three
-/// loops (reported only: the rule compares neighbours, so the first and
-/// third loop may differ more; seeds 1000 to 1999 reach 3.25 for d2).
-const STRETCHES: [(usize, usize, bool); 3] =
-    [(1500, 375, true), (1500, 1025, true), (3000, 1450, false)];
+/// on it: (frames, frames before the join's start). One loop length with
+/// the join a quarter and three quarters in, and two loop lengths with
+/// joins 50, 1450 and 2850 frames in (two loops whole, and 150 frames of
+/// each loop either side), which is why a loop must keep pace with the
+/// loop two back as well as with the one it joins.
+const STRETCHES: [(usize, usize); 3] = [(1500, 375), (1500, 1025), (3000, 1450)];
 
 impl Smoothness {
     fn add(&mut self, other: &Self) {
@@ -356,6 +389,8 @@ impl Smoothness {
     }
 }
 
+/// The seeds the bounds were chosen on; [`SEEDS_UNSEEN`] checks them on
+/// others.
 const SEEDS: u64 = 1000;
 const JOINS: usize = 50;
 
@@ -438,7 +473,7 @@ fn measure(from: u64, to: u64) -> Smoothness {
                         values[i].push(value);
                     }
                 }
-                for (&(len, before, _), found) in STRETCHES.iter().zip(&mut s.stretches) {
+                for (&(len, before), found) in STRETCHES.iter().zip(&mut s.stretches) {
                     let Some(start) = (k * period).checked_sub(before) else {
                         continue;
                     };
@@ -464,12 +499,32 @@ fn median(v: &mut [f64]) -> f64 {
     v[v.len() / 2]
 }
 
+/// Seeds 1000 to 1999, never used to choose the bounds.
+const SEEDS_UNSEEN: std::ops::Range<u64> = SEEDS..2 * SEEDS;
+
 #[test]
-#[allow(clippy::needless_range_loop)] // four measures, indexed in parallel arrays
 fn joins_are_as_smooth_as_a_loops_interior_over_1000_seeds_and_50_joins() {
-    let half = SEEDS / 2;
-    let other = thread::spawn(move || measure(0, half));
-    let mut all = measure(half, SEEDS);
+    smooth_over(0..SEEDS, true);
+}
+
+/// The same figures on seeds the bounds were not chosen on, printed and
+/// not asserted (one 1500-frame stretch in 150,000 reaches 10/3 for d2:
+/// see [`idle_head::idle::MAX_JOIN_TURN_RATIO`]). As long again, so run on
+/// request: `cargo test --release --test idle_stream -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn joins_on_other_seeds_measured() {
+    smooth_over(SEEDS_UNSEEN, false);
+}
+
+/// Measures `seeds` ([`measure`], on two threads), prints the figures and,
+/// if `check`, asserts every ratio and stretch at most 3.
+#[allow(clippy::needless_range_loop)] // four measures, indexed in parallel arrays
+fn smooth_over(seeds: std::ops::Range<u64>, check: bool) {
+    let (from, to) = (seeds.start, seeds.end);
+    let half = from + (to - from) / 2;
+    let other = thread::spawn(move || measure(from, half));
+    let mut all = measure(half, to);
     all.add(&other.join().unwrap());
     let names = [
         "max|d1|/P95|d1|, whole window",
@@ -478,8 +533,9 @@ fn joins_are_as_smooth_as_a_loops_interior_over_1000_seeds_and_50_joins() {
         "max|d2|/P95|d2|, join region ",
     ];
     println!(
-        "{SEEDS} seeds x {JOINS} joins x 3 axes; frames in m°, 1500-frame windows centred on each join \
+        "seeds {from} to {} x {JOINS} joins x 3 axes; frames in m°, 1500-frame windows centred on each join \
          (join region: its {} frames and {MARGIN} either side); each loop alone: one loop, region in its middle",
+        to - 1,
         JOIN_FRAMES
     );
     for i in 0..4 {
@@ -506,7 +562,7 @@ fn joins_are_as_smooth_as_a_loops_interior_over_1000_seeds_and_50_joins() {
         all.most_discarded,
         all.fallbacks
     );
-    for (&(len, before, asserted), found) in STRETCHES.iter().zip(&all.stretches) {
+    for (&(len, before), found) in STRETCHES.iter().zip(&all.stretches) {
         println!(
             "  {len} frames, the join {before} frames in: max|d1|/P95|d1| worst {:.2} (seed {}, join {}, {}), max|d2|/P95|d2| worst {:.2} (seed {}, join {}, {}); {} and {} above 3",
             found[0].0.value,
@@ -520,9 +576,15 @@ fn joins_are_as_smooth_as_a_loops_interior_over_1000_seeds_and_50_joins() {
             found[0].1,
             found[1].1,
         );
+    }
+    if !check {
+        return;
+    }
+    // Every stretch holding one or two joins: at most 3.
+    for (&(len, before), found) in STRETCHES.iter().zip(&all.stretches) {
         for (i, (worst, above)) in found.iter().enumerate() {
             assert!(
-                !asserted || worst.value <= 3.0,
+                worst.value <= 3.0,
                 "{len}-frame stretch, join {before} in, d{}: {above} above 3, worst {worst:?}",
                 i + 1
             );

@@ -21,16 +21,25 @@
 //! start of the next. If one is lively and the other calm, the calm one
 //! lowers the stretch's P95 and the lively one's fastest moments stand out
 //! (max|d1|/P95|d1| reached 3.13 while every loop alone stays below 2.75),
-//! and a join between loops that match badly can turn sharply. So each
-//! axis draws its next loop until it keeps pace with the outgoing loop,
-//! measured on the loops' samples in m° ([`Pace`], cyclic, per sample):
+//! and a join between loops that match badly can turn sharply. A stretch of
+//! two loop lengths holds two loops whole and the ends of the loops either
+//! side, so loops two apart meet in one P95 too. So each axis draws its next loop until
+//! it keeps pace with the axis' last two loops ([`Paces`]), measured on the
+//! loops' samples in m° ([`Pace`], cyclic, per sample):
 //!
-//! - the largest |d1| of either loop is at most [`MAX_SPEED_RATIO`] (2)
-//!   times the other's P95|d1|, and the largest |d2| at most
-//!   [`MAX_TURN_RATIO`] (2.25) times the other's P95|d2|;
-//! - once entered and blended, the largest |d2| over the join's samples is
-//!   at most [`MAX_JOIN_TURN_RATIO`] (3) times the smaller P95|d2|.
+//! - against each of the last two loops, the largest |d1| of either loop is
+//!   at most [`MAX_SPEED_RATIO`] (2) times the other's P95|d1|, and the
+//!   largest |d2| at most [`MAX_TURN_RATIO`] (2.25) times the other's
+//!   P95|d2|;
+//! - the largest |d2| over the join into the last loop is at most
+//!   [`MAX_JOIN_TURN_RATIO`] (2.75) times the new loop's P95|d2|;
+//! - once entered and blended, the largest |d2| over the new join's samples
+//!   is at most [`MAX_JOIN_TURN_RATIO`] times the smallest P95|d2| of the
+//!   new loop and the last two.
 //!
+//! Each loop is thus measured against the loops up to two away, and each
+//! join against the two loops before it, the one it enters and the one
+//! after it.
 //! A loop that breaks a bound is discarded and the axis draws the next
 //! one, from the seed after it; after [`MAX_DRAWS`] (16) draws the one
 //! closest to the bounds is kept (generated again from its seed; the
@@ -38,8 +47,15 @@
 //! frames' 3 because the samples do not see all the frames do (the spline
 //! between samples, the m° rounding of each frame, a stretch holding only
 //! part of each loop). A loop's own interior is never judged, only the
-//! difference between neighbours: "as smooth as a loop's interior". Set 0
-//! is the configuration's own and never discarded.
+//! difference between loops: "as smooth as a loop's interior". Set 0
+//! is the configuration's own and never discarded; set 1 is measured
+//! against it as both of the last two loops.
+//!
+//! Over 1,000 seeds × 50 joins × 3 axes (the host test `idle_stream`),
+//! 43 % of the loops drawn are discarded (36 % with neighbours only), a
+//! set draws 2.26 loops more on average, at most 15 are discarded for one
+//! loop and 127 loops in 153,000 take all 16 draws; the background cost is
+//! in the README ("Never-repeating idle").
 //!
 //! # The join
 //!
@@ -93,6 +109,8 @@ mod stream;
 
 pub use crate::behaviour::IdleSource;
 pub use join::{IdleError, IdleTiming, JOIN_FRAMES, MAX_JOIN_SAMPLES, join_weight};
-pub use pace::{MAX_DRAWS, MAX_JOIN_TURN_RATIO, MAX_SPEED_RATIO, MAX_TURN_RATIO, Pace, Spread};
+pub use pace::{
+    MAX_DRAWS, MAX_JOIN_TURN_RATIO, MAX_SPEED_RATIO, MAX_TURN_RATIO, Pace, Paces, Spread,
+};
 pub use source::{IdleMode, IdlePlayer, IdleStats, LoopSupply, NoSupply};
 pub use stream::{GenerateOnTake, LoopSet, LoopStream, MATCH_STRIDE, SetInfo, SetView, after_loop};

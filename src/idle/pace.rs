@@ -21,9 +21,12 @@ pub const MAX_SPEED_RATIO: u32 = 512;
 /// P95|d2|, Q8: 2.25.
 pub const MAX_TURN_RATIO: u32 = 576;
 
-/// The largest |d2| over the join's samples over the smaller P95|d2| of
-/// the two loops, Q8: 3.
-pub const MAX_JOIN_TURN_RATIO: u32 = 768;
+/// The largest |d2| over a join's samples over the P95|d2| of the loop it
+/// enters, of the two before and of the one after, Q8: 2.75. Below 3
+/// because the frames' |d2| are a few m° per frame², so one m° more is a
+/// tenth more: a join at exactly 3 times a P95|d2| of 9 m°/sample²
+/// measured 10/3 over 3000 frames.
+pub const MAX_JOIN_TURN_RATIO: u32 = 704;
 
 /// Loops an axis may draw for one set: the first, and up to 15 more while
 /// the last drawn breaks a bound.
@@ -191,25 +194,81 @@ impl Pace {
         if speed > turn { speed } else { turn }
     }
 
-    /// How far the join's largest |d2| (`join_turn`, m° per sample²) is from
-    /// its bound against the smaller P95|d2| of `self` and `out`, Q8 (at
-    /// most 256: within it).
-    #[must_use]
-    pub const fn join_score(self, out: Self, join_turn: u16) -> u32 {
-        let p95 = if self.turn.p95 < out.turn.p95 {
-            self.turn.p95
-        } else {
-            out.turn.p95
-        };
-        against(ratio(join_turn, p95), MAX_JOIN_TURN_RATIO)
-    }
-
     /// Whether a score of [`score`](Self::score) or
-    /// [`join_score`](Self::join_score) is within its bounds.
+    /// [`Paces::score`] is within its bounds.
     #[must_use]
     pub const fn within(score: u32) -> bool {
         score <= ONE
     }
+}
+
+/// What an axis' next loop must keep pace with: its last two loops and
+/// the join into the last (18 bytes). A stretch of two loop lengths holds
+/// two loops whole and the ends of those either side, so each loop is
+/// measured against the loops up to two away, and each join against the
+/// two loops before it, the one it enters and the one after.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Paces {
+    /// The last loop's pace: the loop the next one joins.
+    pub last: Pace,
+    /// The pace of the loop before it.
+    pub before: Pace,
+    /// The largest |d2| over the join into the last loop (0: none), m° per
+    /// sample².
+    pub join_turn: u16,
+}
+
+impl Paces {
+    /// The history of a stream whose only loop so far has the pace `first`
+    /// (set 0, with no join: the loop before it is taken to be itself).
+    #[must_use]
+    pub const fn new(first: Pace) -> Self {
+        Self {
+            last: first,
+            before: first,
+            join_turn: 0,
+        }
+    }
+
+    /// How far `pace` is from keeping pace with the last two loops
+    /// ([`Pace::score`] against each) and from being calm enough for the
+    /// join into the last ([`MAX_JOIN_TURN_RATIO`] of its P95|d2|), Q8:
+    /// the largest of the three. At most 256: within the bounds.
+    #[must_use]
+    pub const fn score(self, pace: Pace) -> u32 {
+        let last = pace.score(self.last);
+        let before = pace.score(self.before);
+        let join = against(ratio(self.join_turn, pace.turn.p95), MAX_JOIN_TURN_RATIO);
+        max(max(last, before), join)
+    }
+
+    /// How far the largest |d2| over the join into `pace`'s loop
+    /// (`join_turn`, m° per sample²) is from its bound against the smallest
+    /// P95|d2| of that loop and the last two, Q8 (at most 256: within it).
+    #[must_use]
+    pub const fn join_score(self, pace: Pace, join_turn: u16) -> u32 {
+        let p95 = min(min(pace.turn.p95, self.last.turn.p95), self.before.turn.p95);
+        against(ratio(join_turn, p95), MAX_JOIN_TURN_RATIO)
+    }
+
+    /// Makes `pace` the last loop's, joined with the largest |d2|
+    /// `join_turn`.
+    pub const fn push(&mut self, pace: Pace, join_turn: u16) {
+        self.before = self.last;
+        self.last = pace;
+        self.join_turn = join_turn;
+    }
+}
+
+/// The larger of two scores (`u32::max` is not `const`).
+const fn max(a: u32, b: u32) -> u32 {
+    if a > b { a } else { b }
+}
+
+/// The smaller of two P95s.
+const fn min(a: u16, b: u16) -> u16 {
+    if a < b { a } else { b }
 }
 
 /// The largest |d2| of the samples `values` yields, m° per sample².

@@ -8,7 +8,7 @@ use crate::motion::{
 };
 
 use super::join::{IdleTiming, MAX_JOIN_SAMPLES, blend, join_weight};
-use super::pace::{MAX_DRAWS, Pace, Spread, max_turn};
+use super::pace::{MAX_DRAWS, Pace, Paces, Spread, max_turn};
 
 /// Samples of a join kept per axis: the one before it, and the join's
 /// `J + 1` (see [`LoopSet`]).
@@ -199,6 +199,8 @@ const PACE_ZERO: Pace = Pace {
     speed: Spread { p95: 0, max: 0 },
     turn: Spread { p95: 0, max: 0 },
 };
+/// The same for both loops a new one is measured against.
+const PACES_ZERO: Paces = Paces::new(PACE_ZERO);
 
 /// What [`LoopStream::next_into`] made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -215,8 +217,8 @@ pub struct SetInfo {
     /// [`MATCH_STRIDE`] samples): what the blend has to hide.
     pub mismatch: [u32; 3],
     /// Per axis, the loops drawn and discarded before the one kept, for
-    /// not keeping pace with the outgoing loop or joining it too sharply
-    /// ([`Pace`]).
+    /// not keeping pace with the axis' last two loops or joining the last
+    /// too sharply ([`Paces`]).
     pub discarded: [u8; 3],
 }
 
@@ -237,8 +239,9 @@ pub struct LoopStream<const N: usize> {
     /// The last set's samples at playback indices `N − J − 1 ..= N` per
     /// axis, in m°: the one before its join out, and what it plays.
     exit: [[i16; KEPT]; 3],
-    /// The last set's pace per axis, which the next set's loops must keep.
-    pace: [Pace; 3],
+    /// The pace of the last two sets per axis, which the next set's loops
+    /// must keep.
+    pace: [Paces; 3],
 }
 
 impl<const N: usize> LoopStream<N> {
@@ -257,7 +260,7 @@ impl<const N: usize> LoopStream<N> {
             seeds: [config.pitch.seed, config.roll.seed, config.yaw.seed],
             next: 0,
             exit: [[0; KEPT]; 3],
-            pace: [PACE_ZERO; 3],
+            pace: [PACES_ZERO; 3],
         }
     }
 
@@ -326,13 +329,13 @@ impl<const N: usize> LoopStream<N> {
         })
     }
 
-    /// Draws the loop of `axis` into `set` until one keeps pace with the
-    /// outgoing loop and joins it within the bounds ([`Pace`]), each from
-    /// where the last drawn one's LCG stream stopped; after [`MAX_DRAWS`]
-    /// the one closest to the bounds is kept (generated again from its
-    /// seed). `set` holds the first draw, generated from `set.seeds`, and
-    /// the stream's seeds are already past it. Returns the loops drawn and
-    /// the kept entry's cost.
+    /// Draws the loop of `axis` into `set` until it keeps pace with the
+    /// axis' last two loops and its join is within the bounds ([`Paces`]),
+    /// each draw from where the last one's LCG stream stopped; after
+    /// [`MAX_DRAWS`] the one closest to the bounds is kept (generated again
+    /// from its seed). `set` holds the first draw, generated from
+    /// `set.seeds`, and the stream's seeds are already past it. Returns the
+    /// loops drawn and the kept entry's cost.
     fn draw<const CAP: usize>(
         &mut self,
         set: &mut LoopSet<N, CAP>,
@@ -346,9 +349,9 @@ impl<const N: usize> LoopStream<N> {
         let mut best = (u32::MAX, set.seeds[a]);
         loop {
             if generated {
-                let (score, pace, cost) = self.enter(set, axis, false);
+                let (score, pace, turn, cost) = self.enter(set, axis, false);
                 if Pace::within(score) {
-                    self.pace[a] = pace;
+                    self.pace[a].push(pace, turn);
                     return (draws, cost);
                 }
                 if score < best.0 {
@@ -373,28 +376,28 @@ impl<const N: usize> LoopStream<N> {
             // axis stays neutral).
             let _ = set.loops.generate_axis(config, axis);
         }
-        let (_, pace, cost) = self.enter(set, axis, true);
-        self.pace[a] = pace;
+        let (_, pace, turn, cost) = self.enter(set, axis, true);
+        self.pace[a].push(pace, turn);
         (draws, cost)
     }
 
-    /// Measures the loop of `axis` in `set` against the outgoing one and,
-    /// if it keeps pace (or `always`), enters it where it joins the exit
-    /// best and blends the join. Returns its score ([`Pace::score`], then
-    /// the larger of that and [`Pace::join_score`] once joined), its pace
-    /// and its entry's cost (`u64::MAX`: not entered).
+    /// Measures the loop of `axis` in `set` against the last two and, if
+    /// it keeps pace (or `always`), enters it where it joins the exit best
+    /// and blends the join. Returns its score ([`Paces::score`], then
+    /// the larger of that and [`Paces::join_score`] once joined), its pace,
+    /// its join's largest |d2| and its entry's cost (`u64::MAX`: not
+    /// entered).
     fn enter<const CAP: usize>(
         &self,
         set: &mut LoopSet<N, CAP>,
         axis: Axis,
         always: bool,
-    ) -> (u32, Pace, u64) {
+    ) -> (u32, Pace, u16, u64) {
         let a = axis.index();
-        let out = self.pace[a];
         let pace = Pace::of_loop(set.loops.axis(axis));
-        let score = pace.score(out);
+        let score = self.pace[a].score(pace);
         if !Pace::within(score) && !always {
-            return (score, pace, u64::MAX);
+            return (score, pace, 0, u64::MAX);
         }
         let j = self.join_samples;
         let (start, cost) = best_entry(set.loops.axis(axis), &self.exit[a], j);
@@ -414,7 +417,8 @@ impl<const N: usize> LoopStream<N> {
         let after = [j + 1, j + 2].map(|i| t.angle(i).millidegrees());
         let samples = join.iter().take(j + 2).map(|&v| i32::from(v));
         let turn = max_turn(samples.chain(after));
-        (score.max(pace.join_score(out, turn)), pace, cost)
+        let score = score.max(self.pace[a].join_score(pace, turn));
+        (score, pace, turn, cost)
     }
 
     /// Takes `set`, generated by [`LoopSet::generate`] from this stream's
@@ -426,7 +430,7 @@ impl<const N: usize> LoopStream<N> {
         self.next = set.number + 1;
         self.capture(set);
         for (axis, pace) in Axis::ALL.iter().zip(self.pace.iter_mut()) {
-            *pace = Pace::of_loop(set.loops.axis(*axis));
+            *pace = Paces::new(Pace::of_loop(set.loops.axis(*axis)));
         }
     }
 
