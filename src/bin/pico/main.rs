@@ -267,10 +267,12 @@ async fn main(spawner: Spawner) {
         precompute_us,
         first.checksum()
     );
-    let mut stream = LoopStream::new(*head, &TIMING);
-    stream.adopt(first);
     match IDLE_MODE {
         IdleMode::NeverRepeating => {
+            // The stream starts from the boot set, whose pace it measures
+            // (a fixed loop has no stream and skips that).
+            let mut stream = LoopStream::new(*head, &TIMING);
+            stream.adopt(first);
             defmt::info!(
                 "idle: never repeating, a new loop set every {=u32} frames, joined over {=u32}",
                 TIMING.period(),
