@@ -111,6 +111,11 @@ impl Glide {
         self.target
     }
 
+    /// The frame the move arrives at (meaningful while [`moving`](Self::moving)).
+    pub(crate) const fn end(&self) -> u32 {
+        self.start.wrapping_add(self.frames)
+    }
+
     /// Whether the move is still under way (as of the last [`at`](Self::at)).
     pub(crate) const fn moving(&self) -> bool {
         self.frames != 0

@@ -67,8 +67,18 @@ pub struct Mixer {
     idle_gain: Glide,
     idle_on: bool,
     idle_amp: Percent,
-    /// Frames each axis stays in gesture mode.
+    /// Frames each axis stays in gesture mode after it was last on, as of
+    /// the last frame mixed in full (see [`Mixer::events`]).
     gesture_left: [u32; 3],
+    /// Bit `i`: axis `i` was on (a gesture or a gaze move playing on it) at
+    /// the last frame mixed in full, and so at every frame since.
+    on: u8,
+    /// The first frame that must be mixed in full: nothing but the values
+    /// changes before it (no layer or move starts or ends, no return is
+    /// due, no settle time runs out).
+    until: u32,
+    /// The last frame mixed in full.
+    full: u32,
     /// The limit modes from the next frame on.
     modes: [LimitMode; 3],
     /// Nothing moves but the idle, at `rest_gain` around `rest_centre`.
@@ -94,6 +104,9 @@ impl Mixer {
             idle_on: true,
             idle_amp: amp,
             gesture_left: [0; 3],
+            on: 0,
+            until: 0,
+            full: 0,
             modes: [LimitMode::Idle; 3],
             quiet: true,
             rest_gain: gain_of(amp) as u32,
@@ -145,6 +158,8 @@ impl Mixer {
             Action::Stop => return Ok(Applied::Stop),
         };
         self.quiet = false;
+        // The next frame is mixed in full.
+        self.until = next;
         Ok(applied)
     }
 
@@ -230,10 +245,12 @@ impl Mixer {
     ///
     /// Written per axis rather than over arrays: on a Cortex-M0 the loops
     /// over `[_; 3]` cost more in spilled counters and pointers than their
-    /// bodies (see [`Sums`]).
+    /// bodies (see [`Sums`]). The limit modes and whether the mixer is at
+    /// rest only change at events (see [`events`](Self::events)); the frames
+    /// between compute the values alone.
     #[inline(never)]
     fn mix(&mut self, now: u32, idle: [Angle; 3]) -> [Angle; 3] {
-        let elapsed = now.wrapping_sub(self.now).max(1);
+        let prev = self.now;
         self.now = now;
         self.next = now.wrapping_add(1);
         let sums = self.layers(now);
@@ -249,29 +266,49 @@ impl Mixer {
         let pitch = idle_part(pitch, gain, sums.duck[0]) + sums.add[0] + centre[0];
         let roll = idle_part(roll, gain, sums.duck[1]) + sums.add[1];
         let yaw = idle_part(yaw, gain, sums.duck[2]) + sums.add[2] + centre[1];
+        // `now < until` (frames only increase).
+        if self.until.wrapping_sub(now) as i32 <= 0 {
+            self.events(now, prev, sums.active, centre, gain);
+        }
+        [pitch, roll, yaw].map(Angle::from_millidegrees)
+    }
 
-        // The modes from the next frame on: gesture while anything plays on
-        // the axis (or the return starts) and `settle` after.
+    /// A frame mixed in full: the limit modes from the next frame on,
+    /// whether the mixer comes to rest, and the next such frame.
+    ///
+    /// The modes: gesture while anything plays on the axis (or the return
+    /// starts next frame) and `settle` frames after. An axis' state can only
+    /// change at an *event*: a layer or a gaze move ends, the return is due
+    /// or starts, the idle gain's glide ends, a settle time runs out, or an
+    /// action is applied. Between two events each axis stays on or off, so
+    /// its frames left in gesture mode follow from the frames passed: this
+    /// gives the modes of every frame exactly as counting them down frame by
+    /// frame would.
+    #[inline(never)]
+    fn events(&mut self, now: u32, prev: u32, active: u8, centre: [i32; 2], gain: u32) {
         let moving = self.gaze.moving();
         let returning = self.gaze.returns_by(self.next);
+        let on = active | u8::from(moving[0]) | (u8::from(moving[1]) << 2);
         let settle = self.params.settle;
+        // Frames since the last frame mixed, and since the last mixed in full.
+        let since_prev = now.wrapping_sub(prev).max(1);
+        let since_full = now.wrapping_sub(self.full).max(1);
+        let was_on = self.on;
+        let mut soonest = u32::MAX;
+        let axis = Settle {
+            on,
+            was_on,
+            settle,
+            since_prev,
+            since_full,
+        };
         let [pitch_left, roll_left, yaw_left] = &mut self.gesture_left;
-        let [pitch_mode, roll_mode, yaw_mode] = &mut self.modes;
-        *pitch_mode = settle_mode(
-            pitch_left,
-            sums.active & 1 != 0 || moving[0],
-            returning,
-            settle,
-            elapsed,
-        );
-        *roll_mode = settle_mode(roll_left, sums.active & 2 != 0, false, settle, elapsed);
-        *yaw_mode = settle_mode(
-            yaw_left,
-            sums.active & 4 != 0 || moving[1],
-            returning,
-            settle,
-            elapsed,
-        );
+        self.modes = [
+            axis.mode(0, pitch_left, returning, &mut soonest),
+            axis.mode(1, roll_left, false, &mut soonest),
+            axis.mode(2, yaw_left, returning, &mut soonest),
+        ];
+        self.on = on;
         if LimitMode::same(self.modes, [LimitMode::Idle; 3])
             && self.layers.iter().all(Option::is_none)
             && !self.gaze.pending()
@@ -281,7 +318,27 @@ impl Mixer {
             self.rest_centre = centre;
             self.rest_gain = gain;
         }
-        [pitch, roll, yaw].map(Angle::from_millidegrees)
+        // The next event.
+        let blend = self.params.blend;
+        for layer in self.layers.iter().flatten() {
+            let mut end = layer.start.wrapping_add(layer.plan.frames);
+            if let Some(release) = layer.release {
+                let fade_end = release.wrapping_add(blend);
+                if fade_end.wrapping_sub(now) < end.wrapping_sub(now) {
+                    end = fade_end;
+                }
+            }
+            soonest = soonest.min(end.wrapping_sub(now));
+        }
+        soonest = soonest.min(self.gaze.next_event(now));
+        if self.idle_gain.moving() {
+            soonest = soonest.min(self.idle_gain.end().wrapping_sub(now));
+        }
+        // Every event lies ahead (at least the next frame); at rest, or
+        // nothing due for 2³⁰ frames (about 8 months), the next frame mixed
+        // in full is the first after an action or 2³⁰ frames on.
+        self.full = now;
+        self.until = now.wrapping_add(soonest.clamp(1, 1 << 30));
     }
 
     /// The gesture layers at frame `now`, summed per axis; clears the
@@ -357,20 +414,47 @@ const fn idle_part(idle: i32, gain: u32, duck: u32) -> i32 {
     if duck == ONE { value } else { mul(value, duck) }
 }
 
-/// One axis' limit mode from the next frame on, its frames `left` in
-/// gesture mode updated: gesture while `on` (and `settle` frames after) or
-/// when a return starts (`soon`).
-#[inline]
-const fn settle_mode(left: &mut u32, on: bool, soon: bool, settle: u32, elapsed: u32) -> LimitMode {
-    *left = if on {
-        settle
-    } else {
-        left.saturating_sub(elapsed)
-    };
-    if on || soon || *left > 0 {
-        LimitMode::Gesture
-    } else {
-        LimitMode::Idle
+/// What the limit modes of one frame mixed in full follow from (see
+/// [`Mixer::events`]).
+struct Settle {
+    /// Bit `i`: axis `i` is on at this frame.
+    on: u8,
+    /// Bit `i`: axis `i` was on at the last frame mixed in full.
+    was_on: u8,
+    /// Frames in gesture mode after an axis was last on.
+    settle: u32,
+    /// Frames since the last frame mixed, and since the last mixed in full.
+    since_prev: u32,
+    since_full: u32,
+}
+
+impl Settle {
+    /// Axis `i`'s limit mode from the next frame on, its frames `left` in
+    /// gesture mode updated: gesture while on (and `settle` frames after) or
+    /// when a return starts (`soon`). An axis off but still settling lowers
+    /// `soonest` to the frames until it settles.
+    #[inline]
+    fn mode(&self, i: u32, left: &mut u32, soon: bool, soonest: &mut u32) -> LimitMode {
+        let bit = 1 << i;
+        if self.on & bit != 0 {
+            *left = self.settle;
+            return LimitMode::Gesture;
+        }
+        // Off since the last frame (on until then), or since the last frame
+        // mixed in full: gesture mode counts down by the frames passed.
+        *left = if self.was_on & bit != 0 {
+            self.settle.saturating_sub(self.since_prev)
+        } else {
+            left.saturating_sub(self.since_full)
+        };
+        if *left > 0 {
+            *soonest = (*soonest).min(*left);
+            LimitMode::Gesture
+        } else if soon {
+            LimitMode::Gesture
+        } else {
+            LimitMode::Idle
+        }
     }
 }
 
