@@ -367,13 +367,11 @@ const fn clamp_u32(v: u64) -> u32 {
 }
 
 impl GesturePlan {
-    /// The layer at `t` frames after the start: its offset (m°) and its
-    /// envelope `E` (Q16), or `None` once it has ended.
+    /// The layer at `t` frames after the start, for `t` before its end
+    /// (`t < frames`; the caller ends the layer at `frames`): its offset
+    /// (m°) and its envelope `E` (Q16).
     #[inline]
-    pub(crate) fn at(&self, t: u32) -> Option<(i32, u32)> {
-        if t >= self.frames {
-            return None;
-        }
+    pub(crate) fn at(&self, t: u32) -> (i32, u32) {
         let u = progress(t, self.inverse);
         let n = self.cycles as u32;
         // φ < n: u < 1.
@@ -410,6 +408,6 @@ impl GesturePlan {
                 }
             }
         };
-        Some((value, envelope))
+        (value, envelope)
     }
 }

@@ -54,6 +54,9 @@ struct Layer {
     plan: GesturePlan,
     start: u32,
     release: Option<u32>,
+    /// Frames from `start` to the layer's end: its plan's, or its fade's
+    /// once released.
+    stop: u32,
 }
 
 /// Idle, gestures and gaze mixed into one set of offsets; see the
@@ -193,14 +196,21 @@ impl Mixer {
                 retry_in: self.params.millis(left + 1),
             });
         };
+        let blend = self.params.blend;
         for layer in self.layers.iter_mut().flatten() {
-            layer.release.get_or_insert(next);
+            if layer.release.is_none() {
+                layer.release = Some(next);
+                // The fade ends `blend` frames on, if the plan has not ended by then.
+                let fade_end = next.wrapping_sub(layer.start).saturating_add(blend);
+                layer.stop = layer.stop.min(fade_end);
+            }
         }
         if let Some(slot) = self.layers.get_mut(free) {
             *slot = Some(Layer {
                 plan,
                 start: next,
                 release: None,
+                stop: plan.frames,
             });
         }
         Ok(plan)
@@ -295,7 +305,7 @@ impl Mixer {
         let since_full = now.wrapping_sub(self.full).max(1);
         let was_on = self.on;
         let mut soonest = u32::MAX;
-        let axis = Settle {
+        let axis = Countdown {
             on,
             was_on,
             settle,
@@ -319,15 +329,8 @@ impl Mixer {
             self.rest_gain = gain;
         }
         // The next event.
-        let blend = self.params.blend;
         for layer in self.layers.iter().flatten() {
-            let mut end = layer.start.wrapping_add(layer.plan.frames);
-            if let Some(release) = layer.release {
-                let fade_end = release.wrapping_add(blend);
-                if fade_end.wrapping_sub(now) < end.wrapping_sub(now) {
-                    end = fade_end;
-                }
-            }
+            let end = layer.start.wrapping_add(layer.stop);
             soonest = soonest.min(end.wrapping_sub(now));
         }
         soonest = soonest.min(self.gaze.next_event(now));
@@ -353,18 +356,17 @@ impl Mixer {
         let params = &self.params;
         for slot in &mut self.layers {
             let Some(layer) = slot else { continue };
-            let Some((mut value, mut strength)) = layer.plan.at(now.wrapping_sub(layer.start))
-            else {
+            let t = now.wrapping_sub(layer.start);
+            if t >= layer.stop {
                 *slot = None;
                 continue;
-            };
+            }
+            // t < stop ≤ the plan's frames.
+            let (mut value, mut strength) = layer.plan.at(t);
             if let Some(release) = layer.release {
-                let t = now.wrapping_sub(release);
-                if t >= params.blend {
-                    *slot = None;
-                    continue;
-                }
-                let fade = ONE - smootherstep(progress(t, params.blend_inverse));
+                // now − release < blend: before the stop.
+                let fade =
+                    ONE - smootherstep(progress(now.wrapping_sub(release), params.blend_inverse));
                 value = mul(value, fade);
                 strength = mul(strength as i32, fade) as u32;
             }
@@ -416,7 +418,7 @@ const fn idle_part(idle: i32, gain: u32, duck: u32) -> i32 {
 
 /// What the limit modes of one frame mixed in full follow from (see
 /// [`Mixer::events`]).
-struct Settle {
+struct Countdown {
     /// Bit `i`: axis `i` is on at this frame.
     on: u8,
     /// Bit `i`: axis `i` was on at the last frame mixed in full.
@@ -428,7 +430,7 @@ struct Settle {
     since_full: u32,
 }
 
-impl Settle {
+impl Countdown {
     /// Axis `i`'s limit mode from the next frame on, its frames `left` in
     /// gesture mode updated: gesture while on (and `settle` frames after) or
     /// when a return starts (`soon`). An axis off but still settling lowers

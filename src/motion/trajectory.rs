@@ -135,6 +135,7 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
 
     /// Sample `index` of the loop in playback order (taken modulo N) as an angle.
     #[must_use]
+    #[inline]
     pub fn angle(&self, index: usize) -> Angle {
         // Playback reads indices below N: no division for them (out of
         // line, or the compiler divides before it compares).
@@ -168,6 +169,7 @@ impl<S: Sample, const N: usize> crate::playback::LoopSource for Trajectory<S, N>
         N
     }
 
+    #[inline]
     fn angle(&self, index: usize) -> Angle {
         Trajectory::angle(self, index)
     }
