@@ -47,6 +47,20 @@ impl Envelope {
         }
     }
 
+    /// The gain of this frame, the level then moved one frame on: the
+    /// frame path's [`gain`](Self::gain) and [`advance`](Self::advance).
+    /// Faded in and not stopping, the gain stays 1 and nothing moves: one
+    /// comparison.
+    #[inline]
+    pub(crate) const fn next_gain(&mut self) -> u32 {
+        if self.level >= self.frames && !self.stopping {
+            return UNITY;
+        }
+        let gain = self.gain();
+        self.advance();
+        gain
+    }
+
     /// The current gain in Q16 (`0..=65 536`).
     pub(crate) const fn gain(&self) -> u32 {
         if self.level >= self.frames {

@@ -147,8 +147,7 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         if !self.started {
             return self.start();
         }
-        let gain = self.envelope.gain();
-        self.envelope.advance();
+        let gain = self.envelope.next_gain();
         let [pitch, roll, yaw] = offsets;
         self.servo_frame(0, pitch, gain);
         self.servo_frame(1, roll, gain);
