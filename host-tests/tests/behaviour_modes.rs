@@ -1,0 +1,184 @@
+//! The mixer's limit modes against the rule they follow, counted frame by
+//! frame: an axis is in gesture mode while a gesture plays on it or a gaze
+//! move moves it, and for `settle` frames after (counted down by the frames
+//! passed, late frames included). The mixer works the modes out only at
+//! events (a layer or a move ends, an action is applied, a settle time runs
+//! out); this checks that it gives the modes of every frame exactly, for
+//! random scripts of gestures, looks and moves back to the centre, with
+//! frames skipped.
+
+use idle_head::Angle;
+use idle_head::behaviour::{Applied, LimitMode, Mixer};
+use idle_head::command::{Action, GestureKind, Hold, LookRequest};
+use idle_head::units::Millis;
+use proptest::prelude::*;
+
+use host_tests::behaviour::{default_params as params, gesture};
+
+/// Frame period of the default configuration, ms.
+const FRAME_MS: u32 = 20;
+
+/// A gesture layer as the rule sees it: its axis and end frame.
+#[derive(Clone, Copy, Debug)]
+struct Layer {
+    axis: usize,
+    end: u64,
+    released: bool,
+}
+
+/// The modes counted frame by frame from what the actions answered.
+struct Model {
+    layers: Vec<Layer>,
+    /// The gaze move: start and end frame (moving in `start..end`).
+    gaze: (u64, u64),
+    left: [u64; 3],
+    blend: u64,
+    settle: u64,
+    /// The last frame played, if any.
+    last: Option<u64>,
+}
+
+impl Model {
+    fn next(&self) -> u64 {
+        self.last.map_or(0, |f| f + 1)
+    }
+
+    /// An action applied before frame `next`, as answered.
+    fn apply(&mut self, outcome: &Applied) {
+        let next = self.next();
+        match outcome {
+            Applied::Gesture(plan) => {
+                for layer in &mut self.layers {
+                    if !layer.released {
+                        layer.released = true;
+                        layer.end = layer.end.min(next + self.blend);
+                    }
+                }
+                self.layers.push(Layer {
+                    axis: plan.kind.axis().index(),
+                    end: next + u64::from(plan.duration.0 / FRAME_MS),
+                    released: false,
+                });
+            }
+            Applied::Look(look) => {
+                self.gaze = (next, next + u64::from(look.duration.0 / FRAME_MS));
+            }
+            Applied::Center(ms) => self.gaze = (next, next + u64::from(ms.0 / FRAME_MS)),
+            Applied::Idle(_) | Applied::Stop => {}
+        }
+    }
+
+    /// The modes after frame `frame` is played (for the next frame).
+    fn frame(&mut self, frame: u64) -> [LimitMode; 3] {
+        let elapsed = self.last.map_or(1, |last| (frame - last).max(1));
+        self.last = Some(frame);
+        self.layers.retain(|l| frame < l.end);
+        let mut on = [false; 3];
+        for layer in &self.layers {
+            on[layer.axis] = true;
+        }
+        let moving = (self.gaze.0..self.gaze.1).contains(&frame);
+        on[0] |= moving;
+        on[2] |= moving;
+        core::array::from_fn(|i| {
+            self.left[i] = if on[i] {
+                self.settle
+            } else {
+                self.left[i].saturating_sub(elapsed)
+            };
+            if on[i] || self.left[i] > 0 {
+                LimitMode::Gesture
+            } else {
+                LimitMode::Idle
+            }
+        })
+    }
+}
+
+/// One step of a script: frames to the next frame played (1: the next,
+/// more: late frames skipped) and what to apply before it.
+#[derive(Clone, Debug)]
+struct Step {
+    gap: u64,
+    action: Option<Action>,
+}
+
+fn action() -> impl Strategy<Value = Action> {
+    let kind = prop_oneof![
+        Just(GestureKind::Nod),
+        Just(GestureKind::Shake),
+        Just(GestureKind::Tilt)
+    ];
+    prop_oneof![
+        (kind, proptest::option::of(1_u8..=3)).prop_map(|(kind, cycles)| {
+            let cycles = if kind == GestureKind::Tilt {
+                None
+            } else {
+                cycles
+            };
+            gesture(kind, None, None, cycles)
+        }),
+        (
+            -8000_i32..8000,
+            -15_000_i32..15_000,
+            proptest::option::of(300_u32..1500)
+        )
+            .prop_map(|(pitch, yaw, ms)| {
+                Action::Look(LookRequest {
+                    pitch: Angle::from_millidegrees(pitch),
+                    yaw: Angle::from_millidegrees(yaw),
+                    duration: ms.map(Millis),
+                    hold: Some(Hold::Stay),
+                })
+            }),
+        proptest::option::of(300_u32..1500).prop_map(|ms| Action::Center {
+            duration: ms.map(Millis)
+        }),
+    ]
+}
+
+fn step() -> impl Strategy<Value = Step> {
+    (
+        prop_oneof![8 => Just(1_u64), 1 => 2_u64..6, 1 => 10_u64..40],
+        proptest::option::weighted(0.06, action()),
+    )
+        .prop_map(|(gap, action)| Step { gap, action })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(128))]
+
+    #[test]
+    fn the_modes_are_those_of_the_frame_by_frame_count(
+        script in proptest::collection::vec(step(), 100..600),
+    ) {
+        let params = params();
+        let config = params.config();
+        let mut model = Model {
+            layers: Vec::new(),
+            gaze: (0, 0),
+            left: [0; 3],
+            blend: u64::from(params.frames(config.blend)),
+            settle: u64::from(params.frames(config.settle)),
+            last: None,
+        };
+        let mut mixer = Mixer::new(params);
+        let mut frame = 0;
+        for (k, step) in script.iter().enumerate() {
+            if let Some(action) = &step.action
+                && let Ok(applied) = mixer.apply(action)
+            {
+                model.apply(&applied);
+                // From the next frame on, as the driver gets them.
+                let wanted = mixer.modes();
+                if let Applied::Gesture(plan) = applied {
+                    prop_assert_eq!(wanted[plan.kind.axis().index()], LimitMode::Gesture);
+                }
+            }
+            mixer.frame(frame, [Angle::ZERO; 3]);
+            let expected = model.frame(frame);
+            prop_assert_eq!(mixer.modes(), expected, "step {} at frame {}", k, frame);
+            frame += step.gap;
+        }
+    }
+}
