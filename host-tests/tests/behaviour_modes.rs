@@ -2,13 +2,13 @@
 //! frame: an axis is in gesture mode while a gesture plays on it or a gaze
 //! move moves it, and for `settle` frames after (counted down by the frames
 //! passed, late frames included). The mixer works the modes out only at
-//! events (a layer or a move ends, an action is applied, a settle time runs
-//! out); this checks that it gives the modes of every frame exactly, for
-//! random scripts of gestures, looks and moves back to the centre, with
-//! frames skipped.
+//! events (a layer or a move ends, an action is applied, a return is due, a
+//! settle time runs out); this checks that it gives the modes of every frame
+//! exactly, for random scripts of gestures, looks (held, or returning after
+//! a hold) and moves back to the centre, with frames skipped.
 
 use idle_head::Angle;
-use idle_head::behaviour::{Applied, LimitMode, Mixer};
+use idle_head::behaviour::{Applied, BehaviourParams, LimitMode, Mixer};
 use idle_head::command::{Action, GestureKind, Hold, LookRequest};
 use idle_head::units::Millis;
 use proptest::prelude::*;
@@ -31,6 +31,9 @@ struct Model {
     layers: Vec<Layer>,
     /// The gaze move: start and end frame (moving in `start..end`).
     gaze: (u64, u64),
+    /// The planned return: its start and end frame.
+    back: Option<(u64, u64)>,
+    params: BehaviourParams,
     left: [u64; 3],
     blend: u64,
     settle: u64,
@@ -61,9 +64,28 @@ impl Model {
                 });
             }
             Applied::Look(look) => {
-                self.gaze = (next, next + u64::from(look.duration.0 / FRAME_MS));
+                let end = next + u64::from(look.duration.0 / FRAME_MS);
+                self.gaze = (next, end);
+                self.back = match look.hold {
+                    Hold::Stay => None,
+                    Hold::Return(ms) => {
+                        // Back along the rule's duration for the distance
+                        // (within the gesture limits for these targets).
+                        let pose = self.params.neutral_pose();
+                        let far = (look.pitch.millidegrees() - pose[0].millidegrees())
+                            .unsigned_abs()
+                            .max((look.yaw.millidegrees() - pose[2].millidegrees()).unsigned_abs());
+                        let gaze = self.params.config().gaze;
+                        let back_ms = gaze.base.0 + (gaze.per_degree.0 * far).div_ceil(1000);
+                        let start = end + u64::from(self.params.frames(ms).max(1));
+                        Some((start, start + u64::from(back_ms.div_ceil(FRAME_MS))))
+                    }
+                };
             }
-            Applied::Center(ms) => self.gaze = (next, next + u64::from(ms.0 / FRAME_MS)),
+            Applied::Center(ms) => {
+                self.gaze = (next, next + u64::from(ms.0 / FRAME_MS));
+                self.back = None;
+            }
             Applied::Idle(_) | Applied::Stop => {}
         }
     }
@@ -77,16 +99,24 @@ impl Model {
         for layer in &self.layers {
             on[layer.axis] = true;
         }
+        if let Some(back) = self.back
+            && frame >= back.0
+        {
+            self.gaze = back;
+            self.back = None;
+        }
         let moving = (self.gaze.0..self.gaze.1).contains(&frame);
         on[0] |= moving;
         on[2] |= moving;
+        // The return starts next frame: pitch and yaw in gesture mode now.
+        let soon = self.back.is_some_and(|back| frame + 1 >= back.0);
         core::array::from_fn(|i| {
             self.left[i] = if on[i] {
                 self.settle
             } else {
                 self.left[i].saturating_sub(elapsed)
             };
-            if on[i] || self.left[i] > 0 {
+            if on[i] || self.left[i] > 0 || (soon && i != 1) {
                 LimitMode::Gesture
             } else {
                 LimitMode::Idle
@@ -121,14 +151,18 @@ fn action() -> impl Strategy<Value = Action> {
         (
             -8000_i32..8000,
             -15_000_i32..15_000,
-            proptest::option::of(300_u32..1500)
+            proptest::option::of(300_u32..1500),
+            prop_oneof![
+                Just(Hold::Stay),
+                (0_u32..2000).prop_map(|ms| Hold::Return(Millis(ms)))
+            ],
         )
-            .prop_map(|(pitch, yaw, ms)| {
+            .prop_map(|(pitch, yaw, ms, hold)| {
                 Action::Look(LookRequest {
                     pitch: Angle::from_millidegrees(pitch),
                     yaw: Angle::from_millidegrees(yaw),
                     duration: ms.map(Millis),
-                    hold: Some(Hold::Stay),
+                    hold: Some(hold),
                 })
             }),
         proptest::option::of(300_u32..1500).prop_map(|ms| Action::Center {
@@ -157,6 +191,8 @@ proptest! {
         let mut model = Model {
             layers: Vec::new(),
             gaze: (0, 0),
+            back: None,
+            params,
             left: [0; 3],
             blend: u64::from(params.frames(config.blend)),
             settle: u64::from(params.frames(config.settle)),

@@ -81,18 +81,20 @@ impl Gaze {
             .is_some_and(|back| frame.wrapping_sub(back[0].start) as i32 >= 0)
     }
 
-    /// Frames from `now` to the next frame at which a move ends, the
-    /// planned return is due next frame, or it starts (`u32::MAX`: none).
-    pub(crate) fn next_event(&self, now: u32) -> u32 {
+    /// Frames from `from` to the next frame after it at which a move ends,
+    /// the planned return is due next frame, or it starts (`u32::MAX`:
+    /// none). A return due at `from` or before counts as one frame on (a
+    /// move then starts whose end is not known yet).
+    pub(crate) fn next_event(&self, from: u32) -> u32 {
         let mut soonest = u32::MAX;
         for axis in &self.axes {
             if axis.moving() {
-                soonest = soonest.min(axis.end().wrapping_sub(now));
+                soonest = soonest.min(super::mixer::ahead(axis.end(), from));
             }
         }
         if let Some(back) = &self.back {
-            let start = back[0].start.wrapping_sub(now);
-            soonest = soonest.min(if start > 1 { start - 1 } else { start });
+            let start = back[0].start.wrapping_sub(from);
+            soonest = soonest.min(if start as i32 > 1 { start - 1 } else { 1 });
         }
         soonest
     }

@@ -82,6 +82,10 @@ pub struct Mixer {
     until: u32,
     /// The last frame mixed in full.
     full: u32,
+    /// The next frame at which a layer or a gaze move ends, a return is due
+    /// or starts, or the idle gain's glide ends, as last found (see
+    /// `schedule`); events in between are settle times running out.
+    ends: u32,
     /// The limit modes from the next frame on.
     modes: [LimitMode; 3],
     /// Nothing moves but the idle, at `rest_gain` around `rest_centre`.
@@ -110,6 +114,7 @@ impl Mixer {
             on: 0,
             until: 0,
             full: 0,
+            ends: 0,
             modes: [LimitMode::Idle; 3],
             quiet: true,
             rest_gain: gain_of(amp) as u32,
@@ -161,8 +166,9 @@ impl Mixer {
             Action::Stop => return Ok(Applied::Stop),
         };
         self.quiet = false;
-        // The next frame is mixed in full.
+        // The next frame is mixed in full; the ends after it are known now.
         self.until = next;
+        self.schedule(next);
         Ok(applied)
     }
 
@@ -328,20 +334,35 @@ impl Mixer {
             self.rest_centre = centre;
             self.rest_gain = gain;
         }
-        // The next event.
-        for layer in self.layers.iter().flatten() {
-            let end = layer.start.wrapping_add(layer.stop);
-            soonest = soonest.min(end.wrapping_sub(now));
+        // The next end of a layer or a move: found again once the last one
+        // found has passed, or after an action.
+        if self.ends.wrapping_sub(now) as i32 <= 0 {
+            self.schedule(now);
         }
-        soonest = soonest.min(self.gaze.next_event(now));
-        if self.idle_gain.moving() {
-            soonest = soonest.min(self.idle_gain.end().wrapping_sub(now));
-        }
+        soonest = soonest.min(self.ends.wrapping_sub(now));
         // Every event lies ahead (at least the next frame); at rest, or
         // nothing due for 2³⁰ frames (about 8 months), the next frame mixed
         // in full is the first after an action or 2³⁰ frames on.
         self.full = now;
         self.until = now.wrapping_add(soonest.clamp(1, 1 << 30));
+    }
+
+    /// Finds the next frame after `from` at which a layer or a gaze move
+    /// ends, the return is due next frame or starts, or the idle gain's
+    /// glide ends (`from + 2³⁰` if none). What ends at `from` or before is
+    /// left to the frame mixed in full at `from` (an action's next frame,
+    /// or the frame that found it due).
+    #[inline]
+    fn schedule(&mut self, from: u32) {
+        let mut soonest = u32::MAX;
+        for layer in self.layers.iter().flatten() {
+            soonest = soonest.min(ahead(layer.start.wrapping_add(layer.stop), from));
+        }
+        soonest = soonest.min(self.gaze.next_event(from));
+        if self.idle_gain.moving() {
+            soonest = soonest.min(ahead(self.idle_gain.end(), from));
+        }
+        self.ends = from.wrapping_add(soonest.min(1 << 30));
     }
 
     /// The gesture layers at frame `now`, summed per axis; clears the
@@ -414,6 +435,14 @@ struct Sums {
 const fn idle_part(idle: i32, gain: u32, duck: u32) -> i32 {
     let value = if gain == ONE { idle } else { mul(idle, gain) };
     if duck == ONE { value } else { mul(value, duck) }
+}
+
+/// Frames from `from` to `frame` if it lies after `from`, else `u32::MAX`
+/// (not an event to wait for).
+#[inline]
+pub(crate) const fn ahead(frame: u32, from: u32) -> u32 {
+    let d = frame.wrapping_sub(from);
+    if d as i32 > 0 { d } else { u32::MAX }
 }
 
 /// What the limit modes of one frame mixed in full follow from (see
