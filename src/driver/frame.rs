@@ -390,6 +390,7 @@ impl<P: SetDutyCycle> FrameDriver<P> {
 
     /// Completes the report of the servos just written: totals, fault log
     /// throttling and the frame counter.
+    #[inline]
     fn finish(&mut self) -> FrameReport {
         let report = &mut self.last;
         report.frame = self.stats.frames;

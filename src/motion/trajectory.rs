@@ -135,8 +135,14 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
 
     /// Sample `index` of the loop in playback order (taken modulo N) as an angle.
     #[must_use]
-    #[inline]
     pub fn angle(&self, index: usize) -> Angle {
+        self.read(index)
+    }
+
+    /// [`Trajectory::angle`], inlined where the frame path reads samples
+    /// (through [`LoopSource`](crate::playback::LoopSource)).
+    #[inline(always)]
+    fn read(&self, index: usize) -> Angle {
         // Playback reads indices below N: no division for them (out of
         // line, or the compiler divides before it compares).
         let index = if index < N {
@@ -171,7 +177,7 @@ impl<S: Sample, const N: usize> crate::playback::LoopSource for Trajectory<S, N>
 
     #[inline]
     fn angle(&self, index: usize) -> Angle {
-        Trajectory::angle(self, index)
+        self.read(index)
     }
 }
 

@@ -207,6 +207,7 @@ impl Cursor {
     }
 
     /// One frame on (see the module docs).
+    #[inline]
     fn advance(&mut self) {
         // rem, step_rem < den < 2³¹; pos < n·2¹², step < n·2¹², n < 2¹⁹.
         self.rem += self.step_rem;
