@@ -141,7 +141,7 @@ impl<S: Sample, const N: usize> Trajectory<S, N> {
 
     /// [`Trajectory::angle`], inlined where the frame path reads samples
     /// (through [`LoopSource`](crate::playback::LoopSource)).
-    #[inline(always)]
+    #[inline]
     fn read(&self, index: usize) -> Angle {
         // Playback reads indices below N: no division for them (out of
         // line, or the compiler divides before it compares).
