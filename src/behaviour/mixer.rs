@@ -369,11 +369,7 @@ impl Mixer {
     /// layers that have ended.
     #[inline]
     fn layers(&mut self, now: u32) -> Sums {
-        let mut sums = Sums {
-            add: [0; 3],
-            duck: [ONE; 3],
-            active: 0,
-        };
+        let mut sums = Sums::NONE;
         let params = &self.params;
         for slot in &mut self.layers {
             let Some(layer) = slot else { continue };
@@ -427,6 +423,15 @@ struct Sums {
     duck: [u32; 3],
     /// Bit `i`: a gesture plays on axis `i`.
     active: u8,
+}
+
+impl Sums {
+    /// No gesture: nothing added, no duck.
+    const NONE: Self = Self {
+        add: [0; 3],
+        duck: [ONE; 3],
+        active: 0,
+    };
 }
 
 /// `idle · gain · duck` (Q16 each; a factor of 1 skipped: `mul` by 1 is
