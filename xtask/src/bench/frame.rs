@@ -9,7 +9,7 @@ use crate::log::LogLine;
 /// The rows the bench fails on when they are over the budget, by scenario
 /// (`None`: idle). The row with a gesture and a look playing is reported
 /// against the same budget but not yet held to it: its max is within it,
-/// but it takes about 1,560 instructions at the median, mostly the mixer's
+/// but it takes about 1,430 instructions at the median, mostly the mixer's
 /// gesture shape and the gaze's minimum-jerk moves evaluated afresh every
 /// frame.
 const HELD_TO_BUDGET: [Option<&str>; 1] = [None];
