@@ -11,6 +11,8 @@
 //! Frequencies, speeds and accelerations are printed from integers (no
 //! float formatting: it would cost the firmware tens of kilobytes of flash).
 
+use const_format::StrWriter;
+
 use crate::text::Arg::{Int, Str, Text, Uint};
 use crate::text::{self, Describe, display_from_describe};
 
@@ -104,9 +106,6 @@ pub enum BehaviourError {
     Config {
         /// The field, as written in the configuration (`gaze.base`).
         field: &'static str,
-        /// The whole rule, for logs and compile-time errors
-        /// (``behaviour config `gaze.base`: must be in 0..=5000 ms``).
-        rule: &'static str,
         /// Its unit (`ms`, `mHz`, `°/s`, ...).
         unit: &'static str,
         /// The rejected value.
@@ -130,14 +129,14 @@ impl BehaviourError {
         }
     }
 
-    /// A one-line summary for logs and compile-time errors (without the
-    /// values; `Display` has them).
+    /// A one-line summary for logs (without the values or, for a
+    /// configuration, the field; `Display` has them).
     #[must_use]
     pub const fn message(&self) -> &'static str {
         match self {
             Self::Amplitude { .. } => "gesture amplitude outside what its axis allows",
             Self::Duration { field, .. } => field,
-            Self::Config { rule, .. } => rule,
+            Self::Config { .. } => "behaviour config value out of range",
             Self::Cycles { .. } => "gesture cycles out of range",
             Self::TiltCycles { .. } => "a tilt has exactly one cycle",
             Self::TooFrequent { .. } => "gesture cycles faster than the frequency cap",
@@ -145,6 +144,27 @@ impl BehaviourError {
             Self::TooBrisk { .. } => "gesture faster than the axis' gesture acceleration limit",
             Self::Busy { .. } => "every gesture layer is busy",
         }
+    }
+}
+
+impl BehaviourError {
+    /// Panics with [`message`](Self::message), or for a configuration
+    /// ``behaviour config `<field>` is out of range``: in a `const`
+    /// evaluation, the compile error of an invalid built-in configuration.
+    pub(super) const fn panic(&self) -> ! {
+        if let Self::Config { field, .. } = self {
+            // Long enough for every field; were it not, the summary alone
+            // would still be told.
+            let mut text = StrWriter::new([0u8; 96]);
+            let mut writer = text.as_mut();
+            let written = writer.write_str("behaviour config `").is_ok()
+                && writer.write_str(field).is_ok()
+                && writer.write_str("` is out of range").is_ok();
+            if written {
+                panic!("{}", text.unsize().as_str())
+            }
+        }
+        panic!("{}", self.message())
     }
 }
 
@@ -248,7 +268,6 @@ impl Describe for BehaviourError {
             Self::Config {
                 field,
                 unit,
-                rule: _,
                 value,
                 min,
                 max,
