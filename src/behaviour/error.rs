@@ -152,19 +152,24 @@ impl BehaviourError {
     /// ``behaviour config `<field>` is out of range``: in a `const`
     /// evaluation, the compile error of an invalid built-in configuration.
     pub(super) const fn panic(&self) -> ! {
-        if let Self::Config { field, .. } = self {
-            // Long enough for every field; were it not, the summary alone
-            // would still be told.
-            let mut text = StrWriter::new([0u8; 96]);
-            let mut writer = text.as_mut();
-            let written = writer.write_str("behaviour config `").is_ok()
-                && writer.write_str(field).is_ok()
-                && writer.write_str("` is out of range").is_ok();
-            if written {
-                panic!("{}", text.unsize().as_str())
+        // Long enough for every field; were it not, the summary alone would
+        // still be told.
+        let mut text = StrWriter::new([0u8; 96]);
+        let mut writer = text.as_mut();
+        let written = match self {
+            Self::Config { field, .. } => {
+                writer.write_str("behaviour config `").is_ok()
+                    && writer.write_str(field).is_ok()
+                    && writer.write_str("` is out of range").is_ok()
             }
-        }
-        panic!("{}", self.message())
+            _ => false,
+        };
+        let message = if written {
+            text.unsize().as_str()
+        } else {
+            self.message()
+        };
+        panic!("{}", message)
     }
 }
 
