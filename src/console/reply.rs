@@ -107,18 +107,21 @@ const ELLIPSIS: &str = "…";
 /// One reply line being written into a fixed buffer.
 ///
 /// [`ok`](Self::ok) or [`err`](Self::err) starts it (a reply nobody
-/// started is a bare `ok`), then text follows through [`fmt::Write`]
-/// (`write!`): the first piece of text is separated from the verdict by a
+/// started is a bare `ok`), then text follows through [`Text`] (the
+/// firmware's way, without `core::fmt`) or [`fmt::Write`] (`write!`, the
+/// same text): the first piece of text is separated from the verdict by a
 /// space. Writing never fails; text that does not fit is dropped and the
 /// reply ends in `…`.
 ///
 /// ```
 /// use core::fmt::Write;
 /// use idle_head::console::{ErrorCode, Reply};
+/// use idle_head::text::{Arg, Text};
 ///
 /// let mut buf = [0; 64];
 /// let mut reply = Reply::new(&mut buf);
-/// write!(reply.err(ErrorCode::Limit), "pitch {} mdeg is past {}", 31_000, 20_000).ok();
+/// let text: &mut dyn Text = reply.err(ErrorCode::Limit);
+/// text.fill("pitch {} mdeg is past {}", &[Arg::Int(31_000), Arg::Int(20_000)]);
 /// assert_eq!(reply.finish(), b"err limit pitch 31000 mdeg is past 20000\r\n");
 ///
 /// // Too long for the buffer: cut, and marked.
