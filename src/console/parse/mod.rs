@@ -53,7 +53,7 @@ mod error;
 mod words;
 
 pub use error::{ParseError, ParseErrorKind, Span};
-use words::{Word, Words, once};
+use words::{Kw, Word, Words, once};
 
 /// Parses one line (without its line ending); the grammar is in this
 /// module's source and, for users, in `docs/protocol.md`.
@@ -66,22 +66,22 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
         return Err(words.error_here(ParseErrorKind::Empty));
     };
     let command = match first.lower() {
-        Word::Is("help") => Command::Help,
-        Word::Is("status") => Command::Status,
-        Word::Is("save") => Command::Save,
-        Word::Is("load") => Command::Load,
-        Word::Is("defaults") => Command::Defaults,
-        Word::Is("stop") => Command::Act(Action::Stop),
-        Word::Is("nod") => gesture(&mut words, GestureKind::Nod)?,
-        Word::Is("shake") => gesture(&mut words, GestureKind::Shake)?,
-        Word::Is("tilt") => gesture(&mut words, GestureKind::Tilt)?,
-        Word::Is("look") => look(&mut words)?,
-        Word::Is("center" | "centre") => Command::Act(Action::Center {
+        Word::Is(Kw::Help) => Command::Help,
+        Word::Is(Kw::Status) => Command::Status,
+        Word::Is(Kw::Save) => Command::Save,
+        Word::Is(Kw::Load) => Command::Load,
+        Word::Is(Kw::Defaults) => Command::Defaults,
+        Word::Is(Kw::Stop) => Command::Act(Action::Stop),
+        Word::Is(Kw::Nod) => gesture(&mut words, GestureKind::Nod)?,
+        Word::Is(Kw::Shake) => gesture(&mut words, GestureKind::Shake)?,
+        Word::Is(Kw::Tilt) => gesture(&mut words, GestureKind::Tilt)?,
+        Word::Is(Kw::Look) => look(&mut words)?,
+        Word::Is(Kw::Center | Kw::Centre) => Command::Act(Action::Center {
             duration: words.optional_number(DURATION)?.map(to_millis),
         }),
-        Word::Is("idle") => idle(&mut words)?,
-        Word::Is("seed") => seed(&mut words)?,
-        Word::Is("servo") => servo(&mut words)?,
+        Word::Is(Kw::Idle) => idle(&mut words)?,
+        Word::Is(Kw::Seed) => seed(&mut words)?,
+        Word::Is(Kw::Servo) => servo(&mut words)?,
         _ => return Err(first.error(ParseErrorKind::UnknownCommand)),
     };
     words.end()?;
@@ -164,11 +164,11 @@ fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Command, ParseErr
     };
     while let Some((name, value, word)) = words.option()? {
         match (name, kind) {
-            ("cycles", GestureKind::Nod | GestureKind::Shake) => {
+            (Word::Is(Kw::Cycles), GestureKind::Nod | GestureKind::Shake) => {
                 once(request.cycles.is_some(), word)?;
                 request.cycles = Some(value.number(CYCLES)? as u8);
             }
-            ("intensity", _) => {
+            (Word::Is(Kw::Intensity), _) => {
                 once(request.intensity.is_some(), word)?;
                 request.intensity = Some(to_percent(value.number(PERCENT)?));
             }
@@ -185,11 +185,11 @@ fn look(words: &mut Words<'_>) -> Result<Command, ParseError> {
     let duration = words.optional_number(DURATION)?.map(to_millis);
     let mut hold = None;
     while let Some((name, value, word)) = words.option()? {
-        if name != "hold" {
+        if name != Word::Is(Kw::Hold) {
             return Err(word.error(ParseErrorKind::UnknownOption { allowed: "hold" }));
         }
         once(hold.is_some(), word)?;
-        hold = Some(if value.lower() == Word::Is("stay") {
+        hold = Some(if value.lower() == Word::Is(Kw::Stay) {
             Hold::Stay
         } else {
             Hold::Return(to_millis(value.number(HOLD)?))
@@ -210,9 +210,9 @@ fn idle(words: &mut Words<'_>) -> Result<Command, ParseError> {
         return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
     };
     let action = match word.lower() {
-        Word::Is("on") => Action::Idle(true),
-        Word::Is("off") => Action::Idle(false),
-        Word::Is("amp") => Action::IdleAmp(to_percent(words.number("percentage", PERCENT)?)),
+        Word::Is(Kw::On) => Action::Idle(true),
+        Word::Is(Kw::Off) => Action::Idle(false),
+        Word::Is(Kw::Amp) => Action::IdleAmp(to_percent(words.number("percentage", PERCENT)?)),
         _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: EXPECTED })),
     };
     Ok(Command::Act(action))
@@ -224,7 +224,7 @@ fn seed(words: &mut Words<'_>) -> Result<Command, ParseError> {
     let Some(word) = words.next() else {
         return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
     };
-    if word.lower() == Word::Is("random") {
+    if word.lower() == Word::Is(Kw::Random) {
         return Ok(Command::Seed(SeedChoice::Random));
     }
     Ok(Command::Seed(SeedChoice::Value(word.number(SEED)? as u32)))
@@ -238,9 +238,9 @@ fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
         return Err(words.error_here(ParseErrorKind::Missing(AXES)));
     };
     let axis = match word.lower() {
-        Word::Is("pitch") => Axis::Pitch,
-        Word::Is("roll") => Axis::Roll,
-        Word::Is("yaw") => Axis::Yaw,
+        Word::Is(Kw::Pitch) => Axis::Pitch,
+        Word::Is(Kw::Roll) => Axis::Roll,
+        Word::Is(Kw::Yaw) => Axis::Yaw,
         _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: AXES })),
     };
     let Some(field) = words.next() else {
@@ -253,20 +253,20 @@ fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
         Ok(Microseconds(words.number("pulse in us", PULSE)? as u32))
     };
     let setting = match field.lower() {
-        Word::Is("neutral") => ServoSetting::Neutral(pulse(words)?),
-        Word::Is("min") => ServoSetting::MinPulse(pulse(words)?),
-        Word::Is("max") => ServoSetting::MaxPulse(pulse(words)?),
-        Word::Is("per-degree") => ServoSetting::PerDegree(NanosPerDegree(
+        Word::Is(Kw::Neutral) => ServoSetting::Neutral(pulse(words)?),
+        Word::Is(Kw::Min) => ServoSetting::MinPulse(pulse(words)?),
+        Word::Is(Kw::Max) => ServoSetting::MaxPulse(pulse(words)?),
+        Word::Is(Kw::PerDegree) => ServoSetting::PerDegree(NanosPerDegree(
             words.number("ns per degree", PER_DEGREE)? as u32,
         )),
-        Word::Is("direction") => {
+        Word::Is(Kw::Direction) => {
             const DIRECTIONS: &str = "`normal` or `reversed`";
             let Some(word) = words.next() else {
                 return Err(words.error_here(ParseErrorKind::Missing(DIRECTIONS)));
             };
             ServoSetting::Direction(match word.lower() {
-                Word::Is("normal") => Direction::Normal,
-                Word::Is("reversed") => Direction::Reversed,
+                Word::Is(Kw::Normal) => Direction::Normal,
+                Word::Is(Kw::Reversed) => Direction::Reversed,
                 _ => {
                     return Err(word.error(ParseErrorKind::UnknownWord {
                         expected: DIRECTIONS,
@@ -274,7 +274,7 @@ fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
                 }
             })
         }
-        Word::Is("limits") => {
+        Word::Is(Kw::Limits) => {
             let min = to_angle(words.number("lower limit in mdeg", ANGLE)?);
             let max = to_angle(words.number("upper limit in mdeg", ANGLE)?);
             ServoSetting::Limits(AngleRange { min, max })
