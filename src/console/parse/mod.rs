@@ -77,7 +77,7 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
         Word::Is(Kw::Tilt) => gesture(&mut words, GestureKind::Tilt)?,
         Word::Is(Kw::Look) => look(&mut words)?,
         Word::Is(Kw::Center | Kw::Centre) => Command::Act(Action::Center {
-            duration: words.optional_number(DURATION)?.map(to_millis),
+            duration: words.optional_number(&DURATION)?.map(to_millis),
         }),
         Word::Is(Kw::Idle) => idle(&mut words)?,
         Word::Is(Kw::Seed) => seed(&mut words)?,
@@ -88,7 +88,8 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
     Ok(command)
 }
 
-/// A numeric field: its name and range.
+/// A numeric field: its name and range (passed as `&'static`: one address
+/// per call instead of the whole field).
 #[derive(Clone, Copy)]
 struct Field {
     what: &'static str,
@@ -104,6 +105,22 @@ const AMPLITUDE: Field = Field {
 const ANGLE: Field = Field {
     what: "angle in mdeg",
     ..AMPLITUDE
+};
+const PITCH: Field = Field {
+    what: "pitch in mdeg",
+    ..ANGLE
+};
+const YAW: Field = Field {
+    what: "yaw in mdeg",
+    ..ANGLE
+};
+const LOWER_LIMIT: Field = Field {
+    what: "lower limit in mdeg",
+    ..ANGLE
+};
+const UPPER_LIMIT: Field = Field {
+    what: "upper limit in mdeg",
+    ..ANGLE
 };
 const DURATION: Field = Field {
     what: "duration in ms",
@@ -156,8 +173,8 @@ fn to_percent(v: i64) -> Percent {
 /// `nod|shake|tilt [amp] [ms] [cycles=N] [intensity=P]`.
 fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Command, ParseError> {
     let mut request = GestureRequest::new(kind);
-    request.amplitude = words.optional_number(AMPLITUDE)?.map(to_angle);
-    request.duration = words.optional_number(DURATION)?.map(to_millis);
+    request.amplitude = words.optional_number(&AMPLITUDE)?.map(to_angle);
+    request.duration = words.optional_number(&DURATION)?.map(to_millis);
     let allowed = match kind {
         GestureKind::Tilt => "intensity",
         GestureKind::Nod | GestureKind::Shake => "cycles, intensity",
@@ -166,11 +183,11 @@ fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Command, ParseErr
         match (name, kind) {
             (Word::Is(Kw::Cycles), GestureKind::Nod | GestureKind::Shake) => {
                 once(request.cycles.is_some(), word)?;
-                request.cycles = Some(value.number(CYCLES)? as u8);
+                request.cycles = Some(value.number(&CYCLES)? as u8);
             }
             (Word::Is(Kw::Intensity), _) => {
                 once(request.intensity.is_some(), word)?;
-                request.intensity = Some(to_percent(value.number(PERCENT)?));
+                request.intensity = Some(to_percent(value.number(&PERCENT)?));
             }
             _ => return Err(word.error(ParseErrorKind::UnknownOption { allowed })),
         }
@@ -180,9 +197,9 @@ fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Command, ParseErr
 
 /// `look <pitch> <yaw> [ms] [hold=MS|hold=stay]`.
 fn look(words: &mut Words<'_>) -> Result<Command, ParseError> {
-    let pitch = to_angle(words.number("pitch in mdeg", ANGLE)?);
-    let yaw = to_angle(words.number("yaw in mdeg", ANGLE)?);
-    let duration = words.optional_number(DURATION)?.map(to_millis);
+    let pitch = to_angle(words.number(&PITCH)?);
+    let yaw = to_angle(words.number(&YAW)?);
+    let duration = words.optional_number(&DURATION)?.map(to_millis);
     let mut hold = None;
     while let Some((name, value, word)) = words.option()? {
         if name != Word::Is(Kw::Hold) {
@@ -192,7 +209,7 @@ fn look(words: &mut Words<'_>) -> Result<Command, ParseError> {
         hold = Some(if value.lower() == Word::Is(Kw::Stay) {
             Hold::Stay
         } else {
-            Hold::Return(to_millis(value.number(HOLD)?))
+            Hold::Return(to_millis(value.number(&HOLD)?))
         });
     }
     Ok(Command::Act(Action::Look(LookRequest {
@@ -212,7 +229,7 @@ fn idle(words: &mut Words<'_>) -> Result<Command, ParseError> {
     let action = match word.lower() {
         Word::Is(Kw::On) => Action::Idle(true),
         Word::Is(Kw::Off) => Action::Idle(false),
-        Word::Is(Kw::Amp) => Action::IdleAmp(to_percent(words.number("percentage", PERCENT)?)),
+        Word::Is(Kw::Amp) => Action::IdleAmp(to_percent(words.number(&PERCENT)?)),
         _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: EXPECTED })),
     };
     Ok(Command::Act(action))
@@ -227,7 +244,7 @@ fn seed(words: &mut Words<'_>) -> Result<Command, ParseError> {
     if word.lower() == Word::Is(Kw::Random) {
         return Ok(Command::Seed(SeedChoice::Random));
     }
-    Ok(Command::Seed(SeedChoice::Value(word.number(SEED)? as u32)))
+    Ok(Command::Seed(SeedChoice::Value(word.number(&SEED)? as u32)))
 }
 
 /// `servo <axis> [<field> <value>...]`.
@@ -250,15 +267,15 @@ fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
         });
     };
     let pulse = |words: &mut Words<'_>| -> Result<Microseconds, ParseError> {
-        Ok(Microseconds(words.number("pulse in us", PULSE)? as u32))
+        Ok(Microseconds(words.number(&PULSE)? as u32))
     };
     let setting = match field.lower() {
         Word::Is(Kw::Neutral) => ServoSetting::Neutral(pulse(words)?),
         Word::Is(Kw::Min) => ServoSetting::MinPulse(pulse(words)?),
         Word::Is(Kw::Max) => ServoSetting::MaxPulse(pulse(words)?),
-        Word::Is(Kw::PerDegree) => ServoSetting::PerDegree(NanosPerDegree(
-            words.number("ns per degree", PER_DEGREE)? as u32,
-        )),
+        Word::Is(Kw::PerDegree) => {
+            ServoSetting::PerDegree(NanosPerDegree(words.number(&PER_DEGREE)? as u32))
+        }
         Word::Is(Kw::Direction) => {
             const DIRECTIONS: &str = "`normal` or `reversed`";
             let Some(word) = words.next() else {
@@ -275,8 +292,8 @@ fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
             })
         }
         Word::Is(Kw::Limits) => {
-            let min = to_angle(words.number("lower limit in mdeg", ANGLE)?);
-            let max = to_angle(words.number("upper limit in mdeg", ANGLE)?);
+            let min = to_angle(words.number(&LOWER_LIMIT)?);
+            let max = to_angle(words.number(&UPPER_LIMIT)?);
             ServoSetting::Limits(AngleRange { min, max })
         }
         _ => return Err(field.error(ParseErrorKind::UnknownWord { expected: FIELDS })),

@@ -168,7 +168,7 @@ impl<'a> Token<'a> {
     }
 
     /// The word as a whole number in `field`'s range.
-    pub(super) fn number(&self, field: Field) -> Result<i64, ParseError> {
+    pub(super) fn number(&self, field: &Field) -> Result<i64, ParseError> {
         let value = integer(self.text).ok_or(self.error(ParseErrorKind::NotANumber(field.what)))?;
         if value < field.min || value > field.max {
             return Err(self.error(ParseErrorKind::OutOfRange {
@@ -280,16 +280,16 @@ impl<'a> Words<'a> {
     }
 
     /// A required number.
-    pub(super) fn number(&mut self, what: &'static str, field: Field) -> Result<i64, ParseError> {
+    pub(super) fn number(&mut self, field: &Field) -> Result<i64, ParseError> {
         match self.next() {
-            Some(token) => token.number(Field { what, ..field }),
-            None => Err(self.error_here(ParseErrorKind::Missing(what))),
+            Some(token) => token.number(field),
+            None => Err(self.error_here(ParseErrorKind::Missing(field.what))),
         }
     }
 
     /// An optional positional number: absent at the end of the line or
     /// where the options (`name=value`) begin.
-    pub(super) fn optional_number(&mut self, field: Field) -> Result<Option<i64>, ParseError> {
+    pub(super) fn optional_number(&mut self, field: &Field) -> Result<Option<i64>, ParseError> {
         match self.peek() {
             Some(token) if !token.text.contains(&b'=') => {
                 self.next();
