@@ -371,11 +371,13 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
                         tick.frame,
                         axis.name()
                     ),
+                    // `{}` of the error, not its `message()`: the per-axis
+                    // message texts would take 2.5 KB of flash.
                     Err(e) => defmt::warn!(
-                        "frame {=u64}: {=str} servo calibration refused: {=str}",
+                        "frame {=u64}: {=str} servo calibration refused: {}",
                         tick.frame,
                         axis.name(),
-                        e.message()
+                        e
                     ),
                 }
             }

@@ -50,6 +50,7 @@ pub mod motion;
 pub mod playback;
 pub mod servo;
 pub mod settings;
+pub mod text;
 pub mod units;
 
 pub use axis::Axis;

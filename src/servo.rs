@@ -22,8 +22,6 @@
 
 mod map;
 
-use core::fmt;
-
 pub use map::ServoMap;
 
 use crate::axis::Axis;
@@ -85,7 +83,7 @@ pub enum Direction {
 }
 
 /// A calibration rejected by [`ServoCalibration::validate`], with the rejected
-/// values. Its [`Display`](fmt::Display) says what is wrong in microseconds and
+/// values. Its [`Display`](core::fmt::Display) says what is wrong in microseconds and
 /// degrees; [`message`](Self::message) names the field for `const` checks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -157,56 +155,8 @@ impl ServoError {
     }
 }
 
-/// ```
-/// use idle_head::servo::{ServoCalibration, ServoError};
-/// use idle_head::{Axis, Microseconds};
-/// let mut cal = ServoCalibration::hobby(Axis::Roll);
-/// cal.min_pulse = Microseconds(2500);
-/// let err = cal.validate().unwrap_err();
-/// assert_eq!(err.to_string(), "min_pulse 2500 µs must be below max_pulse 2000 µs");
-/// ```
-impl fmt::Display for ServoError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match *self {
-            Self::PulseRangeEmpty { min, max } => write!(
-                f,
-                "min_pulse {} µs must be below max_pulse {} µs",
-                min.0, max.0
-            ),
-            Self::NeutralOutsidePulseRange { neutral, min, max } => write!(
-                f,
-                "neutral {} µs lies outside the pulse range {}..{} µs",
-                neutral.0, min.0, max.0
-            ),
-            Self::ZeroPerDegree => f.write_str("per_degree must be above 0 ns/°"),
-            Self::LimitsInverted { limits } => write!(
-                f,
-                "limits {}..{}: the lower limit lies above the upper one",
-                Degrees(limits.min),
-                Degrees(limits.max)
-            ),
-            Self::NeutralOutsideLimits { limits } => write!(
-                f,
-                "limits {}..{} must contain 0°, the neutral angle the servo starts at",
-                Degrees(limits.min),
-                Degrees(limits.max)
-            ),
-            Self::LimitUnreachable {
-                angle,
-                needed_us,
-                min,
-                max,
-            } => write!(
-                f,
-                "limit {} needs {} µs, outside the pulse range {}..{} µs",
-                Degrees(angle),
-                needed_us,
-                min.0,
-                max.0
-            ),
-        }
-    }
-}
+// Its text: `impl Describe for ServoError` (driver/error.rs).
+crate::text::display_from_describe!(ServoError, Degrees);
 
 impl core::error::Error for ServoError {}
 
@@ -214,24 +164,6 @@ impl core::error::Error for ServoError {}
 /// (`+20°`, `-12.5°`, `0°`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Degrees(pub(crate) Angle);
-
-impl fmt::Display for Degrees {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let m = self.0.millidegrees();
-        let sign = match m {
-            0 => "",
-            ..0 => "-",
-            _ => "+",
-        };
-        let (whole, frac) = (m.unsigned_abs() / 1000, m.unsigned_abs() % 1000);
-        match frac {
-            0 => write!(f, "{sign}{whole}°"),
-            _ if frac % 100 == 0 => write!(f, "{sign}{whole}.{}°", frac / 100),
-            _ if frac % 10 == 0 => write!(f, "{sign}{whole}.{:02}°", frac / 10),
-            _ => write!(f, "{sign}{whole}.{frac:03}°"),
-        }
-    }
-}
 
 /// Calibration of one servo and the axis it drives.
 ///

@@ -8,7 +8,7 @@
 //! Angles and ranges display in degrees, as a user writes them: `-23°`,
 //! `4.5°`, `-0.25°`, `-23°..32°` (exact: no float formatting).
 
-use core::fmt;
+use crate::text::{Describe, Text, display_from_describe};
 use core::ops::{Add, Neg, Sub};
 
 /// A signed angle in millidegrees (1 LSB = 0.001°).
@@ -110,19 +110,19 @@ impl Written {
     }
 }
 
-impl fmt::Display for Angle {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl Describe for Angle {
+    fn describe(&self, out: &mut dyn Text) {
         let Written {
             sign,
             whole,
             fraction,
             digits,
         } = Written::of(*self);
-        if digits == 0 {
-            write!(f, "{sign}{whole}°")
-        } else {
-            write!(f, "{sign}{whole}.{fraction:0digits$}°")
+        out.str(sign).u64(u64::from(whole));
+        if digits != 0 {
+            out.str(".").zeros(u64::from(fraction), digits);
         }
+        out.str("°");
     }
 }
 
@@ -242,11 +242,13 @@ impl AngleRange {
     }
 }
 
-impl fmt::Display for AngleRange {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}..{}", self.min, self.max)
+impl Describe for AngleRange {
+    fn describe(&self, out: &mut dyn Text) {
+        out.with(&self.min).str("..").with(&self.max);
     }
 }
+
+display_from_describe!(Angle, AngleRange);
 
 #[cfg(feature = "defmt")]
 impl defmt::Format for AngleRange {

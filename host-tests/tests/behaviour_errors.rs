@@ -180,10 +180,14 @@ fn settings() {
     }
     let err = build(&|c| c.idle.fade = Millis(50_000));
     assert_eq!(err.code(), "config");
-    assert_eq!(
-        err.message(),
-        "behaviour config `idle.fade` is out of range"
-    );
+    assert_eq!(err.message(), "behaviour config value out of range");
+    assert!(matches!(
+        err,
+        BehaviourError::Config {
+            field: "idle.fade",
+            ..
+        }
+    ));
     // The idle mode is the driver's: a driver with brisker limits raises the
     // floor of the gesture limits.
     let mut brisk = DriverConfig::DEFAULT;

@@ -53,7 +53,6 @@ macro_rules! check {
         if value < min || value > max {
             return Err(BehaviourError::Config {
                 field: $field,
-                rule: concatcp!("behaviour config `", $field, "` is out of range"),
                 unit: $unit,
                 value,
                 min,
@@ -273,7 +272,7 @@ impl BehaviourConfig {
     /// If [`build`](Self::build) fails (at compile time when used in a `const`).
     pub const fn assert_valid(&self, driver: &DriverParams) {
         if let Err(e) = self.build(driver) {
-            panic!("{}", e.message());
+            e.panic();
         }
     }
 

@@ -11,7 +11,10 @@
 //! Frequencies, speeds and accelerations are printed from integers (no
 //! float formatting: it would cost the firmware tens of kilobytes of flash).
 
-use core::fmt;
+use const_format::StrWriter;
+
+use crate::text::Arg::{Int, Str, Text, Uint};
+use crate::text::{self, Describe, display_from_describe};
 
 use crate::axis::Axis;
 use crate::command::GestureKind;
@@ -103,9 +106,6 @@ pub enum BehaviourError {
     Config {
         /// The field, as written in the configuration (`gaze.base`).
         field: &'static str,
-        /// The whole rule, for logs and compile-time errors
-        /// (``behaviour config `gaze.base`: must be in 0..=5000 ms``).
-        rule: &'static str,
         /// Its unit (`ms`, `mHz`, `°/s`, ...).
         unit: &'static str,
         /// The rejected value.
@@ -129,14 +129,14 @@ impl BehaviourError {
         }
     }
 
-    /// A one-line summary for logs and compile-time errors (without the
-    /// values; `Display` has them).
+    /// A one-line summary for logs (without the values or, for a
+    /// configuration, the field; `Display` has them).
     #[must_use]
     pub const fn message(&self) -> &'static str {
         match self {
             Self::Amplitude { .. } => "gesture amplitude outside what its axis allows",
             Self::Duration { field, .. } => field,
-            Self::Config { rule, .. } => rule,
+            Self::Config { .. } => "behaviour config value out of range",
             Self::Cycles { .. } => "gesture cycles out of range",
             Self::TiltCycles { .. } => "a tilt has exactly one cycle",
             Self::TooFrequent { .. } => "gesture cycles faster than the frequency cap",
@@ -147,112 +147,174 @@ impl BehaviourError {
     }
 }
 
+impl BehaviourError {
+    /// Panics with [`message`](Self::message), or for a configuration
+    /// ``behaviour config `<field>` is out of range``: in a `const`
+    /// evaluation, the compile error of an invalid built-in configuration.
+    pub(super) const fn panic(&self) -> ! {
+        // Long enough for every field; were it not, the summary alone would
+        // still be told.
+        let mut text = StrWriter::new([0u8; 96]);
+        let mut writer = text.as_mut();
+        let written = match self {
+            Self::Config { field, .. } => {
+                writer.write_str("behaviour config `").is_ok()
+                    && writer.write_str(field).is_ok()
+                    && writer.write_str("` is out of range").is_ok()
+            }
+            _ => false,
+        };
+        let message = if written {
+            text.unsize().as_str()
+        } else {
+            self.message()
+        };
+        panic!("{}", message)
+    }
+}
+
 /// `value` thousandths as `int.frac` without trailing zeros (`6.666`, `4`).
 struct Milli(u64);
 
-impl fmt::Display for Milli {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl Describe for Milli {
+    fn describe(&self, out: &mut dyn text::Text) {
         let (int, mut frac) = (self.0 / 1000, self.0 % 1000);
+        out.u64(int);
         if frac == 0 {
-            return write!(f, "{int}");
+            return;
         }
         let mut digits = 3;
         while frac % 10 == 0 {
             frac /= 10;
             digits -= 1;
         }
-        write!(f, "{int}.{frac:0digits$}")
+        out.str(".").zeros(frac, digits);
     }
 }
 
-impl fmt::Display for BehaviourError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl Describe for BehaviourError {
+    fn describe(&self, out: &mut dyn text::Text) {
         match *self {
             Self::Amplitude {
                 kind,
                 amplitude,
                 allowed,
-            } => write!(
-                f,
-                "{} amplitude {amplitude}: must be in {allowed} ({}'s limits around its neutral pose)",
-                kind.name(),
-                kind.axis().name()
+            } => out.fill(
+                "{} amplitude {}: must be in {} ({}'s limits around its neutral pose)",
+                &[
+                    Str(kind.name()),
+                    Text(&amplitude),
+                    Text(&allowed),
+                    Str(kind.axis().name()),
+                ],
             ),
             Self::Duration {
                 field,
                 duration,
                 min,
                 max,
-            } => write!(
-                f,
-                "{field} {} ms: must be in {}..={} ms",
-                duration.0, min.0, max.0
+            } => out.fill(
+                "{} {} ms: must be in {}..={} ms",
+                &[
+                    Str(field),
+                    Uint(duration.0.into()),
+                    Uint(min.0.into()),
+                    Uint(max.0.into()),
+                ],
             ),
-            Self::Cycles { kind, cycles, max } => {
-                write!(f, "{} cycles {cycles}: must be in 1..={max}", kind.name())
-            }
-            Self::TiltCycles { cycles } => write!(f, "tilt cycles {cycles}: a tilt has exactly 1"),
+            Self::Cycles { kind, cycles, max } => out.fill(
+                "{} cycles {}: must be in 1..={}",
+                &[Str(kind.name()), Uint(cycles.into()), Uint(max.into())],
+            ),
+            Self::TiltCycles { cycles } => out.fill(
+                "tilt cycles {}: a tilt has exactly 1",
+                &[Uint(cycles.into())],
+            ),
             Self::TooFrequent {
                 kind,
                 cycles,
                 duration,
                 max,
-            } => {
-                let asked = u64::from(cycles) * 1_000_000 / u64::from(duration.0.max(1));
-                let shortest = (u64::from(cycles) * 1_000_000).div_ceil(u64::from(max.0.max(1)));
-                write!(
-                    f,
-                    "{}: {cycles} cycles in {} ms are {} Hz: at most {} Hz (at least {shortest} ms for {cycles} cycles)",
-                    kind.name(),
-                    duration.0,
-                    Milli(asked),
-                    Milli(u64::from(max.0))
-                )
-            }
+            } => too_frequent(out, kind, cycles, duration, max),
             Self::TooFast {
                 kind,
                 axis,
                 needed,
                 max,
-            } => write!(
-                f,
-                "{}: needs {} °/s on {}: the gesture speed limit is {} °/s (lower the amplitude or the tempo)",
-                kind.name(),
-                needed.0,
-                axis.name(),
-                max.0
+            } => out.fill(
+                "{}: needs {} °/s on {}: the gesture speed limit is {} °/s \
+                 (lower the amplitude or the tempo)",
+                &[
+                    Str(kind.name()),
+                    Uint(needed.0.into()),
+                    Str(axis.name()),
+                    Uint(max.0.into()),
+                ],
             ),
             Self::TooBrisk {
                 kind,
                 axis,
                 needed,
                 max,
-            } => write!(
-                f,
-                "{}: needs {} °/s² on {}: the gesture acceleration limit is {} °/s² (lower the amplitude or the tempo)",
-                kind.name(),
-                needed.0,
-                axis.name(),
-                max.0
+            } => out.fill(
+                "{}: needs {} °/s² on {}: the gesture acceleration limit is {} °/s² \
+                 (lower the amplitude or the tempo)",
+                &[
+                    Str(kind.name()),
+                    Uint(needed.0.into()),
+                    Str(axis.name()),
+                    Uint(max.0.into()),
+                ],
             ),
-            Self::Busy { retry_in } => write!(
-                f,
+            Self::Busy { retry_in } => out.fill(
                 "gestures: every layer is busy; try again in {} ms",
-                retry_in.0
+                &[Uint(retry_in.0.into())],
             ),
             Self::Config {
                 field,
                 unit,
-                rule: _,
                 value,
                 min,
                 max,
-            } => write!(
-                f,
-                "behaviour config `{field}` = {value} {unit}: must be in {min}..={max} {unit}"
+            } => out.fill(
+                "behaviour config `{}` = {} {}: must be in {}..={} {}",
+                &[
+                    Str(field),
+                    Int(value),
+                    Str(unit),
+                    Int(min),
+                    Int(max),
+                    Str(unit),
+                ],
             ),
-        }
+        };
     }
+}
+
+display_from_describe!(BehaviourError);
+
+/// [`BehaviourError::TooFrequent`]'s text.
+fn too_frequent(
+    out: &mut dyn text::Text,
+    kind: GestureKind,
+    cycles: u8,
+    duration: Millis,
+    max: MilliHertz,
+) -> &mut dyn text::Text {
+    let asked = u64::from(cycles) * 1_000_000 / u64::from(duration.0.max(1));
+    let shortest = (u64::from(cycles) * 1_000_000).div_ceil(u64::from(max.0.max(1)));
+    out.fill(
+        "{}: {} cycles in {} ms are {} Hz: at most {} Hz (at least {} ms for {} cycles)",
+        &[
+            Str(kind.name()),
+            Uint(cycles.into()),
+            Uint(duration.0.into()),
+            Text(&Milli(asked)),
+            Text(&Milli(max.0.into())),
+            Uint(shortest),
+            Uint(cycles.into()),
+        ],
+    )
 }
 
 impl core::error::Error for BehaviourError {}

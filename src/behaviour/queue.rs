@@ -9,6 +9,8 @@
 
 use core::fmt;
 
+use crate::text::{Describe, Text, display_from_describe};
+
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::{Channel, TrySendError};
 
@@ -25,11 +27,13 @@ pub const CAPACITY: usize = 8;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct QueueFull(pub Action);
 
-impl fmt::Display for QueueFull {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("command queue full: try again after the next frame")
+impl Describe for QueueFull {
+    fn describe(&self, out: &mut dyn Text) {
+        out.str("command queue full: try again after the next frame");
     }
 }
+
+display_from_describe!(QueueFull);
 
 impl core::error::Error for QueueFull {}
 

@@ -33,7 +33,7 @@
 //! ]);
 //! ```
 
-use core::fmt;
+use crate::text::{Describe, Text, display_from_describe};
 
 /// What is wrong with a line (the framer's part: the parser judges the rest).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,17 +62,26 @@ pub enum LineError {
     },
 }
 
-impl fmt::Display for LineError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl Describe for LineError {
+    fn describe(&self, out: &mut dyn Text) {
         match *self {
-            Self::TooLong { len, max } => {
-                write!(f, "too long ({len} bytes, at most {max})")
-            }
-            Self::Control { at, byte } => write!(f, "control byte 0x{byte:02x} at byte {at}"),
-            Self::NotUtf8 { at } => write!(f, "not UTF-8 from byte {at} on"),
-        }
+            Self::TooLong { len, max } => out
+                .str("too long (")
+                .u64(len as u64)
+                .str(" bytes, at most ")
+                .u64(max as u64)
+                .str(")"),
+            Self::Control { at, byte } => out
+                .str("control byte 0x")
+                .hex2(byte)
+                .str(" at byte ")
+                .u64(at as u64),
+            Self::NotUtf8 { at } => out.str("not UTF-8 from byte ").u64(at as u64).str(" on"),
+        };
     }
 }
+
+display_from_describe!(LineError);
 
 /// Backspace.
 const BS: u8 = 0x08;

@@ -5,10 +5,13 @@
 //! every other control character) are written as `?`, and text that does
 //! not fit is cut at a character boundary and marked with `…` (the only
 //! non-ASCII character a reply can contain: the parser quotes other bytes
-//! as `\xNN`). Numbers go through `core::fmt`'s integer formatting; nothing
-//! here formats a float, which would link about 30 KB of float formatting.
+//! as `\xNN`). Text and numbers go in through [`Text`], not `core::fmt`
+//! (see [`crate::text`]); nothing here formats a float, which would link
+//! about 30 KB of float formatting.
 
 use core::fmt;
+
+use crate::text::{Describe, Text, display_from_describe};
 
 use super::ParseError;
 
@@ -77,11 +80,13 @@ impl ErrorCode {
     }
 }
 
-impl fmt::Display for ErrorCode {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
+impl Describe for ErrorCode {
+    fn describe(&self, out: &mut dyn Text) {
+        out.str(self.as_str());
     }
 }
+
+display_from_describe!(ErrorCode);
 
 /// What a reply says so far.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -102,18 +107,21 @@ const ELLIPSIS: &str = "…";
 /// One reply line being written into a fixed buffer.
 ///
 /// [`ok`](Self::ok) or [`err`](Self::err) starts it (a reply nobody
-/// started is a bare `ok`), then text follows through [`fmt::Write`]
-/// (`write!`): the first piece of text is separated from the verdict by a
+/// started is a bare `ok`), then text follows through [`Text`] (the
+/// firmware's way, without `core::fmt`) or [`fmt::Write`] (`write!`, the
+/// same text): the first piece of text is separated from the verdict by a
 /// space. Writing never fails; text that does not fit is dropped and the
 /// reply ends in `…`.
 ///
 /// ```
 /// use core::fmt::Write;
 /// use idle_head::console::{ErrorCode, Reply};
+/// use idle_head::text::{Arg, Text};
 ///
 /// let mut buf = [0; 64];
 /// let mut reply = Reply::new(&mut buf);
-/// write!(reply.err(ErrorCode::Limit), "pitch {} mdeg is past {}", 31_000, 20_000).ok();
+/// let text: &mut dyn Text = reply.err(ErrorCode::Limit);
+/// text.fill("pitch {} mdeg is past {}", &[Arg::Int(31_000), Arg::Int(20_000)]);
 /// assert_eq!(reply.finish(), b"err limit pitch 31000 mdeg is past 20000\r\n");
 ///
 /// // Too long for the buffer: cut, and marked.
@@ -153,23 +161,25 @@ impl<'a> Reply<'a> {
         }
     }
 
-    /// Writes `prefix` (a machine-mode sequence number) before the verdict.
-    pub(super) fn prefix(&mut self, prefix: fmt::Arguments<'_>) {
+    /// Writes `#<seq> ` (a machine-mode sequence number) before the verdict.
+    pub(super) fn prefix(&mut self, seq: u32) {
         self.len = 0;
-        self.write_raw(prefix);
+        self.space = false;
+        let raw: &mut dyn Text = self;
+        raw.str("#").u64(seq.into()).str(" ");
         self.start = self.len;
         self.verdict = Verdict::Unset;
     }
 
     /// Starts (or restarts) the reply as `ok`; text written next follows it.
     pub fn ok(&mut self) -> &mut Self {
-        self.restart(Verdict::Ok, format_args!("ok"))
+        self.restart(Verdict::Ok, "ok", "")
     }
 
     /// Starts (or restarts) the reply as `err <code>`; text written next is
     /// the reason.
     pub fn err(&mut self, code: ErrorCode) -> &mut Self {
-        self.restart(Verdict::Err, format_args!("err {code}"))
+        self.restart(Verdict::Err, "err ", code.as_str())
     }
 
     /// Whether the reply is an error so far.
@@ -178,19 +188,15 @@ impl<'a> Reply<'a> {
         self.verdict == Verdict::Err
     }
 
-    fn restart(&mut self, verdict: Verdict, head: fmt::Arguments<'_>) -> &mut Self {
+    fn restart(&mut self, verdict: Verdict, head: &str, code: &str) -> &mut Self {
         self.len = self.start;
         self.truncated = false;
         self.space = false;
-        self.write_raw(head);
+        self.put_str(head);
+        self.put_str(code);
         self.verdict = verdict;
         self.space = true;
         self
-    }
-
-    fn write_raw(&mut self, args: fmt::Arguments<'_>) {
-        // Never fails: `write_str` below drops what does not fit.
-        fmt::Write::write_fmt(self, args).ok();
     }
 
     /// The line so far, without its end.
@@ -241,7 +247,7 @@ impl<'a> Reply<'a> {
     }
 
     /// Appends one character if it fits before the limit.
-    fn put(&mut self, c: char) -> bool {
+    fn put_char(&mut self, c: char) -> bool {
         let mut utf8 = [0; 4];
         let bytes = c.encode_utf8(&mut utf8).as_bytes();
         let end = self.len.saturating_add(bytes.len());
@@ -259,22 +265,37 @@ impl<'a> Reply<'a> {
     }
 }
 
-impl fmt::Write for Reply<'_> {
-    fn write_str(&mut self, s: &str) -> fmt::Result {
+impl Reply<'_> {
+    /// Appends `s` (after the separating space, if one is due), control
+    /// characters as `?`, up to the limit.
+    fn put_str(&mut self, s: &str) {
         if self.truncated || s.is_empty() {
-            return Ok(());
+            return;
         }
-        if core::mem::take(&mut self.space) && !self.put(' ') {
+        if core::mem::take(&mut self.space) && !self.put_char(' ') {
             self.truncated = true;
-            return Ok(());
+            return;
         }
         for c in s.chars() {
             let c = if c.is_control() { '?' } else { c };
-            if !self.put(c) {
+            if !self.put_char(c) {
                 self.truncated = true;
                 break;
             }
         }
+    }
+}
+
+impl Text for Reply<'_> {
+    fn put(&mut self, s: &str) {
+        self.put_str(s);
+    }
+}
+
+/// `write!` works too (on the host, in tests): the same text as [`Text`].
+impl fmt::Write for Reply<'_> {
+    fn write_str(&mut self, s: &str) -> fmt::Result {
+        self.put_str(s);
         Ok(())
     }
 }

@@ -48,7 +48,8 @@
 //!
 //! [`FrameDriver::set_servo`]: crate::driver::FrameDriver::set_servo
 
-use core::fmt::Write as _;
+use crate::text::Arg::{Int, Str, Uint};
+use crate::text::Text;
 
 use super::HELP;
 use super::link::{ConsoleLink, HeadStatus};
@@ -128,11 +129,11 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
 
     fn act(&mut self, action: Action, reply: &mut Reply<'_>) {
         if let Err(e) = self.behaviour.check(&action) {
-            write!(reply.err(behaviour_code(&e)), "{e}").ok();
+            text(reply.err(behaviour_code(&e))).with(&e);
             return;
         }
         if let Err(full) = self.queue.try_submit(action) {
-            write!(reply.err(ErrorCode::Busy), "{full}").ok();
+            text(reply.err(ErrorCode::Busy)).with(&full);
         }
     }
 
@@ -144,34 +145,45 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         let off = s.disabled.iter().filter(|&&d| d).count();
         // Frames since start × frame period, in ms.
         let uptime = s.frame * u64::from(self.base.frame_period.0) / 1000;
-        write!(
-            reply.ok(),
-            "mode={} mdeg={p},{r},{y} us={pp},{pr},{py} faults={fp},{fr},{fy} off={off} \
-             uptime_ms={uptime} fw={VERSION} settings={}",
-            s.mode.as_str(),
-            self.source.as_str()
-        )
-        .ok();
+        text(reply.ok()).fill(
+            "mode={} mdeg={},{},{} us={},{},{} faults={},{},{} off={} uptime_ms={} fw={} settings={}",
+            &[
+                Str(s.mode.as_str()),
+                Int(p.into()),
+                Int(r.into()),
+                Int(y.into()),
+                Uint(pp.into()),
+                Uint(pr.into()),
+                Uint(py.into()),
+                Uint(fp.into()),
+                Uint(fr.into()),
+                Uint(fy.into()),
+                Uint(off as u64),
+                Uint(uptime),
+                Str(VERSION),
+                Str(self.source.as_str()),
+            ],
+        );
     }
 
     fn show_servo(&self, axis: Axis, reply: &mut Reply<'_>) {
         let c = self.settings.servo(axis);
-        write!(
-            reply.ok(),
+        text(reply.ok()).fill(
             "{} neutral={} per-degree={} direction={} min={} max={} limits={},{}",
-            axis.name(),
-            c.neutral.0,
-            c.per_degree.0,
-            match c.direction {
-                Direction::Normal => "normal",
-                Direction::Reversed => "reversed",
-            },
-            c.min_pulse.0,
-            c.max_pulse.0,
-            c.limits.min.millidegrees(),
-            c.limits.max.millidegrees()
-        )
-        .ok();
+            &[
+                Str(axis.name()),
+                Uint(c.neutral.0.into()),
+                Uint(c.per_degree.0.into()),
+                Str(match c.direction {
+                    Direction::Normal => "normal",
+                    Direction::Reversed => "reversed",
+                }),
+                Uint(c.min_pulse.0.into()),
+                Uint(c.max_pulse.0.into()),
+                Int(c.limits.min.millidegrees().into()),
+                Int(c.limits.max.millidegrees().into()),
+            ],
+        );
     }
 
     fn set_servo(&mut self, axis: Axis, setting: ServoSetting, reply: &mut Reply<'_>) {
@@ -184,15 +196,15 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         if let ServoSetting::Limits(limits) = setting {
             let at = self.link.status().angles[axis.index()];
             if !limits.contains(at) {
-                write!(
-                    reply.err(ErrorCode::Limit),
+                text(reply.err(ErrorCode::Limit)).fill(
                     "the {} servo stands at {} mdeg, outside {}..{}: move it in first",
-                    axis.name(),
-                    at.millidegrees(),
-                    limits.min.millidegrees(),
-                    limits.max.millidegrees()
-                )
-                .ok();
+                    &[
+                        Str(axis.name()),
+                        Int(at.millidegrees().into()),
+                        Int(limits.min.millidegrees().into()),
+                        Int(limits.max.millidegrees().into()),
+                    ],
+                );
                 return;
             }
         }
@@ -204,14 +216,12 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
                 self.source = SettingsSource::Changed;
             }
             Err(SettingsError::Driver(e)) => {
-                write!(reply.err(ErrorCode::Invalid), "{e}").ok();
+                text(reply.err(ErrorCode::Invalid)).with(&e);
             }
             Err(SettingsError::Behaviour(e)) => {
-                write!(
-                    reply.err(ErrorCode::Limit),
-                    "the head would go past the new limits: {e}"
-                )
-                .ok();
+                text(reply.err(ErrorCode::Limit))
+                    .str("the head would go past the new limits: ")
+                    .with(&e);
             }
         }
     }
@@ -233,7 +243,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         self.link.reseed(seeds);
         self.settings.seeds = seeds;
         self.source = SettingsSource::Changed;
-        write!(reply.ok(), "seed={n}").ok();
+        text(reply.ok()).str("seed=").u64(n.into());
     }
 
     /// Puts `settings` in effect: idle amplitude through the queue (so a
@@ -242,7 +252,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         let valid = match settings.validate(&self.base) {
             Ok(valid) => valid,
             Err(e) => {
-                write!(reply.err(ErrorCode::Invalid), "{e}").ok();
+                text(reply.err(ErrorCode::Invalid)).with(&e);
                 return false;
             }
         };
@@ -250,7 +260,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         if amp != self.settings.behaviour.idle.amplitude
             && let Err(full) = self.queue.try_submit(Action::IdleAmp(amp))
         {
-            write!(reply.err(ErrorCode::Busy), "{full}").ok();
+            text(reply.err(ErrorCode::Busy)).with(&full);
             return false;
         }
         for (axis, (new, old)) in Axis::ALL
@@ -291,7 +301,7 @@ impl<S: SettingsStorage, const N: usize> Handler for ConsoleService<'_, S, N> {
     fn command(&mut self, command: Command, reply: &mut Reply<'_>) {
         match command {
             Command::Help => {
-                reply.ok().write_str(HELP).ok();
+                text(reply.ok()).str(HELP);
             }
             Command::Status => self.status(reply),
             Command::Act(action) => self.act(action, reply),
@@ -345,5 +355,13 @@ const fn behaviour_code(e: &BehaviourError) -> ErrorCode {
 }
 
 fn storage_error(e: StorageError, what: &str, reply: &mut Reply<'_>) {
-    write!(reply.err(ErrorCode::Storage), "{what}: {e}").ok();
+    text(reply.err(ErrorCode::Storage))
+        .str(what)
+        .str(": ")
+        .with(&e);
+}
+
+/// A reply as the [`Text`] its words are written into.
+fn text<'r>(reply: &'r mut Reply<'_>) -> &'r mut dyn Text {
+    reply
 }

@@ -21,7 +21,7 @@
 //! case in a command, lower case in a reply). A line with a bad sequence
 //! number or checksum is not carried out and gets `err line …`.
 
-use core::fmt::{self, Write as _};
+use crate::text::{Describe, Text, display_from_describe};
 
 use crc::{CRC_8_SMBUS, Crc, NoTable};
 
@@ -60,20 +60,22 @@ pub enum EnvelopeError {
     },
 }
 
-impl fmt::Display for EnvelopeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl Describe for EnvelopeError {
+    fn describe(&self, out: &mut dyn Text) {
         match *self {
-            Self::BadSequence => f.write_str("bad sequence number (`#<seq> <command> *<crc>`)"),
-            Self::MissingChecksum => f.write_str("missing checksum (end the line with ` *<crc>`)"),
-            Self::BadChecksum { found, computed } => {
-                write!(
-                    f,
-                    "checksum {found:02x} does not match the line ({computed:02x})"
-                )
-            }
-        }
+            Self::BadSequence => out.str("bad sequence number (`#<seq> <command> *<crc>`)"),
+            Self::MissingChecksum => out.str("missing checksum (end the line with ` *<crc>`)"),
+            Self::BadChecksum { found, computed } => out
+                .str("checksum ")
+                .hex2(found)
+                .str(" does not match the line (")
+                .hex2(computed)
+                .str(")"),
+        };
     }
 }
+
+display_from_describe!(EnvelopeError);
 
 /// Why a line was not a command.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -208,7 +210,7 @@ pub fn respond<'b, H: Handler + ?Sized>(
         Ok(text) if text.first() == Some(&b'#') => {
             let Envelope { seq, command } = envelope(text);
             if let Some(seq) = seq {
-                reply.prefix(format_args!("#{seq} "));
+                reply.prefix(seq);
             }
             match command {
                 Ok(command) => answer(command, handler, &mut reply),
@@ -250,13 +252,12 @@ fn reject<H: Handler + ?Sized>(
     handler: &mut H,
     reply: &mut Reply<'_>,
 ) {
-    let text = reply.err(error.code());
+    let text: &mut dyn Text = reply.err(error.code());
     match &error {
-        InputError::Line(e) => write!(text, "{e}"),
-        InputError::Envelope(e) => write!(text, "{e}"),
-        InputError::Parse(e) => write!(text, "{}", e.describe(line)),
-    }
-    .ok();
+        InputError::Line(e) => text.with(e),
+        InputError::Envelope(e) => text.with(e),
+        InputError::Parse(e) => text.with(&e.describing(line)),
+    };
     handler.rejected(&error);
 }
 

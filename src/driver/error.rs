@@ -1,6 +1,7 @@
 //! Configurations the driver rejects, with the rejected values.
 
-use core::fmt;
+use crate::text::Arg::{Int, Str, Text, Uint};
+use crate::text::{self, Describe, display_from_describe};
 
 use crate::axis::Axis;
 use crate::servo::{Degrees, ServoError};
@@ -14,7 +15,7 @@ use super::limiter::MAX_LIMIT_MDEG;
 /// [`FrameDriver::set_motion_limits`](super::FrameDriver::set_motion_limits),
 /// with the rejected values.
 ///
-/// Its [`Display`](fmt::Display) names the servo and the field and gives the
+/// Its [`Display`](core::fmt::Display) names the servo and the field and gives the
 /// rejected value and what is allowed, in µs and degrees;
 /// [`message`](Self::message) is a fixed text for `const` checks and logs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -167,60 +168,144 @@ impl ConfigError {
 ///     "pitch servo: limit +400° lies beyond ±360°, the widest range the driver takes"
 /// );
 /// ```
-impl fmt::Display for ConfigError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl Describe for ConfigError {
+    fn describe(&self, out: &mut dyn text::Text) {
         match *self {
-            Self::ZeroFramePeriod => f.write_str("frame_period must be longer than 0 µs"),
-            Self::ZeroPwmPeriod => f.write_str("pwm.period must be longer than 0 µs"),
-            Self::ZeroDisableAfter => f.write_str("faults.disable_after must be at least 1 frame"),
-            Self::Servo { axis, error } => write!(f, "{} servo: {error}", axis.name()),
+            Self::ZeroFramePeriod => out.str("frame_period must be longer than 0 µs"),
+            Self::ZeroPwmPeriod => out.str("pwm.period must be longer than 0 µs"),
+            Self::ZeroDisableAfter => out.str("faults.disable_after must be at least 1 frame"),
+            Self::Servo { axis, error } => {
+                out.fill("{} servo: {}", &[Str(axis.name()), Text(&error)])
+            }
             Self::PulseLongerThanPeriod {
                 axis,
                 max_pulse,
                 period,
-            } => write!(
-                f,
+            } => out.fill(
                 "{} servo: max_pulse {} µs is longer than the PWM period of {} µs",
-                axis.name(),
-                max_pulse.0,
-                period.0
+                &[
+                    Str(axis.name()),
+                    Uint(max_pulse.0.into()),
+                    Uint(period.0.into()),
+                ],
             ),
-            Self::LimitOutOfRange { axis, limit } => write!(
-                f,
+            Self::LimitOutOfRange { axis, limit } => out.fill(
                 "{} servo: limit {} lies beyond ±{}°, the widest range the driver takes",
-                axis.name(),
-                Degrees(limit),
-                MAX_LIMIT_MDEG / 1000
+                &[
+                    Str(axis.name()),
+                    Text(&Degrees(limit)),
+                    Int((MAX_LIMIT_MDEG / 1000).into()),
+                ],
             ),
-            Self::NeutralPoseOutsideLimits { axis, pose, limits } => write!(
-                f,
+            Self::NeutralPoseOutsideLimits { axis, pose, limits } => out.fill(
                 "{}: neutral_pose {} lies outside the servo's limits {}..{}",
-                axis.name(),
-                Degrees(pose),
-                Degrees(limits.min),
-                Degrees(limits.max)
+                &[
+                    Str(axis.name()),
+                    Text(&Degrees(pose)),
+                    Text(&Degrees(limits.min)),
+                    Text(&Degrees(limits.max)),
+                ],
             ),
-            Self::ZeroSpeedLimit { axis } => write!(
-                f,
+            Self::ZeroSpeedLimit { axis } => out.fill(
                 "{}: motion max_speed must be at least 1 °/s",
-                axis.name()
+                &[Str(axis.name())],
             ),
             Self::AccelBelowResolution {
                 axis,
                 max_accel,
                 frame_period,
-            } => write!(
-                f,
+            } => out.fill(
                 "{}: motion max_accel {} °/s² is below {} °/s², the least the driver resolves \
                  (1 µ° per frame²) at frames of {} µs",
-                axis.name(),
-                max_accel.0,
-                least_accel(frame_period),
-                frame_period.0
+                &[
+                    Str(axis.name()),
+                    Uint(max_accel.0.into()),
+                    Uint(least_accel(frame_period)),
+                    Uint(frame_period.0.into()),
+                ],
             ),
-        }
+        };
     }
 }
+
+/// ```
+/// use idle_head::servo::{ServoCalibration, ServoError};
+/// use idle_head::{Axis, Microseconds};
+/// let mut cal = ServoCalibration::hobby(Axis::Roll);
+/// cal.min_pulse = Microseconds(2500);
+/// let err = cal.validate().unwrap_err();
+/// assert_eq!(err.to_string(), "min_pulse 2500 µs must be below max_pulse 2000 µs");
+/// ```
+impl Describe for ServoError {
+    fn describe(&self, out: &mut dyn text::Text) {
+        match *self {
+            Self::PulseRangeEmpty { min, max } => out.fill(
+                "min_pulse {} µs must be below max_pulse {} µs",
+                &[Uint(min.0.into()), Uint(max.0.into())],
+            ),
+            Self::NeutralOutsidePulseRange { neutral, min, max } => out.fill(
+                "neutral {} µs lies outside the pulse range {}..{} µs",
+                &[
+                    Uint(neutral.0.into()),
+                    Uint(min.0.into()),
+                    Uint(max.0.into()),
+                ],
+            ),
+            Self::ZeroPerDegree => out.str("per_degree must be above 0 ns/°"),
+            Self::LimitsInverted { limits } => out.fill(
+                "limits {}..{}: the lower limit lies above the upper one",
+                &[Text(&Degrees(limits.min)), Text(&Degrees(limits.max))],
+            ),
+            Self::NeutralOutsideLimits { limits } => out.fill(
+                "limits {}..{} must contain 0°, the neutral angle the servo starts at",
+                &[Text(&Degrees(limits.min)), Text(&Degrees(limits.max))],
+            ),
+            Self::LimitUnreachable {
+                angle,
+                needed_us,
+                min,
+                max,
+            } => out.fill(
+                "limit {} needs {} µs, outside the pulse range {}..{} µs",
+                &[
+                    Text(&Degrees(angle)),
+                    Int(needed_us),
+                    Uint(min.0.into()),
+                    Uint(max.0.into()),
+                ],
+            ),
+        };
+    }
+}
+
+/// `+20°`, `-12.5°`, `0°`: the sign and up to three decimals.
+impl Describe for Degrees {
+    fn describe(&self, out: &mut dyn text::Text) {
+        let m = self.0.millidegrees();
+        let sign = match m {
+            0 => "",
+            ..0 => "-",
+            _ => "+",
+        };
+        let (whole, frac) = (m.unsigned_abs() / 1000, m.unsigned_abs() % 1000);
+        out.str(sign).u64(whole.into());
+        match frac {
+            0 => {}
+            _ if frac % 100 == 0 => {
+                out.str(".").u64((frac / 100).into());
+            }
+            _ if frac % 10 == 0 => {
+                out.str(".").zeros((frac / 10).into(), 2);
+            }
+            _ => {
+                out.str(".").zeros(frac.into(), 3);
+            }
+        }
+        out.str("°");
+    }
+}
+
+display_from_describe!(ConfigError);
 
 impl core::error::Error for ConfigError {}
 

@@ -2,7 +2,7 @@
 //! implements ([`SettingsStorage`]), and [`RamStorage`], a record kept in
 //! RAM (the QEMU image's store; tests).
 
-use core::fmt;
+use crate::text::{Describe, Text, display_from_describe};
 
 use super::record::{DecodeError, Record};
 use super::store::{LoadError, SaveError};
@@ -35,19 +35,25 @@ pub enum StorageError {
     Device,
 }
 
-impl fmt::Display for StorageError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl Describe for StorageError {
+    fn describe(&self, out: &mut dyn Text) {
         match *self {
-            Self::Empty => f.write_str("no settings saved"),
-            Self::Corrupt => f.write_str("stored settings are damaged"),
-            Self::Older { found } => write!(f, "stored settings are of older version {found}"),
-            Self::Newer { found } => write!(f, "stored settings are of newer version {found}"),
-            Self::Invalid => f.write_str("stored settings fail validation"),
-            Self::TooLong => f.write_str("settings do not fit the store"),
-            Self::Device => f.write_str("the flash failed"),
-        }
+            Self::Empty => out.str("no settings saved"),
+            Self::Corrupt => out.str("stored settings are damaged"),
+            Self::Older { found } => out
+                .str("stored settings are of older version ")
+                .u64(found.into()),
+            Self::Newer { found } => out
+                .str("stored settings are of newer version ")
+                .u64(found.into()),
+            Self::Invalid => out.str("stored settings fail validation"),
+            Self::TooLong => out.str("settings do not fit the store"),
+            Self::Device => out.str("the flash failed"),
+        };
     }
 }
+
+display_from_describe!(StorageError);
 
 impl<E> From<LoadError<E>> for StorageError {
     fn from(e: LoadError<E>) -> Self {

@@ -9,7 +9,7 @@
 //! [`BehaviourConfig::build`]), against a board's base driver
 //! configuration (its frame period, PWM and speed limits).
 
-use core::fmt;
+use crate::text::{Describe, Text, display_from_describe};
 
 use crate::axis::Axis;
 use crate::behaviour::{BehaviourConfig, BehaviourError, BehaviourParams};
@@ -39,14 +39,16 @@ pub enum SettingsError {
     Behaviour(BehaviourError),
 }
 
-impl fmt::Display for SettingsError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl Describe for SettingsError {
+    fn describe(&self, out: &mut dyn Text) {
         match self {
-            Self::Driver(e) => e.fmt(f),
-            Self::Behaviour(e) => e.fmt(f),
+            Self::Driver(e) => e.describe(out),
+            Self::Behaviour(e) => e.describe(out),
         }
     }
 }
+
+display_from_describe!(SettingsError);
 
 impl core::error::Error for SettingsError {}
 

@@ -92,6 +92,7 @@ mod calibrate;
 mod console;
 #[cfg(feature = "console")]
 mod handler;
+mod panic;
 mod rp2040_pwm;
 mod servo_pwm;
 #[cfg(feature = "console")]
@@ -118,7 +119,6 @@ use idle_head::idle::{IdleMode, IdleTiming, LoopStream};
 use idle_head::motion::DEFAULT_HEAD;
 use idle_head::motion::DEFAULT_N;
 use idle_head::{Axis, Playback};
-use panic_probe as _;
 use static_cell::ConstStaticCell;
 
 use crate::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};

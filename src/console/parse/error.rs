@@ -2,6 +2,9 @@
 
 use core::fmt;
 
+use crate::text::Arg::{Int, Str, Text};
+use crate::text::{self, Text as Out};
+
 /// Where in the line an error is: a byte range (empty at the end of the line).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -74,17 +77,23 @@ impl ParseError {
     /// that was parsed).
     #[must_use]
     pub fn describe<'a>(&'a self, line: &'a [u8]) -> impl fmt::Display + 'a {
+        self.describing(line)
+    }
+
+    /// The same reason as a [`text::Describe`], for replies.
+    pub(crate) const fn describing<'a>(&'a self, line: &'a [u8]) -> Describe<'a> {
         Describe { error: self, line }
     }
 }
 
-struct Describe<'a> {
+/// A parse error's reason with its line.
+pub(crate) struct Describe<'a> {
     error: &'a ParseError,
     line: &'a [u8],
 }
 
-impl fmt::Display for Describe<'_> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl text::Describe for Describe<'_> {
+    fn describe(&self, out: &mut dyn Out) {
         let Span { start, end } = self.error.at;
         let word = self
             .line
@@ -92,38 +101,45 @@ impl fmt::Display for Describe<'_> {
             .unwrap_or_default();
         let quoted = Quoted(word);
         match self.error.kind {
-            ParseErrorKind::Empty => f.write_str("empty line (try `help`)"),
-            ParseErrorKind::UnknownCommand => write!(f, "unknown command {quoted} (try `help`)"),
-            ParseErrorKind::Missing(what) => write!(f, "missing {what}"),
-            ParseErrorKind::Unexpected => write!(f, "{quoted}: unexpected"),
+            ParseErrorKind::Empty => out.str("empty line (try `help`)"),
+            ParseErrorKind::UnknownCommand => {
+                out.fill("unknown command {} (try `help`)", &[Text(&quoted)])
+            }
+            ParseErrorKind::Missing(what) => out.str("missing ").str(what),
+            ParseErrorKind::Unexpected => out.fill("{}: unexpected", &[Text(&quoted)]),
             ParseErrorKind::NotANumber(what) => {
-                write!(f, "{quoted}: {what} must be a whole number")
+                out.fill("{}: {} must be a whole number", &[Text(&quoted), Str(what)])
             }
-            ParseErrorKind::OutOfRange { what, min, max } => {
-                write!(f, "{quoted}: {what} must be in {min}..={max}")
+            ParseErrorKind::OutOfRange { what, min, max } => out.fill(
+                "{}: {} must be in {}..={}",
+                &[Text(&quoted), Str(what), Int(min), Int(max)],
+            ),
+            ParseErrorKind::UnknownWord { expected } => {
+                out.fill("{}: expected {}", &[Text(&quoted), Str(expected)])
             }
-            ParseErrorKind::UnknownWord { expected } => write!(f, "{quoted}: expected {expected}"),
-            ParseErrorKind::UnknownOption { allowed } => {
-                write!(f, "{quoted}: unknown option (allowed: {allowed})")
-            }
-            ParseErrorKind::DuplicateOption => write!(f, "{quoted}: option given twice"),
-        }
+            ParseErrorKind::UnknownOption { allowed } => out.fill(
+                "{}: unknown option (allowed: {})",
+                &[Text(&quoted), Str(allowed)],
+            ),
+            ParseErrorKind::DuplicateOption => out.fill("{}: option given twice", &[Text(&quoted)]),
+        };
     }
 }
 
 /// A word in backquotes, bytes that are not printable ASCII as `\xNN`.
 struct Quoted<'a>(&'a [u8]);
 
-impl fmt::Display for Quoted<'_> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("`")?;
-        for &b in self.0 {
-            if b.is_ascii_graphic() {
-                write!(f, "{}", char::from(b))?;
-            } else {
-                write!(f, "\\x{b:02x}")?;
-            }
+impl text::Describe for Quoted<'_> {
+    fn describe(&self, out: &mut dyn Out) {
+        out.str("`");
+        for b in self.0 {
+            match core::str::from_utf8(core::slice::from_ref(b)) {
+                Ok(c) if b.is_ascii_graphic() => out.str(c),
+                _ => out.str("\\x").hex2(*b),
+            };
         }
-        f.write_str("`")
+        out.str("`");
     }
 }
+
+text::display_from_describe!(Describe<'_>);

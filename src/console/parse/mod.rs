@@ -53,7 +53,7 @@ mod error;
 mod words;
 
 pub use error::{ParseError, ParseErrorKind, Span};
-use words::{Word, Words, once};
+use words::{Kw, Word, Words, once};
 
 /// Parses one line (without its line ending); the grammar is in this
 /// module's source and, for users, in `docs/protocol.md`.
@@ -66,29 +66,30 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
         return Err(words.error_here(ParseErrorKind::Empty));
     };
     let command = match first.lower() {
-        Word::Is("help") => Command::Help,
-        Word::Is("status") => Command::Status,
-        Word::Is("save") => Command::Save,
-        Word::Is("load") => Command::Load,
-        Word::Is("defaults") => Command::Defaults,
-        Word::Is("stop") => Command::Act(Action::Stop),
-        Word::Is("nod") => gesture(&mut words, GestureKind::Nod)?,
-        Word::Is("shake") => gesture(&mut words, GestureKind::Shake)?,
-        Word::Is("tilt") => gesture(&mut words, GestureKind::Tilt)?,
-        Word::Is("look") => look(&mut words)?,
-        Word::Is("center" | "centre") => Command::Act(Action::Center {
-            duration: words.optional_number(DURATION)?.map(to_millis),
+        Word::Is(Kw::Help) => Command::Help,
+        Word::Is(Kw::Status) => Command::Status,
+        Word::Is(Kw::Save) => Command::Save,
+        Word::Is(Kw::Load) => Command::Load,
+        Word::Is(Kw::Defaults) => Command::Defaults,
+        Word::Is(Kw::Stop) => Command::Act(Action::Stop),
+        Word::Is(Kw::Nod) => gesture(&mut words, GestureKind::Nod)?,
+        Word::Is(Kw::Shake) => gesture(&mut words, GestureKind::Shake)?,
+        Word::Is(Kw::Tilt) => gesture(&mut words, GestureKind::Tilt)?,
+        Word::Is(Kw::Look) => look(&mut words)?,
+        Word::Is(Kw::Center | Kw::Centre) => Command::Act(Action::Center {
+            duration: words.optional_number(&DURATION)?.map(to_millis),
         }),
-        Word::Is("idle") => idle(&mut words)?,
-        Word::Is("seed") => seed(&mut words)?,
-        Word::Is("servo") => servo(&mut words)?,
+        Word::Is(Kw::Idle) => idle(&mut words)?,
+        Word::Is(Kw::Seed) => seed(&mut words)?,
+        Word::Is(Kw::Servo) => servo(&mut words)?,
         _ => return Err(first.error(ParseErrorKind::UnknownCommand)),
     };
     words.end()?;
     Ok(command)
 }
 
-/// A numeric field: its name and range.
+/// A numeric field: its name and range (passed as `&'static`: one address
+/// per call instead of the whole field).
 #[derive(Clone, Copy)]
 struct Field {
     what: &'static str,
@@ -104,6 +105,22 @@ const AMPLITUDE: Field = Field {
 const ANGLE: Field = Field {
     what: "angle in mdeg",
     ..AMPLITUDE
+};
+const PITCH: Field = Field {
+    what: "pitch in mdeg",
+    ..ANGLE
+};
+const YAW: Field = Field {
+    what: "yaw in mdeg",
+    ..ANGLE
+};
+const LOWER_LIMIT: Field = Field {
+    what: "lower limit in mdeg",
+    ..ANGLE
+};
+const UPPER_LIMIT: Field = Field {
+    what: "upper limit in mdeg",
+    ..ANGLE
 };
 const DURATION: Field = Field {
     what: "duration in ms",
@@ -156,21 +173,21 @@ fn to_percent(v: i64) -> Percent {
 /// `nod|shake|tilt [amp] [ms] [cycles=N] [intensity=P]`.
 fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Command, ParseError> {
     let mut request = GestureRequest::new(kind);
-    request.amplitude = words.optional_number(AMPLITUDE)?.map(to_angle);
-    request.duration = words.optional_number(DURATION)?.map(to_millis);
+    request.amplitude = words.optional_number(&AMPLITUDE)?.map(to_angle);
+    request.duration = words.optional_number(&DURATION)?.map(to_millis);
     let allowed = match kind {
         GestureKind::Tilt => "intensity",
         GestureKind::Nod | GestureKind::Shake => "cycles, intensity",
     };
     while let Some((name, value, word)) = words.option()? {
         match (name, kind) {
-            ("cycles", GestureKind::Nod | GestureKind::Shake) => {
+            (Word::Is(Kw::Cycles), GestureKind::Nod | GestureKind::Shake) => {
                 once(request.cycles.is_some(), word)?;
-                request.cycles = Some(value.number(CYCLES)? as u8);
+                request.cycles = Some(value.number(&CYCLES)? as u8);
             }
-            ("intensity", _) => {
+            (Word::Is(Kw::Intensity), _) => {
                 once(request.intensity.is_some(), word)?;
-                request.intensity = Some(to_percent(value.number(PERCENT)?));
+                request.intensity = Some(to_percent(value.number(&PERCENT)?));
             }
             _ => return Err(word.error(ParseErrorKind::UnknownOption { allowed })),
         }
@@ -180,19 +197,19 @@ fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Command, ParseErr
 
 /// `look <pitch> <yaw> [ms] [hold=MS|hold=stay]`.
 fn look(words: &mut Words<'_>) -> Result<Command, ParseError> {
-    let pitch = to_angle(words.number("pitch in mdeg", ANGLE)?);
-    let yaw = to_angle(words.number("yaw in mdeg", ANGLE)?);
-    let duration = words.optional_number(DURATION)?.map(to_millis);
+    let pitch = to_angle(words.number(&PITCH)?);
+    let yaw = to_angle(words.number(&YAW)?);
+    let duration = words.optional_number(&DURATION)?.map(to_millis);
     let mut hold = None;
     while let Some((name, value, word)) = words.option()? {
-        if name != "hold" {
+        if name != Word::Is(Kw::Hold) {
             return Err(word.error(ParseErrorKind::UnknownOption { allowed: "hold" }));
         }
         once(hold.is_some(), word)?;
-        hold = Some(if value.lower() == Word::Is("stay") {
+        hold = Some(if value.lower() == Word::Is(Kw::Stay) {
             Hold::Stay
         } else {
-            Hold::Return(to_millis(value.number(HOLD)?))
+            Hold::Return(to_millis(value.number(&HOLD)?))
         });
     }
     Ok(Command::Act(Action::Look(LookRequest {
@@ -210,9 +227,9 @@ fn idle(words: &mut Words<'_>) -> Result<Command, ParseError> {
         return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
     };
     let action = match word.lower() {
-        Word::Is("on") => Action::Idle(true),
-        Word::Is("off") => Action::Idle(false),
-        Word::Is("amp") => Action::IdleAmp(to_percent(words.number("percentage", PERCENT)?)),
+        Word::Is(Kw::On) => Action::Idle(true),
+        Word::Is(Kw::Off) => Action::Idle(false),
+        Word::Is(Kw::Amp) => Action::IdleAmp(to_percent(words.number(&PERCENT)?)),
         _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: EXPECTED })),
     };
     Ok(Command::Act(action))
@@ -224,10 +241,10 @@ fn seed(words: &mut Words<'_>) -> Result<Command, ParseError> {
     let Some(word) = words.next() else {
         return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
     };
-    if word.lower() == Word::Is("random") {
+    if word.lower() == Word::Is(Kw::Random) {
         return Ok(Command::Seed(SeedChoice::Random));
     }
-    Ok(Command::Seed(SeedChoice::Value(word.number(SEED)? as u32)))
+    Ok(Command::Seed(SeedChoice::Value(word.number(&SEED)? as u32)))
 }
 
 /// `servo <axis> [<field> <value>...]`.
@@ -238,9 +255,9 @@ fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
         return Err(words.error_here(ParseErrorKind::Missing(AXES)));
     };
     let axis = match word.lower() {
-        Word::Is("pitch") => Axis::Pitch,
-        Word::Is("roll") => Axis::Roll,
-        Word::Is("yaw") => Axis::Yaw,
+        Word::Is(Kw::Pitch) => Axis::Pitch,
+        Word::Is(Kw::Roll) => Axis::Roll,
+        Word::Is(Kw::Yaw) => Axis::Yaw,
         _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: AXES })),
     };
     let Some(field) = words.next() else {
@@ -250,23 +267,23 @@ fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
         });
     };
     let pulse = |words: &mut Words<'_>| -> Result<Microseconds, ParseError> {
-        Ok(Microseconds(words.number("pulse in us", PULSE)? as u32))
+        Ok(Microseconds(words.number(&PULSE)? as u32))
     };
     let setting = match field.lower() {
-        Word::Is("neutral") => ServoSetting::Neutral(pulse(words)?),
-        Word::Is("min") => ServoSetting::MinPulse(pulse(words)?),
-        Word::Is("max") => ServoSetting::MaxPulse(pulse(words)?),
-        Word::Is("per-degree") => ServoSetting::PerDegree(NanosPerDegree(
-            words.number("ns per degree", PER_DEGREE)? as u32,
-        )),
-        Word::Is("direction") => {
+        Word::Is(Kw::Neutral) => ServoSetting::Neutral(pulse(words)?),
+        Word::Is(Kw::Min) => ServoSetting::MinPulse(pulse(words)?),
+        Word::Is(Kw::Max) => ServoSetting::MaxPulse(pulse(words)?),
+        Word::Is(Kw::PerDegree) => {
+            ServoSetting::PerDegree(NanosPerDegree(words.number(&PER_DEGREE)? as u32))
+        }
+        Word::Is(Kw::Direction) => {
             const DIRECTIONS: &str = "`normal` or `reversed`";
             let Some(word) = words.next() else {
                 return Err(words.error_here(ParseErrorKind::Missing(DIRECTIONS)));
             };
             ServoSetting::Direction(match word.lower() {
-                Word::Is("normal") => Direction::Normal,
-                Word::Is("reversed") => Direction::Reversed,
+                Word::Is(Kw::Normal) => Direction::Normal,
+                Word::Is(Kw::Reversed) => Direction::Reversed,
                 _ => {
                     return Err(word.error(ParseErrorKind::UnknownWord {
                         expected: DIRECTIONS,
@@ -274,9 +291,9 @@ fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
                 }
             })
         }
-        Word::Is("limits") => {
-            let min = to_angle(words.number("lower limit in mdeg", ANGLE)?);
-            let max = to_angle(words.number("upper limit in mdeg", ANGLE)?);
+        Word::Is(Kw::Limits) => {
+            let min = to_angle(words.number(&LOWER_LIMIT)?);
+            let max = to_angle(words.number(&UPPER_LIMIT)?);
             ServoSetting::Limits(AngleRange { min, max })
         }
         _ => return Err(field.error(ParseErrorKind::UnknownWord { expected: FIELDS })),

@@ -23,11 +23,51 @@ pub(super) struct Token<'a> {
 /// none of the names the parser asks about).
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub(super) enum Word {
-    Is(&'static str),
+    Is(Kw),
     Other,
 }
 
-/// Every word the protocol has, lower case.
+/// Every word the protocol has. The parser matches these, not the texts:
+/// comparing one byte per arm instead of a string keeps it small.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Kw {
+    Help,
+    Status,
+    Save,
+    Load,
+    Defaults,
+    Stop,
+    Nod,
+    Shake,
+    Tilt,
+    Look,
+    Center,
+    Centre,
+    Idle,
+    Seed,
+    Servo,
+    On,
+    Off,
+    Amp,
+    Random,
+    Pitch,
+    Roll,
+    Yaw,
+    Neutral,
+    Min,
+    Max,
+    PerDegree,
+    Direction,
+    Normal,
+    Reversed,
+    Limits,
+    Stay,
+    Hold,
+    Cycles,
+    Intensity,
+}
+
+/// Every word the protocol has, lower case, in the order of [`ALL`].
 const KEYWORDS: [&str; 34] = [
     "help",
     "status",
@@ -65,6 +105,44 @@ const KEYWORDS: [&str; 34] = [
     "intensity",
 ];
 
+/// The [`Kw`] of each of [`KEYWORDS`].
+const ALL: [Kw; 34] = [
+    Kw::Help,
+    Kw::Status,
+    Kw::Save,
+    Kw::Load,
+    Kw::Defaults,
+    Kw::Stop,
+    Kw::Nod,
+    Kw::Shake,
+    Kw::Tilt,
+    Kw::Look,
+    Kw::Center,
+    Kw::Centre,
+    Kw::Idle,
+    Kw::Seed,
+    Kw::Servo,
+    Kw::On,
+    Kw::Off,
+    Kw::Amp,
+    Kw::Random,
+    Kw::Pitch,
+    Kw::Roll,
+    Kw::Yaw,
+    Kw::Neutral,
+    Kw::Min,
+    Kw::Max,
+    Kw::PerDegree,
+    Kw::Direction,
+    Kw::Normal,
+    Kw::Reversed,
+    Kw::Limits,
+    Kw::Stay,
+    Kw::Hold,
+    Kw::Cycles,
+    Kw::Intensity,
+];
+
 impl<'a> Token<'a> {
     pub(super) fn span(&self) -> Span {
         Span {
@@ -84,12 +162,13 @@ impl<'a> Token<'a> {
     pub(super) fn lower(&self) -> Word {
         KEYWORDS
             .iter()
-            .find(|k| k.as_bytes().eq_ignore_ascii_case(self.text))
-            .map_or(Word::Other, |k| Word::Is(k))
+            .zip(ALL)
+            .find(|(k, _)| k.as_bytes().eq_ignore_ascii_case(self.text))
+            .map_or(Word::Other, |(_, kw)| Word::Is(kw))
     }
 
     /// The word as a whole number in `field`'s range.
-    pub(super) fn number(&self, field: Field) -> Result<i64, ParseError> {
+    pub(super) fn number(&self, field: &Field) -> Result<i64, ParseError> {
         let value = integer(self.text).ok_or(self.error(ParseErrorKind::NotANumber(field.what)))?;
         if value < field.min || value > field.max {
             return Err(self.error(ParseErrorKind::OutOfRange {
@@ -102,7 +181,7 @@ impl<'a> Token<'a> {
     }
 
     /// `name=value` split at the first `=`, the name lower-cased.
-    pub(super) fn split_option(&self) -> Option<(&'static str, Token<'a>)> {
+    pub(super) fn split_option(&self) -> Option<(Word, Token<'a>)> {
         let eq = self.text.iter().position(|&b| b == b'=')?;
         let (name, rest) = self.text.split_at(eq);
         let value = Token {
@@ -113,13 +192,7 @@ impl<'a> Token<'a> {
             text: name,
             start: self.start,
         };
-        Some((
-            match name.lower() {
-                Word::Is(k) => k,
-                Word::Other => "",
-            },
-            value,
-        ))
+        Some((name.lower(), value))
     }
 }
 
@@ -207,16 +280,16 @@ impl<'a> Words<'a> {
     }
 
     /// A required number.
-    pub(super) fn number(&mut self, what: &'static str, field: Field) -> Result<i64, ParseError> {
+    pub(super) fn number(&mut self, field: &Field) -> Result<i64, ParseError> {
         match self.next() {
-            Some(token) => token.number(Field { what, ..field }),
-            None => Err(self.error_here(ParseErrorKind::Missing(what))),
+            Some(token) => token.number(field),
+            None => Err(self.error_here(ParseErrorKind::Missing(field.what))),
         }
     }
 
     /// An optional positional number: absent at the end of the line or
     /// where the options (`name=value`) begin.
-    pub(super) fn optional_number(&mut self, field: Field) -> Result<Option<i64>, ParseError> {
+    pub(super) fn optional_number(&mut self, field: &Field) -> Result<Option<i64>, ParseError> {
         match self.peek() {
             Some(token) if !token.text.contains(&b'=') => {
                 self.next();
@@ -227,9 +300,7 @@ impl<'a> Words<'a> {
     }
 
     /// The next `name=value` option, if any.
-    pub(super) fn option(
-        &mut self,
-    ) -> Result<Option<(&'static str, Token<'a>, Token<'a>)>, ParseError> {
+    pub(super) fn option(&mut self) -> Result<Option<(Word, Token<'a>, Token<'a>)>, ParseError> {
         let Some(token) = self.next() else {
             return Ok(None);
         };
