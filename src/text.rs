@@ -63,10 +63,11 @@ impl dyn Text + '_ {
     /// Appends `n` in decimal with at least `width` digits (leading zeros).
     pub fn zeros(&mut self, mut n: u64, width: usize) -> &mut Self {
         // u64::MAX has 20 digits.
-        let mut digits = [b'0'; 20];
-        let mut start = digits.len();
+        const MOST: usize = 20;
+        let mut digits = [b'0'; MOST];
+        let mut start = MOST;
         for slot in digits.iter_mut().rev() {
-            if n == 0 && digits_len(start) >= width {
+            if n == 0 && MOST - start >= width {
                 break;
             }
             *slot = b'0' + (n % 10) as u8;
@@ -79,10 +80,27 @@ impl dyn Text + '_ {
         self
     }
 
+    /// Appends `n` thousandths as a decimal number without trailing zeros
+    /// (`6666` is `6.666`, `12500` is `12.5`, `4000` is `4`): millidegrees
+    /// as degrees, milliseconds as seconds.
+    pub fn milli(&mut self, n: u64) -> &mut Self {
+        let (whole, mut fraction) = (n / 1000, n % 1000);
+        self.u64(whole);
+        if fraction == 0 {
+            return self;
+        }
+        let mut digits = 3;
+        while fraction % 10 == 0 {
+            fraction /= 10;
+            digits -= 1;
+        }
+        self.put(".");
+        self.zeros(fraction, digits)
+    }
+
     /// Appends `byte` as two lowercase hexadecimal digits.
     pub fn hex2(&mut self, byte: u8) -> &mut Self {
-        const HEX: &[u8; 16] = b"0123456789abcdef";
-        let pair = [HEX[usize::from(byte >> 4)], HEX[usize::from(byte & 0xf)]];
+        let pair = [hex_digit(byte >> 4), hex_digit(byte)];
         if let Ok(s) = core::str::from_utf8(&pair) {
             self.put(s);
         }
@@ -140,9 +158,12 @@ pub enum Arg<'a> {
     Text(&'a dyn Describe),
 }
 
-/// Digits written so far when the next one goes at `start` of 20.
-const fn digits_len(start: usize) -> usize {
-    20 - start
+/// The lowercase hexadecimal digit of `v`'s low four bits.
+pub(crate) const fn hex_digit(v: u8) -> u8 {
+    match v & 0xf {
+        d @ 0..=9 => b'0' + d,
+        d => b'a' + d - 10,
+    }
 }
 
 /// Writes `message` into a `fmt::Formatter`: the body of a `Display`.

@@ -84,8 +84,10 @@ impl Angle {
     }
 }
 
-/// An angle in degrees as it is written: sign, whole degrees and the
-/// significant digits of the millidegrees (`-0.25°` is `("-", 0, 25, 2)`).
+/// An angle in degrees as its log line writes it: sign, whole degrees and
+/// the significant digits of the millidegrees (`-0.25°` is `("-", 0, 25,
+/// 2)`), the digits [`Text::milli`] writes.
+#[cfg(feature = "defmt")]
 struct Written {
     sign: &'static str,
     whole: u32,
@@ -93,6 +95,7 @@ struct Written {
     digits: usize,
 }
 
+#[cfg(feature = "defmt")]
 impl Written {
     const fn of(angle: Angle) -> Self {
         let abs = angle.0.unsigned_abs();
@@ -112,17 +115,10 @@ impl Written {
 
 impl Describe for Angle {
     fn describe(&self, out: &mut dyn Text) {
-        let Written {
-            sign,
-            whole,
-            fraction,
-            digits,
-        } = Written::of(*self);
-        out.str(sign).u64(u64::from(whole));
-        if digits != 0 {
-            out.str(".").zeros(u64::from(fraction), digits);
-        }
-        out.str("°");
+        let sign = if self.0 < 0 { "-" } else { "" };
+        out.str(sign)
+            .milli(u64::from(self.0.unsigned_abs()))
+            .str("°");
     }
 }
 

@@ -178,17 +178,7 @@ struct Milli(u64);
 
 impl Describe for Milli {
     fn describe(&self, out: &mut dyn text::Text) {
-        let (int, mut frac) = (self.0 / 1000, self.0 % 1000);
-        out.u64(int);
-        if frac == 0 {
-            return;
-        }
-        let mut digits = 3;
-        while frac % 10 == 0 {
-            frac /= 10;
-            digits -= 1;
-        }
-        out.str(".").zeros(frac, digits);
+        out.milli(self.0);
     }
 }
 

@@ -21,7 +21,7 @@
 //! case in a command, lower case in a reply). A line with a bad sequence
 //! number or checksum is not carried out and gets `err line …`.
 
-use crate::text::{Describe, Text, display_from_describe};
+use crate::text::{Describe, Text, display_from_describe, hex_digit};
 
 use crc::{CRC_8_SMBUS, Crc, NoTable};
 
@@ -328,13 +328,5 @@ fn hex_value(b: u8) -> Option<u8> {
         b'a'..=b'f' => Some(b - b'a' + 10),
         b'A'..=b'F' => Some(b - b'A' + 10),
         _ => None,
-    }
-}
-
-/// The lower-case hex digit of `v`'s low nibble.
-fn hex_digit(v: u8) -> u8 {
-    match v & 0xf {
-        d @ 0..=9 => b'0' + d,
-        d => b'a' + d - 10,
     }
 }

@@ -287,21 +287,7 @@ impl Describe for Degrees {
             ..0 => "-",
             _ => "+",
         };
-        let (whole, frac) = (m.unsigned_abs() / 1000, m.unsigned_abs() % 1000);
-        out.str(sign).u64(whole.into());
-        match frac {
-            0 => {}
-            _ if frac % 100 == 0 => {
-                out.str(".").u64((frac / 100).into());
-            }
-            _ if frac % 10 == 0 => {
-                out.str(".").zeros((frac / 10).into(), 2);
-            }
-            _ => {
-                out.str(".").zeros(frac.into(), 3);
-            }
-        }
-        out.str("°");
+        out.str(sign).milli(m.unsigned_abs().into()).str("°");
     }
 }
 
