@@ -2,7 +2,7 @@
 
 use idle_head::Angle;
 use idle_head::behaviour::{BehaviourConfig, BehaviourParams};
-use idle_head::command::{Action, GestureKind, GestureRequest};
+use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest};
 use idle_head::driver::DriverConfig;
 use idle_head::units::Millis;
 
@@ -24,5 +24,17 @@ pub fn gesture(kind: GestureKind, amp: Option<i32>, ms: Option<u32>, cycles: Opt
         duration: ms.map(Millis),
         cycles,
         intensity: None,
+    })
+}
+
+/// A look at `pitch` and `yaw` (m°), with the duration and the hold as
+/// given (`None`: the default).
+#[must_use]
+pub fn look(pitch: i32, yaw: i32, duration: Option<Millis>, hold: Option<Hold>) -> Action {
+    Action::Look(LookRequest {
+        pitch: Angle::from_millidegrees(pitch),
+        yaw: Angle::from_millidegrees(yaw),
+        duration,
+        hold,
     })
 }

@@ -9,11 +9,11 @@
 
 use idle_head::Angle;
 use idle_head::behaviour::{Applied, BehaviourParams, LimitMode, Mixer};
-use idle_head::command::{Action, GestureKind, Hold, LookRequest};
+use idle_head::command::{Action, GestureKind, Hold};
 use idle_head::units::Millis;
 use proptest::prelude::*;
 
-use host_tests::behaviour::{default_params as params, gesture};
+use host_tests::behaviour::{default_params as params, gesture, look};
 
 /// Frame period of the default configuration, ms.
 const FRAME_MS: u32 = 20;
@@ -157,14 +157,12 @@ fn action() -> impl Strategy<Value = Action> {
                 (0_u32..2000).prop_map(|ms| Hold::Return(Millis(ms)))
             ],
         )
-            .prop_map(|(pitch, yaw, ms, hold)| {
-                Action::Look(LookRequest {
-                    pitch: Angle::from_millidegrees(pitch),
-                    yaw: Angle::from_millidegrees(yaw),
-                    duration: ms.map(Millis),
-                    hold: Some(hold),
-                })
-            }),
+            .prop_map(|(pitch, yaw, ms, hold)| look(
+                pitch,
+                yaw,
+                ms.map(Millis),
+                Some(hold)
+            )),
         proptest::option::of(300_u32..1500).prop_map(|ms| Action::Center {
             duration: ms.map(Millis)
         }),

@@ -4,7 +4,8 @@
 use proptest::prelude::*;
 
 use super::{Rig, assert_safe};
-use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
+use host_tests::behaviour::look;
+use idle_head::command::{Action, GestureKind, GestureRequest, Hold, Percent};
 use idle_head::units::{Angle, Millis};
 
 fn kind() -> impl Strategy<Value = GestureKind> {
@@ -44,14 +45,7 @@ fn action() -> impl Strategy<Value = Action> {
                 (0_u32..5000).prop_map(|ms| Hold::Return(Millis(ms)))
             ]),
         )
-            .prop_map(|(pitch, yaw, duration, hold)| {
-                Action::Look(LookRequest {
-                    pitch: Angle::from_millidegrees(pitch),
-                    yaw: Angle::from_millidegrees(yaw),
-                    duration,
-                    hold,
-                })
-            }),
+            .prop_map(|(pitch, yaw, duration, hold)| look(pitch, yaw, duration, hold)),
         1 => millis.prop_map(|duration| Action::Center { duration }),
         1 => any::<bool>().prop_map(Action::Idle),
         1 => (0_u8..=100).prop_map(|p| Action::IdleAmp(Percent::new(p).unwrap_or(Percent::FULL))),
