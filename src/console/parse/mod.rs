@@ -97,66 +97,28 @@ struct Field {
     max: i64,
 }
 
-const AMPLITUDE: Field = Field {
-    what: "amplitude in mdeg",
-    min: i32::MIN as i64 + 1,
-    max: i32::MAX as i64,
-};
-const ANGLE: Field = Field {
-    what: "angle in mdeg",
-    ..AMPLITUDE
-};
-const PITCH: Field = Field {
-    what: "pitch in mdeg",
-    ..ANGLE
-};
-const YAW: Field = Field {
-    what: "yaw in mdeg",
-    ..ANGLE
-};
-const LOWER_LIMIT: Field = Field {
-    what: "lower limit in mdeg",
-    ..ANGLE
-};
-const UPPER_LIMIT: Field = Field {
-    what: "upper limit in mdeg",
-    ..ANGLE
-};
-const DURATION: Field = Field {
-    what: "duration in ms",
-    min: 1,
-    max: u32::MAX as i64,
-};
-const HOLD: Field = Field {
-    what: "hold in ms",
-    min: 0,
-    max: u32::MAX as i64,
-};
-const CYCLES: Field = Field {
-    what: "cycles",
-    min: 1,
-    max: u8::MAX as i64,
-};
-const PERCENT: Field = Field {
-    what: "percentage",
-    min: 0,
-    max: 100,
-};
-const SEED: Field = Field {
-    what: "seed",
-    min: 0,
-    max: u32::MAX as i64,
-};
-const PULSE: Field = Field {
-    what: "pulse in us",
-    min: 0,
-    max: u32::MAX as i64,
-};
-const PER_DEGREE: Field = Field {
-    what: "ns per degree",
-    min: 0,
-    max: u32::MAX as i64,
-};
+impl Field {
+    /// A field named `what` over `min..=max`.
+    const fn new(what: &'static str, min: i64, max: i64) -> Self {
+        Self { what, min, max }
+    }
+}
+
+/// The range of an angle or an amplitude in m°: the `i32` range without
+/// `i32::MIN`.
+const MDEG: (i64, i64) = (i32::MIN as i64 + 1, i32::MAX as i64);
+const AMPLITUDE: Field = Field::new("amplitude in mdeg", MDEG.0, MDEG.1);
+const PITCH: Field = Field::new("pitch in mdeg", MDEG.0, MDEG.1);
+const YAW: Field = Field::new("yaw in mdeg", MDEG.0, MDEG.1);
+const LOWER_LIMIT: Field = Field::new("lower limit in mdeg", MDEG.0, MDEG.1);
+const UPPER_LIMIT: Field = Field::new("upper limit in mdeg", MDEG.0, MDEG.1);
+const DURATION: Field = Field::new("duration in ms", 1, u32::MAX as i64);
+const HOLD: Field = Field::new("hold in ms", 0, u32::MAX as i64);
+const CYCLES: Field = Field::new("cycles", 1, u8::MAX as i64);
+const PERCENT: Field = Field::new("percentage", 0, 100);
+const SEED: Field = Field::new("seed", 0, u32::MAX as i64);
+const PULSE: Field = Field::new("pulse in us", 0, u32::MAX as i64);
+const PER_DEGREE: Field = Field::new("ns per degree", 0, u32::MAX as i64);
 
 fn to_angle(v: i64) -> Angle {
     Angle::from_millidegrees(v as i32)
