@@ -8,8 +8,8 @@ use futures::executor::block_on;
 use idle_head::command::Percent;
 use idle_head::servo::{NanosPerDegree, ServoCalibration};
 use idle_head::settings::{
-    DecodeError, EncodeError, LoadError, Record, SaveError, Settings, SettingsStore,
-    decode_postcard, encode_postcard,
+    DecodeError, EncodeError, LoadError, Record, SETTINGS_BUFFER, SaveError, Settings,
+    SettingsStore, decode_postcard, encode_postcard,
 };
 use idle_head::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
@@ -378,5 +378,60 @@ fn corrupt_bytes(bytes: &mut [u8], rng: &mut TestRng) {
                 bytes[at..end].fill(0xff);
             }
         }
+    }
+}
+
+/// Sectors that another firmware wrote (a board that ran something else
+/// first: its file system, its code), never a store of this one: a load
+/// finds nothing to use and a save takes the sectors over. Both on the
+/// geometry of the other tests and on the Pico's (4 KiB sectors, bytes
+/// written one at a time).
+#[test]
+fn foreign_data_is_taken_over_by_a_save() {
+    foreign_data_on::<4, 4, 256>();
+    foreign_data_on::<4, 1, 4096>();
+}
+
+fn foreign_data_on<const PAGES: usize, const WORD: usize, const WORDS: usize>() {
+    let mut rng = rng(4);
+    let size = PAGES * WORD * WORDS;
+    let patterns: [(&str, Vec<u8>); 4] = [
+        ("noise", (0..size).map(|_| rng.random()).collect()),
+        ("zeros", vec![0; size]),
+        ("a repeated word", [0x12, 0x34, 0x56, 0x78].repeat(size / 4)),
+        (
+            "noise with erased runs",
+            (0..size)
+                .map(|i| {
+                    if (i / 512) % 2 == 0 {
+                        0xff
+                    } else {
+                        rng.random()
+                    }
+                })
+                .collect(),
+        ),
+    ];
+    for (what, bytes) in patterns {
+        let mut flash =
+            MockFlashBase::<PAGES, WORD, WORDS>::new(WriteCountCheck::Disabled, None, true);
+        flash.as_bytes_mut().copy_from_slice(&bytes);
+        let range = MockFlashBase::<PAGES, WORD, WORDS>::FULL_FLASH_RANGE;
+        let mut s: SettingsStore<_, Settings, SETTINGS_BUFFER> =
+            SettingsStore::new(flash, range).expect("a valid range");
+        let loaded = block_on(s.load());
+        assert!(
+            matches!(loaded, Err(LoadError::Empty | LoadError::Corrupt)),
+            "{what} ({WORD}-byte words, {} B pages): load gave {loaded:?}",
+            WORD * WORDS
+        );
+        let next = random_real(&mut rng);
+        assert_eq!(
+            block_on(s.save(&next)),
+            Ok(()),
+            "{what} ({WORD}-byte words, {} B pages): save",
+            WORD * WORDS
+        );
+        assert_eq!(block_on(s.load()), Ok(next), "{what}: load after the save");
     }
 }

@@ -45,5 +45,8 @@ pub use record::{DecodeError, EncodeError, Record};
 pub use record::{decode_postcard, encode_postcard};
 pub use sequential_storage::map::MapConfigError;
 pub use storage::{RamStorage, SettingsStorage, StorageError};
-pub use store::{LoadError, SaveError, SettingsStore};
+pub use store::{LoadError, SaveError, SettingsStore, buffer_len};
+
+/// The work buffer of a store of [`Settings`] (see [`buffer_len`]).
+pub const SETTINGS_BUFFER: usize = buffer_len(SETTINGS_LEN);
 pub use values::{Settings, SettingsError, SettingsSource, Validated};

@@ -19,6 +19,16 @@ use super::record::{DecodeError, EncodeError, Record};
 const KEY: u8 = 0;
 /// Bytes of the version in front of the record.
 const VERSION_LEN: usize = 2;
+/// Bytes of [`KEY`] as the map stores it.
+const KEY_LEN: usize = core::mem::size_of::<u8>();
+
+/// The work buffer a [`SettingsStore`] needs for records of up to
+/// `record_len` bytes: the key, the version and the record, in whole
+/// 4-byte words.
+#[must_use]
+pub const fn buffer_len(record_len: usize) -> usize {
+    (KEY_LEN + VERSION_LEN + record_len).next_multiple_of(4)
+}
 
 /// Why no record was loaded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -44,8 +44,8 @@ use idle_head::console::ConsoleLink;
 use idle_head::driver::DriverConfig;
 use idle_head::motion::{DEFAULT_HEAD, HeadConfig};
 use idle_head::settings::{
-    LoadError, Record, Settings, SettingsSource, SettingsStorage, SettingsStore, StorageError,
-    Validated,
+    LoadError, Record, SETTINGS_BUFFER, Settings, SettingsSource, SettingsStorage, SettingsStore,
+    StorageError, Validated,
 };
 
 /// The Pico's flash: 2 MiB (W25Q16JV).
@@ -79,8 +79,8 @@ pub static FLASH_BUSY: AtomicBool = AtomicBool::new(false);
 /// The flash driver the store runs on.
 pub type PicoFlash = BlockingAsync<Flash<'static, FLASH, Blocking, FLASH_SIZE>>;
 
-/// The store, with a record of up to 125 bytes.
-pub type Store = SettingsStore<PicoFlash, Settings, 128>;
+/// The store, with a work buffer for the settings record.
+pub type Store = SettingsStore<PicoFlash, Settings, SETTINGS_BUFFER>;
 
 /// The console's `save` and `load` on the flash store.
 pub struct PicoStorage {
