@@ -16,10 +16,15 @@
 //   ns:         virtual time to run, in nanoseconds,
 //   wall_ms:    wall-time limit,
 //   silence_ns: end the run when nothing (log byte, pin edge) happens for this long,
-//   uart:       optional, bytes for UART0's RX line: {hex, at_ns, byte_ns}: from virtual
-//               time at_ns on, one byte every byte_ns (the line rate); boot 0 only,
+//   uart:       bytes for UART0's RX line, a list of {boot, hex, at_ns, byte_ns}: in boot
+//               `boot`, from at_ns after its start on, one byte every byte_ns (the line rate),
 //   usb:        optional, bytes for the USB serial port: {hex, at_ns}: rp2040js's CDC-ACM
 //               host enumerates the device, and from at_ns on sends the bytes; boot 0 only,
+//   rom:        optional, {erase_ns, program_ns}: a boot ROM with the flash functions
+//               (rom.mjs), a sector erase and a page program taking that much virtual time,
+//   flash_fill: optional, {addr, hex}: bytes written over the image's flash before power-on,
+//   power_cycles_ns: optional, virtual times at which the power goes off and on again:
+//               the next boot starts from the flash as the last one left it, nothing else kept,
 // }
 //
 // Events ("ns" is virtual time since power-on, across resets):
@@ -30,6 +35,9 @@
 //   {"ev":"en","slice":0,"on":true,"ns":..}         a PWM slice enabled or disabled
 //   {"ev":"call","cycles":..,"ns":..}               one call of the probed function
 //   {"ev":"watchdog","ns":..,"reason":1}            the watchdog fired (1 timer, 2 forced)
+//   {"ev":"power_cycle","ns":..}                    the power went off (the next boot follows)
+//   {"ev":"flash","op":"erase","addr":..,"len":..,"busy_ns":..,"ns":..}
+//                                                   the ROM erased or programmed ("program") flash
 //   {"ev":"stack","n":0,"low":..}                   lowest stack address written in boot n
 //   {"ev":"uart","ns":..,"hex":".."}                bytes UART0 sent (TX), stamped with the first
 //   {"ev":"uart_rx","ns":..,"n":..}                  the last scripted byte went onto the RX line
@@ -41,6 +49,7 @@
 
 import { readFileSync } from 'node:fs';
 import { RP2040, USBCDC } from 'rp2040js';
+import { romImage, serveRom } from './rom.mjs';
 
 const cfg = JSON.parse(process.argv[2] ?? '{}');
 const FLASH_START = 0x10000000;
@@ -80,10 +89,20 @@ let stop = null; // why the run ends, once it does
 const level = new Map(cfg.pins.map((pin) => [pin, false]));
 const now = () => bootNs + mcu.clock.nanos;
 
-// A fresh chip, as after power-on or a watchdog reset. The watchdog's REASON
-// and SCRATCH registers survive a watchdog reset; SRAM keeps its contents.
+// The flash at power-on: the image, and `flash_fill` over it.
+function firstFlash() {
+  const flash = new Uint8Array(16 << 20).fill(0xff);
+  flash.set(image);
+  if (cfg.flash_fill) flash.set(Buffer.from(cfg.flash_fill.hex, 'hex'), cfg.flash_fill.addr - FLASH_START);
+  return flash;
+}
+
+// A fresh chip, as after power-on, a power cycle or a watchdog reset. The
+// flash keeps what was written to it. The watchdog's REASON and SCRATCH
+// registers survive a watchdog reset, and SRAM keeps its contents.
 function powerUp(kept) {
   const chip = new RP2040();
+  if (cfg.rom) chip.loadBootrom(romImage()); // (this erases the flash: load it after)
   chip.logger = {
     debug() {},
     info() {},
@@ -91,12 +110,18 @@ function powerUp(kept) {
     error: (name, msg) => emit({ ev: 'emu', level: 'error', msg: `[${name}] ${msg}` }),
   };
   chip.onBreak = (code) => {
+    const flashOp = (op) => {
+      emit({ ev: 'flash', ...op, ns: now() });
+      lastActivity = now();
+    };
+    const complain = (msg) => emit({ ev: 'emu', level: 'error', msg });
+    if (cfg.rom && serveRom(chip, code, cfg.rom, flashOp, complain)) return;
     emit({ ev: 'emu', level: 'error', msg: `breakpoint ${code} at ${hex(chip.core.PC)}` });
     stop = 'break';
   };
-  chip.flash.set(image);
+  chip.flash.set(kept.flash);
   const watchdog = chip.peripherals[WATCHDOG_BASE];
-  if (kept) {
+  if (kept.sram) {
     chip.sram.set(kept.sram);
     watchdog.reason = kept.reason;
     watchdog.scratchData.set(kept.scratch);
@@ -113,7 +138,8 @@ function powerUp(kept) {
     chip.gpio[pin].addListener((state) => edge(pin, state === 1));
   }
   uartAsOnTheChip(chip.uart[0]);
-  if (cfg.usb && !kept) usbHost(chip);
+  xipControlAsOnTheChip(chip);
+  if (cfg.usb && boot === 0) usbHost(chip);
   chip.uart[0].onByte = (byte) => {
     if (uartTx.bytes.length === 0) uartTx.ns = now();
     uartTx.bytes.push(byte);
@@ -171,6 +197,27 @@ function uartAsOnTheChip(uart) {
       uart.interruptStatus |= UART_TXINTR;
       uart.checkInterrupts();
     }
+  };
+}
+
+// rp2040js has no XIP control registers (0x14000000..0x14000020): a read
+// gives 0xffffffff. Before a flash operation embassy-rp waits for the XIP
+// stream counter (STREAM_CTR) to reach 0, for ever at 0xffffffff. Here they
+// read as on an idle chip: enabled, no stream, the FIFO empty, the flush
+// done; writes (a flush, a stream set-up) have nothing to act on.
+const XIP_CTRL = 0x14000000;
+const XIP_CTRL_END = 0x14000020;
+const XIP_IDLE = { 0x00: 0x3, 0x08: 0x3 }; // CTRL (enabled), STAT (FIFO empty, flush ready)
+function xipControlAsOnTheChip(chip) {
+  const read = chip.readUint32.bind(chip);
+  chip.readUint32 = (address) => {
+    const a = address >>> 0;
+    return a >= XIP_CTRL && a < XIP_CTRL_END ? XIP_IDLE[a - XIP_CTRL] ?? 0 : read(address);
+  };
+  const write = chip.writeUint32.bind(chip);
+  chip.writeUint32 = (address, value) => {
+    const a = address >>> 0;
+    if (a < XIP_CTRL || a >= XIP_CTRL_END) write(address, value);
   };
 }
 
@@ -241,23 +288,28 @@ function feedUsb() {
   }
 }
 
-// UART0's scripted RX line (boot 0) and the bytes it sent.
-const script = cfg.uart ? Buffer.from(cfg.uart.hex, 'hex') : Buffer.alloc(0);
+// UART0's scripted RX line (per boot) and the bytes it sent.
+const scripts = (cfg.uart ?? []).map((s) => ({ ...s, bytes: Buffer.from(s.hex, 'hex') }));
+let script = null; // this boot's
 let scriptAt = 0;
 const uartTx = { bytes: [], ns: 0 };
 function uartDue() {
-  if (boot !== 0 || scriptAt >= script.length) return Infinity;
-  return cfg.uart.at_ns + scriptAt * cfg.uart.byte_ns;
+  if (!script || scriptAt >= script.bytes.length) return Infinity;
+  return bootNs + script.at_ns + scriptAt * script.byte_ns;
 }
 function feedUart() {
   if (now() < uartDue()) return;
   const uart = mcu.uart[0];
   if (uart.rxFIFO.full) emit({ ev: 'uart_overrun', ns: now() });
-  else uart.feedByte(script[scriptAt]);
+  else uart.feedByte(script.bytes[scriptAt]);
   scriptAt += 1;
   lastActivity = now();
-  if (scriptAt === script.length) emit({ ev: 'uart_rx', ns: now(), n: scriptAt });
+  if (scriptAt === script.bytes.length) emit({ ev: 'uart_rx', ns: now(), n: scriptAt });
 }
+
+// The power cycles still to come.
+const powerCycles = [...(cfg.power_cycles_ns ?? [])].sort((a, b) => a - b);
+const powerCycleDue = () => powerCycles[0] ?? Infinity;
 function flushUart() {
   if (uartTx.bytes.length === 0) return;
   emit({ ev: 'uart', ns: uartTx.ns, hex: Buffer.from(uartTx.bytes).toString('hex') });
@@ -317,6 +369,8 @@ function hex(n) {
 function startBoot(kept) {
   if (mcu) bootNs += mcu.clock.nanos;
   boot += 1;
+  script = scripts.find((s) => s.boot === boot) ?? null;
+  scriptAt = 0;
   mcu = powerUp(kept);
   watchdogFired = null;
   emit({ ev: 'boot', n: boot, ns: bootNs });
@@ -328,7 +382,7 @@ function endBoot() {
 }
 
 function run() {
-  startBoot(null);
+  startBoot({ flash: firstFlash() });
   let call = null; // {ret, cycles} while the probed function runs
   while (!stop) {
     const { core, clock } = mcu;
@@ -341,6 +395,9 @@ function run() {
           continue;
         }
         if (due !== Infinity && (wait <= 0 || due < wait)) wait = due;
+        const cycle = powerCycleDue() - now();
+        if (cycle <= 0) break;
+        if (cycle !== Infinity && (wait <= 0 || cycle < wait)) wait = cycle;
         if (wait <= 0) {
           stop = 'asleep';
           break;
@@ -365,6 +422,7 @@ function run() {
       if ((i & 63) === 0 && cfg.rtt) drainRtt();
       if ((i & 15) === 0 && cfg.uart) feedUart();
       if ((i & 255) === 0 && usbSend) feedUsb();
+      if ((i & 255) === 0 && now() >= powerCycleDue()) break;
     }
     if (cfg.rtt) drainRtt();
     flushRtt();
@@ -372,9 +430,22 @@ function run() {
     if (watchdogFired) {
       emit({ ev: 'watchdog', ns: now(), reason: watchdogFired.reason });
       endBoot();
-      const kept = { sram: mcu.sram.slice(), reason: watchdogFired.reason, scratch: watchdogFired.scratch };
+      const kept = {
+        flash: mcu.flash.slice(),
+        sram: mcu.sram.slice(),
+        reason: watchdogFired.reason,
+        scratch: watchdogFired.scratch,
+      };
       call = null;
       startBoot(kept);
+      continue;
+    }
+    if (now() >= powerCycleDue()) {
+      powerCycles.shift();
+      emit({ ev: 'power_cycle', ns: now() });
+      endBoot();
+      call = null;
+      startBoot({ flash: mcu.flash.slice() });
       continue;
     }
     if (stop) break;

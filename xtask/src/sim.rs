@@ -26,6 +26,7 @@ mod pulses;
 pub(crate) mod rp2040_pwm;
 mod run;
 mod stages;
+mod store;
 
 use std::{fmt::Write as _, time::Duration};
 
@@ -36,6 +37,7 @@ pub use stages::{
     CONSOLE_STAGE, CONSOLE_TIME, DRILL_STAGE, FAILURES_STAGE, PULSES_STAGE, WALL, test_console,
     test_drill, test_failures, test_pulses,
 };
+pub use store::{STORE_STAGE, test_store};
 
 use crate::project::{self, PICO};
 use crate::setup;
@@ -54,14 +56,20 @@ pub struct Args {
     /// watchdog-drill`, in target/watchdog-drill), whose frames stop after
     /// 3 s, and check that the watchdog resets it and the next boot starts
     /// softly again.
-    #[arg(long, conflicts_with = "console")]
+    #[arg(long, conflicts_with_all = ["console", "store"])]
     pub drill: bool,
     /// The console image instead (`--features console`, in target/console):
     /// its memory against the budgets (not enforced), and a scripted
     /// exchange over UART0 and then over USB CDC-ACM, every reply checked.
     /// Without `--seconds`, 6 s: both scripts and their replies.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "store")]
     pub console: bool,
+    /// The console image's settings store instead: a damaged store at
+    /// power-on, `servo pitch neutral 1520` and `save` over UART0 with the
+    /// flash's worst-case erase times, a power cycle, and the next boot on
+    /// the saved settings.
+    #[arg(long)]
+    pub store: bool,
 }
 
 /// One loop (30 s), the fade-in (2 s) and half a second for the boot.
@@ -95,6 +103,15 @@ pub fn command(args: &Args) -> Result<bool> {
             Ok(()) => Ok(true),
             Err(error) => {
                 println!("watchdog drill FAILED: {error:#}");
+                Ok(false)
+            }
+        };
+    }
+    if args.store {
+        return match store::test_store(&root, &metadata) {
+            Ok(()) => Ok(true),
+            Err(error) => {
+                println!("settings store FAILED: {error:#}");
                 Ok(false)
             }
         };

@@ -260,6 +260,7 @@ fn sim_stages(
     stages.run(sim::CONSOLE_STAGE, || {
         sim::test_console(root, metadata, sim::CONSOLE_TIME, sim::WALL)
     });
+    stages.run(sim::STORE_STAGE, || sim::test_store(root, metadata));
     stages.run(sim::FAILURES_STAGE, || sim::test_failures(root, metadata));
     stages.run(MEMORY, || {
         let peak = |elf: &Path, stack: Option<u64>| -> Result<Option<elf::Peak>> {

@@ -28,10 +28,10 @@
 //! comma-separated list of integers), a wildcard written `*` in the
 //! transcript's expectations ([`mask`]).
 //!
-//! `save` is not in the script: it erases and programs flash through the
-//! RP2040's boot ROM, which the emulator does not have. `load` is, as it
-//! only reads the memory-mapped flash: the emulator's store is empty, so
-//! it answers `err storage load: no settings saved`.
+//! `save` is not in the script: it has a run of its own, with a stand-in
+//! for the boot ROM's flash functions and a power cycle (`store.rs`).
+//! `load` is: the emulator's store is empty, so it answers `err storage
+//! load: no settings saved`.
 
 use std::fmt::Write as _;
 use std::time::Duration;

@@ -128,19 +128,38 @@ pub struct Config {
     pub wall: Duration,
     /// Virtual time without a log byte or a pin edge after which the run ends.
     pub silence: Duration,
-    /// Bytes for UART0's RX line, if any.
-    pub uart: Option<UartScript>,
+    /// Bytes for UART0's RX line, per boot.
+    pub uart: Vec<UartScript>,
     /// Bytes for the USB serial port (CDC-ACM), if any, and when to send
-    /// them.
+    /// them (boot 0).
     pub usb: Option<(Vec<u8>, Duration)>,
+    /// A boot ROM with the flash functions (`sim/rom.mjs`), if any: how
+    /// long a 4 KiB sector erase and a 256-byte page program keep the flash
+    /// busy.
+    pub rom: Option<FlashTiming>,
+    /// Bytes written over the image's flash before power-on, and where.
+    pub flash_fill: Option<(u64, Vec<u8>)>,
+    /// Virtual times at which the power goes off and on again.
+    pub power_cycles: Vec<Duration>,
 }
 
-/// Bytes the harness puts on UART0's RX line in boot 0.
+/// How long the flash is busy per operation.
+#[derive(Debug, Clone, Copy)]
+pub struct FlashTiming {
+    /// One 4 KiB sector erase.
+    pub erase: Duration,
+    /// One 256-byte page program.
+    pub program: Duration,
+}
+
+/// Bytes the harness puts on UART0's RX line in one boot.
 #[derive(Debug, Clone)]
 pub struct UartScript {
+    /// The boot (0: power-on).
+    pub boot: usize,
     /// The bytes.
     pub bytes: Vec<u8>,
-    /// Virtual time of the first.
+    /// Virtual time of the first, since the boot's start.
     pub start: Duration,
     /// Time per byte (the line rate).
     pub byte_time: Duration,
@@ -160,15 +179,25 @@ impl Config {
             "ns": nanos(self.virtual_time),
             "wall_ms": self.wall.as_millis(),
             "silence_ns": nanos(self.silence),
-            "uart": self.uart.as_ref().map(|uart| json!({
+            "uart": self.uart.iter().map(|uart| json!({
+                "boot": uart.boot,
                 "hex": hex(&uart.bytes),
                 "at_ns": nanos(uart.start),
                 "byte_ns": nanos(uart.byte_time),
-            })),
+            })).collect::<Vec<_>>(),
             "usb": self.usb.as_ref().map(|(bytes, at)| json!({
                 "hex": hex(bytes),
                 "at_ns": nanos(*at),
             })),
+            "rom": self.rom.map(|rom| json!({
+                "erase_ns": nanos(rom.erase),
+                "program_ns": nanos(rom.program),
+            })),
+            "flash_fill": self.flash_fill.as_ref().map(|(addr, bytes)| json!({
+                "addr": addr,
+                "hex": hex(bytes),
+            })),
+            "power_cycles_ns": self.power_cycles.iter().map(|at| nanos(*at)).collect::<Vec<_>>(),
         })
     }
 }

@@ -56,6 +56,25 @@ pub struct Boot {
     pub usb_connected: Option<f64>,
     /// Bytes the device sent on its CDC-ACM port.
     pub usb: Vec<u8>,
+    /// What the boot ROM erased and programmed, in order.
+    pub flash: Vec<FlashOp>,
+    /// Whether a power cycle ended it.
+    pub power_cycled: bool,
+}
+
+/// One flash erase or program by the boot ROM.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlashOp {
+    /// Whether it erased (else programmed).
+    pub erase: bool,
+    /// Flash address and length, bytes.
+    pub addr: u64,
+    /// See `addr`.
+    pub len: u64,
+    /// How long it kept the flash busy (and the interrupts off), ns.
+    pub busy_ns: f64,
+    /// When it ran, ns of virtual time since power-on.
+    pub ns: f64,
 }
 
 /// How the harness ended.
@@ -127,6 +146,34 @@ pub fn simulate(
     wall: Duration,
     exchange: bool,
 ) -> Result<Report> {
+    let mut report = run_with(root, elf, virtual_time, wall, |config| {
+        if exchange {
+            config.uart.push(node::UartScript {
+                boot: 0,
+                bytes: exchange::script(),
+                start: exchange::START,
+                byte_time: exchange::BYTE_TIME,
+            });
+            config.usb = Some((exchange::script(), exchange::USB_START));
+        }
+    })?;
+    check(&mut report)?;
+    if exchange {
+        check_exchange(&mut report);
+    }
+    Ok(report)
+}
+
+/// Runs `elf` for `virtual_time` (at most `wall` of wall time) with the
+/// harness configured by `setup`, and sorts what happened into boots; the
+/// pulses are not checked against the host.
+pub fn run_with(
+    root: &Path,
+    elf: &Path,
+    virtual_time: Duration,
+    wall: Duration,
+    setup: impl FnOnce(&mut node::Config),
+) -> Result<Report> {
     let image = PicoImage::read(elf)?;
     let bytes = std::fs::read(elf)?;
     let table = Table::parse(&bytes)
@@ -136,7 +183,7 @@ pub fn simulate(
     node::ensure(root)?;
     let flash = elf.with_extension("flash.bin");
     std::fs::write(&flash, &image.flash).with_context(|| format!("writing {}", flash.display()))?;
-    let config = node::Config {
+    let mut config = node::Config {
         flash,
         vtor: VECTOR_TABLE,
         rtt: image.rtt,
@@ -147,13 +194,13 @@ pub fn simulate(
         virtual_time,
         wall,
         silence: SILENCE,
-        uart: exchange.then(|| node::UartScript {
-            bytes: exchange::script(),
-            start: exchange::START,
-            byte_time: exchange::BYTE_TIME,
-        }),
-        usb: exchange.then(|| (exchange::script(), exchange::USB_START)),
+        uart: Vec::new(),
+        usb: None,
+        rom: None,
+        flash_fill: None,
+        power_cycles: Vec::new(),
     };
+    setup(&mut config);
     println!(
         "$ (cd sim && node harness.mjs ...)  # {} of flash, {:.1} s of virtual time",
         image.flash.len(),
@@ -180,10 +227,6 @@ pub fn simulate(
     }
     if let Some(problem) = report.end.problem(SILENCE) {
         report.problems.push(problem);
-    }
-    check(&mut report)?;
-    if exchange {
-        check_exchange(&mut report);
     }
     Ok(report)
 }
@@ -366,8 +409,8 @@ fn sort(
     Ok(report)
 }
 
-/// An event of the console ports (UART0, USB) into `boot`; others are
-/// ignored.
+/// An event of the console ports (UART0, USB) or the flash into `boot`;
+/// others are ignored.
 fn port_event(boot: &mut Boot, kind: &str, event: &Value) -> Result<()> {
     match kind {
         "uart" => boot
@@ -379,6 +422,14 @@ fn port_event(boot: &mut Boot, kind: &str, event: &Value) -> Result<()> {
         "uart_overrun" => boot.uart_overruns += 1,
         "uart_rx" => boot.uart_sent = Some(number(event, "ns")?),
         "usb_connected" => boot.usb_connected = Some(number(event, "ns")?),
+        "power_cycle" => boot.power_cycled = true,
+        "flash" => boot.flash.push(FlashOp {
+            erase: event["op"] == "erase",
+            addr: integer(event, "addr")?,
+            len: integer(event, "len")?,
+            busy_ns: number(event, "busy_ns")?,
+            ns: number(event, "ns")?,
+        }),
         _ => {}
     }
     Ok(())

@@ -188,27 +188,32 @@ pub fn test_console(
     print!("{}", report.table());
     println!("{}", report.verdict());
     println!("{}", report.summary());
-    let static_ram = elf::Image::read(&elf)?.static_ram();
     let mut problems = report.problems.clone();
-    match report.peak_stack() {
-        Some(stack) => {
-            let ram = static_ram + stack;
-            println!(
-                "console image RAM: {static_ram} B static + {stack} B peak stack = {ram} B of the {} B budget",
-                elf::RAM_BUDGET
-            );
-            if ram > elf::RAM_BUDGET {
-                problems.push(format!(
-                    "console image RAM {ram} B (static {static_ram} B + peak stack {stack} B) is over the {} B budget",
-                    elf::RAM_BUDGET
-                ));
-            }
-        }
-        None => problems.push(format!(
-            "console image RAM: {static_ram} B static, but its peak stack was not measured"
-        )),
-    }
+    problems.extend(console_ram(&elf, &report)?);
     fail_if_any(&problems)
+}
+
+/// Prints the console image's RAM in `report`'s run, static plus the
+/// measured peak stack; the problem if it is over the budget or the peak
+/// was not measured.
+pub fn console_ram(elf: &Path, report: &Report) -> Result<Option<String>> {
+    let static_ram = elf::Image::read(elf)?.static_ram();
+    let Some(stack) = report.peak_stack() else {
+        return Ok(Some(format!(
+            "console image RAM: {static_ram} B static, but its peak stack was not measured"
+        )));
+    };
+    let ram = static_ram + stack;
+    println!(
+        "console image RAM: {static_ram} B static + {stack} B peak stack = {ram} B of the {} B budget",
+        elf::RAM_BUDGET
+    );
+    Ok((ram > elf::RAM_BUDGET).then(|| {
+        format!(
+            "console image RAM {ram} B (static {static_ram} B + peak stack {stack} B) is over the {} B budget",
+            elf::RAM_BUDGET
+        )
+    }))
 }
 
 /// A hung image, an image that sleeps for ever, a run out of wall time and
@@ -252,8 +257,11 @@ pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
             virtual_time: Duration::from_secs(if name == "slow" { 3600 } else { 2 }),
             wall,
             silence,
-            uart: None,
+            uart: Vec::new(),
             usb: None,
+            rom: None,
+            flash_fill: None,
+            power_cycles: Vec::new(),
         };
         let events = node::run(root, &config)?;
         let end = run::end_of(&events)?;

@@ -1,0 +1,230 @@
+//! The console image's settings store on the emulated chip: `save` through
+//! the boot ROM's flash functions, a power cycle, and the next boot on the
+//! saved settings.
+//!
+//! The emulator has no boot ROM; the harness stands in for its flash
+//! functions (`sim/rom.mjs`) and gives each erase and program the
+//! datasheet's **worst** time (W25Q16JV: 400 ms a 4 KiB sector, 3 ms a
+//! 256-byte page), during which the firmware keeps its interrupts off.
+//!
+//! - Power-on with the settings sectors full of noise, as another
+//!   firmware may leave them: no settings of this one there, so the boot
+//!   log says the head starts on the built-in settings.
+//! - At 3 s, over UART0: `servo pitch neutral 1520`, `save`, `status`. The
+//!   save erases sectors and writes the settings: no watchdog reset while
+//!   the flash is busy with the interrupts off (400 ms a sector), and
+//!   `status` says `settings=flash`.
+//! - At 5 s the power goes off and on. The next boot logs the settings
+//!   loaded from flash and its first frame's neutral pulses, 1520 1500
+//!   1500 µs; its first pitch pulse is 1520 µs on the pin; and at 2.5 s
+//!   into it `servo pitch` and `status` say the same over UART0.
+//! - The console image's RAM, static plus the peak stack of this run (the
+//!   save goes deepest), is within the budget.
+
+use std::{fmt::Write as _, path::Path, time::Duration};
+
+use anyhow::{Context, Result, bail};
+
+use super::{
+    exchange::BYTE_TIME,
+    node::{FlashTiming, UartScript},
+    run::{self, Boot, FlashOp, Report},
+    stages::{WALL, build_variant, console_ram},
+};
+use crate::{elf, project::Metadata};
+
+/// Stage name.
+pub const STORE_STAGE: &str = "console image in the RP2040 emulator: `save` to flash with \
+     worst-case erase times, power cycle, the next boot on the saved settings";
+
+/// The datasheet's worst times (W25Q16JV): a sector erase, a page program.
+pub const WORST: FlashTiming = FlashTiming {
+    erase: Duration::from_millis(400),
+    program: Duration::from_millis(3),
+};
+/// When the script goes out in each boot (after the 2 s fade-in).
+const SCRIPT_AT: [Duration; 2] = [Duration::from_secs(3), Duration::from_millis(2_500)];
+/// When the power goes off and on.
+const POWER_CYCLE: Duration = Duration::from_secs(5);
+/// The whole run: two boots.
+const TIME: Duration = Duration::from_millis(8_500);
+/// The script of each boot.
+const SCRIPTS: [&[u8]; 2] = [
+    b"servo pitch neutral 1520\r\nsave\r\nstatus\r\n",
+    b"servo pitch\r\nstatus\r\n",
+];
+/// What each reply must start or end with, in order, per boot.
+const REPLIES: [&[(&str, &str)]; 2] = [
+    &[("ok", ""), ("ok", ""), ("ok mode=", " settings=flash")],
+    &[
+        ("ok pitch neutral=1520 ", ""),
+        ("ok mode=", " settings=flash"),
+    ],
+];
+/// The first pulses of the second boot: the saved neutral on pitch.
+const FIRST_US: [u32; 3] = [1520, 1500, 1500];
+
+/// Runs the scenario and checks it (see the module docs).
+pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
+    let elf_path = build_variant(root, metadata, "console")?;
+    let settings = elf::Image::read(&elf_path)?
+        .settings
+        .context("the console image has no settings region")?;
+    let noise = noise(usize::try_from(settings.end - settings.start)?);
+    let report = run::run_with(root, &elf_path, TIME, WALL, |config| {
+        config.rom = Some(WORST);
+        config.flash_fill = Some((settings.start, noise));
+        config.power_cycles = vec![POWER_CYCLE];
+        config.uart = (0..2)
+            .map(|boot| UartScript {
+                boot,
+                bytes: SCRIPTS[boot].to_vec(),
+                start: SCRIPT_AT[boot],
+                byte_time: BYTE_TIME,
+            })
+            .collect();
+    })?;
+    print!("{}", report.log_text());
+    let mut problems = report.problems.clone();
+    let (text, found) = check(&report);
+    print!("{text}");
+    problems.extend(found);
+    // The save is the deepest the console image's stack goes.
+    problems.extend(console_ram(&elf_path, &report)?);
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        bail!("{}", problems.join("; "))
+    }
+}
+
+/// The checks of the module docs: a transcript and the problems found.
+fn check(report: &Report) -> (String, Vec<String>) {
+    let mut text = String::new();
+    let mut problems = Vec::new();
+    if report.boots.len() != 2 {
+        problems.push(format!(
+            "{} boots instead of two (power-on, then the power cycle)",
+            report.boots.len()
+        ));
+        return (text, problems);
+    }
+    let [first, second] = [&report.boots[0], &report.boots[1]];
+    if !first.power_cycled {
+        problems.push("the first boot did not end with the power cycle".to_owned());
+    }
+    for (b, boot) in report.boots.iter().enumerate() {
+        if boot.watchdog {
+            problems.push(format!("boot {b}: the watchdog reset the board"));
+        }
+        let _ = writeln!(text, "boot {b}, UART0:");
+        for (i, line) in replies(&boot.uart).iter().enumerate() {
+            let _ = writeln!(text, "  < {}", line.trim_end());
+            match REPLIES[b].get(i) {
+                Some((start, end)) if line.starts_with(start) && line.trim_end().ends_with(end) => {
+                }
+                Some((start, end)) => problems.push(format!(
+                    "boot {b}: reply {i} `{}` is not `{start}…{end}`",
+                    line.trim_end()
+                )),
+                None => problems.push(format!("boot {b}: an extra reply `{}`", line.trim_end())),
+            }
+        }
+        if replies(&boot.uart).len() < REPLIES[b].len() {
+            problems.push(format!(
+                "boot {b}: {} replies, not {}",
+                replies(&boot.uart).len(),
+                REPLIES[b].len()
+            ));
+        }
+    }
+    if !says(first, "settings: defaults") {
+        problems.push("boot 0 did not log the built-in settings".to_owned());
+    }
+    text.push_str(&flash_summary(&first.flash));
+    if !first.flash.iter().any(|op| op.erase) || !first.flash.iter().any(|op| !op.erase) {
+        problems.push("boot 0's save neither erased nor programmed the flash".to_owned());
+    }
+    let _ = writeln!(
+        text,
+        "boot 0: longest gap between frames {:.0} ms",
+        longest_gap(first) / 1e6
+    );
+    if !says(second, "settings: loaded from flash") {
+        problems.push("boot 1 did not log the settings loaded from flash".to_owned());
+    }
+    if !says(second, "first frame: neutral pulses 1520 1500 1500 us") {
+        problems.push("boot 1 did not log the saved neutral pulses for its first frame".to_owned());
+    }
+    let first_us = first_pulses(second);
+    let _ = writeln!(text, "boot 1: first pulses {first_us:?} us");
+    if first_us != FIRST_US.map(Some) {
+        problems.push(format!(
+            "boot 1's first pulses are {first_us:?} us, not {FIRST_US:?} (the saved neutral on pitch)"
+        ));
+    }
+    (text, problems)
+}
+
+/// The reply lines in `bytes`, each with its line end.
+fn replies(bytes: &[u8]) -> Vec<String> {
+    String::from_utf8_lossy(bytes)
+        .split_inclusive('\n')
+        .map(str::to_owned)
+        .collect()
+}
+
+fn says(boot: &Boot, text: &str) -> bool {
+    boot.log.iter().any(|(_, line)| line.message.contains(text))
+}
+
+/// Erases and programs, summed.
+fn flash_summary(ops: &[FlashOp]) -> String {
+    let sum = |erase: bool| {
+        ops.iter()
+            .filter(|op| op.erase == erase)
+            .fold((0, 0, 0.0), |(n, bytes, ns), op| {
+                (n + 1, bytes + op.len, ns + op.busy_ns)
+            })
+    };
+    let ((erases, erase_bytes, erase_ns), (programs, program_bytes, program_ns)) =
+        (sum(true), sum(false));
+    format!(
+        "boot 0, flash: {erases} erases ({erase_bytes} B, busy {:.0} ms), {programs} programs ({program_bytes} B, busy {:.0} ms)\n",
+        erase_ns / 1e6,
+        program_ns / 1e6
+    )
+}
+
+/// The longest time between two frames' compare writes of the pitch servo, ns.
+fn longest_gap(boot: &Boot) -> f64 {
+    boot.trains[0]
+        .writes
+        .windows(2)
+        .map(|pair| pair[1].0 - pair[0].0)
+        .fold(0.0, f64::max)
+}
+
+/// The width of each servo's first pulse, whole µs.
+fn first_pulses(boot: &Boot) -> [Option<u32>; 3] {
+    std::array::from_fn(|i| {
+        let edges = &boot.trains[i].edges;
+        let rise = edges.iter().position(|&(_, high)| high)?;
+        let fall = edges.get(rise + 1)?;
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // a pulse: µs
+        Some(((fall.0 - edges[rise].0) / 1e3).round() as u32)
+    })
+}
+
+/// `len` bytes of noise (xorshift32): a store no firmware wrote.
+fn noise(len: usize) -> Vec<u8> {
+    let mut x: u32 = 0x2545_f491;
+    (0..len)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x.to_le_bytes()[0]
+        })
+        .collect()
+}
