@@ -4,11 +4,12 @@
 //!
 //! `cargo test --test settings_store -- --nocapture` prints the figures.
 
+use embedded_storage_async::nor_flash::{NorFlash, ReadNorFlash};
 use futures::executor::block_on;
 use idle_head::command::Percent;
 use idle_head::servo::{NanosPerDegree, ServoCalibration};
 use idle_head::settings::{
-    DecodeError, EncodeError, LoadError, Record, SETTINGS_BUFFER, SaveError, Settings,
+    DecodeError, EncodeError, LoadError, Record, SETTINGS_BUFFER, SaveError, SectorWise, Settings,
     SettingsStore, decode_postcard, encode_postcard,
 };
 use idle_head::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
@@ -434,4 +435,94 @@ fn foreign_data_on<const PAGES: usize, const WORD: usize, const WORDS: usize>() 
         );
         assert_eq!(block_on(s.load()), Ok(next), "{what}: load after the save");
     }
+}
+
+/// A flash that records the erases it is asked for.
+struct Erases<F> {
+    flash: F,
+    calls: Vec<(u32, u32)>,
+}
+
+impl<F: embedded_storage_async::nor_flash::ErrorType> embedded_storage_async::nor_flash::ErrorType
+    for Erases<F>
+{
+    type Error = F::Error;
+}
+
+impl<F: ReadNorFlash> ReadNorFlash for Erases<F> {
+    const READ_SIZE: usize = F::READ_SIZE;
+
+    async fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), Self::Error> {
+        self.flash.read(offset, bytes).await
+    }
+
+    fn capacity(&self) -> usize {
+        self.flash.capacity()
+    }
+}
+
+impl<F: NorFlash> NorFlash for Erases<F> {
+    const WRITE_SIZE: usize = F::WRITE_SIZE;
+    const ERASE_SIZE: usize = F::ERASE_SIZE;
+
+    async fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
+        self.calls.push((from, to));
+        self.flash.erase(from, to).await
+    }
+
+    async fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Self::Error> {
+        self.flash.write(offset, bytes).await
+    }
+}
+
+/// Erasing the whole store goes one sector at a time through
+/// `SectorWise` (the Pico's flash keeps its interrupts off for each erase
+/// call), in one call without it; the store works the same over it.
+#[test]
+fn sector_wise_erases_one_sector_per_call() {
+    let pages = Flash::FULL_FLASH_RANGE;
+    let sector = u32::try_from(<Flash as NorFlash>::ERASE_SIZE).unwrap();
+    let whole = |flash: Flash| Erases {
+        flash,
+        calls: Vec::new(),
+    };
+    let mut plain: SettingsStore<_, Settings, SETTINGS_BUFFER> =
+        SettingsStore::new(whole(fresh(WriteCountCheck::OnceOnly)), pages.clone()).unwrap();
+    block_on(plain.erase()).unwrap();
+    assert_eq!(plain.flash().calls, [(pages.start, pages.end)]);
+
+    let mut split: SettingsStore<_, Settings, SETTINGS_BUFFER> = SettingsStore::new(
+        SectorWise(whole(fresh(WriteCountCheck::OnceOnly))),
+        pages.clone(),
+    )
+    .unwrap();
+    let mut rng = rng(5);
+    let first = random_real(&mut rng);
+    block_on(split.save(&first)).unwrap();
+    block_on(split.erase()).unwrap();
+    let expected: Vec<(u32, u32)> = pages
+        .clone()
+        .step_by(sector as usize)
+        .map(|at| (at, at + sector))
+        .collect();
+    assert_eq!(split.flash().0.calls, expected);
+    assert_eq!(block_on(split.load()), Err(LoadError::Empty));
+    for _ in 0..50 {
+        let next = random_real(&mut rng);
+        block_on(split.save(&next)).unwrap();
+        assert_eq!(block_on(split.load()), Ok(next));
+    }
+    assert!(
+        split
+            .flash()
+            .0
+            .calls
+            .iter()
+            .all(|(from, to)| to - from == sector),
+        "every erase one sector"
+    );
+    // A range that is not whole sectors goes to the flash as asked.
+    let mut odd = SectorWise(whole(fresh(WriteCountCheck::Disabled)));
+    assert!(block_on(odd.erase(1, sector + 1)).is_err());
+    assert_eq!(odd.0.calls, [(1, sector + 1)]);
 }

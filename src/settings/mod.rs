@@ -35,6 +35,7 @@
 
 mod codec;
 mod record;
+mod sectors;
 mod storage;
 mod store;
 mod values;
@@ -43,6 +44,7 @@ pub use codec::SETTINGS_LEN;
 pub use record::{DecodeError, EncodeError, Record};
 #[cfg(feature = "postcard")]
 pub use record::{decode_postcard, encode_postcard};
+pub use sectors::SectorWise;
 pub use sequential_storage::map::MapConfigError;
 pub use storage::{RamStorage, SettingsStorage, StorageError};
 pub use store::{LoadError, SaveError, SettingsStore, buffer_len};

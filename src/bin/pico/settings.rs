@@ -6,7 +6,9 @@
 //! The flash driver is embassy-rp's in blocking mode, made async by
 //! [`BlockingAsync`]: reads are plain reads of the memory-mapped flash, and
 //! an erase or a write runs from RAM with interrupts off, as the flash
-//! cannot be read (nor code run from it) meanwhile.
+//! cannot be read (nor code run from it) meanwhile. [`SectorWise`] splits
+//! every erase into one call per sector, so the interrupts come back (and a
+//! due frame runs) between sectors.
 //!
 //! At boot ([`boot`]) the store is read before the first frame: stored
 //! settings of the current version are put in effect (servo calibrations,
@@ -27,7 +29,9 @@
 //! interrupts are off the PWM hardware keeps sending the last pulses, so
 //! the servos hold their pose; the frames due meanwhile are missed (the
 //! frame task's lateness shows it), and the head resumes where its clock
-//! stands.
+//! stands. An erase of several sectors (the whole store, when a damaged one
+//! is started afresh) goes one sector at a time ([`SectorWise`]): the
+//! interrupts are never off for more than one sector.
 
 use core::future::Future;
 use core::ops::Range;
@@ -44,8 +48,8 @@ use idle_head::console::ConsoleLink;
 use idle_head::driver::DriverConfig;
 use idle_head::motion::{DEFAULT_HEAD, HeadConfig};
 use idle_head::settings::{
-    LoadError, Record, SETTINGS_BUFFER, Settings, SettingsSource, SettingsStorage, SettingsStore,
-    StorageError, Validated,
+    LoadError, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsSource, SettingsStorage,
+    SettingsStore, StorageError, Validated,
 };
 
 /// The Pico's flash: 2 MiB (W25Q16JV).
@@ -77,7 +81,7 @@ pub const FRAME_WAIT_MS: u64 = 50;
 pub static FLASH_BUSY: AtomicBool = AtomicBool::new(false);
 
 /// The flash driver the store runs on.
-pub type PicoFlash = BlockingAsync<Flash<'static, FLASH, Blocking, FLASH_SIZE>>;
+pub type PicoFlash = SectorWise<BlockingAsync<Flash<'static, FLASH, Blocking, FLASH_SIZE>>>;
 
 /// The store, with a work buffer for the settings record.
 pub type Store = SettingsStore<PicoFlash, Settings, SETTINGS_BUFFER>;
@@ -194,7 +198,7 @@ pub fn boot(
 /// Opens the store. `None` (logged) if the region is not a valid store
 /// range, which `SETTINGS_RANGE` rules out.
 fn open(flash: Peri<'static, FLASH>) -> Option<Store> {
-    let flash = BlockingAsync::new(Flash::new_blocking(flash));
+    let flash = SectorWise(BlockingAsync::new(Flash::new_blocking(flash)));
     match Store::new(flash, SETTINGS_RANGE) {
         Ok(store) => Some(store),
         Err(_) => {
