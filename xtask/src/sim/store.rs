@@ -16,8 +16,9 @@
 //!   `status` says `settings=flash`.
 //! - At 5 s the power goes off and on. The next boot logs the settings
 //!   loaded from flash and its first frame's neutral pulses, 1520 1500
-//!   1500 µs; its first pitch pulse is 1520 µs on the pin; and at 2.5 s
-//!   into it `servo pitch` and `status` say the same over UART0.
+//!   1500 µs; its first pitch pulse is 1520 µs on the pin. At 2.5 s into
+//!   it, over UART0, `servo pitch neutral 1540` and then `load` bring the
+//!   saved 1520 back from flash: `servo pitch` and `status` say so.
 //! - The console image's RAM, static plus the peak stack of this run (the
 //!   save goes deepest), is within the budget.
 
@@ -51,12 +52,14 @@ const TIME: Duration = Duration::from_millis(8_500);
 /// The script of each boot.
 const SCRIPTS: [&[u8]; 2] = [
     b"servo pitch neutral 1520\r\nsave\r\nstatus\r\n",
-    b"servo pitch\r\nstatus\r\n",
+    b"servo pitch neutral 1540\r\nload\r\nservo pitch\r\nstatus\r\n",
 ];
 /// What each reply must start or end with, in order, per boot.
 const REPLIES: [&[(&str, &str)]; 2] = [
     &[("ok", ""), ("ok", ""), ("ok mode=", " settings=flash")],
     &[
+        ("ok", ""),
+        ("ok", ""),
         ("ok pitch neutral=1520 ", ""),
         ("ok mode=", " settings=flash"),
     ],
