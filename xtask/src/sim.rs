@@ -93,28 +93,33 @@ fn seconds(value: &str, max: f64) -> Result<Duration, String> {
     Ok(Duration::from_secs_f64(seconds))
 }
 
+/// Whether the run called `what` passed; if not, says why.
+fn passed(what: &str, result: Result<()>) -> bool {
+    match result {
+        Ok(()) => true,
+        Err(error) => {
+            println!("{what} FAILED: {error:#}");
+            false
+        }
+    }
+}
+
 /// `cargo xtask sim`. `Ok(false)` when a check failed.
 pub fn command(args: &Args) -> Result<bool> {
     let root = project::root();
     setup::ensure_toolchain(&root)?;
     let metadata = project::metadata(&root)?;
     if args.drill {
-        return match stages::test_drill(&root, &metadata) {
-            Ok(()) => Ok(true),
-            Err(error) => {
-                println!("watchdog drill FAILED: {error:#}");
-                Ok(false)
-            }
-        };
+        return Ok(passed(
+            "watchdog drill",
+            stages::test_drill(&root, &metadata),
+        ));
     }
     if args.store {
-        return match store::test_store(&root, &metadata) {
-            Ok(()) => Ok(true),
-            Err(error) => {
-                println!("settings store FAILED: {error:#}");
-                Ok(false)
-            }
-        };
+        return Ok(passed(
+            "settings store",
+            store::test_store(&root, &metadata),
+        ));
     }
     if args.console {
         let time = args.virtual_time.unwrap_or(CONSOLE_TIME);
@@ -126,13 +131,10 @@ pub fn command(args: &Args) -> Result<bool> {
             );
             return Ok(false);
         }
-        return match stages::test_console(&root, &metadata, time, args.timeout) {
-            Ok(()) => Ok(true),
-            Err(error) => {
-                println!("console FAILED: {error:#}");
-                Ok(false)
-            }
-        };
+        return Ok(passed(
+            "console",
+            stages::test_console(&root, &metadata, time, args.timeout),
+        ));
     }
     PICO.build(&root)?;
     let report = run::simulate(
