@@ -54,7 +54,9 @@ export function romImage() {
 /// every erase and program, `complain(text)` of a call it cannot serve.
 export function serveRom(chip, number, timing, report, complain) {
   const n = number - ROM_BREAKPOINTS;
-  if (n < 0 || n >= CODES.length) return false;
+  // Only the ROM's own breakpoints (the core has already stepped past it).
+  const at = chip.core.PC - 2;
+  if (n < 0 || n >= CODES.length || at !== FUNCTIONS + 4 * n) return false;
   const r = chip.core.registers;
   const inFlash = (address, length) =>
     address >= 0 && length >= 0 && address + length <= chip.flash.length;
