@@ -12,15 +12,16 @@
 mod exchange;
 mod expect;
 mod image;
-// The Pico image's own PWM clocking (divider, TOP, count length), compiled
-// here too, so the host's expectation uses exactly the firmware's numbers.
 mod node;
+mod planted;
 // The Pico console's handler, compiled here too, for the replies the UART
 // exchange must bring back.
 #[path = "../../src/bin/pico/handler.rs"]
 #[allow(dead_code)]
 pub(crate) mod pico_handler;
 mod pulses;
+// The Pico image's own PWM clocking (divider, TOP, count length), compiled
+// here too, so the host's expectation uses exactly the firmware's numbers.
 #[path = "../../src/bin/pico/rp2040_pwm.rs"]
 #[allow(dead_code, clippy::pedantic)]
 pub(crate) mod rp2040_pwm;

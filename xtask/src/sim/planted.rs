@@ -1,0 +1,113 @@
+//! Settings sectors as an earlier firmware would have left them: a store
+//! written by the core's own `SettingsStore` on the host, over a NOR flash
+//! in RAM with the Pico's geometry (4 KiB sectors, bytes written one at a
+//! time), holding a record of another layout version.
+
+use std::{
+    future::Future,
+    pin::pin,
+    task::{Context, Poll, Waker},
+};
+
+use anyhow::{Context as _, Result, bail};
+use embedded_storage_async::nor_flash::{
+    ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash,
+};
+use idle_head::settings::{DecodeError, EncodeError, Record, SettingsStore};
+
+/// The Pico's flash: erase sector and write unit.
+const SECTOR: usize = 4096;
+
+/// The bytes of `sectors` settings sectors holding one record of layout
+/// version `V` (its payload: `payload`), as the store writes it.
+pub fn store_of_version<const V: u16>(payload: &[u8], sectors: usize) -> Result<Vec<u8>> {
+    let flash = RamFlash(vec![0xff; sectors * SECTOR]);
+    let range = 0..u32::try_from(sectors * SECTOR)?;
+    let record = Raw::<V>(payload.to_vec());
+    let mut store: SettingsStore<RamFlash, Raw<V>, 256> = SettingsStore::new(flash, range)
+        .map_err(|e| anyhow::anyhow!("the settings store refused the range: {e:?}"))?;
+    match ready(store.save(&record)).context("the store's save waited")? {
+        Ok(()) => Ok(store.into_flash().0),
+        Err(e) => bail!("planting a version {V} record: {e:?}"),
+    }
+}
+
+/// Polls `future` once: [`RamFlash`] never waits.
+fn ready<F: Future>(future: F) -> Option<F::Output> {
+    match pin!(future).poll(&mut Context::from_waker(Waker::noop())) {
+        Poll::Ready(output) => Some(output),
+        Poll::Pending => None,
+    }
+}
+
+/// A record of layout version `V`: its bytes as they are.
+struct Raw<const V: u16>(Vec<u8>);
+
+impl<const V: u16> Record for Raw<V> {
+    const VERSION: u16 = V;
+
+    fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
+        let out = buf.get_mut(..self.0.len()).ok_or(EncodeError::TooLong)?;
+        out.copy_from_slice(&self.0);
+        Ok(self.0.len())
+    }
+
+    fn decode(bytes: &[u8]) -> Result<Self, DecodeError> {
+        Ok(Self(bytes.to_vec()))
+    }
+}
+
+/// NOR flash in RAM: erased bytes read `0xff`, a write clears bits.
+struct RamFlash(Vec<u8>);
+
+#[derive(Debug)]
+struct OutOfBounds;
+
+impl NorFlashError for OutOfBounds {
+    fn kind(&self) -> NorFlashErrorKind {
+        NorFlashErrorKind::OutOfBounds
+    }
+}
+
+impl ErrorType for RamFlash {
+    type Error = OutOfBounds;
+}
+
+impl RamFlash {
+    fn span(&mut self, offset: u32, len: usize) -> Result<&mut [u8], OutOfBounds> {
+        let start = usize::try_from(offset).map_err(|_| OutOfBounds)?;
+        self.0.get_mut(start..start + len).ok_or(OutOfBounds)
+    }
+}
+
+impl ReadNorFlash for RamFlash {
+    const READ_SIZE: usize = 1;
+
+    async fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), Self::Error> {
+        bytes.copy_from_slice(self.span(offset, bytes.len())?);
+        Ok(())
+    }
+
+    fn capacity(&self) -> usize {
+        self.0.len()
+    }
+}
+
+impl NorFlash for RamFlash {
+    const WRITE_SIZE: usize = 1;
+    const ERASE_SIZE: usize = SECTOR;
+
+    async fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
+        let len =
+            usize::try_from(to.checked_sub(from).ok_or(OutOfBounds)?).map_err(|_| OutOfBounds)?;
+        self.span(from, len)?.fill(0xff);
+        Ok(())
+    }
+
+    async fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Self::Error> {
+        for (cell, byte) in self.span(offset, bytes.len())?.iter_mut().zip(bytes) {
+            *cell &= byte;
+        }
+        Ok(())
+    }
+}
