@@ -181,10 +181,10 @@ impl Report {
     pub fn log_text(&self) -> String {
         let mut text = String::new();
         for (b, boot) in self.boots.iter().enumerate() {
-            let how = if b == 0 {
-                "power-on"
-            } else {
-                "after a watchdog reset"
+            let how = match b.checked_sub(1).map(|last| &self.boots[last]) {
+                None => "power-on",
+                Some(last) if last.power_cycled => "after a power cycle",
+                Some(_) => "after a watchdog reset",
             };
             let _ = writeln!(text, "[boot {b} at {:.6} s, {how}]", boot.start / 1e9);
             for (ns, line) in &boot.log {
