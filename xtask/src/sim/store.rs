@@ -277,3 +277,103 @@ fn noise(len: usize) -> Vec<u8> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::log::LogLine;
+
+    const LOGGED: &str = "settings: defaults (empty store";
+
+    /// Breaks a good report one way.
+    type Breaker = fn(&mut Report);
+
+    /// A report of the two boots as a passing run leaves them.
+    fn good() -> Report {
+        let boot = |log: &[&str], uart: &str, first_us: [f64; 3]| {
+            let mut boot = Boot {
+                log: log
+                    .iter()
+                    .map(|m| (0.0, LogLine::new("INFO", *m)))
+                    .collect(),
+                uart: uart.as_bytes().to_vec(),
+                ..Boot::default()
+            };
+            for (train, us) in boot.trains.iter_mut().zip(first_us) {
+                train.edges = vec![(1e6, true), (1e6 + us * 1e3, false)];
+            }
+            boot
+        };
+        let mut first = boot(
+            &["settings: defaults (empty store at 0x101fc000)"],
+            "ok\r\nok\r\nok mode=running settings=flash\r\n",
+            [1500.0; 3],
+        );
+        first.power_cycled = true;
+        first.flash = vec![FlashOp {
+            erase: false,
+            addr: 0x101f_c000,
+            len: 256,
+            busy_ns: 3e6,
+            ns: 3e9,
+        }];
+        let second = boot(
+            &[
+                "settings: loaded from flash (version 1) at 0x101fc000",
+                "first frame: neutral pulses 1520 1500 1500 us; watchdog armed (100 ms)",
+            ],
+            "ok\r\nok\r\nok pitch neutral=1520 per-degree=11111\r\nok mode=running settings=flash\r\n",
+            [1520.0, 1500.0, 1500.0],
+        );
+        Report {
+            boots: vec![first, second],
+            ..Report::default()
+        }
+    }
+
+    #[test]
+    fn a_good_run_passes_and_each_failure_is_named() {
+        let (_, problems) = check(&good(), LOGGED);
+        assert!(problems.is_empty(), "{problems:?}");
+
+        let failing: [(&str, Breaker); 6] = [
+            ("the watchdog reset the board", |r| {
+                r.boots[0].watchdog = true;
+            }),
+            (
+                "reply 1 `err storage save: settings do not fit the store`",
+                |r| {
+                    r.boots[0].uart = b"ok\r\nerr storage save: settings do not fit the store\r\nok mode=running settings=changed\r\n".to_vec();
+                },
+            ),
+            ("did not program the flash", |r| r.boots[0].flash.clear()),
+            ("did not log the settings loaded from flash", |r| {
+                r.boots[1].log.remove(0);
+            }),
+            (
+                "first pulses are [Some(1500), Some(1500), Some(1500)]",
+                |r| {
+                    r.boots[1].trains[0].edges[1].0 = 1e6 + 1.5e6;
+                },
+            ),
+            ("boots instead of two", |r| {
+                r.boots.pop();
+            }),
+        ];
+        for (want, break_it) in failing {
+            let mut report = good();
+            break_it(&mut report);
+            let (_, problems) = check(&report, LOGGED);
+            assert!(
+                problems.iter().any(|p| p.contains(want)),
+                "`{want}` not among {problems:?}"
+            );
+        }
+        let (_, problems) = check(&good(), "holds settings of version 0");
+        assert!(
+            problems
+                .iter()
+                .any(|p| p.contains("did not log `holds settings"))
+        );
+    }
+}
