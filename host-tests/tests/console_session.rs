@@ -269,3 +269,57 @@ fn error_codes_are_one_word_each() {
     let syntax = parse(b"idle amp x").unwrap_err();
     assert_eq!(ErrorCode::of(&syntax).as_str(), syntax.code());
 }
+
+/// Bytes lost before the framer (a UART overrun or framing error): the
+/// line they belonged to is answered as lost, never carried out as what
+/// its surviving bytes spell; the lines around it are untouched.
+#[test]
+fn a_line_that_lost_bytes_is_answered_so() {
+    let lost: Outcome = Err(LineError::Lost);
+    let mut framer = Framer::<16>::new();
+    let mut out: Vec<Outcome> = Vec::new();
+    // In the middle of a line.
+    framer.feed(b"nod\r\nsta", |l| out.push(l.map(<[u8]>::to_vec)));
+    framer.lose();
+    framer.feed(b"tus\r\nstatus\n", |l| out.push(l.map(<[u8]>::to_vec)));
+    assert_eq!(out, [ok("nod"), lost.clone(), ok("status")]);
+    // Right after a line end (twice): the next line lost its first bytes.
+    // Its CR LF still counts as one line end; the LF after it is an empty
+    // line of its own.
+    out.clear();
+    framer.feed(b"nod\r\n", |l| out.push(l.map(<[u8]>::to_vec)));
+    framer.lose();
+    framer.lose();
+    framer.feed(b"us\r\n\n", |l| out.push(l.map(<[u8]>::to_vec)));
+    assert_eq!(out, [ok("nod"), lost.clone(), ok("")]);
+    // Between a CR and its LF: the LF ends a line of its own, which lost
+    // bytes (whatever came between the two is gone).
+    out.clear();
+    framer.feed(b"nod\r", |l| out.push(l.map(<[u8]>::to_vec)));
+    framer.lose();
+    framer.feed(b"\nnod\n", |l| out.push(l.map(<[u8]>::to_vec)));
+    assert_eq!(out, [ok("nod"), lost, ok("nod")]);
+
+    // The session: one reply per line end, the lost line not carried out.
+    let mut handler = Counter::default();
+    let mut session = Session::<32, 80>::new();
+    let mut replies = Vec::new();
+    session.feed(b"sta", &mut handler, |r| replies.push(r.to_vec()));
+    session.lose();
+    session.feed(b"tus\r\nstatus\r\n", &mut handler, |r| {
+        replies.push(r.to_vec())
+    });
+    let text: Vec<String> = replies
+        .iter()
+        .map(|r| String::from_utf8(r.clone()).unwrap())
+        .collect();
+    assert_eq!(
+        text,
+        [
+            "err line bytes lost on the way in (a receive error): send it again\r\n",
+            "ok\r\n"
+        ]
+    );
+    assert_eq!(handler.commands, [Command::Status]);
+    assert_eq!(handler.rejected, [InputError::Line(LineError::Lost)]);
+}

@@ -60,6 +60,9 @@ pub enum LineError {
         /// Where the first invalid sequence starts.
         at: usize,
     },
+    /// Bytes of the line were lost on the way in (the port reported a
+    /// receive error, such as a UART overrun: see [`Framer::lose`]).
+    Lost,
 }
 
 impl Describe for LineError {
@@ -77,6 +80,7 @@ impl Describe for LineError {
                 .str(" at byte ")
                 .u64(at as u64),
             Self::NotUtf8 { at } => out.str("not UTF-8 from byte ").u64(at as u64).str(" on"),
+            Self::Lost => out.str("bytes lost on the way in (a receive error): send it again"),
         };
     }
 }
@@ -98,6 +102,8 @@ pub struct Framer<const N: usize> {
     len: usize,
     /// Bytes that did not fit; nonzero marks the line as too long.
     dropped: usize,
+    /// Bytes of the line were lost before they reached the framer.
+    lost: bool,
     /// The last byte was a CR: an LF now belongs to the same line end.
     after_cr: bool,
     /// The last call completed a line: start a new one.
@@ -121,6 +127,7 @@ impl<const N: usize> Framer<N> {
             buf: [0; N],
             len: 0,
             dropped: 0,
+            lost: false,
             after_cr: false,
             done: false,
         }
@@ -134,9 +141,7 @@ impl<const N: usize> Framer<N> {
     /// or is not UTF-8.
     pub fn push(&mut self, byte: u8) -> Option<Result<&[u8], LineError>> {
         if self.done {
-            self.done = false;
-            self.len = 0;
-            self.dropped = 0;
+            self.start_line();
         }
         let after_cr = core::mem::replace(&mut self.after_cr, byte == CR);
         match byte {
@@ -183,6 +188,28 @@ impl<const N: usize> Framer<N> {
         *self = Self::new();
     }
 
+    /// Notes that bytes were lost before they reached the framer (a UART
+    /// overrun, a framing error): the line they belonged to, the one in
+    /// progress or, after a line end, the next, ends in
+    /// [`LineError::Lost`]. Its line end may have been lost too, so that
+    /// line can run into the next: both then get the one reply. A lost
+    /// CR also loses the pairing of a following LF with it.
+    pub fn lose(&mut self) {
+        if self.done {
+            self.start_line();
+        }
+        self.lost = true;
+        self.after_cr = false;
+    }
+
+    /// Starts a new line.
+    fn start_line(&mut self) {
+        self.done = false;
+        self.len = 0;
+        self.dropped = 0;
+        self.lost = false;
+    }
+
     /// Where the last character of the line starts: a backspace deletes
     /// a whole UTF-8 sequence, or a single byte that starts none.
     fn char_start(&self) -> usize {
@@ -205,6 +232,9 @@ impl<const N: usize> Framer<N> {
 
     /// The outcome of the completed line.
     fn finish(&self) -> Result<&[u8], LineError> {
+        if self.lost {
+            return Err(LineError::Lost);
+        }
         if self.dropped > 0 {
             return Err(LineError::TooLong {
                 len: N.saturating_add(self.dropped),

@@ -195,6 +195,12 @@ impl<const LINE: usize, const REPLY: usize> Session<LINE, REPLY> {
     pub fn reset(&mut self) {
         self.framer.reset();
     }
+
+    /// Notes that the port lost received bytes (see [`Framer::lose`]):
+    /// the line they belonged to is answered `err line bytes lost …`.
+    pub fn lose(&mut self) {
+        self.framer.lose();
+    }
 }
 
 /// The reply to one line outcome of a [`Framer`], written into `out`

@@ -43,11 +43,20 @@ pub const UART_BAUD: u32 = 115_200;
 /// Bytes [`serve`] reads at once: a full-speed USB packet.
 pub const READ_CHUNK: usize = 64;
 
+/// What a [`Port`] read brought.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Received {
+    /// This many bytes, in the buffer.
+    Bytes(usize),
+    /// Received bytes were lost (a UART overrun or framing error).
+    Lost,
+}
+
 /// A byte port the console runs over.
 pub trait Port {
-    /// Waits for bytes and reads some into `buf`; `Err` when the port is
-    /// gone (a USB host disconnected).
-    async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Gone>;
+    /// Waits for bytes and reads some into `buf`, or reports received
+    /// bytes lost; `Err` when the port is gone (a USB host disconnected).
+    async fn read(&mut self, buf: &mut [u8]) -> Result<Received, Gone>;
     /// Writes all of `bytes`.
     async fn write(&mut self, bytes: &[u8]) -> Result<(), Gone>;
 }
@@ -57,7 +66,9 @@ pub trait Port {
 pub struct Gone;
 
 /// Runs `session` over `port` until the port goes away: every line gets
-/// exactly one reply from `handler`.
+/// exactly one reply from `handler`; a line that lost bytes on the way in
+/// is answered `err line bytes lost …` (and one whose line end was lost
+/// shares its reply with the next).
 pub async fn serve<P: Port, H: Handler, const LINE: usize, const REPLY: usize>(
     port: &mut P,
     session: &mut Session<LINE, REPLY>,
@@ -66,7 +77,11 @@ pub async fn serve<P: Port, H: Handler, const LINE: usize, const REPLY: usize>(
     let mut buf = [0; READ_CHUNK];
     loop {
         let n = match port.read(&mut buf).await {
-            Ok(n) => n,
+            Ok(Received::Bytes(n)) => n,
+            Ok(Received::Lost) => {
+                session.lose();
+                continue;
+            }
             Err(gone) => return gone,
         };
         for &byte in buf.get(..n).unwrap_or_default() {
@@ -80,15 +95,15 @@ pub async fn serve<P: Port, H: Handler, const LINE: usize, const REPLY: usize>(
 }
 
 impl Port for BufferedUart {
-    async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Gone> {
-        loop {
-            match embedded_io_async::Read::read(self, buf).await {
-                Ok(n) => return Ok(n),
-                // A framing, parity, break or overrun error: the bytes
-                // around it are lost, so the line in progress fails the
-                // framer or the parser and gets its `err` reply. The
-                // UART itself keeps working.
-                Err(e) => defmt::warn!("console uart: {}", e),
+    async fn read(&mut self, buf: &mut [u8]) -> Result<Received, Gone> {
+        match embedded_io_async::Read::read(self, buf).await {
+            Ok(n) => Ok(Received::Bytes(n)),
+            // A framing, parity, break or overrun error: bytes around it
+            // are lost, and the line they belonged to gets an `err` reply
+            // saying so. The UART itself keeps working.
+            Err(e) => {
+                defmt::warn!("console uart: {}: received bytes lost", e);
+                Ok(Received::Lost)
             }
         }
     }

@@ -18,7 +18,7 @@ use embassy_usb::driver::EndpointError;
 use embassy_usb::{Builder, Config, UsbDevice};
 use static_cell::{ConstStaticCell, StaticCell};
 
-use crate::console::{Gone, Port, READ_CHUNK};
+use crate::console::{Gone, Port, READ_CHUNK, Received};
 
 /// The shared V-USB vendor ID (Van Ooijen Technische Informatica).
 pub const VID: u16 = 0x16c0;
@@ -77,9 +77,12 @@ pub struct UsbPort<'a> {
 }
 
 impl Port for UsbPort<'_> {
-    async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Gone> {
-        // `serve` reads into a whole packet (`READ_CHUNK`).
-        self.serial.read_packet(buf).await.map_err(gone)
+    async fn read(&mut self, buf: &mut [u8]) -> Result<Received, Gone> {
+        // `serve` reads into a whole packet (`READ_CHUNK`). USB has flow
+        // control: the host holds what the device is not ready for, so
+        // nothing is lost here.
+        let n = self.serial.read_packet(buf).await.map_err(gone)?;
+        Ok(Received::Bytes(n))
     }
 
     async fn write(&mut self, bytes: &[u8]) -> Result<(), Gone> {
