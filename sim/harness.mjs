@@ -16,8 +16,10 @@
 //   ns:         virtual time to run, in nanoseconds,
 //   wall_ms:    wall-time limit,
 //   silence_ns: end the run when nothing (log byte, pin edge) happens for this long,
-//   uart:       bytes for UART0's RX line, a list of {boot, hex, at_ns, byte_ns}: in boot
-//               `boot`, from at_ns after its start on, one byte every byte_ns (the line rate),
+//   uart:       bytes for UART0's RX line, a list of {boot, hex, at_ns, byte_ns, errors}: in
+//               boot `boot`, from at_ns after its start on, one byte every byte_ns (the line
+//               rate), the bytes at the indices in `errors` received with a framing error
+//               (line noise); the scripts of one boot go out one after the other,
 //   usb:        optional, bytes for the USB serial port: {hex, at_ns}: rp2040js's CDC-ACM
 //               host enumerates the device, and from at_ns on sends the bytes; boot 0 only,
 //   rom:        optional, {erase_ns, program_ns}: a boot ROM with the flash functions
@@ -65,6 +67,8 @@ const RTT_SIZE = 32;
 const RTT_BLOCK_IF_FULL = 2; // what a debugger sets, so that no log byte is dropped
 const UARTDR = 0x00;
 const UARTDMACR = 0x48;
+const UARTDR_OE = 1 << 11;
+const UARTDR_FE = 1 << 8;
 const UART_TXINTR = 1 << 5;
 
 const image = readFileSync(cfg.flash);
@@ -167,7 +171,7 @@ function powerUp(kept) {
   return chip;
 }
 
-// Two gaps of rp2040js's UART, bridged as the PL011 behaves:
+// Three gaps of rp2040js's UART, bridged as the PL011 behaves:
 // - It has no DMA control register (UARTDMACR): a read gives 0xffffffff, as
 //   for any register it lacks, so a driver that checks for DMA first
 //   (embassy-rp's buffered UART) returns from every interrupt without
@@ -179,13 +183,24 @@ function powerUp(kept) {
 //   trigger level; the emulator sends each byte at once, so here it is
 //   raised once per byte written, and stays cleared when the firmware
 //   clears it.
+// - It drops a byte that arrives at a full receive FIFO without a word. The
+//   PL011 flags it: the next character read carries the overrun bit (OE,
+//   bit 11 of UARTDR), which embassy-rp reports as an overrun error.
 function uartAsOnTheChip(uart) {
   let dmacr = 0;
+  uart.overrun = false; // set by the harness when a byte found the FIFO full
   uart.checkInterrupts = function () {
     this.rp2040.setInterrupt(this.irq, !!(this.interruptStatus & this.interruptMask));
   };
   const read = uart.readUint32.bind(uart);
-  uart.readUint32 = (offset) => (offset === UARTDMACR ? dmacr : read(offset));
+  uart.readUint32 = (offset) => {
+    if (offset === UARTDMACR) return dmacr;
+    if (offset === UARTDR && uart.overrun && !uart.rxFIFO.empty) {
+      uart.overrun = false;
+      return read(offset) | UARTDR_OE;
+    }
+    return read(offset);
+  };
   const write = uart.writeUint32.bind(uart);
   uart.writeUint32 = (offset, value) => {
     if (offset === UARTDMACR) {
@@ -289,8 +304,11 @@ function feedUsb() {
 }
 
 // UART0's scripted RX line (per boot) and the bytes it sent.
-const scripts = (cfg.uart ?? []).map((s) => ({ ...s, bytes: Buffer.from(s.hex, 'hex') }));
-let script = null; // this boot's
+const scripts = (cfg.uart ?? [])
+  .map((s) => ({ ...s, bytes: Buffer.from(s.hex, 'hex') }))
+  .sort((a, b) => a.at_ns - b.at_ns);
+let bootScripts = []; // this boot's, in order
+let script = null; // the one going out
 let scriptAt = 0;
 const uartTx = { bytes: [], ns: 0 };
 function uartDue() {
@@ -300,11 +318,20 @@ function uartDue() {
 function feedUart() {
   if (now() < uartDue()) return;
   const uart = mcu.uart[0];
-  if (uart.rxFIFO.full) emit({ ev: 'uart_overrun', ns: now() });
-  else uart.feedByte(script.bytes[scriptAt]);
+  if (uart.rxFIFO.full) {
+    emit({ ev: 'uart_overrun', ns: now() });
+    uart.overrun = true;
+  } else {
+    const noisy = script.errors?.includes(scriptAt);
+    uart.feedByte(script.bytes[scriptAt] | (noisy ? UARTDR_FE : 0));
+  }
   scriptAt += 1;
   lastActivity = now();
-  if (scriptAt === script.bytes.length) emit({ ev: 'uart_rx', ns: now(), n: scriptAt });
+  if (scriptAt === script.bytes.length) {
+    emit({ ev: 'uart_rx', ns: now(), n: scriptAt });
+    script = bootScripts.shift() ?? null;
+    scriptAt = 0;
+  }
 }
 
 // The power cycles still to come.
@@ -369,7 +396,8 @@ function hex(n) {
 function startBoot(kept) {
   if (mcu) bootNs += mcu.clock.nanos;
   boot += 1;
-  script = scripts.find((s) => s.boot === boot) ?? null;
+  bootScripts = scripts.filter((s) => s.boot === boot);
+  script = bootScripts.shift() ?? null;
   scriptAt = 0;
   mcu = powerUp(kept);
   watchdogFired = null;

@@ -13,6 +13,7 @@ mod exchange;
 mod expect;
 mod image;
 mod node;
+mod noise;
 mod planted;
 // The Pico console's handler, compiled here too, for the replies the UART
 // exchange must bring back.
@@ -33,6 +34,7 @@ use std::{fmt::Write as _, time::Duration};
 
 use anyhow::Result;
 
+pub use noise::{NOISE_STAGE, test_noise};
 pub use run::{Report, logged_peak_stack};
 pub use stages::{
     CONSOLE_STAGE, CONSOLE_TIME, DRILL_STAGE, FAILURES_STAGE, PULSES_STAGE, WALL, test_console,
@@ -44,6 +46,8 @@ use crate::project::{self, PICO};
 use crate::setup;
 
 /// Options of `cargo xtask sim`.
+// The four runs are flags that exclude each other (clap checks it).
+#[allow(clippy::struct_excessive_bools)]
 #[derive(Debug, Clone, Copy, clap::Args)]
 pub struct Args {
     /// Virtual time to run, in seconds (default: 32.5, a 30 s loop, the
@@ -57,20 +61,25 @@ pub struct Args {
     /// watchdog-drill`, in target/watchdog-drill), whose frames stop after
     /// 3 s, and check that the watchdog resets it and the next boot starts
     /// softly again.
-    #[arg(long, conflicts_with_all = ["console", "store"])]
+    #[arg(long, conflicts_with_all = ["console", "store", "noise"])]
     pub drill: bool,
     /// The console image instead (`--features console`, in target/console):
     /// its memory against the budgets (not enforced), and a scripted
     /// exchange over UART0 and then over USB CDC-ACM, every reply checked.
     /// Without `--seconds`, 6 s: both scripts and their replies.
-    #[arg(long, conflicts_with = "store")]
+    #[arg(long, conflicts_with_all = ["store", "noise"])]
     pub console: bool,
-    /// The console image's settings store instead: a damaged store at
-    /// power-on, `servo pitch neutral 1520` and `save` over UART0 with the
-    /// flash's worst-case erase times, a power cycle, and the next boot on
-    /// the saved settings.
-    #[arg(long)]
+    /// The console image's settings store instead: foreign data, then an
+    /// older record, in the settings sectors at power-on; `servo pitch
+    /// neutral 1520` and `save` over UART0 with the flash's worst-case
+    /// erase times, a power cycle, and the next boot on the saved settings.
+    #[arg(long, conflicts_with = "noise")]
     pub store: bool,
+    /// The console image with line noise on UART0 instead: a byte received
+    /// with a framing error; its line must be answered `err line bytes
+    /// lost …`, the next one `ok`.
+    #[arg(long)]
+    pub noise: bool,
 }
 
 /// One loop (30 s), the fade-in (2 s) and half a second for the boot.
@@ -115,6 +124,9 @@ pub fn command(args: &Args) -> Result<bool> {
             "watchdog drill",
             stages::test_drill(&root, &metadata),
         ));
+    }
+    if args.noise {
+        return Ok(passed("UART noise", noise::test_noise(&root, &metadata)));
     }
     if args.store {
         return Ok(passed(

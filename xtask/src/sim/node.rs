@@ -163,6 +163,8 @@ pub struct UartScript {
     pub start: Duration,
     /// Time per byte (the line rate).
     pub byte_time: Duration,
+    /// Indices of the bytes received with a framing error (line noise).
+    pub errors: Vec<usize>,
 }
 
 impl Config {
@@ -184,6 +186,7 @@ impl Config {
                 "hex": hex(&uart.bytes),
                 "at_ns": nanos(uart.start),
                 "byte_ns": nanos(uart.byte_time),
+                "errors": uart.errors,
             })).collect::<Vec<_>>(),
             "usb": self.usb.as_ref().map(|(bytes, at)| json!({
                 "hex": hex(bytes),

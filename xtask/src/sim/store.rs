@@ -135,6 +135,7 @@ fn run_from(
                 bytes: SCRIPTS[boot].to_vec(),
                 start: SCRIPT_AT[boot],
                 byte_time: BYTE_TIME,
+                errors: Vec::new(),
             })
             .collect();
     })?;

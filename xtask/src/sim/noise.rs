@@ -1,0 +1,88 @@
+//! Line noise on the console image's UART in the emulator: a byte received
+//! with a framing error.
+//!
+//! At 3 s the harness sends `sta`, then a byte with a framing error (as a
+//! glitch on the RX wire gives), then `tus` and a line end, then
+//! `status` on a line of its own. embassy-rp drops the damaged byte and
+//! reports a framing error after the bytes before it; the console marks
+//! the line in progress as having lost bytes. The check: the first line is
+//! answered `err line bytes lost …` (not carried out as the `status` its
+//! surviving bytes spell), the second `ok mode=…`, nothing else; and every
+//! frame's pulses are the host's, on time.
+
+use std::{fmt::Write as _, path::Path, time::Duration};
+
+use anyhow::{Result, bail};
+
+use super::{
+    exchange::BYTE_TIME,
+    node::UartScript,
+    run::{self, Report},
+    stages::{WALL, build_variant},
+};
+use crate::project::Metadata;
+
+/// Stage name.
+pub const NOISE_STAGE: &str = "console image in the RP2040 emulator: a byte with a framing \
+     error on UART0: its line answered `err line bytes lost`, the next one `ok`";
+
+/// The bytes sent, and which of them arrives with a framing error.
+const SCRIPT: &[u8] = b"staXtus\r\nstatus\r\n";
+const NOISY: usize = 3;
+/// When the script goes out (after the fade-in), and the whole run.
+const AT: Duration = Duration::from_secs(3);
+const TIME: Duration = Duration::from_millis(3_500);
+/// The replies, as prefixes.
+const REPLIES: [&str; 2] = ["err line bytes lost", "ok mode="];
+
+/// Runs the scenario and checks it (see the module docs).
+pub fn test_noise(root: &Path, metadata: &Metadata) -> Result<()> {
+    let elf = build_variant(root, metadata, "console")?;
+    let report = run::run_checked(root, &elf, TIME, WALL, |config| {
+        config.uart = vec![UartScript {
+            boot: 0,
+            bytes: SCRIPT.to_vec(),
+            start: AT,
+            byte_time: BYTE_TIME,
+            errors: vec![NOISY],
+        }];
+    })?;
+    println!("{}", report.verdict());
+    println!("{}", report.summary());
+    let (text, problems) = check(&report);
+    print!("{text}");
+    let problems: Vec<String> = report.problems.iter().cloned().chain(problems).collect();
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        bail!("{}", problems.join("; "))
+    }
+}
+
+/// The replies against [`REPLIES`]: a transcript and the problems found.
+fn check(report: &Report) -> (String, Vec<String>) {
+    let Some(boot) = report.boots.first() else {
+        return (String::new(), vec!["no boot".to_owned()]);
+    };
+    let text = String::from_utf8_lossy(&boot.uart);
+    let replies: Vec<&str> = text.split_terminator("\r\n").collect();
+    let mut transcript =
+        String::from("UART0, `sta` + a byte with a framing error + `tus`, then `status`:\n");
+    for reply in &replies {
+        let _ = writeln!(transcript, "  < {reply}");
+    }
+    let fits = replies.len() == REPLIES.len()
+        && replies
+            .iter()
+            .zip(REPLIES)
+            .all(|(got, want)| got.starts_with(want));
+    let problems = if fits {
+        Vec::new()
+    } else {
+        vec![format!(
+            "replies {replies:?}, not `{}…` and `{}…`",
+            REPLIES[0], REPLIES[1]
+        )]
+    };
+    (transcript, problems)
+}
