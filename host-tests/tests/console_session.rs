@@ -277,28 +277,28 @@ fn error_codes_are_one_word_each() {
 fn a_line_that_lost_bytes_is_answered_so() {
     let lost: Outcome = Err(LineError::Lost);
     let mut framer = Framer::<16>::new();
-    let mut out: Vec<Outcome> = Vec::new();
+    // `before`, a loss, `after`: the outcomes.
+    let mut around = |before: &[u8], after: &[u8]| {
+        let mut out: Vec<Outcome> = Vec::new();
+        framer.feed(before, |l| out.push(l.map(<[u8]>::to_vec)));
+        framer.lose();
+        framer.feed(after, |l| out.push(l.map(<[u8]>::to_vec)));
+        out
+    };
     // In the middle of a line.
-    framer.feed(b"nod\r\nsta", |l| out.push(l.map(<[u8]>::to_vec)));
-    framer.lose();
-    framer.feed(b"tus\r\nstatus\n", |l| out.push(l.map(<[u8]>::to_vec)));
-    assert_eq!(out, [ok("nod"), lost.clone(), ok("status")]);
-    // Right after a line end (twice): the next line lost its first bytes.
-    // Its CR LF still counts as one line end; the LF after it is an empty
-    // line of its own.
-    out.clear();
-    framer.feed(b"nod\r\n", |l| out.push(l.map(<[u8]>::to_vec)));
-    framer.lose();
-    framer.lose();
-    framer.feed(b"us\r\n\n", |l| out.push(l.map(<[u8]>::to_vec)));
-    assert_eq!(out, [ok("nod"), lost.clone(), ok("")]);
+    assert_eq!(
+        around(b"nod\r\nsta", b"tus\r\nstatus\n"),
+        [ok("nod"), lost.clone(), ok("status")]
+    );
+    // Right after a line end: the next line lost its first bytes. Its CR
+    // LF still counts as one line end; the LF after it is an empty line.
+    assert_eq!(
+        around(b"nod\r\n", b"us\r\n\n"),
+        [ok("nod"), lost.clone(), ok("")]
+    );
     // Between a CR and its LF: the LF ends a line of its own, which lost
     // bytes (whatever came between the two is gone).
-    out.clear();
-    framer.feed(b"nod\r", |l| out.push(l.map(<[u8]>::to_vec)));
-    framer.lose();
-    framer.feed(b"\nnod\n", |l| out.push(l.map(<[u8]>::to_vec)));
-    assert_eq!(out, [ok("nod"), lost, ok("nod")]);
+    assert_eq!(around(b"nod\r", b"\nnod\n"), [ok("nod"), lost, ok("nod")]);
 
     // The session: one reply per line end, the lost line not carried out.
     let mut handler = Counter::default();

@@ -9,8 +9,8 @@ use futures::executor::block_on;
 use idle_head::command::Percent;
 use idle_head::servo::{NanosPerDegree, ServoCalibration};
 use idle_head::settings::{
-    DecodeError, EncodeError, LoadError, Record, SETTINGS_BUFFER, SaveError, SectorWise, Settings,
-    SettingsStore, decode_postcard, encode_postcard,
+    DecodeError, EncodeError, LoadError, RawRecord, Record, SETTINGS_BUFFER, SaveError, SectorWise,
+    Settings, SettingsStore, decode_postcard, encode_postcard,
 };
 use idle_head::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
@@ -102,20 +102,11 @@ impl Record for ServoSettings {
 }
 
 /// Bytes stored under any version, to plant records of other layouts.
-struct Raw<const V: u16>(Vec<u8>);
+type Raw<const V: u16> = RawRecord<V, 512>;
 
-impl<const V: u16> Record for Raw<V> {
-    const VERSION: u16 = V;
-
-    fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
-        let dst = buf.get_mut(..self.0.len()).ok_or(EncodeError::TooLong)?;
-        dst.copy_from_slice(&self.0);
-        Ok(self.0.len())
-    }
-
-    fn decode(bytes: &[u8]) -> Result<Self, DecodeError> {
-        Ok(Self(bytes.to_vec()))
-    }
+/// `bytes` as a raw record.
+fn raw<const V: u16>(bytes: &[u8]) -> Raw<V> {
+    Raw::new(bytes).expect("at most 512 bytes")
 }
 
 /// Valid settings, every field varied.
@@ -234,17 +225,17 @@ fn round_trip_and_what_a_load_reports() {
     assert_eq!(block_on(s.load()), Err(LoadError::Empty));
 
     // A record too long for the work buffer is refused, nothing changes.
-    let mut raw = store::<Raw<2>>(fresh(WriteCountCheck::OnceOnly));
+    let mut long = store::<Raw<2>>(fresh(WriteCountCheck::OnceOnly));
     assert_eq!(
-        block_on(raw.save(&Raw(vec![7; 300]))),
+        block_on(long.save(&raw::<2>(&[7; 300]))),
         Err(SaveError::TooLong)
     );
-    assert!(matches!(block_on(raw.load()), Err(LoadError::Empty)));
+    assert!(matches!(block_on(long.load()), Err(LoadError::Empty)));
 }
 
 fn save_raw<const V: u16>(flash: Flash, bytes: &[u8]) -> Flash {
     let mut s = store::<Raw<V>>(flash);
-    block_on(s.save(&Raw(bytes.to_vec()))).unwrap();
+    block_on(s.save(&raw::<V>(bytes))).unwrap();
     s.into_flash()
 }
 

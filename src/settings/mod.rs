@@ -41,7 +41,7 @@ mod store;
 mod values;
 
 pub use codec::SETTINGS_LEN;
-pub use record::{DecodeError, EncodeError, Record};
+pub use record::{DecodeError, EncodeError, RawRecord, Record};
 #[cfg(feature = "postcard")]
 pub use record::{decode_postcard, encode_postcard};
 pub use sectors::SectorWise;

@@ -50,6 +50,34 @@ pub enum DecodeError {
     Invalid,
 }
 
+/// A record of layout version `V` kept as its bytes, at most `N`: for tools
+/// that plant a store of another version (tests, the emulator's runs) or
+/// read a record's bytes as they are.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct RawRecord<const V: u16, const N: usize>(pub heapless::Vec<u8, N>);
+
+impl<const V: u16, const N: usize> RawRecord<V, N> {
+    /// `bytes` as a record; `None` if they are more than `N`.
+    #[must_use]
+    pub fn new(bytes: &[u8]) -> Option<Self> {
+        heapless::Vec::from_slice(bytes).ok().map(Self)
+    }
+}
+
+impl<const V: u16, const N: usize> Record for RawRecord<V, N> {
+    const VERSION: u16 = V;
+
+    fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
+        let out = buf.get_mut(..self.0.len()).ok_or(EncodeError::TooLong)?;
+        out.copy_from_slice(&self.0);
+        Ok(self.0.len())
+    }
+
+    fn decode(bytes: &[u8]) -> Result<Self, DecodeError> {
+        Self::new(bytes).ok_or(DecodeError::Malformed)
+    }
+}
+
 /// [`Record::encode`] for a serde type, with postcard (compact: integers
 /// as varints, no field names).
 ///

@@ -13,7 +13,7 @@ use anyhow::{Context as _, Result, bail};
 use embedded_storage_async::nor_flash::{
     ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash,
 };
-use idle_head::settings::{DecodeError, EncodeError, Record, SettingsStore};
+use idle_head::settings::{RawRecord, SettingsStore};
 
 /// The Pico's flash: erase sector and write unit.
 const SECTOR: usize = 4096;
@@ -23,8 +23,8 @@ const SECTOR: usize = 4096;
 pub fn store_of_version<const V: u16>(payload: &[u8], sectors: usize) -> Result<Vec<u8>> {
     let flash = RamFlash(vec![0xff; sectors * SECTOR]);
     let range = 0..u32::try_from(sectors * SECTOR)?;
-    let record = Raw::<V>(payload.to_vec());
-    let mut store: SettingsStore<RamFlash, Raw<V>, 256> = SettingsStore::new(flash, range)
+    let record = RawRecord::<V, 240>::new(payload).context("a payload of at most 240 bytes")?;
+    let mut store: SettingsStore<RamFlash, _, 256> = SettingsStore::new(flash, range)
         .map_err(|e| anyhow::anyhow!("the settings store refused the range: {e:?}"))?;
     match ready(store.save(&record)).context("the store's save waited")? {
         Ok(()) => Ok(store.into_flash().0),
@@ -37,23 +37,6 @@ fn ready<F: Future>(future: F) -> Option<F::Output> {
     match pin!(future).poll(&mut Context::from_waker(Waker::noop())) {
         Poll::Ready(output) => Some(output),
         Poll::Pending => None,
-    }
-}
-
-/// A record of layout version `V`: its bytes as they are.
-struct Raw<const V: u16>(Vec<u8>);
-
-impl<const V: u16> Record for Raw<V> {
-    const VERSION: u16 = V;
-
-    fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
-        let out = buf.get_mut(..self.0.len()).ok_or(EncodeError::TooLong)?;
-        out.copy_from_slice(&self.0);
-        Ok(self.0.len())
-    }
-
-    fn decode(bytes: &[u8]) -> Result<Self, DecodeError> {
-        Ok(Self(bytes.to_vec()))
     }
 }
 

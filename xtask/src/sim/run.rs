@@ -146,7 +146,7 @@ pub fn simulate(
     wall: Duration,
     exchange: bool,
 ) -> Result<Report> {
-    let mut report = run_checked(root, elf, virtual_time, wall, |config| {
+    let mut report = run_with(root, elf, virtual_time, wall, |config| {
         if exchange {
             config.uart.push(node::UartScript {
                 boot: 0,
@@ -158,22 +158,10 @@ pub fn simulate(
             config.usb = Some((exchange::script(), exchange::USB_START));
         }
     })?;
+    check(&mut report)?;
     if exchange {
         check_exchange(&mut report);
     }
-    Ok(report)
-}
-
-/// [`run_with`], and every servo's pulses checked against the host's.
-pub fn run_checked(
-    root: &Path,
-    elf: &Path,
-    virtual_time: Duration,
-    wall: Duration,
-    setup: impl FnOnce(&mut node::Config),
-) -> Result<Report> {
-    let mut report = run_with(root, elf, virtual_time, wall, setup)?;
-    check(&mut report)?;
     Ok(report)
 }
 
@@ -515,7 +503,7 @@ fn limits() -> [Limits; 3] {
 }
 
 /// Checks every boot's pulses against the host's duties.
-fn check(report: &mut Report) -> Result<()> {
+pub fn check(report: &mut Report) -> Result<()> {
     let frames = report
         .boots
         .iter()
