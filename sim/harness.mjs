@@ -52,6 +52,7 @@
 import { readFileSync } from 'node:fs';
 import { RP2040, USBCDC } from 'rp2040js';
 import { romImage, serveRom } from './rom.mjs';
+import { uartAsOnTheChip } from './uart.mjs';
 
 const cfg = JSON.parse(process.argv[2] ?? '{}');
 const FLASH_START = 0x10000000;
@@ -141,7 +142,7 @@ function powerUp(kept) {
   for (const pin of cfg.pins) {
     chip.gpio[pin].addListener((state) => edge(pin, state === 1));
   }
-  uartAsOnTheChip(chip.uart[0]);
+  uartAsOnTheChip(chip.uart[0], () => now());
   xipControlAsOnTheChip(chip);
   if (cfg.usb && boot === 0) usbHost(chip);
   chip.uart[0].onByte = (byte) => {
@@ -169,50 +170,6 @@ function powerUp(kept) {
   chip.core.VTOR = cfg.vtor;
   chip.core.reset(); // SP and PC from the vector table, as boot2 hands over
   return chip;
-}
-
-// Three gaps of rp2040js's UART, bridged as the PL011 behaves:
-// - It has no DMA control register (UARTDMACR): a read gives 0xffffffff, as
-//   for any register it lacks, so a driver that checks for DMA first
-//   (embassy-rp's buffered UART) returns from every interrupt without
-//   serving it, and the interrupt never ends. Here it reads back what was
-//   written, 0 after reset.
-// - It raises the transmit interrupt again on every interrupt check, so once
-//   the firmware unmasks it (embassy-rp's buffered UART keeps it unmasked)
-//   it never clears. The PL011 raises it when its transmit FIFO falls to the
-//   trigger level; the emulator sends each byte at once, so here it is
-//   raised once per byte written, and stays cleared when the firmware
-//   clears it.
-// - It drops a byte that arrives at a full receive FIFO without a word. The
-//   PL011 flags it: the next character read carries the overrun bit (OE,
-//   bit 11 of UARTDR), which embassy-rp reports as an overrun error.
-function uartAsOnTheChip(uart) {
-  let dmacr = 0;
-  uart.overrun = false; // set by the harness when a byte found the FIFO full
-  uart.checkInterrupts = function () {
-    this.rp2040.setInterrupt(this.irq, !!(this.interruptStatus & this.interruptMask));
-  };
-  const read = uart.readUint32.bind(uart);
-  uart.readUint32 = (offset) => {
-    if (offset === UARTDMACR) return dmacr;
-    if (offset === UARTDR && uart.overrun && !uart.rxFIFO.empty) {
-      uart.overrun = false;
-      return read(offset) | UARTDR_OE;
-    }
-    return read(offset);
-  };
-  const write = uart.writeUint32.bind(uart);
-  uart.writeUint32 = (offset, value) => {
-    if (offset === UARTDMACR) {
-      dmacr = value & 0x7;
-      return;
-    }
-    write(offset, value);
-    if (offset === UARTDR && uart.enabled) {
-      uart.interruptStatus |= UART_TXINTR;
-      uart.checkInterrupts();
-    }
-  };
 }
 
 // rp2040js has no XIP control registers (0x14000000..0x14000020): a read
@@ -423,6 +380,12 @@ function run() {
           continue;
         }
         if (due !== Infinity && (wait <= 0 || due < wait)) wait = due;
+        const sending = mcu.uart[0].txDue() - now(); // a byte leaving UART0
+        if (sending <= 0) {
+          mcu.uart[0].sendDue();
+          continue;
+        }
+        if (sending !== Infinity && (wait <= 0 || sending < wait)) wait = sending;
         const cycle = powerCycleDue() - now();
         if (cycle <= 0) break;
         if (cycle !== Infinity && (wait <= 0 || cycle < wait)) wait = cycle;
@@ -449,6 +412,7 @@ function run() {
       if (opcode === OP_SEV) core.eventRegistered = true;
       if ((i & 63) === 0 && cfg.rtt) drainRtt();
       if ((i & 15) === 0 && cfg.uart) feedUart();
+      if ((i & 15) === 0) mcu.uart[0].sendDue();
       if ((i & 255) === 0 && usbSend) feedUsb();
       if ((i & 255) === 0 && now() >= powerCycleDue()) break;
     }

@@ -11,6 +11,7 @@
 
 mod exchange;
 mod expect;
+mod flood;
 mod image;
 mod node;
 mod noise;
@@ -34,6 +35,7 @@ use std::{fmt::Write as _, time::Duration};
 
 use anyhow::Result;
 
+pub use flood::{FLOOD_STAGE, test_flood};
 pub use noise::{NOISE_STAGE, test_noise};
 pub use run::{Report, logged_peak_stack};
 pub use stages::{
@@ -46,7 +48,7 @@ use crate::project::{self, PICO};
 use crate::setup;
 
 /// Options of `cargo xtask sim`.
-// The four runs are flags that exclude each other (clap checks it).
+// The runs are flags that exclude each other (clap checks it).
 #[allow(clippy::struct_excessive_bools)]
 #[derive(Debug, Clone, Copy, clap::Args)]
 pub struct Args {
@@ -61,25 +63,31 @@ pub struct Args {
     /// watchdog-drill`, in target/watchdog-drill), whose frames stop after
     /// 3 s, and check that the watchdog resets it and the next boot starts
     /// softly again.
-    #[arg(long, conflicts_with_all = ["console", "store", "noise"])]
+    #[arg(long, conflicts_with_all = ["console", "store", "noise", "flood"])]
     pub drill: bool,
     /// The console image instead (`--features console`, in target/console):
     /// its memory against the budgets (not enforced), and a scripted
     /// exchange over UART0 and then over USB CDC-ACM, every reply checked.
     /// Without `--seconds`, 6 s: both scripts and their replies.
-    #[arg(long, conflicts_with_all = ["store", "noise"])]
+    #[arg(long, conflicts_with_all = ["store", "noise", "flood"])]
     pub console: bool,
     /// The console image's settings store instead: foreign data, then an
     /// older record, in the settings sectors at power-on; `servo pitch
     /// neutral 1520` and `save` over UART0 with the flash's worst-case
     /// erase times, a power cycle, and the next boot on the saved settings.
-    #[arg(long, conflicts_with = "noise")]
+    #[arg(long, conflicts_with_all = ["noise", "flood"])]
     pub store: bool,
     /// The console image with line noise on UART0 instead: a byte received
     /// with a framing error; its line must be answered `err line bytes
     /// lost …`, the next one `ok`.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "flood")]
     pub noise: bool,
+    /// The console image under a UART flood instead: 200 `status` lines
+    /// back to back at 115200 baud, more than the replies keep up with
+    /// (bytes are lost at the full receive FIFO, as on the chip), then one
+    /// more line.
+    #[arg(long)]
+    pub flood: bool,
 }
 
 /// One loop (30 s), the fade-in (2 s) and half a second for the boot.
@@ -124,6 +132,9 @@ pub fn command(args: &Args) -> Result<bool> {
             "watchdog drill",
             stages::test_drill(&root, &metadata),
         ));
+    }
+    if args.flood {
+        return Ok(passed("UART flood", flood::test_flood(&root, &metadata)));
     }
     if args.noise {
         return Ok(passed("UART noise", noise::test_noise(&root, &metadata)));

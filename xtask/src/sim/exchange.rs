@@ -2,8 +2,10 @@
 //! port in the emulator.
 //!
 //! The harness puts [`SCRIPT`] on the RX line (GP1) at 115200 baud, one
-//! byte every 86.8 µs, from [`START`] on: after the fade-in, while the
-//! idle motion plays; at [`USB_START`] the emulator's CDC-ACM host (which
+//! byte every 86.8 µs, from [`START`] on, one line every [`LINE_GAP`] (a
+//! controller that waits for each reply: the UART has no flow control,
+//! and the replies leave at the line rate too): after the fade-in, while
+//! the idle motion plays; at [`USB_START`] the emulator's CDC-ACM host (which
 //! has enumerated and configured the device at boot) sends it again over
 //! USB. Every byte sent back is recorded. The check, for each port:
 //! exactly one reply line per script line, each the reply the host
@@ -52,6 +54,9 @@ use super::pico_handler::{PicoSession, Shared, SharedService};
 pub const START: Duration = Duration::from_secs(3);
 /// When the same script goes to the USB serial port: 4 s.
 pub const USB_START: Duration = Duration::from_secs(4);
+/// Between the starts of two lines on the UART: more than the longest
+/// reply (160 bytes, 13.9 ms) takes to go out.
+pub const LINE_GAP: Duration = Duration::from_millis(40);
 /// One byte at 115200 baud, 8N1: 10 bits.
 pub const BYTE_TIME: Duration = Duration::from_nanos(1_000_000_000 * 10 / 115_200);
 
@@ -76,15 +81,21 @@ const SCRIPT: &[&[u8]] = &[
 
 /// The bytes of the whole script.
 pub fn script() -> Vec<u8> {
-    let mut bytes: Vec<u8> = SCRIPT.concat();
+    script_lines().concat()
+}
+
+/// The script's lines, each with its line end.
+pub fn script_lines() -> Vec<Vec<u8>> {
+    let mut lines: Vec<Vec<u8>> = SCRIPT.iter().map(|line| line.to_vec()).collect();
     // An overlong line: one byte past the protocol's 96.
-    bytes.extend(std::iter::repeat_n(b'a', 97));
-    bytes.extend(b"\r\n");
+    let mut long = vec![b'a'; 97];
+    long.extend(b"\r\n");
+    lines.push(long);
     // Machine mode: `#<seq> <command> *<crc>`.
     let body = "#7 help";
     let crc = checksum(body.as_bytes());
-    bytes.extend(format!("{body} *{crc:02x}\r\n").into_bytes());
-    bytes
+    lines.push(format!("{body} *{crc:02x}\r\n").into_bytes());
+    lines
 }
 
 /// The replies the firmware must send for `script`, one per line: first

@@ -148,13 +148,17 @@ pub fn simulate(
 ) -> Result<Report> {
     let mut report = run_with(root, elf, virtual_time, wall, |config| {
         if exchange {
-            config.uart.push(node::UartScript {
-                boot: 0,
-                bytes: exchange::script(),
-                start: exchange::START,
-                byte_time: exchange::BYTE_TIME,
-                errors: Vec::new(),
-            });
+            let mut start = exchange::START;
+            for line in exchange::script_lines() {
+                config.uart.push(node::UartScript {
+                    boot: 0,
+                    bytes: line,
+                    start,
+                    byte_time: exchange::BYTE_TIME,
+                    errors: Vec::new(),
+                });
+                start += exchange::LINE_GAP;
+            }
             config.usb = Some((exchange::script(), exchange::USB_START));
         }
     })?;
