@@ -28,13 +28,13 @@
 
 use std::{path::Path, time::Duration};
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 
 use super::{
     exchange::BYTE_TIME,
     node::UartScript,
     run::{self, Report},
-    stages::{WALL, build_variant},
+    stages::{WALL, build_variant, conclude},
 };
 use crate::project::Metadata;
 use idle_head::console::checksum;
@@ -82,16 +82,7 @@ pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
     })?;
     run::check(&mut report)?;
     print!("{}", report.table());
-    println!("{}", report.verdict());
-    println!("{}", report.summary());
-    let (text, problems) = check(&report);
-    print!("{text}");
-    let problems: Vec<String> = report.problems.iter().cloned().chain(problems).collect();
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", problems.join("; "))
-    }
+    conclude(&report, check(&report))
 }
 
 /// Machine-mode `status` with sequence number `n`, and its line end.
@@ -157,11 +148,11 @@ fn check(report: &Report) -> (String, Vec<String>) {
         problems.push("the line after the flood got no `ok` reply".to_owned());
     }
     let summary = format!(
-        "UART flood: {} lines in ({FLOOD_LINES} plain, {FLOOD_LINES} machine mode, 1 after), {} \
+        "UART flood: {FLOOD_LINES} plain and {FLOOD_LINES} machine-mode lines, then a line end \
+         and 1 more line; {} \
          bytes lost at the full receive FIFO; {} replies: {plain} plain `{STATUS}…`, {} machine \
          `#<n> ok` (n = {:?}…), {errors} `err` ({lost} of them `{LOST} …`); the last line \
          answered `{STATUS}…`: {last_ok} (`{}`)\n",
-        2 * FLOOD_LINES + 1,
         boot.uart_overruns,
         replies.len(),
         seqs.len(),

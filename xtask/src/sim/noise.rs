@@ -12,13 +12,13 @@
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 
 use super::{
     exchange::BYTE_TIME,
     node::UartScript,
     run::{self, Report},
-    stages::{WALL, build_variant},
+    stages::{WALL, build_variant, conclude},
 };
 use crate::project::Metadata;
 
@@ -48,16 +48,7 @@ pub fn test_noise(root: &Path, metadata: &Metadata) -> Result<()> {
         }];
     })?;
     run::check(&mut report)?;
-    println!("{}", report.verdict());
-    println!("{}", report.summary());
-    let (text, problems) = check(&report);
-    print!("{text}");
-    let problems: Vec<String> = report.problems.iter().cloned().chain(problems).collect();
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", problems.join("; "))
-    }
+    conclude(&report, check(&report))
 }
 
 /// The replies against [`REPLIES`]: a transcript and the problems found.

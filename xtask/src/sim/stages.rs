@@ -305,6 +305,16 @@ fn synthetic(code: &[u16]) -> Vec<u8> {
     flash
 }
 
+/// Prints `report`'s verdict and summary and a scenario's own `text`;
+/// fails with the run's problems and the scenario's `found`, if any.
+pub fn conclude(report: &Report, (text, found): (String, Vec<String>)) -> Result<()> {
+    println!("{}", report.verdict());
+    println!("{}", report.summary());
+    print!("{text}");
+    let problems: Vec<String> = report.problems.iter().cloned().chain(found).collect();
+    fail_if_any(&problems)
+}
+
 fn fail_if_any(problems: &[String]) -> Result<()> {
     if problems.is_empty() {
         Ok(())
