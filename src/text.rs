@@ -84,15 +84,14 @@ impl dyn Text + '_ {
     /// (`6666` is `6.666`, `12500` is `12.5`, `4000` is `4`): millidegrees
     /// as degrees, milliseconds as seconds.
     pub fn milli(&mut self, n: u64) -> &mut Self {
-        let (whole, mut fraction) = (n / 1000, n % 1000);
+        let Thousandths {
+            whole,
+            fraction,
+            digits,
+        } = Thousandths::of(n);
         self.u64(whole);
-        if fraction == 0 {
+        if digits == 0 {
             return self;
-        }
-        let mut digits = 3;
-        while fraction % 10 == 0 {
-            fraction /= 10;
-            digits -= 1;
         }
         self.put(".");
         self.zeros(fraction, digits)
@@ -156,6 +155,31 @@ pub enum Arg<'a> {
     Int(i64),
     /// A message.
     Text(&'a dyn Describe),
+}
+
+/// `n` thousandths as a decimal number is written: the whole part and
+/// the significant digits of the fraction (`12500` is `12`, `5`, 1 digit;
+/// `4000` is `4`, `0`, 0 digits).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Thousandths {
+    pub(crate) whole: u64,
+    pub(crate) fraction: u64,
+    pub(crate) digits: usize,
+}
+
+impl Thousandths {
+    pub(crate) const fn of(n: u64) -> Self {
+        let (mut fraction, mut digits) = (n % 1000, 3);
+        while digits > 0 && fraction % 10 == 0 {
+            fraction /= 10;
+            digits -= 1;
+        }
+        Self {
+            whole: n / 1000,
+            fraction,
+            digits,
+        }
+    }
 }
 
 /// The lowercase hexadecimal digit of `v`'s low four bits.

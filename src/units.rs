@@ -84,35 +84,6 @@ impl Angle {
     }
 }
 
-/// An angle in degrees as its log line writes it: sign, whole degrees and
-/// the significant digits of the millidegrees (`-0.25°` is `("-", 0, 25,
-/// 2)`), the digits [`Text::milli`] writes.
-#[cfg(feature = "defmt")]
-struct Written {
-    sign: &'static str,
-    whole: u32,
-    fraction: u32,
-    digits: usize,
-}
-
-#[cfg(feature = "defmt")]
-impl Written {
-    const fn of(angle: Angle) -> Self {
-        let abs = angle.0.unsigned_abs();
-        let (mut fraction, mut digits) = (abs % Angle::SCALE as u32, 3);
-        while digits > 0 && fraction % 10 == 0 {
-            fraction /= 10;
-            digits -= 1;
-        }
-        Self {
-            sign: if angle.0 < 0 { "-" } else { "" },
-            whole: abs / Angle::SCALE as u32,
-            fraction,
-            digits,
-        }
-    }
-}
-
 impl Describe for Angle {
     fn describe(&self, out: &mut dyn Text) {
         let sign = if self.0 < 0 { "-" } else { "" };
@@ -125,12 +96,15 @@ impl Describe for Angle {
 #[cfg(feature = "defmt")]
 impl defmt::Format for Angle {
     fn format(&self, f: defmt::Formatter<'_>) {
-        let Written {
-            sign,
+        // The digits `Text::milli` writes; |angle| < 2³¹ m°, so the whole
+        // degrees and the fraction fit u32.
+        let crate::text::Thousandths {
             whole,
             fraction,
             digits,
-        } = Written::of(*self);
+        } = crate::text::Thousandths::of(u64::from(self.0.unsigned_abs()));
+        let (whole, fraction) = (whole as u32, fraction as u32);
+        let sign = if self.0 < 0 { "-" } else { "" };
         // The arms differ in their format strings only (which defmt interns).
         // The sign is part of the format string, not a `{=str}` argument,
         // which a `{:?}` around the angle (a derived `Format`) would quote.
