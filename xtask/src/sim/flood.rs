@@ -31,7 +31,6 @@ use std::{path::Path, time::Duration};
 use anyhow::Result;
 
 use super::{
-    exchange::BYTE_TIME,
     node::UartScript,
     run::{self, Report},
     stages::{WALL, build_variant, conclude},
@@ -71,13 +70,7 @@ pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
             ([b"\r\n", LINE].concat(), AT[2]),
         ]
         .into_iter()
-        .map(|(bytes, start)| UartScript {
-            boot: 0,
-            bytes,
-            start,
-            byte_time: BYTE_TIME,
-            errors: Vec::new(),
-        })
+        .map(|(bytes, start)| UartScript::new(0, bytes, start))
         .collect();
     })?;
     run::check(&mut report)?;

@@ -105,8 +105,9 @@ fn is_root() -> bool {
         .is_ok_and(|output| output.status.success() && output.stdout.trim_ascii() == b"0")
 }
 
-/// What the harness is asked to run.
-#[derive(Debug, Clone)]
+/// What the harness is asked to run (by default: nothing scripted, no
+/// ROM, no power cycle).
+#[derive(Debug, Clone, Default)]
 pub struct Config {
     /// The flash image file.
     pub flash: PathBuf,
@@ -165,6 +166,19 @@ pub struct UartScript {
     pub byte_time: Duration,
     /// Indices of the bytes received with a framing error (line noise).
     pub errors: Vec<usize>,
+}
+
+impl UartScript {
+    /// `bytes` in boot `boot` from `start` on, at 115200 baud, undamaged.
+    pub fn new(boot: usize, bytes: Vec<u8>, start: Duration) -> Self {
+        Self {
+            boot,
+            bytes,
+            start,
+            byte_time: super::exchange::BYTE_TIME,
+            errors: Vec::new(),
+        }
+    }
 }
 
 impl Config {

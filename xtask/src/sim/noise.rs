@@ -15,7 +15,6 @@ use std::{fmt::Write as _, path::Path, time::Duration};
 use anyhow::Result;
 
 use super::{
-    exchange::BYTE_TIME,
     node::UartScript,
     run::{self, Report},
     stages::{WALL, build_variant, conclude},
@@ -40,11 +39,8 @@ pub fn test_noise(root: &Path, metadata: &Metadata) -> Result<()> {
     let elf = build_variant(root, metadata, "console")?;
     let mut report = run::run_with(root, &elf, TIME, WALL, |config| {
         config.uart = vec![UartScript {
-            boot: 0,
-            bytes: SCRIPT.to_vec(),
-            start: AT,
-            byte_time: BYTE_TIME,
             errors: vec![NOISY],
+            ..UartScript::new(0, SCRIPT.to_vec(), AT)
         }];
     })?;
     run::check(&mut report)?;

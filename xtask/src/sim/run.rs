@@ -150,13 +150,7 @@ pub fn simulate(
         if exchange {
             let mut start = exchange::START;
             for line in exchange::script_lines() {
-                config.uart.push(node::UartScript {
-                    boot: 0,
-                    bytes: line,
-                    start,
-                    byte_time: exchange::BYTE_TIME,
-                    errors: Vec::new(),
-                });
+                config.uart.push(node::UartScript::new(0, line, start));
                 start += exchange::LINE_GAP;
             }
             config.usb = Some((exchange::script(), exchange::USB_START));
@@ -199,11 +193,7 @@ pub fn run_with(
         virtual_time,
         wall,
         silence: SILENCE,
-        uart: Vec::new(),
-        usb: None,
-        rom: None,
-        flash_fill: None,
-        power_cycles: Vec::new(),
+        ..node::Config::default()
     };
     setup(&mut config);
     println!(

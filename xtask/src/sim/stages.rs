@@ -249,19 +249,10 @@ pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
         let config = node::Config {
             flash,
             vtor: VECTOR_TABLE,
-            rtt: 0,
-            pins: Vec::new(),
-            slices: Vec::new(),
-            probe: 0,
-            stack: None,
             virtual_time: Duration::from_secs(if name == "slow" { 3600 } else { 2 }),
             wall,
             silence,
-            uart: Vec::new(),
-            usb: None,
-            rom: None,
-            flash_fill: None,
-            power_cycles: Vec::new(),
+            ..node::Config::default()
         };
         let events = node::run(root, &config)?;
         let end = run::end_of(&events)?;

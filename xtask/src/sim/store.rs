@@ -36,7 +36,6 @@ use std::{fmt::Write as _, path::Path, time::Duration};
 use anyhow::{Context, Result, bail};
 
 use super::{
-    exchange::BYTE_TIME,
     node::{FlashTiming, UartScript},
     planted,
     run::{self, Boot, FlashOp, Report},
@@ -130,13 +129,7 @@ fn run_from(
         config.flash_fill = Some((at, bytes));
         config.power_cycles = vec![POWER_CYCLE];
         config.uart = (0..2)
-            .map(|boot| UartScript {
-                boot,
-                bytes: SCRIPTS[boot].to_vec(),
-                start: SCRIPT_AT[boot],
-                byte_time: BYTE_TIME,
-                errors: Vec::new(),
-            })
+            .map(|boot| UartScript::new(boot, SCRIPTS[boot].to_vec(), SCRIPT_AT[boot]))
             .collect();
     })?;
     print!("{}", report.log_text());
