@@ -66,11 +66,6 @@ const RTT_FLAGS = 44;
 const RTT_BUFFER = 28;
 const RTT_SIZE = 32;
 const RTT_BLOCK_IF_FULL = 2; // what a debugger sets, so that no log byte is dropped
-const UARTDR = 0x00;
-const UARTDMACR = 0x48;
-const UARTDR_OE = 1 << 11;
-const UARTDR_FE = 1 << 8;
-const UART_TXINTR = 1 << 5;
 
 const image = readFileSync(cfg.flash);
 const started = Date.now();
@@ -274,13 +269,9 @@ function uartDue() {
 }
 function feedUart() {
   if (now() < uartDue()) return;
-  const uart = mcu.uart[0];
-  if (uart.rxFIFO.full) {
+  const damaged = script.errors?.includes(scriptAt) ?? false;
+  if (!mcu.uart[0].receive(script.bytes[scriptAt], damaged)) {
     emit({ ev: 'uart_overrun', ns: now() });
-    uart.overrun = true;
-  } else {
-    const noisy = script.errors?.includes(scriptAt);
-    uart.feedByte(script.bytes[scriptAt] | (noisy ? UARTDR_FE : 0));
   }
   scriptAt += 1;
   lastActivity = now();

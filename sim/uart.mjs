@@ -16,15 +16,17 @@
 //   interrupt comes as on the chip and stays cleared when the firmware
 //   clears it. So replies take their real time, and a sender that does not
 //   wait for them fills the receive side as on a board.
-// - It drops a byte that arrives at a full receive FIFO without a word. The
-//   PL011 flags it: the next character read carries the overrun bit (OE,
-//   bit 11 of UARTDR), which embassy-rp reports as an overrun error. The
-//   harness sets `uart.overrun` when it has to drop a byte.
+// - It has no way to receive a byte that arrives at a full receive FIFO, nor
+//   a damaged one. `uart.receive` does both as the PL011 does: a byte that
+//   finds the FIFO full is lost, and the next character read carries the
+//   overrun bit (OE, bit 11 of UARTDR); a damaged byte carries the framing
+//   error bit (FE, bit 8). embassy-rp reports either as a receive error.
 
 const UARTDR = 0x00;
 const UARTFR = 0x18;
 const UARTDMACR = 0x48;
 const UARTDR_OE = 1 << 11;
+const UARTDR_FE = 1 << 8;
 const UART_TXINTR = 1 << 5;
 const FR_BUSY = 1 << 3;
 const FR_TXFF = 1 << 5;
@@ -33,14 +35,16 @@ const TX_FIFO = 32;
 const TX_TRIGGER = 4;
 
 /// Bridges `uart`; `now()` is the virtual time in ns. Adds `uart.txDue()`
-/// (when the next byte leaves, Infinity if none waits) and `uart.sendDue()`
-/// (sends every byte whose time has come, to `uart.onByte`).
+/// (when the next byte leaves, Infinity if none waits), `uart.sendDue()`
+/// (sends every byte whose time has come, to `uart.onByte`) and
+/// `uart.receive(byte, damaged)` (a byte on the RX line; false if it was
+/// lost at a full FIFO).
 export function uartAsOnTheChip(uart, now) {
   let dmacr = 0;
   const tx = []; // the transmit FIFO
   let txNext = Infinity; // when its first byte has left the wire
   const byteNs = () => (10 * 1e9) / (uart.baudRate || 115200);
-  uart.overrun = false;
+  let overrun = false; // a byte was lost at a full receive FIFO
   uart.checkInterrupts = function () {
     this.rp2040.setInterrupt(this.irq, !!(this.interruptStatus & this.interruptMask));
   };
@@ -52,8 +56,8 @@ export function uartAsOnTheChip(uart, now) {
       const full = tx.length >= TX_FIFO ? FR_TXFF : 0;
       return rx | full | (tx.length === 0 ? FR_TXFE : FR_BUSY);
     }
-    if (offset === UARTDR && uart.overrun && !uart.rxFIFO.empty) {
-      uart.overrun = false;
+    if (offset === UARTDR && overrun && !uart.rxFIFO.empty) {
+      overrun = false;
       return read(offset) | UARTDR_OE;
     }
     return read(offset);
@@ -71,6 +75,14 @@ export function uartAsOnTheChip(uart, now) {
       return;
     }
     write(offset, value);
+  };
+  uart.receive = (byte, damaged) => {
+    if (uart.rxFIFO.full) {
+      overrun = true;
+      return false;
+    }
+    uart.feedByte(byte | (damaged ? UARTDR_FE : 0));
+    return true;
   };
   uart.txDue = () => txNext;
   uart.sendDue = () => {

@@ -48,7 +48,7 @@ pub use sectors::SectorWise;
 pub use sequential_storage::map::MapConfigError;
 pub use storage::{RamStorage, SettingsStorage, StorageError};
 pub use store::{LoadError, SaveError, SettingsStore, buffer_len};
+pub use values::{Settings, SettingsError, SettingsSource, Validated};
 
 /// The work buffer of a store of [`Settings`] (see [`buffer_len`]).
 pub const SETTINGS_BUFFER: usize = buffer_len(SETTINGS_LEN);
-pub use values::{Settings, SettingsError, SettingsSource, Validated};

@@ -1,7 +1,9 @@
 //! Settings sectors as an earlier firmware would have left them: a store
 //! written by the core's own `SettingsStore` on the host, over a NOR flash
 //! in RAM with the Pico's geometry (4 KiB sectors, bytes written one at a
-//! time), holding a record of another layout version.
+//! time), holding a record of another layout version. (sequential-storage's
+//! own mock flash, which the host tests use, sits behind its internal
+//! `_test` feature; this tool keeps its own small one, [`RamFlash`].)
 
 use std::{
     future::Future,
