@@ -20,11 +20,11 @@ use idle_head::settings::{RawRecord, SettingsStore};
 /// The Pico's flash: erase sector and write unit.
 const SECTOR: usize = 4096;
 
-/// The bytes of `sectors` settings sectors holding one record of layout
-/// version `V` (its payload: `payload`), as the store writes it.
-pub fn store_of_version<const V: u16>(payload: &[u8], sectors: usize) -> Result<Vec<u8>> {
-    let flash = RamFlash(vec![0xff; sectors * SECTOR]);
-    let range = 0..u32::try_from(sectors * SECTOR)?;
+/// `len` bytes of settings sectors (whole sectors) holding one record of
+/// layout version `V` (its payload: `payload`), as the store writes it.
+pub fn store_of_version<const V: u16>(payload: &[u8], len: usize) -> Result<Vec<u8>> {
+    let flash = RamFlash(vec![0xff; len]);
+    let range = 0..u32::try_from(len)?;
     let record = RawRecord::<V, 240>::new(payload).context("a payload of at most 240 bytes")?;
     let mut store: SettingsStore<RamFlash, _, 256> = SettingsStore::new(flash, range)
         .map_err(|e| anyhow::anyhow!("the settings store refused the range: {e:?}"))?;

@@ -87,14 +87,11 @@ fn starts(len: usize) -> Result<[(&'static str, Vec<u8>, &'static str); 2]> {
         ),
         (
             "an older record",
-            planted::store_of_version::<0>(b"an earlier layout", len / SECTOR)?,
+            planted::store_of_version::<0>(b"an earlier layout", len)?,
             "holds settings of version 0, not 1",
         ),
     ])
 }
-
-/// The Pico's flash sector.
-const SECTOR: usize = 4096;
 
 /// Runs the scenario from both starts and checks it (see the module docs).
 pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
