@@ -84,17 +84,14 @@ impl dyn Text + '_ {
     /// (`6666` is `6.666`, `12500` is `12.5`, `4000` is `4`): millidegrees
     /// as degrees, milliseconds as seconds.
     pub fn milli(&mut self, n: u64) -> &mut Self {
-        let Thousandths {
-            whole,
-            fraction,
-            digits,
-        } = Thousandths::of(n);
-        self.u64(whole);
+        // n % 1000 < 1000.
+        let (fraction, digits) = significant((n % 1000) as u32);
+        self.u64(n / 1000);
         if digits == 0 {
             return self;
         }
         self.put(".");
-        self.zeros(fraction, digits)
+        self.zeros(u64::from(fraction), digits)
     }
 
     /// Appends `byte` as two lowercase hexadecimal digits.
@@ -157,29 +154,16 @@ pub enum Arg<'a> {
     Text(&'a dyn Describe),
 }
 
-/// `n` thousandths as a decimal number is written: the whole part and
-/// the significant digits of the fraction (`12500` is `12`, `5`, 1 digit;
-/// `4000` is `4`, `0`, 0 digits).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Thousandths {
-    pub(crate) whole: u64,
-    pub(crate) fraction: u64,
-    pub(crate) digits: usize,
-}
-
-impl Thousandths {
-    pub(crate) const fn of(n: u64) -> Self {
-        let (mut fraction, mut digits) = (n % 1000, 3);
-        while digits > 0 && fraction % 10 == 0 {
-            fraction /= 10;
-            digits -= 1;
-        }
-        Self {
-            whole: n / 1000,
-            fraction,
-            digits,
-        }
+/// A fraction of thousandths (`0..1000`) as a decimal number writes it:
+/// its significant digits and how many (`500` is `(5, 1)`, `250` is
+/// `(25, 2)`, `0` is `(0, 0)`).
+pub(crate) const fn significant(thousandths: u32) -> (u32, usize) {
+    let (mut fraction, mut digits) = (thousandths, 3);
+    while digits > 0 && fraction % 10 == 0 {
+        fraction /= 10;
+        digits -= 1;
     }
+    (fraction, digits)
 }
 
 /// The lowercase hexadecimal digit of `v`'s low four bits.

@@ -96,14 +96,10 @@ impl Describe for Angle {
 #[cfg(feature = "defmt")]
 impl defmt::Format for Angle {
     fn format(&self, f: defmt::Formatter<'_>) {
-        // The digits `Text::milli` writes; |angle| < 2³¹ m°, so the whole
-        // degrees and the fraction fit u32.
-        let crate::text::Thousandths {
-            whole,
-            fraction,
-            digits,
-        } = crate::text::Thousandths::of(u64::from(self.0.unsigned_abs()));
-        let (whole, fraction) = (whole as u32, fraction as u32);
+        // The digits `Text::milli` writes.
+        let abs = self.0.unsigned_abs();
+        let whole = abs / Self::SCALE as u32;
+        let (fraction, digits) = crate::text::significant(abs % Self::SCALE as u32);
         let sign = if self.0 < 0 { "-" } else { "" };
         // The arms differ in their format strings only (which defmt interns).
         // The sign is part of the format string, not a `{=str}` argument,
