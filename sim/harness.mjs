@@ -139,6 +139,7 @@ function powerUp(kept) {
   }
   uartAsOnTheChip(chip.uart[0], () => now());
   xipControlAsOnTheChip(chip);
+  roscRandomBit(chip);
   if (cfg.usb && boot === 0) usbHost(chip);
   chip.uart[0].onByte = (byte) => {
     if (uartTx.bytes.length === 0) uartTx.ns = now();
@@ -185,6 +186,25 @@ function xipControlAsOnTheChip(chip) {
   chip.writeUint32 = (address, value) => {
     const a = address >>> 0;
     if (a < XIP_CTRL || a >= XIP_CTRL_END) write(address, value);
+  };
+}
+
+// rp2040js has no ring oscillator: its RANDOMBIT register (ROSC + 0x1c)
+// would read 0xffffffff, one and the same bit for ever. On the chip it is the
+// oscillator's jitter. Here it reads as the bits of a fixed-seed xorshift, so
+// that the firmware sees varied bits and a run still repeats exactly.
+const ROSC_BASE = 0x40060;
+const ROSC_RANDOMBIT = 0x1c;
+function roscRandomBit(chip) {
+  const rosc = chip.peripherals[ROSC_BASE];
+  const read = rosc.readUint32.bind(rosc);
+  let state = 0x2545f491;
+  rosc.readUint32 = (offset) => {
+    if (offset !== ROSC_RANDOMBIT) return read(offset);
+    state ^= state << 13;
+    state ^= state >>> 17;
+    state ^= state << 5;
+    return state & 1;
   };
 }
 

@@ -313,8 +313,12 @@ async fn main(spawner: Spawner) {
         } = boot;
         match ConsoleService::new(&COMMANDS, &LINK, storage, CONFIG, settings, source) {
             Ok(mut service) => {
-                // `seed random` mixes the loop checksum and the boot time in.
-                service.add_entropy(checksum ^ Instant::now().as_ticks() as u32);
+                // `seed random` mixes in the ring oscillator's jitter (the
+                // loop checksum and the boot time alone are the same on
+                // every boot of the same settings), and the frame count when
+                // it is asked.
+                service
+                    .add_entropy(checksum ^ Instant::now().as_ticks() as u32 ^ oscillator_jitter());
                 let service = SERVICE.init(embassy_sync::blocking_mutex::Mutex::new(
                     core::cell::RefCell::new(service),
                 ));
@@ -335,6 +339,17 @@ async fn main(spawner: Spawner) {
 }
 
 /// Generates each next loop set while the frames play (thread mode).
+/// 32 bits from the ring oscillator's RANDOMBIT: its jitter against the
+/// system clock, different on every boot and board. The ROSC keeps
+/// running beside the crystal in embassy-rp's default clock configuration.
+/// Its bits are not uniform, so 64 are folded into 32; the console's
+/// `seed random` stirs them further.
+#[cfg(feature = "console")]
+fn oscillator_jitter() -> u32 {
+    let bits = embassy_rp::clocks::RoscRng.next_u64();
+    bits as u32 ^ (bits >> 32) as u32
+}
+
 #[embassy_executor::task]
 async fn generator(mut stream: LoopStream<DEFAULT_N>) {
     #[cfg(feature = "console")]
