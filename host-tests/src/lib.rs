@@ -8,6 +8,20 @@ use embedded_hal_mock::eh1::pwm::{Mock, Transaction};
 use idle_head::Angle;
 use idle_head::driver::{DriverConfig, DriverParams};
 
+/// Cases for a property test: `default`, or `PROPTEST_CASES` when set, for
+/// a longer soak (`PROPTEST_CASES=20000 cargo test --release --test driver`;
+/// a case count written in a test's config would otherwise override
+/// proptest's own variable). A value that is not a number is reported.
+#[must_use]
+pub fn cases(default: u32) -> u32 {
+    match std::env::var("PROPTEST_CASES") {
+        Ok(text) => text
+            .parse()
+            .unwrap_or_else(|_| panic!("PROPTEST_CASES={text:?}: not a u32")),
+        Err(_) => default,
+    }
+}
+
 /// Validated parameters of `cfg` (panics with the error if invalid: tests only).
 #[must_use]
 pub fn params(cfg: &DriverConfig) -> DriverParams {

@@ -178,7 +178,7 @@ fn step() -> impl Strategy<Value = Step> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(128))]
+    #![proptest_config(ProptestConfig::with_cases(host_tests::cases(128)))]
 
     #[test]
     fn the_modes_are_those_of_the_frame_by_frame_count(

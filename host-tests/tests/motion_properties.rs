@@ -46,7 +46,7 @@ proptest! {
     // 10,000 cases each, from a fixed seed so that every run (and CI) checks
     // the same configurations; set PROPTEST_RNG_SEED to explore others.
     #![proptest_config(ProptestConfig {
-        cases: 10_000,
+        cases: host_tests::cases(10_000),
         failure_persistence: None,
         rng_seed: std::env::var("PROPTEST_RNG_SEED")
             .ok()

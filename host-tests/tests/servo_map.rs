@@ -44,7 +44,7 @@ fn check_every_angle(cal: &ServoCalibration, max_duty: u16) -> Result<usize, Tes
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(ProptestConfig::with_cases(host_tests::cases(64)))]
 
     /// The calibrations of the driver's property tests, on the channels they
     /// drive and on the Pico's (63 999: 64 000 counts per 20 ms).

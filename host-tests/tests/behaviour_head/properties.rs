@@ -54,7 +54,7 @@ fn action() -> impl Strategy<Value = Action> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(ProptestConfig::with_cases(host_tests::cases(64)))]
 
     #[test]
     fn any_commands_stay_inside_the_safety_stages(

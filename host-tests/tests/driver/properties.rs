@@ -29,7 +29,7 @@ fn accel_bound(cfg: &DriverConfig, axis: Axis) -> i64 {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(300))]
+    #![proptest_config(ProptestConfig::with_cases(host_tests::cases(300)))]
 
     /// For random loops, calibrations, limits and write errors: every duty
     /// written lies within its servo's pulse range (except the single 0 that
