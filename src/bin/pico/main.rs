@@ -338,7 +338,6 @@ async fn main(spawner: Spawner) {
     }
 }
 
-/// Generates each next loop set while the frames play (thread mode).
 /// 32 bits from the ring oscillator's RANDOMBIT: its jitter against the
 /// system clock, different on every boot and board. The ROSC keeps
 /// running beside the crystal in embassy-rp's default clock configuration.
@@ -350,6 +349,7 @@ fn oscillator_jitter() -> u32 {
     bits as u32 ^ (bits >> 32) as u32
 }
 
+/// Generates each next loop set while the frames play (thread mode).
 #[embassy_executor::task]
 async fn generator(mut stream: LoopStream<DEFAULT_N>) {
     #[cfg(feature = "console")]
