@@ -14,11 +14,21 @@ use idle_head::driver::{DriverConfig, DriverParams};
 /// proptest's own variable). A value that is not a number is reported.
 #[must_use]
 pub fn cases(default: u32) -> u32 {
-    match std::env::var("PROPTEST_CASES") {
-        Ok(text) => text
-            .parse()
-            .unwrap_or_else(|_| panic!("PROPTEST_CASES={text:?}: not a u32")),
-        Err(_) => default,
+    env_number("PROPTEST_CASES").unwrap_or(default)
+}
+
+/// The number in the environment variable `name`, if it is set; a value
+/// that is not a number is a mistake to report (a panic naming it), not
+/// to run CI's cases under.
+#[must_use]
+pub fn env_number<T: std::str::FromStr>(name: &str) -> Option<T> {
+    let text = std::env::var(name).ok()?;
+    match text.parse() {
+        Ok(n) => Some(n),
+        Err(_) => panic!(
+            "{name}={text:?}: not a number of {}",
+            std::any::type_name::<T>()
+        ),
     }
 }
 

@@ -48,9 +48,7 @@ proptest! {
     #![proptest_config(ProptestConfig {
         cases: host_tests::cases(10_000),
         failure_persistence: None,
-        rng_seed: std::env::var("PROPTEST_RNG_SEED")
-            .ok()
-            .and_then(|s| s.parse().ok())
+        rng_seed: host_tests::env_number("PROPTEST_RNG_SEED")
             .map_or(RngSeed::Fixed(0x1d1e_4ead), RngSeed::Fixed),
         ..ProptestConfig::default()
     })]

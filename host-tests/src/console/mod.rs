@@ -32,22 +32,12 @@ pub const REPLY: usize = 160;
 /// the cases are CI's.
 #[must_use]
 pub fn rng(seed: u64) -> TestRng {
-    let seed = seed ^ fuzz_seed().wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    let moved = crate::env_number::<u64>("FUZZ_SEED").unwrap_or(0);
+    let seed = seed ^ moved.wrapping_mul(0x9e37_79b9_7f4a_7c15);
     let mut bytes = [0; 16];
     bytes[..8].copy_from_slice(&seed.to_le_bytes());
     bytes[8..].copy_from_slice(&(!seed).to_le_bytes());
     TestRng::from_seed(RngAlgorithm::XorShift, &bytes)
-}
-
-/// `FUZZ_SEED` (0 if unset). A value that is not a number is a mistake to
-/// report, not to run CI's cases under.
-fn fuzz_seed() -> u64 {
-    match std::env::var("FUZZ_SEED") {
-        Ok(text) => text
-            .parse()
-            .unwrap_or_else(|_| panic!("FUZZ_SEED={text:?}: not a u64")),
-        Err(_) => 0,
-    }
 }
 
 /// One line for the parser: a valid command (varied spelling), a mutation
