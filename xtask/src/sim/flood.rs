@@ -99,8 +99,7 @@ fn check(report: &Report) -> (String, Vec<String>) {
     let Some(boot) = report.boots.first() else {
         return (String::new(), vec!["no boot".to_owned()]);
     };
-    let text = String::from_utf8_lossy(&boot.uart);
-    let replies: Vec<&str> = text.split_terminator("\r\n").collect();
+    let replies = boot.uart_replies();
     let is_err = |r: &str| {
         r.starts_with("err ")
             || r.split_once(' ')
@@ -150,7 +149,7 @@ fn check(report: &Report) -> (String, Vec<String>) {
         replies.len(),
         seqs.len(),
         &seqs[..seqs.len().min(8)],
-        replies.last().unwrap_or(&""),
+        replies.last().map_or("", String::as_str),
     );
     (summary, problems)
 }

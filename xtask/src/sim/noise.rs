@@ -52,8 +52,7 @@ fn check(report: &Report) -> (String, Vec<String>) {
     let Some(boot) = report.boots.first() else {
         return (String::new(), vec!["no boot".to_owned()]);
     };
-    let text = String::from_utf8_lossy(&boot.uart);
-    let replies: Vec<&str> = text.split_terminator("\r\n").collect();
+    let replies = boot.uart_replies();
     let mut transcript =
         String::from("UART0, `sta` + a byte with a framing error + `tus`, then `status`:\n");
     for reply in &replies {

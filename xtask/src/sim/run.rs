@@ -62,6 +62,16 @@ pub struct Boot {
     pub power_cycled: bool,
 }
 
+impl Boot {
+    /// The reply lines UART0 sent, without their line ends.
+    pub fn uart_replies(&self) -> Vec<String> {
+        String::from_utf8_lossy(&self.uart)
+            .split_terminator("\r\n")
+            .map(str::to_owned)
+            .collect()
+    }
+}
+
 /// One flash erase or program by the boot ROM.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlashOp {

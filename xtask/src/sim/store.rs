@@ -158,22 +158,21 @@ fn check(report: &Report, logged: &str) -> (String, Vec<String>) {
             problems.push(format!("boot {b}: the watchdog reset the board"));
         }
         let _ = writeln!(text, "boot {b}, UART0:");
-        for (i, line) in replies(&boot.uart).iter().enumerate() {
-            let _ = writeln!(text, "  < {}", line.trim_end());
+        let replies = boot.uart_replies();
+        for (i, line) in replies.iter().enumerate() {
+            let _ = writeln!(text, "  < {line}");
             match REPLIES[b].get(i) {
-                Some((start, end)) if line.starts_with(start) && line.trim_end().ends_with(end) => {
-                }
+                Some((start, end)) if line.starts_with(start) && line.ends_with(end) => {}
                 Some((start, end)) => problems.push(format!(
-                    "boot {b}: reply {i} `{}` is not `{start}…{end}`",
-                    line.trim_end()
+                    "boot {b}: reply {i} `{line}` is not `{start}…{end}`"
                 )),
-                None => problems.push(format!("boot {b}: an extra reply `{}`", line.trim_end())),
+                None => problems.push(format!("boot {b}: an extra reply `{line}`")),
             }
         }
-        if replies(&boot.uart).len() < REPLIES[b].len() {
+        if replies.len() < REPLIES[b].len() {
             problems.push(format!(
                 "boot {b}: {} replies, not {}",
-                replies(&boot.uart).len(),
+                replies.len(),
                 REPLIES[b].len()
             ));
         }
@@ -204,14 +203,6 @@ fn check(report: &Report, logged: &str) -> (String, Vec<String>) {
         ));
     }
     (text, problems)
-}
-
-/// The reply lines in `bytes`, each with its line end.
-fn replies(bytes: &[u8]) -> Vec<String> {
-    String::from_utf8_lossy(bytes)
-        .split_inclusive('\n')
-        .map(str::to_owned)
-        .collect()
 }
 
 fn says(boot: &Boot, text: &str) -> bool {
