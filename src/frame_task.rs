@@ -365,7 +365,7 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         if let Some(link) = self.link {
             for (axis, cal) in crate::Axis::ALL.iter().zip(link.take_servos()) {
                 let Some(cal) = cal else { continue };
-                match driver.set_servo(*axis, cal) {
+                match self.head.set_servo(driver, *axis, cal) {
                     Ok(()) => defmt::info!(
                         "frame {=u64}: {=str} servo calibration changed",
                         tick.frame,

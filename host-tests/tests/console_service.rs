@@ -11,6 +11,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use host_tests::console::head::{SimFrames, service, shared};
 use host_tests::console::{LINE, REPLY, count_line_ends, random_line, random_stream, rng};
+use idle_head::behaviour::Applied;
 use idle_head::console::{ErrorCode, Handler, Session, parse, respond};
 use idle_head::settings::{SettingsStorage, StorageError};
 use proptest::prelude::RngExt as _;
@@ -107,6 +108,49 @@ fn every_command_does_what_it_says() {
         frames.frame(queue, link);
     }
     assert!(say!("status")[0].starts_with("ok mode=stopped"));
+    assert_eq!(frames.violations, 0);
+}
+
+#[test]
+fn new_servo_limits_reach_the_gestures_and_the_looks() {
+    let (queue, link) = shared();
+    let mut frames = SimFrames::new();
+    let mut svc = service(queue, link);
+    macro_rules! say {
+        ($text:expr) => {
+            talk(&mut svc, &mut frames, queue, link, $text)
+        };
+    }
+    // Built in, pitch may go -12°..20°: a 22° nod is too much, and a look
+    // at 30° is clamped to 20°, as the reply says.
+    let r = say!("nod 22000 2000\nlook 30000 0 400 hold=stay");
+    assert!(r[0].starts_with("err limit nod amplitude 22°"), "{}", r[0]);
+    assert_eq!(r[1], "ok clamped pitch=20000 yaw=0");
+    let Some(Applied::Look(look)) = frames.last_applied else {
+        panic!("{:?}", frames.last_applied)
+    };
+    assert!(look.clamped && look.pitch.millidegrees() == 20_000);
+    // Wider limits: the 22° nod the console now accepts is played, not
+    // refused by the head, and a look goes as far as the new limits.
+    let r = say!("center 400\nservo pitch limits -25000 25000\nnod 22000 1500 cycles=1");
+    assert_eq!(r, ["ok", "ok", "ok"]);
+    for _ in 0..150 {
+        frames.frame(queue, link);
+    }
+    assert!(matches!(frames.last_applied, Some(Applied::Gesture(_))));
+    let r = say!("look 30000 0 400 hold=stay\nlook 24000 0 400 hold=stay");
+    assert_eq!(r, ["ok clamped pitch=25000 yaw=0", "ok"]);
+    // Narrower again: a look is clamped to where the servo may go now.
+    let r = say!("center 400\nservo pitch limits -12000 15000\nlook 18000 0 400 hold=stay");
+    assert_eq!(r, ["ok", "ok", "ok clamped pitch=15000 yaw=0"]);
+    let Some(Applied::Look(look)) = frames.last_applied else {
+        panic!("{:?}", frames.last_applied)
+    };
+    assert_eq!((look.clamped, look.pitch.millidegrees()), (true, 15_000));
+    assert_eq!(
+        frames.refused, 0,
+        "every action the console accepted was played"
+    );
     assert_eq!(frames.violations, 0);
 }
 
@@ -223,12 +267,22 @@ fn a_million_lines_drive_a_head_that_stays_within_its_limits() {
     println!(
         "service: {LINES} lines, {ok} ok, {err} err ({refused_after_parse} parsed but refused: \
          busy, limit, invalid, range, storage), panics = {panics}; head: {} frames, {} actions \
-         played, {} refused by the mixer, {} calibrations applied, {} limit violations",
-        frames.frames, frames.applied, frames.refused, frames.calibrations, frames.violations
+         played, {} refused by the mixer ({} not for a busy layer), {} calibrations applied, \
+         {} limit violations",
+        frames.frames,
+        frames.applied,
+        frames.refused,
+        frames.refused_not_busy,
+        frames.calibrations,
+        frames.violations
     );
     assert_eq!(panics, 0);
     assert_eq!(ok + err, LINES, "one reply per line");
     assert_eq!(frames.violations, 0);
+    assert_eq!(
+        frames.refused_not_busy, 0,
+        "the head played what the console accepted"
+    );
     assert!(frames.applied > 10_000 && frames.calibrations > 100 && refused_after_parse > 1000);
 }
 

@@ -339,12 +339,7 @@ impl BehaviourConfig {
         }; 3];
         let mut i = 0;
         while i < 3 {
-            let limits = cfg.servos[i].limits;
-            let pose = cfg.neutral_pose[i];
-            room[i] = AngleRange {
-                min: limits.min.saturating_sub(pose),
-                max: limits.max.saturating_sub(pose),
-            };
+            room[i] = room_around(cfg.servos[i].limits, cfg.neutral_pose[i]);
             let idle = cfg.motion[i];
             let gesture = self.gesture_limits[i];
             match Axis::ALL[i] {
@@ -411,6 +406,14 @@ const _: () = match crate::driver::DriverConfig::DEFAULT.build() {
     Ok(driver) => BehaviourConfig::DEFAULT.assert_valid(&driver),
     Err(e) => panic!("{}", e.message()),
 };
+
+/// The offsets `limits` leave around `pose`.
+const fn room_around(limits: AngleRange, pose: Angle) -> AngleRange {
+    AngleRange {
+        min: limits.min.saturating_sub(pose),
+        max: limits.max.saturating_sub(pose),
+    }
+}
 
 /// The per-frame rates of both modes' limits, `[idle, gesture]` per axis,
 /// at the driver's frame period (`None` where the driver refuses them).
@@ -508,6 +511,16 @@ impl BehaviourParams {
         self.room[axis.index()]
     }
 
+    /// Gives `axis` the servo's new angle `limits` (a calibration changed
+    /// while the head runs): looks are clamped to them and gestures checked
+    /// against them from now on, as the console checked them.
+    pub(crate) fn set_angle_limits(&mut self, axis: Axis, limits: AngleRange) {
+        let i = axis.index();
+        if let (Some(room), Some(&pose)) = (self.room.get_mut(i), self.pose.get(i)) {
+            *room = room_around(limits, pose);
+        }
+    }
+
     /// The limits of `axis` in `mode`.
     #[must_use]
     pub const fn limits(&self, axis: Axis, mode: LimitMode) -> MotionLimits {
@@ -525,12 +538,14 @@ impl BehaviourParams {
 
     /// Checks `action` as [`Mixer::apply`](super::Mixer::apply) would on a
     /// head at rest: every check but the ones that depend on what plays
-    /// ([`BehaviourError::Busy`]). For replies before an action is queued.
+    /// ([`BehaviourError::Busy`]). For replies before an action is queued:
+    /// what the mixer would start, such as where a look goes and whether
+    /// its target was clamped.
     ///
     /// # Errors
     /// The [`BehaviourError`] the mixer would answer.
-    pub fn check(&self, action: &crate::command::Action) -> Result<(), BehaviourError> {
-        super::Mixer::new(*self).apply(action).map(|_| ())
+    pub fn check(&self, action: &crate::command::Action) -> Result<super::Applied, BehaviourError> {
+        super::Mixer::new(*self).apply(action)
     }
 
     /// Whole frames in `duration` (rounded, at least 1).

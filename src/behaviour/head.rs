@@ -23,7 +23,8 @@ use embedded_hal::pwm::SetDutyCycle;
 
 use crate::axis::Axis;
 use crate::command::Action;
-use crate::driver::{FrameDriver, FrameReport};
+use crate::driver::{ConfigError, FrameDriver, FrameReport};
+use crate::servo::ServoCalibration;
 use crate::units::Angle;
 
 use super::config::{BehaviourParams, LimitMode};
@@ -100,6 +101,25 @@ impl<I: IdleSource> Head<I> {
         }
         self.sync(driver);
         Ok(applied)
+    }
+
+    /// Between frames: a new calibration for `axis`' servo
+    /// ([`FrameDriver::set_servo`]: the servo moves to it through its speed
+    /// limits), and its angle limits for the behaviour too: looks are
+    /// clamped to the new limits and gestures checked against them, as the
+    /// console checked the commands it queued.
+    ///
+    /// # Errors
+    /// The [`ConfigError`] the driver refused it with; nothing changes then.
+    pub fn set_servo<P: SetDutyCycle>(
+        &mut self,
+        driver: &mut FrameDriver<P>,
+        axis: Axis,
+        cal: ServoCalibration,
+    ) -> Result<(), ConfigError> {
+        driver.set_servo(axis, cal)?;
+        self.mixer.set_angle_limits(axis, cal.limits);
+        Ok(())
     }
 
     /// Between frames: gives the driver the limits of the modes the mixer

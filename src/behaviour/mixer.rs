@@ -20,7 +20,7 @@
 //! move plays on it and for `settle` after).
 
 use crate::command::{Action, GestureRequest, Percent};
-use crate::units::{Angle, Millis};
+use crate::units::{Angle, AngleRange, Millis};
 
 use super::config::{BehaviourParams, LimitMode};
 use super::error::BehaviourError;
@@ -128,6 +128,12 @@ impl Mixer {
     #[must_use]
     pub const fn params(&self) -> &BehaviourParams {
         &self.params
+    }
+
+    /// Gives `axis` the servo's new angle limits (see
+    /// [`Head::set_servo`](super::Head::set_servo)).
+    pub(crate) fn set_angle_limits(&mut self, axis: crate::axis::Axis, limits: AngleRange) {
+        self.params.set_angle_limits(axis, limits);
     }
 
     /// Applies `action` from the next frame on.

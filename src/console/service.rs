@@ -56,7 +56,7 @@ use super::link::{ConsoleLink, HeadStatus};
 use super::reply::{ErrorCode, Reply};
 use super::session::Handler;
 use crate::axis::Axis;
-use crate::behaviour::{BehaviourError, BehaviourParams, CommandQueue};
+use crate::behaviour::{Applied, BehaviourError, BehaviourParams, CommandQueue};
 use crate::command::{Action, Command, SeedChoice, ServoSetting};
 use crate::driver::DriverConfig;
 use crate::servo::{Direction, ServoCalibration};
@@ -128,12 +128,27 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
     }
 
     fn act(&mut self, action: Action, reply: &mut Reply<'_>) {
-        if let Err(e) = self.behaviour.check(&action) {
-            text(reply.err(behaviour_code(&e))).with(&e);
-            return;
-        }
+        let applied = match self.behaviour.check(&action) {
+            Ok(applied) => applied,
+            Err(e) => {
+                text(reply.err(behaviour_code(&e))).with(&e);
+                return;
+            }
+        };
         if let Err(full) = self.queue.try_submit(action) {
             text(reply.err(ErrorCode::Busy)).with(&full);
+            return;
+        }
+        if let Applied::Look(look) = applied
+            && look.clamped
+        {
+            text(reply.ok()).fill(
+                "clamped pitch={} yaw={}",
+                &[
+                    Int(look.pitch.millidegrees().into()),
+                    Int(look.yaw.millidegrees().into()),
+                ],
+            );
         }
     }
 

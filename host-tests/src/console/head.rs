@@ -6,7 +6,9 @@
 use std::convert::Infallible;
 
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
-use idle_head::behaviour::{BehaviourConfig, CommandQueue, Head, LOOP_DURATION};
+use idle_head::behaviour::{
+    Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION,
+};
 use idle_head::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
 use idle_head::driver::{DriverConfig, FrameDriver};
 use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16, Trajectory};
@@ -70,6 +72,12 @@ pub struct SimFrames {
     pub applied: u64,
     /// Actions the mixer refused when they came to be played.
     pub refused: u64,
+    /// Of those, refused for another reason than every layer being busy
+    /// (which depends on what plays, and the console cannot know): the
+    /// console said `ok` to something the head would not play.
+    pub refused_not_busy: u64,
+    /// What the last action played started.
+    pub last_applied: Option<Applied>,
 }
 
 impl SimFrames {
@@ -102,6 +110,8 @@ impl SimFrames {
             changed: [None; 3],
             applied: 0,
             refused: 0,
+            refused_not_busy: 0,
+            last_applied: None,
         }
     }
 
@@ -110,8 +120,8 @@ impl SimFrames {
     pub fn frame<const N: usize>(&mut self, queue: &CommandQueue<N>, link: &ConsoleLink) {
         for (axis, cal) in Axis::ALL.iter().zip(link.take_servos()) {
             if let Some(cal) = cal {
-                self.driver
-                    .set_servo(*axis, cal)
+                self.head
+                    .set_servo(&mut self.driver, *axis, cal)
                     .expect("the service sends only valid calibrations");
                 self.calibrations += 1;
                 if let Some(at) = self.changed.get_mut(axis.index()) {
@@ -119,14 +129,22 @@ impl SimFrames {
                 }
             }
         }
-        let (mut applied, mut refused) = (0, 0);
+        let (mut applied, mut refused, mut not_busy) = (0, 0, 0);
+        let last = &mut self.last_applied;
         self.head
             .drain(&mut self.driver, queue, |_, outcome| match outcome {
-                Ok(_) => applied += 1,
-                Err(_) => refused += 1,
+                Ok(started) => {
+                    applied += 1;
+                    *last = Some(*started);
+                }
+                Err(e) => {
+                    refused += 1;
+                    not_busy += u64::from(!matches!(e, BehaviourError::Busy { .. }));
+                }
             });
         self.applied += applied;
         self.refused += refused;
+        self.refused_not_busy += not_busy;
         let report = self.head.frame(&mut self.driver, self.frame).report;
         let servos = self.driver.params().config().servos;
         for ((s, cal), changed) in report.servos.iter().zip(&servos).zip(&self.changed) {
