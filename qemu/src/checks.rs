@@ -28,6 +28,11 @@ const FADE_FRAMES: u64 = crate::PARAMS.fade_frames() as u64;
 /// A trace line every 50 frames (1 s on the Pico) for the host's plot.
 const TRACE_EVERY: u64 = 50;
 
+/// Frames a servo left outside new angle limits may take to come back:
+/// the widest span (720°) at the slowest limiter (60 °/s, 600 °/s²) takes
+/// 12 s, 600 frames.
+const RETURN_FRAMES: u64 = 650;
+
 /// The servo whose PWM output gets the injected faults.
 const FAULTY: Axis = Axis::Yaw;
 /// A burst of failed writes shorter than the disable threshold: counted,
@@ -91,6 +96,8 @@ pub struct Checks {
     stopped_at: Option<u64>,
     stop_requested: bool,
     last: u64,
+    /// The frame of each servo's last calibration change (from the console).
+    recalibrated: [Option<u64>; 3],
     /// SysTick count when the current frame's write began.
     write_started: u64,
     /// Largest and total SysTick counts of the frame writes.
@@ -116,6 +123,7 @@ impl Checks {
             stopped_at: None,
             stop_requested: false,
             last: 0,
+            recalibrated: [None; 3],
             write_started: 0,
             write_counts: (0, 0),
         }
@@ -253,14 +261,31 @@ impl Checks {
         if frame.tick.skipped != 0 {
             self.fail(); // also counted in `missed`; the run logs it
         }
-        let servos = self.config.servos;
+        // The calibrations as they are now: the console may change them.
+        let servos = driver.params().config().servos;
         for (i, (servo, cal)) in frame.report.servos.iter().zip(servos.iter()).enumerate() {
+            let known = self.config.servos.get_mut(i);
+            if let (Some(known), Some(at)) = (known, self.recalibrated.get_mut(i))
+                && known != cal
+            {
+                *known = *cal;
+                *at = Some(index);
+            }
             if servo.outcome != Outcome::Written {
                 continue;
             }
+            // Pulse limits are hard. New angle limits may leave a servo
+            // outside them; the limiter brings it back in within
+            // `RETURN_FRAMES`.
+            let returning = self
+                .recalibrated
+                .get(i)
+                .copied()
+                .flatten()
+                .is_some_and(|at| index <= at + RETURN_FRAMES);
             if servo.pulse < cal.min_pulse
                 || servo.pulse > cal.max_pulse
-                || !cal.limits.contains(servo.angle)
+                || (!cal.limits.contains(servo.angle) && !returning)
             {
                 defmt::error!(
                     "check: frame {=u64}: {=str} at {} = {=u32} us, outside its limits",
