@@ -11,45 +11,61 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use host_tests::console::head::{SimFrames, service, shared};
 use host_tests::console::{LINE, REPLY, count_line_ends, random_line, random_stream, rng};
-use idle_head::behaviour::Applied;
-use idle_head::console::{ErrorCode, Handler, Session, parse, respond};
-use idle_head::settings::{SettingsStorage, StorageError};
+use idle_head::behaviour::{Applied, CommandQueue};
+use idle_head::console::{ConsoleLink, ConsoleService, ErrorCode, Session, parse, respond};
+use idle_head::settings::{RamStorage, SettingsStorage, StorageError};
 use proptest::prelude::RngExt as _;
 
-/// Feeds `text` (lines) to the service, a frame after each line; the replies.
-fn talk<H: Handler>(
-    service: &mut H,
-    frames: &mut SimFrames,
-    queue: &idle_head::behaviour::CommandQueue,
-    link: &idle_head::console::ConsoleLink,
-    text: &str,
-) -> Vec<String> {
-    let mut session = Session::<LINE, REPLY>::new();
-    let mut replies = Vec::new();
-    for line in text.lines() {
-        session.feed(line.as_bytes(), service, |_| {
-            panic!("reply before the line end")
-        });
-        session.feed(b"\n", service, |r| {
-            replies.push(String::from_utf8(r.to_vec()).unwrap().trim_end().to_owned());
-        });
-        frames.frame(queue, link);
+/// The console service of a simulated head, talked to line by line.
+struct Console {
+    queue: &'static CommandQueue,
+    link: &'static ConsoleLink,
+    frames: SimFrames,
+    service: ConsoleService<'static, RamStorage<256>>,
+}
+
+impl Console {
+    /// On the built-in settings.
+    fn new() -> Self {
+        let (queue, link) = shared();
+        Self {
+            queue,
+            link,
+            frames: SimFrames::new(),
+            service: service(queue, link),
+        }
     }
-    replies
+
+    /// Feeds `text` (lines) to the service, a frame after each line; the
+    /// replies.
+    fn say(&mut self, text: &str) -> Vec<String> {
+        let mut session = Session::<LINE, REPLY>::new();
+        let mut replies = Vec::new();
+        for line in text.lines() {
+            session.feed(line.as_bytes(), &mut self.service, |_| {
+                panic!("reply before the line end")
+            });
+            session.feed(b"\n", &mut self.service, |r| {
+                replies.push(String::from_utf8(r.to_vec()).unwrap().trim_end().to_owned());
+            });
+            self.play(1);
+        }
+        replies
+    }
+
+    /// Plays `n` frames.
+    fn play(&mut self, n: usize) {
+        for _ in 0..n {
+            self.frames.frame(self.queue, self.link);
+        }
+    }
 }
 
 #[test]
 fn every_command_does_what_it_says() {
-    let (queue, link) = shared();
-    let mut frames = SimFrames::new();
-    let mut svc = service(queue, link);
-    macro_rules! say {
-        ($text:expr) => {
-            talk(&mut svc, &mut frames, queue, link, $text)
-        };
-    }
+    let mut c = Console::new();
 
-    let r = say!("help\nstatus");
+    let r = c.say("help\nstatus");
     assert!(r[0].starts_with("ok commands: help status"), "{r:?}");
     assert!(
         r[1].starts_with("ok mode=running mdeg=")
@@ -59,13 +75,13 @@ fn every_command_does_what_it_says() {
         r[1]
     );
     // Motion goes through the queue; a refused one says why.
-    let r = say!("nod\nlook 5000 -12000\nnod 90000\ncenter");
+    let r = c.say("nod\nlook 5000 -12000\nnod 90000\ncenter");
     assert_eq!(r[..2], ["ok", "ok"]);
     assert!(r[2].starts_with("err limit "), "{}", r[2]);
     assert_eq!(r[3], "ok");
     // Servo: show, change, invalid, past the limits.
-    let r = say!(
-        "servo yaw\nservo yaw neutral 1520\nservo yaw min 2600\nservo pitch limits -1000 1000"
+    let r = c.say(
+        "servo yaw\nservo yaw neutral 1520\nservo yaw min 2600\nservo pitch limits -1000 1000",
     );
     assert_eq!(
         r[0],
@@ -83,75 +99,64 @@ fn every_command_does_what_it_says() {
         "{}",
         r[3]
     );
-    assert_eq!(frames.calibrations, 1);
-    assert_eq!(frames.config().servos[2].neutral.0, 1520);
-    let r = say!("status");
+    assert_eq!(c.frames.calibrations, 1);
+    assert_eq!(c.frames.config().servos[2].neutral.0, 1520);
+    let r = c.say("status");
     assert!(r[0].ends_with("settings=changed"), "{}", r[0]);
     // Seeds.
-    let r = say!("seed 42\nseed random");
+    let r = c.say("seed 42\nseed random");
     assert_eq!(r[0], "ok seed=42");
     assert!(r[1].starts_with("ok seed="));
-    assert!(link.take_seeds().is_some());
+    assert!(c.link.take_seeds().is_some());
     // Save, change, load, defaults.
     let r =
-        say!("save\nstatus\nservo yaw neutral 1480\nload\nservo yaw\ndefaults\nservo yaw\nstatus");
+        c.say("save\nstatus\nservo yaw neutral 1480\nload\nservo yaw\ndefaults\nservo yaw\nstatus");
     assert_eq!(r[0], "ok");
     assert!(r[1].ends_with("settings=flash"), "{}", r[1]);
     assert_eq!(r[3], "ok");
     assert!(r[4].contains("neutral=1520"), "{}", r[4]);
     assert!(r[6].contains("neutral=1500"), "{}", r[6]);
     assert!(r[7].ends_with("settings=defaults"), "{}", r[7]);
-    assert_eq!(frames.config().servos[2].neutral.0, 1500);
+    assert_eq!(c.frames.config().servos[2].neutral.0, 1500);
     // Stop, and status says so (after the fade).
-    say!("stop");
-    for _ in 0..200 {
-        frames.frame(queue, link);
-    }
-    assert!(say!("status")[0].starts_with("ok mode=stopped"));
-    assert_eq!(frames.violations, 0);
+    c.say("stop");
+    c.play(200);
+    assert!(c.say("status")[0].starts_with("ok mode=stopped"));
+    assert_eq!(c.frames.violations, 0);
 }
 
 #[test]
 fn new_servo_limits_reach_the_gestures_and_the_looks() {
-    let (queue, link) = shared();
-    let mut frames = SimFrames::new();
-    let mut svc = service(queue, link);
-    macro_rules! say {
-        ($text:expr) => {
-            talk(&mut svc, &mut frames, queue, link, $text)
-        };
-    }
+    let mut c = Console::new();
     // Built in, pitch may go -12°..20°: a 22° nod is too much, and a look
     // at 30° is clamped to 20°, as the reply says.
-    let r = say!("nod 22000 2000\nlook 30000 0 400 hold=stay");
+    let r = c.say("nod 22000 2000\nlook 30000 0 400 hold=stay");
     assert!(r[0].starts_with("err limit nod amplitude 22°"), "{}", r[0]);
     assert_eq!(r[1], "ok clamped pitch=20000 yaw=0");
-    let Some(Applied::Look(look)) = frames.last_applied else {
-        panic!("{:?}", frames.last_applied)
+    let Some(Applied::Look(look)) = c.frames.last_applied else {
+        panic!("{:?}", c.frames.last_applied)
     };
     assert!(look.clamped && look.pitch.millidegrees() == 20_000);
     // Wider limits: the 22° nod the console now accepts is played, not
     // refused by the head, and a look goes as far as the new limits.
-    let r = say!("center 400\nservo pitch limits -25000 25000\nnod 22000 1500 cycles=1");
+    let r = c.say("center 400\nservo pitch limits -25000 25000\nnod 22000 1500 cycles=1");
     assert_eq!(r, ["ok", "ok", "ok"]);
-    for _ in 0..150 {
-        frames.frame(queue, link);
-    }
-    assert!(matches!(frames.last_applied, Some(Applied::Gesture(_))));
-    let r = say!("look 30000 0 400 hold=stay\nlook 24000 0 400 hold=stay");
+    c.play(150);
+    assert!(matches!(c.frames.last_applied, Some(Applied::Gesture(_))));
+    let r = c.say("look 30000 0 400 hold=stay\nlook 24000 0 400 hold=stay");
     assert_eq!(r, ["ok clamped pitch=25000 yaw=0", "ok"]);
     // Narrower again: a look is clamped to where the servo may go now.
-    let r = say!("center 400\nservo pitch limits -12000 15000\nlook 18000 0 400 hold=stay");
+    let r = c.say("center 400\nservo pitch limits -12000 15000\nlook 18000 0 400 hold=stay");
     assert_eq!(r, ["ok", "ok", "ok clamped pitch=15000 yaw=0"]);
-    let Some(Applied::Look(look)) = frames.last_applied else {
-        panic!("{:?}", frames.last_applied)
+    let Some(Applied::Look(look)) = c.frames.last_applied else {
+        panic!("{:?}", c.frames.last_applied)
     };
     assert_eq!((look.clamped, look.pitch.millidegrees()), (true, 15_000));
     assert_eq!(
-        frames.refused, 0,
+        c.frames.refused, 0,
         "every action the console accepted was played"
     );
-    assert_eq!(frames.violations, 0);
+    assert_eq!(c.frames.violations, 0);
 }
 
 #[test]
