@@ -263,26 +263,32 @@ impl Checks {
         }
         // The calibrations as they are now: the console may change them.
         let servos = driver.params().config().servos;
-        for (i, (servo, cal)) in frame.report.servos.iter().zip(servos.iter()).enumerate() {
-            let known = self.config.servos.get_mut(i);
-            if let (Some(known), Some(at)) = (known, self.recalibrated.get_mut(i))
-                && known != cal
-            {
+        for ((known, at), cal) in self
+            .config
+            .servos
+            .iter_mut()
+            .zip(&mut self.recalibrated)
+            .zip(&servos)
+        {
+            if known != cal {
                 *known = *cal;
                 *at = Some(index);
             }
+        }
+        let report = frame
+            .report
+            .servos
+            .iter()
+            .zip(&servos)
+            .zip(self.recalibrated);
+        for (i, ((servo, cal), recalibrated)) in report.enumerate() {
             if servo.outcome != Outcome::Written {
                 continue;
             }
             // Pulse limits are hard. New angle limits may leave a servo
             // outside them; the limiter brings it back in within
             // `RETURN_FRAMES`.
-            let returning = self
-                .recalibrated
-                .get(i)
-                .copied()
-                .flatten()
-                .is_some_and(|at| index <= at + RETURN_FRAMES);
+            let returning = recalibrated.is_some_and(|at| index <= at + RETURN_FRAMES);
             if servo.pulse < cal.min_pulse
                 || servo.pulse > cal.max_pulse
                 || (!cal.limits.contains(servo.angle) && !returning)
