@@ -1,10 +1,10 @@
 //! Shared helpers for the behaviour tests.
 
-use idle_head::Angle;
-use idle_head::behaviour::{BehaviourConfig, BehaviourParams};
-use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest};
-use idle_head::driver::DriverConfig;
-use idle_head::units::Millis;
+use idle_head_core::Angle;
+use idle_head_core::behaviour::{BehaviourConfig, BehaviourParams};
+use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest};
+use idle_head_core::driver::DriverConfig;
+use idle_head_core::units::Millis;
 
 /// The built-in behaviour on the built-in driver configuration (panics if
 /// either is invalid: tests only).

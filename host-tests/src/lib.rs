@@ -5,8 +5,8 @@ pub mod console;
 
 use embedded_hal_mock::eh1::MockError;
 use embedded_hal_mock::eh1::pwm::{Mock, Transaction};
-use idle_head::Angle;
-use idle_head::driver::{DriverConfig, DriverParams};
+use idle_head_core::Angle;
+use idle_head_core::driver::{DriverConfig, DriverParams};
 
 /// Cases for a property test: `default`, or `PROPTEST_CASES` when set, for
 /// a longer soak (`PROPTEST_CASES=20000 cargo test --release --test driver`;
@@ -137,8 +137,8 @@ impl embedded_hal::pwm::SetDutyCycle for Recorder {
 /// commanded angle is exactly neutral pose + offset.
 #[must_use]
 pub fn direct_config() -> DriverConfig {
-    use idle_head::Millis;
-    use idle_head::driver::{DegreesPerSecond, DegreesPerSecondSquared, MotionLimits};
+    use idle_head_core::Millis;
+    use idle_head_core::driver::{DegreesPerSecond, DegreesPerSecondSquared, MotionLimits};
     let mut cfg = DriverConfig::DEFAULT;
     cfg.fade = Millis(0);
     cfg.motion = [MotionLimits {
@@ -152,11 +152,11 @@ pub fn direct_config() -> DriverConfig {
 pub mod strategies {
     use std::ops::RangeInclusive;
 
-    use idle_head::driver::{
+    use idle_head_core::driver::{
         DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, MotionLimits,
     };
-    use idle_head::servo::{Direction, NanosPerDegree, ServoCalibration};
-    use idle_head::{Angle, AngleRange, Microseconds, Millis};
+    use idle_head_core::servo::{Direction, NanosPerDegree, ServoCalibration};
+    use idle_head_core::{Angle, AngleRange, Microseconds, Millis};
     use proptest::prelude::*;
 
     /// A valid calibration with limits within `±limit` m° and `per_degree`

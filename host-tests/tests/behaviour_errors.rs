@@ -1,13 +1,13 @@
 //! Typed errors of the behaviour: bad requests, bad settings, a full
 //! command queue. Each names the field, the value and what is allowed.
 
-use idle_head::Angle;
-use idle_head::behaviour::{
+use idle_head_core::Angle;
+use idle_head_core::behaviour::{
     BehaviourConfig, BehaviourError, CommandQueue, MilliHertz, Mixer, QueueFull,
 };
-use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
-use idle_head::driver::{DegreesPerSecond, DriverConfig, DriverParams};
-use idle_head::units::Millis;
+use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
+use idle_head_core::driver::{DegreesPerSecond, DriverConfig, DriverParams};
+use idle_head_core::units::Millis;
 
 use host_tests::behaviour::{default_params as params, gesture};
 

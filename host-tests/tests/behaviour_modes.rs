@@ -7,10 +7,10 @@
 //! exactly, for random scripts of gestures, looks (held, or returning after
 //! a hold) and moves back to the centre, with frames skipped.
 
-use idle_head::Angle;
-use idle_head::behaviour::{Applied, BehaviourParams, LimitMode, Mixer};
-use idle_head::command::{Action, GestureKind, Hold};
-use idle_head::units::Millis;
+use idle_head_core::Angle;
+use idle_head_core::behaviour::{Applied, BehaviourParams, LimitMode, Mixer};
+use idle_head_core::command::{Action, GestureKind, Hold};
+use idle_head_core::units::Millis;
 use proptest::prelude::*;
 
 use host_tests::behaviour::{default_params as params, gesture, look};

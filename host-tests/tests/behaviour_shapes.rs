@@ -4,10 +4,10 @@
 
 use std::f64::consts::TAU;
 
-use idle_head::Angle;
-use idle_head::behaviour::{Applied, GesturePlan, LimitMode, LookApplied, Mixer};
-use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
-use idle_head::units::Millis;
+use idle_head_core::Angle;
+use idle_head_core::behaviour::{Applied, GesturePlan, LimitMode, LookApplied, Mixer};
+use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
+use idle_head_core::units::Millis;
 
 use host_tests::behaviour::{default_params as params, gesture};
 

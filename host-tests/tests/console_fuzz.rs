@@ -15,7 +15,7 @@ use host_tests::console::{
     LINE, LineKind, REPLY, Recorder, ReplyCounts, check_replies, command_text, random_command,
     random_line, random_stream, reference_lines, rng, run_stream, varied_text,
 };
-use idle_head::console::{ErrorCode, Framer, LineError, parse, respond};
+use idle_head_core::console::{ErrorCode, Framer, LineError, parse, respond};
 use proptest::prelude::RngExt as _;
 
 /// Lines through the parser (and the reply formatting); a fifth are valid

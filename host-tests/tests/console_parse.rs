@@ -1,13 +1,13 @@
 //! The console parser: every command, every kind of error, and the reason
 //! text a user reads.
 
-use idle_head::command::{
+use idle_head_core::command::{
     Action, Command, GestureKind, GestureRequest, Hold, LookRequest, Percent, SeedChoice,
     ServoSetting,
 };
-use idle_head::console::{ParseErrorKind, Span, parse};
-use idle_head::servo::{Direction, NanosPerDegree};
-use idle_head::{Angle, AngleRange, Axis, Microseconds, Millis};
+use idle_head_core::console::{ParseErrorKind, Span, parse};
+use idle_head_core::servo::{Direction, NanosPerDegree};
+use idle_head_core::{Angle, AngleRange, Axis, Microseconds, Millis};
 
 fn ok(line: &str) -> Command {
     parse(line.as_bytes()).unwrap_or_else(|e| {

@@ -11,9 +11,9 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use host_tests::console::head::{SimFrames, service, shared};
 use host_tests::console::{LINE, REPLY, count_line_ends, random_line, random_stream, rng};
-use idle_head::behaviour::{Applied, CommandQueue};
-use idle_head::console::{ConsoleLink, ConsoleService, ErrorCode, Session, parse, respond};
-use idle_head::settings::{RamStorage, SettingsStorage, StorageError};
+use idle_head_core::behaviour::{Applied, CommandQueue};
+use idle_head_core::console::{ConsoleLink, ConsoleService, ErrorCode, Session, parse, respond};
+use idle_head_core::settings::{RamStorage, SettingsStorage, StorageError};
 use proptest::prelude::RngExt as _;
 
 /// The console service of a simulated head, talked to line by line.
@@ -186,21 +186,21 @@ fn a_full_queue_is_busy_and_nothing_is_dropped() {
 fn storage_errors_are_replies() {
     struct Broken;
     impl SettingsStorage for Broken {
-        fn save(&mut self, _: &idle_head::settings::Settings) -> Result<(), StorageError> {
+        fn save(&mut self, _: &idle_head_core::settings::Settings) -> Result<(), StorageError> {
             Err(StorageError::Device)
         }
-        fn load(&mut self) -> Result<idle_head::settings::Settings, StorageError> {
+        fn load(&mut self) -> Result<idle_head_core::settings::Settings, StorageError> {
             Err(StorageError::Older { found: 0 })
         }
     }
     let (queue, link) = shared();
-    let mut svc = idle_head::console::ConsoleService::new(
+    let mut svc = idle_head_core::console::ConsoleService::new(
         queue,
         link,
         Broken,
-        idle_head::DriverConfig::DEFAULT,
-        idle_head::settings::Settings::DEFAULT,
-        idle_head::settings::SettingsSource::Defaults,
+        idle_head_core::DriverConfig::DEFAULT,
+        idle_head_core::settings::Settings::DEFAULT,
+        idle_head_core::settings::SettingsSource::Defaults,
     )
     .unwrap();
     let mut out = [0; REPLY];

@@ -3,8 +3,8 @@
 
 use std::fmt::Write as _;
 
-use idle_head::command::{Action, Command};
-use idle_head::console::{
+use idle_head_core::command::{Action, Command};
+use idle_head_core::console::{
     EnvelopeError, ErrorCode, Framer, Handler, InputError, LineError, MIN_REPLY, Reply, Session,
     checksum, parse, respond,
 };

@@ -2,11 +2,11 @@
 //! user's units: `Display` with the value, the static `message()` for logs,
 //! and the compile-time error of an invalid built-in configuration.
 
-use idle_head::motion::{
+use idle_head_core::motion::{
     AxisConfig, AxisError, DEFAULT_HEAD, DEFAULT_N, HeadConfig, MAX_N, MAX_STEP, MAX_WINDOW, MIN_N,
     MIN_WINDOW, MotionError,
 };
-use idle_head::{Angle, AngleRange, Axis};
+use idle_head_core::{Angle, AngleRange, Axis};
 
 /// The error `cfg` gets on `axis` with `n` samples.
 fn rejected(axis: Axis, n: usize, cfg: AxisConfig) -> MotionError {

@@ -3,12 +3,12 @@
 //! Valid configurations: any seed, N in MIN_N..=MAX_N, W in 3..=min(N/2, 511),
 //! any range inside the axis' anatomical limits containing 0, both closures.
 
-use idle_head::metrics::LoopMetrics;
-use idle_head::motion::{
+use idle_head_core::metrics::LoopMetrics;
+use idle_head_core::motion::{
     AxisConfig, Closure, HannKernel, MAX_N, MIN_N, MIN_WINDOW, Mdeg16, MotionError, Sample,
     generate_into,
 };
-use idle_head::{Angle, AngleRange, Axis};
+use idle_head_core::{Angle, AngleRange, Axis};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 
@@ -35,7 +35,10 @@ fn run<S: Sample + Default>(
     n: usize,
     cfg: &AxisConfig,
     axis: Axis,
-) -> (Result<idle_head::motion::LoopInfo, MotionError>, Vec<S>) {
+) -> (
+    Result<idle_head_core::motion::LoopInfo, MotionError>,
+    Vec<S>,
+) {
     let mut buf = vec![S::ZERO; n];
     let kernel = HannKernel::new(cfg.window).expect("valid window");
     let r = generate_into(&mut buf, cfg, axis, &kernel, &mut ());
@@ -202,7 +205,7 @@ fn wrong_kernel_is_rejected_not_misused() {
 /// angles that `Mdeg16` stores, and a fresh trajectory reads neutral.
 #[test]
 fn integral16_reads_the_mdeg16_angles() {
-    use idle_head::motion::{Integral16, LoopScale, Trajectory};
+    use idle_head_core::motion::{Integral16, LoopScale, Trajectory};
     let fresh: Trajectory<Integral16, 900> = Trajectory::new();
     assert_eq!(*fresh.scale(), LoopScale::NEUTRAL);
     assert!((0..900).all(|i| fresh.angle(i).millidegrees() == 0));

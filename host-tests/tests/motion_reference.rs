@@ -2,11 +2,11 @@
 
 mod reference;
 
-use idle_head::motion::{
+use idle_head_core::motion::{
     AxisConfig, Closure, DEFAULT_HEAD, DEFAULT_N, Fnv1a, HannKernel, HeadConfig, HeadTrajectories,
     Integral16, Lcg, Mdeg16, Sample, Trajectory, generate_into,
 };
-use idle_head::{AngleRange, Axis};
+use idle_head_core::{AngleRange, Axis};
 
 fn engine<const N: usize>(
     seed: u32,

@@ -1,7 +1,7 @@
 //! Loop playback: exact timing, interpolation, the seam.
 
-use idle_head::playback::{LoopSource, Playback, PlaybackError, Player};
-use idle_head::{Angle, Microseconds, Millis};
+use idle_head_core::playback::{LoopSource, Playback, PlaybackError, Player};
+use idle_head_core::{Angle, Microseconds, Millis};
 use proptest::prelude::*;
 
 const FRAME: Microseconds = Microseconds(20_000);

@@ -5,7 +5,7 @@
 //! under it, byte for byte.
 
 use host_tests::console::head::{SimFrames, service, shared};
-use idle_head::console::Session;
+use idle_head_core::console::Session;
 
 #[test]
 fn the_examples_in_the_protocol_document_hold() {

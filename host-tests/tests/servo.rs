@@ -1,9 +1,9 @@
 //! Servo calibration: validation, angle → pulse, pulse → duty.
 
-use idle_head::servo::{
+use idle_head_core::servo::{
     Direction, Duty, NanosPerDegree, PwmTiming, ServoCalibration, ServoError, defaults,
 };
-use idle_head::{Angle, AngleRange, Axis, Microseconds};
+use idle_head_core::{Angle, AngleRange, Axis, Microseconds};
 use proptest::prelude::*;
 
 const YAW: ServoCalibration = ServoCalibration::hobby(Axis::Yaw);

@@ -2,8 +2,10 @@
 //! (`ServoCalibration::pulse`, `PwmTiming::duty`), over every angle.
 
 use host_tests::strategies::calibration;
-use idle_head::servo::{Direction, Duty, NanosPerDegree, PwmTiming, ServoCalibration, ServoMap};
-use idle_head::{Angle, AngleRange, Axis, Microseconds};
+use idle_head_core::servo::{
+    Direction, Duty, NanosPerDegree, PwmTiming, ServoCalibration, ServoMap,
+};
+use idle_head_core::{Angle, AngleRange, Axis, Microseconds};
 use proptest::prelude::*;
 
 /// Every angle from 2° below the lower limit to 2° above the upper one: the

@@ -3,15 +3,15 @@
 //! refused with a typed error (never a panic, never settings that were
 //! not saved).
 
-use idle_head::behaviour::{BehaviourError, MilliHertz};
-use idle_head::command::{Hold, Percent};
-use idle_head::driver::{ConfigError, DegreesPerSecond, DriverConfig};
-use idle_head::servo::{NanosPerDegree, ServoError};
-use idle_head::settings::{
+use idle_head_core::behaviour::{BehaviourError, MilliHertz};
+use idle_head_core::command::{Hold, Percent};
+use idle_head_core::driver::{ConfigError, DegreesPerSecond, DriverConfig};
+use idle_head_core::servo::{NanosPerDegree, ServoError};
+use idle_head_core::settings::{
     DecodeError, RamStorage, Record, SETTINGS_LEN, Settings, SettingsError, SettingsStorage,
     StorageError,
 };
-use idle_head::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
+use idle_head_core::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
 
 /// A change to the built-in settings.

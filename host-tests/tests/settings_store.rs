@@ -6,13 +6,13 @@
 
 use embedded_storage_async::nor_flash::{NorFlash, ReadNorFlash};
 use futures::executor::block_on;
-use idle_head::command::Percent;
-use idle_head::servo::{NanosPerDegree, ServoCalibration};
-use idle_head::settings::{
+use idle_head_core::command::Percent;
+use idle_head_core::servo::{NanosPerDegree, ServoCalibration};
+use idle_head_core::settings::{
     DecodeError, EncodeError, LoadError, RawRecord, Record, SETTINGS_BUFFER, SaveError, SectorWise,
     Settings, SettingsStore, decode_postcard, encode_postcard,
 };
-use idle_head::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
+use idle_head_core::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
 use proptest::test_runner::TestRng;
 use sequential_storage::mock_flash::{MockFlashBase, MockFlashError, WriteCountCheck};
@@ -145,7 +145,7 @@ fn random_real(rng: &mut TestRng) -> Settings {
     loop {
         let s = random_real_candidate(rng);
         // Narrow random limits can leave no room for the default gestures.
-        if s.validate(&idle_head::DriverConfig::DEFAULT).is_ok() {
+        if s.validate(&idle_head_core::DriverConfig::DEFAULT).is_ok() {
             return s;
         }
     }

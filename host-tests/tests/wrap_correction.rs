@@ -15,7 +15,7 @@
 //! SA(k) = Σ_{n=W−1}^{k+W−1} T[n mod W],  SB(k) = Σ_{n=k+N}^{N+W−2} T[n mod W]
 //! ```
 
-use idle_head::motion::{HannKernel, MAX_WINDOW, MIN_WINDOW};
+use idle_head_core::motion::{HannKernel, MAX_WINDOW, MIN_WINDOW};
 
 #[test]
 fn wrap_correction_is_far_inside_i32() {

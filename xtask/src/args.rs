@@ -4,7 +4,7 @@
 use std::time::Duration;
 
 use clap::Args;
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N};
+use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N};
 
 /// Options of the commands that run QEMU.
 #[derive(Debug, Clone, Copy)]

@@ -23,7 +23,10 @@ use crate::{project, setup};
 /// The Pico's USB vendor and product ID: the V-USB shared pair for
 /// CDC-ACM serial devices (0x16c0:0x27dd), free for hobby devices that
 /// are told apart by their strings.
-pub const PICO_USB_ID: (u16, u16) = (0x16c0, 0x27dd);
+pub const PICO_USB_ID: (u16, u16) = (
+    idle_head_core::console::usb_identity::VID,
+    idle_head_core::console::usb_identity::PID,
+);
 
 /// `cargo xtask console` options.
 #[derive(Debug, clap::Args)]
@@ -83,8 +86,8 @@ pub fn command(args: &Args) -> Result<bool> {
     serial_session(&port, stdin, &mut stdout, wait)
 }
 
-/// The product string the head's USB port reports (`src/bin/pico/usb.rs`).
-pub const PICO_PRODUCT: &str = "idle-head console";
+/// The product string the head's USB port reports.
+pub const PICO_PRODUCT: &str = idle_head_core::console::usb_identity::PRODUCT;
 
 /// The Pico's port: the USB serial device with [`PICO_USB_ID`] and
 /// [`PICO_PRODUCT`] (see [`pick_pico`]).

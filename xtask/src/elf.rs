@@ -13,7 +13,7 @@ use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, Sect
 pub const RAM_BUDGET: u64 = 32 * 1024;
 /// Flash budget of the Pico image: everything stored in flash
 /// (`.boot2 + .vector_table + .text + .rodata` and `.data`'s initial values).
-pub const FLASH_BUDGET: u64 = 64 * 1024;
+pub const FLASH_BUDGET: u64 = 128 * 1024;
 /// Where the RP2040 boot ROM looks for the 256-byte second-stage bootloader:
 /// the first flash page (XIP base `0x1000_0000`).
 pub const BOOT2_ADDRESS: u64 = 0x1000_0000;
@@ -180,20 +180,10 @@ impl Image {
     }
 }
 
-/// Whether a Pico image must stay within the memory budgets.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Budgets {
-    /// The shipped image: over a budget fails.
-    Enforce,
-    /// An opt-in image (the console): its figures against the budgets are
-    /// printed, not enforced.
-    Report,
-}
-
 /// Prints the Pico image's sections and budgets; fails if `.boot2` is misplaced,
-/// a budget is exceeded (with [`Budgets::Enforce`]), an allocator is linked
-/// or the image reaches into the settings region.
-pub fn check_pico(path: &Path, budgets: Budgets) -> Result<()> {
+/// a budget is exceeded, an allocator is linked or the image reaches into the
+/// settings region.
+pub fn check_pico(path: &Path) -> Result<()> {
     let image = Image::read(path)?;
     println!("{}", path.display());
     print!("{}", image.table());
@@ -228,24 +218,15 @@ pub fn check_pico(path: &Path, budgets: Budgets) -> Result<()> {
         kib(ram),
         RAM_BUDGET / 1024
     );
-    let mut over = Vec::new();
     if flash > FLASH_BUDGET {
-        over.push(format!(
+        problems.push(format!(
             "flash use {flash} B is over the {FLASH_BUDGET} B budget"
         ));
     }
     if ram > RAM_BUDGET {
-        over.push(format!(
+        problems.push(format!(
             "static RAM use {ram} B is over the {RAM_BUDGET} B budget"
         ));
-    }
-    match budgets {
-        Budgets::Enforce => problems.extend(over),
-        Budgets::Report => {
-            for line in over {
-                println!("  {line} (reported, not enforced for this image)");
-            }
-        }
     }
     if let Err(error) = image.check_no_allocator() {
         problems.push(error.to_string());

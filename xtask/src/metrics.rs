@@ -24,7 +24,7 @@
 use std::{fmt::Write as _, thread, time::Instant};
 
 use anyhow::{Context, Result, anyhow};
-use idle_head::{
+use idle_head_core::{
     Angle, Axis,
     metrics::LoopMetrics,
     motion::{AxisConfig, AxisError, Closure, DEFAULT_HEAD, HannKernel, Mdeg16, generate_into},

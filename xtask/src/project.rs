@@ -71,9 +71,9 @@ pub fn run(sh: &Shell, env: &[(&str, &str)], cmd: Cmd<'_>) -> Result<()> {
 /// own memory map (`memory.x`), in the one workspace and target directory.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Package {
-    /// The root package `idle-head`: the core library and the Pico image.
+    /// The root package `idle-head`: the Pico image.
     Root,
-    /// `qemu/`, the package `idle-head-qemu`: the QEMU `lm3s6965evb` images.
+    /// `boards/qemu/`, the package `idle-head-qemu`: the QEMU `lm3s6965evb` images.
     Qemu,
 }
 
@@ -103,7 +103,7 @@ pub const PICO: Image = Image {
     bin: "pico",
 };
 
-/// The QEMU `lm3s6965evb` smoke image (`qemu/src/main.rs`).
+/// The QEMU `lm3s6965evb` smoke image (`boards/qemu/src/main.rs`).
 pub const QEMU: Image = Image::qemu("qemu");
 
 impl Image {
@@ -149,26 +149,17 @@ impl Image {
 pub struct Metadata {
     /// Where cargo puts build output (`target/` unless configured otherwise).
     pub target_dir: PathBuf,
-    /// Whether the core library's doc tests are switched on (`[lib] doctest`).
-    pub lib_doctests: bool,
 }
 
 /// Reads `cargo metadata` for the workspace (no dependency resolution).
 pub fn metadata(root: &Path) -> Result<Metadata> {
     let main = MetadataCommand::new()
         .current_dir(root)
-        .manifest_path(root.join("Cargo.toml"))
+        .manifest_path(root.join("crates/Cargo.toml"))
         .no_deps()
         .exec()
         .context("running `cargo metadata`")?;
-    let lib_doctests = main
-        .packages
-        .iter()
-        .filter(|package| package.name.as_str() == "idle-head")
-        .flat_map(|package| &package.targets)
-        .any(|target| target.is_lib() && target.doctest);
     Ok(Metadata {
         target_dir: main.target_directory.into(),
-        lib_doctests,
     })
 }

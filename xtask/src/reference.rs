@@ -2,7 +2,7 @@
 //! same core library the firmware links.
 
 use anyhow::{Result, anyhow};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16};
+use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16};
 
 /// Checksum of the three default loops (`DEFAULT_HEAD`, `DEFAULT_N` samples,
 /// `Integral16` storage with its loop scales), as the firmware prints it in its summary line.

@@ -16,17 +16,7 @@ mod image;
 mod node;
 mod noise;
 mod planted;
-// The Pico console's handler, compiled here too, for the replies the UART
-// exchange must bring back.
-#[path = "../../src/bin/pico/handler.rs"]
-#[allow(dead_code)]
-pub(crate) mod pico_handler;
 mod pulses;
-// The Pico image's own PWM clocking (divider, TOP, count length), compiled
-// here too, so the host's expectation uses exactly the firmware's numbers.
-#[path = "../../src/bin/pico/rp2040_pwm.rs"]
-#[allow(dead_code, clippy::pedantic)]
-pub(crate) mod rp2040_pwm;
 mod run;
 mod stages;
 mod store;

@@ -29,7 +29,7 @@ const WILDCARD: &str = "[..]";
 
 /// `qemu/expected.log`.
 pub fn expected_path() -> PathBuf {
-    project::root().join("qemu/expected.log")
+    project::root().join("boards/qemu/expected.log")
 }
 
 /// Re-records the expected log from `run`, keeping the wildcard lines that

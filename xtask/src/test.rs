@@ -112,6 +112,7 @@ pub fn command(options: Options) -> Result<bool> {
     let metadata = project::metadata(&root)?;
     let sh = project::shell(".")?;
     let host_tests = project::shell("host-tests")?;
+    let core = project::shell("crates/core")?;
     let xtask = project::shell("xtask")?;
     let mut stages = Stages::new();
 
@@ -119,15 +120,15 @@ pub fn command(options: Options) -> Result<bool> {
     stages.run("host tests (host-tests/)", || {
         project::run(&host_tests, &[], cmd!(host_tests, "cargo test"))
     });
-    stages.run_or_skip("doc tests of the core library (host)", || {
-        doc_tests(&sh, &metadata)
+    stages.run("core crate: unit and doc tests (crates/core, host)", || {
+        project::run(&core, &[], cmd!(core, "cargo test"))
     });
     stages.run("xtask unit tests", || {
         project::run(&xtask, &[], cmd!(xtask, "cargo test --profile xtask"))
     });
 
     // 2. Formatting and lints: firmware (thumb, both packages) and host crates.
-    stages.run("rustfmt: core + Pico, qemu/, host-tests, xtask", || {
+    stages.run("rustfmt: every package of the workspace", || {
         project::run(&sh, &[], cmd!(sh, "cargo fmt --all --check"))
     });
     clippy_stages(&mut stages, &sh, &host_tests, &xtask);
@@ -137,7 +138,7 @@ pub fn command(options: Options) -> Result<bool> {
     if pico_built {
         stages.run(
             "Pico image: .boot2 placement, memory budgets, no allocator",
-            || elf::check_pico(&PICO.elf(&metadata), elf::Budgets::Enforce),
+            || elf::check_pico(&PICO.elf(&metadata)),
         );
     } else {
         stages.blocked(
@@ -159,7 +160,7 @@ pub fn command(options: Options) -> Result<bool> {
     );
     // The frame path cannot panic: this image links the frame update against
     // a panic handler that does not exist, so the link fails if any panic
-    // path survives optimisation (qemu/src/panic_proof.rs).
+    // path survives optimisation (boards/qemu/src/panic_proof.rs).
     stages.run(
         "frame path has no panic path (link of frame-path-proof)",
         || project::Image::qemu("frame-path-proof").build(&root),
@@ -183,27 +184,17 @@ pub fn command(options: Options) -> Result<bool> {
 
 fn clippy_stages(stages: &mut Stages, sh: &Shell, host_tests: &Shell, xtask: &Shell) {
     // `--release` shares build scripts and proc-macros with the release builds below.
-    stages.run("clippy: Pico image + core (thumbv6m)", || {
+    stages.run("clippy: Pico image, firmware layer, core (thumbv6m)", || {
         project::run(
             sh,
             FIRMWARE_ENV,
-            cmd!(sh, "cargo clippy --release --lib --bins -- -D warnings"),
+            cmd!(
+                sh,
+                "cargo clippy --release --package idle-head --package idle-head-firmware --package idle-head-core -- -D warnings"
+            ),
         )
     });
-    stages.run(
-        "clippy: Pico console image (thumbv6m, --features console)",
-        || {
-            project::run(
-                sh,
-                FIRMWARE_ENV,
-                cmd!(
-                    sh,
-                    "cargo clippy --release --bins --features console -- -D warnings"
-                ),
-            )
-        },
-    );
-    stages.run("clippy: QEMU images, qemu/ (thumbv6m)", || {
+    stages.run("clippy: QEMU images, boards/qemu/ (thumbv6m)", || {
         project::run(
             sh,
             FIRMWARE_ENV,
@@ -213,13 +204,13 @@ fn clippy_stages(stages: &mut Stages, sh: &Shell, host_tests: &Shell, xtask: &Sh
             ),
         )
     });
-    stages.run("clippy: core library (host)", || {
+    stages.run("clippy: core crate and its unit tests (host)", || {
         project::run(
             sh,
             &[],
             cmd!(
                 sh,
-                "cargo clippy --lib --no-default-features --target host-tuple -- -D warnings"
+                "cargo clippy --package idle-head-core --all-targets --target host-tuple -- -D warnings"
             ),
         )
     });
@@ -288,7 +279,7 @@ fn qemu_stages(
 ) -> Option<Run> {
     const BUILD: &str = "QEMU build (LM3S6965 memory map, no allocator linked)";
     const RUN: &str = "QEMU run: firmware exits with success";
-    const SNAPSHOT: &str = "QEMU log matches qemu/expected.log";
+    const SNAPSHOT: &str = "QEMU log matches boards/qemu/expected.log";
     const SUMMARY: &str = "QEMU summary: missed=0 pulse_violations=0, checksum = host's";
     const FLOOD: &str = "QEMU flood: 10,000 console lines during a run, one reply each, missed=0";
     const CONSOLE: &str = "cargo xtask console --qemu with a piped script";
@@ -355,21 +346,4 @@ fn qemu_stages(
         Ok(())
     });
     Some(run)
-}
-
-fn doc_tests(sh: &Shell, metadata: &Metadata) -> Result<Option<String>> {
-    if !metadata.lib_doctests {
-        return Ok(Some(
-            "`doctest = false` in the root Cargo.toml's [lib]".to_owned(),
-        ));
-    }
-    project::run(
-        sh,
-        &[],
-        cmd!(
-            sh,
-            "cargo test --doc --no-default-features --target host-tuple"
-        ),
-    )?;
-    Ok(None)
 }

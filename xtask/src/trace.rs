@@ -16,7 +16,7 @@
 //!
 //! the commanded angles after every safety stage (fade, speed and
 //! acceleration limits, angle clamps) and the pulse widths of the duties
-//! written, on PWM channels clocked as the Pico's (`src/bin/pico/rp2040_pwm.rs`:
+//! written, on PWM channels clocked as the Pico's (`idle_head_core::pwm_clock`:
 //! 64 000 counts of 312.5 ns per 20 ms period).
 
 mod plot;
@@ -25,14 +25,14 @@ mod script;
 use std::{fs, path::PathBuf};
 
 use anyhow::{Context, Result, anyhow};
-use idle_head::behaviour::{Applied, BehaviourConfig, CommandQueue, Head, LOOP_DURATION};
-use idle_head::driver::{DriverConfig, FrameDriver};
-use idle_head::frame_task::IDLE_MODE;
-use idle_head::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
-use idle_head::{Axis, Playback};
+use idle_head_core::behaviour::{Applied, BehaviourConfig, CommandQueue, Head, LOOP_DURATION};
+use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
+use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
+use idle_head_core::{Axis, Playback};
+use idle_head_firmware::frame::IDLE_MODE;
 
-use crate::sim::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
+use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use script::Event;
 
 /// Options of `cargo xtask trace`.
@@ -242,7 +242,7 @@ fn is_gesture(mark: &Mark) -> bool {
 fn mark(
     event: &Event,
     t_ms: u64,
-    outcome: &Result<Applied, idle_head::behaviour::BehaviourError>,
+    outcome: &Result<Applied, idle_head_core::behaviour::BehaviourError>,
 ) -> Mark {
     let word = event
         .text

@@ -6,15 +6,15 @@
 use std::convert::Infallible;
 
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
-use idle_head::behaviour::{
+use idle_head_core::behaviour::{
     Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION,
 };
-use idle_head::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
-use idle_head::driver::{DriverConfig, FrameDriver};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16, Trajectory};
-use idle_head::playback::Player;
-use idle_head::settings::{RamStorage, Settings, SettingsSource};
-use idle_head::{Axis, Playback};
+use idle_head_core::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
+use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16, Trajectory};
+use idle_head_core::playback::Player;
+use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
+use idle_head_core::{Axis, Playback};
 
 /// A PWM channel that keeps the last duty (1 µs per count at 50 Hz).
 #[derive(Debug, Default)]

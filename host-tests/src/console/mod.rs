@@ -8,8 +8,8 @@ pub mod head;
 mod model;
 mod text;
 
-use idle_head::command::Command;
-use idle_head::console::{Handler, InputError, Reply, Session, checksum, parse};
+use idle_head_core::command::Command;
+use idle_head_core::console::{Handler, InputError, Reply, Session, checksum, parse};
 use proptest::prelude::RngExt as _;
 use proptest::test_runner::{RngAlgorithm, TestRng};
 

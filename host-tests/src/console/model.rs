@@ -2,7 +2,7 @@
 //! whole stream at once), to check the framer against, and the line ends
 //! of a stream counted on their own.
 
-use idle_head::console::LineError;
+use idle_head_core::console::LineError;
 
 /// Line ends in `stream`: every CR, and every LF not right after a CR.
 #[must_use]

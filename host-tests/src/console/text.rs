@@ -3,12 +3,12 @@
 
 use std::fmt::Write as _;
 
-use idle_head::command::{
+use idle_head_core::command::{
     Action, Command, GestureKind, GestureRequest, Hold, LookRequest, Percent, SeedChoice,
     ServoSetting,
 };
-use idle_head::servo::{Direction, NanosPerDegree};
-use idle_head::{Angle, AngleRange, Axis, Microseconds, Millis};
+use idle_head_core::servo::{Direction, NanosPerDegree};
+use idle_head_core::{Angle, AngleRange, Axis, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
 use proptest::test_runner::TestRng;
 

@@ -7,16 +7,16 @@ mod properties;
 
 use embedded_hal_mock::eh1::pwm::Mock;
 use host_tests::{Recorder, params, pwm, writes};
-use idle_head::behaviour::{
+use idle_head_core::behaviour::{
     Applied, BehaviourConfig, BehaviourParams, CommandQueue, Head, IdleSource, LOOP_DURATION,
     LimitMode, Mixer, QueueFull,
 };
-use idle_head::command::{Action, GestureKind, GestureRequest, Hold, LookRequest};
-use idle_head::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16};
-use idle_head::playback::Player;
-use idle_head::units::{Angle, Millis};
-use idle_head::{Axis, Playback};
+use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest};
+use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
+use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16};
+use idle_head_core::playback::Player;
+use idle_head_core::units::{Angle, Millis};
+use idle_head_core::{Axis, Playback};
 
 /// The Table 2 loops, as the firmware keeps them.
 fn loops() -> &'static HeadTrajectories<Integral16, DEFAULT_N> {
@@ -29,7 +29,7 @@ fn loops() -> &'static HeadTrajectories<Integral16, DEFAULT_N> {
     })
 }
 
-type Idle = Player<'static, idle_head::motion::Trajectory<Integral16, DEFAULT_N>>;
+type Idle = Player<'static, idle_head_core::motion::Trajectory<Integral16, DEFAULT_N>>;
 
 fn idle(driver: &DriverParams) -> Idle {
     let playback = Playback::new(LOOP_DURATION, driver.config().frame_period, DEFAULT_N).unwrap();

@@ -5,8 +5,8 @@ use proptest::prelude::*;
 
 use super::{Rig, assert_safe};
 use host_tests::behaviour::look;
-use idle_head::command::{Action, GestureKind, GestureRequest, Hold, Percent};
-use idle_head::units::{Angle, Millis};
+use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, Percent};
+use idle_head_core::units::{Angle, Millis};
 
 fn kind() -> impl Strategy<Value = GestureKind> {
     prop_oneof![

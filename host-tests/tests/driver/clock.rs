@@ -1,7 +1,7 @@
 //! The frame clock: deadlines without drift, late frames skipped without a
 //! burst, saturation.
 
-use idle_head::driver::{FrameClock, FrameTick, ZeroPeriod};
+use idle_head_core::driver::{FrameClock, FrameTick, ZeroPeriod};
 
 #[test]
 fn frame_clock_runs_on_time_without_drift() {

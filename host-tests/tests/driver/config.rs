@@ -2,11 +2,11 @@
 //! their messages in the user's units.
 
 use host_tests::params;
-use idle_head::driver::{
+use idle_head_core::driver::{
     ConfigError, DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, MotionLimits,
 };
-use idle_head::servo::ServoError;
-use idle_head::{Angle, AngleRange, Axis, Microseconds};
+use idle_head_core::servo::ServoError;
+use idle_head_core::{Angle, AngleRange, Axis, Microseconds};
 
 #[test]
 fn config_errors_name_the_field() {
@@ -69,7 +69,7 @@ fn config_errors_name_the_field() {
     );
     check(
         &|c| {
-            c.servos[2].per_degree = idle_head::servo::NanosPerDegree(1000);
+            c.servos[2].per_degree = idle_head_core::servo::NanosPerDegree(1000);
             c.servos[2].limits = AngleRange::degrees(-23, 400);
         },
         ConfigError::LimitOutOfRange {
@@ -149,7 +149,7 @@ fn config_errors_read_in_the_users_units() {
     );
     assert_eq!(
         shown(&|c| {
-            c.servos[2].per_degree = idle_head::servo::NanosPerDegree(1000);
+            c.servos[2].per_degree = idle_head_core::servo::NanosPerDegree(1000);
             c.servos[2].limits = AngleRange::degrees(-361, 32);
         }),
         "yaw servo: limit -361° lies beyond ±360°, the widest range the driver takes"

@@ -2,8 +2,8 @@
 //! stop request, reversal mid-fade.
 
 use host_tests::{direct_config, mdeg, params};
-use idle_head::Millis;
-use idle_head::driver::{DriverConfig, FrameDriver};
+use idle_head_core::Millis;
+use idle_head_core::driver::{DriverConfig, FrameDriver};
 
 use super::{pitch_angles, recorders};
 

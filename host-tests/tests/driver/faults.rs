@@ -5,9 +5,9 @@
 use embedded_hal::pwm::ErrorKind;
 use embedded_hal_mock::eh1::pwm::Transaction;
 use host_tests::{Recorder, direct_config, failing, mdeg, params, pwm, writes};
-use idle_head::driver::{DriverConfig, FaultPolicy, FrameDriver, Outcome};
-use idle_head::servo::Duty;
-use idle_head::{Angle, Microseconds, Millis};
+use idle_head_core::driver::{DriverConfig, FaultPolicy, FrameDriver, Outcome};
+use idle_head_core::servo::Duty;
+use idle_head_core::{Angle, Microseconds, Millis};
 
 use super::{done, pitch_angles, recorders};
 

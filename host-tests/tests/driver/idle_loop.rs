@@ -1,9 +1,9 @@
 //! The default limits against the real idle loops (motion engine, Table 2 set).
 
 use host_tests::{Recorder, params};
-use idle_head::driver::{DriverConfig, FrameDriver};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Mdeg16, Trajectory};
-use idle_head::{Angle, Axis, LoopSource, Microseconds, Millis, Playback};
+use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Mdeg16, Trajectory};
+use idle_head_core::{Angle, Axis, LoopSource, Microseconds, Millis, Playback};
 
 /// Adapter until `Trajectory` implements `LoopSource` itself.
 struct Loop<'a>(&'a Trajectory<Mdeg16, DEFAULT_N>);

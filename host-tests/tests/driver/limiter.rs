@@ -2,8 +2,8 @@
 //! alone, the approach to the neutral pose, braking for the angle limits.
 
 use host_tests::{mdeg, params};
-use idle_head::driver::{DriverConfig, FrameDriver};
-use idle_head::{Angle, Axis, Millis};
+use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::{Angle, Axis, Millis};
 
 use super::{angles, duties, pitch_angles, recorders};
 

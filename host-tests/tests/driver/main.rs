@@ -15,7 +15,7 @@ mod runtime;
 
 use embedded_hal_mock::eh1::pwm::Mock;
 use host_tests::{Recorder, mdeg};
-use idle_head::driver::{FrameDriver, FrameReport};
+use idle_head_core::driver::{FrameDriver, FrameReport};
 
 /// Checks that every expected PWM transaction happened.
 fn done(driver: FrameDriver<Mock>) {

@@ -2,9 +2,9 @@
 //! seam, a reversed servo, the angle limits.
 
 use host_tests::{direct_config, mdeg, params, pwm, writes};
-use idle_head::driver::{FrameDriver, Outcome};
-use idle_head::servo::Direction;
-use idle_head::{Angle, LoopSource, Microseconds, Millis, Playback};
+use idle_head_core::driver::{FrameDriver, Outcome};
+use idle_head_core::servo::Direction;
+use idle_head_core::{Angle, LoopSource, Microseconds, Millis, Playback};
 
 use super::{angles, done, duties};
 

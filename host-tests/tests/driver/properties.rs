@@ -5,18 +5,18 @@
 
 use host_tests::strategies::{calibration, calibration_in, config};
 use host_tests::{Recorder, params};
-use idle_head::driver::{
+use idle_head_core::driver::{
     DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, FrameDriver, MotionLimits, Outcome,
 };
-use idle_head::servo::PwmTiming;
-use idle_head::{Angle, Axis, Microseconds, Millis, Playback};
+use idle_head_core::servo::PwmTiming;
+use idle_head_core::{Angle, Axis, Microseconds, Millis, Playback};
 use proptest::prelude::*;
 
 use super::reference::{Limits, Model};
 
 /// A hobby servo, or one whose limits reach up to ±360° (at a few µs per
 /// degree, to keep its pulses positive).
-fn wide() -> impl Strategy<Value = idle_head::servo::ServoCalibration> {
+fn wide() -> impl Strategy<Value = idle_head_core::servo::ServoCalibration> {
     prop_oneof![calibration(), calibration_in(360_000, 1000..=3000)]
 }
 

@@ -2,11 +2,11 @@
 //! moving) and servo calibrations (without a jump), validated as `build`.
 
 use host_tests::{Recorder, mdeg, params, pwm, writes};
-use idle_head::driver::{
+use idle_head_core::driver::{
     ConfigError, DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, FrameDriver, MotionLimits,
 };
-use idle_head::servo::{Direction, ServoCalibration, ServoError};
-use idle_head::{Angle, AngleRange, Axis, Microseconds, Millis};
+use idle_head_core::servo::{Direction, ServoCalibration, ServoError};
+use idle_head_core::{Angle, AngleRange, Axis, Microseconds, Millis};
 
 use super::{done, recorders};
 

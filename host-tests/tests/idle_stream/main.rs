@@ -6,12 +6,12 @@
 //! `cargo test --release --test idle_stream -- --nocapture` to see the
 //! figures they print.
 
-use idle_head::idle::{
+use idle_head_core::idle::{
     GenerateOnTake, IdleMode, IdlePlayer, IdleTiming, LoopSet, LoopStream, LoopSupply, NoSupply,
     Pace, Paces, Spread, after_loop, join_weight,
 };
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
-use idle_head::{Axis, Microseconds, Millis, Playback};
+use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
+use idle_head_core::{Axis, Microseconds, Millis, Playback};
 
 type Set = LoopSet<DEFAULT_N>;
 type Stream = LoopStream<DEFAULT_N>;

@@ -2,8 +2,8 @@
 
 use std::thread;
 
-use idle_head::idle::IdleMode;
-use idle_head::motion::DEFAULT_HEAD;
+use idle_head_core::idle::IdleMode;
+use idle_head_core::motion::DEFAULT_HEAD;
 
 use super::play;
 

@@ -3,16 +3,16 @@
 
 use std::thread;
 
-use idle_head::Axis;
-use idle_head::idle::{IdleMode, IdlePlayer, JOIN_FRAMES, MAX_DRAWS, NoSupply};
-use idle_head::motion::HeadConfig;
+use idle_head_core::Axis;
+use idle_head_core::idle::{IdleMode, IdlePlayer, JOIN_FRAMES, MAX_DRAWS, NoSupply};
+use idle_head_core::motion::HeadConfig;
 
 use super::{Set, Stream, config_for, play, timing};
 
 /// The ratios of a window `x`: max|d1|/P95|d1| and max|d2|/P95|d2| over
 /// the whole window, then the same maxima taken over `region` only (the
 /// join), still against the whole window's P95 (P95 nearest-rank, as
-/// `idle_head::metrics`).
+/// `idle_head_core::metrics`).
 fn ratios(x: &[i32], region: std::ops::Range<usize>) -> [f64; 4] {
     let d1: Vec<i64> = x.windows(2).map(|w| i64::from(w[1] - w[0])).collect();
     let d2: Vec<i64> = d1.windows(2).map(|w| w[1] - w[0]).collect();
@@ -217,7 +217,7 @@ fn joins_are_as_smooth_as_a_loops_interior_over_1000_seeds_and_50_joins() {
 
 /// The same figures on seeds the bounds were not chosen on, printed and
 /// not asserted (one 1500-frame stretch in 150,000 reaches 10/3 for d2:
-/// see [`idle_head::idle::MAX_JOIN_TURN_RATIO`]). As long again, so run on
+/// see [`idle_head_core::idle::MAX_JOIN_TURN_RATIO`]). As long again, so run on
 /// request: `cargo test --release --test idle_stream -- --ignored --nocapture`.
 #[test]
 #[ignore]

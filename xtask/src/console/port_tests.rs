@@ -9,10 +9,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread;
 use std::time::Duration;
 
-use idle_head::behaviour::CommandQueue;
-use idle_head::console::{ConsoleLink, ConsoleService, Session};
-use idle_head::driver::DriverConfig;
-use idle_head::settings::{RamStorage, Settings, SettingsSource};
+use idle_head_core::behaviour::CommandQueue;
+use idle_head_core::console::{ConsoleLink, ConsoleService, Session};
+use idle_head_core::driver::DriverConfig;
+use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
 use nix::pty::openpty;
 
 use super::serial_session;
@@ -165,17 +165,4 @@ fn two_heads_need_a_port() {
             .contains("/dev/ttyACM0, /dev/ttyACM1; give --port"),
         "{err}"
     );
-}
-
-#[test]
-fn the_product_looked_for_is_the_one_the_firmware_reports() {
-    let usb = include_str!("../../../src/bin/pico/usb.rs");
-    let (vid, pid) = super::PICO_USB_ID;
-    for line in [
-        format!("pub const PRODUCT: &str = \"{}\";", super::PICO_PRODUCT),
-        format!("pub const VID: u16 = 0x{vid:04x};"),
-        format!("pub const PID: u16 = 0x{pid:04x};"),
-    ] {
-        assert!(usb.contains(&line), "src/bin/pico/usb.rs lacks `{line}`");
-    }
 }

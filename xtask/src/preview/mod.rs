@@ -41,7 +41,7 @@ use std::{
 
 use anyhow::{Context, Result};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
-use idle_head::{
+use idle_head_core::{
     Angle, AngleRange, Axis,
     motion::{AxisError, Closure, DEFAULT_HEAD},
 };
@@ -221,7 +221,7 @@ pub fn command(args: &Args) -> Result<bool> {
 #[cfg(test)]
 mod tests {
     use clap::Parser;
-    use idle_head::motion::DEFAULT_N;
+    use idle_head_core::motion::DEFAULT_N;
 
     use super::*;
 

@@ -14,7 +14,7 @@
 use std::path::Path;
 
 use anyhow::{Result, anyhow};
-use idle_head::motion::Closure;
+use idle_head_core::motion::Closure;
 use plotters::{
     coord::Shift,
     prelude::*,

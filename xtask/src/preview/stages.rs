@@ -9,7 +9,7 @@
 use std::fmt::Write as _;
 
 use anyhow::{Context, Result};
-use idle_head::{
+use idle_head_core::{
     Angle, Axis,
     metrics::LoopMetrics,
     motion::{
@@ -375,7 +375,7 @@ pub fn closure_name(closure: Closure) -> &'static str {
 #[cfg(test)]
 #[allow(clippy::float_cmp)] // exact values by construction
 mod tests {
-    use idle_head::{
+    use idle_head_core::{
         Axis,
         motion::{DEFAULT_HEAD, DEFAULT_N},
     };

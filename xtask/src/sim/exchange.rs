@@ -38,17 +38,17 @@
 use std::fmt::Write as _;
 use std::time::Duration;
 
-use idle_head::console::checksum;
+use idle_head_core::console::checksum;
 
 use std::cell::RefCell;
 
 use embassy_sync::blocking_mutex::Mutex;
-use idle_head::behaviour::CommandQueue;
-use idle_head::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
-use idle_head::driver::DriverConfig;
-use idle_head::settings::{RamStorage, Settings, SettingsSource};
+use idle_head_core::behaviour::CommandQueue;
+use idle_head_core::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
+use idle_head_core::driver::DriverConfig;
+use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
 
-use super::pico_handler::{PicoSession, Shared, SharedService};
+use idle_head_core::console::{PortSession, Shared, SharedService};
 
 /// When the first byte goes out: 3 s, after the 2 s fade-in.
 pub const START: Duration = Duration::from_secs(3);
@@ -123,7 +123,7 @@ pub fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
     let service: &'static SharedService<RamStorage<256>> =
         Box::leak(Box::new(Mutex::new(RefCell::new(service))));
     [(), ()].map(|()| {
-        let mut session = PicoSession::new();
+        let mut session = PortSession::new();
         let mut handler = Shared::new(service);
         let mut replies = Vec::new();
         session.feed(script, &mut handler, |reply| replies.push(mask(reply)));

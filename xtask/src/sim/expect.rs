@@ -2,13 +2,13 @@
 
 use anyhow::{Result, anyhow, bail};
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
-use idle_head::driver::{DriverConfig, FrameDriver};
-use idle_head::frame_task::{FrameLoop, IDLE_MODE, LOOP_DURATION};
-use idle_head::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
-use idle_head::motion::{DEFAULT_HEAD, DEFAULT_N};
+use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
+use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N};
+use idle_head_firmware::frame::{FrameLoop, IDLE_MODE, LOOP_DURATION};
 
-use super::rp2040_pwm::PICO_SERVO_CLOCK;
-use idle_head::Playback;
+use idle_head_core::Playback;
+use idle_head_core::pwm_clock::PICO_SERVO_CLOCK;
 
 /// embassy-time's tick rate on the RP2040 (its 1 MHz TIMER).
 const TICK_HZ: u64 = 1_000_000;

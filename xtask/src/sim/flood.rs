@@ -33,10 +33,10 @@ use anyhow::Result;
 use super::{
     node::UartScript,
     run::{self, Report},
-    stages::{WALL, build_variant, conclude},
+    stages::{WALL, conclude, shipped_image},
 };
 use crate::project::Metadata;
-use idle_head::console::checksum;
+use idle_head_core::console::checksum;
 
 /// Stage name.
 pub const FLOOD_STAGE: &str = "console image in the RP2040 emulator: a UART flood with no \
@@ -61,7 +61,7 @@ const STATUS: &str = "ok mode=";
 
 /// Runs the flood and checks it (see the module docs).
 pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf = build_variant(root, metadata, "console")?;
+    let elf = shipped_image(root, metadata)?;
     let mut report = run::run_with(root, &elf, TIME, WALL, |config| {
         let machine: Vec<u8> = (1..=FLOOD_LINES).flat_map(machine_line).collect();
         config.uart = [

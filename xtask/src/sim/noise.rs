@@ -17,7 +17,7 @@ use anyhow::Result;
 use super::{
     node::UartScript,
     run::{self, Report},
-    stages::{WALL, build_variant, conclude},
+    stages::{WALL, conclude, shipped_image},
 };
 use crate::project::Metadata;
 
@@ -36,7 +36,7 @@ const REPLIES: [&str; 2] = ["err line bytes lost", "ok mode="];
 
 /// Runs the scenario and checks it (see the module docs).
 pub fn test_noise(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf = build_variant(root, metadata, "console")?;
+    let elf = shipped_image(root, metadata)?;
     let mut report = run::run_with(root, &elf, TIME, WALL, |config| {
         config.uart = vec![UartScript {
             errors: vec![NOISY],

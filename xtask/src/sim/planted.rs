@@ -15,7 +15,7 @@ use anyhow::{Context as _, Result, bail};
 use embedded_storage_async::nor_flash::{
     ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash,
 };
-use idle_head::settings::{RawRecord, SettingsStore};
+use idle_head_core::settings::{RawRecord, SettingsStore};
 
 /// The Pico's flash: erase sector and write unit.
 const SECTOR: usize = 4096;

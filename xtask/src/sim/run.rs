@@ -3,10 +3,10 @@
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
-use super::rp2040_pwm::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use anyhow::{Context, Result, bail};
 use defmt_decoder::{DecodeError, Locations, StreamDecoder, Table};
-use idle_head::driver::DriverConfig;
+use idle_head_core::driver::DriverConfig;
+use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use serde_json::Value;
 
 use super::{

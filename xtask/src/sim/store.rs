@@ -39,7 +39,7 @@ use super::{
     node::{FlashTiming, UartScript},
     planted,
     run::{self, Boot, FlashOp, Report},
-    stages::{WALL, build_variant, console_ram},
+    stages::{WALL, console_ram, shipped_image},
 };
 use crate::{elf, project::Metadata};
 
@@ -95,7 +95,7 @@ fn starts(len: usize) -> Result<[(&'static str, Vec<u8>, &'static str); 2]> {
 
 /// Runs the scenario from both starts and checks it (see the module docs).
 pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf_path = build_variant(root, metadata, "console")?;
+    let elf_path = shipped_image(root, metadata)?;
     let settings = elf::Image::read(&elf_path)?
         .settings
         .context("the console image has no settings region")?;

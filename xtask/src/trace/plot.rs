@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use anyhow::{Result, anyhow};
-use idle_head::Axis;
+use idle_head_core::Axis;
 use plotters::{prelude::*, style::FontStyle};
 
 use super::{Mark, Trace};

@@ -4,9 +4,9 @@
 use std::fmt::Write as _;
 
 use anyhow::{Result, bail};
-use idle_head::behaviour::BehaviourParams;
-use idle_head::command::{Action, Command};
-use idle_head::console;
+use idle_head_core::behaviour::BehaviourParams;
+use idle_head_core::command::{Action, Command};
+use idle_head_core::console;
 
 /// One scripted command.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -101,9 +101,9 @@ fn event(line: usize, text: &str, params: &BehaviourParams) -> Result<Event, Str
 #[cfg(test)]
 mod tests {
     use super::*;
-    use idle_head::behaviour::BehaviourConfig;
-    use idle_head::command::GestureKind;
-    use idle_head::driver::DriverConfig;
+    use idle_head_core::behaviour::BehaviourConfig;
+    use idle_head_core::command::GestureKind;
+    use idle_head_core::driver::DriverConfig;
 
     fn params() -> BehaviourParams {
         BehaviourConfig::DEFAULT

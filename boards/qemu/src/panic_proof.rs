@@ -1,0 +1,221 @@
+//! Link-time proof that the frame path cannot panic.
+//!
+//! ```text
+//! cargo build --release --manifest-path qemu/Cargo.toml --bin frame-path-proof
+//! ```
+//!
+//! (from the repository root; in qemu/, `cargo build --release --bin frame-path-proof`).
+//!
+//! This image runs the per-frame work of the firmware — [`FrameLoop::next`]
+//! (frame clock) and [`FrameLoop::write`] (the never-repeating idle: loop
+//! sets taken from and given back to the generator's channels, joins
+//! blended; playback interpolation, fade,
+//! limits, pulse and duty conversion, PWM writes and fault handling in
+//! `FrameDriver::write_frame`) — on inputs the optimiser cannot see
+//! through (`core::hint::black_box`): any time, any loop contents, any PWM
+//! maximum, PWM writes that fail or not, stop and resume requests at any
+//! frame, new motion limits and servo calibrations (any values, valid or
+//! not) between any two frames, and the behaviour: any behaviour parameters
+//! and any command (gestures, looks, `center`, idle changes, stop) applied
+//! between any two frames ([`FrameLoop::apply`]), mixed into every frame,
+//! servo calibrations from the console's link, the status published for
+//! it after every frame ([`FrameLoop::publish`]), and the console's
+//! parser (`idle_head_core::console::parse`) on any line. Its panic handler calls `frame_path_has_a_panic_path`, a function
+//! that exists nowhere. If any panic (index, division, overflow check,
+//! `unwrap`, ...) remains reachable after optimisation, the call survives
+//! and the link fails:
+//!
+//! ```text
+//! rust-lld: error: undefined symbol: frame_path_has_a_panic_path
+//! ```
+//!
+//! A successful build is the proof, for the release profile the firmware is
+//! built with. The image is never run. The driver parameters and the
+//! playback are built outside the proof (at compile time, as in the board
+//! images); only the frame work is covered.
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+
+use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
+use idle_head_core::behaviour::{BehaviourConfig, BehaviourParams};
+use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
+use idle_head_core::console::{ConsoleLink, parse};
+use idle_head_core::driver::{
+    DegreesPerSecond, DegreesPerSecondSquared, DriverParams, FrameDriver, MotionLimits,
+};
+use idle_head_core::idle::{IdlePlayer, IdleTiming};
+use idle_head_core::servo::{Direction, NanosPerDegree, ServoCalibration};
+use idle_head_core::units::{Angle, AngleRange, Microseconds, Millis};
+use idle_head_core::{Axis, Playback};
+use idle_head_firmware::frame::{
+    DEFAULT_PARAMS, DEFAULT_PLAYBACK, DEFAULT_TIMING, Exchange, FrameLoop, IDLE_MODE, Set,
+};
+use static_cell::ConstStaticCell;
+
+const PARAMS: DriverParams = DEFAULT_PARAMS;
+const PLAYBACK: Playback = DEFAULT_PLAYBACK;
+const TIMING: IdleTiming = DEFAULT_TIMING;
+
+/// Loop sets with unknown contents (the optimiser sees them through
+/// `black_box`).
+static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::new()]);
+
+/// The channels to the generator (none runs: whether a set is ready is
+/// unknown to the optimiser).
+static EXCHANGE: Exchange = Exchange::new();
+
+/// What the console shares with the frame task: calibrations in, status out.
+static LINK: ConsoleLink = ConsoleLink::new();
+
+/// A PWM channel whose maximum duty and write results are unknown.
+struct OpaquePwm;
+
+impl ErrorType for OpaquePwm {
+    type Error = ErrorKind;
+}
+
+impl SetDutyCycle for OpaquePwm {
+    fn max_duty_cycle(&self) -> u16 {
+        black_box(u16::MAX)
+    }
+
+    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Self::Error> {
+        if black_box(duty) == black_box(0) {
+            Err(ErrorKind::Other)
+        } else {
+            Ok(())
+        }
+    }
+}
+
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo<'_>) -> ! {
+    unsafe extern "C" {
+        /// Defined nowhere: the proof.
+        fn frame_path_has_a_panic_path() -> !;
+    }
+    // Note(unsafe): never executed; the image only links if no call to this
+    // handler is left.
+    unsafe { frame_path_has_a_panic_path() }
+}
+
+/// The built-in behaviour (the proof hides it from the optimiser: any
+/// parameters).
+const BEHAVIOUR: BehaviourParams = match BehaviourConfig::DEFAULT.build(&PARAMS) {
+    Ok(p) => p,
+    Err(e) => panic!("{}", e.message()),
+};
+
+/// Any command, with any values.
+fn any_action() -> Action {
+    let angle = || Angle::from_millidegrees(black_box(0));
+    let millis = || black_box(Some(Millis(black_box(0))));
+    match black_box(0_u8) {
+        0 => Action::Gesture(GestureRequest {
+            kind: match black_box(0_u8) {
+                0 => GestureKind::Nod,
+                1 => GestureKind::Shake,
+                _ => GestureKind::Tilt,
+            },
+            amplitude: black_box(Some(angle())),
+            duration: millis(),
+            cycles: black_box(Some(black_box(0))),
+            intensity: Percent::new(black_box(0)),
+        }),
+        1 => Action::Look(LookRequest {
+            pitch: angle(),
+            yaw: angle(),
+            duration: millis(),
+            hold: match black_box(0_u8) {
+                0 => None,
+                1 => Some(Hold::Stay),
+                _ => Some(Hold::Return(Millis(black_box(0)))),
+            },
+        }),
+        2 => Action::Center { duration: millis() },
+        3 => Action::Idle(black_box(false)),
+        4 => Action::IdleAmp(Percent::new(black_box(0)).unwrap_or(Percent::FULL)),
+        _ => Action::Stop,
+    }
+}
+
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    let Some([first, second]) = black_box(SETS.try_take()) else {
+        loop {
+            cortex_m::asm::wfi();
+        }
+    };
+    EXCHANGE.give(black_box(second));
+    let idle = IdlePlayer::new(first, EXCHANGE.supply(), black_box(TIMING), IDLE_MODE);
+    let mut driver = FrameDriver::new([OpaquePwm, OpaquePwm, OpaquePwm], black_box(PARAMS));
+    let Ok(mut frames) = FrameLoop::with_behaviour(
+        idle,
+        black_box(PLAYBACK.frame_period()),
+        black_box(BEHAVIOUR),
+        black_box(1_000_000),
+        black_box(0),
+    )
+    .map(|frames| frames.with_link(&LINK)) else {
+        // Not reached with the built-in playback; no panic either way.
+        loop {
+            cortex_m::asm::wfi();
+        }
+    };
+    loop {
+        let axis = Axis::ALL[usize::from(black_box(0_u8) % 3)];
+        match black_box(0_u8) {
+            1 => driver.request_stop(),
+            2 => driver.resume(),
+            3 => {
+                let limits = MotionLimits {
+                    max_speed: DegreesPerSecond(black_box(0)),
+                    max_accel: DegreesPerSecondSquared(black_box(0)),
+                };
+                black_box(driver.set_motion_limits(axis, limits)).ok();
+            }
+            4 => {
+                let cal = ServoCalibration {
+                    neutral: Microseconds(black_box(0)),
+                    per_degree: NanosPerDegree(black_box(0)),
+                    direction: if black_box(false) {
+                        Direction::Reversed
+                    } else {
+                        Direction::Normal
+                    },
+                    min_pulse: Microseconds(black_box(0)),
+                    max_pulse: Microseconds(black_box(0)),
+                    limits: AngleRange {
+                        min: Angle::from_millidegrees(black_box(0)),
+                        max: Angle::from_millidegrees(black_box(0)),
+                    },
+                };
+                black_box(driver.set_servo(axis, cal)).ok();
+            }
+            5 => {
+                black_box(frames.apply(&mut driver, &any_action())).ok();
+            }
+            6 => {
+                // Calibrations the console sent, as `FrameLoop::drain` applies them.
+                for (axis, cal) in Axis::ALL.iter().zip(LINK.take_servos()) {
+                    if let Some(cal) = cal {
+                        black_box(driver.set_servo(*axis, cal)).ok();
+                    }
+                }
+            }
+            7 => {
+                // The console's parser, on any line of up to 96 bytes.
+                let line = black_box([0_u8; 96]);
+                let len = usize::from(black_box(0_u8)) % (line.len() + 1);
+                black_box(parse(line.get(..len).unwrap_or_default())).ok();
+            }
+            _ => {}
+        }
+        let tick = frames.next(black_box(0));
+        let written = frames.write(&mut driver, tick);
+        frames.publish(&driver, &written.report);
+        black_box((written, driver.is_stopped(), driver.stats()));
+    }
+}

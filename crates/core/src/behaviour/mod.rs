@@ -1,0 +1,73 @@
+//! Behaviour: gestures and gaze layered over the idle motion.
+//!
+//! ```text
+//!  console, scripts ──try_submit──▶ CommandQueue ──drain (≤ 2 a frame)──┐
+//!                                                                       ▼
+//!  IdleSource ──idle offsets──▶ Mixer (gaze + idle·gain·duck + gestures) ──▶ FrameDriver
+//!                                   └── limit mode per axis (idle | gesture)
+//! ```
+//!
+//! - [`gesture`]: nod, shake and tilt shapes (human-like, C2 envelopes).
+//! - [`glide`](self#gaze-and-idle-changes): minimum-jerk moves that start
+//!   from any state (gaze, idle gain).
+//! - [`gaze`]: `look` and `center`, holds and returns.
+//! - [`mixer`]: where the layers meet, and the limit mode per axis.
+//! - [`config`]: [`BehaviourConfig`] in physical units, validated into
+//!   [`BehaviourParams`].
+//! - [`queue`]: the command queue; [`head`]: the frame engine.
+//!
+//! # Gaze and idle changes
+//!
+//! Both move along minimum-jerk glides that start from the current
+//! position, velocity and acceleration (see `glide.rs`), so a new `look`
+//! or `center` while the head moves, or an `idle amp` while the gain
+//! changes, never jumps in angle, velocity or acceleration.
+//!
+//! # Fixed point
+//!
+//! The frame path is integer arithmetic with 32-bit multiplies only
+//! (ARMv6-M has neither a 64-bit multiply nor a divide instruction):
+//! fractions are Q16 (`u32`, 65 536 = 1) unless named Q32, angles are
+//! millidegrees; every reciprocal is computed when an action is applied.
+//!
+//! ```
+//! use idle_head_core::behaviour::{BehaviourConfig, Mixer};
+//! use idle_head_core::command::{Action, GestureKind, GestureRequest};
+//! use idle_head_core::driver::DriverConfig;
+//! use idle_head_core::Angle;
+//!
+//! let driver = DriverConfig::DEFAULT.build().unwrap();
+//! let mut mixer = Mixer::new(BehaviourConfig::DEFAULT.build(&driver).unwrap());
+//! mixer.apply(&Action::Gesture(GestureRequest::new(GestureKind::Nod))).unwrap();
+//! // The default nod: 2 cycles at 2.5 Hz in 800 ms; its first dip peaks at frame 10 at
+//! // 6.3° (6° × 1.05: a default amplitude rises with the number of cycles).
+//! let pitch: Vec<i32> = (0..45)
+//!     .map(|k| mixer.frame(k, [Angle::ZERO; 3])[0].millidegrees())
+//!     .collect();
+//! assert_eq!(pitch[0], 0);
+//! assert_eq!(pitch[10], 6300);
+//! assert_eq!(pitch[40], 0);
+//! ```
+
+pub mod config;
+pub mod error;
+mod fixed;
+pub mod gaze;
+pub mod gesture;
+mod glide;
+pub mod head;
+pub mod idle;
+pub mod mixer;
+pub mod queue;
+
+pub use config::{
+    BehaviourConfig, BehaviourParams, GazeConfig, GestureDefaults, IdleConfig, LimitMode,
+    MilliHertz,
+};
+pub use error::BehaviourError;
+pub use gaze::LookApplied;
+pub use gesture::GesturePlan;
+pub use head::{Head, HeadFrame};
+pub use idle::{IdleSource, LOOP_DURATION};
+pub use mixer::{Applied, Mixer};
+pub use queue::{CommandQueue, QueueFull};

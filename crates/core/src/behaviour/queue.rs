@@ -1,0 +1,104 @@
+//! The command queue between whoever asks (the console, a script) and the
+//! frame task, which drains it every frame.
+//!
+//! An embassy-sync [`Channel`] behind a critical section: any task or
+//! interrupt may submit, and [`try_submit`](CommandQueue::try_submit) never
+//! waits. A full queue hands the action back ([`QueueFull`]): nothing is
+//! dropped silently. The frame task takes at most [`PER_FRAME`] actions a
+//! frame, so a flood of commands never delays a frame.
+
+use core::fmt;
+
+use crate::text::{Describe, Text, display_from_describe};
+
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::channel::{Channel, TrySendError};
+
+use crate::command::Action;
+
+/// Actions the frame task applies per frame at most.
+pub const PER_FRAME: usize = 2;
+
+/// The queue's capacity on the boards.
+pub const CAPACITY: usize = 8;
+
+/// The queue was full: the action was not taken (here it is back).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct QueueFull(pub Action);
+
+impl Describe for QueueFull {
+    fn describe(&self, out: &mut dyn Text) {
+        out.str("command queue full: try again after the next frame");
+    }
+}
+
+display_from_describe!(QueueFull);
+
+impl core::error::Error for QueueFull {}
+
+/// Actions waiting for the frame task, at most `N`.
+///
+/// ```
+/// use idle_head_core::behaviour::{CommandQueue, QueueFull};
+/// use idle_head_core::command::Action;
+///
+/// static QUEUE: CommandQueue<2> = CommandQueue::new();
+/// QUEUE.try_submit(Action::Stop).unwrap();
+/// QUEUE.try_submit(Action::Idle(true)).unwrap();
+/// assert_eq!(QUEUE.try_submit(Action::Idle(false)), Err(QueueFull(Action::Idle(false))));
+/// assert_eq!(QUEUE.take(), Some(Action::Stop));
+/// ```
+pub struct CommandQueue<const N: usize = CAPACITY> {
+    channel: Channel<CriticalSectionRawMutex, Action, N>,
+}
+
+impl<const N: usize> CommandQueue<N> {
+    /// An empty queue (usable in a `static`).
+    #[must_use]
+    pub const fn new() -> Self {
+        Self {
+            channel: Channel::new(),
+        }
+    }
+
+    /// Queues `action` for the frame task.
+    ///
+    /// # Errors
+    /// [`QueueFull`] with the action if `N` actions are waiting.
+    pub fn try_submit(&self, action: Action) -> Result<(), QueueFull> {
+        self.channel.try_send(action).map_err(|e| match e {
+            TrySendError::Full(action) => QueueFull(action),
+        })
+    }
+
+    /// The oldest waiting action, if any.
+    pub fn take(&self) -> Option<Action> {
+        self.channel.try_receive().ok()
+    }
+
+    /// Actions waiting.
+    pub fn len(&self) -> usize {
+        self.channel.len()
+    }
+
+    /// Whether none is waiting.
+    pub fn is_empty(&self) -> bool {
+        self.channel.is_empty()
+    }
+}
+
+impl<const N: usize> Default for CommandQueue<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> fmt::Debug for CommandQueue<N> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("CommandQueue")
+            .field("waiting", &self.len())
+            .field("capacity", &N)
+            .finish()
+    }
+}

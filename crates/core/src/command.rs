@@ -1,0 +1,227 @@
+//! What the head can be asked to do: the command vocabulary shared by the
+//! serial console ([`crate::console`]), the behaviour mixer and the host
+//! trace scripts, in the project's units (millidegrees, milliseconds,
+//! microseconds, nanoseconds per degree).
+//!
+//! An optional field left `None` takes the configured default (the
+//! behaviour settings decide amplitudes, durations and intensities).
+
+use crate::axis::Axis;
+use crate::servo::{Direction, NanosPerDegree};
+use crate::units::{Angle, AngleRange, Microseconds, Millis};
+
+/// A whole percentage, `0..=100`.
+///
+/// ```
+/// use idle_head_core::command::Percent;
+/// assert_eq!(Percent::new(40).map(Percent::get), Some(40));
+/// assert_eq!(Percent::new(101), None);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Percent(u8);
+
+impl Percent {
+    /// 0 %.
+    pub const ZERO: Self = Self(0);
+    /// 50 %.
+    pub const HALF: Self = Self(50);
+    /// 100 %.
+    pub const FULL: Self = Self(100);
+
+    /// `value` percent, if it is at most 100.
+    #[must_use]
+    pub const fn new(value: u8) -> Option<Self> {
+        if value <= 100 {
+            Some(Self(value))
+        } else {
+            None
+        }
+    }
+
+    /// The percentage.
+    #[must_use]
+    pub const fn get(self) -> u8 {
+        self.0
+    }
+}
+
+/// The three gestures, each on its own axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum GestureKind {
+    /// Nodding "yes" on the pitch axis.
+    Nod,
+    /// Shaking "no" on the yaw axis.
+    Shake,
+    /// Tilting the head to one side on the roll axis.
+    Tilt,
+}
+
+impl GestureKind {
+    /// The axis the gesture moves.
+    #[must_use]
+    pub const fn axis(self) -> Axis {
+        match self {
+            Self::Nod => Axis::Pitch,
+            Self::Shake => Axis::Yaw,
+            Self::Tilt => Axis::Roll,
+        }
+    }
+
+    /// The command word (`nod`, `shake`, `tilt`).
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Nod => "nod",
+            Self::Shake => "shake",
+            Self::Tilt => "tilt",
+        }
+    }
+}
+
+/// A gesture as asked for; `None` fields take the configured defaults.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GestureRequest {
+    /// Which gesture.
+    pub kind: GestureKind,
+    /// Peak amplitude. Nods and shakes take a positive amplitude; a tilt's
+    /// sign chooses the side.
+    pub amplitude: Option<Angle>,
+    /// Total duration.
+    pub duration: Option<Millis>,
+    /// Number of cycles (nods and shakes).
+    pub cycles: Option<u8>,
+    /// How brisk: faster and fuller at 100 %, slow and soft at 0 %.
+    pub intensity: Option<Percent>,
+}
+
+impl GestureRequest {
+    /// A gesture with every parameter at its default.
+    #[must_use]
+    pub const fn new(kind: GestureKind) -> Self {
+        Self {
+            kind,
+            amplitude: None,
+            duration: None,
+            cycles: None,
+            intensity: None,
+        }
+    }
+}
+
+/// What the head does after a look has arrived.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Hold {
+    /// Return to the centre after this long.
+    Return(Millis),
+    /// Stay until told otherwise (`center` or another `look`).
+    Stay,
+}
+
+/// A gaze target as asked for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LookRequest {
+    /// Target pitch of the head's centre.
+    pub pitch: Angle,
+    /// Target yaw of the head's centre.
+    pub yaw: Angle,
+    /// Duration of the move (`None`: from the distance).
+    pub duration: Option<Millis>,
+    /// What to do once there (`None`: the configured default).
+    pub hold: Option<Hold>,
+}
+
+/// A request for the frame task: it changes what the head does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Action {
+    /// Play a gesture over the idle motion.
+    Gesture(GestureRequest),
+    /// Move the head's centre to a target.
+    Look(LookRequest),
+    /// Move the head's centre back to the neutral pose.
+    Center {
+        /// Duration of the move (`None`: from the distance).
+        duration: Option<Millis>,
+    },
+    /// Switch the idle motion on (`true`) or off (`false`), smoothly.
+    Idle(bool),
+    /// Scale the idle motion, smoothly.
+    IdleAmp(Percent),
+    /// Fade all motion out to the neutral pose and hold it.
+    Stop,
+}
+
+/// Where the idle motion's random stream starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SeedChoice {
+    /// This seed.
+    Value(u32),
+    /// A seed drawn from the board's entropy source.
+    Random,
+}
+
+/// One field of a servo's calibration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ServoSetting {
+    /// Pulse at the neutral angle.
+    Neutral(Microseconds),
+    /// Pulse change per degree.
+    PerDegree(NanosPerDegree),
+    /// Sense of rotation.
+    Direction(Direction),
+    /// Shortest pulse.
+    MinPulse(Microseconds),
+    /// Longest pulse.
+    MaxPulse(Microseconds),
+    /// Mechanical angle limits.
+    Limits(AngleRange),
+}
+
+impl ServoSetting {
+    /// The field's name in the protocol.
+    #[must_use]
+    pub const fn field(&self) -> &'static str {
+        match self {
+            Self::Neutral(_) => "neutral",
+            Self::PerDegree(_) => "per-degree",
+            Self::Direction(_) => "direction",
+            Self::MinPulse(_) => "min",
+            Self::MaxPulse(_) => "max",
+            Self::Limits(_) => "limits",
+        }
+    }
+}
+
+/// One line of the console protocol, parsed ([`crate::console::parse`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Command {
+    /// List the commands.
+    Help,
+    /// Report mode, angles, pulses, faults, uptime, version, settings source.
+    Status,
+    /// Change what the head does.
+    Act(Action),
+    /// Restart the idle motion's random stream.
+    Seed(SeedChoice),
+    /// Show (`None`) or change one field of a servo's calibration.
+    Servo {
+        /// The servo's axis.
+        axis: Axis,
+        /// The change, if any.
+        setting: Option<ServoSetting>,
+    },
+    /// Store the settings in flash.
+    Save,
+    /// Load the settings stored in flash.
+    Load,
+    /// Go back to the built-in settings (not stored until `save`).
+    Defaults,
+}

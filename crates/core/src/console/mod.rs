@@ -1,0 +1,48 @@
+//! The serial console: where bytes become commands and replies.
+//!
+//! - [`Framer`]: bytes → lines (line ends, backspace, overlong lines,
+//!   control bytes, UTF-8).
+//! - [`parse`]: one line → a [`Command`](crate::command::Command).
+//! - [`Session`]: both, a [`Handler`] that carries the commands out, and
+//!   exactly one [`Reply`] line per input line (`ok …` or
+//!   `err <code> <reason>`, codes in [`ErrorCode`]).
+//! - [`ConsoleService`]: the handler that carries every command out,
+//!   through the frame task's queue and the [`ConsoleLink`] it shares
+//!   with the frame task.
+//!
+//! Nothing here allocates or panics. See `docs/protocol.md` for the
+//! protocol as a user sees it.
+
+mod framer;
+mod link;
+mod parse;
+mod reply;
+mod service;
+mod session;
+mod shared;
+
+pub use framer::{Framer, LineError};
+pub use link::{ConsoleLink, HeadMode, HeadStatus};
+pub use parse::{ParseError, ParseErrorKind, Span, parse};
+pub use reply::{ErrorCode, Reply};
+pub use service::{ConsoleService, VERSION};
+pub use session::{EnvelopeError, Handler, InputError, MIN_REPLY, Session, checksum, respond};
+pub use shared::{PortSession, Shared, SharedService};
+
+/// How a board's USB serial port (CDC-ACM) introduces itself, so that a
+/// host finds the head among other serial devices.
+pub mod usb_identity {
+    /// The shared V-USB vendor ID (Van Ooijen Technische Informatica).
+    pub const VID: u16 = 0x16c0;
+    /// Its product ID for CDC-ACM serial devices of hobby projects, shared
+    /// by many: a host tells a head from the others by [`PRODUCT`].
+    pub const PID: u16 = 0x27dd;
+    /// Manufacturer string descriptor.
+    pub const MANUFACTURER: &str = "idle-head";
+    /// Product string descriptor: what the host tools look for.
+    pub const PRODUCT: &str = "idle-head console";
+}
+
+/// The reply to `help`: the command words, one line.
+pub const HELP: &str =
+    "commands: help status stop nod shake tilt look center idle seed servo save load defaults";

@@ -1,0 +1,267 @@
+//! One line of the console protocol → a [`Command`].
+//!
+//! Words are separated by spaces or tabs and compared without regard to
+//! ASCII case. Numbers are decimal integers with an optional sign, in the
+//! project's units. Optional trailing options are `name=value` words, in
+//! any order after the positional arguments.
+//!
+//! ```text
+//! help | status | save | load | defaults | stop
+//! nod   [amp_mdeg] [ms] [cycles=N] [intensity=PCT]
+//! shake [amp_mdeg] [ms] [cycles=N] [intensity=PCT]
+//! tilt  [amp_mdeg] [ms] [intensity=PCT]
+//! look <pitch_mdeg> <yaw_mdeg> [ms] [hold=MS|hold=stay]
+//! center [ms]
+//! idle on | idle off | idle amp <percent>
+//! seed <n> | seed random
+//! servo <pitch|roll|yaw> [neutral <us> | per-degree <ns> | direction <normal|reversed>
+//!                        | min <us> | max <us> | limits <min_mdeg> <max_mdeg>]
+//! ```
+//!
+//! The parser checks the syntax and that each number fits its type
+//! (a percentage is at most 100, a duration is positive); whether a value
+//! suits the head (an amplitude inside the axis' limits, a calibration
+//! that validates) is for the behaviour and the settings to decide. It
+//! never panics and allocates nothing.
+//!
+//! ```
+//! use idle_head_core::command::{Action, Command, GestureKind};
+//! use idle_head_core::console::parse;
+//! use idle_head_core::{Angle, Millis};
+//!
+//! let Ok(Command::Act(Action::Gesture(nod))) = parse(b"nod 6000 900 cycles=3") else {
+//!     panic!("a nod")
+//! };
+//! assert_eq!(nod.kind, GestureKind::Nod);
+//! assert_eq!(nod.amplitude, Some(Angle::from_degrees(6)));
+//! assert_eq!(nod.duration, Some(Millis(900)));
+//! assert_eq!(nod.cycles, Some(3));
+//!
+//! let err = parse(b"nod six").unwrap_err();
+//! assert_eq!(err.describe(b"nod six").to_string(), "`six`: amplitude in mdeg must be a whole number");
+//! ```
+
+use crate::axis::Axis;
+use crate::command::{
+    Action, Command, GestureKind, GestureRequest, Hold, LookRequest, Percent, SeedChoice,
+    ServoSetting,
+};
+use crate::servo::{Direction, NanosPerDegree};
+use crate::units::{Angle, AngleRange, Microseconds, Millis};
+
+mod error;
+mod words;
+
+pub use error::{ParseError, ParseErrorKind, Span};
+use words::{Kw, Word, Words, once};
+
+/// Parses one line (without its line ending); the grammar is in this
+/// module's source and, for users, in `docs/protocol.md`.
+///
+/// # Errors
+/// A [`ParseError`] naming the first problem and the word it is in.
+pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
+    let mut words = Words::new(line);
+    let Some(first) = words.next() else {
+        return Err(words.error_here(ParseErrorKind::Empty));
+    };
+    let command = match first.lower() {
+        Word::Is(Kw::Help) => Command::Help,
+        Word::Is(Kw::Status) => Command::Status,
+        Word::Is(Kw::Save) => Command::Save,
+        Word::Is(Kw::Load) => Command::Load,
+        Word::Is(Kw::Defaults) => Command::Defaults,
+        Word::Is(Kw::Stop) => Command::Act(Action::Stop),
+        Word::Is(Kw::Nod) => gesture(&mut words, GestureKind::Nod)?,
+        Word::Is(Kw::Shake) => gesture(&mut words, GestureKind::Shake)?,
+        Word::Is(Kw::Tilt) => gesture(&mut words, GestureKind::Tilt)?,
+        Word::Is(Kw::Look) => look(&mut words)?,
+        Word::Is(Kw::Center | Kw::Centre) => Command::Act(Action::Center {
+            duration: words.optional_number(&DURATION)?.map(to_millis),
+        }),
+        Word::Is(Kw::Idle) => idle(&mut words)?,
+        Word::Is(Kw::Seed) => seed(&mut words)?,
+        Word::Is(Kw::Servo) => servo(&mut words)?,
+        _ => return Err(first.error(ParseErrorKind::UnknownCommand)),
+    };
+    words.end()?;
+    Ok(command)
+}
+
+/// A numeric field: its name and range (passed as `&'static`: one address
+/// per call instead of the whole field).
+#[derive(Clone, Copy)]
+struct Field {
+    what: &'static str,
+    min: i64,
+    max: i64,
+}
+
+impl Field {
+    /// A field named `what` over `min..=max`.
+    const fn new(what: &'static str, min: i64, max: i64) -> Self {
+        Self { what, min, max }
+    }
+}
+
+/// The range of an angle or an amplitude in m°: the `i32` range without
+/// `i32::MIN`.
+const MDEG: (i64, i64) = (i32::MIN as i64 + 1, i32::MAX as i64);
+const AMPLITUDE: Field = Field::new("amplitude in mdeg", MDEG.0, MDEG.1);
+const PITCH: Field = Field::new("pitch in mdeg", MDEG.0, MDEG.1);
+const YAW: Field = Field::new("yaw in mdeg", MDEG.0, MDEG.1);
+const LOWER_LIMIT: Field = Field::new("lower limit in mdeg", MDEG.0, MDEG.1);
+const UPPER_LIMIT: Field = Field::new("upper limit in mdeg", MDEG.0, MDEG.1);
+const DURATION: Field = Field::new("duration in ms", 1, u32::MAX as i64);
+const HOLD: Field = Field::new("hold in ms", 0, u32::MAX as i64);
+const CYCLES: Field = Field::new("cycles", 1, u8::MAX as i64);
+const PERCENT: Field = Field::new("percentage", 0, 100);
+const SEED: Field = Field::new("seed", 0, u32::MAX as i64);
+const PULSE: Field = Field::new("pulse in us", 0, u32::MAX as i64);
+const PER_DEGREE: Field = Field::new("ns per degree", 0, u32::MAX as i64);
+
+fn to_angle(v: i64) -> Angle {
+    Angle::from_millidegrees(v as i32)
+}
+
+fn to_millis(v: i64) -> Millis {
+    Millis(v as u32)
+}
+
+fn to_percent(v: i64) -> Percent {
+    Percent::new(v as u8).unwrap_or(Percent::FULL)
+}
+
+/// `nod|shake|tilt [amp] [ms] [cycles=N] [intensity=P]`.
+fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Command, ParseError> {
+    let mut request = GestureRequest::new(kind);
+    request.amplitude = words.optional_number(&AMPLITUDE)?.map(to_angle);
+    request.duration = words.optional_number(&DURATION)?.map(to_millis);
+    let allowed = match kind {
+        GestureKind::Tilt => "intensity",
+        GestureKind::Nod | GestureKind::Shake => "cycles, intensity",
+    };
+    while let Some((name, value, word)) = words.option()? {
+        match (name, kind) {
+            (Word::Is(Kw::Cycles), GestureKind::Nod | GestureKind::Shake) => {
+                once(request.cycles.is_some(), word)?;
+                request.cycles = Some(value.number(&CYCLES)? as u8);
+            }
+            (Word::Is(Kw::Intensity), _) => {
+                once(request.intensity.is_some(), word)?;
+                request.intensity = Some(to_percent(value.number(&PERCENT)?));
+            }
+            _ => return Err(word.error(ParseErrorKind::UnknownOption { allowed })),
+        }
+    }
+    Ok(Command::Act(Action::Gesture(request)))
+}
+
+/// `look <pitch> <yaw> [ms] [hold=MS|hold=stay]`.
+fn look(words: &mut Words<'_>) -> Result<Command, ParseError> {
+    let pitch = to_angle(words.number(&PITCH)?);
+    let yaw = to_angle(words.number(&YAW)?);
+    let duration = words.optional_number(&DURATION)?.map(to_millis);
+    let mut hold = None;
+    while let Some((name, value, word)) = words.option()? {
+        if name != Word::Is(Kw::Hold) {
+            return Err(word.error(ParseErrorKind::UnknownOption { allowed: "hold" }));
+        }
+        once(hold.is_some(), word)?;
+        hold = Some(if value.lower() == Word::Is(Kw::Stay) {
+            Hold::Stay
+        } else {
+            Hold::Return(to_millis(value.number(&HOLD)?))
+        });
+    }
+    Ok(Command::Act(Action::Look(LookRequest {
+        pitch,
+        yaw,
+        duration,
+        hold,
+    })))
+}
+
+/// `idle on|off|amp <percent>`.
+fn idle(words: &mut Words<'_>) -> Result<Command, ParseError> {
+    const EXPECTED: &str = "`on`, `off` or `amp`";
+    let Some(word) = words.next() else {
+        return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
+    };
+    let action = match word.lower() {
+        Word::Is(Kw::On) => Action::Idle(true),
+        Word::Is(Kw::Off) => Action::Idle(false),
+        Word::Is(Kw::Amp) => Action::IdleAmp(to_percent(words.number(&PERCENT)?)),
+        _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: EXPECTED })),
+    };
+    Ok(Command::Act(action))
+}
+
+/// `seed <n>|random`.
+fn seed(words: &mut Words<'_>) -> Result<Command, ParseError> {
+    const EXPECTED: &str = "a seed or `random`";
+    let Some(word) = words.next() else {
+        return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
+    };
+    if word.lower() == Word::Is(Kw::Random) {
+        return Ok(Command::Seed(SeedChoice::Random));
+    }
+    Ok(Command::Seed(SeedChoice::Value(word.number(&SEED)? as u32)))
+}
+
+/// `servo <axis> [<field> <value>...]`.
+fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
+    const AXES: &str = "`pitch`, `roll` or `yaw`";
+    const FIELDS: &str = "`neutral`, `per-degree`, `direction`, `min`, `max` or `limits`";
+    let Some(word) = words.next() else {
+        return Err(words.error_here(ParseErrorKind::Missing(AXES)));
+    };
+    let axis = match word.lower() {
+        Word::Is(Kw::Pitch) => Axis::Pitch,
+        Word::Is(Kw::Roll) => Axis::Roll,
+        Word::Is(Kw::Yaw) => Axis::Yaw,
+        _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: AXES })),
+    };
+    let Some(field) = words.next() else {
+        return Ok(Command::Servo {
+            axis,
+            setting: None,
+        });
+    };
+    let pulse = |words: &mut Words<'_>| -> Result<Microseconds, ParseError> {
+        Ok(Microseconds(words.number(&PULSE)? as u32))
+    };
+    let setting = match field.lower() {
+        Word::Is(Kw::Neutral) => ServoSetting::Neutral(pulse(words)?),
+        Word::Is(Kw::Min) => ServoSetting::MinPulse(pulse(words)?),
+        Word::Is(Kw::Max) => ServoSetting::MaxPulse(pulse(words)?),
+        Word::Is(Kw::PerDegree) => {
+            ServoSetting::PerDegree(NanosPerDegree(words.number(&PER_DEGREE)? as u32))
+        }
+        Word::Is(Kw::Direction) => {
+            const DIRECTIONS: &str = "`normal` or `reversed`";
+            let Some(word) = words.next() else {
+                return Err(words.error_here(ParseErrorKind::Missing(DIRECTIONS)));
+            };
+            ServoSetting::Direction(match word.lower() {
+                Word::Is(Kw::Normal) => Direction::Normal,
+                Word::Is(Kw::Reversed) => Direction::Reversed,
+                _ => {
+                    return Err(word.error(ParseErrorKind::UnknownWord {
+                        expected: DIRECTIONS,
+                    }));
+                }
+            })
+        }
+        Word::Is(Kw::Limits) => {
+            let min = to_angle(words.number(&LOWER_LIMIT)?);
+            let max = to_angle(words.number(&UPPER_LIMIT)?);
+            ServoSetting::Limits(AngleRange { min, max })
+        }
+        _ => return Err(field.error(ParseErrorKind::UnknownWord { expected: FIELDS })),
+    };
+    Ok(Command::Servo {
+        axis,
+        setting: Some(setting),
+    })
+}

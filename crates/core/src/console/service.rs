@@ -1,0 +1,382 @@
+//! The console service: the [`Handler`] that carries out every command.
+//!
+//! Board-neutral: a board gives it the frame task's [`CommandQueue`], the
+//! [`ConsoleLink`] shared with the frame task and the loop generator, its
+//! [`SettingsStorage`] and its base driver configuration, and runs a
+//! [`Session`](super::Session) over its transport with the service as
+//! handler:
+//!
+//! ```
+//! use idle_head_core::behaviour::CommandQueue;
+//! use idle_head_core::console::{ConsoleLink, ConsoleService, Session};
+//! use idle_head_core::driver::DriverConfig;
+//! use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
+//!
+//! static QUEUE: CommandQueue = CommandQueue::new();
+//! static LINK: ConsoleLink = ConsoleLink::new();
+//! let mut service = ConsoleService::new(
+//!     &QUEUE, &LINK, RamStorage::<256>::new(), DriverConfig::DEFAULT,
+//!     Settings::DEFAULT, SettingsSource::Defaults,
+//! ).unwrap();
+//! let mut session = Session::<96, 160>::new();
+//! let mut replies = Vec::new();
+//! session.feed(b"nod\nservo yaw min 2600\nsave\n", &mut service, |r| replies.push(r.to_vec()));
+//! assert_eq!(replies[0], b"ok\r\n");
+//! assert!(replies[1].starts_with(b"err invalid "));
+//! assert_eq!(replies[2], b"ok\r\n");
+//! ```
+//!
+//! What each command does:
+//!
+//! - motion (`nod`, `look`, `stop`, `idle …`): checked as the mixer
+//!   would ([`BehaviourParams::check`]) and queued for the frame task;
+//!   a full queue is `err busy` (nothing queued, send it again);
+//! - `status`: the head as the last frame left it ([`HeadStatus`]),
+//!   uptime, firmware version, where the settings came from;
+//! - `servo <axis> <field> <value>`: the settings with that field
+//!   changed are validated as the typed configuration is
+//!   ([`Settings::validate`]); `err invalid` for a calibration the
+//!   driver refuses, `err limit` if the behaviour would then drive the
+//!   servo past its new limits; otherwise the frame task applies it
+//!   between two frames through the limiter ([`FrameDriver::set_servo`]);
+//! - `seed`: the next loop set is generated from the new seeds and
+//!   joined in as any set is (no jump);
+//! - `save`, `load`, `defaults`: the [`SettingsStorage`]; a loaded or
+//!   default set is applied as `servo` and `seed` are, and its idle
+//!   amplitude through the queue. (Gesture and gaze defaults take effect
+//!   at the next boot: the frame task's behaviour is built once.)
+//!
+//! [`FrameDriver::set_servo`]: crate::driver::FrameDriver::set_servo
+
+use crate::text::Arg::{Int, Str, Uint};
+use crate::text::Text;
+
+use super::HELP;
+use super::link::{ConsoleLink, HeadStatus};
+use super::reply::{ErrorCode, Reply};
+use super::session::Handler;
+use crate::axis::Axis;
+use crate::behaviour::{Applied, BehaviourError, BehaviourParams, CommandQueue};
+use crate::command::{Action, Command, SeedChoice, ServoSetting};
+use crate::driver::DriverConfig;
+use crate::servo::{Direction, ServoCalibration};
+use crate::settings::{Settings, SettingsError, SettingsSource, SettingsStorage, StorageError};
+
+/// The firmware version `status` reports.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// The console service; see the [module docs](self).
+pub struct ConsoleService<'a, S, const N: usize = { crate::behaviour::queue::CAPACITY }> {
+    queue: &'a CommandQueue<N>,
+    link: &'a ConsoleLink,
+    storage: S,
+    base: DriverConfig,
+    settings: Settings,
+    behaviour: BehaviourParams,
+    source: SettingsSource,
+    /// xorshift32 state for `seed random`.
+    entropy: u32,
+}
+
+impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
+    /// A service for a head that runs `settings` (from `source`) on the
+    /// board's driver configuration `base`.
+    ///
+    /// # Errors
+    /// The [`SettingsError`] if `settings` are not valid with `base`.
+    pub fn new(
+        queue: &'a CommandQueue<N>,
+        link: &'a ConsoleLink,
+        storage: S,
+        base: DriverConfig,
+        settings: Settings,
+        source: SettingsSource,
+    ) -> Result<Self, SettingsError> {
+        let valid = settings.validate(&base)?;
+        Ok(Self {
+            queue,
+            link,
+            storage,
+            base,
+            settings,
+            behaviour: valid.behaviour,
+            source,
+            entropy: 0x9e37_79b9,
+        })
+    }
+
+    /// Mixes `bits` from the board's entropy source into `seed random`.
+    pub fn add_entropy(&mut self, bits: u32) {
+        self.entropy = (self.entropy ^ bits) | 1;
+    }
+
+    /// The settings in effect (as the console last set them).
+    #[must_use]
+    pub const fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Where they came from.
+    #[must_use]
+    pub const fn source(&self) -> SettingsSource {
+        self.source
+    }
+
+    /// The board's store.
+    pub fn storage_mut(&mut self) -> &mut S {
+        &mut self.storage
+    }
+
+    fn act(&mut self, action: Action, reply: &mut Reply<'_>) {
+        let applied = match self.behaviour.check(&action) {
+            Ok(applied) => applied,
+            Err(e) => {
+                text(reply.err(behaviour_code(&e))).with(&e);
+                return;
+            }
+        };
+        if let Err(full) = self.queue.try_submit(action) {
+            text(reply.err(ErrorCode::Busy)).with(&full);
+            return;
+        }
+        if let Applied::Look(look) = applied
+            && look.clamped
+        {
+            text(reply.ok()).fill(
+                "clamped pitch={} yaw={}",
+                &[
+                    Int(look.pitch.millidegrees().into()),
+                    Int(look.yaw.millidegrees().into()),
+                ],
+            );
+        }
+    }
+
+    fn status(&self, reply: &mut Reply<'_>) {
+        let s: HeadStatus = self.link.status();
+        let [p, r, y] = s.angles.map(crate::units::Angle::millidegrees);
+        let [pp, pr, py] = s.pulses.map(|us| us.0);
+        let [fp, fr, fy] = s.faults;
+        let off = s.disabled.iter().filter(|&&d| d).count();
+        // Frames since start × frame period, in ms.
+        let uptime = s.frame * u64::from(self.base.frame_period.0) / 1000;
+        text(reply.ok()).fill(
+            "mode={} mdeg={},{},{} us={},{},{} faults={},{},{} off={} uptime_ms={} fw={} settings={}",
+            &[
+                Str(s.mode.as_str()),
+                Int(p.into()),
+                Int(r.into()),
+                Int(y.into()),
+                Uint(pp.into()),
+                Uint(pr.into()),
+                Uint(py.into()),
+                Uint(fp.into()),
+                Uint(fr.into()),
+                Uint(fy.into()),
+                Uint(off as u64),
+                Uint(uptime),
+                Str(VERSION),
+                Str(self.source.as_str()),
+            ],
+        );
+    }
+
+    fn show_servo(&self, axis: Axis, reply: &mut Reply<'_>) {
+        let c = self.settings.servo(axis);
+        text(reply.ok()).fill(
+            "{} neutral={} per-degree={} direction={} min={} max={} limits={},{}",
+            &[
+                Str(axis.name()),
+                Uint(c.neutral.0.into()),
+                Uint(c.per_degree.0.into()),
+                Str(match c.direction {
+                    Direction::Normal => "normal",
+                    Direction::Reversed => "reversed",
+                }),
+                Uint(c.min_pulse.0.into()),
+                Uint(c.max_pulse.0.into()),
+                Int(c.limits.min.millidegrees().into()),
+                Int(c.limits.max.millidegrees().into()),
+            ],
+        );
+    }
+
+    fn set_servo(&mut self, axis: Axis, setting: ServoSetting, reply: &mut Reply<'_>) {
+        let mut next = self.settings;
+        let Some(cal) = next.servos.get_mut(axis.index()) else {
+            return;
+        };
+        change(cal, setting);
+        let cal = *cal;
+        if let ServoSetting::Limits(limits) = setting {
+            let at = self.link.status().angles[axis.index()];
+            if !limits.contains(at) {
+                text(reply.err(ErrorCode::Limit)).fill(
+                    "the {} servo stands at {} mdeg, outside {}..{}: move it in first",
+                    &[
+                        Str(axis.name()),
+                        Int(at.millidegrees().into()),
+                        Int(limits.min.millidegrees().into()),
+                        Int(limits.max.millidegrees().into()),
+                    ],
+                );
+                return;
+            }
+        }
+        match next.validate(&self.base) {
+            Ok(valid) => {
+                self.link.set_servo(axis, cal);
+                self.settings = next;
+                self.behaviour = valid.behaviour;
+                self.source = SettingsSource::Changed;
+            }
+            Err(SettingsError::Driver(e)) => {
+                text(reply.err(ErrorCode::Invalid)).with(&e);
+            }
+            Err(SettingsError::Behaviour(e)) => {
+                text(reply.err(ErrorCode::Limit))
+                    .str("the head would go past the new limits: ")
+                    .with(&e);
+            }
+        }
+    }
+
+    fn seed(&mut self, choice: SeedChoice, reply: &mut Reply<'_>) {
+        let n = match choice {
+            SeedChoice::Value(n) => n,
+            SeedChoice::Random => {
+                // xorshift32, stirred with the frame count.
+                let mut x = self.entropy ^ (self.link.status().frame as u32);
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                self.entropy = x | 1;
+                x
+            }
+        };
+        let seeds = Settings::seeds_from(n);
+        self.link.reseed(seeds);
+        self.settings.seeds = seeds;
+        self.source = SettingsSource::Changed;
+        text(reply.ok()).str("seed=").u64(n.into());
+    }
+
+    /// Puts `settings` in effect: idle amplitude through the queue (so a
+    /// full queue changes nothing), servos and seeds through the link.
+    fn adopt(&mut self, settings: Settings, source: SettingsSource, reply: &mut Reply<'_>) -> bool {
+        let valid = match settings.validate(&self.base) {
+            Ok(valid) => valid,
+            Err(e) => {
+                text(reply.err(ErrorCode::Invalid)).with(&e);
+                return false;
+            }
+        };
+        let amp = settings.behaviour.idle.amplitude;
+        if amp != self.settings.behaviour.idle.amplitude
+            && let Err(full) = self.queue.try_submit(Action::IdleAmp(amp))
+        {
+            text(reply.err(ErrorCode::Busy)).with(&full);
+            return false;
+        }
+        for (axis, (new, old)) in Axis::ALL
+            .iter()
+            .zip(settings.servos.iter().zip(&self.settings.servos))
+        {
+            if new != old {
+                self.link.set_servo(*axis, *new);
+            }
+        }
+        if settings.seeds != self.settings.seeds {
+            self.link.reseed(settings.seeds);
+        }
+        self.settings = settings;
+        self.behaviour = valid.behaviour;
+        self.source = source;
+        true
+    }
+
+    fn load(&mut self, reply: &mut Reply<'_>) {
+        match self.storage.load() {
+            Ok(settings) => {
+                self.adopt(settings, SettingsSource::Flash, reply);
+            }
+            Err(e) => storage_error(e, "load", reply),
+        }
+    }
+
+    fn save(&mut self, reply: &mut Reply<'_>) {
+        match self.storage.save(&self.settings) {
+            Ok(()) => self.source = SettingsSource::Flash,
+            Err(e) => storage_error(e, "save", reply),
+        }
+    }
+}
+
+impl<S: SettingsStorage, const N: usize> Handler for ConsoleService<'_, S, N> {
+    fn command(&mut self, command: Command, reply: &mut Reply<'_>) {
+        match command {
+            Command::Help => {
+                text(reply.ok()).str(HELP);
+            }
+            Command::Status => self.status(reply),
+            Command::Act(action) => self.act(action, reply),
+            Command::Seed(choice) => self.seed(choice, reply),
+            Command::Servo {
+                axis,
+                setting: None,
+            } => self.show_servo(axis, reply),
+            Command::Servo {
+                axis,
+                setting: Some(setting),
+            } => self.set_servo(axis, setting, reply),
+            Command::Save => self.save(reply),
+            Command::Load => self.load(reply),
+            Command::Defaults => {
+                self.adopt(Settings::DEFAULT, SettingsSource::Defaults, reply);
+            }
+        }
+    }
+}
+
+impl<S, const N: usize> core::fmt::Debug for ConsoleService<'_, S, N> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("ConsoleService")
+            .field("settings", &self.settings)
+            .field("source", &self.source)
+            .finish_non_exhaustive()
+    }
+}
+
+/// `cal` with `setting` applied.
+fn change(cal: &mut ServoCalibration, setting: ServoSetting) {
+    match setting {
+        ServoSetting::Neutral(us) => cal.neutral = us,
+        ServoSetting::PerDegree(ns) => cal.per_degree = ns,
+        ServoSetting::Direction(d) => cal.direction = d,
+        ServoSetting::MinPulse(us) => cal.min_pulse = us,
+        ServoSetting::MaxPulse(us) => cal.max_pulse = us,
+        ServoSetting::Limits(range) => cal.limits = range,
+    }
+}
+
+/// The reply code of a refused motion.
+const fn behaviour_code(e: &BehaviourError) -> ErrorCode {
+    match e {
+        BehaviourError::Busy { .. } => ErrorCode::Busy,
+        BehaviourError::Amplitude { .. } => ErrorCode::Limit,
+        BehaviourError::Config { .. } => ErrorCode::Invalid,
+        _ => ErrorCode::Range,
+    }
+}
+
+fn storage_error(e: StorageError, what: &str, reply: &mut Reply<'_>) {
+    text(reply.err(ErrorCode::Storage))
+        .str(what)
+        .str(": ")
+        .with(&e);
+}
+
+/// A reply as the [`Text`] its words are written into.
+fn text<'r>(reply: &'r mut Reply<'_>) -> &'r mut dyn Text {
+    reply
+}

@@ -1,0 +1,59 @@
+//! The hardware-free core of the idle-head firmware (`no_std`, no
+//! allocation, no `unsafe`): motion generation after Kocoń's idle-loop method
+//! ([`motion`]), servo mapping ([`servo`]), frame playback ([`playback`]) and
+//! the frame driver ([`driver`]). The Raspberry Pi Pico image is
+//! `src/bin/pico/`; the QEMU images are a package of their own, `qemu/`.
+//!
+//! ```
+//! use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Mdeg16};
+//! use idle_head_core::{Angle, Axis, LoopSource};
+//!
+//! // The three loops of the paper's Table 2 set, as the firmware computes them at boot.
+//! let mut head: HeadTrajectories<Mdeg16, DEFAULT_N> = HeadTrajectories::new();
+//! head.generate(&DEFAULT_HEAD).unwrap();
+//! let yaw = head.axis(Axis::Yaw);
+//! assert_eq!(yaw.angle(0), Angle::ZERO); // every loop starts at the neutral pose
+//! let range = DEFAULT_HEAD.yaw.range;
+//! assert!((0..DEFAULT_N).all(|i| range.contains(yaw.angle(i))));
+//! ```
+//!
+//! The hardware, the wiring, the commands and how the motion is computed are
+//! in the project's README (`README.md` at the repository root).
+#![cfg_attr(not(test), no_std)]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+#![warn(clippy::pedantic)]
+#![allow(
+    clippy::module_name_repetitions,
+    clippy::cast_possible_truncation,
+    clippy::cast_possible_wrap,
+    clippy::cast_sign_loss,
+    clippy::cast_lossless,
+    clippy::cast_precision_loss
+)]
+
+// A bare `cargo test` builds for the firmware's target, where no test can
+// run: say where the tests are instead of failing on each doc test.
+#[cfg(all(doctest, target_os = "none"))]
+compile_error!("the tests run on the host: `cargo xtask test` (or `cd host-tests && cargo test`)");
+
+pub mod axis;
+pub mod behaviour;
+pub mod command;
+pub mod console;
+pub mod driver;
+pub mod idle;
+pub mod metrics;
+pub mod motion;
+pub mod playback;
+pub mod pwm_clock;
+pub mod servo;
+pub mod settings;
+pub mod text;
+pub mod units;
+
+pub use axis::Axis;
+pub use driver::{DriverConfig, FrameClock, FrameDriver, FrameReport};
+pub use playback::{LoopSource, Playback};
+pub use servo::{Direction, PwmTiming, ServoCalibration};
+pub use units::{Angle, AngleRange, Microseconds, Millis};

@@ -1,0 +1,357 @@
+//! Frame-by-frame playback: the exact position kept with additions only,
+//! and each loop's spline window reused until the position leaves it.
+//!
+//! # The position
+//!
+//! Frame `k` lies at time `t = k·F mod L` in the loop (`F`: frame period,
+//! `L`: loop duration, µs) and at `X/L` samples with `X = t·n·2¹²` (`n`
+//! samples, Q12). The player keeps `⌊X/L⌋` and the remainder. One frame adds
+//! `S = (F mod L)·n·2¹²`, i.e. `⌊S/L⌋` to the position and `S mod L` to the
+//! remainder (a carry when it reaches `L`), and the position wraps at
+//! `n·2¹²` when `t` passes `L`. Every remainder is a multiple of
+//! `g = gcd(S, L)` (it is `k·S mod L`), so it is kept in units of `g`, below
+//! `L/g`. With `n < 2¹⁹` and `L/g < 2³¹` (any loop up to 35 minutes, and
+//! longer ones unless their duration is almost prime to the frame
+//! period) the sums fit `u32`. A frame that does not follow the last one
+//! (frames skipped while late, or a jump) is located from its index with
+//! 64-bit long division, as [`Playback::position`] does: exact either way,
+//! without drift over any run length.
+//!
+//! # The windows
+//!
+//! Each loop's window holds the four samples of the current spline segment
+//! and up to two samples past it, read ahead. A frame that stays in its
+//! segment reads ahead (the frame has the time: it moves no window); a
+//! frame that moves on shifts the windows and uses the samples read ahead,
+//! reading only those it lacks. At 1.67 frames per sample (the defaults)
+//! two of five frames stay and three move on: after the first samples,
+//! every read happens on a frame that stays. A frame that moves more than
+//! three samples, or jumps, reads whole windows. A frame located exactly on
+//! a sample (such as frame 0) needs only that sample, and the next frame
+//! reads the other three.
+
+use crate::playback::{LoopSource, Playback, T_BITS, Weights, Window, mul_div_rem, wrap};
+use crate::units::Angle;
+
+/// Plays three loops frame by frame; the same offsets as
+/// [`Playback::offsets`], see the [module docs](self).
+///
+/// ```
+/// use idle_head_core::playback::{Playback, Player};
+/// use idle_head_core::{Angle, Microseconds, Millis};
+///
+/// let ramp: [Angle; 4] = [0, 1000, 2000, 1000].map(Angle::from_millidegrees);
+/// let playback = Playback::new(Millis(160), Microseconds(20_000), 4).unwrap();
+/// let mut player = Player::new(playback, [&ramp, &ramp, &ramp]);
+/// for frame in 0..20 {
+///     assert_eq!(player.offsets(frame), playback.offsets(frame, [&ramp, &ramp, &ramp]));
+/// }
+/// assert_eq!(player.offsets(3)[0].millidegrees(), 1625); // a jump back: located exactly
+/// ```
+#[derive(Debug)]
+pub struct Player<'a, L: ?Sized> {
+    cursor: Cursor,
+    loops: [&'a L; 3],
+}
+
+impl<L: ?Sized> Clone for Player<'_, L> {
+    fn clone(&self) -> Self {
+        Self {
+            cursor: self.cursor,
+            loops: self.loops,
+        }
+    }
+}
+
+impl<'a, L: LoopSource + ?Sized> Player<'a, L> {
+    /// Playback of `loops` (`[pitch, roll, yaw]`) by `playback`, at frame 0.
+    #[must_use]
+    pub const fn new(playback: Playback, loops: [&'a L; 3]) -> Self {
+        Self {
+            cursor: Cursor::new(playback),
+            loops,
+        }
+    }
+
+    /// The playback parameters.
+    #[must_use]
+    pub const fn playback(&self) -> &Playback {
+        self.cursor.playback()
+    }
+
+    /// The three offsets (pitch, roll, yaw) of frame `frame`: those of
+    /// [`Playback::offsets`], cheapest when `frame` follows the last one.
+    #[inline]
+    pub fn offsets(&mut self, frame: u64) -> [Angle; 3] {
+        self.cursor.offsets(frame, &self.loops)
+    }
+}
+
+/// The state of a [`Player`] without its loops: the position and the
+/// spline windows, for callers that hold the loops themselves (and change
+/// them: a cursor must be given the same loops from one call to the next,
+/// or be [`reset`](Self::reset)).
+#[derive(Clone, Copy, Debug)]
+pub struct Cursor {
+    playback: Playback,
+    /// The frame played as the loops' frame 0.
+    origin: u64,
+    /// The frame after the one `pos` and `rem` belong to.
+    next: u64,
+    /// `⌊X/L⌋`: the sample index (above 12 bits) and `t` (Q12).
+    pos: u32,
+    /// `(X mod L)/g`.
+    rem: u32,
+    /// `⌊S/L⌋`.
+    step: u32,
+    /// `(S mod L)/g`.
+    step_rem: u32,
+    /// `L/g`.
+    den: u32,
+    /// The windows around `pos`, `[pitch, roll, yaw]`.
+    windows: [Window; 3],
+    /// Samples read ahead in each window (0..=2).
+    ahead: u8,
+    /// Whether the sums fit `u32` (else every frame is [`Playback::offsets`]).
+    incremental: bool,
+    /// Whether `pos` and `rem` belong to the frame before `next`.
+    positioned: bool,
+    /// Whether `windows` hold the segment around `pos` (else only its first
+    /// sample, `pos` being on it).
+    loaded: bool,
+}
+
+impl Cursor {
+    /// A cursor for `playback`, at frame 0, with nothing read yet.
+    #[must_use]
+    pub const fn new(playback: Playback) -> Self {
+        let loop_us = playback.loop_us.get();
+        let samples = playback.samples.get() as u64;
+        // S = (F mod L)·n·2¹²: ⌊S/L⌋ and S mod L; g = gcd(S, L) = gcd(S mod L, L).
+        let (step, s_rem) = mul_div_rem(
+            playback.frame_us as u64 % loop_us,
+            samples << T_BITS,
+            loop_us,
+        );
+        // g ≥ 1 as L ≥ 1.
+        let g = gcd(s_rem, loop_us);
+        let (step_rem, den) = match (s_rem.checked_div(g), loop_us.checked_div(g)) {
+            (Some(rem), Some(den)) => (rem, den),
+            _ => (0, 1),
+        };
+        let incremental = samples < 1 << 19 && den < 1 << 31;
+        Self {
+            playback,
+            origin: 0,
+            next: 0,
+            pos: 0,
+            rem: 0,
+            step: if incremental { step as u32 } else { 0 },
+            step_rem: if incremental { step_rem as u32 } else { 0 },
+            den: if incremental { den as u32 } else { 1 },
+            windows: [Window::EMPTY; 3],
+            ahead: 0,
+            incremental,
+            positioned: false,
+            loaded: false,
+        }
+    }
+
+    /// Forgets the position and the samples read and plays frame `origin`
+    /// as the loops' frame 0: the next call locates its frame from its index
+    /// and reads whole windows.
+    pub const fn restart_at(&mut self, origin: u64) {
+        self.origin = origin;
+        self.positioned = false;
+    }
+
+    /// The playback parameters.
+    #[must_use]
+    pub const fn playback(&self) -> &Playback {
+        &self.playback
+    }
+
+    /// The three offsets (pitch, roll, yaw) of frame `frame` of `loops`:
+    /// those of [`Playback::offsets`], cheapest when `frame` follows the
+    /// last one.
+    #[inline(never)]
+    pub fn offsets<A: Axes + ?Sized>(&mut self, frame: u64, loops: &A) -> [Angle; 3] {
+        if !self.incremental {
+            let local = frame.wrapping_sub(self.origin);
+            return self
+                .playback
+                .offsets(local, [loops.axis(0), loops.axis(1), loops.axis(2)]);
+        }
+        if frame == self.next && self.positioned {
+            let before = self.pos;
+            self.advance();
+            self.next = frame.wrapping_add(1);
+            if self.loaded {
+                self.follow(before, loops);
+            } else {
+                self.complete(before, loops);
+            }
+        } else if frame.wrapping_add(1) != self.next || !self.positioned {
+            self.seek(frame, loops);
+        }
+        let t = self.pos & ((1 << T_BITS) - 1);
+        // One set of weights for the three axes.
+        let weights = Weights::at(t);
+        let [pitch, roll, yaw] = &self.windows;
+        [
+            pitch.at_weights(&weights),
+            roll.at_weights(&weights),
+            yaw.at_weights(&weights),
+        ]
+        .map(Angle::from_millidegrees)
+    }
+
+    /// One frame on (see the module docs).
+    #[inline]
+    fn advance(&mut self) {
+        // rem, step_rem < den < 2³¹; pos < n·2¹², step < n·2¹², n < 2¹⁹.
+        self.rem += self.step_rem;
+        self.pos += self.step;
+        if self.rem >= self.den {
+            self.rem -= self.den;
+            self.pos += 1;
+        }
+        let wrap = (self.playback.samples.get() as u32) << T_BITS;
+        if self.pos >= wrap {
+            self.pos -= wrap;
+        }
+    }
+
+    /// Goes to `frame` from its index, exactly, and reads its windows (only
+    /// the sample it lies on, if it lies on one).
+    #[inline(never)]
+    fn seek<A: Axes + ?Sized>(&mut self, frame: u64, loops: &A) {
+        let (pos, rem) = match frame.wrapping_sub(self.origin) {
+            0 => (0, 0),
+            local => self.playback.locate(local, T_BITS),
+        };
+        // pos < n·2¹² < 2³¹; the remainder in units of g = L/den is below den.
+        self.pos = pos as u32;
+        // (A remainder of 0, as at frame 0, needs no 64-bit division.)
+        self.rem = if rem == 0 {
+            0
+        } else {
+            let g = self.playback.loop_us.get().checked_div(u64::from(self.den));
+            rem.checked_div(g.unwrap_or(1)).unwrap_or(0) as u32
+        };
+        self.next = frame.wrapping_add(1);
+        self.positioned = true;
+        let index = (self.pos >> T_BITS) as usize;
+        if self.pos & ((1 << T_BITS) - 1) == 0 {
+            // The segment's value at t = 0 is its first sample, whatever the others.
+            for (i, window) in self.windows.iter_mut().enumerate() {
+                *window = Window::flat(loops.axis(i).angle(index).millidegrees());
+            }
+            self.ahead = 0;
+            self.loaded = false;
+        } else {
+            self.load(index, loops);
+        }
+    }
+
+    /// Brings the windows from `before`'s sample to the position's.
+    fn follow<A: Axes + ?Sized>(&mut self, before: u32, loops: &A) {
+        let (index, from) = ((self.pos >> T_BITS) as usize, (before >> T_BITS) as usize);
+        let n = self.playback.samples.get();
+        if index == from {
+            self.read_ahead(index, n, loops);
+            return;
+        }
+        // Both below n.
+        let passed = if index > from {
+            index - from
+        } else {
+            index + n - from
+        };
+        if passed > 3 {
+            self.load(index, loops);
+            return;
+        }
+        // The samples entering: from + 3 ..= index + 2.
+        for k in from + 3..=from + 2 + passed {
+            if self.ahead > 0 {
+                self.ahead -= 1;
+                for window in &mut self.windows {
+                    window.shift_ahead();
+                }
+            } else {
+                let next = wrap(k, n);
+                for (i, window) in self.windows.iter_mut().enumerate() {
+                    window.shift(loops.axis(i).angle(next).millidegrees());
+                }
+            }
+        }
+    }
+
+    /// Reads up to two samples past the windows of sample `index`.
+    fn read_ahead<A: Axes + ?Sized>(&mut self, index: usize, n: usize, loops: &A) {
+        while self.ahead < 2 {
+            let next = wrap(index + 3 + usize::from(self.ahead), n);
+            for (i, window) in self.windows.iter_mut().enumerate() {
+                window.set_ahead(self.ahead, loops.axis(i).angle(next).millidegrees());
+            }
+            self.ahead += 1;
+        }
+    }
+
+    /// Reads the rest of windows that hold only `before`'s sample: the three
+    /// other samples if the position is still on its segment, else all four.
+    fn complete<A: Axes + ?Sized>(&mut self, before: u32, loops: &A) {
+        let index = (self.pos >> T_BITS) as usize;
+        if index != (before >> T_BITS) as usize {
+            self.load(index, loops);
+            return;
+        }
+        let n = self.playback.samples.get();
+        for (i, window) in self.windows.iter_mut().enumerate() {
+            window.complete(loops.axis(i), n, index);
+        }
+        self.ahead = 0;
+        self.loaded = true;
+    }
+
+    /// Reads the windows around sample `index`.
+    fn load<A: Axes + ?Sized>(&mut self, index: usize, loops: &A) {
+        let n = self.playback.samples.get();
+        for (i, window) in self.windows.iter_mut().enumerate() {
+            *window = Window::load(loops.axis(i), n, index);
+        }
+        self.ahead = 0;
+        self.loaded = true;
+    }
+}
+
+/// Three loops `[pitch, roll, yaw]` as a [`Cursor`] reads them.
+pub trait Axes {
+    /// The type of one axis' loop.
+    type Loop: LoopSource + ?Sized;
+    /// The loop of axis `index` (0, 1, 2; others read as the last).
+    fn axis(&self, index: usize) -> &Self::Loop;
+}
+
+impl<L: LoopSource + ?Sized> Axes for [&L; 3] {
+    type Loop = L;
+
+    #[inline]
+    fn axis(&self, index: usize) -> &L {
+        match index {
+            0 => self[0],
+            1 => self[1],
+            _ => self[2],
+        }
+    }
+}
+
+/// Greatest common divisor (`gcd(0, b) = b`).
+const fn gcd(mut a: u64, mut b: u64) -> u64 {
+    while let Some(r) = a.checked_rem(b) {
+        a = b;
+        b = r;
+    }
+    a
+}

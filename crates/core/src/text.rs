@@ -1,0 +1,208 @@
+//! Messages written without `core::fmt`.
+//!
+//! The console's replies and the error reasons they carry are written
+//! through [`Text`]: strings, and integers in decimal. `core::fmt` does the
+//! same with padding, alignment and dynamic dispatch per argument, which
+//! costs the console image about 5 KB of flash; this costs a few hundred
+//! bytes. Every error type implements [`Describe`] once, and its `Display`
+//! is that same text (through [`display`]), so the host, the tests and the
+//! board all read one wording.
+//!
+//! ```
+//! use idle_head_core::text::{Describe, Text, display};
+//!
+//! struct Late(u64);
+//! impl Describe for Late {
+//!     fn describe(&self, out: &mut dyn Text) {
+//!         out.str("woke ").u64(self.0).str(" us late, ").i64(-7).str(" dB, 0x").hex2(0x0a);
+//!     }
+//! }
+//! impl core::fmt::Display for Late {
+//!     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+//!         display(self, f)
+//!     }
+//! }
+//!
+//! assert_eq!(Late(42).to_string(), "woke 42 us late, -7 dB, 0x0a");
+//! ```
+
+use core::fmt;
+
+/// Where a message is written: a console reply, a `fmt::Formatter`.
+pub trait Text {
+    /// Appends `s`.
+    fn put(&mut self, s: &str);
+}
+
+/// A message that writes itself into a [`Text`].
+pub trait Describe {
+    /// Writes the message.
+    fn describe(&self, out: &mut dyn Text);
+}
+
+impl dyn Text + '_ {
+    /// Appends `s`.
+    pub fn str(&mut self, s: &str) -> &mut Self {
+        self.put(s);
+        self
+    }
+
+    /// Appends `n` in decimal.
+    pub fn u64(&mut self, n: u64) -> &mut Self {
+        self.zeros(n, 1)
+    }
+
+    /// Appends `n` in decimal, with a `-` if negative.
+    pub fn i64(&mut self, n: i64) -> &mut Self {
+        if n < 0 {
+            self.put("-");
+        }
+        self.u64(n.unsigned_abs())
+    }
+
+    /// Appends `n` in decimal with at least `width` digits (leading zeros).
+    pub fn zeros(&mut self, mut n: u64, width: usize) -> &mut Self {
+        // u64::MAX has 20 digits.
+        const MOST: usize = 20;
+        let mut digits = [b'0'; MOST];
+        let mut start = MOST;
+        for slot in digits.iter_mut().rev() {
+            if n == 0 && MOST - start >= width {
+                break;
+            }
+            *slot = b'0' + (n % 10) as u8;
+            n /= 10;
+            start -= 1;
+        }
+        if let Some(Ok(s)) = digits.get(start..).map(core::str::from_utf8) {
+            self.put(s);
+        }
+        self
+    }
+
+    /// Appends `n` thousandths as a decimal number without trailing zeros
+    /// (`6666` is `6.666`, `12500` is `12.5`, `4000` is `4`): millidegrees
+    /// as degrees, milliseconds as seconds.
+    pub fn milli(&mut self, n: u64) -> &mut Self {
+        // n % 1000 < 1000.
+        let (fraction, digits) = significant((n % 1000) as u32);
+        self.u64(n / 1000);
+        if digits == 0 {
+            return self;
+        }
+        self.put(".");
+        self.zeros(u64::from(fraction), digits)
+    }
+
+    /// Appends `byte` as two lowercase hexadecimal digits.
+    pub fn hex2(&mut self, byte: u8) -> &mut Self {
+        let pair = [hex_digit(byte >> 4), hex_digit(byte)];
+        if let Ok(s) = core::str::from_utf8(&pair) {
+            self.put(s);
+        }
+        self
+    }
+
+    /// Appends what `message` describes.
+    pub fn with(&mut self, message: &dyn Describe) -> &mut Self {
+        message.describe(self);
+        self
+    }
+
+    /// Appends `template` with each `{}` in it replaced by the next of
+    /// `args` (a `{}` without an argument is dropped). One call with a
+    /// table of arguments takes less flash than a call per piece.
+    pub fn fill(&mut self, template: &str, args: &[Arg<'_>]) -> &mut Self {
+        let bytes = template.as_bytes();
+        let mut args = args.iter();
+        let (mut from, mut at) = (0, 0);
+        while at < bytes.len() {
+            if !(bytes.get(at) == Some(&b'{') && bytes.get(at + 1) == Some(&b'}')) {
+                at += 1;
+                continue;
+            }
+            self.put(template.get(from..at).unwrap_or_default());
+            match args.next() {
+                Some(Arg::Str(s)) => self.put(s),
+                Some(&Arg::Uint(n)) => {
+                    self.u64(n);
+                }
+                Some(&Arg::Int(n)) => {
+                    self.i64(n);
+                }
+                Some(Arg::Text(message)) => message.describe(self),
+                None => {}
+            }
+            at += 2;
+            from = at;
+        }
+        self.put(template.get(from..).unwrap_or_default());
+        self
+    }
+}
+
+/// An argument of `fill` (a method of every `dyn Text`).
+#[derive(Clone, Copy)]
+pub enum Arg<'a> {
+    /// A string.
+    Str(&'a str),
+    /// An unsigned integer, in decimal.
+    Uint(u64),
+    /// A signed integer, in decimal.
+    Int(i64),
+    /// A message.
+    Text(&'a dyn Describe),
+}
+
+/// A fraction of thousandths (`0..1000`) as a decimal number writes it:
+/// its significant digits and how many (`500` is `(5, 1)`, `250` is
+/// `(25, 2)`, `0` is `(0, 0)`).
+pub(crate) const fn significant(thousandths: u32) -> (u32, usize) {
+    let (mut fraction, mut digits) = (thousandths, 3);
+    while digits > 0 && fraction % 10 == 0 {
+        fraction /= 10;
+        digits -= 1;
+    }
+    (fraction, digits)
+}
+
+/// The lowercase hexadecimal digit of `v`'s low four bits.
+pub(crate) const fn hex_digit(v: u8) -> u8 {
+    match v & 0xf {
+        d @ 0..=9 => b'0' + d,
+        d => b'a' + d - 10,
+    }
+}
+
+/// Writes `message` into a `fmt::Formatter`: the body of a `Display`.
+///
+/// # Errors
+/// The formatter's first error.
+pub fn display(message: &dyn Describe, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+    struct Out<'a, 'b> {
+        f: &'a mut fmt::Formatter<'b>,
+        result: fmt::Result,
+    }
+    impl Text for Out<'_, '_> {
+        fn put(&mut self, s: &str) {
+            if self.result.is_ok() {
+                self.result = self.f.write_str(s);
+            }
+        }
+    }
+    let mut out = Out { f, result: Ok(()) };
+    message.describe(&mut out);
+    out.result
+}
+
+/// Implements `Display` for types that implement [`Describe`].
+macro_rules! display_from_describe {
+    ($($t:ty),+ $(,)?) => {$(
+        impl core::fmt::Display for $t {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                $crate::text::display(self, f)
+            }
+        }
+    )+};
+}
+pub(crate) use display_from_describe;

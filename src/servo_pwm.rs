@@ -1,0 +1,90 @@
+//! A servo output on its own RP2040 PWM slice, silent until its first duty.
+//!
+//! # No pulse before the first valid frame
+//!
+//! - From reset until [`ServoPwm::new`] the pin is an unconnected GPIO
+//!   (function NULL) with the RP2040's reset pad setting, pull-down enabled:
+//!   the servo input sees a low level.
+//! - [`ServoPwm::new`] gives the pin to the slice with the slice *disabled*,
+//!   its counter at 0 and its compare value at 0, so the output is driven low
+//!   (the output is high only while the counter is below the compare value).
+//! - The first [`SetDutyCycle::set_duty_cycle`] (the frame driver's neutral
+//!   pulse) writes the compare value, sets the counter half a period in
+//!   (above any servo's compare value, so the output stays low) and only
+//!   then enables the slice. The first wrap comes half a period later and
+//!   starts the first pulse: the whole neutral pulse.
+//! - Later writes change the compare value while the slice runs; the RP2040
+//!   latches it at the next wrap, so a pulse is never cut or stretched.
+//!
+//! # One frame, one pulse
+//!
+//! The PWM period is exactly one frame (`idle_head_core::pwm_clock`) and both come from
+//! the same crystal, so the frames' writes keep the phase the first one set:
+//! each lands half a period before the wrap that latches it, whatever the
+//! frame's wake-up latency or cost (anything below 10 ms). Frame `k` is
+//! latched at wrap `k + 1` and goes out as the `k`-th pulse: no frame is
+//! ever overwritten before it went out, none goes out twice.
+
+use embassy_rp::Peri;
+use embassy_rp::pwm::{ChannelAPin, Config, Pwm, PwmError, Slice};
+use embedded_hal::pwm::{ErrorType, SetDutyCycle};
+use fixed::FixedU16;
+use fixed::types::extra::U4;
+
+use idle_head_core::pwm_clock::SliceClock;
+
+/// One servo output: channel A of a PWM slice of its own.
+pub struct ServoPwm {
+    pwm: Pwm<'static>,
+    config: Config,
+    running: bool,
+}
+
+impl ServoPwm {
+    /// Takes `slice` and its channel A `pin`, clocked by `clock`; the output
+    /// stays low until the first duty is written.
+    pub fn new<S: Slice>(
+        slice: Peri<'static, S>,
+        pin: Peri<'static, impl ChannelAPin<S>>,
+        clock: &SliceClock,
+    ) -> Self {
+        let mut config = Config::default();
+        config.divider = FixedU16::<U4>::from_bits(clock.divider_16ths);
+        config.top = clock.top;
+        config.compare_a = 0;
+        config.compare_b = 0;
+        config.enable = false;
+        Self {
+            pwm: Pwm::new_output_a(slice, pin, config.clone()),
+            config,
+            running: false,
+        }
+    }
+}
+
+impl ErrorType for ServoPwm {
+    type Error = PwmError;
+}
+
+impl SetDutyCycle for ServoPwm {
+    fn max_duty_cycle(&self) -> u16 {
+        self.config.top
+    }
+
+    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Self::Error> {
+        if self.running {
+            return self.pwm.set_duty_cycle(duty);
+        }
+        if duty > self.config.top {
+            return Err(PwmError::InvalidDutyCycle);
+        }
+        // First duty: compare value, the counter half a period in, then run.
+        self.config.compare_a = duty;
+        self.pwm.set_config(&self.config);
+        self.pwm.set_counter(self.config.top / 2 + 1);
+        self.config.enable = true;
+        self.pwm.set_config(&self.config);
+        self.running = true;
+        Ok(())
+    }
+}
