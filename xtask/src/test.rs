@@ -184,13 +184,13 @@ pub fn command(options: Options) -> Result<bool> {
 
 fn clippy_stages(stages: &mut Stages, sh: &Shell, host_tests: &Shell, xtask: &Shell) {
     // `--release` shares build scripts and proc-macros with the release builds below.
-    stages.run("clippy: Pico image, firmware layer, core (thumbv6m)", || {
+    stages.run("clippy: Pico image, RP support, firmware layer, core (thumbv6m)", || {
         project::run(
             sh,
             FIRMWARE_ENV,
             cmd!(
                 sh,
-                "cargo clippy --release --package idle-head --package idle-head-firmware --package idle-head-core -- -D warnings"
+                "cargo clippy --release --package idle-head --package idle-head-rp --package idle-head-firmware --package idle-head-core -- -D warnings"
             ),
         )
     });

@@ -30,7 +30,7 @@ use idle_head_core::driver::{DriverConfig, FrameDriver};
 use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
 use idle_head_core::{Axis, Playback};
-use idle_head_firmware::frame::IDLE_MODE;
+use idle_head_firmware::config::IDLE_MODE;
 
 use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use script::Event;

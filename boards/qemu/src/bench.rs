@@ -3,7 +3,7 @@
 //! smoothing (the costly stage it names), on the same core.
 //!
 //! Run with `cargo xtask bench`, or `cargo run --release --bin bench` in
-//! qemu/ (QEMU `-icount shift=0`: one instruction is one nanosecond of
+//! boards/qemu/ (QEMU `-icount shift=0`: one instruction is one nanosecond of
 //! virtual time, SysTick counts 12.5 MHz, so one count is 80 instructions,
 //! the same every run). Each row measures three axes (pitch,
 //! roll, yaw) of the paper's Table 2 set with N and W as given:
@@ -22,11 +22,8 @@
 #![no_std]
 #![no_main]
 
-#[path = "exit.rs"]
 mod exit;
-#[path = "frame_bench.rs"]
 mod frame_bench;
-#[path = "systick.rs"]
 #[allow(dead_code)] // the time driver half is the smoke image's
 mod systick;
 

@@ -13,16 +13,11 @@ use core::pin::Pin;
 use core::sync::atomic::{AtomicBool, Ordering};
 use core::task::{Context, Poll};
 
-use idle_head_core::behaviour::CommandQueue;
-use idle_head_core::console::{ConsoleLink, ConsoleService, Session};
+use idle_head_core::console::{ConsoleService, Session};
 use idle_head_core::settings::RamStorage;
+use idle_head_firmware::boot::{COMMANDS as QUEUE, LINK};
 
 use crate::uart::{RX_READY, UART0, UART1};
-
-/// The frame task's command queue.
-pub static QUEUE: CommandQueue = CommandQueue::new();
-/// Status and calibrations between the console and the frame task.
-pub static LINK: ConsoleLink = ConsoleLink::new();
 
 /// Whether the run waits for the host to hang up.
 pub static HOLD: AtomicBool = AtomicBool::new(false);

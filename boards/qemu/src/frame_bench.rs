@@ -61,7 +61,8 @@ use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver, FrameTick}
 use idle_head_core::idle::{IdleMode, IdlePlayer, IdleTiming, LoopStream, LoopSupply};
 use idle_head_core::motion::DEFAULT_HEAD;
 use idle_head_core::units::Angle;
-use idle_head_firmware::frame::{DEFAULT_PARAMS, DEFAULT_PLAYBACK, DEFAULT_TIMING, FrameLoop};
+use idle_head_firmware::config::{DEFAULT_PARAMS, DEFAULT_PLAYBACK, DEFAULT_TIMING};
+use idle_head_firmware::frame::FrameLoop;
 
 use idle_head_core::Playback;
 use idle_head_core::pwm_clock::PICO_SERVO_CLOCK;
@@ -89,7 +90,7 @@ const PLAYBACK: Playback = DEFAULT_PLAYBACK;
 const TIMING: IdleTiming = DEFAULT_TIMING;
 
 /// A loop set of the default length.
-pub use idle_head_firmware::frame::Set;
+pub use idle_head_firmware::config::Set;
 
 /// Hands loop set 1 over when its join is due; a set given back is dropped.
 #[derive(Clone, Copy)]

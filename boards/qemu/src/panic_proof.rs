@@ -49,9 +49,11 @@ use idle_head_core::idle::{IdlePlayer, IdleTiming};
 use idle_head_core::servo::{Direction, NanosPerDegree, ServoCalibration};
 use idle_head_core::units::{Angle, AngleRange, Microseconds, Millis};
 use idle_head_core::{Axis, Playback};
-use idle_head_firmware::frame::{
-    DEFAULT_PARAMS, DEFAULT_PLAYBACK, DEFAULT_TIMING, Exchange, FrameLoop, IDLE_MODE, Set,
+use idle_head_firmware::config::{
+    DEFAULT_PARAMS, DEFAULT_PLAYBACK, DEFAULT_TIMING, IDLE_MODE, Set,
 };
+use idle_head_firmware::exchange::Exchange;
+use idle_head_firmware::frame::FrameLoop;
 use static_cell::ConstStaticCell;
 
 const PARAMS: DriverParams = DEFAULT_PARAMS;

@@ -233,3 +233,18 @@ impl Driver for SysTickDriver {
 fn SysTick() {
     DRIVER.on_wrap();
 }
+
+/// The boot sequence's stopwatch on SysTick, in instructions (see
+/// [`stopwatch`]).
+pub struct Stopwatch<'a>(pub &'a mut SYST);
+
+impl idle_head_firmware::boot::Stopwatch for Stopwatch<'_> {
+    fn time(&mut self, work: &mut dyn FnMut()) -> u64 {
+        let ((), counts) = stopwatch(self.0, work);
+        counts * INSNS_PER_COUNT
+    }
+
+    fn unit(&self) -> &'static str {
+        "instructions"
+    }
+}

@@ -1,8 +1,19 @@
 //! The board-neutral firmware layer of idle-head: what every board runs
 //! around the hardware-free core (`idle_head_core`), written once.
 //!
-//! - [`frame`]: the embassy frame task's loop, the loop generator and the
-//!   exchange of loop sets between them.
+//! - [`boot`]: the boot sequence before the first frame, and the firmware's
+//!   singletons (command queue, console link, loop set buffers).
+//! - [`config`]: the built-in configuration every board starts from.
+//! - [`frame`]: the frame task's loop, one frame every 20 ms; [`tasks`]: its
+//!   body and the loop generator task.
+//! - [`exchange`]: the loop sets' round between the frame task and the loop
+//!   generator, which makes each next set in the background.
+//! - [`hooks`]: the watchdog and status log of a board running on its own.
+//! - [`console`]: the console's loop over a board's byte [`console::Port`].
+//! - [`storage`]: the settings store in a board's flash.
+//!
+//! What a board adds is its hardware: the PWM outputs, the ports, the flash,
+//! the watchdog, the executors (see `idle-head-rp`, `boards/qemu`).
 #![no_std]
 #![deny(missing_docs)]
 #![warn(clippy::pedantic)]
@@ -15,4 +26,13 @@
     clippy::cast_precision_loss
 )]
 
+pub mod boot;
+#[cfg(feature = "calibrate")]
+pub mod calibrate;
+pub mod config;
+pub mod console;
+pub mod exchange;
 pub mod frame;
+pub mod hooks;
+pub mod storage;
+pub mod tasks;

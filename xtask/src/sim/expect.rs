@@ -5,7 +5,8 @@ use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use idle_head_core::driver::{DriverConfig, FrameDriver};
 use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N};
-use idle_head_firmware::frame::{FrameLoop, IDLE_MODE, LOOP_DURATION};
+use idle_head_firmware::config::{IDLE_MODE, LOOP_DURATION};
+use idle_head_firmware::frame::FrameLoop;
 
 use idle_head_core::Playback;
 use idle_head_core::pwm_clock::PICO_SERVO_CLOCK;

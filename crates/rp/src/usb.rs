@@ -18,7 +18,7 @@ use embassy_usb::driver::EndpointError;
 use embassy_usb::{Builder, Config, UsbDevice};
 use static_cell::{ConstStaticCell, StaticCell};
 
-use crate::console::{Gone, Port, READ_CHUNK, Received};
+use idle_head_firmware::console::{Gone, Port, READ_CHUNK, Received};
 
 pub use idle_head_core::console::usb_identity::{MANUFACTURER, PID, PRODUCT, VID};
 
@@ -64,28 +64,31 @@ pub fn build(driver: Driver<'static, USB>) -> (Device, Serial) {
     (builder.build(), serial)
 }
 
-/// The CDC-ACM port as a console [`Port`].
-pub struct UsbPort<'a> {
-    pub serial: &'a mut Serial,
-}
+/// The CDC-ACM port as a console [`Port`]: connected while a terminal has
+/// the port open.
+pub struct UsbPort(pub Serial);
 
-impl Port for UsbPort<'_> {
+impl Port for UsbPort {
+    async fn connected(&mut self) {
+        self.0.wait_connection().await;
+    }
+
     async fn read(&mut self, buf: &mut [u8]) -> Result<Received, Gone> {
         // `serve` reads into a whole packet (`READ_CHUNK`). USB has flow
         // control: the host holds what the device is not ready for, so
         // nothing is lost here.
-        let n = self.serial.read_packet(buf).await.map_err(gone)?;
+        let n = self.0.read_packet(buf).await.map_err(gone)?;
         Ok(Received::Bytes(n))
     }
 
     async fn write(&mut self, bytes: &[u8]) -> Result<(), Gone> {
         for chunk in bytes.chunks(usize::from(PACKET)) {
-            self.serial.write_packet(chunk).await.map_err(gone)?;
+            self.0.write_packet(chunk).await.map_err(gone)?;
         }
         // A transfer that ends on a full packet needs a zero-length packet
         // to end it, or the host waits for more.
         if bytes.len().is_multiple_of(usize::from(PACKET)) {
-            self.serial.write_packet(&[]).await.map_err(gone)?;
+            self.0.write_packet(&[]).await.map_err(gone)?;
         }
         Ok(())
     }

@@ -1,4 +1,5 @@
-//! Calibration sweep (`cargo run --release --features calibrate`).
+//! Calibration sweep (`cargo run --release --features calibrate`: the
+//! calibration image, never the shipped one).
 //!
 //! Plays, through the same frame task and driver (fade-in, speed and
 //! acceleration limits, angle and pulse clamps), a slow sweep instead of the
@@ -22,7 +23,9 @@
 
 use idle_head_core::driver::Outcome;
 use idle_head_core::{Angle, AngleRange, Axis, LoopSource, Microseconds, Millis, Playback};
-use idle_head_firmware::frame::Frame;
+use static_cell::StaticCell;
+
+use crate::frame::Frame;
 
 /// Samples per second of the sweep timeline (one sample = 100 ms).
 const RATE: usize = 10;
@@ -109,6 +112,20 @@ impl LoopSource for Sweep {
             lerp(lo, Angle::ZERO, k - back, RAMP)
         }
     }
+}
+
+/// The sweeps of the three axes between the built-in limits, as the frame
+/// task plays them instead of the idle. Call once.
+pub fn player() -> idle_head_core::playback::Player<'static, Sweep> {
+    static SWEEPS: StaticCell<[Sweep; 3]> = StaticCell::new();
+    let limits =
+        |axis: Axis| idle_head_core::driver::DriverConfig::DEFAULT.servos[axis.index()].limits;
+    let sweeps: &'static [Sweep; 3] =
+        SWEEPS.init(Axis::ALL.map(|axis| Sweep::new(axis, limits(axis))));
+    idle_head_core::playback::Player::new(
+        playback(idle_head_core::driver::DriverConfig::DEFAULT.frame_period),
+        [&sweeps[0], &sweeps[1], &sweeps[2]],
+    )
 }
 
 /// Logs the pulse at the end of each hold (the servo has settled there).

@@ -1,28 +1,27 @@
-//! The settings store in the Pico's flash: the last four 4 KiB erase
-//! sectors, `0x101f_c000..0x1020_0000` (`SETTINGS` in memory.x, which keeps
-//! code out of them), kept by `sequential-storage` through
+//! The settings store in a board's flash: a range of whole erase sectors
+//! that the board's memory map keeps code out of (the last four 4 KiB
+//! sectors on the RP boards), kept by `sequential-storage` through
 //! [`SettingsStore`].
 //!
-//! The flash driver is embassy-rp's in blocking mode, made async by
-//! [`BlockingAsync`]: reads are plain reads of the memory-mapped flash, and
-//! an erase or a write runs from RAM with interrupts off, as the flash
-//! cannot be read (nor code run from it) meanwhile. [`SectorWise`] splits
-//! every erase into one call per sector, so the interrupts come back (and a
-//! due frame runs) between sectors.
+//! The flash driver is the board's, blocking underneath and made async
+//! (embassy-embedded-hal's `BlockingAsync` on the RP boards): reads are plain
+//! reads of the memory-mapped flash, and an erase or a write runs from RAM
+//! with interrupts off, as the flash cannot be read (nor code run from it)
+//! meanwhile. [`SectorWise`] splits every erase into one call per sector, so
+//! the interrupts come back (and a due frame runs) between sectors.
 //!
-//! At boot ([`boot`]) the store is read before the first frame: stored
-//! settings of the current version are put in effect (servo calibrations,
-//! behaviour, seeds) and logged with their version; an empty store gives
-//! the built-in settings; a damaged store, or one of another version,
-//! gives the built-in settings with a warning. The console's `save` and
-//! `load` go through [`PicoStorage`].
+//! At boot ([`open`]) the store is read before the first frame: stored
+//! settings are put in effect (servo calibrations, behaviour, seeds) and
+//! logged; an empty store gives the built-in settings; a damaged store, or
+//! one of another version, gives the built-in settings with a warning. The
+//! console's `save` and `load` go through [`FlashStorage`].
 //!
 //! # `save` and the watchdog
 //!
 //! A sector erase takes 45 ms typically (W25Q16JV), up to 400 ms, with
 //! interrupts off: no frame runs meanwhile, and the watchdog (100 ms) would
 //! reset the board. So around every flash operation of `save` and `load`
-//! [`PicoStorage`] sets [`FLASH_BUSY`] and waits (at most
+//! [`FlashStorage`] sets [`FLASH_BUSY`] and waits (at most
 //! [`FRAME_WAIT_MS`]) for one frame: that frame, and every frame until the
 //! operation ends, feeds the watchdog with [`FLASH_WATCHDOG_MS`] instead of
 //! 100 ms. Afterwards the next frame feeds it with 100 ms again. While the
@@ -39,35 +38,16 @@ use core::pin::pin;
 use core::sync::atomic::{AtomicBool, Ordering};
 use core::task::{Context, Poll, Waker};
 
-use embassy_embedded_hal::adapter::BlockingAsync;
-use embassy_rp::Peri;
-use embassy_rp::flash::{Blocking, ERASE_SIZE, Error as FlashError, Flash};
-use embassy_rp::peripherals::FLASH;
 use embassy_time::{Duration, Instant};
+use embedded_storage_async::nor_flash::NorFlash;
 use idle_head_core::console::ConsoleLink;
 use idle_head_core::driver::DriverConfig;
-use idle_head_core::motion::{DEFAULT_HEAD, HeadConfig};
 use idle_head_core::settings::{
     LoadError, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsSource, SettingsStorage,
     SettingsStore, StorageError, Validated,
 };
 
-/// The Pico's flash: 2 MiB (W25Q16JV).
-pub const FLASH_SIZE: usize = 2 * 1024 * 1024;
-/// Erase sectors of the settings region.
-const SECTORS: u32 = 4;
-/// The settings region, offsets from the start of flash (as the driver
-/// counts): the last [`SECTORS`] sectors. memory.x's `SETTINGS` region.
-pub const SETTINGS_RANGE: Range<u32> = {
-    let end = FLASH_SIZE as u32;
-    let start = end - SECTORS * ERASE_SIZE as u32;
-    start..end
-};
-/// Where the region appears in the address space (XIP base + offset).
-pub const SETTINGS_ADDRESS: u32 = 0x1000_0000 + SETTINGS_RANGE.start;
-// memory.x reserves the same sectors (`SETTINGS`); `cargo xtask test`
-// checks that no code is linked there.
-const _: () = assert!(SETTINGS_ADDRESS == 0x101f_c000);
+use crate::boot::Loaded;
 
 /// The watchdog timeout the frames feed while a flash operation is under
 /// way: a 400 ms sector erase, with a wide margin.
@@ -80,25 +60,23 @@ pub const FRAME_WAIT_MS: u64 = 50;
 /// with [`FLASH_WATCHDOG_MS`] (see the [module docs](self)).
 pub static FLASH_BUSY: AtomicBool = AtomicBool::new(false);
 
-/// The flash driver the store runs on.
-pub type PicoFlash = SectorWise<BlockingAsync<Flash<'static, FLASH, Blocking, FLASH_SIZE>>>;
-
-/// The store, with a work buffer for the settings record.
-pub type Store = SettingsStore<PicoFlash, Settings, SETTINGS_BUFFER>;
+/// The store on flash driver `F`, with a work buffer for the settings
+/// record; erases go one sector at a time.
+pub type Store<F> = SettingsStore<SectorWise<F>, Settings, SETTINGS_BUFFER>;
 
 /// The console's `save` and `load` on the flash store.
-pub struct PicoStorage {
+pub struct FlashStorage<F: NorFlash> {
     /// `None` if the store could not be opened (logged at boot).
-    store: Option<Store>,
+    store: Option<Store<F>>,
     /// The frame task's status, to see a frame pass.
     link: &'static ConsoleLink,
 }
 
-impl PicoStorage {
+impl<F: NorFlash> FlashStorage<F> {
     /// Runs `op` on the store with the watchdog's flash timeout in force.
     fn guarded<T>(
         &mut self,
-        op: impl FnOnce(&mut Store) -> Result<T, StorageError>,
+        op: impl FnOnce(&mut Store<F>) -> Result<T, StorageError>,
     ) -> Result<T, StorageError> {
         let store = self.store.as_mut().ok_or(StorageError::Device)?;
         FLASH_BUSY.store(true, Ordering::Release);
@@ -118,7 +96,7 @@ impl PicoStorage {
     }
 }
 
-impl SettingsStorage for PicoStorage {
+impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
     fn save(&mut self, settings: &Settings) -> Result<(), StorageError> {
         self.guarded(|store| match at_once(store.save(settings)) {
             Some(result) => result.map_err(StorageError::from),
@@ -134,77 +112,49 @@ impl SettingsStorage for PicoStorage {
     }
 }
 
-/// The settings the board boots with.
-pub struct Boot {
-    /// The console's store.
-    pub storage: PicoStorage,
-    /// The settings in effect.
-    pub settings: Settings,
-    /// Where they came from.
-    pub source: SettingsSource,
-    /// Their parameters for the driver and the behaviour.
-    pub valid: Validated,
-}
-
-impl Boot {
-    /// The idle motion's configuration with these settings' seeds.
-    pub const fn head(&self) -> HeadConfig {
-        let mut head = DEFAULT_HEAD;
-        head.pitch.seed = self.settings.seeds[0];
-        head.roll.seed = self.settings.seeds[1];
-        head.yaw.seed = self.settings.seeds[2];
-        head
-    }
-}
-
-/// Opens the store on the flash peripheral and reads the settings in it
-/// (before the first frame: no watchdog, no frames yet), checked against
-/// `base`; the built-in settings (`defaults`, checked with `base` at compile
-/// time) if there are none or they are not usable. The log says which.
-pub fn boot(
-    flash: Peri<'static, FLASH>,
+/// Opens the store on `flash` in `range` (offsets as the driver counts,
+/// whole erase sectors; `address` is where the range appears in the address
+/// space, for the log) and reads the settings in it, before the first frame
+/// (no watchdog, no frames yet), checked against `base`; the built-in
+/// settings (`defaults`, checked with `base` at compile time) if there are
+/// none or they are not usable. The log says which.
+pub fn open<F>(
+    flash: F,
+    range: Range<u32>,
+    address: u32,
     base: &DriverConfig,
     defaults: Validated,
     link: &'static ConsoleLink,
-) -> Boot {
-    let mut store = open(flash);
-    let loaded = match store.as_mut() {
-        Some(store) => match at_once(store.load()) {
-            Some(loaded) => loaded_settings(loaded, base),
-            None => {
-                defmt::error!("settings: defaults; the blocking flash driver waited");
-                None
-            }
-        },
-        None => None,
-    };
-    let storage = PicoStorage { store, link };
+) -> Loaded<FlashStorage<F>>
+where
+    F: NorFlash,
+    F::Error: defmt::Format,
+{
+    let mut store = Store::new(SectorWise(flash), range).ok();
+    if store.is_none() {
+        defmt::error!("settings: no store: the region is not whole erase sectors");
+    }
+    let loaded = store.as_mut().and_then(|store| {
+        let loaded = at_once(store.load());
+        if loaded.is_none() {
+            defmt::error!("settings: defaults; the blocking flash driver waited");
+        }
+        loaded.and_then(|loaded| loaded_settings(loaded, base, address))
+    });
+    let storage = FlashStorage { store, link };
     match loaded {
-        Some((settings, valid)) => Boot {
+        Some((settings, valid)) => Loaded {
             storage,
             settings,
             source: SettingsSource::Flash,
             valid,
         },
-        None => Boot {
+        None => Loaded {
             storage,
             settings: Settings::DEFAULT,
             source: SettingsSource::Defaults,
             valid: defaults,
         },
-    }
-}
-
-/// Opens the store. `None` (logged) if the region is not a valid store
-/// range, which `SETTINGS_RANGE` rules out.
-fn open(flash: Peri<'static, FLASH>) -> Option<Store> {
-    let flash = SectorWise(BlockingAsync::new(Flash::new_blocking(flash)));
-    match Store::new(flash, SETTINGS_RANGE) {
-        Ok(store) => Some(store),
-        Err(_) => {
-            defmt::error!("settings: no store: the region is not whole erase sectors");
-            None
-        }
     }
 }
 
@@ -218,11 +168,11 @@ fn at_once<F: Future>(future: F) -> Option<F::Output> {
 }
 
 /// The stored settings if they can be used with `base`, logged either way.
-fn loaded_settings(
-    loaded: Result<Settings, LoadError<FlashError>>,
+fn loaded_settings<E: defmt::Format>(
+    loaded: Result<Settings, LoadError<E>>,
     base: &DriverConfig,
+    at: u32,
 ) -> Option<(Settings, Validated)> {
-    let at = SETTINGS_ADDRESS;
     match loaded {
         Ok(settings) => match settings.validate(base) {
             Ok(valid) => {

@@ -1,0 +1,133 @@
+//! The frame hooks of a board running on its own: a watchdog fed after every
+//! frame, a log line at the first frame and one per loop.
+//!
+//! The hardware watchdog is started just after the first frame (the neutral
+//! pulses) and fed after every frame with [`WATCHDOG_TIMEOUT`] = 100 ms (5
+//! frames), or longer while `save` or `load` uses the flash
+//! ([`crate::storage::FLASH_BUSY`]). If frames stop, the board resets; the
+//! next boot logs that the last reset came from the watchdog and starts
+//! softly again: outputs low, neutral pulses first, motion faded in.
+//!
+//! # Watchdog drill
+//!
+//! With the `watchdog-drill` feature (a test image, never shipped) frames
+//! stop after [`DRILL_FRAMES`] frames of every boot, so that the watchdog
+//! resets the board; `cargo xtask test` runs it in the RP2040 emulator and
+//! checks the next boot.
+
+use core::sync::atomic::Ordering;
+
+use embassy_time::Duration;
+use embedded_hal::pwm::SetDutyCycle;
+use idle_head_core::driver::FrameDriver;
+use idle_head_core::playback::Playback;
+
+use crate::frame::{Flow, Frame, FrameHooks};
+use crate::storage::{FLASH_BUSY, FLASH_WATCHDOG_MS};
+
+/// Watchdog timeout: 100 ms = 5 frames of 20 ms. Long enough for a frame
+/// that runs late, short enough that a stuck board stops driving its servos
+/// quickly (a reset releases the pins: no pulses until the next soft start).
+pub const WATCHDOG_TIMEOUT: Duration = Duration::from_millis(100);
+
+/// Frames of each boot after which the drill image stops its frames: 3 s,
+/// the 2 s fade-in and a second of motion.
+pub const DRILL_FRAMES: u64 = 150;
+
+/// A board's hardware watchdog.
+pub trait Watchdog {
+    /// Starts it: the board resets unless fed within `timeout`.
+    fn start(&mut self, timeout: Duration);
+    /// Feeds it, for another `timeout`.
+    fn feed(&mut self, timeout: Duration);
+}
+
+/// Feeds the watchdog after every frame and logs a status line per loop.
+pub struct BoardHooks<W> {
+    watchdog: W,
+    /// The deepest the stack has been, in bytes, as the board measures it.
+    peak_stack: fn() -> u32,
+    /// Frames per loop of the playback.
+    loop_frames: u64,
+    started: bool,
+    max_lateness: u64,
+    #[cfg(feature = "calibrate")]
+    playback: Playback,
+}
+
+impl<W: Watchdog> BoardHooks<W> {
+    /// Hooks feeding `watchdog`, with a status line every loop of
+    /// `playback`; `peak_stack` tells the stack's deepest use.
+    pub fn new(watchdog: W, playback: Playback, peak_stack: fn() -> u32) -> Self {
+        let loop_ms = u64::from(playback.loop_duration().0);
+        let frame_us = u64::from(playback.frame_period().0).max(1);
+        Self {
+            watchdog,
+            peak_stack,
+            loop_frames: (loop_ms * 1000 / frame_us).max(1),
+            started: false,
+            max_lateness: 0,
+            #[cfg(feature = "calibrate")]
+            playback,
+        }
+    }
+}
+
+/// The watchdog timeout the frames feed: [`WATCHDOG_TIMEOUT`], or longer
+/// while the console's `save` or `load` uses the flash.
+fn watchdog_timeout() -> Duration {
+    if FLASH_BUSY.load(Ordering::Acquire) {
+        Duration::from_millis(FLASH_WATCHDOG_MS)
+    } else {
+        WATCHDOG_TIMEOUT
+    }
+}
+
+impl<P: SetDutyCycle, W: Watchdog> FrameHooks<P> for BoardHooks<W> {
+    fn after_frame(&mut self, frame: &Frame, driver: &mut FrameDriver<P>) -> Flow {
+        if self.started {
+            self.watchdog.feed(watchdog_timeout());
+        } else {
+            // The first frame (neutral pulses) is out: from now on frames
+            // must keep coming.
+            self.watchdog.start(WATCHDOG_TIMEOUT);
+            self.started = true;
+            let [p, r, y] = frame.report.servos;
+            defmt::info!(
+                "first frame: neutral pulses {=u32} {=u32} {=u32} us; watchdog armed ({=u64} ms); peak stack {=u32} B",
+                p.pulse.0,
+                r.pulse.0,
+                y.pulse.0,
+                WATCHDOG_TIMEOUT.as_millis(),
+                (self.peak_stack)()
+            );
+        }
+        self.max_lateness = self
+            .max_lateness
+            .max(frame.woke.saturating_sub(frame.deadline));
+        #[cfg(feature = "calibrate")]
+        crate::calibrate::log_frame(frame, &self.playback);
+        let index = frame.tick.frame;
+        if index > 0 && index.is_multiple_of(self.loop_frames) {
+            let stats = driver.stats();
+            defmt::info!(
+                "loop {=u64} done: {=u64} frames written, wake-up at most {=u64} us late, faults {}, disabled {}, peak stack {=u32} B",
+                index / self.loop_frames,
+                stats.frames,
+                Duration::from_ticks(self.max_lateness).as_micros(),
+                stats.faults,
+                stats.disabled,
+                (self.peak_stack)()
+            );
+        }
+        #[cfg(feature = "watchdog-drill")]
+        if index == DRILL_FRAMES {
+            defmt::warn!(
+                "watchdog drill: frames stop after frame {=u64}; the watchdog must reset the board",
+                index
+            );
+            return Flow::Stop;
+        }
+        Flow::Continue
+    }
+}

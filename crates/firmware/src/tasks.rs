@@ -1,0 +1,102 @@
+//! The bodies of the tasks every board runs: the loop generator's,
+//! [`generate`], and the frame task's, [`play`]. Each board calls them from
+//! one-line embassy tasks of its own: the frame task's types are the
+//! board's (embassy tasks cannot be generic), and an embassy task defined
+//! here would be linked into every image of a board, the frame path's
+//! panic proof included, whether it is spawned or not.
+
+use embassy_time::Duration;
+use embedded_hal::pwm::SetDutyCycle;
+use idle_head_core::behaviour::BehaviourParams;
+use idle_head_core::driver::FrameDriver;
+use idle_head_core::idle::{IdleStats, LoopStream, SetInfo};
+use idle_head_core::motion::{AxisError, DEFAULT_N};
+use idle_head_core::playback::Playback;
+
+use crate::boot::{COMMANDS, EXCHANGE, LINK};
+use crate::config::SetRef;
+use crate::frame::{FrameHooks, FrameLoop, RunStats};
+
+/// Generates each next loop set while the frames play (thread mode, below
+/// the frame task), logging each.
+pub async fn generate(mut stream: LoopStream<DEFAULT_N>) -> ! {
+    EXCHANGE
+        .generate_seeded(&mut stream, Some(&LINK), log_set)
+        .await
+}
+
+/// Logs a loop set the generator made.
+fn log_set(result: &Result<SetInfo, AxisError>, ticks: u64) {
+    match result {
+        Ok(info) => defmt::info!(
+            "loop set {=u32} ready in {=u64} us: seeds {:#010x} ({} discarded), entered at {}, join mismatch {} mdeg rms",
+            info.number,
+            Duration::from_ticks(ticks).as_micros(),
+            info.seeds,
+            info.discarded,
+            info.starts,
+            info.mismatch
+        ),
+        Err(e) => defmt::error!(
+            "loop set failed: {=str} {=str}; trying the next seeds",
+            e.axis.name(),
+            e.error.message()
+        ),
+    }
+}
+
+/// The playback the frame task runs at: the default loops at 20 ms frames,
+/// or with the `calibrate` feature the calibration sweep's.
+#[must_use]
+pub const fn playback() -> Playback {
+    #[cfg(feature = "calibrate")]
+    {
+        crate::calibrate::playback(idle_head_core::driver::DriverConfig::DEFAULT.frame_period)
+    }
+    #[cfg(not(feature = "calibrate"))]
+    {
+        crate::config::DEFAULT_PLAYBACK
+    }
+}
+
+/// The frame task's body: plays the idle from loop set `first` (and the
+/// generator's sets after it), with `behaviour` and the console's commands,
+/// through `driver`, each frame on the timer of `tick_hz` ticks a second,
+/// until `hooks` says stop (the frames of a board never stop but in the
+/// watchdog drill). `frame_period` is the board's time between frames (the
+/// QEMU smoke run plays faster than real time). Returns the frames' and the
+/// idle's totals.
+pub async fn play<P: SetDutyCycle, H: FrameHooks<P>>(
+    driver: &mut FrameDriver<P>,
+    first: SetRef,
+    behaviour: BehaviourParams,
+    hooks: &mut H,
+    frame_period: idle_head_core::Microseconds,
+) -> (RunStats, IdleStats) {
+    let start = embassy_time::Instant::now().as_ticks();
+    #[cfg(not(feature = "calibrate"))]
+    let idle = idle_head_core::idle::IdlePlayer::new(
+        first,
+        EXCHANGE.supply(),
+        crate::config::DEFAULT_TIMING,
+        crate::config::IDLE_MODE,
+    );
+    #[cfg(feature = "calibrate")]
+    let idle = {
+        let _ = first;
+        crate::calibrate::player()
+    };
+    let frames =
+        FrameLoop::with_behaviour(idle, frame_period, behaviour, embassy_time::TICK_HZ, start);
+    let Ok(frames) = frames else {
+        defmt::error!("frame period below one timer tick");
+        return (RunStats::default(), IdleStats::default());
+    };
+    let mut frames = frames.with_commands(&COMMANDS).with_link(&LINK);
+    let run = crate::frame::run(driver, &mut frames, hooks).await;
+    #[cfg(not(feature = "calibrate"))]
+    let idle = frames.idle_mut().stats();
+    #[cfg(feature = "calibrate")]
+    let idle = IdleStats::default();
+    (run, idle)
+}

@@ -1,0 +1,292 @@
+//! idle-head on the Raspberry Pi RP2040 and RP2350 (embassy-rp): what the
+//! Pico and Pico 2 boards share, so that a board file only says which pins
+//! and peripherals go where.
+//!
+//! A board makes the [`Board`] (the three servo outputs, the console's
+//! UART and USB driver, the flash, the watchdog) and calls [`start`], which
+//! runs the firmware layer's boot sequence and spawns
+//!
+//! - the frame task, in an interrupt executor on `SWI_IRQ_1` above thread
+//!   mode, so a frame is never delayed by anything below it;
+//! - the loop generator (thread mode): generating a set takes about 2 ms of
+//!   CPU every 28 s, which frames preempt;
+//! - the console on the UART and on the USB serial port (thread mode), whose
+//!   interrupts sit below the frame task's ([`PORT_PRIORITY`]).
+//!
+//! Exactly one chip feature: `rp2040` or `rp235xa`.
+#![no_std]
+#![deny(missing_docs)]
+#![warn(clippy::pedantic)]
+#![allow(clippy::cast_possible_truncation)]
+
+#[cfg(all(feature = "rp2040", feature = "rp235xa"))]
+compile_error!("choose one chip: the `rp2040` or the `rp235xa` feature");
+#[cfg(not(any(feature = "rp2040", feature = "rp235xa")))]
+compile_error!("choose a chip: the `rp2040` or the `rp235xa` feature");
+
+pub mod flash;
+mod panic;
+pub mod pwm;
+pub mod uart;
+pub mod usb;
+
+use core::cell::RefCell;
+
+use embassy_executor::{InterruptExecutor, Spawner};
+use embassy_rp::Peri;
+use embassy_rp::interrupt::{self, InterruptExt, Priority};
+use embassy_rp::peripherals::{FLASH, USB, WATCHDOG};
+use embassy_rp::watchdog::{ResetReason, Watchdog as RpWatchdog};
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_time::Duration;
+
+use idle_head_core::behaviour::BehaviourParams;
+use idle_head_core::console::SharedService;
+use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::idle::LoopStream;
+use idle_head_core::motion::DEFAULT_N;
+use idle_head_core::pwm_clock::{SERVO_PWM_HZ, SliceClock};
+use idle_head_firmware::boot::{self, Clock};
+use idle_head_firmware::config::SetRef;
+use idle_head_firmware::hooks::{BoardHooks, Watchdog};
+use static_cell::StaticCell;
+
+use crate::pwm::ServoPwm;
+use crate::uart::UartPort;
+use crate::usb::UsbPort;
+
+/// The system clock embassy-rp's default configuration runs the RP2040 at.
+#[cfg(feature = "rp2040")]
+pub const SYS_HZ: u32 = 125_000_000;
+/// The system clock embassy-rp's default configuration runs the RP2350 at.
+#[cfg(feature = "rp235xa")]
+pub const SYS_HZ: u32 = 150_000_000;
+
+/// The servo outputs' slice clock: exactly 50 Hz from [`SYS_HZ`] (see
+/// `idle_head_core::pwm_clock`).
+pub const SERVO_CLOCK: SliceClock = match SliceClock::exact(SYS_HZ, SERVO_PWM_HZ) {
+    Ok(clock) => clock,
+    Err(_) => panic!("no exact 50 Hz slice clock"),
+};
+
+/// The ports' interrupt priority: below the frame task's (`P1`), above
+/// thread mode, where the console tasks run.
+pub const PORT_PRIORITY: Priority = Priority::P2;
+
+/// The frame driver's configuration: 50 Hz frames and PWM, hobby servos on
+/// the anatomical limits, a 2 s fade (see `DriverConfig::DEFAULT`).
+const CONFIG: DriverConfig = DriverConfig::DEFAULT;
+
+/// What a board hands over: its peripherals, set up for their part.
+pub struct Board {
+    /// The board's name, for the log.
+    pub name: &'static str,
+    /// The servo outputs `[pitch, roll, yaw]`, each on a PWM slice of its
+    /// own, clocked by [`SERVO_CLOCK`] ([`ServoPwm::new`]).
+    pub servos: [ServoPwm; 3],
+    /// Where the servos are, for the log (`"pitch GP16 (PWM0 A), …"`).
+    pub servo_pins: &'static str,
+    /// The console's UART ([`uart::console`]).
+    pub uart: UartPort,
+    /// Where the UART is, for the log.
+    pub uart_pins: &'static str,
+    /// The USB driver, for the console's USB serial port.
+    pub usb: embassy_rp::usb::Driver<'static, USB>,
+    /// The flash, for the settings store.
+    pub flash: Peri<'static, FLASH>,
+    /// The watchdog.
+    pub watchdog: Peri<'static, WATCHDOG>,
+}
+
+/// The console service, shared by the ports (thread mode only).
+type Service = SharedService<flash::Storage>;
+static SERVICE: StaticCell<Service> = StaticCell::new();
+
+/// The frame task's executor, above thread mode.
+static FRAME_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
+
+#[embassy_rp::interrupt]
+unsafe fn SWI_IRQ_1() {
+    // Note(unsafe): called from this interrupt only, which `start` enables
+    // after the executor is set up.
+    unsafe { FRAME_EXECUTOR.on_interrupt() }
+}
+
+/// Boots the head on `board` and spawns its tasks (see the crate docs);
+/// `spawner` is the thread-mode executor's. Call once, from `main`.
+pub fn start(spawner: Spawner, board: Board) {
+    let watchdog = RpWatchdog::new(board.watchdog);
+    match watchdog.reset_reason() {
+        Some(ResetReason::TimedOut) => {
+            defmt::warn!("boot: last reset by the WATCHDOG (frames had stopped); soft start again");
+        }
+        Some(ResetReason::Forced) => defmt::info!("boot: last reset forced (debugger or software)"),
+        None => defmt::info!("boot: power-on or reset pin"),
+    }
+    log_clocks(board.name, board.servo_pins);
+
+    // Before the first frame: nothing else runs yet while the store is read.
+    let loaded = flash::open(board.flash, &CONFIG);
+    let Ok(booted) = boot::boot(&CONFIG, loaded, &mut Clock, oscillator_jitter()) else {
+        defmt::error!("boot: called twice");
+        return;
+    };
+    if let Some(stream) = booted.stream {
+        spawn(spawner, generator(stream), "generator");
+    }
+
+    let driver = FrameDriver::new(board.servos, booted.driver);
+    // The frame task's interrupt: above thread mode, below the time
+    // driver's alarm (priority 0), which wakes it.
+    interrupt::SWI_IRQ_1.set_priority(Priority::P1);
+    let frames = FRAME_EXECUTOR.start(interrupt::SWI_IRQ_1);
+    if let Ok(token) = frame_task(
+        driver,
+        booted.first,
+        booted.behaviour,
+        BoardWatchdog(watchdog),
+    ) {
+        frames.spawn(token);
+    } else {
+        defmt::error!("frame task already running");
+    }
+
+    let Some(service) = booted.service else {
+        return;
+    };
+    let service: &'static Service = SERVICE.init(Mutex::new(RefCell::new(service)));
+    spawn(spawner, uart_console(board.uart, service), "uart console");
+    defmt::info!("console: UART {=str}, 115200 8N1", board.uart_pins);
+    let (device, serial) = usb::build(board.usb);
+    interrupt::USBCTRL_IRQ.set_priority(PORT_PRIORITY);
+    spawn(spawner, usb_device(device), "usb device");
+    spawn(
+        spawner,
+        usb_console(UsbPort(serial), service),
+        "usb console",
+    );
+    defmt::info!(
+        "console: USB CDC-ACM {=u16:04x}:{=u16:04x}",
+        usb::VID,
+        usb::PID
+    );
+}
+
+/// Spawns `token` on `spawner`, or logs that it could not.
+fn spawn<S>(
+    spawner: Spawner,
+    token: Result<embassy_executor::SpawnToken<S>, embassy_executor::SpawnError>,
+    name: &'static str,
+) {
+    if let Ok(token) = token {
+        spawner.spawn(token);
+    } else {
+        defmt::error!("{=str} task already running", name);
+    }
+}
+
+/// Logs the board, the servo outputs' clocking and the frame timing.
+fn log_clocks(name: &str, servo_pins: &str) {
+    let clock = SERVO_CLOCK;
+    defmt::info!(
+        "{=str}: servos {=str}; {=u32} Hz system clock, divider {=u8}+{=u8}/16, TOP {=u16}, {=u64} ps per count, period {=u64} ns",
+        name,
+        servo_pins,
+        SYS_HZ,
+        clock.divider_int(),
+        clock.divider_frac(),
+        clock.top,
+        clock.count_ps(SYS_HZ),
+        clock.period_ns(SYS_HZ)
+    );
+    let running = embassy_rp::clocks::clk_sys_freq();
+    if running != SYS_HZ {
+        defmt::error!(
+            "system clock {=u32} Hz, not {=u32} Hz: the servo pulses are off by the same ratio",
+            running,
+            SYS_HZ
+        );
+    }
+}
+
+/// 32 bits from the ring oscillator's RANDOMBIT: its jitter against the
+/// system clock, different on every boot and board. The ROSC keeps running
+/// beside the crystal in embassy-rp's default clock configuration. Its bits
+/// are not uniform, so 64 are folded into 32; the console's `seed random`
+/// stirs them further.
+fn oscillator_jitter() -> u32 {
+    let bits = embassy_rp::clocks::RoscRng.next_u64();
+    bits as u32 ^ (bits >> 32) as u32
+}
+
+/// The hardware watchdog, fed by the frame task.
+struct BoardWatchdog(RpWatchdog);
+
+impl Watchdog for BoardWatchdog {
+    fn start(&mut self, timeout: Duration) {
+        self.0.start(timeout);
+    }
+
+    fn feed(&mut self, timeout: Duration) {
+        self.0.feed(timeout);
+    }
+}
+
+/// Bytes of stack used since reset: the stack region was painted before
+/// `main` (cortex-m-rt's `paint-stack`), and the deepest write is the
+/// lowest word that lost its paint.
+fn peak_stack() -> u32 {
+    cortex_m_stack::stack_size().saturating_sub(cortex_m_stack::stack_painted())
+}
+
+// The behaviour's parameters go to the task once, at boot.
+#[allow(clippy::large_types_passed_by_value)]
+#[embassy_executor::task]
+async fn frame_task(
+    mut driver: FrameDriver<ServoPwm>,
+    first: SetRef,
+    behaviour: BehaviourParams,
+    watchdog: BoardWatchdog,
+) {
+    let playback = idle_head_firmware::tasks::playback();
+    let mut hooks = BoardHooks::new(watchdog, playback, peak_stack);
+    let (stats, _) = idle_head_firmware::tasks::play(
+        &mut driver,
+        first,
+        behaviour,
+        &mut hooks,
+        playback.frame_period(),
+    )
+    .await;
+    // The hooks only stop in the watchdog drill; then the watchdog resets
+    // the board.
+    defmt::error!("frame task ended: {}", stats);
+    // The drill stalls here, a hung frame task: the PWM keeps sending the
+    // last pulse until the reset (returning would drop the driver, whose
+    // slices switch off at once, mid-pulse).
+    core::future::pending::<()>().await;
+}
+
+/// Generates each next loop set while the frames play.
+#[embassy_executor::task]
+async fn generator(stream: LoopStream<DEFAULT_N>) {
+    idle_head_firmware::tasks::generate(stream).await;
+}
+
+/// The USB device: enumeration, control requests, bus resets.
+#[embassy_executor::task]
+async fn usb_device(mut device: usb::Device) {
+    device.run().await;
+}
+
+/// The console on the USB serial port: one session per connection.
+#[embassy_executor::task]
+async fn usb_console(mut port: UsbPort, service: &'static Service) {
+    idle_head_firmware::console::run(&mut port, service, "usb").await;
+}
+
+/// The console on the UART, for as long as the board runs.
+#[embassy_executor::task]
+async fn uart_console(mut port: UartPort, service: &'static Service) {
+    idle_head_firmware::console::run(&mut port, service, "uart").await;
+}
