@@ -51,6 +51,7 @@ mod executor;
 mod exit;
 mod pwm;
 mod script;
+#[allow(dead_code)] // its stopwatch is the bench's
 mod systick;
 mod uart;
 
@@ -59,12 +60,12 @@ use core::sync::atomic::Ordering;
 use defmt_semihosting as _;
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head_core::idle::{IdleTiming, LoopStream};
+use idle_head_core::idle::IdleTiming;
 use idle_head_core::motion::DEFAULT_N;
 use idle_head_core::settings::RamStorage;
 use idle_head_core::{Microseconds, Millis, Playback};
-use idle_head_firmware::boot::{self, COMMANDS, Loaded};
-use idle_head_firmware::config::{LOOP_DURATION, SetRef};
+use idle_head_firmware::boot::{self, COMMANDS, EXCHANGE, Generator, Loaded};
+use idle_head_firmware::config::LOOP_DURATION;
 use idle_head_firmware::tasks;
 
 use crate::checks::Checks;
@@ -128,15 +129,7 @@ fn main() -> ! {
         CONFIG.servos[0].max_pulse.0
     );
 
-    // Precompute cost: SysTick counts 12.5 MHz, i.e. 80 instructions per
-    // count under `-icount shift=0` (see systick.rs).
-    let booted = boot::boot(
-        &CONFIG,
-        Loaded::defaults(RamStorage::new()),
-        &mut systick::Stopwatch(&mut core.SYST),
-        0,
-    );
-    let Ok(booted) = booted else {
+    let Ok(booted) = boot::boot(&CONFIG, Loaded::defaults(RamStorage::new()), 0) else {
         exit::exit(false)
     };
     let hold = console::held_by_host();
@@ -150,11 +143,9 @@ fn main() -> ! {
     let Some((thread, frame_executor)) = executor::take() else {
         exit::exit(false)
     };
-    if let Some(stream) = booted.stream {
-        match generator(stream) {
-            Ok(token) => thread.spawner().spawn(token),
-            Err(_) => exit::exit(false),
-        }
+    match generator(booted.generator) {
+        Ok(token) => thread.spawner().spawn(token),
+        Err(_) => exit::exit(false),
     }
     // Settings in Pico units (the frame task's behaviour is built for
     // them too); status reports Pico time (frames of 20 ms).
@@ -165,40 +156,34 @@ fn main() -> ! {
         Ok(token) => thread.spawner().spawn(token),
         Err(_) => exit::exit(false),
     }
-    let run = Run {
-        precompute_insns: booted.precompute,
-        checksum: booted.checksum,
-        generated: booted.generated,
-    };
-    match frame_task(booted.first, booted.driver, booted.behaviour, run) {
+    match frame_task(booted.driver, booted.behaviour) {
         Ok(token) => frame_executor.spawner().spawn(token),
         Err(_) => exit::exit(false),
     }
     executor::run(&mut core.NVIC, thread, frame_executor)
 }
 
-/// Generates each next loop set while the frames play (thread mode).
+/// Generates loop set 0 (its cost measured in instructions: SysTick counts
+/// 12.5 MHz, 80 instructions per count under `-icount shift=0`, see
+/// systick.rs), then each next loop set while the frames play (thread mode).
 #[embassy_executor::task]
-async fn generator(stream: LoopStream<DEFAULT_N>) {
-    tasks::generate(stream).await
+async fn generator(generator: Generator) {
+    tasks::generate(generator, systick::Instructions).await;
 }
 
-/// What the boot run measured, for the summary line.
-struct Run {
-    precompute_insns: u64,
-    checksum: u32,
-    generated: bool,
-}
-
+// The behaviour's parameters go to the task once, at boot.
+#[allow(clippy::large_types_passed_by_value)]
 #[embassy_executor::task]
-async fn frame_task(first: SetRef, params: DriverParams, behaviour: BehaviourParams, run: Run) {
+async fn frame_task(params: DriverParams, behaviour: BehaviourParams) {
     let channels = CONFIG
         .servos
         .map(|servo| VirtualPwm::new(PICO_TOP, CONFIG.pwm.period, &servo));
     let mut driver = FrameDriver::new(channels, params);
     // The script's commands share the console's queue, as a board's would.
     let mut checks = Checks::new(CONFIG, &COMMANDS, console::HOLD.load(Ordering::Relaxed));
-    let (stats, idle) = tasks::play(&mut driver, first, behaviour, &mut checks, FRAME_PERIOD).await;
+    let (first, run) = EXCHANGE.first().await;
+    let (stats, idle) =
+        tasks::play(&mut driver, first, &behaviour, &mut checks, FRAME_PERIOD).await;
     defmt::info!(
         "frame timing: {=u64} frames, {=u64} missed, wake-up at most {=u64} us after the deadline",
         stats.frames,
@@ -229,7 +214,7 @@ async fn frame_task(first: SetRef, params: DriverParams, behaviour: BehaviourPar
         stats.frames,
         stats.missed,
         violations,
-        run.precompute_insns,
+        run.precompute,
         run.checksum,
         faults,
         disabled

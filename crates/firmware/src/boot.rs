@@ -3,30 +3,30 @@
 //!
 //! A board reads its settings store ([`crate::storage::open`], or
 //! [`Loaded::defaults`] for a board without one) and calls [`boot`], which
+//! logs the servo configuration the head starts with, takes the two loop set
+//! buffers and makes the console service; it returns what the board's tasks
+//! need. The board then spawns the loop generator, the frame task above it
+//! and the console ports (see `idle-head-rp` for the RP boards,
+//! `boards/qemu` for QEMU).
 //!
-//! 1. logs the servo configuration the head starts with;
-//! 2. generates loop set 0 from the settings' seeds into the first of the
-//!    two loop set buffers and logs what it took;
-//! 3. starts the never-repeating stream from it, hands the second buffer to
-//!    the generator, and makes the console service;
-//!
-//! and returns what the board's tasks need: the frame task's first set and
-//! parameters, the generator's stream, the console's service. The board then
-//! spawns the frame task above the generator and the console ports (see
-//! `idle-head-rp` for the RP boards, `boards/qemu` for QEMU).
+//! The generator's first job is loop set 0, from the settings' seeds
+//! ([`crate::tasks::generate`]): the frame task waits for it before its
+//! first frame. Generating it there rather than here keeps the deepest
+//! stack of the boot (the generation) on the generator's own, shallow
+//! frame, instead of on top of everything the boot sequence holds.
 
 use embassy_time::Instant;
 use idle_head_core::Axis;
 use idle_head_core::behaviour::{BehaviourParams, CommandQueue};
 use idle_head_core::console::{ConsoleLink, ConsoleService};
-use idle_head_core::driver::{DriverConfig, DriverParams};
-use idle_head_core::idle::{IdleMode, LoopStream};
-use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig};
+use idle_head_core::driver::DriverConfig;
+use idle_head_core::driver::DriverParams;
+use idle_head_core::motion::{DEFAULT_HEAD, HeadConfig};
 use idle_head_core::settings::{Settings, SettingsSource, SettingsStorage, Validated};
 use static_cell::ConstStaticCell;
 
-use crate::config::{DEFAULT_TIMING, IDLE_MODE, Set, SetRef};
-use crate::exchange::Exchange;
+use crate::config::{Set, SetRef};
+use crate::exchange::{Exchange, FirstSet};
 
 /// Actions from the console ports (and the inputs) to the frame task, which
 /// it drains between frames.
@@ -107,25 +107,28 @@ impl Stopwatch for Clock {
     }
 }
 
+/// What the generator task starts from: the idle's configuration and the
+/// two loop set buffers.
+pub struct Generator {
+    /// The idle's configuration, with the settings' seeds.
+    pub head: HeadConfig,
+    /// The buffer loop set 0 is generated into.
+    pub first: SetRef,
+    /// The other buffer.
+    pub spare: SetRef,
+}
+
 /// What the boot sequence hands the board's tasks.
 pub struct Booted<S: 'static> {
-    /// Loop set 0, generated: the frame task plays it first.
-    pub first: SetRef,
-    /// The never-repeating stream for the generator task (`None` for the
-    /// fixed loop).
-    pub stream: Option<LoopStream<DEFAULT_N>>,
+    /// The loop generator's start (it generates loop set 0, which the frame
+    /// task waits for, then each next set).
+    pub generator: Generator,
     /// The driver's parameters of the settings in effect.
     pub driver: DriverParams,
     /// The behaviour's parameters of the settings in effect.
     pub behaviour: BehaviourParams,
     /// The console's service, on the board's storage.
     pub service: Option<ConsoleService<'static, S>>,
-    /// Loop set 0's checksum (the host computes the same).
-    pub checksum: u32,
-    /// Whether loop set 0 was generated (else it holds the neutral pose).
-    pub generated: bool,
-    /// What generating loop set 0 took, in the stopwatch's unit.
-    pub precompute: u64,
 }
 
 /// Why [`boot`] could not run.
@@ -144,14 +147,44 @@ pub enum BootError {
 pub fn boot<S: SettingsStorage>(
     base: &DriverConfig,
     loaded: Loaded<S>,
-    stopwatch: &mut dyn Stopwatch,
     entropy: u32,
 ) -> Result<Booted<S>, BootError> {
-    log_servos(base, &loaded);
+    log_servos(&loaded);
     let [first, spare] = SETS.try_take().ok_or(BootError::AlreadyBooted)?;
     let head = loaded.head();
+    let Loaded {
+        storage,
+        settings,
+        source,
+        valid,
+    } = loaded;
+    let service = match ConsoleService::new(&COMMANDS, &LINK, storage, *base, settings, source) {
+        Ok(mut service) => {
+            service.add_entropy(entropy);
+            Some(service)
+        }
+        Err(e) => {
+            defmt::error!("console: no service: {}", e);
+            None
+        }
+    };
+    Ok(Booted {
+        generator: Generator { head, first, spare },
+        driver: valid.driver,
+        behaviour: valid.behaviour,
+        service,
+    })
+}
+
+/// Generates loop set 0 of `head` into `first` and logs it (the generator
+/// task's first step).
+pub(crate) fn first_set(
+    first: &mut Set,
+    head: &HeadConfig,
+    stopwatch: &mut impl Stopwatch,
+) -> FirstSet {
     let mut generated = Err(None);
-    let precompute = stopwatch.time(&mut || generated = first.generate(&head).map_err(Some));
+    let precompute = stopwatch.time(&mut || generated = first.generate(head).map_err(Some));
     let generated = match generated {
         Ok(info) => {
             for (axis, info) in Axis::ALL.iter().zip(info.iter()) {
@@ -183,56 +216,15 @@ pub fn boot<S: SettingsStorage>(
         stopwatch.unit(),
         checksum
     );
-    let stream = match IDLE_MODE {
-        IdleMode::NeverRepeating => {
-            // The stream starts from the boot set, whose pace it measures
-            // (a fixed loop has no stream and skips that).
-            let mut stream = LoopStream::new(head, &DEFAULT_TIMING);
-            stream.adopt(first);
-            defmt::info!(
-                "idle: never repeating, a new loop set every {=u32} frames, joined over {=u32}",
-                DEFAULT_TIMING.period(),
-                DEFAULT_TIMING.join_frames
-            );
-            EXCHANGE.give(spare);
-            Some(stream)
-        }
-        IdleMode::FixedLoop => {
-            defmt::info!("idle: the fixed loop, replayed every loop");
-            None
-        }
-    };
-    let Loaded {
-        storage,
-        settings,
-        source,
-        valid,
-    } = loaded;
-    let service = match ConsoleService::new(&COMMANDS, &LINK, storage, *base, settings, source) {
-        Ok(mut service) => {
-            service.add_entropy(checksum ^ entropy);
-            Some(service)
-        }
-        Err(e) => {
-            defmt::error!("console: no service: {}", e);
-            None
-        }
-    };
-    Ok(Booted {
-        first,
-        stream,
-        driver: valid.driver,
-        behaviour: valid.behaviour,
-        service,
+    FirstSet {
         checksum,
         generated,
         precompute,
-    })
+    }
 }
 
 /// Logs each servo's calibration as the head starts with it.
-fn log_servos<S>(base: &DriverConfig, loaded: &Loaded<S>) {
-    let _ = base;
+fn log_servos<S>(loaded: &Loaded<S>) {
     for (axis, servo) in Axis::ALL.iter().zip(loaded.settings.servos.iter()) {
         defmt::info!(
             "{=str}: neutral {=u32} us, {=u32} ns/deg, pulses [{=u32}, {=u32}] us, limits [{=i32}, {=i32}] mdeg",

@@ -18,12 +18,27 @@ use idle_head_core::motion::{AxisError, DEFAULT_N};
 
 use crate::config::SetRef;
 
+/// What generating loop set 0 gave, for the boards' logs and checks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+pub struct FirstSet {
+    /// Its checksum (the host computes the same).
+    pub checksum: u32,
+    /// Whether it was generated (else it holds the neutral pose).
+    pub generated: bool,
+    /// What it took, in the stopwatch's unit.
+    pub precompute: u64,
+}
+
 /// The two one-slot channels the loop set buffers go round through: `free`
 /// (a set the frame task no longer reads) and `ready` (a set generated,
 /// waiting for its join). With two buffers, one plays while the other is
 /// generated or waits: each slot holds at most one set, so none is ever
 /// overwritten (a set signalled over another would be lost, never shared).
+///
+/// Loop set 0 goes from the generator to the frame task through a slot of
+/// its own, `first`: the frame task waits for it before its first frame.
 pub struct Exchange {
+    first: Signal<CriticalSectionRawMutex, (SetRef, FirstSet)>,
     free: Signal<CriticalSectionRawMutex, SetRef>,
     ready: Signal<CriticalSectionRawMutex, SetRef>,
 }
@@ -33,9 +48,20 @@ impl Exchange {
     #[must_use]
     pub const fn new() -> Self {
         Self {
+            first: Signal::new(),
             free: Signal::new(),
             ready: Signal::new(),
         }
+    }
+
+    /// Hands loop set 0, generated, to the frame task.
+    pub fn start(&self, set: SetRef, info: FirstSet) {
+        self.first.signal((set, info));
+    }
+
+    /// The frame task's wait for loop set 0.
+    pub async fn first(&self) -> (SetRef, FirstSet) {
+        self.first.wait().await
     }
 
     /// Hands `set` to the generator (at boot: the buffer not playing).

@@ -9,20 +9,43 @@ use embassy_time::Duration;
 use embedded_hal::pwm::SetDutyCycle;
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::driver::FrameDriver;
-use idle_head_core::idle::{IdleStats, LoopStream, SetInfo};
-use idle_head_core::motion::{AxisError, DEFAULT_N};
+use idle_head_core::idle::{IdleMode, IdleStats, LoopStream, SetInfo};
+use idle_head_core::motion::AxisError;
 use idle_head_core::playback::Playback;
 
-use crate::boot::{COMMANDS, EXCHANGE, LINK};
-use crate::config::SetRef;
+use crate::boot::{COMMANDS, EXCHANGE, Generator, LINK, Stopwatch, first_set};
+use crate::config::{DEFAULT_TIMING, IDLE_MODE, SetRef};
 use crate::frame::{FrameHooks, FrameLoop, RunStats};
 
-/// Generates each next loop set while the frames play (thread mode, below
-/// the frame task), logging each.
-pub async fn generate(mut stream: LoopStream<DEFAULT_N>) -> ! {
-    EXCHANGE
-        .generate_seeded(&mut stream, Some(&LINK), log_set)
-        .await
+/// The generator task's body: generates loop set 0 (timed by `stopwatch`)
+/// and hands it to the frame task, then each next set while the frames
+/// play (thread mode, below the frame task), logging each.
+pub async fn generate(generator: Generator, mut stopwatch: impl Stopwatch) -> ! {
+    let Generator { head, first, spare } = generator;
+    let info = first_set(first, &head, &mut stopwatch);
+    match IDLE_MODE {
+        IdleMode::NeverRepeating => {
+            // The stream starts from the boot set, whose pace it measures
+            // (a fixed loop has no stream and skips that).
+            let mut stream = LoopStream::new(head, &DEFAULT_TIMING);
+            stream.adopt(first);
+            defmt::info!(
+                "idle: never repeating, a new loop set every {=u32} frames, joined over {=u32}",
+                DEFAULT_TIMING.period(),
+                DEFAULT_TIMING.join_frames
+            );
+            EXCHANGE.start(first, info);
+            EXCHANGE.give(spare);
+            EXCHANGE
+                .generate_seeded(&mut stream, Some(&LINK), log_set)
+                .await
+        }
+        IdleMode::FixedLoop => {
+            defmt::info!("idle: the fixed loop, replayed every loop");
+            EXCHANGE.start(first, info);
+            core::future::pending().await
+        }
+    }
 }
 
 /// Logs a loop set the generator made.
@@ -59,7 +82,8 @@ pub const fn playback() -> Playback {
     }
 }
 
-/// The frame task's body: plays the idle from loop set `first` (and the
+/// The frame task's body: plays the idle from loop set `first` (from
+/// [`Exchange::first`](crate::exchange::Exchange::first); and the
 /// generator's sets after it), with `behaviour` and the console's commands,
 /// through `driver`, each frame on the timer of `tick_hz` ticks a second,
 /// until `hooks` says stop (the frames of a board never stop but in the
@@ -69,25 +93,21 @@ pub const fn playback() -> Playback {
 pub async fn play<P: SetDutyCycle, H: FrameHooks<P>>(
     driver: &mut FrameDriver<P>,
     first: SetRef,
-    behaviour: BehaviourParams,
+    behaviour: &BehaviourParams,
     hooks: &mut H,
     frame_period: idle_head_core::Microseconds,
 ) -> (RunStats, IdleStats) {
     let start = embassy_time::Instant::now().as_ticks();
     #[cfg(not(feature = "calibrate"))]
-    let idle = idle_head_core::idle::IdlePlayer::new(
-        first,
-        EXCHANGE.supply(),
-        crate::config::DEFAULT_TIMING,
-        crate::config::IDLE_MODE,
-    );
+    let idle =
+        idle_head_core::idle::IdlePlayer::new(first, EXCHANGE.supply(), DEFAULT_TIMING, IDLE_MODE);
     #[cfg(feature = "calibrate")]
     let idle = {
         let _ = first;
         crate::calibrate::player()
     };
     let frames =
-        FrameLoop::with_behaviour(idle, frame_period, behaviour, embassy_time::TICK_HZ, start);
+        FrameLoop::with_behaviour(idle, frame_period, *behaviour, embassy_time::TICK_HZ, start);
     let Ok(frames) = frames else {
         defmt::error!("frame period below one timer tick");
         return (RunStats::default(), IdleStats::default());

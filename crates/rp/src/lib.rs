@@ -43,11 +43,8 @@ use embassy_time::Duration;
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::console::SharedService;
 use idle_head_core::driver::{DriverConfig, FrameDriver};
-use idle_head_core::idle::LoopStream;
-use idle_head_core::motion::DEFAULT_N;
 use idle_head_core::pwm_clock::{SERVO_PWM_HZ, SliceClock};
-use idle_head_firmware::boot::{self, Clock};
-use idle_head_firmware::config::SetRef;
+use idle_head_firmware::boot::{self, Clock, EXCHANGE, Generator};
 use idle_head_firmware::hooks::{BoardHooks, Watchdog};
 use static_cell::StaticCell;
 
@@ -127,25 +124,18 @@ pub fn start(spawner: Spawner, board: Board) {
 
     // Before the first frame: nothing else runs yet while the store is read.
     let loaded = flash::open(board.flash, &CONFIG);
-    let Ok(booted) = boot::boot(&CONFIG, loaded, &mut Clock, oscillator_jitter()) else {
+    let Ok(booted) = boot::boot(&CONFIG, loaded, oscillator_jitter()) else {
         defmt::error!("boot: called twice");
         return;
     };
-    if let Some(stream) = booted.stream {
-        spawn(spawner, generator(stream), "generator");
-    }
+    spawn(spawner, generator(booted.generator), "generator");
 
     let driver = FrameDriver::new(board.servos, booted.driver);
     // The frame task's interrupt: above thread mode, below the time
     // driver's alarm (priority 0), which wakes it.
     interrupt::SWI_IRQ_1.set_priority(Priority::P1);
     let frames = FRAME_EXECUTOR.start(interrupt::SWI_IRQ_1);
-    if let Ok(token) = frame_task(
-        driver,
-        booted.first,
-        booted.behaviour,
-        BoardWatchdog(watchdog),
-    ) {
+    if let Ok(token) = frame_task(driver, booted.behaviour, BoardWatchdog(watchdog)) {
         frames.spawn(token);
     } else {
         defmt::error!("frame task already running");
@@ -244,16 +234,17 @@ fn peak_stack() -> u32 {
 #[embassy_executor::task]
 async fn frame_task(
     mut driver: FrameDriver<ServoPwm>,
-    first: SetRef,
     behaviour: BehaviourParams,
     watchdog: BoardWatchdog,
 ) {
     let playback = idle_head_firmware::tasks::playback();
     let mut hooks = BoardHooks::new(watchdog, playback, peak_stack);
+    // Loop set 0, from the generator: about 3 ms after boot.
+    let (first, _) = EXCHANGE.first().await;
     let (stats, _) = idle_head_firmware::tasks::play(
         &mut driver,
         first,
-        behaviour,
+        &behaviour,
         &mut hooks,
         playback.frame_period(),
     )
@@ -267,10 +258,10 @@ async fn frame_task(
     core::future::pending::<()>().await;
 }
 
-/// Generates each next loop set while the frames play.
+/// Generates loop set 0, then each next loop set while the frames play.
 #[embassy_executor::task]
-async fn generator(stream: LoopStream<DEFAULT_N>) {
-    idle_head_firmware::tasks::generate(stream).await;
+async fn generator(generator: Generator) {
+    idle_head_firmware::tasks::generate(generator, Clock).await;
 }
 
 /// The USB device: enumeration, control requests, bus resets.
