@@ -124,9 +124,6 @@ impl AxisConfig {
         if r.min.millidegrees() >= 0 || r.max.millidegrees() <= 0 {
             return Err(MotionError::RangeExcludesNeutral { range: r });
         }
-        if matches!(self.closure, Closure::Paper) && !cfg!(feature = "paper-closure") {
-            return Err(MotionError::ClosureNotBuilt);
-        }
         Ok(())
     }
 

@@ -105,9 +105,6 @@ pub enum MotionError {
         /// The seed.
         seed: u32,
     },
-    /// [`Closure::Paper`](super::Closure::Paper) asked of a build without
-    /// it (the `paper-closure` feature; the firmware images leave it out).
-    ClosureNotBuilt,
 }
 
 /// The parts of an error's text.
@@ -138,7 +135,6 @@ const WINDOW: &str = "window W";
 const STEP: &str = "step δ";
 const RANGE: &str = "range";
 const SEED: &str = "seed";
-const CLOSURE: &str = "closure";
 
 /// [`MAX_STEP`] in whole degrees, for the static message.
 const MAX_STEP_DEGREES: i32 = MAX_STEP.millidegrees() / Angle::SCALE;
@@ -152,7 +148,6 @@ enum Value {
     Angle(Angle),
     Range(AngleRange),
     AtMost(u16),
-    Name(&'static str),
 }
 
 impl MotionError {
@@ -188,12 +183,6 @@ impl MotionError {
                     "the smoothed walk is flat, no motion to scale: choose another seed"
                 )
             }
-            Self::ClosureNotBuilt => {
-                text!(
-                    CLOSURE,
-                    "the paper's closure is not in this build (feature `paper-closure`)"
-                )
-            }
         }
     }
 
@@ -218,7 +207,6 @@ impl MotionError {
             | Self::RangeOutsideLimits { range, .. }
             | Self::StorageOverflow { range } => Value::Range(range),
             Self::Degenerate { seed } => Value::Seed(seed),
-            Self::ClosureNotBuilt => Value::Name("paper"),
         }
     }
 
@@ -242,7 +230,6 @@ impl fmt::Display for Value {
             Value::Angle(angle) => write!(f, "{angle}"),
             Value::Range(range) => write!(f, "{range}"),
             Value::AtMost(max) => write!(f, "at most {max}"),
-            Value::Name(name) => f.write_str(name),
         }
     }
 }
@@ -272,7 +259,6 @@ impl defmt::Format for Value {
             Value::Angle(angle) => defmt::write!(f, "{}", angle),
             Value::Range(range) => defmt::write!(f, "{}", range),
             Value::AtMost(max) => defmt::write!(f, "at most {=u16}", max),
-            Value::Name(name) => defmt::write!(f, "{=str}", name),
         }
     }
 }

@@ -52,7 +52,6 @@
 //!   forms ΔX·m with m sized by the largest |ΔX|: < 2³¹.
 #![allow(clippy::many_single_char_names)] // the notation of the derivation above
 
-#[cfg(feature = "paper-closure")]
 mod paper;
 mod scale;
 mod seamless;
@@ -118,11 +117,7 @@ pub(super) fn generate<S: Sample, T: Trace, const CAP: usize>(
     }
     match cfg.closure {
         Closure::Seamless => seamless::seamless(out, cfg, kernel, trace),
-        #[cfg(feature = "paper-closure")]
         Closure::Paper => paper::paper(out, cfg, kernel, trace),
-        // `AxisConfig::validate` refuses it first.
-        #[cfg(not(feature = "paper-closure"))]
-        Closure::Paper => Err(MotionError::ClosureNotBuilt),
     }
 }
 
@@ -136,7 +131,6 @@ pub(super) struct Basics<'k> {
     /// The kernel table, W entries.
     table: &'k [(i16, i16)],
     /// The table scale Q (the paper's closure only).
-    #[cfg_attr(not(feature = "paper-closure"), allow(dead_code))]
     q: i32,
     /// Q².
     qq: i32,
@@ -163,14 +157,12 @@ impl<'k> Basics<'k> {
 /// The paper's closure quantises with it; the seamless one does the same
 /// inside its sweep.
 #[derive(Clone, Copy)]
-#[cfg_attr(not(feature = "paper-closure"), allow(dead_code))]
 pub(super) struct Quantiser {
     /// The inputs' sum so far, modulo 2^shift.
     residue: i32,
     shift: u32,
 }
 
-#[cfg_attr(not(feature = "paper-closure"), allow(dead_code))]
 impl Quantiser {
     /// A quantiser by 2^`shift` with nothing carried over.
     pub(super) const fn new(shift: u32) -> Self {
