@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 
 use crate::{
     args::{Bless, Budget, Options, Timeout},
-    console, metrics, preview, sim, trace, uf2,
+    console, flash, metrics, preview, sim, trace, uf2,
 };
 
 /// Project commands of idle-head: build and run the firmware in QEMU, test,
@@ -133,6 +133,13 @@ pub enum Command {
     /// back and compared with the ELF before it is kept. Copy it onto the
     /// USB drive the board shows when it is plugged in with BOOTSEL held.
     Uf2(uf2::Args),
+    /// Flash an image: the runner of `cargo run --release`.
+    ///
+    /// Copies the image's UF2 onto the board's BOOTSEL drive if one is
+    /// mounted; else runs `probe-rs run --chip <chip> <ELF>` if probe-rs is
+    /// installed; else writes the UF2 and says how to flash it, or what to
+    /// install.
+    Flash(flash::Args),
 }
 
 impl Command {
@@ -226,6 +233,7 @@ mod tests {
         assert!(error(&["qemu", "--timeout", "-5"]).contains("--timeout"));
         assert!(error(&["preview", "--bogus"]).contains("--bogus"));
         assert!(error(&["deploy"]).contains("deploy"));
+        assert!(error(&["flash"]).contains("<ELF>"));
         assert!(error(&["uf2", "--board", "pico3"]).contains("pico3"));
     }
 

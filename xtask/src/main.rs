@@ -16,6 +16,8 @@
 //! - `cargo xtask trace`: the firmware's frames simulated on the host, with
 //!   scripted gestures and looks, as CSV and PNG.
 //! - `cargo xtask uf2`: the firmware as a UF2 file for a board's BOOTSEL drive.
+//! - `cargo xtask flash`: the runner of `cargo run --release`: BOOTSEL drive,
+//!   debug probe, or what to install.
 //!
 //! The firmware commands install what they need and is missing: the
 //! firmware's Rust target and, when running as root on Debian or Ubuntu, QEMU.
@@ -27,6 +29,7 @@ mod board;
 mod cli;
 mod console;
 mod elf;
+mod flash;
 mod fonts;
 mod log;
 mod metrics;
@@ -73,6 +76,7 @@ fn main() -> ExitCode {
         Some(Command::Trace(args)) => trace::command(&args),
         Some(Command::Console(args)) => console::command(&args),
         Some(Command::Uf2(args)) => uf2::command(&args),
+        Some(Command::Flash(args)) => flash::command(&args),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,
