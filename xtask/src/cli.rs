@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 
 use crate::{
     args::{Bless, Budget, Options, Timeout},
-    console, metrics, preview, sim, trace,
+    console, flash, metrics, preview, sim, trace, uf2,
 };
 
 /// Project commands of idle-head: build and run the firmware in QEMU, test,
@@ -124,6 +124,22 @@ pub enum Command {
     /// line printed. With --port <dev> that serial port is opened (115200
     /// 8N1); with neither, the Pico is found by its USB VID:PID 16c0:27dd.
     Console(console::Args),
+    /// Write the firmware as a UF2 file, for a board in BOOTSEL mode.
+    ///
+    /// Builds the board's release image (unless an ELF is given) and writes
+    /// <ELF>.uf2 beside it: the ELF's loadable segments at their flash
+    /// addresses, one 256-byte page per block, of the board's UF2 family
+    /// (RP2040 0xe48bff56; RP2350 Arm Secure 0xe48bff59). The file is read
+    /// back and compared with the ELF before it is kept. Copy it onto the
+    /// USB drive the board shows when it is plugged in with BOOTSEL held.
+    Uf2(uf2::Args),
+    /// Flash an image: the runner of `cargo run --release`.
+    ///
+    /// Copies the image's UF2 onto the board's BOOTSEL drive if one is
+    /// mounted; else runs `probe-rs run --chip <chip> <ELF>` if probe-rs is
+    /// installed; else writes the UF2 and says how to flash it, or what to
+    /// install.
+    Flash(flash::Args),
 }
 
 impl Command {
@@ -216,7 +232,9 @@ mod tests {
         assert!(error(&["metrics", "--n", "-3"]).contains("--n"));
         assert!(error(&["qemu", "--timeout", "-5"]).contains("--timeout"));
         assert!(error(&["preview", "--bogus"]).contains("--bogus"));
-        assert!(error(&["flash"]).contains("flash"));
+        assert!(error(&["deploy"]).contains("deploy"));
+        assert!(error(&["flash"]).contains("<ELF>"));
+        assert!(error(&["uf2", "--board", "pico3"]).contains("pico3"));
     }
 
     #[test]

@@ -15,6 +15,9 @@
 //!   checked against the host frame for frame.
 //! - `cargo xtask trace`: the firmware's frames simulated on the host, with
 //!   scripted gestures and looks, as CSV and PNG.
+//! - `cargo xtask uf2`: the firmware as a UF2 file for a board's BOOTSEL drive.
+//! - `cargo xtask flash`: the runner of `cargo run --release`: BOOTSEL drive,
+//!   debug probe, or what to install.
 //!
 //! The firmware commands install what they need and is missing: the
 //! firmware's Rust target and, when running as root on Debian or Ubuntu, QEMU.
@@ -22,12 +25,15 @@
 
 mod args;
 mod bench;
+mod board;
 mod cli;
 mod console;
 mod elf;
+mod flash;
 mod fonts;
 mod log;
 mod metrics;
+mod pico2;
 mod preview;
 mod project;
 mod qemu;
@@ -38,6 +44,7 @@ mod sim;
 mod snapshot;
 mod test;
 mod trace;
+mod uf2;
 
 use std::process::ExitCode;
 
@@ -68,6 +75,8 @@ fn main() -> ExitCode {
         Some(Command::Sim(args)) => sim::command(&args),
         Some(Command::Trace(args)) => trace::command(&args),
         Some(Command::Console(args)) => console::command(&args),
+        Some(Command::Uf2(args)) => uf2::command(&args),
+        Some(Command::Flash(args)) => flash::command(&args),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

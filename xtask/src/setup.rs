@@ -5,7 +5,10 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use xshell::{Shell, cmd};
 
-use crate::project::{self, TARGET};
+use crate::{
+    board::PICO2_TARGET,
+    project::{self, TARGET},
+};
 
 /// QEMU's system emulator for Arm, and the Debian/Ubuntu package that has it.
 pub const QEMU_BINARY: &str = "qemu-system-arm";
@@ -14,7 +17,7 @@ const QEMU_PACKAGE: &str = "qemu-system-arm";
 /// Rustup components the checks use.
 const COMPONENTS: [&str; 2] = ["rustfmt", "clippy"];
 
-/// Adds the firmware target, rustfmt and clippy to the toolchain the
+/// Adds the firmware targets, rustfmt and clippy to the toolchain the
 /// repository uses (the one named by `rust-toolchain.toml`, so rustup runs in
 /// the repository root).
 pub fn ensure_toolchain(root: &Path) -> Result<()> {
@@ -36,8 +39,12 @@ pub fn ensure_toolchain(root: &Path) -> Result<()> {
     let Some(targets) = installed("target") else {
         return Ok(());
     };
-    if !targets.iter().any(|target| target == TARGET) {
-        project::run(&sh, &[], cmd!(sh, "rustup target add {TARGET}"))?;
+    let missing: Vec<&str> = [TARGET, PICO2_TARGET]
+        .into_iter()
+        .filter(|wanted| !targets.iter().any(|target| target == wanted))
+        .collect();
+    if !missing.is_empty() {
+        project::run(&sh, &[], cmd!(sh, "rustup target add {missing...}"))?;
     }
     let components = installed("component").unwrap_or_default();
     let missing: Vec<&str> = COMPONENTS

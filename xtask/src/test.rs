@@ -11,9 +11,10 @@ use crate::{
     args::Options,
     bench, console, elf,
     log::Run,
+    pico2,
     project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
     qemu::{self, Echo},
-    setup, sim, snapshot,
+    setup, sim, snapshot, uf2,
 };
 
 /// How a stage ended.
@@ -140,12 +141,16 @@ pub fn command(options: Options) -> Result<bool> {
             "Pico image: .boot2 placement, memory budgets, no allocator",
             || elf::check_pico(&PICO.elf(&metadata)),
         );
+        stages.run(uf2::PICO_STAGE, || uf2::test_pico(&metadata));
     } else {
         stages.blocked(
             "Pico image: .boot2 placement, memory budgets, no allocator",
             "the Pico build",
         );
+        stages.blocked(uf2::PICO_STAGE, "the Pico build");
     }
+    // The Pico 2 on its own: its embassy-rp chip feature excludes the Pico's.
+    stages.run(pico2::STAGE, || pico2::test(&metadata));
 
     // The calibration image (same bin, feature `calibrate`): it must compile.
     stages.run(
@@ -204,6 +209,17 @@ fn clippy_stages(stages: &mut Stages, sh: &Shell, host_tests: &Shell, xtask: &Sh
             ),
         )
     });
+    stages.run(
+        "clippy: Pico 2 image, boards/pico2/ (thumbv8m.main)",
+        || {
+            let pico2 = project::shell("boards/pico2")?;
+            project::run(
+                &pico2,
+                FIRMWARE_ENV,
+                cmd!(pico2, "cargo clippy --release -- -D warnings"),
+            )
+        },
+    );
     stages.run("clippy: core crate and its unit tests (host)", || {
         project::run(
             sh,

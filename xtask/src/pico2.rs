@@ -1,0 +1,148 @@
+//! The Raspberry Pi Pico 2 image (boards/pico2, RP2350): where its boot
+//! ROM finds it, its memory, its UF2.
+//!
+//! The RP2350 boot ROM has no second stage to load. It searches the first
+//! 4 KiB of flash for a block, between the markers `0xffffded3` and
+//! `0xab123579`, that declares the image (an `IMAGE_DEF`: embassy-rp links
+//! one into `.start_block`), and starts it from the vector table at the
+//! start of flash. No emulator runs this image here: these checks are all
+//! that is known of it before it meets a board.
+
+use std::{ops::Range, path::Path};
+
+use anyhow::{Context, Result, bail};
+use object::{Object, ObjectSection};
+
+use crate::{board::Board, elf, project::Metadata, uf2};
+
+/// Where the boot ROM searches for the image's first block: the first
+/// 4 KiB of flash.
+pub const BLOCK_SEARCH: Range<u64> = 0x1000_0000..0x1000_1000;
+/// Where the vector table must be: the start of flash.
+pub const VECTOR_TABLE: u64 = 0x1000_0000;
+/// A block's first word (`PICOBIN_BLOCK_MARKER_START`).
+pub const BLOCK_MARKER_START: u32 = 0xffff_ded3;
+/// A block's last word (`PICOBIN_BLOCK_MARKER_END`).
+pub const BLOCK_MARKER_END: u32 = 0xab12_3579;
+
+/// The name of the stage of `cargo xtask test` that builds the Pico 2
+/// image and makes its UF2.
+pub const STAGE: &str = "Pico 2 build (boards/pico2): start block, settings sectors clear, UF2 \
+                         family RP2350 Arm Secure";
+
+/// The stage [`STAGE`]: builds the image, checks it and makes its UF2.
+///
+/// # Errors
+/// If the build fails, the image is misplaced, or its UF2 cannot be made.
+pub fn test(metadata: &Metadata) -> Result<()> {
+    let board = Board::Pico2;
+    board.build()?;
+    let path = board.elf(metadata);
+    check(&path)?;
+    let (uf2, made) = uf2::write(&path, board)?;
+    println!("  {}", uf2::describe(&uf2, board, &made.layout));
+    Ok(())
+}
+
+/// Prints the image's sections and sizes; fails unless the vector table is
+/// at the start of flash, a whole block lies in the first 4 KiB, the
+/// settings sectors are reserved and clear, and no allocator is linked.
+///
+/// # Errors
+/// The problems found, all of them.
+pub fn check(path: &Path) -> Result<()> {
+    let image = elf::Image::read(path)?;
+    println!("{}", path.display());
+    print!("{}", image.table());
+    println!(
+        "  flash {} B, static RAM {} B (.data + .bss + .uninit)",
+        image.flash(),
+        image.static_ram()
+    );
+    let mut problems = Vec::new();
+    match image.section(".vector_table") {
+        Some(table) if table.address == VECTOR_TABLE => {}
+        Some(table) => problems.push(format!(
+            "`.vector_table` is at {:#010x}; the RP2350 starts the image from {VECTOR_TABLE:#010x}",
+            table.address
+        )),
+        None => problems.push("no `.vector_table` section".to_owned()),
+    }
+    let data = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    match start_block(&data) {
+        Ok(block) => println!(
+            "  start block: {} B at {:#010x}, markers {BLOCK_MARKER_START:#010x} .. \
+             {BLOCK_MARKER_END:#010x}",
+            block.end - block.start,
+            block.start
+        ),
+        Err(error) => problems.push(format!("{error:#}")),
+    }
+    let settings = Board::Pico2.settings();
+    let settings = u64::from(settings.start)..u64::from(settings.end);
+    match image.settings.clone() {
+        Some(region) if region == settings && image.flash_end <= region.start => println!(
+            "  settings sectors {:#010x}..{:#010x} clear: the image ends at {:#010x}",
+            region.start, region.end, image.flash_end
+        ),
+        Some(region) if region == settings => problems.push(format!(
+            "the image's flash contents end at {:#010x}, inside the settings sectors",
+            image.flash_end
+        )),
+        Some(region) => problems.push(format!(
+            "memory.x reserves {:#010x}..{:#010x} for the settings, not the last 16 KiB of the \
+             4 MiB flash {:#010x}..{:#010x}",
+            region.start, region.end, settings.start, settings.end
+        )),
+        None => problems.push(
+            "no `__settings_start`/`__settings_end`: memory.x must reserve the settings sectors"
+                .to_owned(),
+        ),
+    }
+    if let Err(error) = image.check_no_allocator() {
+        problems.push(error.to_string());
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        bail!("{}", problems.join("; "))
+    }
+}
+
+/// The addresses of the `.start_block` section of the ELF `data`, checked:
+/// inside the boot ROM's search window, opening and closing with the block
+/// markers.
+///
+/// # Errors
+/// If there is no such section, or it is misplaced or not a block.
+pub fn start_block(data: &[u8]) -> Result<Range<u64>> {
+    let file = object::File::parse(data).context("parsing the ELF")?;
+    let section = file.section_by_name(".start_block").context(
+        "no `.start_block` section: the RP2350 boot ROM would not find the image (does memory.x \
+         place `.start_block`, and does embassy-rp link its IMAGE_DEF?)",
+    )?;
+    let range = section.address()..section.address() + section.size();
+    if range.start < BLOCK_SEARCH.start || range.end > BLOCK_SEARCH.end {
+        bail!(
+            "`.start_block` is at {:#010x}..{:#010x}, outside the first 4 KiB of flash where the \
+             boot ROM searches",
+            range.start,
+            range.end
+        );
+    }
+    let bytes = section.data().context("reading `.start_block`")?;
+    let word = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+    };
+    let last = bytes.len().checked_sub(4);
+    if word(0) != Some(BLOCK_MARKER_START) || last.and_then(word) != Some(BLOCK_MARKER_END) {
+        bail!(
+            "`.start_block` ({} B) does not open with {BLOCK_MARKER_START:#010x} and close with \
+             {BLOCK_MARKER_END:#010x}: not a block the boot ROM reads",
+            bytes.len()
+        );
+    }
+    Ok(range)
+}
