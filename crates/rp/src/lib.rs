@@ -26,6 +26,7 @@ compile_error!("choose a chip: the `rp2040` or the `rp235xa` feature");
 
 pub mod flash;
 mod panic;
+pub mod pico;
 pub mod pwm;
 pub mod uart;
 pub mod usb;

@@ -1,0 +1,50 @@
+//! The Raspberry Pi Pico's pinout, which the Pico 2 keeps: where the servos
+//! and the console go on both boards.
+//!
+//! | what        | GPIO | board pin | peripheral         |
+//! |-------------|------|-----------|--------------------|
+//! | pitch servo | GP16 | 21        | PWM0 A             |
+//! | roll servo  | GP18 | 24        | PWM1 A             |
+//! | yaw servo   | GP20 | 26        | PWM2 A             |
+//! | console TX  | GP0  | 1         | UART0, 115200 8N1  |
+//! | console RX  | GP1  | 2         | UART0              |
+//! | console     | USB  |           | CDC-ACM serial port|
+//!
+//! (GPIO n drives PWM slice ⌊n/2⌋ mod 8, channel A for even n.) One slice
+//! per servo, so each output starts on its own first valid pulse
+//! ([`crate::pwm`]). Servo signal wires to these pins, servo ground to a
+//! board GND (e.g. pin 23) and to the servo supply's ground; power the
+//! servos from their own 5 to 6 V supply, not from the board.
+//!
+//! A board with another pinout builds its [`Board`] the same way with its
+//! own pins.
+
+use embassy_rp::peripherals::{UART0, USB};
+use embassy_rp::{Peripherals, bind_interrupts, uart, usb};
+
+use crate::pwm::ServoPwm;
+use crate::{Board, SERVO_CLOCK};
+
+bind_interrupts!(struct Irqs {
+    UART0_IRQ => uart::BufferedInterruptHandler<UART0>;
+    USBCTRL_IRQ => usb::InterruptHandler<USB>;
+});
+
+/// The [`Board`] of a Raspberry Pi Pico or Pico 2 named `name`, from the
+/// chip's peripherals. The servo outputs stay low until the first frame.
+pub fn board(p: Peripherals, name: &'static str) -> Board {
+    Board {
+        name,
+        servos: [
+            ServoPwm::new(p.PWM_SLICE0, p.PIN_16, &SERVO_CLOCK),
+            ServoPwm::new(p.PWM_SLICE1, p.PIN_18, &SERVO_CLOCK),
+            ServoPwm::new(p.PWM_SLICE2, p.PIN_20, &SERVO_CLOCK),
+        ],
+        servo_pins: "pitch GP16 (PWM0 A), roll GP18 (PWM1 A), yaw GP20 (PWM2 A)",
+        uart: crate::uart::console(p.UART0, p.PIN_0, p.PIN_1, Irqs),
+        uart_pins: "UART0 GP0 TX, GP1 RX",
+        usb: usb::Driver::new(p.USB, Irqs),
+        flash: p.FLASH,
+        watchdog: p.WATCHDOG,
+    }
+}
