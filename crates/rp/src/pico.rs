@@ -32,6 +32,7 @@ bind_interrupts!(struct Irqs {
 
 /// The [`Board`] of a Raspberry Pi Pico or Pico 2 named `name`, from the
 /// chip's peripherals. The servo outputs stay low until the first frame.
+#[must_use]
 pub fn board(p: Peripherals, name: &'static str) -> Board {
     Board {
         name,
