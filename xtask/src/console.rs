@@ -13,9 +13,10 @@ use std::sync::mpsc;
 use std::thread;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 use defmt_decoder::Table;
 
+use crate::child;
 use crate::log::Run;
 use crate::qemu::{self, Echo};
 use crate::{project, setup};
@@ -285,7 +286,7 @@ pub fn qemu_session(
         Pace::RealTime => "on",
         Pace::Fast => "off",
     };
-    let mut child = Command::new(setup::QEMU_BINARY)
+    let child = Command::new(setup::QEMU_BINARY)
         .args([
             "-machine",
             "lm3s6965evb",
@@ -311,12 +312,13 @@ pub fn qemu_session(
         .stderr(Stdio::piped())
         .spawn()
         .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
-    let stdout = child.stdout.take().context("QEMU's stdout")?;
-    let stderr = child.stderr.take().context("QEMU's stderr")?;
     let start = Instant::now();
-    thread::scope(|scope| {
-        let decoder = scope.spawn(|| qemu::decode(stdout, &table, locations.as_ref(), &root, echo));
-        scope.spawn(|| {
+    let done = child::run(
+        child,
+        setup::QEMU_BINARY,
+        Duration::from_secs(120),
+        |stdout| qemu::decode(stdout, &table, locations.as_ref(), &root, echo),
+        |stderr| {
             // QEMU says it waits for each socket's connection: not news here.
             let mut to = std::io::stderr();
             for line in BufReader::new(stderr).lines().map_while(Result::ok) {
@@ -324,25 +326,21 @@ pub fn qemu_session(
                     let _ = writeln!(to, "{line}");
                 }
             }
-        });
-        let talked = talk(&uart0, &uart1, lines, &mut on_reply, wait);
-        let exit = qemu::wait_or_kill(&mut child, Duration::from_secs(120))?;
-        let log = decoder
-            .join()
-            .map_err(|_| anyhow!("the log decoder panicked"))?;
-        let _ = std::fs::remove_dir_all(&dir);
-        let (sent, replies, talk_time) = talked?;
-        Ok(QemuSession {
-            run: Run {
-                log,
-                exit,
-                elapsed: start.elapsed(),
-            },
-            sent,
-            replies,
-            missing: sent.saturating_sub(replies),
-            talk_time,
-        })
+        },
+        || talk(&uart0, &uart1, lines, &mut on_reply, wait),
+    )?;
+    let _ = std::fs::remove_dir_all(&dir);
+    let (sent, replies, talk_time) = done.meanwhile?;
+    Ok(QemuSession {
+        run: Run {
+            log: done.stdout,
+            exit: done.exit,
+            elapsed: start.elapsed(),
+        },
+        sent,
+        replies,
+        missing: sent.saturating_sub(replies),
+        talk_time,
     })
 }
 

@@ -22,6 +22,7 @@
 
 mod args;
 mod bench;
+mod child;
 mod cli;
 mod console;
 mod elf;
