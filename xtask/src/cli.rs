@@ -119,6 +119,12 @@ pub enum Command {
     Trace(trace::Args),
     /// Talk to a head: lines from stdin, replies to stdout, one per line.
     ///
+    /// The bytes go through unchanged: a line that is not UTF-8 reaches the
+    /// head, which answers it with an error; lines end at CR, LF or CR LF,
+    /// as on the head, and a last line without a line end gets an LF. What
+    /// ends a session early (a port that closes, lines left unanswered) is
+    /// said on stderr, and the command fails.
+    ///
     /// With --qemu the firmware runs in QEMU and its UART0 carries the
     /// console; when stdin closes, the firmware is stopped and its summary
     /// line printed. With --port <dev> that serial port is opened (115200
