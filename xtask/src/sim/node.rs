@@ -8,9 +8,10 @@ use std::{
     time::Duration,
 };
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 use serde_json::{Value, json};
 
+use super::event::Event;
 use crate::{child, log::Exit, project, setup};
 use xshell::cmd;
 
@@ -230,9 +231,9 @@ fn nanos(duration: Duration) -> u64 {
 }
 
 /// Runs the harness; returns its events, in order. Fails if node cannot be
-/// started, exits with an error, prints a line that is not an event, or
-/// outlives the wall time (plus a grace).
-pub fn run(root: &Path, config: &Config) -> Result<Vec<Value>> {
+/// started, exits with an error, prints a line that is not a known event,
+/// or outlives the wall time (plus a grace).
+pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     let mut command = Command::new("node");
     command
         .arg("harness.mjs")
@@ -255,7 +256,7 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Value>> {
         ),
     };
     let events = done.stdout?;
-    if !status.success() && events.last().is_none_or(|e| e["ev"] != "end") {
+    if !status.success() && !matches!(events.last(), Some(Event::End { .. })) {
         bail!(
             "the emulator harness failed ({status}):\n{}",
             done.stderr.trim_end()
@@ -269,18 +270,16 @@ const GRACE: Duration = Duration::from_secs(15);
 
 /// The harness's events, one JSON line each, read to the end of its output
 /// (also past a bad line, so that node never waits on a full pipe); the
-/// first bad line is the error.
-fn events(stdout: impl Read) -> Result<Vec<Value>> {
+/// first line that is not a known event is the error.
+fn events(stdout: impl Read) -> Result<Vec<Event>> {
     let mut events = Vec::new();
     let mut bad = None;
     for line in BufReader::new(stdout).lines() {
         let line = line.context("reading the harness's output")?;
-        match serde_json::from_str(&line) {
+        match Event::parse(&line) {
             Ok(event) => events.push(event),
             Err(e) => {
-                bad.get_or_insert_with(|| {
-                    anyhow!("the harness printed a line that is not JSON ({e}): {line}")
-                });
+                bad.get_or_insert(e);
             }
         }
     }
