@@ -46,7 +46,10 @@
 //   {"ev":"uart_overrun","ns":..}                   a scripted byte found UART0's RX FIFO full
 //   {"ev":"usb_connected","ns":..}                  the CDC-ACM host configured the device
 //   {"ev":"usb","ns":..,"hex":".."}                 bytes the device sent on its CDC-ACM IN endpoint
-//   {"ev":"emu","level":"warn","msg":".."}          a complaint of the emulator
+//   {"ev":"unmodelled","peripheral":"ROSC_BASE","op":"write","offset":4,"count":1}
+//                                                   accesses to a register rp2040js does not
+//                                                   model, counted over the run (at its end)
+//   {"ev":"emu","level":"warn","msg":".."}          another complaint of the emulator
 //   {"ev":"end","why":"time|silent|asleep|wall|break|error","ns":..,"instructions":..,"wall_ms":..}
 
 import { readFileSync } from 'node:fs';
@@ -106,7 +109,7 @@ function powerUp(kept) {
   chip.logger = {
     debug() {},
     info() {},
-    warn: (name, msg) => emit({ ev: 'emu', level: 'warn', msg: `[${name}] ${msg}` }),
+    warn: (name, msg) => unmodelled(name, msg) || emit({ ev: 'emu', level: 'warn', msg: `[${name}] ${msg}` }),
     error: (name, msg) => emit({ ev: 'emu', level: 'error', msg: `[${name}] ${msg}` }),
   };
   chip.onBreak = (code) => {
@@ -166,6 +169,28 @@ function powerUp(kept) {
   chip.core.VTOR = cfg.vtor;
   chip.core.reset(); // SP and PC from the vector table, as boot2 hands over
   return chip;
+}
+
+// rp2040js warns at every access to a register it does not model (a read
+// gives 0xffffffff, a write does nothing). They are counted per register
+// instead, and reported once at the end: `cargo xtask sim` tells the known
+// ones from the others.
+const UNMODELLED = /^Unimplemented peripheral (read from|write to) 0x([0-9a-f]+)/;
+const unmodelledCounts = new Map(); // "name op offset" -> {peripheral, op, offset, count}
+function unmodelled(name, msg) {
+  const match = UNMODELLED.exec(msg);
+  if (!match) return false;
+  const op = match[1] === 'read from' ? 'read' : 'write';
+  const offset = parseInt(match[2], 16);
+  const key = `${name} ${op} ${offset}`;
+  const seen = unmodelledCounts.get(key) ?? { peripheral: name, op, offset, count: 0 };
+  seen.count += 1;
+  unmodelledCounts.set(key, seen);
+  return true;
+}
+function emitUnmodelled() {
+  for (const seen of unmodelledCounts.values()) emit({ ev: 'unmodelled', ...seen });
+  unmodelledCounts.clear();
 }
 
 // rp2040js has no XIP control registers (0x14000000..0x14000020): a read
@@ -457,6 +482,7 @@ function run() {
     else if (Date.now() - started > cfg.wall_ms) stop = 'wall';
   }
   endBoot();
+  emitUnmodelled();
   emit({ ev: 'end', why: stop, ns: now(), instructions, wall_ms: Date.now() - started });
   flush();
 }
@@ -464,6 +490,7 @@ function run() {
 try {
   run();
 } catch (error) {
+  emitUnmodelled();
   emit({ ev: 'end', why: 'error', msg: String(error?.stack ?? error), ns: mcu ? now() : 0, instructions, wall_ms: Date.now() - started });
   flush();
   process.exitCode = 1;

@@ -217,7 +217,7 @@ fn errors_name_the_word_and_the_rule() {
         ("status now", "syntax `now`: unexpected"),
         (
             "nod 99999999999999999999",
-            "syntax `99999999999999999999`: amplitude in mdeg must be a whole number",
+            "range `99999999999999999999`: amplitude in mdeg must be in -2147483647..=2147483647",
         ),
         (
             "nod \u{e9}",
@@ -227,6 +227,32 @@ fn errors_name_the_word_and_the_rule() {
     for (line, want) in cases {
         assert_eq!(reason(line), want, "line `{line}`");
     }
+}
+
+/// However many digits a number has, it is a number: one too long for its
+/// field is out of range, as a shorter one past the field's limit is.
+#[test]
+fn an_over_long_number_is_out_of_range_not_a_syntax_error() {
+    for digits in [10, 11, 19, 20, 40, 200] {
+        let number = "9".repeat(digits);
+        for (line, what) in [
+            (format!("look 0 {number}"), "yaw in mdeg"),
+            (format!("look 0 -{number}"), "yaw in mdeg"),
+            (format!("seed {number}"), "seed"),
+            (format!("seed +{number}"), "seed"),
+            (format!("nod 5000 800 intensity={number}"), "percentage"),
+        ] {
+            let err = parse(line.as_bytes()).unwrap_err();
+            assert!(
+                matches!(err.kind, ParseErrorKind::OutOfRange { what: w, .. } if w == what),
+                "`{line}`: {err:?}"
+            );
+            assert_eq!(err.code(), "range", "`{line}`");
+        }
+    }
+    // Digits and something else are still no number.
+    let err = parse(format!("seed {}x", "9".repeat(40)).as_bytes()).unwrap_err();
+    assert_eq!(err.kind, ParseErrorKind::NotANumber("seed"));
 }
 
 #[test]

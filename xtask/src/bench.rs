@@ -18,12 +18,10 @@
 //! frame bench scenario=gesture+look frames=<n> min=<insns> ...
 //! ```
 //!
-//! This module decodes that log, prints the table and the `frame` row,
-//! reports the `default` row against its [`BUDGET`] and both frame rows (idle,
-//! and with a gesture and a look) against [`FRAME_MEDIAN_BUDGET`] and
-//! [`FRAME_MAX_BUDGET`], and fails past the default's budget or the idle
-//! frame row's, naming the row (the gesture row is reported, not yet held
-//! to its budget: see `frame.rs`).
+//! This module decodes that log, prints the table and the `frame` rows,
+//! reports the `default` row against its [`BUDGET`] and each frame row (idle,
+//! and with a gesture and a look) against its own ceiling
+//! ([`frame::CEILINGS`]), and fails past any of them, naming the row.
 
 // Instruction counts are far below 2^52 and positive: the float conversions are exact.
 #![allow(
@@ -58,17 +56,10 @@ pub const BENCH: Image = Image::qemu("bench");
 /// rust-toolchain.toml pins the toolchain.
 pub const BUDGET: u64 = 150_000;
 
-/// The budget of one frame update (three servos: playback, fade, limits,
-/// mapping, PWM writes), the median over a whole loop: about 8 µs of a 20 ms
-/// frame on a 125 MHz RP2040.
-pub const FRAME_MEDIAN_BUDGET: u64 = 1000;
-
-/// The budget of the costliest frame update of the loop.
-pub const FRAME_MAX_BUDGET: u64 = 2000;
-
 /// The name of the benchmark's stage in `cargo xtask test`.
 pub const STAGE: &str = "QEMU bench: default set within its 150,000-instruction budget, \
-                         idle frame median within 1,000, max within 2,000";
+                         frame update median within 1,000 idle and 1,500 with a gesture and \
+                         a look, max within 2,000";
 
 /// RP2040 system clock (Hz) the time column assumes: 125 MHz, the Pico's default.
 const RP2040_HZ: f64 = 125e6;
@@ -321,7 +312,7 @@ pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Resu
     }
     if let Some(over) = frames_over_budget(&frames) {
         if options.no_budget {
-            println!("(--no-budget: the frame budget is reported, not enforced)");
+            println!("(--no-budget: the frame ceilings are reported, not enforced)");
         } else {
             bail!("{over} (pass --no-budget to report without failing)");
         }
@@ -444,7 +435,7 @@ mod tests {
     }
 
     #[test]
-    fn frame_row_is_parsed_and_held_to_its_budget() {
+    fn frame_row_is_parsed_and_held_to_its_ceiling() {
         let line = "frame bench frames=1601 min=930 median=945 max=1861 max_at=1 mean=1084";
         let row = FrameRow::parse(line).unwrap().unwrap();
         assert_eq!(
@@ -461,13 +452,17 @@ mod tests {
         );
         assert!(row.within_budget());
         assert!(row.lines().contains("frame                    1601"));
+        assert!(
+            row.lines()
+                .contains("ceiling: median 945 against 1,000: ok; max 1,861 against 2,000: ok")
+        );
         assert!(!row.lines().contains("OVER"));
         let slow = FrameRow {
             median: 1001,
             ..row.clone()
         };
         assert!(!slow.within_budget());
-        assert!(slow.lines().contains("OVER"));
+        assert!(slow.lines().contains("median 1,001 against 1,000: OVER"));
         let spiky = FrameRow { max: 2001, ..row };
         assert!(!spiky.within_budget());
         assert!(
@@ -487,31 +482,57 @@ mod tests {
     }
 
     #[test]
-    fn the_idle_frame_row_is_held_to_the_budget_and_named() {
+    fn each_frame_row_is_held_to_its_own_ceiling_and_named() {
         let idle = FrameRow::parse(
             "frame bench frames=1601 min=880 median=890 max=1500 max_at=1 mean=950",
         )
         .unwrap()
         .unwrap();
         let busy = FrameRow::parse(
-            "frame bench scenario=gesture+look frames=1601 min=900 median=980 max=1900 max_at=9 mean=990",
+            "frame bench scenario=gesture+look frames=1601 min=900 median=1430 max=1900 max_at=9 mean=1290",
         )
         .unwrap()
         .unwrap();
+        // 1,430 is over the idle row's 1,000 but within this row's 1,500:
+        // no OVER printed for it, and the bench passes.
+        assert!(busy.within_budget());
+        assert!(!busy.lines().contains("OVER"), "{}", busy.lines());
+        assert!(busy.lines().contains("median 1,430 against 1,500: ok"));
         assert_eq!(frames_over_budget(&[idle.clone(), busy.clone()]), None);
-        // The gesture row over its budget is reported, not failed on.
         let slow_busy = FrameRow {
-            median: 1001,
+            median: 1501,
             ..busy.clone()
         };
-        assert!(!slow_busy.held_to_budget());
-        assert!(slow_busy.lines().contains("OVER"));
-        assert!(slow_busy.lines().contains("not yet held"));
-        assert_eq!(frames_over_budget(&[idle.clone(), slow_busy]), None);
+        assert!(
+            slow_busy
+                .lines()
+                .contains("median 1,501 against 1,500: OVER")
+        );
+        let message = frames_over_budget(&[idle.clone(), slow_busy]).unwrap();
+        assert_eq!(
+            message,
+            "frame update over its ceiling: row `frame (gesture + look)` takes 1,501 \
+             instructions at the median and 1,900 at most (ceiling 1,500 and 2,000)"
+        );
         let spiky_idle = FrameRow { max: 2001, ..idle };
         let message = frames_over_budget(&[spiky_idle, busy]).unwrap();
         assert!(message.contains("`frame` takes 890 instructions at the median and 2,001"));
         assert!(!message.contains("gesture"), "{message}");
+    }
+
+    #[test]
+    fn a_frame_row_of_an_unknown_scenario_is_an_error() {
+        let log: Vec<LogLine> = [
+            "frame bench frames=2 min=1 median=1 max=1 max_at=0 mean=1",
+            "frame bench scenario=gesture+look frames=2 min=1 median=1 max=1 max_at=0 mean=1",
+            "frame bench scenario=juggling frames=2 min=1 median=1 max=1 max_at=0 mean=1",
+        ]
+        .into_iter()
+        .map(|message| LogLine::new("INFO", message))
+        .collect();
+        let err = FrameRow::all(&log).unwrap_err().to_string();
+        assert!(err.contains("`frame (juggling)`"), "{err}");
+        assert_eq!(FrameRow::all(&log[..2]).unwrap().len(), 2);
     }
 
     #[test]

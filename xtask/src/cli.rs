@@ -114,10 +114,18 @@ pub enum Command {
     /// console's words: nod, shake, tilt [amplitude m°] [ms] [cycles=N]
     /// [intensity=PCT]; look <pitch m°> <yaw m°> [ms] [hold=MS|hold=stay];
     /// center [ms]; idle on|off; idle amp <percent>; stop. Blank lines and
-    /// `#` comments are ignored; any bad line is an error naming it, and then
-    /// nothing runs.
+    /// `#` comments are ignored; a script runs top to bottom, so a line timed
+    /// before the one above it is an error, as is any bad line: each is
+    /// named, and then nothing runs. The CSV (and the PNG, given `--png`
+    /// alone) go to trace/ in the target directory unless told otherwise.
     Trace(trace::Args),
     /// Talk to a head: lines from stdin, replies to stdout, one per line.
+    ///
+    /// The bytes go through unchanged: a line that is not UTF-8 reaches the
+    /// head, which answers it with an error; lines end at CR, LF or CR LF,
+    /// as on the head, and a last line without a line end gets an LF. What
+    /// ends a session early (a port that closes, lines left unanswered) is
+    /// said on stderr, and the command fails.
     ///
     /// With --qemu the firmware runs in QEMU and its UART0 carries the
     /// console; when stdin closes, the firmware is stopped and its summary
@@ -218,6 +226,26 @@ mod tests {
             panic!("not `metrics`");
         };
         assert_eq!((args.seeds, args.shape.n(), args.shape.w()), (300, 450, 15));
+    }
+
+    #[test]
+    fn the_trace_writes_under_the_target_directory_unless_told() {
+        let trace = |args: &[&str]| {
+            let args: Vec<&str> = ["trace", "--seconds", "2"]
+                .into_iter()
+                .chain(args.iter().copied())
+                .collect();
+            match parse(&args).unwrap() {
+                Some(Command::Trace(args)) => (args.out, args.png),
+                other => panic!("not `trace`: {other:?}"),
+            }
+        };
+        assert_eq!(trace(&[]), (None, None));
+        assert_eq!(trace(&["--png"]), (None, Some(None)));
+        assert_eq!(
+            trace(&["--png", "a.png", "--out", "a.csv"]),
+            (Some("a.csv".into()), Some(Some("a.png".into())))
+        );
     }
 
     #[test]

@@ -26,6 +26,7 @@
 mod args;
 mod bench;
 mod board;
+mod child;
 mod cli;
 mod console;
 mod elf;

@@ -3,19 +3,18 @@
 use std::{
     io::{BufRead, BufReader, Read, Write},
     path::Path,
-    process::{Child, Command, Stdio},
-    thread,
+    process::{Command, Stdio},
     time::{Duration, Instant},
 };
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 use defmt_decoder::{DecodeError, Locations, Table};
-use wait_timeout::ChildExt;
 use xshell::{Cmd, Shell, cmd};
 
 use crate::{
     args::Options,
-    log::{Exit, LogLine, Run},
+    child,
+    log::{LogLine, Run},
     project::{self, QEMU},
     reference, render,
     setup::{self, QEMU_BINARY},
@@ -109,37 +108,24 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     let start = Instant::now();
-    let mut child = command
+    let child = command
         .spawn()
         .with_context(|| format!("could not start {QEMU_BINARY}"))?;
-    let stdout = child.stdout.take().context("QEMU's stdout")?;
-    let stderr = child.stderr.take().context("QEMU's stderr")?;
-
     // The log is decoded while QEMU runs; its end is the end of QEMU's
     // output, which comes when QEMU exits or is killed.
-    thread::scope(|scope| {
-        let decoder = scope.spawn(|| decode(stdout, &table, locations.as_ref(), &root, echo));
-        scope.spawn(|| forward(stderr, &mut std::io::stderr()));
-        let exit = wait_or_kill(&mut child, timeout)?;
-        let log = decoder
-            .join()
-            .map_err(|_| anyhow!("the log decoder panicked"))?;
-        Ok(Run {
-            log,
-            exit,
-            elapsed: start.elapsed(),
-        })
+    let done = child::run(
+        child,
+        QEMU_BINARY,
+        timeout,
+        |stdout| decode(stdout, &table, locations.as_ref(), &root, echo),
+        |stderr| forward(stderr, &mut std::io::stderr()),
+        || (),
+    )?;
+    Ok(Run {
+        log: done.stdout,
+        exit: done.exit,
+        elapsed: start.elapsed(),
     })
-}
-
-/// Waits for `child` to exit, at most `timeout`; kills it past that.
-pub(crate) fn wait_or_kill(child: &mut Child, timeout: Duration) -> Result<Exit> {
-    if let Some(status) = child.wait_timeout(timeout).context("waiting for QEMU")? {
-        return Ok(Exit::Status(status));
-    }
-    let _ = child.kill();
-    let _ = child.wait();
-    Ok(Exit::TimedOut(timeout))
 }
 
 /// Decodes the defmt stream `output` to its end, echoing lines as they come.
@@ -278,20 +264,6 @@ mod tests {
         assert_eq!(summary.number("checksum").unwrap(), 0x1a2b_3c4d);
         assert!(summary.number("absent").is_err());
         assert!(Summary::find(&log[..1]).is_none());
-    }
-
-    #[test]
-    fn a_hung_firmware_is_killed_at_the_timeout() {
-        // A program that does not end stands for a hung firmware: the wait
-        // ends at the limit, not with the program.
-        let mut child = Command::new("sleep").arg("30").spawn().unwrap();
-        let start = Instant::now();
-        let exit = wait_or_kill(&mut child, Duration::from_millis(200)).unwrap();
-        assert!(matches!(exit, Exit::TimedOut(limit) if limit.as_millis() == 200));
-        assert!(start.elapsed() < Duration::from_secs(10));
-        let mut child = Command::new("true").spawn().unwrap();
-        let exit = wait_or_kill(&mut child, Duration::from_secs(60)).unwrap();
-        assert!(matches!(exit, Exit::Status(status) if status.success()));
     }
 
     #[test]

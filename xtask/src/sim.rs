@@ -9,6 +9,7 @@
 //! the duties the host computes with the same core (`pulses.rs` explains how
 //! PWM periods map to frames).
 
+mod event;
 mod exchange;
 mod expect;
 mod flood;
@@ -20,6 +21,7 @@ mod pulses;
 mod run;
 mod stages;
 mod store;
+mod unmodelled;
 
 use std::{fmt::Write as _, time::Duration};
 
@@ -78,6 +80,10 @@ pub struct Args {
     /// more line.
     #[arg(long)]
     pub flood: bool,
+    /// List every access to a register the emulator does not model, also
+    /// the known gaps that do not matter (summed up in one line without).
+    #[arg(long, short)]
+    pub verbose: bool,
 }
 
 /// One loop (30 s), the fade-in (2 s) and half a second for the boot.
@@ -158,7 +164,7 @@ pub fn command(args: &Args) -> Result<bool> {
         args.timeout,
         false,
     )?;
-    print!("{}", report.log_text());
+    print!("{}", report.log_text(args.verbose));
     print!("{}", report.table());
     println!("{}", report.verdict());
     println!("{}", report.summary());
@@ -190,8 +196,10 @@ impl Report {
         logged.chain(ram).max()
     }
 
-    /// The decoded log with virtual times, boots and resets marked.
-    pub fn log_text(&self) -> String {
+    /// The decoded log with virtual times, boots and resets marked, and
+    /// what the emulator said (`verbose`: each access to a register it does
+    /// not model, also the known ones).
+    pub fn log_text(&self, verbose: bool) -> String {
         let mut text = String::new();
         for (b, boot) in self.boots.iter().enumerate() {
             let how = match b.checked_sub(1).map(|last| &self.boots[last]) {
@@ -215,6 +223,7 @@ impl Report {
         for (message, count) in &self.emulator {
             let _ = writeln!(text, "emulator: {message} ({count}x)");
         }
+        text.push_str(&unmodelled::lines(&self.unmodelled, verbose));
         text
     }
 

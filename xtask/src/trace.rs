@@ -19,13 +19,14 @@
 //! written, on PWM channels clocked as the Pico's (`idle_head_core::pwm_clock`:
 //! 64 000 counts of 312.5 ns per 20 ms period).
 
+mod marks;
 mod plot;
 mod script;
 
 use std::{fs, path::PathBuf};
 
 use anyhow::{Context, Result, anyhow};
-use idle_head_core::behaviour::{Applied, BehaviourConfig, CommandQueue, Head, LOOP_DURATION};
+use idle_head_core::behaviour::{BehaviourConfig, CommandQueue, Head, LOOP_DURATION};
 use idle_head_core::driver::{DriverConfig, FrameDriver};
 use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
@@ -33,6 +34,7 @@ use idle_head_core::{Axis, Playback};
 use idle_head_firmware::config::IDLE_MODE;
 
 use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
+use marks::Mark;
 use script::Event;
 
 /// Options of `cargo xtask trace`.
@@ -48,12 +50,22 @@ pub struct Args {
     /// The commands and their times, one per line: `<seconds> <command>`.
     #[arg(long, value_name = "file")]
     pub script: Option<PathBuf>,
-    /// The CSV to write.
-    #[arg(long, value_name = "csv", default_value = "trace.csv")]
-    pub out: PathBuf,
-    /// Also draw the three axes over time, the commands marked, to this PNG.
+    /// The CSV to write [default: trace/trace.csv in the target directory].
+    #[arg(long, value_name = "csv")]
+    pub out: Option<PathBuf>,
+    /// Also draw the three axes over time, the commands marked, to this PNG
+    /// [without a file: trace/trace.png in the target directory].
     #[arg(long, value_name = "file")]
-    pub png: Option<PathBuf>,
+    #[allow(clippy::option_option)] // absent, present without a value, with one
+    pub png: Option<Option<PathBuf>>,
+}
+
+/// Where the trace goes without `--out` or a `--png` file: build output,
+/// not the repository (`target/trace/` unless cargo is told otherwise).
+fn default_dir() -> Result<PathBuf> {
+    Ok(crate::project::metadata(&crate::project::root())?
+        .target_dir
+        .join("trace"))
 }
 
 /// `--seconds`: more than 0, in µs.
@@ -78,26 +90,12 @@ pub struct Row {
     pub pulses: [u64; 3],
 }
 
-/// What a script command did, for the summary and the plot.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Mark {
-    /// When it was applied, in ms.
-    pub t_ms: u64,
-    /// How long its motion lasts, in ms (0: a switch).
-    pub span_ms: u64,
-    /// The axes it moves.
-    pub axes: Vec<Axis>,
-    /// A short label (`nod`, `look clamped`, ...).
-    pub label: String,
-    /// The reply a console would give.
-    pub reply: String,
-}
-
 /// The simulated run.
 pub struct Trace {
     /// One row per frame.
     pub rows: Vec<Row>,
-    /// The script's commands as applied.
+    /// The script's commands as applied, and the looks' returns, in time
+    /// order.
     pub marks: Vec<Mark>,
 }
 
@@ -194,7 +192,7 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
                 return;
             };
             debug_assert_eq!(&event.action, action);
-            marks.push(mark(event, t_us / 1000, outcome));
+            marks.extend(marks::marks(event, t_us / 1000, outcome, &params));
         });
         let played = head.frame(&mut driver, frame);
         let servos = played.report.servos;
@@ -205,7 +203,11 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
             pulses: servos.map(|s| (u64::from(s.duty.0) * count_ps + 500) / 1000),
         });
     }
-    interrupted(&mut marks, params.config().blend.0);
+    marks::settle(
+        &mut marks,
+        params.config().blend.0,
+        frames * frame_us / 1000,
+    );
     for event in pending {
         println!(
             "line {}: at {} s, after the trace's end: not run",
@@ -214,99 +216,6 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
         );
     }
     Ok(Trace { rows, marks })
-}
-
-/// A gesture interrupted by a newer one fades out within `blend_ms` of it:
-/// its mark ends there.
-fn interrupted(marks: &mut [Mark], blend_ms: u32) {
-    let gestures: Vec<usize> = (0..marks.len())
-        .filter(|&i| marks[i].reply.starts_with("ok ") && is_gesture(&marks[i]))
-        .collect();
-    for pair in gestures.windows(2) {
-        let next = marks[pair[1]].t_ms;
-        let mark = &mut marks[pair[0]];
-        let end = next + u64::from(blend_ms);
-        if mark.t_ms + mark.span_ms > end {
-            mark.span_ms = end - mark.t_ms;
-        }
-    }
-}
-
-fn is_gesture(mark: &Mark) -> bool {
-    ["ok nod", "ok shake", "ok tilt"]
-        .iter()
-        .any(|p| mark.reply.starts_with(p))
-}
-
-/// The mark of `event`, applied at `t_ms` with `outcome`.
-fn mark(
-    event: &Event,
-    t_ms: u64,
-    outcome: &Result<Applied, idle_head_core::behaviour::BehaviourError>,
-) -> Mark {
-    let word = event
-        .text
-        .split_whitespace()
-        .next()
-        .unwrap_or("")
-        .to_owned();
-    let (axes, span_ms, label, reply) = match outcome {
-        Err(e) => (
-            vec![],
-            0,
-            format!("{word} (refused)"),
-            format!("err {} {e}", e.code()),
-        ),
-        Ok(Applied::Gesture(plan)) => (
-            vec![plan.kind.axis()],
-            u64::from(plan.duration.0),
-            word,
-            format!(
-                "ok {} {} mdeg {} cycles {} ms intensity {}",
-                plan.kind.name(),
-                plan.amplitude.millidegrees(),
-                plan.cycles,
-                plan.duration.0,
-                plan.intensity.get()
-            ),
-        ),
-        Ok(Applied::Look(look)) => (
-            vec![Axis::Pitch, Axis::Yaw],
-            u64::from(look.duration.0),
-            if look.clamped {
-                "look (clamped)".to_owned()
-            } else {
-                word
-            },
-            format!(
-                "ok look{} {} {} {} ms",
-                if look.clamped { " clamped" } else { "" },
-                look.pitch.millidegrees(),
-                look.yaw.millidegrees(),
-                look.duration.0
-            ),
-        ),
-        Ok(Applied::Center(ms)) => (
-            vec![Axis::Pitch, Axis::Yaw],
-            u64::from(ms.0),
-            word,
-            format!("ok center {} ms", ms.0),
-        ),
-        Ok(Applied::Idle(p)) => (
-            vec![],
-            0,
-            event.text.clone(),
-            format!("ok idle {} %", p.get()),
-        ),
-        Ok(Applied::Stop) => (vec![], 0, word, "ok stop".to_owned()),
-    };
-    Mark {
-        t_ms,
-        span_ms,
-        axes,
-        label,
-        reply,
-    }
 }
 
 /// `cargo xtask trace`.
@@ -326,14 +235,22 @@ pub fn command(args: &Args) -> Result<bool> {
         None => Vec::new(),
     };
     let trace = simulate(args.micros, args.seed, &events)?;
-    write_csv(&trace, &args.out)?;
+    let out = match &args.out {
+        Some(out) => out.clone(),
+        None => default_dir()?.join("trace.csv"),
+    };
+    write_csv(&trace, &out)?;
     for mark in &trace.marks {
         println!("{:>9} ms  {}", mark.t_ms, mark.reply);
     }
     summary(&trace);
-    println!("wrote {} ({} frames)", args.out.display(), trace.rows.len());
+    println!("wrote {} ({} frames)", out.display(), trace.rows.len());
     if let Some(png) = &args.png {
-        plot::draw(&trace, args.seed, png)?;
+        let png = match png {
+            Some(png) => png.clone(),
+            None => default_dir()?.join("trace.png"),
+        };
+        plot::draw(&trace, args.seed, &png)?;
         println!("wrote {}", png.display());
     }
     Ok(true)
@@ -408,6 +325,63 @@ mod tests {
             let report = plain.write_frame(source.offsets(row.frame));
             assert_eq!(row.angles, report.servos.map(|s| s.angle.millidegrees()));
         }
+    }
+
+    #[test]
+    fn a_looks_return_is_marked_where_the_head_goes_back() {
+        // The idle motion off (it fades out in 1 s): only the gaze moves.
+        let trace = run("0 idle off\n2 look 10000 0 500 hold=1000\n", 6);
+        let back: Vec<&Mark> = trace
+            .marks
+            .iter()
+            .filter(|m| m.kind == marks::Kind::Return)
+            .collect();
+        assert_eq!(back.len(), 1, "{:?}", trace.marks);
+        let back = back[0];
+        // 500 ms there, the 1 s hold, then back.
+        assert_eq!(back.t_ms, 3500);
+        assert_eq!(back.axes, [Axis::Pitch, Axis::Yaw]);
+        let pitch = |t_ms: u64| trace.rows[usize::try_from(t_ms / 20).unwrap()].angles[0];
+        assert_eq!(pitch(back.t_ms - 20), 10_000);
+        assert_eq!(pitch(back.t_ms), 10_000);
+        assert!(pitch(back.t_ms + 20) < 10_000);
+        assert!(pitch(back.t_ms + back.span_ms - 20) > 0);
+        assert_eq!(pitch(back.t_ms + back.span_ms), 0);
+        assert_eq!(
+            back.reply,
+            format!(
+                "(the look at line 2 returns to the centre after its 1000 ms hold, in {} ms)",
+                back.span_ms
+            )
+        );
+        // The marks are in time order.
+        assert!(trace.marks.windows(2).all(|w| w[0].t_ms <= w[1].t_ms));
+    }
+
+    #[test]
+    fn a_return_is_cut_or_left_out_by_the_next_gaze_move() {
+        let returns = |script: &str| -> Vec<(u64, u64)> {
+            run(script, 8)
+                .marks
+                .iter()
+                .filter(|m| m.kind == marks::Kind::Return)
+                .map(|m| (m.t_ms, m.span_ms))
+                .collect()
+        };
+        let look = "2 look 10000 0 500 hold=1000\n";
+        let whole = returns(look);
+        assert_eq!(whole.len(), 1);
+        assert!(whole[0].1 > 100);
+        // A center before the return starts: there is none.
+        assert_eq!(returns(&format!("{look}3 center\n")), []);
+        // Another look while it plays: it ends there.
+        assert_eq!(
+            returns(&format!("{look}3.6 look 0 5000 hold=stay\n")),
+            [(3500, 100)]
+        );
+        // A nod does not touch it; a return after the end is left out.
+        assert_eq!(returns(&format!("{look}3.6 nod\n")), whole);
+        assert_eq!(returns("7.5 look 10000 0 500 hold=1000\n"), []);
     }
 
     #[test]

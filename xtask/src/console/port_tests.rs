@@ -16,10 +16,12 @@ use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
 use nix::pty::openpty;
 
 use super::serial_session;
+use super::talk::Talk;
 
 /// A head on the master side of a pty: every line in, the firmware's
 /// replies out, until `stop`. Lines containing `mute` get no reply, so
-/// that the session's count of missing replies can be checked.
+/// that the session's count of missing replies can be checked; at a line
+/// containing `unplug`, the head goes away: it closes the pty's master.
 fn head(master: RawFd, stop: &AtomicBool) {
     static QUEUE: CommandQueue = CommandQueue::new();
     static LINK: ConsoleLink = ConsoleLink::new();
@@ -45,6 +47,13 @@ fn head(master: RawFd, stop: &AtomicBool) {
             if b != b'\n' {
                 continue;
             }
+            if line.windows(6).any(|w| w == b"unplug") {
+                // The replies already written are read first (a hang-up
+                // discards what the other side has not read yet).
+                thread::sleep(Duration::from_millis(300));
+                let _ = nix::unistd::close(master);
+                return;
+            }
             if !line.windows(4).any(|w| w == b"mute") {
                 session.feed(&line, &mut service, |reply| {
                     let mut rest = reply;
@@ -61,32 +70,65 @@ fn head(master: RawFd, stop: &AtomicBool) {
     }
 }
 
+/// What a `--port` session printed and how it went.
+struct Outcome {
+    /// The reply lines, as bytes.
+    replies: Vec<Vec<u8>>,
+    /// The session's own account.
+    talk: Talk,
+}
+
+impl Outcome {
+    fn text(&self) -> String {
+        self.replies
+            .iter()
+            .map(|r| String::from_utf8_lossy(r) + "\n")
+            .collect()
+    }
+}
+
 /// Runs a `--port` session over a fresh pty with `input` on stdin.
-fn session(input: &str) -> (bool, String) {
+fn session(input: &[u8]) -> Outcome {
     let pty = openpty(None, None).expect("a pseudo-terminal pair");
     let path = std::fs::read_link(format!("/proc/self/fd/{}", pty.slave))
         .unwrap_or_else(|_| PathBuf::from("/dev/ptmx"));
     let stop = AtomicBool::new(false);
-    let mut out = Vec::new();
-    let ok = thread::scope(|scope| {
-        scope.spawn(|| head(pty.master, &stop));
-        let ok = serial_session(&path, input.as_bytes(), &mut out, Duration::from_secs(2))
-            .expect("the port opens");
+    let unplugs = input.windows(6).any(|w| w == b"unplug");
+    let mut replies = Vec::new();
+    let talk = thread::scope(|scope| {
+        let head = scope.spawn(|| head(pty.master, &stop));
+        let talk = serial_session(
+            &path,
+            input,
+            |reply: &[u8]| replies.push(reply.to_vec()),
+            Duration::from_secs(2),
+        )
+        .expect("the port opens");
         stop.store(true, Ordering::Relaxed);
-        // Wakes the head's read.
-        let _ = nix::unistd::write(pty.slave, b"\n");
-        ok
+        if !unplugs {
+            // Wakes the head's read.
+            let _ = nix::unistd::write(pty.slave, b"\n");
+        }
+        let _ = head.join();
+        talk
     });
-    let _ = nix::unistd::close(pty.master);
+    // The head closed the master itself when it was unplugged.
+    if !unplugs {
+        let _ = nix::unistd::close(pty.master);
+    }
     let _ = nix::unistd::close(pty.slave);
-    (ok, String::from_utf8(out).expect("replies are text"))
+    Outcome { replies, talk }
 }
 
 #[test]
 fn a_port_session_prints_one_reply_per_line_in_order() {
-    let (ok, out) = session("help\nnod\nservo yaw min 2600\nfrobnicate\nservo pitch\n");
+    let outcome = session(b"help\nnod\nservo yaw min 2600\nfrobnicate\nservo pitch\n");
+    let out = outcome.text();
     let lines: Vec<&str> = out.lines().collect();
-    assert!(ok, "every line answered: {out}");
+    assert!(
+        outcome.talk.problems().is_empty(),
+        "every line answered: {out}"
+    );
     assert_eq!(lines.len(), 5, "{out}");
     assert!(lines[0].starts_with("ok commands: help status"), "{out}");
     assert_eq!(lines[1], "ok");
@@ -96,11 +138,47 @@ fn a_port_session_prints_one_reply_per_line_in_order() {
 }
 
 #[test]
+fn a_line_that_is_not_utf8_reaches_the_head_and_the_next_lines_too() {
+    // CR, LF and CR LF each end one line, as on the head; the last line's
+    // missing line end is added.
+    let outcome = session(b"help\nnod \xff\r\nnod \xc3\xa9\rstatus");
+    let out = outcome.text();
+    assert!(outcome.talk.problems().is_empty(), "{out}");
+    assert_eq!(outcome.talk.sent, 4);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 4, "{out}");
+    assert!(lines[0].starts_with("ok commands:"), "{out}");
+    assert_eq!(lines[1], "err line not UTF-8 from byte 4 on", "{out}");
+    // The head quotes a word that is not ASCII as escapes: it did get é.
+    assert!(lines[2].starts_with("err syntax `\\xc3\\xa9`"), "{out}");
+    assert!(lines[3].starts_with("ok mode="), "{out}");
+}
+
+#[test]
 fn a_line_without_a_reply_fails_the_session_after_the_wait() {
-    let (ok, out) = session("status\nmute\nnod\n");
-    assert!(!ok, "a reply was missing: {out}");
+    let outcome = session(b"status\nmute\nnod\n");
+    let out = outcome.text();
+    assert_eq!(
+        outcome.talk.problems(),
+        ["1 of 3 lines got no reply"],
+        "{out}"
+    );
     assert_eq!(out.lines().count(), 2, "{out}");
     assert!(out.starts_with("ok mode=starting"), "{out}");
+}
+
+#[test]
+fn a_port_that_goes_away_ends_the_session_with_a_reason() {
+    let outcome = session(b"status\nunplug\nstatus\nhelp\n");
+    assert_eq!(outcome.replies.len(), 1, "{}", outcome.text());
+    let early = outcome.talk.early.as_deref().unwrap_or_default();
+    assert!(
+        early.starts_with("reading the port failed")
+            || early.starts_with("writing to the port failed")
+            || early == "the port closed",
+        "{early:?}"
+    );
+    assert_eq!(outcome.talk.missing(), 3);
 }
 
 /// A USB serial port as the system lists it.

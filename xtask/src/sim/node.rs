@@ -2,18 +2,17 @@
 
 use std::{
     fmt::Write as _,
-    io::{BufRead, BufReader},
+    io::{BufRead, BufReader, Read},
     path::{Path, PathBuf},
     process::{Command, Stdio},
-    sync::mpsc::{self, RecvTimeoutError},
-    thread,
-    time::{Duration, Instant},
+    time::Duration,
 };
 
 use anyhow::{Context, Result, bail};
 use serde_json::{Value, json};
 
-use crate::{project, setup};
+use super::event::Event;
+use crate::{child, log::Exit, project, setup};
 use xshell::cmd;
 
 /// The Debian/Ubuntu packages that bring `node` and `npm`.
@@ -232,8 +231,9 @@ fn nanos(duration: Duration) -> u64 {
 }
 
 /// Runs the harness; returns its events, in order. Fails if node cannot be
-/// started, exits with an error, or outlives the wall time (plus a grace).
-pub fn run(root: &Path, config: &Config) -> Result<Vec<Value>> {
+/// started, exits with an error, prints a line that is not a known event,
+/// or outlives the wall time (plus a grace).
+pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     let mut command = Command::new("node");
     command
         .arg("harness.mjs")
@@ -242,58 +242,55 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Value>> {
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
-    let mut child = command
+    let child = command
         .spawn()
         .context("could not start `node` (is Node.js installed?)")?;
-    let stdout = child.stdout.take().context("node's stdout")?;
-    let stderr = child.stderr.take().context("node's stderr")?;
-    let (sender, receiver) = mpsc::channel::<String>();
-    let reader = thread::spawn(move || {
-        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-            if sender.send(line).is_err() {
-                break;
-            }
-        }
-    });
-    let errors = thread::spawn(move || {
-        let mut text = String::new();
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            text.push_str(&line);
-            text.push('\n');
-        }
-        text
-    });
     // The harness stops itself at `wall`; the grace covers node's start-up.
-    let deadline = Instant::now() + config.wall + Duration::from_secs(15);
-    let mut events: Vec<Value> = Vec::new();
-    loop {
-        match receiver.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
-            Ok(line) => {
-                events.push(serde_json::from_str(&line).with_context(|| {
-                    format!("the harness printed a line that is not JSON: {line}")
-                })?);
-            }
-            Err(RecvTimeoutError::Disconnected) => break,
-            Err(RecvTimeoutError::Timeout) => {
-                let _ = child.kill();
-                let _ = child.wait();
-                bail!(
-                    "the emulator made no progress: node was killed after {} s of wall time",
-                    config.wall.as_secs() + 15
-                );
-            }
-        }
-    }
-    let status = child.wait().context("waiting for node")?;
-    let _ = reader.join();
-    let stderr = errors.join().unwrap_or_default();
-    if !status.success() && events.last().is_none_or(|e| e["ev"] != "end") {
+    let limit = config.wall + GRACE;
+    let done = child::run(child, "node", limit, events, read_all, || ())?;
+    let status = match done.exit {
+        Exit::Status(status) => status,
+        Exit::TimedOut(_) => bail!(
+            "the emulator made no progress: node was killed after {} s of wall time",
+            limit.as_secs()
+        ),
+    };
+    let events = done.stdout?;
+    if !status.success() && !matches!(events.last(), Some(Event::End { .. })) {
         bail!(
             "the emulator harness failed ({status}):\n{}",
-            stderr.trim_end()
+            done.stderr.trim_end()
         );
     }
     Ok(events)
+}
+
+/// Wall time the harness has beyond its own limit: node's start-up.
+const GRACE: Duration = Duration::from_secs(15);
+
+/// The harness's events, one JSON line each, read to the end of its output
+/// (also past a bad line, so that node never waits on a full pipe); the
+/// first line that is not a known event is the error.
+fn events(stdout: impl Read) -> Result<Vec<Event>> {
+    let mut events = Vec::new();
+    let mut bad = None;
+    for line in BufReader::new(stdout).lines() {
+        let line = line.context("reading the harness's output")?;
+        match Event::parse(&line) {
+            Ok(event) => events.push(event),
+            Err(e) => {
+                bad.get_or_insert(e);
+            }
+        }
+    }
+    bad.map_or(Ok(events), Err)
+}
+
+/// All of `stderr`, as text.
+fn read_all(mut stderr: impl Read) -> String {
+    let mut bytes = Vec::new();
+    let _ = stderr.read_to_end(&mut bytes);
+    String::from_utf8_lossy(&bytes).into_owned()
 }
 
 #[cfg(test)]

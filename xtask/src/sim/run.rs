@@ -7,13 +7,14 @@ use anyhow::{Context, Result, bail};
 use defmt_decoder::{DecodeError, Locations, StreamDecoder, Table};
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
-use serde_json::Value;
 
 use super::{
+    event::{Event, FlashKind, Why},
     exchange, expect,
     image::{PicoImage, VECTOR_TABLE},
     node,
     pulses::{self, Limits, ServoCheck, Timing, Train},
+    unmodelled::Unmodelled,
 };
 use crate::log::LogLine;
 
@@ -90,8 +91,8 @@ pub struct FlashOp {
 /// How the harness ended.
 #[derive(Debug, Default)]
 pub struct End {
-    /// `time` when it ran the whole virtual time.
-    pub why: String,
+    /// Why it stopped: [`Why::Time`] when it ran the whole virtual time.
+    pub why: Why,
     /// Virtual time reached, ns.
     pub ns: f64,
     /// Instructions executed.
@@ -106,25 +107,25 @@ impl End {
     /// Why the run did not reach its virtual time, if it did not.
     pub fn problem(&self, silence: Duration) -> Option<String> {
         let at = self.ns / 1e9;
-        match self.why.as_str() {
-            "time" => None,
-            "silent" => Some(format!(
+        match self.why {
+            Why::Time => None,
+            Why::Silent => Some(format!(
                 "the emulator made no progress: no log byte and no pin edge for {} s of virtual \
                  time (stopped at {at:.3} s)",
                 silence.as_secs_f64()
             )),
-            "asleep" => Some(format!(
+            Why::Asleep => Some(format!(
                 "the emulator made no progress: the core sleeps with nothing left to wake it \
                  (at {at:.3} s)"
             )),
-            "wall" => Some(format!(
+            Why::Wall => Some(format!(
                 "the emulator made no progress in time: stopped after {:.1} s of wall time at \
                  {at:.3} s of virtual time (raise with --timeout)",
                 Duration::from_millis(self.wall_ms).as_secs_f64()
             )),
-            "break" => Some(format!("the firmware hit a breakpoint at {at:.3} s")),
-            other => Some(format!(
-                "the emulator stopped ({other}) at {at:.3} s: {}",
+            Why::Break => Some(format!("the firmware hit a breakpoint at {at:.3} s")),
+            Why::Error => Some(format!(
+                "the emulator stopped (error) at {at:.3} s: {}",
                 self.error.as_deref().unwrap_or("no reason given")
             )),
         }
@@ -140,6 +141,8 @@ pub struct Report {
     pub end: End,
     /// The emulator's complaints, each with how often it came.
     pub emulator: Vec<(String, usize)>,
+    /// Accesses to peripherals the emulator does not model.
+    pub unmodelled: Vec<Unmodelled>,
     /// Problems with the run itself (it stopped early, a frame is missing...).
     pub problems: Vec<String>,
     /// The UART exchange as a transcript, if the run had one.
@@ -301,111 +304,63 @@ fn check_exchange(report: &mut Report) {
     report.exchange = Some(text);
 }
 
-fn number(event: &Value, key: &str) -> Result<f64> {
-    event[key]
-        .as_f64()
-        .with_context(|| format!("harness event without `{key}`: {event}"))
-}
-
-#[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // counts and addresses < 2^53
-fn integer(event: &Value, key: &str) -> Result<u64> {
-    number(event, key).map(|n| n as u64)
-}
-
 /// Sorts the events into boots and decodes each boot's log.
 fn sort(
-    events: &[Value],
+    events: &[Event],
     table: &Table,
     locations: Option<&Locations>,
     root: &Path,
 ) -> Result<Report> {
     let mut report = Report::default();
     let mut decoder: Option<Box<dyn StreamDecoder + '_>> = None;
-    let servo = |key: &str, event: &Value| -> Result<Option<usize>> {
-        let n = integer(event, key)?;
-        Ok(SERVOS
-            .iter()
-            .position(|s| u64::from(if key == "pin" { s.1 } else { s.2 }) == n))
-    };
+    let mut ended = false;
     for event in events {
-        let kind = event["ev"].as_str().unwrap_or_default();
-        if kind == "boot" {
-            let start = number(event, "ns")?;
-            if let Some(last) = report.boots.last_mut() {
-                last.end = start;
+        match event {
+            Event::Boot { ns, .. } => {
+                if let Some(last) = report.boots.last_mut() {
+                    last.end = *ns;
+                }
+                report.boots.push(Boot {
+                    start: *ns,
+                    ..Boot::default()
+                });
+                decoder = Some(table.new_stream_decoder());
+                continue;
             }
-            report.boots.push(Boot {
-                start,
-                ..Boot::default()
-            });
-            decoder = Some(table.new_stream_decoder());
-            continue;
-        }
-        if kind == "emu" {
-            let message = event["msg"].as_str().unwrap_or_default().to_owned();
-            match report.emulator.iter_mut().find(|(m, _)| *m == message) {
-                Some((_, count)) => *count += 1,
-                None => report.emulator.push((message, 1)),
+            Event::Emu { msg, .. } => {
+                match report.emulator.iter_mut().find(|(m, _)| m == msg) {
+                    Some((_, count)) => *count += 1,
+                    None => report.emulator.push((msg.clone(), 1)),
+                }
+                continue;
             }
-            continue;
-        }
-        if kind == "end" {
-            report.end = end(event)?;
-            continue;
+            Event::Unmodelled {
+                peripheral,
+                op,
+                offset,
+                count,
+            } => {
+                report.unmodelled.push(Unmodelled {
+                    peripheral: peripheral.clone(),
+                    op: *op,
+                    offset: *offset,
+                    count: *count,
+                });
+                continue;
+            }
+            Event::End { .. } => {
+                report.end = End::from_event(event)?;
+                ended = true;
+                continue;
+            }
+            _ => {}
         }
         let Some(boot) = report.boots.last_mut() else {
-            bail!("harness event before the first boot: {event}");
+            bail!("harness event before the first boot: {event:?}");
         };
-        match kind {
-            "rtt" => {
-                let ns = number(event, "ns")?;
-                let bytes = hex(event["hex"].as_str().unwrap_or_default())?;
-                let Some(decoder) = decoder.as_mut() else {
-                    continue;
-                };
-                decoder.received(&bytes);
-                loop {
-                    let line = match decoder.decode() {
-                        Ok(frame) => line(&frame, locations, root),
-                        Err(DecodeError::UnexpectedEof) => break,
-                        Err(DecodeError::Malformed) => LogLine {
-                            level: Some("ERROR".to_owned()),
-                            message: "(malformed defmt frame: the log stream is corrupt)"
-                                .to_owned(),
-                            timestamp: None,
-                            location: None,
-                        },
-                    };
-                    boot.log.push((ns, line));
-                }
-            }
-            "edge" if event["reset"] != true => {
-                if let Some(i) = servo("pin", event)? {
-                    boot.trains[i]
-                        .edges
-                        .push((number(event, "ns")?, event["high"] == true));
-                }
-            }
-            "cc" => {
-                if let Some(i) = servo("slice", event)? {
-                    // Channel A is the low half of the compare register.
-                    let value = (integer(event, "value")? & 0xffff) as u16;
-                    boot.trains[i].writes.push((number(event, "ns")?, value));
-                }
-            }
-            "en" if event["on"] == true => {
-                if let Some(i) = servo("slice", event)? {
-                    let train = &mut boot.trains[i];
-                    train.enabled = train.enabled.or(Some(number(event, "ns")?));
-                }
-            }
-            "call" => boot.frame_cycles.push(integer(event, "cycles")?),
-            "watchdog" => boot.watchdog = true,
-            "stack" => boot.stack_low = Some(integer(event, "low")?),
-            _ => port_event(boot, kind, event)?,
-        }
+        into_boot(boot, event, decoder.as_mut(), locations, root);
     }
-    if report.end.why.is_empty() {
+    if !ended {
         bail!("the emulator harness ended without saying how");
     }
     if let Some(last) = report.boots.last_mut() {
@@ -414,49 +369,124 @@ fn sort(
     Ok(report)
 }
 
-/// An event of the console ports (UART0, USB) or the flash into `boot`;
-/// others are ignored.
-fn port_event(boot: &mut Boot, kind: &str, event: &Value) -> Result<()> {
-    match kind {
-        "uart" => boot
-            .uart
-            .extend(hex(event["hex"].as_str().unwrap_or_default())?),
-        "usb" => boot
-            .usb
-            .extend(hex(event["hex"].as_str().unwrap_or_default())?),
-        "uart_overrun" => boot.uart_overruns += 1,
-        "uart_rx" => boot.uart_sent = Some(number(event, "ns")?),
-        "usb_connected" => boot.usb_connected = Some(number(event, "ns")?),
-        "power_cycle" => boot.power_cycled = true,
-        "flash" => boot.flash.push(FlashOp {
-            erase: event["op"] == "erase",
-            addr: integer(event, "addr")?,
-            len: integer(event, "len")?,
-            busy_ns: number(event, "busy_ns")?,
-            ns: number(event, "ns")?,
+/// An event of the current boot into `boot`; its log bytes through
+/// `decoder`.
+fn into_boot(
+    boot: &mut Boot,
+    event: &Event,
+    decoder: Option<&mut Box<dyn StreamDecoder + '_>>,
+    locations: Option<&Locations>,
+    root: &Path,
+) {
+    match event {
+        Event::Rtt { ns, hex } => {
+            let Some(decoder) = decoder else {
+                return;
+            };
+            decoder.received(hex);
+            loop {
+                let line = match decoder.decode() {
+                    Ok(frame) => line(&frame, locations, root),
+                    Err(DecodeError::UnexpectedEof) => break,
+                    Err(DecodeError::Malformed) => LogLine {
+                        level: Some("ERROR".to_owned()),
+                        message: "(malformed defmt frame: the log stream is corrupt)".to_owned(),
+                        timestamp: None,
+                        location: None,
+                    },
+                };
+                boot.log.push((*ns, line));
+            }
+        }
+        Event::Edge {
+            pin,
+            high,
+            ns,
+            reset: false,
+        } => {
+            if let Some(i) = SERVOS.iter().position(|s| s.1 == *pin) {
+                boot.trains[i].edges.push((*ns, *high));
+            }
+        }
+        Event::Cc { slice, value, ns } => {
+            if let Some(i) = SERVOS.iter().position(|s| s.2 == *slice) {
+                // Channel A is the low half of the compare register.
+                boot.trains[i].writes.push((*ns, (value & 0xffff) as u16));
+            }
+        }
+        Event::En {
+            slice,
+            on: true,
+            ns,
+        } => {
+            if let Some(i) = SERVOS.iter().position(|s| s.2 == *slice) {
+                let train = &mut boot.trains[i];
+                train.enabled = train.enabled.or(Some(*ns));
+            }
+        }
+        Event::Call { cycles, .. } => boot.frame_cycles.push(*cycles),
+        Event::Watchdog { .. } => boot.watchdog = true,
+        Event::Stack { low, .. } => boot.stack_low = Some(*low),
+        Event::Uart { hex, .. } => boot.uart.extend(hex),
+        Event::Usb { hex, .. } => boot.usb.extend(hex),
+        Event::UartOverrun { .. } => boot.uart_overruns += 1,
+        Event::UartRx { ns, .. } => boot.uart_sent = Some(*ns),
+        Event::UsbConnected { ns } => boot.usb_connected = Some(*ns),
+        Event::PowerCycle { .. } => boot.power_cycled = true,
+        Event::Flash {
+            op,
+            addr,
+            len,
+            busy_ns,
+            ns,
+        } => boot.flash.push(FlashOp {
+            erase: *op == FlashKind::Erase,
+            addr: *addr,
+            len: *len,
+            busy_ns: *busy_ns,
+            ns: *ns,
         }),
-        _ => {}
+        // A reset's pin release and a slice switched off are not
+        // needed; the rest is sorted before a boot is needed.
+        Event::Edge { reset: true, .. }
+        | Event::En { on: false, .. }
+        | Event::Boot { .. }
+        | Event::Emu { .. }
+        | Event::Unmodelled { .. }
+        | Event::End { .. } => {}
     }
-    Ok(())
 }
 
-fn end(event: &Value) -> Result<End> {
-    Ok(End {
-        why: event["why"].as_str().unwrap_or("?").to_owned(),
-        ns: number(event, "ns")?,
-        instructions: integer(event, "instructions")?,
-        wall_ms: integer(event, "wall_ms")?,
-        error: event["msg"].as_str().map(str::to_owned),
-    })
+impl End {
+    /// The end of a run from its `end` event.
+    fn from_event(event: &Event) -> Result<Self> {
+        let Event::End {
+            why,
+            ns,
+            instructions,
+            wall_ms,
+            msg,
+        } = event
+        else {
+            bail!("not an `end` event: {event:?}");
+        };
+        Ok(Self {
+            why: *why,
+            ns: *ns,
+            instructions: *instructions,
+            wall_ms: *wall_ms,
+            error: msg.clone(),
+        })
+    }
 }
 
 /// How a run ended, from its events.
-pub fn end_of(events: &[Value]) -> Result<End> {
+pub fn end_of(events: &[Event]) -> Result<End> {
     let event = events
         .iter()
-        .rfind(|event| event["ev"] == "end")
+        .rfind(|event| matches!(event, Event::End { .. }))
         .context("the emulator harness ended without saying how")?;
-    end(event)
+    End::from_event(event)
 }
 
 fn line(frame: &defmt_decoder::Frame<'_>, locations: Option<&Locations>, root: &Path) -> LogLine {
@@ -472,17 +502,6 @@ fn line(frame: &defmt_decoder::Frame<'_>, locations: Option<&Locations>, root: &
         timestamp: None,
         location,
     }
-}
-
-fn hex(text: &str) -> Result<Vec<u8>> {
-    (0..text.len())
-        .step_by(2)
-        .map(|i| {
-            text.get(i..i + 2)
-                .and_then(|pair| u8::from_str_radix(pair, 16).ok())
-                .with_context(|| format!("bad hex in an RTT event: {text}"))
-        })
-        .collect()
 }
 
 /// The PWM timing of the Pico's servo slices.

@@ -54,7 +54,7 @@ pub const CONSOLE_TIME: Duration = Duration::from_secs(6);
 /// checksum is the host's. Returns the run for the memory stage.
 pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
     let report = run::simulate(root, &PICO.elf(metadata), DEFAULT_TIME, WALL, false)?;
-    print!("{}", report.log_text());
+    print!("{}", report.log_text(false));
     print!("{}", report.table());
     println!("{}", report.verdict());
     println!("{}", report.summary());
@@ -90,7 +90,7 @@ pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
 pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
     let elf = build_variant(root, metadata, "watchdog-drill")?;
     let report = run::simulate(root, &elf, DRILL_TIME, WALL, false)?;
-    print!("{}", report.log_text());
+    print!("{}", report.log_text(false));
     print!("{}", report.table());
     println!("{}", report.verdict());
     println!("{}", report.summary());
@@ -187,7 +187,7 @@ pub fn test_console(
 ) -> Result<()> {
     let elf = shipped_image(root, metadata)?;
     let report = run::simulate(root, &elf, virtual_time, wall, true)?;
-    print!("{}", report.log_text());
+    print!("{}", report.log_text(false));
     print!("{}", report.exchange.as_deref().unwrap_or_default());
     print!("{}", report.table());
     println!("{}", report.verdict());

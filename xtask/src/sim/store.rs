@@ -129,7 +129,7 @@ fn run_from(
             .map(|boot| UartScript::new(boot, SCRIPTS[boot].to_vec(), SCRIPT_AT[boot]))
             .collect();
     })?;
-    print!("{}", report.log_text());
+    print!("{}", report.log_text(false));
     let mut problems = report.problems.clone();
     let (text, found) = check(&report, logged);
     print!("{text}");

@@ -51,11 +51,12 @@ pub fn show_seconds(us: u64) -> String {
     text
 }
 
-/// Parses a script; the events sorted by time (in line order at equal
-/// times). Every bad line is reported, each with its number and reason,
-/// and then none runs.
+/// Parses a script: its events, in time order. A script is a program, read
+/// top to bottom: a line timed before the line above it is an error (lines
+/// at the same time run in line order). Every bad line is reported, each
+/// with its number and reason, and then none runs.
 pub fn parse(script: &str, params: &BehaviourParams) -> Result<Vec<Event>> {
-    let mut events = Vec::new();
+    let mut events: Vec<Event> = Vec::new();
     let mut errors = Vec::new();
     for (index, raw) in script.lines().enumerate() {
         let line = index + 1;
@@ -64,14 +65,25 @@ pub fn parse(script: &str, params: &BehaviourParams) -> Result<Vec<Event>> {
             continue;
         }
         match event(line, text, params) {
-            Ok(event) => events.push(event),
+            Ok(event) => {
+                if let Some(last) = events.last().filter(|last| last.at_us > event.at_us) {
+                    errors.push(format!(
+                        "line {line}: at {} s, before line {} (at {} s): lines must be in time order",
+                        show_seconds(event.at_us),
+                        last.line,
+                        show_seconds(last.at_us)
+                    ));
+                    // Later lines are compared with the latest time so far.
+                    continue;
+                }
+                events.push(event);
+            }
             Err(reason) => errors.push(format!("line {line}: {reason}")),
         }
     }
     if !errors.is_empty() {
         bail!("{}", errors.join("\n"));
     }
-    events.sort_by_key(|e| e.at_us);
     Ok(events)
 }
 
@@ -126,12 +138,12 @@ mod tests {
     #[test]
     fn a_script_in_time_order() {
         let script = "\
-# a nod, then a shake interrupted by a tilt
-2.5 nod 6000 900
-
+# a look, a nod, then a shake interrupted by a tilt
 1 look 5000 -10000 hold=stay   # first
+
+2.5 nod 6000 900
 4 shake
-4.4 tilt -8000
+4 tilt -8000
 6 center
 7 idle amp 50
 8 stop
@@ -141,16 +153,33 @@ mod tests {
         assert_eq!(
             lines,
             [
-                (4, 1_000_000),
-                (2, 2_500_000),
+                (2, 1_000_000),
+                (4, 2_500_000),
                 (5, 4_000_000),
-                (6, 4_400_000),
+                (6, 4_000_000),
                 (7, 6_000_000),
                 (8, 7_000_000),
                 (9, 8_000_000),
             ]
         );
         assert!(matches!(events[1].action, Action::Gesture(g) if g.kind == GestureKind::Nod));
+    }
+
+    #[test]
+    fn a_line_before_the_line_above_it_is_an_error() {
+        let script = "\
+2.5 nod 6000 900
+1 look 5000 -10000
+3 shake
+2.9 tilt
+";
+        let err = parse(script, &params()).unwrap_err().to_string();
+        assert_eq!(
+            err,
+            "\
+line 2: at 1 s, before line 1 (at 2.5 s): lines must be in time order
+line 4: at 2.9 s, before line 3 (at 3 s): lines must be in time order"
+        );
     }
 
     #[test]

@@ -204,7 +204,10 @@ const fn clamp_u16(v: usize) -> u16 {
     }
 }
 
-/// A decimal integer with an optional sign; `None` if not one or beyond ±2⁶².
+/// A decimal integer with an optional sign; `None` if not one. However
+/// many digits it has, a number is a number: past ±`i64::MAX` it saturates
+/// there, far outside every field's range, so that the range check rejects
+/// it (`err range`) instead of calling it no number (`err syntax`).
 fn integer(text: &[u8]) -> Option<i64> {
     let (negative, digits) = match text.split_first() {
         Some((b'-', rest)) => (true, rest),
@@ -219,12 +222,13 @@ fn integer(text: &[u8]) -> Option<i64> {
         if !d.is_ascii_digit() {
             return None;
         }
-        value = value.checked_mul(10)?.checked_add(i64::from(d - b'0'))?;
-        if value > 1 << 62 {
-            return None;
-        }
+        value = value.saturating_mul(10).saturating_add(i64::from(d - b'0'));
     }
-    Some(if negative { -value } else { value })
+    Some(if negative {
+        value.saturating_neg()
+    } else {
+        value
+    })
 }
 
 /// The words of a line, separated by spaces and tabs.

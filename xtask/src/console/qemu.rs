@@ -1,0 +1,178 @@
+//! A console session with the firmware in QEMU: UART0 on one socket for the
+//! conversation, UART1 on another for the hang-up.
+
+use std::{
+    io::{BufRead, BufReader, Read, Write},
+    os::unix::net::UnixStream,
+    path::Path,
+    process::{Command, Stdio},
+    thread,
+    time::{Duration, Instant},
+};
+
+use anyhow::{Context, Result};
+use defmt_decoder::Table;
+
+use super::talk::{self, Talk};
+use crate::child;
+use crate::log::Run;
+use crate::qemu::{self, Echo};
+use crate::{project, setup};
+
+/// How QEMU's virtual clock runs while the core sleeps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pace {
+    /// With the wall clock (`sleep=on`): for a person at the console.
+    RealTime,
+    /// Jumping over idle time (`sleep=off`): as fast as the host can.
+    Fast,
+}
+
+/// A QEMU run with its console.
+pub struct QemuSession {
+    /// The firmware's log and exit.
+    pub run: Run,
+    /// The conversation: lines sent, replies, what ended it early.
+    pub talk: Talk,
+}
+
+impl QemuSession {
+    /// The firmware's summary line.
+    pub fn summary(&self) -> Option<String> {
+        self.run
+            .log
+            .iter()
+            .rev()
+            .find(|line| line.message.starts_with("summary"))
+            .map(|line| line.message.clone())
+    }
+}
+
+/// How long QEMU has to stop after the hang-up (the firmware fades out for
+/// a moment of virtual time, then prints its summary), and how long the
+/// reply reader waits for a byte after it.
+const AFTER_HANG_UP: Duration = Duration::from_secs(120);
+
+/// Runs `elf` in QEMU held for its console (semihosting argument
+/// `console`): sends `input` to UART0 as it comes, byte for byte, hands
+/// each reply line to `on_reply`, waits up to `wait` for the replies still
+/// due, then hangs up (a byte on UART1), so that the firmware fades out and
+/// prints its summary.
+pub fn qemu_session(
+    elf: &Path,
+    input: impl Read,
+    mut on_reply: impl FnMut(&[u8]) + Send,
+    pace: Pace,
+    echo: Echo,
+    wait: Duration,
+) -> Result<QemuSession> {
+    let root = project::root();
+    let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
+    let table = Table::parse(&bytes)?.context("no defmt data in the image")?;
+    let locations = table.get_locations(&bytes).ok();
+    let dir = std::env::temp_dir().join(format!("idle-head-console-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    let [uart0, uart1] = ["uart0", "uart1"].map(|n| dir.join(format!("{n}.sock")));
+    for path in [&uart0, &uart1] {
+        let _ = std::fs::remove_file(path);
+    }
+    let sleep = match pace {
+        Pace::RealTime => "on",
+        Pace::Fast => "off",
+    };
+    let child = Command::new(setup::QEMU_BINARY)
+        .args([
+            "-machine",
+            "lm3s6965evb",
+            "-cpu",
+            "cortex-m0",
+            "-display",
+            "none",
+        ])
+        .args(["-monitor", "none"])
+        .args([
+            "-semihosting-config",
+            "enable=on,target=native,arg=idle-head,arg=console",
+        ])
+        .args(["-icount", &format!("shift=0,sleep={sleep}")])
+        .arg("-serial")
+        .arg(format!("unix:{},server=on,wait=on", uart0.display()))
+        .arg("-serial")
+        .arg(format!("unix:{},server=on,wait=on", uart1.display()))
+        .arg("-kernel")
+        .arg(elf)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
+    let start = Instant::now();
+    let done = child::run(
+        child,
+        setup::QEMU_BINARY,
+        AFTER_HANG_UP,
+        |stdout| qemu::decode(stdout, &table, locations.as_ref(), &root, echo),
+        |stderr| {
+            // QEMU says it waits for each socket's connection: not news here.
+            let mut to = std::io::stderr();
+            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+                if !line.contains("QEMU waiting for connection") && !qemu::is_reset_noise(&line) {
+                    let _ = writeln!(to, "{line}");
+                }
+            }
+        },
+        || talk(&uart0, &uart1, input, &mut on_reply, wait),
+    )?;
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(QemuSession {
+        run: Run {
+            log: done.stdout,
+            exit: done.exit,
+            elapsed: start.elapsed(),
+        },
+        talk: done.meanwhile?,
+    })
+}
+
+/// Connects to a socket QEMU serves, waiting for it to appear.
+fn connect(path: &Path) -> Result<UnixStream> {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    loop {
+        match UnixStream::connect(path) {
+            Ok(stream) => return Ok(stream),
+            Err(e) if Instant::now() > deadline => {
+                return Err(e).with_context(|| format!("connecting to {}", path.display()));
+            }
+            Err(_) => thread::sleep(Duration::from_millis(20)),
+        }
+    }
+}
+
+/// The conversation on UART0 ([`talk::converse`]), then the hang-up on
+/// UART1: the firmware fades out, prints its summary and exits, which
+/// closes the socket and ends the reader.
+fn talk(
+    uart0: &Path,
+    uart1: &Path,
+    input: impl Read,
+    on_reply: &mut (impl FnMut(&[u8]) + Send),
+    wait: Duration,
+) -> Result<Talk> {
+    let mut console = connect(uart0)?;
+    let mut hangup = connect(uart1)?;
+    let reader = console.try_clone()?;
+    let timeout = console.try_clone()?;
+    Ok(talk::converse(
+        input,
+        &mut console,
+        reader,
+        on_reply,
+        wait,
+        || {
+            hangup.write_all(b"\0")?;
+            // A firmware that does not stop must not hold the reader for ever.
+            timeout.set_read_timeout(Some(AFTER_HANG_UP))?;
+            Ok(())
+        },
+    ))
+}

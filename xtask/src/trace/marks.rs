@@ -1,0 +1,207 @@
+//! What the script's commands did, as marks for the summary and the plot:
+//! when each was applied, how long its motion lasts and on which axes, and
+//! the return to the centre a look plans after its hold.
+
+use idle_head_core::behaviour::{Applied, BehaviourError, BehaviourParams};
+use idle_head_core::command::{Action, Hold, LookRequest};
+use idle_head_core::{Angle, Axis, Millis};
+
+use super::script::Event;
+
+/// What kind of motion a mark stands for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// A gesture (nod, shake, tilt).
+    Gesture,
+    /// A move of the gaze: `look` or `center`.
+    Gaze,
+    /// A look's return to the centre after its hold.
+    Return,
+    /// Anything else (idle, stop, a refused command).
+    Other,
+}
+
+/// A command as applied, or a look's return.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mark {
+    /// When it was applied (or the return starts), in ms.
+    pub t_ms: u64,
+    /// How long its motion lasts, in ms (0: a switch).
+    pub span_ms: u64,
+    /// The axes it moves.
+    pub axes: Vec<Axis>,
+    /// What it is.
+    pub kind: Kind,
+    /// A short label (`nod`, `look clamped`, `return`, ...).
+    pub label: String,
+    /// The reply a console would give (for a return: what it is).
+    pub reply: String,
+}
+
+impl Mark {
+    /// Whether the head refused it.
+    pub fn refused(&self) -> bool {
+        self.reply.starts_with("err")
+    }
+}
+
+/// The marks of `event`, applied at `t_ms` with `outcome`: its own, and
+/// for a look that returns, the return.
+pub fn marks(
+    event: &Event,
+    t_ms: u64,
+    outcome: &Result<Applied, BehaviourError>,
+    params: &BehaviourParams,
+) -> Vec<Mark> {
+    let word = event
+        .text
+        .split_whitespace()
+        .next()
+        .unwrap_or("")
+        .to_owned();
+    let (axes, span_ms, kind, label, reply) = match outcome {
+        Err(e) => (
+            vec![],
+            0,
+            Kind::Other,
+            format!("{word} (refused)"),
+            format!("err {} {e}", e.code()),
+        ),
+        Ok(Applied::Gesture(plan)) => (
+            vec![plan.kind.axis()],
+            u64::from(plan.duration.0),
+            Kind::Gesture,
+            word,
+            format!(
+                "ok {} {} mdeg {} cycles {} ms intensity {}",
+                plan.kind.name(),
+                plan.amplitude.millidegrees(),
+                plan.cycles,
+                plan.duration.0,
+                plan.intensity.get()
+            ),
+        ),
+        Ok(Applied::Look(look)) => (
+            vec![Axis::Pitch, Axis::Yaw],
+            u64::from(look.duration.0),
+            Kind::Gaze,
+            if look.clamped {
+                "look (clamped)".to_owned()
+            } else {
+                word
+            },
+            format!(
+                "ok look{} {} {} {} ms",
+                if look.clamped { " clamped" } else { "" },
+                look.pitch.millidegrees(),
+                look.yaw.millidegrees(),
+                look.duration.0
+            ),
+        ),
+        Ok(Applied::Center(ms)) => (
+            vec![Axis::Pitch, Axis::Yaw],
+            u64::from(ms.0),
+            Kind::Gaze,
+            word,
+            format!("ok center {} ms", ms.0),
+        ),
+        Ok(Applied::Idle(p)) => (
+            vec![],
+            0,
+            Kind::Other,
+            event.text.clone(),
+            format!("ok idle {} %", p.get()),
+        ),
+        Ok(Applied::Stop) => (vec![], 0, Kind::Other, word, "ok stop".to_owned()),
+    };
+    let mut marks = vec![Mark {
+        t_ms,
+        span_ms,
+        axes,
+        kind,
+        label,
+        reply,
+    }];
+    if let Ok(Applied::Look(look)) = outcome
+        && let Hold::Return(hold) = look.hold
+        && let Some(back) = return_duration(params, look.pitch, look.yaw)
+    {
+        // As the gaze plans it: the move's frames, then the hold's (at
+        // least one), then the move back at the rule's duration.
+        let frame_ms = u64::from(params.frame_us()) / 1000;
+        let frames =
+            u64::from(params.frames(look.duration)) + u64::from(params.frames(hold).max(1));
+        marks.push(Mark {
+            t_ms: t_ms + frames * frame_ms,
+            span_ms: u64::from(back.0),
+            axes: vec![Axis::Pitch, Axis::Yaw],
+            kind: Kind::Return,
+            label: "return".to_owned(),
+            reply: format!(
+                "(the look at line {} returns to the centre after its {} ms hold, in {} ms)",
+                event.line, hold.0, back.0
+            ),
+        });
+    }
+    marks
+}
+
+/// How long the way back from a look at `pitch`, `yaw` takes: as long as
+/// the way there from the centre at the rule's duration, which the core
+/// answers for a look from a head at rest.
+fn return_duration(params: &BehaviourParams, pitch: Angle, yaw: Angle) -> Option<Millis> {
+    let there = Action::Look(LookRequest {
+        pitch,
+        yaw,
+        duration: None,
+        hold: Some(Hold::Stay),
+    });
+    match params.check(&there) {
+        Ok(Applied::Look(look)) => Some(look.duration),
+        _ => None,
+    }
+}
+
+/// Settles the marks once the run is over: a gesture interrupted by a newer
+/// one ends within `blend_ms` of it; a look's return does not happen when
+/// another look or a `center` comes before it starts, and ends where one
+/// comes while it plays; a return after `end_ms` is left out. The marks end
+/// up in time order.
+pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
+    let applied = |m: &Mark| !m.refused();
+    let gestures: Vec<usize> = (0..marks.len())
+        .filter(|&i| marks[i].kind == Kind::Gesture && applied(&marks[i]))
+        .collect();
+    for pair in gestures.windows(2) {
+        let next = marks[pair[1]].t_ms;
+        let mark = &mut marks[pair[0]];
+        let end = next + u64::from(blend_ms);
+        if mark.t_ms + mark.span_ms > end {
+            mark.span_ms = end - mark.t_ms;
+        }
+    }
+    // A return follows its look in the list; the next gaze move after the
+    // look is the one that cancels or cuts it.
+    let mut keep = vec![true; marks.len()];
+    for i in 0..marks.len() {
+        if marks[i].kind != Kind::Return {
+            continue;
+        }
+        let next_move = marks[i + 1..]
+            .iter()
+            .find(|m| m.kind == Kind::Gaze && applied(m))
+            .map(|m| m.t_ms);
+        let mark = &mut marks[i];
+        match next_move {
+            Some(t) if t <= mark.t_ms => keep[i] = false,
+            Some(t) if t < mark.t_ms + mark.span_ms => mark.span_ms = t - mark.t_ms,
+            _ => {}
+        }
+        if mark.t_ms >= end_ms {
+            keep[i] = false;
+        }
+    }
+    let mut keep = keep.into_iter();
+    marks.retain(|_| keep.next().unwrap_or(true));
+    marks.sort_by_key(|m| m.t_ms);
+}
