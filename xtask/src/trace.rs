@@ -26,6 +26,7 @@ use std::{fs, path::PathBuf};
 
 use anyhow::{Context, Result, anyhow};
 use idle_head_core::behaviour::{Applied, BehaviourConfig, CommandQueue, Head, LOOP_DURATION};
+use idle_head_core::command::GestureKind;
 use idle_head_core::driver::{DriverConfig, FrameDriver};
 use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
@@ -232,10 +233,11 @@ fn interrupted(marks: &mut [Mark], blend_ms: u32) {
     }
 }
 
+/// Whether the mark's reply is a gesture's (`ok <word> …`; every gesture of
+/// the core's table).
 fn is_gesture(mark: &Mark) -> bool {
-    ["ok nod", "ok shake", "ok tilt"]
-        .iter()
-        .any(|p| mark.reply.starts_with(p))
+    let word = mark.reply.split_whitespace().nth(1);
+    GestureKind::ALL.iter().any(|k| word == Some(k.name()))
 }
 
 /// The mark of `event`, applied at `t_ms` with `outcome`.

@@ -53,7 +53,7 @@ use idle_head_core::behaviour::{
     Applied, BehaviourConfig, BehaviourError, BehaviourParams, CommandQueue, Head, HeadFrame,
     IdleSource,
 };
-use idle_head_core::command::{Action, GestureKind, Hold};
+use idle_head_core::command::{Action, Hold};
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::driver::{
     DriverConfig, DriverParams, FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod,
@@ -512,11 +512,7 @@ fn log_faults(report: &FrameReport) {
 /// The command word of `action`, as the console spells it.
 const fn word(action: &Action) -> &'static str {
     match action {
-        Action::Gesture(request) => match request.kind {
-            GestureKind::Nod => "nod",
-            GestureKind::Shake => "shake",
-            GestureKind::Tilt => "tilt",
-        },
+        Action::Gesture(request) => request.kind.name(),
         Action::Look(_) => "look",
         Action::Center { .. } => "center",
         Action::Idle(true) => "idle on",

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 
 use anyhow::{Result, bail};
 use idle_head_core::behaviour::BehaviourParams;
-use idle_head_core::command::{Action, Command};
+use idle_head_core::command::{Action, Command, GestureKind};
 use idle_head_core::console;
 
 /// One scripted command.
@@ -21,8 +21,15 @@ pub struct Event {
     pub action: Action,
 }
 
-/// The commands a script may give.
-const ALLOWED: &str = "nod, shake, tilt, look, center, idle on|off, idle amp, stop";
+/// The commands a script may give: every gesture of the core's table, and
+/// the other motion commands.
+fn allowed() -> String {
+    let gestures: Vec<&str> = GestureKind::ALL.iter().map(|k| k.name()).collect();
+    format!(
+        "{}, look, center, idle on|off, idle amp, stop",
+        gestures.join(", ")
+    )
+}
 
 /// `text` as seconds (`2`, `2.5`, `0.125`; at most µs), in µs.
 pub fn seconds(text: &str) -> Result<u64> {
@@ -85,7 +92,10 @@ fn event(line: usize, text: &str, params: &BehaviourParams) -> Result<Event, Str
         Ok(Command::Act(action)) => action,
         Ok(_) => {
             let word = command.split_whitespace().next().unwrap_or("");
-            return Err(format!("`{word}` cannot be scripted (commands: {ALLOWED})"));
+            return Err(format!(
+                "`{word}` cannot be scripted (commands: {})",
+                allowed()
+            ));
         }
         Err(e) => return Err(e.describe(command.as_bytes()).to_string()),
     };
@@ -102,7 +112,6 @@ fn event(line: usize, text: &str, params: &BehaviourParams) -> Result<Event, Str
 mod tests {
     use super::*;
     use idle_head_core::behaviour::BehaviourConfig;
-    use idle_head_core::command::GestureKind;
     use idle_head_core::driver::DriverConfig;
 
     fn params() -> BehaviourParams {
@@ -151,6 +160,23 @@ mod tests {
             ]
         );
         assert!(matches!(events[1].action, Action::Gesture(g) if g.kind == GestureKind::Nod));
+    }
+
+    #[test]
+    fn every_gesture_of_the_table_can_be_scripted() {
+        let mut script = String::new();
+        for (i, kind) in GestureKind::ALL.iter().enumerate() {
+            let _ = writeln!(script, "{} {}", i + 1, kind.name());
+        }
+        let events = parse(&script, &params()).unwrap();
+        let kinds: Vec<GestureKind> = events
+            .iter()
+            .map(|e| match e.action {
+                Action::Gesture(g) => g.kind,
+                other => panic!("{other:?}"),
+            })
+            .collect();
+        assert_eq!(kinds, GestureKind::ALL);
     }
 
     #[test]
