@@ -191,16 +191,27 @@ x nod
 7
 ";
         let err = parse(script, &params()).unwrap_err().to_string();
+        let commands = allowed();
         assert_eq!(
             err,
-            "\
+            format!(
+                "\
 line 1: `six`: amplitude in mdeg must be a whole number
 line 2: unknown command `wave` (try `help`)
-line 3: `servo` cannot be scripted (commands: nod, shake, tilt, look, center, idle on|off, idle amp, stop)
+line 3: `servo` cannot be scripted (commands: {commands})
 line 4: `x`: expected seconds such as 2 or 2.5 (at most 6 decimals)
 line 5: nod amplitude 30°: must be in 0.001°..20° (pitch's limits around its neutral pose)
 line 6: missing yaw in mdeg
 line 7: `7`: expected `<seconds> <command>`"
+            )
         );
+        // The commands: every gesture of the table, then the others.
+        for kind in GestureKind::ALL {
+            assert!(
+                commands.contains(&format!("{}, ", kind.name())),
+                "{commands}"
+            );
+        }
+        assert!(commands.ends_with("look, center, idle on|off, idle amp, stop"));
     }
 }
