@@ -137,20 +137,6 @@ gestures! {
             intensity: Percent::HALF,
         },
     },
-    /// A slow sway from side to side on the yaw axis.
-    Sway {
-        name: "sway",
-        axis: Axis::Yaw,
-        shape: Shape::Swing,
-        max_cycles: 4,
-        defaults: GestureDefaults {
-            amplitude: Angle::from_degrees(10),
-            cycles: 2,
-            slow: MilliHertz(300),
-            brisk: MilliHertz(700),
-            intensity: Percent::HALF,
-        },
-    },
 }
 
 /// One row of the table.
