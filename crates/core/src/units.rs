@@ -4,6 +4,8 @@
 //! - [`Angle`]: signed angle in **millidegrees** (1 LSB = 0.001°) held in an `i32`.
 //! - [`Microseconds`]: pulse width or period in **microseconds** held in a `u32`.
 //! - [`Millis`]: duration in **milliseconds** held in a `u32`.
+//! - [`DegreesPerSecond`], [`DegreesPerSecondSquared`]: angular speed and
+//!   acceleration in **whole degrees** per second (squared) held in a `u32`.
 //! - [`MilliHertz`]: frequency in **millihertz** held in a `u32`.
 //! - [`Percent`]: a whole percentage, `0..=100`, held in a `u8`.
 //!
@@ -166,6 +168,16 @@ impl Millis {
         self.0
     }
 }
+
+/// Angular speed in whole degrees per second.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DegreesPerSecond(pub u32);
+
+/// Angular acceleration in whole degrees per second squared.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DegreesPerSecondSquared(pub u32);
 
 /// A frequency in millihertz (1 LSB = 0.001 Hz).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]

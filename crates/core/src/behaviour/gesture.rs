@@ -1,5 +1,5 @@
 //! Gestures as they play: a request resolved against the defaults and
-//! checked ([`plan`]), and its offset at each frame ([`GesturePlan`]).
+//! checked (`plan`), and its offset at each frame ([`GesturePlan`]).
 //!
 //! Which gestures there are, their axes and defaults, is the
 //! [gesture table](crate::gestures); how each moves is its
