@@ -157,20 +157,20 @@ fn settings() {
             "behaviour config `gesture_limits[yaw].max_speed` = 30 °/s: must be in 60..=2000 °/s",
         ),
         (
-            &|c| c.nod.slow = MilliHertz(5000),
+            &|c| c.defaults_mut(GestureKind::Nod).slow = MilliHertz(5000),
             "behaviour config `nod.slow` = 5000 mHz: must be in 100..=3500 mHz",
         ),
         (
-            &|c| c.shake.brisk = MilliHertz(4500),
+            &|c| c.defaults_mut(GestureKind::Shake).brisk = MilliHertz(4500),
             "behaviour config `shake.brisk` = 4500 mHz: must be in 1200..=4000 mHz",
         ),
         (
-            &|c| c.tilt.cycles = 0,
-            "behaviour config `tilt.cycles` = 0 cycles: must be in 1..=32 cycles",
+            &|c| c.defaults_mut(GestureKind::Tilt).cycles = 0,
+            "behaviour config `tilt.cycles` = 0 cycles: must be in 1..=1 cycles",
         ),
         (
             // The default nod at 100 % (amplitude × 1.25 × 1.05) leaves pitch.
-            &|c| c.nod.amplitude = Angle::from_degrees(18),
+            &|c| c.defaults_mut(GestureKind::Nod).amplitude = Angle::from_degrees(18),
             "nod amplitude 23.625°: must be in 0.001°..20° (pitch's limits around its neutral pose)",
         ),
     ];

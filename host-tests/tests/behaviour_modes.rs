@@ -134,14 +134,10 @@ struct Step {
 }
 
 fn action() -> impl Strategy<Value = Action> {
-    let kind = prop_oneof![
-        Just(GestureKind::Nod),
-        Just(GestureKind::Shake),
-        Just(GestureKind::Tilt)
-    ];
+    let kind = proptest::sample::select(GestureKind::ALL.to_vec());
     prop_oneof![
         (kind, proptest::option::of(1_u8..=3)).prop_map(|(kind, cycles)| {
-            let cycles = if kind == GestureKind::Tilt {
+            let cycles = if kind.row().max_cycles == 1 {
                 None
             } else {
                 cycles

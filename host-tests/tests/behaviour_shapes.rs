@@ -7,6 +7,7 @@ use std::f64::consts::TAU;
 use idle_head_core::Angle;
 use idle_head_core::behaviour::{Applied, GesturePlan, LimitMode, LookApplied, Mixer};
 use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
+use idle_head_core::gestures::Shape;
 use idle_head_core::units::Millis;
 
 use host_tests::behaviour::{default_params as params, gesture};
@@ -35,10 +36,9 @@ fn reference(plan: &GesturePlan, frames: u32, t: u32) -> f64 {
     let n = f64::from(plan.cycles);
     let a = f64::from(plan.amplitude.millidegrees());
     let phi = n * f64::from(t) / f64::from(frames);
-    let ramp = if plan.kind == GestureKind::Tilt {
-        3.0
-    } else {
-        2.0
+    let ramp = match plan.kind.shape() {
+        Shape::Dip | Shape::Swing => 2.0,
+        Shape::Lean => 3.0,
     };
     let envelope = if phi * ramp < 1.0 {
         smootherstep(phi * ramp)
@@ -52,10 +52,10 @@ fn reference(plan: &GesturePlan, frames: u32, t: u32) -> f64 {
         profile = a * (1.0 - (phi - 0.5) / (4.0 * n));
         profile *= 1.0 - 0.4 * smootherstep(phi - (n - 1.5));
     }
-    let carrier = match plan.kind {
-        GestureKind::Nod => (1.0 - (TAU * phi).cos()) / 2.0,
-        GestureKind::Shake => (TAU * phi).sin(),
-        GestureKind::Tilt => 1.0,
+    let carrier = match plan.kind.shape() {
+        Shape::Dip => (1.0 - (TAU * phi).cos()) / 2.0,
+        Shape::Swing => (TAU * phi).sin(),
+        Shape::Lean => 1.0,
     };
     envelope * profile * carrier
 }
@@ -66,15 +66,15 @@ fn frames_of(plan: &GesturePlan) -> u32 {
 
 #[test]
 fn shapes_follow_the_documented_formula() {
-    let cases = [
-        gesture(GestureKind::Nod, None, None, None),
+    // Every gesture of the table at its defaults, and a few asked for.
+    let defaults = GestureKind::ALL.map(|kind| gesture(kind, None, None, None));
+    let cases = defaults.into_iter().chain([
         gesture(GestureKind::Nod, Some(6000), Some(900), None),
         gesture(GestureKind::Nod, Some(9000), Some(2000), Some(5)),
         gesture(GestureKind::Shake, None, None, None),
         gesture(GestureKind::Shake, Some(12_000), Some(1200), Some(2)),
-        gesture(GestureKind::Tilt, None, None, None),
         gesture(GestureKind::Tilt, Some(-9000), Some(1500), None),
-    ];
+    ]);
     for action in cases {
         let mut mixer = Mixer::new(params());
         let plan = plan_of(mixer.apply(&action).unwrap());
@@ -203,7 +203,7 @@ fn peaks(values: &[f64]) -> (f64, f64) {
 
 #[test]
 fn entries_and_exits_are_smooth() {
-    for kind in [GestureKind::Nod, GestureKind::Shake, GestureKind::Tilt] {
+    for kind in GestureKind::ALL {
         let mut mixer = Mixer::new(params());
         let plan = plan_of(mixer.apply(&gesture(kind, None, None, None)).unwrap());
         let frames = frames_of(&plan) as usize;
@@ -229,17 +229,13 @@ fn entries_and_exits_are_smooth() {
 #[test]
 fn validated_peaks_bound_the_played_ones() {
     // The documented (Kv, Ka) bound every shape the mixer plays.
-    let factors = |kind| match kind {
-        GestureKind::Nod => (1.45, 1.85),
-        GestureKind::Shake => (1.05, 1.65),
-        GestureKind::Tilt => (0.9, 1.32),
+    let factors = |kind: GestureKind| match kind.shape() {
+        Shape::Dip => (1.45, 1.85),
+        Shape::Swing => (1.05, 1.65),
+        Shape::Lean => (0.9, 1.32),
     };
-    for kind in [GestureKind::Nod, GestureKind::Shake, GestureKind::Tilt] {
-        let cycle_range = if kind == GestureKind::Tilt {
-            1..=1
-        } else {
-            1..=8
-        };
+    for kind in GestureKind::ALL {
+        let cycle_range = 1..=kind.row().max_cycles.min(8);
         for cycles in cycle_range {
             for ms in [500, 900, 1600, 3000] {
                 let mut mixer = Mixer::new(params());
@@ -252,7 +248,7 @@ fn validated_peaks_bound_the_played_ones() {
                 let values = run(&mut mixer, 0, u64::from(frames) + 1, kind.axis().index());
                 let (v, a) = peaks(&values);
                 let omega = TAU * f64::from(plan.cycles) / f64::from(frames); // per frame
-                let carrier = if kind == GestureKind::Nod {
+                let carrier = if kind.shape() == Shape::Dip {
                     2000.0
                 } else {
                     4000.0

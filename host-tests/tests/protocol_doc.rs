@@ -35,3 +35,23 @@ fn the_examples_in_the_protocol_document_hold() {
     }
     assert!(exchanges >= 20, "{exchanges} exchanges found");
 }
+
+/// Every gesture of the table has its row in the document's table of
+/// commands, with `cycles=` where the gesture may have more than one.
+#[test]
+fn the_protocol_document_lists_every_gesture() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/protocol.md");
+    let doc = std::fs::read_to_string(path).expect("docs/protocol.md");
+    for kind in idle_head_core::command::GestureKind::ALL {
+        let options = if kind.row().max_cycles > 1 {
+            "[cycles=N] [intensity=P]"
+        } else {
+            "[intensity=P]"
+        };
+        let row = format!("| `{} [amp] [ms] {options}` |", kind.name());
+        assert!(
+            doc.lines().any(|line| line.starts_with(&row)),
+            "docs/protocol.md has no row `{row}`"
+        );
+    }
+}

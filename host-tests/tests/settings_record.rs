@@ -4,7 +4,7 @@
 //! not saved).
 
 use idle_head_core::behaviour::{BehaviourError, MilliHertz};
-use idle_head_core::command::{Hold, Percent};
+use idle_head_core::command::{GestureKind, Hold, Percent};
 use idle_head_core::driver::{ConfigError, DegreesPerSecond, DriverConfig};
 use idle_head_core::servo::{NanosPerDegree, ServoError};
 use idle_head_core::settings::{
@@ -60,7 +60,8 @@ fn every_field_round_trips() {
             Hold::Return(Millis(rng.random_range(0..=3_600_000)))
         };
         s.behaviour.gaze.base = Millis(rng.random_range(0..=5000));
-        s.behaviour.shake.intensity = Percent::new(rng.random_range(0..=100)).unwrap();
+        s.behaviour.defaults_mut(GestureKind::Shake).intensity =
+            Percent::new(rng.random_range(0..=100)).unwrap();
         s.behaviour.settle = Millis(rng.random_range(0..=5000));
         s.seeds = [rng.random(), rng.random(), rng.random()];
         if s.validate(&DriverConfig::DEFAULT).is_err() {
@@ -133,11 +134,17 @@ fn every_field_has_its_validation_error() {
     };
     let cases: [(&str, Edit); 12] = [
         ("nod.amplitude", |s| {
-            s.behaviour.nod.amplitude = Angle::from_degrees(80)
+            s.behaviour.defaults_mut(GestureKind::Nod).amplitude = Angle::from_degrees(80)
         }),
-        ("shake.cycles", |s| s.behaviour.shake.cycles = 0),
-        ("tilt.slow", |s| s.behaviour.tilt.slow = MilliHertz(0)),
-        ("nod.brisk", |s| s.behaviour.nod.brisk = MilliHertz(90_000)),
+        ("shake.cycles", |s| {
+            s.behaviour.defaults_mut(GestureKind::Shake).cycles = 0
+        }),
+        ("tilt.slow", |s| {
+            s.behaviour.defaults_mut(GestureKind::Tilt).slow = MilliHertz(0)
+        }),
+        ("nod.brisk", |s| {
+            s.behaviour.defaults_mut(GestureKind::Nod).brisk = MilliHertz(90_000)
+        }),
         ("max_frequency", |s| {
             s.behaviour.max_frequency = MilliHertz(1)
         }),

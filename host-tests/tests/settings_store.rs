@@ -6,7 +6,7 @@
 
 use embedded_storage_async::nor_flash::{NorFlash, ReadNorFlash};
 use futures::executor::block_on;
-use idle_head_core::command::Percent;
+use idle_head_core::command::{GestureKind, Percent};
 use idle_head_core::servo::{NanosPerDegree, ServoCalibration};
 use idle_head_core::settings::{
     DecodeError, EncodeError, LoadError, RawRecord, Record, SETTINGS_BUFFER, SaveError, SectorWise,
@@ -159,7 +159,8 @@ fn random_real_candidate(rng: &mut TestRng) -> Settings {
     };
     s.behaviour.idle.amplitude = Percent::new(rng.random_range(0..=100)).unwrap();
     s.behaviour.gaze.base = Millis(rng.random_range(0..=5000));
-    s.behaviour.nod.intensity = Percent::new(rng.random_range(0..=100)).unwrap();
+    s.behaviour.defaults_mut(GestureKind::Nod).intensity =
+        Percent::new(rng.random_range(0..=100)).unwrap();
     s.seeds = [rng.random(), rng.random(), rng.random()];
     s
 }

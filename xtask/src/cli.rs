@@ -111,8 +111,8 @@ pub enum Command {
     /// its time in ms, the three commanded angles in m° after every safety
     /// stage and the three pulse widths in ns on the Pico's PWM counts. A
     /// script line is `<seconds> <command>` (`2.5 nod 6000 900`) in the
-    /// console's words: nod, shake, tilt [amplitude m°] [ms] [cycles=N]
-    /// [intensity=PCT]; look <pitch m°> <yaw m°> [ms] [hold=MS|hold=stay];
+    /// console's words: a gesture (any the console's `help` lists: nod,
+    /// shake, tilt, ...) [amplitude m°] [ms] [cycles=N] [intensity=PCT]; look <pitch m°> <yaw m°> [ms] [hold=MS|hold=stay];
     /// center [ms]; idle on|off; idle amp <percent>; stop. Blank lines and
     /// `#` comments are ignored; a script runs top to bottom, so a line timed
     /// before the one above it is an error, as is any bad line: each is

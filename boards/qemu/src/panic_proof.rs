@@ -116,11 +116,8 @@ fn any_action() -> Action {
     let millis = || black_box(Some(Millis(black_box(0))));
     match black_box(0_u8) {
         0 => Action::Gesture(GestureRequest {
-            kind: match black_box(0_u8) {
-                0 => GestureKind::Nod,
-                1 => GestureKind::Shake,
-                _ => GestureKind::Tilt,
-            },
+            // Every row of the gesture table.
+            kind: GestureKind::ALL[usize::from(black_box(0_u8)) % GestureKind::COUNT],
             amplitude: black_box(Some(angle())),
             duration: millis(),
             cycles: black_box(Some(black_box(0))),

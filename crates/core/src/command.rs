@@ -10,75 +10,8 @@ use crate::axis::Axis;
 use crate::servo::{Direction, NanosPerDegree};
 use crate::units::{Angle, AngleRange, Microseconds, Millis};
 
-/// A whole percentage, `0..=100`.
-///
-/// ```
-/// use idle_head_core::command::Percent;
-/// assert_eq!(Percent::new(40).map(Percent::get), Some(40));
-/// assert_eq!(Percent::new(101), None);
-/// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Percent(u8);
-
-impl Percent {
-    /// 0 %.
-    pub const ZERO: Self = Self(0);
-    /// 50 %.
-    pub const HALF: Self = Self(50);
-    /// 100 %.
-    pub const FULL: Self = Self(100);
-
-    /// `value` percent, if it is at most 100.
-    #[must_use]
-    pub const fn new(value: u8) -> Option<Self> {
-        if value <= 100 {
-            Some(Self(value))
-        } else {
-            None
-        }
-    }
-
-    /// The percentage.
-    #[must_use]
-    pub const fn get(self) -> u8 {
-        self.0
-    }
-}
-
-/// The three gestures, each on its own axis.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum GestureKind {
-    /// Nodding "yes" on the pitch axis.
-    Nod,
-    /// Shaking "no" on the yaw axis.
-    Shake,
-    /// Tilting the head to one side on the roll axis.
-    Tilt,
-}
-
-impl GestureKind {
-    /// The axis the gesture moves.
-    #[must_use]
-    pub const fn axis(self) -> Axis {
-        match self {
-            Self::Nod => Axis::Pitch,
-            Self::Shake => Axis::Yaw,
-            Self::Tilt => Axis::Roll,
-        }
-    }
-
-    /// The command word (`nod`, `shake`, `tilt`).
-    #[must_use]
-    pub const fn name(self) -> &'static str {
-        match self {
-            Self::Nod => "nod",
-            Self::Shake => "shake",
-            Self::Tilt => "tilt",
-        }
-    }
-}
+pub use crate::gestures::GestureKind;
+pub use crate::units::Percent;
 
 /// A gesture as asked for; `None` fields take the configured defaults.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -86,12 +19,13 @@ impl GestureKind {
 pub struct GestureRequest {
     /// Which gesture.
     pub kind: GestureKind,
-    /// Peak amplitude. Nods and shakes take a positive amplitude; a tilt's
-    /// sign chooses the side.
+    /// Peak amplitude. Most gestures take a positive amplitude; a posture's
+    /// (a tilt's) sign chooses the side (see [`Shape`](crate::gestures::Shape)).
     pub amplitude: Option<Angle>,
     /// Total duration.
     pub duration: Option<Millis>,
-    /// Number of cycles (nods and shakes).
+    /// Number of cycles (up to the gesture's
+    /// [`max_cycles`](crate::gestures::Gesture::max_cycles)).
     pub cycles: Option<u8>,
     /// How brisk: faster and fuller at 100 %, slow and soft at 0 %.
     pub intensity: Option<Percent>,

@@ -39,11 +39,9 @@ mod frame;
 mod limiter;
 mod report;
 
+pub use crate::units::{DegreesPerSecond, DegreesPerSecondSquared};
 pub use clock::{FrameClock, FrameTick, ZeroPeriod};
-pub use config::{
-    DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, DriverParams, FaultPolicy,
-    MotionLimits,
-};
+pub use config::{DriverConfig, DriverParams, FaultPolicy, MotionLimits};
 pub use error::ConfigError;
 pub use frame::FrameDriver;
 pub use report::{DriverStats, FrameReport, Outcome, ServoReport};

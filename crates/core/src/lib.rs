@@ -42,6 +42,7 @@ pub mod behaviour;
 pub mod command;
 pub mod console;
 pub mod driver;
+pub mod gestures;
 pub mod idle;
 pub mod metrics;
 pub mod motion;

@@ -4,6 +4,10 @@
 //! - [`Angle`]: signed angle in **millidegrees** (1 LSB = 0.001°) held in an `i32`.
 //! - [`Microseconds`]: pulse width or period in **microseconds** held in a `u32`.
 //! - [`Millis`]: duration in **milliseconds** held in a `u32`.
+//! - [`DegreesPerSecond`], [`DegreesPerSecondSquared`]: angular speed and
+//!   acceleration in **whole degrees** per second (squared) held in a `u32`.
+//! - [`MilliHertz`]: frequency in **millihertz** held in a `u32`.
+//! - [`Percent`]: a whole percentage, `0..=100`, held in a `u8`.
 //!
 //! Angles and ranges display in degrees, as a user writes them: `-23°`,
 //! `4.5°`, `-0.25°`, `-23°..32°` (exact: no float formatting).
@@ -161,6 +165,57 @@ impl Millis {
     /// The value in milliseconds.
     #[must_use]
     pub const fn get(self) -> u32 {
+        self.0
+    }
+}
+
+/// Angular speed in whole degrees per second.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DegreesPerSecond(pub u32);
+
+/// Angular acceleration in whole degrees per second squared.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DegreesPerSecondSquared(pub u32);
+
+/// A frequency in millihertz (1 LSB = 0.001 Hz).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MilliHertz(pub u32);
+
+/// A whole percentage, `0..=100`.
+///
+/// ```
+/// use idle_head_core::units::Percent;
+/// assert_eq!(Percent::new(40).map(Percent::get), Some(40));
+/// assert_eq!(Percent::new(101), None);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Percent(u8);
+
+impl Percent {
+    /// 0 %.
+    pub const ZERO: Self = Self(0);
+    /// 50 %.
+    pub const HALF: Self = Self(50);
+    /// 100 %.
+    pub const FULL: Self = Self(100);
+
+    /// `value` percent, if it is at most 100.
+    #[must_use]
+    pub const fn new(value: u8) -> Option<Self> {
+        if value <= 100 {
+            Some(Self(value))
+        } else {
+            None
+        }
+    }
+
+    /// The percentage.
+    #[must_use]
+    pub const fn get(self) -> u8 {
         self.0
     }
 }

@@ -45,7 +45,7 @@ use embedded_hal::pwm::SetDutyCycle;
 use idle_head_core::behaviour::{
     Applied, BehaviourError, BehaviourParams, CommandQueue, Head, HeadFrame, IdleSource,
 };
-use idle_head_core::command::{Action, GestureKind, Hold};
+use idle_head_core::command::{Action, Hold};
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::driver::{FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod};
 use idle_head_core::{Angle, Microseconds};
@@ -362,11 +362,7 @@ fn log_faults(report: &FrameReport) {
 /// The command word of `action`, as the console spells it.
 const fn word(action: &Action) -> &'static str {
     match action {
-        Action::Gesture(request) => match request.kind {
-            GestureKind::Nod => "nod",
-            GestureKind::Shake => "shake",
-            GestureKind::Tilt => "tilt",
-        },
+        Action::Gesture(request) => request.kind.name(),
         Action::Look(_) => "look",
         Action::Center { .. } => "center",
         Action::Idle(true) => "idle on",

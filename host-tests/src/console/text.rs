@@ -12,7 +12,8 @@ use idle_head_core::{Angle, AngleRange, Axis, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
 use proptest::test_runner::TestRng;
 
-/// Every word of the protocol, for random token lines.
+/// Every word of the protocol but the gestures' (those are
+/// [`GestureKind::ALL`]'s; [`vocabulary_word`] draws from both).
 pub const VOCABULARY: &[&str] = &[
     "help",
     "status",
@@ -20,9 +21,6 @@ pub const VOCABULARY: &[&str] = &[
     "load",
     "defaults",
     "stop",
-    "nod",
-    "shake",
-    "tilt",
     "look",
     "center",
     "centre",
@@ -51,6 +49,15 @@ pub const VOCABULARY: &[&str] = &[
     "hold=stay",
     "=",
 ];
+
+/// A random word of the protocol: one of [`VOCABULARY`] or a gesture's.
+pub fn vocabulary_word(rng: &mut TestRng) -> &'static str {
+    let i = rng.random_range(0..VOCABULARY.len() + GestureKind::COUNT);
+    VOCABULARY
+        .get(i)
+        .copied()
+        .unwrap_or_else(|| GestureKind::ALL[i - VOCABULARY.len()].name())
+}
 
 /// Numbers at and past the limits of every field.
 pub const EDGE_NUMBERS: &[&str] = &[
@@ -145,14 +152,13 @@ pub fn random_command(rng: &mut TestRng) -> Command {
         4 => Command::Defaults,
         5 => Command::Act(Action::Stop),
         6 => {
-            let kind =
-                [GestureKind::Nod, GestureKind::Shake, GestureKind::Tilt][rng.random_range(0..3)];
+            let kind = GestureKind::ALL[rng.random_range(0..GestureKind::COUNT)];
             let mut g = GestureRequest::new(kind);
             g.amplitude = maybe(rng, angle);
             if g.amplitude.is_some() {
                 g.duration = maybe(rng, |r| millis(r, 1));
             }
-            if kind != GestureKind::Tilt {
+            if kind.row().max_cycles > 1 {
                 g.cycles = maybe(rng, |r| r.random_range(1..=255));
             }
             g.intensity = maybe(rng, percent);
@@ -423,7 +429,7 @@ pub fn mutate(line: &[u8], rng: &mut TestRng) -> Vec<u8> {
             5 => out = edit_words(&out, rng),
             6 | 7 => out = replace_number(&out, rng),
             8 => {
-                let word = VOCABULARY[rng.random_range(0..VOCABULARY.len())];
+                let word = vocabulary_word(rng);
                 let mut piece = Vec::from(b" ".as_slice());
                 piece.extend_from_slice(word.as_bytes());
                 out.splice(at..at, piece);
@@ -484,7 +490,7 @@ pub fn token_line(rng: &mut TestRng) -> Vec<u8> {
             out.push(b' ');
         }
         let word = if rng.random_bool(0.7) {
-            VOCABULARY[rng.random_range(0..VOCABULARY.len())]
+            vocabulary_word(rng)
         } else {
             EDGE_NUMBERS[rng.random_range(0..EDGE_NUMBERS.len())]
         };

@@ -9,11 +9,7 @@ use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, Percent
 use idle_head_core::units::{Angle, Millis};
 
 fn kind() -> impl Strategy<Value = GestureKind> {
-    prop_oneof![
-        Just(GestureKind::Nod),
-        Just(GestureKind::Shake),
-        Just(GestureKind::Tilt)
-    ]
+    prop::sample::select(GestureKind::ALL.to_vec())
 }
 
 /// Commands, valid or not (amplitudes past the limits, absurd durations).

@@ -11,7 +11,7 @@ use super::script::Event;
 /// What kind of motion a mark stands for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
-    /// A gesture (nod, shake, tilt).
+    /// A gesture (any of the core's gesture table).
     Gesture,
     /// A move of the gaze: `look` or `center`.
     Gaze,

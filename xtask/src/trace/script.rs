@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 
 use anyhow::{Result, bail};
 use idle_head_core::behaviour::BehaviourParams;
-use idle_head_core::command::{Action, Command};
+use idle_head_core::command::{Action, Command, GestureKind};
 use idle_head_core::console;
 
 /// One scripted command.
@@ -21,8 +21,15 @@ pub struct Event {
     pub action: Action,
 }
 
-/// The commands a script may give.
-const ALLOWED: &str = "nod, shake, tilt, look, center, idle on|off, idle amp, stop";
+/// The commands a script may give: every gesture of the core's table, and
+/// the other motion commands.
+fn allowed() -> String {
+    let gestures: Vec<&str> = GestureKind::ALL.iter().map(|k| k.name()).collect();
+    format!(
+        "{}, look, center, idle on|off, idle amp, stop",
+        gestures.join(", ")
+    )
+}
 
 /// `text` as seconds (`2`, `2.5`, `0.125`; at most µs), in µs.
 pub fn seconds(text: &str) -> Result<u64> {
@@ -97,7 +104,10 @@ fn event(line: usize, text: &str, params: &BehaviourParams) -> Result<Event, Str
         Ok(Command::Act(action)) => action,
         Ok(_) => {
             let word = command.split_whitespace().next().unwrap_or("");
-            return Err(format!("`{word}` cannot be scripted (commands: {ALLOWED})"));
+            return Err(format!(
+                "`{word}` cannot be scripted (commands: {})",
+                allowed()
+            ));
         }
         Err(e) => return Err(e.describe(command.as_bytes()).to_string()),
     };
@@ -114,7 +124,6 @@ fn event(line: usize, text: &str, params: &BehaviourParams) -> Result<Event, Str
 mod tests {
     use super::*;
     use idle_head_core::behaviour::BehaviourConfig;
-    use idle_head_core::command::GestureKind;
     use idle_head_core::driver::DriverConfig;
 
     fn params() -> BehaviourParams {
@@ -183,6 +192,23 @@ line 4: at 2.9 s, before line 3 (at 3 s): lines must be in time order"
     }
 
     #[test]
+    fn every_gesture_of_the_table_can_be_scripted() {
+        let mut script = String::new();
+        for (i, kind) in GestureKind::ALL.iter().enumerate() {
+            let _ = writeln!(script, "{} {}", i + 1, kind.name());
+        }
+        let events = parse(&script, &params()).unwrap();
+        let kinds: Vec<GestureKind> = events
+            .iter()
+            .map(|e| match e.action {
+                Action::Gesture(g) => g.kind,
+                other => panic!("{other:?}"),
+            })
+            .collect();
+        assert_eq!(kinds, GestureKind::ALL);
+    }
+
+    #[test]
     fn every_bad_line_is_named_and_nothing_runs() {
         let script = "\
 1 nod six
@@ -194,16 +220,27 @@ x nod
 7
 ";
         let err = parse(script, &params()).unwrap_err().to_string();
+        let commands = allowed();
         assert_eq!(
             err,
-            "\
+            format!(
+                "\
 line 1: `six`: amplitude in mdeg must be a whole number
 line 2: unknown command `wave` (try `help`)
-line 3: `servo` cannot be scripted (commands: nod, shake, tilt, look, center, idle on|off, idle amp, stop)
+line 3: `servo` cannot be scripted (commands: {commands})
 line 4: `x`: expected seconds such as 2 or 2.5 (at most 6 decimals)
 line 5: nod amplitude 30°: must be in 0.001°..20° (pitch's limits around its neutral pose)
 line 6: missing yaw in mdeg
 line 7: `7`: expected `<seconds> <command>`"
+            )
         );
+        // The commands: every gesture of the table, then the others.
+        for kind in GestureKind::ALL {
+            assert!(
+                commands.contains(&format!("{}, ", kind.name())),
+                "{commands}"
+            );
+        }
+        assert!(commands.ends_with("look, center, idle on|off, idle amp, stop"));
     }
 }

@@ -17,11 +17,9 @@ use crate::text::Arg::{Int, Str, Text, Uint};
 use crate::text::{self, Describe, display_from_describe};
 
 use crate::axis::Axis;
-use crate::command::GestureKind;
 use crate::driver::{DegreesPerSecond, DegreesPerSecondSquared};
-use crate::units::{Angle, AngleRange, Millis};
-
-use super::config::MilliHertz;
+use crate::gestures::GestureKind;
+use crate::units::{Angle, AngleRange, MilliHertz, Millis};
 
 /// A request or a configuration the behaviour refuses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,7 +27,8 @@ use super::config::MilliHertz;
 #[non_exhaustive]
 pub enum BehaviourError {
     /// A gesture's amplitude is outside what its axis allows around the
-    /// neutral pose (nods and shakes: positive; tilts: not zero).
+    /// neutral pose (see [`Shape`](crate::gestures::Shape): a dip or a
+    /// swing positive, a lean of either sign).
     Amplitude {
         /// The gesture.
         kind: GestureKind,
@@ -49,7 +48,8 @@ pub enum BehaviourError {
         /// The longest allowed.
         max: Millis,
     },
-    /// A number of cycles outside `1..=max`.
+    /// A number of cycles outside `1..=max` (the gesture's
+    /// [`max_cycles`](crate::gestures::Gesture::max_cycles)).
     Cycles {
         /// The gesture.
         kind: GestureKind,
@@ -57,11 +57,6 @@ pub enum BehaviourError {
         cycles: u8,
         /// The most allowed.
         max: u8,
-    },
-    /// A tilt has exactly one cycle.
-    TiltCycles {
-        /// The rejected number.
-        cycles: u8,
     },
     /// More cycles than the frequency cap allows in the duration.
     TooFrequent {
@@ -138,7 +133,6 @@ impl BehaviourError {
             Self::Duration { field, .. } => field,
             Self::Config { .. } => "behaviour config value out of range",
             Self::Cycles { .. } => "gesture cycles out of range",
-            Self::TiltCycles { .. } => "a tilt has exactly one cycle",
             Self::TooFrequent { .. } => "gesture cycles faster than the frequency cap",
             Self::TooFast { .. } => "gesture faster than the axis' gesture speed limit",
             Self::TooBrisk { .. } => "gesture faster than the axis' gesture acceleration limit",
@@ -212,13 +206,17 @@ impl Describe for BehaviourError {
                     Uint(max.0.into()),
                 ],
             ),
+            Self::Cycles {
+                kind,
+                cycles,
+                max: 1,
+            } => out.fill(
+                "{} cycles {}: a {} has exactly 1",
+                &[Str(kind.name()), Uint(cycles.into()), Str(kind.name())],
+            ),
             Self::Cycles { kind, cycles, max } => out.fill(
                 "{} cycles {}: must be in 1..={}",
                 &[Str(kind.name()), Uint(cycles.into()), Uint(max.into())],
-            ),
-            Self::TiltCycles { cycles } => out.fill(
-                "tilt cycles {}: a tilt has exactly 1",
-                &[Uint(cycles.into())],
             ),
             Self::TooFrequent {
                 kind,

@@ -1,5 +1,6 @@
 //! Fixed-point helpers of the frame path: 32-bit multiplies only (ARMv6-M
-//! has no 64-bit multiply and no divide instruction).
+//! has no 64-bit multiply and no divide instruction); and frame counting
+//! ([`ahead`]).
 //!
 //! Convention: a *fraction* is a `u32` in Q16 (`0..=65 536` is 0..=1), a
 //! signed one an `i32` in Q16. Angles are `i32` millidegrees.
@@ -76,4 +77,12 @@ pub(crate) const fn progress(t: u32, inverse: u32) -> u32 {
     // t ≤ F − 1 and ⌈2³²/F⌉ < 2³²/F + 1: t·inverse + 2¹⁵ < 2³² − 2³²/F + F + 2¹⁵,
     // below 2³² − 2¹⁵ for F < 2¹⁶.
     t.wrapping_mul(inverse).wrapping_add(1 << 15) >> 16
+}
+
+/// Frames from `from` to `frame` if it lies after `from`, else `u32::MAX`
+/// (not an event to wait for).
+#[inline]
+pub(crate) const fn ahead(frame: u32, from: u32) -> u32 {
+    let d = frame.wrapping_sub(from);
+    if d as i32 > 0 { d } else { u32::MAX }
 }

@@ -24,9 +24,11 @@ use crate::axis::Axis;
 use crate::command::{Hold, LookRequest};
 use crate::units::{Angle, Millis};
 
-use super::config::{BehaviourParams, LimitMode, MAX_HOLD};
+use super::config::MAX_HOLD;
 use super::error::BehaviourError;
+use super::fixed::ahead;
 use super::glide::{Glide, State};
+use super::params::{BehaviourParams, LimitMode};
 
 /// The axes a look moves, in `Gaze`'s order.
 pub(crate) const AXES: [Axis; 2] = [Axis::Pitch, Axis::Yaw];
@@ -89,7 +91,7 @@ impl Gaze {
         let mut soonest = u32::MAX;
         for axis in &self.axes {
             if axis.moving() {
-                soonest = soonest.min(super::mixer::ahead(axis.end(), from));
+                soonest = soonest.min(ahead(axis.end(), from));
             }
         }
         if let Some(back) = &self.back {

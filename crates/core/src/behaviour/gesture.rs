@@ -1,4 +1,9 @@
-//! Gesture shapes: nod (pitch), shake (yaw), tilt (roll).
+//! Gestures as they play: a request resolved against the defaults and
+//! checked (`plan`), and its offset at each frame ([`GesturePlan`]).
+//!
+//! Which gestures there are, their axes and defaults, is the
+//! [gesture table](crate::gestures); how each moves is its
+//! [`Shape`](super::shape) (nod: a dip, shake: a swing, tilt: a lean).
 //!
 //! # The shape
 //!
@@ -8,19 +13,15 @@
 //! g(t) = E(φ) · A(φ) · c(φ),      φ = n·t/D ∈ [0, n]  (cycle position)
 //! ```
 //!
-//! - **Carrier** `c`: nod `(1 − cos 2πφ)/2` (each cycle dips towards
-//!   positive pitch and comes back up: a cycle is a down and an up movement
-//!   and its magnitude is the dip, as Mori, Den & Jokinen measure nods);
-//!   shake `sin 2πφ` (to either side of the centre); tilt `1` (a posture).
+//! - **Carrier** `c`: the shape's ([`super::shape`]): a dip
+//!   `(1 − cos 2πφ)/2`, a swing `sin 2πφ`, a lean `1` (a posture).
 //! - **Envelope** `E`: a smootherstep `S(x) = 6x⁵ − 15x⁴ + 10x³` over the
-//!   first and the last half cycle (tilt: third), 1 between. `S` has zero
+//!   first and the last half cycle (a lean: third), 1 between. `S` has zero
 //!   first and second derivatives at both ends, so the layer comes in and
-//!   goes out with angle, velocity and acceleration continuous (C2). The
-//!   nod's first downstroke is its ramp and still reaches the full first dip
-//!   at `φ = ½`.
+//!   goes out with angle, velocity and acceleration continuous (C2).
 //! - **Profile** `A(φ)`, for `n ≥ 2`, after the structure Mori, Den & Jokinen
 //!   found in conversational nods (*Structure of nods in conversation*, PLOS
-//!   One 2025, e0323448), applied to shakes too:
+//!   One 2025, e0323448), applied to every shape that repeats:
 //!   - *declination*: `A(φ) = A·(1 − (φ − ½)/(4n))`, the cycle at position
 //!     `k` peaks at `A·(1 − k/(4n))`, a quarter less over the gesture;
 //!   - *final lowering*: the last cycle is 0.6 times that trend (a
@@ -32,15 +33,13 @@
 //!
 //!   A default 3-cycle nod dips 1.0, 0.92 and 0.5 times its first peak; a
 //!   2-cycle nod 1.0 and 0.53.
-//! - **Tilt**: up over the first third along `S`, held, down over the last
-//!   third; the amplitude's sign chooses the side.
 //!
 //! # Tempo and intensity
 //!
 //! Fast listener nods run at 2.6–6.5 Hz (Hale et al., *Are you on my
 //! wavelength?*, J. Nonverbal Behav. 2020). The intensity `p` (0–100 %)
 //! sets the cycle frequency `f = slow + (brisk − slow)·p/100` (default nod
-//! 1.5–3.5 Hz, shake 1.2–2.5 Hz; a tilt's "cycle" is its duration, 2.5–1 s)
+//! 1.5–3.5 Hz, shake 1.2–2.5 Hz; a posture's "cycle" is its duration, tilt 2.5–1 s)
 //! and scales a default amplitude by `0.75 + p/200` (0.75 to 1.25).
 //! Duration and cycles: both given, as given; only cycles, `n/f`; only a
 //! duration, `round(D·f)` cycles (at least 1); neither, the default cycles
@@ -55,11 +54,8 @@
 //! ([`BehaviourError::TooFrequent`]).
 //!
 //! **Speed check.** The shape's peak speed and acceleration are at most
-//! `Kv·ω·a` and `Ka·ω²·a` (`ω = 2πf`; `a = A/2` for the nod's carrier, `A`
-//! otherwise) with `(Kv, Ka)` = (1.45, 1.85) for nods, (1.05, 1.65) for
-//! shakes and (0.9, 1.32) for tilts: measured on the continuous shape over
-//! 1 to 32 cycles and rounded up (the envelope's ramps make the first and the
-//! last half cycle steeper than the bare carrier). A gesture whose bound
+//! `Kv·ω·a` and `Ka·ω²·a` (`ω = 2πf`, `(Kv, Ka)` and the carrier's
+//! amplitude `a` the shape's, see [`super::shape`]). A gesture whose bound
 //! exceeds its axis' gesture limits is refused ([`BehaviourError::TooFast`],
 //! [`BehaviourError::TooBrisk`]), so the limiter never flattens one that
 //! plays.
@@ -71,25 +67,17 @@
 //! `frac(φ)·2³²`), envelope and profile in Q16: a handful of 32-bit
 //! multiplies, no division.
 
-use crate::command::{GestureKind, GestureRequest, Percent};
+use crate::command::{GestureKind, GestureRequest};
 use crate::driver::{DegreesPerSecond, DegreesPerSecondSquared};
-use crate::units::{Angle, AngleRange, Millis};
+use crate::units::{Angle, Millis, Percent};
 
-use super::config::{BehaviourParams, LimitMode, MAX_CYCLES};
 use super::error::BehaviourError;
-use super::fixed::{ONE, inverse, mul, mul_signed, progress, smootherstep};
+use super::fixed::{ONE, inverse, mul, progress, smootherstep};
+use super::params::{BehaviourParams, LimitMode};
+use super::shape::Shape;
 
 /// Final lowering: the last cycle loses 0.4 of the trend (Q16).
 const LOWERING: u32 = ONE * 2 / 5;
-
-/// `(Kv, Ka)` of each shape in thousandths (see the module docs).
-const fn peak_factors(kind: GestureKind) -> (u64, u64) {
-    match kind {
-        GestureKind::Nod => (1450, 1850),
-        GestureKind::Shake => (1050, 1650),
-        GestureKind::Tilt => (900, 1320),
-    }
-}
 
 /// A gesture as it plays: what was asked for, resolved, and the constants
 /// of its frame path.
@@ -108,6 +96,8 @@ pub struct GesturePlan {
     pub intensity: Percent,
     /// Frames.
     pub(crate) frames: u32,
+    /// The gesture's shape (its row's, kept for the frame path).
+    shape: Shape,
     inverse: u32,
     /// Profile at `u = 0` and its fall over the gesture (m°).
     start: i32,
@@ -167,10 +157,8 @@ pub(crate) const fn plan(
         start,
         fall,
         lower_from,
-        ramp: match kind {
-            GestureKind::Nod | GestureKind::Shake => 2,
-            GestureKind::Tilt => 3,
-        },
+        shape: kind.shape(),
+        ramp: kind.shape().ramp(),
     })
 }
 
@@ -186,25 +174,20 @@ const fn tempo(
     let p = intensity.get() as u64;
     let f_mhz = d.slow.0 as u64 + (d.brisk.0 as u64).saturating_sub(d.slow.0 as u64) * p / 100;
     let f_mhz = if f_mhz == 0 { 1 } else { f_mhz };
-    let field = match kind {
-        GestureKind::Nod => "nod duration",
-        GestureKind::Shake => "shake duration",
-        GestureKind::Tilt => "tilt duration",
-    };
+    let row = kind.row();
+    let field = row.fields.duration;
     let longest = config.longest_gesture;
-    let asked = match (kind, request.cycles) {
-        (GestureKind::Tilt, Some(c)) if c != 1 => {
-            return Err(BehaviourError::TiltCycles { cycles: c });
-        }
-        (GestureKind::Tilt, _) => Some(1),
-        (_, Some(c)) if c == 0 || c > MAX_CYCLES => {
+    let asked = match request.cycles {
+        Some(c) if c == 0 || c > row.max_cycles => {
             return Err(BehaviourError::Cycles {
                 kind,
                 cycles: c,
-                max: MAX_CYCLES,
+                max: row.max_cycles,
             });
         }
-        (_, c) => c,
+        // A posture has its one cycle (the defaults' count is not asked).
+        None if row.max_cycles == 1 => Some(1),
+        c => c,
     };
     let (cycles, ms) = if let Some(duration) = request.duration {
         if duration.0 == 0 || duration.0 > longest.0 {
@@ -216,8 +199,8 @@ const fn tempo(
             let n = (duration.0 as u64 * f_mhz + 500_000) / 1_000_000;
             if n == 0 {
                 1
-            } else if n > MAX_CYCLES as u64 {
-                MAX_CYCLES as u64
+            } else if n > row.max_cycles as u64 {
+                row.max_cycles as u64
             } else {
                 n
             }
@@ -269,25 +252,7 @@ const fn amplitude(
         (num + num.signum() * den / 2) / den
     };
     let room = params.room(kind.axis());
-    let allowed = match kind {
-        GestureKind::Nod => AngleRange {
-            min: Angle::from_millidegrees(1),
-            max: room.max,
-        },
-        GestureKind::Shake => {
-            // Both sides: the nearer limit.
-            let other = room.min.millidegrees().saturating_neg();
-            AngleRange {
-                min: Angle::from_millidegrees(1),
-                max: if room.max.millidegrees() < other {
-                    room.max
-                } else {
-                    Angle::from_millidegrees(other)
-                },
-            }
-        }
-        GestureKind::Tilt => room,
-    };
+    let allowed = kind.shape().allowed(room);
     if amplitude < allowed.min.millidegrees() as i64
         || amplitude > allowed.max.millidegrees() as i64
     {
@@ -317,13 +282,11 @@ const fn check_peaks(
 ) -> Result<(), BehaviourError> {
     let axis = kind.axis();
     let limits = params.limits(axis, LimitMode::Gesture);
-    let (kv, ka) = peak_factors(kind);
+    let shape = kind.shape();
+    let (kv, ka) = shape.peak_factors();
     // The amplitude lies within the axis' room (the driver keeps limits
     // within ±2¹⁸ m°): capped at 2²⁰, with n ≤ 32 every product fits u64.
-    let carrier = match kind {
-        GestureKind::Nod => amplitude.unsigned_abs() as u64 / 2,
-        GestureKind::Shake | GestureKind::Tilt => amplitude.unsigned_abs() as u64,
-    };
+    let carrier = shape.carrier(amplitude.unsigned_abs() as u64);
     let carrier = if carrier > 1 << 20 { 1 << 20 } else { carrier };
     let (n, ms) = (cycles, if ms == 0 { 1 } else { ms });
     // Kv·a·2π·n/D with 2π·1000 = 6283; Ka·a·(2π·n/D)² with 4π²·1000 = 39 478.
@@ -395,19 +358,7 @@ impl GesturePlan {
         } else {
             mul(amplitude, envelope)
         };
-        let value = match self.kind {
-            GestureKind::Tilt => scaled,
-            GestureKind::Nod | GestureKind::Shake => {
-                // frac(φ) as a 32-bit phase (2³² = one turn).
-                let (cos, sin) = idsp::cossin((phi << 16) as i32);
-                if self.kind == GestureKind::Nod {
-                    // (1 − cos)/2 in Q16: cos in Q31 → Q17 halves it.
-                    mul(scaled, (ONE as i32 - (cos >> 15)) as u32 >> 1)
-                } else {
-                    mul_signed(scaled, sin >> 15)
-                }
-            }
-        };
+        let value = self.shape.value(scaled, phi);
         (value, envelope)
     }
 }

@@ -27,10 +27,10 @@ use crate::driver::{ConfigError, FrameDriver, FrameReport};
 use crate::servo::ServoCalibration;
 use crate::units::Angle;
 
-use super::config::{BehaviourParams, LimitMode};
 use super::error::BehaviourError;
 use super::idle::IdleSource;
 use super::mixer::{Applied, Mixer};
+use super::params::{BehaviourParams, LimitMode};
 use super::queue::{CommandQueue, PER_FRAME};
 
 /// What one frame did.

@@ -22,12 +22,12 @@
 use crate::command::{Action, GestureRequest, Percent};
 use crate::units::{Angle, AngleRange, Millis};
 
-use super::config::{BehaviourParams, LimitMode};
 use super::error::BehaviourError;
-use super::fixed::{ONE, mul, progress, smootherstep};
+use super::fixed::{ONE, ahead, mul, progress, smootherstep};
 use super::gaze::{Gaze, LookApplied};
 use super::gesture::{self, GesturePlan};
 use super::glide::Glide;
+use super::params::{BehaviourParams, LimitMode};
 
 /// Gesture layers: one playing and up to two fading out under it.
 pub const LAYERS: usize = 3;
@@ -46,6 +46,20 @@ pub enum Applied {
     Idle(Percent),
     /// Stop: the driver fades everything out (not the mixer's to do).
     Stop,
+}
+
+impl BehaviourParams {
+    /// Checks `action` as [`Mixer::apply`] would on a
+    /// head at rest: every check but the ones that depend on what plays
+    /// ([`BehaviourError::Busy`]). For replies before an action is queued:
+    /// what the mixer would start, such as where a look goes and whether
+    /// its target was clamped.
+    ///
+    /// # Errors
+    /// The [`BehaviourError`] the mixer would answer.
+    pub fn check(&self, action: &Action) -> Result<Applied, BehaviourError> {
+        Mixer::new(*self).apply(action)
+    }
 }
 
 /// A gesture layer: its plan, start, and the start of its fade-out.
@@ -446,14 +460,6 @@ impl Sums {
 const fn idle_part(idle: i32, gain: u32, duck: u32) -> i32 {
     let value = if gain == ONE { idle } else { mul(idle, gain) };
     if duck == ONE { value } else { mul(value, duck) }
-}
-
-/// Frames from `from` to `frame` if it lies after `from`, else `u32::MAX`
-/// (not an event to wait for).
-#[inline]
-pub(crate) const fn ahead(frame: u32, from: u32) -> u32 {
-    let d = frame.wrapping_sub(from);
-    if d as i32 > 0 { d } else { u32::MAX }
 }
 
 /// What the limit modes of one frame mixed in full follow from (see

@@ -7,13 +7,15 @@
 //!                                   └── limit mode per axis (idle | gesture)
 //! ```
 //!
-//! - [`gesture`]: nod, shake and tilt shapes (human-like, C2 envelopes).
+//! - [`gesture`]: gestures as they play (human-like, C2 envelopes); which
+//!   gestures there are is the [gesture table](crate::gestures), how each
+//!   moves its [`shape`].
 //! - [`glide`](self#gaze-and-idle-changes): minimum-jerk moves that start
 //!   from any state (gaze, idle gain).
 //! - [`gaze`]: `look` and `center`, holds and returns.
 //! - [`mixer`]: where the layers meet, and the limit mode per axis.
-//! - [`config`]: [`BehaviourConfig`] in physical units, validated into
-//!   [`BehaviourParams`].
+//! - [`config`]: [`BehaviourConfig`] in physical units, validated
+//!   (`validate.rs`) into [`BehaviourParams`] ([`params`]).
 //! - [`queue`]: the command queue; [`head`]: the frame engine.
 //!
 //! # Gaze and idle changes
@@ -58,16 +60,19 @@ mod glide;
 pub mod head;
 pub mod idle;
 pub mod mixer;
+pub mod params;
 pub mod queue;
+pub mod shape;
+mod validate;
 
-pub use config::{
-    BehaviourConfig, BehaviourParams, GazeConfig, GestureDefaults, IdleConfig, LimitMode,
-    MilliHertz,
-};
+pub use crate::gestures::{GestureDefaults, MAX_CYCLES};
+pub use crate::units::MilliHertz;
+pub use config::{BehaviourConfig, GazeConfig, IdleConfig};
 pub use error::BehaviourError;
 pub use gaze::LookApplied;
 pub use gesture::GesturePlan;
 pub use head::{Head, HeadFrame};
 pub use idle::{IdleSource, LOOP_DURATION};
 pub use mixer::{Applied, Mixer};
+pub use params::{BehaviourParams, LimitMode};
 pub use queue::{CommandQueue, QueueFull};

@@ -25,7 +25,7 @@ pub use framer::{Framer, LineError};
 pub use link::{ConsoleLink, HeadMode, HeadStatus};
 pub use parse::{ParseError, ParseErrorKind, Span, parse};
 pub use reply::{ErrorCode, Reply};
-pub use service::{ConsoleService, VERSION};
+pub use service::{ConsoleService, HELP, VERSION};
 pub use session::{EnvelopeError, Handler, InputError, MIN_REPLY, Session, checksum, respond};
 pub use shared::{PortSession, Shared, SharedService};
 
@@ -42,7 +42,3 @@ pub mod usb_identity {
     /// Product string descriptor: what the host tools look for.
     pub const PRODUCT: &str = "idle-head console";
 }
-
-/// The reply to `help`: the command words, one line.
-pub const HELP: &str =
-    "commands: help status stop nod shake tilt look center idle seed servo save load defaults";

@@ -51,7 +51,6 @@
 use crate::text::Arg::{Int, Str, Uint};
 use crate::text::Text;
 
-use super::HELP;
 use super::link::{ConsoleLink, HeadStatus};
 use super::reply::{ErrorCode, Reply};
 use super::session::Handler;
@@ -59,8 +58,17 @@ use crate::axis::Axis;
 use crate::behaviour::{Applied, BehaviourError, BehaviourParams, CommandQueue};
 use crate::command::{Action, Command, SeedChoice, ServoSetting};
 use crate::driver::DriverConfig;
+use crate::gestures::GestureKind;
 use crate::servo::{Direction, ServoCalibration};
 use crate::settings::{Settings, SettingsError, SettingsSource, SettingsStorage, StorageError};
+
+/// The reply to `help`: the command words, one line (the gestures' from
+/// the [gesture table](crate::gestures)).
+pub const HELP: &str = const_format::concatcp!(
+    "commands: help status stop",
+    GestureKind::WORDS,
+    " look center idle seed servo save load defaults"
+);
 
 /// The firmware version `status` reports.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -3,20 +3,12 @@
 
 use crate::axis::Axis;
 use crate::servo::{PwmTiming, ServoCalibration};
-use crate::units::{Angle, AngleRange, Microseconds, Millis};
+use crate::units::{
+    Angle, AngleRange, DegreesPerSecond, DegreesPerSecondSquared, Microseconds, Millis,
+};
 
 use super::ConfigError;
 use super::limiter::{MAX_LIMIT_MDEG, SlewParams, SlewRates};
-
-/// Angular speed in whole degrees per second.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct DegreesPerSecond(pub u32);
-
-/// Angular acceleration in whole degrees per second squared.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct DegreesPerSecondSquared(pub u32);
 
 /// Speed and acceleration limits of one axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -5,9 +5,8 @@ use crate::text::{self, Describe, display_from_describe};
 
 use crate::axis::Axis;
 use crate::servo::{Degrees, ServoError};
-use crate::units::{Angle, AngleRange, Microseconds};
+use crate::units::{Angle, AngleRange, DegreesPerSecondSquared, Microseconds};
 
-use super::DegreesPerSecondSquared;
 use super::limiter::MAX_LIMIT_MDEG;
 
 /// A configuration rejected by [`DriverConfig::build`](super::DriverConfig::build),

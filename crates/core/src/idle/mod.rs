@@ -106,11 +106,13 @@ mod join;
 mod pace;
 mod source;
 mod stream;
+mod supply;
 
 pub use crate::behaviour::IdleSource;
 pub use join::{IdleError, IdleTiming, JOIN_FRAMES, MAX_JOIN_SAMPLES, join_weight};
 pub use pace::{
     MAX_DRAWS, MAX_JOIN_TURN_RATIO, MAX_SPEED_RATIO, MAX_TURN_RATIO, Pace, Paces, Spread,
 };
-pub use source::{IdleMode, IdlePlayer, IdleStats, LoopSupply, NoSupply};
+pub use source::{IdleMode, IdlePlayer, IdleStats};
 pub use stream::{GenerateOnTake, LoopSet, LoopStream, MATCH_STRIDE, SetInfo, SetView, after_loop};
+pub use supply::{LoopSupply, NoSupply};

@@ -9,6 +9,7 @@ use crate::motion::{
 
 use super::join::{IdleTiming, MAX_JOIN_SAMPLES, blend, join_weight};
 use super::pace::{MAX_DRAWS, Pace, Paces, Spread, max_turn};
+use super::supply::LoopSupply;
 
 /// Samples of a join kept per axis: the one before it, and the join's
 /// `J + 1` (see [`LoopSet`]).
@@ -574,7 +575,7 @@ where
     }
 }
 
-impl<H, const N: usize, const CAP: usize> super::LoopSupply<H> for GenerateOnTake<H, N>
+impl<H, const N: usize, const CAP: usize> LoopSupply<H> for GenerateOnTake<H, N>
 where
     H: core::ops::DerefMut<Target = LoopSet<N, CAP>>,
 {

@@ -1,20 +1,14 @@
 //! What a head's motion is made of: per axis the seed, the window, the step,
 //! the range and the closure (the paper's Table 2), and their validation.
 
-use super::kernel::{MAX_WINDOW, MIN_WINDOW};
+use super::error::{AxisError, MotionError};
+use super::limits::{MAX_N, MAX_STEP, MAX_WINDOW, MIN_N, MIN_WINDOW};
 use super::storage::Mdeg16;
-use super::{AxisError, MotionError};
 use crate::axis::Axis;
 use crate::units::{Angle, AngleRange};
 
 /// Samples per loop of the paper's examples (Table 2).
 pub const DEFAULT_N: usize = 900;
-/// Smallest loop length (samples).
-pub const MIN_N: usize = 16;
-/// Largest loop length (samples); keeps every intermediate sum inside `i32`.
-pub const MAX_N: usize = 8192;
-/// Largest walk step δ.
-pub const MAX_STEP: Angle = Angle::from_degrees(90);
 
 /// How the loop is closed so that it starts at zero and repeats seamlessly.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

@@ -16,9 +16,8 @@ use core::fmt;
 
 use const_format::{StrWriter, concatcp};
 
-use super::kernel::{MAX_WINDOW, MIN_WINDOW};
+use super::limits::{MAX_N, MAX_STEP, MAX_WINDOW, MIN_N, MIN_WINDOW};
 use super::storage::Mdeg16;
-use super::{MAX_N, MAX_STEP, MIN_N};
 use crate::axis::Axis;
 use crate::units::{Angle, AngleRange};
 

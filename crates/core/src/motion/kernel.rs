@@ -13,12 +13,8 @@
 //! construction and the cosine column absorbs its rounding residue in its
 //! j = 0 entry (a change of a few parts in 10⁴ of one tap).
 
-use super::MotionError;
-
-/// Smallest supported window (taps).
-pub const MIN_WINDOW: u16 = 3;
-/// Largest supported window (taps); bounds the table (4 bytes a tap).
-pub const MAX_WINDOW: u16 = 511;
+use super::error::MotionError;
+use super::limits::{MAX_WINDOW, MIN_WINDOW};
 
 /// The kernel table for one window length `W`, of at most `CAP` taps.
 ///

@@ -21,16 +21,15 @@ mod engine;
 mod error;
 mod kernel;
 mod lcg;
+mod limits;
 mod storage;
 mod trajectory;
 
-pub use config::{
-    AxisConfig, Closure, DEFAULT_HEAD, DEFAULT_N, DEFAULT_WINDOW_CAP, HeadConfig, MAX_N, MAX_STEP,
-    MIN_N,
-};
+pub use config::{AxisConfig, Closure, DEFAULT_HEAD, DEFAULT_N, DEFAULT_WINDOW_CAP, HeadConfig};
 pub use engine::{LoopInfo, Trace};
 pub use error::{AxisError, MotionError};
-pub use kernel::{HannKernel, MAX_WINDOW, MIN_WINDOW};
+pub use kernel::HannKernel;
 pub use lcg::{A as LCG_A, C as LCG_C, Lcg, step_of};
+pub use limits::{MAX_N, MAX_STEP, MAX_WINDOW, MIN_N, MIN_WINDOW};
 pub use storage::{FINE_PER_MDEG, Fnv1a, Integral16, LoopScale, Mdeg16, Sample};
 pub use trajectory::{HeadTrajectories, Trajectory, generate_into};

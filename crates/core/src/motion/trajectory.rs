@@ -3,7 +3,8 @@
 //! time ([`generate_into`]).
 
 use super::engine::{self, LoopInfo, Trace};
-use super::kernel::{HannKernel, MAX_WINDOW};
+use super::kernel::HannKernel;
+use super::limits::MAX_WINDOW;
 use super::storage::{Fnv1a, LoopScale, Sample};
 use super::{AxisConfig, AxisError, HeadConfig, MAX_N, MIN_N, MotionError};
 use crate::axis::Axis;

@@ -30,7 +30,7 @@
 //! a sample (such as frame 0) needs only that sample, and the next frame
 //! reads the other three.
 
-use crate::playback::{LoopSource, Playback, T_BITS, Weights, Window, mul_div_rem, wrap};
+use super::timing::{LoopSource, Playback, T_BITS, Weights, Window, mul_div_rem, wrap};
 use crate::units::Angle;
 
 /// Plays three loops frame by frame; the same offsets as

@@ -30,7 +30,7 @@
 //! tens of thousands of duty counts per pulse range) takes
 //! [`ServoCalibration::pulse`] and [`PwmTiming::duty`] themselves, in 64 bits.
 
-use super::{Duty, PwmTiming, ServoCalibration};
+use super::calibration::{Direction, Duty, PwmTiming, ServoCalibration};
 use crate::units::{Angle, Microseconds};
 
 /// Picoseconds per microsecond.
@@ -110,8 +110,8 @@ impl ServoMap {
             return;
         }
         let s = match cal.direction {
-            super::Direction::Normal => per_degree,
-            super::Direction::Reversed => -per_degree,
+            Direction::Normal => per_degree,
+            Direction::Reversed => -per_degree,
         };
         // Pulse offsets (µs) from neutral that the pulse range, widened by
         // 1 µs, allows; the angles giving them, one m° further out.

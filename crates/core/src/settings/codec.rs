@@ -6,7 +6,7 @@
 //! | part | fields (bytes) |
 //! |---|---|
 //! | each servo, pitch, roll, yaw | neutral µs (4), per-degree ns (4), direction 0 normal / 1 reversed (1), min µs (4), max µs (4), limits min, max mdeg (4, 4 signed) |
-//! | nod, shake, tilt | amplitude mdeg (4 signed), cycles (1), slow mHz (4), brisk mHz (4), intensity % (1) |
+//! | each gesture, in the order of `GestureKind::ALL` (nod, shake, tilt) | amplitude mdeg (4 signed), cycles (1), slow mHz (4), brisk mHz (4), intensity % (1) |
 //! | gestures | max frequency mHz (4), longest gesture ms (4), blend ms (4) |
 //! | gaze | base ms (4), per degree ms (4), hold 0 return / 1 stay (1) and ms (4), longest ms (4) |
 //! | idle | amplitude % (1), duck % (1), fade ms (4) |
@@ -22,6 +22,7 @@
 use crate::behaviour::{GazeConfig, GestureDefaults, IdleConfig, MilliHertz};
 use crate::command::{Hold, Percent};
 use crate::driver::{DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, MotionLimits};
+use crate::gestures::GestureKind;
 use crate::servo::{Direction, NanosPerDegree, ServoCalibration};
 use crate::units::{Angle, AngleRange, Microseconds, Millis};
 
@@ -29,7 +30,7 @@ use super::record::{DecodeError, EncodeError, Record};
 use super::values::Settings;
 
 /// Bytes of a version 1 record.
-pub const SETTINGS_LEN: usize = 3 * 25 + 3 * 14 + 12 + 17 + 6 + 3 * 8 + 4 + 3 * 4;
+pub const SETTINGS_LEN: usize = 3 * 25 + GestureKind::COUNT * 14 + 12 + 17 + 6 + 3 * 8 + 4 + 3 * 4;
 
 impl Record for Settings {
     const VERSION: u16 = 1;
@@ -53,7 +54,7 @@ impl Record for Settings {
             w.i32(s.limits.max.millidegrees());
         }
         let b = &self.behaviour;
-        for g in [&b.nod, &b.shake, &b.tilt] {
+        for g in &b.gestures {
             w.i32(g.amplitude.millidegrees());
             w.u8(g.cycles);
             w.u32(g.slow.0);
@@ -114,7 +115,7 @@ impl Record for Settings {
             };
         }
         let b = &mut settings.behaviour;
-        for g in [&mut b.nod, &mut b.shake, &mut b.tilt] {
+        for g in &mut b.gestures {
             *g = GestureDefaults {
                 amplitude: Angle::from_millidegrees(r.i32()),
                 cycles: r.u8(),

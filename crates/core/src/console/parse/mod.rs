@@ -7,9 +7,9 @@
 //!
 //! ```text
 //! help | status | save | load | defaults | stop
-//! nod   [amp_mdeg] [ms] [cycles=N] [intensity=PCT]
-//! shake [amp_mdeg] [ms] [cycles=N] [intensity=PCT]
-//! tilt  [amp_mdeg] [ms] [intensity=PCT]
+//! nod   [amp_mdeg] [ms] [cycles=N] [intensity=PCT]     (each gesture of the
+//! shake [amp_mdeg] [ms] [cycles=N] [intensity=PCT]      gesture table;
+//! tilt  [amp_mdeg] [ms] [intensity=PCT]                 cycles= if it repeats)
 //! look <pitch_mdeg> <yaw_mdeg> [ms] [hold=MS|hold=stay]
 //! center [ms]
 //! idle on | idle off | idle amp <percent>
@@ -53,7 +53,7 @@ mod error;
 mod words;
 
 pub use error::{ParseError, ParseErrorKind, Span};
-use words::{Kw, Word, Words, once};
+use words::{Field, Kw, Word, Words, once};
 
 /// Parses one line (without its line ending); the grammar is in this
 /// module's source and, for users, in `docs/protocol.md`.
@@ -65,6 +65,11 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
     let Some(first) = words.next() else {
         return Err(words.error_here(ParseErrorKind::Empty));
     };
+    if let Some(kind) = first.gesture() {
+        let command = gesture(&mut words, kind)?;
+        words.end()?;
+        return Ok(command);
+    }
     let command = match first.lower() {
         Word::Is(Kw::Help) => Command::Help,
         Word::Is(Kw::Status) => Command::Status,
@@ -72,9 +77,6 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
         Word::Is(Kw::Load) => Command::Load,
         Word::Is(Kw::Defaults) => Command::Defaults,
         Word::Is(Kw::Stop) => Command::Act(Action::Stop),
-        Word::Is(Kw::Nod) => gesture(&mut words, GestureKind::Nod)?,
-        Word::Is(Kw::Shake) => gesture(&mut words, GestureKind::Shake)?,
-        Word::Is(Kw::Tilt) => gesture(&mut words, GestureKind::Tilt)?,
         Word::Is(Kw::Look) => look(&mut words)?,
         Word::Is(Kw::Center | Kw::Centre) => Command::Act(Action::Center {
             duration: words.optional_number(&DURATION)?.map(to_millis),
@@ -86,22 +88,6 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
     };
     words.end()?;
     Ok(command)
-}
-
-/// A numeric field: its name and range (passed as `&'static`: one address
-/// per call instead of the whole field).
-#[derive(Clone, Copy)]
-struct Field {
-    what: &'static str,
-    min: i64,
-    max: i64,
-}
-
-impl Field {
-    /// A field named `what` over `min..=max`.
-    const fn new(what: &'static str, min: i64, max: i64) -> Self {
-        Self { what, min, max }
-    }
 }
 
 /// The range of an angle or an amplitude in m°: the `i32` range without
@@ -132,22 +118,26 @@ fn to_percent(v: i64) -> Percent {
     Percent::new(v as u8).unwrap_or(Percent::FULL)
 }
 
-/// `nod|shake|tilt [amp] [ms] [cycles=N] [intensity=P]`.
+/// `<gesture> [amp] [ms] [cycles=N] [intensity=P]`, any row of the
+/// [gesture table](crate::gestures); `cycles=` where the gesture may have
+/// more than one.
 fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Command, ParseError> {
     let mut request = GestureRequest::new(kind);
     request.amplitude = words.optional_number(&AMPLITUDE)?.map(to_angle);
     request.duration = words.optional_number(&DURATION)?.map(to_millis);
-    let allowed = match kind {
-        GestureKind::Tilt => "intensity",
-        GestureKind::Nod | GestureKind::Shake => "cycles, intensity",
+    let cycles = kind.row().max_cycles > 1;
+    let allowed = if cycles {
+        "cycles, intensity"
+    } else {
+        "intensity"
     };
     while let Some((name, value, word)) = words.option()? {
-        match (name, kind) {
-            (Word::Is(Kw::Cycles), GestureKind::Nod | GestureKind::Shake) => {
+        match name {
+            Word::Is(Kw::Cycles) if cycles => {
                 once(request.cycles.is_some(), word)?;
                 request.cycles = Some(value.number(&CYCLES)? as u8);
             }
-            (Word::Is(Kw::Intensity), _) => {
+            Word::Is(Kw::Intensity) => {
                 once(request.intensity.is_some(), word)?;
                 request.intensity = Some(to_percent(value.number(&PERCENT)?));
             }

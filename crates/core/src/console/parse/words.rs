@@ -1,7 +1,24 @@
 //! The words of a line: tokens with their positions, keywords, numbers.
 
-use super::Field;
+use crate::gestures::{GestureKind, same};
+
 use super::error::{ParseError, ParseErrorKind, Span};
+
+/// A numeric field: its name and range (passed as `&'static`: one address
+/// per call instead of the whole field).
+#[derive(Clone, Copy)]
+pub(super) struct Field {
+    what: &'static str,
+    min: i64,
+    max: i64,
+}
+
+impl Field {
+    /// A field named `what` over `min..=max`.
+    pub(super) const fn new(what: &'static str, min: i64, max: i64) -> Self {
+        Self { what, min, max }
+    }
+}
 
 /// An error for an option seen before.
 pub(super) fn once(seen: bool, word: Token<'_>) -> Result<(), ParseError> {
@@ -27,8 +44,9 @@ pub(super) enum Word {
     Other,
 }
 
-/// Every word the protocol has. The parser matches these, not the texts:
-/// comparing one byte per arm instead of a string keeps it small.
+/// Every word the protocol has but the gestures' (those are the
+/// [gesture table](crate::gestures)'s). The parser matches these, not the
+/// texts: comparing one byte per arm instead of a string keeps it small.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub(super) enum Kw {
     Help,
@@ -37,9 +55,6 @@ pub(super) enum Kw {
     Load,
     Defaults,
     Stop,
-    Nod,
-    Shake,
-    Tilt,
     Look,
     Center,
     Centre,
@@ -68,16 +83,13 @@ pub(super) enum Kw {
 }
 
 /// Every word the protocol has, lower case, in the order of [`ALL`].
-const KEYWORDS: [&str; 34] = [
+const KEYWORDS: [&str; 31] = [
     "help",
     "status",
     "save",
     "load",
     "defaults",
     "stop",
-    "nod",
-    "shake",
-    "tilt",
     "look",
     "center",
     "centre",
@@ -106,16 +118,13 @@ const KEYWORDS: [&str; 34] = [
 ];
 
 /// The [`Kw`] of each of [`KEYWORDS`].
-const ALL: [Kw; 34] = [
+const ALL: [Kw; 31] = [
     Kw::Help,
     Kw::Status,
     Kw::Save,
     Kw::Load,
     Kw::Defaults,
     Kw::Stop,
-    Kw::Nod,
-    Kw::Shake,
-    Kw::Tilt,
     Kw::Look,
     Kw::Center,
     Kw::Centre,
@@ -143,6 +152,24 @@ const ALL: [Kw; 34] = [
     Kw::Intensity,
 ];
 
+// A gesture's word must not be a word the protocol already has: the
+// gesture would shadow it (or it the gesture). Checked when the crate
+// compiles.
+const _: () = {
+    let mut k = 0;
+    while k < GestureKind::COUNT {
+        let mut i = 0;
+        while i < KEYWORDS.len() {
+            assert!(
+                !same(GestureKind::ALL[k].name(), KEYWORDS[i]),
+                "a gesture's word is already a console word"
+            );
+            i += 1;
+        }
+        k += 1;
+    }
+};
+
 impl<'a> Token<'a> {
     pub(super) fn span(&self) -> Span {
         Span {
@@ -165,6 +192,11 @@ impl<'a> Token<'a> {
             .zip(ALL)
             .find(|(k, _)| k.as_bytes().eq_ignore_ascii_case(self.text))
             .map_or(Word::Other, |(_, kw)| Word::Is(kw))
+    }
+
+    /// The gesture this word names, ignoring ASCII case.
+    pub(super) fn gesture(&self) -> Option<GestureKind> {
+        GestureKind::from_name(self.text)
     }
 
     /// The word as a whole number in `field`'s range.

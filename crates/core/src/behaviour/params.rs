@@ -1,0 +1,137 @@
+//! [`BehaviourParams`]: a validated [`BehaviourConfig`] in the integer
+//! form the frame path uses (built by [`BehaviourConfig::build`]), and the
+//! [`LimitMode`]s an axis is driven with.
+
+use crate::axis::Axis;
+use crate::driver::{MotionLimits, SlewRates};
+use crate::units::{Angle, AngleRange, Millis};
+
+use super::config::BehaviourConfig;
+
+/// The offsets `limits` leave around `pose`.
+pub(super) const fn room_around(limits: AngleRange, pose: Angle) -> AngleRange {
+    AngleRange {
+        min: limits.min.saturating_sub(pose),
+        max: limits.max.saturating_sub(pose),
+    }
+}
+
+/// A validated [`BehaviourConfig`] in the integer form the frame path uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct BehaviourParams {
+    pub(super) config: BehaviourConfig,
+    pub(super) frame_us: u32,
+    /// Offsets each axis may take around the neutral pose (limits − pose).
+    pub(super) room: [AngleRange; 3],
+    /// The driver's configured limits: the idle mode.
+    pub(super) idle_limits: [MotionLimits; 3],
+    /// The per-frame rates of both modes' limits (`[idle, gesture]` per
+    /// axis) at `frame_us`, computed here so that a switch between the modes
+    /// divides nothing (`None`: the driver refuses those limits).
+    pub(super) rates: [[Option<SlewRates>; 2]; 3],
+    /// Frames of a gesture's fade-out under a newer one, and its reciprocal.
+    pub(crate) blend: u32,
+    pub(crate) blend_inverse: u32,
+    /// Frames in gesture mode after the motion.
+    pub(crate) settle: u32,
+    /// Frames of an idle change.
+    pub(crate) idle_fade: u32,
+    /// The driver's neutral pose.
+    pub(super) pose: [Angle; 3],
+    /// Idle duck depth, Q16.
+    pub(crate) duck: u32,
+}
+
+/// The limits an axis is driven with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
+pub enum LimitMode {
+    /// Idle motion only: the driver's configured limits.
+    Idle,
+    /// A gesture or a gaze move plays (or just did): the gesture limits.
+    Gesture,
+}
+
+impl LimitMode {
+    /// Whether two sets of modes are the same (three byte compares).
+    pub(crate) const fn same(a: [Self; 3], b: [Self; 3]) -> bool {
+        a[0] as u8 == b[0] as u8 && a[1] as u8 == b[1] as u8 && a[2] as u8 == b[2] as u8
+    }
+}
+
+impl BehaviourParams {
+    /// The configuration these parameters were built from.
+    #[must_use]
+    pub const fn config(&self) -> &BehaviourConfig {
+        &self.config
+    }
+
+    /// The frame period in µs.
+    #[must_use]
+    pub const fn frame_us(&self) -> u32 {
+        self.frame_us
+    }
+
+    /// The driver's neutral pose, `[pitch, roll, yaw]`: the gaze's centre.
+    #[must_use]
+    pub const fn neutral_pose(&self) -> [Angle; 3] {
+        self.pose
+    }
+
+    /// The offsets `axis` may take around its neutral pose.
+    #[must_use]
+    pub const fn room(&self, axis: Axis) -> AngleRange {
+        self.room[axis.index()]
+    }
+
+    /// Gives `axis` the servo's new angle `limits` (a calibration changed
+    /// while the head runs): looks are clamped to them and gestures checked
+    /// against them from now on, as the console checked them.
+    pub(crate) fn set_angle_limits(&mut self, axis: Axis, limits: AngleRange) {
+        let i = axis.index();
+        if let (Some(room), Some(&pose)) = (self.room.get_mut(i), self.pose.get(i)) {
+            *room = room_around(limits, pose);
+        }
+    }
+
+    /// The limits of `axis` in `mode`.
+    #[must_use]
+    pub const fn limits(&self, axis: Axis, mode: LimitMode) -> MotionLimits {
+        match mode {
+            LimitMode::Idle => self.idle_limits[axis.index()],
+            LimitMode::Gesture => self.config.gesture_limits[axis.index()],
+        }
+    }
+
+    /// The per-frame rates of [`limits`](Self::limits)`(axis, mode)` at
+    /// [`frame_us`](Self::frame_us), if the driver takes those limits.
+    pub(crate) const fn rates(&self, axis: Axis, mode: LimitMode) -> Option<SlewRates> {
+        self.rates[axis.index()][mode as usize]
+    }
+
+    /// Whole frames in `duration` (rounded, at least 1).
+    #[must_use]
+    pub const fn frames(&self, duration: Millis) -> u32 {
+        let frame_us = if self.frame_us == 0 {
+            1
+        } else {
+            self.frame_us as u64
+        };
+        let frames = (duration.0 as u64 * 1000 + frame_us / 2) / frame_us;
+        if frames == 0 {
+            1
+        } else if frames > u32::MAX as u64 {
+            u32::MAX
+        } else {
+            frames as u32
+        }
+    }
+
+    /// The duration of `frames` frames, rounded to ms.
+    #[must_use]
+    pub const fn millis(&self, frames: u32) -> Millis {
+        Millis(((frames as u64 * self.frame_us as u64 + 500) / 1000) as u32)
+    }
+}
