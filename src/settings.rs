@@ -11,10 +11,11 @@
 //! due frame runs) between sectors.
 //!
 //! At boot ([`boot`]) the store is read before the first frame: stored
-//! settings of the current version are put in effect (servo calibrations,
-//! behaviour, seeds) and logged with their version; an empty store gives
-//! the built-in settings; a damaged store, or one of another version,
-//! gives the built-in settings with a warning. The console's `save` and
+//! settings are put in effect (servo calibrations, behaviour, seeds) and
+//! logged with their version (an older layout is migrated), with the
+//! fields the load skipped or left on their defaults; an empty store gives
+//! the built-in settings; a damaged store, or one of a version this
+//! firmware cannot read, gives the built-in settings with a warning. The console's `save` and
 //! `load` go through [`PicoStorage`].
 //!
 //! # `save` and the watchdog
@@ -48,8 +49,8 @@ use idle_head_core::console::ConsoleLink;
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::motion::{DEFAULT_HEAD, HeadConfig};
 use idle_head_core::settings::{
-    LoadError, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsSource, SettingsStorage,
-    SettingsStore, StorageError, Validated,
+    LoadError, Loaded, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsError,
+    SettingsSource, SettingsStorage, SettingsStore, StorageError, Validated,
 };
 
 /// The Pico's flash: 2 MiB (W25Q16JV).
@@ -128,7 +129,9 @@ impl SettingsStorage for PicoStorage {
 
     fn load(&mut self) -> Result<Settings, StorageError> {
         self.guarded(|store| match at_once(store.load()) {
-            Some(result) => result.map_err(StorageError::from),
+            Some(result) => result
+                .map(|loaded| loaded.record)
+                .map_err(StorageError::from),
             None => Err(StorageError::Device),
         })
     }
@@ -219,18 +222,47 @@ fn at_once<F: Future>(future: F) -> Option<F::Output> {
 
 /// The stored settings if they can be used with `base`, logged either way.
 fn loaded_settings(
-    loaded: Result<Settings, LoadError<FlashError>>,
+    loaded: Result<Loaded<Settings>, LoadError<FlashError, SettingsError>>,
     base: &DriverConfig,
 ) -> Option<(Settings, Validated)> {
     let at = SETTINGS_ADDRESS;
     match loaded {
-        Ok(settings) => match settings.validate(base) {
+        Ok(Loaded {
+            record: settings,
+            version,
+            fields,
+        }) => match settings.validate(base) {
             Ok(valid) => {
                 defmt::info!(
                     "settings: loaded from flash (version {=u16}) at {=u32:#010x}",
-                    Settings::VERSION,
+                    version,
                     at
                 );
+                if version != Settings::VERSION {
+                    defmt::info!(
+                        "settings: migrated from version {=u16} to {=u16}",
+                        version,
+                        Settings::VERSION
+                    );
+                }
+                if !fields.missing.is_empty() {
+                    defmt::info!(
+                        "settings: fields not in the stored record, on their defaults: {}",
+                        fields.missing
+                    );
+                }
+                if !fields.unknown.is_empty() {
+                    defmt::warn!(
+                        "settings: fields of a newer firmware skipped (a save leaves them out): {}",
+                        fields.unknown
+                    );
+                }
+                if !fields.rejected.is_empty() {
+                    defmt::warn!(
+                        "settings: fields with values out of range, on their defaults: {}",
+                        fields.rejected
+                    );
+                }
                 return Some((settings, valid));
             }
             Err(e) => defmt::warn!(
@@ -247,12 +279,21 @@ fn loaded_settings(
             found,
             Settings::VERSION
         ),
+        Err(LoadError::TooLong { needs }) => defmt::warn!(
+            "settings: defaults; the record at {=u32:#010x} needs {=usize} B, more than this firmware reads",
+            at,
+            needs
+        ),
+        Err(LoadError::Invalid(e)) => defmt::warn!(
+            "settings: defaults; the stored settings fail validation: {}",
+            e
+        ),
         Err(LoadError::Flash(e)) => defmt::warn!(
             "settings: defaults; reading the store at {=u32:#010x} failed: {}",
             at,
             e
         ),
-        Err(LoadError::Corrupt | LoadError::Invalid) => defmt::warn!(
+        Err(LoadError::Corrupt) => defmt::warn!(
             "settings: defaults; the store at {=u32:#010x} is damaged",
             at
         ),
