@@ -114,7 +114,7 @@ macro_rules! fields {
 }
 
 // Ids 1 to 56 are the fields of layout version 1, in its order (`v1.rs`).
-// A new field takes the next free id (57 was the first), at the end.
+// A new field takes the next free id (the first after them: 57), at the end.
 fields! { s;
     // The servos: pulses in µs, the scale in ns per degree, the direction,
     // the angle limits in millidegrees.
