@@ -166,7 +166,7 @@ fn settings() {
         ),
         (
             &|c| c.defaults_mut(GestureKind::Tilt).cycles = 0,
-            "behaviour config `tilt.cycles` = 0 cycles: must be in 1..=1 cycles",
+            "behaviour config `tilt.cycles` = 0 cycles: must be in 1..=32 cycles",
         ),
         (
             // The default nod at 100 % (amplitude × 1.25 × 1.05) leaves pitch.

@@ -21,7 +21,7 @@ struct Console {
     queue: &'static CommandQueue,
     link: &'static ConsoleLink,
     frames: SimFrames,
-    service: ConsoleService<'static, RamStorage<256>>,
+    service: ConsoleService<'static, RamStorage>,
 }
 
 impl Console {

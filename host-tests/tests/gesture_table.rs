@@ -10,7 +10,7 @@ use idle_head_core::behaviour::{Applied, BehaviourConfig, Mixer};
 use idle_head_core::command::{Action, Command, GestureKind, GestureRequest, Percent};
 use idle_head_core::console::{HELP, Session, parse};
 use idle_head_core::gestures::{MAX_CYCLES, Shape};
-use idle_head_core::settings::{Record, Settings};
+use idle_head_core::settings::{FieldReport, Record, Settings};
 use idle_head_core::{Angle, Axis};
 
 /// `line` parsed as a gesture request.
@@ -146,5 +146,18 @@ fn the_settings_record_keeps_every_gestures_defaults() {
     }
     let mut buf = [0; 512];
     let n = settings.encode(&mut buf).unwrap();
-    assert_eq!(Settings::decode(&buf[..n]), Ok(settings));
+    let mut report = FieldReport::default();
+    assert_eq!(
+        Settings::decode(Settings::VERSION, &buf[..n], &mut report),
+        Ok(settings)
+    );
+    // Every gesture's block is in the record, each of its fields read back.
+    assert!(report.is_clean(), "{report:?}");
+    for kind in GestureKind::ALL {
+        let first = kind.row().settings;
+        for id in first..first + idle_head_core::gestures::SETTINGS_IDS {
+            let field = idle_head_core::settings::field(id).expect("a field of the table");
+            assert!(field.name.starts_with(kind.name()), "{}", field.name);
+        }
+    }
 }

@@ -1,18 +1,22 @@
 //! The firmware's settings record: every field round-trips, every field's
-//! validation error is typed, and damaged, older or newer records are
-//! refused with a typed error (never a panic, never settings that were
-//! not saved).
+//! validation error is typed, a record of layout version 1 (the fixture
+//! in `fixtures/`) loads intact, and damaged or newer records are refused
+//! with a typed error (never a panic, never settings that were not saved).
 
+use futures::executor::block_on;
 use idle_head_core::behaviour::{BehaviourError, MilliHertz};
 use idle_head_core::command::{GestureKind, Hold, Percent};
-use idle_head_core::driver::{ConfigError, DegreesPerSecond, DriverConfig};
+use idle_head_core::driver::{
+    ConfigError, DegreesPerSecond, DegreesPerSecondSquared, DriverConfig,
+};
 use idle_head_core::servo::{NanosPerDegree, ServoError};
 use idle_head_core::settings::{
-    DecodeError, RamStorage, Record, SETTINGS_LEN, Settings, SettingsError, SettingsStorage,
-    StorageError,
+    DecodeError, FIELDS, FieldReport, FieldSet, Loaded, RamStorage, Record, SETTINGS_BUFFER,
+    SETTINGS_LEN, Settings, SettingsError, SettingsStorage, SettingsStore, StorageError,
 };
 use idle_head_core::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
+use sequential_storage::mock_flash::{MockFlashBase, WriteCountCheck};
 
 /// A change to the built-in settings.
 type Edit = fn(&mut Settings);
@@ -23,13 +27,241 @@ fn encode(s: &Settings) -> Vec<u8> {
     buf[..n].to_vec()
 }
 
+/// A record of today's layout, and what the load reported.
+fn decode(bytes: &[u8]) -> Result<(Settings, FieldReport), DecodeError<SettingsError>> {
+    let mut report = FieldReport::default();
+    Settings::decode(Settings::VERSION, bytes, &mut report).map(|s| (s, report))
+}
+
+/// The settings in the version 1 fixture (`fixtures/README.md`).
+fn fixture_v1() -> Settings {
+    let mut s = Settings::DEFAULT;
+    let p = |v| Percent::new(v).unwrap();
+    let us = Microseconds;
+    let mdeg = Angle::from_millidegrees;
+    let servo = |neutral, per_degree, direction, min, max, limits: [i32; 2]| {
+        idle_head_core::servo::ServoCalibration {
+            neutral: us(neutral),
+            per_degree: NanosPerDegree(per_degree),
+            direction,
+            min_pulse: us(min),
+            max_pulse: us(max),
+            limits: AngleRange {
+                min: mdeg(limits[0]),
+                max: mdeg(limits[1]),
+            },
+        }
+    };
+    s.servos = [
+        servo(
+            1520,
+            10_800,
+            Direction::Reversed,
+            900,
+            2100,
+            [-25_500, 18_250],
+        ),
+        servo(
+            1480,
+            11_600,
+            Direction::Normal,
+            950,
+            2050,
+            [-20_000, 21_000],
+        ),
+        servo(
+            1510,
+            9_900,
+            Direction::Reversed,
+            800,
+            2200,
+            [-40_000, 35_000],
+        ),
+    ];
+    let b = &mut s.behaviour;
+    let gesture =
+        |amplitude, cycles, slow, brisk, intensity| idle_head_core::behaviour::GestureDefaults {
+            amplitude: mdeg(amplitude),
+            cycles,
+            slow: MilliHertz(slow),
+            brisk: MilliHertz(brisk),
+            intensity: p(intensity),
+        };
+    *b.defaults_mut(GestureKind::Nod) = gesture(5_500, 3, 1_400, 3_200, 40);
+    *b.defaults_mut(GestureKind::Shake) = gesture(7_250, 4, 1_100, 2_400, 65);
+    *b.defaults_mut(GestureKind::Tilt) = gesture(9_000, 2, 450, 1_100, 30);
+    b.max_frequency = MilliHertz(3_800);
+    b.longest_gesture = Millis(9_000);
+    b.blend = Millis(300);
+    b.gaze.base = Millis(280);
+    b.gaze.per_degree = Millis(9);
+    b.gaze.hold = Hold::Return(Millis(2_500));
+    b.gaze.longest = Millis(7_000);
+    b.idle.amplitude = p(85);
+    b.idle.duck = p(55);
+    b.idle.fade = Millis(1_200);
+    for (limits, (speed, accel)) in
+        b.gesture_limits
+            .iter_mut()
+            .zip([(240, 4_800), (230, 4_600), (220, 4_400)])
+    {
+        limits.max_speed = DegreesPerSecond(speed);
+        limits.max_accel = DegreesPerSecondSquared(accel);
+    }
+    b.settle = Millis(600);
+    s.seeds = [42, 1_013_904_216, 3_000_000_001];
+    s
+}
+
+/// The fixture's record, as `RamStorage` kept it: `01 00`, then 192 bytes.
+const V1_RECORD: &[u8] = include_bytes!("../fixtures/settings-v1-record.bin");
+/// The Pico's four settings sectors after two saves of version 1.
+const V1_SECTORS: &[u8] = include_bytes!("../fixtures/settings-v1-sectors.bin");
+/// The Pico's flash geometry: bytes read and written one at a time, 4 KiB
+/// sectors, four of them.
+type PicoSectors = MockFlashBase<4, 1, 4096>;
+
+/// The ids of the fields version 1 had.
+const V1_FIELDS: std::ops::RangeInclusive<u8> = 1..=56;
+
+/// What a load of a version 1 record reports: the fields added since,
+/// missing.
+fn v1_report() -> FieldReport {
+    let mut missing = FieldSet::EMPTY;
+    for field in FIELDS.iter().filter(|f| !V1_FIELDS.contains(&f.id)) {
+        missing.insert(field.id);
+    }
+    FieldReport {
+        missing,
+        ..FieldReport::default()
+    }
+}
+
+/// The fields of version 1 whose stored bytes are the same for `a` and `b`.
+fn same_fields(a: &Settings, b: &Settings) -> Vec<&'static str> {
+    let (a, b) = (encode(a), encode(b));
+    let entries = |bytes: &[u8]| {
+        let mut out = Vec::new();
+        let mut rest = bytes;
+        while let [id, len, tail @ ..] = rest {
+            out.push((*id, tail[..usize::from(*len)].to_vec()));
+            rest = &tail[usize::from(*len)..];
+        }
+        out
+    };
+    entries(&a)
+        .into_iter()
+        .zip(entries(&b))
+        .filter(|(x, y)| x == y && V1_FIELDS.contains(&x.0))
+        .map(|((id, _), _)| FIELDS.iter().find(|f| f.id == id).unwrap().name)
+        .collect()
+}
+
+#[test]
+fn the_version_1_record_loads_with_every_value_intact() {
+    let expected = fixture_v1();
+    assert_eq!(
+        expected.validate(&DriverConfig::DEFAULT).map(|_| ()),
+        Ok(())
+    );
+    // The fixture is worth its name: only roll's direction is the built-in one.
+    assert_eq!(
+        same_fields(&expected, &Settings::DEFAULT),
+        ["servo.roll.direction"]
+    );
+    assert_eq!(V1_RECORD.len(), 2 + 192);
+    assert_eq!(V1_RECORD[..2], [1, 0]);
+    let mut report = FieldReport::default();
+    assert_eq!(
+        Settings::decode(1, &V1_RECORD[2..], &mut report),
+        Ok(expected)
+    );
+    assert_eq!(report, v1_report());
+    // Through the console's storage, and saved again in today's layout.
+    let mut ram = RamStorage::<{ SETTINGS_BUFFER }>::new();
+    ram.set_raw(V1_RECORD).unwrap();
+    assert_eq!(ram.load(), Ok(expected));
+    ram.save(&expected).unwrap();
+    assert_eq!(ram.raw()[..2], Settings::VERSION.to_le_bytes());
+    assert_eq!(ram.load(), Ok(expected));
+}
+
+#[test]
+fn the_version_1_flash_sectors_load_with_every_value_intact() {
+    let mut flash = PicoSectors::new(WriteCountCheck::OnceOnly, None, true);
+    assert_eq!(V1_SECTORS.len(), flash.as_bytes().len());
+    flash.as_bytes_mut().copy_from_slice(V1_SECTORS);
+    let mut store: SettingsStore<_, Settings, SETTINGS_BUFFER> =
+        SettingsStore::new(flash, PicoSectors::FULL_FLASH_RANGE).unwrap();
+    let expected = fixture_v1();
+    // The newest of the two records, migrated.
+    assert_eq!(
+        block_on(store.load()),
+        Ok(Loaded {
+            record: expected,
+            version: 1,
+            fields: v1_report(),
+        })
+    );
+    // A save writes today's layout after it; the next load reads that.
+    let mut changed = expected;
+    changed.servos[0].neutral = Microseconds(1530);
+    block_on(store.save(&changed)).unwrap();
+    let loaded = block_on(store.load()).unwrap();
+    assert_eq!(
+        (loaded.record, loaded.version),
+        (changed, Settings::VERSION)
+    );
+    assert!(loaded.fields.is_clean());
+    // A store opened afresh on those sectors (the next boot) reads the same.
+    let mut again: SettingsStore<_, Settings, SETTINGS_BUFFER> =
+        SettingsStore::new(store.into_flash(), PicoSectors::FULL_FLASH_RANGE).unwrap();
+    assert_eq!(block_on(again.load()).map(|l| l.record), Ok(changed));
+}
+
+#[test]
+fn a_damaged_version_1_record_is_refused() {
+    let mut ram = RamStorage::<{ SETTINGS_BUFFER }>::new();
+    // A byte short, or a byte more: not a version 1 record.
+    ram.set_raw(&V1_RECORD[..V1_RECORD.len() - 1]).unwrap();
+    assert_eq!(ram.load(), Err(StorageError::Corrupt));
+    let mut long = V1_RECORD.to_vec();
+    long.push(0);
+    ram.set_raw(&long).unwrap();
+    assert_eq!(ram.load(), Err(StorageError::Corrupt));
+    // Pitch's neutral (bytes 2..6) far outside its pulse range: refused
+    // with the reason.
+    let mut bad = V1_RECORD.to_vec();
+    bad[2..6].copy_from_slice(&3000_u32.to_le_bytes());
+    ram.set_raw(&bad).unwrap();
+    assert!(matches!(
+        ram.load(),
+        Err(StorageError::Invalid(SettingsError::Driver(
+            ConfigError::Servo {
+                axis: Axis::Pitch,
+                error: ServoError::NeutralOutsidePulseRange { .. }
+            }
+        )))
+    ));
+    // Roll's direction byte (2 + 25 + 8) out of range: that field's default.
+    let mut direction = V1_RECORD.to_vec();
+    direction[2 + 25 + 8] = 7;
+    let mut report = FieldReport::default();
+    let loaded = Settings::decode(1, &direction[2..], &mut report).unwrap();
+    assert_eq!(loaded, fixture_v1());
+    assert_eq!(report.rejected.iter().collect::<Vec<_>>(), [10]);
+}
+
 #[test]
 fn defaults_are_the_built_in_configuration_and_round_trip() {
     assert_eq!(Settings::DEFAULT.servos, DriverConfig::DEFAULT.servos);
     assert_eq!(Settings::DEFAULT.seeds, [127, 259, 8821]);
     let bytes = encode(&Settings::DEFAULT);
     assert_eq!(bytes.len(), SETTINGS_LEN);
-    assert_eq!(Settings::decode(&bytes), Ok(Settings::DEFAULT));
+    assert_eq!(
+        decode(&bytes),
+        Ok((Settings::DEFAULT, FieldReport::default()))
+    );
     // A buffer one byte short is refused, not overrun.
     let mut short = vec![0; SETTINGS_LEN - 1];
     assert!(Settings::DEFAULT.encode(&mut short).is_err());
@@ -69,7 +301,7 @@ fn every_field_round_trips() {
         }
         let bytes = encode(&s);
         assert_eq!(bytes.len(), SETTINGS_LEN);
-        assert_eq!(Settings::decode(&bytes), Ok(s));
+        assert_eq!(decode(&bytes), Ok((s, FieldReport::default())));
         checked += 1;
     }
     println!("settings round trips: {checked}");
@@ -85,8 +317,8 @@ fn every_field_has_its_validation_error() {
         let mut s = Settings::DEFAULT;
         edit(&mut s);
         let err = s.validate(&base).unwrap_err();
-        // And a record of it does not load.
-        assert_eq!(Settings::decode(&encode(&s)), Err(DecodeError::Invalid));
+        // And a record of it does not load, for the same reason.
+        assert_eq!(decode(&encode(&s)), Err(DecodeError::Invalid(err)));
         err
     };
     for axis in Axis::ALL {
@@ -188,21 +420,28 @@ fn every_field_has_its_validation_error() {
 #[test]
 fn damaged_older_and_newer_records_are_typed_errors() {
     let bytes = encode(&Settings::DEFAULT);
-    // Every truncation and one byte more.
+    // Every truncation: cut inside an entry, the record is malformed; cut
+    // between two, the fields after the cut are missing (on their
+    // defaults, which are the values saved here).
+    let mut malformed = 0;
     for n in 0..bytes.len() {
-        assert_eq!(
-            Settings::decode(&bytes[..n]),
-            Err(DecodeError::Malformed),
-            "{n}"
-        );
+        match decode(&bytes[..n]) {
+            Err(DecodeError::Malformed) => malformed += 1,
+            Ok((s, report)) => {
+                assert_eq!(s, Settings::DEFAULT, "{n}");
+                assert!(!report.missing.is_empty(), "{n}");
+            }
+            other => panic!("cut at {n}: {other:?}"),
+        }
     }
-    let mut long = bytes.clone();
-    long.push(0);
-    assert_eq!(Settings::decode(&long), Err(DecodeError::Malformed));
-    // Bad enum bytes: the direction and the hold tag.
+    assert_eq!(malformed, bytes.len() - FIELDS.len());
+    // Bad values: the direction and the hold tag take their defaults.
     let mut bad = bytes.clone();
-    bad[8] = 2;
-    assert_eq!(Settings::decode(&bad), Err(DecodeError::Malformed));
+    assert_eq!(bad[12..15], [3, 1, 0], "pitch's direction");
+    bad[14] = 2;
+    let (s, report) = decode(&bad).unwrap();
+    assert_eq!(s, Settings::DEFAULT);
+    assert_eq!(report.rejected.iter().collect::<Vec<_>>(), [3]);
     // Every single-byte change: refused or a valid record, never a panic.
     let mut rng = host_tests::console::rng(12);
     let (mut refused, mut other) = (0, 0);
@@ -210,8 +449,8 @@ fn damaged_older_and_newer_records_are_typed_errors() {
         let mut b = bytes.clone();
         let at = rng.random_range(0..b.len());
         b[at] = rng.random();
-        match Settings::decode(&b) {
-            Ok(s) => {
+        match decode(&b) {
+            Ok((s, _)) => {
                 assert!(s.validate(&DriverConfig::DEFAULT).is_ok());
                 other += 1;
             }
@@ -222,7 +461,7 @@ fn damaged_older_and_newer_records_are_typed_errors() {
     assert!(refused > 0);
 
     // Through a store: versions are checked before the bytes.
-    let mut ram = RamStorage::<256>::new();
+    let mut ram = RamStorage::<{ SETTINGS_BUFFER }>::new();
     assert_eq!(ram.load(), Err(StorageError::Empty));
     ram.save(&Settings::DEFAULT).unwrap();
     assert_eq!(ram.load(), Ok(Settings::DEFAULT));
@@ -242,9 +481,106 @@ fn damaged_older_and_newer_records_are_typed_errors() {
     let mut rec = Settings::VERSION.to_le_bytes().to_vec();
     rec.extend(encode(&invalid));
     ram.set_raw(&rec).unwrap();
-    assert_eq!(ram.load(), Err(StorageError::Invalid));
-    // A store too small refuses the save.
+    let why = invalid.validate(&DriverConfig::DEFAULT).unwrap_err();
+    assert_eq!(ram.load(), Err(StorageError::Invalid(why)));
+    assert_eq!(
+        StorageError::Invalid(why).to_string(),
+        format!("stored settings fail validation: {why}")
+    );
+    // A store too small refuses the save and keeps what it holds.
     let mut tiny = RamStorage::<64>::new();
     assert_eq!(tiny.save(&Settings::DEFAULT), Err(StorageError::TooLong));
     assert_eq!(tiny.load(), Err(StorageError::Empty));
+    let mut short = RamStorage::<{ SETTINGS_LEN + 1 }>::new();
+    short.set_raw(V1_RECORD).unwrap();
+    assert_eq!(short.save(&Settings::DEFAULT), Err(StorageError::TooLong));
+    assert_eq!(short.load(), Ok(fixture_v1()));
+}
+
+/// The entries of a record of today's layout, `(id, value)`.
+fn entries(mut bytes: &[u8]) -> Vec<(u8, Vec<u8>)> {
+    let mut out = Vec::new();
+    while let [id, len, rest @ ..] = bytes {
+        let (value, rest) = rest.split_at(usize::from(*len));
+        out.push((*id, value.to_vec()));
+        bytes = rest;
+    }
+    out
+}
+
+/// `entries` as a stored record of today's version.
+fn stored(entries: &[(u8, Vec<u8>)]) -> Vec<u8> {
+    let mut out = Settings::VERSION.to_le_bytes().to_vec();
+    for (id, value) in entries {
+        out.push(*id);
+        out.push(u8::try_from(value.len()).unwrap());
+        out.extend(value);
+    }
+    out
+}
+
+/// `stored` as a board's storage loads it, and what the load reported.
+fn load_stored(stored: &[u8]) -> (Result<Settings, StorageError>, FieldReport) {
+    let mut ram = RamStorage::<{ SETTINGS_BUFFER }>::new();
+    ram.set_raw(stored).unwrap();
+    let mut report = FieldReport::default();
+    let decoded = Settings::decode(Settings::VERSION, &stored[2..], &mut report);
+    let loaded = ram.load();
+    assert_eq!(
+        loaded.ok(),
+        decoded.ok(),
+        "the storage and the record agree"
+    );
+    (ram.load(), report)
+}
+
+/// A record saved by a firmware that had one field less (each field in
+/// turn) loads: every field it holds as saved, the one it lacks on its
+/// default, and the load says which.
+#[test]
+fn a_record_without_a_field_loads_with_every_other_value() {
+    let saved = fixture_v1();
+    let fields = entries(&encode(&saved));
+    let defaults = entries(&encode(&Settings::DEFAULT));
+    for (i, (id, _)) in fields.iter().enumerate() {
+        let older: Vec<_> = fields.iter().filter(|(f, _)| f != id).cloned().collect();
+        let (loaded, report) = load_stored(&stored(&older));
+        assert_eq!(report.missing.iter().collect::<Vec<_>>(), [*id]);
+        assert!(report.unknown.is_empty() && report.rejected.is_empty());
+        // Every field's default fits these saved settings, as a new field's
+        // default must fit any settings an older firmware saved.
+        let settings = loaded.unwrap_or_else(|e| panic!("without {id}: {e}"));
+        // The saved record with field `id` taken from the defaults.
+        let mut expected = fields.clone();
+        expected[i] = defaults[i].clone();
+        assert_eq!(entries(&encode(&settings)), expected, "without {id}");
+    }
+}
+
+/// A record saved by a firmware with a field this one does not have, at
+/// any place among the others: skipped, every other field as saved.
+#[test]
+fn a_field_of_a_newer_firmware_is_skipped_wherever_it_is() {
+    let saved = fixture_v1();
+    let fields = entries(&encode(&saved));
+    for at in 0..=fields.len() {
+        for value in [vec![], vec![1, 2, 3, 4], vec![0xff; 50]] {
+            let mut newer = fields.clone();
+            newer.insert(at, (250, value));
+            let (loaded, report) = load_stored(&stored(&newer));
+            assert_eq!(loaded, Ok(saved), "a new field at {at}");
+            assert_eq!(
+                report,
+                FieldReport {
+                    unknown: FieldSet::of(&[250]),
+                    ..FieldReport::default()
+                }
+            );
+        }
+    }
+    // Fields stored in another order still load (the order is not part of
+    // the layout).
+    let mut shuffled = fields.clone();
+    shuffled.reverse();
+    assert_eq!(load_stored(&stored(&shuffled)).0, Ok(saved));
 }

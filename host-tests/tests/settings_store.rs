@@ -1,6 +1,7 @@
 //! The settings store on sequential-storage's mock flash: round trips,
-//! versions, a power cut at every byte of hundreds of saves in a row of the
-//! firmware's own [`Settings`] record, and random corruption.
+//! versions, records with fields added or unknown, a power cut at every
+//! byte of hundreds of saves in a row of the firmware's own [`Settings`]
+//! record, and random corruption.
 //!
 //! `cargo test --test settings_store -- --nocapture` prints the figures.
 
@@ -9,8 +10,8 @@ use futures::executor::block_on;
 use idle_head_core::command::{GestureKind, Percent};
 use idle_head_core::servo::{NanosPerDegree, ServoCalibration};
 use idle_head_core::settings::{
-    DecodeError, EncodeError, LoadError, RawRecord, Record, SETTINGS_BUFFER, SaveError, SectorWise,
-    Settings, SettingsStore, decode_postcard, encode_postcard,
+    DecodeError, EncodeError, FieldReport, LoadError, RawRecord, Record, SETTINGS_BUFFER,
+    SaveError, SectorWise, Settings, SettingsStore, decode_postcard, encode_postcard,
 };
 use idle_head_core::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
@@ -21,7 +22,7 @@ use serde::{Deserialize, Serialize};
 /// Four 1 KiB pages of 4-byte words (the RP2040's flash reads in words;
 /// small pages make the store turn pages over often).
 type Flash = MockFlashBase<4, 4, 256>;
-type Store<R> = SettingsStore<Flash, R, 256>;
+type Store<R> = SettingsStore<Flash, R, SETTINGS_BUFFER>;
 
 /// A record like the firmware's settings: three servo calibrations and a
 /// few integers.
@@ -54,6 +55,7 @@ struct SettingsWire {
 
 impl Record for ServoSettings {
     const VERSION: u16 = 2;
+    type Invalid = ();
 
     fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
         let wire = SettingsWire {
@@ -72,7 +74,10 @@ impl Record for ServoSettings {
         encode_postcard(&wire, buf)
     }
 
-    fn decode(bytes: &[u8]) -> Result<Self, DecodeError> {
+    fn decode(version: u16, bytes: &[u8], _: &mut FieldReport) -> Result<Self, DecodeError<()>> {
+        if version != Self::VERSION {
+            return Err(DecodeError::Version);
+        }
         let wire: SettingsWire = decode_postcard(bytes)?;
         let servos = wire.servos.map(|w| ServoCalibration {
             neutral: Microseconds(w.neutral_us),
@@ -90,11 +95,11 @@ impl Record for ServoSettings {
             },
         });
         if servos.iter().any(|c| c.validate().is_err()) {
-            return Err(DecodeError::Invalid);
+            return Err(DecodeError::Invalid(()));
         }
         Ok(Self {
             servos,
-            idle_amp: Percent::new(wire.idle_amp).ok_or(DecodeError::Invalid)?,
+            idle_amp: Percent::new(wire.idle_amp).ok_or(DecodeError::Invalid(()))?,
             seed: wire.seed,
             fade: Millis(wire.fade_ms),
         })
@@ -177,15 +182,26 @@ fn store<R: Record>(flash: Flash) -> Store<R> {
     Store::new(flash, Flash::FULL_FLASH_RANGE).expect("a valid range")
 }
 
+/// The record a load gives, without its report.
+fn load<F, R, const BUF: usize>(
+    s: &mut SettingsStore<F, R, BUF>,
+) -> Result<R, LoadError<F::Error, R::Invalid>>
+where
+    F: NorFlash,
+    R: Record,
+{
+    block_on(s.load()).map(|loaded| loaded.record)
+}
+
 #[test]
 fn round_trip_and_what_a_load_reports() {
     let mut rng = rng(1);
     let mut s = store::<ServoSettings>(fresh(WriteCountCheck::OnceOnly));
-    assert_eq!(block_on(s.load()), Err(LoadError::Empty));
+    assert_eq!(load(&mut s), Err(LoadError::Empty));
     for _ in 0..200 {
         let settings = random_settings(&mut rng);
         block_on(s.save(&settings)).unwrap();
-        assert_eq!(block_on(s.load()), Ok(settings));
+        assert_eq!(load(&mut s), Ok(settings));
     }
     let valid = random_settings(&mut rng);
     let mut encoded = [0; 128];
@@ -202,36 +218,36 @@ fn round_trip_and_what_a_load_reports() {
         store(flash)
     };
     let mut s = plant(s.into_flash(), encoded, 1);
-    assert_eq!(block_on(s.load()), Err(LoadError::Older { found: 1 }));
+    assert_eq!(load(&mut s), Err(LoadError::Older { found: 1 }));
     let mut s = plant(s.into_flash(), encoded, 3);
-    assert_eq!(block_on(s.load()), Err(LoadError::Newer { found: 3 }));
+    assert_eq!(load(&mut s), Err(LoadError::Newer { found: 3 }));
     let mut s = plant(s.into_flash(), &[0xff, 0xff, 0xff], 2);
-    assert_eq!(block_on(s.load()), Err(LoadError::Corrupt));
+    assert_eq!(load(&mut s), Err(LoadError::Corrupt));
     let mut trailing = encoded.to_vec();
     trailing.push(0);
     let mut s = plant(s.into_flash(), &trailing, 2);
-    assert_eq!(block_on(s.load()), Err(LoadError::Corrupt));
+    assert_eq!(load(&mut s), Err(LoadError::Corrupt));
     let mut s = plant(s.into_flash(), &[], 2);
-    assert_eq!(block_on(s.load()), Err(LoadError::Corrupt));
+    assert_eq!(load(&mut s), Err(LoadError::Corrupt));
     let mut invalid = valid;
     invalid.servos[1].neutral = Microseconds(3000);
     let mut bytes = [0; 128];
     let n = invalid.encode(&mut bytes).unwrap();
     let mut s = plant(s.into_flash(), &bytes[..n], 2);
-    assert_eq!(block_on(s.load()), Err(LoadError::Invalid));
+    assert_eq!(load(&mut s), Err(LoadError::Invalid(())));
     // A save puts things right.
     block_on(s.save(&valid)).unwrap();
-    assert_eq!(block_on(s.load()), Ok(valid));
+    assert_eq!(load(&mut s), Ok(valid));
     block_on(s.erase()).unwrap();
-    assert_eq!(block_on(s.load()), Err(LoadError::Empty));
+    assert_eq!(load(&mut s), Err(LoadError::Empty));
 
     // A record too long for the work buffer is refused, nothing changes.
     let mut long = store::<Raw<2>>(fresh(WriteCountCheck::OnceOnly));
     assert_eq!(
-        block_on(long.save(&raw::<2>(&[7; 300]))),
+        block_on(long.save(&raw::<2>(&[7; SETTINGS_BUFFER]))),
         Err(SaveError::TooLong)
     );
-    assert!(matches!(block_on(long.load()), Err(LoadError::Empty)));
+    assert!(matches!(load(&mut long), Err(LoadError::Empty)));
 }
 
 fn save_raw<const V: u16>(flash: Flash, bytes: &[u8]) -> Flash {
@@ -267,7 +283,7 @@ fn a_power_cut_at_every_byte_leaves_the_old_or_the_new_record() {
             let mut after = s.into_flash();
             after.bytes_until_shutoff = None;
             let mut s = store::<Settings>(after);
-            match (block_on(s.load()), old) {
+            match (load(&mut s), old) {
                 (Ok(r), _) if r == new => got_new += 1,
                 (Ok(r), Some(o)) if r == o => kept_old += 1,
                 (Err(LoadError::Empty), None) => kept_old += 1,
@@ -275,7 +291,7 @@ fn a_power_cut_at_every_byte_leaves_the_old_or_the_new_record() {
             }
             // The store works on from there.
             block_on(s.save(&new)).unwrap_or_else(|e| panic!("save {i}, cut {cut}: {e:?}"));
-            assert_eq!(block_on(s.load()), Ok(new), "save {i}, cut {cut}");
+            assert_eq!(load(&mut s), Ok(new), "save {i}, cut {cut}");
             if rng.random_range(0..=cut) == 0 {
                 resume = Some(s.into_flash());
             }
@@ -324,7 +340,7 @@ fn random_corruption_never_panics_nor_invents_a_record() {
         let mut flash = base.clone();
         corrupt_bytes(flash.as_bytes_mut(), &mut rng);
         let mut s = store::<Settings>(flash);
-        match block_on(s.load()) {
+        match load(&mut s) {
             Ok(r) if Some(&r) == saved.last() => newest += 1,
             Ok(r) if saved.contains(&r) => older += 1,
             Err(LoadError::Empty) => empty += 1,
@@ -333,7 +349,7 @@ fn random_corruption_never_panics_nor_invents_a_record() {
         }
         let next = random_real(&mut rng);
         let saved_ok = block_on(s.save(&next));
-        let loaded = block_on(s.load());
+        let loaded = load(&mut s);
         if saved_ok.is_ok() && loaded == Ok(next) {
             resaved += 1;
         } else {
@@ -412,7 +428,7 @@ fn foreign_data_on<const PAGES: usize, const WORD: usize, const WORDS: usize>() 
         let range = MockFlashBase::<PAGES, WORD, WORDS>::FULL_FLASH_RANGE;
         let mut s: SettingsStore<_, Settings, SETTINGS_BUFFER> =
             SettingsStore::new(flash, range).expect("a valid range");
-        let loaded = block_on(s.load());
+        let loaded = load(&mut s);
         assert!(
             matches!(loaded, Err(LoadError::Empty | LoadError::Corrupt)),
             "{what} ({WORD}-byte words, {} B pages): load gave {loaded:?}",
@@ -425,7 +441,7 @@ fn foreign_data_on<const PAGES: usize, const WORD: usize, const WORDS: usize>() 
             "{what} ({WORD}-byte words, {} B pages): save",
             WORD * WORDS
         );
-        assert_eq!(block_on(s.load()), Ok(next), "{what}: load after the save");
+        assert_eq!(load(&mut s), Ok(next), "{what}: load after the save");
     }
 }
 
@@ -498,11 +514,11 @@ fn sector_wise_erases_one_sector_per_call() {
         .map(|at| (at, at + sector))
         .collect();
     assert_eq!(split.flash().0.calls, expected);
-    assert_eq!(block_on(split.load()), Err(LoadError::Empty));
+    assert_eq!(load(&mut split), Err(LoadError::Empty));
     for _ in 0..50 {
         let next = random_real(&mut rng);
         block_on(split.save(&next)).unwrap();
-        assert_eq!(block_on(split.load()), Ok(next));
+        assert_eq!(load(&mut split), Ok(next));
     }
     assert!(
         split
@@ -517,4 +533,25 @@ fn sector_wise_erases_one_sector_per_call() {
     let mut odd = SectorWise(whole(fresh(WriteCountCheck::Disabled)));
     assert!(block_on(odd.erase(1, sector + 1)).is_err());
     assert_eq!(odd.0.calls, [(1, sector + 1)]);
+}
+
+/// A record longer than the work buffer (a newer firmware with many more
+/// fields): a typed error, and the next save starts the store afresh.
+#[test]
+fn a_record_longer_than_the_buffer_is_refused_and_saved_over() {
+    let big = vec![0; SETTINGS_BUFFER + 100];
+    let mut newer: SettingsStore<_, Raw<2>, 1024> =
+        SettingsStore::new(fresh(WriteCountCheck::OnceOnly), Flash::FULL_FLASH_RANGE).unwrap();
+    block_on(newer.save(&raw::<2>(&big))).unwrap();
+    let mut s = store::<Settings>(newer.into_flash());
+    match block_on(s.load()) {
+        Err(LoadError::TooLong { needs }) => assert!(needs > SETTINGS_BUFFER, "{needs}"),
+        other => panic!("{other:?}"),
+    }
+    let mut rng = rng(7);
+    let next = random_real(&mut rng);
+    assert_eq!(block_on(s.save(&next)), Ok(()));
+    assert_eq!(load(&mut s), Ok(next));
+    let mut again = store::<Settings>(s.into_flash());
+    assert_eq!(load(&mut again), Ok(next));
 }

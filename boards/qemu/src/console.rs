@@ -25,7 +25,7 @@ pub static HOLD: AtomicBool = AtomicBool::new(false);
 pub static HUNG_UP: AtomicBool = AtomicBool::new(false);
 
 /// The service as the QEMU image runs it.
-pub type Service = ConsoleService<'static, RamStorage<256>>;
+pub type Service = ConsoleService<'static, RamStorage>;
 
 /// Whether the semihosting command line holds the word `console`.
 pub fn held_by_host() -> bool {

@@ -39,7 +39,8 @@ macro_rules! gestures {
             axis: $axis:expr,
             shape: $shape:expr,
             max_cycles: $max:expr,
-            defaults: $defaults:expr $(,)?
+            defaults: $defaults:expr,
+            settings: $settings:expr $(,)?
         }
     ),+ $(,)?) => {
         /// The gestures, one per row of the [table](self).
@@ -69,7 +70,10 @@ macro_rules! gestures {
                             shape: $shape,
                             max_cycles: $max,
                             defaults: $defaults,
+                            settings: $settings,
                             fields: Fields {
+                                amplitude: concatcp!($name, ".amplitude"),
+                                intensity: concatcp!($name, ".intensity"),
                                 duration: concatcp!($name, " duration"),
                                 cycles: concatcp!($name, ".cycles"),
                                 slow: concatcp!($name, ".slow"),
@@ -92,7 +96,10 @@ pub const MAX_CYCLES: u8 = 32;
 // default amplitude scales with intensity and cycles, see
 // `behaviour::gesture`), the cycles when not asked for, the cycle frequency
 // at 0 % and at 100 % intensity (a posture's "cycle" is its whole
-// duration), the intensity when not asked for.
+// duration), the intensity when not asked for. `settings`: the first of
+// the five ids its defaults take in the stored settings; ids are never
+// reused, so a new gesture takes a new block (the next free one is named
+// in `settings/fields.rs`).
 gestures! {
     /// Nodding "yes" on the pitch axis.
     Nod {
@@ -107,6 +114,7 @@ gestures! {
             brisk: MilliHertz(3500),
             intensity: Percent::HALF,
         },
+        settings: 22,
     },
     /// Shaking "no" on the yaw axis.
     Shake {
@@ -121,6 +129,7 @@ gestures! {
             brisk: MilliHertz(2500),
             intensity: Percent::HALF,
         },
+        settings: 27,
     },
     /// Tilting the head to one side on the roll axis.
     Tilt {
@@ -136,8 +145,14 @@ gestures! {
             brisk: MilliHertz(1000),
             intensity: Percent::HALF,
         },
+        settings: 32,
     },
 }
+
+/// How many ids a gesture's defaults take in the stored settings: its
+/// amplitude, cycles, slow and brisk frequencies and intensity, in this
+/// order from [`Gesture::settings`].
+pub const SETTINGS_IDS: u8 = 5;
 
 /// One row of the table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -154,7 +169,13 @@ pub struct Gesture {
     pub max_cycles: u8,
     /// The built-in defaults ([`BehaviourConfig::DEFAULT`](crate::behaviour::BehaviourConfig::DEFAULT)).
     pub defaults: GestureDefaults,
-    /// The names its fields have in errors, made from `name`.
+    /// The first of the [`SETTINGS_IDS`] ids its defaults take in the
+    /// stored settings (`crate::settings::FIELDS`): a block no other field
+    /// or gesture uses, never reused once a firmware has saved it. A new
+    /// gesture takes the next free block (the settings table says which).
+    pub settings: u8,
+    /// The names its fields have in errors and in the settings, made from
+    /// `name`.
     pub fields: Fields,
 }
 
@@ -162,6 +183,10 @@ pub struct Gesture {
 /// `nod.cycles`, ...), made from its command word at compile time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Fields {
+    /// The configured default amplitude (`nod.amplitude`).
+    pub amplitude: &'static str,
+    /// The configured default intensity (`nod.intensity`).
+    pub intensity: &'static str,
     /// A request's duration (`nod duration`).
     pub duration: &'static str,
     /// The configured default cycles (`nod.cycles`).

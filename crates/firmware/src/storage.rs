@@ -12,8 +12,10 @@
 //!
 //! At boot ([`open`]) the store is read before the first frame: stored
 //! settings are put in effect (servo calibrations, behaviour, seeds) and
-//! logged; an empty store gives the built-in settings; a damaged store, or
-//! one of another version, gives the built-in settings with a warning. The
+//! logged with their version (an older layout is migrated), with the
+//! fields the load skipped or left on their defaults; an empty store gives
+//! the built-in settings; a damaged store, or one of a version this
+//! firmware cannot read, gives the built-in settings with a warning. The
 //! console's `save` and `load` go through [`FlashStorage`].
 //!
 //! # `save` and the watchdog
@@ -43,8 +45,8 @@ use embedded_storage_async::nor_flash::NorFlash;
 use idle_head_core::console::ConsoleLink;
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::settings::{
-    LoadError, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsSource, SettingsStorage,
-    SettingsStore, StorageError, Validated,
+    LoadError, Loaded as Stored, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsError,
+    SettingsSource, SettingsStorage, SettingsStore, StorageError, Validated,
 };
 
 use crate::boot::Loaded;
@@ -106,7 +108,9 @@ impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
 
     fn load(&mut self) -> Result<Settings, StorageError> {
         self.guarded(|store| match at_once(store.load()) {
-            Some(result) => result.map_err(StorageError::from),
+            Some(result) => result
+                .map(|loaded| loaded.record)
+                .map_err(StorageError::from),
             None => Err(StorageError::Device),
         })
     }
@@ -169,18 +173,47 @@ fn at_once<F: Future>(future: F) -> Option<F::Output> {
 
 /// The stored settings if they can be used with `base`, logged either way.
 fn loaded_settings<E: defmt::Format>(
-    loaded: Result<Settings, LoadError<E>>,
+    loaded: Result<Stored<Settings>, LoadError<E, SettingsError>>,
     base: &DriverConfig,
     at: u32,
 ) -> Option<(Settings, Validated)> {
     match loaded {
-        Ok(settings) => match settings.validate(base) {
+        Ok(Stored {
+            record: settings,
+            version,
+            fields,
+        }) => match settings.validate(base) {
             Ok(valid) => {
                 defmt::info!(
                     "settings: loaded from flash (version {=u16}) at {=u32:#010x}",
-                    Settings::VERSION,
+                    version,
                     at
                 );
+                if version != Settings::VERSION {
+                    defmt::info!(
+                        "settings: migrated from version {=u16} to {=u16}",
+                        version,
+                        Settings::VERSION
+                    );
+                }
+                if !fields.missing.is_empty() {
+                    defmt::info!(
+                        "settings: fields not in the stored record, on their defaults: {}",
+                        fields.missing
+                    );
+                }
+                if !fields.unknown.is_empty() {
+                    defmt::warn!(
+                        "settings: fields of a newer firmware skipped (a save leaves them out): {}",
+                        fields.unknown
+                    );
+                }
+                if !fields.rejected.is_empty() {
+                    defmt::warn!(
+                        "settings: fields with values out of range, on their defaults: {}",
+                        fields.rejected
+                    );
+                }
                 return Some((settings, valid));
             }
             Err(e) => defmt::warn!(
@@ -197,12 +230,21 @@ fn loaded_settings<E: defmt::Format>(
             found,
             Settings::VERSION
         ),
+        Err(LoadError::TooLong { needs }) => defmt::warn!(
+            "settings: defaults; the record at {=u32:#010x} needs {=usize} B, more than this firmware reads",
+            at,
+            needs
+        ),
+        Err(LoadError::Invalid(e)) => defmt::warn!(
+            "settings: defaults; the stored settings fail validation: {}",
+            e
+        ),
         Err(LoadError::Flash(e)) => defmt::warn!(
             "settings: defaults; reading the store at {=u32:#010x} failed: {}",
             at,
             e
         ),
-        Err(LoadError::Corrupt | LoadError::Invalid) => defmt::warn!(
+        Err(LoadError::Corrupt) => defmt::warn!(
             "settings: defaults; the store at {=u32:#010x} is damaged",
             at
         ),

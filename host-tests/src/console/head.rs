@@ -203,7 +203,7 @@ pub fn shared() -> (&'static CommandQueue, &'static ConsoleLink) {
 pub fn service(
     queue: &'static CommandQueue,
     link: &'static ConsoleLink,
-) -> ConsoleService<'static, RamStorage<256>> {
+) -> ConsoleService<'static, RamStorage> {
     ConsoleService::new(
         queue,
         link,

@@ -12,7 +12,7 @@ use std::time::Duration;
 use idle_head_core::behaviour::CommandQueue;
 use idle_head_core::console::{ConsoleLink, ConsoleService, Session};
 use idle_head_core::driver::DriverConfig;
-use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
+use idle_head_core::settings::{RamStorage, SETTINGS_BUFFER, Settings, SettingsSource};
 use nix::pty::openpty;
 
 use super::serial_session;
@@ -28,7 +28,7 @@ fn head(master: RawFd, stop: &AtomicBool) {
     let mut service = ConsoleService::new(
         &QUEUE,
         &LINK,
-        RamStorage::<256>::new(),
+        RamStorage::<SETTINGS_BUFFER>::new(),
         DriverConfig::DEFAULT,
         Settings::DEFAULT,
         SettingsSource::Defaults,

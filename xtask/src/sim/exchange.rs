@@ -114,13 +114,13 @@ pub fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
     let service = ConsoleService::new(
         queue,
         link,
-        RamStorage::<256>::new(),
+        RamStorage::new(),
         DriverConfig::DEFAULT,
         Settings::DEFAULT,
         SettingsSource::Defaults,
     )
     .expect("the built-in settings are valid");
-    let service: &'static SharedService<RamStorage<256>> =
+    let service: &'static SharedService<RamStorage> =
         Box::leak(Box::new(Mutex::new(RefCell::new(service))));
     [(), ()].map(|()| {
         let mut session = PortSession::new();

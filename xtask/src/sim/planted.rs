@@ -1,12 +1,17 @@
-//! Settings sectors as an earlier firmware would have left them: a store
-//! written by the core's own `SettingsStore` on the host, over a NOR flash
-//! in RAM with the Pico's geometry (4 KiB sectors, bytes written one at a
-//! time), holding a record of another layout version. (sequential-storage's
-//! own mock flash, which the host tests use, sits behind its internal
-//! `_test` feature; this tool keeps its own small one, [`RamFlash`].)
+//! Settings sectors as an earlier firmware would have left them:
+//!
+//! - [`version_1_sectors`]: the fixture `host-tests/fixtures/settings-v1-sectors.bin`,
+//!   the sectors as the firmware of layout version 1 wrote them;
+//! - [`store_of_version`]: a store written by the core's own
+//!   `SettingsStore` on the host, over a NOR flash in RAM with the Pico's
+//!   geometry (4 KiB sectors, bytes written one at a time), holding a
+//!   record of any layout version. (sequential-storage's own mock flash,
+//!   which the host tests use, sits behind its internal `_test` feature;
+//!   this tool keeps its own small one, [`RamFlash`].)
 
 use std::{
     future::Future,
+    path::Path,
     pin::pin,
     task::{Context, Poll, Waker},
 };
@@ -19,6 +24,24 @@ use idle_head_core::settings::{RawRecord, SettingsStore};
 
 /// The Pico's flash: erase sector and write unit.
 const SECTOR: usize = 4096;
+
+/// The version 1 fixture, in the repository at this path.
+pub const VERSION_1_SECTORS: &str = "host-tests/fixtures/settings-v1-sectors.bin";
+
+/// The settings sectors of the version 1 fixture (`len` bytes, the Pico's
+/// settings region).
+pub fn version_1_sectors(root: &Path, len: usize) -> Result<Vec<u8>> {
+    let path = root.join(VERSION_1_SECTORS);
+    let bytes = std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;
+    if bytes.len() != len {
+        bail!(
+            "{} holds {} bytes, not the {len} of the settings region",
+            path.display(),
+            bytes.len()
+        );
+    }
+    Ok(bytes)
+}
 
 /// `len` bytes of settings sectors (whole sectors) holding one record of
 /// layout version `V` (its payload: `payload`), as the store writes it.

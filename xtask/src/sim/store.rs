@@ -7,15 +7,19 @@
 //! datasheet's **worst** time (W25Q16JV: 400 ms a 4 KiB sector, 3 ms a
 //! 256-byte page), during which the firmware keeps its interrupts off.
 //!
-//! It runs twice, from two starts of the settings sectors:
+//! It runs three times, from three starts of the settings sectors:
 //!
 //! - full of noise, as another firmware may leave them: no settings of this
 //!   one there, so the boot log says the head starts on the built-in
 //!   settings (`settings: defaults (empty store …)`);
-//! - holding a record of an older layout (version 0, written by the core's
-//!   own store on the host, `planted.rs`), as an earlier firmware would
-//!   leave it: the boot log warns (`… holds settings of version 0, not 1`)
-//!   and the head starts on the built-in settings.
+//! - holding a record this firmware cannot read (layout version 0, written
+//!   by the core's own store on the host, `planted.rs`), as a foreign or
+//!   damaged store would: the boot log **warns** (`… holds settings of
+//!   version 0, not 2`) and the head starts on the built-in settings;
+//! - holding the settings a firmware of layout version 1 saved (the
+//!   fixture `host-tests/fixtures/settings-v1-sectors.bin`): the boot log
+//!   says they were loaded and migrated, and the first frame's neutral
+//!   pulses are the saved ones (1520 1480 1510 µs), before any command.
 //!
 //! Then, in each run:
 //!
@@ -24,10 +28,12 @@
 //!   no watchdog reset while the flash is busy with the interrupts off
 //!   (400 ms a sector), and `status` says `settings=flash`.
 //! - At 5 s the power goes off and on. The next boot logs the settings
-//!   loaded from flash and its first frame's neutral pulses, 1520 1500
-//!   1500 µs; its first pitch pulse is 1520 µs on the pin. At 2.5 s into
-//!   it, over UART0, `servo pitch neutral 1540` and then `load` bring the
-//!   saved 1520 back from flash: `servo pitch` and `status` say so.
+//!   loaded from flash and its first frame's neutral pulses: 1520 on pitch,
+//!   roll and yaw as the run started (the version 1 record's survive its
+//!   save in today's layout); its first pulses on the pins are the same.
+//!   At 2.5 s into it, over UART0, `servo pitch neutral 1540` and then
+//!   `load` bring the saved 1520 back from flash: `servo pitch` and
+//!   `status` say so.
 //! - The console image's RAM, static plus the peak stack of the run, is
 //!   within the budget.
 
@@ -73,36 +79,62 @@ const REPLIES: [&[(&str, &str)]; 2] = [
         ("ok mode=", " settings=flash"),
     ],
 ];
-/// The first pulses of the second boot: the saved neutral on pitch.
-const FIRST_US: [u32; 3] = [1520, 1500, 1500];
+/// The neutral pulse the script saves on pitch.
+const SAVED_PITCH_US: u32 = 1520;
 
-/// The two starts: a name, the bytes of the settings sectors and what the
-/// first boot must log about them.
-fn starts(len: usize) -> Result<[(&'static str, Vec<u8>, &'static str); 2]> {
+/// A start of the settings sectors.
+struct Start {
+    /// What they hold.
+    what: &'static str,
+    /// Their bytes.
+    sectors: Vec<u8>,
+    /// What the first boot must log about them: a level and a text.
+    logged: &'static [(&'static str, &'static str)],
+    /// The neutral pulses from power-on, µs.
+    neutral: [u32; 3],
+}
+
+/// The three starts (see the module docs).
+fn starts(root: &Path, len: usize) -> Result<[Start; 3]> {
     Ok([
-        (
-            "foreign data",
-            noise(len),
-            "settings: defaults (empty store",
-        ),
-        (
-            "an older record",
-            planted::store_of_version::<0>(b"an earlier layout", len)?,
-            "holds settings of version 0, not 1",
-        ),
+        Start {
+            what: "foreign data",
+            sectors: noise(len),
+            logged: &[("INFO", "settings: defaults (empty store")],
+            neutral: [1500; 3],
+        },
+        Start {
+            what: "a record this firmware cannot read",
+            sectors: planted::store_of_version::<0>(b"an unknown layout", len)?,
+            logged: &[(
+                "WARN",
+                "settings: defaults; the store at 0x101fc000 holds settings of version 0, not 2",
+            )],
+            neutral: [1500; 3],
+        },
+        Start {
+            what: "a record of layout version 1",
+            sectors: planted::version_1_sectors(root, len)?,
+            logged: &[
+                ("INFO", "settings: loaded from flash (version 1)"),
+                ("INFO", "settings: migrated from version 1 to 2"),
+            ],
+            neutral: [1520, 1480, 1510],
+        },
     ])
 }
 
-/// Runs the scenario from both starts and checks it (see the module docs).
+/// Runs the scenario from every start and checks it (see the module docs).
 pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
     let elf_path = shipped_image(root, metadata)?;
     let settings = elf::Image::read(&elf_path)?
         .settings
         .context("the console image has no settings region")?;
     let mut problems = Vec::new();
-    for (what, bytes, logged) in starts(usize::try_from(settings.end - settings.start)?)? {
-        println!("settings sectors holding {what}:");
-        let found = run_from(root, &elf_path, settings.start, bytes, logged)?;
+    for start in starts(root, usize::try_from(settings.end - settings.start)?)? {
+        println!("settings sectors holding {}:", start.what);
+        let what = start.what;
+        let found = run_from(root, &elf_path, settings.start, start)?;
         problems.extend(found.into_iter().map(|p| format!("from {what}: {p}")));
     }
     if problems.is_empty() {
@@ -112,18 +144,18 @@ pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
     }
 }
 
-/// One run with the settings sectors at `at` holding `bytes`; the first
-/// boot must log `logged`. Returns the problems found.
-fn run_from(
-    root: &Path,
-    elf_path: &Path,
-    at: u64,
-    bytes: Vec<u8>,
-    logged: &str,
-) -> Result<Vec<String>> {
+/// One run with the settings sectors at `at` as `start` has them. Returns
+/// the problems found.
+fn run_from(root: &Path, elf_path: &Path, at: u64, start: Start) -> Result<Vec<String>> {
+    let Start {
+        sectors,
+        logged,
+        neutral,
+        ..
+    } = start;
     let report = run::run_with(root, elf_path, TIME, WALL, |config| {
         config.rom = Some(WORST);
-        config.flash_fill = Some((at, bytes));
+        config.flash_fill = Some((at, sectors));
         config.power_cycles = vec![POWER_CYCLE];
         config.uart = (0..2)
             .map(|boot| UartScript::new(boot, SCRIPTS[boot].to_vec(), SCRIPT_AT[boot]))
@@ -131,15 +163,16 @@ fn run_from(
     })?;
     print!("{}", report.log_text(false));
     let mut problems = report.problems.clone();
-    let (text, found) = check(&report, logged);
+    let (text, found) = check(&report, logged, neutral);
     print!("{text}");
     problems.extend(found);
     problems.extend(console_ram(elf_path, &report)?);
     Ok(problems)
 }
 
-/// The checks of the module docs: a transcript and the problems found.
-fn check(report: &Report, logged: &str) -> (String, Vec<String>) {
+/// The checks of the module docs, for a start whose first boot logs
+/// `logged` and runs on `neutral`: a transcript and the problems found.
+fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String, Vec<String>) {
     let mut text = String::new();
     let mut problems = Vec::new();
     if report.boots.len() != 2 {
@@ -177,8 +210,15 @@ fn check(report: &Report, logged: &str) -> (String, Vec<String>) {
             ));
         }
     }
-    if !says(first, logged) {
-        problems.push(format!("boot 0 did not log `{logged}`"));
+    for (level, line) in logged {
+        if !says_at(first, level, line) {
+            problems.push(format!("boot 0 did not log `{level} {line}`"));
+        }
+    }
+    let [pitch, roll, yaw] = neutral;
+    let first_neutral = format!("first frame: neutral pulses {pitch} {roll} {yaw} us");
+    if !says(first, &first_neutral) {
+        problems.push(format!("boot 0 did not log `{first_neutral}`"));
     }
     text.push_str(&flash_summary(&first.flash));
     if !first.flash.iter().any(|op| !op.erase) {
@@ -192,14 +232,18 @@ fn check(report: &Report, logged: &str) -> (String, Vec<String>) {
     if !says(second, "settings: loaded from flash") {
         problems.push("boot 1 did not log the settings loaded from flash".to_owned());
     }
-    if !says(second, "first frame: neutral pulses 1520 1500 1500 us") {
-        problems.push("boot 1 did not log the saved neutral pulses for its first frame".to_owned());
+    let saved = [SAVED_PITCH_US, roll, yaw];
+    let second_neutral = format!("first frame: neutral pulses {SAVED_PITCH_US} {roll} {yaw} us");
+    if !says(second, &second_neutral) {
+        problems.push(format!(
+            "boot 1 did not log the saved neutral pulses for its first frame (`{second_neutral}`)"
+        ));
     }
     let first_us = first_pulses(second);
     let _ = writeln!(text, "boot 1: first pulses {first_us:?} us");
-    if first_us != FIRST_US.map(Some) {
+    if first_us != saved.map(Some) {
         problems.push(format!(
-            "boot 1's first pulses are {first_us:?} us, not {FIRST_US:?} (the saved neutral on pitch)"
+            "boot 1's first pulses are {first_us:?} us, not {saved:?} (the saved neutral pulses)"
         ));
     }
     (text, problems)
@@ -207,6 +251,13 @@ fn check(report: &Report, logged: &str) -> (String, Vec<String>) {
 
 fn says(boot: &Boot, text: &str) -> bool {
     boot.log.iter().any(|(_, line)| line.message.contains(text))
+}
+
+/// Whether `boot` logged `text` at `level`.
+fn says_at(boot: &Boot, level: &str, text: &str) -> bool {
+    boot.log
+        .iter()
+        .any(|(_, line)| line.level.as_deref() == Some(level) && line.message.contains(text))
 }
 
 /// Erases and programs, summed.
@@ -265,7 +316,8 @@ mod tests {
     use super::*;
     use crate::log::LogLine;
 
-    const LOGGED: &str = "settings: defaults (empty store";
+    const LOGGED: &[(&str, &str)] = &[("INFO", "settings: defaults (empty store")];
+    const NEUTRAL: [u32; 3] = [1500; 3];
 
     /// Breaks a good report one way.
     type Breaker = fn(&mut Report);
@@ -287,7 +339,10 @@ mod tests {
             boot
         };
         let mut first = boot(
-            &["settings: defaults (empty store at 0x101fc000)"],
+            &[
+                "settings: defaults (empty store at 0x101fc000)",
+                "first frame: neutral pulses 1500 1500 1500 us; watchdog armed (100 ms)",
+            ],
             "ok\r\nok\r\nok mode=running settings=flash\r\n",
             [1500.0; 3],
         );
@@ -301,7 +356,7 @@ mod tests {
         }];
         let second = boot(
             &[
-                "settings: loaded from flash (version 1) at 0x101fc000",
+                "settings: loaded from flash (version 2) at 0x101fc000",
                 "first frame: neutral pulses 1520 1500 1500 us; watchdog armed (100 ms)",
             ],
             "ok\r\nok\r\nok pitch neutral=1520 per-degree=11111\r\nok mode=running settings=flash\r\n",
@@ -315,10 +370,10 @@ mod tests {
 
     #[test]
     fn a_good_run_passes_and_each_failure_is_named() {
-        let (_, problems) = check(&good(), LOGGED);
+        let (_, problems) = check(&good(), LOGGED, NEUTRAL);
         assert!(problems.is_empty(), "{problems:?}");
 
-        let failing: [(&str, Breaker); 6] = [
+        let failing: [(&str, Breaker); 8] = [
             ("the watchdog reset the board", |r| {
                 r.boots[0].watchdog = true;
             }),
@@ -341,21 +396,43 @@ mod tests {
             ("boots instead of two", |r| {
                 r.boots.pop();
             }),
+            ("boot 0 did not log `INFO settings: defaults", |r| {
+                r.boots[0].log[0].1.level = Some("WARN".to_owned());
+            }),
+            (
+                "boot 0 did not log `first frame: neutral pulses 1500 1500 1500 us`",
+                |r| {
+                    r.boots[0].log.pop();
+                },
+            ),
         ];
         for (want, break_it) in failing {
             let mut report = good();
             break_it(&mut report);
-            let (_, problems) = check(&report, LOGGED);
+            let (_, problems) = check(&report, LOGGED, NEUTRAL);
             assert!(
                 problems.iter().any(|p| p.contains(want)),
                 "`{want}` not among {problems:?}"
             );
         }
-        let (_, problems) = check(&good(), "holds settings of version 0");
+        let (_, problems) = check(&good(), &[("WARN", "holds settings of version 0")], NEUTRAL);
         assert!(
             problems
                 .iter()
-                .any(|p| p.contains("did not log `holds settings"))
+                .any(|p| p.contains("did not log `WARN holds settings"))
+        );
+        // Another start's neutral pulses: both boots are checked against them.
+        let (_, problems) = check(&good(), LOGGED, [1520, 1480, 1510]);
+        assert!(
+            problems
+                .iter()
+                .any(|p| p.contains("boot 0 did not log `first frame: neutral pulses 1520 1480"))
+        );
+        assert!(
+            problems
+                .iter()
+                .any(|p| p
+                    .contains("boot 1's first pulses are [Some(1520), Some(1500), Some(1500)]"))
         );
     }
 }

@@ -12,7 +12,7 @@ use const_format::concatcp;
 use crate::axis::Axis;
 use crate::command::{GestureRequest, Hold};
 use crate::driver::{DriverParams, MotionLimits, SlewRates, slew_rates};
-use crate::gestures::GestureKind;
+use crate::gestures::{GestureKind, MAX_CYCLES};
 use crate::units::{Angle, AngleRange, Percent};
 
 use super::config::{BehaviourConfig, MAX_HOLD};
@@ -198,7 +198,11 @@ impl BehaviourConfig {
         while k < GestureKind::COUNT {
             let row = GestureKind::ALL[k].row();
             let d = self.defaults(row.kind);
-            check_defaults!(row.fields, d, row.max_cycles, self.max_frequency);
+            // The default count may be anything a gesture could have
+            // (1..=MAX_CYCLES), as settings saved by earlier firmware hold:
+            // a request without cycles plays at most the gesture's own
+            // `max_cycles` (a posture: its one), see `gesture::plan`.
+            check_defaults!(row.fields, d, MAX_CYCLES, self.max_frequency);
             let mut request = GestureRequest::new(row.kind);
             request.intensity = Some(Percent::FULL);
             if let Err(e) = gesture::plan(&params, &request) {

@@ -10,12 +10,12 @@
 //! use idle_head_core::behaviour::CommandQueue;
 //! use idle_head_core::console::{ConsoleLink, ConsoleService, Session};
 //! use idle_head_core::driver::DriverConfig;
-//! use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
+//! use idle_head_core::settings::{RamStorage, SETTINGS_BUFFER, Settings, SettingsSource};
 //!
 //! static QUEUE: CommandQueue = CommandQueue::new();
 //! static LINK: ConsoleLink = ConsoleLink::new();
 //! let mut service = ConsoleService::new(
-//!     &QUEUE, &LINK, RamStorage::<256>::new(), DriverConfig::DEFAULT,
+//!     &QUEUE, &LINK, RamStorage::<SETTINGS_BUFFER>::new(), DriverConfig::DEFAULT,
 //!     Settings::DEFAULT, SettingsSource::Defaults,
 //! ).unwrap();
 //! let mut session = Session::<96, 160>::new();

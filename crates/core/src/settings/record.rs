@@ -1,18 +1,28 @@
 //! The record trait: a settings type, its bytes and its layout version.
 
-/// A settings record as stored in flash.
+use super::report::{FieldReport, Loaded};
+use super::store::LoadError;
+
+/// Bytes of the version in front of a stored record.
+pub(super) const VERSION_LEN: usize = 2;
+
+/// A settings record as stored: its bytes and the version of their layout.
 ///
 /// The store writes [`VERSION`](Self::VERSION) next to the bytes of
-/// [`encode`](Self::encode) and checks it before calling
-/// [`decode`](Self::decode), so `decode` only ever sees bytes written for
-/// its own version. Change the version whenever the encoding changes (a
-/// field added, removed, reordered or retyped): a record of another
-/// version loads as [`LoadError::Older`](super::LoadError::Older) or
-/// [`LoadError::Newer`](super::LoadError::Newer), and the firmware falls
-/// back to its defaults.
+/// [`encode`](Self::encode), and hands both to [`decode`](Self::decode) on
+/// a load. A record of a newer version than `VERSION` is refused before
+/// `decode` sees it ([`LoadError::Newer`](super::LoadError::Newer)); an
+/// older one is `decode`'s to migrate, or to refuse with
+/// [`DecodeError::Version`] ([`LoadError::Older`](super::LoadError::Older)).
+/// The [`Settings`](super::Settings) record is a list of tagged fields
+/// whose layout does not change when a field is added (see the [module
+/// docs](super)).
 pub trait Record: Sized {
     /// The version of the layout [`encode`](Self::encode) writes.
     const VERSION: u16;
+
+    /// Why a record that reads well is refused (`()` if it never is).
+    type Invalid;
 
     /// Writes the record into `buf`, returning the length used.
     ///
@@ -20,13 +30,19 @@ pub trait Record: Sized {
     /// [`EncodeError::TooLong`] if `buf` is too small.
     fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError>;
 
-    /// Reads a record written by [`encode`](Self::encode) (with the same
-    /// version).
+    /// Reads a record stored with layout `version` (at most
+    /// [`VERSION`](Self::VERSION)), and notes in `fields` what it skipped
+    /// or left on its defaults.
     ///
     /// # Errors
-    /// [`DecodeError::Malformed`] for bytes that are not an encoding,
+    /// [`DecodeError::Malformed`] for bytes that are not a record of that
+    /// version, [`DecodeError::Version`] for a version it cannot read,
     /// [`DecodeError::Invalid`] for a record that fails validation.
-    fn decode(bytes: &[u8]) -> Result<Self, DecodeError>;
+    fn decode(
+        version: u16,
+        bytes: &[u8],
+        fields: &mut FieldReport,
+    ) -> Result<Self, DecodeError<Self::Invalid>>;
 }
 
 /// Why a record could not be written into a buffer.
@@ -39,15 +55,48 @@ pub enum EncodeError {
     Unsupported,
 }
 
-/// Why bytes are not a record.
+/// Why bytes are not a record; `I` says why a record is invalid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum DecodeError {
-    /// Not an encoding of the record (truncated, bytes left over, a value
-    /// its type cannot hold).
+pub enum DecodeError<I> {
+    /// Not an encoding of the record (truncated, bytes left over, a field
+    /// twice).
     Malformed,
-    /// A well-formed record that fails validation.
-    Invalid,
+    /// A layout version this record cannot read.
+    Version,
+    /// A well-formed record that fails validation, and why.
+    Invalid(I),
+}
+
+/// The record stored as `stored` (the version, little-endian, then the
+/// record's bytes), as the flash store and [`RamStorage`] keep it.
+///
+/// [`RamStorage`]: super::RamStorage
+///
+/// # Errors
+/// A [`LoadError`] saying why it cannot be used (never `Empty`, `TooLong`
+/// or `Flash`).
+pub(super) fn open_record<R: Record, E>(
+    stored: &[u8],
+) -> Result<Loaded<R>, LoadError<E, R::Invalid>> {
+    let Some((version, bytes)) = stored.split_first_chunk::<VERSION_LEN>() else {
+        return Err(LoadError::Corrupt);
+    };
+    let version = u16::from_le_bytes(*version);
+    if version > R::VERSION {
+        return Err(LoadError::Newer { found: version });
+    }
+    let mut fields = FieldReport::default();
+    match R::decode(version, bytes, &mut fields) {
+        Ok(record) => Ok(Loaded {
+            record,
+            version,
+            fields,
+        }),
+        Err(DecodeError::Malformed) => Err(LoadError::Corrupt),
+        Err(DecodeError::Version) => Err(LoadError::Older { found: version }),
+        Err(DecodeError::Invalid(why)) => Err(LoadError::Invalid(why)),
+    }
 }
 
 /// A record of layout version `V` kept as its bytes, at most `N`: for tools
@@ -66,6 +115,7 @@ impl<const V: u16, const N: usize> RawRecord<V, N> {
 
 impl<const V: u16, const N: usize> Record for RawRecord<V, N> {
     const VERSION: u16 = V;
+    type Invalid = ();
 
     fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
         let out = buf.get_mut(..self.0.len()).ok_or(EncodeError::TooLong)?;
@@ -73,7 +123,11 @@ impl<const V: u16, const N: usize> Record for RawRecord<V, N> {
         Ok(self.0.len())
     }
 
-    fn decode(bytes: &[u8]) -> Result<Self, DecodeError> {
+    /// The bytes of a record of version `V`, as they are.
+    fn decode(version: u16, bytes: &[u8], _: &mut FieldReport) -> Result<Self, DecodeError<()>> {
+        if version != V {
+            return Err(DecodeError::Version);
+        }
         Self::new(bytes).ok_or(DecodeError::Malformed)
     }
 }
@@ -101,7 +155,9 @@ pub fn encode_postcard<T: serde::Serialize>(
 /// # Errors
 /// [`DecodeError::Malformed`] if the bytes are not exactly one value.
 #[cfg(feature = "postcard")]
-pub fn decode_postcard<T: serde::de::DeserializeOwned>(bytes: &[u8]) -> Result<T, DecodeError> {
+pub fn decode_postcard<T: serde::de::DeserializeOwned, I>(
+    bytes: &[u8],
+) -> Result<T, DecodeError<I>> {
     match postcard::take_from_bytes(bytes) {
         Ok((value, [])) => Ok(value),
         _ => Err(DecodeError::Malformed),

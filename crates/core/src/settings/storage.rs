@@ -4,9 +4,10 @@
 
 use crate::text::{Describe, Text, display_from_describe};
 
-use super::record::{DecodeError, Record};
+use super::record::{Record, VERSION_LEN, open_record};
 use super::store::{LoadError, SaveError};
-use super::values::Settings;
+use super::values::{Settings, SettingsError};
+use super::{SETTINGS_BUFFER, SETTINGS_LEN};
 
 /// Why `save` or `load` failed: the board-neutral form of the store's
 /// errors, for the console's `err storage` reply.
@@ -17,7 +18,7 @@ pub enum StorageError {
     Empty,
     /// The stored bytes are damaged or not a record.
     Corrupt,
-    /// A record of an older layout version.
+    /// A record of an older layout version that cannot be migrated.
     Older {
         /// Its version.
         found: u16,
@@ -27,9 +28,10 @@ pub enum StorageError {
         /// Its version.
         found: u16,
     },
-    /// A record that fails validation.
-    Invalid,
-    /// The record does not fit the store.
+    /// A record that fails validation, and why.
+    Invalid(SettingsError),
+    /// The record does not fit the store (or a stored one does not fit the
+    /// buffer that reads it).
     TooLong,
     /// The flash (or whatever holds the record) failed.
     Device,
@@ -46,7 +48,7 @@ impl Describe for StorageError {
             Self::Newer { found } => out
                 .str("stored settings are of newer version ")
                 .u64(found.into()),
-            Self::Invalid => out.str("stored settings fail validation"),
+            Self::Invalid(e) => out.str("stored settings fail validation: ").with(&e),
             Self::TooLong => out.str("settings do not fit the store"),
             Self::Device => out.str("the flash failed"),
         };
@@ -55,14 +57,15 @@ impl Describe for StorageError {
 
 display_from_describe!(StorageError);
 
-impl<E> From<LoadError<E>> for StorageError {
-    fn from(e: LoadError<E>) -> Self {
+impl<E> From<LoadError<E, SettingsError>> for StorageError {
+    fn from(e: LoadError<E, SettingsError>) -> Self {
         match e {
             LoadError::Empty => Self::Empty,
             LoadError::Corrupt => Self::Corrupt,
             LoadError::Older { found } => Self::Older { found },
             LoadError::Newer { found } => Self::Newer { found },
-            LoadError::Invalid => Self::Invalid,
+            LoadError::TooLong { .. } => Self::TooLong,
+            LoadError::Invalid(e) => Self::Invalid(e),
             LoadError::Flash(_) => Self::Device,
         }
     }
@@ -92,7 +95,8 @@ pub trait SettingsStorage {
     /// Why nothing new was stored.
     fn save(&mut self, settings: &Settings) -> Result<(), StorageError>;
 
-    /// The settings stored last.
+    /// The settings stored last (migrated from an older layout if need
+    /// be; fields the record lacks on their defaults).
     ///
     /// # Errors
     /// Why none could be loaded (the caller keeps its settings).
@@ -100,9 +104,10 @@ pub trait SettingsStorage {
 }
 
 /// One record kept in RAM as the flash store keeps it (version, then the
-/// record's bytes), `N` bytes at most: lost at reset.
+/// record's bytes), `N` bytes at most (by default as many as the flash
+/// store's buffer holds): lost at reset.
 #[derive(Clone, Debug)]
-pub struct RamStorage<const N: usize = 256> {
+pub struct RamStorage<const N: usize = SETTINGS_BUFFER> {
     bytes: [u8; N],
     /// Bytes used (0: nothing saved).
     len: usize,
@@ -146,34 +151,29 @@ impl<const N: usize> Default for RamStorage<N> {
 }
 
 impl<const N: usize> SettingsStorage for RamStorage<N> {
+    /// Refuses with [`StorageError::TooLong`], keeping the stored record,
+    /// if `N` is less than a record's longest ([`SETTINGS_LEN`] and the
+    /// version).
     fn save(&mut self, settings: &Settings) -> Result<(), StorageError> {
+        if N < VERSION_LEN + SETTINGS_LEN {
+            return Err(StorageError::TooLong);
+        }
         let (version, body) = self
             .bytes
-            .split_at_mut_checked(2)
+            .split_at_mut_checked(VERSION_LEN)
             .ok_or(StorageError::TooLong)?;
         let used = settings.encode(body).map_err(|_| StorageError::TooLong)?;
         version.copy_from_slice(&Settings::VERSION.to_le_bytes());
-        self.len = 2 + used;
+        self.len = VERSION_LEN + used;
         Ok(())
     }
 
     fn load(&mut self) -> Result<Settings, StorageError> {
-        let raw = self.raw();
-        let Some((version, body)) = raw.split_first_chunk::<2>() else {
-            return Err(if raw.is_empty() {
-                StorageError::Empty
-            } else {
-                StorageError::Corrupt
-            });
-        };
-        let found = u16::from_le_bytes(*version);
-        match found.cmp(&Settings::VERSION) {
-            core::cmp::Ordering::Less => Err(StorageError::Older { found }),
-            core::cmp::Ordering::Greater => Err(StorageError::Newer { found }),
-            core::cmp::Ordering::Equal => Settings::decode(body).map_err(|e| match e {
-                DecodeError::Malformed => StorageError::Corrupt,
-                DecodeError::Invalid => StorageError::Invalid,
-            }),
+        match self.raw() {
+            [] => Err(StorageError::Empty),
+            stored => open_record::<Settings, ()>(stored)
+                .map(|loaded| loaded.record)
+                .map_err(StorageError::from),
         }
     }
 }

@@ -1,7 +1,8 @@
 //! One record in a range of NOR flash, kept by `sequential-storage`.
 //!
 //! The record is the map's only item (key 0). Its value is the layout
-//! version as a little-endian `u16`, then the record's own bytes.
+//! version as a little-endian `u16`, then the record's own bytes (see the
+//! [module docs](super) for the layout of the settings).
 
 use core::cell::Cell;
 use core::marker::PhantomData;
@@ -13,12 +14,11 @@ use sequential_storage::Error;
 use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapConfigError, MapStorage, SerializationError, Value};
 
-use super::record::{DecodeError, EncodeError, Record};
+use super::record::{EncodeError, Record, VERSION_LEN, open_record};
+use super::report::Loaded;
 
 /// The map key of the record.
 const KEY: u8 = 0;
-/// Bytes of the version in front of the record.
-const VERSION_LEN: usize = 2;
 /// Bytes of [`KEY`] as the map stores it.
 const KEY_LEN: usize = core::mem::size_of::<u8>();
 
@@ -30,16 +30,17 @@ pub const fn buffer_len(record_len: usize) -> usize {
     (KEY_LEN + VERSION_LEN + record_len).next_multiple_of(4)
 }
 
-/// Why no record was loaded.
+/// Why no record was loaded: `E` is the flash driver's error, `I` why a
+/// record is invalid ([`Record::Invalid`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum LoadError<E> {
+pub enum LoadError<E, I> {
     /// Nothing was ever saved (or the range was erased).
     Empty,
     /// The stored bytes are damaged beyond what the store repairs, or do
     /// not decode as the record.
     Corrupt,
-    /// A record saved by firmware with an older layout.
+    /// A record of an older layout that this firmware cannot migrate.
     Older {
         /// Its version.
         found: u16,
@@ -49,8 +50,14 @@ pub enum LoadError<E> {
         /// Its version.
         found: u16,
     },
-    /// A record that decodes but fails validation.
-    Invalid,
+    /// A stored item longer than the work buffer: a record saved by a
+    /// firmware with more fields than this one can read at once.
+    TooLong {
+        /// The buffer it needs, in bytes.
+        needs: usize,
+    },
+    /// A record that decodes but fails validation, and why.
+    Invalid(I),
     /// The flash driver failed.
     Flash(E),
 }
@@ -96,7 +103,7 @@ impl<F: NorFlash, R: Record, const BUF: usize> SettingsStore<F, R, BUF> {
     /// A [`MapConfigError`] if the range is not page-aligned or holds fewer
     /// than two pages.
     pub fn new(flash: F, range: Range<u32>) -> Result<Self, MapConfigError> {
-        const { assert!(BUF > VERSION_LEN, "the work buffer is too small") };
+        const { assert!(BUF > KEY_LEN + VERSION_LEN, "the work buffer is too small") };
         let config = MapConfig::try_new(range)?;
         Ok(Self {
             map: MapStorage::new(flash, config, Cache::new_uncached()),
@@ -105,41 +112,29 @@ impl<F: NorFlash, R: Record, const BUF: usize> SettingsStore<F, R, BUF> {
         })
     }
 
-    /// The newest record saved.
+    /// The newest record saved (migrated if it is of an older layout),
+    /// with the fields the load skipped or left on their defaults.
     ///
     /// # Errors
     /// A [`LoadError`] saying why there is none to use.
-    pub async fn load(&mut self) -> Result<R, LoadError<F::Error>> {
-        let bytes = match self.map.fetch_item::<&[u8]>(&mut self.buf.0, &KEY).await {
-            Ok(Some(bytes)) => bytes,
-            Ok(None) => return Err(LoadError::Empty),
-            Err(Error::Storage { value, .. }) => return Err(LoadError::Flash(value)),
-            // Damage the map could not repair, or an item larger than any
-            // this firmware writes.
-            Err(_) => return Err(LoadError::Corrupt),
-        };
-        let Some(([lo, hi], payload)) = bytes.split_first_chunk::<VERSION_LEN>() else {
-            return Err(LoadError::Corrupt);
-        };
-        let found = u16::from_le_bytes([*lo, *hi]);
-        if found < R::VERSION {
-            return Err(LoadError::Older { found });
+    pub async fn load(&mut self) -> Result<Loaded<R>, LoadError<F::Error, R::Invalid>> {
+        match self.map.fetch_item::<&[u8]>(&mut self.buf.0, &KEY).await {
+            Ok(Some(stored)) => open_record(stored),
+            Ok(None) => Err(LoadError::Empty),
+            Err(Error::Storage { value, .. }) => Err(LoadError::Flash(value)),
+            Err(Error::BufferTooSmall(needs)) => Err(LoadError::TooLong { needs }),
+            // Damage the map could not repair.
+            Err(_) => Err(LoadError::Corrupt),
         }
-        if found > R::VERSION {
-            return Err(LoadError::Newer { found });
-        }
-        R::decode(payload).map_err(|e| match e {
-            DecodeError::Malformed => LoadError::Corrupt,
-            DecodeError::Invalid => LoadError::Invalid,
-        })
     }
 
     /// Saves `record` as the newest, and reads it back.
     ///
     /// A record that does not read back (written over damaged flash) is
     /// written once more, after the damaged spot. If that fails too, or the
-    /// store is damaged beyond what `sequential-storage` repairs, the range
-    /// is erased and the record written afresh.
+    /// store is damaged beyond what `sequential-storage` repairs, or it
+    /// holds an item too long for the work buffer (a newer firmware's
+    /// record), the range is erased and the record written afresh.
     ///
     /// # Errors
     /// A [`SaveError`]; the stored record is then unchanged, or after a
@@ -153,7 +148,7 @@ impl<F: NorFlash, R: Record, const BUF: usize> SettingsStore<F, R, BUF> {
             match self.map.store_item(&mut self.buf.0, &KEY, &value).await {
                 Ok(()) if self.reads_back(&value).await? => return Ok(()),
                 Ok(()) => {}
-                Err(Error::Corrupted { .. }) => break,
+                Err(Error::Corrupted { .. } | Error::BufferTooSmall(_)) => break,
                 Err(e) => return Err(save_error(e)),
             }
         }
@@ -173,7 +168,7 @@ impl<F: NorFlash, R: Record, const BUF: usize> SettingsStore<F, R, BUF> {
     async fn reads_back(&mut self, value: &Versioned<'_, R>) -> Result<bool, SaveError<F::Error>> {
         match self.map.fetch_item::<&[u8]>(&mut self.buf.0, &KEY).await {
             Ok(Some(bytes)) => Ok(value.crc.get() == Some(CRC32.checksum(bytes))),
-            Ok(None) | Err(Error::Corrupted { .. }) => Ok(false),
+            Ok(None) | Err(Error::Corrupted { .. } | Error::BufferTooSmall(_)) => Ok(false),
             Err(e) => Err(save_error(e)),
         }
     }

@@ -1,0 +1,651 @@
+//! The fields of the [`Settings`] record: one row per field, its id, its
+//! name and where its value lives (see the [module docs](super) for the
+//! record's layout and how to add a field).
+
+use crate::driver::DriverConfig;
+use crate::gestures::{GestureKind, SETTINGS_IDS};
+
+use super::record::{DecodeError, EncodeError, Record};
+use super::report::{FieldReport, FieldSet};
+use super::tlv::{Entries, Entry, FieldValue, HEADER, Truncated, Writer};
+use super::v1;
+use super::values::{Settings, SettingsError};
+
+/// A field of the record, as the table lists it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Field {
+    /// Its id in the record: never reused, never renumbered.
+    pub id: u8,
+    /// Its name (`servo.pitch.neutral`), for tools and tests.
+    pub name: &'static str,
+    /// Most bytes its value takes.
+    pub max_len: usize,
+}
+
+/// A structure kept as tagged fields: what the record's encoder and
+/// decoder need from a table of fields. The table below implements it for
+/// [`Settings`]; a test implements it for a layout with one field more.
+pub(super) trait Fields: Sized {
+    /// The ids of the table.
+    const KNOWN: FieldSet;
+    /// The values a field missing from a record takes.
+    const DEFAULT: Self;
+
+    /// Writes every field.
+    fn write(&self, w: &mut Writer<'_>);
+
+    /// Reads field `id` from its bytes: `Some(true)` if it holds them now,
+    /// `Some(false)` if they are not a value of its type (the field is left
+    /// as it was), `None` if the table has no field `id`.
+    fn read(&mut self, id: u8, bytes: &[u8]) -> Option<bool>;
+}
+
+/// Sets `place` to the value `bytes` hold; `false` (and `place` as it
+/// was) if they hold none.
+pub(super) fn read_into<T: FieldValue>(place: &mut T, bytes: &[u8]) -> bool {
+    match T::from_bytes(bytes) {
+        Some(value) => {
+            *place = value;
+            true
+        }
+        None => false,
+    }
+}
+
+/// The longest value of `T` (for [`SETTINGS_LEN`], at compile time).
+const fn max_len<T: FieldValue>(_: &T) -> usize {
+    T::MAX_LEN
+}
+
+/// Whether no id is listed twice.
+const fn unique(ids: &[u8]) -> bool {
+    let mut i = 0;
+    while i < ids.len() {
+        let mut j = i + 1;
+        while j < ids.len() {
+            if ids[i] == ids[j] {
+                return false;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    true
+}
+
+/// The ids of every gesture's block (see [`GestureKind::row`]'s
+/// `settings`): `SETTINGS_IDS` ids each.
+const fn gesture_ids() -> [u8; GESTURE_FIELDS] {
+    let mut ids = [0; GESTURE_FIELDS];
+    let mut i = 0;
+    while i < GESTURE_FIELDS {
+        let kind = GestureKind::ALL[i / SETTINGS_IDS as usize];
+        ids[i] = kind.row().settings + (i % SETTINGS_IDS as usize) as u8;
+        i += 1;
+    }
+    ids
+}
+
+/// The settings fields of the gestures' defaults: [`SETTINGS_IDS`] a
+/// gesture.
+const GESTURE_FIELDS: usize = GestureKind::COUNT * SETTINGS_IDS as usize;
+
+/// The gesture field `id`, as the gesture and the place in its block.
+const fn gesture_field(id: u8) -> Option<(GestureKind, u8)> {
+    let mut k = 0;
+    while k < GestureKind::COUNT {
+        let kind = GestureKind::ALL[k];
+        let first = kind.row().settings;
+        if id >= first && id - first < SETTINGS_IDS {
+            return Some((kind, id - first));
+        }
+        k += 1;
+    }
+    None
+}
+
+/// The most bytes a gesture's block takes, headers included.
+const GESTURE_BLOCK_LEN: usize = {
+    let d = &GestureKind::DEFAULTS[0];
+    5 * HEADER
+        + max_len(&d.amplitude)
+        + max_len(&d.cycles)
+        + max_len(&d.slow)
+        + max_len(&d.brisk)
+        + max_len(&d.intensity)
+};
+
+/// The table: `id "name" => s.place;` per field, in the order they are
+/// written, then every gesture's block. It makes [`FIELDS`],
+/// [`SETTINGS_LEN`] and the [`Fields`] implementation of [`Settings`],
+/// and checks that no id is used twice.
+macro_rules! fields {
+    ($s:ident; $($id:literal $name:literal => $place:expr;)+) => {
+        /// The fields of the table's rows (the gestures' blocks follow).
+        const ROWS: usize = [$($id),+].len();
+
+        /// Every field of the [`Settings`] record, in the order a save writes
+        /// them.
+        pub const FIELDS: &[Field] = &{
+            let $s = &Settings::DEFAULT;
+            let rows = [$(Field { id: $id, name: $name, max_len: max_len(&$place) }),+];
+            let d = &GestureKind::DEFAULTS[0];
+            let lens = [
+                max_len(&d.amplitude),
+                max_len(&d.cycles),
+                max_len(&d.slow),
+                max_len(&d.brisk),
+                max_len(&d.intensity),
+            ];
+            let ids = gesture_ids();
+            let mut all = [rows[0]; ROWS + GESTURE_FIELDS];
+            let mut i = 0;
+            while i < ROWS + GESTURE_FIELDS {
+                all[i] = if i < ROWS {
+                    rows[i]
+                } else {
+                    let g = i - ROWS;
+                    let names = &GestureKind::ALL[g / SETTINGS_IDS as usize].row().fields;
+                    let place = g % SETTINGS_IDS as usize;
+                    let name = match place {
+                        0 => names.amplitude,
+                        1 => names.cycles,
+                        2 => names.slow,
+                        3 => names.brisk,
+                        _ => names.intensity,
+                    };
+                    Field { id: ids[g], name, max_len: lens[place] }
+                };
+                i += 1;
+            }
+            all
+        };
+
+        /// Most bytes a record of [`Settings`] takes: every field at its
+        /// longest, with its header.
+        pub const SETTINGS_LEN: usize = {
+            let $s = &Settings::DEFAULT;
+            0 $(+ HEADER + max_len(&$place))+ + GestureKind::COUNT * GESTURE_BLOCK_LEN
+        };
+
+        const _: () = {
+            let rows = [$($id),+];
+            let ids = gesture_ids();
+            let mut all = [0; ROWS + GESTURE_FIELDS];
+            let mut i = 0;
+            while i < ROWS + GESTURE_FIELDS {
+                all[i] = if i < ROWS { rows[i] } else { ids[i - ROWS] };
+                i += 1;
+            }
+            assert!(unique(&all), "two fields of the settings share an id");
+        };
+
+        impl Fields for Settings {
+            const KNOWN: FieldSet = FieldSet::of(&[$($id),+]).union(&FieldSet::of(&gesture_ids()));
+            const DEFAULT: Self = Settings::DEFAULT;
+
+            fn write(&self, w: &mut Writer<'_>) {
+                let $s = self;
+                $(w.field($id, &$place);)+
+                for kind in GestureKind::ALL {
+                    let first = kind.row().settings;
+                    let d = $s.behaviour.defaults(kind);
+                    w.field(first, &d.amplitude);
+                    w.field(first + 1, &d.cycles);
+                    w.field(first + 2, &d.slow);
+                    w.field(first + 3, &d.brisk);
+                    w.field(first + 4, &d.intensity);
+                }
+            }
+
+            fn read(&mut self, id: u8, bytes: &[u8]) -> Option<bool> {
+                let $s = self;
+                match id {
+                    $($id => Some(read_into(&mut $place, bytes)),)+
+                    _ => {
+                        let (kind, place) = gesture_field(id)?;
+                        let d = $s.behaviour.defaults_mut(kind);
+                        Some(match place {
+                            0 => read_into(&mut d.amplitude, bytes),
+                            1 => read_into(&mut d.cycles, bytes),
+                            2 => read_into(&mut d.slow, bytes),
+                            3 => read_into(&mut d.brisk, bytes),
+                            _ => read_into(&mut d.intensity, bytes),
+                        })
+                    }
+                }
+            }
+        }
+    };
+}
+
+// Ids 1 to 56 are the fields of layout version 1, in its order (`v1.rs`).
+// A new field takes the next free id (the first after them: 57), at the end;
+// a new gesture's block of five takes the next five free ids.
+fields! { s;
+    // The servos: pulses in µs, the scale in ns per degree, the direction,
+    // the angle limits in millidegrees.
+    1 "servo.pitch.neutral" => s.servos[0].neutral;
+    2 "servo.pitch.per_degree" => s.servos[0].per_degree;
+    3 "servo.pitch.direction" => s.servos[0].direction;
+    4 "servo.pitch.min" => s.servos[0].min_pulse;
+    5 "servo.pitch.max" => s.servos[0].max_pulse;
+    6 "servo.pitch.limit_min" => s.servos[0].limits.min;
+    7 "servo.pitch.limit_max" => s.servos[0].limits.max;
+    8 "servo.roll.neutral" => s.servos[1].neutral;
+    9 "servo.roll.per_degree" => s.servos[1].per_degree;
+    10 "servo.roll.direction" => s.servos[1].direction;
+    11 "servo.roll.min" => s.servos[1].min_pulse;
+    12 "servo.roll.max" => s.servos[1].max_pulse;
+    13 "servo.roll.limit_min" => s.servos[1].limits.min;
+    14 "servo.roll.limit_max" => s.servos[1].limits.max;
+    15 "servo.yaw.neutral" => s.servos[2].neutral;
+    16 "servo.yaw.per_degree" => s.servos[2].per_degree;
+    17 "servo.yaw.direction" => s.servos[2].direction;
+    18 "servo.yaw.min" => s.servos[2].min_pulse;
+    19 "servo.yaw.max" => s.servos[2].max_pulse;
+    20 "servo.yaw.limit_min" => s.servos[2].limits.min;
+    21 "servo.yaw.limit_max" => s.servos[2].limits.max;
+    // Ids 22 to 36: the gestures' defaults (nod, shake, tilt: their
+    // `settings` blocks in the gesture table), written after these rows:
+    // amplitude in millidegrees, cycles, slow and brisk frequencies in mHz,
+    // intensity in percent.
+    // Every gesture: highest frequency (mHz), longest gesture and blend (ms).
+    37 "gesture.max_frequency" => s.behaviour.max_frequency;
+    38 "gesture.longest" => s.behaviour.longest_gesture;
+    39 "gesture.blend" => s.behaviour.blend;
+    // Gaze moves (ms).
+    40 "gaze.base" => s.behaviour.gaze.base;
+    41 "gaze.per_degree" => s.behaviour.gaze.per_degree;
+    42 "gaze.hold" => s.behaviour.gaze.hold;
+    43 "gaze.longest" => s.behaviour.gaze.longest;
+    // The idle layer.
+    44 "idle.amplitude" => s.behaviour.idle.amplitude;
+    45 "idle.duck" => s.behaviour.idle.duck;
+    46 "idle.fade" => s.behaviour.idle.fade;
+    // The gesture mode's limits per axis: °/s and °/s².
+    47 "gesture_limits.pitch.speed" => s.behaviour.gesture_limits[0].max_speed;
+    48 "gesture_limits.pitch.accel" => s.behaviour.gesture_limits[0].max_accel;
+    49 "gesture_limits.roll.speed" => s.behaviour.gesture_limits[1].max_speed;
+    50 "gesture_limits.roll.accel" => s.behaviour.gesture_limits[1].max_accel;
+    51 "gesture_limits.yaw.speed" => s.behaviour.gesture_limits[2].max_speed;
+    52 "gesture_limits.yaw.accel" => s.behaviour.gesture_limits[2].max_accel;
+    53 "gesture.settle" => s.behaviour.settle;
+    // The idle motion's seeds.
+    54 "seed.pitch" => s.seeds[0];
+    55 "seed.roll" => s.seeds[1];
+    56 "seed.yaw" => s.seeds[2];
+}
+
+/// The field `id` of the table, if there is one.
+#[must_use]
+pub fn field(id: u8) -> Option<&'static Field> {
+    FIELDS.iter().find(|f| f.id == id)
+}
+
+/// Writes every field of `record` (the record's bytes).
+pub(super) fn encode_fields<T: Fields>(record: &T, buf: &mut [u8]) -> Result<usize, EncodeError> {
+    let mut w = Writer::new(buf);
+    record.write(&mut w);
+    w.finish()
+}
+
+/// A record of `T` from its entries, `(id, value)` in stored order: every
+/// field found takes its stored value, the rest keep their defaults, and
+/// `report` says which fields were unknown, missing or rejected.
+///
+/// # Errors
+/// [`DecodeError::Malformed`] for an entry cut short, or a field twice.
+pub(super) fn decode_fields<'a, T: Fields, I>(
+    entries: impl Iterator<Item = Entry<'a>>,
+    report: &mut FieldReport,
+) -> Result<T, DecodeError<I>> {
+    let mut record = T::DEFAULT;
+    let mut seen = FieldSet::EMPTY;
+    for entry in entries {
+        let (id, bytes) = entry.map_err(|Truncated| DecodeError::Malformed)?;
+        if !seen.insert(id) {
+            return Err(DecodeError::Malformed);
+        }
+        match record.read(id, bytes) {
+            Some(true) => {}
+            Some(false) => _ = report.rejected.insert(id),
+            None => _ = report.unknown.insert(id),
+        }
+    }
+    report.missing = T::KNOWN.without(&seen);
+    Ok(record)
+}
+
+impl Record for Settings {
+    /// Version 2: tagged fields. Version 1 (fixed layout) is migrated.
+    const VERSION: u16 = 2;
+    type Invalid = SettingsError;
+
+    fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
+        encode_fields(self, buf)
+    }
+
+    /// Reads version 2, or migrates version 1; then validates the settings
+    /// with the built-in driver configuration ([`DriverConfig::DEFAULT`]).
+    fn decode(
+        version: u16,
+        bytes: &[u8],
+        report: &mut FieldReport,
+    ) -> Result<Self, DecodeError<SettingsError>> {
+        let settings: Self = match version {
+            1 => decode_fields(v1::entries(bytes)?, report)?,
+            2 => decode_fields(Entries::new(bytes), report)?,
+            _ => return Err(DecodeError::Version),
+        };
+        match settings.validate(&DriverConfig::DEFAULT) {
+            Ok(_) => Ok(settings),
+            Err(e) => Err(DecodeError::Invalid(e)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::command::Percent;
+    use crate::settings::{LoadError, Loaded, RamStorage, SettingsStorage, record::open_record};
+    use crate::units::{Microseconds, Millis};
+
+    /// An id the table will not reach for a long time: the field a test
+    /// firmware adds.
+    const NEW: u8 = 255;
+
+    /// The settings of a firmware with one field more than this one (the
+    /// real table and one row), as the next firmware will be.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    struct Grown {
+        settings: Settings,
+        rest: Millis,
+    }
+
+    impl Fields for Grown {
+        const KNOWN: FieldSet = <Settings as Fields>::KNOWN.with(NEW);
+        const DEFAULT: Self = Self {
+            settings: Settings::DEFAULT,
+            rest: Millis(30_000),
+        };
+
+        fn write(&self, w: &mut Writer<'_>) {
+            self.settings.write(w);
+            w.field(NEW, &self.rest);
+        }
+
+        fn read(&mut self, id: u8, bytes: &[u8]) -> Option<bool> {
+            match id {
+                NEW => Some(read_into(&mut self.rest, bytes)),
+                _ => self.settings.read(id, bytes),
+            }
+        }
+    }
+
+    impl Record for Grown {
+        const VERSION: u16 = Settings::VERSION;
+        type Invalid = SettingsError;
+
+        fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
+            encode_fields(self, buf)
+        }
+
+        fn decode(
+            version: u16,
+            bytes: &[u8],
+            report: &mut FieldReport,
+        ) -> Result<Self, DecodeError<SettingsError>> {
+            let grown: Self = match version {
+                2 => decode_fields(Entries::new(bytes), report)?,
+                _ => return Err(DecodeError::Version),
+            };
+            match grown.settings.validate(&DriverConfig::DEFAULT) {
+                Ok(_) => Ok(grown),
+                Err(e) => Err(DecodeError::Invalid(e)),
+            }
+        }
+    }
+
+    /// Settings that differ from the built-in ones in many fields.
+    fn calibrated() -> Settings {
+        let mut s = Settings::DEFAULT;
+        s.servos[0].neutral = Microseconds(1520);
+        s.servos[2].per_degree = crate::servo::NanosPerDegree(10_500);
+        s.servos[1].direction = crate::servo::Direction::Reversed;
+        s.behaviour.idle.amplitude = Percent::new(70).unwrap();
+        s.behaviour.gaze.hold = crate::command::Hold::Stay;
+        s.seeds = [1, 2, 3];
+        s.validate(&DriverConfig::DEFAULT).unwrap();
+        s
+    }
+
+    /// `record` as a store keeps it: the version, then the fields.
+    fn stored<R: Record>(record: &R) -> Vec<u8> {
+        let mut buf = [0; 1024];
+        let n = record.encode(&mut buf[2..]).unwrap();
+        buf[..2].copy_from_slice(&R::VERSION.to_le_bytes());
+        buf[..2 + n].to_vec()
+    }
+
+    fn open<R: Record>(stored: &[u8]) -> Result<Loaded<R>, LoadError<(), R::Invalid>> {
+        open_record::<R, ()>(stored)
+    }
+
+    #[test]
+    fn the_table_names_each_field_once() {
+        let mut names: Vec<_> = FIELDS.iter().map(|f| f.name).collect();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), FIELDS.len());
+        assert_eq!(
+            SETTINGS_LEN,
+            FIELDS.iter().map(|f| HEADER + f.max_len).sum::<usize>()
+        );
+        assert_eq!(FIELDS.len(), <Settings as Fields>::KNOWN.len());
+        assert_eq!(field(1).map(|f| f.name), Some("servo.pitch.neutral"));
+        assert!(
+            !<Settings as Fields>::KNOWN.contains(NEW),
+            "the test's id is taken"
+        );
+        // Every field is written, once, in the table's order.
+        let bytes = stored(&Settings::DEFAULT);
+        let ids: Vec<u8> = Entries::new(&bytes[2..]).map(|e| e.unwrap().0).collect();
+        assert_eq!(ids, FIELDS.iter().map(|f| f.id).collect::<Vec<_>>());
+        assert!(bytes.len() - 2 <= SETTINGS_LEN);
+    }
+
+    /// The next firmware adds a field: a record saved today loads there,
+    /// every field as saved, the new one on its default.
+    #[test]
+    fn a_record_of_today_loads_after_a_field_is_added() {
+        let today = calibrated();
+        let loaded = open::<Grown>(&stored(&today)).unwrap();
+        assert_eq!(loaded.record.settings, today);
+        assert_eq!(loaded.record.rest, Grown::DEFAULT.rest);
+        assert_eq!(loaded.version, 2);
+        assert_eq!(
+            loaded.fields,
+            FieldReport {
+                missing: FieldSet::of(&[NEW]),
+                ..FieldReport::default()
+            }
+        );
+        // Through the console's storage, as the board saves it.
+        let mut ram = RamStorage::<512>::new();
+        ram.save(&today).unwrap();
+        assert_eq!(open::<Grown>(ram.raw()).unwrap().record.settings, today);
+        // And the new firmware's own record round-trips.
+        let grown = Grown {
+            settings: today,
+            rest: Millis(5_000),
+        };
+        let back = open::<Grown>(&stored(&grown)).unwrap();
+        assert_eq!(back.record, grown);
+        assert!(back.fields.is_clean());
+    }
+
+    /// A record of that next firmware loads today: its new field skipped
+    /// and reported, every other field as saved.
+    #[test]
+    fn a_field_of_a_newer_firmware_is_skipped_and_reported() {
+        let grown = Grown {
+            settings: calibrated(),
+            rest: Millis(5_000),
+        };
+        let loaded = open::<Settings>(&stored(&grown)).unwrap();
+        assert_eq!(loaded.record, grown.settings);
+        assert_eq!(
+            loaded.fields,
+            FieldReport {
+                unknown: FieldSet::of(&[NEW]),
+                ..FieldReport::default()
+            }
+        );
+        let mut ram = RamStorage::<512>::new();
+        ram.set_raw(&stored(&grown)).unwrap();
+        assert_eq!(ram.load(), Ok(grown.settings));
+    }
+
+    /// The entries of `stored`'s record, edited, as a store keeps them.
+    fn edited(stored: &[u8], edit: impl Fn(u8, &[u8]) -> Option<Vec<u8>>) -> Vec<u8> {
+        let mut out = stored[..2].to_vec();
+        for entry in Entries::new(&stored[2..]) {
+            let (id, value) = entry.unwrap();
+            if let Some(value) = edit(id, value) {
+                out.push(id);
+                out.push(u8::try_from(value.len()).unwrap());
+                out.extend(value);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_value_out_of_its_range_takes_its_default_and_is_reported() {
+        let today = calibrated();
+        // idle.amplitude 170 %, servo.roll.direction 2, a seed of 3 bytes.
+        let bytes = edited(&stored(&today), |id, v| match id {
+            44 => Some(vec![170]),
+            10 => Some(vec![2]),
+            55 => Some(v[..3].to_vec()),
+            _ => Some(v.to_vec()),
+        });
+        let loaded = open::<Settings>(&bytes).unwrap();
+        assert_eq!(loaded.fields.rejected, FieldSet::of(&[10, 44, 55]));
+        let mut expected = today;
+        expected.behaviour.idle.amplitude = Settings::DEFAULT.behaviour.idle.amplitude;
+        expected.servos[1].direction = Settings::DEFAULT.servos[1].direction;
+        expected.seeds[1] = Settings::DEFAULT.seeds[1];
+        assert_eq!(loaded.record, expected);
+    }
+
+    #[test]
+    fn settings_that_fail_as_a_whole_are_refused_with_the_reason() {
+        let mut bad = calibrated();
+        bad.servos[2].neutral = Microseconds(2600);
+        let err = open::<Settings>(&stored(&bad)).unwrap_err();
+        let Err(why) = bad.validate(&DriverConfig::DEFAULT) else {
+            panic!("valid")
+        };
+        assert_eq!(err, LoadError::Invalid(why));
+        // A missing field whose default does not fit the others: refused too.
+        let mut narrow = Settings::DEFAULT;
+        narrow.servos[0].min_pulse = Microseconds(1600);
+        narrow.servos[0].neutral = Microseconds(1700);
+        narrow.servos[0].limits.min = crate::units::Angle::ZERO;
+        narrow.validate(&DriverConfig::DEFAULT).unwrap();
+        let without_neutral = edited(&stored(&narrow), |id, v| (id != 1).then(|| v.to_vec()));
+        assert!(matches!(
+            open::<Settings>(&without_neutral),
+            Err(LoadError::Invalid(SettingsError::Driver(_)))
+        ));
+    }
+
+    #[test]
+    fn a_cut_entry_or_a_field_twice_is_corrupt() {
+        let bytes = stored(&calibrated());
+        for cut in 2..bytes.len() {
+            let loaded = open::<Settings>(&bytes[..cut]);
+            // A cut between two entries leaves fields missing, which
+            // validation may accept (the built-in values fit).
+            let between = Entries::new(&bytes[2..cut]).all(|e| e.is_ok());
+            match loaded {
+                Err(LoadError::Corrupt) => assert!(!between, "cut at {cut}"),
+                Ok(l) => assert!(between && !l.fields.missing.is_empty(), "cut at {cut}"),
+                Err(LoadError::Invalid(_)) => assert!(between, "cut at {cut}"),
+                Err(e) => panic!("cut at {cut}: {e:?}"),
+            }
+        }
+        let mut twice = bytes.clone();
+        twice.extend([1, 4, 0xdc, 5, 0, 0]);
+        assert_eq!(open::<Settings>(&twice), Err(LoadError::Corrupt));
+        let mut unknown_twice = bytes;
+        unknown_twice.extend([NEW, 0, NEW, 1, 7]);
+        assert_eq!(open::<Settings>(&unknown_twice), Err(LoadError::Corrupt));
+        assert_eq!(open::<Settings>(&[2]), Err(LoadError::Corrupt));
+    }
+
+    #[test]
+    fn versions() {
+        let bytes = stored(&calibrated());
+        let with = |v: u16| {
+            let mut b = bytes.clone();
+            b[..2].copy_from_slice(&v.to_le_bytes());
+            b
+        };
+        assert_eq!(
+            open::<Settings>(&with(3)),
+            Err(LoadError::Newer { found: 3 })
+        );
+        assert_eq!(
+            open::<Settings>(&with(0)),
+            Err(LoadError::Older { found: 0 })
+        );
+        // Version 2's bytes are not a version 1 record.
+        assert_eq!(open::<Settings>(&with(1)), Err(LoadError::Corrupt));
+        // An empty record of version 2: every field on its default.
+        let empty = open::<Settings>(&2_u16.to_le_bytes()).unwrap();
+        assert_eq!(empty.record, Settings::DEFAULT);
+        assert_eq!(empty.fields.missing, <Settings as Fields>::KNOWN);
+    }
+
+    /// Version 1 was today's values without ids and lengths, in the order
+    /// of their ids: stripping the headers of a record of today gives the
+    /// record version 1 wrote.
+    #[test]
+    fn version_1_is_migrated_field_by_field() {
+        for settings in [Settings::DEFAULT, calibrated()] {
+            let today = stored(&settings);
+            let mut fields: Vec<(u8, &[u8])> =
+                Entries::new(&today[2..]).map(Result::unwrap).collect();
+            fields.sort_by_key(|&(id, _)| id);
+            let mut v1 = 1_u16.to_le_bytes().to_vec();
+            for (id, value) in fields {
+                if id <= 56 {
+                    v1.extend(value);
+                }
+            }
+            assert_eq!(v1.len(), 2 + v1::V1_LEN);
+            let loaded = open::<Settings>(&v1).unwrap();
+            assert_eq!(loaded.record, settings);
+            assert_eq!(loaded.version, 1);
+            assert_eq!(
+                loaded.fields.missing,
+                <Settings as Fields>::KNOWN.without(&FieldSet::of(&[
+                    1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22,
+                    23, 24, 25, 26, 27, 28, 29, 30, 31, 32, 33, 34, 35, 36, 37, 38, 39, 40, 41, 42,
+                    43, 44, 45, 46, 47, 48, 49, 50, 51, 52, 53, 54, 55, 56
+                ]))
+            );
+            // A version 1 record of another length is not one.
+            for n in [0, 1, v1.len() - 1] {
+                assert_eq!(open::<Settings>(&v1[..n.max(2)]), Err(LoadError::Corrupt));
+            }
+            let mut long = v1.clone();
+            long.push(0);
+            assert_eq!(open::<Settings>(&long), Err(LoadError::Corrupt));
+        }
+    }
+}
