@@ -124,6 +124,15 @@ pub enum Command {
     /// line printed. With --port <dev> that serial port is opened (115200
     /// 8N1); with neither, the Pico is found by its USB VID:PID 16c0:27dd.
     Console(console::Args),
+    /// Build the book (docs/) into target/book and check every link in it.
+    ///
+    /// Writes the measured figures page (docs/design/figures.md, not in
+    /// git) from target/figures.json, which `cargo xtask test` and `cargo
+    /// xtask metrics` fill; builds the book with the pinned mdBook (installed
+    /// with `cargo install` when missing); then fails if a relative link of a
+    /// rendered page, or of the README, does not reach a file, or its
+    /// #anchor an id in the page it points to.
+    Book,
 }
 
 impl Command {

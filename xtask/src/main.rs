@@ -15,6 +15,8 @@
 //!   checked against the host frame for frame.
 //! - `cargo xtask trace`: the firmware's frames simulated on the host, with
 //!   scripted gestures and looks, as CSV and PNG.
+//! - `cargo xtask book`: the book (docs/) built with mdBook into
+//!   target/book, every link in it checked.
 //!
 //! The firmware commands install what they need and is missing: the
 //! firmware's Rust target and, when running as root on Debian or Ubuntu, QEMU.
@@ -22,9 +24,11 @@
 
 mod args;
 mod bench;
+mod book;
 mod cli;
 mod console;
 mod elf;
+mod figures;
 mod fonts;
 mod log;
 mod metrics;
@@ -68,6 +72,7 @@ fn main() -> ExitCode {
         Some(Command::Sim(args)) => sim::command(&args),
         Some(Command::Trace(args)) => trace::command(&args),
         Some(Command::Console(args)) => console::command(&args),
+        Some(Command::Book) => book::command(),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,
