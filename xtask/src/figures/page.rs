@@ -48,38 +48,26 @@ pub fn render(figures: &Figures) -> (String, Vec<&'static str>) {
                 out.push_str(&body);
             }
             None => {
-                let _ = writeln!(
-                    out,
-                    "Not measured yet: run `{how}`, then `cargo xtask book`."
-                );
+                let _ = writeln!(out, "Not measured yet: {how}.");
             }
         }
     };
-    section("memory", "Memory", memory(figures), "cargo xtask test");
+    let test = "`cargo xtask test` measures these (and builds this page again)";
+    section("memory", "Memory", memory(figures), test);
     let bench = figures.bench.as_ref();
-    section(
-        "frames",
-        "Frame cost",
-        bench.map(frames),
-        "cargo xtask test",
-    );
-    section(
-        "precompute",
-        "Boot precompute",
-        bench.map(precompute),
-        "cargo xtask test",
-    );
+    section("frames", "Frame cost", bench.map(frames), test);
+    section("precompute", "Boot precompute", bench.map(precompute), test);
     section(
         "qemu",
         "Idle loop sets",
         figures.qemu.as_ref().map(loop_sets),
-        "cargo xtask qemu",
+        test,
     );
     section(
         "metrics",
         "Loop quality",
         figures.metrics.as_ref().map(metrics),
-        "cargo xtask metrics",
+        "run `cargo xtask metrics`, then `cargo xtask book`",
     );
     (out, recorded)
 }
@@ -323,7 +311,8 @@ mod tests {
             assert!(page.contains(heading), "{heading}");
         }
         assert_eq!(page.matches("Not measured yet").count(), 5);
-        assert!(page.contains("run `cargo xtask metrics`"));
+        assert!(page.contains("run `cargo xtask metrics`, then `cargo xtask book`"));
+        assert!(page.contains("`cargo xtask test` measures these"));
     }
 
     #[test]
