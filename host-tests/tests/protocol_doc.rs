@@ -1,4 +1,4 @@
-//! The exchanges in `docs/protocol.md` are what the console does: every
+//! The exchanges in `docs/user/protocol.md` are what the console does: every
 //! `> line` of an example, sent to the firmware's console service on a
 //! simulated head (built-in settings, one frame played after each line,
 //! the examples in the order of the document), gets the `< reply` written
@@ -9,8 +9,8 @@ use idle_head_core::console::Session;
 
 #[test]
 fn the_examples_in_the_protocol_document_hold() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/protocol.md");
-    let doc = std::fs::read_to_string(path).expect("docs/protocol.md");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/user/protocol.md");
+    let doc = std::fs::read_to_string(path).expect("docs/user/protocol.md");
     let (queue, link) = shared();
     let mut frames = SimFrames::new();
     let mut handler = service(queue, link);
@@ -40,8 +40,8 @@ fn the_examples_in_the_protocol_document_hold() {
 /// commands, with `cycles=` where the gesture may have more than one.
 #[test]
 fn the_protocol_document_lists_every_gesture() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/protocol.md");
-    let doc = std::fs::read_to_string(path).expect("docs/protocol.md");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/user/protocol.md");
+    let doc = std::fs::read_to_string(path).expect("docs/user/protocol.md");
     for kind in idle_head_core::command::GestureKind::ALL {
         let options = if kind.row().max_cycles > 1 {
             "[cycles=N] [intensity=P]"
@@ -51,7 +51,7 @@ fn the_protocol_document_lists_every_gesture() {
         let row = format!("| `{} [amp] [ms] {options}` |", kind.name());
         assert!(
             doc.lines().any(|line| line.starts_with(&row)),
-            "docs/protocol.md has no row `{row}`"
+            "docs/user/protocol.md has no row `{row}`"
         );
     }
 }

@@ -271,7 +271,7 @@ impl Verdict {
 }
 
 /// `1234567` as `1,234,567`.
-fn thousands(value: u64) -> String {
+pub(crate) fn thousands(value: u64) -> String {
     let digits = value.to_string();
     let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {
@@ -306,6 +306,7 @@ pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Resu
     let verdict = Verdict::of(&rows)?;
     print!("{}", verdict.lines());
     let frames = FrameRow::all(&run.log)?;
+    crate::figures::record::bench(&rows, &frames, BUDGET);
     for frame in &frames {
         println!();
         print!("{}", frame.lines());

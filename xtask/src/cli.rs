@@ -148,6 +148,15 @@ pub enum Command {
     /// installed; else writes the UF2 and says how to flash it, or what to
     /// install.
     Flash(flash::Args),
+    /// Build the book (docs/) into target/book and check every link in it.
+    ///
+    /// Writes the measured figures page (docs/design/figures.md, not in
+    /// git) from target/figures.json, which `cargo xtask test` and `cargo
+    /// xtask metrics` fill; builds the book with the pinned mdBook (installed
+    /// with `cargo install` when missing); then fails if a relative link of a
+    /// rendered page, or of the README, does not reach a file, or its
+    /// #anchor an id in the page it points to.
+    Book,
 }
 
 impl Command {

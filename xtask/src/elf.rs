@@ -205,6 +205,7 @@ pub fn check_pico(path: &Path) -> Result<()> {
 
     let flash = image.flash();
     let ram = image.static_ram();
+    crate::figures::record::image(path, &image, Some(FLASH_BUDGET));
     println!(
         "  flash      {:>6} B = {:>5.1} KiB of {} KiB budget  ({})",
         flash,
@@ -300,6 +301,10 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
             None => println!("  {name:<34} (no measurement)"),
         }
     }
+    crate::figures::record::ram(&[
+        ("pico", "the RP2040 emulator", pico, Some(RAM_BUDGET)),
+        ("qemu", "QEMU (lm3s6965evb)", qemu, None),
+    ]);
     let pico =
         pico.context("the Pico image's peak stack was not measured (the emulator run failed)")?;
     let total = pico.static_ram + pico.stack;

@@ -18,6 +18,8 @@
 //! - `cargo xtask uf2`: the firmware as a UF2 file for a board's BOOTSEL drive.
 //! - `cargo xtask flash`: the runner of `cargo run --release`: BOOTSEL drive,
 //!   debug probe, or what to install.
+//! - `cargo xtask book`: the book (docs/) built with mdBook into
+//!   target/book, every link in it checked.
 //!
 //! The firmware commands install what they need and is missing: the
 //! firmware's Rust target and, when running as root on Debian or Ubuntu, QEMU.
@@ -26,10 +28,12 @@
 mod args;
 mod bench;
 mod board;
+mod book;
 mod child;
 mod cli;
 mod console;
 mod elf;
+mod figures;
 mod flash;
 mod fonts;
 mod log;
@@ -78,6 +82,7 @@ fn main() -> ExitCode {
         Some(Command::Console(args)) => console::command(&args),
         Some(Command::Uf2(args)) => uf2::command(&args),
         Some(Command::Flash(args)) => flash::command(&args),
+        Some(Command::Book) => book::command(),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

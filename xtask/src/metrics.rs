@@ -109,17 +109,17 @@ impl Measured {
         }
     }
 
-    fn discontinuous(&self) -> bool {
+    pub(crate) fn discontinuous(&self) -> bool {
         let limit = f64::from(CONTINUITY_LIMIT);
         self.velocity > limit || self.acceleration > limit
     }
 }
 
 /// Reads one value of a [`Measured`].
-type Getter = fn(&Measured) -> f64;
+pub(crate) type Getter = fn(&Measured) -> f64;
 
 /// The table rows: name and how to read the value.
-const ROWS: [(&str, Getter); 6] = [
+pub(crate) const ROWS: [(&str, Getter); 6] = [
     ("max|d1|/P95|d1|", |m| m.velocity),
     ("max|d2|/P95|d2|", |m| m.acceleration),
     ("liveliness", |m| m.liveliness),
@@ -295,6 +295,7 @@ pub fn command(args: &Args) -> Result<bool> {
         results.push((closure, run(args, closure)?));
     }
     print!("{}", report(&results, args));
+    crate::figures::record::loop_quality(&results, args);
     println!(
         "{} loops in {:.1} s",
         2 * u64::from(args.seeds),

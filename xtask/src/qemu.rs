@@ -46,7 +46,10 @@ pub fn command(options: Options) -> Result<bool> {
     println!("{}", run.describe());
     let mut ok = run.succeeded();
     match check_summary(&run.log) {
-        Ok(line) => println!("{line}"),
+        Ok(line) => {
+            println!("{line}");
+            crate::figures::record::qemu(&run.log);
+        }
         Err(error) => {
             println!("summary check failed: {error:#}");
             ok = false;

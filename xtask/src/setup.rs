@@ -1,6 +1,9 @@
 //! Installs what the commands need and is missing.
 
-use std::path::Path;
+use std::{
+    path::{Path, PathBuf},
+    process::Command,
+};
 
 use anyhow::{Context, Result, bail};
 use xshell::{Shell, cmd};
@@ -116,4 +119,97 @@ pub fn qemu_version() -> Option<String> {
     let sh = project::shell(".").ok()?;
     let version = cmd!(sh, "{QEMU_BINARY} --version").quiet().read().ok()?;
     Some(version.lines().next().unwrap_or_default().to_owned())
+}
+
+/// The mdBook release the book is built with (`cargo xtask book`): pinned,
+/// as its HTML (and so the ids the link check reads) may change between
+/// releases.
+pub const MDBOOK_VERSION: &str = "0.5.4";
+
+/// The `mdbook` program to run: the pinned release if it is on the `PATH`
+/// or was installed into `tools` before; otherwise it is installed from
+/// crates.io with `cargo install` (a few minutes, once), into cargo's own
+/// folder of programs if no other mdBook is on the `PATH`, and into `tools`
+/// if one is (so that another project's mdBook is left as it is). Only
+/// the HTML renderer and its search are built (`--no-default-features
+/// --features search`): the book needs no `mdbook serve` or `watch`.
+pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
+    let local = tools.join("bin").join("mdbook");
+    let version = |program: &Path| {
+        Command::new(program)
+            .arg("--version")
+            .output()
+            .ok()
+            .filter(|out| out.status.success())
+            .map(|out| String::from_utf8_lossy(&out.stdout).trim().to_owned())
+    };
+    let wanted = format!("mdbook v{MDBOOK_VERSION}");
+    if version(&local).as_deref() == Some(wanted.as_str()) {
+        return Ok(local);
+    }
+    let on_path = version(Path::new("mdbook"));
+    if on_path.as_deref() == Some(wanted.as_str()) {
+        return Ok(PathBuf::from("mdbook"));
+    }
+    let sh = project::shell(".")?;
+    // The repository's .cargo/config.toml builds for the firmware's target:
+    // mdBook is a host program.
+    let host = host_triple()?;
+    let root = if let Some(other) = &on_path {
+        println!(
+            "{other} is on the PATH, not v{MDBOOK_VERSION}: installing v{MDBOOK_VERSION} into {}",
+            project::relative(tools).display()
+        );
+        Some(tools.to_path_buf())
+    } else {
+        println!(
+            "mdbook is missing: installing v{MDBOOK_VERSION} with cargo install (a few minutes, once)"
+        );
+        None
+    };
+    let root_args: Vec<String> = root
+        .iter()
+        .flat_map(|dir| ["--root".to_owned(), dir.display().to_string()])
+        .collect();
+    let build_dir = tools.join("build");
+    project::run(
+        &sh,
+        &[],
+        cmd!(
+            sh,
+            "cargo install mdbook --locked --version {MDBOOK_VERSION} --no-default-features --features search --target {host} --target-dir {build_dir} {root_args...}"
+        ),
+    )?;
+    let installed = match root {
+        Some(_) => local,
+        None => cargo_home()?.join("bin").join("mdbook"),
+    };
+    if version(&installed).as_deref() != Some(wanted.as_str()) {
+        bail!(
+            "installed mdBook v{MDBOOK_VERSION}, but {} does not run as it",
+            installed.display()
+        );
+    }
+    Ok(installed)
+}
+
+/// The host's target triple (`rustc -vV`'s `host:` line).
+fn host_triple() -> Result<String> {
+    let sh = project::shell(".")?;
+    let info = cmd!(sh, "rustc -vV").quiet().read()?;
+    info.lines()
+        .find_map(|line| line.strip_prefix("host: "))
+        .map(str::to_owned)
+        .context("`rustc -vV` names no host")
+}
+
+/// Where `cargo install` puts programs without `--root`: `$CARGO_HOME`, or
+/// `~/.cargo`.
+fn cargo_home() -> Result<PathBuf> {
+    if let Some(home) = std::env::var_os("CARGO_HOME") {
+        return Ok(PathBuf::from(home));
+    }
+    std::env::var_os("HOME")
+        .map(|home| PathBuf::from(home).join(".cargo"))
+        .context("neither CARGO_HOME nor HOME is set")
 }

@@ -9,7 +9,7 @@ use xshell::{Shell, cmd};
 
 use crate::{
     args::Options,
-    bench, console, elf,
+    bench, book, console, elf,
     log::Run,
     pico2,
     project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
@@ -183,6 +183,9 @@ pub fn command(options: Options) -> Result<bool> {
         setup::ensure_qemu()?;
         bench::run_and_check(&root, &metadata, options)
     });
+
+    // 6. The book, with the figures measured above, and its links.
+    stages.run(book::STAGE, || book::stage(&root, qemu_run.as_ref()));
 
     Ok(stages.finish(start))
 }

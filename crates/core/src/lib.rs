@@ -18,7 +18,8 @@
 //! ```
 //!
 //! The hardware, the wiring, the commands and how the motion is computed are
-//! in the project's README (`README.md` at the repository root).
+//! in the project's book (`docs/`, built by `cargo xtask book`): the user
+//! guide for the hardware and the console, the design notes for the method.
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]

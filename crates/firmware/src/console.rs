@@ -59,7 +59,7 @@ pub struct Gone;
 /// Runs `session` over `port` until the port goes away: every line gets
 /// exactly one reply from `handler`. When the port reports received bytes
 /// lost, the line in progress is answered `err line bytes lost …`
-/// (docs/protocol.md says what a flood does to the lines around it).
+/// (docs/user/protocol.md says what a flood does to the lines around it).
 pub async fn serve<P: Port, H: Handler, const LINE: usize, const REPLY: usize>(
     port: &mut P,
     session: &mut Session<LINE, REPLY>,

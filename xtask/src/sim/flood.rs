@@ -9,14 +9,14 @@
 //! fills, and the bytes that find the FIFO full are lost, as on the chip;
 //! the harness sets the PL011's overrun bit. At 7 s, when every reply has
 //! gone out, a line end alone (it ends what is left of the flood's last
-//! line, as docs/protocol.md advises after a loss) and one more `status`.
+//! line, as docs/user/protocol.md advises after a loss) and one more `status`.
 //!
 //! The UART driver reports an overrun once the bytes received before it
 //! have been read, and by then some received after it may have been read
 //! too: the line said to have lost bytes can be a line late, and the lines
 //! that ran together before it get whatever reply they make. The check:
 //! - every reply is a `status` reply, plain or in machine mode, or an
-//!   `err` (lines lost whole get none: docs/protocol.md tells programs to
+//!   `err` (lines lost whole get none: docs/user/protocol.md tells programs to
 //!   wait for each reply, or to use machine mode);
 //! - every machine-mode `ok` carries a sequence number that was sent, in
 //!   increasing order, and a valid checksum: a program sees exactly which

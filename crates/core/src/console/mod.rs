@@ -10,7 +10,7 @@
 //!   through the frame task's queue and the [`ConsoleLink`] it shares
 //!   with the frame task.
 //!
-//! Nothing here allocates or panics. See `docs/protocol.md` for the
+//! Nothing here allocates or panics. See `docs/user/protocol.md` for the
 //! protocol as a user sees it.
 
 mod framer;

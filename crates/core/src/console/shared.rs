@@ -23,7 +23,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 
 /// A console session on a port: lines up to 96 bytes, replies up to 160,
-/// as `docs/protocol.md` promises.
+/// as `docs/user/protocol.md` promises.
 pub type PortSession = Session<96, 160>;
 
 /// One service for both ports, in thread mode.

@@ -54,8 +54,9 @@
 //! Over 1,000 seeds × 50 joins × 3 axes (the host test `idle_stream`),
 //! 43 % of the loops drawn are discarded (36 % with neighbours only), a
 //! set draws 2.26 loops more on average, at most 15 are discarded for one
-//! loop and 127 loops in 153,000 take all 16 draws; the background cost is
-//! in the README ("Never-repeating idle").
+//! loop and 127 loops in 153,000 take all 16 draws. The design and its
+//! reasons are in the book's "Never-repeating idle" (`docs/design/idle.md`);
+//! what a set costs in the background, on its measured figures page.
 //!
 //! # The join
 //!
@@ -86,9 +87,10 @@
 //!
 //! # Generation and hand-over
 //!
-//! [`LoopStream`] generates each set (about 2 million instructions for the
-//! loops, their pace and the entry search on a Cortex-M0+, see the README)
-//! into a [`LoopSet`] buffer;
+//! [`LoopStream`] generates each set (the loops, their pace and the entry
+//! search: a few million instructions on a Cortex-M0+, measured by the QEMU
+//! smoke run and shown on the book's measured figures page) into a
+//! [`LoopSet`] buffer;
 //! [`IdlePlayer`] plays the sets frame by frame and takes the next one
 //! through a [`LoopSupply`] on the frame its join is due. The firmware
 //! generates in a low-priority task and passes `&'static mut` buffers

@@ -56,7 +56,7 @@ pub use error::{ParseError, ParseErrorKind, Span};
 use words::{Field, Kw, Word, Words, once};
 
 /// Parses one line (without its line ending); the grammar is in this
-/// module's source and, for users, in `docs/protocol.md`.
+/// module's source and, for users, in `docs/user/protocol.md`.
 ///
 /// # Errors
 /// A [`ParseError`] naming the first problem and the word it is in.
