@@ -144,6 +144,7 @@ pub enum BootError {
 ///
 /// # Errors
 /// [`BootError::AlreadyBooted`] if called a second time.
+#[inline(never)]
 pub fn boot<S: SettingsStorage>(
     base: &DriverConfig,
     loaded: Loaded<S>,

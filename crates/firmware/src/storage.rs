@@ -49,6 +49,8 @@ use idle_head_core::settings::{
     SettingsSource, SettingsStorage, SettingsStore, StorageError, Validated,
 };
 
+use static_cell::StaticCell;
+
 use crate::boot::Loaded;
 
 /// The watchdog timeout the frames feed while a flash operation is under
@@ -118,35 +120,37 @@ impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
 
 /// Opens the store on `flash` in `range` (offsets as the driver counts,
 /// whole erase sectors; `address` is where the range appears in the address
-/// space, for the log) and reads the settings in it, before the first frame
-/// (no watchdog, no frames yet), checked against `base`; the built-in
-/// settings (`defaults`, checked with `base` at compile time) if there are
-/// none or they are not usable. The log says which.
+/// space, for the log) in `cell`, where it stays (the console saves through
+/// it), and reads the settings in it, before the first frame (no watchdog,
+/// no frames yet), checked against `base`; the built-in settings
+/// (`defaults`, checked with `base` at compile time) if there are none or
+/// they are not usable. The log says which. `None` if `cell` was taken.
 pub fn open<F>(
+    cell: &'static StaticCell<FlashStorage<F>>,
     flash: F,
     range: Range<u32>,
     address: u32,
     base: &DriverConfig,
     defaults: Validated,
     link: &'static ConsoleLink,
-) -> Loaded<FlashStorage<F>>
+) -> Option<Loaded<&'static mut FlashStorage<F>>>
 where
     F: NorFlash,
     F::Error: defmt::Format,
 {
-    let mut store = Store::new(SectorWise(flash), range).ok();
+    let store = Store::new(SectorWise(flash), range).ok();
     if store.is_none() {
         defmt::error!("settings: no store: the region is not whole erase sectors");
     }
-    let loaded = store.as_mut().and_then(|store| {
+    let storage = cell.try_init(FlashStorage { store, link })?;
+    let loaded = storage.store.as_mut().and_then(|store| {
         let loaded = at_once(store.load());
         if loaded.is_none() {
             defmt::error!("settings: defaults; the blocking flash driver waited");
         }
         loaded.and_then(|loaded| loaded_settings(loaded, base, address))
     });
-    let storage = FlashStorage { store, link };
-    match loaded {
+    Some(match loaded {
         Some((settings, valid)) => Loaded {
             storage,
             settings,
@@ -159,7 +163,7 @@ where
             source: SettingsSource::Defaults,
             valid: defaults,
         },
-    }
+    })
 }
 
 /// Polls `future` once: every flash operation of [`PicoFlash`] is blocking

@@ -12,6 +12,7 @@ use embassy_rp::peripherals::FLASH;
 use idle_head_core::driver::DriverConfig;
 use idle_head_firmware::boot::{DEFAULT_SETTINGS, LINK, Loaded};
 use idle_head_firmware::storage::{self, FlashStorage};
+use static_cell::StaticCell;
 
 /// The board's flash: the Raspberry Pi Pico's 2 MiB (W25Q16JV).
 #[cfg(feature = "rp2040")]
@@ -36,15 +37,24 @@ pub const SETTINGS_ADDRESS: u32 = 0x1000_0000 + SETTINGS_RANGE.start;
 /// The flash driver the store runs on.
 pub type BoardFlash = BlockingAsync<Flash<'static, FLASH, Blocking, FLASH_SIZE>>;
 
+/// The store on the board's flash, in a static of its own.
+pub type Store = FlashStorage<BoardFlash>;
+
 /// The console's `save` and `load` on the board's flash.
-pub type Storage = FlashStorage<BoardFlash>;
+pub type Storage = &'static mut Store;
+
+/// Where the store stays.
+static STORE: StaticCell<Store> = StaticCell::new();
 
 /// Opens the store and reads the settings the board boots with, checked
-/// against `base` (see `idle_head_firmware::storage::open`).
+/// against `base` (see `idle_head_firmware::storage::open`). `None` if
+/// called twice.
 #[must_use]
-pub fn open(flash: Peri<'static, FLASH>, base: &DriverConfig) -> Loaded<Storage> {
+#[inline(never)]
+pub fn open(flash: Peri<'static, FLASH>, base: &DriverConfig) -> Option<Loaded<Storage>> {
     let flash = BlockingAsync::new(Flash::new_blocking(flash));
     storage::open(
+        &STORE,
         flash,
         SETTINGS_RANGE,
         SETTINGS_ADDRESS,

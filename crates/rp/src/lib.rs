@@ -43,9 +43,9 @@ use embassy_time::Duration;
 
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::console::SharedService;
-use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head_core::pwm_clock::{SERVO_PWM_HZ, SliceClock};
-use idle_head_firmware::boot::{self, Clock, EXCHANGE, Generator};
+use idle_head_firmware::boot::{self, Clock, EXCHANGE, Generator, Loaded};
 use idle_head_firmware::hooks::{BoardHooks, Watchdog};
 use static_cell::StaticCell;
 
@@ -112,8 +112,23 @@ unsafe fn SWI_IRQ_1() {
 
 /// Boots the head on `board` and spawns its tasks (see the crate docs);
 /// `spawner` is the thread-mode executor's. Call once, from `main`.
+///
+/// Each step is a function of its own, out of line, so that what one step
+/// holds on the stack (the settings store and the record it reads, the
+/// console service on its way to its static, the USB builder) is gone
+/// before the next: the boot's stack is the deepest step's, not their sum.
 pub fn start(spawner: Spawner, board: Board) {
-    let watchdog = RpWatchdog::new(board.watchdog);
+    let Board {
+        name,
+        servos,
+        servo_pins,
+        uart,
+        uart_pins,
+        usb,
+        flash,
+        watchdog,
+    } = board;
+    let watchdog = RpWatchdog::new(watchdog);
     match watchdog.reset_reason() {
         Some(ResetReason::TimedOut) => {
             defmt::warn!("boot: last reset by the WATCHDOG (frames had stopped); soft start again");
@@ -121,34 +136,74 @@ pub fn start(spawner: Spawner, board: Board) {
         Some(ResetReason::Forced) => defmt::info!("boot: last reset forced (debugger or software)"),
         None => defmt::info!("boot: power-on or reset pin"),
     }
-    log_clocks(board.name, board.servo_pins);
-
+    log_clocks(name, servo_pins);
     // Before the first frame: nothing else runs yet while the store is read.
-    let loaded = flash::open(board.flash, &CONFIG);
-    let Ok(booted) = boot::boot(&CONFIG, loaded, oscillator_jitter()) else {
+    let Some(loaded) = flash::open(flash, &CONFIG) else {
         defmt::error!("boot: called twice");
         return;
     };
-    spawn(spawner, generator(booted.generator), "generator");
+    let Some(head) = boot_head(spawner, loaded) else {
+        return;
+    };
+    spawn_frames(servos, &head, BoardWatchdog(watchdog));
+    if let Some(service) = head.service {
+        spawn_console(spawner, uart, uart_pins, usb, service);
+    }
+}
 
-    let driver = FrameDriver::new(board.servos, booted.driver);
+/// What the boot leaves for the frame task and the console.
+struct Head {
+    driver: DriverParams,
+    behaviour: BehaviourParams,
+    service: Option<&'static Service>,
+}
+
+/// Runs the boot sequence on the settings `loaded`, spawns the loop
+/// generator and puts the console service in its static.
+#[inline(never)]
+fn boot_head(spawner: Spawner, loaded: Loaded<flash::Storage>) -> Option<Head> {
+    let Ok(booted) = boot::boot(&CONFIG, loaded, oscillator_jitter()) else {
+        defmt::error!("boot: called twice");
+        return None;
+    };
+    spawn(spawner, generator(booted.generator), "generator");
+    let service = booted
+        .service
+        .map(|service| &*SERVICE.init(Mutex::new(RefCell::new(service))));
+    Some(Head {
+        driver: booted.driver,
+        behaviour: booted.behaviour,
+        service,
+    })
+}
+
+/// Starts the frame task's executor and spawns the frame task on `servos`.
+#[inline(never)]
+fn spawn_frames(servos: [ServoPwm; 3], head: &Head, watchdog: BoardWatchdog) {
+    let driver = FrameDriver::new(servos, head.driver);
     // The frame task's interrupt: above thread mode, below the time
     // driver's alarm (priority 0), which wakes it.
     interrupt::SWI_IRQ_1.set_priority(Priority::P1);
     let frames = FRAME_EXECUTOR.start(interrupt::SWI_IRQ_1);
-    if let Ok(token) = frame_task(driver, booted.behaviour, BoardWatchdog(watchdog)) {
+    if let Ok(token) = frame_task(driver, head.behaviour, watchdog) {
         frames.spawn(token);
     } else {
         defmt::error!("frame task already running");
     }
+}
 
-    let Some(service) = booted.service else {
-        return;
-    };
-    let service: &'static Service = SERVICE.init(Mutex::new(RefCell::new(service)));
-    spawn(spawner, uart_console(board.uart, service), "uart console");
-    defmt::info!("console: UART {=str}, 115200 8N1", board.uart_pins);
-    let (device, serial) = usb::build(board.usb);
+/// Spawns the console on the UART and on the USB serial port.
+#[inline(never)]
+fn spawn_console(
+    spawner: Spawner,
+    uart: UartPort,
+    uart_pins: &'static str,
+    usb: embassy_rp::usb::Driver<'static, USB>,
+    service: &'static Service,
+) {
+    spawn(spawner, uart_console(uart, service), "uart console");
+    defmt::info!("console: UART {=str}, 115200 8N1", uart_pins);
+    let (device, serial) = usb::build(usb);
     interrupt::USBCTRL_IRQ.set_priority(PORT_PRIORITY);
     spawn(spawner, usb_device(device), "usb device");
     spawn(

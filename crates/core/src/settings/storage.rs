@@ -103,6 +103,18 @@ pub trait SettingsStorage {
     fn load(&mut self) -> Result<Settings, StorageError>;
 }
 
+/// A storage borrowed for good: a board keeps its store (and the record
+/// buffer in it) in a static, and hands the console service a reference.
+impl<T: SettingsStorage + ?Sized> SettingsStorage for &mut T {
+    fn save(&mut self, settings: &Settings) -> Result<(), StorageError> {
+        (**self).save(settings)
+    }
+
+    fn load(&mut self) -> Result<Settings, StorageError> {
+        (**self).load()
+    }
+}
+
 /// One record kept in RAM as the flash store keeps it (version, then the
 /// record's bytes), `N` bytes at most (by default as many as the flash
 /// store's buffer holds): lost at reset.
