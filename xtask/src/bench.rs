@@ -39,6 +39,7 @@ mod frame;
 pub use frame::FrameRow;
 use frame::frames_over_budget;
 
+use crate::figures;
 use crate::{
     args::Options,
     log::LogLine,
@@ -306,7 +307,7 @@ pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Resu
     let verdict = Verdict::of(&rows)?;
     print!("{}", verdict.lines());
     let frames = FrameRow::all(&run.log)?;
-    crate::figures::record::bench(&rows, &frames, BUDGET);
+    record_figures(&rows, &frames, BUDGET);
     for frame in &frames {
         println!();
         print!("{}", frame.lines());
@@ -346,6 +347,40 @@ pub fn command(options: Options) -> Result<bool> {
             Ok(false)
         }
     }
+}
+
+/// The benchmark's rows.
+fn record_figures(rows: &[Row], frames: &[FrameRow], budget: u64) {
+    let entry = figures::Bench {
+        source: figures::Source::now(),
+        budget,
+        rows: rows
+            .iter()
+            .map(|row| figures::PrecomputeRow {
+                label: row.label.clone(),
+                n: row.n,
+                w: row.w,
+                engine: row.engine,
+                direct: row.direct,
+            })
+            .collect(),
+        frames: frames
+            .iter()
+            .map(|row| figures::FrameCost {
+                label: row.label(),
+                frames: row.frames,
+                min: row.min,
+                median: row.median,
+                max: row.max,
+                mean: row.mean,
+                median_budget: row.ceiling().map_or(0, |c| c.median),
+                max_budget: row.ceiling().map_or(0, |c| c.max),
+                // Every row with a ceiling is held to it.
+                held: row.ceiling().is_some(),
+            })
+            .collect(),
+    };
+    figures::save_section("benchmark", |f| f.bench = Some(entry));
 }
 
 #[cfg(test)]

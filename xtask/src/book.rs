@@ -27,7 +27,7 @@ const README: &str = "README.md";
 /// checks its links; fails on a build error or a broken link.
 pub fn stage(root: &Path, smoke: Option<&Run>) -> Result<()> {
     if let Some(run) = smoke {
-        figures::record::qemu(&run.log);
+        crate::qemu::record_figures(&run.log);
     }
     let recorded = figures::write_page(&figures::path(), &root.join(FIGURES_PAGE))?;
     if recorded.is_empty() {

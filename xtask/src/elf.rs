@@ -4,6 +4,8 @@
 use std::{fmt::Write as _, path::Path};
 
 use anyhow::{Context, Result, bail};
+
+use crate::figures;
 use object::read::elf::{ElfFile32, ProgramHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, SectionKind, elf};
 
@@ -205,7 +207,7 @@ pub fn check_pico(path: &Path) -> Result<()> {
 
     let flash = image.flash();
     let ram = image.static_ram();
-    crate::figures::record::image(path, &image, Some(FLASH_BUDGET));
+    record_image(path, &image, Some(FLASH_BUDGET));
     println!(
         "  flash      {:>6} B = {:>5.1} KiB of {} KiB budget  ({})",
         flash,
@@ -301,7 +303,7 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
             None => println!("  {name:<34} (no measurement)"),
         }
     }
-    crate::figures::record::ram(&[
+    record_ram(&[
         ("pico", "the RP2040 emulator", pico, Some(RAM_BUDGET)),
         ("qemu", "QEMU (lm3s6965evb)", qemu, None),
     ]);
@@ -389,6 +391,56 @@ fn stored_names(image: &Image) -> String {
 #[allow(clippy::cast_precision_loss)] // sizes far below 2^52
 fn kib(bytes: u64) -> f64 {
     bytes as f64 / 1024.0
+}
+
+/// The sizes of the image at `path`, held to `flash_budget`.
+pub fn record_image(path: &Path, image: &Image, flash_budget: Option<u64>) {
+    let name = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let entry = figures::Image {
+        source: figures::Source::now(),
+        flash: image.flash(),
+        flash_budget,
+        static_ram: image.static_ram(),
+        sections: image
+            .sections
+            .iter()
+            .map(|s| figures::Section {
+                name: s.name.clone(),
+                size: s.size,
+                stored: s.stored,
+            })
+            .collect(),
+    };
+    figures::save_section(&format!("sizes of `{name}`"), |f| {
+        f.images.insert(name.clone(), entry);
+    });
+}
+
+/// Static RAM plus the peak stack of each image that has a measurement:
+/// `(image, where the stack was measured, the peak, the ceiling)`.
+pub fn record_ram(rows: &[(&str, &str, Option<Peak>, Option<u64>)]) {
+    let rows: Vec<figures::RamRow> = rows
+        .iter()
+        .filter_map(|&(image, measured_in, peak, budget)| {
+            peak.map(|peak| figures::RamRow {
+                image: image.to_owned(),
+                measured_in: measured_in.to_owned(),
+                static_ram: peak.static_ram,
+                stack: peak.stack,
+                budget,
+            })
+        })
+        .collect();
+    if rows.is_empty() {
+        return;
+    }
+    let source = figures::Source::now();
+    figures::save_section("RAM with the peak stack", |f| {
+        f.ram = Some(figures::Ram { source, rows });
+    });
 }
 
 #[cfg(test)]

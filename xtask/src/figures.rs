@@ -7,11 +7,11 @@
 //!
 //! | section | recorded by | run by |
 //! |---|---|---|
-//! | `images` | [`elf::check_pico`](crate::elf::check_pico) → [`record::image`] | `cargo xtask test` |
-//! | `ram` | [`elf::check_ram`](crate::elf::check_ram) → [`record::ram`] | `cargo xtask test` |
-//! | `qemu` | [`qemu::check_summary`](crate::qemu::check_summary) → [`record::qemu`] | `cargo xtask qemu`, `cargo xtask test` |
-//! | `bench` | [`bench::run_and_check`](crate::bench::run_and_check) → [`record::bench`] | `cargo xtask bench`, `cargo xtask test` |
-//! | `metrics` | [`metrics::command`](crate::metrics::command) → [`record::loop_quality`] | `cargo xtask metrics` |
+//! | `images` | [`elf::check_pico`](crate::elf::check_pico) → [`elf::record_image`](crate::elf::record_image) | `cargo xtask test` |
+//! | `ram` | [`elf::check_ram`](crate::elf::check_ram) → [`elf::record_ram`](crate::elf::record_ram) | `cargo xtask test` |
+//! | `qemu` | [`qemu::check_summary`](crate::qemu::check_summary) → [`qemu::record_figures`](crate::qemu::record_figures) | `cargo xtask qemu`, `cargo xtask test` |
+//! | `bench` | [`bench::run_and_check`](crate::bench::run_and_check) → its `record_figures` | `cargo xtask bench`, `cargo xtask test` |
+//! | `metrics` | [`metrics::command`](crate::metrics::command) → its `record_figures` | `cargo xtask metrics` |
 //!
 //! `cargo xtask book` then writes `docs/design/figures.md` (ignored by git)
 //! with [`write_page`] before it builds the book. Each section says which
@@ -19,7 +19,6 @@
 //! to get it.
 
 mod page;
-pub mod record;
 
 use std::{
     collections::BTreeMap,
@@ -280,7 +279,7 @@ fn update_at(path: &Path, change: impl FnOnce(&mut Figures)) -> Result<()> {
 /// Records a section in [`path`]. A figure that cannot be recorded does not
 /// fail the check that measured it: it is reported, and the book's page
 /// then shows the last figures recorded.
-fn save_section(what: &str, change: impl FnOnce(&mut Figures)) {
+pub fn save_section(what: &str, change: impl FnOnce(&mut Figures)) {
     let path = path();
     match update_at(&path, change) {
         Ok(()) => println!(

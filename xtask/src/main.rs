@@ -44,6 +44,7 @@ mod project;
 mod qemu;
 mod reference;
 mod render;
+mod rp2350;
 mod setup;
 mod sim;
 mod snapshot;

@@ -31,6 +31,7 @@ use idle_head_core::{
 };
 
 use crate::args::LoopShape;
+use crate::figures;
 
 /// The continuity ratio a loop must not exceed (max over P95, both d1 and d2).
 pub const CONTINUITY_LIMIT: f32 = 3.0;
@@ -295,13 +296,45 @@ pub fn command(args: &Args) -> Result<bool> {
         results.push((closure, run(args, closure)?));
     }
     print!("{}", report(&results, args));
-    crate::figures::record::loop_quality(&results, args);
+    record_figures(&results, args);
     println!(
         "{} loops in {:.1} s",
         2 * u64::from(args.seeds),
         start.elapsed().as_secs_f64()
     );
     Ok(true)
+}
+
+/// `cargo xtask metrics`'s distributions.
+fn record_figures(results: &[(Closure, Results)], args: Args) {
+    let closures = results
+        .iter()
+        .map(|(closure, result)| figures::ClosureMetrics {
+            closure: match closure {
+                Closure::Paper => "paper",
+                Closure::Seamless => "seamless",
+            }
+            .to_owned(),
+            rows: ROWS
+                .iter()
+                .map(|(metric, get)| figures::MetricRow {
+                    metric: (*metric).to_owned(),
+                    values: distribution(result.loops.iter().map(get).collect()),
+                })
+                .collect(),
+            discontinuous: result.loops.iter().filter(|m| m.discontinuous()).count(),
+            rejected: result.rejected.len(),
+        })
+        .collect();
+    let entry = figures::Metrics {
+        source: figures::Source::now(),
+        seeds: args.seeds,
+        n: args.shape.n(),
+        w: args.shape.w(),
+        limit: CONTINUITY_LIMIT,
+        closures,
+    };
+    figures::save_section("loop quality", |f| f.metrics = Some(entry));
 }
 
 #[cfg(test)]

@@ -11,6 +11,7 @@ use anyhow::{Context, Result, bail};
 use defmt_decoder::{DecodeError, Locations, Table};
 use xshell::{Cmd, Shell, cmd};
 
+use crate::figures;
 use crate::{
     args::Options,
     child,
@@ -48,7 +49,7 @@ pub fn command(options: Options) -> Result<bool> {
     match check_summary(&run.log) {
         Ok(line) => {
             println!("{line}");
-            crate::figures::record::qemu(&run.log);
+            record_figures(&run.log);
         }
         Err(error) => {
             println!("summary check failed: {error:#}");
@@ -249,6 +250,40 @@ pub fn check_summary(log: &[LogLine]) -> Result<String> {
     }
 }
 
+/// The QEMU smoke run's boot precompute (`precompute_insns` of its summary
+/// line) and the loop sets its log reports. Only the smoke run's: a run
+/// with console traffic would count that traffic in its sets' times.
+pub fn record_figures(log: &[LogLine]) {
+    let entry = figures::QemuRun {
+        source: figures::Source::now(),
+        precompute: Summary::find(log).and_then(|s| s.number("precompute_insns").ok()),
+        sets: log
+            .iter()
+            .filter_map(|line| set_cost(&line.message))
+            .collect(),
+    };
+    figures::save_section("QEMU run", |f| f.qemu = Some(entry));
+}
+
+/// `loop set <n> ready in <µs> us: seeds [..] ([..] discarded), ...`
+fn set_cost(message: &str) -> Option<figures::SetCost> {
+    let rest = message.strip_prefix("loop set ")?;
+    let (set, rest) = rest.split_once(" ready in ")?;
+    let (micros, rest) = rest.split_once(" us")?;
+    // Virtual time under `-icount shift=0`: one instruction a nanosecond,
+    // the frames that preempt the generator included.
+    let instructions = micros.parse::<u64>().ok()?.checked_mul(1000)?;
+    let discarded = rest
+        .split_once('(')
+        .and_then(|(_, after)| after.split_once(" discarded)"))
+        .map_or_else(String::new, |(list, _)| list.to_owned());
+    Some(figures::SetCost {
+        set: set.parse().ok()?,
+        instructions,
+        discarded,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -275,5 +310,21 @@ mod tests {
         let mut shown = Vec::new();
         forward(stderr.as_bytes(), &mut shown);
         assert_eq!(shown, b"qemu-system-arm: a real problem\n");
+    }
+
+    #[test]
+    fn reads_the_loop_set_lines() {
+        let set = set_cost(
+            "loop set 2 ready in 3470 us: seeds [0x417b904f, 0xcbb40bbb, \
+             0xd00c5039] ([2, 3, 3] discarded), entered at [407, 233, 791], join mismatch \
+             [1142, 1108, 1391] mdeg rms",
+        )
+        .unwrap();
+        assert_eq!(
+            (set.set, set.instructions, set.discarded.as_str()),
+            (2, 3_470_000, "[2, 3, 3]")
+        );
+        assert!(set_cost("loop set failed: range; trying the next seeds").is_none());
+        assert!(set_cost("frame 1400: join").is_none());
     }
 }

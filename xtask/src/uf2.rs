@@ -15,7 +15,9 @@
 //! sectors, and every byte the ELF's.
 
 mod format;
+mod problem;
 mod segments;
+mod sizes;
 #[cfg(test)]
 mod test_elf;
 
@@ -26,7 +28,7 @@ use elf2flash_core::boards::{BoardInfo, RP2040, RP2350};
 use object::{Object, ObjectSection};
 
 pub use self::format::Layout;
-use crate::{board::Board, elf, pico2, project, setup};
+use crate::{board::Board, elf, project, rp2350, setup};
 
 /// `cargo xtask uf2`.
 #[derive(Debug, clap::Args)]
@@ -95,7 +97,7 @@ pub fn check_boot(data: &[u8], board: Board) -> Result<()> {
             }
             Ok(())
         }
-        Board::Pico2 => pico2::start_block(data).map(|_| ()),
+        Board::Pico2 => rp2350::start_block(data).map(|_| ()),
     }
 }
 
@@ -194,7 +196,8 @@ pub fn sample_elf() -> Vec<u8> {
 
 #[cfg(test)]
 mod tests {
-    use super::format::{self, BLOCK_SIZE, Problem};
+    use super::format::{self, BLOCK_SIZE};
+    use super::problem::Problem;
     use super::test_elf::{Load, build, pattern};
     use super::*;
 

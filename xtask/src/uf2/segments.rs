@@ -7,7 +7,7 @@ use std::ops::Range;
 use object::read::elf::{ElfFile32, ProgramHeader};
 use object::{Endianness, elf};
 
-use super::format::Problem;
+use super::problem::Problem;
 use crate::board::Board;
 
 /// The contents of one loadable segment.

@@ -132,11 +132,11 @@ pub use fields::{FIELDS, Field, SETTINGS_LEN, field};
 pub use record::{DecodeError, EncodeError, RawRecord, Record};
 #[cfg(feature = "postcard")]
 pub use record::{decode_postcard, encode_postcard};
-pub use report::{FieldReport, FieldSet, Loaded};
+pub use report::{FieldReport, FieldSet, LoadError, Loaded};
 pub use sectors::SectorWise;
 pub use sequential_storage::map::MapConfigError;
 pub use storage::{RamStorage, SettingsStorage, StorageError};
-pub use store::{LoadError, SaveError, SettingsStore, buffer_len};
+pub use store::{SaveError, SettingsStore, buffer_len};
 pub use values::{Settings, SettingsError, SettingsSource, Validated};
 
 /// Bytes of fields a newer firmware may have added that a store of

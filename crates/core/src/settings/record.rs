@@ -1,7 +1,6 @@
 //! The record trait: a settings type, its bytes and its layout version.
 
-use super::report::{FieldReport, Loaded};
-use super::store::LoadError;
+use super::report::{FieldReport, LoadError, Loaded};
 
 /// Bytes of the version in front of a stored record.
 pub(super) const VERSION_LEN: usize = 2;

@@ -5,7 +5,8 @@
 use crate::text::{Describe, Text, display_from_describe};
 
 use super::record::{Record, VERSION_LEN, open_record};
-use super::store::{LoadError, SaveError};
+use super::report::LoadError;
+use super::store::SaveError;
 use super::values::{Settings, SettingsError};
 use super::{SETTINGS_BUFFER, SETTINGS_LEN};
 

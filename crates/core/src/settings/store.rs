@@ -15,7 +15,7 @@ use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapConfigError, MapStorage, SerializationError, Value};
 
 use super::record::{EncodeError, Record, VERSION_LEN, open_record};
-use super::report::Loaded;
+use super::report::{LoadError, Loaded};
 
 /// The map key of the record.
 const KEY: u8 = 0;
@@ -28,38 +28,6 @@ const KEY_LEN: usize = core::mem::size_of::<u8>();
 #[must_use]
 pub const fn buffer_len(record_len: usize) -> usize {
     (KEY_LEN + VERSION_LEN + record_len).next_multiple_of(4)
-}
-
-/// Why no record was loaded: `E` is the flash driver's error, `I` why a
-/// record is invalid ([`Record::Invalid`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum LoadError<E, I> {
-    /// Nothing was ever saved (or the range was erased).
-    Empty,
-    /// The stored bytes are damaged beyond what the store repairs, or do
-    /// not decode as the record.
-    Corrupt,
-    /// A record of an older layout that this firmware cannot migrate.
-    Older {
-        /// Its version.
-        found: u16,
-    },
-    /// A record saved by firmware with a newer layout.
-    Newer {
-        /// Its version.
-        found: u16,
-    },
-    /// A stored item longer than the work buffer: a record saved by a
-    /// firmware with more fields than this one can read at once.
-    TooLong {
-        /// The buffer it needs, in bytes.
-        needs: usize,
-    },
-    /// A record that decodes but fails validation, and why.
-    Invalid(I),
-    /// The flash driver failed.
-    Flash(E),
 }
 
 /// Why a record was not saved; the stored record is unchanged (or, for a
