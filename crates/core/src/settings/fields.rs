@@ -58,12 +58,12 @@ const fn max_len<T: FieldValue>(_: &T) -> usize {
 }
 
 /// Whether no id is listed twice.
-const fn unique(ids: &[u8]) -> bool {
+const fn unique(fields: &[Field]) -> bool {
     let mut i = 0;
-    while i < ids.len() {
+    while i < fields.len() {
         let mut j = i + 1;
-        while j < ids.len() {
-            if ids[i] == ids[j] {
+        while j < fields.len() {
+            if fields[i].id == fields[j].id {
                 return false;
             }
             j += 1;
@@ -168,17 +168,7 @@ macro_rules! fields {
             0 $(+ HEADER + max_len(&$place))+ + GestureKind::COUNT * GESTURE_BLOCK_LEN
         };
 
-        const _: () = {
-            let rows = [$($id),+];
-            let ids = gesture_ids();
-            let mut all = [0; ROWS + GESTURE_FIELDS];
-            let mut i = 0;
-            while i < ROWS + GESTURE_FIELDS {
-                all[i] = if i < ROWS { rows[i] } else { ids[i - ROWS] };
-                i += 1;
-            }
-            assert!(unique(&all), "two fields of the settings share an id");
-        };
+        const _: () = assert!(unique(FIELDS), "two fields of the settings share an id");
 
         impl Fields for Settings {
             const KNOWN: FieldSet = FieldSet::of(&[$($id),+]).union(&FieldSet::of(&gesture_ids()));
