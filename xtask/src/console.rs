@@ -146,7 +146,7 @@ fn pick_pico(ports: &[serialport::SerialPortInfo]) -> Result<PathBuf> {
         ([one], _) | ([], [one]) => Ok(PathBuf::from(one)),
         ([], []) if shared.is_empty() => bail!(
             "no USB serial device {vid:04x}:{pid:04x} found; is the head plugged in, \
-             running the console image (--features console)? (or give --port <dev>)"
+             running the firmware? (or give --port <dev>)"
         ),
         ([], []) => bail!(
             "no head among the USB serial devices {vid:04x}:{pid:04x}: {}; give --port <dev>",

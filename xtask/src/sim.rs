@@ -57,24 +57,26 @@ pub struct Args {
     /// softly again.
     #[arg(long, conflicts_with_all = ["console", "store", "noise", "flood"])]
     pub drill: bool,
-    /// The console image instead (`--features console`, in target/console):
-    /// its memory against the budgets (not enforced), and a scripted
-    /// exchange over UART0 and then over USB CDC-ACM, every reply checked.
+    /// The console instead: a scripted exchange over UART0 and then over
+    /// USB CDC-ACM, every reply checked, and the image's RAM with the peak
+    /// stack of that run against the budget.
     /// Without `--seconds`, 6 s: both scripts and their replies.
     #[arg(long, conflicts_with_all = ["store", "noise", "flood"])]
     pub console: bool,
-    /// The console image's settings store instead: foreign data, then an
-    /// older record, in the settings sectors at power-on; `servo pitch
-    /// neutral 1520` and `save` over UART0 with the flash's worst-case
-    /// erase times, a power cycle, and the next boot on the saved settings.
+    /// The settings store instead: noise, then a record of an unknown
+    /// version, then a record of layout version 1 in the settings sectors
+    /// at power-on (defaults, defaults, the saved settings migrated);
+    /// `servo pitch neutral 1520` and `save` over UART0 with the flash's
+    /// worst-case erase times, a power cycle, and the next boot on the saved
+    /// settings.
     #[arg(long, conflicts_with_all = ["noise", "flood"])]
     pub store: bool,
-    /// The console image with line noise on UART0 instead: a byte received
+    /// Line noise on UART0 instead: a byte received
     /// with a framing error; its line must be answered `err line bytes
     /// lost …`, the next one `ok`.
     #[arg(long, conflicts_with = "flood")]
     pub noise: bool,
-    /// The console image under a UART flood instead: 200 `status` lines
+    /// A UART flood instead: 200 `status` lines
     /// back to back at 115200 baud, more than the replies keep up with
     /// (bytes are lost at the full receive FIFO, as on the chip), then one
     /// more line.

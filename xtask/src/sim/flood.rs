@@ -1,4 +1,4 @@
-//! A flood on the console image's UART in the emulator: more lines than
+//! A flood on the Pico image's UART in the emulator: more lines than
 //! the head can answer at 115200 baud, with no flow control.
 //!
 //! At 3 s the harness sends [`FLOOD_LINES`] `status` lines back to back at
@@ -39,7 +39,7 @@ use crate::project::Metadata;
 use idle_head_core::console::checksum;
 
 /// Stage name.
-pub const FLOOD_STAGE: &str = "console image in the RP2040 emulator: a UART flood with no \
+pub const FLOOD_STAGE: &str = "Pico image in the RP2040 emulator: a UART flood with no \
      flow control: lines that lost bytes say so, the console works on, no frame late";
 
 /// Lines in each flood.

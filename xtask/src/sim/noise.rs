@@ -1,4 +1,4 @@
-//! Line noise on the console image's UART in the emulator: a byte received
+//! Line noise on the Pico image's UART in the emulator: a byte received
 //! with a framing error.
 //!
 //! At 3 s the harness sends `sta`, then a byte with a framing error (as a
@@ -22,7 +22,7 @@ use super::{
 use crate::project::Metadata;
 
 /// Stage name.
-pub const NOISE_STAGE: &str = "console image in the RP2040 emulator: a byte with a framing \
+pub const NOISE_STAGE: &str = "Pico image in the RP2040 emulator: a byte with a framing \
      error on UART0: its line answered `err line bytes lost`, the next one `ok`";
 
 /// The bytes sent, and which of them arrives with a framing error.

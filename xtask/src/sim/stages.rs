@@ -197,24 +197,24 @@ pub fn test_console(
     fail_if_any(&problems)
 }
 
-/// Prints the console image's RAM in `report`'s run, static plus the
+/// Prints the Pico image's RAM in `report`'s run, static plus the
 /// measured peak stack; the problem if it is over the budget or the peak
 /// was not measured.
 pub fn console_ram(elf: &Path, report: &Report) -> Result<Option<String>> {
     let static_ram = elf::Image::read(elf)?.static_ram();
     let Some(stack) = report.peak_stack() else {
         return Ok(Some(format!(
-            "console image RAM: {static_ram} B static, but its peak stack was not measured"
+            "Pico image RAM: {static_ram} B static, but its peak stack was not measured"
         )));
     };
     let ram = static_ram + stack;
     println!(
-        "console image RAM: {static_ram} B static + {stack} B peak stack = {ram} B of the {} B budget",
+        "Pico image RAM: {static_ram} B static + {stack} B peak stack = {ram} B of the {} B budget",
         elf::RAM_BUDGET
     );
     Ok((ram > elf::RAM_BUDGET).then(|| {
         format!(
-            "console image RAM {ram} B (static {static_ram} B + peak stack {stack} B) is over the {} B budget",
+            "Pico image RAM {ram} B (static {static_ram} B + peak stack {stack} B) is over the {} B budget",
             elf::RAM_BUDGET
         )
     }))

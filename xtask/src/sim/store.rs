@@ -1,4 +1,4 @@
-//! The console image's settings store on the emulated chip: `save` through
+//! The Pico image's settings store on the emulated chip: `save` through
 //! the boot ROM's flash functions, a power cycle, and the next boot on the
 //! saved settings.
 //!
@@ -50,7 +50,7 @@ use super::{
 use crate::{elf, project::Metadata};
 
 /// Stage name.
-pub const STORE_STAGE: &str = "console image in the RP2040 emulator: `save` to flash with \
+pub const STORE_STAGE: &str = "Pico image in the RP2040 emulator: `save` to flash with \
      worst-case erase times, power cycle, the next boot on the saved settings";
 
 /// The datasheet's worst times (W25Q16JV): a sector erase, a page program.
