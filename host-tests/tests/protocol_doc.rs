@@ -1,8 +1,9 @@
 //! The exchanges in `docs/user/protocol.md` are what the console does: every
 //! `> line` of an example, sent to the firmware's console service on a
 //! simulated head (built-in settings, one frame played after each line,
-//! the examples in the order of the document), gets the `< reply` written
-//! under it, byte for byte.
+//! and the frames a queued action's reply waits for; the examples in the
+//! order of the document), gets the `< reply` written under it, byte for
+//! byte.
 
 use host_tests::console::head::{SimFrames, service, shared};
 use idle_head_core::console::Session;
@@ -26,9 +27,15 @@ fn the_examples_in_the_protocol_document_hold() {
             .and_then(|l| l.strip_prefix("< "))
             .unwrap_or_else(|| panic!("`> {sent}` has no `< ` reply under it"));
         let mut got = Vec::new();
-        session.feed(format!("{sent}\r\n").as_bytes(), &mut handler, |r| {
-            got.push(String::from_utf8(r.to_vec()).unwrap());
-        });
+        for &byte in format!("{sent}\r\n").as_bytes() {
+            if let Some(r) = session.push(byte, &mut handler) {
+                got.push(String::from_utf8(r.to_vec()).unwrap());
+            }
+            // A queued action's reply: once the frame task took it.
+            if let Some(r) = frames.finish(&mut session, queue, link, 0) {
+                got.push(String::from_utf8(r.to_vec()).unwrap());
+            }
+        }
         frames.frame(queue, link);
         assert_eq!(got, [format!("{want}\r\n")], "`> {sent}`");
         exchanges += 1;
