@@ -295,7 +295,7 @@ impl Later {
     /// Finishes the reply in `out`, the buffer [`respond`] wrote into,
     /// `write` writing its verdict (a reply left alone, or deferred
     /// again, is a bare `ok`).
-    pub fn finish<'b>(self, out: &'b mut [u8], write: impl FnOnce(&mut Reply<'_>)) -> &'b [u8] {
+    pub fn finish(self, out: &mut [u8], write: impl FnOnce(&mut Reply<'_>)) -> &[u8] {
         let mut reply = Reply::resume(out, self.start);
         write(&mut reply);
         if self.machine {

@@ -44,6 +44,7 @@ impl<S: SettingsStorage> Shared<S> {
     }
 
     /// The port.
+    #[must_use]
     pub const fn port(&self) -> u8 {
         self.port
     }
