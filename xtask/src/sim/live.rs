@@ -33,17 +33,15 @@ pub enum LiveEvent {
     Bytes(Vec<u8>),
     /// The CDC-ACM host configured the device: the port is open.
     Connected,
-    /// A compare register write of a servo's PWM slice: the servo
-    /// (0 pitch, 1 roll, 2 yaw) and its new duty in counts.
-    Duty(usize, u16),
     /// The run ended, and why.
     End(String),
 }
 
-/// Starts `elf` live in the emulator: the settings store's flash
-/// functions as in the store run (`save` and `load` work), the servo
-/// slices' compare writes reported.
-pub fn start(root: &Path, elf: &Path) -> Result<Live> {
+/// The harness's argument for a live run of `elf`: the settings store's
+/// flash functions as in the store run (`save` and `load` work), the servo
+/// slices' compare writes reported (`cc` events of slices 0, 1, 2: pitch,
+/// roll, yaw).
+pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
     let image = PicoImage::read(elf)?;
     node::ensure(root)?;
     let flash = elf.with_extension("live.bin");
@@ -58,9 +56,15 @@ pub fn start(root: &Path, elf: &Path) -> Result<Live> {
         live: true,
         ..node::Config::default()
     };
+    Ok(config.json())
+}
+
+/// Starts `elf` live in the emulator ([`config`]).
+pub fn start(root: &Path, elf: &Path) -> Result<Live> {
+    let config = config(root, elf)?;
     let mut child = Command::new("node")
         .arg("harness.mjs")
-        .arg(config.json().to_string())
+        .arg(config.to_string())
         .current_dir(node::folder(root))
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
@@ -81,7 +85,7 @@ pub fn start(root: &Path, elf: &Path) -> Result<Live> {
 /// # Errors
 /// The harness has gone.
 pub fn send(stdin: &mut impl Write, bytes: &[u8]) -> std::io::Result<()> {
-    let mut line: String = bytes.iter().map(|b| format!("{b:02x}")).collect();
+    let mut line = node::hex(bytes);
     line.push('\n');
     stdin.write_all(line.as_bytes())?;
     stdin.flush()
@@ -90,17 +94,11 @@ pub fn send(stdin: &mut impl Write, bytes: &[u8]) -> std::io::Result<()> {
 /// Reads the harness's events until it ends, handing each that matters
 /// to `each`; the last is [`LiveEvent::End`].
 pub fn events(stdout: ChildStdout, mut each: impl FnMut(LiveEvent)) {
-    let slices: Vec<u8> = SERVOS.iter().map(|s| s.2).collect();
     let mut why = "the emulator stopped".to_owned();
     for line in BufReader::new(stdout).lines().map_while(Result::ok) {
         match Event::parse(&line) {
             Ok(Event::Usb { hex, .. }) => each(LiveEvent::Bytes(hex)),
             Ok(Event::UsbConnected { .. }) => each(LiveEvent::Connected),
-            Ok(Event::Cc { slice, value, .. }) => {
-                if let Some(servo) = slices.iter().position(|s| *s == slice) {
-                    each(LiveEvent::Duty(servo, (value & 0xffff) as u16));
-                }
-            }
             Ok(Event::End { why: end, .. }) => why = format!("the emulator stopped ({end:?})"),
             Ok(_) => {}
             Err(e) => why = format!("{e:#}"),
