@@ -49,8 +49,8 @@ function banner(text, { reconnect = false, info = false } = {}) {
 
 function setControls(enabled) {
   for (const el of document.querySelectorAll('#actions button, #actions input, #calibration button, #calibration input')) {
-    if (el.id === 'limit-stop') continue;
-    el.disabled = !enabled;
+    // Stop is for a "go to limit" in progress only.
+    el.disabled = !enabled || (el.id === 'limit-stop' && !limitRun);
   }
   $('lookpad').setAttribute('aria-disabled', String(!enabled));
 }
@@ -464,6 +464,7 @@ async function setField(field, value) {
     line = `servo ${axis} ${field.key} ${Math.round(value)}`;
   }
   const reply = await ask(line);
+  why.classList.toggle('warn', reply.startsWith('ok'));
   if (reply.startsWith('ok')) {
     servo[field.key] = value;
     if (reply.startsWith('ok warning')) why.textContent = reply.replace(/^ok warning: /, 'warning: ');

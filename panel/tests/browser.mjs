@@ -312,6 +312,7 @@ async function bridgeSession() {
       return match ? Number(match[3]) : NaN;
     };
     await page.goto(cfg.url);
+    await until(async () => (await page.locator('#state').textContent()).startsWith('connected'), 20000, 'connected on load');
     check((await page.locator('#transport').textContent()).startsWith('bridged to'), `connected on load, no chooser: ${await page.locator('#transport').textContent()}`);
     await session(page, { yawPulse });
     check(errors.length === 0, `no page errors${errors.length ? `: ${errors.join('; ')}` : ''}`);
