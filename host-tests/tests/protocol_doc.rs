@@ -62,3 +62,39 @@ fn the_protocol_document_lists_every_gesture() {
         );
     }
 }
+
+/// The telemetry example and the bandwidth figures in the document are
+/// the firmware's: its line for that status, and the arithmetic on it.
+#[test]
+fn the_telemetry_figures_in_the_protocol_document_hold() {
+    use idle_head_core::console::{HeadMode, HeadStatus, TELEMETRY_LINE, telemetry_line};
+    use idle_head_core::{Angle, Microseconds};
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/user/protocol.md");
+    let doc = std::fs::read_to_string(path).expect("docs/user/protocol.md");
+    let status = HeadStatus {
+        frame: 123_440 / 20,
+        mode: HeadMode::Running,
+        angles: [-1505, -119, -236].map(Angle::from_millidegrees),
+        pulses: [1483, 1499, 1497].map(Microseconds),
+        faults: [0; 3],
+        disabled: [false; 3],
+    };
+    let mut out = [0; TELEMETRY_LINE];
+    let line = telemetry_line(&status, 20_000, 0, &mut out);
+    let text = std::str::from_utf8(line).unwrap();
+    assert!(doc.contains(text.trim_end()), "the document's example line: {text}");
+    let bytes = line.len();
+    // 50 lines a second, 10 bits a byte on the UART (8N1), 115200 baud.
+    let per_second = bytes * 50;
+    let percent = |n: usize| n * 50 * 10 * 100 / 115_200;
+    let figures = [
+        format!("about {bytes} bytes"),
+        format!("{},{:03} bytes", per_second / 1000, per_second % 1000),
+        format!("{},{:03} bits a second", per_second * 10 / 1000, per_second * 10 % 1000),
+        format!("{} % of UART0", percent(bytes)),
+        format!("({TELEMETRY_LINE} bytes) would take {} %", percent(TELEMETRY_LINE)),
+    ];
+    for figure in figures {
+        assert!(doc.contains(&figure), "docs/user/protocol.md should say `{figure}`");
+    }
+}

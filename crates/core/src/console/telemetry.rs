@@ -2,7 +2,7 @@
 //! frame left them, streamed by a port's console task between replies.
 //!
 //! ```text
-//! ~ t=123440 p=-1505 r=-119 y=-236 us=1483,1499,1497 lost=0 *3c
+//! ~ t=123440 p=-1505 r=-119 y=-236 us=1483,1499,1497 lost=0 *c4
 //! ```
 //!
 //! A line starts with `~`, which no reply starts with (`ok`, `err`, `#`),
