@@ -314,7 +314,10 @@ pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Resu
     }
     println!();
     QEMU.build(root)?;
-    println!("{}", telemetry::check(&QEMU.elf(metadata), options.timeout)?);
+    println!(
+        "{}",
+        telemetry::check(&QEMU.elf(metadata), options.timeout)?
+    );
     if let Some(over) = frames_over_budget(&frames) {
         if options.no_budget {
             println!("(--no-budget: the frame ceilings are reported, not enforced)");

@@ -9,7 +9,7 @@
 //! not touch; this run shows it on the image as it plays: the frame work
 //! the smoke run logs (instructions between the frame hooks: commands,
 //! frame update, status, fault log) must be the same with and without the
-//! stream, on average and at worst, within one SysTick count (the smoke
+//! stream, on average and at worst, within one `SysTick` count (the smoke
 //! run counts 80 instructions a count; a frame's wake-up moves against the
 //! count's edges when the console holds a critical section, and the time
 //! driver's alarm for the console's telemetry timer, an interrupt above the
@@ -32,7 +32,7 @@ use crate::console::{Pace, qemu_session};
 use crate::log::LogLine;
 use crate::qemu::{self, Echo};
 
-/// Instructions per SysTick count in the smoke run: 12.5 MHz after reset
+/// Instructions per `SysTick` count in the smoke run: 12.5 MHz after reset
 /// under `-icount shift=0` (`boards/qemu/src/systick.rs`).
 const INSNS_PER_COUNT: u64 = 80;
 
@@ -115,7 +115,9 @@ pub fn check(elf: &Path, timeout: Duration) -> Result<String> {
     );
     let count = INSNS_PER_COUNT;
     if with.0.abs_diff(without.0) > count || with.1.abs_diff(without.1) > count {
-        bail!("{line}: telemetry changed the frame work by more than one count ({count} instructions)");
+        bail!(
+            "{line}: telemetry changed the frame work by more than one count ({count} instructions)"
+        );
     }
     Ok(format!(
         "{line}\ntelemetry adds nothing to the frame path (within one count of {count} \
