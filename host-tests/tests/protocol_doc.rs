@@ -82,7 +82,10 @@ fn the_telemetry_figures_in_the_protocol_document_hold() {
     let mut out = [0; TELEMETRY_LINE];
     let line = telemetry_line(&status, 20_000, 0, &mut out);
     let text = std::str::from_utf8(line).unwrap();
-    assert!(doc.contains(text.trim_end()), "the document's example line: {text}");
+    assert!(
+        doc.contains(text.trim_end()),
+        "the document's example line: {text}"
+    );
     let bytes = line.len();
     // 50 lines a second, 10 bits a byte on the UART (8N1), 115200 baud.
     let per_second = bytes * 50;
@@ -90,11 +93,21 @@ fn the_telemetry_figures_in_the_protocol_document_hold() {
     let figures = [
         format!("about {bytes} bytes"),
         format!("{},{:03} bytes", per_second / 1000, per_second % 1000),
-        format!("{},{:03} bits a second", per_second * 10 / 1000, per_second * 10 % 1000),
+        format!(
+            "{},{:03} bits a second",
+            per_second * 10 / 1000,
+            per_second * 10 % 1000
+        ),
         format!("{} % of UART0", percent(bytes)),
-        format!("({TELEMETRY_LINE} bytes) would take {} %", percent(TELEMETRY_LINE)),
+        format!(
+            "({TELEMETRY_LINE} bytes) would take {} %",
+            percent(TELEMETRY_LINE)
+        ),
     ];
     for figure in figures {
-        assert!(doc.contains(&figure), "docs/user/protocol.md should say `{figure}`");
+        assert!(
+            doc.contains(&figure),
+            "docs/user/protocol.md should say `{figure}`"
+        );
     }
 }
