@@ -315,10 +315,33 @@ async function bridgeSession() {
     await until(async () => (await page.locator('#state').textContent()).startsWith('connected'), 20000, 'connected on load');
     check((await page.locator('#transport').textContent()).startsWith('bridged to'), `connected on load, no chooser: ${await page.locator('#transport').textContent()}`);
     await session(page, { yawPulse });
+    if (cfg.label === 'qemu') await gazeControls(page);
     check(errors.length === 0, `no page errors${errors.length ? `: ${errors.join('; ')}` : ''}`);
   } finally {
     await chrome.close();
   }
+}
+
+/** The look pad from the keyboard, and "go to limit" (yaw). */
+async function gazeControls(page) {
+  const pad = page.getByRole('slider', { name: /Look pad/ });
+  await pad.focus();
+  for (let i = 0; i < 5; i++) await page.keyboard.press('ArrowRight');
+  await page.keyboard.press('Enter');
+  const yaw = await until(async () => {
+    const value = await readout(page, 'yaw');
+    return value > 8 ? value : null;
+  }, 4000, 'the head looks 10° to the right');
+  check(true, `look pad from the keyboard (5 × ArrowRight, Enter): yaw readout ${yaw}°`);
+  await page.getByRole('radio', { name: 'yaw' }).check();
+  const limit = Number(await page.getByLabel('upper limit (°)').inputValue());
+  await page.getByRole('button', { name: 'Go to upper limit' }).click();
+  const reached = await until(async () => {
+    const value = await readout(page, 'yaw');
+    return Math.abs(value - limit) < 0.5 ? value : null;
+  }, 10000, `yaw steps to its upper limit, ${limit}°`);
+  check(true, `go to upper limit: yaw readout ${reached}° (limit ${limit}°), stepped 1° every 100 ms`);
+  await page.getByRole('button', { name: 'Center' }).click();
 }
 
 try {
