@@ -30,7 +30,8 @@
 //   live:       optional, true: a head for a person (`cargo xtask panel --sim`): the chip runs
 //               at real time (virtual time kept within a few ms of the wall clock since the
 //               start) for as long as stdin is open; each stdin line is hex digits, bytes for
-//               the USB serial port (sent once the CDC-ACM host has configured the device);
+//               the USB serial port (sent once the CDC-ACM host has configured the device),
+//               or `dtr 0` / `dtr 1`: the host closes or opens the port (DTR and RTS);
 //               the bytes the device sends are `usb` events, the log `rtt` events, flushed as
 //               they come; `ns`, `silence_ns`, `uart`, `usb` and the power cycles are not used,
 // }
@@ -302,6 +303,7 @@ function usbHost(chip) {
   };
   cdc.onDeviceConnected = () => {
     emit({ ev: 'usb_connected', ns: now() });
+    usbLines = (value) => cdc.cdcSetControlLineState(value);
     if (cfg.live) usbLive = sendBytes;
     else usbSend = () => sendBytes(Buffer.from(cfg.usb.hex, 'hex'));
   };
@@ -312,6 +314,7 @@ function usbHost(chip) {
 }
 let usbSend = null; // sends the USB script, once the device is configured
 let usbLive = null; // sends bytes from stdin (a live run), once the device is configured
+let usbLines = null; // sets the host's control lines (DTR, RTS), once the device is configured
 function feedUsb() {
   if (usbSend && now() >= cfg.usb.at_ns) {
     usbSend();
@@ -513,11 +516,16 @@ function run() {
 const AHEAD_NS = 5e6;
 async function runLive() {
   const pending = []; // bytes from stdin, waiting for the device
+  const controls = []; // control line states from stdin, waiting for the device
   let carry = '';
   process.stdin.on('data', (chunk) => {
     const lines = (carry + chunk.toString('latin1')).split('\n');
     carry = lines.pop();
-    for (const line of lines) pending.push(...Buffer.from(line.trim(), 'hex'));
+    for (const line of lines) {
+      const dtr = /^dtr ([01])$/.exec(line.trim());
+      if (dtr) controls.push(dtr[1] === '1' ? 0x3 : 0x0);
+      else pending.push(...Buffer.from(line.trim(), 'hex'));
+    }
   });
   process.stdin.on('end', () => {
     stop = stop ?? 'closed';
@@ -527,6 +535,7 @@ async function runLive() {
   const wallNs = () => Number(process.hrtime.bigint() - t0);
   while (!stop) {
     if (usbLive && pending.length) usbLive(pending.splice(0));
+    if (usbLines && controls.length) usbLines(controls.shift());
     const until = wallNs() + AHEAD_NS;
     const { core, clock } = mcu;
     while (!stop && !watchdogFired && now() < until) {

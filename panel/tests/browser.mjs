@@ -218,6 +218,7 @@ async function serialSession() {
   const pitchDuties = [];
   let page = null;
   let port = -1; // the fake port the emulator's USB port is plugged into
+  let telemetry = 0; // telemetry lines the emulated head sent
   let mode = 'normal'; // or 'old' (answers `watch` with err), 'swallow' (drops `seed` lines)
   let line = '';
   const toPage = (bytes) => page?.evaluate(([id, b]) => window.__serialData(id, b), [port, bytes]).catch(() => {});
@@ -228,7 +229,11 @@ async function serialSession() {
     while ((end = buffered.indexOf('\n')) >= 0) {
       const event = JSON.parse(buffered.slice(0, end));
       buffered = buffered.slice(end + 1);
-      if (event.ev === 'usb') toPage(Array.from(Buffer.from(event.hex, 'hex')));
+      if (event.ev === 'usb') {
+        const bytes = Buffer.from(event.hex, 'hex');
+        telemetry += (bytes.toString('latin1').match(/~ t=/g) ?? []).length;
+        toPage(Array.from(bytes));
+      }
       if (event.ev === 'cc' && event.slice <= 2) {
         duty[event.slice] = event.value & 0xffff;
         if (event.slice === 0) pitchDuties.push({ at: Date.now(), us: ((event.value & 0xffff) * 20000) / 64000 });
@@ -290,6 +295,21 @@ async function serialSession() {
     await until(async () => (await page.locator('#banner-text').textContent()).includes('no reply'), 6000, 'the page says a reply never came');
     check(await page.getByRole('button', { name: 'Reconnect' }).isVisible(), `no reply: "${await page.locator('#banner-text').textContent()}", with Reconnect`);
     check(errors.length === 0, `no page errors${errors.length ? `: ${errors.join('; ')}` : ''}`);
+
+    // The host closes the port (DTR drops): the telemetry stops, and does
+    // not come back when it opens the port again until asked.
+    const send = (text) => harness.stdin.write(Buffer.from(text).toString('hex') + '\n');
+    send('watch 50\n');
+    await sleep(500);
+    const streaming = telemetry;
+    await sleep(300);
+    check(telemetry - streaming >= 10, `watch 50 from the host: ${telemetry - streaming} lines in 300 ms`);
+    harness.stdin.write('dtr 0\n');
+    await sleep(200);
+    const closed = telemetry;
+    harness.stdin.write('dtr 1\n');
+    await sleep(500);
+    check(telemetry === closed, `DTR dropped: the telemetry stopped (${telemetry - closed} lines after it)`);
   } finally {
     await chrome.close();
     harness.stdin.end();
