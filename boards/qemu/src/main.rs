@@ -144,7 +144,11 @@ fn main() -> ! {
         ),
     }
 
-    systick::start_time_driver(&mut core.SYST);
+    let period = match mode {
+        console::Mode::Interactive => systick::INTERACTIVE_PERIOD,
+        console::Mode::Smoke | console::Mode::Held => systick::DRIVER_PERIOD,
+    };
+    systick::start_time_driver(&mut core.SYST, period);
 
     let Some((thread, frame_executor)) = executor::take() else {
         exit::exit(false)
