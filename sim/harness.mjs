@@ -27,6 +27,13 @@
 //   flash_fill: optional, {addr, hex}: bytes written over the image's flash before power-on,
 //   power_cycles_ns: optional, virtual times at which the power goes off and on again:
 //               the next boot starts from the flash as the last one left it, nothing else kept,
+//   live:       optional, true: a head for a person (`cargo xtask panel --sim`): the chip runs
+//               at real time (virtual time kept within a few ms of the wall clock since the
+//               start) for as long as stdin is open; each stdin line is hex digits, bytes for
+//               the USB serial port (sent once the CDC-ACM host has configured the device),
+//               or `dtr 0` / `dtr 1`: the host closes or opens the port (DTR and RTS);
+//               the bytes the device sends are `usb` events, the log `rtt` events, flushed as
+//               they come; `ns`, `silence_ns`, `uart`, `usb` and the power cycles are not used,
 // }
 //
 // Events ("ns" is virtual time since power-on, across resets):
@@ -50,7 +57,8 @@
 //                                                   accesses to a register rp2040js does not
 //                                                   model, counted over the run (at its end)
 //   {"ev":"emu","level":"warn","msg":".."}          another complaint of the emulator
-//   {"ev":"end","why":"time|silent|asleep|wall|break|error","ns":..,"instructions":..,"wall_ms":..}
+//   {"ev":"end","why":"time|silent|asleep|wall|break|error|closed","ns":..,"instructions":..,"wall_ms":..}
+//                                                   ("closed": stdin closed, in a live run)
 
 import { readFileSync } from 'node:fs';
 import { RP2040, USBCDC } from 'rp2040js';
@@ -143,7 +151,7 @@ function powerUp(kept) {
   uartAsOnTheChip(chip.uart[0], () => now());
   xipControlAsOnTheChip(chip);
   roscRandomBit(chip);
-  if (cfg.usb && boot === 0) usbHost(chip);
+  if ((cfg.usb || cfg.live) && boot === 0) usbHost(chip);
   chip.uart[0].onByte = (byte) => {
     if (uartTx.bytes.length === 0) uartTx.ns = now();
     uartTx.bytes.push(byte);
@@ -276,16 +284,28 @@ function usbHost(chip) {
     if (endpoint === cdc.outEndpoint && cdc.txFIFO.empty) waiting = { endpoint, size };
     else read(endpoint, size);
   };
+  // Its SET_CONTROL_LINE_STATE (DTR and RTS on) goes to the device, where
+  // a real host (and the CDC-ACM class) addresses the communication
+  // interface (bmRequestType 0x21): the device never sees DTR, which says
+  // that a terminal has the port open. Sent as a host sends it.
+  cdc.cdcSetControlLineState = function (value = 0x3, interfaceNumber = 0) {
+    const setup = new Uint8Array([0x21, 0x22, value & 0xff, value >> 8, interfaceNumber, 0, 0, 0]);
+    this.usb.sendSetupPacket(setup);
+    this.initialized = true;
+  };
+  const sendBytes = (bytes) => {
+    for (const byte of bytes) cdc.sendSerialByte(byte);
+    if (waiting && !cdc.txFIFO.empty) {
+      const { endpoint, size } = waiting;
+      waiting = null;
+      read(endpoint, size);
+    }
+  };
   cdc.onDeviceConnected = () => {
     emit({ ev: 'usb_connected', ns: now() });
-    usbSend = () => {
-      for (const byte of Buffer.from(cfg.usb.hex, 'hex')) cdc.sendSerialByte(byte);
-      if (waiting) {
-        const { endpoint, size } = waiting;
-        waiting = null;
-        read(endpoint, size);
-      }
-    };
+    usbLines = (value) => cdc.cdcSetControlLineState(value);
+    if (cfg.live) usbLive = sendBytes;
+    else usbSend = () => sendBytes(Buffer.from(cfg.usb.hex, 'hex'));
   };
   cdc.onSerialData = (bytes) => {
     emit({ ev: 'usb', ns: now(), hex: Buffer.from(bytes).toString('hex') });
@@ -293,6 +313,8 @@ function usbHost(chip) {
   };
 }
 let usbSend = null; // sends the USB script, once the device is configured
+let usbLive = null; // sends bytes from stdin (a live run), once the device is configured
+let usbLines = null; // sets the host's control lines (DTR, RTS), once the device is configured
 function feedUsb() {
   if (usbSend && now() >= cfg.usb.at_ns) {
     usbSend();
@@ -487,8 +509,87 @@ function run() {
   flush();
 }
 
+// A live run: the chip at real time, stdin to its USB serial port. The
+// chip runs in slices up to a few ms ahead of the wall clock, then the
+// harness sleeps until the wall clock catches up, so timers, the frames and
+// the replies come at their true times; stdin is read between slices.
+const AHEAD_NS = 5e6;
+async function runLive() {
+  const pending = []; // bytes from stdin, waiting for the device
+  const controls = []; // control line states from stdin, waiting for the device
+  let carry = '';
+  process.stdin.on('data', (chunk) => {
+    const lines = (carry + chunk.toString('latin1')).split('\n');
+    carry = lines.pop();
+    for (const line of lines) {
+      const dtr = /^dtr ([01])$/.exec(line.trim());
+      if (dtr) controls.push(dtr[1] === '1' ? 0x3 : 0x0);
+      else pending.push(...Buffer.from(line.trim(), 'hex'));
+    }
+  });
+  process.stdin.on('end', () => {
+    stop = stop ?? 'closed';
+  });
+  startBoot({ flash: firstFlash() });
+  const t0 = process.hrtime.bigint();
+  const wallNs = () => Number(process.hrtime.bigint() - t0);
+  while (!stop) {
+    if (usbLive && pending.length) usbLive(pending.splice(0));
+    if (usbLines && controls.length) usbLines(controls.shift());
+    const until = wallNs() + AHEAD_NS;
+    const { core, clock } = mcu;
+    while (!stop && !watchdogFired && now() < until) {
+      if (core.waiting) {
+        const wait = clock.nanosToNextAlarm;
+        const sending = mcu.uart[0].txDue() - now();
+        if (sending <= 0) {
+          mcu.uart[0].sendDue();
+          continue;
+        }
+        // Asleep with nothing due before `until`: on to the wall clock.
+        let step = until - now();
+        if (wait > 0 && wait < step) step = wait;
+        if (sending !== Infinity && sending < step) step = sending;
+        clock.tick(step);
+        continue;
+      }
+      const pc = core.PC;
+      const cycles = core.executeInstruction();
+      instructions++;
+      clock.tick(cycles * NS_PER_CYCLE);
+      const inFlash = pc >= FLASH_START && pc < RAM_START;
+      const opcode = inFlash ? mcu.flash16[(pc - FLASH_START) >>> 1] : mcu.readUint16(pc);
+      if (opcode === OP_SEV) core.eventRegistered = true;
+      if ((instructions & 63) === 0 && cfg.rtt) drainRtt();
+      if ((instructions & 15) === 0) mcu.uart[0].sendDue();
+    }
+    if (cfg.rtt) drainRtt();
+    flushRtt();
+    flushUart();
+    flush();
+    if (watchdogFired) {
+      emit({ ev: 'watchdog', ns: now(), reason: watchdogFired.reason });
+      const kept = {
+        flash: mcu.flash.slice(),
+        sram: mcu.sram.slice(),
+        reason: watchdogFired.reason,
+        scratch: watchdogFired.scratch,
+      };
+      startBoot(kept);
+      continue;
+    }
+    const ahead = (now() - wallNs()) / 1e6;
+    await new Promise((resolve) => setTimeout(resolve, Math.max(0, ahead)));
+  }
+  emitUnmodelled();
+  emit({ ev: 'end', why: stop, ns: now(), instructions, wall_ms: Date.now() - started });
+  flush();
+  process.exit(0);
+}
+
 try {
-  run();
+  if (cfg.live) await runLive();
+  else run();
 } catch (error) {
   emitUnmodelled();
   emit({ ev: 'end', why: 'error', msg: String(error?.stack ?? error), ns: mcu ? now() : 0, instructions, wall_ms: Date.now() - started });

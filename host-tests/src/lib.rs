@@ -161,7 +161,8 @@ pub mod strategies {
 
     /// A valid calibration with limits within `±limit` m° and `per_degree`
     /// ns/°: random neutral, scale, direction and limits, with pulse limits
-    /// just wide enough (plus a random margin) to reach the limits.
+    /// just wide enough (plus a random margin) to reach the limits, inside
+    /// the hard pulse bounds.
     pub fn calibration_in(
         limit: i32,
         per_degree: RangeInclusive<u32>,
@@ -176,6 +177,14 @@ pub mod strategies {
             0u32..200,
         )
             .prop_map(|(neutral, per_degree, reversed, lo, hi, below, above)| {
+                // The limits' pulses, margins included, stay inside the
+                // hard bounds (500..=2500 µs): at most 700 µs below the
+                // neutral pulse and 2300 µs above, less the margin.
+                let room = |us: u32| i64::from(us) * 1_000_000 / i64::from(per_degree.max(1));
+                let (down, up) = (room(neutral - 700), room(2300 - neutral));
+                let (down, up) = if reversed { (up, down) } else { (down, up) };
+                let lo = i64::from(lo).max(-down) as i32;
+                let hi = i64::from(hi).min(up) as i32;
                 let mut cal = ServoCalibration {
                     neutral: Microseconds(neutral),
                     per_degree: NanosPerDegree(per_degree),

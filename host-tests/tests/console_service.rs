@@ -12,7 +12,9 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use host_tests::console::head::{SimFrames, service, shared};
 use host_tests::console::{LINE, REPLY, count_line_ends, random_line, random_stream, rng};
 use idle_head_core::behaviour::{Applied, CommandQueue};
-use idle_head_core::console::{ConsoleLink, ConsoleService, ErrorCode, Session, parse, respond};
+use idle_head_core::console::{
+    ConsoleLink, ConsoleService, ErrorCode, Response, Session, outcome_reply, parse, respond,
+};
 use idle_head_core::settings::{RamStorage, SettingsStorage, StorageError};
 use proptest::prelude::RngExt as _;
 
@@ -36,8 +38,8 @@ impl Console {
         }
     }
 
-    /// Feeds `text` (lines) to the service, a frame after each line; the
-    /// replies.
+    /// Feeds `text` (lines) to the service, a frame after each line (and
+    /// the frames a queued action's reply waits for); the replies.
     fn say(&mut self, text: &str) -> Vec<String> {
         let mut session = Session::<LINE, REPLY>::new();
         let mut replies = Vec::new();
@@ -45,9 +47,15 @@ impl Console {
             session.feed(line.as_bytes(), &mut self.service, |_| {
                 panic!("reply before the line end")
             });
-            session.feed(b"\n", &mut self.service, |r| {
-                replies.push(String::from_utf8(r.to_vec()).unwrap().trim_end().to_owned());
-            });
+            let reply = match session.push(b'\n', &mut self.service) {
+                Some(reply) => reply.to_vec(),
+                None => self
+                    .frames
+                    .finish(&mut session, self.queue, self.link, 0)
+                    .expect("a reply that waits")
+                    .to_vec(),
+            };
+            replies.push(String::from_utf8(reply).unwrap().trim_end().to_owned());
             self.play(1);
         }
         replies
@@ -74,11 +82,26 @@ fn every_command_does_what_it_says() {
         "{}",
         r[1]
     );
-    // Motion goes through the queue; a refused one says why.
+    // Motion goes through the queue, and the reply says what the frame
+    // task started; a refused one says why.
     let r = c.say("nod\nlook 5000 -12000\nnod 90000\ncenter");
-    assert_eq!(r[..2], ["ok", "ok"]);
+    assert!(r[0].starts_with("ok nod amp_mdeg="), "{}", r[0]);
+    assert!(
+        r[1].starts_with("ok look pitch=5000 yaw=-12000 ms="),
+        "{}",
+        r[1]
+    );
     assert!(r[2].starts_with("err limit "), "{}", r[2]);
-    assert_eq!(r[3], "ok");
+    assert!(r[3].starts_with("ok center ms="), "{}", r[3]);
+    // Gestures faster than their layers free up: the head refuses, and
+    // the console says so (with the time to try again).
+    let r = c.say("shake\nnod\ntilt\nnod");
+    assert!(
+        r.iter()
+            .any(|r| r.starts_with("err busy gestures: every layer is busy; try again in ")),
+        "{r:?}"
+    );
+    assert_eq!(c.frames.refused, c.frames.refusals_told);
     // Servo: show, change, invalid, past the limits.
     let r = c.say(
         "servo yaw\nservo yaw neutral 1520\nservo yaw min 2600\nservo pitch limits -1000 1000",
@@ -119,7 +142,7 @@ fn every_command_does_what_it_says() {
     assert!(r[7].ends_with("settings=defaults"), "{}", r[7]);
     assert_eq!(c.frames.config().servos[2].neutral.0, 1500);
     // Stop, and status says so (after the fade).
-    c.say("stop");
+    assert_eq!(c.say("stop"), ["ok stopping"]);
     c.play(200);
     assert!(c.say("status")[0].starts_with("ok mode=stopped"));
     assert_eq!(c.frames.violations, 0);
@@ -132,7 +155,7 @@ fn new_servo_limits_reach_the_gestures_and_the_looks() {
     // at 30° is clamped to 20°, as the reply says.
     let r = c.say("nod 22000 2000\nlook 30000 0 400 hold=stay");
     assert!(r[0].starts_with("err limit nod amplitude 22°"), "{}", r[0]);
-    assert_eq!(r[1], "ok clamped pitch=20000 yaw=0");
+    assert_eq!(r[1], "ok look pitch=20000 yaw=0 ms=400 hold=stay clamped");
     let Some(Applied::Look(look)) = c.frames.last_applied else {
         panic!("{:?}", c.frames.last_applied)
     };
@@ -140,14 +163,34 @@ fn new_servo_limits_reach_the_gestures_and_the_looks() {
     // Wider limits: the 22° nod the console now accepts is played, not
     // refused by the head, and a look goes as far as the new limits.
     let r = c.say("center 400\nservo pitch limits -25000 25000\nnod 22000 1500 cycles=1");
-    assert_eq!(r, ["ok", "ok", "ok"]);
+    assert_eq!(
+        r,
+        [
+            "ok center ms=400",
+            "ok",
+            "ok nod amp_mdeg=22000 ms=1500 cycles=1 intensity=50"
+        ]
+    );
     c.play(150);
     assert!(matches!(c.frames.last_applied, Some(Applied::Gesture(_))));
     let r = c.say("look 30000 0 400 hold=stay\nlook 24000 0 400 hold=stay");
-    assert_eq!(r, ["ok clamped pitch=25000 yaw=0", "ok"]);
+    assert_eq!(
+        r,
+        [
+            "ok look pitch=25000 yaw=0 ms=400 hold=stay clamped",
+            "ok look pitch=24000 yaw=0 ms=400 hold=stay"
+        ]
+    );
     // Narrower again: a look is clamped to where the servo may go now.
     let r = c.say("center 400\nservo pitch limits -12000 15000\nlook 18000 0 400 hold=stay");
-    assert_eq!(r, ["ok", "ok", "ok clamped pitch=15000 yaw=0"]);
+    assert_eq!(
+        r,
+        [
+            "ok center ms=400",
+            "ok",
+            "ok look pitch=15000 yaw=0 ms=400 hold=stay clamped"
+        ]
+    );
     let Some(Applied::Look(look)) = c.frames.last_applied else {
         panic!("{:?}", c.frames.last_applied)
     };
@@ -165,16 +208,15 @@ fn a_full_queue_is_busy_and_nothing_is_dropped() {
     let mut frames = SimFrames::new();
     let mut svc = service(queue, link);
     let mut out = [0; REPLY];
-    let (mut ok, mut busy) = (0, 0);
+    let (mut queued, mut busy) = (0, 0);
     for _ in 0..20 {
-        let reply = respond(Ok(b"idle amp 50"), &mut svc, &mut out);
-        match reply {
-            b"ok\r\n" => ok += 1,
-            r if r.starts_with(b"err busy ") => busy += 1,
-            r => panic!("{}", String::from_utf8_lossy(r)),
+        match respond(Ok(b"idle amp 50"), &mut svc, &mut out) {
+            Response::Later(_) => queued += 1,
+            Response::Now(r) if r.starts_with(b"err busy ") => busy += 1,
+            Response::Now(r) => panic!("{}", String::from_utf8_lossy(r)),
         }
     }
-    assert_eq!((ok, busy), (8, 12), "the queue holds 8");
+    assert_eq!((queued, busy), (8, 12), "the queue holds 8");
     for _ in 0..4 {
         frames.frame(queue, link);
     }
@@ -205,17 +247,17 @@ fn storage_errors_are_replies() {
     .unwrap();
     let mut out = [0; REPLY];
     assert_eq!(
-        respond(Ok(b"save"), &mut svc, &mut out),
-        b"err storage save: the flash failed\r\n"
+        respond(Ok(b"save"), &mut svc, &mut out).now(),
+        Some(&b"err storage save: the flash failed\r\n"[..])
     );
     assert_eq!(
-        respond(Ok(b"load"), &mut svc, &mut out),
-        b"err storage load: stored settings are of older version 0\r\n"
+        respond(Ok(b"load"), &mut svc, &mut out).now(),
+        Some(&b"err storage load: stored settings are of older version 0\r\n"[..])
     );
     let mut ram = service(queue, link);
     assert_eq!(
-        respond(Ok(b"load"), &mut ram, &mut out),
-        b"err storage load: no settings saved\r\n"
+        respond(Ok(b"load"), &mut ram, &mut out).now(),
+        Some(&b"err storage load: no settings saved\r\n"[..])
     );
 }
 
@@ -242,6 +284,7 @@ fn a_million_lines_drive_a_head_that_stays_within_its_limits() {
     let mut rng = rng(0x5e41_11ce);
     let mut out = [0; REPLY];
     let (mut ok, mut err, mut refused_after_parse, mut panics) = (0_usize, 0_usize, 0_usize, 0);
+    let (mut waited, mut told) = (0_u64, 0_u64);
     for _ in 0..LINES {
         let (_, line) = random_line(&mut rng);
         // A line holds no line end (the framer splits there).
@@ -250,7 +293,28 @@ fn a_million_lines_drive_a_head_that_stays_within_its_limits() {
             .filter(|b| *b != b'\n' && *b != b'\r')
             .collect();
         let run = catch_unwind(AssertUnwindSafe(|| {
-            let reply = respond(Ok(&line), &mut svc, &mut out).to_vec();
+            let reply = match respond(Ok(&line), &mut svc, &mut out) {
+                Response::Now(reply) => reply.to_vec(),
+                Response::Later(later) => {
+                    // As a port's console does: wait for the frame task's
+                    // outcome, then answer with it.
+                    let outcome = frames
+                        .outcome(queue, link, 0, later.ticket())
+                        .expect("the frame task answers within a few frames");
+                    waited += 1;
+                    let reply = later
+                        .finish(&mut out, |r| outcome_reply(r, &outcome.result))
+                        .to_vec();
+                    if outcome.result.is_err() {
+                        // The head refused it: the console says so.
+                        assert!(reply.starts_with(b"err busy "), "{outcome:?}");
+                        told += 1;
+                    } else {
+                        assert!(reply.starts_with(b"ok "), "{outcome:?}");
+                    }
+                    reply
+                }
+            };
             check_verdict(&line, &reply)
         }));
         match run {
@@ -272,7 +336,8 @@ fn a_million_lines_drive_a_head_that_stays_within_its_limits() {
     println!(
         "service: {LINES} lines, {ok} ok, {err} err ({refused_after_parse} parsed but refused: \
          busy, limit, invalid, range, storage), panics = {panics}; head: {} frames, {} actions \
-         played, {} refused by the mixer ({} not for a busy layer), {} calibrations applied, \
+         played, {} refused by the mixer ({} not for a busy layer; {told} replies said so, \
+         {waited} replies waited for the frame task), {} calibrations applied, \
          {} limit violations",
         frames.frames,
         frames.applied,
@@ -286,8 +351,13 @@ fn a_million_lines_drive_a_head_that_stays_within_its_limits() {
     assert_eq!(frames.violations, 0);
     assert_eq!(
         frames.refused_not_busy, 0,
-        "the head played what the console accepted"
+        "the head refuses only what depends on what plays (a busy layer)"
     );
+    assert_eq!(
+        told, frames.refused,
+        "the console says so each time the head refuses"
+    );
+    assert!(told >= 10, "refusals happen, and are told: {told}");
     assert!(frames.applied > 10_000 && frames.calibrations > 100 && refused_after_parse > 1000);
 }
 
@@ -307,10 +377,18 @@ fn random_streams_through_a_session_into_the_head() {
         while !rest.is_empty() {
             let n = rng.random_range(1..=rest.len().min(64));
             let (chunk, tail) = rest.split_at(n);
-            session.feed(chunk, &mut svc, |r| {
-                assert!(r.ends_with(b"\r\n") && r.len() <= REPLY);
-                got += 1;
-            });
+            for &byte in chunk {
+                let mut check = |r: &[u8]| {
+                    assert!(r.ends_with(b"\r\n") && r.len() <= REPLY);
+                    got += 1;
+                };
+                if let Some(r) = session.push(byte, &mut svc) {
+                    check(r);
+                }
+                if let Some(r) = frames.finish(&mut session, queue, link, 0) {
+                    check(r);
+                }
+            }
             frames.frame(queue, link);
             rest = tail;
         }

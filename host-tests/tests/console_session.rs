@@ -239,7 +239,7 @@ fn a_long_machine_reply_keeps_its_checksum() {
     let mut framer = Framer::<32>::new();
     let mut reply = Vec::new();
     framer.feed(format!("{line}\n").as_bytes(), |l| {
-        reply = respond(l, &mut h, &mut out).to_vec();
+        reply = respond(l, &mut h, &mut out).now().unwrap().to_vec();
     });
     let text = String::from_utf8(reply).unwrap();
     let (signed_part, crc) = text.trim_end().rsplit_once(" *").unwrap();

@@ -116,14 +116,21 @@ fn the_console_head_plays_every_gesture() {
     let mut handler = service(queue, link);
     let mut session = Session::<96, 160>::new();
     for kind in GestureKind::ALL {
-        let mut replies = Vec::new();
-        session.feed(
-            format!("{}\r\n", kind.name()).as_bytes(),
-            &mut handler,
-            |r| replies.push(r.to_vec()),
+        session.feed(kind.name().as_bytes(), &mut handler, |_| {
+            panic!("a reply before the line end")
+        });
+        assert_eq!(
+            session.push(b'\n', &mut handler),
+            None,
+            "{kind:?}: it waits"
         );
-        assert_eq!(replies, [b"ok\r\n".to_vec()], "{kind:?}");
-        frames.frame(queue, link);
+        // The reply once the frame task took it: what it started.
+        let reply = frames.finish(&mut session, queue, link, 0).unwrap();
+        let reply = String::from_utf8_lossy(reply);
+        assert!(
+            reply.starts_with(&format!("ok {} amp_mdeg=", kind.name())),
+            "{kind:?}: {reply}"
+        );
         assert!(
             matches!(frames.last_applied, Some(Applied::Gesture(plan)) if plan.kind == kind),
             "{kind:?}: {:?}",

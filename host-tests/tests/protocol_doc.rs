@@ -1,8 +1,9 @@
 //! The exchanges in `docs/user/protocol.md` are what the console does: every
 //! `> line` of an example, sent to the firmware's console service on a
 //! simulated head (built-in settings, one frame played after each line,
-//! the examples in the order of the document), gets the `< reply` written
-//! under it, byte for byte.
+//! and the frames a queued action's reply waits for; the examples in the
+//! order of the document), gets the `< reply` written under it, byte for
+//! byte.
 
 use host_tests::console::head::{SimFrames, service, shared};
 use idle_head_core::console::Session;
@@ -26,9 +27,15 @@ fn the_examples_in_the_protocol_document_hold() {
             .and_then(|l| l.strip_prefix("< "))
             .unwrap_or_else(|| panic!("`> {sent}` has no `< ` reply under it"));
         let mut got = Vec::new();
-        session.feed(format!("{sent}\r\n").as_bytes(), &mut handler, |r| {
-            got.push(String::from_utf8(r.to_vec()).unwrap());
-        });
+        for &byte in format!("{sent}\r\n").as_bytes() {
+            if let Some(r) = session.push(byte, &mut handler) {
+                got.push(String::from_utf8(r.to_vec()).unwrap());
+            }
+            // A queued action's reply: once the frame task took it.
+            if let Some(r) = frames.finish(&mut session, queue, link, 0) {
+                got.push(String::from_utf8(r.to_vec()).unwrap());
+            }
+        }
         frames.frame(queue, link);
         assert_eq!(got, [format!("{want}\r\n")], "`> {sent}`");
         exchanges += 1;
@@ -52,6 +59,55 @@ fn the_protocol_document_lists_every_gesture() {
         assert!(
             doc.lines().any(|line| line.starts_with(&row)),
             "docs/user/protocol.md has no row `{row}`"
+        );
+    }
+}
+
+/// The telemetry example and the bandwidth figures in the document are
+/// the firmware's: its line for that status, and the arithmetic on it.
+#[test]
+fn the_telemetry_figures_in_the_protocol_document_hold() {
+    use idle_head_core::console::{HeadMode, HeadStatus, TELEMETRY_LINE, telemetry_line};
+    use idle_head_core::{Angle, Microseconds};
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/user/protocol.md");
+    let doc = std::fs::read_to_string(path).expect("docs/user/protocol.md");
+    let status = HeadStatus {
+        frame: 123_440 / 20,
+        mode: HeadMode::Running,
+        angles: [-1505, -119, -236].map(Angle::from_millidegrees),
+        pulses: [1483, 1499, 1497].map(Microseconds),
+        faults: [0; 3],
+        disabled: [false; 3],
+    };
+    let mut out = [0; TELEMETRY_LINE];
+    let line = telemetry_line(&status, 20_000, 0, &mut out);
+    let text = std::str::from_utf8(line).unwrap();
+    assert!(
+        doc.contains(text.trim_end()),
+        "the document's example line: {text}"
+    );
+    let bytes = line.len();
+    // 50 lines a second, 10 bits a byte on the UART (8N1), 115200 baud.
+    let per_second = bytes * 50;
+    let percent = |n: usize| n * 50 * 10 * 100 / 115_200;
+    let figures = [
+        format!("about {bytes} bytes"),
+        format!("{},{:03} bytes", per_second / 1000, per_second % 1000),
+        format!(
+            "{},{:03} bits a second",
+            per_second * 10 / 1000,
+            per_second * 10 % 1000
+        ),
+        format!("{} % of UART0", percent(bytes)),
+        format!(
+            "({TELEMETRY_LINE} bytes) would take {} %",
+            percent(TELEMETRY_LINE)
+        ),
+    ];
+    for figure in figures {
+        assert!(
+            doc.contains(&figure),
+            "docs/user/protocol.md should say `{figure}`"
         );
     }
 }

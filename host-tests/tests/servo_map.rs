@@ -3,7 +3,7 @@
 
 use host_tests::strategies::calibration;
 use idle_head_core::servo::{
-    Direction, Duty, NanosPerDegree, PwmTiming, ServoCalibration, ServoMap,
+    Direction, Duty, NanosPerDegree, PwmTiming, ServoCalibration, ServoError, ServoMap,
 };
 use idle_head_core::{Angle, AngleRange, Axis, Microseconds};
 use proptest::prelude::*;
@@ -96,7 +96,15 @@ fn calibrations_beyond_the_32_bit_forms_take_the_documented_conversions() {
         max_pulse: Microseconds(19_000),
         limits: AngleRange::degrees(-1, 17),
     };
-    assert_eq!(wide.validate(), Ok(()));
+    // No setting may write such pulses (the hard bounds refuse it); the
+    // map on its own stays exact over them all the same.
+    assert_eq!(
+        wide.validate(),
+        Err(ServoError::PulseOutsideBounds {
+            max: false,
+            pulse: Microseconds(100)
+        })
+    );
     check_every_angle(&wide, u16::MAX).unwrap();
     // Far outside the domain, the ends.
     let map = ServoMap::new(&wide, PwmTiming::SERVO_50HZ, u16::MAX);

@@ -341,11 +341,21 @@ fn every_field_has_its_validation_error() {
         s.servos[i].per_degree = NanosPerDegree(0);
         assert!(s.validate(&base).is_err());
         let mut s = Settings::DEFAULT;
-        s.servos[i].min_pulse = Microseconds(2600);
+        s.servos[i].min_pulse = Microseconds(2100);
         assert!(matches!(
             servo(s.validate(&base).unwrap_err()),
             ServoError::PulseRangeEmpty { .. }
         ));
+        // Past the hard bounds no setting may pass.
+        for (min, max) in [(400, 2000), (1000, 2600)] {
+            let mut s = Settings::DEFAULT;
+            s.servos[i].min_pulse = Microseconds(min);
+            s.servos[i].max_pulse = Microseconds(max);
+            assert!(matches!(
+                servo(s.validate(&base).unwrap_err()),
+                ServoError::PulseOutsideBounds { .. }
+            ));
+        }
         let mut s = Settings::DEFAULT;
         s.servos[i].max_pulse = Microseconds(30_000);
         assert!(s.validate(&base).is_err());

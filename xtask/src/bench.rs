@@ -35,6 +35,7 @@ use std::{fmt::Write as _, path::Path};
 use anyhow::{Context, Result, bail};
 
 mod frame;
+mod telemetry;
 
 pub use frame::FrameRow;
 use frame::frames_over_budget;
@@ -43,7 +44,7 @@ use crate::figures;
 use crate::{
     args::Options,
     log::LogLine,
-    project::{self, Image, Metadata},
+    project::{self, Image, Metadata, QEMU},
     qemu::{self, Echo},
     setup,
 };
@@ -312,6 +313,12 @@ pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Resu
         println!();
         print!("{}", frame.lines());
     }
+    println!();
+    QEMU.build(root)?;
+    println!(
+        "{}",
+        telemetry::check(&QEMU.elf(metadata), options.timeout)?
+    );
     if let Some(over) = frames_over_budget(&frames) {
         if options.no_budget {
             println!("(--no-budget: the frame ceilings are reported, not enforced)");

@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 
 use crate::{
     args::{Bless, Budget, Options, Timeout},
-    console, flash, metrics, preview, sim, trace, uf2,
+    console, flash, metrics, panel, preview, sim, trace, uf2,
 };
 
 /// Project commands of idle-head: build and run the firmware in QEMU, test,
@@ -127,11 +127,23 @@ pub enum Command {
     /// ends a session early (a port that closes, lines left unanswered) is
     /// said on stderr, and the command fails.
     ///
-    /// With --qemu the firmware runs in QEMU and its UART0 carries the
-    /// console; when stdin closes, the firmware is stopped and its summary
-    /// line printed. With --port <dev> that serial port is opened (115200
-    /// 8N1); with neither, the Pico is found by its USB VID:PID 16c0:27dd.
+    /// With --qemu the firmware runs in QEMU (a clean head at real time: no
+    /// script, no injected faults) and its UART0 carries the console; when
+    /// stdin closes, the firmware is stopped and its summary line printed.
+    /// With --port <dev> that serial port is opened (115200 8N1); with
+    /// neither, the Pico is found by its USB VID:PID 16c0:27dd.
     Console(console::Args),
+    /// Serve the browser control panel, bridged to a head.
+    ///
+    /// Prints `panel: http://ADDR:PORT/` once the page can be loaded. With
+    /// --sim the shipped Pico image runs in the RP2040 emulator at real
+    /// time and the page talks to its USB serial port; with --qemu to the
+    /// QEMU image's UART0; with --port <dev> to a board's serial port. The
+    /// page connects to the bridge when it loads. Without a bridge the page
+    /// talks to a board itself over Web Serial (Chromium, Edge, Opera).
+    /// --export <dir> writes the page with its dependencies for any static
+    /// host instead. Ctrl-C stops everything it started.
+    Panel(panel::Args),
     /// Write the firmware as a UF2 file, for a board in BOOTSEL mode.
     ///
     /// Builds the board's release image (unless an ELF is given) and writes

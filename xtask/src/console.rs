@@ -10,7 +10,7 @@
 //! replies due are counted where the head's framer ends lines (CR, LF or
 //! CR LF); whatever ends a session early is said on stderr.
 
-mod qemu;
+pub mod qemu;
 mod stages;
 mod talk;
 

@@ -20,6 +20,8 @@
 //!   debug probe, or what to install.
 //! - `cargo xtask book`: the book (docs/) built with mdBook into
 //!   target/book, every link in it checked.
+//! - `cargo xtask panel`: the browser control panel, served and bridged to
+//!   a head (emulated, QEMU or a serial port).
 //!
 //! The firmware commands install what they need and is missing: the
 //! firmware's Rust target and, when running as root on Debian or Ubuntu, QEMU.
@@ -38,6 +40,7 @@ mod flash;
 mod fonts;
 mod log;
 mod metrics;
+mod panel;
 mod pico2;
 mod preview;
 mod project;
@@ -81,6 +84,7 @@ fn main() -> ExitCode {
         Some(Command::Sim(args)) => sim::command(&args),
         Some(Command::Trace(args)) => trace::command(&args),
         Some(Command::Console(args)) => console::command(&args),
+        Some(Command::Panel(args)) => panel::command(&args),
         Some(Command::Uf2(args)) => uf2::command(&args),
         Some(Command::Flash(args)) => flash::command(&args),
         Some(Command::Book) => book::command(),

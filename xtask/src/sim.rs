@@ -14,6 +14,7 @@ mod exchange;
 mod expect;
 mod flood;
 mod image;
+pub mod live;
 mod node;
 mod noise;
 mod planted;
@@ -28,6 +29,8 @@ use std::{fmt::Write as _, time::Duration};
 use anyhow::Result;
 
 pub use flood::{FLOOD_STAGE, test_flood};
+pub use node::ensure as ensure_node;
+pub use node::folder as node_folder;
 pub use noise::{NOISE_STAGE, test_noise};
 pub use run::{Report, logged_peak_stack};
 pub use stages::{

@@ -11,7 +11,7 @@ use crate::{
     args::Options,
     bench, book, console, elf,
     log::Run,
-    pico2,
+    panel, pico2,
     project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
     qemu::{self, Echo},
     setup, sim, snapshot, uf2,
@@ -182,6 +182,12 @@ pub fn command(options: Options) -> Result<bool> {
     stages.run(bench::STAGE, || {
         setup::ensure_qemu()?;
         bench::run_and_check(&root, &metadata, options)
+    });
+
+    // The panel in a real browser (Chromium, headless).
+    stages.run(panel::browser::STAGE, || {
+        println!("{}", panel::browser::stage(&root, &metadata)?);
+        Ok(())
     });
 
     // 6. The book, with the figures measured above, and its links.

@@ -263,16 +263,19 @@ impl Checks {
         }
         // The calibrations as they are now: the console may change them.
         let servos = driver.params().config().servos;
-        for ((known, at), cal) in self
+        for (((known, at), cal), channel) in self
             .config
             .servos
             .iter_mut()
             .zip(&mut self.recalibrated)
             .zip(&servos)
+            .zip(driver.channels_mut().iter_mut())
         {
             if known != cal {
                 *known = *cal;
                 *at = Some(index);
+                // The outputs judge the next pulses by the new range.
+                channel.judge(cal);
             }
         }
         let report = frame

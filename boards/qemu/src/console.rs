@@ -1,80 +1,153 @@
-//! The console task of the QEMU image: the core's console service over
-//! UART0, settings kept in RAM.
+//! The console task of the QEMU image: the firmware's console loop
+//! ([`idle_head_firmware::console::serve`]) over UART0, settings kept in
+//! RAM; UART1 is the hang-up line.
 //!
-//! With `console` on the semihosting command line (`cargo xtask console
-//! --qemu`, and the flood stage of `cargo xtask test`) the run is *held*:
-//! the smoke schedule plays as usual, but the fade-out that ends it waits
-//! until the host hangs up, which it signals with any byte on UART1 (as a
-//! modem's DTR line would). Without it (`cargo xtask qemu`) the run ends
-//! on its schedule; the console still answers whatever arrives.
+//! The semihosting command line says what kind of run this is
+//! ([`Mode::from_host`]):
+//!
+//! - nothing: the smoke run (`cargo xtask qemu`): the script, the injected
+//!   faults and the checks, at 20 times real time, ending on its schedule;
+//!   the console answers whatever arrives;
+//! - `console`: the smoke run *held* for its console (the flood stage of
+//!   `cargo xtask test`): its fade-out waits until the host hangs up,
+//!   which it signals with any byte on UART1 (as a modem's DTR line would);
+//! - `interactive`: a clean head for a person (`cargo xtask console
+//!   --qemu`, `cargo xtask panel --qemu`): no script, no injected fault,
+//!   frames at the board's real 20 ms, and no end but the hang-up. `stop`
+//!   holds the head at its neutral pose until a motion command wakes it,
+//!   as on a board.
 
 use core::future::Future;
 use core::pin::Pin;
-use core::sync::atomic::{AtomicBool, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use core::task::{Context, Poll};
 
+use embassy_time::Duration;
 use idle_head_core::console::{ConsoleService, Session};
 use idle_head_core::settings::RamStorage;
 use idle_head_firmware::boot::{COMMANDS as QUEUE, LINK};
+use idle_head_firmware::console::{Gone, Place, Port, Received, serve};
 
 use crate::uart::{RX_READY, UART0, UART1};
 
-/// Whether the run waits for the host to hang up.
-pub static HOLD: AtomicBool = AtomicBool::new(false);
+/// What kind of run this is; see the [module docs](self).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+pub enum Mode {
+    /// The smoke run, on its schedule.
+    Smoke,
+    /// The smoke run, its fade-out held until the host hangs up.
+    Held,
+    /// A clean head at real time, until the host hangs up.
+    Interactive,
+}
+
+impl Mode {
+    /// The mode the semihosting command line asks for: the word
+    /// `interactive` or `console` in it, or neither.
+    pub fn from_host() -> Self {
+        let mut buf = [0_u8; 64];
+        let mut block = [buf.as_mut_ptr() as usize, buf.len()];
+        // Note(unsafe): SYS_GET_CMDLINE writes at most `block[1]` bytes into
+        // `buf` and the length used into `block[1]`; both outlive the call.
+        let status = unsafe {
+            cortex_m_semihosting::syscall1(
+                cortex_m_semihosting::nr::GET_CMDLINE,
+                block.as_mut_ptr() as usize,
+            )
+        };
+        let len = block[1].min(buf.len());
+        let mut words = buf[..len].split(|b| *b == b' ' || *b == 0);
+        if status != 0 {
+            Self::Smoke
+        } else if words.clone().any(|word| word == b"interactive") {
+            Self::Interactive
+        } else if words.any(|word| word == b"console") {
+            Self::Held
+        } else {
+            Self::Smoke
+        }
+    }
+
+    /// Whether the run lasts until the host hangs up.
+    pub const fn held(self) -> bool {
+        !matches!(self, Self::Smoke)
+    }
+}
+
+/// The run's [`Mode`], as an index (set once by `main`).
+static MODE: AtomicU8 = AtomicU8::new(0);
+
+/// Sets the run's mode.
+pub fn set_mode(mode: Mode) {
+    MODE.store(mode as u8, Ordering::Relaxed);
+}
+
+/// The run's mode.
+pub fn mode() -> Mode {
+    match MODE.load(Ordering::Relaxed) {
+        1 => Mode::Held,
+        2 => Mode::Interactive,
+        _ => Mode::Smoke,
+    }
+}
+
 /// Set once the host has hung up and every queued command was played.
 pub static HUNG_UP: AtomicBool = AtomicBool::new(false);
 
 /// The service as the QEMU image runs it.
 pub type Service = ConsoleService<'static, RamStorage>;
 
-/// Whether the semihosting command line holds the word `console`.
-pub fn held_by_host() -> bool {
-    let mut buf = [0_u8; 64];
-    let mut block = [buf.as_mut_ptr() as usize, buf.len()];
-    // Note(unsafe): SYS_GET_CMDLINE writes at most `block[1]` bytes into
-    // `buf` and the length used into `block[1]`; both outlive the call.
-    let status = unsafe {
-        cortex_m_semihosting::syscall1(
-            cortex_m_semihosting::nr::GET_CMDLINE,
-            block.as_mut_ptr() as usize,
-        )
-    };
-    let len = block[1].min(buf.len());
-    status == 0
-        && buf[..len]
-            .split(|b| *b == b' ' || *b == 0)
-            .any(|word| word == b"console")
+/// UART0 as a console port; a byte on UART1 (the host hanging up) makes
+/// it go away.
+struct Uart0;
+
+impl Port for Uart0 {
+    async fn read(&mut self, buf: &mut [u8]) -> Result<Received, Gone> {
+        loop {
+            if UART1.read().is_some() {
+                return Err(Gone);
+            }
+            let mut n = 0;
+            while let Some(slot) = buf.get_mut(n) {
+                let Some(byte) = UART0.read() else { break };
+                *slot = byte;
+                n += 1;
+            }
+            if n > 0 {
+                // Let the loop generator (same executor) run between reads.
+                YieldNow(false).await;
+                return Ok(Received::Bytes(n));
+            }
+            UART0.listen();
+            UART1.listen();
+            RX_READY.wait().await;
+        }
+    }
+
+    async fn write(&mut self, bytes: &[u8]) -> Result<(), Gone> {
+        UART0.write_all(bytes);
+        Ok(())
+    }
 }
 
-/// Reads lines from UART0, answers each, until the host hangs up.
+/// Answers the lines on UART0 until the host hangs up, then lets the
+/// queued commands play and says so ([`HUNG_UP`]).
 #[embassy_executor::task]
-pub async fn console(mut service: Service) {
+pub async fn console(mut service: Service, frame: Duration) {
     UART0.init();
     UART1.init();
     let mut session = Session::<96, 160>::new();
-    let mut lines: u32 = 0;
-    loop {
-        while let Some(byte) = UART0.read() {
-            if let Some(reply) = session.push(byte, &mut service) {
-                UART0.write_all(reply);
-                lines = lines.wrapping_add(1);
-                // Let the loop generator (same executor) run between lines.
-                YieldNow(false).await;
-            }
-        }
-        if UART1.read().is_some() {
-            break;
-        }
-        UART0.listen();
-        UART1.listen();
-        RX_READY.wait().await;
-    }
+    let place = Place {
+        port: 0,
+        link: &LINK,
+        frame,
+    };
+    let Gone = serve(&mut Uart0, &mut session, &mut service, place).await;
     defmt::info!(
-        "console: the host hung up after {=u32} lines, at frame {=u64}",
-        lines,
+        "console: the host hung up at frame {=u64}",
         LINK.status().frame
     );
-    // The queued commands are played before the run fades out.
+    // The queued commands are played before the run ends.
     while !QUEUE.is_empty() || LINK.servos_pending() {
         YieldNow(false).await;
     }

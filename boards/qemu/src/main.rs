@@ -49,13 +49,12 @@ mod checks;
 mod console;
 mod executor;
 mod exit;
+mod interactive;
 mod pwm;
 mod script;
 #[allow(dead_code)] // its stopwatch is the bench's
 mod systick;
 mod uart;
-
-use core::sync::atomic::Ordering;
 
 use defmt_semihosting as _;
 use idle_head_core::behaviour::BehaviourParams;
@@ -132,13 +131,24 @@ fn main() -> ! {
     let Ok(booted) = boot::boot(&CONFIG, Loaded::defaults(RamStorage::new()), 0) else {
         exit::exit(false)
     };
-    let hold = console::held_by_host();
-    console::HOLD.store(hold, Ordering::Relaxed);
-    if hold {
-        defmt::info!("console: the run lasts until the host hangs up (UART1)");
+    let mode = console::Mode::from_host();
+    console::set_mode(mode);
+    match mode {
+        console::Mode::Smoke => {}
+        console::Mode::Held => {
+            defmt::info!("console: the run lasts until the host hangs up (UART1)");
+        }
+        console::Mode::Interactive => defmt::info!(
+            "interactive: a clean head at real time (frames of {=u32} us), no script, no faults, until the host hangs up (UART1)",
+            CONFIG.frame_period.0
+        ),
     }
 
-    systick::start_time_driver(&mut core.SYST);
+    let period = match mode {
+        console::Mode::Interactive => systick::INTERACTIVE_PERIOD,
+        console::Mode::Smoke | console::Mode::Held => systick::DRIVER_PERIOD,
+    };
+    systick::start_time_driver(&mut core.SYST, period);
 
     let Some((thread, frame_executor)) = executor::take() else {
         exit::exit(false)
@@ -152,7 +162,8 @@ fn main() -> ! {
     let Some(service) = booted.service else {
         exit::exit(false)
     };
-    match console::console(service) {
+    let frame = embassy_time::Duration::from_micros(frame_period(mode).0.into());
+    match console::console(service, frame) {
         Ok(token) => thread.spawner().spawn(token),
         Err(_) => exit::exit(false),
     }
@@ -179,9 +190,18 @@ async fn frame_task(params: DriverParams, behaviour: BehaviourParams) {
         .servos
         .map(|servo| VirtualPwm::new(PICO_TOP, CONFIG.pwm.period, &servo));
     let mut driver = FrameDriver::new(channels, params);
-    // The script's commands share the console's queue, as a board's would.
-    let mut checks = Checks::new(CONFIG, &COMMANDS, console::HOLD.load(Ordering::Relaxed));
+    let mode = console::mode();
     let (first, run) = EXCHANGE.first().await;
+    if mode == console::Mode::Interactive {
+        let mut hooks = interactive::Interactive::default();
+        let period = frame_period(mode);
+        let (stats, _) = tasks::play(&mut driver, first, &behaviour, &mut hooks, period).await;
+        let violations = hooks.violations + channel_violations(&mut driver);
+        summary(&stats, violations, &run, &driver);
+        exit::exit(violations == 0 && stats.missed == 0);
+    }
+    // The script's commands share the console's queue, as a board's would.
+    let mut checks = Checks::new(CONFIG, &COMMANDS, mode.held());
     let (stats, idle) =
         tasks::play(&mut driver, first, &behaviour, &mut checks, FRAME_PERIOD).await;
     defmt::info!(
@@ -197,8 +217,33 @@ async fn frame_task(params: DriverParams, behaviour: BehaviourParams) {
         idle.set
     );
     let ok = checks.finish(&stats, &idle, &mut driver, run.generated);
+    let violations = channel_violations(&mut driver);
+    summary(&stats, violations, &run, &driver);
+    exit::exit(ok && violations == 0 && stats.missed == 0);
+}
+
+/// The time between frames: the smoke run's compressed one, or the
+/// board's in an interactive run.
+const fn frame_period(mode: console::Mode) -> Microseconds {
+    match mode {
+        console::Mode::Interactive => CONFIG.frame_period,
+        console::Mode::Smoke | console::Mode::Held => FRAME_PERIOD,
+    }
+}
+
+/// The pulses the virtual outputs judged outside the hard bounds.
+fn channel_violations(driver: &mut FrameDriver<VirtualPwm>) -> u32 {
     let logs = driver.channels_mut().each_ref().map(|c| *c.log());
-    let violations: u32 = logs.iter().map(|l| l.violations).sum();
+    logs.iter().map(|l| l.violations).sum()
+}
+
+/// The peak stack and the run's summary line.
+fn summary(
+    stats: &idle_head_firmware::frame::RunStats,
+    violations: u32,
+    run: &idle_head_firmware::exchange::FirstSet,
+    driver: &FrameDriver<VirtualPwm>,
+) {
     // The stack was painted before `main` (cortex-m-rt's `paint-stack`): the
     // bytes that lost their paint are the deepest the stack has been.
     defmt::info!(
@@ -219,5 +264,4 @@ async fn frame_task(params: DriverParams, behaviour: BehaviourParams) {
         faults,
         disabled
     );
-    exit::exit(ok && violations == 0 && stats.missed == 0);
 }

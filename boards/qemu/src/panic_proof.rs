@@ -18,7 +18,9 @@
 //! not) between any two frames, and the behaviour: any behaviour parameters
 //! and any command (gestures, looks, `center`, idle changes, stop) applied
 //! between any two frames ([`FrameLoop::apply`]), mixed into every frame,
-//! servo calibrations from the console's link, the status published for
+//! servo calibrations from the console's link, each command's outcome told
+//! to the console port that asked for it (`ConsoleLink::answer`, as
+//! [`FrameLoop::drain`] does), the status published for
 //! it after every frame ([`FrameLoop::publish`]), and the console's
 //! parser (`idle_head_core::console::parse`) on any line. Its panic handler calls `frame_path_has_a_panic_path`, a function
 //! that exists nowhere. If any panic (index, division, overflow check,
@@ -39,7 +41,7 @@
 use core::hint::black_box;
 
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
-use idle_head_core::behaviour::{BehaviourConfig, BehaviourParams};
+use idle_head_core::behaviour::{Asker, BehaviourConfig, BehaviourParams};
 use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
 use idle_head_core::console::{ConsoleLink, parse};
 use idle_head_core::driver::{
@@ -194,7 +196,16 @@ fn main() -> ! {
                 black_box(driver.set_servo(axis, cal)).ok();
             }
             5 => {
-                black_box(frames.apply(&mut driver, &any_action())).ok();
+                let outcome = frames.apply(&mut driver, &any_action());
+                // The outcome to the console port that asked, as
+                // `FrameLoop::drain` answers it (any port, any ticket).
+                LINK.answer(
+                    Asker {
+                        port: black_box(0),
+                        ticket: black_box(0),
+                    },
+                    outcome,
+                );
             }
             6 => {
                 // Calibrations the console sent, as `FrameLoop::drain` applies them.

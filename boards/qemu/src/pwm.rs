@@ -4,7 +4,7 @@
 
 use embedded_hal::pwm::{Error, ErrorKind, ErrorType, SetDutyCycle};
 use idle_head_core::Microseconds;
-use idle_head_core::servo::ServoCalibration;
+use idle_head_core::servo::{ServoCalibration, bounds};
 
 /// Why a virtual channel rejected a write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
@@ -57,7 +57,10 @@ pub struct VirtualPwm {
 
 impl VirtualPwm {
     /// A channel of `max_duty` counts per `period` driving a servo with
-    /// calibration `servo` (only its pulse limits are used).
+    /// calibration `servo`. It judges every pulse against the hard bounds
+    /// no setting may pass ([`bounds`]) and, tighter, the servo's own pulse
+    /// range: the calibration the head starts with, or the one in effect
+    /// once the hooks say it changed ([`VirtualPwm::judge`]).
     pub const fn new(max_duty: u16, period: Microseconds, servo: &ServoCalibration) -> Self {
         Self {
             max_duty,
@@ -73,6 +76,22 @@ impl VirtualPwm {
                 current: 0,
             },
         }
+    }
+
+    /// Judges the following pulses against `servo`'s pulse range (the
+    /// calibration now in effect), within the hard bounds.
+    pub fn judge(&mut self, servo: &ServoCalibration) {
+        let min = if servo.min_pulse.0 < bounds::MIN_PULSE.0 {
+            bounds::MIN_PULSE
+        } else {
+            servo.min_pulse
+        };
+        let max = if servo.max_pulse.0 > bounds::MAX_PULSE.0 {
+            bounds::MAX_PULSE
+        } else {
+            servo.max_pulse
+        };
+        self.allowed = allowed_duties(self.max_duty, self.period, min, max);
     }
 
     /// Makes every following write fail (`true`) or succeed again (`false`).

@@ -158,11 +158,22 @@ pub fn stopwatch<R>(syst: &mut SYST, f: impl FnOnce() -> R) -> (R, u64) {
     (result, end - start)
 }
 
-/// Starts the embassy time driver on SysTick; embassy time starts at 0.
+/// SysTick counts per wrap in an interactive run (`console.rs`): 1 ms,
+/// the alarm resolution. Its frames are 20 ms apart in real time, and
+/// under `-icount sleep=on` every wake-up from `WFI` costs QEMU real time
+/// that the virtual clock does not see: at one every 100 µs the virtual
+/// clock ran at little more than half the wall clock's pace, at one a
+/// millisecond it keeps up.
+pub const INTERACTIVE_PERIOD: u32 = 12_500;
+const _: () = assert!((INTERACTIVE_PERIOD as u64 * 2).is_multiple_of(25));
+
+/// Starts the embassy time driver on SysTick, wrapping every `period`
+/// counts ([`DRIVER_PERIOD`], or [`INTERACTIVE_PERIOD`]); embassy time
+/// starts at 0.
 ///
 /// Before this call `embassy_time::Instant::now()` reads 0.
-pub fn start_time_driver(syst: &mut SYST) {
-    critical_section::with(|cs| restart(syst, cs, DRIVER_PERIOD, true));
+pub fn start_time_driver(syst: &mut SYST, period: u32) {
+    critical_section::with(|cs| restart(syst, cs, period, true));
 }
 
 impl SysTickDriver {

@@ -158,4 +158,7 @@ pub enum Command {
     Load,
     /// Go back to the built-in settings (not stored until `save`).
     Defaults,
+    /// Stream telemetry lines on this port, this many a second
+    /// (`1..=50`), or stop them (`None`).
+    Watch(Option<u8>),
 }

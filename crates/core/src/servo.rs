@@ -25,6 +25,6 @@ mod map;
 
 pub(crate) use calibration::Degrees;
 pub use calibration::{
-    Direction, Duty, NanosPerDegree, PwmTiming, ServoCalibration, ServoError, defaults,
+    Direction, Duty, NanosPerDegree, PwmTiming, ServoCalibration, ServoError, bounds, defaults,
 };
 pub use map::ServoMap;

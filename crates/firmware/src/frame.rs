@@ -207,7 +207,8 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
     }
 
     /// Before frame `tick`: the limit modes the behaviour asks for, then the
-    /// queued commands (at most two), each logged with its answer.
+    /// queued commands (at most two), each logged with its answer, which
+    /// goes to the console port that asked for it, if one did.
     pub fn drain<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, tick: FrameTick) {
         if let Some(link) = self.link {
             for (axis, cal) in idle_head_core::Axis::ALL.iter().zip(link.take_servos()) {
@@ -231,18 +232,30 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         }
         match self.commands {
             Some(queue) => {
+                let link = self.link;
                 self.head
-                    .drain(driver, queue, |action, outcome| match outcome {
-                        Ok(applied) => {
-                            defmt::info!(
-                                "frame {=u64}: {=str}: ok {}",
-                                tick.frame,
-                                word(action),
-                                Started(applied)
-                            );
+                    .drain_asked(driver, queue, |action, asker, outcome| {
+                        match outcome {
+                            Ok(applied) => {
+                                defmt::info!(
+                                    "frame {=u64}: {=str}: ok {}",
+                                    tick.frame,
+                                    word(action),
+                                    Started(applied)
+                                );
+                            }
+                            Err(e) => {
+                                defmt::warn!(
+                                    "frame {=u64}: {=str}: {}",
+                                    tick.frame,
+                                    word(action),
+                                    e
+                                );
+                            }
                         }
-                        Err(e) => {
-                            defmt::warn!("frame {=u64}: {=str}: {}", tick.frame, word(action), e);
+                        // The port that asked answers its line with it.
+                        if let (Some(link), Some(asker)) = (link, asker) {
+                            link.answer(asker, *outcome);
                         }
                     });
             }

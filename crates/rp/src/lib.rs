@@ -326,14 +326,23 @@ async fn usb_device(mut device: usb::Device) {
     device.run().await;
 }
 
-/// The console on the USB serial port: one session per connection.
-#[embassy_executor::task]
-async fn usb_console(mut port: UsbPort, service: &'static Service) {
-    idle_head_firmware::console::run(&mut port, service, "usb").await;
+/// Where a console port is: its number, the link, the frame period.
+const fn place(port: u8) -> idle_head_firmware::console::Place<'static> {
+    idle_head_firmware::console::Place {
+        port,
+        link: &boot::LINK,
+        frame: Duration::from_micros(CONFIG.frame_period.0 as u64),
+    }
 }
 
-/// The console on the UART, for as long as the board runs.
+/// The console on the USB serial port (port 1): one session per connection.
+#[embassy_executor::task]
+async fn usb_console(mut port: UsbPort, service: &'static Service) {
+    idle_head_firmware::console::run(&mut port, service, "usb", place(1)).await;
+}
+
+/// The console on the UART (port 0), for as long as the board runs.
 #[embassy_executor::task]
 async fn uart_console(mut port: UartPort, service: &'static Service) {
-    idle_head_firmware::console::run(&mut port, service, "uart").await;
+    idle_head_firmware::console::run(&mut port, service, "uart", place(0)).await;
 }

@@ -73,6 +73,10 @@ impl Port for UsbPort {
         self.0.wait_connection().await;
     }
 
+    fn open(&self) -> bool {
+        self.0.dtr()
+    }
+
     async fn read(&mut self, buf: &mut [u8]) -> Result<Received, Gone> {
         // `serve` reads into a whole packet (`READ_CHUNK`). USB has flow
         // control: the host holds what the device is not ready for, so

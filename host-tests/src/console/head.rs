@@ -9,7 +9,9 @@ use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use idle_head_core::behaviour::{
     Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION,
 };
-use idle_head_core::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
+use idle_head_core::console::{
+    ConsoleLink, ConsoleService, HeadMode, HeadStatus, Outcome, Session, outcome_reply, unanswered,
+};
 use idle_head_core::driver::{DriverConfig, FrameDriver};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16, Trajectory};
 use idle_head_core::playback::Player;
@@ -34,6 +36,10 @@ impl SetDutyCycle for LastDuty {
         Ok(())
     }
 }
+
+/// Frames the firmware's console waits for an outcome
+/// (`idle_head_firmware::console::OUTCOME_FRAMES`).
+pub const OUTCOME_FRAMES: u32 = 5;
 
 /// Frames a servo left outside new angle limits may take to come back:
 /// the widest span (720°) at the slowest limiter (60 °/s, 600 °/s²) is
@@ -78,6 +84,9 @@ pub struct SimFrames {
     pub refused_not_busy: u64,
     /// What the last action played started.
     pub last_applied: Option<Applied>,
+    /// Refusals whose outcome a waiting reply was finished with
+    /// ([`Self::finish`]).
+    pub refusals_told: u64,
 }
 
 impl SimFrames {
@@ -112,6 +121,7 @@ impl SimFrames {
             refused: 0,
             refused_not_busy: 0,
             last_applied: None,
+            refusals_told: 0,
         }
     }
 
@@ -132,14 +142,20 @@ impl SimFrames {
         let (mut applied, mut refused, mut not_busy) = (0, 0, 0);
         let last = &mut self.last_applied;
         self.head
-            .drain(&mut self.driver, queue, |_, outcome| match outcome {
-                Ok(started) => {
-                    applied += 1;
-                    *last = Some(*started);
+            .drain_asked(&mut self.driver, queue, |_, asker, outcome| {
+                match outcome {
+                    Ok(started) => {
+                        applied += 1;
+                        *last = Some(*started);
+                    }
+                    Err(e) => {
+                        refused += 1;
+                        not_busy += u64::from(!matches!(e, BehaviourError::Busy { .. }));
+                    }
                 }
-                Err(e) => {
-                    refused += 1;
-                    not_busy += u64::from(!matches!(e, BehaviourError::Busy { .. }));
+                // As the frame task does: the port that asked hears it.
+                if let Some(asker) = asker {
+                    link.answer(asker, *outcome);
                 }
             });
         self.applied += applied;
@@ -172,6 +188,49 @@ impl SimFrames {
         link.publish(HeadStatus::of(&report, self.driver.stats(), mode));
         self.frame += 1;
         self.frames += 1;
+    }
+
+    /// Plays frames until the frame task's outcome for `port`'s action
+    /// with `ticket` is there, at most [`OUTCOME_FRAMES`] of them, as the
+    /// firmware's console waits; the outcome, if one came.
+    pub fn outcome<const N: usize>(
+        &mut self,
+        queue: &CommandQueue<N>,
+        link: &ConsoleLink,
+        port: u8,
+        ticket: u8,
+    ) -> Option<Outcome> {
+        let slot = link.outcomes(port)?;
+        for _ in 0..OUTCOME_FRAMES {
+            self.frame(queue, link);
+            if let Some(outcome) = slot.try_take()
+                && outcome.ticket == ticket
+            {
+                return Some(outcome);
+            }
+        }
+        None
+    }
+
+    /// Finishes the reply `session` waits for, if it waits: frames until
+    /// the outcome is there ([`Self::outcome`]), then the firmware's text
+    /// for it ([`outcome_reply`], or [`unanswered`]).
+    pub fn finish<'s, const N: usize, const L: usize, const R: usize>(
+        &mut self,
+        session: &'s mut Session<L, R>,
+        queue: &CommandQueue<N>,
+        link: &ConsoleLink,
+        port: u8,
+    ) -> Option<&'s [u8]> {
+        let ticket = session.waiting()?;
+        let outcome = self.outcome(queue, link, port, ticket);
+        if outcome.is_some_and(|o| o.result.is_err()) {
+            self.refusals_told += 1;
+        }
+        session.finish(|reply| match outcome {
+            Some(outcome) => outcome_reply(reply, &outcome.result),
+            None => unanswered(reply, OUTCOME_FRAMES * 20),
+        })
     }
 
     /// The driver's current configuration.

@@ -48,6 +48,7 @@ pub const VOCABULARY: &[&str] = &[
     "intensity=",
     "hold=stay",
     "=",
+    "watch",
 ];
 
 /// A random word of the protocol: one of [`VOCABULARY`] or a gesture's.
@@ -66,6 +67,8 @@ pub const EDGE_NUMBERS: &[&str] = &[
     "+0",
     "1",
     "-1",
+    "50",
+    "51",
     "100",
     "101",
     "255",
@@ -144,7 +147,8 @@ fn maybe<T>(rng: &mut TestRng, f: impl FnOnce(&mut TestRng) -> T) -> Option<T> {
 
 /// A random command, every field anywhere in its parseable range.
 pub fn random_command(rng: &mut TestRng) -> Command {
-    match rng.random_range(0..12) {
+    match rng.random_range(0..13) {
+        12 => Command::Watch(maybe(rng, |r| r.random_range(1..=50))),
         0 => Command::Help,
         1 => Command::Status,
         2 => Command::Save,
@@ -370,6 +374,14 @@ fn write_command(s: &mut Style<'_>, command: &Command) {
         Command::Seed(SeedChoice::Value(v)) => {
             s.word("seed");
             s.number(i64::from(v));
+        }
+        Command::Watch(None) => {
+            s.word("watch");
+            s.word("off");
+        }
+        Command::Watch(Some(hz)) => {
+            s.word("watch");
+            s.number(i64::from(hz));
         }
         Command::Servo { axis, setting } => {
             s.word("servo");

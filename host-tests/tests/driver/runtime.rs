@@ -241,10 +241,12 @@ fn a_new_calibration_is_checked_as_build_checks_it() {
     );
     assert_eq!(
         rejected(&mut d, &|c| c.max_pulse = Microseconds(25_000)),
-        ConfigError::PulseLongerThanPeriod {
+        ConfigError::Servo {
             axis: Axis::Pitch,
-            max_pulse: Microseconds(25_000),
-            period: Microseconds(20_000),
+            error: ServoError::PulseOutsideBounds {
+                max: true,
+                pulse: Microseconds(25_000),
+            }
         }
     );
     let mut cfg = unfaded();

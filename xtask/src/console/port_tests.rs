@@ -10,7 +10,7 @@ use std::thread;
 use std::time::Duration;
 
 use idle_head_core::behaviour::CommandQueue;
-use idle_head_core::console::{ConsoleLink, ConsoleService, Session};
+use idle_head_core::console::{ConsoleLink, ConsoleService, Session, outcome_reply};
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::settings::{RamStorage, SETTINGS_BUFFER, Settings, SettingsSource};
 use nix::pty::openpty;
@@ -34,6 +34,10 @@ fn head(master: RawFd, stop: &AtomicBool) {
         SettingsSource::Defaults,
     )
     .expect("the built-in settings are valid");
+    let behaviour = Settings::DEFAULT
+        .validate(&DriverConfig::DEFAULT)
+        .expect("the built-in settings are valid")
+        .behaviour;
     let mut session = Session::<96, 160>::new();
     let mut line = Vec::new();
     let mut buf = [0_u8; 256];
@@ -55,7 +59,7 @@ fn head(master: RawFd, stop: &AtomicBool) {
                 return;
             }
             if !line.windows(4).any(|w| w == b"mute") {
-                session.feed(&line, &mut service, |reply| {
+                let write = |reply: &[u8]| {
                     let mut rest = reply;
                     while !rest.is_empty() {
                         match nix::unistd::write(master, rest) {
@@ -63,7 +67,22 @@ fn head(master: RawFd, stop: &AtomicBool) {
                             Err(_) => return,
                         }
                     }
-                });
+                };
+                for &byte in &line {
+                    if let Some(reply) = session.push(byte, &mut service) {
+                        write(reply);
+                    }
+                    // A queued action: the frame task's answer, as the
+                    // mixer of a head at rest gives it.
+                    if session.waiting().is_some()
+                        && let Some((action, _)) = QUEUE.take_asked()
+                    {
+                        let outcome = behaviour.check(&action);
+                        if let Some(reply) = session.finish(|r| outcome_reply(r, &outcome)) {
+                            write(reply);
+                        }
+                    }
+                }
             }
             line.clear();
         }
@@ -131,7 +150,7 @@ fn a_port_session_prints_one_reply_per_line_in_order() {
     );
     assert_eq!(lines.len(), 5, "{out}");
     assert!(lines[0].starts_with("ok commands: help status"), "{out}");
-    assert_eq!(lines[1], "ok");
+    assert!(lines[1].starts_with("ok nod amp_mdeg="), "{out}");
     assert!(lines[2].starts_with("err invalid "), "{out}");
     assert!(lines[3].starts_with("err "), "{out}");
     assert!(lines[4].starts_with("ok pitch neutral="), "{out}");

@@ -19,12 +19,19 @@ use crate::log::Run;
 use crate::qemu::{self, Echo};
 use crate::{project, setup};
 
-/// How QEMU's virtual clock runs while the core sleeps.
+/// Which run the image plays, and how QEMU's virtual clock runs while the
+/// core sleeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Pace {
-    /// With the wall clock (`sleep=on`): for a person at the console.
+    /// A clean head for a person (semihosting argument `interactive`: no
+    /// script, no injected faults, the board's 20 ms frames, until the
+    /// hang-up), its virtual clock with the wall clock (`-icount
+    /// shift=0,sleep=on`: one instruction a nanosecond while the core
+    /// works, the wall clock's pace while it sleeps, which is almost all
+    /// the time: so the head moves at its true speed).
     RealTime,
-    /// Jumping over idle time (`sleep=off`): as fast as the host can.
+    /// The smoke run held for its console (semihosting argument `console`),
+    /// jumping over idle time (`sleep=off`): as fast as the host can.
     Fast,
 }
 
@@ -76,36 +83,19 @@ pub fn qemu_session(
     for path in [&uart0, &uart1] {
         let _ = std::fs::remove_file(path);
     }
-    let sleep = match pace {
-        Pace::RealTime => "on",
-        Pace::Fast => "off",
-    };
-    let child = Command::new(setup::QEMU_BINARY)
-        .args([
-            "-machine",
-            "lm3s6965evb",
-            "-cpu",
-            "cortex-m0",
-            "-display",
-            "none",
-        ])
-        .args(["-monitor", "none"])
-        .args([
-            "-semihosting-config",
-            "enable=on,target=native,arg=idle-head,arg=console",
-        ])
-        .args(["-icount", &format!("shift=0,sleep={sleep}")])
-        .arg("-serial")
-        .arg(format!("unix:{},server=on,wait=on", uart0.display()))
-        .arg("-serial")
-        .arg(format!("unix:{},server=on,wait=on", uart1.display()))
-        .arg("-kernel")
-        .arg(elf)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
+    let child = qemu_command(
+        elf,
+        pace,
+        [
+            &format!("unix:{},server=on,wait=on", uart0.display()),
+            &format!("unix:{},server=on,wait=on", uart1.display()),
+        ],
+    )
+    .stdin(Stdio::null())
+    .stdout(Stdio::piped())
+    .stderr(Stdio::piped())
+    .spawn()
+    .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
     let start = Instant::now();
     let done = child::run(
         child,
@@ -134,8 +124,38 @@ pub fn qemu_session(
     })
 }
 
+/// QEMU running `elf` for a console: the run `pace` asks for, UART0 and
+/// UART1 (the hang-up line) on the character devices `serials` (QEMU's
+/// `-serial` arguments: a socket, `pty`, `null`).
+pub fn qemu_command(elf: &Path, pace: Pace, serials: [&str; 2]) -> Command {
+    let (sleep, run) = match pace {
+        Pace::RealTime => ("on", "interactive"),
+        Pace::Fast => ("off", "console"),
+    };
+    let mut command = Command::new(setup::QEMU_BINARY);
+    command
+        .args([
+            "-machine",
+            "lm3s6965evb",
+            "-cpu",
+            "cortex-m0",
+            "-display",
+            "none",
+        ])
+        .args(["-monitor", "none"])
+        .args([
+            "-semihosting-config",
+            &format!("enable=on,target=native,arg=idle-head,arg={run}"),
+        ])
+        .args(["-icount", &format!("shift=0,sleep={sleep}")])
+        .args(["-serial", serials[0], "-serial", serials[1]])
+        .arg("-kernel")
+        .arg(elf);
+    command
+}
+
 /// Connects to a socket QEMU serves, waiting for it to appear.
-fn connect(path: &Path) -> Result<UnixStream> {
+pub fn connect(path: &Path) -> Result<UnixStream> {
     let deadline = Instant::now() + Duration::from_secs(20);
     loop {
         match UnixStream::connect(path) {

@@ -129,7 +129,7 @@ pub fn piped_script() -> Result<String> {
         "ok yaw neutral=1500 ",
         "ok",
         "ok yaw neutral=1520 ",
-        "ok",
+        "ok idle=60",
         "ok seed=42",
         "ok",
         "ok",

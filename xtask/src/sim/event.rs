@@ -207,6 +207,8 @@ pub enum Why {
     Wall,
     /// The firmware hit a breakpoint.
     Break,
+    /// Its stdin closed (a live run).
+    Closed,
     /// The harness failed.
     #[default]
     Error,

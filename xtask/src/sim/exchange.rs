@@ -48,7 +48,7 @@ use idle_head_core::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus}
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
 
-use idle_head_core::console::{PortSession, Shared, SharedService};
+use idle_head_core::console::{PortSession, Shared, SharedService, outcome_reply};
 
 /// When the first byte goes out: 3 s, after the 2 s fade-in.
 pub const START: Duration = Duration::from_secs(3);
@@ -101,9 +101,6 @@ pub fn script_lines() -> Vec<Vec<u8>> {
 /// The replies the firmware must send for `script`, one per line: first
 /// on the UART, then on the USB port, with one service as on the board.
 pub fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
-    // The firmware's frame task drains its queue; the script holds fewer
-    // actions than the queue holds (twice over), so here it never needs
-    // draining.
     let queue: &'static CommandQueue = Box::leak(Box::new(CommandQueue::new()));
     let link: &'static ConsoleLink = Box::leak(Box::new(ConsoleLink::new()));
     // As on the board from its fade-in on; the rest is masked ([`mask`]).
@@ -122,11 +119,29 @@ pub fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
     .expect("the built-in settings are valid");
     let service: &'static SharedService<RamStorage> =
         Box::leak(Box::new(Mutex::new(RefCell::new(service))));
-    [(), ()].map(|()| {
+    // What the frame task answers a queued action: the mixer's answer on
+    // a head whose gaze is at the centre and plays no gesture, as the
+    // emulated head's is when the script's one motion (`center`) arrives.
+    let behaviour = Settings::DEFAULT
+        .validate(&DriverConfig::DEFAULT)
+        .expect("the built-in settings are valid")
+        .behaviour;
+    [0, 1].map(|port| {
         let mut session = PortSession::new();
-        let mut handler = Shared::new(service);
+        let mut handler = Shared::new(service, port);
         let mut replies = Vec::new();
-        session.feed(script, &mut handler, |reply| replies.push(mask(reply)));
+        for &byte in script {
+            if let Some(reply) = session.push(byte, &mut handler) {
+                replies.push(mask(reply));
+            }
+            if session.waiting().is_some() {
+                let (action, _) = queue.take_asked().expect("the action waits in the queue");
+                let outcome = behaviour.check(&action);
+                if let Some(reply) = session.finish(|reply| outcome_reply(reply, &outcome)) {
+                    replies.push(mask(reply));
+                }
+            }
+        }
         replies
     })
 }

@@ -141,6 +141,9 @@ pub struct Config {
     pub flash_fill: Option<(u64, Vec<u8>)>,
     /// Virtual times at which the power goes off and on again.
     pub power_cycles: Vec<Duration>,
+    /// A live run: real time, stdin to the USB serial port, for as long
+    /// as stdin is open (`live.rs`).
+    pub live: bool,
 }
 
 /// How long the flash is busy per operation.
@@ -181,7 +184,8 @@ impl UartScript {
 }
 
 impl Config {
-    fn json(&self) -> Value {
+    /// The harness's command-line argument.
+    pub fn json(&self) -> Value {
         json!({
             "flash": self.flash,
             "vtor": self.vtor,
@@ -214,12 +218,13 @@ impl Config {
                 "hex": hex(bytes),
             })),
             "power_cycles_ns": self.power_cycles.iter().map(|at| nanos(*at)).collect::<Vec<_>>(),
+            "live": self.live,
         })
     }
 }
 
 /// `bytes` as lower-case hex digits, as the harness reads them.
-fn hex(bytes: &[u8]) -> String {
+pub(super) fn hex(bytes: &[u8]) -> String {
     bytes.iter().fold(String::new(), |mut text, byte| {
         let _ = write!(text, "{byte:02x}");
         text

@@ -124,6 +124,7 @@ impl End {
                 Duration::from_millis(self.wall_ms).as_secs_f64()
             )),
             Why::Break => Some(format!("the firmware hit a breakpoint at {at:.3} s")),
+            Why::Closed => Some(format!("the live run's input closed at {at:.3} s")),
             Why::Error => Some(format!(
                 "the emulator stopped (error) at {at:.3} s: {}",
                 self.error.as_deref().unwrap_or("no reason given")

@@ -31,7 +31,7 @@ use super::error::BehaviourError;
 use super::idle::IdleSource;
 use super::mixer::{Applied, Mixer};
 use super::params::{BehaviourParams, LimitMode};
-use super::queue::{CommandQueue, PER_FRAME};
+use super::queue::{Asker, CommandQueue, PER_FRAME};
 
 /// What one frame did.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -140,12 +140,25 @@ impl<I: IdleSource> Head<I> {
         queue: &CommandQueue<N>,
         mut done: impl FnMut(&Action, &Result<Applied, BehaviourError>),
     ) -> usize {
+        self.drain_asked(driver, queue, |action, _, outcome| done(action, outcome))
+    }
+
+    /// [`drain`](Self::drain), telling `done` also who asked for each
+    /// action (the console port waiting for its outcome, if any).
+    pub fn drain_asked<P: SetDutyCycle, const N: usize>(
+        &mut self,
+        driver: &mut FrameDriver<P>,
+        queue: &CommandQueue<N>,
+        mut done: impl FnMut(&Action, Option<Asker>, &Result<Applied, BehaviourError>),
+    ) -> usize {
         self.sync(driver);
         let mut count = 0;
         while count < PER_FRAME {
-            let Some(action) = queue.take() else { break };
+            let Some((action, asker)) = queue.take_asked() else {
+                break;
+            };
             let outcome = self.apply(driver, &action);
-            done(&action, &outcome);
+            done(&action, asker, &outcome);
             count += 1;
         }
         count

@@ -75,4 +75,4 @@ pub use head::{Head, HeadFrame};
 pub use idle::{IdleSource, LOOP_DURATION};
 pub use mixer::{Applied, Mixer};
 pub use params::{BehaviourParams, LimitMode};
-pub use queue::{CommandQueue, QueueFull};
+pub use queue::{Asker, CommandQueue, QueueFull};

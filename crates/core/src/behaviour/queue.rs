@@ -22,6 +22,18 @@ pub const PER_FRAME: usize = 2;
 /// The queue's capacity on the boards.
 pub const CAPACITY: usize = 8;
 
+/// Who asked for a queued action and is waiting for its outcome: a
+/// console port and the ticket the port's console gave it (see
+/// [`ConsoleLink::answer`](crate::console::ConsoleLink::answer)).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Asker {
+    /// The port (`0..console::PORTS`).
+    pub port: u8,
+    /// The ticket, to tell this action's outcome from an older one's.
+    pub ticket: u8,
+}
+
 /// The queue was full: the action was not taken (here it is back).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -50,7 +62,7 @@ impl core::error::Error for QueueFull {}
 /// assert_eq!(QUEUE.take(), Some(Action::Stop));
 /// ```
 pub struct CommandQueue<const N: usize = CAPACITY> {
-    channel: Channel<CriticalSectionRawMutex, Action, N>,
+    channel: Channel<CriticalSectionRawMutex, (Action, Option<Asker>), N>,
 }
 
 impl<const N: usize> CommandQueue<N> {
@@ -67,13 +79,30 @@ impl<const N: usize> CommandQueue<N> {
     /// # Errors
     /// [`QueueFull`] with the action if `N` actions are waiting.
     pub fn try_submit(&self, action: Action) -> Result<(), QueueFull> {
-        self.channel.try_send(action).map_err(|e| match e {
-            TrySendError::Full(action) => QueueFull(action),
+        self.submit(action, None)
+    }
+
+    /// Queues `action` for the frame task, which tells `asker` its outcome.
+    ///
+    /// # Errors
+    /// [`QueueFull`] with the action if `N` actions are waiting.
+    pub fn try_submit_from(&self, action: Action, asker: Asker) -> Result<(), QueueFull> {
+        self.submit(action, Some(asker))
+    }
+
+    fn submit(&self, action: Action, asker: Option<Asker>) -> Result<(), QueueFull> {
+        self.channel.try_send((action, asker)).map_err(|e| match e {
+            TrySendError::Full((action, _)) => QueueFull(action),
         })
     }
 
     /// The oldest waiting action, if any.
     pub fn take(&self) -> Option<Action> {
+        self.take_asked().map(|(action, _)| action)
+    }
+
+    /// The oldest waiting action and who asked for it, if any.
+    pub fn take_asked(&self) -> Option<(Action, Option<Asker>)> {
         self.channel.try_receive().ok()
     }
 

@@ -1,7 +1,9 @@
 //! What the console task and the frame task share, besides the command
 //! queue: the head's status (frame task → console), servo calibrations
-//! to apply (console → frame task) and new idle seeds (console → loop
-//! generator).
+//! to apply (console → frame task), new idle seeds (console → loop
+//! generator), the outcome of each port's queued action (frame task →
+//! the port's console, which answers the line with it) and each port's
+//! telemetry rate (`watch`).
 //!
 //! Each is an embassy-sync blocking `Mutex` over a `Cell`, or a `Signal`
 //! (whose state is a `Cell` too): a critical section around a copy, no
@@ -14,6 +16,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 
 use crate::axis::Axis;
+use crate::behaviour::{Applied, Asker, BehaviourError};
 use crate::driver::{DriverStats, FrameReport};
 use crate::servo::ServoCalibration;
 use crate::units::{Angle, Microseconds};
@@ -79,11 +82,28 @@ impl HeadStatus {
     }
 }
 
+/// Console ports a board may have: UART (0) and USB (1).
+pub const PORTS: usize = 2;
+
+/// What the frame task did with a port's queued action: its ticket and
+/// what the mixer answered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Outcome {
+    /// The ticket the console gave the action ([`Asker::ticket`]).
+    pub ticket: u8,
+    /// What it started, or why it was refused.
+    pub result: Result<Applied, BehaviourError>,
+}
+
 /// The shared state; see the [module docs](self). Lives in a `static`.
 pub struct ConsoleLink {
     status: Mutex<CriticalSectionRawMutex, Cell<HeadStatus>>,
     servos: Mutex<CriticalSectionRawMutex, Cell<[Option<ServoCalibration>; 3]>>,
     seeds: Signal<CriticalSectionRawMutex, [u32; 3]>,
+    outcomes: [Signal<CriticalSectionRawMutex, Outcome>; PORTS],
+    /// Telemetry lines a second per port (0: off).
+    watch: Mutex<CriticalSectionRawMutex, Cell<[u8; PORTS]>>,
 }
 
 impl ConsoleLink {
@@ -101,7 +121,44 @@ impl ConsoleLink {
             })),
             servos: Mutex::new(Cell::new([None; 3])),
             seeds: Signal::new(),
+            outcomes: [const { Signal::new() }; PORTS],
+            watch: Mutex::new(Cell::new([0; PORTS])),
         }
+    }
+
+    /// The frame task: `asker`'s action was taken (or refused) with
+    /// `result`. A port beyond [`PORTS`] is ignored.
+    pub fn answer(&self, asker: Asker, result: Result<Applied, BehaviourError>) {
+        if let Some(slot) = self.outcomes.get(usize::from(asker.port)) {
+            slot.signal(Outcome {
+                ticket: asker.ticket,
+                result,
+            });
+        }
+    }
+
+    /// The console of `port`: where the outcomes of its actions arrive
+    /// (`None` for a port beyond [`PORTS`]). The console resets it before
+    /// it queues an action and waits for the outcome with its ticket.
+    pub fn outcomes(&self, port: u8) -> Option<&Signal<CriticalSectionRawMutex, Outcome>> {
+        self.outcomes.get(usize::from(port))
+    }
+
+    /// The console: `port` streams `hz` telemetry lines a second (0: none).
+    pub fn set_watch(&self, port: u8, hz: u8) {
+        self.watch.lock(|cell| {
+            let mut rates = cell.get();
+            if let Some(rate) = rates.get_mut(usize::from(port)) {
+                *rate = hz;
+            }
+            cell.set(rates);
+        });
+    }
+
+    /// The console: `port`'s telemetry rate in lines a second (0: none).
+    pub fn watch(&self, port: u8) -> u8 {
+        self.watch
+            .lock(|cell| cell.get().get(usize::from(port)).copied().unwrap_or(0))
     }
 
     /// The frame task: the head after the last frame.

@@ -8,26 +8,35 @@
 //!   `err <code> <reason>`, codes in [`ErrorCode`]).
 //! - [`ConsoleService`]: the handler that carries every command out,
 //!   through the frame task's queue and the [`ConsoleLink`] it shares
-//!   with the frame task.
+//!   with the frame task. The reply to a queued action waits until the
+//!   frame task has taken or refused it ([`Reply::defer`],
+//!   [`Session::finish`], [`outcome_reply`]).
+//! - [`telemetry_line`]: the lines `watch` streams.
 //!
 //! Nothing here allocates or panics. See `docs/user/protocol.md` for the
 //! protocol as a user sees it.
 
 mod framer;
 mod link;
+mod outcome;
 mod parse;
 mod reply;
 mod service;
 mod session;
 mod shared;
+mod telemetry;
 
 pub use framer::{Framer, LineError};
-pub use link::{ConsoleLink, HeadMode, HeadStatus};
+pub use link::{ConsoleLink, HeadMode, HeadStatus, Outcome, PORTS};
+pub use outcome::{outcome_reply, unanswered};
 pub use parse::{ParseError, ParseErrorKind, Span, parse};
 pub use reply::{ErrorCode, Reply};
 pub use service::{ConsoleService, HELP, VERSION};
-pub use session::{EnvelopeError, Handler, InputError, MIN_REPLY, Session, checksum, respond};
+pub use session::{
+    EnvelopeError, Handler, InputError, Later, MIN_REPLY, Response, Session, checksum, respond,
+};
 pub use shared::{PortSession, Shared, SharedService};
+pub use telemetry::{MAX_WATCH_HZ, TELEMETRY_LINE, telemetry_line};
 
 /// How a board's USB serial port (CDC-ACM) introduces itself, so that a
 /// host finds the head among other serial devices.

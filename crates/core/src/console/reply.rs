@@ -95,6 +95,8 @@ enum Verdict {
     Unset,
     Ok,
     Err,
+    /// The reply waits for the outcome of the action with this ticket.
+    Later(u8),
 }
 
 /// Bytes kept free at the end of the buffer: `…` (3), a machine-mode
@@ -171,6 +173,44 @@ impl<'a> Reply<'a> {
         self.verdict = Verdict::Unset;
     }
 
+    /// A reply written into `buf` after the `start` bytes already there (a
+    /// machine-mode sequence number written before the reply was
+    /// [deferred](Self::defer)).
+    #[must_use]
+    pub(super) fn resume(buf: &'a mut [u8], start: usize) -> Self {
+        let mut reply = Self::new(buf);
+        let start = start.min(reply.limit);
+        reply.start = start;
+        reply.len = start;
+        reply
+    }
+
+    /// Defers the reply until the action with `ticket` has been taken or
+    /// refused by the frame task (see [`Session::waiting`]); text written
+    /// so far is dropped.
+    ///
+    /// [`Session::waiting`]: super::Session::waiting
+    pub fn defer(&mut self, ticket: u8) {
+        self.len = self.start;
+        self.truncated = false;
+        self.space = false;
+        self.verdict = Verdict::Later(ticket);
+    }
+
+    /// The ticket of the outcome the reply waits for, if deferred.
+    #[must_use]
+    pub fn later(&self) -> Option<u8> {
+        match self.verdict {
+            Verdict::Later(ticket) => Some(ticket),
+            _ => None,
+        }
+    }
+
+    /// Where the verdict starts (after a machine-mode sequence number).
+    pub(super) fn start(&self) -> usize {
+        self.start
+    }
+
     /// Starts (or restarts) the reply as `ok`; text written next follows it.
     pub fn ok(&mut self) -> &mut Self {
         self.restart(Verdict::Ok, "ok", "")
@@ -227,7 +267,7 @@ impl<'a> Reply<'a> {
 
     /// Everything but the line end (machine mode adds its checksum after).
     pub(super) fn close(&mut self) {
-        if self.verdict == Verdict::Unset {
+        if matches!(self.verdict, Verdict::Unset | Verdict::Later(_)) {
             self.ok();
         }
         if self.truncated {

@@ -20,17 +20,40 @@
 //! ).unwrap();
 //! let mut session = Session::<96, 160>::new();
 //! let mut replies = Vec::new();
-//! session.feed(b"nod\nservo yaw min 2600\nsave\n", &mut service, |r| replies.push(r.to_vec()));
-//! assert_eq!(replies[0], b"ok\r\n");
-//! assert!(replies[1].starts_with(b"err invalid "));
-//! assert_eq!(replies[2], b"ok\r\n");
+//! session.feed(b"servo yaw min 2600\nsave\n", &mut service, |r| replies.push(r.to_vec()));
+//! assert!(replies[0].starts_with(b"err invalid "));
+//! assert_eq!(replies[1], b"ok\r\n");
+//!
+//! // A motion's reply waits for the frame task: it is queued, with a
+//! // ticket, and answered with what the frame task did.
+//! assert_eq!(session.push(b'n', &mut service), None);
+//! for &b in b"od\n" {
+//!     assert_eq!(session.push(b, &mut service), None);
+//! }
+//! let ticket = session.waiting().unwrap();
+//! assert_eq!(QUEUE.len(), 1);
+//! // (the frame task takes it, and answers through the link:)
+//! # let (action, asker) = QUEUE.take_asked().unwrap();
+//! # let params = Settings::DEFAULT.validate(&DriverConfig::DEFAULT).unwrap().behaviour;
+//! # LINK.answer(asker.unwrap(), params.check(&action));
+//! let outcome = LINK.outcomes(0).unwrap().try_take().unwrap();
+//! assert_eq!(outcome.ticket, ticket);
+//! let reply = session.finish(|r| idle_head_core::console::outcome_reply(r, &outcome.result));
+//! assert!(reply.unwrap().starts_with(b"ok nod amp_mdeg="));
 //! ```
 //!
 //! What each command does:
 //!
 //! - motion (`nod`, `look`, `stop`, `idle …`): checked as the mixer
-//!   would ([`BehaviourParams::check`]) and queued for the frame task;
-//!   a full queue is `err busy` (nothing queued, send it again);
+//!   would ([`BehaviourParams::check`]) and queued for the frame task
+//!   with the port's ticket; a full queue is `err busy` (nothing queued,
+//!   send it again). The reply is deferred ([`Reply::defer`]): the
+//!   port's console answers once the frame task has taken or refused the
+//!   action ([`ConsoleLink::answer`], [`super::outcome_reply`]): `ok`
+//!   with what it started, or `err busy` when every gesture layer is
+//!   busy;
+//! - `watch <hz>|off`: the port's telemetry rate, in the link (the
+//!   port's console streams the lines);
 //! - `status`: the head as the last frame left it ([`HeadStatus`]),
 //!   uptime, firmware version, where the settings came from;
 //! - `servo <axis> <field> <value>`: the settings with that field
@@ -52,14 +75,15 @@ use crate::text::Arg::{Int, Str, Uint};
 use crate::text::Text;
 
 use super::link::{ConsoleLink, HeadStatus};
+use super::outcome::behaviour_code;
 use super::reply::{ErrorCode, Reply};
 use super::session::Handler;
 use crate::axis::Axis;
-use crate::behaviour::{Applied, BehaviourError, BehaviourParams, CommandQueue};
+use crate::behaviour::{Asker, BehaviourParams, CommandQueue};
 use crate::command::{Action, Command, SeedChoice, ServoSetting};
 use crate::driver::DriverConfig;
 use crate::gestures::GestureKind;
-use crate::servo::{Direction, ServoCalibration};
+use crate::servo::{Direction, ServoCalibration, bounds};
 use crate::settings::{Settings, SettingsError, SettingsSource, SettingsStorage, StorageError};
 
 /// The reply to `help`: the command words, one line (the gestures' from
@@ -67,7 +91,7 @@ use crate::settings::{Settings, SettingsError, SettingsSource, SettingsStorage, 
 pub const HELP: &str = const_format::concatcp!(
     "commands: help status stop",
     GestureKind::WORDS,
-    " look center idle seed servo save load defaults"
+    " look center idle seed servo save load defaults watch"
 );
 
 /// The firmware version `status` reports.
@@ -84,6 +108,8 @@ pub struct ConsoleService<'a, S, const N: usize = { crate::behaviour::queue::CAP
     source: SettingsSource,
     /// xorshift32 state for `seed random`.
     entropy: u32,
+    /// The last ticket given to a queued action.
+    ticket: u8,
 }
 
 impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
@@ -110,6 +136,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
             behaviour: valid.behaviour,
             source,
             entropy: 0x9e37_79b9,
+            ticket: 0,
         })
     }
 
@@ -135,29 +162,36 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         &mut self.storage
     }
 
-    fn act(&mut self, action: Action, reply: &mut Reply<'_>) {
-        let applied = match self.behaviour.check(&action) {
-            Ok(applied) => applied,
-            Err(e) => {
-                text(reply.err(behaviour_code(&e))).with(&e);
-                return;
-            }
-        };
-        if let Err(full) = self.queue.try_submit(action) {
-            text(reply.err(ErrorCode::Busy)).with(&full);
+    fn act(&mut self, port: u8, action: Action, reply: &mut Reply<'_>) {
+        if let Err(e) = self.behaviour.check(&action) {
+            text(reply.err(behaviour_code(&e))).with(&e);
             return;
         }
-        if let Applied::Look(look) = applied
-            && look.clamped
-        {
-            text(reply.ok()).fill(
-                "clamped pitch={} yaw={}",
-                &[
-                    Int(look.pitch.millidegrees().into()),
-                    Int(look.yaw.millidegrees().into()),
-                ],
-            );
+        self.ticket = self.ticket.wrapping_add(1);
+        let asker = Asker {
+            port,
+            ticket: self.ticket,
+        };
+        // An outcome left from an action answered without it (a wait that
+        // timed out) is not this one's.
+        if let Some(outcomes) = self.link.outcomes(port) {
+            outcomes.reset();
         }
+        match self.queue.try_submit_from(action, asker) {
+            Ok(()) => reply.defer(asker.ticket),
+            Err(full) => {
+                text(reply.err(ErrorCode::Busy)).with(&full);
+            }
+        }
+    }
+
+    fn watch(&mut self, port: u8, hz: Option<u8>, reply: &mut Reply<'_>) {
+        self.link.set_watch(port, hz.unwrap_or(0));
+        let text = text(reply.ok()).str("watch=");
+        match hz {
+            Some(hz) => text.u64(hz.into()),
+            None => text.str("off"),
+        };
     }
 
     fn status(&self, reply: &mut Reply<'_>) {
@@ -237,6 +271,17 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
                 self.settings = next;
                 self.behaviour = valid.behaviour;
                 self.source = SettingsSource::Changed;
+                if let Some(pulse) = cal.unusual() {
+                    text(reply.ok()).fill(
+                        "warning: {} pulses may reach {} us, outside the {}..{} us most hobby servos accept: check the servo's travel",
+                        &[
+                            Str(axis.name()),
+                            Uint(pulse.0.into()),
+                            Uint(bounds::TYPICAL_MIN.0.into()),
+                            Uint(bounds::TYPICAL_MAX.0.into()),
+                        ],
+                    );
+                }
             }
             Err(SettingsError::Driver(e)) => {
                 text(reply.err(ErrorCode::Invalid)).with(&e);
@@ -320,14 +365,17 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
     }
 }
 
-impl<S: SettingsStorage, const N: usize> Handler for ConsoleService<'_, S, N> {
-    fn command(&mut self, command: Command, reply: &mut Reply<'_>) {
+impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
+    /// Carries out `command` from console port `port` (which waits for
+    /// the outcome of a queued action, and has its own telemetry rate).
+    pub fn command_on(&mut self, port: u8, command: Command, reply: &mut Reply<'_>) {
         match command {
             Command::Help => {
                 text(reply.ok()).str(HELP);
             }
             Command::Status => self.status(reply),
-            Command::Act(action) => self.act(action, reply),
+            Command::Act(action) => self.act(port, action, reply),
+            Command::Watch(hz) => self.watch(port, hz, reply),
             Command::Seed(choice) => self.seed(choice, reply),
             Command::Servo {
                 axis,
@@ -343,6 +391,13 @@ impl<S: SettingsStorage, const N: usize> Handler for ConsoleService<'_, S, N> {
                 self.adopt(Settings::DEFAULT, SettingsSource::Defaults, reply);
             }
         }
+    }
+}
+
+/// As a handler of its own, the service is port 0's.
+impl<S: SettingsStorage, const N: usize> Handler for ConsoleService<'_, S, N> {
+    fn command(&mut self, command: Command, reply: &mut Reply<'_>) {
+        self.command_on(0, command, reply);
     }
 }
 
@@ -364,16 +419,6 @@ fn change(cal: &mut ServoCalibration, setting: ServoSetting) {
         ServoSetting::MinPulse(us) => cal.min_pulse = us,
         ServoSetting::MaxPulse(us) => cal.max_pulse = us,
         ServoSetting::Limits(range) => cal.limits = range,
-    }
-}
-
-/// The reply code of a refused motion.
-const fn behaviour_code(e: &BehaviourError) -> ErrorCode {
-    match e {
-        BehaviourError::Busy { .. } => ErrorCode::Busy,
-        BehaviourError::Amplitude { .. } => ErrorCode::Limit,
-        BehaviourError::Config { .. } => ErrorCode::Invalid,
-        _ => ErrorCode::Range,
     }
 }
 

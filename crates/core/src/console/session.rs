@@ -152,6 +152,8 @@ pub const MIN_REPLY: usize = 48;
 pub struct Session<const LINE: usize = 96, const REPLY: usize = 160> {
     framer: Framer<LINE>,
     reply: [u8; REPLY],
+    /// The reply that waits for the frame task, in `reply`.
+    later: Option<Later>,
 }
 
 impl<const LINE: usize, const REPLY: usize> Default for Session<LINE, REPLY> {
@@ -168,16 +170,49 @@ impl<const LINE: usize, const REPLY: usize> Session<LINE, REPLY> {
         Self {
             framer: Framer::new(),
             reply: [0; REPLY],
+            later: None,
         }
     }
 
-    /// Takes one byte; at a line end, the reply line (CR LF included).
+    /// Takes one byte; at a line end, the reply line (CR LF included), or
+    /// nothing if the reply waits for the frame task ([`waiting`](Self::waiting)).
+    ///
+    /// While a reply waits, finish it ([`finish`](Self::finish)) before
+    /// pushing more: a byte pushed meanwhile is not taken (`None`), as
+    /// the line it belongs to could not be answered in order.
     pub fn push<H: Handler + ?Sized>(&mut self, byte: u8, handler: &mut H) -> Option<&[u8]> {
+        if self.later.is_some() {
+            return None;
+        }
         let outcome = self.framer.push(byte)?;
-        Some(respond(outcome, handler, &mut self.reply))
+        match respond(outcome, handler, &mut self.reply) {
+            Response::Now(line) => Some(line),
+            Response::Later(later) => {
+                self.later = Some(later);
+                None
+            }
+        }
     }
 
-    /// Takes a run of bytes, calling `emit` with each reply line.
+    /// The ticket of the action whose outcome the last line's reply waits
+    /// for, if it waits (see [`Reply::defer`]).
+    #[must_use]
+    pub fn waiting(&self) -> Option<u8> {
+        self.later.map(|later| later.ticket())
+    }
+
+    /// Finishes the reply that waits, `write` writing its verdict (with
+    /// [`super::answer`] from the outcome, or [`super::unanswered`]), and
+    /// returns it; `None` if no reply waits.
+    pub fn finish(&mut self, write: impl FnOnce(&mut Reply<'_>)) -> Option<&[u8]> {
+        let later = self.later.take()?;
+        Some(later.finish(&mut self.reply, write))
+    }
+
+    /// Takes a run of bytes, calling `emit` with each reply line. For
+    /// handlers that answer at once: this cannot wait for the frame task,
+    /// so a reply that would wait is finished at once as
+    /// [`unanswered`](super::unanswered).
     pub fn feed<H: Handler + ?Sized>(
         &mut self,
         bytes: &[u8],
@@ -188,18 +223,86 @@ impl<const LINE: usize, const REPLY: usize> Session<LINE, REPLY> {
             if let Some(reply) = self.push(byte, handler) {
                 emit(reply);
             }
+            if let Some(reply) = self.finish(|reply| super::unanswered(reply, 0)) {
+                emit(reply);
+            }
         }
     }
 
-    /// Forgets the line in progress (e.g. when the port reconnects).
+    /// The reply buffer, for a line of the console's own between replies
+    /// (a telemetry line); it holds a reply that waits, if one does, so
+    /// then the buffer is not handed out (an empty one is).
+    pub fn spare(&mut self) -> &mut [u8] {
+        if self.later.is_some() {
+            return &mut [];
+        }
+        &mut self.reply
+    }
+
+    /// Forgets the line in progress and a reply that waits (e.g. when the
+    /// port reconnects: the new host did not send that line).
     pub fn reset(&mut self) {
         self.framer.reset();
+        self.later = None;
     }
 
     /// Notes that the port lost received bytes (see [`Framer::lose`]):
     /// the line they belonged to is answered `err line bytes lost …`.
     pub fn lose(&mut self) {
         self.framer.lose();
+    }
+}
+
+/// A reply: the line, or a reply that waits for the frame task.
+#[derive(Debug, PartialEq, Eq)]
+pub enum Response<'b> {
+    /// The reply line (CR LF included).
+    Now(&'b [u8]),
+    /// The handler deferred the reply ([`Reply::defer`]): finish it with
+    /// [`Later::finish`] in the same buffer once the outcome is there.
+    Later(Later),
+}
+
+impl<'b> Response<'b> {
+    /// The line, if the reply did not wait.
+    #[must_use]
+    pub fn now(self) -> Option<&'b [u8]> {
+        match self {
+            Self::Now(line) => Some(line),
+            Self::Later(_) => None,
+        }
+    }
+}
+
+/// A reply that waits for the outcome of a queued action. What it keeps
+/// of the line (a machine-mode sequence number) stays in the reply
+/// buffer: finishing it needs no second buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Later {
+    ticket: u8,
+    /// Bytes of the buffer already written: `#<seq> `.
+    start: usize,
+    machine: bool,
+}
+
+impl Later {
+    /// The ticket of the action whose outcome the reply waits for.
+    #[must_use]
+    pub const fn ticket(&self) -> u8 {
+        self.ticket
+    }
+
+    /// Finishes the reply in `out`, the buffer [`respond`] wrote into,
+    /// `write` writing its verdict (a reply left alone, or deferred
+    /// again, is a bare `ok`).
+    pub fn finish(self, out: &mut [u8], write: impl FnOnce(&mut Reply<'_>)) -> &[u8] {
+        let mut reply = Reply::resume(out, self.start);
+        write(&mut reply);
+        if self.machine {
+            sign(reply)
+        } else {
+            reply.finish()
+        }
     }
 }
 
@@ -210,10 +313,11 @@ pub fn respond<'b, H: Handler + ?Sized>(
     line: Result<&[u8], LineError>,
     handler: &mut H,
     out: &'b mut [u8],
-) -> &'b [u8] {
+) -> Response<'b> {
     let mut reply = Reply::new(out);
+    let machine = matches!(line, Ok(text) if text.first() == Some(&b'#'));
     match line {
-        Ok(text) if text.first() == Some(&b'#') => {
+        Ok(text) if machine => {
             let Envelope { seq, command } = envelope(text);
             if let Some(seq) = seq {
                 reply.prefix(seq);
@@ -222,25 +326,34 @@ pub fn respond<'b, H: Handler + ?Sized>(
                 Ok(command) => answer(command, handler, &mut reply),
                 Err(error) => reject(InputError::Envelope(error), &[], handler, &mut reply),
             }
-            reply.close();
-            let crc = checksum(reply.text());
-            reply.append_tail(&[b' ', b'*', hex_digit(crc >> 4), hex_digit(crc)]);
-            reply.end_line();
-            reply.into_line()
         }
-        Ok(text) => {
-            answer(text, handler, &mut reply);
-            reply.finish()
-        }
-        Err(error) => {
-            reject(InputError::Line(error), &[], handler, &mut reply);
-            reply.finish()
-        }
+        Ok(text) => answer(text, handler, &mut reply),
+        Err(error) => reject(InputError::Line(error), &[], handler, &mut reply),
     }
+    if let Some(ticket) = reply.later() {
+        return Response::Later(Later {
+            ticket,
+            start: reply.start(),
+            machine,
+        });
+    }
+    Response::Now(if machine { sign(reply) } else { reply.finish() })
+}
+
+/// Closes a machine-mode reply: its checksum and the line end.
+fn sign(mut reply: Reply<'_>) -> &[u8] {
+    reply.close();
+    let crc = checksum(reply.text());
+    reply.append_tail(&[b' ', b'*', hex_digit(crc >> 4), hex_digit(crc)]);
+    reply.end_line();
+    reply.into_line()
 }
 
 // The tail kept by every reply holds the checksum and the line end.
 const _: () = assert!(TAIL >= "…".len() + " *hh".len() + "\r\n".len());
+
+// A port's telemetry line is written into its session's reply buffer.
+const _: () = assert!(super::TELEMETRY_LINE <= 160);
 
 /// Parses `line` and carries it out, or rejects it.
 fn answer<H: Handler + ?Sized>(line: &[u8], handler: &mut H, reply: &mut Reply<'_>) {

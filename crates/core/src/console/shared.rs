@@ -32,19 +32,28 @@ pub type SharedService<S> = Mutex<NoopRawMutex, RefCell<ConsoleService<'static, 
 /// A port's handle on the shared service.
 pub struct Shared<S: 'static> {
     service: &'static SharedService<S>,
+    port: u8,
 }
 
 impl<S: SettingsStorage> Shared<S> {
-    /// A handle on `service`.
-    pub const fn new(service: &'static SharedService<S>) -> Self {
-        Self { service }
+    /// Port `port`'s handle on `service` (`0..PORTS`: the port its
+    /// queued actions' outcomes and its telemetry rate are kept for, see
+    /// [`ConsoleLink`]).
+    pub const fn new(service: &'static SharedService<S>, port: u8) -> Self {
+        Self { service, port }
+    }
+
+    /// The port.
+    #[must_use]
+    pub const fn port(&self) -> u8 {
+        self.port
     }
 }
 
 impl<S: SettingsStorage> Handler for Shared<S> {
     fn command(&mut self, command: Command, reply: &mut Reply<'_>) {
         self.service.lock(|cell| match cell.try_borrow_mut() {
-            Ok(mut service) => service.command(command, reply),
+            Ok(mut service) => service.command_on(self.port, command, reply),
             // Cannot happen (see the module docs); an answer all the same.
             Err(_) => {
                 reply

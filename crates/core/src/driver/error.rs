@@ -110,6 +110,14 @@ impl ConfigError {
                 ServoError::ZeroPerDegree => {
                     per_axis!(axis, "servos", ".per_degree", "must not be zero")
                 }
+                ServoError::PulseOutsideBounds { .. } => {
+                    per_axis!(
+                        axis,
+                        "servos",
+                        ".min_pulse",
+                        "or `max_pulse` outside 500..=2500 µs"
+                    )
+                }
                 ServoError::LimitsInverted { .. } => {
                     per_axis!(axis, "servos", ".limits", "is inverted (min > max)")
                 }
@@ -251,6 +259,15 @@ impl Describe for ServoError {
                 ],
             ),
             Self::ZeroPerDegree => out.str("per_degree must be above 0 ns/°"),
+            Self::PulseOutsideBounds { max, pulse } => out.fill(
+                "{} {} µs is outside {}..={} µs, the pulses no servo setting may pass",
+                &[
+                    Str(if max { "max_pulse" } else { "min_pulse" }),
+                    Uint(pulse.0.into()),
+                    Uint(crate::servo::bounds::MIN_PULSE.0.into()),
+                    Uint(crate::servo::bounds::MAX_PULSE.0.into()),
+                ],
+            ),
             Self::LimitsInverted { limits } => out.fill(
                 "limits {}..{}: the lower limit lies above the upper one",
                 &[Text(&Degrees(limits.min)), Text(&Degrees(limits.max))],

@@ -94,6 +94,14 @@ pub enum ServoError {
         /// The rejected limits.
         limits: AngleRange,
     },
+    /// `min_pulse` or `max_pulse` lies outside the hard bounds
+    /// [`bounds::MIN_PULSE`]..=[`bounds::MAX_PULSE`] that no setting may pass.
+    PulseOutsideBounds {
+        /// `true` for `max_pulse`, `false` for `min_pulse`.
+        max: bool,
+        /// The rejected pulse.
+        pulse: Microseconds,
+    },
     /// An angle limit needs a pulse outside `[min_pulse, max_pulse]`: the servo cannot reach it.
     LimitUnreachable {
         /// The unreachable limit angle.
@@ -119,6 +127,9 @@ impl ServoError {
                 "servo calibration: `neutral` must lie in [`min_pulse`, `max_pulse`]"
             }
             Self::ZeroPerDegree => "servo calibration: `per_degree` must not be zero",
+            Self::PulseOutsideBounds { .. } => {
+                "servo calibration: `min_pulse` and `max_pulse` must lie in 500..=2500 µs"
+            }
             Self::LimitsInverted { .. } => {
                 "servo calibration: `limits.min` must not exceed `limits.max`"
             }
@@ -162,6 +173,31 @@ pub struct ServoCalibration {
     pub max_pulse: Microseconds,
     /// Mechanical angle limits of the axis; commanded angles are clamped to them.
     pub limits: AngleRange,
+}
+
+/// Hard bounds on the pulses that no setting may pass, and the range most
+/// hobby servos accept.
+///
+/// Analogue hobby servos are specified for 1000..2000 µs (±45° on most);
+/// many travel further, to about 500..2500 µs, and some lock up, stall
+/// against their end stops or reverse past that. So `min_pulse` and
+/// `max_pulse` must lie in [`MIN_PULSE`]..=[`MAX_PULSE`] (`err invalid`
+/// otherwise), and a calibration outside [`TYPICAL_MIN`]..=[`TYPICAL_MAX`]
+/// is accepted with a warning ([`ServoCalibration::unusual`]). The angle
+/// limits are bounded by the pulses: each limit's pulse must lie in
+/// `[min_pulse, max_pulse]` ([`ServoError::LimitUnreachable`]), so with
+/// 11.111 µs/° no limit can pass ±90° however the pulses are set.
+pub mod bounds {
+    use super::Microseconds;
+
+    /// The shortest pulse any setting may write.
+    pub const MIN_PULSE: Microseconds = Microseconds(500);
+    /// The longest pulse any setting may write.
+    pub const MAX_PULSE: Microseconds = Microseconds(2500);
+    /// The shortest pulse most hobby servos are specified for.
+    pub const TYPICAL_MIN: Microseconds = Microseconds(1000);
+    /// The longest pulse most hobby servos are specified for.
+    pub const TYPICAL_MAX: Microseconds = Microseconds(2000);
 }
 
 /// Defaults for a typical analogue hobby servo (SG90/MG90S/MG996R class).
@@ -209,7 +245,8 @@ impl ServoCalibration {
     /// Checks the calibration.
     ///
     /// # Errors
-    /// The first problem found, in this order: [`ServoError::PulseRangeEmpty`],
+    /// The first problem found, in this order:
+    /// [`ServoError::PulseOutsideBounds`], [`ServoError::PulseRangeEmpty`],
     /// [`ServoError::NeutralOutsidePulseRange`], [`ServoError::ZeroPerDegree`],
     /// [`ServoError::LimitsInverted`], [`ServoError::NeutralOutsideLimits`],
     /// [`ServoError::LimitUnreachable`].
@@ -232,6 +269,18 @@ impl ServoCalibration {
     /// assert_eq!(err.to_string(), "limit +20° needs 1722 µs, outside the pulse range 1000..1700 µs");
     /// ```
     pub const fn validate(&self) -> Result<(), ServoError> {
+        if self.min_pulse.0 < bounds::MIN_PULSE.0 || self.min_pulse.0 > bounds::MAX_PULSE.0 {
+            return Err(ServoError::PulseOutsideBounds {
+                max: false,
+                pulse: self.min_pulse,
+            });
+        }
+        if self.max_pulse.0 < bounds::MIN_PULSE.0 || self.max_pulse.0 > bounds::MAX_PULSE.0 {
+            return Err(ServoError::PulseOutsideBounds {
+                max: true,
+                pulse: self.max_pulse,
+            });
+        }
         if self.min_pulse.0 >= self.max_pulse.0 {
             return Err(ServoError::PulseRangeEmpty {
                 min: self.min_pulse,
@@ -274,6 +323,30 @@ impl ServoCalibration {
             i += 1;
         }
         Ok(())
+    }
+
+    /// The pulse (shortest, then longest) outside the range most hobby
+    /// servos accept ([`bounds::TYPICAL_MIN`]..=[`bounds::TYPICAL_MAX`]),
+    /// if the calibration can write one: a valid calibration, but one to
+    /// check against the servo's data sheet and end stops.
+    ///
+    /// ```
+    /// use idle_head_core::servo::ServoCalibration;
+    /// use idle_head_core::{Axis, Microseconds};
+    /// let mut cal = ServoCalibration::hobby(Axis::Yaw);
+    /// assert_eq!(cal.unusual(), None);
+    /// cal.min_pulse = Microseconds(900);
+    /// assert_eq!(cal.unusual(), Some(Microseconds(900)));
+    /// ```
+    #[must_use]
+    pub const fn unusual(&self) -> Option<Microseconds> {
+        if self.min_pulse.0 < bounds::TYPICAL_MIN.0 {
+            Some(self.min_pulse)
+        } else if self.max_pulse.0 > bounds::TYPICAL_MAX.0 {
+            Some(self.max_pulse)
+        } else {
+            None
+        }
     }
 
     /// Fails compilation (in a `const` context) with a message naming the field

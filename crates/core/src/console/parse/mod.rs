@@ -16,6 +16,7 @@
 //! seed <n> | seed random
 //! servo <pitch|roll|yaw> [neutral <us> | per-degree <ns> | direction <normal|reversed>
 //!                        | min <us> | max <us> | limits <min_mdeg> <max_mdeg>]
+//! watch <hz> | watch off                                (hz 1..=50)
 //! ```
 //!
 //! The parser checks the syntax and that each number fits its type
@@ -84,6 +85,7 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
         Word::Is(Kw::Idle) => idle(&mut words)?,
         Word::Is(Kw::Seed) => seed(&mut words)?,
         Word::Is(Kw::Servo) => servo(&mut words)?,
+        Word::Is(Kw::Watch) => watch(&mut words)?,
         _ => return Err(first.error(ParseErrorKind::UnknownCommand)),
     };
     words.end()?;
@@ -105,6 +107,7 @@ const PERCENT: Field = Field::new("percentage", 0, 100);
 const SEED: Field = Field::new("seed", 0, u32::MAX as i64);
 const PULSE: Field = Field::new("pulse in us", 0, u32::MAX as i64);
 const PER_DEGREE: Field = Field::new("ns per degree", 0, u32::MAX as i64);
+const WATCH_HZ: Field = Field::new("lines a second", 1, crate::console::MAX_WATCH_HZ as i64);
 
 fn to_angle(v: i64) -> Angle {
     Angle::from_millidegrees(v as i32)
@@ -197,6 +200,18 @@ fn seed(words: &mut Words<'_>) -> Result<Command, ParseError> {
         return Ok(Command::Seed(SeedChoice::Random));
     }
     Ok(Command::Seed(SeedChoice::Value(word.number(&SEED)? as u32)))
+}
+
+/// `watch <hz>|off`.
+fn watch(words: &mut Words<'_>) -> Result<Command, ParseError> {
+    const EXPECTED: &str = "lines a second or `off`";
+    let Some(word) = words.next() else {
+        return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
+    };
+    if word.lower() == Word::Is(Kw::Off) {
+        return Ok(Command::Watch(None));
+    }
+    Ok(Command::Watch(Some(word.number(&WATCH_HZ)? as u8)))
 }
 
 /// `servo <axis> [<field> <value>...]`.

@@ -80,10 +80,11 @@ pub(super) enum Kw {
     Hold,
     Cycles,
     Intensity,
+    Watch,
 }
 
 /// Every word the protocol has, lower case, in the order of [`ALL`].
-const KEYWORDS: [&str; 31] = [
+const KEYWORDS: [&str; 32] = [
     "help",
     "status",
     "save",
@@ -115,10 +116,11 @@ const KEYWORDS: [&str; 31] = [
     "hold",
     "cycles",
     "intensity",
+    "watch",
 ];
 
 /// The [`Kw`] of each of [`KEYWORDS`].
-const ALL: [Kw; 31] = [
+const ALL: [Kw; 32] = [
     Kw::Help,
     Kw::Status,
     Kw::Save,
@@ -150,6 +152,7 @@ const ALL: [Kw; 31] = [
     Kw::Hold,
     Kw::Cycles,
     Kw::Intensity,
+    Kw::Watch,
 ];
 
 // A gesture's word must not be a word the protocol already has: the

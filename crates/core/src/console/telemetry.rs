@@ -1,0 +1,128 @@
+//! Telemetry lines (`watch <hz>`): the head's pose and pulses as the last
+//! frame left them, streamed by a port's console task between replies.
+//!
+//! ```text
+//! ~ t=123440 p=-1505 r=-119 y=-236 us=1483,1499,1497 lost=0 *c4
+//! ```
+//!
+//! A line starts with `~`, which no reply starts with (`ok`, `err`, `#`),
+//! and ends with the same checksum as a machine-mode reply (CRC-8 of every
+//! byte before ` *`), so that a program tells it from a reply and catches
+//! a damaged one. `t` is the frame's time in ms since the first frame;
+//! `p`, `r`, `y` the commanded angles in mdeg; `us` the pulses written;
+//! `lost` the lines this port dropped so far because the host read too
+//! slowly (each tick whose line could not go out in time).
+
+use crate::text::Arg::{Int, Uint};
+use crate::text::{Text, hex_digit};
+
+use super::link::HeadStatus;
+use super::session::checksum;
+
+/// The longest telemetry line, CR LF included:
+/// `~ t=` (4) + 20 digits, ` p=`/` r=`/` y=` 3 × (3 + 11), ` us=` (4) +
+/// 3 × 10 + 2 commas, ` lost=` (6) + 10, ` *hh` (4), CR LF (2).
+pub const TELEMETRY_LINE: usize = 4 + 20 + 3 * 14 + 4 + 32 + 6 + 10 + 4 + 2;
+
+/// The fastest telemetry: one line a frame at 50 Hz.
+pub const MAX_WATCH_HZ: u8 = 50;
+
+/// Writes the telemetry line of `status` (frames of `frame_us` µs) with
+/// `lost` lines dropped so far into `out` (at least [`TELEMETRY_LINE`]
+/// bytes: a console writes it into its session's reply buffer, free
+/// between replies, [`Session::spare`](super::Session::spare)); returns
+/// the line. (Into a shorter buffer the line is cut, without its end.)
+pub fn telemetry_line<'b>(
+    status: &HeadStatus,
+    frame_us: u32,
+    lost: u32,
+    out: &'b mut [u8],
+) -> &'b [u8] {
+    let mut line = Line { buf: out, len: 0 };
+    let [p, r, y] = status.angles.map(crate::units::Angle::millidegrees);
+    let [pp, pr, py] = status.pulses.map(|us| us.0);
+    let text: &mut dyn Text = &mut line;
+    text.fill(
+        "~ t={} p={} r={} y={} us={},{},{} lost={}",
+        &[
+            Uint(status.frame.saturating_mul(frame_us.into()) / 1000),
+            Int(p.into()),
+            Int(r.into()),
+            Int(y.into()),
+            Uint(pp.into()),
+            Uint(pr.into()),
+            Uint(py.into()),
+            Uint(lost.into()),
+        ],
+    );
+    let crc = checksum(line.buf.get(..line.len).unwrap_or_default());
+    line.put_bytes(&[
+        b' ',
+        b'*',
+        hex_digit(crc >> 4),
+        hex_digit(crc),
+        b'\r',
+        b'\n',
+    ]);
+    let Line { buf, len } = line;
+    buf.get(..len).unwrap_or_default()
+}
+
+/// A line being written into a buffer.
+struct Line<'b> {
+    buf: &'b mut [u8],
+    len: usize,
+}
+
+impl Line<'_> {
+    fn put_bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            if let Some(slot) = self.buf.get_mut(self.len) {
+                *slot = b;
+                self.len += 1;
+            }
+        }
+    }
+}
+
+impl Text for Line<'_> {
+    fn put(&mut self, s: &str) {
+        self.put_bytes(s.as_bytes());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::console::HeadMode;
+    use crate::units::{Angle, Microseconds};
+
+    #[test]
+    fn a_line_reads_back_and_the_longest_fits() {
+        let mut out = [0; TELEMETRY_LINE];
+        let status = HeadStatus {
+            frame: 50,
+            mode: HeadMode::Running,
+            angles: [-1505, -119, 236].map(Angle::from_millidegrees),
+            pulses: [1483, 1499, 1497].map(Microseconds),
+            faults: [0; 3],
+            disabled: [false; 3],
+        };
+        let line = telemetry_line(&status, 20_000, 3, &mut out).to_vec();
+        let text = std::str::from_utf8(&line).unwrap();
+        let (body, tail) = text.rsplit_once(" *").unwrap();
+        assert_eq!(
+            body,
+            "~ t=1000 p=-1505 r=-119 y=236 us=1483,1499,1497 lost=3"
+        );
+        assert_eq!(tail, format!("{:02x}\r\n", checksum(body.as_bytes())));
+        let worst = HeadStatus {
+            frame: u64::MAX,
+            angles: [Angle::from_millidegrees(i32::MIN + 1); 3],
+            pulses: [Microseconds(u32::MAX); 3],
+            ..status
+        };
+        let line = telemetry_line(&worst, u32::MAX, u32::MAX, &mut out);
+        assert!(line.ends_with(b"\r\n"), "{}", String::from_utf8_lossy(line));
+    }
+}

@@ -1,0 +1,374 @@
+// The panel in a real browser: Debian's Chromium, headless, driven by
+// playwright-core (never Playwright's own browser download). Run by
+// `cargo xtask test` (xtask/src/panel/browser.rs), which starts what each
+// session talks to and passes it here as JSON:
+//
+//   node tests/browser.mjs '{"session": "serial", "url": …, "harness": {"cwd": …, "arg": …}, "shots": …}'
+//   node tests/browser.mjs '{"session": "bridge", "url": …, "label": …, "shots": …}'
+//
+// - serial: the page served without a bridge uses Web Serial; a fake
+//   `navigator.serial` (addInitScript) is bridged (exposeBinding) to the
+//   shipped Pico image in the RP2040 emulator, live, over its USB serial
+//   port. The fake can also unplug the board, answer `watch` as an older
+//   firmware does, and swallow a line (a reply that never comes).
+// - bridge: the page served by `cargo xtask panel` with a bridge (QEMU, a
+//   serial port) connects over its WebSocket on load.
+//
+// Each prints what it checked; any failed check, page error or timeout
+// fails the run (exit 1). Screenshots at 1280×800 go to `shots`.
+
+import { spawn } from 'node:child_process';
+import { mkdirSync } from 'node:fs';
+import { join } from 'node:path';
+import { chromium } from 'playwright-core';
+
+const cfg = JSON.parse(process.argv[2] ?? '{}');
+const CHROMIUM = cfg.chromium ?? '/usr/bin/chromium';
+const ARGS = [
+  '--headless',
+  '--no-sandbox',
+  '--disable-gpu',
+  '--disable-quic',
+  '--no-first-run',
+  '--disable-background-networking',
+  '--disable-component-update',
+  '--disable-sync',
+];
+const started = Date.now();
+const say = (text) => console.log(`[${((Date.now() - started) / 1000).toFixed(1)} s] ${text}`);
+const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+
+function check(ok, what) {
+  if (!ok) throw new Error(`check failed: ${what}`);
+  say(`ok: ${what}`);
+}
+
+/** Waits until `probe()` is truthy (polling), or fails after `ms`. */
+async function until(probe, ms, what) {
+  const end = Date.now() + ms;
+  for (;;) {
+    const value = await probe();
+    if (value) return value;
+    if (Date.now() > end) throw new Error(`timed out after ${ms} ms: ${what}`);
+    await sleep(50);
+  }
+}
+
+async function readout(page, axis) {
+  return Number(await page.locator(`#${axis}`).textContent());
+}
+
+async function shot(page, name) {
+  mkdirSync(cfg.shots, { recursive: true });
+  const path = join(cfg.shots, `panel-${name}.png`);
+  await page.screenshot({ path });
+  say(`screenshot ${path}`);
+}
+
+/** The pitch readout swings by more than 2° within 2 s of a click on Nod. */
+async function nodSwings(page) {
+  await until(async () => !(await page.getByRole('button', { name: 'Nod' }).isDisabled()), 10000, 'the Nod button');
+  // Idle off and centred first: the swing is the nod's alone.
+  const before = await readout(page, 'pitch');
+  const clicked = Date.now();
+  await page.getByRole('button', { name: 'Nod' }).click();
+  let swing = 0;
+  while (Date.now() - clicked < 2000) {
+    swing = Math.max(swing, Math.abs((await readout(page, 'pitch')) - before));
+    if (swing > 2) break;
+    await sleep(20);
+  }
+  check(swing > 2, `Nod: the pitch readout swung by ${swing.toFixed(1)}° within ${Date.now() - clicked} ms (more than 2° within 2 s)`);
+  return swing;
+}
+
+/** What every session checks once connected: status, a calibration
+ * slider moved from the keyboard and a refused value, a nod, save. */
+async function session(page, { yawPulse }) {
+  await until(async () => (await page.locator('#state').textContent()).startsWith('connected'), 20000, 'connected');
+  const firmware = await page.locator('#firmware').textContent();
+  check(/^firmware \d+\.\d+\.\d+/.test(firmware), `connected; the page shows the ${firmware}`);
+  const status = await until(async () => {
+    const text = await page.locator('#status-line').textContent();
+    return text.includes('mode=') ? text : null;
+  }, 5000, 'the status line');
+  check(/mode=(running|starting)/.test(status), `status read: ${status}`);
+  const gestures = await page.locator('#gestures button').allTextContents();
+  check(gestures.includes('Nod') && gestures.includes('Shake') && gestures.includes('Tilt'), `gesture buttons from help: ${gestures.join(', ')}`);
+
+  // A still head: idle off, centred.
+  await page.getByLabel('idle motion').uncheck();
+  await page.getByRole('button', { name: 'Center' }).click();
+  await sleep(2500);
+  const yaw0 = await yawPulse();
+  check(Math.abs(yaw0 - 1500) <= 2, `yaw pulse at rest ${yaw0.toFixed(1)} µs (its neutral, 1500)`);
+
+  // The yaw neutral slider, moved from the keyboard: 20 steps of 1 µs.
+  await page.getByRole('radio', { name: 'yaw' }).check();
+  const slider = page.getByLabel('neutral slider (µs)');
+  await slider.focus();
+  for (let i = 0; i < 20; i++) await page.keyboard.press('ArrowRight');
+  await until(async () => (await page.getByLabel('neutral (µs)').inputValue()) === '1520', 5000, 'the number field follows the slider');
+  const yaw1 = await until(async () => {
+    const us = await yawPulse();
+    return Math.abs(us - 1520) <= 2 ? us : null;
+  }, 6000, 'the yaw pulse moves to the new neutral');
+  check(true, `yaw neutral slider 1500 → 1520 µs: the yaw pulse went ${yaw0.toFixed(1)} → ${yaw1.toFixed(1)} µs`);
+
+  // A refused value snaps back, with the firmware's reason.
+  const max = page.getByLabel('max pulse (µs)');
+  await max.fill('3000');
+  await max.press('Enter');
+  const why = await until(async () => (await page.locator('#why-max').textContent()) || null, 5000, 'the reason');
+  check((await max.inputValue()) === '2000' && why.includes('2500'), `max pulse 3000 refused, snapped back to 2000: "${why}"`);
+
+  await shot(page, cfg.label ?? cfg.session);
+  await nodSwings(page);
+
+  // Save: the unsaved-changes mark goes.
+  check(!(await page.locator('#unsaved').isHidden()), 'unsaved changes marked after the neutral change');
+  await page.getByRole('button', { name: 'Save' }).click();
+  await until(async () => page.locator('#unsaved').isHidden(), 8000, 'the unsaved mark goes after Save');
+  check(true, 'Save: the settings are stored, the unsaved mark is gone');
+}
+
+async function browser() {
+  return chromium.launch({ executablePath: CHROMIUM, args: ARGS, headless: true });
+}
+
+function watchErrors(page, errors) {
+  page.on('pageerror', (error) => errors.push(`page error: ${error.message}`));
+  page.on('console', (message) => {
+    if (message.type() === 'error') errors.push(`console error: ${message.text()}`);
+  });
+}
+
+// ---- the Web Serial session ------------------------------------------
+
+/** The page's fake `navigator.serial`: ports whose bytes go to and come
+ * from Node (`__serialWrite`, `__serialData`), which can be unplugged. */
+function fakeSerial() {
+  class FakePort extends EventTarget {
+    constructor(id) {
+      super();
+      this.id = id;
+      this.readable = null;
+      this.writable = null;
+    }
+    getInfo() {
+      return { usbVendorId: 0x16c0, usbProductId: 0x27dd };
+    }
+    async open() {
+      if (window.__fake.unplugged.has(this.id)) throw new Error('the device has been lost');
+      this.readable = new ReadableStream({
+        start: (controller) => {
+          this.controller = controller;
+        },
+      });
+      this.writable = new WritableStream({
+        write: (chunk) => window.__serialWrite(this.id, Array.from(chunk)),
+      });
+    }
+    async close() {
+      this.readable = this.writable = null;
+    }
+  }
+  const listeners = new EventTarget();
+  window.__fake = { ports: [], unplugged: new Set() };
+  window.__serialData = (id, bytes) => {
+    const port = window.__fake.ports.find((p) => p.id === id);
+    try {
+      port?.controller?.enqueue(new Uint8Array(bytes));
+    } catch {
+      // closed
+    }
+  };
+  window.__unplug = (id) => {
+    const port = window.__fake.ports.find((p) => p.id === id);
+    window.__fake.unplugged.add(id);
+    try {
+      port.controller.error(new DOMException('The device has been lost.', 'NetworkError'));
+    } catch {
+      // closed
+    }
+    const event = new Event('disconnect');
+    Object.defineProperty(event, 'target', { value: port });
+    listeners.dispatchEvent(event);
+  };
+  let next = 0;
+  Object.defineProperty(navigator, 'serial', {
+    value: {
+      async requestPort() {
+        const port = new FakePort(next++);
+        window.__fake.ports.push(port);
+        return port;
+      },
+      async getPorts() {
+        return window.__fake.ports.filter((p) => !window.__fake.unplugged.has(p.id));
+      },
+      addEventListener: (type, fn) => listeners.addEventListener(type, fn),
+      removeEventListener: (type, fn) => listeners.removeEventListener(type, fn),
+    },
+  });
+}
+
+async function serialSession() {
+  const harness = spawn('node', ['harness.mjs', cfg.harness.arg], { cwd: cfg.harness.cwd, stdio: ['pipe', 'pipe', 'inherit'] });
+  const duty = [0, 0, 0]; // the servos' last compare values (counts of 20 ms / 64000)
+  const pitchDuties = [];
+  let page = null;
+  let port = -1; // the fake port the emulator's USB port is plugged into
+  let telemetry = 0; // telemetry lines the emulated head sent
+  let mode = 'normal'; // or 'old' (answers `watch` with err), 'swallow' (drops `seed` lines)
+  let line = '';
+  const toPage = (bytes) => page?.evaluate(([id, b]) => window.__serialData(id, b), [port, bytes]).catch(() => {});
+  let buffered = '';
+  harness.stdout.on('data', (chunk) => {
+    buffered += chunk.toString();
+    let end;
+    while ((end = buffered.indexOf('\n')) >= 0) {
+      const event = JSON.parse(buffered.slice(0, end));
+      buffered = buffered.slice(end + 1);
+      if (event.ev === 'usb') {
+        const bytes = Buffer.from(event.hex, 'hex');
+        telemetry += (bytes.toString('latin1').match(/~ t=/g) ?? []).length;
+        toPage(Array.from(bytes));
+      }
+      if (event.ev === 'cc' && event.slice <= 2) {
+        duty[event.slice] = event.value & 0xffff;
+        if (event.slice === 0) pitchDuties.push({ at: Date.now(), us: ((event.value & 0xffff) * 20000) / 64000 });
+      }
+      if (event.ev === 'end') say(`emulator ended: ${event.why}`);
+    }
+  });
+  const yawPulse = async () => (duty[2] * 20000) / 64000;
+  const chrome = await browser();
+  const errors = [];
+  try {
+    const context = await chrome.newContext({ viewport: { width: 1280, height: 800 } });
+    await context.addInitScript(fakeSerial);
+    await context.exposeBinding('__serialWrite', (_source, id, bytes) => {
+      port = id;
+      for (const b of bytes) {
+        line += String.fromCharCode(b);
+        if (b !== 10) continue;
+        const sent = line.trim();
+        line = '';
+        if (mode === 'old' && sent.startsWith('watch')) {
+          toPage(Array.from(Buffer.from('err syntax unknown command `watch` (try `help`)\r\n')));
+          continue;
+        }
+        if (mode === 'swallow' && sent.startsWith('seed')) continue;
+        harness.stdin.write(Buffer.from(sent + '\n').toString('hex') + '\n');
+      }
+    });
+    page = await context.newPage();
+    watchErrors(page, errors);
+    await page.goto(cfg.url);
+    check((await page.locator('#state').textContent()) === 'not connected', 'served without a bridge: the page waits for Connect');
+    await page.getByRole('button', { name: 'Connect' }).click();
+    await session(page, { yawPulse });
+    const pitch = pitchDuties.filter((d) => d.at > Date.now() - 4000).map((d) => d.us);
+    const span = Math.max(...pitch) - Math.min(...pitch);
+    check(span > 2 * 11.1, `the nod in the emulator's pitch pulses on GP16: ${span.toFixed(0)} µs of swing (more than 2° at 11.1 µs/°)`);
+
+    // Unplugged mid-session.
+    await page.evaluate((id) => window.__unplug(id), port);
+    await until(async () => (await page.locator('#banner-text').textContent()).includes('unplugged'), 5000, 'the page says the board was unplugged');
+    check(await page.getByRole('button', { name: 'Reconnect' }).isVisible(), `unplugged: "${await page.locator('#banner-text').textContent()}", with Reconnect`);
+    await shot(page, 'unplugged');
+
+    // Plugged in again, an older firmware: `watch` is an error.
+    mode = 'old';
+    await page.getByRole('button', { name: 'Reconnect' }).click();
+    await until(async () => (await page.locator('#banner-text').textContent()).includes('watch'), 10000, 'the page says the firmware has no telemetry');
+    const p0 = await readout(page, 'pitch');
+    await page.getByLabel('idle motion').check();
+    await page.getByRole('button', { name: 'Nod' }).click();
+    await until(async () => Math.abs((await readout(page, 'pitch')) - p0) > 1, 4000, 'the readouts follow status without telemetry');
+    check(true, `older firmware: "${(await page.locator('#banner-text').textContent()).slice(0, 70)}…", the readouts still move`);
+
+    // A reply that never comes.
+    mode = 'swallow';
+    await page.getByLabel('seed', { exact: true }).fill('7');
+    await page.getByRole('button', { name: 'Set seed' }).click();
+    await until(async () => (await page.locator('#banner-text').textContent()).includes('no reply'), 6000, 'the page says a reply never came');
+    check(await page.getByRole('button', { name: 'Reconnect' }).isVisible(), `no reply: "${await page.locator('#banner-text').textContent()}", with Reconnect`);
+    check(errors.length === 0, `no page errors${errors.length ? `: ${errors.join('; ')}` : ''}`);
+
+    // The host closes the port (DTR drops): the telemetry stops, and does
+    // not come back when it opens the port again until asked.
+    const send = (text) => harness.stdin.write(Buffer.from(text).toString('hex') + '\n');
+    send('watch 50\n');
+    await sleep(500);
+    const streaming = telemetry;
+    await sleep(300);
+    check(telemetry - streaming >= 10, `watch 50 from the host: ${telemetry - streaming} lines in 300 ms`);
+    harness.stdin.write('dtr 0\n');
+    await sleep(200);
+    const closed = telemetry;
+    harness.stdin.write('dtr 1\n');
+    await sleep(500);
+    check(telemetry === closed, `DTR dropped: the telemetry stopped (${telemetry - closed} lines after it)`);
+  } finally {
+    await chrome.close();
+    harness.stdin.end();
+    harness.kill();
+  }
+}
+
+// ---- a session over the bridge's WebSocket ----------------------------
+
+async function bridgeSession() {
+  const chrome = await browser();
+  const errors = [];
+  try {
+    const page = await chrome.newPage({ viewport: { width: 1280, height: 800 } });
+    watchErrors(page, errors);
+    // The yaw pulse as the telemetry reports it.
+    const yawPulse = async () => {
+      const text = await page.locator('#pulses').textContent();
+      const match = /pulses (\d+), (\d+), (\d+)/.exec(text);
+      return match ? Number(match[3]) : NaN;
+    };
+    await page.goto(cfg.url);
+    await until(async () => (await page.locator('#state').textContent()).startsWith('connected'), 20000, 'connected on load');
+    check((await page.locator('#transport').textContent()).startsWith('bridged to'), `connected on load, no chooser: ${await page.locator('#transport').textContent()}`);
+    await session(page, { yawPulse });
+    if (cfg.label === 'qemu') await gazeControls(page);
+    check(errors.length === 0, `no page errors${errors.length ? `: ${errors.join('; ')}` : ''}`);
+  } finally {
+    await chrome.close();
+  }
+}
+
+/** The look pad from the keyboard, and "go to limit" (yaw). */
+async function gazeControls(page) {
+  const pad = page.getByRole('slider', { name: /Look pad/ });
+  await pad.focus();
+  for (let i = 0; i < 5; i++) await page.keyboard.press('ArrowRight');
+  await page.keyboard.press('Enter');
+  const yaw = await until(async () => {
+    const value = await readout(page, 'yaw');
+    return value > 8 ? value : null;
+  }, 4000, 'the head looks 10° to the right');
+  check(true, `look pad from the keyboard (5 × ArrowRight, Enter): yaw readout ${yaw}°`);
+  await page.getByRole('radio', { name: 'yaw' }).check();
+  const limit = Number(await page.getByLabel('upper limit (°)').inputValue());
+  await page.getByRole('button', { name: 'Go to upper limit' }).click();
+  const reached = await until(async () => {
+    const value = await readout(page, 'yaw');
+    return Math.abs(value - limit) < 0.5 ? value : null;
+  }, 10000, `yaw steps to its upper limit, ${limit}°`);
+  check(true, `go to upper limit: yaw readout ${reached}° (limit ${limit}°), stepped 1° every 100 ms`);
+  await page.getByRole('button', { name: 'Center' }).click();
+}
+
+try {
+  if (cfg.session === 'serial') await serialSession();
+  else await bridgeSession();
+  say(`passed: ${cfg.label ?? cfg.session}`);
+} catch (error) {
+  console.log(`FAILED: ${error.message}`);
+  process.exitCode = 1;
+}

@@ -1,0 +1,127 @@
+//! The frame rows with telemetry streaming: `watch 50` on the QEMU image's
+//! UART0 through the whole smoke schedule (script, faults, fade-out; the
+//! run held for its console), against the same schedule without a console.
+//!
+//! Telemetry lines are written by the console task, in thread mode, from
+//! the status the frame task publishes after every frame whether a port
+//! watches or not; the frame task runs in the interrupt executor above it.
+//! The frame rows measure `FrameLoop::write` alone, which telemetry does
+//! not touch; this run shows it on the image as it plays: the frame work
+//! the smoke run logs (instructions between the frame hooks: commands,
+//! frame update, status, fault log) must be the same with and without the
+//! stream, on average and at worst, within one `SysTick` count (the smoke
+//! run counts 80 instructions a count; a frame's wake-up moves against the
+//! count's edges when the console holds a critical section, and the time
+//! driver's alarm for the console's telemetry timer, an interrupt above the
+//! frame task as on the Pico, now and then lands inside a frame), and no
+//! frame may be missed.
+
+use std::{
+    io::Read,
+    path::Path,
+    sync::{
+        Arc,
+        atomic::{AtomicUsize, Ordering},
+    },
+    time::{Duration, Instant},
+};
+
+use anyhow::{Context, Result, bail};
+
+use crate::console::{Pace, qemu_session};
+use crate::log::LogLine;
+use crate::qemu::{self, Echo};
+
+/// Instructions per `SysTick` count in the smoke run: 12.5 MHz after reset
+/// under `-icount shift=0` (`boards/qemu/src/systick.rs`).
+const INSNS_PER_COUNT: u64 = 80;
+
+/// Telemetry lines to see before the host hangs up: the schedule's
+/// fade-out starts at frame 1800, a line every 20 frames.
+const LINES: usize = 80;
+
+/// The console's input: `watch 50`, then nothing until [`LINES`]
+/// telemetry lines came (or the deadline passed), then the end (the host
+/// hangs up, and the schedule fades out).
+struct Streaming {
+    sent: bool,
+    seen: Arc<AtomicUsize>,
+    deadline: Instant,
+}
+
+impl Read for Streaming {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if !std::mem::replace(&mut self.sent, true) {
+            let line = b"watch 50\n";
+            buf[..line.len()].copy_from_slice(line);
+            return Ok(line.len());
+        }
+        while self.seen.load(Ordering::Acquire) < LINES && Instant::now() < self.deadline {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        Ok(0)
+    }
+}
+
+/// What a run logged of its frame work: `(average, at most)`.
+fn frame_work(log: &[LogLine]) -> Result<(u64, u64)> {
+    let line = log
+        .iter()
+        .find_map(|l| l.message.strip_prefix("frame work: "))
+        .context("the run logged no frame work")?;
+    let mut numbers = line
+        .split(|c: char| !c.is_ascii_digit())
+        .filter(|w| !w.is_empty())
+        .map(str::parse::<u64>);
+    match (numbers.next(), numbers.next()) {
+        (Some(Ok(average)), Some(Ok(most))) => Ok((average, most)),
+        _ => bail!("unreadable frame work line: {line}"),
+    }
+}
+
+/// Runs the QEMU smoke image `elf` plain and with `watch 50` streaming;
+/// the bench's line about it, or why the frames were not untouched.
+pub fn check(elf: &Path, timeout: Duration) -> Result<String> {
+    let plain = qemu::run(elf, timeout, Echo::Problems)?;
+    let without = frame_work(&plain.log)?;
+    let seen = Arc::new(AtomicUsize::new(0));
+    let counted = Arc::clone(&seen);
+    let session = qemu_session(
+        elf,
+        Streaming {
+            sent: false,
+            seen: Arc::clone(&seen),
+            deadline: Instant::now() + timeout,
+        },
+        move |line| {
+            if line.starts_with(b"~ ") {
+                counted.fetch_add(1, Ordering::AcqRel);
+            }
+        },
+        Pace::Fast,
+        Echo::Problems,
+        Duration::from_secs(5),
+    )?;
+    let lines = seen.load(Ordering::Acquire);
+    let with = frame_work(&session.run.log)?;
+    let verdict = qemu::check_summary(&session.run.log)?;
+    if lines < LINES {
+        bail!("telemetry: only {lines} lines streamed during the run");
+    }
+    let line = format!(
+        "telemetry: the smoke schedule with `watch 50` streaming on UART0 ({lines} lines): \
+         frame work {} instructions on average, at most {} (without: {}, {}); {verdict}",
+        with.0, with.1, without.0, without.1
+    );
+    let count = INSNS_PER_COUNT;
+    if with.0.abs_diff(without.0) > count || with.1.abs_diff(without.1) > count {
+        bail!(
+            "{line}: telemetry changed the frame work by more than one count ({count} instructions)"
+        );
+    }
+    Ok(format!(
+        "{line}\ntelemetry adds nothing to the frame path (within one count of {count} \
+         instructions): it is written by the console task, and the frame rows above hold with \
+         `watch 50` running"
+    ))
+}

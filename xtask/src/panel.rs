@@ -1,0 +1,193 @@
+//! `cargo xtask panel`: the browser control panel (`panel/`, static files)
+//! served on localhost, bridged over a WebSocket to a head: the shipped
+//! Pico image in the RP2040 emulator (`--sim`), the QEMU image (`--qemu`)
+//! or a board's serial port (`--port`). Without a bridge the page talks to
+//! a board itself, over Web Serial. `--export DIR` writes a copy of the
+//! page, its dependencies included, for any static host.
+//!
+//! The page's dependencies (uPlot) come from the npm registry, pinned by
+//! `panel/package-lock.json`, installed into `panel/node_modules` (never
+//! committed) and served from there under `vendor/`.
+
+mod bridge;
+pub mod browser;
+mod server;
+
+use std::net::SocketAddr;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+
+use anyhow::{Context, Result, bail};
+use serde_json::Value;
+use xshell::cmd;
+
+use crate::{project, setup};
+
+pub use bridge::Bridge;
+
+/// `cargo xtask panel` options.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Bridge the page to the shipped Pico image running in the RP2040
+    /// emulator at real time, over its USB serial port: a head without a
+    /// board.
+    #[arg(long, conflicts_with_all = ["qemu", "port", "export"])]
+    pub sim: bool,
+    /// Bridge the page to the QEMU image (a clean head at real time) over
+    /// its UART0.
+    #[arg(long, conflicts_with_all = ["port", "export"])]
+    pub qemu: bool,
+    /// Bridge the page to a board's serial port (115200 8N1), e.g.
+    /// /dev/ttyACM0.
+    #[arg(long, value_name = "dev", conflicts_with = "export")]
+    pub port: Option<PathBuf>,
+    /// Where to serve the page.
+    #[arg(long, value_name = "addr:port", default_value = "127.0.0.1:8080")]
+    pub listen: SocketAddr,
+    /// Write a self-contained copy of the page (dependencies included) to
+    /// this folder, for any static host, instead of serving it.
+    #[arg(long, value_name = "dir")]
+    pub export: Option<PathBuf>,
+    /// Run the panel's browser tests (the stage of `cargo xtask test`)
+    /// instead: headless Chromium over Web Serial, WebSocket and a serial
+    /// port.
+    #[arg(long, conflicts_with_all = ["sim", "qemu", "port", "export"])]
+    pub test: bool,
+}
+
+/// `cargo xtask panel`.
+pub fn command(args: &Args) -> Result<bool> {
+    let root = project::root();
+    if args.test {
+        setup::ensure_toolchain(&root)?;
+        let metadata = project::metadata(&root)?;
+        println!("{}", browser::stage(&root, &metadata)?);
+        return Ok(true);
+    }
+    ensure_dependencies(&root)?;
+    if let Some(dir) = &args.export {
+        export(&root, dir)?;
+        println!("panel: exported to {}", dir.display());
+        return Ok(true);
+    }
+    let bridge = if args.sim {
+        setup::ensure_toolchain(&root)?;
+        let metadata = project::metadata(&root)?;
+        project::PICO.build(&root)?;
+        Some(Bridge::sim(&root, &project::PICO.elf(&metadata))?)
+    } else if args.qemu {
+        setup::ensure_toolchain(&root)?;
+        setup::ensure_qemu()?;
+        let metadata = project::metadata(&root)?;
+        project::QEMU.build(&root)?;
+        Some(Bridge::qemu(&project::QEMU.elf(&metadata))?)
+    } else if let Some(port) = &args.port {
+        Some(Bridge::port(port)?)
+    } else {
+        None
+    };
+    let (stop_tx, stop_rx) = mpsc::channel();
+    let ctrlc_tx = stop_tx.clone();
+    ctrlc::set_handler(move || {
+        let _ = ctrlc_tx.send("interrupted".to_owned());
+    })
+    .context("setting the Ctrl-C handler")?;
+    let server = server::Server::start(&root, args.listen, bridge, stop_tx)?;
+    println!("panel: http://{}/", server.address());
+    match server.bridge_name() {
+        Some(name) => eprintln!(
+            "panel: bridged to {name}; open the address in a browser (Ctrl-C stops everything)"
+        ),
+        None => eprintln!(
+            "panel: no bridge; open the address in Chromium, Edge or Opera and press Connect \
+             to choose the head's serial port (Web Serial)"
+        ),
+    }
+    let why = stop_rx.recv().unwrap_or_else(|_| "stopped".to_owned());
+    eprintln!("panel: {why}; stopping");
+    drop(server);
+    Ok(true)
+}
+
+/// The files of the page in `panel/` (not its tests or package files),
+/// relative to it.
+pub fn page_files(root: &Path) -> Result<Vec<PathBuf>> {
+    let dir = root.join("panel");
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(&dir).with_context(|| format!("reading {}", dir.display()))? {
+        let entry = entry?;
+        let name = PathBuf::from(entry.file_name());
+        let page = matches!(
+            name.extension().and_then(|e| e.to_str()),
+            Some("html" | "css" | "js" | "svg")
+        );
+        if page && entry.file_type()?.is_file() {
+            files.push(name);
+        }
+    }
+    files.sort();
+    Ok(files)
+}
+
+/// The dependencies' files the page loads, as `(URL path under vendor/,
+/// file in node_modules)`.
+pub const VENDOR: [(&str, &str); 2] = [
+    ("uplot/uPlot.iife.min.js", "uplot/dist/uPlot.iife.min.js"),
+    ("uplot/uPlot.min.css", "uplot/dist/uPlot.min.css"),
+];
+
+/// Writes the page and its dependencies to `dir`.
+fn export(root: &Path, dir: &Path) -> Result<()> {
+    let panel = root.join("panel");
+    std::fs::create_dir_all(dir.join("vendor/uplot"))
+        .with_context(|| format!("creating {}", dir.display()))?;
+    for file in page_files(root)? {
+        std::fs::copy(panel.join(&file), dir.join(&file))
+            .with_context(|| format!("copying {}", file.display()))?;
+    }
+    std::fs::write(dir.join("bridge.json"), server::NO_BRIDGE)?;
+    for (url, file) in VENDOR {
+        std::fs::copy(
+            panel.join("node_modules").join(file),
+            dir.join("vendor").join(url),
+        )
+        .with_context(|| format!("copying {file}"))?;
+    }
+    Ok(())
+}
+
+/// Makes sure the page's pinned npm packages are installed in
+/// `panel/node_modules` (`npm ci`, with Playwright's browser download
+/// off: the tests use the system's Chromium).
+pub fn ensure_dependencies(root: &Path) -> Result<()> {
+    crate::sim::ensure_node(root)?;
+    let panel = root.join("panel");
+    let read = |path: PathBuf| -> Option<Value> {
+        serde_json::from_slice(&std::fs::read(path).ok()?).ok()
+    };
+    let lock = read(panel.join("package-lock.json"))
+        .context("panel/package-lock.json is missing or not JSON")?;
+    let stale = ["uplot", "playwright-core"].iter().any(|name| {
+        let pinned = &lock["packages"][format!("node_modules/{name}")]["version"];
+        let installed = read(panel.join(format!("node_modules/{name}/package.json")))
+            .map_or(Value::Null, |package| package["version"].clone());
+        pinned.is_null() || installed != *pinned
+    });
+    if stale {
+        let sh = project::shell(".")?;
+        sh.change_dir(&panel);
+        project::run(
+            &sh,
+            &[("PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD", "1")],
+            cmd!(sh, "npm ci --no-audit --no-fund"),
+        )
+        .context("installing the panel's dependencies with `npm ci` in panel/")?;
+    }
+    if !panel
+        .join("node_modules/uplot/dist/uPlot.iife.min.js")
+        .exists()
+    {
+        bail!("panel/node_modules has no uPlot after `npm ci`");
+    }
+    Ok(())
+}

@@ -1,0 +1,278 @@
+//! The panel's browser tests, a stage of `cargo xtask test`: Debian's
+//! Chromium, headless, driven by playwright-core (`panel/tests/browser.mjs`)
+//! through four sessions:
+//!
+//! 1. Web Serial: the page served without a bridge, a fake
+//!    `navigator.serial` bridged to the shipped Pico image live in the
+//!    RP2040 emulator (its USB serial port); unplugged, an older firmware,
+//!    a reply that never comes;
+//! 2. the WebSocket bridge of `cargo xtask panel --qemu`;
+//! 3. a real serial port: QEMU's UART0 as a pseudo-terminal (`-serial
+//!    pty`), first through `cargo xtask console --port`, then through the
+//!    bridge of `cargo xtask panel --port`.
+//!
+//! Screenshots at 1280×800 go to `target/panel/`.
+
+use std::{
+    io::{BufRead, BufReader, Write},
+    path::{Path, PathBuf},
+    process::{Child, Command, Stdio},
+    sync::mpsc,
+    time::{Duration, Instant},
+};
+
+use anyhow::{Context, Result, bail};
+
+use super::{Bridge, ensure_dependencies, server::Server};
+use crate::console::{Pace, qemu::qemu_command};
+use crate::project::{Metadata, PICO, QEMU};
+use crate::{setup, sim};
+
+/// The stage's name.
+pub const STAGE: &str =
+    "panel in a real browser: Web Serial (emulated Pico), WebSocket (QEMU), serial port (pty)";
+
+/// Debian's Chromium.
+const CHROMIUM: &str = "/usr/bin/chromium";
+
+/// Makes sure Chromium is installed (with apt-get, as root on Debian or
+/// Ubuntu, as QEMU is).
+pub fn ensure_chromium() -> Result<PathBuf> {
+    let path = PathBuf::from(CHROMIUM);
+    if path.exists() {
+        return Ok(path);
+    }
+    let root = Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| o.stdout.trim_ascii() == b"0");
+    if !Path::new("/etc/debian_version").exists() || !root {
+        bail!("Chromium was not found at {CHROMIUM}: install it (`sudo apt-get install chromium`)");
+    }
+    println!("chromium is missing: installing the `chromium` package");
+    setup::apt_install(&["chromium"])?;
+    Ok(path)
+}
+
+/// The stage: every session; a summary line of what it measured.
+pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
+    let start = Instant::now();
+    let chromium = ensure_chromium()?;
+    ensure_dependencies(root)?;
+    setup::ensure_qemu()?;
+    PICO.build(root)?;
+    QEMU.build(root)?;
+    let shots = metadata.target_dir.join("panel");
+    let mut report = Vec::new();
+
+    // 1. Web Serial, the emulated Pico.
+    let (stop, _) = mpsc::channel();
+    let plain = Server::start(root, "127.0.0.1:0".parse()?, None, stop)?;
+    let harness = sim::live::config(root, &PICO.elf(metadata))?;
+    report.push(browser(
+        root,
+        &chromium,
+        &serde_json::json!({
+            "session": "serial",
+            "url": format!("http://{}/", plain.address()),
+            "harness": { "cwd": sim::node_folder(root), "arg": harness.to_string() },
+            "shots": shots,
+            "label": "web-serial",
+        }),
+    )?);
+    drop(plain);
+
+    // 2. The WebSocket bridge to QEMU.
+    let (stop, _) = mpsc::channel();
+    let bridged = Server::start(
+        root,
+        "127.0.0.1:0".parse()?,
+        Some(Bridge::qemu(&QEMU.elf(metadata))?),
+        stop,
+    )?;
+    report.push(browser(
+        root,
+        &chromium,
+        &serde_json::json!({
+            "session": "bridge",
+            "url": format!("http://{}/", bridged.address()),
+            "shots": shots,
+            "label": "qemu",
+        }),
+    )?);
+    drop(bridged);
+
+    // 3. A real serial port: QEMU's UART0 as a pseudo-terminal.
+    report.push(serial_port(root, &chromium, &QEMU.elf(metadata), &shots)?);
+    Ok(format!(
+        "{}; {:.0} s",
+        report.join("; "),
+        start.elapsed().as_secs_f64()
+    ))
+}
+
+/// Runs one browser session; its last line.
+fn browser(root: &Path, chromium: &Path, config: &serde_json::Value) -> Result<String> {
+    let mut config = config.clone();
+    config["chromium"] = serde_json::json!(chromium);
+    let out = Command::new("node")
+        .arg("tests/browser.mjs")
+        .arg(config.to_string())
+        .current_dir(root.join("panel"))
+        .stdin(Stdio::null())
+        .stderr(Stdio::inherit())
+        .output()
+        .context("could not start node")?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    print!("{text}");
+    if !out.status.success() {
+        let why = text
+            .lines()
+            .rfind(|l| l.starts_with("FAILED"))
+            .unwrap_or("failed");
+        bail!("browser session {}: {why}", config["label"]);
+    }
+    Ok(text
+        .lines()
+        .rfind(|l| l.contains("Nod: the pitch readout swung"))
+        .map_or_else(
+            || format!("{} passed", config["label"]),
+            |l| format!("{}: {l}", config["label"]),
+        ))
+}
+
+/// QEMU with UART0 on a pseudo-terminal: `cargo xtask console --port` with
+/// a piped script, then the panel bridged to it (`panel --port`).
+fn serial_port(root: &Path, chromium: &Path, elf: &Path, shots: &Path) -> Result<String> {
+    let mut qemu = Pty::start(elf)?;
+    let pty = qemu.path.clone();
+    println!("QEMU's UART0 is {}", pty.display());
+    // `cargo xtask console --port`, as a person would run it.
+    let exe = std::env::current_exe().context("the xtask's own path")?;
+    let mut console = Command::new(&exe)
+        .args(["console", "--port"])
+        .arg(&pty)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .context("starting `cargo xtask console --port`")?;
+    console
+        .stdin
+        .take()
+        .context("its stdin")?
+        .write_all(b"help\nstatus\nnod\nservo yaw max 3000\nwatch off\n")?;
+    let out = console.wait_with_output()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    print!("{text}");
+    let want = [
+        "ok commands:",
+        "ok mode=",
+        "ok nod amp_mdeg=",
+        "err invalid yaw servo: max_pulse 3000",
+        "ok watch=off",
+    ];
+    let lines: Vec<&str> = text.lines().collect();
+    if !out.status.success()
+        || lines.len() != want.len()
+        || !lines.iter().zip(want).all(|(l, w)| l.starts_with(w))
+    {
+        bail!("`cargo xtask console --port {}`: {lines:?}", pty.display());
+    }
+    let console_report = format!(
+        "console --port {}: {} replies as expected",
+        pty.display(),
+        want.len()
+    );
+    // `cargo xtask panel --port`: the page bridged to the same port.
+    let (stop, _) = mpsc::channel();
+    let server = Server::start(
+        root,
+        "127.0.0.1:0".parse()?,
+        Some(Bridge::port(&pty)?),
+        stop,
+    )?;
+    let session = browser(
+        root,
+        chromium,
+        &serde_json::json!({
+            "session": "bridge",
+            "url": format!("http://{}/", server.address()),
+            "shots": shots,
+            "label": "serial-port",
+        }),
+    );
+    drop(server);
+    qemu.stop();
+    Ok(format!("{console_report}; {}", session?))
+}
+
+/// QEMU, its UART0 on a pseudo-terminal, UART1 nowhere (no hang-up: it is
+/// stopped when done).
+struct Pty {
+    child: Child,
+    path: PathBuf,
+}
+
+impl Pty {
+    /// Starts QEMU and asks its QMP monitor where the pseudo-terminal is
+    /// (this QEMU writes no message saying so, and cannot link it to a
+    /// path of our choosing).
+    fn start(elf: &Path) -> Result<Self> {
+        let qmp = std::env::temp_dir().join(format!("idle-head-qmp-{}.sock", std::process::id()));
+        let _ = std::fs::remove_file(&qmp);
+        let mut child = qemu_command(elf, Pace::RealTime, ["pty", "null"])
+            .arg("-qmp")
+            .arg(format!("unix:{},server=on,wait=off", qmp.display()))
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
+        let path = match pty_path(&qmp) {
+            Ok(path) => path,
+            Err(e) => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return Err(e);
+            }
+        };
+        let _ = std::fs::remove_file(&qmp);
+        Ok(Self { child, path })
+    }
+
+    fn stop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// The pseudo-terminal of QEMU's `serial0`, from its QMP monitor at `qmp`
+/// (`query-chardev`: `"filename": "pty:/dev/pts/N"`).
+fn pty_path(qmp: &Path) -> Result<PathBuf> {
+    let stream = crate::console::qemu::connect(qmp)?;
+    stream.set_read_timeout(Some(Duration::from_secs(10)))?;
+    let mut writer = stream.try_clone()?;
+    let mut lines = BufReader::new(stream).lines();
+    writer.write_all(b"{\"execute\":\"qmp_capabilities\"}\n{\"execute\":\"query-chardev\"}\n")?;
+    for line in lines.by_ref() {
+        let reply: serde_json::Value = serde_json::from_str(&line?)?;
+        let Some(devices) = reply["return"].as_array() else {
+            continue;
+        };
+        if let Some(file) = devices
+            .iter()
+            .filter(|d| d["label"] == "serial0")
+            .find_map(|d| d["filename"].as_str()?.strip_prefix("pty:"))
+        {
+            return Ok(PathBuf::from(file));
+        }
+    }
+    bail!("QEMU's monitor did not say where its pseudo-terminal is")
+}
+
+impl Drop for Pty {
+    fn drop(&mut self) {
+        self.stop();
+    }
+}
