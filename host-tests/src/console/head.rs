@@ -7,7 +7,7 @@ use std::convert::Infallible;
 
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use idle_head_core::behaviour::{
-    Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION,
+    Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION, ShowLink,
 };
 use idle_head_core::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
 use idle_head_core::driver::{DriverConfig, FrameDriver};
@@ -213,4 +213,5 @@ pub fn service(
         SettingsSource::Defaults,
     )
     .expect("the built-in settings")
+    .with_show(Box::leak(Box::new(ShowLink::new())))
 }

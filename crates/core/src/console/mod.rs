@@ -9,6 +9,8 @@
 //! - [`ConsoleService`]: the handler that carries every command out,
 //!   through the frame task's queue and the [`ConsoleLink`] it shares
 //!   with the frame task.
+//! - [`DualSession`]: a port's session that turns into a Bottango driver
+//!   at a Bottango handshake ([`crate::bottango`]).
 //!
 //! Nothing here allocates or panics. See `docs/user/protocol.md` for the
 //! protocol as a user sees it.
@@ -16,6 +18,7 @@
 mod framer;
 mod link;
 mod parse;
+mod port;
 mod reply;
 mod service;
 mod session;
@@ -24,6 +27,7 @@ mod shared;
 pub use framer::{Framer, LineError};
 pub use link::{ConsoleLink, HeadMode, HeadStatus};
 pub use parse::{ParseError, ParseErrorKind, Span, parse};
+pub use port::DualSession;
 pub use reply::{ErrorCode, Reply};
 pub use service::{ConsoleService, HELP, VERSION};
 pub use session::{EnvelopeError, Handler, InputError, MIN_REPLY, Session, checksum, respond};

@@ -16,6 +16,7 @@
 //! seed <n> | seed random
 //! servo <pitch|roll|yaw> [neutral <us> | per-degree <ns> | direction <normal|reversed>
 //!                        | min <us> | max <us> | limits <min_mdeg> <max_mdeg>]
+//! dmx [on | off | address <1..503>]
 //! ```
 //!
 //! The parser checks the syntax and that each number fits its type
@@ -49,6 +50,7 @@ use crate::command::{
 use crate::servo::{Direction, NanosPerDegree};
 use crate::units::{Angle, AngleRange, Microseconds, Millis};
 
+mod dmx;
 mod error;
 mod words;
 
@@ -84,6 +86,7 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
         Word::Is(Kw::Idle) => idle(&mut words)?,
         Word::Is(Kw::Seed) => seed(&mut words)?,
         Word::Is(Kw::Servo) => servo(&mut words)?,
+        Word::Is(Kw::Dmx) => dmx::dmx(&mut words)?,
         _ => return Err(first.error(ParseErrorKind::UnknownCommand)),
     };
     words.end()?;

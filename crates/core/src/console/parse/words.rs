@@ -80,10 +80,12 @@ pub(super) enum Kw {
     Hold,
     Cycles,
     Intensity,
+    Dmx,
+    Address,
 }
 
 /// Every word the protocol has, lower case, in the order of [`ALL`].
-const KEYWORDS: [&str; 31] = [
+const KEYWORDS: [&str; 33] = [
     "help",
     "status",
     "save",
@@ -115,10 +117,12 @@ const KEYWORDS: [&str; 31] = [
     "hold",
     "cycles",
     "intensity",
+    "dmx",
+    "address",
 ];
 
 /// The [`Kw`] of each of [`KEYWORDS`].
-const ALL: [Kw; 31] = [
+const ALL: [Kw; 33] = [
     Kw::Help,
     Kw::Status,
     Kw::Save,
@@ -150,6 +154,8 @@ const ALL: [Kw; 31] = [
     Kw::Hold,
     Kw::Cycles,
     Kw::Intensity,
+    Kw::Dmx,
+    Kw::Address,
 ];
 
 // A gesture's word must not be a word the protocol already has: the
