@@ -14,13 +14,24 @@
 //! ([`Shared`]), with the board's settings store: a servo changed on one
 //! port shows on the other.
 //!
+//! A port becomes a Bottango driver at a valid Bottango handshake
+//! ([`DualSession`]), until Bottango's `STOP` or until the port goes
+//! away: its curves go to the frame task through the show link
+//! ([`SHOW`](crate::boot::SHOW)). In a Bottango session a line that stops
+//! arriving for 50 ms is dropped and answered `TIMEOUT`, as Bottango's own
+//! driver does.
+//!
 //! A board implements [`Port`] for each of its transports and runs
 //! [`run`] in a task per port.
 //!
 //! [`CommandQueue`]: idle_head_core::behaviour::CommandQueue
 
-use idle_head_core::console::{Handler, PortSession, Session, Shared, SharedService};
+use embassy_time::{Duration, with_timeout};
+use idle_head_core::bottango::TIMEOUT_MS;
+use idle_head_core::console::{DualSession, Handler, Session, Shared, SharedService};
 use idle_head_core::settings::SettingsStorage;
+
+use crate::boot::SHOW;
 
 /// The console's baud rate on a UART (8 data bits, no parity, 1 stop bit).
 pub const UART_BAUD: u32 = 115_200;
@@ -85,20 +96,82 @@ pub async fn serve<P: Port, H: Handler, const LINE: usize, const REPLY: usize>(
     }
 }
 
+/// Runs `session` over `port` until the port goes away, as [`serve`] does;
+/// in a Bottango session a line that pauses for [`TIMEOUT_MS`] is dropped
+/// and answered `TIMEOUT`.
+pub async fn serve_dual<P: Port, H: Handler>(
+    port: &mut P,
+    session: &mut DualSession<'_>,
+    handler: &mut H,
+) -> Gone {
+    let mut buf = [0; READ_CHUNK];
+    loop {
+        // One read call and one write call (one future each in flash), the
+        // read with a timeout that only matters in a Bottango session with
+        // a line in progress.
+        let armed = session.bottango() && session.in_progress();
+        let wait = if armed { TIMEOUT_MS } else { IDLE_WAIT_MS };
+        let (n, mut timed_out) =
+            match with_timeout(Duration::from_millis(wait), port.read(&mut buf)).await {
+                Ok(Ok(Received::Bytes(n))) => (n, false),
+                Ok(Ok(Received::Lost)) => {
+                    session.lose();
+                    continue;
+                }
+                Ok(Err(gone)) => return gone,
+                Err(_) => (0, true),
+            };
+        let was = session.bottango();
+        let mut bytes = buf.get(..n).unwrap_or_default().iter();
+        loop {
+            let reply = if core::mem::take(&mut timed_out) {
+                session.timeout()
+            } else if let Some(&byte) = bytes.next() {
+                session.push(byte, handler)
+            } else {
+                break;
+            };
+            if let Some(reply) = reply
+                && !reply.is_empty()
+                && let Err(gone) = port.write(reply).await
+            {
+                return gone;
+            }
+        }
+        log_mode(was, session.bottango());
+    }
+}
+
+/// How long a read waits before looking again when no timeout is due.
+const IDLE_WAIT_MS: u64 = 60_000;
+
+/// Logs a port switching to Bottango's protocol or back.
+fn log_mode(was: bool, is: bool) {
+    match (was, is) {
+        (false, true) => defmt::info!(
+            "console: Bottango handshake: a Bottango driver (protocol {=str}) until STOP",
+            idle_head_core::bottango::VERSION
+        ),
+        (true, false) => defmt::info!("console: Bottango STOP: the console again"),
+        _ => {}
+    }
+}
+
 /// Runs the console on `port` for as long as the board runs: a session per
-/// connection (the half-typed line of a host that went away is forgotten),
-/// commands carried out by the shared `service`.
+/// connection (the half-typed line of a host that went away is forgotten,
+/// a Bottango session ends), commands carried out by the shared `service`.
 pub async fn run<P: Port, S: SettingsStorage>(
     port: &mut P,
     service: &'static SharedService<S>,
     name: &'static str,
 ) -> ! {
-    let mut session = PortSession::new();
+    let mut session = DualSession::new(Some(&SHOW.curves));
     let mut handler = Shared::new(service);
     loop {
         port.connected().await;
         session.reset();
-        let Gone = serve(port, &mut session, &mut handler).await;
+        let Gone = serve_dual(port, &mut session, &mut handler).await;
+        session.reset();
         defmt::info!("console {=str}: the host went away", name);
     }
 }

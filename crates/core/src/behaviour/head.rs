@@ -201,12 +201,13 @@ impl<I: IdleSource> Head<I> {
             let amp = self.mixer.idle_amp();
             let asked = self.show.dmx(now, dmx, amp, self.mixer.params());
             events.signal = asked.signal;
-            events.fired = asked
-                .fired
-                .map(|action| (action, self.mixer.apply(&action)));
-            events.idle = asked
-                .idle
-                .map(|amp| (amp, self.mixer.apply(&Action::IdleAmp(amp))));
+            if let Some(action) = asked.fired {
+                events.fired = Some((action, self.mixer.apply(&action)));
+            }
+            // An idle amplitude always applies (a glide to it).
+            if let Some(amp) = asked.idle {
+                let _ = self.mixer.apply(&Action::IdleAmp(amp));
+            }
         }
         self.sync(driver);
         events

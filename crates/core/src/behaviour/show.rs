@@ -97,8 +97,6 @@ pub struct ShowEvents {
     /// The gesture trigger entered a band: the action it asked for, and
     /// what the mixer answered.
     pub fired: Option<(Action, Result<Applied, BehaviourError>)>,
-    /// The idle amplitude DMX asked for (or gave back), and the answer.
-    pub idle: Option<(Percent, Result<Applied, BehaviourError>)>,
 }
 
 /// What [`Show::dmx`] asks the mixer for.
@@ -296,9 +294,11 @@ impl Show {
             for (i, (pose, &value)) in self.pose.iter_mut().zip(&cue.pose).enumerate() {
                 let room = params.room[i];
                 let (lo, hi) = (room.min.millidegrees(), room.max.millidegrees());
-                // lo + (hi − lo)·value/65 535, rounded; within ±720° · 2¹⁶.
-                let span = i64::from(hi) - i64::from(lo);
-                *pose = lo + ((span * i64::from(value) + 32_767) / 65_535) as i32;
+                // lo + (hi − lo)·value/65 535: value·65 536/65 535 is
+                // value + value/2¹⁵ to within one count (0 → 0, 65 535 →
+                // 65 536, exact at both ends), a Q16 fraction of the span.
+                let fraction = u32::from(value) + (u32::from(value) >> 15);
+                *pose = lo + mul(hi - lo, fraction);
             }
             self.weight = (u32::from(cue.mix) * ONE + 127) / 255;
             self.source = Source::Dmx;

@@ -116,16 +116,16 @@ impl Curve {
         // 0 < t < T: 0 < τ < 1 (Q15).
         let tau = ((u64::from(t) << 15) / u64::from(self.duration.max(1))) as i32;
         let [x1, x2] = self.x.map(i32::from);
-        let (mut lo, mut hi) = (0, ONE);
+        let (mut lo, mut hi): (i32, i32) = (0, ONE);
         for _ in 0..15 {
-            let mid = (lo + hi) / 2;
+            let mid = lo.midpoint(hi);
             if bezier(0, x1, x2, ONE, mid) < tau {
                 lo = mid;
             } else {
                 hi = mid;
             }
         }
-        bezier(y0, y1, y2, y3, (lo + hi) / 2)
+        bezier(y0, y1, y2, y3, lo.midpoint(hi))
     }
 }
 
@@ -136,9 +136,9 @@ const fn lerp(a: i32, b: i32, u: i32) -> i32 {
 
 /// The cubic Bézier of `p` at `u` (Q15), by de Casteljau's construction.
 const fn bezier(p0: i32, p1: i32, p2: i32, p3: i32, u: i32) -> i32 {
-    let (a, b, c) = (lerp(p0, p1, u), lerp(p1, p2, u), lerp(p2, p3, u));
-    let (d, e) = (lerp(a, b, u), lerp(b, c, u));
-    lerp(d, e, u)
+    let (q0, q1, q2) = (lerp(p0, p1, u), lerp(p1, p2, u), lerp(p2, p3, u));
+    let (r0, r1) = (lerp(q0, q1, u), lerp(q1, q2, u));
+    lerp(r0, r1, u)
 }
 
 #[cfg(test)]
@@ -168,7 +168,7 @@ mod tests {
         };
         let (mut lo, mut hi) = (0.0, 1.0);
         for _ in 0..60 {
-            let mid = (lo + hi) / 2.0;
+            let mid = f64::midpoint(lo, hi);
             if b(p[0].0, p[1].0, p[2].0, p[3].0, mid) < t {
                 lo = mid;
             } else {

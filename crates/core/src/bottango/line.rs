@@ -139,24 +139,25 @@ pub fn parse(line: &[u8]) -> Result<Command<'_>, LineError> {
     let body = checked(line).ok_or(LineError::Hash)?;
     let mut args = Args(body.split(|&b| b == b','));
     let name = args.0.next().unwrap_or_default();
-    let command = match name {
-        b"hRQ" | b"hrq" => Command::Handshake(args.word("a challenge code")?),
-        b"hMOD" => Command::Modules,
-        b"OK" => Command::Continue,
-        b"tSYN" => Command::TimeSync(args.time()?),
-        b"STOP" => Command::Stop,
-        b"xE" => Command::DeregisterAll,
-        b"xUE" => Command::Deregister(args.motor()?),
-        b"xC" => Command::ClearAll,
-        b"xUC" => Command::Clear(args.motor()?),
-        b"rMTR" => {
+    // One comparison loop over a table, not a string comparison per arm.
+    let command = match NAMES.iter().position(|n| *n == name) {
+        Some(0) => Command::Handshake(args.word("a challenge code")?),
+        Some(1) => Command::Modules,
+        Some(2) => Command::Continue,
+        Some(3) => Command::TimeSync(args.time()?),
+        Some(4) => Command::Stop,
+        Some(5) => Command::DeregisterAll,
+        Some(6) => Command::Deregister(args.motor()?),
+        Some(7) => Command::ClearAll,
+        Some(8) => Command::Clear(args.motor()?),
+        Some(9) => {
             let motor = args.motor()?;
             let bounds = args.bounds()?;
             let _start = args.number()?;
             Command::Register(motor, bounds)
         }
-        b"upE" => Command::Bounds(args.motor()?, args.bounds()?),
-        b"sC" => {
+        Some(10) => Command::Bounds(args.motor()?, args.bounds()?),
+        Some(11) => {
             let motor = args.motor()?;
             let start = args.number()?;
             let duration = u32::try_from(args.number()?)
@@ -177,13 +178,19 @@ pub fn parse(line: &[u8]) -> Result<Command<'_>, LineError> {
                 },
             )
         }
-        b"sCI" => Command::Instant(args.motor()?, args.number()?),
+        Some(12) => Command::Instant(args.motor()?, args.number()?),
         _ => return Ok(Command::Other(name)),
     };
     // Extra parameters are left alone, as Bottango's own driver does: a
     // newer app may send more.
     Ok(command)
 }
+
+/// The commands' names, in the order `parse` matches them.
+const NAMES: [&[u8]; 13] = [
+    b"hRQ", b"hMOD", b"OK", b"tSYN", b"STOP", b"xE", b"xUE", b"xC", b"xUC", b"rMTR", b"upE", b"sC",
+    b"sCI",
+];
 
 /// The parameters after the command's name.
 struct Args<'a, I: Iterator<Item = &'a [u8]>>(I);

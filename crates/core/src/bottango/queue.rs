@@ -22,6 +22,32 @@ use crate::axis::Axis;
 /// pre-cache depth.
 pub const DEPTH: usize = 4;
 
+/// What to do to a motor ([`Curves::apply`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Op {
+    /// Register it, its signal running from `min` (movement 0) to `max`
+    /// (full movement), m° of the axis.
+    Register {
+        /// The signal at movement 0.
+        min: i32,
+        /// The signal at full movement.
+        max: i32,
+    },
+    /// New signal bounds.
+    Bounds {
+        /// The signal at movement 0.
+        min: i32,
+        /// The signal at full movement.
+        max: i32,
+    },
+    /// Deregister it.
+    Deregister,
+    /// Drop its curves (its position is held).
+    Clear,
+    /// Add a curve, over the oldest if it has [`DEPTH`] already.
+    Push(Curve),
+}
+
 /// Why a motor command was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -165,53 +191,48 @@ impl Curves {
         self.clock.load(Ordering::Acquire)
     }
 
-    /// Registers `axis` as a motor whose signal runs from `min` (movement 0)
-    /// to `max` (full movement), m°.
+    /// Carries `op` out on `axis`' motor.
     ///
     /// # Errors
-    /// [`MotorError::Registered`] if it is already.
-    pub fn register(&self, axis: Axis, min: i32, max: i32) -> Result<(), MotorError> {
+    /// [`MotorError::Registered`] to register a motor that is already,
+    /// [`MotorError::NotRegistered`] for anything else on a motor that is
+    /// not.
+    // One function for every operation: each is a few lines, and one body
+    // under one lock takes less flash than one per operation.
+    #[inline(never)]
+    pub fn apply(&self, axis: Axis, op: Op) -> Result<(), MotorError> {
         self.motor(axis, |m| {
-            if m.registered {
-                return Err(MotorError::Registered);
+            if let Op::Register { min, max } = op {
+                if m.registered {
+                    return Err(MotorError::Registered);
+                }
+                *m = Motor {
+                    registered: true,
+                    bounds: (min, max),
+                    ..Motor::EMPTY
+                };
+                return Ok(());
             }
-            *m = Motor {
-                registered: true,
-                bounds: (min, max),
-                ..Motor::EMPTY
-            };
+            if !m.registered {
+                return Err(MotorError::NotRegistered);
+            }
+            match op {
+                Op::Register { .. } => {}
+                Op::Bounds { min, max } => m.bounds = (min, max),
+                Op::Deregister => *m = Motor::EMPTY,
+                Op::Clear => m.valid = 0,
+                Op::Push(curve) => {
+                    let i = usize::from(m.next) % DEPTH;
+                    if let Some(slot) = m.curves.get_mut(i) {
+                        *slot = curve;
+                    }
+                    m.valid |= 1 << i;
+                    m.next = ((i + 1) % DEPTH) as u8;
+                }
+            }
             Ok(())
         })
         .unwrap_or(Err(MotorError::NotRegistered))
-    }
-
-    /// New signal bounds for `axis`.
-    ///
-    /// # Errors
-    /// [`MotorError::NotRegistered`].
-    pub fn set_bounds(&self, axis: Axis, min: i32, max: i32) -> Result<(), MotorError> {
-        self.registered(axis, |m| m.bounds = (min, max))
-    }
-
-    /// Runs `f` on `axis`' motor if it is registered.
-    fn registered(&self, axis: Axis, f: impl FnOnce(&mut Motor)) -> Result<(), MotorError> {
-        self.motor(axis, |m| {
-            if m.registered {
-                f(m);
-                Ok(())
-            } else {
-                Err(MotorError::NotRegistered)
-            }
-        })
-        .unwrap_or(Err(MotorError::NotRegistered))
-    }
-
-    /// Deregisters `axis`.
-    ///
-    /// # Errors
-    /// [`MotorError::NotRegistered`].
-    pub fn deregister(&self, axis: Axis) -> Result<(), MotorError> {
-        self.registered(axis, |m| *m = Motor::EMPTY)
     }
 
     /// Deregisters every motor.
@@ -219,37 +240,13 @@ impl Curves {
         self.with(|motors| *motors = [Motor::EMPTY; 3]);
     }
 
-    /// Drops `axis`' curves (its position is held).
-    ///
-    /// # Errors
-    /// [`MotorError::NotRegistered`].
-    pub fn clear(&self, axis: Axis) -> Result<(), MotorError> {
-        self.registered(axis, |m| m.valid = 0)
-    }
-
-    /// Drops every motor's curves.
+    /// Drops every motor's curves (their positions are held).
     pub fn clear_all(&self) {
         self.with(|motors| {
             for m in motors {
                 m.valid = 0;
             }
         });
-    }
-
-    /// Adds `curve` to `axis`' motor, over its oldest if it has
-    /// [`DEPTH`] already.
-    ///
-    /// # Errors
-    /// [`MotorError::NotRegistered`].
-    pub fn push(&self, axis: Axis, curve: Curve) -> Result<(), MotorError> {
-        self.registered(axis, |m| {
-            let i = usize::from(m.next) % DEPTH;
-            if let Some(slot) = m.curves.get_mut(i) {
-                *slot = curve;
-            }
-            m.valid |= 1 << i;
-            m.next = ((i + 1) % DEPTH) as u8;
-        })
     }
 
     /// The frame task, once a frame at `now` ms of its clock: the motors'
@@ -315,18 +312,28 @@ mod tests {
         let curves = Curves::new();
         assert_eq!(curves.sample(0), None);
         curves.set_active(true);
-        curves.register(Axis::Yaw, -23_000, 32_000).unwrap();
+        curves
+            .apply(
+                Axis::Yaw,
+                Op::Register {
+                    min: -23_000,
+                    max: 32_000,
+                },
+            )
+            .unwrap();
         assert_eq!(
-            curves.register(Axis::Yaw, 0, 1),
+            curves.apply(Axis::Yaw, Op::Register { min: 0, max: 1 }),
             Err(MotorError::Registered)
         );
         assert_eq!(
-            curves.push(Axis::Pitch, ramp(0, 10, 0, 1)),
+            curves.apply(Axis::Pitch, Op::Push(ramp(0, 10, 0, 1))),
             Err(MotorError::NotRegistered)
         );
         // Nothing yet: no position, nothing plays.
         assert_eq!(curves.sample(0), Some(Sample::default()));
-        curves.push(Axis::Yaw, ramp(100, 1000, 0, 8192)).unwrap();
+        curves
+            .apply(Axis::Yaw, Op::Push(ramp(100, 1000, 0, 8192)))
+            .unwrap();
         let before = curves.sample(50).unwrap();
         assert_eq!((before.axes, before.playing), (0, true));
         let start = curves.sample(100).unwrap();
@@ -342,7 +349,9 @@ mod tests {
             (0b100, 32_000, false)
         );
         // An end that falls between two samples is still reached.
-        curves.push(Axis::Yaw, ramp(5010, 20, 8192, 4096)).unwrap();
+        curves
+            .apply(Axis::Yaw, Op::Push(ramp(5010, 20, 8192, 4096)))
+            .unwrap();
         assert!(curves.sample(5015).unwrap().playing);
         let past = curves.sample(5100).unwrap();
         assert_eq!((past.angles[2], past.playing), (4500, false));
@@ -356,22 +365,22 @@ mod tests {
     fn keeps_the_newest_curves_and_the_latest_start_wins() {
         let curves = Curves::new();
         curves.set_active(true);
-        curves.register(Axis::Pitch, 0, 8192).unwrap();
+        curves
+            .apply(Axis::Pitch, Op::Register { min: 0, max: 8192 })
+            .unwrap();
         for k in 0..6 {
-            curves
-                .push(
-                    Axis::Pitch,
-                    ramp(k * 100, 100, 1000 * k as i32, 1000 * k as i32),
-                )
-                .unwrap();
+            let curve = ramp(k * 100, 100, 1000 * k as i32, 1000 * k as i32);
+            curves.apply(Axis::Pitch, Op::Push(curve)).unwrap();
         }
         // The first two were overwritten: at 50 nothing plays yet.
         assert!(curves.sample(50).unwrap().axes == 0);
         assert_eq!(curves.sample(250).unwrap().angles[0], 2000);
         // Overlapping: the hold started last plays.
-        curves.push(Axis::Pitch, Curve::hold(260, 7000)).unwrap();
+        curves
+            .apply(Axis::Pitch, Op::Push(Curve::hold(260, 7000)))
+            .unwrap();
         assert_eq!(curves.sample(270).unwrap().angles[0], 7000);
-        curves.clear(Axis::Pitch).unwrap();
+        curves.apply(Axis::Pitch, Op::Clear).unwrap();
         let cleared = curves.sample(280).unwrap();
         assert_eq!((cleared.angles[0], cleared.playing), (7000, false));
     }

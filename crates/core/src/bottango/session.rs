@@ -2,8 +2,14 @@
 
 use super::curve::Curve;
 use super::line::{self, Command, Motor};
-use super::queue::{Curves, DEPTH, MotorError};
+use super::queue::{Curves, DEPTH, MotorError, Op};
 use crate::console::LineError as FramerError;
+use crate::text::Text;
+
+/// `out` as the [`Text`] numbers are written into.
+fn text<'r>(out: &'r mut Out<'_>) -> &'r mut dyn Text {
+    out
+}
 
 /// The driver version the handshake reports: the protocol of Bottango's
 /// Arduino driver of that version, as far as this head implements it
@@ -27,6 +33,7 @@ impl<'b> Out<'b> {
     }
 
     /// Appends `bytes` (as much as fits).
+    #[inline(never)]
     fn put(&mut self, bytes: &[u8]) -> &mut Self {
         let room = self.buf.get_mut(self.len..).unwrap_or_default();
         let n = room.len().min(bytes.len());
@@ -35,30 +42,6 @@ impl<'b> Out<'b> {
         }
         self.len += n;
         self
-    }
-
-    /// Appends `n` in decimal.
-    fn number(&mut self, n: u32) -> &mut Self {
-        let mut digits = [0_u8; 10];
-        let mut at = digits.len();
-        let mut rest = n;
-        loop {
-            at -= 1;
-            if let Some(d) = digits.get_mut(at) {
-                *d = b'0' + (rest % 10) as u8;
-            }
-            rest /= 10;
-            if rest == 0 || at == 0 {
-                break;
-            }
-        }
-        let digits = digits.get(at..).unwrap_or_default();
-        let mut copy = [0_u8; 10];
-        let n = digits.len();
-        for (d, s) in copy.iter_mut().zip(digits) {
-            *d = *s;
-        }
-        self.put(copy.get(..n).unwrap_or_default())
     }
 
     /// How many bytes are written.
@@ -74,10 +57,17 @@ impl<'b> Out<'b> {
     }
 
     /// The bytes written.
+    #[must_use]
     pub fn into_bytes(self) -> &'b [u8] {
         let len = self.len;
         let buf: &'b [u8] = self.buf;
         buf.get(..len).unwrap_or_default()
+    }
+}
+
+impl Text for Out<'_> {
+    fn put(&mut self, s: &str) {
+        Out::put(self, s.as_bytes());
     }
 }
 
@@ -164,10 +154,9 @@ impl<'a> Driver<'a> {
         let line = match line {
             Ok(line) => line,
             Err(FramerError::TooLong { len, .. }) => {
-                out.put(b"\nerrCmdTooLong: ")
-                    .number(u32::try_from(len).unwrap_or(u32::MAX))
-                    .put(b"\n")
-                    .put(OK);
+                out.put(b"\nerrCmdTooLong: ");
+                text(out).u64(len as u64);
+                out.put(b"\n").put(OK);
                 return;
             }
             // Bytes lost or damaged on the way: the hash would not match.
@@ -215,55 +204,36 @@ impl<'a> Driver<'a> {
             }
             Command::DeregisterAll => curves.deregister_all(),
             Command::ClearAll => curves.clear_all(),
-            Command::Deregister(motor) => self.on_motor(motor, out, |axis| curves.deregister(axis)),
-            Command::Clear(motor) => self.on_motor(motor, out, |axis| curves.clear(axis)),
-            Command::Register(motor, bounds) => {
-                self.on_motor(motor, out, |axis| {
-                    curves.register(axis, bounds.min, bounds.max)
-                });
+            Command::Deregister(motor) => on_motor(curves, motor, Op::Deregister, out),
+            Command::Clear(motor) => on_motor(curves, motor, Op::Clear, out),
+            Command::Register(motor, b) => {
+                let op = Op::Register {
+                    min: b.min,
+                    max: b.max,
+                };
+                on_motor(curves, motor, op, out);
             }
-            Command::Bounds(motor, bounds) => {
-                self.on_motor(motor, out, |axis| {
-                    curves.set_bounds(axis, bounds.min, bounds.max)
-                });
+            Command::Bounds(motor, b) => {
+                let op = Op::Bounds {
+                    min: b.min,
+                    max: b.max,
+                };
+                on_motor(curves, motor, op, out);
             }
             Command::Curve(motor, args) => {
                 // A start before the sync wraps back: the curve is late.
                 let start = self.sync.wrapping_add(args.start as u32);
-                let curve = Curve::new(start, &args);
-                self.on_motor(motor, out, |axis| curves.push(axis, curve));
+                on_motor(curves, motor, Op::Push(Curve::new(start, &args)), out);
             }
             Command::Instant(motor, movement) => {
                 let curve = Curve::hold(curves.clock(), movement);
-                self.on_motor(motor, out, |axis| curves.push(axis, curve));
+                on_motor(curves, motor, Op::Push(curve), out);
             }
             Command::Other(name) => {
                 out.put(b"\nerrUnsupported: ").put(name).put(b"\n");
             }
         }
         out.put(OK);
-    }
-
-    /// `what` on `motor`'s axis; an error line for a motor the head does
-    /// not have or that is not (or already) registered.
-    fn on_motor(
-        &self,
-        motor: Motor<'_>,
-        out: &mut Out<'_>,
-        what: impl FnOnce(crate::axis::Axis) -> Result<(), MotorError>,
-    ) {
-        let (error, id): (&[u8], &[u8]) = match motor {
-            Motor::Unknown(id) => (b"\nerrUnknownMotor: ", id),
-            Motor::Axis(axis) => match what(axis) {
-                Ok(()) => return,
-                Err(MotorError::NotRegistered) => {
-                    (b"\nerrNoEffectorOnPin: ", axis.name().as_bytes())
-                }
-                Err(MotorError::Registered) => (b"\nerrServoCollision: ", axis.name().as_bytes()),
-            },
-        };
-        // Identifiers are at most 8 characters in Bottango.
-        out.put(error).put(id.get(..8).unwrap_or(id)).put(b"\n");
     }
 
     /// The next part of the modules answer, if one is pending.
@@ -273,12 +243,15 @@ impl<'a> Driver<'a> {
             1 => out.put(b"MOD,CMD_SRC,0\n"),
             // Longest line, curves kept per motor, no synchronised
             // commands, 32-bit signals.
-            2 => out
-                .put(b"MOD,CMD_CFG,")
-                .number(MAX_LINE as u32)
-                .put(b",")
-                .number(DEPTH as u32)
-                .put(b",0,32\n"),
+            2 => {
+                text(out)
+                    .str("MOD,CMD_CFG,")
+                    .u64(MAX_LINE as u64)
+                    .str(",")
+                    .u64(DEPTH as u64)
+                    .str(",0,32\n");
+                out
+            }
             3 => out.put(b"MOD,EoM\n"),
             _ => {
                 self.modules = 0;
@@ -287,6 +260,22 @@ impl<'a> Driver<'a> {
         };
         self.modules += 1;
     }
+}
+
+/// `op` on `motor`'s axis; an error line for a motor the head does not
+/// have or that is not (or already) registered.
+#[inline(never)]
+fn on_motor(curves: &Curves, motor: Motor<'_>, op: Op, out: &mut Out<'_>) {
+    let (error, id): (&[u8], &[u8]) = match motor {
+        Motor::Unknown(id) => (b"\nerrUnknownMotor: ", id),
+        Motor::Axis(axis) => match curves.apply(axis, op) {
+            Ok(()) => return,
+            Err(MotorError::NotRegistered) => (b"\nerrNoEffectorOnPin: ", axis.name().as_bytes()),
+            Err(MotorError::Registered) => (b"\nerrServoCollision: ", axis.name().as_bytes()),
+        },
+    };
+    // Identifiers are at most 8 characters in Bottango.
+    out.put(error).put(id.get(..8).unwrap_or(id)).put(b"\n");
 }
 
 /// How long a line in progress may pause before the driver answers

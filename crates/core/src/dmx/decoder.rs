@@ -54,8 +54,9 @@ enum State {
 /// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Decoder {
-    /// The personality's first slot, 1-based.
-    address: u16,
+    /// The personality's first slot, 0-based (so that a decoder at
+    /// address 1 is all zero: a `static` of it takes no flash).
+    first: u16,
     state: State,
     /// Slots received in this frame (saturating).
     slot: u16,
@@ -69,7 +70,7 @@ impl Decoder {
     #[must_use]
     pub const fn new(address: DmxAddress) -> Self {
         Self {
-            address: address.get(),
+            first: address.get() - 1,
             state: State::Unsynced,
             slot: 0,
             slots: [0; FOOTPRINT as usize],
@@ -83,19 +84,21 @@ impl Decoder {
         }
     }
 
-    /// The head's address from the next break on (the frame in progress is
-    /// dropped, uncounted).
+    /// The head's address from the next frame on: at once right after a
+    /// break, else the frame in progress is dropped, uncounted.
     pub fn set_address(&mut self, address: DmxAddress) {
-        if address.get() != self.address {
-            self.address = address.get();
-            self.state = State::Unsynced;
+        if address.get() - 1 != self.first {
+            self.first = address.get() - 1;
+            if self.state != State::Start {
+                self.state = State::Unsynced;
+            }
         }
     }
 
     /// The address in use.
     #[must_use]
     pub const fn address(&self) -> DmxAddress {
-        match DmxAddress::new(self.address) {
+        match DmxAddress::new(self.first + 1) {
             Some(a) => a,
             None => DmxAddress::FIRST,
         }
@@ -129,7 +132,7 @@ impl Decoder {
         // `rest` holds slots first..first + len (1-based); keep the ones
         // of the personality, address..address + FOOTPRINT.
         let first = usize::from(self.slot) + 1;
-        let from = usize::from(self.address);
+        let from = usize::from(self.first) + 1;
         let skip = from.saturating_sub(first);
         let at = first.saturating_sub(from);
         let src = rest.get(skip..).unwrap_or_default();
@@ -166,7 +169,7 @@ impl Decoder {
                 self.counters.long = self.counters.long.saturating_add(1);
                 None
             }
-            State::Slots if self.slot < self.address + (USED - 1) => {
+            State::Slots if self.slot < self.first + USED => {
                 self.counters.short = self.counters.short.saturating_add(1);
                 None
             }
@@ -262,5 +265,9 @@ mod tests {
         assert_eq!(d.end_frame(), Some([5, 6, 7, 8, 9, 10, 11, 12, 13, 14]));
         assert_eq!(d.counters().good, 1);
         assert_eq!(d.address().get(), 5);
+        // Right after a break, the next frame is read at the new address.
+        d.set_address(DmxAddress::new(2).unwrap());
+        d.push(&frame(20, |s| s as u8));
+        assert_eq!(d.end_frame(), Some([2, 3, 4, 5, 6, 7, 8, 9, 10, 11]));
     }
 }

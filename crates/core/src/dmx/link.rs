@@ -10,7 +10,7 @@ use core::cell::Cell;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 
-use super::{Counters, Cue, DmxSettings};
+use super::{Counters, Cue, DmxAddress, DmxSettings};
 
 /// The latest good frame's cue, and how many good frames there have been
 /// (the frame task tells a new cue by the count).
@@ -27,13 +27,13 @@ pub struct Latest {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Signal {
-    /// DMX is switched off (`dmx off`).
-    Off,
     /// No good frame for a second (or never): the head plays on its own.
     #[default]
     Lost,
     /// Good frames arrive: the head follows them.
     Ok,
+    /// DMX is switched off (`dmx off`).
+    Off,
 }
 
 impl Signal {
@@ -48,35 +48,47 @@ impl Signal {
     }
 }
 
-/// The shared DMX state; lives in a `static`.
+/// What the receiver has received: the latest cue and the counters.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Received {
+    latest: Latest,
+    counters: Counters,
+}
+
+/// The shared DMX state; lives in a `static`. All zero at first (off,
+/// nothing received), so that it takes no flash: the boot sets the
+/// settings.
 pub struct DmxLink {
-    settings: Mutex<CriticalSectionRawMutex, Cell<DmxSettings>>,
-    latest: Mutex<CriticalSectionRawMutex, Cell<Latest>>,
-    counters: Mutex<CriticalSectionRawMutex, Cell<Counters>>,
+    /// Whether on, and the address less one.
+    settings: Mutex<CriticalSectionRawMutex, Cell<(bool, u16)>>,
+    received: Mutex<CriticalSectionRawMutex, Cell<Received>>,
     signal: Mutex<CriticalSectionRawMutex, Cell<Signal>>,
 }
 
 impl DmxLink {
-    /// The built-in settings ([`DmxSettings::DEFAULT`]), nothing received.
+    /// Off until the settings are set ([`set`](Self::set)), nothing
+    /// received.
     #[must_use]
     pub const fn new() -> Self {
         Self {
-            settings: Mutex::new(Cell::new(DmxSettings::DEFAULT)),
-            latest: Mutex::new(Cell::new(Latest {
-                seq: 0,
-                cue: Cue {
-                    pose: [0; 3],
-                    mix: 0,
-                    trigger: 0,
-                    intensity: 0,
+            settings: Mutex::new(Cell::new((false, 0))),
+            received: Mutex::new(Cell::new(Received {
+                latest: Latest {
+                    seq: 0,
+                    cue: Cue {
+                        pose: [0; 3],
+                        mix: 0,
+                        trigger: 0,
+                        intensity: 0,
+                    },
                 },
-            })),
-            counters: Mutex::new(Cell::new(Counters {
-                good: 0,
-                short: 0,
-                long: 0,
-                bad_start: 0,
-                garbled: 0,
+                counters: Counters {
+                    good: 0,
+                    short: 0,
+                    long: 0,
+                    bad_start: 0,
+                    garbled: 0,
+                },
             })),
             signal: Mutex::new(Cell::new(Signal::Lost)),
         }
@@ -84,37 +96,44 @@ impl DmxLink {
 
     /// The console (and the boot): DMX on or off, and the address.
     pub fn set(&self, settings: DmxSettings) {
-        self.settings.lock(|cell| cell.set(settings));
+        let raw = (settings.on, settings.address.get() - 1);
+        self.settings.lock(|cell| cell.set(raw));
     }
 
     /// The settings in effect.
     pub fn settings(&self) -> DmxSettings {
-        self.settings.lock(Cell::get)
+        let (on, less_one) = self.settings.lock(Cell::get);
+        DmxSettings {
+            on,
+            address: DmxAddress::new(less_one + 1).unwrap_or(DmxAddress::FIRST),
+        }
     }
 
-    /// The receiver: a good frame's cue, and the counters with it.
-    pub fn publish(&self, cue: Cue, counters: Counters) {
-        self.latest.lock(|cell| {
-            let seq = cell.get().seq.wrapping_add(1);
-            cell.set(Latest { seq, cue });
+    /// The receiver, at a frame's end: the counters, and the frame's cue if
+    /// it was a good one.
+    pub fn record(&self, cue: Option<Cue>, counters: Counters) {
+        self.received.lock(|cell| {
+            let mut received = cell.get();
+            if let Some(cue) = cue {
+                received.latest = Latest {
+                    seq: received.latest.seq.wrapping_add(1),
+                    cue,
+                };
+            }
+            received.counters = counters;
+            cell.set(received);
         });
-        self.count(counters);
-    }
-
-    /// The receiver: the counters after a frame that was not used.
-    pub fn count(&self, counters: Counters) {
-        self.counters.lock(|cell| cell.set(counters));
     }
 
     /// The frame task: whether DMX is on, and the latest cue.
     pub fn latest(&self) -> (bool, Latest) {
-        let on = self.settings.lock(Cell::get).on;
-        (on, self.latest.lock(Cell::get))
+        let on = self.settings.lock(Cell::get).0;
+        (on, self.received.lock(Cell::get).latest)
     }
 
     /// The console: what became of the frames so far.
     pub fn counters(&self) -> Counters {
-        self.counters.lock(Cell::get)
+        self.received.lock(Cell::get).counters
     }
 
     /// The frame task: the signal as it judges it.

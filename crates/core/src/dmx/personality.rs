@@ -93,10 +93,10 @@ mod tests {
 
     #[test]
     fn bands_and_their_edges() {
+        use Trigger::*;
         let bands: Vec<Trigger> = [0, 9, 10, 29, 30, 49, 50, 69, 70, 89, 90, 255]
             .map(Trigger::of)
             .to_vec();
-        use Trigger::*;
         assert_eq!(
             bands,
             [
