@@ -141,6 +141,11 @@ pub struct Config {
     pub flash_fill: Option<(u64, Vec<u8>)>,
     /// Virtual times at which the power goes off and on again.
     pub power_cycles: Vec<Duration>,
+    /// Chunks for the USB serial port, each sent at its time (instead of
+    /// `usb`).
+    pub usb_chunks: Vec<(Vec<u8>, Duration)>,
+    /// DMX512 frames on UART1's RX line (`sim/dmx.mjs`).
+    pub dmx: Option<Value>,
 }
 
 /// How long the flash is busy per operation.
@@ -201,10 +206,18 @@ impl Config {
                 "byte_ns": nanos(uart.byte_time),
                 "errors": uart.errors,
             })).collect::<Vec<_>>(),
-            "usb": self.usb.as_ref().map(|(bytes, at)| json!({
-                "hex": hex(bytes),
-                "at_ns": nanos(*at),
-            })),
+            "usb": if self.usb_chunks.is_empty() {
+                self.usb.as_ref().map(|(bytes, at)| json!({
+                    "hex": hex(bytes),
+                    "at_ns": nanos(*at),
+                }))
+            } else {
+                Some(Value::Array(self.usb_chunks.iter().map(|(bytes, at)| json!({
+                    "hex": hex(bytes),
+                    "at_ns": nanos(*at),
+                })).collect()))
+            },
+            "dmx": self.dmx,
             "rom": self.rom.map(|rom| json!({
                 "erase_ns": nanos(rom.erase),
                 "program_ns": nanos(rom.program),
@@ -226,7 +239,7 @@ fn hex(bytes: &[u8]) -> String {
     })
 }
 
-fn nanos(duration: Duration) -> u64 {
+pub fn nanos(duration: Duration) -> u64 {
     u64::try_from(duration.as_nanos()).unwrap_or(u64::MAX)
 }
 
