@@ -15,7 +15,7 @@ mod exchange;
 mod expect;
 mod flood;
 mod image;
-mod node;
+pub(crate) mod node;
 mod noise;
 mod planted;
 mod pulses;
@@ -34,6 +34,32 @@ pub use flood::{FLOOD_STAGE, test_flood};
 pub use noise::{NOISE_STAGE, test_noise};
 pub use run::{Report, logged_peak_stack};
 pub use show::{SHOW_STAGE, test_show};
+
+/// The harness's DMX line for a DMX script's text (see `sim/dmx.rs`).
+pub fn dmx_line(script: &str) -> Result<serde_json::Value> {
+    Ok(dmx::line(&dmx::parse(script)?))
+}
+
+/// One PWM count of the servo slices, ns.
+pub fn count_ns() -> f64 {
+    run::timing().count_ns
+}
+
+/// Builds the shipped Pico image and runs it for `time` (at most `wall`),
+/// the harness configured by `setup`; the run sorted into boots, its
+/// pulses not checked against the host.
+pub fn run_shipped(
+    root: &std::path::Path,
+    metadata: &project::Metadata,
+    time: Duration,
+    wall: Duration,
+    setup: impl FnOnce(&mut node::Config) -> Result<()>,
+) -> Result<Report> {
+    let elf = stages::shipped_image(root, metadata)?;
+    let mut outcome = Ok(());
+    let report = run::run_with(root, &elf, time, wall, |config| outcome = setup(config))?;
+    outcome.map(|()| report)
+}
 pub use stages::{
     CONSOLE_STAGE, CONSOLE_TIME, DRILL_STAGE, FAILURES_STAGE, PULSES_STAGE, WALL, test_console,
     test_drill, test_failures, test_pulses,

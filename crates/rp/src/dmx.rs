@@ -11,10 +11,13 @@
 //! error is flagged on its character the same way. So the receiver is the
 //! UART's receive interrupt reading the FIFO character by character into
 //! the firmware layer's [`RECEIVER`] (the core's decoder, which keeps only
-//! the personality's slots): no task, no DMA, no frame buffer. Its FIFO
-//! (32 characters, 1.4 ms of DMX) rides out any other interrupt; the
+//! the personality's slots): no task, no DMA, no frame buffer. The
 //! interrupt comes at 8 characters and at a pause of 32 bit periods, at the
-//! ports' priority: below the frame task, which it never delays.
+//! highest priority (with the time driver's alarm): its FIFO holds 32
+//! characters, 1.4 ms of DMX, and the frame task runs longer than that
+//! once a loop (its status line, which scans the stack for its peak), so
+//! below it a frame would be lost every 30 s. Reading a few characters
+//! takes microseconds: the frames' timing does not see it.
 //!
 //! embassy-rp's `UartRx::read_to_break` would find breaks too, with DMA
 //! into a buffer and a task to wake; the interrupt does the same work with
@@ -22,14 +25,12 @@
 //! (PIO is not needed: the UART already finds breaks.)
 
 use embassy_rp::Peri;
-use embassy_rp::interrupt::{self, InterruptExt};
+use embassy_rp::interrupt::{self, InterruptExt, Priority};
 use embassy_rp::pac;
 use embassy_rp::peripherals::UART1;
 use embassy_rp::uart::{self, Blocking, DataBits, Parity, RxPin, StopBits, UartRx};
 use idle_head_firmware::boot::SHOW;
 use idle_head_firmware::dmx::{RECEIVER, Rx};
-
-use crate::PORT_PRIORITY;
 
 /// DMX512's line rate.
 pub const BAUD: u32 = 250_000;
@@ -60,7 +61,7 @@ pub fn listen(uart: DmxUart) {
         w.set_rxim(true);
         w.set_rtim(true);
     });
-    interrupt::UART1_IRQ.set_priority(PORT_PRIORITY);
+    interrupt::UART1_IRQ.set_priority(Priority::P0);
     interrupt::UART1_IRQ.unpend();
     // Note(unsafe): the handler below takes nothing that a critical
     // section does not guard.

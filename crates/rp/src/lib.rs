@@ -12,8 +12,8 @@
 //!   CPU every 28 s, which frames preempt;
 //! - the console on the UART and on the USB serial port (thread mode), whose
 //!   interrupts sit below the frame task's ([`PORT_PRIORITY`]);
-//! - the DMX512 receiver ([`dmx`]): UART1's interrupt at the ports'
-//!   priority, below the frames.
+//! - the DMX512 receiver ([`dmx`]): UART1's interrupt, at the highest
+//!   priority (a few microseconds per character).
 //!
 //! Exactly one chip feature: `rp2040` or `rp235xa`.
 #![no_std]
