@@ -22,6 +22,15 @@
 //! ([`FrameLoop::with_commands`]), at most two a frame, each logged with its
 //! answer.
 //!
+//! # Show
+//!
+//! With a [`ShowLink`] ([`FrameLoop::with_show`]), before each frame the
+//! frame task takes the DMX receiver's latest cue and samples Bottango's
+//! curves for the frame's time ([`FrameLoop::show`], part of
+//! [`FrameLoop::drain`]): the show layer blends them over the mixer's
+//! offsets (see `idle_head_core::behaviour::show`). Changes of the DMX
+//! signal and the gestures its trigger fires are logged.
+//!
 //! # Idle motion and the loop generator
 //!
 //! On the boards the idle source is an [`IdlePlayer`](idle_head_core::idle::IdlePlayer)
