@@ -172,8 +172,8 @@ impl<I: IdleSource> Head<I> {
     /// starts with neutral pulses on its first frame).
     pub fn frame<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, frame: u64) -> HeadFrame {
         let idle = self.idle.offsets(frame);
-        let mixed = self.mixer.frame(frame, idle);
-        let offsets = self.show.blend(frame as u32, mixed);
+        let mut offsets = self.mixer.frame(frame, idle);
+        self.show.blend(frame as u32, &mut offsets);
         HeadFrame {
             offsets,
             report: driver.write_frame(offsets),

@@ -167,18 +167,18 @@ impl Show {
         self.axes
     }
 
-    /// The offsets of frame `now` over the mixer's `mixed`.
+    /// Frame `now`'s offsets: the mixer's, `offsets`, blended with the
+    /// show's pose in place.
     #[inline]
-    pub(crate) fn blend(&mut self, now: u32, mixed: [Angle; 3]) -> [Angle; 3] {
-        if self.axes == 0 {
-            return mixed;
+    pub(crate) fn blend(&mut self, now: u32, offsets: &mut [Angle; 3]) {
+        if self.axes != 0 {
+            self.blend_on(now, offsets);
         }
-        self.blend_on(now, mixed)
     }
 
     /// [`blend`](Self::blend) while the layer is on.
     #[inline(never)]
-    fn blend_on(&mut self, now: u32, mixed: [Angle; 3]) -> [Angle; 3] {
+    fn blend_on(&mut self, now: u32, offsets: &mut [Angle; 3]) {
         let axes = self.axes;
         let w = match &mut self.handback {
             Some(glide) => {
@@ -194,15 +194,13 @@ impl Show {
             }
             None => self.weight,
         };
-        let mut out = mixed;
-        for (i, (slot, &pose)) in out.iter_mut().zip(&self.pose).enumerate() {
+        for (i, (slot, &pose)) in offsets.iter_mut().zip(&self.pose).enumerate() {
             if axes & (1 << i) != 0 {
                 let m = slot.millidegrees();
                 // Both within ±360°: the difference fits.
                 *slot = Angle::from_millidegrees(m + mul(pose - m, w));
             }
         }
-        out
     }
 
     /// Between frames, before frame `now`: hands back from the current
