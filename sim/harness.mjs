@@ -21,7 +21,9 @@
 //               rate), the bytes at the indices in `errors` received with a framing error
 //               (line noise); the scripts of one boot go out one after the other,
 //   usb:        optional, bytes for the USB serial port: {hex, at_ns}: rp2040js's CDC-ACM
-//               host enumerates the device, and from at_ns on sends the bytes; boot 0 only,
+//               host enumerates the device, and from at_ns on sends the bytes; boot 0 only;
+//               or a list of them, each sent at its time,
+//   dmx:        optional, DMX512 frames on UART1's RX line (GP9): see dmx.mjs,
 //   rom:        optional, {erase_ns, program_ns}: a boot ROM with the flash functions
 //               (rom.mjs), a sector erase and a page program taking that much virtual time,
 //   flash_fill: optional, {addr, hex}: bytes written over the image's flash before power-on,
@@ -53,6 +55,8 @@
 //   {"ev":"uart_overrun","ns":..}                   a scripted byte found UART0's RX FIFO full
 //   {"ev":"usb_connected","ns":..}                  the CDC-ACM host configured the device
 //   {"ev":"usb","ns":..,"hex":".."}                 bytes the device sent on its CDC-ACM IN endpoint
+//   {"ev":"usb_in","ns":..,"n":..}                  the host sent a scripted chunk of n bytes
+//   {"ev":"dmx","ns":..,"frame":..,"changed":true}  a DMX frame with a change ended (dmx.mjs)
 //   {"ev":"unmodelled","peripheral":"ROSC_BASE","op":"write","offset":4,"count":1}
 //                                                   accesses to a register rp2040js does not
 //                                                   model, counted over the run (at its end)
@@ -64,6 +68,7 @@ import { readFileSync } from 'node:fs';
 import { RP2040, USBCDC } from 'rp2040js';
 import { romImage, serveRom } from './rom.mjs';
 import { uartAsOnTheChip } from './uart.mjs';
+import { dmxLine } from './dmx.mjs';
 
 const cfg = JSON.parse(process.argv[2] ?? '{}');
 const FLASH_START = 0x10000000;
@@ -149,6 +154,7 @@ function powerUp(kept) {
     chip.gpio[pin].addListener((state) => edge(pin, state === 1));
   }
   uartAsOnTheChip(chip.uart[0], () => now());
+  if (dmx) dmx.attach(chip.uart[1], () => now());
   xipControlAsOnTheChip(chip);
   roscRandomBit(chip);
   if ((cfg.usb || cfg.live) && boot === 0) usbHost(chip);
@@ -305,22 +311,30 @@ function usbHost(chip) {
     emit({ ev: 'usb_connected', ns: now() });
     usbLines = (value) => cdc.cdcSetControlLineState(value);
     if (cfg.live) usbLive = sendBytes;
-    else usbSend = () => sendBytes(Buffer.from(cfg.usb.hex, 'hex'));
+    else
+      usbSend = (chunk) => {
+        const bytes = Buffer.from(chunk.hex, 'hex');
+        sendBytes(bytes);
+        if (usbChunks.length > 1 || Array.isArray(cfg.usb)) emit({ ev: 'usb_in', ns: now(), n: bytes.length });
+      };
   };
   cdc.onSerialData = (bytes) => {
     emit({ ev: 'usb', ns: now(), hex: Buffer.from(bytes).toString('hex') });
     lastActivity = now();
   };
 }
-let usbSend = null; // sends the USB script, once the device is configured
+let usbSend = null; // sends a chunk of the USB script, once the device is configured
 let usbLive = null; // sends bytes from stdin (a live run), once the device is configured
 let usbLines = null; // sets the host's control lines (DTR, RTS), once the device is configured
+const usbChunks = cfg.usb ? [].concat(cfg.usb).sort((a, b) => a.at_ns - b.at_ns) : [];
+const usbDue = () => (usbSend && usbChunks.length ? usbChunks[0].at_ns : Infinity);
 function feedUsb() {
-  if (usbSend && now() >= cfg.usb.at_ns) {
-    usbSend();
-    usbSend = null;
-  }
+  while (usbSend && usbChunks.length && now() >= usbChunks[0].at_ns) usbSend(usbChunks.shift());
+  if (!usbChunks.length) usbSend = null;
 }
+
+// DMX512 on UART1's RX line, if scripted (dmx.mjs).
+const dmx = cfg.dmx ? dmxLine(cfg.dmx, emit) : null;
 
 // UART0's scripted RX line (per boot) and the bytes it sent.
 const scripts = (cfg.uart ?? [])
@@ -444,6 +458,13 @@ function run() {
           continue;
         }
         if (sending !== Infinity && (wait <= 0 || sending < wait)) wait = sending;
+        const more = Math.min(dmx ? dmx.due() : Infinity, usbDue()) - now(); // DMX, USB
+        if (more <= 0) {
+          if (dmx) dmx.feed();
+          if (usbSend) feedUsb();
+          continue;
+        }
+        if (more !== Infinity && (wait <= 0 || more < wait)) wait = more;
         const cycle = powerCycleDue() - now();
         if (cycle <= 0) break;
         if (cycle !== Infinity && (wait <= 0 || cycle < wait)) wait = cycle;
@@ -472,6 +493,7 @@ function run() {
       if ((i & 15) === 0 && cfg.uart) feedUart();
       if ((i & 15) === 0) mcu.uart[0].sendDue();
       if ((i & 255) === 0 && usbSend) feedUsb();
+      if ((i & 15) === 0 && dmx) dmx.feed();
       if ((i & 255) === 0 && now() >= powerCycleDue()) break;
     }
     if (cfg.rtt) drainRtt();

@@ -78,7 +78,7 @@ fn every_command_does_what_it_says() {
     assert!(
         r[1].starts_with("ok mode=running mdeg=")
             && r[1].contains(" us=")
-            && r[1].contains(" faults=0,0,0 off=0 uptime_ms=0 fw=0.1.0 settings=defaults"),
+            && r[1].contains(" faults=0,0,0 off=0 uptime_ms=0 fw=0.1.0 dmx=lost settings=defaults"),
         "{}",
         r[1]
     );

@@ -35,6 +35,7 @@ use std::{fmt::Write as _, path::Path};
 use anyhow::{Context, Result, bail};
 
 mod frame;
+pub mod latency;
 mod telemetry;
 
 pub use frame::FrameRow;
@@ -347,13 +348,26 @@ pub fn command(options: Options) -> Result<bool> {
     setup::ensure_toolchain(&root)?;
     setup::ensure_qemu()?;
     let metadata = project::metadata(&root)?;
-    match run_and_check(&root, &metadata, options) {
-        Ok(()) => Ok(true),
+    let mut passed = match run_and_check(&root, &metadata, options) {
+        Ok(()) => true,
         Err(error) => {
             println!("bench FAILED: {error:#}");
-            Ok(false)
+            false
+        }
+    };
+    // The latency rows: the shipped image in the RP2040 emulator
+    // (`bench/latency.rs`).
+    println!();
+    for path in [latency::dmx, latency::usb_look] {
+        match path(&root, &metadata, crate::sim::WALL) {
+            Ok(row) => print!("{}", row.lines()),
+            Err(error) => {
+                println!("latency FAILED: {error:#}");
+                passed = false;
+            }
         }
     }
+    Ok(passed)
 }
 
 /// The benchmark's rows.

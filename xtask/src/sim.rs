@@ -9,17 +9,20 @@
 //! the duties the host computes with the same core (`pulses.rs` explains how
 //! PWM periods map to frames).
 
+mod dmx;
 mod event;
 mod exchange;
 mod expect;
 mod flood;
 mod image;
 pub mod live;
-mod node;
+pub(crate) mod node;
 mod noise;
 mod planted;
 mod pulses;
+pub mod pulses_csv;
 mod run;
+mod show;
 mod stages;
 mod store;
 mod unmodelled;
@@ -33,6 +36,33 @@ pub use node::ensure as ensure_node;
 pub use node::folder as node_folder;
 pub use noise::{NOISE_STAGE, test_noise};
 pub use run::{Report, logged_peak_stack};
+pub use show::{SHOW_STAGE, test_show};
+
+/// The harness's DMX line for a DMX script's text (see `sim/dmx.rs`).
+pub fn dmx_line(script: &str) -> Result<serde_json::Value> {
+    Ok(dmx::line(&dmx::parse(script)?))
+}
+
+/// One PWM count of the servo slices, ns.
+pub fn count_ns() -> f64 {
+    run::timing().count_ns
+}
+
+/// Builds the shipped Pico image and runs it for `time` (at most `wall`),
+/// the harness configured by `setup`; the run sorted into boots, its
+/// pulses not checked against the host.
+pub fn run_shipped(
+    root: &std::path::Path,
+    metadata: &project::Metadata,
+    time: Duration,
+    wall: Duration,
+    setup: impl FnOnce(&mut node::Config) -> Result<()>,
+) -> Result<Report> {
+    let elf = stages::shipped_image(root, metadata)?;
+    let mut outcome = Ok(());
+    let report = run::run_with(root, &elf, time, wall, |config| outcome = setup(config))?;
+    outcome.map(|()| report)
+}
 pub use stages::{
     CONSOLE_STAGE, CONSOLE_TIME, DRILL_STAGE, FAILURES_STAGE, PULSES_STAGE, WALL, test_console,
     test_drill, test_failures, test_pulses,
@@ -45,7 +75,7 @@ use crate::setup;
 /// Options of `cargo xtask sim`.
 // The runs are flags that exclude each other (clap checks it).
 #[allow(clippy::struct_excessive_bools)]
-#[derive(Debug, Clone, Copy, clap::Args)]
+#[derive(Debug, Clone, clap::Args)]
 pub struct Args {
     /// Virtual time to run, in seconds (default: 32.5, a 30 s loop, the
     /// 2 s fade-in and half a second of boot; with `--console`, 6).
@@ -89,6 +119,21 @@ pub struct Args {
     /// the known gaps that do not matter (summed up in one line without).
     #[arg(long, short)]
     pub verbose: bool,
+    /// The show control run instead (the stage of `cargo xtask test`): DMX
+    /// frames into GP9 and a Bottango session over USB, each checked from
+    /// the pulses on the servo pins (see `xtask/src/sim/show.rs`).
+    #[arg(long, conflicts_with_all = ["drill", "console", "store", "noise", "flood", "dmx", "pulses"])]
+    pub show: bool,
+    /// Play DMX512 into GP9 (UART1 RX): FILE has lines `<s> <slot>=<value>
+    /// …` (slots relative to the head's address, 1-based; values hold until
+    /// changed) and `<s> dmx stop`; frames at about 44 Hz with proper
+    /// breaks. Runs until 3 s after the last line unless `--seconds`.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood"])]
+    pub dmx: Option<std::path::PathBuf>,
+    /// Write the run's servo pulses to FILE.csv, one row per frame:
+    /// `t_ms,pitch_us,roll_us,yaw_us`, as measured on GP16, GP18, GP20.
+    #[arg(long, value_name = "FILE.csv", conflicts_with_all = ["drill", "console", "store", "noise", "flood"])]
+    pub pulses: Option<std::path::PathBuf>,
 }
 
 /// One loop (30 s), the fade-in (2 s) and half a second for the boot.
@@ -160,6 +205,12 @@ pub fn command(args: &Args) -> Result<bool> {
             "console",
             stages::test_console(&root, &metadata, time, args.timeout),
         ));
+    }
+    if args.show {
+        return Ok(passed("show control", show::test_show(&root, &metadata)));
+    }
+    if args.dmx.is_some() || args.pulses.is_some() {
+        return show::command(&root, &metadata, args);
     }
     PICO.build(&root)?;
     let report = run::simulate(

@@ -280,6 +280,7 @@ fn sim_stages(
     stages.run(sim::NOISE_STAGE, || sim::test_noise(root, metadata));
     stages.run(sim::FLOOD_STAGE, || sim::test_flood(root, metadata));
     stages.run(sim::FAILURES_STAGE, || sim::test_failures(root, metadata));
+    stages.run(sim::SHOW_STAGE, || sim::test_show(root, metadata));
     stages.run(MEMORY, || {
         let peak = |elf: &Path, stack: Option<u64>| -> Result<Option<elf::Peak>> {
             let Some(stack) = stack else { return Ok(None) };

@@ -23,7 +23,7 @@ use core::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use core::task::{Context, Poll};
 
 use embassy_time::Duration;
-use idle_head_core::console::{ConsoleService, Session};
+use idle_head_core::console::{ConsoleService, DualSession};
 use idle_head_core::settings::RamStorage;
 use idle_head_firmware::boot::{COMMANDS as QUEUE, LINK};
 use idle_head_firmware::console::{Gone, Place, Port, Received, serve};
@@ -136,7 +136,8 @@ impl Port for Uart0 {
 pub async fn console(mut service: Service, frame: Duration) {
     UART0.init();
     UART1.init();
-    let mut session = Session::<96, 160>::new();
+    // No Bottango here: the QEMU image has no show layer's curves to play.
+    let mut session = DualSession::new(None);
     let place = Place {
         port: 0,
         link: &LINK,

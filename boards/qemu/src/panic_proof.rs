@@ -22,7 +22,13 @@
 //! to the console port that asked for it (`ConsoleLink::answer`, as
 //! [`FrameLoop::drain`] does), the status published for
 //! it after every frame ([`FrameLoop::publish`]), and the console's
-//! parser (`idle_head_core::console::parse`) on any line. Its panic handler calls `frame_path_has_a_panic_path`, a function
+//! parser (`idle_head_core::console::parse`) on any line; the show layer
+//! ([`FrameLoop::show`]: any DMX cue, DMX on or off, any Bottango curves
+//! sampled at any time, blended into every frame), the DMX receiver
+//! (`idle_head_firmware::dmx::Receiver`, the UART interrupt's work: any
+//! character, break or error at any address) and Bottango's side of the
+//! console (its line parser on any line, any motor command on the shared
+//! curves, any curve built from any parameters). Its panic handler calls `frame_path_has_a_panic_path`, a function
 //! that exists nowhere. If any panic (index, division, overflow check,
 //! `unwrap`, ...) remains reachable after optimisation, the call survives
 //! and the link fails:
@@ -41,9 +47,11 @@
 use core::hint::black_box;
 
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
-use idle_head_core::behaviour::{Asker, BehaviourConfig, BehaviourParams};
+use idle_head_core::behaviour::{Asker, BehaviourConfig, BehaviourParams, ShowLink};
+use idle_head_core::bottango::{self, Curve, Op, line::CurveArgs};
 use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
 use idle_head_core::console::{ConsoleLink, parse};
+use idle_head_core::dmx::{DmxAddress, DmxSettings};
 use idle_head_core::driver::{
     DegreesPerSecond, DegreesPerSecondSquared, DriverParams, FrameDriver, MotionLimits,
 };
@@ -54,6 +62,7 @@ use idle_head_core::{Axis, Playback};
 use idle_head_firmware::config::{
     DEFAULT_PARAMS, DEFAULT_PLAYBACK, DEFAULT_TIMING, IDLE_MODE, Set,
 };
+use idle_head_firmware::dmx::{Receiver, Rx};
 use idle_head_firmware::exchange::Exchange;
 use idle_head_firmware::frame::FrameLoop;
 use static_cell::ConstStaticCell;
@@ -72,6 +81,25 @@ static EXCHANGE: Exchange = Exchange::new();
 
 /// What the console shares with the frame task: calibrations in, status out.
 static LINK: ConsoleLink = ConsoleLink::new();
+
+/// The show layer's inputs: DMX cues and Bottango's curves in.
+static SHOW: ShowLink = ShowLink::new();
+
+/// Any curve parameters.
+fn any_curve() -> Curve {
+    let n = || black_box(0_i32);
+    Curve::new(
+        black_box(0),
+        &CurveArgs {
+            start: n(),
+            duration: black_box(0),
+            start_y: n(),
+            start_control: (n(), n()),
+            end_y: n(),
+            end_control: (n(), n()),
+        },
+    )
+}
 
 /// A PWM channel whose maximum duty and write results are unknown.
 struct OpaquePwm;
@@ -159,12 +187,13 @@ fn main() -> ! {
         black_box(1_000_000),
         black_box(0),
     )
-    .map(|frames| frames.with_link(&LINK)) else {
+    .map(|frames| frames.with_link(&LINK).with_show(&SHOW)) else {
         // Not reached with the built-in playback; no panic either way.
         loop {
             cortex_m::asm::wfi();
         }
     };
+    let mut receiver = Receiver::new();
     loop {
         let axis = Axis::ALL[usize::from(black_box(0_u8) % 3)];
         match black_box(0_u8) {
@@ -221,9 +250,47 @@ fn main() -> ! {
                 let len = usize::from(black_box(0_u8)) % (line.len() + 1);
                 black_box(parse(line.get(..len).unwrap_or_default())).ok();
             }
+            8 => {
+                // The DMX receiver (the UART interrupt's work), any
+                // character at any address, DMX on or off.
+                let address = DmxAddress::new(black_box(1)).unwrap_or(DmxAddress::FIRST);
+                SHOW.dmx.set(DmxSettings {
+                    on: black_box(true),
+                    address,
+                });
+                let rx = match black_box(0_u8) {
+                    0 => Rx::Break,
+                    1 => Rx::Error,
+                    byte => Rx::Byte(byte),
+                };
+                receiver.take(rx, &SHOW.dmx);
+                receiver.flush();
+            }
+            9 => {
+                // Bottango's parser on any line of up to 96 bytes, and any
+                // motor command on the shared curves.
+                let line = black_box([0_u8; 96]);
+                let len = usize::from(black_box(0_u8)) % (line.len() + 1);
+                black_box(bottango::parse(line.get(..len).unwrap_or_default())).ok();
+                let (min, max) = (black_box(0), black_box(0));
+                let op = match black_box(0_u8) {
+                    0 => Op::Register { min, max },
+                    1 => Op::Bounds { min, max },
+                    2 => Op::Deregister,
+                    3 => Op::Clear,
+                    4 => Op::Push(Curve::hold(black_box(0), black_box(0))),
+                    _ => Op::Push(any_curve()),
+                };
+                black_box(SHOW.curves.apply(axis, op)).ok();
+                SHOW.curves.set_active(black_box(true));
+                if black_box(false) {
+                    SHOW.curves.clear_all();
+                }
+            }
             _ => {}
         }
         let tick = frames.next(black_box(0));
+        black_box(frames.show(&mut driver, tick));
         let written = frames.write(&mut driver, tick);
         frames.publish(&driver, &written.report);
         black_box((written, driver.is_stopped(), driver.stats()));

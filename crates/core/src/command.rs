@@ -161,4 +161,17 @@ pub enum Command {
     /// Stream telemetry lines on this port, this many a second
     /// (`1..=50`), or stop them (`None`).
     Watch(Option<u8>),
+    /// Show the DMX receiver's state and counters (`None`), or change a
+    /// DMX setting.
+    Dmx(Option<DmxSetting>),
+}
+
+/// A DMX setting (`dmx on|off`, `dmx address <n>`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum DmxSetting {
+    /// DMX drives the head (`true`) or not.
+    On(bool),
+    /// The head's start address.
+    Address(crate::dmx::DmxAddress),
 }

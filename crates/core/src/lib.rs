@@ -40,8 +40,10 @@ compile_error!("the tests run on the host: `cargo xtask test` (or `cd host-tests
 
 pub mod axis;
 pub mod behaviour;
+pub mod bottango;
 pub mod command;
 pub mod console;
+pub mod dmx;
 pub mod driver;
 pub mod gestures;
 pub mod idle;

@@ -17,7 +17,7 @@
 
 use embassy_time::Instant;
 use idle_head_core::Axis;
-use idle_head_core::behaviour::{BehaviourParams, CommandQueue};
+use idle_head_core::behaviour::{BehaviourParams, CommandQueue, ShowLink};
 use idle_head_core::console::{ConsoleLink, ConsoleService};
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::driver::DriverParams;
@@ -38,6 +38,10 @@ pub static LINK: ConsoleLink = ConsoleLink::new();
 
 /// The channels the loop set buffers go round through.
 pub static EXCHANGE: Exchange = Exchange::new();
+
+/// The show layer's inputs: the DMX receiver's cues and settings, and a
+/// Bottango session's curves (console ports → frame task).
+pub static SHOW: ShowLink = ShowLink::new();
 
 /// The two loop set buffers, 2 · 5.4 KB: one plays while the generator
 /// fills the other. All zero (the neutral pose) until generated.
@@ -159,10 +163,11 @@ pub fn boot<S: SettingsStorage>(
         source,
         valid,
     } = loaded;
+    SHOW.dmx.set(settings.dmx);
     let service = match ConsoleService::new(&COMMANDS, &LINK, storage, *base, settings, source) {
         Ok(mut service) => {
             service.add_entropy(entropy);
-            Some(service)
+            Some(service.with_show(&SHOW))
         }
         Err(e) => {
             defmt::error!("console: no service: {}", e);

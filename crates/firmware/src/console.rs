@@ -1,7 +1,9 @@
 //! The console on a board's byte ports (a UART, a USB serial port).
 //!
-//! Each port has a task of its own in thread mode with its own
-//! [`Session`]: bytes in, one reply line out per input line. The commands
+//! Each port has a task of its own in thread mode with its own session
+//! ([`DualSession`]): bytes in, one reply line out per input line; a
+//! Bottango handshake turns the port into a Bottango driver until `STOP`
+//! or until the host goes away. The commands
 //! are carried out by a [`Handler`], the one generic parameter of
 //! [`serve`]; actions reach the frame task only through its
 //! [`CommandQueue`], which it drains between frames, and servo
@@ -21,11 +23,14 @@
 
 use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Instant, Timer, with_timeout};
+use idle_head_core::bottango::TIMEOUT_MS;
 use idle_head_core::console::{
-    ConsoleLink, Handler, Outcome, PortSession, Session, Shared, SharedService, outcome_reply,
+    ConsoleLink, DualSession, Handler, Outcome, Shared, SharedService, outcome_reply,
     telemetry_line, unanswered,
 };
 use idle_head_core::settings::SettingsStorage;
+
+use crate::boot::SHOW;
 
 /// The console's baud rate on a UART (8 data bits, no parity, 1 stop bit).
 pub const UART_BAUD: u32 = 115_200;
@@ -98,10 +103,13 @@ pub struct Place<'a> {
 /// telemetry at the rate `watch` set ([`telemetry_line`]), from the
 /// status the frame task published: written here, never by the frame
 /// task. A tick whose line cannot go out because the host reads too
-/// slowly is dropped and counted in the next line's `lost=`.
-pub async fn serve<P: Port, H: Handler, const LINE: usize, const REPLY: usize>(
+/// slowly is dropped and counted in the next line's `lost=`. In a
+/// Bottango session there is no telemetry (the port speaks Bottango's
+/// protocol), and a line that pauses for [`TIMEOUT_MS`] is dropped and
+/// answered `TIMEOUT`.
+pub async fn serve<P: Port, H: Handler>(
     port: &mut P,
-    session: &mut Session<LINE, REPLY>,
+    session: &mut DualSession<'_>,
     handler: &mut H,
     place: Place<'_>,
 ) -> Gone {
@@ -113,10 +121,31 @@ pub async fn serve<P: Port, H: Handler, const LINE: usize, const REPLY: usize>(
         if !port.open() {
             place.link.set_watch(place.port, 0);
         }
-        let rate = place.link.watch(place.port);
+        let rate = if session.bottango() {
+            0
+        } else {
+            place.link.watch(place.port)
+        };
         let due = watch.due(rate).unwrap_or(Instant::MAX);
-        let read = match select(port.read(&mut buf), Timer::at(due)).await {
+        // A Bottango line in progress times out; nothing else does.
+        let armed = session.bottango() && session.in_progress();
+        let timeout = if armed {
+            Instant::now() + Duration::from_millis(TIMEOUT_MS)
+        } else {
+            Instant::MAX
+        };
+        let read = match select(port.read(&mut buf), Timer::at(due.min(timeout))).await {
             Either::First(read) => read,
+            Either::Second(()) if armed && Instant::now() >= timeout => {
+                let was = session.bottango();
+                if let Some(reply) = session.timeout()
+                    && let Err(gone) = port.write(reply).await
+                {
+                    return gone;
+                }
+                log_mode(was, session.bottango());
+                continue;
+            }
             Either::Second(()) => {
                 // Between replies: the reply buffer is free for the line.
                 let status = place.link.status();
@@ -137,8 +166,10 @@ pub async fn serve<P: Port, H: Handler, const LINE: usize, const REPLY: usize>(
             }
             Err(gone) => return gone,
         };
+        let was = session.bottango();
         for &byte in buf.get(..n).unwrap_or_default() {
             if let Some(reply) = session.push(byte, handler)
+                && !reply.is_empty()
                 && let Err(gone) = port.write(reply).await
             {
                 return gone;
@@ -157,6 +188,19 @@ pub async fn serve<P: Port, H: Handler, const LINE: usize, const REPLY: usize>(
                 }
             }
         }
+        log_mode(was, session.bottango());
+    }
+}
+
+/// Logs a port switching to Bottango's protocol or back.
+fn log_mode(was: bool, is: bool) {
+    match (was, is) {
+        (false, true) => defmt::info!(
+            "console: Bottango handshake: a Bottango driver (protocol {=str}) until STOP",
+            idle_head_core::bottango::VERSION
+        ),
+        (true, false) => defmt::info!("console: Bottango STOP: the console again"),
+        _ => {}
     }
 }
 
@@ -217,19 +261,21 @@ impl Watch {
 
 /// Runs the console on `port` for as long as the board runs: a session per
 /// connection (the half-typed line of a host that went away is forgotten,
-/// and its telemetry stops), commands carried out by the shared `service`.
+/// its telemetry stops and a Bottango session ends), commands carried out
+/// by the shared `service`.
 pub async fn run<P: Port, S: SettingsStorage>(
     port: &mut P,
     service: &'static SharedService<S>,
     name: &'static str,
     place: Place<'_>,
 ) -> ! {
-    let mut session = PortSession::new();
+    let mut session = DualSession::new(Some(&SHOW.curves));
     let mut handler = Shared::new(service, place.port);
     loop {
         port.connected().await;
         session.reset();
         let Gone = serve(port, &mut session, &mut handler, place).await;
+        session.reset();
         place.link.set_watch(place.port, 0);
         defmt::info!("console {=str}: the host went away", name);
     }

@@ -22,6 +22,15 @@
 //! ([`FrameLoop::with_commands`]), at most two a frame, each logged with its
 //! answer.
 //!
+//! # Show
+//!
+//! With a [`ShowLink`] ([`FrameLoop::with_show`]), before each frame the
+//! frame task takes the DMX receiver's latest cue and samples Bottango's
+//! curves for the frame's time ([`FrameLoop::show`], part of
+//! [`FrameLoop::drain`]): the show layer blends them over the mixer's
+//! offsets (see `idle_head_core::behaviour::show`). Changes of the DMX
+//! signal and the gestures its trigger fires are logged.
+//!
 //! # Idle motion and the loop generator
 //!
 //! On the boards the idle source is an [`IdlePlayer`](idle_head_core::idle::IdlePlayer)
@@ -44,9 +53,11 @@ use embedded_hal::pwm::SetDutyCycle;
 
 use idle_head_core::behaviour::{
     Applied, BehaviourError, BehaviourParams, CommandQueue, Head, HeadFrame, IdleSource,
+    ShowEvents, ShowLink,
 };
 use idle_head_core::command::{Action, Hold};
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
+use idle_head_core::dmx::Signal;
 use idle_head_core::driver::{FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod};
 use idle_head_core::{Angle, Microseconds};
 
@@ -107,6 +118,9 @@ pub struct FrameLoop<'a, I> {
     clock: FrameClock,
     commands: Option<&'a CommandQueue>,
     link: Option<&'a ConsoleLink>,
+    show: Option<&'a ShowLink>,
+    /// The behaviour's frame period in whole ms: the show clock's step.
+    frame_ms: u32,
 }
 
 impl<'a, I: IdleSource> FrameLoop<'a, I> {
@@ -146,6 +160,8 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
             clock,
             commands: None,
             link: None,
+            show: None,
+            frame_ms: params.frame_us().div_ceil(1000),
         })
     }
 
@@ -163,6 +179,15 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
     #[must_use]
     pub const fn with_link(mut self, link: &'a ConsoleLink) -> Self {
         self.link = Some(link);
+        self
+    }
+
+    /// Takes the show layer's inputs from `show` before each frame: the
+    /// DMX receiver's latest cue and Bottango's curves (see
+    /// [`Head::show`]); publishes the DMX signal as judged there.
+    #[must_use]
+    pub const fn with_show(mut self, show: &'a ShowLink) -> Self {
+        self.show = Some(show);
         self
     }
 
@@ -261,6 +286,32 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
             }
             None => self.head.sync(driver),
         }
+        if let Some(events) = self.show(driver, tick) {
+            log_show(tick.frame, &events);
+        }
+    }
+
+    /// Before frame `tick` (part of [`drain`](Self::drain)): the show
+    /// layer's inputs from the show link, if linked ([`Head::show`]); the
+    /// DMX signal as judged there is published to the link. What happened,
+    /// for the log.
+    pub fn show<P: SetDutyCycle>(
+        &mut self,
+        driver: &mut FrameDriver<P>,
+        tick: FrameTick,
+    ) -> Option<ShowEvents> {
+        let show = self.show?;
+        // The frame task's clock, ms (wrapping): Bottango's curves are
+        // timed on it.
+        let now_ms = (tick.frame as u32).wrapping_mul(self.frame_ms);
+        let curves = show.curves.sample(now_ms);
+        let events = self
+            .head
+            .show(driver, tick.frame, Some(show.dmx.latest()), curves);
+        if let Some(signal) = events.signal {
+            show.dmx.set_signal(signal);
+        }
+        Some(events)
     }
 
     /// After a frame that wrote `report`: the head's status for the
@@ -346,6 +397,34 @@ where
                 missed: frames.missed(),
                 max_lateness,
             };
+        }
+    }
+}
+
+/// Logs what the show layer's inputs did before frame `frame`: the DMX
+/// signal's changes, the gestures its trigger fired.
+fn log_show(frame: u64, events: &ShowEvents) {
+    if let Some(signal) = events.signal {
+        defmt::info!(
+            "frame {=u64}: dmx: signal {=str}{=str}",
+            frame,
+            signal.as_str(),
+            if signal == Signal::Lost {
+                " (none for 1 s): the head plays on its own"
+            } else {
+                ""
+            }
+        );
+    }
+    if let Some((action, outcome)) = &events.fired {
+        match outcome {
+            Ok(applied) => defmt::info!(
+                "frame {=u64}: dmx {=str}: ok {}",
+                frame,
+                word(action),
+                Started(applied)
+            ),
+            Err(e) => defmt::warn!("frame {=u64}: dmx {=str}: {}", frame, word(action), e),
         }
     }
 }

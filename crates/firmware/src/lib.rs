@@ -9,7 +9,9 @@
 //! - [`exchange`]: the loop sets' round between the frame task and the loop
 //!   generator, which makes each next set in the background.
 //! - [`hooks`]: the watchdog and status log of a board running on its own.
-//! - [`console`]: the console's loop over a board's byte [`console::Port`].
+//! - [`console`]: the console's loop over a board's byte [`console::Port`]
+//!   (a Bottango driver on a port after a Bottango handshake).
+//! - [`dmx`]: the DMX512 receiver's loop over a board's [`dmx::DmxPort`].
 //! - [`storage`]: the settings store in a board's flash.
 //!
 //! What a board adds is its hardware: the PWM outputs, the ports, the flash,
@@ -31,6 +33,7 @@ pub mod boot;
 pub mod calibrate;
 pub mod config;
 pub mod console;
+pub mod dmx;
 pub mod exchange;
 pub mod frame;
 pub mod hooks;

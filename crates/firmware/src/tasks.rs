@@ -13,7 +13,7 @@ use idle_head_core::idle::{IdleMode, IdleStats, LoopStream, SetInfo};
 use idle_head_core::motion::AxisError;
 use idle_head_core::playback::Playback;
 
-use crate::boot::{COMMANDS, EXCHANGE, Generator, LINK, Stopwatch, first_set};
+use crate::boot::{COMMANDS, EXCHANGE, Generator, LINK, SHOW, Stopwatch, first_set};
 use crate::config::{DEFAULT_TIMING, IDLE_MODE, SetRef};
 use crate::frame::{FrameHooks, FrameLoop, RunStats};
 
@@ -112,7 +112,10 @@ pub async fn play<P: SetDutyCycle, H: FrameHooks<P>>(
         defmt::error!("frame period below one timer tick");
         return (RunStats::default(), IdleStats::default());
     };
-    let mut frames = frames.with_commands(&COMMANDS).with_link(&LINK);
+    let mut frames = frames
+        .with_commands(&COMMANDS)
+        .with_link(&LINK)
+        .with_show(&SHOW);
     let run = crate::frame::run(driver, &mut frames, hooks).await;
     #[cfg(not(feature = "calibrate"))]
     let idle = frames.idle_mut().stats();

@@ -11,7 +11,9 @@
 //! - the loop generator (thread mode): generating a set takes about 2 ms of
 //!   CPU every 28 s, which frames preempt;
 //! - the console on the UART and on the USB serial port (thread mode), whose
-//!   interrupts sit below the frame task's ([`PORT_PRIORITY`]).
+//!   interrupts sit below the frame task's ([`PORT_PRIORITY`]);
+//! - the DMX512 receiver ([`dmx`]): UART1's interrupt, at the highest
+//!   priority (a few microseconds per character).
 //!
 //! Exactly one chip feature: `rp2040` or `rp235xa`.
 #![no_std]
@@ -24,6 +26,7 @@ compile_error!("choose one chip: the `rp2040` or the `rp235xa` feature");
 #[cfg(not(any(feature = "rp2040", feature = "rp235xa")))]
 compile_error!("choose a chip: the `rp2040` or the `rp235xa` feature");
 
+pub mod dmx;
 pub mod flash;
 mod panic;
 pub mod pico;
@@ -45,10 +48,11 @@ use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::console::SharedService;
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head_core::pwm_clock::{SERVO_PWM_HZ, SliceClock};
-use idle_head_firmware::boot::{self, Clock, EXCHANGE, Generator, Loaded};
+use idle_head_firmware::boot::{self, Clock, EXCHANGE, Generator, Loaded, SHOW};
 use idle_head_firmware::hooks::{BoardHooks, Watchdog};
 use static_cell::StaticCell;
 
+use crate::dmx::DmxUart;
 use crate::pwm::ServoPwm;
 use crate::uart::UartPort;
 use crate::usb::UsbPort;
@@ -88,6 +92,10 @@ pub struct Board {
     pub uart: UartPort,
     /// Where the UART is, for the log.
     pub uart_pins: &'static str,
+    /// The DMX512 receiver's UART ([`dmx::receiver`]).
+    pub dmx: DmxUart,
+    /// Where the DMX input is, for the log.
+    pub dmx_pins: &'static str,
     /// The USB driver, for the console's USB serial port.
     pub usb: embassy_rp::usb::Driver<'static, USB>,
     /// The flash, for the settings store.
@@ -124,6 +132,8 @@ pub fn start(spawner: Spawner, board: Board) {
         servo_pins,
         uart,
         uart_pins,
+        dmx,
+        dmx_pins,
         usb,
         flash,
         watchdog,
@@ -146,6 +156,7 @@ pub fn start(spawner: Spawner, board: Board) {
         return;
     };
     spawn_frames(servos, &head, BoardWatchdog(watchdog));
+    spawn_dmx(dmx, dmx_pins);
     if let Some(service) = head.service {
         spawn_console(spawner, uart, uart_pins, usb, service);
     }
@@ -190,6 +201,20 @@ fn spawn_frames(servos: [ServoPwm; 3], head: &Head, watchdog: BoardWatchdog) {
     } else {
         defmt::error!("frame task already running");
     }
+}
+
+/// Starts the DMX receiver on `dmx`.
+#[inline(never)]
+fn spawn_dmx(dmx: DmxUart, pins: &'static str) {
+    dmx::listen(dmx);
+    let settings = SHOW.dmx.settings();
+    defmt::info!(
+        "dmx: {=str}, {=u32} baud 8N2, {=str}, address {=u16}",
+        pins,
+        dmx::BAUD,
+        if settings.on { "on" } else { "off" },
+        settings.address.get()
+    );
 }
 
 /// Spawns the console on the UART and on the USB serial port.

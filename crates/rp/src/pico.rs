@@ -9,6 +9,7 @@
 //! | console TX  | GP0  | 1         | UART0, 115200 8N1  |
 //! | console RX  | GP1  | 2         | UART0              |
 //! | console     | USB  |           | CDC-ACM serial port|
+//! | DMX512 in   | GP9  | 12        | UART1 RX, 250 kbaud 8N2 |
 //!
 //! (GPIO n drives PWM slice ⌊n/2⌋ mod 8, channel A for even n.) One slice
 //! per servo, so each output starts on its own first valid pulse
@@ -44,6 +45,8 @@ pub fn board(p: Peripherals, name: &'static str) -> Board {
         servo_pins: "pitch GP16 (PWM0 A), roll GP18 (PWM1 A), yaw GP20 (PWM2 A)",
         uart: crate::uart::console(p.UART0, p.PIN_0, p.PIN_1, Irqs),
         uart_pins: "UART0 GP0 TX, GP1 RX",
+        dmx: crate::dmx::receiver(p.UART1, p.PIN_9),
+        dmx_pins: "UART1 RX GP9",
         usb: usb::Driver::new(p.USB, Irqs),
         flash: p.FLASH,
         watchdog: p.WATCHDOG,

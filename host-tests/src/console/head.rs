@@ -7,7 +7,7 @@ use std::convert::Infallible;
 
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use idle_head_core::behaviour::{
-    Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION,
+    Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION, ShowLink,
 };
 use idle_head_core::console::{
     ConsoleLink, ConsoleService, HeadMode, HeadStatus, Outcome, Session, outcome_reply, unanswered,
@@ -272,4 +272,5 @@ pub fn service(
         SettingsSource::Defaults,
     )
     .expect("the built-in settings")
+    .with_show(Box::leak(Box::new(ShowLink::new())))
 }

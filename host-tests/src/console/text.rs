@@ -4,9 +4,10 @@
 use std::fmt::Write as _;
 
 use idle_head_core::command::{
-    Action, Command, GestureKind, GestureRequest, Hold, LookRequest, Percent, SeedChoice,
-    ServoSetting,
+    Action, Command, DmxSetting, GestureKind, GestureRequest, Hold, LookRequest, Percent,
+    SeedChoice, ServoSetting,
 };
+use idle_head_core::dmx::DmxAddress;
 use idle_head_core::servo::{Direction, NanosPerDegree};
 use idle_head_core::{Angle, AngleRange, Axis, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
@@ -49,6 +50,8 @@ pub const VOCABULARY: &[&str] = &[
     "hold=stay",
     "=",
     "watch",
+    "dmx",
+    "address",
 ];
 
 /// A random word of the protocol: one of [`VOCABULARY`] or a gesture's.
@@ -147,7 +150,7 @@ fn maybe<T>(rng: &mut TestRng, f: impl FnOnce(&mut TestRng) -> T) -> Option<T> {
 
 /// A random command, every field anywhere in its parseable range.
 pub fn random_command(rng: &mut TestRng) -> Command {
-    match rng.random_range(0..13) {
+    match rng.random_range(0..14) {
         12 => Command::Watch(maybe(rng, |r| r.random_range(1..=50))),
         0 => Command::Help,
         1 => Command::Status,
@@ -193,6 +196,14 @@ pub fn random_command(rng: &mut TestRng) -> Command {
         } else {
             SeedChoice::Value(u32_any(rng))
         }),
+        11 => Command::Dmx(maybe(rng, |r| match r.random_range(0..3) {
+            0 => DmxSetting::On(true),
+            1 => DmxSetting::On(false),
+            _ => {
+                let slot = pick_i64(r, 1, 503, &[1, 2, 502, 503]) as u16;
+                DmxSetting::Address(DmxAddress::new(slot).unwrap_or(DmxAddress::FIRST))
+            }
+        })),
         _ => Command::Servo {
             axis: Axis::ALL[rng.random_range(0..3)],
             setting: maybe(rng, |r| match r.random_range(0..6) {
@@ -398,6 +409,17 @@ fn write_command(s: &mut Style<'_>, command: &Command) {
                 ServoSetting::Limits(r) => {
                     s.mdeg(r.min);
                     s.mdeg(r.max);
+                }
+            }
+        }
+        Command::Dmx(setting) => {
+            s.word("dmx");
+            match setting {
+                None => {}
+                Some(DmxSetting::On(on)) => s.word(if on { "on" } else { "off" }),
+                Some(DmxSetting::Address(a)) => {
+                    s.word("address");
+                    s.number(i64::from(a.get()));
                 }
             }
         }

@@ -128,6 +128,22 @@ pub enum Event {
         #[serde(deserialize_with = "from_hex")]
         hex: Vec<u8>,
     },
+    /// The USB host sent a scripted chunk (a list of chunks only).
+    UsbIn {
+        /// When.
+        ns: f64,
+        /// Its bytes.
+        n: usize,
+    },
+    /// A DMX frame carrying a change ended (its last byte went out).
+    Dmx {
+        /// When.
+        ns: f64,
+        /// The frame's number since the line started.
+        frame: u64,
+        /// Always true: only frames with a change are reported.
+        changed: bool,
+    },
     /// Accesses to a register rp2040js does not model, counted over the
     /// run.
     Unmodelled {

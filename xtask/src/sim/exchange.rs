@@ -43,7 +43,7 @@ use idle_head_core::console::checksum;
 use std::cell::RefCell;
 
 use embassy_sync::blocking_mutex::Mutex;
-use idle_head_core::behaviour::CommandQueue;
+use idle_head_core::behaviour::{CommandQueue, ShowLink};
 use idle_head_core::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
@@ -116,7 +116,9 @@ pub fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
         Settings::DEFAULT,
         SettingsSource::Defaults,
     )
-    .expect("the built-in settings are valid");
+    .expect("the built-in settings are valid")
+    // As on the board: DMX on, no frames in this run (`dmx=lost`).
+    .with_show(Box::leak(Box::new(ShowLink::new())));
     let service: &'static SharedService<RamStorage> =
         Box::leak(Box::new(Mutex::new(RefCell::new(service))));
     // What the frame task answers a queued action: the mixer's answer on

@@ -144,6 +144,11 @@ pub struct Config {
     /// A live run: real time, stdin to the USB serial port, for as long
     /// as stdin is open (`live.rs`).
     pub live: bool,
+    /// Chunks for the USB serial port, each sent at its time (instead of
+    /// `usb`).
+    pub usb_chunks: Vec<(Vec<u8>, Duration)>,
+    /// DMX512 frames on UART1's RX line (`sim/dmx.mjs`).
+    pub dmx: Option<Value>,
 }
 
 /// How long the flash is busy per operation.
@@ -205,10 +210,18 @@ impl Config {
                 "byte_ns": nanos(uart.byte_time),
                 "errors": uart.errors,
             })).collect::<Vec<_>>(),
-            "usb": self.usb.as_ref().map(|(bytes, at)| json!({
-                "hex": hex(bytes),
-                "at_ns": nanos(*at),
-            })),
+            "usb": if self.usb_chunks.is_empty() {
+                self.usb.as_ref().map(|(bytes, at)| json!({
+                    "hex": hex(bytes),
+                    "at_ns": nanos(*at),
+                }))
+            } else {
+                Some(Value::Array(self.usb_chunks.iter().map(|(bytes, at)| json!({
+                    "hex": hex(bytes),
+                    "at_ns": nanos(*at),
+                })).collect()))
+            },
+            "dmx": self.dmx,
             "rom": self.rom.map(|rom| json!({
                 "erase_ns": nanos(rom.erase),
                 "program_ns": nanos(rom.program),
@@ -231,7 +244,7 @@ pub(super) fn hex(bytes: &[u8]) -> String {
     })
 }
 
-fn nanos(duration: Duration) -> u64 {
+pub fn nanos(duration: Duration) -> u64 {
     u64::try_from(duration.as_nanos()).unwrap_or(u64::MAX)
 }
 

@@ -61,6 +61,10 @@ pub struct Boot {
     pub flash: Vec<FlashOp>,
     /// Whether a power cycle ended it.
     pub power_cycled: bool,
+    /// When each scripted USB chunk went to the device (a list of chunks).
+    pub usb_in: Vec<f64>,
+    /// When each DMX frame that carried a change ended.
+    pub dmx_changes: Vec<f64>,
 }
 
 impl Boot {
@@ -434,6 +438,8 @@ fn into_boot(
         Event::UartRx { ns, .. } => boot.uart_sent = Some(*ns),
         Event::UsbConnected { ns } => boot.usb_connected = Some(*ns),
         Event::PowerCycle { .. } => boot.power_cycled = true,
+        Event::UsbIn { ns, .. } => boot.usb_in.push(*ns),
+        Event::Dmx { ns, .. } => boot.dmx_changes.push(*ns),
         Event::Flash {
             op,
             addr,

@@ -33,7 +33,7 @@ struct Known {
 /// The known gaps. embassy-rp's start-up touches each of them; none changes
 /// what the firmware does in the emulator, which the pulse, console and
 /// store checks of the same runs show.
-const KNOWN: [Known; 4] = [
+const KNOWN: [Known; 5] = [
     Known {
         peripheral: "ROSC_BASE",
         writes: None,
@@ -52,6 +52,14 @@ const KNOWN: [Known; 4] = [
         why: "UARTIFLS, the FIFO trigger levels: the transmit level set is the reset value \
               that sim/uart.mjs models, and the receive side interrupts at every byte, \
               sooner than the chip",
+    },
+    Known {
+        peripheral: "UART1",
+        // UARTIFLS.
+        writes: Some(&[0x34]),
+        why: "UARTIFLS of the DMX receiver: the receive side interrupts at every byte, \
+              sooner than the chip's trigger level, and the handler reads whatever is \
+              in the FIFO either way",
     },
     Known {
         peripheral: "USB",

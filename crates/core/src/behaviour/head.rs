@@ -32,6 +32,9 @@ use super::idle::IdleSource;
 use super::mixer::{Applied, Mixer};
 use super::params::{BehaviourParams, LimitMode};
 use super::queue::{Asker, CommandQueue, PER_FRAME};
+use super::show::{Show, ShowEvents, Source};
+use crate::bottango::Sample;
+use crate::dmx::{Latest, Signal};
 
 /// What one frame did.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,6 +51,8 @@ pub struct HeadFrame {
 pub struct Head<I> {
     idle: I,
     mixer: Mixer,
+    /// The show layer over the mixer's offsets.
+    show: Show,
     /// The limit mode the driver has, per axis.
     modes: [LimitMode; 3],
 }
@@ -58,6 +63,7 @@ impl<I> Head<I> {
         Self {
             idle,
             mixer: Mixer::new(params),
+            show: Show::new(&params),
             modes: [LimitMode::Idle; 3],
         }
     }
@@ -92,6 +98,9 @@ impl<I: IdleSource> Head<I> {
         action: &Action,
     ) -> Result<Applied, BehaviourError> {
         let applied = self.mixer.apply(action)?;
+        if let Action::IdleAmp(amp) = action {
+            self.show.own_amp(*amp);
+        }
         match action {
             Action::Stop => driver.request_stop(),
             Action::Gesture(_) | Action::Look(_) | Action::Idle(true) | Action::IdleAmp(_) => {
@@ -125,7 +134,15 @@ impl<I: IdleSource> Head<I> {
     /// Between frames: gives the driver the limits of the modes the mixer
     /// asks for from the next frame on (see the [module docs](self)).
     pub fn sync<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>) {
-        let wanted = self.mixer.modes();
+        let mut wanted = self.mixer.modes();
+        let show = self.show.engaged();
+        if show != 0 {
+            for (i, mode) in wanted.iter_mut().enumerate() {
+                if show & (1 << i) != 0 {
+                    *mode = LimitMode::Gesture;
+                }
+            }
+        }
         if !LimitMode::same(wanted, self.modes) {
             self.switch(driver, wanted);
         }
@@ -168,11 +185,55 @@ impl<I: IdleSource> Head<I> {
     /// starts with neutral pulses on its first frame).
     pub fn frame<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, frame: u64) -> HeadFrame {
         let idle = self.idle.offsets(frame);
-        let offsets = self.mixer.frame(frame, idle);
+        let mut offsets = self.mixer.frame(frame, idle);
+        self.show.blend(frame as u32, &mut offsets);
         HeadFrame {
             offsets,
             report: driver.write_frame(offsets),
         }
+    }
+
+    /// Between frames, before frame `frame`: the show layer's inputs (see
+    /// [`show`](super::show)): the DMX link's state and latest cue (`None`
+    /// on a board without DMX) and Bottango's curves as sampled for this
+    /// frame (`None` without a session). A gesture the DMX trigger fires
+    /// and the idle amplitude it sets are applied here (neither wakes a
+    /// head that `stop` stopped); returns what happened, for the log.
+    pub fn show<P: SetDutyCycle>(
+        &mut self,
+        driver: &mut FrameDriver<P>,
+        frame: u64,
+        dmx: Option<(bool, Latest)>,
+        curves: Option<Sample>,
+    ) -> ShowEvents {
+        let now = frame as u32;
+        self.show
+            .bottango(now, curves, self.mixer.params().neutral_pose());
+        let mut events = ShowEvents::default();
+        if let Some(dmx) = dmx {
+            let amp = self.mixer.idle_amp();
+            let asked = self.show.dmx(now, dmx, amp, self.mixer.params());
+            events.signal = asked.signal;
+            if let Some(action) = asked.fired {
+                events.fired = Some((action, self.mixer.apply(&action)));
+            }
+            // An idle amplitude always applies (a glide to it).
+            if let Some(amp) = asked.idle {
+                let _ = self.mixer.apply(&Action::IdleAmp(amp));
+            }
+        }
+        self.sync(driver);
+        events
+    }
+
+    /// What drives the show layer.
+    pub const fn show_source(&self) -> Source {
+        self.show.source()
+    }
+
+    /// The DMX signal as the show layer last judged it.
+    pub const fn dmx_signal(&self) -> Signal {
+        self.show.signal()
     }
 
     /// Gives the driver the limits of `modes` where they changed. (They were

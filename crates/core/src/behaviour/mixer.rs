@@ -433,6 +433,13 @@ impl Mixer {
     pub const fn modes(&self) -> [LimitMode; 3] {
         self.modes
     }
+
+    /// The idle amplitude as last set (`idle amp`), whether the idle is on
+    /// or off.
+    #[must_use]
+    pub const fn idle_amp(&self) -> Percent {
+        self.idle_amp
+    }
 }
 
 /// The gesture layers of one frame, per axis `[pitch, roll, yaw]`.

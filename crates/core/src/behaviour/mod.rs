@@ -3,8 +3,8 @@
 //! ```text
 //!  console, scripts ──try_submit──▶ CommandQueue ──drain (≤ 2 a frame)──┐
 //!                                                                       ▼
-//!  IdleSource ──idle offsets──▶ Mixer (gaze + idle·gain·duck + gestures) ──▶ FrameDriver
-//!                                   └── limit mode per axis (idle | gesture)
+//!  IdleSource ──idle offsets──▶ Mixer (gaze + idle·gain·duck + gestures) ──▶ Show ──▶ FrameDriver
+//!                                   └── limit mode per axis (idle | gesture)   (DMX, Bottango)
 //! ```
 //!
 //! - [`gesture`]: gestures as they play (human-like, C2 envelopes); which
@@ -14,6 +14,7 @@
 //!   from any state (gaze, idle gain).
 //! - [`gaze`]: `look` and `center`, holds and returns.
 //! - [`mixer`]: where the layers meet, and the limit mode per axis.
+//! - [`show`]: the show layer (DMX, Bottango) over all of it.
 //! - [`config`]: [`BehaviourConfig`] in physical units, validated
 //!   (`validate.rs`) into [`BehaviourParams`] ([`params`]).
 //! - [`queue`]: the command queue; [`head`]: the frame engine.
@@ -63,6 +64,7 @@ pub mod mixer;
 pub mod params;
 pub mod queue;
 pub mod shape;
+pub mod show;
 mod validate;
 
 pub use crate::gestures::{GestureDefaults, MAX_CYCLES};
@@ -76,3 +78,4 @@ pub use idle::{IdleSource, LOOP_DURATION};
 pub use mixer::{Applied, Mixer};
 pub use params::{BehaviourParams, LimitMode};
 pub use queue::{Asker, CommandQueue, QueueFull};
+pub use show::{ShowEvents, ShowLink, Source};

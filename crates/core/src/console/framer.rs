@@ -183,6 +183,12 @@ impl<const N: usize> Framer<N> {
         }
     }
 
+    /// Whether bytes of a line have arrived and its end has not yet.
+    #[must_use]
+    pub const fn in_progress(&self) -> bool {
+        !self.done && (self.len > 0 || self.dropped > 0 || self.lost)
+    }
+
     /// Forgets the line in progress (e.g. when the port reconnects).
     pub fn reset(&mut self) {
         *self = Self::new();

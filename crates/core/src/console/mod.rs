@@ -12,6 +12,8 @@
 //!   frame task has taken or refused it ([`Reply::defer`],
 //!   [`Session::finish`], [`outcome_reply`]).
 //! - [`telemetry_line`]: the lines `watch` streams.
+//! - [`DualSession`]: a port's session that turns into a Bottango driver
+//!   at a Bottango handshake ([`crate::bottango`]).
 //!
 //! Nothing here allocates or panics. See `docs/user/protocol.md` for the
 //! protocol as a user sees it.
@@ -20,6 +22,7 @@ mod framer;
 mod link;
 mod outcome;
 mod parse;
+mod port;
 mod reply;
 mod service;
 mod session;
@@ -30,6 +33,7 @@ pub use framer::{Framer, LineError};
 pub use link::{ConsoleLink, HeadMode, HeadStatus, Outcome, PORTS};
 pub use outcome::{outcome_reply, unanswered};
 pub use parse::{ParseError, ParseErrorKind, Span, parse};
+pub use port::DualSession;
 pub use reply::{ErrorCode, Reply};
 pub use service::{ConsoleService, HELP, VERSION};
 pub use session::{

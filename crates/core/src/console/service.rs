@@ -74,12 +74,14 @@
 use crate::text::Arg::{Int, Str, Uint};
 use crate::text::Text;
 
+mod dmx;
+
 use super::link::{ConsoleLink, HeadStatus};
 use super::outcome::behaviour_code;
 use super::reply::{ErrorCode, Reply};
 use super::session::Handler;
 use crate::axis::Axis;
-use crate::behaviour::{Asker, BehaviourParams, CommandQueue};
+use crate::behaviour::{Asker, BehaviourParams, CommandQueue, ShowLink};
 use crate::command::{Action, Command, SeedChoice, ServoSetting};
 use crate::driver::DriverConfig;
 use crate::gestures::GestureKind;
@@ -91,7 +93,7 @@ use crate::settings::{Settings, SettingsError, SettingsSource, SettingsStorage, 
 pub const HELP: &str = const_format::concatcp!(
     "commands: help status stop",
     GestureKind::WORDS,
-    " look center idle seed servo save load defaults watch"
+    " look center idle seed servo save load defaults watch dmx"
 );
 
 /// The firmware version `status` reports.
@@ -110,6 +112,9 @@ pub struct ConsoleService<'a, S, const N: usize = { crate::behaviour::queue::CAP
     entropy: u32,
     /// The last ticket given to a queued action.
     ticket: u8,
+    /// The show layer's inputs (DMX settings and signal), on a board that
+    /// has them.
+    show: Option<&'a ShowLink>,
 }
 
 impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
@@ -137,6 +142,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
             source,
             entropy: 0x9e37_79b9,
             ticket: 0,
+            show: None,
         })
     }
 
@@ -203,7 +209,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         // Frames since start × frame period, in ms.
         let uptime = s.frame * u64::from(self.base.frame_period.0) / 1000;
         text(reply.ok()).fill(
-            "mode={} mdeg={},{},{} us={},{},{} faults={},{},{} off={} uptime_ms={} fw={} settings={}",
+            "mode={} mdeg={},{},{} us={},{},{} faults={},{},{} off={} uptime_ms={} fw={}{} settings={}",
             &[
                 Str(s.mode.as_str()),
                 Int(p.into()),
@@ -218,6 +224,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
                 Uint(off as u64),
                 Uint(uptime),
                 Str(VERSION),
+                Str(self.dmx_status()),
                 Str(self.source.as_str()),
             ],
         );
@@ -342,6 +349,9 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         if settings.seeds != self.settings.seeds {
             self.link.reseed(settings.seeds);
         }
+        if let Some(show) = self.show {
+            show.dmx.set(settings.dmx);
+        }
         self.settings = settings;
         self.behaviour = valid.behaviour;
         self.source = source;
@@ -390,6 +400,7 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
             Command::Defaults => {
                 self.adopt(Settings::DEFAULT, SettingsSource::Defaults, reply);
             }
+            Command::Dmx(setting) => self.dmx(setting, reply),
         }
     }
 }

@@ -265,6 +265,9 @@ fields! { s;
     54 "seed.pitch" => s.seeds[0];
     55 "seed.roll" => s.seeds[1];
     56 "seed.yaw" => s.seeds[2];
+    // The DMX receiver (ids from 80: 57 and up are other fields').
+    80 "dmx.on" => s.dmx.on;
+    81 "dmx.address" => s.dmx.address;
 }
 
 /// The field `id` of the table, if there is one.

@@ -30,8 +30,9 @@
 //! a count of µs, ms, ns per degree, mHz, °/s or °/s², and a seed, as four
 //! little-endian bytes; an angle as four (millidegrees, two's
 //! complement); a percentage (0 to 100), a direction (0 normal, 1
-//! reversed) or a gesture's cycles as one byte; a gaze hold as five (0
-//! and the ms of the return, or 1 and four zero bytes for `stay`).
+//! reversed), a switch (0 off, 1 on) or a gesture's cycles as one byte; a
+//! DMX address (1 to 503) as two little-endian bytes; a gaze hold as five
+//! (0 and the ms of the return, or 1 and four zero bytes for `stay`).
 //!
 //! # Loading: fields added, fields unknown, values out of range
 //!

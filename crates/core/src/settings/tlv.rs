@@ -5,6 +5,7 @@
 
 use crate::behaviour::MilliHertz;
 use crate::command::{Hold, Percent};
+use crate::dmx::DmxAddress;
 use crate::driver::{DegreesPerSecond, DegreesPerSecondSquared};
 use crate::servo::{Direction, NanosPerDegree};
 use crate::units::{Angle, Microseconds, Millis};
@@ -286,6 +287,37 @@ impl FieldValue for Hold {
     }
 }
 
+/// One byte: 0 off, 1 on.
+impl FieldValue for bool {
+    const MAX_LEN: usize = 1;
+
+    fn to_bytes(&self, out: &mut [u8]) -> usize {
+        u8::from(*self).to_bytes(out)
+    }
+
+    fn from_bytes(bytes: &[u8]) -> Option<Self> {
+        match u8_of(bytes)? {
+            0 => Some(false),
+            1 => Some(true),
+            _ => None,
+        }
+    }
+}
+
+/// Two little-endian bytes, 1 to 503.
+impl FieldValue for DmxAddress {
+    const MAX_LEN: usize = 2;
+
+    fn to_bytes(&self, out: &mut [u8]) -> usize {
+        put(out, &self.get().to_le_bytes())
+    }
+
+    fn from_bytes(bytes: &[u8]) -> Option<Self> {
+        let pair = <[u8; 2]>::try_from(bytes).ok()?;
+        Self::new(u16::from_le_bytes(pair))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -323,6 +355,13 @@ mod tests {
         assert_eq!(Percent::from_bytes(&[101]), None);
         assert_eq!(Direction::from_bytes(&[1]), Some(Direction::Reversed));
         assert_eq!(Direction::from_bytes(&[2]), None);
+        assert_eq!((bytes_of(&true), bytes_of(&false)), (vec![1], vec![0]));
+        assert_eq!(bool::from_bytes(&[2]), None);
+        assert_eq!(bytes_of(&DmxAddress::LAST), [0xf7, 1]);
+        assert_eq!(DmxAddress::from_bytes(&[0xf7, 1]), Some(DmxAddress::LAST));
+        assert_eq!(DmxAddress::from_bytes(&[0xf8, 1]), None);
+        assert_eq!(DmxAddress::from_bytes(&[0, 0]), None);
+        assert_eq!(DmxAddress::from_bytes(&[1]), None);
         // A wrong length is refused, never read in part.
         assert_eq!(Millis::from_bytes(&[1, 0, 0]), None);
         assert_eq!(Millis::from_bytes(&[1, 0, 0, 0, 0]), None);

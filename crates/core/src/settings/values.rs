@@ -2,8 +2,8 @@
 //!
 //! [`Settings`] holds what a person may change at run time and keep in
 //! flash: the calibration and limits of the three servos, the behaviour
-//! (idle amplitude, gesture and gaze parameters) and the idle motion's
-//! seeds. [`Settings::DEFAULT`] is the built-in configuration.
+//! (idle amplitude, gesture and gaze parameters), the idle motion's
+//! seeds and the DMX receiver's settings. [`Settings::DEFAULT`] is the built-in configuration.
 //! [`Settings::validate`] checks them exactly as the typed
 //! configurations are checked ([`DriverConfig::build`],
 //! [`BehaviourConfig::build`]), against a board's base driver
@@ -13,6 +13,7 @@ use crate::text::{Describe, Text, display_from_describe};
 
 use crate::axis::Axis;
 use crate::behaviour::{BehaviourConfig, BehaviourError, BehaviourParams};
+use crate::dmx::DmxSettings;
 use crate::driver::{ConfigError, DriverConfig, DriverParams};
 use crate::motion::DEFAULT_HEAD;
 use crate::servo::ServoCalibration;
@@ -27,6 +28,8 @@ pub struct Settings {
     pub behaviour: BehaviourConfig,
     /// Seeds r(0) of the idle motion's random streams, `[pitch, roll, yaw]`.
     pub seeds: [u32; 3],
+    /// The DMX receiver: on or off, and the head's start address.
+    pub dmx: DmxSettings,
 }
 
 /// Why settings are not valid.
@@ -74,6 +77,7 @@ impl Settings {
             DEFAULT_HEAD.roll.seed,
             DEFAULT_HEAD.yaw.seed,
         ],
+        dmx: DmxSettings::DEFAULT,
     };
 
     /// `base` with these settings' servos.

@@ -17,6 +17,7 @@
 //! servo <pitch|roll|yaw> [neutral <us> | per-degree <ns> | direction <normal|reversed>
 //!                        | min <us> | max <us> | limits <min_mdeg> <max_mdeg>]
 //! watch <hz> | watch off                                (hz 1..=50)
+//! dmx [on | off | address <1..503>]
 //! ```
 //!
 //! The parser checks the syntax and that each number fits its type
@@ -50,6 +51,7 @@ use crate::command::{
 use crate::servo::{Direction, NanosPerDegree};
 use crate::units::{Angle, AngleRange, Microseconds, Millis};
 
+mod dmx;
 mod error;
 mod words;
 
@@ -86,6 +88,7 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
         Word::Is(Kw::Seed) => seed(&mut words)?,
         Word::Is(Kw::Servo) => servo(&mut words)?,
         Word::Is(Kw::Watch) => watch(&mut words)?,
+        Word::Is(Kw::Dmx) => dmx::dmx(&mut words)?,
         _ => return Err(first.error(ParseErrorKind::UnknownCommand)),
     };
     words.end()?;

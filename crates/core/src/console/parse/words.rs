@@ -81,10 +81,12 @@ pub(super) enum Kw {
     Cycles,
     Intensity,
     Watch,
+    Dmx,
+    Address,
 }
 
 /// Every word the protocol has, lower case, in the order of [`ALL`].
-const KEYWORDS: [&str; 32] = [
+const KEYWORDS: [&str; 34] = [
     "help",
     "status",
     "save",
@@ -117,10 +119,12 @@ const KEYWORDS: [&str; 32] = [
     "cycles",
     "intensity",
     "watch",
+    "dmx",
+    "address",
 ];
 
 /// The [`Kw`] of each of [`KEYWORDS`].
-const ALL: [Kw; 32] = [
+const ALL: [Kw; 34] = [
     Kw::Help,
     Kw::Status,
     Kw::Save,
@@ -153,6 +157,8 @@ const ALL: [Kw; 32] = [
     Kw::Cycles,
     Kw::Intensity,
     Kw::Watch,
+    Kw::Dmx,
+    Kw::Address,
 ];
 
 // A gesture's word must not be a word the protocol already has: the

@@ -1,0 +1,107 @@
+//! The personality: what each of the head's slots means (table in the
+//! [module docs](super)).
+
+use super::FOOTPRINT;
+
+/// One good frame's slots, taken apart.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Cue {
+    /// Yaw, pitch and roll, 16 bit each (coarse · 256 + fine), `[pitch,
+    /// roll, yaw]`: 0 is the axis' lower angle limit, 65 535 its upper.
+    pub pose: [u16; 3],
+    /// Position mix, 0 (the head's own motion) to 255 (the DMX pose).
+    pub mix: u8,
+    /// The gesture trigger's value ([`Trigger::of`]).
+    pub trigger: u8,
+    /// Idle intensity, 0 to 255.
+    pub intensity: u8,
+}
+
+impl Cue {
+    /// The cue of a frame's personality slots (slot 10, reserved, is not
+    /// read).
+    #[must_use]
+    pub const fn from_slots(s: &[u8; FOOTPRINT as usize]) -> Self {
+        Self {
+            pose: [wide(s[2], s[3]), wide(s[4], s[5]), wide(s[0], s[1])],
+            mix: s[6],
+            trigger: s[7],
+            intensity: s[8],
+        }
+    }
+
+    /// The idle intensity as a percentage: 0–255 → 0–100 %, rounded.
+    #[must_use]
+    pub const fn intensity_percent(&self) -> u8 {
+        ((self.intensity as u16 * 100 + 127) / 255) as u8
+    }
+}
+
+/// A 16-bit slot pair: coarse, fine.
+const fn wide(coarse: u8, fine: u8) -> u16 {
+    (coarse as u16) << 8 | fine as u16
+}
+
+/// The gesture trigger's bands (slot 8). A gesture fires when the slot
+/// enters its band, and not again until the slot has left it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Trigger {
+    /// 0–9 and 90–255: nothing.
+    None,
+    /// 10–29.
+    Nod,
+    /// 30–49.
+    Shake,
+    /// 50–69.
+    Tilt,
+    /// 70–89: back to the centre.
+    Center,
+}
+
+impl Trigger {
+    /// The band `value` lies in.
+    #[must_use]
+    pub const fn of(value: u8) -> Self {
+        match value {
+            10..=29 => Self::Nod,
+            30..=49 => Self::Shake,
+            50..=69 => Self::Tilt,
+            70..=89 => Self::Center,
+            _ => Self::None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slots_in_the_order_of_the_table() {
+        let cue = Cue::from_slots(&[0xc8, 0x01, 0x12, 0x34, 0x56, 0x78, 255, 20, 128, 99]);
+        assert_eq!(cue.pose, [0x1234, 0x5678, 0xc801]);
+        assert_eq!((cue.mix, cue.trigger, cue.intensity), (255, 20, 128));
+        assert_eq!(cue.intensity_percent(), 50);
+        let full = Cue {
+            intensity: 255,
+            ..cue
+        };
+        assert_eq!(full.intensity_percent(), 100);
+    }
+
+    #[test]
+    fn bands_and_their_edges() {
+        use Trigger::*;
+        let bands: Vec<Trigger> = [0, 9, 10, 29, 30, 49, 50, 69, 70, 89, 90, 255]
+            .map(Trigger::of)
+            .to_vec();
+        assert_eq!(
+            bands,
+            [
+                None, None, Nod, Nod, Shake, Shake, Tilt, Tilt, Center, Center, None, None
+            ]
+        );
+    }
+}

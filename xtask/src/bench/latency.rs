@@ -1,0 +1,316 @@
+//! The latency rows of `cargo xtask bench`: how long an input takes to
+//! reach the servo pins, measured in the RP2040 emulator on the shipped
+//! image.
+//!
+//! # Method
+//!
+//! One emulator run per path, with at least [`EVENTS`] events. The events
+//! come at random times (a seeded generator: every run is the same), each a
+//! random gap after the last, a little longer than the head takes to
+//! settle after one and spread over several frames, so their phases against
+//! the 20 ms frame are spread evenly (the rows print the events in each
+//! fifth of the frame). For each event:
+//!
+//! - its time: when the input has fully arrived (the path's own: the end of
+//!   the DMX frame that carries the change, the moment the USB host hands
+//!   over the line's last byte);
+//! - the baseline: the axis at rest before it, the last two pulses before
+//!   the event of equal width (an event whose axis still moves is skipped
+//!   and counted);
+//! - the response: the rising edge of the first pulse after the event whose
+//!   width differs from the baseline by more than one count (0.3125 µs,
+//!   0.028°): the first pulse that reflects the input.
+//!
+//! The latency is the response's time minus the event's; the row gives the
+//! median, the 99th percentile and the largest, in ms:
+//!
+//! ```text
+//! latency dmx p50=<ms> p99=<ms> max=<ms> events=<n> skipped=<n>
+//! ```
+//!
+//! The goal is p99 within 25 ms (a frame and the transport); the rows
+//! report against it without failing. A path's runs live in a function of
+//! their own below ([`dmx`], [`usb_look`]); another path (an input pin's
+//! edge) adds one the same way, with its own events and axis.
+
+use std::{fmt::Write as _, path::Path, time::Duration};
+
+use anyhow::{Context, Result, bail};
+
+use crate::project::Metadata;
+use crate::sim::pulses_csv::{self, Measured};
+use crate::sim::{dmx_line, run_shipped};
+
+/// Events per row, at least.
+pub const EVENTS: usize = 1000;
+/// More are scheduled, for the ones skipped.
+const SCHEDULED: usize = 1100;
+/// The goal: a frame and the transport.
+pub const GOAL_MS: f64 = 25.0;
+/// The gaps between DMX events: a one-step move settles in a frame or two.
+const DMX_GAP: (Duration, Duration) = (Duration::from_millis(80), Duration::from_millis(130));
+/// The gaps between `look` events: a move starts a frame after the line and
+/// takes two more.
+const LOOK_GAP: (Duration, Duration) = (Duration::from_millis(110), Duration::from_millis(160));
+
+/// One latency row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// `dmx`, `usb look`.
+    pub name: &'static str,
+    /// Latencies, ms, sorted.
+    pub ms: Vec<f64>,
+    /// Events skipped: the axis still moved when they came.
+    pub skipped: usize,
+    /// Events' phases against the frame, per fifth of it.
+    pub phases: [usize; 5],
+    /// The three slowest events: when (s) and their latency (ms).
+    pub worst: Vec<(f64, f64)>,
+}
+
+impl Row {
+    /// The `p`-th percentile (nearest rank), ms.
+    pub fn percentile(&self, p: f64) -> f64 {
+        if self.ms.is_empty() {
+            return f64::NAN;
+        }
+        #[allow(
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss,
+            clippy::cast_precision_loss
+        )]
+        let rank = ((p / 100.0 * self.ms.len() as f64).ceil() as usize).clamp(1, self.ms.len());
+        self.ms[rank - 1]
+    }
+
+    /// `latency <name> p50=… p99=… max=… events=… skipped=…`, and the spread.
+    pub fn lines(&self) -> String {
+        let mut text = format!(
+            "latency {} p50={:.1} p99={:.1} max={:.1} events={} skipped={}\n",
+            self.name,
+            self.percentile(50.0),
+            self.percentile(99.0),
+            self.ms.last().copied().unwrap_or(f64::NAN),
+            self.ms.len(),
+            self.skipped
+        );
+        let _ = writeln!(
+            text,
+            "  (ms; goal p99 ≤ {GOAL_MS} ms: {}; events per fifth of the frame: {:?}; slowest: {})",
+            if self.percentile(99.0) <= GOAL_MS {
+                "met"
+            } else {
+                "missed"
+            },
+            self.phases,
+            self.worst
+                .iter()
+                .map(|(at, ms)| format!("{ms:.1} ms at {at:.3} s"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        text
+    }
+}
+
+/// Event times from `start`, each a random `gap` (from, to) after the last
+/// (xorshift, seeded: the same every run).
+pub fn schedule(
+    start: Duration,
+    count: usize,
+    gap: (Duration, Duration),
+    seed: u32,
+) -> Vec<Duration> {
+    let mut state = seed | 1;
+    let mut at = start;
+    let span = u64::try_from(gap.1.saturating_sub(gap.0).as_micros()).unwrap_or(0);
+    (0..count)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            at += gap.0 + Duration::from_micros(u64::from(state) % span.max(1));
+            at
+        })
+        .collect()
+}
+
+/// What became of one event.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Response {
+    /// The axis still moved (or had no pulse yet) when it came: skipped.
+    Moving,
+    /// No pulse after it reflects it.
+    Never,
+    /// The first pulse that reflects it rose this many ms after it.
+    After(f64),
+}
+
+/// The response to an event at `at` (ns) on an axis whose pulses are
+/// `pulses`.
+pub fn response(pulses: &[Measured], at: f64, count_ns: f64) -> Response {
+    let before = pulses.partition_point(|p| p.rise < at);
+    let (Some(a), Some(b)) = (
+        before.checked_sub(2).and_then(|i| pulses.get(i)),
+        before.checked_sub(1).and_then(|i| pulses.get(i)),
+    ) else {
+        return Response::Moving;
+    };
+    if (a.width - b.width).abs() > count_ns / 2.0 {
+        return Response::Moving;
+    }
+    pulses[before..]
+        .iter()
+        .find(|p| (p.width - b.width).abs() > count_ns * 1.5)
+        .map_or(Response::Never, |p| Response::After((p.rise - at) / 1e6))
+}
+
+/// The row of `events` (ns) on the pulses of `axis`.
+fn row(name: &'static str, events: &[f64], pulses: &[Measured]) -> Result<Row> {
+    let count_ns = crate::sim::count_ns();
+    let mut ms = Vec::new();
+    let mut worst: Vec<(f64, f64)> = Vec::new();
+    let mut skipped = 0;
+    let mut phases = [0; 5];
+    let first = pulses.first().map_or(0.0, |p| p.rise);
+    for &at in events {
+        match response(pulses, at, count_ns) {
+            Response::Moving => skipped += 1,
+            Response::Never => bail!("{name}: no pulse reflects the event at {:.3} s", at / 1e9),
+            Response::After(latency) => {
+                ms.push(latency);
+                worst.push((at / 1e9, latency));
+                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+                let fifth = (((at - first).rem_euclid(20e6)) / 4e6) as usize;
+                phases[fifth.min(4)] += 1;
+            }
+        }
+    }
+    if ms.len() < EVENTS {
+        bail!(
+            "{name}: {} events measured ({skipped} skipped), fewer than {EVENTS}",
+            ms.len()
+        );
+    }
+    ms.sort_by(f64::total_cmp);
+    worst.sort_by(|a, b| b.1.total_cmp(&a.1));
+    worst.truncate(3);
+    Ok(Row {
+        name,
+        ms,
+        skipped,
+        phases,
+        worst,
+    })
+}
+
+/// `latency dmx`: a console at full mix moves yaw one coarse step up and
+/// down; each change's DMX frame against yaw's first pulse that moves.
+pub fn dmx(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
+    let start = Duration::from_secs(4);
+    let times = schedule(start, SCHEDULED, DMX_GAP, 0x5eed_d3c5);
+    let mut script = String::from("2.5 7=255 1=100 3=128 5=128 9=255\n");
+    for (k, at) in times.iter().enumerate() {
+        // 101, 100, 101, …: every event a change from the set-up's 100.
+        let _ = writeln!(script, "{:.6} 1={}", at.as_secs_f64(), 101 - k % 2);
+    }
+    let end = times.last().copied().unwrap_or(start) + Duration::from_millis(500);
+    let report = run_shipped(root, metadata, end, wall, |config| {
+        config.dmx = Some(dmx_line(&script)?);
+        Ok(())
+    })?;
+    let boot = report.boots.first().context("no boot")?;
+    // The first change is the set-up's.
+    let events: Vec<f64> = boot.dmx_changes.iter().skip(1).copied().collect();
+    if events.len() != times.len() {
+        bail!(
+            "{} DMX frames carried a change, not {}",
+            events.len(),
+            times.len()
+        );
+    }
+    row("dmx", &events, &pulses_csv::measure(&boot.trains[2]))
+}
+
+/// `latency usb look`: with the idle off, `look` lines over USB move yaw
+/// a degree there and back; each line's last byte against yaw's first
+/// pulse that moves.
+pub fn usb_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
+    let start = Duration::from_secs(4);
+    let times = schedule(start, SCHEDULED, LOOK_GAP, 0x1007_c0de);
+    let mut chunks = vec![(b"idle off\n".to_vec(), Duration::from_millis(2500))];
+    for (k, at) in times.iter().enumerate() {
+        let yaw = if k % 2 == 0 { 1000 } else { 0 };
+        chunks.push((format!("look 0 {yaw} 40 hold=stay\n").into_bytes(), *at));
+    }
+    let end = times.last().copied().unwrap_or(start) + Duration::from_millis(500);
+    let report = run_shipped(root, metadata, end, wall, |config| {
+        config.usb_chunks = chunks;
+        Ok(())
+    })?;
+    let boot = report.boots.first().context("no boot")?;
+    let events: Vec<f64> = boot.usb_in.iter().skip(1).copied().collect();
+    if events.len() != times.len() {
+        bail!("{} USB lines went out, not {}", events.len(), times.len());
+    }
+    let usb = String::from_utf8_lossy(&boot.usb);
+    let refused = usb.lines().filter(|l| !l.starts_with("ok")).count();
+    if refused > 0 {
+        bail!(
+            "{refused} lines refused: {:?}",
+            usb.lines().find(|l| !l.starts_with("ok"))
+        );
+    }
+    row("usb look", &events, &pulses_csv::measure(&boot.trains[2]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pulse(rise_ms: f64, width_us: f64) -> Measured {
+        Measured {
+            rise: rise_ms * 1e6,
+            width: width_us * 1e3,
+        }
+    }
+
+    #[test]
+    fn the_first_pulse_that_moves_after_a_settled_axis() {
+        let count = 312.5;
+        let pulses: Vec<Measured> = [1500.0, 1500.0, 1500.0, 1500.3125, 1502.0, 1503.0]
+            .iter()
+            .enumerate()
+            .map(|(k, &w)| pulse(10.0 + 20.0 * k as f64, w))
+            .collect();
+        // An event at 55 ms: a count of change is noise, 1502 µs moves.
+        assert_eq!(response(&pulses, 55e6, count), Response::After(35.0));
+        // The axis still moved before 95 ms.
+        assert_eq!(response(&pulses, 95e6, count), Response::Moving);
+        // Nothing before: no baseline.
+        assert_eq!(response(&pulses, 5e6, count), Response::Moving);
+        let still = vec![pulse(0.0, 1500.0); 4];
+        assert_eq!(response(&still, 30e6, count), Response::Never);
+    }
+
+    #[test]
+    fn percentiles_and_schedules() {
+        let row = Row {
+            name: "x",
+            ms: (1..=200).map(f64::from).collect(),
+            skipped: 0,
+            phases: [0; 5],
+            worst: Vec::new(),
+        };
+        assert_eq!((row.percentile(50.0), row.percentile(99.0)), (100.0, 198.0));
+        assert!(
+            row.lines()
+                .starts_with("latency x p50=100.0 p99=198.0 max=200.0 events=200")
+        );
+        let times = schedule(Duration::from_secs(1), 100, DMX_GAP, 7);
+        assert_eq!(times, schedule(Duration::from_secs(1), 100, DMX_GAP, 7));
+        for w in times.windows(2) {
+            assert!((DMX_GAP.0..DMX_GAP.1).contains(&w[1].saturating_sub(w[0])));
+        }
+    }
+}

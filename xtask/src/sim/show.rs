@@ -1,0 +1,393 @@
+//! Show control in the emulator: `cargo xtask sim --dmx FILE [--pulses
+//! FILE.csv]`, and the stage of `cargo xtask test` that checks the show
+//! issue's acceptance on the shipped image, from the pulses on the pins.
+//!
+//! The stage's run (14 s of virtual time): DMX frames from 3 s on, mix 0;
+//! at 3.5 s mix 255 and yaw coarse 200; at 5 s the frames stop; at 7 s
+//! they come back with mix 0, at 7.5 s the trigger enters the nod band; at
+//! 9 s they stop again. At 10.5 s a Bottango session over USB: handshake,
+//! time sync, two motors (yaw, pitch), a curve each; at 12.6 s `STOP`.
+//! What it checks:
+//!
+//! - with the mix at 255, yaw goes to 200/255 of its way across its limits
+//!   (coarse 200, fine 0: 51 200 of 65 535) and stays there, every step
+//!   within the gesture speed limit;
+//! - the frames dropped, the log says the signal is lost 1 s later, the
+//!   head glides back (every step within the limits) and from then on every
+//!   pulse is the idle's own, the host's duty within a count;
+//! - the band entry plays exactly one nod (one `dmx nod: ok` in the log,
+//!   pitch away from the idle's pulses during it, on them again after);
+//! - the Bottango session is answered (handshake, every `OK`), yaw follows
+//!   the curve (halfway at its middle, 20° at its end), and the idle's own
+//!   pulses come back after it;
+//! - the run's RAM (static and the peak stack measured here) within the
+//!   budget.
+
+use std::{fmt::Write as _, path::Path, time::Duration};
+
+use anyhow::{Context, Result, bail};
+use idle_head_core::bottango::hash;
+use idle_head_core::driver::DriverConfig;
+
+use super::{
+    DEFAULT_TIME, dmx, expect,
+    pulses_csv::{self, Measured},
+    run::{self, Boot},
+    stages,
+};
+use crate::project::Metadata;
+
+/// Stage name.
+pub const SHOW_STAGE: &str = "Pico image in the RP2040 emulator: DMX and Bottango drive the \
+     head, lost frames and the end of a curve hand back to the idle";
+
+/// The stage's DMX script.
+const SCRIPT: &str = "\
+3.0 7=0 8=0 9=255 1=0 3=128 5=128
+3.5 7=255 1=200
+5.0 dmx stop
+7.0 7=0 1=0
+7.5 8=20
+9.0 dmx stop
+";
+
+/// When the Bottango session starts, and `STOP`.
+const BOTTANGO: Duration = Duration::from_millis(10_500);
+const STOP: Duration = Duration::from_millis(12_600);
+/// The stage's virtual time.
+const TIME: Duration = Duration::from_secs(14);
+
+/// The session's lines, with their hashes.
+fn bottango_lines() -> Vec<String> {
+    [
+        "hRQ,144",
+        "tSYN,0",
+        "rMTR,yaw,-20000,20000,3000,4096",
+        "rMTR,pitch,-10000,10000,3000,4096",
+        // 200 ms after the sync, 1 s, eased in and out.
+        "sC,yaw,200,1000,4096,333,0,8192,-333,0",
+        "sC,pitch,200,1000,4096,333,0,6144,-333,0",
+    ]
+    .iter()
+    .map(|body| format!("{body},h{}\n", hash(body.as_bytes())))
+    .collect()
+}
+
+/// The angle, m°, of a pulse of `width` ns on `axis`' servo (the built-in
+/// calibration).
+fn angle(axis: usize, width: f64) -> f64 {
+    let servo = DriverConfig::DEFAULT.servos[axis];
+    let neutral = f64::from(servo.neutral.0) * 1e3;
+    (width - neutral) / f64::from(servo.per_degree.0) * 1e3
+}
+
+/// `cargo xtask sim --dmx FILE [--pulses FILE.csv]` (either alone too).
+pub fn command(root: &Path, metadata: &Metadata, args: &super::Args) -> Result<bool> {
+    let changes = args.dmx.as_deref().map(dmx::read).transpose()?;
+    let time = args.virtual_time.unwrap_or_else(|| {
+        changes
+            .as_ref()
+            .and_then(|c| c.last())
+            .map_or(DEFAULT_TIME, |last| last.at + Duration::from_secs(3))
+    });
+    let elf = stages::shipped_image(root, metadata)?;
+    let report = run::run_with(root, &elf, time, args.timeout, |config| {
+        if let Some(changes) = &changes {
+            dmx::configure(config, changes);
+        }
+    })?;
+    print!("{}", report.log_text(args.verbose));
+    let Some(boot) = report.boots.first() else {
+        bail!("no boot");
+    };
+    print!("{}", servo_table(boot));
+    if let Some(path) = &args.pulses {
+        let rows = pulses_csv::write(path, &boot.trains)?;
+        println!("{rows} rows of pulses written to {}", path.display());
+    }
+    if let Some(changes) = &changes {
+        println!(
+            "dmx: {} change(s) from {:.3} s on, {} frame(s) carrying one",
+            changes.len(),
+            changes.first().map_or(0.0, |c| c.at.as_secs_f64()),
+            boot.dmx_changes.len()
+        );
+    }
+    for problem in &report.problems {
+        println!("problem: {problem}");
+    }
+    Ok(report.problems.is_empty())
+}
+
+/// Per servo: pulses, shortest and longest, as measured.
+fn servo_table(boot: &Boot) -> String {
+    let mut text = String::from("\nservo   pulses   min µs   max µs\n");
+    for ((name, ..), train) in run::SERVOS.iter().zip(&boot.trains) {
+        let pulses = pulses_csv::measure(train);
+        let widths = pulses.iter().map(|p| p.width / 1e3);
+        let min = widths.clone().fold(f64::INFINITY, f64::min);
+        let max = widths.fold(0.0, f64::max);
+        let _ = writeln!(text, "{name:<6} {:>7} {min:>8.1} {max:>8.1}", pulses.len());
+    }
+    text
+}
+
+/// The stage: see the [module docs](self).
+pub fn test_show(root: &Path, metadata: &Metadata) -> Result<()> {
+    let changes = dmx::parse(SCRIPT)?;
+    let elf = stages::shipped_image(root, metadata)?;
+    let lines = bottango_lines();
+    let report = run::run_with(root, &elf, TIME, stages::WALL, |config| {
+        dmx::configure(config, &changes);
+        config.usb_chunks = vec![
+            (lines.concat().into_bytes(), BOTTANGO),
+            (b"STOP,h326\n".to_vec(), STOP),
+        ];
+    })?;
+    print!("{}", report.log_text(false));
+    let boot = report.boots.first().context("no boot")?;
+    print!("{}", servo_table(boot));
+    let mut problems = report.problems.clone();
+    let (text, found) = check(boot, &lines)?;
+    print!("{text}");
+    problems.extend(found);
+    problems.extend(stages::console_ram(&elf, &report)?);
+    if report.boots.len() != 1 {
+        problems.push(format!(
+            "{} boots: the watchdog reset the image",
+            report.boots.len()
+        ));
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        bail!("{}", problems.join("; "))
+    }
+}
+
+/// The pulses of one run, per servo, with the host's idle duties.
+struct Pulses {
+    servos: [Vec<Measured>; 3],
+    idle: Vec<[u16; 3]>,
+    count_ns: f64,
+}
+
+impl Pulses {
+    fn of(boot: &Boot) -> Result<Self> {
+        let servos = boot.trains.each_ref().map(pulses_csv::measure);
+        let frames = servos.iter().map(Vec::len).max().unwrap_or(0);
+        Ok(Self {
+            servos,
+            idle: expect::pico_duties(frames)?,
+            count_ns: run::timing().count_ns,
+        })
+    }
+
+    /// `axis`' pulses rising within `[from, to)` s: their index, time (s)
+    /// and angle (m°).
+    fn window(&self, axis: usize, from: f64, to: f64) -> Vec<(usize, f64, f64)> {
+        self.servos[axis]
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| (from * 1e9..to * 1e9).contains(&p.rise))
+            .map(|(n, p)| (n, p.rise / 1e9, angle(axis, p.width)))
+            .collect()
+    }
+
+    /// The pulses of every axis rising within `[from, to)` s that are not
+    /// the idle's own (the host's duty, within a count).
+    fn off_idle(&self, from: f64, to: f64) -> Vec<String> {
+        let mut off = Vec::new();
+        for axis in 0..3 {
+            for (n, t, _) in self.window(axis, from, to) {
+                let counts = self.servos[axis][n].width / self.count_ns;
+                let want = self.idle.get(n).map_or(0.0, |d| f64::from(d[axis]));
+                if (counts - want).abs() > 1.5 {
+                    off.push(format!(
+                        "{} at {t:.3} s: {counts:.0} counts, not {want}",
+                        run::SERVOS[axis].0
+                    ));
+                }
+            }
+        }
+        off
+    }
+
+    /// The largest change of `axis`' angle from one pulse to the next within
+    /// `[from, to)` s, m°.
+    fn fastest(&self, axis: usize, from: f64, to: f64) -> f64 {
+        self.window(axis, from, to)
+            .windows(2)
+            .map(|w| (w[1].2 - w[0].2).abs())
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The acceptance checks on boot 0: what they found, and the problems.
+#[allow(clippy::too_many_lines)] // one check after another, in the order of the module docs
+fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
+    let p = Pulses::of(boot)?;
+    let (mut text, mut problems) = (String::new(), Vec::new());
+    let (yaw, pitch) = (2, 0);
+    // The gesture limit, 250 °/s, in m° a frame, and a count of rounding.
+    let step = 250.0 * 20.0 + 0.5 * 11.1;
+
+    // 1. Mix 255, yaw coarse 200.
+    let limits = DriverConfig::DEFAULT.servos[yaw].limits;
+    let (lo, hi) = (
+        f64::from(limits.min.millidegrees()),
+        f64::from(limits.max.millidegrees()),
+    );
+    let want = lo + (hi - lo) * 51_200.0 / 65_535.0;
+    let held = p.window(yaw, 4.3, 5.0);
+    let worst = held.iter().map(|w| (w.2 - want).abs()).fold(0.0, f64::max);
+    let fastest = p.fastest(yaw, 3.4, 5.0);
+    let _ = writeln!(
+        text,
+        "dmx mix 255, yaw coarse 200: yaw at {:.3}° ({:.4} of its way, 200/255 = {:.4}), at most {:.3}° off over {} pulses; fastest step {:.2}° a frame (limit {:.2}°)",
+        held.last().map_or(f64::NAN, |w| w.2 / 1e3),
+        held.last().map_or(f64::NAN, |w| (w.2 - lo) / (hi - lo)),
+        200.0 / 255.0,
+        worst / 1e3,
+        held.len(),
+        fastest / 1e3,
+        step / 1e3
+    );
+    if held.len() < 30 || worst > 100.0 {
+        problems.push(format!(
+            "yaw did not hold {:.3}° under DMX (off by {:.3}°)",
+            want / 1e3,
+            worst / 1e3
+        ));
+    }
+    if fastest > step {
+        problems.push(format!(
+            "a yaw step of {:.3}° a frame: past the speed limit",
+            fastest / 1e3
+        ));
+    }
+
+    // 2. The frames dropped at 5 s: lost at 6 s, and the idle's own pulses.
+    let lost: Vec<f64> = boot
+        .log
+        .iter()
+        .filter(|(_, l)| l.message.contains("dmx: signal lost"))
+        .map(|(ns, _)| ns / 1e9)
+        .collect();
+    let _ = writeln!(
+        text,
+        "dmx signal lost at {lost:.3?} s (frames dropped at 5.0 s and 9.0 s)"
+    );
+    if !lost.first().is_some_and(|&t| (5.95..6.2).contains(&t)) {
+        problems.push(format!(
+            "the first `dmx: signal lost` came at {lost:?} s, not 1 s after 5.0 s"
+        ));
+    }
+    let jumps: Vec<String> = (0..3)
+        .filter_map(|axis| {
+            let f = p.fastest(axis, 5.0, 7.0);
+            (f > step).then(|| format!("{} {:.3}°", run::SERVOS[axis].0, f / 1e3))
+        })
+        .collect();
+    let after_loss = p.off_idle(6.8, 7.0);
+    let _ = writeln!(
+        text,
+        "hand-back: fastest steps within the limit ({}), pulses off the idle's from 6.8 s to 7.0 s: {}",
+        if jumps.is_empty() {
+            "yes".to_owned()
+        } else {
+            jumps.join(", ")
+        },
+        after_loss.len()
+    );
+    if !jumps.is_empty() {
+        problems.push(format!(
+            "a jump after the frames dropped: {}",
+            jumps.join(", ")
+        ));
+    }
+    if !after_loss.is_empty() {
+        problems.push(format!(
+            "not the idle's own pulses after the hand-back: {}",
+            after_loss[0]
+        ));
+    }
+
+    // 3. One nod from the band entry at 7.5 s.
+    let nods = boot
+        .log
+        .iter()
+        .filter(|(_, l)| l.message.contains(": dmx nod: ok"))
+        .count();
+    let during = p.off_idle(7.5, 8.5).len();
+    let after = p.off_idle(9.3, 10.5);
+    let _ = writeln!(
+        text,
+        "dmx trigger 20 (nod band) at 7.5 s: {nods} nod(s) logged, {during} pulses off the idle's during it, {} after it (9.3 s to 10.5 s)",
+        after.len()
+    );
+    if nods != 1 {
+        problems.push(format!("{nods} nods logged for one band entry, not 1"));
+    }
+    if during < 20 {
+        problems.push(format!(
+            "only {during} pulses of a nod: the band entry played none"
+        ));
+    }
+    if let Some(first) = after.first() {
+        problems.push(format!("the nod went on: {first}"));
+    }
+
+    // 4. Bottango over USB.
+    let usb = String::from_utf8_lossy(&boot.usb).into_owned();
+    let oks = usb.matches("OK\n").count();
+    let handshake = usb.contains("btngoHSK,0.8.0c1,144\nOK\n");
+    let sent = boot.usb_in.first().map_or(f64::NAN, |ns| ns / 1e9);
+    let curve = p.window(yaw, sent, sent + 2.0);
+    let top = curve.iter().map(|w| w.2).fold(f64::MIN, f64::max);
+    // Halfway (10°) half-way through the curve: 0.7 s after the sync.
+    let crossing = curve
+        .iter()
+        .find(|w| w.2 >= 10_000.0)
+        .map_or(f64::NAN, |w| w.1 - sent);
+    let back = p.off_idle(sent + 1.9, STOP.as_secs_f64() + 1.3);
+    let _ = writeln!(
+        text,
+        "Bottango (USB from {sent:.3} s): handshake {}, {oks} OK for {} lines; yaw past 10° {crossing:.3} s after the lines (0.7 s: 0.2 s and half the curve, a frame either way), top {:.3}° (20°); pulses off the idle's after the hand-back: {}",
+        if handshake { "answered" } else { "MISSING" },
+        lines.len() + 1,
+        top / 1e3,
+        back.len()
+    );
+    if !handshake || oks != lines.len() + 1 {
+        problems.push(format!(
+            "Bottango's session was not answered as expected: {usb:?}"
+        ));
+    }
+    if !(0.64..0.78).contains(&crossing) {
+        problems.push(format!(
+            "yaw crossed 10° {crossing:.3} s after the curve was sent, not about 0.7 s"
+        ));
+    }
+    if (top - 20_000.0).abs() > 150.0 {
+        problems.push(format!(
+            "yaw topped at {:.3}°, not the curve's 20°",
+            top / 1e3
+        ));
+    }
+    if let Some(first) = back.first() {
+        problems.push(format!("the idle did not resume after the curve: {first}"));
+    }
+    let pitch_top = p
+        .window(pitch, sent, sent + 2.0)
+        .iter()
+        .map(|w| w.2)
+        .fold(f64::MIN, f64::max);
+    if (pitch_top - 5_000.0).abs() > 150.0 {
+        problems.push(format!(
+            "pitch topped at {:.3}°, not the curve's 5°",
+            pitch_top / 1e3
+        ));
+    }
+    Ok((text, problems))
+}
