@@ -56,6 +56,7 @@ use crate::dmx::DmxUart;
 use crate::pwm::ServoPwm;
 use crate::uart::UartPort;
 use crate::usb::UsbPort;
+use idle_head_firmware::console::{Gone, Port, Received};
 
 /// The system clock embassy-rp's default configuration runs the RP2040 at.
 #[cfg(feature = "rp2040")]
@@ -226,14 +227,18 @@ fn spawn_console(
     usb: embassy_rp::usb::Driver<'static, USB>,
     service: &'static Service,
 ) {
-    spawn(spawner, uart_console(uart, service), "uart console");
+    spawn(
+        spawner,
+        console(ConsolePort::Uart(uart), service),
+        "uart console",
+    );
     defmt::info!("console: UART {=str}, 115200 8N1", uart_pins);
     let (device, serial) = usb::build(usb);
     interrupt::USBCTRL_IRQ.set_priority(PORT_PRIORITY);
     spawn(spawner, usb_device(device), "usb device");
     spawn(
         spawner,
-        usb_console(UsbPort(serial), service),
+        console(ConsolePort::Usb(UsbPort(serial)), service),
         "usb console",
     );
     defmt::info!(
@@ -360,14 +365,52 @@ const fn place(port: u8) -> idle_head_firmware::console::Place<'static> {
     }
 }
 
-/// The console on the USB serial port (port 1): one session per connection.
-#[embassy_executor::task]
-async fn usb_console(mut port: UsbPort, service: &'static Service) {
-    idle_head_firmware::console::run(&mut port, service, "usb", place(1)).await;
+/// The console on a port (the UART is port 0, the USB serial port 1), for
+/// as long as the board runs: one task, run twice, so that the console's
+/// loop is in the image once ([`ConsolePort`]).
+#[embassy_executor::task(pool_size = 2)]
+async fn console(mut port: ConsolePort, service: &'static Service) {
+    let (name, number) = match port {
+        ConsolePort::Uart(_) => ("uart", 0),
+        ConsolePort::Usb(_) => ("usb", 1),
+    };
+    idle_head_firmware::console::run(&mut port, service, name, place(number)).await;
 }
 
-/// The console on the UART (port 0), for as long as the board runs.
-#[embassy_executor::task]
-async fn uart_console(mut port: UartPort, service: &'static Service) {
-    idle_head_firmware::console::run(&mut port, service, "uart", place(0)).await;
+/// Either of the console's ports, as one type: the console's loop (the
+/// session, Bottango, telemetry) is generic over its port, and one type
+/// compiles it once instead of once a port (about 2.5 KB of flash).
+enum ConsolePort {
+    Uart(UartPort),
+    Usb(UsbPort),
+}
+
+impl Port for ConsolePort {
+    async fn connected(&mut self) {
+        match self {
+            Self::Uart(port) => port.connected().await,
+            Self::Usb(port) => port.connected().await,
+        }
+    }
+
+    fn open(&self) -> bool {
+        match self {
+            Self::Uart(port) => port.open(),
+            Self::Usb(port) => port.open(),
+        }
+    }
+
+    async fn read(&mut self, buf: &mut [u8]) -> Result<Received, Gone> {
+        match self {
+            Self::Uart(port) => port.read(buf).await,
+            Self::Usb(port) => port.read(buf).await,
+        }
+    }
+
+    async fn write(&mut self, bytes: &[u8]) -> Result<(), Gone> {
+        match self {
+            Self::Uart(port) => port.write(bytes).await,
+            Self::Usb(port) => port.write(bytes).await,
+        }
+    }
 }
