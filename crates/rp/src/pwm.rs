@@ -9,21 +9,30 @@
 //!   its counter at 0 and its compare value at 0, so the output is driven low
 //!   (the output is high only while the counter is below the compare value).
 //! - The first [`SetDutyCycle::set_duty_cycle`] (the frame driver's neutral
-//!   pulse) writes the compare value, sets the counter half a period in
-//!   (above any servo's compare value, so the output stays low) and only
-//!   then enables the slice. The first wrap comes half a period later and
-//!   starts the first pulse: the whole neutral pulse.
+//!   pulse) writes the compare value, sets the counter a tenth of a period
+//!   ([`WRAP_MARGIN_DIVISOR`]) before its wrap (above any servo's compare value, so the output
+//!   stays low) and only then enables the slice. The first wrap comes that
+//!   much later and starts the first pulse: the whole neutral pulse.
 //! - Later writes change the compare value while the slice runs; the RP2040
 //!   latches it at the next wrap, so a pulse is never cut or stretched.
 //!
 //! # One frame, one pulse
 //!
-//! The PWM period is exactly one frame (`idle_head_core::pwm_clock`) and both come from
-//! the same crystal, so the frames' writes keep the phase the first one set:
-//! each lands half a period before the wrap that latches it, whatever the
-//! frame's wake-up latency or cost (anything below 10 ms). Frame `k` is
-//! latched at wrap `k + 1` and goes out as the `k`-th pulse: no frame is
-//! ever overwritten before it went out, none goes out twice.
+//! The PWM period is exactly one frame (`idle_head_core::pwm_clock`) and
+//! both come from the same crystal, so the frames' writes keep the phase the
+//! first one set: each lands 2 ms (a period over [`WRAP_MARGIN_DIVISOR`]) before the wrap that
+//! latches it, whatever the frame's wake-up latency or cost, as long as it
+//! is below that (it is tens of microseconds: the frame task runs above
+//! everything but the timer's alarm). Frame `k` is latched at wrap `k + 1`
+//! and goes out as the `k`-th pulse: no frame is ever overwritten before it
+//! went out, none goes out twice.
+//!
+//! The margin is what a frame's pulse waits after its write: the smaller,
+//! the sooner a command shows on the servo. Half a period (10 ms) would
+//! forgive any lateness below 10 ms and put 10 ms into every command's
+//! latency; 2 ms forgives a hundred times the lateness measured and costs
+//! 2 ms. A frame written later still goes out, a period late, as the
+//! previous frame's pulse repeated once.
 
 use embassy_rp::Peri;
 use embassy_rp::pwm::{ChannelAPin, Config, Pwm, PwmError, Slice};
@@ -32,6 +41,10 @@ use fixed::FixedU16;
 use fixed::types::extra::U4;
 
 use idle_head_core::pwm_clock::SliceClock;
+
+/// The wrap that latches a frame's duty comes a period over this after the
+/// write (a tenth: 2 ms of a 20 ms frame); see the module docs.
+pub const WRAP_MARGIN_DIVISOR: u32 = 10;
 
 /// One servo output: channel A of a PWM slice of its own.
 pub struct ServoPwm {
@@ -78,10 +91,13 @@ impl SetDutyCycle for ServoPwm {
         if duty > self.config.top {
             return Err(PwmError::InvalidDutyCycle);
         }
-        // First duty: compare value, the counter half a period in, then run.
+        // First duty: compare value, the counter a tenth of a period
+        // before its wrap, then run.
         self.config.compare_a = duty;
         self.pwm.set_config(&self.config);
-        self.pwm.set_counter(self.config.top / 2 + 1);
+        let counts = u32::from(self.config.top) + 1;
+        let margin = counts / WRAP_MARGIN_DIVISOR;
+        self.pwm.set_counter((counts - margin) as u16);
         self.config.enable = true;
         self.pwm.set_config(&self.config);
         self.running = true;
