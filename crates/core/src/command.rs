@@ -88,6 +88,15 @@ pub enum Action {
     IdleAmp(Percent),
     /// Fade all motion out to the neutral pose and hold it.
     Stop,
+    /// Glide to the rest pose (the idle fades out) and stay there; relax
+    /// there if the settings say so (see [`crate::behaviour::rest`]).
+    Rest,
+    /// Wake from a rest: the idle fades back in. With a direction, glance
+    /// there once awake (or at once, if awake already).
+    Wake {
+        /// The glance's yaw (an axis angle, as a look's), if any.
+        toward: Option<Angle>,
+    },
 }
 
 /// Where the idle motion's random stream starts.

@@ -254,13 +254,11 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
     /// console, if linked.
     pub fn publish<P: SetDutyCycle>(&self, driver: &FrameDriver<P>, report: &FrameReport) {
         if let Some(link) = self.link {
-            let mode = if driver.is_stopped() {
-                HeadMode::Stopped
-            } else if driver.is_stopping() {
-                HeadMode::Stopping
-            } else {
-                HeadMode::Running
-            };
+            let mode = HeadMode::of(
+                driver.is_stopped(),
+                driver.is_stopping(),
+                self.head.rest_state(),
+            );
             link.publish(HeadStatus::of(report, driver.stats(), mode));
         }
     }
@@ -369,6 +367,8 @@ const fn word(action: &Action) -> &'static str {
         Action::Idle(false) => "idle off",
         Action::IdleAmp(_) => "idle amp",
         Action::Stop => "stop",
+        Action::Rest => "rest",
+        Action::Wake { .. } => "wake",
     }
 }
 
@@ -413,6 +413,12 @@ impl defmt::Format for Started<'_> {
             }
             Applied::Stop => {
                 defmt::write!(f, "fading out");
+            }
+            Applied::Rest(duration) => {
+                defmt::write!(f, "to the rest pose in {=u32} ms", duration.0);
+            }
+            Applied::Wake(duration) => {
+                defmt::write!(f, "idle back in {=u32} ms", duration.0);
             }
         }
     }

@@ -162,13 +162,11 @@ impl SimFrames {
                 self.violations += 1;
             }
         }
-        let mode = if self.driver.is_stopped() {
-            HeadMode::Stopped
-        } else if self.driver.is_stopping() {
-            HeadMode::Stopping
-        } else {
-            HeadMode::Running
-        };
+        let mode = HeadMode::of(
+            self.driver.is_stopped(),
+            self.driver.is_stopping(),
+            self.head.rest_state(),
+        );
         link.publish(HeadStatus::of(&report, self.driver.stats(), mode));
         self.frame += 1;
         self.frames += 1;

@@ -312,6 +312,9 @@ fn write_command(s: &mut Style<'_>, command: &Command) {
         Command::Load => s.word("load"),
         Command::Defaults => s.word("defaults"),
         Command::Act(Action::Stop) => s.word("stop"),
+        Command::Act(Action::Rest) => s.word("rest"),
+        // A direction comes from a presence input, never from a line.
+        Command::Act(Action::Wake { .. }) => s.word("wake"),
         Command::Act(Action::Gesture(g)) => {
             s.word(g.kind.name());
             if let Some(a) = g.amplitude {

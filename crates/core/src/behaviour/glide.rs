@@ -138,32 +138,44 @@ impl Glide {
         self.at_s(ONE - progress(t, self.inverse))
     }
 
-    /// The values of two glides at frame `now`, each as [`at`](Self::at)
-    /// gives it. Glides that share their clock (the same start and
-    /// duration, as the gaze's two axes always do) work out `s` once.
+    /// The values of three glides on one clock (the same start and
+    /// duration, as the gaze's axes and its envelope always are) at frame
+    /// `now`, each as [`at`](Self::at) gives it: `s` is worked out once,
+    /// and a third glide that holds its value (the gaze's envelope from
+    /// one look to the next) costs nothing.
     #[inline]
-    pub(crate) fn pair_at(pair: &mut [Self; 2], now: u32) -> [i32; 2] {
-        let [a, b] = pair;
+    pub(crate) fn trio_at(trio: &mut [Self; 3], now: u32) -> [i32; 3] {
+        let [a, b, c] = trio;
+        debug_assert!(
+            a.start == c.start && a.frames == c.frames,
+            "not on one clock"
+        );
         if a.start != b.start || a.frames != b.frames {
-            return [a.at(now), b.at(now)];
+            return [a.at(now), b.at(now), c.at(now)];
         }
         let t = now.wrapping_sub(a.start);
         if t >= a.frames {
-            (a.frames, b.frames) = (0, 0);
-            return [a.target, b.target];
+            (a.frames, b.frames, c.frames) = (0, 0, 0);
+            return [a.target, b.target, c.target];
         }
         if t == 0 {
-            return [a.at(now), b.at(now)];
+            return [a.at(now), b.at(now), c.at(now)];
         }
         // The same frames, the same reciprocal.
         let s = ONE - progress(t, a.inverse);
-        [a.at_s(s), b.at_s(s)]
+        let [r0, r1, r2] = c.r;
+        let third = if r0 == 0 && r1 == 0 && r2 == 0 {
+            c.target
+        } else {
+            c.at_s(s)
+        };
+        [a.at_s(s), b.at_s(s), third]
     }
 
     /// The value at `s = 1 − τ` (Q16, `0 < s < 1`). Each multiply rounds to
     /// the unit: the value is within 2.5 units of the exact polynomial at
     /// this `s`.
-    #[inline]
+    #[inline(always)]
     fn at_s(&self, s: u32) -> i32 {
         let [r0, r1, r2] = self.r;
         let q = mul(mul(r2, s) + r1, s) + r0;

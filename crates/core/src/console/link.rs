@@ -27,6 +27,10 @@ pub enum HeadMode {
     Starting,
     /// Playing (fading in or at full strength).
     Running,
+    /// Gliding to the rest pose, or resting there (relaxed: no pulses).
+    Resting,
+    /// Waking from a rest: the idle fades back in.
+    Waking,
     /// Fading out after `stop`.
     Stopping,
     /// Holding the neutral pose after `stop`.
@@ -40,6 +44,8 @@ impl HeadMode {
         match self {
             Self::Starting => "starting",
             Self::Running => "running",
+            Self::Resting => "resting",
+            Self::Waking => "waking",
             Self::Stopping => "stopping",
             Self::Stopped => "stopped",
         }
@@ -62,6 +68,26 @@ pub struct HeadStatus {
     pub faults: [u32; 3],
     /// Servos switched off.
     pub disabled: [bool; 3],
+}
+
+impl HeadMode {
+    /// The mode of a head whose driver is `stopped` or `stopping` (after a
+    /// `stop`), and which is in `rest` otherwise.
+    #[must_use]
+    pub const fn of(stopped: bool, stopping: bool, rest: crate::behaviour::RestState) -> Self {
+        use crate::behaviour::RestState;
+        if stopped {
+            Self::Stopped
+        } else if stopping {
+            Self::Stopping
+        } else {
+            match rest {
+                RestState::Awake => Self::Running,
+                RestState::Resting => Self::Resting,
+                RestState::Waking => Self::Waking,
+            }
+        }
+    }
 }
 
 impl HeadStatus {
