@@ -236,7 +236,7 @@ fn a_new_pose_while_resting_is_glided_to() {
     let mut config = BehaviourConfig::DEFAULT;
     config.rest.pose = [-12_000, 5000, 10_000].map(Angle::from_millidegrees);
     let start = rig.played.len();
-    rig.head.set_live(&mut rig.driver, &config);
+    rig.head.set_live(&mut rig.driver, &config.live());
     // The new pose at the next rest: `rest` again glides there.
     rig.run(5);
     assert_eq!(rig.played.last().unwrap().angles, [-8000, 0, 0]);
@@ -246,7 +246,7 @@ fn a_new_pose_while_resting_is_glided_to() {
     assert_eq!(rig.played.last().unwrap().angles, [-12_000, 5000, 10_000]);
     // A pose past the limits is clamped to them (pitch's are −12°..20°).
     config.rest.pose = [-30_000, 0, 0].map(Angle::from_millidegrees);
-    rig.head.set_live(&mut rig.driver, &config);
+    rig.head.set_live(&mut rig.driver, &config.live());
     rig.apply(Action::Rest);
     rig.run(300);
     assert_eq!(rig.played.last().unwrap().angles, [-12_000, 0, 0]);

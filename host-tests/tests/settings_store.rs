@@ -107,11 +107,11 @@ impl Record for ServoSettings {
 }
 
 /// Bytes stored under any version, to plant records of other layouts.
-type Raw<const V: u16> = RawRecord<V, 512>;
+type Raw<const V: u16> = RawRecord<V, 1024>;
 
 /// `bytes` as a raw record.
 fn raw<const V: u16>(bytes: &[u8]) -> Raw<V> {
-    Raw::new(bytes).expect("at most 512 bytes")
+    Raw::new(bytes).expect("at most 1024 bytes")
 }
 
 /// Valid settings, every field varied.

@@ -142,6 +142,50 @@ impl ServoSetting {
     }
 }
 
+/// What a trigger input is (see [`crate::input`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum InputRole {
+    /// Not used (the default): its level means nothing.
+    #[default]
+    Off,
+    /// A push button to ground, active low with the internal pull-up: a
+    /// press runs `action`, any motion line the console accepts.
+    Button(Action),
+    /// A presence sensor (a PIR module), active high: someone there keeps
+    /// the head awake and wakes it; with a direction, the head glances
+    /// there (a yaw, as a look's).
+    Presence {
+        /// Where the sensor looks, if given.
+        toward: Option<Angle>,
+    },
+}
+
+/// When the head rests with nobody there (see [`crate::input`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RestAfter {
+    /// Never: presence inputs only wake the head and make it glance.
+    Never,
+    /// After this many seconds (`1..=`[`MAX_REST_AFTER`]) without presence.
+    Seconds(u32),
+}
+
+/// The longest `rest after`: a day, in seconds.
+pub const MAX_REST_AFTER: u32 = 86_400;
+
+/// A change of the rest settings (`rest after|pose|relax`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RestSetting {
+    /// When the head rests with nobody there.
+    After(RestAfter),
+    /// The rest pose, `[pitch, roll, yaw]`.
+    Pose([Angle; 3]),
+    /// Whether the pulses stop once there.
+    Relax(bool),
+}
+
 /// One line of the console protocol, parsed ([`crate::console::parse`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -167,4 +211,16 @@ pub enum Command {
     Load,
     /// Go back to the built-in settings (not stored until `save`).
     Defaults,
+    /// Show (`None`) or change a trigger input's role.
+    Input {
+        /// The input's number, as the console names it (2 to 5: GP2 to
+        /// GP5 on the Pico; see [`crate::input::FIRST_INPUT`]).
+        input: u8,
+        /// The new role, if any.
+        role: Option<InputRole>,
+    },
+    /// Change the rest settings.
+    Rest(RestSetting),
+    /// How much a held look ducks the idle on its axes.
+    LookDuck(Percent),
 }

@@ -45,6 +45,7 @@ pub mod console;
 pub mod driver;
 pub mod gestures;
 pub mod idle;
+pub mod input;
 pub mod metrics;
 pub mod motion;
 pub mod playback;

@@ -206,29 +206,12 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         self.head.apply(driver, action)
     }
 
-    /// Before frame `tick`: the limit modes the behaviour asks for, then the
-    /// queued commands (at most two), each logged with its answer.
+    /// Before frame `tick`: what the console sent through the link (see
+    /// [`from_link`](Self::from_link)), the limit modes the behaviour asks
+    /// for, then the queued commands (at most two), each logged with its
+    /// answer.
     pub fn drain<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, tick: FrameTick) {
-        if let Some(link) = self.link {
-            for (axis, cal) in idle_head_core::Axis::ALL.iter().zip(link.take_servos()) {
-                let Some(cal) = cal else { continue };
-                match self.head.set_servo(driver, *axis, cal) {
-                    Ok(()) => defmt::info!(
-                        "frame {=u64}: {=str} servo calibration changed",
-                        tick.frame,
-                        axis.name()
-                    ),
-                    // `{}` of the error, not its `message()`: the per-axis
-                    // message texts would take 2.5 KB of flash.
-                    Err(e) => defmt::warn!(
-                        "frame {=u64}: {=str} servo calibration refused: {}",
-                        tick.frame,
-                        axis.name(),
-                        e
-                    ),
-                }
-            }
-        }
+        self.from_link(driver, tick);
         match self.commands {
             Some(queue) => {
                 self.head
@@ -247,6 +230,37 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
                     });
             }
             None => self.head.sync(driver),
+        }
+    }
+
+    /// Before frame `tick`: the servo calibrations and the live behaviour
+    /// settings (rest pose, relax, the look's duck) the console sent, if
+    /// linked, each logged.
+    pub fn from_link<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, tick: FrameTick) {
+        let Some(link) = self.link else {
+            return;
+        };
+        if let Some(live) = link.take_live() {
+            self.head.set_live(driver, &live);
+            defmt::info!("frame {=u64}: rest and look settings changed", tick.frame);
+        }
+        for (axis, cal) in idle_head_core::Axis::ALL.iter().zip(link.take_servos()) {
+            let Some(cal) = cal else { continue };
+            match self.head.set_servo(driver, *axis, cal) {
+                Ok(()) => defmt::info!(
+                    "frame {=u64}: {=str} servo calibration changed",
+                    tick.frame,
+                    axis.name()
+                ),
+                // `{}` of the error, not its `message()`: the per-axis
+                // message texts would take 2.5 KB of flash.
+                Err(e) => defmt::warn!(
+                    "frame {=u64}: {=str} servo calibration refused: {}",
+                    tick.frame,
+                    axis.name(),
+                    e
+                ),
+            }
         }
     }
 
@@ -377,6 +391,9 @@ const fn word(action: &Action) -> &'static str {
 struct Started<'a>(&'a Applied);
 
 impl defmt::Format for Started<'_> {
+    // defmt keeps each text in a symbol of its own: arms that differ in
+    // their text alone look the same to clippy.
+    #[allow(clippy::match_same_arms)]
     fn format(&self, f: defmt::Formatter<'_>) {
         match self.0 {
             Applied::Gesture(plan) => {

@@ -1,16 +1,18 @@
 //! A simulated head behind the console service: the frame task's code
-//! (queue drain, servo calibrations from the link, frame, status) on the
-//! host, with PWM channels that keep the last duty, and a check of every
+//! (queue drain, servo calibrations and live settings from the link,
+//! frame, status) and the input task's (its inputs at their idle levels)
+//! on the host, with PWM channels that keep the last duty, and a check of every
 //! frame against the servos' limits as they are at that frame.
 
 use std::convert::Infallible;
 
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use idle_head_core::behaviour::{
-    Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION,
+    Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION, RestState,
 };
 use idle_head_core::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
 use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::input::{InputSettings, Inputs, Micros};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16, Trajectory};
 use idle_head_core::playback::Player;
 use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
@@ -78,6 +80,12 @@ pub struct SimFrames {
     pub refused_not_busy: u64,
     /// What the last action played started.
     pub last_applied: Option<Applied>,
+    /// The input task's state machine, its inputs at their idle levels
+    /// (buttons released, nobody there) unless `levels` says otherwise.
+    pub inputs: Inputs,
+    /// The inputs' levels (bit `i`: input `i` high); `None`: each at its
+    /// idle level.
+    pub levels: Option<u8>,
 }
 
 impl SimFrames {
@@ -112,12 +120,45 @@ impl SimFrames {
             refused: 0,
             refused_not_busy: 0,
             last_applied: None,
+            inputs: Inputs::new(&InputSettings::DEFAULT, Micros(0)),
+            levels: None,
         }
+    }
+
+    /// The input task's part, as it would run at this frame: new settings
+    /// from `link`, the levels, actions into `queue`, the status published.
+    fn inputs<const N: usize>(&mut self, queue: &CommandQueue<N>, link: &ConsoleLink) {
+        let now = Micros(self.frame * 20_000);
+        if let Some(settings) = link.take_inputs() {
+            self.inputs.configure(&settings, now);
+        }
+        let idle = self
+            .inputs
+            .settings()
+            .roles
+            .iter()
+            .enumerate()
+            .filter(|(_, role)| !role.active_high())
+            .fold(0, |bits, (i, _)| bits | (1 << i));
+        let resting = self.head.rest_state() == RestState::Resting;
+        self.inputs
+            .update(now, self.levels.unwrap_or(idle), resting);
+        while let Some(action) = self.inputs.pending() {
+            if queue.try_submit(action).is_err() {
+                break;
+            }
+            self.inputs.sent();
+        }
+        link.publish_inputs(self.inputs.status());
     }
 
     /// Plays one frame as the frame task does: calibrations from `link`,
     /// queued actions, the frame, the status published.
     pub fn frame<const N: usize>(&mut self, queue: &CommandQueue<N>, link: &ConsoleLink) {
+        self.inputs(queue, link);
+        if let Some(live) = link.take_live() {
+            self.head.set_live(&mut self.driver, &live);
+        }
         for (axis, cal) in Axis::ALL.iter().zip(link.take_servos()) {
             if let Some(cal) = cal {
                 self.head
@@ -152,9 +193,10 @@ impl SimFrames {
             // outside its new angle limits: the driver brings it back in
             // through the limiter, within `RETURN_FRAMES`.
             let returning = changed.is_some_and(|at| self.frame <= at + RETURN_FRAMES);
+            // Relaxed at rest: no pulse at all (duty 0), not a short one.
+            let pulse = s.duty.0 != 0 || s.pulse.0 != 0;
             if (!cal.limits.contains(s.angle) && !returning)
-                || s.pulse.0 < cal.min_pulse.0
-                || s.pulse.0 > cal.max_pulse.0
+                || (pulse && (s.pulse.0 < cal.min_pulse.0 || s.pulse.0 > cal.max_pulse.0))
             {
                 if !cal.limits.contains(s.angle) {
                     self.outside_after_return += 1;

@@ -80,6 +80,17 @@ pub struct RestConfig {
     pub relax: bool,
 }
 
+/// The behaviour's settings a running head takes between two frames (the
+/// rest of the configuration takes effect at the next boot).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LiveConfig {
+    /// The rest pose and relax.
+    pub rest: RestConfig,
+    /// The look's duck ([`GazeConfig::duck`]).
+    pub look_duck: Percent,
+}
+
 /// Everything the behaviour layer needs, in physical units.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -148,6 +159,15 @@ impl BehaviourConfig {
             relax: false,
         },
     };
+
+    /// The settings a running head takes between two frames.
+    #[must_use]
+    pub const fn live(&self) -> LiveConfig {
+        LiveConfig {
+            rest: self.rest,
+            look_duck: self.gaze.duck,
+        }
+    }
 
     /// The defaults of gesture `kind`.
     #[must_use]

@@ -145,37 +145,37 @@ impl Glide {
     /// one look to the next) costs nothing.
     #[inline]
     pub(crate) fn trio_at(trio: &mut [Self; 3], now: u32) -> [i32; 3] {
-        let [a, b, c] = trio;
+        let [one, two, three] = trio;
         debug_assert!(
-            a.start == c.start && a.frames == c.frames,
+            one.start == three.start && one.frames == three.frames,
             "not on one clock"
         );
-        if a.start != b.start || a.frames != b.frames {
-            return [a.at(now), b.at(now), c.at(now)];
+        if one.start != two.start || one.frames != two.frames {
+            return [one.at(now), two.at(now), three.at(now)];
         }
-        let t = now.wrapping_sub(a.start);
-        if t >= a.frames {
-            (a.frames, b.frames, c.frames) = (0, 0, 0);
-            return [a.target, b.target, c.target];
+        let t = now.wrapping_sub(one.start);
+        if t >= one.frames {
+            (one.frames, two.frames, three.frames) = (0, 0, 0);
+            return [one.target, two.target, three.target];
         }
         if t == 0 {
-            return [a.at(now), b.at(now), c.at(now)];
+            return [one.at(now), two.at(now), three.at(now)];
         }
         // The same frames, the same reciprocal.
-        let s = ONE - progress(t, a.inverse);
-        let [r0, r1, r2] = c.r;
-        let third = if r0 == 0 && r1 == 0 && r2 == 0 {
-            c.target
+        let s = ONE - progress(t, one.inverse);
+        let [r0, r1, r2] = three.r;
+        let held = if r0 == 0 && r1 == 0 && r2 == 0 {
+            three.target
         } else {
-            c.at_s(s)
+            three.at_s(s)
         };
-        [a.at_s(s), b.at_s(s), third]
+        [one.at_s(s), two.at_s(s), held]
     }
 
     /// The value at `s = 1 − τ` (Q16, `0 < s < 1`). Each multiply rounds to
     /// the unit: the value is within 2.5 units of the exact polynomial at
     /// this `s`.
-    #[inline(always)]
+    #[inline]
     fn at_s(&self, s: u32) -> i32 {
         let [r0, r1, r2] = self.r;
         let q = mul(mul(r2, s) + r1, s) + r0;

@@ -27,7 +27,7 @@ use crate::driver::{ConfigError, FrameDriver, FrameReport};
 use crate::servo::ServoCalibration;
 use crate::units::Angle;
 
-use super::config::BehaviourConfig;
+use super::config::LiveConfig;
 use super::error::BehaviourError;
 use super::idle::IdleSource;
 use super::mixer::{Applied, Mixer};
@@ -116,15 +116,11 @@ impl<I: IdleSource> Head<I> {
     }
 
     /// Between frames: the rest pose, relax and the look's duck of
-    /// `config`, as the console changed them (the pose clamped to the
+    /// `live`, as the console changed them (the pose clamped to the
     /// servos' limits). A new pose takes effect at the next rest (or `rest`
     /// again); relax at once.
-    pub fn set_live<P: SetDutyCycle>(
-        &mut self,
-        driver: &mut FrameDriver<P>,
-        config: &BehaviourConfig,
-    ) {
-        self.mixer.set_live(config);
+    pub fn set_live<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, live: &LiveConfig) {
+        self.mixer.set_live(live);
         self.sync(driver);
     }
 

@@ -178,8 +178,8 @@ impl Mixer {
 
     /// Takes the live settings of `config` (see
     /// [`BehaviourParams::set_live`]); the rest pose from the next rest on.
-    pub(crate) fn set_live(&mut self, config: &super::BehaviourConfig) {
-        self.params.set_live(config);
+    pub(crate) fn set_live(&mut self, live: &super::LiveConfig) {
+        self.params.set_live(live);
         // The look's duck changes the quiet gains: mix the next frame in full.
         self.quiet = false;
         self.until = self.next;

@@ -68,7 +68,7 @@ mod validate;
 
 pub use crate::gestures::{GestureDefaults, MAX_CYCLES};
 pub use crate::units::MilliHertz;
-pub use config::{BehaviourConfig, GazeConfig, IdleConfig, RestConfig};
+pub use config::{BehaviourConfig, GazeConfig, IdleConfig, LiveConfig, RestConfig};
 pub use error::BehaviourError;
 pub use gaze::LookApplied;
 pub use gesture::GesturePlan;

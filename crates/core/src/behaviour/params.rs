@@ -6,7 +6,7 @@ use crate::axis::Axis;
 use crate::driver::{MotionLimits, SlewRates};
 use crate::units::{Angle, AngleRange, Millis};
 
-use super::config::BehaviourConfig;
+use super::config::{BehaviourConfig, LiveConfig};
 
 /// The offsets `limits` leave around `pose`.
 pub(super) const fn room_around(limits: AngleRange, pose: Angle) -> AngleRange {
@@ -88,13 +88,13 @@ impl BehaviourParams {
         self.pose
     }
 
-    /// Takes the rest pose, relax and the look's duck of `config`: the
+    /// Takes the rest pose, relax and the look's duck of `live`: the
     /// settings a running head takes between two frames. Returns whether
     /// the rest pose had to be clamped to the servos' limits.
-    pub fn set_live(&mut self, config: &BehaviourConfig) -> bool {
-        self.config.rest = config.rest;
-        self.config.gaze.duck = config.gaze.duck;
-        self.look_duck = super::validate::q16(config.gaze.duck);
+    pub fn set_live(&mut self, live: &LiveConfig) -> bool {
+        self.config.rest = live.rest;
+        self.config.gaze.duck = live.look_duck;
+        self.look_duck = super::validate::q16(live.look_duck);
         let (pose, clamped) = super::validate::rest_offsets(&self.config, &self.pose, &self.room);
         self.rest_pose = pose;
         clamped

@@ -249,7 +249,12 @@ pub(crate) fn glance(params: &BehaviourParams, yaw: Angle) -> LookRequest {
 
 /// The largest distance between `a` and `b` over the axes, plus `extra`, m°.
 fn far(a: [i32; 3], b: [i32; 3], extra: u32) -> u32 {
-    let d = (0..3).map(|i| a[i].abs_diff(b[i])).max().unwrap_or(0);
+    let d = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| x.abs_diff(*y))
+        .max()
+        .unwrap_or(0);
     d.saturating_add(extra)
 }
 

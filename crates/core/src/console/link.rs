@@ -1,7 +1,8 @@
 //! What the console task and the frame task share, besides the command
 //! queue: the head's status (frame task → console), servo calibrations
-//! to apply (console → frame task) and new idle seeds (console → loop
-//! generator).
+//! and the live behaviour settings to apply (console → frame task), new
+//! idle seeds (console → loop generator), and the trigger inputs' settings
+//! and levels (console → input task → console).
 //!
 //! Each is an embassy-sync blocking `Mutex` over a `Cell`, or a `Signal`
 //! (whose state is a `Cell` too): a critical section around a copy, no
@@ -14,7 +15,9 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 
 use crate::axis::Axis;
+use crate::behaviour::LiveConfig;
 use crate::driver::{DriverStats, FrameReport};
+use crate::input::{InputSettings, InputStatus};
 use crate::servo::ServoCalibration;
 use crate::units::{Angle, Microseconds};
 
@@ -110,6 +113,9 @@ pub struct ConsoleLink {
     status: Mutex<CriticalSectionRawMutex, Cell<HeadStatus>>,
     servos: Mutex<CriticalSectionRawMutex, Cell<[Option<ServoCalibration>; 3]>>,
     seeds: Signal<CriticalSectionRawMutex, [u32; 3]>,
+    live: Signal<CriticalSectionRawMutex, LiveConfig>,
+    inputs: Signal<CriticalSectionRawMutex, InputSettings>,
+    input_status: Mutex<CriticalSectionRawMutex, Cell<InputStatus>>,
 }
 
 impl ConsoleLink {
@@ -127,6 +133,9 @@ impl ConsoleLink {
             })),
             servos: Mutex::new(Cell::new([None; 3])),
             seeds: Signal::new(),
+            live: Signal::new(),
+            inputs: Signal::new(),
+            input_status: Mutex::new(Cell::new(InputStatus { high: 0, active: 0 })),
         }
     }
 
@@ -172,6 +181,42 @@ impl ConsoleLink {
     /// The loop generator: new seeds, if asked for since the last call.
     pub fn take_seeds(&self) -> Option<[u32; 3]> {
         self.seeds.try_take()
+    }
+
+    /// The console: the rest pose, relax and the look's duck from the next
+    /// frame on (the newest replaces one not yet taken).
+    pub fn set_live(&self, live: LiveConfig) {
+        self.live.signal(live);
+    }
+
+    /// The frame task: the live settings, if changed since the last call.
+    pub fn take_live(&self) -> Option<LiveConfig> {
+        self.live.try_take()
+    }
+
+    /// The console: the inputs' roles and the rest timer for the input task.
+    pub fn set_inputs(&self, inputs: InputSettings) {
+        self.inputs.signal(inputs);
+    }
+
+    /// The input task: waits for new input settings.
+    pub async fn inputs_changed(&self) -> InputSettings {
+        self.inputs.wait().await
+    }
+
+    /// The input task (or a host test): new input settings, if any.
+    pub fn take_inputs(&self) -> Option<InputSettings> {
+        self.inputs.try_take()
+    }
+
+    /// The input task: the inputs' levels as they are now.
+    pub fn publish_inputs(&self, status: InputStatus) {
+        self.input_status.lock(|cell| cell.set(status));
+    }
+
+    /// The console: the inputs' levels.
+    pub fn inputs(&self) -> InputStatus {
+        self.input_status.lock(Cell::get)
     }
 }
 

@@ -23,7 +23,7 @@ mod shared;
 
 pub use framer::{Framer, LineError};
 pub use link::{ConsoleLink, HeadMode, HeadStatus};
-pub use parse::{ParseError, ParseErrorKind, Span, parse};
+pub use parse::{ActionLine, ParseError, ParseErrorKind, Span, parse};
 pub use reply::{ErrorCode, Reply};
 pub use service::{ConsoleService, HELP, VERSION};
 pub use session::{EnvelopeError, Handler, InputError, MIN_REPLY, Session, checksum, respond};

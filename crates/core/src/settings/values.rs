@@ -2,8 +2,8 @@
 //!
 //! [`Settings`] holds what a person may change at run time and keep in
 //! flash: the calibration and limits of the three servos, the behaviour
-//! (idle amplitude, gesture and gaze parameters) and the idle motion's
-//! seeds. [`Settings::DEFAULT`] is the built-in configuration.
+//! (idle amplitude, gesture and gaze parameters, the rest pose) and the
+//! idle motion's seeds, and the trigger inputs' roles. [`Settings::DEFAULT`] is the built-in configuration.
 //! [`Settings::validate`] checks them exactly as the typed
 //! configurations are checked ([`DriverConfig::build`],
 //! [`BehaviourConfig::build`]), against a board's base driver
@@ -13,7 +13,9 @@ use crate::text::{Describe, Text, display_from_describe};
 
 use crate::axis::Axis;
 use crate::behaviour::{BehaviourConfig, BehaviourError, BehaviourParams};
+use crate::command::InputRole;
 use crate::driver::{ConfigError, DriverConfig, DriverParams};
+use crate::input::{FIRST_INPUT, InputSettings};
 use crate::motion::DEFAULT_HEAD;
 use crate::servo::ServoCalibration;
 
@@ -27,6 +29,8 @@ pub struct Settings {
     pub behaviour: BehaviourConfig,
     /// Seeds r(0) of the idle motion's random streams, `[pitch, roll, yaw]`.
     pub seeds: [u32; 3],
+    /// The trigger inputs' roles and the rest timer.
+    pub inputs: InputSettings,
 }
 
 /// Why settings are not valid.
@@ -74,6 +78,7 @@ impl Settings {
             DEFAULT_HEAD.roll.seed,
             DEFAULT_HEAD.yaw.seed,
         ],
+        inputs: InputSettings::DEFAULT,
     };
 
     /// `base` with these settings' servos.
@@ -100,6 +105,23 @@ impl Settings {
             Ok(behaviour) => Ok(Validated { driver, behaviour }),
             Err(e) => Err(SettingsError::Behaviour(e)),
         }
+    }
+
+    /// Checks each button's action with `behaviour` as the console checks
+    /// a motion command: the first that the head would refuse, with its
+    /// input's number. (Not part of [`validate`](Self::validate): a record
+    /// loads whatever its buttons say, and a press the head refuses is
+    /// logged, not played.)
+    ///
+    /// # Errors
+    /// The input's number (as the console names it) and why.
+    pub fn check_inputs(&self, behaviour: &BehaviourParams) -> Result<(), (u8, BehaviourError)> {
+        for (n, role) in (FIRST_INPUT..).zip(&self.inputs.roles) {
+            if let InputRole::Button(action) = role {
+                behaviour.check(action).map_err(|e| (n, e))?;
+            }
+        }
+        Ok(())
     }
 
     /// The calibration of `axis`' servo.

@@ -80,10 +80,20 @@ pub(super) enum Kw {
     Hold,
     Cycles,
     Intensity,
+    Input,
+    Button,
+    Presence,
+    Rest,
+    Wake,
+    After,
+    Never,
+    Pose,
+    Relax,
+    Duck,
 }
 
 /// Every word the protocol has, lower case, in the order of [`ALL`].
-const KEYWORDS: [&str; 31] = [
+const KEYWORDS: [&str; 41] = [
     "help",
     "status",
     "save",
@@ -115,10 +125,20 @@ const KEYWORDS: [&str; 31] = [
     "hold",
     "cycles",
     "intensity",
+    "input",
+    "button",
+    "presence",
+    "rest",
+    "wake",
+    "after",
+    "never",
+    "pose",
+    "relax",
+    "duck",
 ];
 
 /// The [`Kw`] of each of [`KEYWORDS`].
-const ALL: [Kw; 31] = [
+const ALL: [Kw; 41] = [
     Kw::Help,
     Kw::Status,
     Kw::Save,
@@ -150,6 +170,16 @@ const ALL: [Kw; 31] = [
     Kw::Hold,
     Kw::Cycles,
     Kw::Intensity,
+    Kw::Input,
+    Kw::Button,
+    Kw::Presence,
+    Kw::Rest,
+    Kw::Wake,
+    Kw::After,
+    Kw::Never,
+    Kw::Pose,
+    Kw::Relax,
+    Kw::Duck,
 ];
 
 // A gesture's word must not be a word the protocol already has: the
@@ -344,6 +374,15 @@ impl<'a> Words<'a> {
             Some((name, value)) => Ok(Some((name, value, token))),
             None => Err(token.error(ParseErrorKind::Unexpected)),
         }
+    }
+
+    /// The rest of the line (from the next word on) and where it starts;
+    /// nothing is left after it.
+    pub(super) fn rest(&mut self) -> (&'a [u8], usize) {
+        self.skip_blanks();
+        let start = self.pos;
+        self.pos = self.line.len();
+        (self.line.get(start..).unwrap_or_default(), start)
     }
 
     /// Nothing may follow.
