@@ -277,8 +277,12 @@ fn main() -> ! {
                 };
                 let now = Micros(black_box(0));
                 inputs.configure(&settings, now);
-                inputs.update(now, black_box(0), black_box(false));
-                black_box((inputs.pending(), inputs.deadline(), inputs.status()));
+                inputs.update(&settings, now, black_box(0), black_box(false));
+                black_box((
+                    inputs.pending(&settings),
+                    inputs.deadline(&settings),
+                    inputs.status(&settings),
+                ));
                 inputs.sent();
             }
             _ => {}

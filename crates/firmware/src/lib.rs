@@ -10,6 +10,7 @@
 //!   generator, which makes each next set in the background.
 //! - [`hooks`]: the watchdog and status log of a board running on its own.
 //! - [`console`]: the console's loop over a board's byte [`console::Port`].
+//! - [`input`]: the trigger inputs' task over a board's [`input::InputSource`].
 //! - [`storage`]: the settings store in a board's flash.
 //!
 //! What a board adds is its hardware: the PWM outputs, the ports, the flash,
@@ -34,5 +35,6 @@ pub mod console;
 pub mod exchange;
 pub mod frame;
 pub mod hooks;
+pub mod input;
 pub mod storage;
 pub mod tasks;

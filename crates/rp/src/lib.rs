@@ -11,7 +11,9 @@
 //! - the loop generator (thread mode): generating a set takes about 2 ms of
 //!   CPU every 28 s, which frames preempt;
 //! - the console on the UART and on the USB serial port (thread mode), whose
-//!   interrupts sit below the frame task's ([`PORT_PRIORITY`]).
+//!   interrupts sit below the frame task's ([`PORT_PRIORITY`]);
+//! - the trigger inputs (thread mode, on their GPIO interrupt; see
+//!   [`input`]).
 //!
 //! Exactly one chip feature: `rp2040` or `rp235xa`.
 #![no_std]
@@ -25,6 +27,7 @@ compile_error!("choose one chip: the `rp2040` or the `rp235xa` feature");
 compile_error!("choose a chip: the `rp2040` or the `rp235xa` feature");
 
 pub mod flash;
+pub mod input;
 mod panic;
 pub mod pico;
 pub mod pwm;
@@ -49,6 +52,7 @@ use idle_head_firmware::boot::{self, Clock, EXCHANGE, Generator, Loaded};
 use idle_head_firmware::hooks::{BoardHooks, Watchdog};
 use static_cell::StaticCell;
 
+use crate::input::GpioInputs;
 use crate::pwm::ServoPwm;
 use crate::uart::UartPort;
 use crate::usb::UsbPort;
@@ -94,6 +98,10 @@ pub struct Board {
     pub flash: Peri<'static, FLASH>,
     /// The watchdog.
     pub watchdog: Peri<'static, WATCHDOG>,
+    /// The trigger inputs ([`input::GpioInputs`]).
+    pub inputs: GpioInputs,
+    /// Where the inputs are, for the log.
+    pub input_pins: &'static str,
 }
 
 /// The console service, shared by the ports (thread mode only).
@@ -127,6 +135,8 @@ pub fn start(spawner: Spawner, board: Board) {
         usb,
         flash,
         watchdog,
+        inputs,
+        input_pins,
     } = board;
     let watchdog = RpWatchdog::new(watchdog);
     match watchdog.reset_reason() {
@@ -146,6 +156,8 @@ pub fn start(spawner: Spawner, board: Board) {
         return;
     };
     spawn_frames(servos, &head, BoardWatchdog(watchdog));
+    spawn(spawner, input_task(inputs), "input");
+    defmt::info!("inputs: {=str}", input_pins);
     if let Some(service) = head.service {
         spawn_console(spawner, uart, uart_pins, usb, service);
     }
@@ -318,6 +330,12 @@ async fn frame_task(
 #[embassy_executor::task]
 async fn generator(generator: Generator) {
     idle_head_firmware::tasks::generate(generator, Clock).await;
+}
+
+/// The trigger inputs, for as long as the board runs.
+#[embassy_executor::task]
+async fn input_task(mut inputs: GpioInputs) {
+    idle_head_firmware::input::run(&mut inputs).await;
 }
 
 /// The USB device: enumeration, control requests, bus resets.

@@ -129,12 +129,11 @@ impl SimFrames {
     /// from `link`, the levels, actions into `queue`, the status published.
     fn inputs<const N: usize>(&mut self, queue: &CommandQueue<N>, link: &ConsoleLink) {
         let now = Micros(self.frame * 20_000);
-        if let Some(settings) = link.take_inputs() {
+        let settings = link.input_settings();
+        if link.take_inputs_changed() {
             self.inputs.configure(&settings, now);
         }
-        let idle = self
-            .inputs
-            .settings()
+        let idle = settings
             .roles
             .iter()
             .enumerate()
@@ -142,14 +141,14 @@ impl SimFrames {
             .fold(0, |bits, (i, _)| bits | (1 << i));
         let resting = self.head.rest_state() == RestState::Resting;
         self.inputs
-            .update(now, self.levels.unwrap_or(idle), resting);
-        while let Some(action) = self.inputs.pending() {
+            .update(&settings, now, self.levels.unwrap_or(idle), resting);
+        while let Some(action) = self.inputs.pending(&settings) {
             if queue.try_submit(action).is_err() {
                 break;
             }
             self.inputs.sent();
         }
-        link.publish_inputs(self.inputs.status());
+        link.publish_inputs(self.inputs.status(&settings));
     }
 
     /// Plays one frame as the frame task does: calibrations from `link`,

@@ -64,7 +64,8 @@ pub struct LookApplied {
 pub(crate) struct Gaze {
     /// `[pitch, yaw, envelope]`, on one clock.
     axes: [Glide; 3],
-    back: Option<[Glide; 3]>,
+    /// The planned return `[pitch, yaw]` (the envelope falls along it).
+    back: Option<[Glide; 2]>,
 }
 
 impl Gaze {
@@ -83,9 +84,10 @@ impl Gaze {
     #[inline]
     pub(crate) fn at(&mut self, now: u32) -> [i32; 3] {
         if self.returns_by(now)
-            && let Some(back) = self.back.take()
+            && let Some([pitch, yaw]) = self.back.take()
         {
-            self.axes = back;
+            let envelope = pitch.falling(ONE as i32);
+            self.axes = [pitch, yaw, envelope];
         }
         Glide::trio_at(&mut self.axes, now)
     }
@@ -171,11 +173,7 @@ impl Gaze {
                     .wrapping_add(frames)
                     .wrapping_add(params.frames(ms).max(1));
                 let back_frames = duration(params, offsets.map(i32::unsigned_abs), None);
-                let [pitch, yaw] = offsets;
-                Some(
-                    [pitch, yaw, ONE as i32]
-                        .map(|o| Glide::new(at, State::rest(o), 0, back_frames)),
-                )
+                Some(offsets.map(|o| Glide::new(at, State::rest(o), 0, back_frames)))
             }
         };
         let absolute =
@@ -247,28 +245,15 @@ fn check_duration(
 fn duration(params: &BehaviourParams, distance: [u32; 2], given: Option<Millis>) -> u32 {
     let gaze = params.config().gaze;
     let far = u64::from(distance[0].max(distance[1]));
-    let mut ms = match given {
+    let ms = match given {
         Some(ms) => u64::from(ms.0),
         None => u64::from(gaze.base.0) + (u64::from(gaze.per_degree.0) * far).div_ceil(1000),
     };
-    for (i, axis) in AXES.iter().enumerate() {
-        let d = u64::from(distance[i]);
+    let mut frames = 2;
+    for (axis, d) in AXES.iter().zip(distance) {
         let limits = params.limits(*axis, LimitMode::Gesture);
-        let speed = u64::from(limits.max_speed.0.max(1));
-        let accel = u64::from(limits.max_accel.0.max(1));
-        // T ≥ 1.875·D/v and T² ≥ 5.774·D/a (D in m°, T in ms).
-        ms = ms.max((1875 * d).div_ceil(1000 * speed));
-        let squared = (57_735 * d).div_ceil(10 * accel);
-        let root = squared.isqrt();
-        ms = ms.max(if root * root < squared {
-            root + 1
-        } else {
-            root
-        });
+        let fit = params.move_frames(ms, d, limits.max_speed.0, limits.max_accel.0);
+        frames = frames.max(fit);
     }
-    // Whole frames, rounded up: never faster than the limits allow.
-    let frame_us = u64::from(params.frame_us().max(1));
-    u32::try_from((ms * 1000).div_ceil(frame_us))
-        .unwrap_or(u32::MAX)
-        .max(2)
+    frames
 }

@@ -106,6 +106,21 @@ impl Glide {
         }
     }
 
+    /// A glide on this one's clock that falls from `from`, at rest, to 0:
+    /// the profile of a move from rest, `r = −from·(10, −15, 6)`, no
+    /// division (the reciprocal is this glide's).
+    pub(crate) fn falling(&self, from: i32) -> Self {
+        let d = -i64::from(from);
+        let r = |k: i64| (k * d).clamp(-BOUND, BOUND) as i32;
+        Self {
+            start: self.start,
+            frames: self.frames,
+            inverse: self.inverse,
+            target: 0,
+            r: [r(10), r(-15), r(6)],
+        }
+    }
+
     /// The target.
     pub(crate) const fn target(&self) -> i32 {
         self.target

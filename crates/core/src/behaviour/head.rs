@@ -97,9 +97,8 @@ impl<I: IdleSource> Head<I> {
     ) -> Result<Applied, BehaviourError> {
         let pose = driver.params().config().neutral_pose;
         let angles = driver.angles();
-        self.mixer
-            .note_position(core::array::from_fn(|i| angles[i].saturating_sub(pose[i])));
-        let applied = self.mixer.apply(action)?;
+        let at = core::array::from_fn(|i| angles[i].saturating_sub(pose[i]));
+        let applied = self.mixer.apply_at(action, at)?;
         match action {
             Action::Stop => driver.request_stop(),
             Action::Gesture(_)

@@ -134,9 +134,6 @@ pub struct Mixer {
     layers: [Option<Layer>; LAYERS],
     /// The rest layer.
     rest: Rest,
-    /// Where the head was at the last frame, offsets m° (for a rest's
-    /// duration; see [`Mixer::note_position`]).
-    position: [i32; 3],
 }
 
 impl Mixer {
@@ -164,7 +161,6 @@ impl Mixer {
             quiet_gain: [gain_of(amp) as u32; 3],
             quiet_centre: [0; 2],
             rest: Rest::new(),
-            position: [0; 3],
             now: 0,
             next: 0,
         }
@@ -199,6 +195,16 @@ impl Mixer {
     /// # Errors
     /// A [`BehaviourError`] for bad parameters (nothing changes then).
     pub fn apply(&mut self, action: &Action) -> Result<Applied, BehaviourError> {
+        self.apply_at(action, [Angle::ZERO; 3])
+    }
+
+    /// [`apply`](Self::apply) to a head whose last frame's offsets were
+    /// `at` (`[pitch, roll, yaw]`, what the driver made of them): a rest's
+    /// duration is fitted to the distance from there.
+    ///
+    /// # Errors
+    /// A [`BehaviourError`] for bad parameters (nothing changes then).
+    pub fn apply_at(&mut self, action: &Action, at: [Angle; 3]) -> Result<Applied, BehaviourError> {
         let next = self.next;
         let applied = match action {
             Action::Gesture(request) => {
@@ -225,7 +231,7 @@ impl Mixer {
                 Applied::Idle(self.glide_idle())
             }
             Action::Stop => return Ok(Applied::Stop),
-            Action::Rest => Applied::Rest(self.start_rest(next)),
+            Action::Rest => Applied::Rest(self.start_rest(next, at.map(Angle::millidegrees))),
             Action::Wake { toward } => match self.rest.wake(&self.params, next, *toward) {
                 Some(duration) => Applied::Wake(duration),
                 None => match toward {
@@ -257,12 +263,12 @@ impl Mixer {
         Ok(applied)
     }
 
-    /// Starts a rest at frame `next`: the pose's weight rises, and the
-    /// gaze, hidden under it, goes back to the centre (a wake starts from
-    /// there); returns the rest's duration.
-    fn start_rest(&mut self, next: u32) -> Millis {
+    /// Starts a rest at frame `next` of a head at `at` (offsets, m°): the
+    /// pose's weight rises, and the gaze, hidden under it, goes back to the
+    /// centre (a wake starts from there); returns the rest's duration.
+    fn start_rest(&mut self, next: u32, at: [i32; 3]) -> Millis {
         let pose = self.params.rest_pose;
-        let duration = self.rest.rest(&self.params, next, pose, self.position);
+        let duration = self.rest.rest(&self.params, next, pose, at);
         let frames = self.params.frames(duration);
         if !self.gaze.centred() {
             // Within the longest move: the built-in rest times are.
@@ -273,13 +279,6 @@ impl Mixer {
                 .center(&self.params, next, Some(Millis(ms.0.max(1))));
         }
         duration
-    }
-
-    /// The head's offsets at the last frame, `[pitch, roll, yaw]` (what the
-    /// driver made of them): a rest's duration is fitted to the distance
-    /// from there. [`Head`](super::Head) notes it before each action.
-    pub fn note_position(&mut self, offsets: [Angle; 3]) {
-        self.position = offsets.map(Angle::millidegrees);
     }
 
     /// Where the head is in resting.

@@ -159,6 +159,29 @@ impl BehaviourParams {
         }
     }
 
+    /// Whole frames of a move of `distance` m° that takes at least `ms`,
+    /// lengthened until its minimum-jerk profile fits `speed` °/s and
+    /// `accel` °/s² (it peaks at `1.875·D/T` and `5.774·D/T²`); rounded up,
+    /// at least 2: never faster than the limits allow.
+    pub(crate) fn move_frames(&self, ms: u64, distance: u32, speed: u32, accel: u32) -> u32 {
+        let d = u64::from(distance);
+        let (speed, accel) = (u64::from(speed.max(1)), u64::from(accel.max(1)));
+        // T ≥ 1.875·D/v and T² ≥ 5.774·D/a (D in m°, T in ms).
+        let squared = (57_735 * d).div_ceil(10 * accel);
+        let root = squared.isqrt();
+        let ms = ms
+            .max((1875 * d).div_ceil(1000 * speed))
+            .max(if root * root < squared {
+                root + 1
+            } else {
+                root
+            });
+        let frame_us = u64::from(self.frame_us.max(1));
+        u32::try_from((ms * 1000).div_ceil(frame_us))
+            .unwrap_or(u32::MAX)
+            .max(2)
+    }
+
     /// The duration of `frames` frames, rounded to ms.
     #[must_use]
     pub const fn millis(&self, frames: u32) -> Millis {

@@ -189,12 +189,9 @@ impl Rest {
     #[inline(never)]
     pub(crate) fn blend(&mut self, now: u32, base: [i32; 3]) -> [i32; 3] {
         self.base = base;
-        let w = self.weight.at(now);
-        let pose = [
-            self.pose[0].at(now),
-            self.pose[1].at(now),
-            self.pose[2].at(now),
-        ];
+        let w = value(&mut self.weight, now);
+        let [pitch, roll, yaw] = &mut self.pose;
+        let pose = [value(pitch, now), value(roll, now), value(yaw, now)];
         if w >= ONE as i32 {
             return pose;
         }
@@ -237,6 +234,13 @@ impl Rest {
     }
 }
 
+/// A glide's value at `now`, out of line: the blend's four glides share
+/// one copy of the code (they play only while resting or waking).
+#[inline(never)]
+fn value(glide: &mut Glide, now: u32) -> i32 {
+    glide.at(now)
+}
+
 /// The glance towards `yaw`: level, held [`GLANCE_HOLD`], then back.
 pub(crate) fn glance(params: &BehaviourParams, yaw: Angle) -> LookRequest {
     LookRequest {
@@ -261,19 +265,12 @@ fn far(a: [i32; 3], b: [i32; 3], extra: u32) -> u32 {
 /// Frames of a blend over `distance` m°: at least `least`, and long enough
 /// for the idle limits of every axis (see the [module docs](self#how-long)).
 fn fit(params: &BehaviourParams, least: Millis, distance: u32) -> u32 {
-    let d = u64::from(distance);
-    let mut ms = u64::from(least.0);
+    let mut frames = 2;
     for axis in crate::axis::Axis::ALL {
         let limits = params.limits(axis, LimitMode::Idle);
-        let speed = u64::from(limits.max_speed.0.saturating_sub(IDLE_SPEED).max(1));
-        let accel = u64::from((limits.max_accel.0 / 2).max(1));
-        // T ≥ 1.875·D/v and T² ≥ 5.774·D/a (D in m°, T in ms).
-        ms = ms.max((1875 * d).div_ceil(1000 * speed));
-        let squared = (57_735 * d).div_ceil(10 * accel);
-        ms = ms.max(squared.isqrt() + 1);
+        let speed = limits.max_speed.0.saturating_sub(IDLE_SPEED);
+        let fit = params.move_frames(least.0.into(), distance, speed, limits.max_accel.0 / 2);
+        frames = frames.max(fit);
     }
-    let frame_us = u64::from(params.frame_us().max(1));
-    u32::try_from((ms * 1000).div_ceil(frame_us))
-        .unwrap_or(u32::MAX)
-        .max(2)
+    frames
 }

@@ -114,7 +114,10 @@ pub struct ConsoleLink {
     servos: Mutex<CriticalSectionRawMutex, Cell<[Option<ServoCalibration>; 3]>>,
     seeds: Signal<CriticalSectionRawMutex, [u32; 3]>,
     live: Signal<CriticalSectionRawMutex, LiveConfig>,
-    inputs: Signal<CriticalSectionRawMutex, InputSettings>,
+    /// The inputs' settings in effect (one copy, which the input task
+    /// reads at every wake), and whether they changed.
+    inputs: Mutex<CriticalSectionRawMutex, Cell<InputSettings>>,
+    inputs_changed: Signal<CriticalSectionRawMutex, ()>,
     input_status: Mutex<CriticalSectionRawMutex, Cell<InputStatus>>,
 }
 
@@ -134,7 +137,8 @@ impl ConsoleLink {
             servos: Mutex::new(Cell::new([None; 3])),
             seeds: Signal::new(),
             live: Signal::new(),
-            inputs: Signal::new(),
+            inputs: Mutex::new(Cell::new(InputSettings::DEFAULT)),
+            inputs_changed: Signal::new(),
             input_status: Mutex::new(Cell::new(InputStatus { high: 0, active: 0 })),
         }
     }
@@ -194,19 +198,27 @@ impl ConsoleLink {
         self.live.try_take()
     }
 
-    /// The console: the inputs' roles and the rest timer for the input task.
+    /// The boot, then the console: the inputs' roles and the rest timer in
+    /// effect, for the input task.
     pub fn set_inputs(&self, inputs: InputSettings) {
-        self.inputs.signal(inputs);
+        self.inputs.lock(|cell| cell.set(inputs));
+        self.inputs_changed.signal(());
     }
 
-    /// The input task: waits for new input settings.
-    pub async fn inputs_changed(&self) -> InputSettings {
-        self.inputs.wait().await
+    /// The input task: the inputs' settings in effect.
+    pub fn input_settings(&self) -> InputSettings {
+        self.inputs.lock(Cell::get)
     }
 
-    /// The input task (or a host test): new input settings, if any.
-    pub fn take_inputs(&self) -> Option<InputSettings> {
-        self.inputs.try_take()
+    /// The input task: waits until the inputs' settings change.
+    pub async fn inputs_changed(&self) {
+        self.inputs_changed.wait().await;
+    }
+
+    /// The input task (or a host test): whether the inputs' settings changed
+    /// since the last call.
+    pub fn take_inputs_changed(&self) -> bool {
+        self.inputs_changed.try_take().is_some()
     }
 
     /// The input task: the inputs' levels as they are now.

@@ -311,10 +311,10 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         if settings.seeds != self.settings.seeds {
             self.link.reseed(settings.seeds);
         }
-        let old = core::mem::replace(&mut self.settings, *settings);
+        self.settings = *settings;
         self.behaviour = valid.behaviour;
         self.source = source;
-        self.adopt_inputs(&old);
+        self.adopt_inputs();
         true
     }
 

@@ -10,7 +10,8 @@
 
 use super::Micros;
 
-/// One input's debouncer; see the [module docs](self).
+/// One input's debouncer; see the [module docs](self). Its debounce time
+/// is its input's role's, given with each call.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Debouncer {
     /// The debounced level (`true`: high).
@@ -18,21 +19,24 @@ pub struct Debouncer {
     /// The level last seen, and since when.
     candidate: bool,
     since: Micros,
-    /// The debounce time, µs.
-    hold: u64,
     /// Whether a level was seen yet.
     primed: bool,
 }
 
+impl Default for Debouncer {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl Debouncer {
-    /// A debouncer that waits `hold_us` µs; its first level is taken as it is.
+    /// A debouncer that has seen nothing: its first level is taken as it is.
     #[must_use]
-    pub const fn new(hold_us: u64) -> Self {
+    pub const fn new() -> Self {
         Self {
             stable: false,
             candidate: false,
             since: Micros(0),
-            hold: hold_us,
             primed: false,
         }
     }
@@ -43,9 +47,9 @@ impl Debouncer {
         self.stable
     }
 
-    /// The level `level` seen at `now`: `Some(new level)` when it makes an
-    /// edge.
-    pub fn update(&mut self, now: Micros, level: bool) -> Option<bool> {
+    /// The level `level` seen at `now`, with a debounce time of `hold` µs:
+    /// `Some(new level)` when it makes an edge.
+    pub fn update(&mut self, now: Micros, level: bool, hold: u64) -> Option<bool> {
         if !self.primed {
             self.primed = true;
             (self.stable, self.candidate, self.since) = (level, level, now);
@@ -55,19 +59,19 @@ impl Debouncer {
             self.candidate = level;
             self.since = now;
         }
-        if self.candidate != self.stable && now.0.saturating_sub(self.since.0) >= self.hold {
+        if self.candidate != self.stable && now.0.saturating_sub(self.since.0) >= hold {
             self.stable = self.candidate;
             return Some(self.stable);
         }
         None
     }
 
-    /// When to look again for an edge, if one may come without another
-    /// change of level.
+    /// When to look again for an edge (with a debounce time of `hold` µs),
+    /// if one may come without another change of level.
     #[must_use]
-    pub const fn deadline(&self) -> Option<Micros> {
+    pub const fn deadline(&self, hold: u64) -> Option<Micros> {
         if self.primed && self.candidate != self.stable {
-            Some(Micros(self.since.0.saturating_add(self.hold)))
+            Some(Micros(self.since.0.saturating_add(hold)))
         } else {
             None
         }
@@ -83,27 +87,28 @@ mod tests {
     /// Edges out of `levels` (`(ms, level)`), each seen at its time and at
     /// every deadline asked for, as the input task does.
     fn edges(hold_ms: u64, levels: &[(u64, bool)]) -> Vec<(u64, bool)> {
-        let mut d = Debouncer::new(hold_ms * MS);
+        let hold = hold_ms * MS;
+        let mut d = Debouncer::new();
         let mut out = Vec::new();
         let mut level = false;
         let seen = |d: &mut Debouncer, at: u64, level: bool, out: &mut Vec<(u64, bool)>| {
-            if let Some(edge) = d.update(Micros(at), level) {
+            if let Some(edge) = d.update(Micros(at), level, hold) {
                 out.push((at / MS, edge));
             }
         };
         for (i, &(at, new)) in levels.iter().enumerate() {
             let at = at * MS;
             // The deadlines before this change.
-            while let Some(due) = d.deadline().filter(|due| due.0 <= at) {
+            while let Some(due) = d.deadline(hold).filter(|due| due.0 <= at) {
                 seen(&mut d, due.0, level, &mut out);
-                if d.deadline() == Some(due) {
+                if d.deadline(hold) == Some(due) {
                     break;
                 }
             }
             level = new;
             seen(&mut d, at, level, &mut out);
             if i + 1 == levels.len()
-                && let Some(due) = d.deadline()
+                && let Some(due) = d.deadline(hold)
             {
                 seen(&mut d, due.0, level, &mut out);
             }
@@ -123,9 +128,9 @@ mod tests {
     fn the_first_level_is_no_edge() {
         assert_eq!(edges(5, &[(0, false)]), []);
         assert_eq!(edges(5, &[(0, true)]), []);
-        let mut d = Debouncer::new(5 * MS);
-        assert_eq!(d.deadline(), None);
-        assert_eq!(d.update(Micros(7), true), None);
+        let mut d = Debouncer::new();
+        assert_eq!(d.deadline(5 * MS), None);
+        assert_eq!(d.update(Micros(7), true, 5 * MS), None);
         assert!(d.level());
     }
 
@@ -147,13 +152,14 @@ mod tests {
     #[test]
     fn a_level_stuck_forever_is_one_edge() {
         assert_eq!(edges(50, &[(0, false), (10, true)]), [(60, true)]);
-        let mut d = Debouncer::new(50 * MS);
-        d.update(Micros(0), false);
-        d.update(Micros(10 * MS), true);
-        assert_eq!(d.update(Micros(60 * MS), true), Some(true));
+        let hold = 50 * MS;
+        let mut d = Debouncer::new();
+        d.update(Micros(0), false, hold);
+        d.update(Micros(10 * MS), true, hold);
+        assert_eq!(d.update(Micros(60 * MS), true, hold), Some(true));
         for t in 61..10_000 {
-            assert_eq!(d.update(Micros(t * MS), true), None);
+            assert_eq!(d.update(Micros(t * MS), true, hold), None);
         }
-        assert_eq!(d.deadline(), None);
+        assert_eq!(d.deadline(hold), None);
     }
 }

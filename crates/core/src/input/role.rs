@@ -2,7 +2,6 @@
 //! the pull resistor its source sets up for it ([`Pull`]).
 
 pub use crate::command::InputRole;
-use crate::units::Millis;
 
 use super::{BUTTON_DEBOUNCE, PRESENCE_DEBOUNCE};
 
@@ -34,14 +33,16 @@ impl InputRole {
         !matches!(self, Self::Button(_))
     }
 
-    /// How long its level must hold to count (`None`: off, never counts).
+    /// How long its level must hold to count, in µs (`None`: off, never
+    /// counts).
     #[must_use]
-    pub const fn debounce(&self) -> Option<Millis> {
-        match self {
-            Self::Off => None,
-            Self::Button(_) => Some(BUTTON_DEBOUNCE),
-            Self::Presence { .. } => Some(PRESENCE_DEBOUNCE),
-        }
+    pub const fn debounce(&self) -> Option<u64> {
+        let ms = match self {
+            Self::Off => return None,
+            Self::Button(_) => BUTTON_DEBOUNCE,
+            Self::Presence { .. } => PRESENCE_DEBOUNCE,
+        };
+        Some(ms.0 as u64 * 1000)
     }
 
     /// Whether it is a presence sensor.

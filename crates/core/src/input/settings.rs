@@ -48,6 +48,17 @@ impl InputSettings {
     pub fn presence(&self) -> bool {
         self.roles.iter().any(InputRole::is_presence)
     }
+
+    /// The inputs a source should watch for a change: every input that is
+    /// not off (bit `i`).
+    #[must_use]
+    pub fn watched(&self) -> u8 {
+        self.roles
+            .iter()
+            .enumerate()
+            .filter(|(_, role)| !matches!(role, InputRole::Off))
+            .fold(0, |bits, (i, _)| bits | (1 << i))
+    }
 }
 
 impl Default for InputSettings {

@@ -1,14 +1,14 @@
 //! `input <n> [off | button <action line> | presence [<yaw_mdeg>]]`.
 //!
 //! A button's action is any motion line (what `Command::Act` parses to),
-//! parsed by the same parser from the rest of the line: its errors point
-//! at the word in the whole line.
+//! parsed from the rest of the line by the parser's own motion grammar (a
+//! motion holds no other command: a line never nests).
 
 use crate::command::{Command, InputRole};
 use crate::input::{FIRST_INPUT, INPUTS};
 use crate::units::Angle;
 
-use super::error::{ParseError, ParseErrorKind, Span};
+use super::error::{ParseError, ParseErrorKind};
 use super::words::{Field, Kw, Word, Words};
 
 /// The inputs' numbers, as the console names them (GP2 to GP5).
@@ -37,11 +37,14 @@ pub(super) fn input(words: &mut Words<'_>) -> Result<Command, ParseError> {
                 .map(|v| Angle::from_millidegrees(v as i32)),
         },
         Word::Is(Kw::Button) => {
-            let (line, at) = words.rest();
-            if line.is_empty() {
+            // The motion command: the rest of the line, on the same words.
+            let Some(first) = words.next() else {
                 return Err(words.error_here(ParseErrorKind::Missing(MOTION)));
-            }
-            InputRole::Button(action(line, at)?)
+            };
+            let Some(action) = super::motion(first, words)? else {
+                return Err(first.error(ParseErrorKind::UnknownWord { expected: MOTION }));
+            };
+            InputRole::Button(action)
         }
         _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: ROLES })),
     };
@@ -49,33 +52,4 @@ pub(super) fn input(words: &mut Words<'_>) -> Result<Command, ParseError> {
         input,
         role: Some(role),
     })
-}
-
-/// The motion command of `line`, which starts at byte `at` of the whole
-/// line (its errors are moved there). Not the whole parser: a motion
-/// holds no other command, so a line never nests.
-fn action(line: &[u8], at: usize) -> Result<crate::command::Action, ParseError> {
-    let moved = |e: ParseError| ParseError {
-        kind: e.kind,
-        at: Span {
-            start: shift(e.at.start, at),
-            end: shift(e.at.end, at),
-        },
-    };
-    let mut words = Words::new(line);
-    let Some(first) = words.next() else {
-        return Err(moved(words.error_here(ParseErrorKind::Missing(MOTION))));
-    };
-    let Some(action) = super::motion(first, &mut words).map_err(moved)? else {
-        return Err(moved(
-            first.error(ParseErrorKind::UnknownWord { expected: MOTION }),
-        ));
-    };
-    words.end().map_err(moved)?;
-    Ok(action)
-}
-
-/// `position + offset`, within `u16`.
-fn shift(position: u16, offset: usize) -> u16 {
-    u16::try_from(usize::from(position).saturating_add(offset)).unwrap_or(u16::MAX)
 }

@@ -23,6 +23,7 @@ use crate::text::{Describe, Text};
 pub struct ActionLine<'a>(pub &'a Action);
 
 impl Describe for ActionLine<'_> {
+    #[inline(never)]
     fn describe(&self, out: &mut dyn Text) {
         match *self.0 {
             Action::Gesture(g) => {

@@ -376,15 +376,6 @@ impl<'a> Words<'a> {
         }
     }
 
-    /// The rest of the line (from the next word on) and where it starts;
-    /// nothing is left after it.
-    pub(super) fn rest(&mut self) -> (&'a [u8], usize) {
-        self.skip_blanks();
-        let start = self.pos;
-        self.pos = self.line.len();
-        (self.line.get(start..).unwrap_or_default(), start)
-    }
-
     /// Nothing may follow.
     pub(super) fn end(&mut self) -> Result<(), ParseError> {
         match self.next() {

@@ -19,6 +19,7 @@ use crate::console::ActionLine;
 impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
     /// `input <n>`: `ok input <n> off`, or its level, then its role as
     /// `input <n> <role>` takes it (`button nod 6000`, `presence -20000`).
+    #[inline(never)]
     pub(super) fn show_input(&self, input: u8, reply: &mut Reply<'_>) {
         let i = usize::from(input - FIRST_INPUT);
         let Some(role) = self.settings.inputs.roles.get(i) else {
@@ -50,6 +51,7 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
     /// the console checks a motion command; a direction past the yaw
     /// limits is kept, and the glance clamped to them (the reply says
     /// where it goes).
+    #[inline(never)]
     pub(super) fn set_input(&mut self, input: u8, role: InputRole, reply: &mut Reply<'_>) {
         let i = usize::from(input - FIRST_INPUT);
         if i >= INPUTS {
@@ -83,6 +85,7 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
     }
 
     /// `rest after|pose|relax …`.
+    #[inline(never)]
     pub(super) fn set_rest(&mut self, setting: RestSetting, reply: &mut Reply<'_>) {
         match setting {
             RestSetting::After(after) => {
@@ -112,6 +115,7 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
     }
 
     /// `look duck <percent>`.
+    #[inline(never)]
     pub(super) fn set_look_duck(&mut self, duck: Percent) {
         self.settings.behaviour.gaze.duck = duck;
         self.behaviour.set_live(&self.settings.behaviour.live());
@@ -122,6 +126,7 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
     /// The inputs for `status`: `-` for an input that is off, else `b`
     /// (button) or `p` (presence) and `1` if active, `0` if not, from GP2
     /// on (`inputs=b0,p1,-,-`).
+    #[inline(never)]
     pub(super) fn status_inputs(&self, out: &mut dyn Text) {
         let status = self.link.inputs();
         out.str(" inputs=");
@@ -144,14 +149,11 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
     }
 
     /// Puts the inputs, rest and look settings of the settings just
-    /// adopted in effect, where they changed from `old`'s.
-    pub(super) fn adopt_inputs(&self, old: &crate::settings::Settings) {
-        if self.settings.inputs != old.inputs {
-            self.link.set_inputs(self.settings.inputs);
-        }
-        if self.settings.behaviour.live() != old.behaviour.live() {
-            self.link.set_live(self.settings.behaviour.live());
-        }
+    /// adopted in effect (sent whether they changed or not: taking them
+    /// again changes nothing).
+    pub(super) fn adopt_inputs(&self) {
+        self.link.set_inputs(self.settings.inputs);
+        self.link.set_live(self.settings.behaviour.live());
     }
 
     /// Why the settings `next` would refuse a button's action with their
