@@ -14,20 +14,24 @@ mod exchange;
 mod expect;
 mod flood;
 mod image;
+mod inputs;
 mod node;
 mod noise;
 mod planted;
 mod pulses;
+mod pulses_csv;
 mod run;
+mod script;
 mod stages;
 mod store;
 mod unmodelled;
 
-use std::{fmt::Write as _, time::Duration};
+use std::{fmt::Write as _, path::PathBuf, time::Duration};
 
 use anyhow::Result;
 
 pub use flood::{FLOOD_STAGE, test_flood};
+pub use inputs::{INPUTS_STAGE, test_inputs};
 pub use noise::{NOISE_STAGE, test_noise};
 pub use run::{Report, logged_peak_stack};
 pub use stages::{
@@ -42,7 +46,7 @@ use crate::setup;
 /// Options of `cargo xtask sim`.
 // The runs are flags that exclude each other (clap checks it).
 #[allow(clippy::struct_excessive_bools)]
-#[derive(Debug, Clone, Copy, clap::Args)]
+#[derive(Debug, Clone, clap::Args)]
 pub struct Args {
     /// Virtual time to run, in seconds (default: 32.5, a 30 s loop, the
     /// 2 s fade-in and half a second of boot; with `--console`, 6).
@@ -57,6 +61,12 @@ pub struct Args {
     /// softly again.
     #[arg(long, conflicts_with_all = ["console", "store", "noise", "flood"])]
     pub drill: bool,
+    /// The trigger inputs' check instead: a presence script (a sensor on
+    /// GP2, a rest after 2 s with relax on, someone at 7 s) played into the
+    /// shipped image; the rest, the pulses stopping, the soft wake and the
+    /// glance checked from the pulses, every pulse against the host trace.
+    #[arg(long, conflicts_with_all = ["drill", "console", "store", "noise", "flood", "script"])]
+    pub inputs: bool,
     /// The console instead: a scripted exchange over UART0 and then over
     /// USB CDC-ACM, every reply checked, and the image's RAM with the peak
     /// stack of that run against the budget.
@@ -86,6 +96,16 @@ pub struct Args {
     /// the known gaps that do not matter (summed up in one line without).
     #[arg(long, short)]
     pub verbose: bool,
+    /// Play a trace script into the shipped image instead (`cargo xtask
+    /// trace --script`'s: pin lines drive GP2 to GP5, console lines go to
+    /// UART0, times from the first frame) and check every pulse against the
+    /// host trace of it. Without `--seconds`, to 5 s after its last line.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood"])]
+    pub script: Option<PathBuf>,
+    /// With `--script`: write the pulses measured on GP16, GP18 and GP20 to
+    /// this CSV, one row per frame: `t_ms,pitch_us,roll_us,yaw_us`.
+    #[arg(long, value_name = "FILE.csv", requires = "script")]
+    pub pulses: Option<PathBuf>,
 }
 
 /// One loop (30 s), the fade-in (2 s) and half a second for the boot.
@@ -125,6 +145,20 @@ pub fn command(args: &Args) -> Result<bool> {
     let root = project::root();
     setup::ensure_toolchain(&root)?;
     let metadata = project::metadata(&root)?;
+    if let Some(path) = &args.script {
+        return script::command(
+            &root,
+            &metadata,
+            path,
+            args.virtual_time,
+            args.timeout,
+            args.pulses.as_ref(),
+        );
+    }
+    if args.inputs {
+        PICO.build(&root)?;
+        return Ok(passed("inputs", inputs::test_inputs(&root, &metadata)));
+    }
     if args.drill {
         return Ok(passed(
             "watchdog drill",

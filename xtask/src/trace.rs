@@ -38,10 +38,19 @@ use idle_head_core::{Axis, Playback};
 use idle_head_firmware::config::IDLE_MODE;
 
 use host::Origin;
+use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use marks::Mark;
-use script::{Event, Kind};
+pub use script::{Event, Kind};
+
+/// A script's events (see `script.rs`), checked with `params`.
+///
+/// # Errors
+/// Every bad line, each with its number and why.
+pub fn parse_script(text: &str, params: &BehaviourParams) -> Result<Vec<Event>> {
+    script::parse(text, params)
+}
 
 /// Options of `cargo xtask trace`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
@@ -94,6 +103,8 @@ pub struct Row {
     pub angles: [i32; 3],
     /// Pulse widths, ns.
     pub pulses: [u64; 3],
+    /// The duties written, counts of the Pico's PWM (0: no pulse).
+    pub duties: [u16; 3],
 }
 
 /// The simulated run.
@@ -229,6 +240,7 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
             t_ms: t_us / 1000,
             angles: servos.map(|s| s.angle.millidegrees()),
             pulses: servos.map(|s| (u64::from(s.duty.0) * count_ps + 500) / 1000),
+            duties: servos.map(|s| s.duty.0),
         });
     }
     marks::settle(

@@ -23,7 +23,7 @@
 //! frame task takes it before its next frame: it starts within a frame of
 //! the edge.
 
-use embassy_futures::select::select3;
+use embassy_futures::select::{Either3, select3};
 use embassy_time::{Duration, Instant, Timer};
 use idle_head_core::console::HeadMode;
 use idle_head_core::input::{FIRST_INPUT, INPUTS, InputSettings, Inputs, Micros, Pull};
@@ -75,26 +75,31 @@ pub async fn run(source: &mut impl InputSource) -> ! {
     // (The settings are read into short scopes, not kept across an
     // `.await`: the task's future holds no copy of them.)
     let mut inputs = {
+        // The boot's settings are these: no change to take.
+        let _ = LINK.take_inputs_changed();
         let settings = LINK.input_settings();
         pulls(source, &settings);
         log_roles(&settings);
         Inputs::new(&settings, now())
     };
     let mut shown = Shown::default();
+    let mut changed = false;
     loop {
-        let (levels, watched, deadline) = step(source, &mut inputs, &mut shown);
+        let (levels, watched, deadline) = step(source, &mut inputs, &mut shown, changed);
         let timer = async {
             match deadline {
                 Some(at) => Timer::at(at).await,
                 None => core::future::pending().await,
             }
         };
-        select3(
+        let woke = select3(
             source.changed(levels, watched),
             timer,
             LINK.inputs_changed(),
         )
         .await;
+        // (The wait took the signal of a change of settings.)
+        changed = matches!(woke, Either3::Third(()));
     }
 }
 
@@ -105,16 +110,17 @@ struct Shown {
     lost: u32,
 }
 
-/// One wake of the input task: new settings, the levels, the actions to
-/// the queue, the status to the link. Returns the levels read, the inputs
-/// to watch and when to wake at the latest.
+/// One wake of the input task: new settings (if `changed`), the levels,
+/// the actions to the queue, the status to the link. Returns the levels
+/// read, the inputs to watch and when to wake at the latest.
 fn step(
     source: &mut impl InputSource,
     inputs: &mut Inputs,
     shown: &mut Shown,
+    changed: bool,
 ) -> (u8, u8, Option<Instant>) {
     let settings = LINK.input_settings();
-    if LINK.take_inputs_changed() {
+    if changed || LINK.take_inputs_changed() {
         inputs.configure(&settings, now());
         pulls(source, &settings);
         log_roles(&settings);

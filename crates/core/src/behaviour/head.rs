@@ -148,9 +148,9 @@ impl<I: IdleSource> Head<I> {
     }
 
     /// Between frames: gives the driver the limits of the modes the mixer
-    /// asks for from the next frame on (see the [module docs](self)), and
-    /// stops or brings back the pulses as the rest asks (relaxed at the
-    /// rest pose).
+    /// asks for from the next frame on (see the [module docs](self)), stops
+    /// or brings back the pulses as the rest asks (relaxed at the rest
+    /// pose), and starts the glance a wake ended in.
     pub fn sync<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>) {
         let wanted = self.mixer.modes();
         if !LimitMode::same(wanted, self.modes) {
@@ -159,6 +159,12 @@ impl<I: IdleSource> Head<I> {
         let relaxed = self.mixer.wants_relaxed();
         if relaxed != driver.is_relaxed() {
             driver.set_relaxed(relaxed);
+        }
+        if let Some(glance) = self.mixer.take_glance() {
+            // A wake ended with a direction: the glance, as a look. (It is
+            // clamped to the limits and never refused: a failure changes
+            // nothing.)
+            let _ = self.apply(driver, &glance);
         }
     }
 

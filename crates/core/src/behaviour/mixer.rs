@@ -109,6 +109,8 @@ pub struct Mixer {
     /// The rest layer is on: [`Rest::active`], kept here where the frame
     /// path reaches it cheaply.
     resting: bool,
+    /// A wake has ended: the glance to start (see [`Mixer::take_glance`]).
+    glance: Option<Angle>,
     /// Bit `i`: axis `i` was on (a gesture or a gaze move playing on it) at
     /// the last frame mixed in full, and so at every frame since.
     on: u8,
@@ -158,6 +160,7 @@ impl Mixer {
             quiet: true,
             quiet_unity: gain_of(amp) as u32 == ONE,
             resting: false,
+            glance: None,
             quiet_gain: [gain_of(amp) as u32; 3],
             quiet_centre: [0; 2],
             rest: Rest::new(),
@@ -279,6 +282,14 @@ impl Mixer {
                 .center(&self.params, next, Some(Millis(ms.0.max(1))));
         }
         duration
+    }
+
+    /// The glance a wake with a direction ends in, once it is due: a look
+    /// to apply before the next frame (what [`Head::sync`](super::Head::sync)
+    /// does).
+    pub fn take_glance(&mut self) -> Option<Action> {
+        let yaw = self.glance.take()?;
+        Some(Action::Look(rest::glance(&self.params, yaw)))
     }
 
     /// Where the head is in resting.
@@ -444,18 +455,12 @@ impl Mixer {
     /// axes.
     #[inline(never)]
     fn events(&mut self, now: u32, prev: u32, active: u8, centre: [i32; 2], gains: [u32; 2]) {
-        let glance = self.rest.settle();
-        self.resting = self.rest.active();
-        if let Some(yaw) = glance {
-            // Awake again: the glance. (A glance is a valid look: clamped
-            // to the limits, the built-in hold.)
-            let glance = rest::glance(&self.params, yaw);
-            if self.gaze.look(&self.params, self.next, &glance).is_ok() {
-                self.gazing();
-                // Its end is an event to find.
-                self.ends = now;
-            }
+        if let Some(yaw) = self.rest.settle() {
+            // Awake again: the glance, from the next frame on. It is applied
+            // between frames, as an action is (its planning divides).
+            self.glance = Some(yaw);
         }
+        self.resting = self.rest.active();
         let moving = self.gaze.moving();
         let returning = self.gaze.returns_by(self.next);
         let on = active | u8::from(moving[0]) | (u8::from(moving[1]) << 2);
