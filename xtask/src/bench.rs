@@ -35,6 +35,7 @@ use std::{fmt::Write as _, path::Path};
 use anyhow::{Context, Result, bail};
 
 mod frame;
+mod latency_input;
 
 pub use frame::FrameRow;
 use frame::frames_over_budget;
@@ -312,6 +313,11 @@ pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Resu
         println!();
         print!("{}", frame.lines());
     }
+    // The input edge's latency, in the RP2040 emulator (the Pico image).
+    project::PICO.build(root)?;
+    let latency = latency_input::run(root, metadata)?;
+    println!();
+    print!("{}", latency.lines());
     if let Some(over) = frames_over_budget(&frames) {
         if options.no_budget {
             println!("(--no-budget: the frame ceilings are reported, not enforced)");

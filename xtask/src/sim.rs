@@ -32,6 +32,23 @@ use anyhow::Result;
 
 pub use flood::{FLOOD_STAGE, test_flood};
 pub use inputs::{INPUTS_STAGE, test_inputs};
+pub use script::{default_time as script_time, parse as parse_script};
+
+/// Plays a script's `events` into the shipped image (built) for `time` from
+/// its first frame; every pulse checked against what the firmware wrote:
+/// on time, its own frame's, within the servos' limits (see `script.rs`).
+///
+/// # Errors
+/// If the emulator cannot run.
+pub fn play_script(
+    root: &std::path::Path,
+    metadata: &crate::project::Metadata,
+    events: Vec<crate::trace::Event>,
+    time: Duration,
+    wall: Duration,
+) -> Result<Report> {
+    Ok(script::play(root, metadata, events, time, wall, script::Against::Written)?.report)
+}
 pub use noise::{NOISE_STAGE, test_noise};
 pub use run::{Report, logged_peak_stack};
 pub use stages::{

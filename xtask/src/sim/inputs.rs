@@ -54,7 +54,14 @@ const REST_PITCH: f64 = (1500.0 - 8.0 * 11.111) / 0.3125;
 /// `cargo xtask test`'s stage: plays [`SCRIPT`] and checks it.
 pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     let events = script::parse(SCRIPT)?;
-    let run = script::play(root, metadata, events, TIME, super::WALL)?;
+    let run = script::play(
+        root,
+        metadata,
+        events,
+        TIME,
+        super::WALL,
+        script::Against::Host,
+    )?;
     let report = &run.report;
     print!("{}", report.table());
     println!("{}", report.verdict());
@@ -96,7 +103,9 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
         .filter(|p| p.rise <= before.rise && before.rise - p.rise < 2.5 * period)
         .all(|p| (f64::from(p.counts) - REST_PITCH).abs() <= 1.0);
     if !held {
-        problems.push("the head did not hold the rest pose (pitch −8°) before the pulses stopped".into());
+        problems.push(
+            "the head did not hold the rest pose (pitch −8°) before the pulses stopped".into(),
+        );
     }
     // 2. Relaxed: seconds without pulses on every servo, ending after the
     // sensor's edge.
@@ -114,46 +123,8 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
             problems.push(format!("{name} had pulses while pitch had none"));
         }
     }
-    // 3. Soft start: the first pulse after the gap is the last before it,
-    // and the next second (the idle coming back) within the idle limits.
-    for (i, name) in ["pitch", "roll", "yaw"].iter().enumerate() {
-        let first = pulses[i].iter().position(|p| p.rise >= after.rise - period / 2.0);
-        let Some(first) = first else {
-            problems.push(format!("{name}: no pulse after the gap"));
-            continue;
-        };
-        let last_before = first.checked_sub(1).map(|k| pulses[i][k].counts);
-        if last_before.is_none_or(|c| c.abs_diff(pulses[i][first].counts) > 1) {
-            problems.push(format!("{name}: the first pulse after the gap is not the last before it"));
-        }
-        let wake: Vec<f64> = pulses[i][first..]
-            .iter()
-            .take(50)
-            .map(|p| f64::from(p.counts))
-            .collect();
-        let step = wake.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
-        let turn = wake
-            .windows(3)
-            .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
-            .fold(0.0, f64::max);
-        println!("{name}: waking, steps up to {step:.0} counts a frame, changes of step up to {turn:.0}");
-        // (A count of rounding each way.)
-        if step > IDLE_STEP + 1.0 || turn > IDLE_TURN + 2.0 {
-            problems.push(format!(
-                "{name}: the wake exceeds the idle limits ({step:.0} counts/frame, {turn:.0} counts/frame²)"
-            ));
-        }
-    }
-    // 4. The glance: yaw at −20° (1277.8 µs) within 2.5° (the idle's sway).
-    let target = (1500.0 - 20.0 * 11.111) / 0.3125;
-    let near = pulses[2]
-        .iter()
-        .filter(|p| p.rise > after.rise && (f64::from(p.counts) - target).abs() < 2.5 * 11.111 / 0.3125)
-        .count();
-    println!("yaw: {near} pulses within 2.5° of the sensor's −20°");
-    if near < 90 {
-        problems.push(format!("the head did not glance towards the sensor: {near} frames near −20°"));
-    }
+    soft_start(&pulses, after.rise, period, &mut problems);
+    glance(pulses[2], after.rise, &mut problems);
     if problems.is_empty() {
         println!(
             "inputs: ok: rested, relaxed {:.1} s, woke softly from the pose, glanced towards the sensor",
@@ -162,5 +133,64 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
         Ok(())
     } else {
         bail!("{}", problems.join("\n"))
+    }
+}
+
+/// The soft start (check 3): the first pulse after the gap (at `after`) is
+/// the last before it, and the next second (the idle coming back) within
+/// the idle limits.
+fn soft_start(pulses: &[&Vec<Pulse>; 3], after: f64, period: f64, problems: &mut Vec<String>) {
+    for (i, name) in ["pitch", "roll", "yaw"].iter().enumerate() {
+        let first = pulses[i]
+            .iter()
+            .position(|p| p.rise >= after - period / 2.0);
+        let Some(first) = first else {
+            problems.push(format!("{name}: no pulse after the gap"));
+            continue;
+        };
+        let last_before = first.checked_sub(1).map(|k| pulses[i][k].counts);
+        if last_before.is_none_or(|c| c.abs_diff(pulses[i][first].counts) > 1) {
+            problems.push(format!(
+                "{name}: the first pulse after the gap is not the last before it"
+            ));
+        }
+        let wake: Vec<f64> = pulses[i][first..]
+            .iter()
+            .take(50)
+            .map(|p| f64::from(p.counts))
+            .collect();
+        let step = wake
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f64::max);
+        let turn = wake
+            .windows(3)
+            .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
+            .fold(0.0, f64::max);
+        println!(
+            "{name}: waking, steps up to {step:.0} counts a frame, changes of step up to {turn:.0}"
+        );
+        // (A count of rounding each way.)
+        if step > IDLE_STEP + 1.0 || turn > IDLE_TURN + 2.0 {
+            problems.push(format!(
+                "{name}: the wake exceeds the idle limits ({step:.0} counts/frame, {turn:.0} counts/frame²)"
+            ));
+        }
+    }
+}
+
+/// The glance (check 4): yaw at −20° (1277.8 µs) within 2.5° (the idle's
+/// sway) after the wake (at `after`), for about its 2 s hold.
+fn glance(yaw: &[Pulse], after: f64, problems: &mut Vec<String>) {
+    let target = (1500.0 - 20.0 * 11.111) / 0.3125;
+    let near = yaw
+        .iter()
+        .filter(|p| p.rise > after && (f64::from(p.counts) - target).abs() < 2.5 * 11.111 / 0.3125)
+        .count();
+    println!("yaw: {near} pulses within 2.5° of the sensor's −20°");
+    if near < 90 {
+        problems.push(format!(
+            "the head did not glance towards the sensor: {near} frames near −20°"
+        ));
     }
 }

@@ -435,7 +435,9 @@ mod tests {
             .map(|k| if (20..40).contains(&k) { 0 } else { 4800 + k })
             .collect();
         let mut t = train(&duties, 60.0 * 20e6 + 5e6);
-        t.edges.retain(|&(ns, _)| !(20.4 * TIMING.period_ns()..40.0 * TIMING.period_ns()).contains(&ns));
+        t.edges.retain(|&(ns, _)| {
+            !(20.4 * TIMING.period_ns()..40.0 * TIMING.period_ns()).contains(&ns)
+        });
         let check = check(&t, &duties, &TIMING, LIMITS);
         assert!(check.problems.is_empty(), "{:?}", check.problems);
         assert_eq!((check.fresh, check.mismatches), (40, 0));
@@ -444,7 +446,10 @@ mod tests {
         wanted[25] = 4800;
         let check = check_wanted(&t, &wanted);
         assert!(
-            check.problems.iter().any(|p| p.contains("frame 25: wrote 0 counts")),
+            check
+                .problems
+                .iter()
+                .any(|p| p.contains("frame 25: wrote 0 counts")),
             "{:?}",
             check.problems
         );

@@ -30,7 +30,11 @@ pub fn write(path: &Path, servos: &[ServoCheck; 3], timing: &Timing) -> Result<u
 }
 
 /// The CSV's text.
-#[allow(clippy::cast_precision_loss, clippy::cast_possible_truncation, clippy::cast_sign_loss)] // periods and counts, far below 2^52
+#[allow(
+    clippy::cast_precision_loss,
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss
+)] // periods and counts, far below 2^52
 fn rows(servos: &[ServoCheck; 3], timing: &Timing) -> String {
     let period = f64::from(timing.period_counts) * timing.count_ns;
     let first = servos
@@ -50,8 +54,9 @@ fn rows(servos: &[ServoCheck; 3], timing: &Timing) -> String {
     let frames = widths.iter().map(Vec::len).min().unwrap_or(0);
     let us = |counts: Option<u32>| counts.map_or(0.0, |c| f64::from(c) * timing.count_ns / 1e3);
     let mut text = String::from("t_ms,pitch_us,roll_us,yaw_us\n");
-    for k in 0..frames {
-        let [p, r, y] = [0, 1, 2].map(|i| us(widths[i][k]));
+    let [pitch, roll, yaw] = &widths;
+    for (k, ((p, r), y)) in pitch.iter().zip(roll).zip(yaw).take(frames).enumerate() {
+        let [p, r, y] = [*p, *r, *y].map(us);
         let _ = writeln!(text, "{},{p:.1},{r:.1},{y:.1}", k * 20);
     }
     text
@@ -81,7 +86,12 @@ mod tests {
         let servos = [
             servo(vec![pulse(0, 4800), pulse(1, 4801), pulse(3, 4803)]),
             servo(vec![pulse(0, 4800), pulse(1, 4800), pulse(3, 4800)]),
-            servo(vec![pulse(0, 4800), pulse(1, 4800), pulse(3, 4800), pulse(4, 1)]),
+            servo(vec![
+                pulse(0, 4800),
+                pulse(1, 4800),
+                pulse(3, 4800),
+                pulse(4, 1),
+            ]),
         ];
         assert_eq!(
             rows(&servos, &timing),

@@ -66,15 +66,29 @@ pub fn default_time(events: &[Event]) -> Duration {
     Duration::from_micros(last) + Duration::from_secs(5)
 }
 
+/// What a script run's pulses are checked against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Against {
+    /// The host trace's duties, frame for frame.
+    Host,
+    /// The duties the firmware wrote: every pulse carries its own frame's
+    /// duty, within the servos' limits and on time (for runs whose inputs
+    /// land at any phase, where the host's frame and the board's may
+    /// differ by one at an edge within microseconds of a frame).
+    Written,
+}
+
 /// Runs `events` in the shipped image (built) for `time` of virtual time
-/// from its first frame, and checks every pulse against the host trace
-/// (console lines before [`CONSOLE_UP`] moved there, in both).
+/// from its first frame, and checks every pulse `against` the host trace or
+/// what was written (console lines before [`CONSOLE_UP`] moved there, in
+/// both).
 pub fn play(
     root: &Path,
     metadata: &Metadata,
     mut events: Vec<Event>,
     time: Duration,
     wall: Duration,
+    against: Against,
 ) -> Result<ScriptRun> {
     let up = u64::try_from(CONSOLE_UP.as_micros()).unwrap_or(u64::MAX);
     for event in &mut events {
@@ -94,7 +108,9 @@ pub fn play(
         match event.kind {
             Kind::Pin { input, high } => script.pins.push((at, input, high)),
             Kind::Act(_) | Kind::Console => {
-                script.lines.push((at, format!("{}\r\n", event.text).into_bytes()));
+                script
+                    .lines
+                    .push((at, format!("{}\r\n", event.text).into_bytes()));
             }
         }
     }
@@ -108,16 +124,41 @@ pub fn play(
         // stuck run.
         config.silence = time + boot;
     })?;
-    // The host's frames outlast the emulator's (which began a little
-    // after power-on).
-    let host = trace::simulate(
-        u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX),
-        None,
-        &events,
-    )?;
-    let expected: Vec<[u16; 3]> = host.rows.iter().map(|row| row.duties).collect();
+    let expected: Vec<[u16; 3]> = match against {
+        Against::Host => {
+            // The host's frames outlast the emulator's (which began a
+            // little after power-on).
+            let host = trace::simulate(
+                u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX),
+                None,
+                &events,
+            )?;
+            host.rows.iter().map(|row| row.duties).collect()
+        }
+        Against::Written => written(&report),
+    };
     run::check_with(&mut report, &expected);
     Ok(ScriptRun { report })
+}
+
+/// The duties boot 0 wrote, frame by frame from frame 0 (its compare
+/// writes from the one its slice was enabled with on).
+fn written(report: &Report) -> Vec<[u16; 3]> {
+    let Some(boot) = report.boots.first() else {
+        return Vec::new();
+    };
+    let frames: [Vec<u16>; 3] = core::array::from_fn(|i| {
+        let train = &boot.trains[i];
+        let from = train
+            .enabled
+            .and_then(|at| train.writes.iter().rposition(|&(t, _)| t <= at))
+            .unwrap_or(0);
+        train.writes[from..].iter().map(|&(_, d)| d).collect()
+    });
+    let n = frames.iter().map(Vec::len).max().unwrap_or(0);
+    (0..n)
+        .map(|k| core::array::from_fn(|i| frames[i].get(k).copied().unwrap_or(0)))
+        .collect()
 }
 
 /// `cargo xtask sim --script FILE [--pulses CSV]`.
@@ -132,7 +173,7 @@ pub fn command(
     PICO.build(root)?;
     let events = read(path)?;
     let time = time.unwrap_or_else(|| default_time(&events));
-    let run = play(root, metadata, events, time, wall)?;
+    let run = play(root, metadata, events, time, wall, Against::Host)?;
     let report = &run.report;
     print!("{}", report.log_text(false));
     if let Some(boot) = report.boots.first() {
@@ -142,7 +183,12 @@ pub fn command(
         }
     }
     print!("{}", report.table());
-    println!("{}", report.verdict().replace("the host's duty", "the host trace's duty"));
+    println!(
+        "{}",
+        report
+            .verdict()
+            .replace("the host's duty", "the host trace's duty")
+    );
     println!("{}", report.summary());
     if let (Some(path), Some(boot)) = (pulses, report.boots.first()) {
         let rows = super::pulses_csv::write(path, &boot.servos, &run::timing())?;
