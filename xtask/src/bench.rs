@@ -308,7 +308,6 @@ pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Resu
     let verdict = Verdict::of(&rows)?;
     print!("{}", verdict.lines());
     let frames = FrameRow::all(&run.log)?;
-    record_figures(&rows, &frames, BUDGET);
     for frame in &frames {
         println!();
         print!("{}", frame.lines());
@@ -318,6 +317,7 @@ pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Resu
     let latency = latency_input::run(root, metadata)?;
     println!();
     print!("{}", latency.lines());
+    record_figures(&rows, &frames, &[latency.figure()], BUDGET);
     if let Some(over) = frames_over_budget(&frames) {
         if options.no_budget {
             println!("(--no-budget: the frame ceilings are reported, not enforced)");
@@ -356,7 +356,7 @@ pub fn command(options: Options) -> Result<bool> {
 }
 
 /// The benchmark's rows.
-fn record_figures(rows: &[Row], frames: &[FrameRow], budget: u64) {
+fn record_figures(rows: &[Row], frames: &[FrameRow], latency: &[figures::Latency], budget: u64) {
     let entry = figures::Bench {
         source: figures::Source::now(),
         budget,
@@ -385,6 +385,7 @@ fn record_figures(rows: &[Row], frames: &[FrameRow], budget: u64) {
                 held: row.ceiling().is_some(),
             })
             .collect(),
+        latency: latency.to_vec(),
     };
     figures::save_section("benchmark", |f| f.bench = Some(entry));
 }

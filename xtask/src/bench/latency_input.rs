@@ -85,6 +85,18 @@ impl LatencyRow {
         })
     }
 
+    /// The row for the measured figures.
+    pub fn figure(&self) -> crate::figures::Latency {
+        crate::figures::Latency {
+            label: "latency input edge".into(),
+            events: self.events,
+            p50_ms: self.p50,
+            p99_ms: self.p99,
+            max_ms: self.max,
+            goal_p99_ms: GOAL_P99_MS,
+        }
+    }
+
     /// `latency input edge p50=<ms> p99=<ms> max=<ms>` and its verdict.
     pub fn lines(&self) -> String {
         let mut text = format!(
