@@ -36,6 +36,13 @@
 //               or `dtr 0` / `dtr 1`: the host closes or opens the port (DTR and RTS);
 //               the bytes the device sends are `usb` events, the log `rtt` events, flushed as
 //               they come; `ns`, `silence_ns`, `uart`, `usb` and the power cycles are not used,
+//   inputs:     optional, GPIOs the outside drives as inputs (GP2 to GP5): each sits at the level
+//               its pad's pull gives it (pull-up: high, else low) until the script drives it,
+//   script:     optional, boot 0's script, its times counted from the first frame (when
+//               `anchor_slice`, a PWM slice, is enabled): {anchor_slice, pins: [{at_ns, pin,
+//               high}], lines: [{at_ns, hex}], byte_ns}: a pin driven high or low at at_ns; a
+//               console line on UART0's RX line at the line rate, its last byte in by at_ns less
+//               `early_ns` (so that the firmware has it before the frame due at at_ns),
 // }
 //
 // Events ("ns" is virtual time since power-on, across resets):
@@ -52,6 +59,7 @@
 //   {"ev":"stack","n":0,"low":..}                   lowest stack address written in boot n
 //   {"ev":"uart","ns":..,"hex":".."}                bytes UART0 sent (TX), stamped with the first
 //   {"ev":"uart_rx","ns":..,"n":..}                  the last scripted byte went onto the RX line
+//   {"ev":"drive","pin":2,"high":true,"ns":..}      the script drove an input pin (the time of its edge)
 //   {"ev":"uart_overrun","ns":..}                   a scripted byte found UART0's RX FIFO full
 //   {"ev":"usb_connected","ns":..}                  the CDC-ACM host configured the device
 //   {"ev":"usb","ns":..,"hex":".."}                 bytes the device sent on its CDC-ACM IN endpoint
@@ -65,7 +73,7 @@
 //                                                   ("closed": stdin closed, in a live run)
 
 import { readFileSync } from 'node:fs';
-import { RP2040, USBCDC } from 'rp2040js';
+import { GPIOPinState, RP2040, USBCDC } from 'rp2040js';
 import { romImage, serveRom } from './rom.mjs';
 import { uartAsOnTheChip } from './uart.mjs';
 import { dmxLine } from './dmx.mjs';
@@ -153,6 +161,7 @@ function powerUp(kept) {
   for (const pin of cfg.pins) {
     chip.gpio[pin].addListener((state) => edge(pin, state === 1));
   }
+  watchInputs(chip);
   uartAsOnTheChip(chip.uart[0], () => now());
   if (dmx) dmx.attach(chip.uart[1], () => now());
   xipControlAsOnTheChip(chip);
@@ -172,6 +181,7 @@ function powerUp(kept) {
       if (offset === 0x0c) emit({ ev: 'cc', slice, value: value >>> 0, ns: now() });
       if (offset === 0x00 && (channel.csr & 1) !== on) {
         emit({ ev: 'en', slice, on: !on, ns: now() });
+        if (!on && boot === 0 && slice === scriptCfg?.anchor_slice) anchor(now());
         // On the chip a channel's output is high while the counter is below
         // the compare value, also right after the enable; rp2040js only
         // raises it at the first wrap. Set it here as the chip does (the
@@ -335,6 +345,76 @@ function feedUsb() {
 
 // DMX512 on UART1's RX line, if scripted (dmx.mjs).
 const dmx = cfg.dmx ? dmxLine(cfg.dmx, emit) : null;
+// The inputs the outside drives (GPIO2..5): at their pads' pull until the
+// script drives them. rp2040js has no model of the pulls for an input:
+// here a pin nobody drives reads high with the pull-up on and low
+// otherwise, as on the chip (no floating inputs), and follows its pad
+// register as the firmware changes it. A level is only set when it
+// changes: rp2040js latches an edge interrupt at every set.
+const inputs = new Map(); // pin -> {driven: null|bool, level: bool}
+function inputLevel(pin, state) {
+  const input = inputs.get(pin);
+  return input.driven ?? state === GPIOPinState.InputPullUp;
+}
+function setInput(chip, pin, level) {
+  const input = inputs.get(pin);
+  if (input.level === level) return;
+  input.level = level;
+  chip.gpio[pin].setInputValue(level);
+}
+function watchInputs(chip) {
+  for (const pin of cfg.inputs ?? []) {
+    // A new chip reads low; what the outside drives it keeps driving.
+    const driven = inputs.get(pin)?.driven ?? null;
+    inputs.set(pin, { driven, level: false });
+    if (driven) setInput(chip, pin, true);
+    chip.gpio[pin].addListener((state) => setInput(chip, pin, inputLevel(pin, state)));
+  }
+}
+
+// Boot 0's script: pin levels and console lines from the first frame on.
+const scriptCfg = cfg.script ?? null;
+let anchorNs = null; // when the first frame went out
+let pinQueue = []; // [{ns, pin, high}], absolute, in order
+function anchor(at) {
+  if (anchorNs !== null || !scriptCfg) return;
+  anchorNs = at;
+  pinQueue = scriptCfg.pins.map((p) => ({ ...p, ns: at + p.at_ns })).sort((a, b) => a.ns - b.ns);
+  // Lines go out at the line rate, one after the other, each in by its
+  // time less `early_ns`: scheduled from the last one back, so that lines
+  // due together go out back to back ahead of their time.
+  const lines = scriptCfg.lines
+    .map((l) => ({ bytes: Buffer.from(l.hex, 'hex'), end: at - bootNs + l.at_ns - scriptCfg.early_ns }))
+    .sort((a, b) => a.end - b.end);
+  let next = Infinity;
+  for (let k = lines.length - 1; k >= 0; k--) {
+    const line = lines[k];
+    line.end = Math.min(line.end, next);
+    line.at_ns = Math.max(0, line.end - line.bytes.length * scriptCfg.byte_ns);
+    next = line.at_ns;
+  }
+  for (const line of lines) Object.assign(line, { boot, byte_ns: scriptCfg.byte_ns });
+  bootScripts.push(...lines);
+  bootScripts.sort((a, b) => a.at_ns - b.at_ns);
+  if (!script || scriptAt === 0) {
+    if (script) bootScripts.unshift(script);
+    bootScripts.sort((a, b) => a.at_ns - b.at_ns);
+    script = bootScripts.shift() ?? null;
+    scriptAt = 0;
+  }
+}
+const pinDue = () => (pinQueue.length ? pinQueue[0].ns : Infinity);
+function feedPins() {
+  while (pinQueue.length && pinQueue[0].ns <= now()) {
+    const { pin, high } = pinQueue.shift();
+    const input = inputs.get(pin);
+    if (!input) continue;
+    input.driven = high;
+    emit({ ev: 'drive', pin, high, ns: now() });
+    setInput(mcu, pin, high);
+    lastActivity = now();
+  }
+}
 
 // UART0's scripted RX line (per boot) and the bytes it sent.
 const scripts = (cfg.uart ?? [])
@@ -468,6 +548,12 @@ function run() {
         const cycle = powerCycleDue() - now();
         if (cycle <= 0) break;
         if (cycle !== Infinity && (wait <= 0 || cycle < wait)) wait = cycle;
+        const driving = pinDue() - now(); // asleep until the next scripted pin at the latest
+        if (driving <= 0) {
+          feedPins();
+          continue;
+        }
+        if (driving !== Infinity && (wait <= 0 || driving < wait)) wait = driving;
         if (wait <= 0) {
           stop = 'asleep';
           break;
@@ -490,7 +576,8 @@ function run() {
       const opcode = inFlash ? mcu.flash16[(pc - FLASH_START) >>> 1] : mcu.readUint16(pc);
       if (opcode === OP_SEV) core.eventRegistered = true;
       if ((i & 63) === 0 && cfg.rtt) drainRtt();
-      if ((i & 15) === 0 && cfg.uart) feedUart();
+      if ((i & 15) === 0 && (cfg.uart || scriptCfg)) feedUart();
+      if ((i & 15) === 0 && pinQueue.length) feedPins();
       if ((i & 15) === 0) mcu.uart[0].sendDue();
       if ((i & 255) === 0 && usbSend) feedUsb();
       if ((i & 15) === 0 && dmx) dmx.feed();

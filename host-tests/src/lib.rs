@@ -2,6 +2,7 @@
 
 pub mod behaviour;
 pub mod console;
+pub mod rig;
 
 use embedded_hal_mock::eh1::MockError;
 use embedded_hal_mock::eh1::pwm::{Mock, Transaction};

@@ -87,6 +87,9 @@ impl Model {
                 self.back = None;
             }
             Applied::Idle(_) | Applied::Stop => {}
+            // The rest has its own tests (`behaviour_rest`): this model
+            // plays no rest.
+            Applied::Rest(_) | Applied::Wake(_) => panic!("the model plays no rest: {outcome:?}"),
         }
     }
 

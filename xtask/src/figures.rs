@@ -200,6 +200,26 @@ pub struct Bench {
     pub rows: Vec<PrecomputeRow>,
     /// The frame rows.
     pub frames: Vec<FrameCost>,
+    /// The latency rows, measured in the RP2040 emulator.
+    #[serde(default)]
+    pub latency: Vec<Latency>,
+}
+
+/// A latency row: from an event to the first pulse that shows it.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Latency {
+    /// `latency input edge`, ...
+    pub label: String,
+    /// Events measured.
+    pub events: usize,
+    /// Median, 99th percentile and largest, ms.
+    pub p50_ms: f64,
+    /// See `p50_ms`.
+    pub p99_ms: f64,
+    /// See `p50_ms`.
+    pub max_ms: f64,
+    /// The goal for the 99th percentile, ms.
+    pub goal_p99_ms: f64,
 }
 
 /// One metric's distribution over the seeds.

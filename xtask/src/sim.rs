@@ -15,6 +15,7 @@ mod exchange;
 mod expect;
 mod flood;
 mod image;
+mod inputs;
 pub mod live;
 pub(crate) mod node;
 mod noise;
@@ -22,18 +23,37 @@ mod planted;
 mod pulses;
 pub mod pulses_csv;
 mod run;
+mod script;
 mod show;
 mod stages;
 mod store;
 mod unmodelled;
 
-use std::{fmt::Write as _, time::Duration};
+use std::{fmt::Write as _, path::PathBuf, time::Duration};
 
 use anyhow::Result;
 
 pub use flood::{FLOOD_STAGE, test_flood};
+pub use inputs::{INPUTS_STAGE, test_inputs};
 pub use node::ensure as ensure_node;
 pub use node::folder as node_folder;
+pub use script::{default_time as script_time, parse as parse_script};
+
+/// Plays a script's `events` into the shipped image (built) for `time` from
+/// its first frame; every pulse checked against what the firmware wrote:
+/// on time, its own frame's, within the servos' limits (see `script.rs`).
+///
+/// # Errors
+/// If the emulator cannot run.
+pub fn play_script(
+    root: &std::path::Path,
+    metadata: &crate::project::Metadata,
+    events: Vec<crate::trace::Event>,
+    time: Duration,
+    wall: Duration,
+) -> Result<Report> {
+    Ok(script::play(root, metadata, events, time, wall, script::Against::Written)?.report)
+}
 pub use noise::{NOISE_STAGE, test_noise};
 pub use run::{Report, logged_peak_stack};
 pub use show::{SHOW_STAGE, test_show};
@@ -90,6 +110,12 @@ pub struct Args {
     /// softly again.
     #[arg(long, conflicts_with_all = ["console", "store", "noise", "flood"])]
     pub drill: bool,
+    /// The trigger inputs' check instead: a presence script (a sensor on
+    /// GP2, a rest after 2 s with relax on, someone at 7 s) played into the
+    /// shipped image; the rest, the pulses stopping, the soft wake and the
+    /// glance checked from the pulses, every pulse against the host trace.
+    #[arg(long, conflicts_with_all = ["drill", "console", "store", "noise", "flood", "script"])]
+    pub inputs: bool,
     /// The console instead: a scripted exchange over UART0 and then over
     /// USB CDC-ACM, every reply checked, and the image's RAM with the peak
     /// stack of that run against the budget.
@@ -122,18 +148,24 @@ pub struct Args {
     /// The show control run instead (the stage of `cargo xtask test`): DMX
     /// frames into GP9 and a Bottango session over USB, each checked from
     /// the pulses on the servo pins (see `xtask/src/sim/show.rs`).
-    #[arg(long, conflicts_with_all = ["drill", "console", "store", "noise", "flood", "dmx", "pulses"])]
+    #[arg(long, conflicts_with_all = ["drill", "console", "store", "noise", "flood", "dmx", "pulses", "script"])]
     pub show: bool,
     /// Play DMX512 into GP9 (UART1 RX): FILE has lines `<s> <slot>=<value>
     /// …` (slots relative to the head's address, 1-based; values hold until
     /// changed) and `<s> dmx stop`; frames at about 44 Hz with proper
     /// breaks. Runs until 3 s after the last line unless `--seconds`.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood"])]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood", "script"])]
     pub dmx: Option<std::path::PathBuf>,
-    /// Write the run's servo pulses to FILE.csv, one row per frame:
-    /// `t_ms,pitch_us,roll_us,yaw_us`, as measured on GP16, GP18, GP20.
+    /// Play a trace script into the shipped image instead (`cargo xtask
+    /// trace --script`'s: pin lines drive GP2 to GP5, console lines go to
+    /// UART0, times from the first frame) and check every pulse against the
+    /// host trace of it. Without `--seconds`, to 5 s after its last line.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood"])]
+    pub script: Option<PathBuf>,
+    /// With `--script` or `--dmx`: write the pulses measured on GP16, GP18
+    /// and GP20 to this CSV, one row per frame: `t_ms,pitch_us,roll_us,yaw_us`.
     #[arg(long, value_name = "FILE.csv", conflicts_with_all = ["drill", "console", "store", "noise", "flood"])]
-    pub pulses: Option<std::path::PathBuf>,
+    pub pulses: Option<PathBuf>,
 }
 
 /// One loop (30 s), the fade-in (2 s) and half a second for the boot.
@@ -173,6 +205,20 @@ pub fn command(args: &Args) -> Result<bool> {
     let root = project::root();
     setup::ensure_toolchain(&root)?;
     let metadata = project::metadata(&root)?;
+    if let Some(path) = &args.script {
+        return script::command(
+            &root,
+            &metadata,
+            path,
+            args.virtual_time,
+            args.timeout,
+            args.pulses.as_ref(),
+        );
+    }
+    if args.inputs {
+        PICO.build(&root)?;
+        return Ok(passed("inputs", inputs::test_inputs(&root, &metadata)));
+    }
     if args.drill {
         return Ok(passed(
             "watchdog drill",

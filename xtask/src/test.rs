@@ -273,6 +273,7 @@ fn sim_stages(
         stages.blocked(sim::PULSES_STAGE, "the Pico build");
     }
     stages.run(sim::DRILL_STAGE, || sim::test_drill(root, metadata));
+    stages.run(sim::INPUTS_STAGE, || sim::test_inputs(root, metadata));
     stages.run(sim::CONSOLE_STAGE, || {
         sim::test_console(root, metadata, sim::CONSOLE_TIME, sim::WALL)
     });

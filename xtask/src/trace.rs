@@ -6,7 +6,10 @@
 //! exactly as the frame task runs it on the board, with the built-in
 //! configuration: the Table 2 loops (or the ones of `--seed`), 30 s loops,
 //! 50 Hz frames, the default servos, driver and behaviour. A script's
-//! commands go through the same queue at their times.
+//! motion commands go through the same queue at their times, its other
+//! console lines through the console's service, its pin lines into the
+//! input task's state machine (`host.rs`): the same core as the board's.
+//! A line at a frame's time is taken before that frame.
 //!
 //! The CSV has one row per frame:
 //!
@@ -19,6 +22,7 @@
 //! written, on PWM channels clocked as the Pico's (`idle_head_core::pwm_clock`:
 //! 64 000 counts of 312.5 ns per 20 ms period).
 
+mod host;
 mod marks;
 mod plot;
 mod script;
@@ -33,9 +37,20 @@ use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
 use idle_head_core::{Axis, Playback};
 use idle_head_firmware::config::IDLE_MODE;
 
+use host::Origin;
+use idle_head_core::behaviour::BehaviourParams;
+use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use marks::Mark;
-use script::Event;
+pub use script::{Event, Kind};
+
+/// A script's events (see `script.rs`), checked with `params`.
+///
+/// # Errors
+/// Every bad line, each with its number and why.
+pub fn parse_script(text: &str, params: &BehaviourParams) -> Result<Vec<Event>> {
+    script::parse(text, params)
+}
 
 /// Options of `cargo xtask trace`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
@@ -88,6 +103,8 @@ pub struct Row {
     pub angles: [i32; 3],
     /// Pulse widths, ns.
     pub pulses: [u64; 3],
+    /// The duties written, counts of the Pico's PWM (0: no pulse).
+    pub duties: [u16; 3],
 }
 
 /// The simulated run.
@@ -145,7 +162,9 @@ fn idle(config: HeadConfig, playback: Playback, seed: Option<u32>) -> Result<Idl
     Ok(IdlePlayer::new(first, supply, timing, IDLE_MODE))
 }
 
-/// Runs `micros` of frames with `events` (sorted by time).
+/// Runs `micros` of frames with `events` (sorted by time): motion lines
+/// through the queue, other console lines through the console's service,
+/// pin lines into the input task ([`host`]).
 pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trace> {
     let driver_params = DriverConfig::DEFAULT
         .build()
@@ -165,42 +184,63 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
     let mut head = Head::new(idle, params);
     let mut driver = FrameDriver::new([Channel(0), Channel(0), Channel(0)], driver_params);
     let queue: CommandQueue = CommandQueue::new();
+    let link = ConsoleLink::new();
+    let mut console = host::Console::new(&queue, &link)?;
+    let mut task = host::Task::new(&link);
 
     let frames = micros / frame_us;
     let mut rows = Vec::with_capacity(usize::try_from(frames).unwrap_or(0));
     let mut marks = Vec::new();
-    let mut pending = events.iter().peekable();
-    // Which line each queued action came from, oldest first.
-    let mut queued: std::collections::VecDeque<&Event> = std::collections::VecDeque::new();
+    let mut next = 0;
+    // Where each queued action came from, oldest first.
+    let mut origins: Vec<Origin> = Vec::new();
     for frame in 0..frames {
         let t_us = frame * frame_us;
-        while let Some(event) = pending.next_if(|e| e.at_us <= t_us) {
-            if queue.try_submit(event.action).is_err() {
-                // A console would be told `err busy`; the script waits.
-                println!(
-                    "line {}: command queue full at {} ms, `{}` waits a frame",
-                    event.line,
-                    t_us / 1000,
-                    event.text
-                );
+        let rest = head.rest_state();
+        // The script's lines due, and the input task's wakes between them.
+        while let Some(event) = events.get(next).filter(|e| e.at_us <= t_us) {
+            wake_until(&mut task, event.at_us, rest, &link, &queue, &mut origins);
+            let lines = Lines {
+                queue: &queue,
+                link: &link,
+                origins: &mut origins,
+            };
+            if !lines.take(event, next, rest, &mut console, &mut task) {
                 break;
             }
-            queued.push_back(event);
+            next += 1;
         }
+        wake_until(&mut task, t_us, rest, &link, &queue, &mut origins);
+        // What the console sent through the link, then the queue.
+        from_link(&link, &mut head, &mut driver, t_us);
+        let mut taken = origins.drain(..).collect::<std::collections::VecDeque<_>>();
         head.drain(&mut driver, &queue, |action, outcome| {
-            let Some(event) = queued.pop_front() else {
+            let Some(origin) = taken.pop_front() else {
                 return;
             };
-            debug_assert_eq!(&event.action, action);
-            marks.extend(marks::marks(event, t_us / 1000, outcome, &params));
+            let event = match origin {
+                Origin::Line(i) => events[i].clone(),
+                Origin::Other(text) => Event {
+                    line: 0,
+                    at_us: t_us,
+                    text,
+                    kind: Kind::Act(*action),
+                },
+            };
+            marks.extend(marks::marks(&event, t_us / 1000, outcome, &params));
         });
+        origins.extend(taken);
         let played = head.frame(&mut driver, frame);
-        let servos = played.report.servos;
+        let report = played.report;
+        let mode = HeadMode::of(driver.is_stopped(), driver.is_stopping(), head.rest_state());
+        link.publish(HeadStatus::of(&report, driver.stats(), mode));
+        let servos = report.servos;
         rows.push(Row {
             frame,
             t_ms: t_us / 1000,
             angles: servos.map(|s| s.angle.millidegrees()),
             pulses: servos.map(|s| (u64::from(s.duty.0) * count_ps + 500) / 1000),
+            duties: servos.map(|s| s.duty.0),
         });
     }
     marks::settle(
@@ -208,7 +248,7 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
         params.config().blend.0,
         frames * frame_us / 1000,
     );
-    for event in pending {
+    for event in &events[next..] {
         println!(
             "line {}: at {} s, after the trace's end: not run",
             event.line,
@@ -216,6 +256,96 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
         );
     }
     Ok(Trace { rows, marks })
+}
+
+/// Where a script's lines go.
+struct Lines<'a> {
+    queue: &'a CommandQueue,
+    link: &'a ConsoleLink,
+    origins: &'a mut Vec<Origin>,
+}
+
+impl Lines<'_> {
+    /// Takes `event` (the script's `index`-th) with the head in `rest`;
+    /// `false` if it has to wait for the next frame (the queue is full).
+    fn take(
+        self,
+        event: &Event,
+        index: usize,
+        rest: idle_head_core::behaviour::RestState,
+        console: &mut host::Console<'_>,
+        task: &mut host::Task,
+    ) -> bool {
+        match event.kind {
+            Kind::Act(action) => {
+                if self.queue.try_submit(action).is_err() {
+                    // A console would be told `err busy`; the script waits.
+                    println!(
+                        "line {}: command queue full at {} ms, `{}` waits a frame",
+                        event.line,
+                        event.at_us / 1000,
+                        event.text
+                    );
+                    return false;
+                }
+                self.origins.push(Origin::Line(index));
+            }
+            Kind::Console => {
+                let (reply, queued) = console.line(&event.text);
+                println!("{:>9} ms  {}: {reply}", event.at_us / 1000, event.text);
+                if queued {
+                    self.origins.push(Origin::Other(event.text.clone()));
+                }
+                // The input task takes new settings at once.
+                task.wake(event.at_us, rest, self.link, self.queue, self.origins);
+            }
+            Kind::Pin { input, high } => {
+                task.drive(input, high);
+                task.wake(event.at_us, rest, self.link, self.queue, self.origins);
+            }
+        }
+        true
+    }
+}
+
+/// Between frames: the live settings and calibrations the console sent.
+fn from_link<I: idle_head_core::behaviour::IdleSource>(
+    link: &ConsoleLink,
+    head: &mut Head<I>,
+    driver: &mut FrameDriver<Channel>,
+    t_us: u64,
+) {
+    if let Some(live) = link.take_live() {
+        head.set_live(driver, &live);
+    }
+    for (axis, cal) in Axis::ALL.iter().zip(link.take_servos()) {
+        if let Some(cal) = cal
+            && let Err(e) = head.set_servo(driver, *axis, cal)
+        {
+            println!(
+                "{} ms: {} servo calibration refused: {e}",
+                t_us / 1000,
+                axis.name()
+            );
+        }
+    }
+}
+
+/// The input task's wakes at its deadlines up to `until` µs.
+fn wake_until(
+    task: &mut host::Task,
+    until: u64,
+    rest: idle_head_core::behaviour::RestState,
+    link: &ConsoleLink,
+    queue: &CommandQueue,
+    origins: &mut Vec<Origin>,
+) {
+    while let Some(at) = task.deadline().filter(|&at| at <= until) {
+        task.wake(at, rest, link, queue, origins);
+        if task.deadline() == Some(at) {
+            break;
+        }
+    }
 }
 
 /// `cargo xtask trace`.
@@ -409,5 +539,84 @@ mod tests {
             (dip - 6000 - ducked).abs() <= 3,
             "{dip}, ducked by {ducked}"
         );
+    }
+
+    /// The idle limits of the built-in driver per 20 ms frame: 60 °/s,
+    /// 600 °/s².
+    const IDLE_STEP: i32 = 1200;
+    const IDLE_TURN: i32 = 240;
+
+    #[test]
+    fn a_presence_script_rests_relaxes_wakes_and_glances() {
+        let trace = run(
+            "\
+0 input 2 presence -20000
+0 rest after 5
+0 rest relax on
+12 pin 2 high
+16 pin 2 low
+",
+            20,
+        );
+        let at = |ms: u64| trace.rows[usize::try_from(ms / 20).unwrap()];
+        // Rested 5 s in, there after the 3 s glide: the pose held, the
+        // pulses off.
+        for ms in (8020..12060).step_by(20) {
+            assert_eq!(at(ms).angles, [-8000, 0, 0], "{ms} ms");
+            assert_eq!(at(ms).pulses, [0; 3], "{ms} ms");
+        }
+        assert!(at(8000).pulses.iter().all(|&p| p > 0));
+        // Woken by the sensor 50 ms after its edge: the first pulse is the
+        // last before the gap, and the idle comes back within the idle
+        // limits until the glance starts, a second later.
+        assert_eq!(at(12_060).pulses, at(8000).pulses);
+        let wake: Vec<[i32; 3]> = (12_040..=13_060)
+            .step_by(20)
+            .map(|ms| at(ms).angles)
+            .collect();
+        for axis in 0..3 {
+            let v: Vec<i32> = wake.iter().map(|a| a[axis]).collect();
+            let step = v.windows(2).map(|w| (w[1] - w[0]).abs()).max().unwrap();
+            let turn = v
+                .windows(3)
+                .map(|w| (w[2] - 2 * w[1] + w[0]).abs())
+                .max()
+                .unwrap();
+            assert!(
+                step <= IDLE_STEP && turn <= IDLE_TURN,
+                "axis {axis}: {step} {turn}"
+            );
+        }
+        assert_ne!(at(13_060).angles, [-8000, 0, 0]);
+        // Then the glance towards the sensor: yaw at −20° (the idle's
+        // ducked sway aside), held about 2 s, then back.
+        let near = |ms: u64| (at(ms).angles[2] + 20_000).abs() < 2500;
+        let held: Vec<u64> = (13_000..17_000)
+            .step_by(20)
+            .filter(|&ms| near(ms))
+            .collect();
+        assert!(held.len() >= 100, "{} frames near -20°", held.len());
+        assert!(!near(19_000));
+        let wake = trace
+            .marks
+            .iter()
+            .find(|m| m.reply.starts_with("ok wake"))
+            .unwrap();
+        assert_eq!(
+            (wake.t_ms, wake.reply.as_str()),
+            (12_060, "ok wake 1000 ms")
+        );
+    }
+
+    #[test]
+    fn a_button_runs_its_action_within_a_frame_of_its_debounced_edge() {
+        let trace = run("0 input 3 button nod 6000\n3 pin 3 low\n", 5);
+        let nod = trace.marks.iter().find(|m| m.label == "inputs:").unwrap();
+        // Pressed at 3 s, debounced at 3.005 s, played from the next frame.
+        assert_eq!(nod.t_ms, 3020);
+        assert!(nod.reply.starts_with("ok nod 6000 mdeg"), "{}", nod.reply);
+        let idle = run("", 5);
+        let first = (150..250).find(|&k| trace.rows[k].angles[0] != idle.rows[k].angles[0]);
+        assert_eq!(first, Some(152));
     }
 }

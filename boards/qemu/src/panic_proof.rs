@@ -15,20 +15,23 @@
 //! through (`core::hint::black_box`): any time, any loop contents, any PWM
 //! maximum, PWM writes that fail or not, stop and resume requests at any
 //! frame, new motion limits and servo calibrations (any values, valid or
-//! not) between any two frames, and the behaviour: any behaviour parameters
-//! and any command (gestures, looks, `center`, idle changes, stop) applied
-//! between any two frames ([`FrameLoop::apply`]), mixed into every frame,
-//! servo calibrations from the console's link, each command's outcome told
-//! to the console port that asked for it (`ConsoleLink::answer`, as
-//! [`FrameLoop::drain`] does), the status published for
-//! it after every frame ([`FrameLoop::publish`]), and the console's
-//! parser (`idle_head_core::console::parse`) on any line; the show layer
-//! ([`FrameLoop::show`]: any DMX cue, DMX on or off, any Bottango curves
-//! sampled at any time, blended into every frame), the DMX receiver
-//! (`idle_head_firmware::dmx::Receiver`, the UART interrupt's work: any
-//! character, break or error at any address) and Bottango's side of the
-//! console (its line parser on any line, any motor command on the shared
-//! curves, any curve built from any parameters). Its panic handler calls `frame_path_has_a_panic_path`, a function
+//! not) between any two frames, relax on or off at any frame, and the
+//! behaviour: any behaviour parameters and any command (gestures, looks,
+//! `center`, idle changes, stop, rest, wake) applied between any two frames
+//! ([`FrameLoop::apply`], and through the queue with any live rest and look
+//! settings from the link: [`FrameLoop::from_link`]), mixed into every
+//! frame, servo calibrations from the console's link, each command's
+//! outcome told to the console port that asked for it
+//! (`ConsoleLink::answer`, as [`FrameLoop::drain`] does), the status
+//! published for it after every frame ([`FrameLoop::publish`]), the
+//! console's parser (`idle_head_core::console::parse`) on any line, the
+//! trigger inputs' state machine (`idle_head_core::input::Inputs`) on any
+//! levels; the show layer ([`FrameLoop::show`]: any DMX cue, DMX on or off,
+//! any Bottango curves sampled at any time, blended into every frame), the
+//! DMX receiver (`idle_head_firmware::dmx::Receiver`, the UART interrupt's
+//! work: any character, break or error at any address) and Bottango's side
+//! of the console (its line parser on any line, any motor command on the
+//! shared curves, any curve built from any parameters). Its panic handler calls `frame_path_has_a_panic_path`, a function
 //! that exists nowhere. If any panic (index, division, overflow check,
 //! `unwrap`, ...) remains reachable after optimisation, the call survives
 //! and the link fails:
@@ -47,15 +50,20 @@
 use core::hint::black_box;
 
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
-use idle_head_core::behaviour::{Asker, BehaviourConfig, BehaviourParams, ShowLink};
+use idle_head_core::behaviour::{
+    Asker, BehaviourConfig, BehaviourParams, LiveConfig, RestConfig, ShowLink,
+};
 use idle_head_core::bottango::{self, Curve, Op, line::CurveArgs};
-use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest, Percent};
+use idle_head_core::command::{
+    Action, GestureKind, GestureRequest, Hold, InputRole, LookRequest, Percent, RestAfter,
+};
 use idle_head_core::console::{ConsoleLink, parse};
 use idle_head_core::dmx::{DmxAddress, DmxSettings};
 use idle_head_core::driver::{
     DegreesPerSecond, DegreesPerSecondSquared, DriverParams, FrameDriver, MotionLimits,
 };
 use idle_head_core::idle::{IdlePlayer, IdleTiming};
+use idle_head_core::input::{InputSettings, Inputs, Micros};
 use idle_head_core::servo::{Direction, NanosPerDegree, ServoCalibration};
 use idle_head_core::units::{Angle, AngleRange, Microseconds, Millis};
 use idle_head_core::{Axis, Playback};
@@ -79,7 +87,8 @@ static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::
 /// unknown to the optimiser).
 static EXCHANGE: Exchange = Exchange::new();
 
-/// What the console shares with the frame task: calibrations in, status out.
+/// What the console shares with the frame task: calibrations and live
+/// settings in, status out.
 static LINK: ConsoleLink = ConsoleLink::new();
 
 /// The show layer's inputs: DMX cues and Bottango's curves in.
@@ -119,6 +128,22 @@ impl SetDutyCycle for OpaquePwm {
         } else {
             Ok(())
         }
+    }
+}
+
+/// The log goes nowhere: the proof covers what the frame path formats for
+/// its log (the drain logs every action with its answer), not a transport.
+#[defmt::global_logger]
+struct Nowhere;
+
+// Note(unsafe): defmt's logger contract (acquire, write, flush, release in
+// order, one at a time) holds trivially for a logger that does nothing.
+unsafe impl defmt::Logger for Nowhere {
+    fn acquire() {}
+    unsafe fn flush() {}
+    unsafe fn release() {}
+    unsafe fn write(bytes: &[u8]) {
+        black_box(bytes);
     }
 }
 
@@ -166,7 +191,23 @@ fn any_action() -> Action {
         2 => Action::Center { duration: millis() },
         3 => Action::Idle(black_box(false)),
         4 => Action::IdleAmp(Percent::new(black_box(0)).unwrap_or(Percent::FULL)),
+        5 => Action::Rest,
+        6 => Action::Wake {
+            toward: black_box(Some(angle())),
+        },
         _ => Action::Stop,
+    }
+}
+
+/// Any live behaviour settings: any rest pose, relax or not, any duck.
+fn any_live() -> LiveConfig {
+    let angle = || Angle::from_millidegrees(black_box(0));
+    LiveConfig {
+        rest: RestConfig {
+            pose: [angle(), angle(), angle()],
+            relax: black_box(false),
+        },
+        look_duck: Percent::new(black_box(0)).unwrap_or(Percent::FULL),
     }
 }
 
@@ -194,6 +235,7 @@ fn main() -> ! {
         }
     };
     let mut receiver = Receiver::new();
+    let mut inputs = Inputs::new(&InputSettings::DEFAULT, Micros(0));
     loop {
         let axis = Axis::ALL[usize::from(black_box(0_u8) % 3)];
         match black_box(0_u8) {
@@ -286,6 +328,40 @@ fn main() -> ! {
                 if black_box(false) {
                     SHOW.curves.clear_all();
                 }
+            }
+            10 => driver.set_relaxed(black_box(false)),
+            11 => {
+                // Live settings and calibrations from the link, as the frame
+                // task takes them before a frame (`FrameLoop::drain`, whose
+                // queue is an embassy-sync channel behind a `RefCell`: the
+                // actions it holds are covered by `apply` above).
+                LINK.set_live(any_live());
+                let tick = frames.next(black_box(0));
+                frames.from_link(&mut driver, tick);
+            }
+            12 => {
+                // The inputs' state machine (the input task's, below the
+                // frame task) on any levels at any time, with any roles.
+                let roles = [0; 4].map(|_| match black_box(0_u8) {
+                    0 => InputRole::Off,
+                    1 => InputRole::Button(any_action()),
+                    _ => InputRole::Presence {
+                        toward: black_box(Some(Angle::from_millidegrees(black_box(0)))),
+                    },
+                });
+                let settings = InputSettings {
+                    roles,
+                    rest_after: RestAfter::seconds(black_box(0)).unwrap_or(RestAfter::Never),
+                };
+                let now = Micros(black_box(0));
+                inputs.configure(&settings, now);
+                inputs.update(&settings, now, black_box(0), black_box(false));
+                black_box((
+                    inputs.pending(&settings),
+                    inputs.deadline(&settings),
+                    inputs.status(&settings),
+                ));
+                inputs.sent();
             }
             _ => {}
         }

@@ -88,6 +88,15 @@ pub enum Action {
     IdleAmp(Percent),
     /// Fade all motion out to the neutral pose and hold it.
     Stop,
+    /// Glide to the rest pose (the idle fades out) and stay there; relax
+    /// there if the settings say so (see [`crate::behaviour::rest`]).
+    Rest,
+    /// Wake from a rest: the idle fades back in. With a direction, glance
+    /// there once awake (or at once, if awake already).
+    Wake {
+        /// The glance's yaw (an axis angle, as a look's), if any.
+        toward: Option<Angle>,
+    },
 }
 
 /// Where the idle motion's random stream starts.
@@ -133,6 +142,50 @@ impl ServoSetting {
     }
 }
 
+/// What a trigger input is (see [`crate::input`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum InputRole {
+    /// Not used (the default): its level means nothing.
+    #[default]
+    Off,
+    /// A push button to ground, active low with the internal pull-up: a
+    /// press runs `action`, any motion line the console accepts.
+    Button(Action),
+    /// A presence sensor (a PIR module), active high: someone there keeps
+    /// the head awake and wakes it; with a direction, the head glances
+    /// there (a yaw, as a look's).
+    Presence {
+        /// Where the sensor looks, if given.
+        toward: Option<Angle>,
+    },
+}
+
+/// When the head rests with nobody there (see [`crate::input`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RestAfter {
+    /// Never: presence inputs only wake the head and make it glance.
+    Never,
+    /// After this many seconds (`1..=`[`MAX_REST_AFTER`]) without presence.
+    Seconds(u32),
+}
+
+/// The longest `rest after`: a day, in seconds.
+pub const MAX_REST_AFTER: u32 = 86_400;
+
+/// A change of the rest settings (`rest after|pose|relax`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RestSetting {
+    /// When the head rests with nobody there.
+    After(RestAfter),
+    /// The rest pose, `[pitch, roll, yaw]`.
+    Pose([Angle; 3]),
+    /// Whether the pulses stop once there.
+    Relax(bool),
+}
+
 /// One line of the console protocol, parsed ([`crate::console::parse`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -164,6 +217,18 @@ pub enum Command {
     /// Show the DMX receiver's state and counters (`None`), or change a
     /// DMX setting.
     Dmx(Option<DmxSetting>),
+    /// Show (`None`) or change a trigger input's role.
+    Input {
+        /// The input's number, as the console names it (2 to 5: GP2 to
+        /// GP5 on the Pico; see [`crate::input::FIRST_INPUT`]).
+        input: u8,
+        /// The new role, if any.
+        role: Option<InputRole>,
+    },
+    /// Change the rest settings.
+    Rest(RestSetting),
+    /// How much a held look ducks the idle on its axes.
+    LookDuck(Percent),
 }
 
 /// A DMX setting (`dmx on|off`, `dmx address <n>`).

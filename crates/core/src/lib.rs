@@ -47,6 +47,7 @@ pub mod dmx;
 pub mod driver;
 pub mod gestures;
 pub mod idle;
+pub mod input;
 pub mod metrics;
 pub mod motion;
 pub mod playback;

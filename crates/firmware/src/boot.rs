@@ -157,6 +157,8 @@ pub fn boot<S: SettingsStorage>(
     log_servos(&loaded);
     let [first, spare] = SETS.try_take().ok_or(BootError::AlreadyBooted)?;
     let head = loaded.head();
+    // The input task reads its settings from the link.
+    LINK.set_inputs(loaded.settings.inputs);
     let Loaded {
         storage,
         settings,

@@ -231,30 +231,12 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         self.head.apply(driver, action)
     }
 
-    /// Before frame `tick`: the limit modes the behaviour asks for, then the
-    /// queued commands (at most two), each logged with its answer, which
-    /// goes to the console port that asked for it, if one did.
+    /// Before frame `tick`: what the console sent through the link (see
+    /// [`from_link`](Self::from_link)), the limit modes the behaviour asks
+    /// for, then the queued commands (at most two), each logged with its
+    /// answer, which goes to the console port that asked for it, if one did.
     pub fn drain<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, tick: FrameTick) {
-        if let Some(link) = self.link {
-            for (axis, cal) in idle_head_core::Axis::ALL.iter().zip(link.take_servos()) {
-                let Some(cal) = cal else { continue };
-                match self.head.set_servo(driver, *axis, cal) {
-                    Ok(()) => defmt::info!(
-                        "frame {=u64}: {=str} servo calibration changed",
-                        tick.frame,
-                        axis.name()
-                    ),
-                    // `{}` of the error, not its `message()`: the per-axis
-                    // message texts would take 2.5 KB of flash.
-                    Err(e) => defmt::warn!(
-                        "frame {=u64}: {=str} servo calibration refused: {}",
-                        tick.frame,
-                        axis.name(),
-                        e
-                    ),
-                }
-            }
-        }
+        self.from_link(driver, tick);
         match self.commands {
             Some(queue) => {
                 let link = self.link;
@@ -314,17 +296,46 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         Some(events)
     }
 
+    /// Before frame `tick`: the servo calibrations and the live behaviour
+    /// settings (rest pose, relax, the look's duck) the console sent, if
+    /// linked, each logged.
+    pub fn from_link<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, tick: FrameTick) {
+        let Some(link) = self.link else {
+            return;
+        };
+        if let Some(live) = link.take_live() {
+            self.head.set_live(driver, &live);
+            defmt::info!("frame {=u64}: rest and look settings changed", tick.frame);
+        }
+        for (axis, cal) in idle_head_core::Axis::ALL.iter().zip(link.take_servos()) {
+            let Some(cal) = cal else { continue };
+            match self.head.set_servo(driver, *axis, cal) {
+                Ok(()) => defmt::info!(
+                    "frame {=u64}: {=str} servo calibration changed",
+                    tick.frame,
+                    axis.name()
+                ),
+                // `{}` of the error, not its `message()`: the per-axis
+                // message texts would take 2.5 KB of flash.
+                Err(e) => defmt::warn!(
+                    "frame {=u64}: {=str} servo calibration refused: {}",
+                    tick.frame,
+                    axis.name(),
+                    e
+                ),
+            }
+        }
+    }
+
     /// After a frame that wrote `report`: the head's status for the
     /// console, if linked.
     pub fn publish<P: SetDutyCycle>(&self, driver: &FrameDriver<P>, report: &FrameReport) {
         if let Some(link) = self.link {
-            let mode = if driver.is_stopped() {
-                HeadMode::Stopped
-            } else if driver.is_stopping() {
-                HeadMode::Stopping
-            } else {
-                HeadMode::Running
-            };
+            let mode = HeadMode::of(
+                driver.is_stopped(),
+                driver.is_stopping(),
+                self.head.rest_state(),
+            );
             link.publish(HeadStatus::of(report, driver.stats(), mode));
         }
     }
@@ -461,6 +472,8 @@ const fn word(action: &Action) -> &'static str {
         Action::Idle(false) => "idle off",
         Action::IdleAmp(_) => "idle amp",
         Action::Stop => "stop",
+        Action::Rest => "rest",
+        Action::Wake { .. } => "wake",
     }
 }
 
@@ -469,6 +482,9 @@ const fn word(action: &Action) -> &'static str {
 struct Started<'a>(&'a Applied);
 
 impl defmt::Format for Started<'_> {
+    // defmt keeps each text in a symbol of its own: arms that differ in
+    // their text alone look the same to clippy.
+    #[allow(clippy::match_same_arms)]
     fn format(&self, f: defmt::Formatter<'_>) {
         match self.0 {
             Applied::Gesture(plan) => {
@@ -505,6 +521,12 @@ impl defmt::Format for Started<'_> {
             }
             Applied::Stop => {
                 defmt::write!(f, "fading out");
+            }
+            Applied::Rest(duration) => {
+                defmt::write!(f, "to the rest pose in {=u32} ms", duration.0);
+            }
+            Applied::Wake(duration) => {
+                defmt::write!(f, "idle back in {=u32} ms", duration.0);
             }
         }
     }

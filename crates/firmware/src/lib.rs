@@ -12,6 +12,7 @@
 //! - [`console`]: the console's loop over a board's byte [`console::Port`]
 //!   (a Bottango driver on a port after a Bottango handshake).
 //! - [`dmx`]: the DMX512 receiver's loop over a board's [`dmx::DmxPort`].
+//! - [`input`]: the trigger inputs' task over a board's [`input::InputSource`].
 //! - [`storage`]: the settings store in a board's flash.
 //!
 //! What a board adds is its hardware: the PWM outputs, the ports, the flash,
@@ -37,5 +38,6 @@ pub mod dmx;
 pub mod exchange;
 pub mod frame;
 pub mod hooks;
+pub mod input;
 pub mod storage;
 pub mod tasks;

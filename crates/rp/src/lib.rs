@@ -14,6 +14,8 @@
 //!   interrupts sit below the frame task's ([`PORT_PRIORITY`]);
 //! - the DMX512 receiver ([`dmx`]): UART1's interrupt, at the highest
 //!   priority (a few microseconds per character).
+//! - the trigger inputs (thread mode, on their GPIO interrupt; see
+//!   [`input`]).
 //!
 //! Exactly one chip feature: `rp2040` or `rp235xa`.
 #![no_std]
@@ -28,6 +30,7 @@ compile_error!("choose a chip: the `rp2040` or the `rp235xa` feature");
 
 pub mod dmx;
 pub mod flash;
+pub mod input;
 mod panic;
 pub mod pico;
 pub mod pwm;
@@ -53,6 +56,7 @@ use idle_head_firmware::hooks::{BoardHooks, Watchdog};
 use static_cell::StaticCell;
 
 use crate::dmx::DmxUart;
+use crate::input::GpioInputs;
 use crate::pwm::ServoPwm;
 use crate::uart::UartPort;
 use crate::usb::UsbPort;
@@ -103,6 +107,10 @@ pub struct Board {
     pub flash: Peri<'static, FLASH>,
     /// The watchdog.
     pub watchdog: Peri<'static, WATCHDOG>,
+    /// The trigger inputs ([`input::GpioInputs`]).
+    pub inputs: GpioInputs,
+    /// Where the inputs are, for the log.
+    pub input_pins: &'static str,
 }
 
 /// The console service, shared by the ports (thread mode only).
@@ -138,6 +146,8 @@ pub fn start(spawner: Spawner, board: Board) {
         usb,
         flash,
         watchdog,
+        inputs,
+        input_pins,
     } = board;
     let watchdog = RpWatchdog::new(watchdog);
     match watchdog.reset_reason() {
@@ -158,6 +168,8 @@ pub fn start(spawner: Spawner, board: Board) {
     };
     spawn_frames(servos, &head, BoardWatchdog(watchdog));
     spawn_dmx(dmx, dmx_pins);
+    spawn(spawner, input_task(inputs), "input");
+    defmt::info!("inputs: {=str}", input_pins);
     if let Some(service) = head.service {
         spawn_console(spawner, uart, uart_pins, usb, service);
     }
@@ -348,6 +360,12 @@ async fn frame_task(
 #[embassy_executor::task]
 async fn generator(generator: Generator) {
     idle_head_firmware::tasks::generate(generator, Clock).await;
+}
+
+/// The trigger inputs, for as long as the board runs.
+#[embassy_executor::task]
+async fn input_task(mut inputs: GpioInputs) {
+    idle_head_firmware::input::run(&mut inputs).await;
 }
 
 /// The USB device: enumeration, control requests, bus resets.

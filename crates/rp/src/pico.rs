@@ -9,6 +9,10 @@
 //! | console TX  | GP0  | 1         | UART0, 115200 8N1  |
 //! | console RX  | GP1  | 2         | UART0              |
 //! | console     | USB  |           | CDC-ACM serial port|
+//! | input 2     | GP2  | 4         | GPIO, trigger input|
+//! | input 3     | GP3  | 5         | GPIO, trigger input|
+//! | input 4     | GP4  | 6         | GPIO, trigger input|
+//! | input 5     | GP5  | 7         | GPIO, trigger input|
 //! | DMX512 in   | GP9  | 12        | UART1 RX, 250 kbaud 8N2 |
 //!
 //! (GPIO n drives PWM slice ⌊n/2⌋ mod 8, channel A for even n.) One slice
@@ -17,12 +21,17 @@
 //! board GND (e.g. pin 23) and to the servo supply's ground; power the
 //! servos from their own 5 to 6 V supply, not from the board.
 //!
+//! The trigger inputs take a button to ground or a presence sensor's
+//! output (3.3 V logic, never 5 V) each, with a board GND (pin 3 or 8)
+//! beside them ([`crate::input`]; the user guide's chapter on inputs).
+//!
 //! A board with another pinout builds its [`Board`] the same way with its
 //! own pins.
 
 use embassy_rp::peripherals::{UART0, USB};
 use embassy_rp::{Peripherals, bind_interrupts, uart, usb};
 
+use crate::input::GpioInputs;
 use crate::pwm::ServoPwm;
 use crate::{Board, SERVO_CLOCK};
 
@@ -50,5 +59,12 @@ pub fn board(p: Peripherals, name: &'static str) -> Board {
         usb: usb::Driver::new(p.USB, Irqs),
         flash: p.FLASH,
         watchdog: p.WATCHDOG,
+        inputs: GpioInputs::new([
+            p.PIN_2.into(),
+            p.PIN_3.into(),
+            p.PIN_4.into(),
+            p.PIN_5.into(),
+        ]),
+        input_pins: "input 2 GP2, input 3 GP3, input 4 GP4, input 5 GP5",
     }
 }

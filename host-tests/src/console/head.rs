@@ -1,18 +1,21 @@
 //! A simulated head behind the console service: the frame task's code
-//! (queue drain, servo calibrations from the link, frame, status) on the
-//! host, with PWM channels that keep the last duty, and a check of every
+//! (queue drain, servo calibrations and live settings from the link,
+//! frame, status) and the input task's (its inputs at their idle levels)
+//! on the host, with PWM channels that keep the last duty, and a check of every
 //! frame against the servos' limits as they are at that frame.
 
 use std::convert::Infallible;
 
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use idle_head_core::behaviour::{
-    Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION, ShowLink,
+    Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION, RestState,
+    ShowLink,
 };
 use idle_head_core::console::{
     ConsoleLink, ConsoleService, HeadMode, HeadStatus, Outcome, Session, outcome_reply, unanswered,
 };
 use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::input::{InputSettings, Inputs, Micros};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16, Trajectory};
 use idle_head_core::playback::Player;
 use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
@@ -87,6 +90,12 @@ pub struct SimFrames {
     /// Refusals whose outcome a waiting reply was finished with
     /// ([`Self::finish`]).
     pub refusals_told: u64,
+    /// The input task's state machine, its inputs at their idle levels
+    /// (buttons released, nobody there) unless `levels` says otherwise.
+    pub inputs: Inputs,
+    /// The inputs' levels (bit `i`: input `i` high); `None`: each at its
+    /// idle level.
+    pub levels: Option<u8>,
 }
 
 impl SimFrames {
@@ -122,12 +131,44 @@ impl SimFrames {
             refused_not_busy: 0,
             last_applied: None,
             refusals_told: 0,
+            inputs: Inputs::new(&InputSettings::DEFAULT, Micros(0)),
+            levels: None,
         }
+    }
+
+    /// The input task's part, as it would run at this frame: new settings
+    /// from `link`, the levels, actions into `queue`, the status published.
+    fn inputs<const N: usize>(&mut self, queue: &CommandQueue<N>, link: &ConsoleLink) {
+        let now = Micros(self.frame * 20_000);
+        let settings = link.input_settings();
+        if link.take_inputs_changed() {
+            self.inputs.configure(&settings, now);
+        }
+        let idle = settings
+            .roles
+            .iter()
+            .enumerate()
+            .filter(|(_, role)| !role.active_high())
+            .fold(0, |bits, (i, _)| bits | (1 << i));
+        let resting = self.head.rest_state() == RestState::Resting;
+        self.inputs
+            .update(&settings, now, self.levels.unwrap_or(idle), resting);
+        while let Some(action) = self.inputs.pending(&settings) {
+            if queue.try_submit(action).is_err() {
+                break;
+            }
+            self.inputs.sent();
+        }
+        link.publish_inputs(self.inputs.status(&settings));
     }
 
     /// Plays one frame as the frame task does: calibrations from `link`,
     /// queued actions, the frame, the status published.
     pub fn frame<const N: usize>(&mut self, queue: &CommandQueue<N>, link: &ConsoleLink) {
+        self.inputs(queue, link);
+        if let Some(live) = link.take_live() {
+            self.head.set_live(&mut self.driver, &live);
+        }
         for (axis, cal) in Axis::ALL.iter().zip(link.take_servos()) {
             if let Some(cal) = cal {
                 self.head
@@ -168,9 +209,10 @@ impl SimFrames {
             // outside its new angle limits: the driver brings it back in
             // through the limiter, within `RETURN_FRAMES`.
             let returning = changed.is_some_and(|at| self.frame <= at + RETURN_FRAMES);
+            // Relaxed at rest: no pulse at all (duty 0), not a short one.
+            let pulse = s.duty.0 != 0 || s.pulse.0 != 0;
             if (!cal.limits.contains(s.angle) && !returning)
-                || s.pulse.0 < cal.min_pulse.0
-                || s.pulse.0 > cal.max_pulse.0
+                || (pulse && (s.pulse.0 < cal.min_pulse.0 || s.pulse.0 > cal.max_pulse.0))
             {
                 if !cal.limits.contains(s.angle) {
                     self.outside_after_return += 1;
@@ -178,13 +220,11 @@ impl SimFrames {
                 self.violations += 1;
             }
         }
-        let mode = if self.driver.is_stopped() {
-            HeadMode::Stopped
-        } else if self.driver.is_stopping() {
-            HeadMode::Stopping
-        } else {
-            HeadMode::Running
-        };
+        let mode = HeadMode::of(
+            self.driver.is_stopped(),
+            self.driver.is_stopping(),
+            self.head.rest_state(),
+        );
         link.publish(HeadStatus::of(&report, self.driver.stats(), mode));
         self.frame += 1;
         self.frames += 1;

@@ -15,8 +15,8 @@ use proptest::test_runner::{RngAlgorithm, TestRng};
 
 pub use model::{count_line_ends, reference_lines};
 pub use text::{
-    EDGE_NUMBERS, VOCABULARY, command_text, mutate, random_bytes, random_command, token_line,
-    varied_text,
+    EDGE_NUMBERS, VOCABULARY, command_text, mutate, random_action, random_bytes, random_command,
+    token_line, varied_text,
 };
 
 /// The line capacity the firmware uses.

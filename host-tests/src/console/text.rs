@@ -4,8 +4,8 @@
 use std::fmt::Write as _;
 
 use idle_head_core::command::{
-    Action, Command, DmxSetting, GestureKind, GestureRequest, Hold, LookRequest, Percent,
-    SeedChoice, ServoSetting,
+    Action, Command, DmxSetting, GestureKind, GestureRequest, Hold, InputRole, LookRequest,
+    Percent, RestAfter, RestSetting, SeedChoice, ServoSetting,
 };
 use idle_head_core::dmx::DmxAddress;
 use idle_head_core::servo::{Direction, NanosPerDegree};
@@ -52,6 +52,16 @@ pub const VOCABULARY: &[&str] = &[
     "watch",
     "dmx",
     "address",
+    "input",
+    "button",
+    "presence",
+    "rest",
+    "wake",
+    "after",
+    "never",
+    "pose",
+    "relax",
+    "duck",
 ];
 
 /// A random word of the protocol: one of [`VOCABULARY`] or a gesture's.
@@ -148,17 +158,11 @@ fn maybe<T>(rng: &mut TestRng, f: impl FnOnce(&mut TestRng) -> T) -> Option<T> {
     }
 }
 
-/// A random command, every field anywhere in its parseable range.
-pub fn random_command(rng: &mut TestRng) -> Command {
-    match rng.random_range(0..14) {
-        12 => Command::Watch(maybe(rng, |r| r.random_range(1..=50))),
-        0 => Command::Help,
-        1 => Command::Status,
-        2 => Command::Save,
-        3 => Command::Load,
-        4 => Command::Defaults,
-        5 => Command::Act(Action::Stop),
-        6 => {
+/// A random motion command, every field anywhere in its parseable range.
+pub fn random_action(rng: &mut TestRng) -> Action {
+    match rng.random_range(0..7) {
+        0 => Action::Stop,
+        1 => {
             let kind = GestureKind::ALL[rng.random_range(0..GestureKind::COUNT)];
             let mut g = GestureRequest::new(kind);
             g.amplitude = maybe(rng, angle);
@@ -169,9 +173,9 @@ pub fn random_command(rng: &mut TestRng) -> Command {
                 g.cycles = maybe(rng, |r| r.random_range(1..=255));
             }
             g.intensity = maybe(rng, percent);
-            Command::Act(Action::Gesture(g))
+            Action::Gesture(g)
         }
-        7 => Command::Act(Action::Look(LookRequest {
+        2 => Action::Look(LookRequest {
             pitch: angle(rng),
             yaw: angle(rng),
             duration: maybe(rng, |r| millis(r, 1)),
@@ -182,15 +186,51 @@ pub fn random_command(rng: &mut TestRng) -> Command {
                     Hold::Return(millis(r, 0))
                 }
             }),
-        })),
-        8 => Command::Act(Action::Center {
-            duration: maybe(rng, |r| millis(r, 1)),
         }),
-        9 => Command::Act(match rng.random_range(0..3) {
+        3 => Action::Center {
+            duration: maybe(rng, |r| millis(r, 1)),
+        },
+        4 => match rng.random_range(0..3) {
             0 => Action::Idle(true),
             1 => Action::Idle(false),
             _ => Action::IdleAmp(percent(rng)),
-        }),
+        },
+        5 => Action::Rest,
+        _ => Action::Wake { toward: None },
+    }
+}
+
+/// A random command, every field anywhere in its parseable range.
+pub fn random_command(rng: &mut TestRng) -> Command {
+    // Motion about half the time, as a show controller sends it.
+    match rng.random_range(0..21) {
+        14 => Command::Watch(maybe(rng, |r| r.random_range(1..=50))),
+        0 => Command::Help,
+        1 => Command::Status,
+        2 => Command::Save,
+        3 => Command::Load,
+        4 => Command::Defaults,
+        5..=9 | 16..=20 => Command::Act(random_action(rng)),
+        12 => Command::Input {
+            input: rng.random_range(2..=5),
+            role: maybe(rng, |r| match r.random_range(0..3) {
+                0 => InputRole::Off,
+                1 => InputRole::Button(random_action(r)),
+                _ => InputRole::Presence {
+                    toward: maybe(r, angle),
+                },
+            }),
+        },
+        13 => match rng.random_range(0..4) {
+            0 => Command::Rest(RestSetting::After(if rng.random_bool(0.2) {
+                RestAfter::Never
+            } else {
+                RestAfter::Seconds(rng.random_range(1..=86_400))
+            })),
+            1 => Command::Rest(RestSetting::Pose([angle(rng), angle(rng), angle(rng)])),
+            2 => Command::Rest(RestSetting::Relax(rng.random_bool(0.5))),
+            _ => Command::LookDuck(percent(rng)),
+        },
         10 => Command::Seed(if rng.random_bool(0.2) {
             SeedChoice::Random
         } else {
@@ -326,56 +366,51 @@ fn write_command(s: &mut Style<'_>, command: &Command) {
         Command::Save => s.word("save"),
         Command::Load => s.word("load"),
         Command::Defaults => s.word("defaults"),
-        Command::Act(Action::Stop) => s.word("stop"),
-        Command::Act(Action::Gesture(g)) => {
-            s.word(g.kind.name());
-            if let Some(a) = g.amplitude {
-                s.mdeg(a);
-                if let Some(d) = g.duration {
-                    s.millis(d);
+        Command::Act(action) => write_action(s, &action),
+        Command::Input { input, role } => {
+            s.word("input");
+            s.number(i64::from(input));
+            match role {
+                None => {}
+                Some(InputRole::Off) => s.word("off"),
+                Some(InputRole::Button(action)) => {
+                    s.word("button");
+                    write_action(s, &action);
+                }
+                Some(InputRole::Presence { toward }) => {
+                    s.word("presence");
+                    if let Some(yaw) = toward {
+                        s.mdeg(yaw);
+                    }
                 }
             }
-            let mut options = Vec::new();
-            if let Some(c) = g.cycles {
-                options.push(("cycles", c.to_string()));
-            }
-            if let Some(i) = g.intensity {
-                options.push(("intensity", i.get().to_string()));
-            }
-            if s.chance(0.5) {
-                options.reverse();
-            }
-            for (name, value) in options {
-                s.option(name, &value);
+        }
+        Command::Rest(setting) => {
+            s.word("rest");
+            match setting {
+                RestSetting::After(RestAfter::Never) => {
+                    s.word("after");
+                    s.word("never");
+                }
+                RestSetting::After(RestAfter::Seconds(n)) => {
+                    s.word("after");
+                    s.number(i64::from(n));
+                }
+                RestSetting::Pose(pose) => {
+                    s.word("pose");
+                    for a in pose {
+                        s.mdeg(a);
+                    }
+                }
+                RestSetting::Relax(on) => {
+                    s.word("relax");
+                    s.word(if on { "on" } else { "off" });
+                }
             }
         }
-        Command::Act(Action::Look(l)) => {
+        Command::LookDuck(p) => {
             s.word("look");
-            s.mdeg(l.pitch);
-            s.mdeg(l.yaw);
-            if let Some(d) = l.duration {
-                s.millis(d);
-            }
-            match l.hold {
-                Some(Hold::Stay) => s.option("hold", "stay"),
-                Some(Hold::Return(m)) => s.option("hold", &m.0.to_string()),
-                None => {}
-            }
-        }
-        Command::Act(Action::Center { duration }) => {
-            let word = if s.chance(0.3) { "centre" } else { "center" };
-            s.word(word);
-            if let Some(d) = duration {
-                s.millis(d);
-            }
-        }
-        Command::Act(Action::Idle(on)) => {
-            s.word("idle");
-            s.word(if on { "on" } else { "off" });
-        }
-        Command::Act(Action::IdleAmp(p)) => {
-            s.word("idle");
-            s.word("amp");
+            s.word("duck");
             s.number(i64::from(p.get()));
         }
         Command::Seed(SeedChoice::Random) => {
@@ -422,6 +457,67 @@ fn write_command(s: &mut Style<'_>, command: &Command) {
                     s.number(i64::from(a.get()));
                 }
             }
+        }
+    }
+}
+
+/// The text of a motion command.
+fn write_action(s: &mut Style<'_>, action: &Action) {
+    match *action {
+        Action::Stop => s.word("stop"),
+        Action::Rest => s.word("rest"),
+        // A direction comes from a presence input, never from a line.
+        Action::Wake { .. } => s.word("wake"),
+        Action::Gesture(g) => {
+            s.word(g.kind.name());
+            if let Some(a) = g.amplitude {
+                s.mdeg(a);
+                if let Some(d) = g.duration {
+                    s.millis(d);
+                }
+            }
+            let mut options = Vec::new();
+            if let Some(c) = g.cycles {
+                options.push(("cycles", c.to_string()));
+            }
+            if let Some(i) = g.intensity {
+                options.push(("intensity", i.get().to_string()));
+            }
+            if s.chance(0.5) {
+                options.reverse();
+            }
+            for (name, value) in options {
+                s.option(name, &value);
+            }
+        }
+        Action::Look(l) => {
+            s.word("look");
+            s.mdeg(l.pitch);
+            s.mdeg(l.yaw);
+            if let Some(d) = l.duration {
+                s.millis(d);
+            }
+            match l.hold {
+                Some(Hold::Stay) => s.option("hold", "stay"),
+                Some(Hold::Return(m)) => s.option("hold", &m.0.to_string()),
+                None => {}
+            }
+        }
+        Action::Center { duration } => {
+            let word = if s.chance(0.3) { "centre" } else { "center" };
+            s.word(word);
+            if let Some(d) = duration {
+                s.millis(d);
+            }
+        }
+        Action::Idle(on) => {
+            s.word("idle");
+            s.word(if on { "on" } else { "off" });
+        }
+        Action::IdleAmp(p) => {
+            s.word("idle");
+            s.word("amp");
+            s.number(i64::from(p.get()));
         }
     }
 }

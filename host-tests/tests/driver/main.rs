@@ -11,6 +11,7 @@ mod limiter;
 mod output;
 mod properties;
 mod reference;
+mod relax;
 mod runtime;
 
 use embedded_hal_mock::eh1::pwm::Mock;

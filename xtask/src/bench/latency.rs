@@ -69,6 +69,18 @@ pub struct Row {
 }
 
 impl Row {
+    /// The row for the measured figures.
+    pub fn figure(&self) -> crate::figures::Latency {
+        crate::figures::Latency {
+            label: format!("latency {}", self.name),
+            events: self.ms.len(),
+            p50_ms: self.percentile(50.0),
+            p99_ms: self.percentile(99.0),
+            max_ms: self.ms.last().copied().unwrap_or(f64::NAN),
+            goal_p99_ms: GOAL_MS,
+        }
+    }
+
     /// The `p`-th percentile (nearest rank), ms.
     pub fn percentile(&self, p: f64) -> f64 {
         if self.ms.is_empty() {

@@ -55,7 +55,12 @@ pub fn render(figures: &Figures) -> (String, Vec<&'static str>) {
     let test = "`cargo xtask test` measures these (and builds this page again)";
     section("memory", "Memory", memory(figures), test);
     let bench = figures.bench.as_ref();
-    section("frames", "Frame cost", bench.map(frames), test);
+    section(
+        "frames",
+        "Frame cost",
+        bench.map(|b| format!("{}{}", frames(b), latency(b))),
+        test,
+    );
     section("precompute", "Boot precompute", bench.map(precompute), test);
     section(
         "qemu",
@@ -186,6 +191,38 @@ fn frames(bench: &Bench) -> String {
             thousands(row.max_budget),
             if row.held { "" } else { " (reported only)" },
             row.median as f64 / RP2040_MHZ,
+        );
+    }
+    out
+}
+
+/// The latency rows, under the frame costs.
+fn latency(bench: &Bench) -> String {
+    if bench.latency.is_empty() {
+        return String::new();
+    }
+    let mut out = String::from(
+        "\nLatency, measured in the RP2040 emulator on the shipped image, from an event \
+         to the first servo pulse that shows it, in ms \
+         ([the emulators](../dev/emulators.md#latency-of-an-input-edge)):\n\n\
+         | row | events | p50 | p99 | max | goal (p99) |\n\
+         |---|---|---|---|---|---|\n",
+    );
+    for row in &bench.latency {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.1} | {:.1} | {:.1} | {:.0}{} |",
+            row.label,
+            thousands(row.events as u64),
+            row.p50_ms,
+            row.p99_ms,
+            row.max_ms,
+            row.goal_p99_ms,
+            if row.p99_ms <= row.goal_p99_ms {
+                ""
+            } else {
+                " (missed)"
+            },
         );
     }
     out
@@ -353,8 +390,17 @@ mod tests {
                 max_budget: 2000,
                 held: false,
             }],
+            latency: vec![super::super::Latency {
+                label: "latency input edge".into(),
+                events: 1000,
+                p50_ms: 45.6,
+                p99_ms: 55.0,
+                max_ms: 55.1,
+                goal_p99_ms: 25.0,
+            }],
         });
         let (page, recorded) = render(&figures);
+        assert!(page.contains("| latency input edge | 1,000 | 45.6 | 55.0 | 55.1 | 25 (missed) |"));
         assert_eq!(recorded, ["memory", "frames", "precompute"]);
         assert!(page.contains("| pico | 101,200 B (98.8 KiB) | 77 % of 131,072 B | 20,764 B |"));
         assert!(page.contains("Recorded by `cargo xtask test` on `abc1234`."));

@@ -38,6 +38,15 @@ pub enum Event {
         #[serde(default)]
         reset: bool,
     },
+    /// The script drove an input pin.
+    Drive {
+        /// The GPIO.
+        pin: u8,
+        /// Its new level.
+        high: bool,
+        /// When.
+        ns: f64,
+    },
     /// A PWM compare register write.
     Cc {
         /// The slice.

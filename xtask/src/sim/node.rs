@@ -149,6 +149,24 @@ pub struct Config {
     pub usb_chunks: Vec<(Vec<u8>, Duration)>,
     /// DMX512 frames on UART1's RX line (`sim/dmx.mjs`).
     pub dmx: Option<Value>,
+    /// GPIOs the outside drives as inputs (at their pull until driven).
+    pub inputs: Vec<u8>,
+    /// Boot 0's script of pin levels and console lines, if any.
+    pub script: Option<PinScript>,
+}
+
+/// Boot 0's script, its times counted from the first frame (when the
+/// slice `anchor` is enabled).
+#[derive(Debug, Clone, Default)]
+pub struct PinScript {
+    /// The PWM slice whose enable is the first frame.
+    pub anchor: u8,
+    /// Pin levels: when, which GPIO, high or low.
+    pub pins: Vec<(Duration, u8, bool)>,
+    /// Console lines (with their line end) for UART0: when each must be in.
+    pub lines: Vec<(Duration, Vec<u8>)>,
+    /// How much before its time a line's last byte goes in.
+    pub early: Duration,
 }
 
 /// How long the flash is busy per operation.
@@ -232,6 +250,21 @@ impl Config {
             })),
             "power_cycles_ns": self.power_cycles.iter().map(|at| nanos(*at)).collect::<Vec<_>>(),
             "live": self.live,
+            "inputs": self.inputs,
+            "script": self.script.as_ref().map(|script| json!({
+                "anchor_slice": script.anchor,
+                "pins": script.pins.iter().map(|(at, pin, high)| json!({
+                    "at_ns": nanos(*at),
+                    "pin": pin,
+                    "high": high,
+                })).collect::<Vec<_>>(),
+                "lines": script.lines.iter().map(|(at, bytes)| json!({
+                    "at_ns": nanos(*at),
+                    "hex": hex(bytes),
+                })).collect::<Vec<_>>(),
+                "byte_ns": nanos(super::exchange::BYTE_TIME),
+                "early_ns": nanos(script.early),
+            })),
         })
     }
 }

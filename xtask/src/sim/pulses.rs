@@ -17,9 +17,12 @@
 //!   microseconds): it is latched at wrap `k + 1`, and the pulse starting
 //!   there, the `k`-th, carries it.
 //!
-//! So pulse `n` must carry frame `n`, and the check verifies exactly that
-//! from the write times instead of assuming it: for every pulse it finds the
-//! last compare write before the pulse's rising edge. A frame written late
+//! So the pulse of period `n` must carry frame `n`, and the check verifies
+//! exactly that from the write times instead of assuming it: for every
+//! pulse it finds the last compare write before the pulse's rising edge,
+//! and its period from its rise (`n = (rise − first rise) / P`, rounded). A
+//! frame written with duty 0 (the pulses stopped: a head relaxed at rest)
+//! has no pulse; its period stays empty. A frame written late
 //! (after its wrap) shows up as a pulse carrying the previous frame, a frame
 //! lost as a pulse carrying the next one; either is a problem. Pulses after
 //! the last frame (frames stopped: the watchdog drill) repeat the last duty
@@ -187,7 +190,13 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
         (Kind::default(), Kind::default(), Kind::default());
     let (mut outside, mut bad_period) = (Kind::default(), Kind::default());
     let mut mismatched = vec![false; frames.len()];
-    for (n, &(r, f)) in spans.iter().enumerate() {
+    let first_rise = spans.first().map_or(0.0, |&(r, _)| r);
+    let mut last_period = None;
+    for &(r, f) in &spans {
+        // The period this pulse went out in (pulse `n` of a train without
+        // gaps).
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // a period count, ≥ 0
+        let n = ((r - first_rise) / timing.period_ns()).round().max(0.0) as usize;
         // The duty latched at this rise: the last write before it.
         let latched = frames.partition_point(|&(t, _)| t < r);
         let Some(frame) = latched.checked_sub(1) else {
@@ -245,8 +254,10 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
                 )
             });
         }
-        if n > 0 {
-            let period = r - spans[n - 1].0;
+        if let Some((k, previous)) = last_period
+            && n == k + 1
+        {
+            let period = r - previous;
             let (low, high) = out.periods.unwrap_or((period, period));
             out.periods = Some((low.min(period), high.max(period)));
             for want in [timing.period_ns(), timing.frame_ns] {
@@ -256,6 +267,15 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
                     });
                 }
             }
+        }
+        last_period = Some((n, r));
+    }
+    // Frames written with duty 0 (no pulse) that the host also gave 0.
+    for (frame, &(_, duty)) in frames.iter().enumerate() {
+        if duty == 0 && expected[frame] != 0 && !mismatched[frame] {
+            mismatched[frame] = true;
+            let want = expected[frame];
+            wrong_duty.push(|| format!("frame {frame}: wrote 0 counts, the host {want}"));
         }
     }
     out.mismatches = mismatched.iter().filter(|&&m| m).count();
@@ -269,9 +289,9 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
         ));
     }
     // Every frame written early enough to be latched and finished before the
-    // boot ended must have had its pulse.
-    let finished = |&&(t, _): &&(f64, u16)| {
-        t + timing.period_ns() + f64::from(limits.max) * timing.count_ns < train.end
+    // boot ended must have had its pulse (but for one written with duty 0).
+    let finished = |&&(t, duty): &&(f64, u16)| {
+        duty != 0 && t + timing.period_ns() + f64::from(limits.max) * timing.count_ns < train.end
     };
     let due = frames.iter().filter(finished).count();
     if out.fresh < due {
@@ -406,6 +426,37 @@ mod tests {
         ] {
             assert!(problems.contains(part), "no `{part}` in\n{problems}");
         }
+    }
+
+    #[test]
+    fn frames_of_duty_0_leave_their_periods_empty() {
+        // Frames 20 to 39 relaxed (duty 0: no pulse), then pulses again.
+        let duties: Vec<u16> = (0..60)
+            .map(|k| if (20..40).contains(&k) { 0 } else { 4800 + k })
+            .collect();
+        let mut t = train(&duties, 60.0 * 20e6 + 5e6);
+        t.edges.retain(|&(ns, _)| {
+            !(20.4 * TIMING.period_ns()..40.0 * TIMING.period_ns()).contains(&ns)
+        });
+        let check = check(&t, &duties, &TIMING, LIMITS);
+        assert!(check.problems.is_empty(), "{:?}", check.problems);
+        assert_eq!((check.fresh, check.mismatches), (40, 0));
+        // The host wanted pulses there: every frame of the gap is named.
+        let mut wanted = duties.clone();
+        wanted[25] = 4800;
+        let check = check_wanted(&t, &wanted);
+        assert!(
+            check
+                .problems
+                .iter()
+                .any(|p| p.contains("frame 25: wrote 0 counts")),
+            "{:?}",
+            check.problems
+        );
+    }
+
+    fn check_wanted(t: &Train, wanted: &[u16]) -> ServoCheck {
+        check(t, wanted, &TIMING, LIMITS)
     }
 
     #[test]

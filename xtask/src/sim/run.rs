@@ -65,6 +65,8 @@ pub struct Boot {
     pub usb_in: Vec<f64>,
     /// When each DMX frame that carried a change ended.
     pub dmx_changes: Vec<f64>,
+    /// The input pins the script drove: when, which GPIO, high or low.
+    pub drives: Vec<(f64, u8, bool)>,
 }
 
 impl Boot {
@@ -430,6 +432,7 @@ fn into_boot(
             }
         }
         Event::Call { cycles, .. } => boot.frame_cycles.push(*cycles),
+        Event::Drive { pin, high, ns } => boot.drives.push((*ns, *pin, *high)),
         Event::Watchdog { .. } => boot.watchdog = true,
         Event::Stack { low, .. } => boot.stack_low = Some(*low),
         Event::Uart { hex, .. } => boot.uart.extend(hex),
@@ -522,7 +525,7 @@ pub fn timing() -> Timing {
 }
 
 /// Neutral, shortest and longest pulse of each servo, in counts.
-fn limits() -> [Limits; 3] {
+pub fn limits() -> [Limits; 3] {
     let config = DriverConfig::DEFAULT;
     let top = PICO_SERVO_CLOCK.top;
     config.servos.map(|servo| Limits {
@@ -541,6 +544,13 @@ pub fn check(report: &mut Report) -> Result<()> {
         .max()
         .unwrap_or(0);
     let expected = expect::pico_duties(frames)?;
+    check_with(report, &expected);
+    Ok(())
+}
+
+/// Checks every boot's pulses against `expected`, the duties the host
+/// computed for each frame from frame 0 (`[pitch, roll, yaw]`).
+pub fn check_with(report: &mut Report, expected: &[[u16; 3]]) {
     let (timing, limits) = (timing(), limits());
     let boots = report.boots.len();
     for (b, boot) in report.boots.iter_mut().enumerate() {
@@ -567,7 +577,6 @@ pub fn check(report: &mut Report) -> Result<()> {
             boot.servos[i] = verdict;
         }
     }
-    Ok(())
 }
 
 /// The largest `peak stack <n> B` the firmware logged.

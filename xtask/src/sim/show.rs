@@ -102,7 +102,7 @@ pub fn command(root: &Path, metadata: &Metadata, args: &super::Args) -> Result<b
     };
     print!("{}", servo_table(boot));
     if let Some(path) = &args.pulses {
-        let rows = pulses_csv::write(path, &boot.trains)?;
+        let rows = pulses_csv::write(path, &boot.servos, &super::run::timing())?;
         println!("{rows} rows of pulses written to {}", path.display());
     }
     if let Some(changes) = &changes {

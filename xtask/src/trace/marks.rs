@@ -17,6 +17,8 @@ pub enum Kind {
     Gaze,
     /// A look's return to the centre after its hold.
     Return,
+    /// A rest or a wake: the blend to the rest pose and back.
+    Rest,
     /// Anything else (idle, stop, a refused command).
     Other,
 }
@@ -113,6 +115,15 @@ pub fn marks(
             format!("ok idle {} %", p.get()),
         ),
         Ok(Applied::Stop) => (vec![], 0, Kind::Other, word, "ok stop".to_owned()),
+        Ok(Applied::Rest(ms) | Applied::Wake(ms)) => {
+            let what = if matches!(outcome, Ok(Applied::Rest(_))) {
+                "rest"
+            } else {
+                "wake"
+            };
+            let reply = format!("ok {what} {} ms", ms.0);
+            (Axis::ALL.to_vec(), u64::from(ms.0), Kind::Rest, word, reply)
+        }
     };
     let mut marks = vec![Mark {
         t_ms,

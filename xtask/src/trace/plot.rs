@@ -366,6 +366,7 @@ mod tests {
                 // A saw tooth of 10 frames: 0..9 °.
                 angles: [i32::try_from(frame % 10).unwrap() * 1000; 3],
                 pulses: [0; 3],
+                duties: [0; 3],
             })
             .collect()
     }

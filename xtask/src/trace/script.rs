@@ -1,34 +1,60 @@
 //! Trace scripts: `<seconds> <command>` per line, the command in the
-//! console's words (parsed by the core's `console::parse`).
+//! console's words (parsed by the core's `console::parse`), or a trigger
+//! input's level: `<seconds> pin <n> high|low` (`n` 2 to 5, as `input <n>`).
+//!
+//! A motion command is queued for the frame task as the console would
+//! queue it; any other console line (`input 2 presence -20000`, `rest after
+//! 5`, `servo …`) goes through the console's service, whose reply the trace
+//! prints; a pin line changes the level the input task sees. Pins start at
+//! their idle level (a button's pull-up keeps it high, a presence sensor's
+//! pull-down low) until a line changes them.
 
 use std::fmt::Write as _;
 
 use anyhow::{Result, bail};
 use idle_head_core::behaviour::BehaviourParams;
-use idle_head_core::command::{Action, Command, GestureKind};
+use idle_head_core::command::{Action, Command};
 use idle_head_core::console;
+use idle_head_core::input::{FIRST_INPUT, INPUTS};
 
-/// One scripted command.
+/// One scripted line.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Event {
-    /// Its line in the script (from 1).
+    /// Its line in the script (from 1; 0 for what an input did).
     pub line: usize,
     /// When, in µs from the first frame.
     pub at_us: u64,
     /// The command as written.
     pub text: String,
-    /// The command.
-    pub action: Action,
+    /// What it is.
+    pub kind: Kind,
 }
 
-/// The commands a script may give: every gesture of the core's table, and
-/// the other motion commands.
-fn allowed() -> String {
-    let gestures: Vec<&str> = GestureKind::ALL.iter().map(|k| k.name()).collect();
-    format!(
-        "{}, look, center, idle on|off, idle amp, stop",
-        gestures.join(", ")
-    )
+/// What a scripted line is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// A motion command, for the frame task's queue.
+    Act(Action),
+    /// Any other console line, for the console's service.
+    Console,
+    /// A trigger input's level: `input` 2 to 5, high or low.
+    Pin {
+        /// The input's number.
+        input: u8,
+        /// Its level.
+        high: bool,
+    },
+}
+
+#[cfg(test)]
+impl Event {
+    /// The action, if the line is a motion command.
+    pub fn action(&self) -> Option<Action> {
+        match self.kind {
+            Kind::Act(action) => Some(action),
+            Kind::Console | Kind::Pin { .. } => None,
+        }
+    }
 }
 
 /// `text` as seconds (`2`, `2.5`, `0.125`; at most µs), in µs.
@@ -100,30 +126,51 @@ fn event(line: usize, text: &str, params: &BehaviourParams) -> Result<Event, Str
         .map(|(t, c)| (t, c.trim()))
         .ok_or_else(|| format!("`{text}`: expected `<seconds> <command>`"))?;
     let at_us = seconds(time).map_err(|e| e.to_string())?;
-    let action = match console::parse(command.as_bytes()) {
-        Ok(Command::Act(action)) => action,
-        Ok(_) => {
-            let word = command.split_whitespace().next().unwrap_or("");
-            return Err(format!(
-                "`{word}` cannot be scripted (commands: {})",
-                allowed()
-            ));
+    let kind = if let Some(pin) = command
+        .strip_prefix("pin")
+        .filter(|rest| rest.starts_with(char::is_whitespace))
+    {
+        self::pin(pin.trim())?
+    } else {
+        match console::parse(command.as_bytes()) {
+            Ok(Command::Act(action)) => {
+                params.check(&action).map_err(|e| e.to_string())?;
+                Kind::Act(action)
+            }
+            Ok(_) => Kind::Console,
+            Err(e) => return Err(e.describe(command.as_bytes()).to_string()),
         }
-        Err(e) => return Err(e.describe(command.as_bytes()).to_string()),
     };
-    params.check(&action).map_err(|e| e.to_string())?;
     Ok(Event {
         line,
         at_us,
         text: command.to_owned(),
-        action,
+        kind,
     })
+}
+
+/// `<n> high|low` (after `pin`).
+fn pin(text: &str) -> Result<Kind, String> {
+    let usage = || format!("`pin {text}`: expected `pin <2..5> high|low`");
+    let (input, level) = text.split_once(char::is_whitespace).ok_or_else(usage)?;
+    let input: u8 = input
+        .parse()
+        .ok()
+        .filter(|&n| n >= FIRST_INPUT && usize::from(n - FIRST_INPUT) < INPUTS)
+        .ok_or_else(usage)?;
+    let high = match level.trim() {
+        "high" => true,
+        "low" => false,
+        _ => return Err(usage()),
+    };
+    Ok(Kind::Pin { input, high })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use idle_head_core::behaviour::BehaviourConfig;
+    use idle_head_core::command::GestureKind;
     use idle_head_core::driver::DriverConfig;
 
     fn params() -> BehaviourParams {
@@ -171,7 +218,9 @@ mod tests {
                 (9, 8_000_000),
             ]
         );
-        assert!(matches!(events[1].action, Action::Gesture(g) if g.kind == GestureKind::Nod));
+        assert!(
+            matches!(events[1].action(), Some(Action::Gesture(g)) if g.kind == GestureKind::Nod)
+        );
     }
 
     #[test]
@@ -200,8 +249,8 @@ line 4: at 2.9 s, before line 3 (at 3 s): lines must be in time order"
         let events = parse(&script, &params()).unwrap();
         let kinds: Vec<GestureKind> = events
             .iter()
-            .map(|e| match e.action {
-                Action::Gesture(g) => g.kind,
+            .map(|e| match e.action() {
+                Some(Action::Gesture(g)) => g.kind,
                 other => panic!("{other:?}"),
             })
             .collect();
@@ -213,34 +262,55 @@ line 4: at 2.9 s, before line 3 (at 3 s): lines must be in time order"
         let script = "\
 1 nod six
 2 wave
-3 servo pitch neutral 1500
+3 pin 6 high
 x nod
 5 nod 30000
 6 look 0
 7
+8 pin 2 up
 ";
         let err = parse(script, &params()).unwrap_err().to_string();
-        let commands = allowed();
         assert_eq!(
             err,
-            format!(
-                "\
+            "\
 line 1: `six`: amplitude in mdeg must be a whole number
 line 2: unknown command `wave` (try `help`)
-line 3: `servo` cannot be scripted (commands: {commands})
+line 3: `pin 6 high`: expected `pin <2..5> high|low`
 line 4: `x`: expected seconds such as 2 or 2.5 (at most 6 decimals)
 line 5: nod amplitude 30°: must be in 0.001°..20° (pitch's limits around its neutral pose)
 line 6: missing yaw in mdeg
-line 7: `7`: expected `<seconds> <command>`"
-            )
+line 7: `7`: expected `<seconds> <command>`
+line 8: `pin 2 up`: expected `pin <2..5> high|low`"
         );
-        // The commands: every gesture of the table, then the others.
-        for kind in GestureKind::ALL {
-            assert!(
-                commands.contains(&format!("{}, ", kind.name())),
-                "{commands}"
-            );
-        }
-        assert!(commands.ends_with("look, center, idle on|off, idle amp, stop"));
+    }
+
+    #[test]
+    fn pins_and_console_lines() {
+        let script = "\
+0 input 2 presence -20000
+0 rest after 5
+1.5 pin 2 high
+2 servo pitch neutral 1520
+3 pin 2 low
+";
+        let events = parse(script, &params()).unwrap();
+        let kinds: Vec<Kind> = events.iter().map(|e| e.kind).collect();
+        assert_eq!(
+            kinds,
+            [
+                Kind::Console,
+                Kind::Console,
+                Kind::Pin {
+                    input: 2,
+                    high: true
+                },
+                Kind::Console,
+                Kind::Pin {
+                    input: 2,
+                    high: false
+                },
+            ]
+        );
+        assert_eq!(events[2].at_us, 1_500_000);
     }
 }

@@ -25,7 +25,7 @@
 use crate::command::Hold;
 use crate::driver::{DegreesPerSecond, DegreesPerSecondSquared, MotionLimits};
 use crate::gestures::{GestureDefaults, GestureKind};
-use crate::units::{MilliHertz, Millis, Percent};
+use crate::units::{Angle, MilliHertz, Millis, Percent};
 
 /// `value` % (a compile-time constant below 100).
 const fn percent(value: u8) -> Percent {
@@ -47,6 +47,11 @@ pub struct GazeConfig {
     pub hold: Hold,
     /// Longest move (a given duration may not exceed it).
     pub longest: Millis,
+    /// How much of the idle motion the look's axes (pitch and yaw) lose
+    /// while a look holds, so that the head points where it was asked: 0
+    /// leaves the idle at full swing around the target, 100 freezes those
+    /// axes on it.
+    pub duck: Percent,
 }
 
 /// The idle layer under gestures and gaze.
@@ -60,6 +65,30 @@ pub struct IdleConfig {
     pub duck: Percent,
     /// Time of an idle change (`idle on|off`, `idle amp`).
     pub fade: Millis,
+}
+
+/// Rest: where the head rests, and whether it relaxes there (see
+/// [`super::rest`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RestConfig {
+    /// The rest pose, `[pitch, roll, yaw]`, axis angles within the servos'
+    /// limits.
+    pub pose: [Angle; 3],
+    /// Stop the pulses once there (the servos go limp: a head that is not
+    /// balanced may slump).
+    pub relax: bool,
+}
+
+/// The behaviour's settings a running head takes between two frames (the
+/// rest of the configuration takes effect at the next boot).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LiveConfig {
+    /// The rest pose and relax.
+    pub rest: RestConfig,
+    /// The look's duck ([`GazeConfig::duck`]).
+    pub look_duck: Percent,
 }
 
 /// Everything the behaviour layer needs, in physical units.
@@ -84,6 +113,8 @@ pub struct BehaviourConfig {
     pub gesture_limits: [MotionLimits; 3],
     /// How long an axis stays in gesture mode after its motion ended.
     pub settle: Millis,
+    /// Rest.
+    pub rest: RestConfig,
 }
 
 /// Longest hold of a look before it returns (`hold=stay` has none).
@@ -99,9 +130,11 @@ impl BehaviourConfig {
     /// The defaults: each gesture's from its row of the
     /// [gesture table](crate::gestures); frequency cap 4 Hz; gestures up
     /// to 10 s; an interrupted gesture fades out in 250 ms. Gaze: 300 ms +
-    /// 8 ms per degree, back to centre after 3 s, moves up to 8 s. Idle at
+    /// 8 ms per degree, back to centre after 3 s, moves up to 8 s, the idle
+    /// ducked by 80 % on the look's axes while a look holds. Idle at
     /// 100 %, ducked by 60 % under a gesture, changes over 1 s. Gesture
-    /// mode 250 °/s and 5000 °/s², for 500 ms after the motion.
+    /// mode 250 °/s and 5000 °/s², for 500 ms after the motion. Rest with a
+    /// slight droop (pitch −8°), the pulses on.
     pub const DEFAULT: Self = Self {
         gestures: GestureKind::DEFAULTS,
         max_frequency: MilliHertz(4000),
@@ -112,6 +145,7 @@ impl BehaviourConfig {
             per_degree: Millis(8),
             hold: Hold::Return(Millis(3000)),
             longest: Millis(8000),
+            duck: percent(80),
         },
         idle: IdleConfig {
             amplitude: Percent::FULL,
@@ -120,7 +154,20 @@ impl BehaviourConfig {
         },
         gesture_limits: [GESTURE_LIMITS; 3],
         settle: Millis(500),
+        rest: RestConfig {
+            pose: [Angle::from_millidegrees(-8000), Angle::ZERO, Angle::ZERO],
+            relax: false,
+        },
     };
+
+    /// The settings a running head takes between two frames.
+    #[must_use]
+    pub const fn live(&self) -> LiveConfig {
+        LiveConfig {
+            rest: self.rest,
+            look_duck: self.gaze.duck,
+        }
+    }
 
     /// The defaults of gesture `kind`.
     #[must_use]

@@ -19,6 +19,15 @@
 //! 3 s), then returns to the centre with the rule's duration, or stays until
 //! told (`hold=stay`). The return is planned when the look is applied, so the
 //! frame path never divides.
+//!
+//! # The look's envelope
+//!
+//! Beside its two axes the gaze keeps an envelope `E` (Q16, 0 to 1) on the
+//! same clock: it rises to 1 along the move of a look, stays 1 while the
+//! look holds and falls to 0 along the return or a `center`. The mixer
+//! ducks the idle on pitch and yaw by `duck · E` ([`super::mixer`]), so that
+//! a look lands where it was asked, and the duck comes and goes as smoothly
+//! as the move itself.
 
 use crate::axis::Axis;
 use crate::command::{Hold, LookRequest};
@@ -26,7 +35,7 @@ use crate::units::{Angle, Millis};
 
 use super::config::MAX_HOLD;
 use super::error::BehaviourError;
-use super::fixed::ahead;
+use super::fixed::{ONE, ahead};
 use super::glide::{Glide, State};
 use super::params::{BehaviourParams, LimitMode};
 
@@ -49,10 +58,13 @@ pub struct LookApplied {
     pub hold: Hold,
 }
 
-/// The gaze's centre: a glide per axis and, maybe, the return planned.
+/// The gaze's centre: a glide per axis and the envelope (see the [module
+/// docs](self#the-looks-envelope)), and, maybe, the return planned.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Gaze {
-    axes: [Glide; 2],
+    /// `[pitch, yaw, envelope]`, on one clock.
+    axes: [Glide; 3],
+    /// The planned return `[pitch, yaw]` (the envelope falls along it).
     back: Option<[Glide; 2]>,
 }
 
@@ -60,20 +72,30 @@ impl Gaze {
     /// At the centre, at rest.
     pub(crate) const fn new() -> Self {
         Self {
-            axes: [Glide::rest(0); 2],
+            axes: [Glide::rest(0); 3],
             back: None,
         }
     }
 
-    /// The centre's offsets `[pitch, yaw]` (m°) at frame `now`.
+    /// The centre's offsets (m°) and the look's envelope (Q16) at frame
+    /// `now`: `[pitch, yaw, envelope]`. (A move that starts while another
+    /// plays may overshoot its ends a little: the envelope may pass 0 or 1
+    /// by a few counts.)
     #[inline]
-    pub(crate) fn at(&mut self, now: u32) -> [i32; 2] {
+    pub(crate) fn at(&mut self, now: u32) -> [i32; 3] {
         if self.returns_by(now)
-            && let Some(back) = self.back.take()
+            && let Some([pitch, yaw]) = self.back.take()
         {
-            self.axes = back;
+            let envelope = pitch.falling(ONE as i32);
+            self.axes = [pitch, yaw, envelope];
         }
-        Glide::pair_at(&mut self.axes, now)
+        Glide::trio_at(&mut self.axes, now)
+    }
+
+    /// Whether the gaze rests at the centre, nothing planned (as of the
+    /// last `at`).
+    pub(crate) fn centred(&self) -> bool {
+        self.back.is_none() && self.axes.iter().all(|g| !g.moving() && g.target() == 0)
     }
 
     /// Whether the planned return starts at or before frame `frame`.
@@ -89,7 +111,8 @@ impl Gaze {
     /// move then starts whose end is not known yet).
     pub(crate) fn next_event(&self, from: u32) -> u32 {
         let mut soonest = u32::MAX;
-        for axis in &self.axes {
+        // (The envelope ends with the axes.)
+        for axis in &self.axes[..2] {
             if axis.moving() {
                 soonest = soonest.min(ahead(axis.end(), from));
             }
@@ -106,7 +129,8 @@ impl Gaze {
         self.back.is_some()
     }
 
-    /// Whether each axis `[pitch, yaw]` is moving (as of the last `at`).
+    /// Whether each axis `[pitch, yaw]` is moving (as of the last `at`;
+    /// the envelope moves with them).
     pub(crate) const fn moving(&self) -> [bool; 2] {
         [self.axes[0].moving(), self.axes[1].moving()]
     }
@@ -141,7 +165,7 @@ impl Gaze {
             clamped |= inside != offset;
             inside.millidegrees()
         });
-        let frames = self.move_to(params, next, offsets, request.duration);
+        let frames = self.move_to(params, next, offsets, ONE as i32, request.duration);
         self.back = match hold {
             Hold::Stay => None,
             Hold::Return(ms) => {
@@ -171,18 +195,19 @@ impl Gaze {
         given: Option<Millis>,
     ) -> Result<Millis, BehaviourError> {
         check_duration(params, "center duration", given)?;
-        let frames = self.move_to(params, next, [0, 0], given);
+        let frames = self.move_to(params, next, [0, 0], 0, given);
         self.back = None;
         Ok(params.millis(frames))
     }
 
-    /// Glides both axes from where they are at `next` to `offsets`; returns
-    /// the duration in frames.
+    /// Glides both axes from where they are at `next` to `offsets`, and the
+    /// envelope to `envelope`; returns the duration in frames.
     fn move_to(
         &mut self,
         params: &BehaviourParams,
         next: u32,
         offsets: [i32; 2],
+        envelope: i32,
         given: Option<Millis>,
     ) -> u32 {
         // A return that was due by `next` is under way: start from it.
@@ -190,7 +215,9 @@ impl Gaze {
         let from = self.axes.map(|g| g.state(next));
         let distance: [u32; 2] = core::array::from_fn(|i| offsets[i].abs_diff(from[i].pos));
         let frames = duration(params, distance, given);
-        self.axes = core::array::from_fn(|i| Glide::new(next, from[i], offsets[i], frames));
+        let [pitch, yaw] = offsets;
+        let to = [pitch, yaw, envelope];
+        self.axes = core::array::from_fn(|i| Glide::new(next, from[i], to[i], frames));
         frames
     }
 }
@@ -218,28 +245,15 @@ fn check_duration(
 fn duration(params: &BehaviourParams, distance: [u32; 2], given: Option<Millis>) -> u32 {
     let gaze = params.config().gaze;
     let far = u64::from(distance[0].max(distance[1]));
-    let mut ms = match given {
+    let ms = match given {
         Some(ms) => u64::from(ms.0),
         None => u64::from(gaze.base.0) + (u64::from(gaze.per_degree.0) * far).div_ceil(1000),
     };
-    for (i, axis) in AXES.iter().enumerate() {
-        let d = u64::from(distance[i]);
+    let mut frames = 2;
+    for (axis, d) in AXES.iter().zip(distance) {
         let limits = params.limits(*axis, LimitMode::Gesture);
-        let speed = u64::from(limits.max_speed.0.max(1));
-        let accel = u64::from(limits.max_accel.0.max(1));
-        // T ≥ 1.875·D/v and T² ≥ 5.774·D/a (D in m°, T in ms).
-        ms = ms.max((1875 * d).div_ceil(1000 * speed));
-        let squared = (57_735 * d).div_ceil(10 * accel);
-        let root = squared.isqrt();
-        ms = ms.max(if root * root < squared {
-            root + 1
-        } else {
-            root
-        });
+        let fit = params.move_frames(ms, d, limits.max_speed.0, limits.max_accel.0);
+        frames = frames.max(fit);
     }
-    // Whole frames, rounded up: never faster than the limits allow.
-    let frame_us = u64::from(params.frame_us().max(1));
-    u32::try_from((ms * 1000).div_ceil(frame_us))
-        .unwrap_or(u32::MAX)
-        .max(2)
+    frames
 }

@@ -106,6 +106,21 @@ impl Glide {
         }
     }
 
+    /// A glide on this one's clock that falls from `from`, at rest, to 0:
+    /// the profile of a move from rest, `r = −from·(10, −15, 6)`, no
+    /// division (the reciprocal is this glide's).
+    pub(crate) fn falling(&self, from: i32) -> Self {
+        let d = -i64::from(from);
+        let r = |k: i64| (k * d).clamp(-BOUND, BOUND) as i32;
+        Self {
+            start: self.start,
+            frames: self.frames,
+            inverse: self.inverse,
+            target: 0,
+            r: [r(10), r(-15), r(6)],
+        }
+    }
+
     /// The target.
     pub(crate) const fn target(&self) -> i32 {
         self.target
@@ -138,26 +153,38 @@ impl Glide {
         self.at_s(ONE - progress(t, self.inverse))
     }
 
-    /// The values of two glides at frame `now`, each as [`at`](Self::at)
-    /// gives it. Glides that share their clock (the same start and
-    /// duration, as the gaze's two axes always do) work out `s` once.
+    /// The values of three glides on one clock (the same start and
+    /// duration, as the gaze's axes and its envelope always are) at frame
+    /// `now`, each as [`at`](Self::at) gives it: `s` is worked out once,
+    /// and a third glide that holds its value (the gaze's envelope from
+    /// one look to the next) costs nothing.
     #[inline]
-    pub(crate) fn pair_at(pair: &mut [Self; 2], now: u32) -> [i32; 2] {
-        let [a, b] = pair;
-        if a.start != b.start || a.frames != b.frames {
-            return [a.at(now), b.at(now)];
+    pub(crate) fn trio_at(trio: &mut [Self; 3], now: u32) -> [i32; 3] {
+        let [one, two, three] = trio;
+        debug_assert!(
+            one.start == three.start && one.frames == three.frames,
+            "not on one clock"
+        );
+        if one.start != two.start || one.frames != two.frames {
+            return [one.at(now), two.at(now), three.at(now)];
         }
-        let t = now.wrapping_sub(a.start);
-        if t >= a.frames {
-            (a.frames, b.frames) = (0, 0);
-            return [a.target, b.target];
+        let t = now.wrapping_sub(one.start);
+        if t >= one.frames {
+            (one.frames, two.frames, three.frames) = (0, 0, 0);
+            return [one.target, two.target, three.target];
         }
         if t == 0 {
-            return [a.at(now), b.at(now)];
+            return [one.at(now), two.at(now), three.at(now)];
         }
         // The same frames, the same reciprocal.
-        let s = ONE - progress(t, a.inverse);
-        [a.at_s(s), b.at_s(s)]
+        let s = ONE - progress(t, one.inverse);
+        let [r0, r1, r2] = three.r;
+        let held = if r0 == 0 && r1 == 0 && r2 == 0 {
+            three.target
+        } else {
+            three.at_s(s)
+        };
+        [one.at_s(s), two.at_s(s), held]
     }
 
     /// The value at `s = 1 − τ` (Q16, `0 < s < 1`). Each multiply rounds to

@@ -27,11 +27,13 @@ use crate::driver::{ConfigError, FrameDriver, FrameReport};
 use crate::servo::ServoCalibration;
 use crate::units::Angle;
 
+use super::config::LiveConfig;
 use super::error::BehaviourError;
 use super::idle::IdleSource;
 use super::mixer::{Applied, Mixer};
 use super::params::{BehaviourParams, LimitMode};
 use super::queue::{Asker, CommandQueue, PER_FRAME};
+use super::rest::RestState;
 use super::show::{Show, ShowEvents, Source};
 use crate::bottango::Sample;
 use crate::dmx::{Latest, Signal};
@@ -87,8 +89,10 @@ impl<I: IdleSource> Head<I> {
     }
 
     /// Applies `action` from the next frame on. `Stop` fades the driver out;
-    /// a gesture, a look, `idle on` or `idle amp` after a stop fades it in
-    /// again. An axis that starts moving gets its gesture limits at once.
+    /// a gesture, a look, `idle on`, `idle amp` or `wake` after a stop fades
+    /// it in again. An axis that starts moving gets its gesture limits at
+    /// once. A gesture, a look or `wake` brings back the pulses of a head
+    /// relaxed at rest, from where it stands.
     ///
     /// # Errors
     /// A [`BehaviourError`] for bad parameters; nothing changes then.
@@ -97,19 +101,40 @@ impl<I: IdleSource> Head<I> {
         driver: &mut FrameDriver<P>,
         action: &Action,
     ) -> Result<Applied, BehaviourError> {
-        let applied = self.mixer.apply(action)?;
+        let pose = driver.params().config().neutral_pose;
+        let angles = driver.angles();
+        let at = core::array::from_fn(|i| angles[i].saturating_sub(pose[i]));
+        let applied = self.mixer.apply_at(action, at)?;
         if let Action::IdleAmp(amp) = action {
             self.show.own_amp(*amp);
         }
         match action {
             Action::Stop => driver.request_stop(),
-            Action::Gesture(_) | Action::Look(_) | Action::Idle(true) | Action::IdleAmp(_) => {
+            Action::Gesture(_)
+            | Action::Look(_)
+            | Action::Idle(true)
+            | Action::IdleAmp(_)
+            | Action::Wake { .. } => {
                 driver.resume();
             }
-            Action::Center { .. } | Action::Idle(false) => {}
+            Action::Center { .. } | Action::Idle(false) | Action::Rest => {}
         }
         self.sync(driver);
         Ok(applied)
+    }
+
+    /// Between frames: the rest pose, relax and the look's duck of
+    /// `live`, as the console changed them (the pose clamped to the
+    /// servos' limits). A new pose takes effect at the next rest (or `rest`
+    /// again); relax at once.
+    pub fn set_live<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, live: &LiveConfig) {
+        self.mixer.set_live(live);
+        self.sync(driver);
+    }
+
+    /// Where the head is in resting.
+    pub const fn rest_state(&self) -> RestState {
+        self.mixer.rest_state()
     }
 
     /// Between frames: a new calibration for `axis`' servo
@@ -132,7 +157,9 @@ impl<I: IdleSource> Head<I> {
     }
 
     /// Between frames: gives the driver the limits of the modes the mixer
-    /// asks for from the next frame on (see the [module docs](self)).
+    /// asks for from the next frame on (see the [module docs](self)), stops
+    /// or brings back the pulses as the rest asks (relaxed at the rest
+    /// pose), and starts the glance a wake ended in.
     pub fn sync<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>) {
         let mut wanted = self.mixer.modes();
         let show = self.show.engaged();
@@ -145,6 +172,16 @@ impl<I: IdleSource> Head<I> {
         }
         if !LimitMode::same(wanted, self.modes) {
             self.switch(driver, wanted);
+        }
+        let relaxed = self.mixer.wants_relaxed();
+        if relaxed != driver.is_relaxed() {
+            driver.set_relaxed(relaxed);
+        }
+        if let Some(glance) = self.mixer.take_glance() {
+            // A wake ended with a direction: the glance, as a look. (It is
+            // clamped to the limits and never refused: a failure changes
+            // nothing.)
+            let _ = self.apply(driver, &glance);
         }
     }
 

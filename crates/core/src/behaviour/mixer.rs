@@ -3,24 +3,32 @@
 //! Per axis and frame:
 //!
 //! ```text
-//! offset = centre + idle · gain · Π(1 − duck·Eᵢ) + Σ gestureᵢ
+//! base   = centre + idle · gain · Π(1 − duck·Eᵢ) · (1 − look_duck·E_look)
+//! offset = base + w · (pose − base) + Σ gestureᵢ
 //! ```
 //!
 //! - `centre`: the gaze (pitch and yaw; roll stays 0), [`super::gaze`];
 //! - `idle`: the idle source's offset, scaled by the idle gain (`idle on|off`,
 //!   `idle amp`, a minimum-jerk glide over `idle.fade`) and ducked under each
 //!   gesture on the axis by its envelope `Eᵢ` (so the duck is as smooth as the
-//!   gesture's own ramps);
+//!   gesture's own ramps), and on pitch and yaw by the look's envelope
+//!   `E_look` while a look holds (`gaze.duck`, see [`super::gaze`]): the
+//!   head points where it was asked, with a small sway left;
+//! - `w · (pose − base)`: the rest layer, [`super::rest`]: 0 while awake,
+//!   1 at rest, where the offsets are the rest pose;
 //! - `gestureᵢ`: up to [`LAYERS`] gesture layers, [`super::gesture`]. A new
 //!   gesture takes a free layer and every older one fades out under it
 //!   along `1 − S(t/blend)` (a smootherstep, C2), still playing: never a jump.
 //!
 //! The mixer also says which limit mode each axis needs from the next frame
 //! on ([`Mixer::modes`]: [`LimitMode::Gesture`] while a gesture or a gaze
-//! move plays on it and for `settle` after).
+//! move plays on it and for `settle` after; a rest or a wake keeps to the
+//! idle limits).
 
 use crate::command::{Action, GestureRequest, Percent};
 use crate::units::{Angle, AngleRange, Millis};
+
+pub use super::rest::RestState;
 
 use super::error::BehaviourError;
 use super::fixed::{ONE, ahead, mul, progress, smootherstep};
@@ -28,6 +36,7 @@ use super::gaze::{Gaze, LookApplied};
 use super::gesture::{self, GesturePlan};
 use super::glide::Glide;
 use super::params::{BehaviourParams, LimitMode};
+use super::rest::{self, Rest};
 
 /// Gesture layers: one playing and up to two fading out under it.
 pub const LAYERS: usize = 3;
@@ -46,6 +55,10 @@ pub enum Applied {
     Idle(Percent),
     /// Stop: the driver fades everything out (not the mixer's to do).
     Stop,
+    /// The head glides to its rest pose; it takes this long.
+    Rest(Millis),
+    /// The head wakes; the idle is back after this long (0: it was awake).
+    Wake(Millis),
 }
 
 impl BehaviourParams {
@@ -75,40 +88,54 @@ struct Layer {
 
 /// Idle, gestures and gaze mixed into one set of offsets; see the
 /// [module docs](self).
+///
+/// The fields are laid out in the order written (`repr(C)`), those every
+/// frame reads first: on ARMv6-M a load reaches 124 bytes past a pointer,
+/// and a field further on costs an instruction or two more to address.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
 pub struct Mixer {
-    params: BehaviourParams,
-    layers: [Option<Layer>; LAYERS],
-    gaze: Gaze,
-    /// Idle gain, Q16.
-    idle_gain: Glide,
-    idle_on: bool,
-    idle_amp: Percent,
-    /// Frames each axis stays in gesture mode after it was last on, as of
-    /// the last frame mixed in full (see [`Mixer::events`]).
-    gesture_left: [u32; 3],
-    /// Bit `i`: axis `i` was on (a gesture or a gaze move playing on it) at
-    /// the last frame mixed in full, and so at every frame since.
-    on: u8,
+    /// The last frame mixed, and the frame actions start at.
+    now: u32,
+    next: u32,
     /// The first frame that must be mixed in full: nothing but the values
     /// changes before it (no layer or move starts or ends, no return is
     /// due, no settle time runs out).
     until: u32,
+    /// Nothing moves but the idle, at `quiet_gain` (per axis) around
+    /// `quiet_centre`; `quiet_unity` if every gain is 1.
+    quiet: bool,
+    quiet_unity: bool,
+    /// The rest layer is on: [`Rest::active`], kept here where the frame
+    /// path reaches it cheaply.
+    resting: bool,
+    /// A wake has ended: the glance to start (see [`Mixer::take_glance`]).
+    glance: Option<Angle>,
+    /// Bit `i`: axis `i` was on (a gesture or a gaze move playing on it) at
+    /// the last frame mixed in full, and so at every frame since.
+    on: u8,
+    idle_on: bool,
+    quiet_gain: [u32; 3],
+    quiet_centre: [i32; 2],
+    /// The limit modes from the next frame on.
+    modes: [LimitMode; 3],
+    idle_amp: Percent,
     /// The last frame mixed in full.
     full: u32,
     /// The next frame at which a layer or a gaze move ends, a return is due
     /// or starts, or the idle gain's glide ends, as last found (see
     /// `schedule`); events in between are settle times running out.
     ends: u32,
-    /// The limit modes from the next frame on.
-    modes: [LimitMode; 3],
-    /// Nothing moves but the idle, at `rest_gain` around `rest_centre`.
-    quiet: bool,
-    rest_gain: u32,
-    rest_centre: [i32; 2],
-    /// The last frame mixed, and the frame actions start at.
-    now: u32,
-    next: u32,
+    /// Frames each axis stays in gesture mode after it was last on, as of
+    /// the last frame mixed in full (see [`Mixer::events`]).
+    gesture_left: [u32; 3],
+    /// Idle gain, Q16.
+    idle_gain: Glide,
+    params: BehaviourParams,
+    gaze: Gaze,
+    layers: [Option<Layer>; LAYERS],
+    /// The rest layer.
+    rest: Rest,
 }
 
 impl Mixer {
@@ -131,8 +158,12 @@ impl Mixer {
             ends: 0,
             modes: [LimitMode::Idle; 3],
             quiet: true,
-            rest_gain: gain_of(amp) as u32,
-            rest_centre: [0; 2],
+            quiet_unity: gain_of(amp) as u32 == ONE,
+            resting: false,
+            glance: None,
+            quiet_gain: [gain_of(amp) as u32; 3],
+            quiet_centre: [0; 2],
+            rest: Rest::new(),
             now: 0,
             next: 0,
         }
@@ -142,6 +173,15 @@ impl Mixer {
     #[must_use]
     pub const fn params(&self) -> &BehaviourParams {
         &self.params
+    }
+
+    /// Takes the live settings of `config` (see
+    /// [`BehaviourParams::set_live`]); the rest pose from the next rest on.
+    pub(crate) fn set_live(&mut self, live: &super::LiveConfig) {
+        self.params.set_live(live);
+        // The look's duck changes the quiet gains: mix the next frame in full.
+        self.quiet = false;
+        self.until = self.next;
     }
 
     /// Gives `axis` the servo's new angle limits (see
@@ -158,6 +198,16 @@ impl Mixer {
     /// # Errors
     /// A [`BehaviourError`] for bad parameters (nothing changes then).
     pub fn apply(&mut self, action: &Action) -> Result<Applied, BehaviourError> {
+        self.apply_at(action, [Angle::ZERO; 3])
+    }
+
+    /// [`apply`](Self::apply) to a head whose last frame's offsets were
+    /// `at` (`[pitch, roll, yaw]`, what the driver made of them): a rest's
+    /// duration is fitted to the distance from there.
+    ///
+    /// # Errors
+    /// A [`BehaviourError`] for bad parameters (nothing changes then).
+    pub fn apply_at(&mut self, action: &Action, at: [Angle; 3]) -> Result<Applied, BehaviourError> {
         let next = self.next;
         let applied = match action {
             Action::Gesture(request) => {
@@ -184,12 +234,77 @@ impl Mixer {
                 Applied::Idle(self.glide_idle())
             }
             Action::Stop => return Ok(Applied::Stop),
+            Action::Rest => Applied::Rest(self.start_rest(next, at.map(Angle::millidegrees))),
+            Action::Wake { toward } => match self.rest.wake(&self.params, next, *toward) {
+                Some(duration) => Applied::Wake(duration),
+                None => match toward {
+                    // Awake already: the glance alone.
+                    Some(yaw) => {
+                        let applied = self.gaze.look(
+                            &self.params,
+                            next,
+                            &rest::glance(&self.params, *yaw),
+                        )?;
+                        self.gazing();
+                        Applied::Look(applied)
+                    }
+                    None => Applied::Wake(Millis(0)),
+                },
+            },
         };
+        if matches!(action, Action::Gesture(_) | Action::Look(_)) {
+            // A gesture or a look wakes a resting head: it plays over the
+            // wake (a gesture on top of the blend, a look under it, arriving
+            // as the idle comes back).
+            self.rest.wake(&self.params, next, None);
+        }
+        self.resting = self.rest.active();
         self.quiet = false;
         // The next frame is mixed in full; the ends after it are known now.
         self.until = next;
         self.schedule(next);
         Ok(applied)
+    }
+
+    /// Starts a rest at frame `next` of a head at `at` (offsets, m°): the
+    /// pose's weight rises, and the gaze, hidden under it, goes back to the
+    /// centre (a wake starts from there); returns the rest's duration.
+    fn start_rest(&mut self, next: u32, at: [i32; 3]) -> Millis {
+        let pose = self.params.rest_pose;
+        let duration = self.rest.rest(&self.params, next, pose, at);
+        let frames = self.params.frames(duration);
+        if !self.gaze.centred() {
+            // Within the longest move: the built-in rest times are.
+            let longest = self.params.config().gaze.longest;
+            let ms = self.params.millis(frames).min(longest);
+            let _ = self
+                .gaze
+                .center(&self.params, next, Some(Millis(ms.0.max(1))));
+        }
+        duration
+    }
+
+    /// The glance a wake with a direction ends in, once it is due: a look
+    /// to apply before the next frame (what [`Head::sync`](super::Head::sync)
+    /// does).
+    pub fn take_glance(&mut self) -> Option<Action> {
+        let yaw = self.glance.take()?;
+        Some(Action::Look(rest::glance(&self.params, yaw)))
+    }
+
+    /// Where the head is in resting.
+    #[must_use]
+    pub const fn rest_state(&self) -> RestState {
+        self.rest.state()
+    }
+
+    /// Whether the head rests at its pose with nothing moving, and should
+    /// relax there (`rest.relax`): the driver may stop the pulses.
+    #[must_use]
+    pub const fn wants_relaxed(&self) -> bool {
+        self.params.config().rest.relax
+            && matches!(self.rest.state(), RestState::Resting)
+            && self.rest.arrived()
     }
 
     /// A gaze move starts: pitch and yaw in gesture mode.
@@ -262,17 +377,17 @@ impl Mixer {
         if !self.quiet {
             return self.mix(now, idle);
         }
-        // Nothing moves but the idle: at its resting gain, around the resting
+        // Nothing moves but the idle: at its quiet gains, around the quiet
         // centre (within the limits: no overflow).
         self.now = now;
         self.next = now.wrapping_add(1);
         let [pitch, roll, yaw] = idle.map(Angle::millidegrees);
-        let [centre_pitch, centre_yaw] = self.rest_centre;
-        let gain = self.rest_gain;
-        let [pitch, roll, yaw] = if gain == ONE {
+        let [centre_pitch, centre_yaw] = self.quiet_centre;
+        let [pitch, roll, yaw] = if self.quiet_unity {
             [pitch, roll, yaw]
         } else {
-            [mul(pitch, gain), mul(roll, gain), mul(yaw, gain)]
+            let [p, r, y] = self.quiet_gain;
+            [mul(pitch, p), mul(roll, r), mul(yaw, y)]
         };
         [pitch + centre_pitch, roll, yaw + centre_yaw].map(Angle::from_millidegrees)
     }
@@ -291,22 +406,37 @@ impl Mixer {
         self.next = now.wrapping_add(1);
         let sums = self.layers(now);
 
-        let centre = self.gaze.at(now);
+        let [centre_pitch, centre_yaw, envelope] = self.gaze.at(now);
         let gain = if self.idle_gain.moving() {
             self.idle_gain.at(now).clamp(0, ONE as i32) as u32
         } else {
             self.idle_gain.target() as u32
         };
+        // The look's duck on pitch and yaw (1 without a look), with the gain.
+        let look = look_keep(self.params.look_duck, envelope);
+        let looked = both(gain, look);
         let [pitch, roll, yaw] = idle.map(Angle::millidegrees);
         // Within the limits: no overflow.
-        let pitch = idle_part(pitch, gain, sums.duck[0]) + sums.add[0] + centre[0];
-        let roll = idle_part(roll, gain, sums.duck[1]) + sums.add[1];
-        let yaw = idle_part(yaw, gain, sums.duck[2]) + sums.add[2] + centre[1];
+        let pitch = idle_part(pitch, looked, sums.duck[0]) + centre_pitch;
+        let roll = idle_part(roll, gain, sums.duck[1]);
+        let yaw = idle_part(yaw, looked, sums.duck[2]) + centre_yaw;
+        let [pitch, roll, yaw] = if self.resting {
+            self.rest.blend(now, [pitch, roll, yaw])
+        } else {
+            [pitch, roll, yaw]
+        };
+        let offsets = [pitch + sums.add[0], roll + sums.add[1], yaw + sums.add[2]];
         // `now < until` (frames only increase).
         if self.until.wrapping_sub(now) as i32 <= 0 {
-            self.events(now, prev, sums.active, centre, gain);
+            self.events(
+                now,
+                prev,
+                sums.active,
+                [centre_pitch, centre_yaw],
+                [gain, looked],
+            );
         }
-        [pitch, roll, yaw].map(Angle::from_millidegrees)
+        offsets.map(Angle::from_millidegrees)
     }
 
     /// A frame mixed in full: the limit modes from the next frame on,
@@ -320,8 +450,17 @@ impl Mixer {
     /// its frames left in gesture mode follow from the frames passed: this
     /// gives the modes of every frame exactly as counting them down frame by
     /// frame would.
+    ///
+    /// `gains`: the idle's gain of this frame, on roll and on the look's
+    /// axes.
     #[inline(never)]
-    fn events(&mut self, now: u32, prev: u32, active: u8, centre: [i32; 2], gain: u32) {
+    fn events(&mut self, now: u32, prev: u32, active: u8, centre: [i32; 2], gains: [u32; 2]) {
+        if let Some(yaw) = self.rest.settle() {
+            // Awake again: the glance, from the next frame on. It is applied
+            // between frames, as an action is (its planning divides).
+            self.glance = Some(yaw);
+        }
+        self.resting = self.rest.active();
         let moving = self.gaze.moving();
         let returning = self.gaze.returns_by(self.next);
         let on = active | u8::from(moving[0]) | (u8::from(moving[1]) << 2);
@@ -349,10 +488,13 @@ impl Mixer {
             && self.layers.iter().all(Option::is_none)
             && !self.gaze.pending()
             && !self.idle_gain.moving()
+            && !self.resting
         {
+            let [gain, looked] = gains;
             self.quiet = true;
-            self.rest_centre = centre;
-            self.rest_gain = gain;
+            self.quiet_centre = centre;
+            self.quiet_gain = [looked, gain, looked];
+            self.quiet_unity = gain == ONE && looked == ONE;
         }
         // The next end of a layer or a move: found again once the last one
         // found has passed, or after an action.
@@ -379,6 +521,9 @@ impl Mixer {
             soonest = soonest.min(ahead(layer.start.wrapping_add(layer.stop), from));
         }
         soonest = soonest.min(self.gaze.next_event(from));
+        if self.resting {
+            soonest = soonest.min(self.rest.next_event(from));
+        }
         if self.idle_gain.moving() {
             soonest = soonest.min(ahead(self.idle_gain.end(), from));
         }
@@ -459,6 +604,32 @@ impl Sums {
         duck: [ONE; 3],
         active: 0,
     };
+}
+
+/// The idle kept on a look's axes at envelope `envelope` (Q16, taken
+/// within `0..=1`): `1 − duck · envelope` (1 without a look, one
+/// subtraction while it holds).
+#[inline]
+const fn look_keep(duck: u32, envelope: i32) -> u32 {
+    if envelope <= 0 {
+        ONE
+    } else if envelope >= ONE as i32 {
+        ONE - duck
+    } else {
+        ONE - mul(duck as i32, envelope as u32) as u32
+    }
+}
+
+/// The product of two Q16 fractions (a factor of 1 skipped).
+#[inline]
+const fn both(a: u32, b: u32) -> u32 {
+    if b == ONE {
+        a
+    } else if a == ONE {
+        b
+    } else {
+        mul(a as i32, b) as u32
+    }
 }
 
 /// `idle · gain · duck` (Q16 each; a factor of 1 skipped: `mul` by 1 is

@@ -6,7 +6,7 @@ use crate::axis::Axis;
 use crate::driver::{MotionLimits, SlewRates};
 use crate::units::{Angle, AngleRange, Millis};
 
-use super::config::BehaviourConfig;
+use super::config::{BehaviourConfig, LiveConfig};
 
 /// The offsets `limits` leave around `pose`.
 pub(super) const fn room_around(limits: AngleRange, pose: Angle) -> AngleRange {
@@ -17,11 +17,29 @@ pub(super) const fn room_around(limits: AngleRange, pose: Angle) -> AngleRange {
 }
 
 /// A validated [`BehaviourConfig`] in the integer form the frame path uses.
+///
+/// Laid out in the order written (`repr(C)`), what the frame path reads
+/// first (see [`Mixer`](super::Mixer)'s layout).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(C)]
 pub struct BehaviourParams {
-    pub(super) config: BehaviourConfig,
+    /// Frames of a gesture's fade-out under a newer one, and its reciprocal.
+    pub(crate) blend: u32,
+    pub(crate) blend_inverse: u32,
+    /// Idle duck depth, Q16.
+    pub(crate) duck: u32,
+    /// The idle's duck on the look's axes while a look holds, Q16.
+    pub(crate) look_duck: u32,
+    /// Frames in gesture mode after the motion.
+    pub(crate) settle: u32,
+    /// Frames of an idle change.
+    pub(crate) idle_fade: u32,
     pub(super) frame_us: u32,
+    /// The driver's neutral pose.
+    pub(super) pose: [Angle; 3],
+    /// The rest pose's offsets around the neutral pose, m°.
+    pub(crate) rest_pose: [i32; 3],
     /// Offsets each axis may take around the neutral pose (limits − pose).
     pub(super) room: [AngleRange; 3],
     /// The driver's configured limits: the idle mode.
@@ -30,17 +48,7 @@ pub struct BehaviourParams {
     /// axis) at `frame_us`, computed here so that a switch between the modes
     /// divides nothing (`None`: the driver refuses those limits).
     pub(super) rates: [[Option<SlewRates>; 2]; 3],
-    /// Frames of a gesture's fade-out under a newer one, and its reciprocal.
-    pub(crate) blend: u32,
-    pub(crate) blend_inverse: u32,
-    /// Frames in gesture mode after the motion.
-    pub(crate) settle: u32,
-    /// Frames of an idle change.
-    pub(crate) idle_fade: u32,
-    /// The driver's neutral pose.
-    pub(super) pose: [Angle; 3],
-    /// Idle duck depth, Q16.
-    pub(crate) duck: u32,
+    pub(super) config: BehaviourConfig,
 }
 
 /// The limits an axis is driven with.
@@ -80,6 +88,27 @@ impl BehaviourParams {
         self.pose
     }
 
+    /// Takes the rest pose, relax and the look's duck of `live`: the
+    /// settings a running head takes between two frames. Returns whether
+    /// the rest pose had to be clamped to the servos' limits.
+    pub fn set_live(&mut self, live: &LiveConfig) -> bool {
+        self.config.rest = live.rest;
+        self.config.gaze.duck = live.look_duck;
+        self.look_duck = super::validate::q16(live.look_duck);
+        let (pose, clamped) = super::validate::rest_offsets(&self.config, &self.pose, &self.room);
+        self.rest_pose = pose;
+        clamped
+    }
+
+    /// The rest pose, `[pitch, roll, yaw]` axis angles, as the head rests:
+    /// within the servos' limits.
+    #[must_use]
+    pub fn rest_pose(&self) -> [Angle; 3] {
+        core::array::from_fn(|i| {
+            Angle::from_millidegrees(self.rest_pose[i]).saturating_add(self.pose[i])
+        })
+    }
+
     /// The offsets `axis` may take around its neutral pose.
     #[must_use]
     pub const fn room(&self, axis: Axis) -> AngleRange {
@@ -94,6 +123,7 @@ impl BehaviourParams {
         if let (Some(room), Some(&pose)) = (self.room.get_mut(i), self.pose.get(i)) {
             *room = room_around(limits, pose);
         }
+        self.rest_pose = super::validate::rest_offsets(&self.config, &self.pose, &self.room).0;
     }
 
     /// The limits of `axis` in `mode`.
@@ -127,6 +157,29 @@ impl BehaviourParams {
         } else {
             frames as u32
         }
+    }
+
+    /// Whole frames of a move of `distance` m° that takes at least `ms`,
+    /// lengthened until its minimum-jerk profile fits `speed` °/s and
+    /// `accel` °/s² (it peaks at `1.875·D/T` and `5.774·D/T²`); rounded up,
+    /// at least 2: never faster than the limits allow.
+    pub(crate) fn move_frames(&self, ms: u64, distance: u32, speed: u32, accel: u32) -> u32 {
+        let d = u64::from(distance);
+        let (speed, accel) = (u64::from(speed.max(1)), u64::from(accel.max(1)));
+        // T ≥ 1.875·D/v and T² ≥ 5.774·D/a (D in m°, T in ms).
+        let squared = (57_735 * d).div_ceil(10 * accel);
+        let root = squared.isqrt();
+        let ms = ms
+            .max((1875 * d).div_ceil(1000 * speed))
+            .max(if root * root < squared {
+                root + 1
+            } else {
+                root
+            });
+        let frame_us = u64::from(self.frame_us.max(1));
+        u32::try_from((ms * 1000).div_ceil(frame_us))
+            .unwrap_or(u32::MAX)
+            .max(2)
     }
 
     /// The duration of `frames` frames, rounded to ms.

@@ -184,8 +184,10 @@ impl BehaviourConfig {
             blend_inverse: 0,
             settle: 0,
             idle_fade: 0,
-            duck: (self.idle.duck.get() as u32 * ONE) / 100,
+            duck: q16(self.idle.duck),
+            look_duck: q16(self.gaze.duck),
             pose: cfg.neutral_pose,
+            rest_pose: [0; 3],
         };
         params.rates = mode_rates(cfg, &self.gesture_limits);
         params.blend = params.frames(self.blend);
@@ -214,8 +216,37 @@ impl BehaviourConfig {
             }
             k += 1;
         }
+        params.rest_pose = rest_offsets(self, &cfg.neutral_pose, &room).0;
         Ok(params)
     }
+}
+
+/// A percentage as a Q16 fraction.
+pub(super) const fn q16(p: Percent) -> u32 {
+    (p.get() as u32 * ONE) / 100
+}
+
+/// `config`'s rest pose as offsets around the neutral `pose`, each clamped
+/// to the `room` its axis has there (the servos' limits), and whether it
+/// had to be. (Clamped, not refused: settings saved before the rest pose
+/// existed keep loading whatever their limits, as a look's target is
+/// clamped.)
+pub(super) const fn rest_offsets(
+    config: &BehaviourConfig,
+    pose: &[Angle; 3],
+    room: &[AngleRange; 3],
+) -> ([i32; 3], bool) {
+    let mut offsets = [0; 3];
+    let mut clamped = false;
+    let mut i = 0;
+    while i < 3 {
+        let offset = config.rest.pose[i].saturating_sub(pose[i]);
+        let inside = offset.clamp_to(room[i].min, room[i].max);
+        clamped |= inside.millidegrees() != offset.millidegrees();
+        offsets[i] = inside.millidegrees();
+        i += 1;
+    }
+    (offsets, clamped)
 }
 
 // The built-in configuration must be valid with the built-in driver: a

@@ -1,9 +1,10 @@
 //! What the console task and the frame task share, besides the command
 //! queue: the head's status (frame task → console), servo calibrations
-//! to apply (console → frame task), new idle seeds (console → loop
-//! generator), the outcome of each port's queued action (frame task →
-//! the port's console, which answers the line with it) and each port's
-//! telemetry rate (`watch`).
+//! and the live behaviour settings to apply (console → frame task), new
+//! idle seeds (console → loop generator), the outcome of each port's
+//! queued action (frame task → the port's console, which answers the line
+//! with it), each port's telemetry rate (`watch`), and the trigger inputs'
+//! settings and levels (console → input task → console).
 //!
 //! Each is an embassy-sync blocking `Mutex` over a `Cell`, or a `Signal`
 //! (whose state is a `Cell` too): a critical section around a copy, no
@@ -16,8 +17,9 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 
 use crate::axis::Axis;
-use crate::behaviour::{Applied, Asker, BehaviourError};
+use crate::behaviour::{Applied, Asker, BehaviourError, LiveConfig};
 use crate::driver::{DriverStats, FrameReport};
+use crate::input::{InputSettings, InputStatus};
 use crate::servo::ServoCalibration;
 use crate::units::{Angle, Microseconds};
 
@@ -30,6 +32,10 @@ pub enum HeadMode {
     Starting,
     /// Playing (fading in or at full strength).
     Running,
+    /// Gliding to the rest pose, or resting there (relaxed: no pulses).
+    Resting,
+    /// Waking from a rest: the idle fades back in.
+    Waking,
     /// Fading out after `stop`.
     Stopping,
     /// Holding the neutral pose after `stop`.
@@ -43,6 +49,8 @@ impl HeadMode {
         match self {
             Self::Starting => "starting",
             Self::Running => "running",
+            Self::Resting => "resting",
+            Self::Waking => "waking",
             Self::Stopping => "stopping",
             Self::Stopped => "stopped",
         }
@@ -65,6 +73,26 @@ pub struct HeadStatus {
     pub faults: [u32; 3],
     /// Servos switched off.
     pub disabled: [bool; 3],
+}
+
+impl HeadMode {
+    /// The mode of a head whose driver is `stopped` or `stopping` (after a
+    /// `stop`), and which is in `rest` otherwise.
+    #[must_use]
+    pub const fn of(stopped: bool, stopping: bool, rest: crate::behaviour::RestState) -> Self {
+        use crate::behaviour::RestState;
+        if stopped {
+            Self::Stopped
+        } else if stopping {
+            Self::Stopping
+        } else {
+            match rest {
+                RestState::Awake => Self::Running,
+                RestState::Resting => Self::Resting,
+                RestState::Waking => Self::Waking,
+            }
+        }
+    }
 }
 
 impl HeadStatus {
@@ -104,6 +132,12 @@ pub struct ConsoleLink {
     outcomes: [Signal<CriticalSectionRawMutex, Outcome>; PORTS],
     /// Telemetry lines a second per port (0: off).
     watch: Mutex<CriticalSectionRawMutex, Cell<[u8; PORTS]>>,
+    live: Signal<CriticalSectionRawMutex, LiveConfig>,
+    /// The inputs' settings in effect (one copy, which the input task
+    /// reads at every wake), and whether they changed.
+    inputs: Mutex<CriticalSectionRawMutex, Cell<InputSettings>>,
+    inputs_changed: Signal<CriticalSectionRawMutex, ()>,
+    input_status: Mutex<CriticalSectionRawMutex, Cell<InputStatus>>,
 }
 
 impl ConsoleLink {
@@ -123,6 +157,10 @@ impl ConsoleLink {
             seeds: Signal::new(),
             outcomes: [const { Signal::new() }; PORTS],
             watch: Mutex::new(Cell::new([0; PORTS])),
+            live: Signal::new(),
+            inputs: Mutex::new(Cell::new(InputSettings::DEFAULT)),
+            inputs_changed: Signal::new(),
+            input_status: Mutex::new(Cell::new(InputStatus { high: 0, active: 0 })),
         }
     }
 
@@ -203,6 +241,50 @@ impl ConsoleLink {
     /// The loop generator: new seeds, if asked for since the last call.
     pub fn take_seeds(&self) -> Option<[u32; 3]> {
         self.seeds.try_take()
+    }
+
+    /// The console: the rest pose, relax and the look's duck from the next
+    /// frame on (the newest replaces one not yet taken).
+    pub fn set_live(&self, live: LiveConfig) {
+        self.live.signal(live);
+    }
+
+    /// The frame task: the live settings, if changed since the last call.
+    pub fn take_live(&self) -> Option<LiveConfig> {
+        self.live.try_take()
+    }
+
+    /// The boot, then the console: the inputs' roles and the rest timer in
+    /// effect, for the input task.
+    pub fn set_inputs(&self, inputs: InputSettings) {
+        self.inputs.lock(|cell| cell.set(inputs));
+        self.inputs_changed.signal(());
+    }
+
+    /// The input task: the inputs' settings in effect.
+    pub fn input_settings(&self) -> InputSettings {
+        self.inputs.lock(Cell::get)
+    }
+
+    /// The input task: waits until the inputs' settings change.
+    pub async fn inputs_changed(&self) {
+        self.inputs_changed.wait().await;
+    }
+
+    /// The input task (or a host test): whether the inputs' settings changed
+    /// since the last call.
+    pub fn take_inputs_changed(&self) -> bool {
+        self.inputs_changed.try_take().is_some()
+    }
+
+    /// The input task: the inputs' levels as they are now.
+    pub fn publish_inputs(&self, status: InputStatus) {
+        self.input_status.lock(|cell| cell.set(status));
+    }
+
+    /// The console: the inputs' levels.
+    pub fn inputs(&self) -> InputStatus {
+        self.input_status.lock(Cell::get)
     }
 }
 

@@ -84,6 +84,12 @@ fn started(reply: &mut Reply<'_>, applied: &Applied) {
         Applied::Stop => {
             text.str("stopping");
         }
+        Applied::Rest(duration) => {
+            text.str("rest ms=").u64(duration.0.into());
+        }
+        Applied::Wake(duration) => {
+            text.str("wake ms=").u64(duration.0.into());
+        }
     }
 }
 

@@ -64,10 +64,15 @@
 //!   between two frames through the limiter ([`FrameDriver::set_servo`]);
 //! - `seed`: the next loop set is generated from the new seeds and
 //!   joined in as any set is (no jump);
+//! - `input`, `rest after|pose|relax`, `look duck`: the settings changed
+//!   and sent through the link, to the input task (the roles and the rest
+//!   timer) or to the frame task (the rest pose, relax, the look's duck;
+//!   see `service/inputs.rs`); `rest` and `wake` alone are motions;
 //! - `save`, `load`, `defaults`: the [`SettingsStorage`]; a loaded or
 //!   default set is applied as `servo` and `seed` are, and its idle
-//!   amplitude through the queue. (Gesture and gaze defaults take effect
-//!   at the next boot: the frame task's behaviour is built once.)
+//!   amplitude through the queue, its inputs and live behaviour settings
+//!   through the link. (The other gesture and gaze defaults take effect at
+//!   the next boot: the frame task's behaviour is built once.)
 //!
 //! [`FrameDriver::set_servo`]: crate::driver::FrameDriver::set_servo
 
@@ -75,6 +80,7 @@ use crate::text::Arg::{Int, Str, Uint};
 use crate::text::Text;
 
 mod dmx;
+mod inputs;
 
 use super::link::{ConsoleLink, HeadStatus};
 use super::outcome::behaviour_code;
@@ -93,7 +99,7 @@ use crate::settings::{Settings, SettingsError, SettingsSource, SettingsStorage, 
 pub const HELP: &str = const_format::concatcp!(
     "commands: help status stop",
     GestureKind::WORDS,
-    " look center idle seed servo save load defaults watch dmx"
+    " look center idle rest wake input seed servo save load defaults watch dmx"
 );
 
 /// The firmware version `status` reports.
@@ -228,6 +234,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
                 Str(self.source.as_str()),
             ],
         );
+        self.status_inputs(text(reply));
     }
 
     fn show_servo(&self, axis: Axis, reply: &mut Reply<'_>) {
@@ -273,6 +280,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
             }
         }
         match next.validate(&self.base) {
+            Ok(valid) if Self::inputs_refused(&next, &valid.behaviour, reply) => {}
             Ok(valid) => {
                 self.link.set_servo(axis, cal);
                 self.settings = next;
@@ -323,7 +331,12 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
 
     /// Puts `settings` in effect: idle amplitude through the queue (so a
     /// full queue changes nothing), servos and seeds through the link.
-    fn adopt(&mut self, settings: Settings, source: SettingsSource, reply: &mut Reply<'_>) -> bool {
+    fn adopt(
+        &mut self,
+        settings: &Settings,
+        source: SettingsSource,
+        reply: &mut Reply<'_>,
+    ) -> bool {
         let valid = match settings.validate(&self.base) {
             Ok(valid) => valid,
             Err(e) => {
@@ -352,16 +365,17 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         if let Some(show) = self.show {
             show.dmx.set(settings.dmx);
         }
-        self.settings = settings;
+        self.settings = *settings;
         self.behaviour = valid.behaviour;
         self.source = source;
+        self.adopt_inputs();
         true
     }
 
     fn load(&mut self, reply: &mut Reply<'_>) {
         match self.storage.load() {
             Ok(settings) => {
-                self.adopt(settings, SettingsSource::Flash, reply);
+                self.adopt(&settings, SettingsSource::Flash, reply);
             }
             Err(e) => storage_error(e, "load", reply),
         }
@@ -398,9 +412,16 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
             Command::Save => self.save(reply),
             Command::Load => self.load(reply),
             Command::Defaults => {
-                self.adopt(Settings::DEFAULT, SettingsSource::Defaults, reply);
+                self.adopt(&Settings::DEFAULT, SettingsSource::Defaults, reply);
             }
             Command::Dmx(setting) => self.dmx(setting, reply),
+            Command::Input { input, role: None } => self.show_input(input, reply),
+            Command::Input {
+                input,
+                role: Some(role),
+            } => self.set_input(input, role, reply),
+            Command::Rest(setting) => self.set_rest(setting, reply),
+            Command::LookDuck(duck) => self.set_look_duck(duck),
         }
     }
 }

@@ -68,6 +68,8 @@ pub struct FrameDriver<P> {
     last: FrameReport,
     /// Whether the start frame was written.
     started: bool,
+    /// No pulses: every servo gets duty 0, its limiter held where it was.
+    relaxed: bool,
     stats: DriverStats,
     /// The frame of the last fault log suggestion ([`NEVER`] before the first).
     last_log: u64,
@@ -116,6 +118,7 @@ impl<P: SetDutyCycle> FrameDriver<P> {
                 unlogged_faults: 0,
             },
             started: false,
+            relaxed: false,
             stats: DriverStats::default(),
             last_log: NEVER,
             unlogged: 0,
@@ -147,6 +150,9 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         if !self.started {
             return self.start();
         }
+        if self.relaxed {
+            return self.relaxed_frame();
+        }
         let gain = self.envelope.next_gain();
         let [pitch, roll, yaw] = offsets;
         self.servo_frame(0, pitch, gain);
@@ -171,6 +177,61 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         };
         let target = pose.saturating_add(scale(offset, gain));
         servo.frame(cal, channel, target, config.faults.disable_after, slot);
+    }
+
+    /// Stops the pulses from the next frame on (once started): each servo
+    /// gets duty 0, its output held low, and goes limp; its limiter stays
+    /// where it was, at rest. The fade stays where it was too.
+    ///
+    /// [`set_relaxed`](Self::set_relaxed)`(false)` brings the pulses back:
+    /// the first one is the last one written before, and the head moves on
+    /// from there within its limits (a servo that was moved by hand or
+    /// slumped meanwhile is pulled back to it by its own controller).
+    pub fn set_relaxed(&mut self, relaxed: bool) {
+        self.relaxed = relaxed && self.started;
+        if self.relaxed {
+            for servo in &mut self.servos {
+                servo.slew.halt();
+            }
+        }
+    }
+
+    /// Whether the pulses are stopped ([`set_relaxed`](Self::set_relaxed)).
+    #[must_use]
+    pub const fn is_relaxed(&self) -> bool {
+        self.relaxed
+    }
+
+    /// The angles the last frame commanded, `[pitch, roll, yaw]`: where the
+    /// head is (or, relaxed, where it was left).
+    #[must_use]
+    pub fn angles(&self) -> [Angle; 3] {
+        self.last.servos.map(|s| s.angle)
+    }
+
+    /// A frame without pulses: duty 0 on every servo still on.
+    #[inline(never)]
+    fn relaxed_frame(&mut self) -> FrameReport {
+        let disable_after = self.params.config.faults.disable_after;
+        for ((servo, channel), slot) in self
+            .servos
+            .iter_mut()
+            .zip(self.channels.iter_mut())
+            .zip(self.last.servos.iter_mut())
+        {
+            let outcome = if servo.disabled {
+                Outcome::Off
+            } else {
+                write_duty(servo, channel, Duty(0), disable_after)
+            };
+            *slot = ServoReport {
+                angle: servo.slew.angle(),
+                pulse: Microseconds(0),
+                duty: Duty(0),
+                outcome,
+            };
+        }
+        self.finish()
     }
 
     /// Fades the motion out to the neutral pose (then holds it).
@@ -497,31 +558,43 @@ fn map_and_write<P: SetDutyCycle>(
     let outcome = if servo.disabled {
         Outcome::Off
     } else {
-        match channel.set_duty_cycle(duty.0) {
-            Ok(()) => {
-                servo.consecutive_failures = 0;
-                Outcome::Written
-            }
-            Err(e) => {
-                let kind = e.kind();
-                servo.consecutive_failures = servo.consecutive_failures.saturating_add(1);
-                if servo.consecutive_failures >= disable_after {
-                    // Best effort: no pulses, the servo goes limp. Nothing
-                    // more can be done if this write fails too.
-                    let _ = channel.set_duty_cycle(0);
-                    servo.disabled = true;
-                    Outcome::Disabled(kind)
-                } else {
-                    Outcome::Failed(kind)
-                }
-            }
-        }
+        write_duty(servo, channel, duty, disable_after)
     };
     ServoReport {
         angle,
         pulse,
         duty,
         outcome,
+    }
+}
+
+/// Writes `duty` to a servo that is still on, and counts the outcome: a
+/// servo whose writes fail `disable_after` frames in a row is switched off.
+#[inline]
+fn write_duty<P: SetDutyCycle>(
+    servo: &mut ServoState,
+    channel: &mut P,
+    duty: Duty,
+    disable_after: u16,
+) -> Outcome {
+    match channel.set_duty_cycle(duty.0) {
+        Ok(()) => {
+            servo.consecutive_failures = 0;
+            Outcome::Written
+        }
+        Err(e) => {
+            let kind = e.kind();
+            servo.consecutive_failures = servo.consecutive_failures.saturating_add(1);
+            if servo.consecutive_failures >= disable_after {
+                // Best effort: no pulses, the servo goes limp. Nothing
+                // more can be done if this write fails too.
+                let _ = channel.set_duty_cycle(0);
+                servo.disabled = true;
+                Outcome::Disabled(kind)
+            } else {
+                Outcome::Failed(kind)
+            }
+        }
     }
 }
 

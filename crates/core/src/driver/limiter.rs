@@ -226,6 +226,13 @@ impl Slew {
         Angle::from_millidegrees(round_to_mdeg(self.pos))
     }
 
+    /// Stops where it is: at rest, its target there too (the servo was left
+    /// without pulses).
+    pub(crate) const fn halt(&mut self) {
+        self.vel = 0;
+        self.last_target = self.pos;
+    }
+
     /// The last step, µ°/frame.
     pub(crate) const fn velocity(&self) -> i32 {
         self.vel

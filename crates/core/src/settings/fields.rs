@@ -210,8 +210,8 @@ macro_rules! fields {
 }
 
 // Ids 1 to 56 are the fields of layout version 1, in its order (`v1.rs`).
-// A new field takes the next free id (the first after them: 57), at the end;
-// a new gesture's block of five takes the next five free ids.
+// A new field takes the next free id (now 67), at the end; a new gesture's
+// block of five takes the next five free ids.
 fields! { s;
     // The servos: pulses in µs, the scale in ns per degree, the direction,
     // the angle limits in millidegrees.
@@ -268,6 +268,19 @@ fields! { s;
     // The DMX receiver (ids from 80: 57 and up are other fields').
     80 "dmx.on" => s.dmx.on;
     81 "dmx.address" => s.dmx.address;
+    // Rest: the timer (s, 0 for never), the pose (m°), relax (0 or 1).
+    57 "rest.after" => s.inputs.rest_after;
+    58 "rest.pose.pitch" => s.behaviour.rest.pose[0];
+    59 "rest.pose.roll" => s.behaviour.rest.pose[1];
+    60 "rest.pose.yaw" => s.behaviour.rest.pose[2];
+    61 "rest.relax" => s.behaviour.rest.relax;
+    // How much a held look ducks the idle on its axes (%).
+    62 "gaze.duck" => s.behaviour.gaze.duck;
+    // The trigger inputs' roles, GP2 to GP5 (see `tlv_inputs.rs`).
+    63 "input.2" => s.inputs.roles[0];
+    64 "input.3" => s.inputs.roles[1];
+    65 "input.4" => s.inputs.roles[2];
+    66 "input.5" => s.inputs.roles[3];
 }
 
 /// The field `id` of the table, if there is one.

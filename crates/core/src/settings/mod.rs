@@ -32,7 +32,9 @@
 //! complement); a percentage (0 to 100), a direction (0 normal, 1
 //! reversed), a switch (0 off, 1 on) or a gesture's cycles as one byte; a
 //! DMX address (1 to 503) as two little-endian bytes; a gaze hold as five
-//! (0 and the ms of the return, or 1 and four zero bytes for `stay`).
+//! (0 and the ms of the return, or 1 and four zero bytes for `stay`); the
+//! rest timer as four (seconds, 0 for `never`); a trigger input's role and
+//! a button's action as `tlv_inputs.rs` says (20 bytes at most).
 //!
 //! # Loading: fields added, fields unknown, values out of range
 //!
@@ -77,8 +79,9 @@
 //!    part of), with its default in [`Settings::DEFAULT`] and its check in
 //!    [`Settings::validate`]; its default must be valid with any settings
 //!    an older firmware saved.
-//! 2. Add one row to the table in `fields.rs`, with the next free id:
-//!    `57 "rest.timeout" => s.rest.timeout;`.
+//! 2. Add one row to the table in `fields.rs`, with the next free id (the
+//!    comment above the table says which):
+//!    `67 "look.speed" => s.behaviour.gaze.speed;`.
 //! 3. Only if its type is new to the record: implement `FieldValue` for it
 //!    in `tlv.rs` (its bytes, and which bytes are a value).
 //!
@@ -126,6 +129,7 @@ mod sectors;
 mod storage;
 mod store;
 mod tlv;
+mod tlv_inputs;
 mod v1;
 mod values;
 

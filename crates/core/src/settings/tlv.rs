@@ -145,7 +145,7 @@ impl<'a> Iterator for Entries<'a> {
 
 /// `value` into `out`, its length.
 #[inline(never)]
-fn put(out: &mut [u8], value: &[u8]) -> usize {
+pub(super) fn put(out: &mut [u8], value: &[u8]) -> usize {
     if let Some(slot) = out.get_mut(..value.len()) {
         slot.copy_from_slice(value);
     }
@@ -154,12 +154,12 @@ fn put(out: &mut [u8], value: &[u8]) -> usize {
 
 /// The `u32` of exactly four little-endian bytes.
 #[inline(never)]
-fn u32_of(bytes: &[u8]) -> Option<u32> {
+pub(super) fn u32_of(bytes: &[u8]) -> Option<u32> {
     <[u8; 4]>::try_from(bytes).ok().map(u32::from_le_bytes)
 }
 
 /// The one byte of `bytes`.
-fn u8_of(bytes: &[u8]) -> Option<u8> {
+pub(super) fn u8_of(bytes: &[u8]) -> Option<u8> {
     match bytes {
         [b] => Some(*b),
         _ => None,

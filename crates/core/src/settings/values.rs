@@ -2,8 +2,9 @@
 //!
 //! [`Settings`] holds what a person may change at run time and keep in
 //! flash: the calibration and limits of the three servos, the behaviour
-//! (idle amplitude, gesture and gaze parameters), the idle motion's
-//! seeds and the DMX receiver's settings. [`Settings::DEFAULT`] is the built-in configuration.
+//! (idle amplitude, gesture and gaze parameters, the rest pose), the idle
+//! motion's seeds, the trigger inputs' roles and the DMX receiver's
+//! settings. [`Settings::DEFAULT`] is the built-in configuration.
 //! [`Settings::validate`] checks them exactly as the typed
 //! configurations are checked ([`DriverConfig::build`],
 //! [`BehaviourConfig::build`]), against a board's base driver
@@ -13,8 +14,10 @@ use crate::text::{Describe, Text, display_from_describe};
 
 use crate::axis::Axis;
 use crate::behaviour::{BehaviourConfig, BehaviourError, BehaviourParams};
+use crate::command::InputRole;
 use crate::dmx::DmxSettings;
 use crate::driver::{ConfigError, DriverConfig, DriverParams};
+use crate::input::{FIRST_INPUT, InputSettings};
 use crate::motion::DEFAULT_HEAD;
 use crate::servo::ServoCalibration;
 
@@ -30,6 +33,8 @@ pub struct Settings {
     pub seeds: [u32; 3],
     /// The DMX receiver: on or off, and the head's start address.
     pub dmx: DmxSettings,
+    /// The trigger inputs' roles and the rest timer.
+    pub inputs: InputSettings,
 }
 
 /// Why settings are not valid.
@@ -78,6 +83,7 @@ impl Settings {
             DEFAULT_HEAD.yaw.seed,
         ],
         dmx: DmxSettings::DEFAULT,
+        inputs: InputSettings::DEFAULT,
     };
 
     /// `base` with these settings' servos.
@@ -104,6 +110,23 @@ impl Settings {
             Ok(behaviour) => Ok(Validated { driver, behaviour }),
             Err(e) => Err(SettingsError::Behaviour(e)),
         }
+    }
+
+    /// Checks each button's action with `behaviour` as the console checks
+    /// a motion command: the first that the head would refuse, with its
+    /// input's number. (Not part of [`validate`](Self::validate): a record
+    /// loads whatever its buttons say, and a press the head refuses is
+    /// logged, not played.)
+    ///
+    /// # Errors
+    /// The input's number (as the console names it) and why.
+    pub fn check_inputs(&self, behaviour: &BehaviourParams) -> Result<(), (u8, BehaviourError)> {
+        for (n, role) in (FIRST_INPUT..).zip(&self.inputs.roles) {
+            if let InputRole::Button(action) = role {
+                behaviour.check(action).map_err(|e| (n, e))?;
+            }
+        }
+        Ok(())
     }
 
     /// The calibration of `axis`' servo.

@@ -13,6 +13,10 @@
 //! look <pitch_mdeg> <yaw_mdeg> [ms] [hold=MS|hold=stay]
 //! center [ms]
 //! idle on | idle off | idle amp <percent>
+//! look duck <percent>
+//! rest | wake | rest after <seconds>|never | rest pose <pitch> <roll> <yaw>
+//! rest relax on|off
+//! input <2..5> [off | button <motion command> | presence [<yaw_mdeg>]]
 //! seed <n> | seed random
 //! servo <pitch|roll|yaw> [neutral <us> | per-degree <ns> | direction <normal|reversed>
 //!                        | min <us> | max <us> | limits <min_mdeg> <max_mdeg>]
@@ -52,11 +56,16 @@ use crate::servo::{Direction, NanosPerDegree};
 use crate::units::{Angle, AngleRange, Microseconds, Millis};
 
 mod dmx;
+mod duck;
 mod error;
+mod input;
+mod line;
+mod rest;
 mod words;
 
 pub use error::{ParseError, ParseErrorKind, Span};
-use words::{Field, Kw, Word, Words, once};
+pub use line::ActionLine;
+use words::{Field, Kw, Token, Word, Words, once};
 
 /// Parses one line (without its line ending); the grammar is in this
 /// module's source and, for users, in `docs/user/protocol.md`.
@@ -68,31 +77,49 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
     let Some(first) = words.next() else {
         return Err(words.error_here(ParseErrorKind::Empty));
     };
-    if let Some(kind) = first.gesture() {
-        let command = gesture(&mut words, kind)?;
-        words.end()?;
-        return Ok(command);
-    }
-    let command = match first.lower() {
-        Word::Is(Kw::Help) => Command::Help,
-        Word::Is(Kw::Status) => Command::Status,
-        Word::Is(Kw::Save) => Command::Save,
-        Word::Is(Kw::Load) => Command::Load,
-        Word::Is(Kw::Defaults) => Command::Defaults,
-        Word::Is(Kw::Stop) => Command::Act(Action::Stop),
-        Word::Is(Kw::Look) => look(&mut words)?,
-        Word::Is(Kw::Center | Kw::Centre) => Command::Act(Action::Center {
-            duration: words.optional_number(&DURATION)?.map(to_millis),
-        }),
-        Word::Is(Kw::Idle) => idle(&mut words)?,
-        Word::Is(Kw::Seed) => seed(&mut words)?,
-        Word::Is(Kw::Servo) => servo(&mut words)?,
-        Word::Is(Kw::Watch) => watch(&mut words)?,
-        Word::Is(Kw::Dmx) => dmx::dmx(&mut words)?,
-        _ => return Err(first.error(ParseErrorKind::UnknownCommand)),
+    let command = if let Some(action) = motion(first, &mut words)? {
+        Command::Act(action)
+    } else {
+        match first.lower() {
+            Word::Is(Kw::Help) => Command::Help,
+            Word::Is(Kw::Status) => Command::Status,
+            Word::Is(Kw::Save) => Command::Save,
+            Word::Is(Kw::Load) => Command::Load,
+            Word::Is(Kw::Defaults) => Command::Defaults,
+            Word::Is(Kw::Seed) => seed(&mut words)?,
+            Word::Is(Kw::Servo) => servo(&mut words)?,
+            Word::Is(Kw::Input) => input::input(&mut words)?,
+            Word::Is(Kw::Rest) => rest::rest(&mut words)?,
+            Word::Is(Kw::Look) => duck::look_duck(&mut words)?,
+            Word::Is(Kw::Watch) => watch(&mut words)?,
+            Word::Is(Kw::Dmx) => dmx::dmx(&mut words)?,
+            _ => return Err(first.error(ParseErrorKind::UnknownCommand)),
+        }
     };
     words.end()?;
     Ok(command)
+}
+
+/// The motion command that starts with `first`, if it is one (its words
+/// up to the end, not checked for more): a gesture, `look`, `center`,
+/// `idle`, `stop`, `rest` or `wake`. `None` for any other first word (and
+/// for the settings `rest` and `look` take: `rest after …`, `look duck …`).
+fn motion(first: Token<'_>, words: &mut Words<'_>) -> Result<Option<Action>, ParseError> {
+    if let Some(kind) = first.gesture() {
+        return gesture(words, kind).map(Some);
+    }
+    let action = match first.lower() {
+        Word::Is(Kw::Stop) => Action::Stop,
+        Word::Is(Kw::Look) if !duck::follows(words) => look(words)?,
+        Word::Is(Kw::Center | Kw::Centre) => Action::Center {
+            duration: words.optional_number(&DURATION)?.map(to_millis),
+        },
+        Word::Is(Kw::Idle) => idle(words)?,
+        Word::Is(Kw::Rest) if words.peek().is_none() => Action::Rest,
+        Word::Is(Kw::Wake) => Action::Wake { toward: None },
+        _ => return Ok(None),
+    };
+    Ok(Some(action))
 }
 
 /// The range of an angle or an amplitude in m°: the `i32` range without
@@ -127,7 +154,7 @@ fn to_percent(v: i64) -> Percent {
 /// `<gesture> [amp] [ms] [cycles=N] [intensity=P]`, any row of the
 /// [gesture table](crate::gestures); `cycles=` where the gesture may have
 /// more than one.
-fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Command, ParseError> {
+fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Action, ParseError> {
     let mut request = GestureRequest::new(kind);
     request.amplitude = words.optional_number(&AMPLITUDE)?.map(to_angle);
     request.duration = words.optional_number(&DURATION)?.map(to_millis);
@@ -150,11 +177,11 @@ fn gesture(words: &mut Words<'_>, kind: GestureKind) -> Result<Command, ParseErr
             _ => return Err(word.error(ParseErrorKind::UnknownOption { allowed })),
         }
     }
-    Ok(Command::Act(Action::Gesture(request)))
+    Ok(Action::Gesture(request))
 }
 
 /// `look <pitch> <yaw> [ms] [hold=MS|hold=stay]`.
-fn look(words: &mut Words<'_>) -> Result<Command, ParseError> {
+fn look(words: &mut Words<'_>) -> Result<Action, ParseError> {
     let pitch = to_angle(words.number(&PITCH)?);
     let yaw = to_angle(words.number(&YAW)?);
     let duration = words.optional_number(&DURATION)?.map(to_millis);
@@ -170,16 +197,16 @@ fn look(words: &mut Words<'_>) -> Result<Command, ParseError> {
             Hold::Return(to_millis(value.number(&HOLD)?))
         });
     }
-    Ok(Command::Act(Action::Look(LookRequest {
+    Ok(Action::Look(LookRequest {
         pitch,
         yaw,
         duration,
         hold,
-    })))
+    }))
 }
 
 /// `idle on|off|amp <percent>`.
-fn idle(words: &mut Words<'_>) -> Result<Command, ParseError> {
+fn idle(words: &mut Words<'_>) -> Result<Action, ParseError> {
     const EXPECTED: &str = "`on`, `off` or `amp`";
     let Some(word) = words.next() else {
         return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
@@ -190,7 +217,7 @@ fn idle(words: &mut Words<'_>) -> Result<Command, ParseError> {
         Word::Is(Kw::Amp) => Action::IdleAmp(to_percent(words.number(&PERCENT)?)),
         _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: EXPECTED })),
     };
-    Ok(Command::Act(action))
+    Ok(action)
 }
 
 /// `seed <n>|random`.

@@ -83,10 +83,20 @@ pub(super) enum Kw {
     Watch,
     Dmx,
     Address,
+    Input,
+    Button,
+    Presence,
+    Rest,
+    Wake,
+    After,
+    Never,
+    Pose,
+    Relax,
+    Duck,
 }
 
 /// Every word the protocol has, lower case, in the order of [`ALL`].
-const KEYWORDS: [&str; 34] = [
+const KEYWORDS: [&str; 44] = [
     "help",
     "status",
     "save",
@@ -121,10 +131,20 @@ const KEYWORDS: [&str; 34] = [
     "watch",
     "dmx",
     "address",
+    "input",
+    "button",
+    "presence",
+    "rest",
+    "wake",
+    "after",
+    "never",
+    "pose",
+    "relax",
+    "duck",
 ];
 
 /// The [`Kw`] of each of [`KEYWORDS`].
-const ALL: [Kw; 34] = [
+const ALL: [Kw; 44] = [
     Kw::Help,
     Kw::Status,
     Kw::Save,
@@ -159,6 +179,16 @@ const ALL: [Kw; 34] = [
     Kw::Watch,
     Kw::Dmx,
     Kw::Address,
+    Kw::Input,
+    Kw::Button,
+    Kw::Presence,
+    Kw::Rest,
+    Kw::Wake,
+    Kw::After,
+    Kw::Never,
+    Kw::Pose,
+    Kw::Relax,
+    Kw::Duck,
 ];
 
 // A gesture's word must not be a word the protocol already has: the

@@ -1,0 +1,55 @@
+//! `input <n> [off | button <action line> | presence [<yaw_mdeg>]]`.
+//!
+//! A button's action is any motion line (what `Command::Act` parses to),
+//! parsed from the rest of the line by the parser's own motion grammar (a
+//! motion holds no other command: a line never nests).
+
+use crate::command::{Command, InputRole};
+use crate::input::{FIRST_INPUT, INPUTS};
+use crate::units::Angle;
+
+use super::error::{ParseError, ParseErrorKind};
+use super::words::{Field, Kw, Word, Words};
+
+/// The inputs' numbers, as the console names them (GP2 to GP5).
+const INPUT: Field = Field::new(
+    "input (2 to 5)",
+    FIRST_INPUT as i64,
+    FIRST_INPUT as i64 + INPUTS as i64 - 1,
+);
+const DIRECTION: Field = Field::new("yaw in mdeg", i32::MIN as i64 + 1, i32::MAX as i64);
+
+/// What `button` takes.
+const MOTION: &str = "a motion command (a gesture, look, center, idle, stop, rest or wake)";
+
+/// `input <n> …` (after the word `input`).
+pub(super) fn input(words: &mut Words<'_>) -> Result<Command, ParseError> {
+    const ROLES: &str = "`off`, `button` or `presence`";
+    let input = words.number(&INPUT)? as u8;
+    let Some(word) = words.next() else {
+        return Ok(Command::Input { input, role: None });
+    };
+    let role = match word.lower() {
+        Word::Is(Kw::Off) => InputRole::Off,
+        Word::Is(Kw::Presence) => InputRole::Presence {
+            toward: words
+                .optional_number(&DIRECTION)?
+                .map(|v| Angle::from_millidegrees(v as i32)),
+        },
+        Word::Is(Kw::Button) => {
+            // The motion command: the rest of the line, on the same words.
+            let Some(first) = words.next() else {
+                return Err(words.error_here(ParseErrorKind::Missing(MOTION)));
+            };
+            let Some(action) = super::motion(first, words)? else {
+                return Err(first.error(ParseErrorKind::UnknownWord { expected: MOTION }));
+            };
+            InputRole::Button(action)
+        }
+        _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: ROLES })),
+    };
+    Ok(Command::Input {
+        input,
+        role: Some(role),
+    })
+}

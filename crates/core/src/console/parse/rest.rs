@@ -1,0 +1,53 @@
+//! `rest after <seconds>|never`, `rest pose <pitch> <roll> <yaw>`,
+//! `rest relax on|off` (`rest` alone is a motion: the head rests).
+
+use crate::command::{Command, MAX_REST_AFTER, RestAfter, RestSetting};
+use crate::units::Angle;
+
+use super::error::{ParseError, ParseErrorKind};
+use super::words::{Field, Kw, Word, Words};
+
+const SECONDS: Field = Field::new("seconds", 1, MAX_REST_AFTER as i64);
+const PITCH: Field = Field::new("pitch in mdeg", i32::MIN as i64 + 1, i32::MAX as i64);
+const ROLL: Field = Field::new("roll in mdeg", i32::MIN as i64 + 1, i32::MAX as i64);
+const YAW: Field = Field::new("yaw in mdeg", i32::MIN as i64 + 1, i32::MAX as i64);
+
+/// `rest after|pose|relax …` (after the word `rest`).
+pub(super) fn rest(words: &mut Words<'_>) -> Result<Command, ParseError> {
+    const EXPECTED: &str = "`after`, `pose` or `relax`";
+    let Some(word) = words.next() else {
+        return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
+    };
+    let setting = match word.lower() {
+        Word::Is(Kw::After) => {
+            const WHEN: &str = "seconds or `never`";
+            match words.peek() {
+                Some(w) if w.lower() == Word::Is(Kw::Never) => {
+                    words.next();
+                    RestSetting::After(RestAfter::Never)
+                }
+                Some(_) => RestSetting::After(RestAfter::Seconds(words.number(&SECONDS)? as u32)),
+                None => return Err(words.error_here(ParseErrorKind::Missing(WHEN))),
+            }
+        }
+        Word::Is(Kw::Pose) => {
+            let mut angle = |field| -> Result<Angle, ParseError> {
+                Ok(Angle::from_millidegrees(words.number(field)? as i32))
+            };
+            RestSetting::Pose([angle(&PITCH)?, angle(&ROLL)?, angle(&YAW)?])
+        }
+        Word::Is(Kw::Relax) => {
+            const SWITCH: &str = "`on` or `off`";
+            let Some(word) = words.next() else {
+                return Err(words.error_here(ParseErrorKind::Missing(SWITCH)));
+            };
+            match word.lower() {
+                Word::Is(Kw::On) => RestSetting::Relax(true),
+                Word::Is(Kw::Off) => RestSetting::Relax(false),
+                _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: SWITCH })),
+            }
+        }
+        _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: EXPECTED })),
+    };
+    Ok(Command::Rest(setting))
+}

@@ -1,0 +1,178 @@
+//! The service's trigger inputs, rest and look settings: `input <n> …`,
+//! `rest after|pose|relax …`, `look duck …`, and the inputs in `status`.
+//!
+//! Each change is checked, put in the settings (kept with `save`) and sent
+//! where it takes effect: the roles and the rest timer to the input task,
+//! the rest pose, relax and the look's duck to the frame task (both through
+//! the [`ConsoleLink`](super::ConsoleLink)), between two of its frames.
+
+use crate::command::{InputRole, RestSetting};
+use crate::input::{FIRST_INPUT, INPUTS};
+use crate::settings::{SettingsSource, SettingsStorage};
+use crate::text::Arg::Int;
+use crate::text::Text;
+use crate::units::{Angle, Percent};
+
+use super::{ConsoleService, ErrorCode, Reply, behaviour_code, text};
+use crate::console::ActionLine;
+
+impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
+    /// `input <n>`: `ok input <n> off`, or its level, then its role as
+    /// `input <n> <role>` takes it (`button nod 6000`, `presence -20000`).
+    #[inline(never)]
+    pub(super) fn show_input(&self, input: u8, reply: &mut Reply<'_>) {
+        let i = usize::from(input - FIRST_INPUT);
+        let Some(role) = self.settings.inputs.roles.get(i) else {
+            return;
+        };
+        let out = text(reply.ok());
+        out.str("input ").u64(input.into()).str(" ");
+        if !matches!(role, InputRole::Off) {
+            let status = self.link.inputs();
+            out.str("level=")
+                .str(if status.is_high(i) { "high" } else { "low" })
+                .str(" active=")
+                .u64(status.is_active(i).into())
+                .str(" ");
+        }
+        out.str(role.word());
+        match role {
+            InputRole::Button(action) => {
+                out.str(" ").with(&ActionLine(action));
+            }
+            InputRole::Presence { toward: Some(yaw) } => {
+                out.str(" ").i64(yaw.millidegrees().into());
+            }
+            InputRole::Off | InputRole::Presence { toward: None } => {}
+        }
+    }
+
+    /// `input <n> off|button …|presence …`: a button's action is checked as
+    /// the console checks a motion command; a direction past the yaw
+    /// limits is kept, and the glance clamped to them (the reply says
+    /// where it goes).
+    #[inline(never)]
+    pub(super) fn set_input(&mut self, input: u8, role: InputRole, reply: &mut Reply<'_>) {
+        let i = usize::from(input - FIRST_INPUT);
+        if i >= INPUTS {
+            return;
+        }
+        match role {
+            InputRole::Button(action) => {
+                if let Err(e) = self.behaviour.check(&action) {
+                    text(reply.err(behaviour_code(&e))).with(&e);
+                    return;
+                }
+            }
+            InputRole::Presence { toward: Some(yaw) } => {
+                let room = self.behaviour.room(crate::Axis::Yaw);
+                let pose = self.behaviour.neutral_pose()[2];
+                let inside = yaw.saturating_sub(pose).clamp_to(room.min, room.max);
+                if inside.saturating_add(pose) != yaw {
+                    text(reply.ok()).fill(
+                        "clamped yaw={}",
+                        &[Int(inside.saturating_add(pose).millidegrees().into())],
+                    );
+                }
+            }
+            InputRole::Off | InputRole::Presence { toward: None } => {}
+        }
+        if let Some(slot) = self.settings.inputs.roles.get_mut(i) {
+            *slot = role;
+        }
+        self.link.set_inputs(self.settings.inputs);
+        self.source = SettingsSource::Changed;
+    }
+
+    /// `rest after|pose|relax …`.
+    #[inline(never)]
+    pub(super) fn set_rest(&mut self, setting: RestSetting, reply: &mut Reply<'_>) {
+        match setting {
+            RestSetting::After(after) => {
+                self.settings.inputs.rest_after = after;
+                self.link.set_inputs(self.settings.inputs);
+            }
+            RestSetting::Pose(pose) => {
+                self.settings.behaviour.rest.pose = pose;
+                let mut params = self.behaviour;
+                if params.set_live(&self.settings.behaviour.live()) {
+                    let [p, r, y] = params.rest_pose().map(Angle::millidegrees);
+                    text(reply.ok()).fill(
+                        "clamped pitch={} roll={} yaw={}",
+                        &[Int(p.into()), Int(r.into()), Int(y.into())],
+                    );
+                }
+                self.behaviour = params;
+                self.link.set_live(self.settings.behaviour.live());
+            }
+            RestSetting::Relax(on) => {
+                self.settings.behaviour.rest.relax = on;
+                self.behaviour.set_live(&self.settings.behaviour.live());
+                self.link.set_live(self.settings.behaviour.live());
+            }
+        }
+        self.source = SettingsSource::Changed;
+    }
+
+    /// `look duck <percent>`.
+    #[inline(never)]
+    pub(super) fn set_look_duck(&mut self, duck: Percent) {
+        self.settings.behaviour.gaze.duck = duck;
+        self.behaviour.set_live(&self.settings.behaviour.live());
+        self.link.set_live(self.settings.behaviour.live());
+        self.source = SettingsSource::Changed;
+    }
+
+    /// The inputs for `status`: `-` for an input that is off, else `b`
+    /// (button) or `p` (presence) and `1` if active, `0` if not, from GP2
+    /// on (`inputs=b0,p1,-,-`).
+    #[inline(never)]
+    pub(super) fn status_inputs(&self, out: &mut dyn Text) {
+        let status = self.link.inputs();
+        out.str(" inputs=");
+        for (i, role) in self.settings.inputs.roles.iter().enumerate() {
+            if i > 0 {
+                out.str(",");
+            }
+            match role {
+                InputRole::Off => {
+                    out.str("-");
+                }
+                InputRole::Button(_) => {
+                    out.str("b").u64(status.is_active(i).into());
+                }
+                InputRole::Presence { .. } => {
+                    out.str("p").u64(status.is_active(i).into());
+                }
+            }
+        }
+    }
+
+    /// Puts the inputs, rest and look settings of the settings just
+    /// adopted in effect (sent whether they changed or not: taking them
+    /// again changes nothing).
+    pub(super) fn adopt_inputs(&self) {
+        self.link.set_inputs(self.settings.inputs);
+        self.link.set_live(self.settings.behaviour.live());
+    }
+
+    /// Why the settings `next` would refuse a button's action with their
+    /// behaviour, if one would: `err limit`.
+    pub(super) fn inputs_refused(
+        next: &crate::settings::Settings,
+        behaviour: &crate::behaviour::BehaviourParams,
+        reply: &mut Reply<'_>,
+    ) -> bool {
+        match next.check_inputs(behaviour) {
+            Ok(()) => false,
+            Err((input, e)) => {
+                text(reply.err(ErrorCode::Limit))
+                    .str("input ")
+                    .u64(input.into())
+                    .str(" would go past the new limits: ")
+                    .with(&e);
+                true
+            }
+        }
+    }
+}

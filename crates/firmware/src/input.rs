@@ -1,0 +1,167 @@
+//! Trigger inputs: what a board implements to give the levels of its
+//! inputs ([`InputSource`]), and the input task's body ([`run`]), the same
+//! on every board.
+//!
+//! The task is event-driven: it reads the levels when the source says one
+//! may have changed, at the deadline the core's state machine asks for (a
+//! level to confirm after its debounce time, the rest timer) and when the
+//! console changes the inputs' settings; between those it sleeps. With no
+//! input configured it never wakes but for a change of settings, and the
+//! board behaves as it does without inputs. What a level means (debounce,
+//! roles, the rest timer) is the core's ([`idle_head_core::input`]); the
+//! actions go to the frame task's queue ([`COMMANDS`]) like the console's,
+//! and the levels to the console's `status` through the link ([`LINK`]).
+//!
+//! The task runs in thread mode, below the frame task, as the console
+//! tasks do. Like every embassy task, it is defined by the board (a task
+//! defined here would be linked into every image): a board's task is one
+//! line calling [`run`].
+//!
+//! A full queue (the console flooding it) holds the actions back: they are
+//! sent, oldest first, a few milliseconds later. A button's action
+//! reaches the queue within microseconds of its debounced edge, and the
+//! frame task takes it before its next frame: it starts within a frame of
+//! the edge.
+
+use embassy_futures::select::{Either3, select3};
+use embassy_time::{Duration, Instant, Timer};
+use idle_head_core::console::HeadMode;
+use idle_head_core::input::{FIRST_INPUT, INPUTS, InputSettings, Inputs, Micros, Pull};
+
+use crate::boot::{COMMANDS, LINK};
+
+/// How long the task waits before it tries a full queue again.
+pub const RETRY: Duration = Duration::from_millis(5);
+
+/// What a board implements for its trigger inputs: [`INPUTS`] of them,
+/// the first as `input 2` (GP2 on the Pico).
+///
+/// A source reads levels and waits for them to change; it interprets
+/// nothing (no debouncing, no roles). It must not block.
+// The executors here are single-threaded: no `Send` bound is wanted on the
+// futures, which is what the lint warns about.
+#[allow(async_fn_in_trait)]
+pub trait InputSource {
+    /// Sets input `i` (from 0) up with `pull`, the one its role needs.
+    fn set_pull(&mut self, i: usize, pull: Pull);
+
+    /// The levels now: bit `i` set while input `i` is high.
+    fn levels(&mut self) -> u8;
+
+    /// Returns once one of the inputs in `watched` (bit `i`) is at
+    /// another level than in `seen`: at once if one is already. A change
+    /// in between the read of `seen` and this call must not be missed
+    /// (wait for the other level, not for an edge).
+    async fn changed(&mut self, seen: u8, watched: u8);
+}
+
+/// Sets every input's pull for its role in `settings`.
+fn pulls(source: &mut impl InputSource, settings: &InputSettings) {
+    for (i, role) in settings.roles.iter().enumerate() {
+        source.set_pull(i, role.pull());
+    }
+}
+
+/// Now, as the core's state machine counts time.
+fn now() -> Micros {
+    Micros(Instant::now().as_micros())
+}
+
+/// The input task's body: reads `source` with the roles in the link's
+/// settings (the boot's, then the console's, see
+/// [`ConsoleLink::set_inputs`](idle_head_core::console::ConsoleLink::set_inputs)),
+/// and sends what the inputs do to the frame task. Never returns.
+pub async fn run(source: &mut impl InputSource) -> ! {
+    // (The settings are read into short scopes, not kept across an
+    // `.await`: the task's future holds no copy of them.)
+    let mut inputs = {
+        // The boot's settings are these: no change to take.
+        let _ = LINK.take_inputs_changed();
+        let settings = LINK.input_settings();
+        pulls(source, &settings);
+        log_roles(&settings);
+        Inputs::new(&settings, now())
+    };
+    let mut shown = Shown::default();
+    let mut changed = false;
+    loop {
+        let (levels, watched, deadline) = step(source, &mut inputs, &mut shown, changed);
+        let timer = async {
+            match deadline {
+                Some(at) => Timer::at(at).await,
+                None => core::future::pending().await,
+            }
+        };
+        let woke = select3(
+            source.changed(levels, watched),
+            timer,
+            LINK.inputs_changed(),
+        )
+        .await;
+        // (The wait took the signal of a change of settings.)
+        changed = matches!(woke, Either3::Third(()));
+    }
+}
+
+/// What the log last said of the inputs.
+#[derive(Default)]
+struct Shown {
+    active: u8,
+    lost: u32,
+}
+
+/// One wake of the input task: new settings (if `changed`), the levels,
+/// the actions to the queue, the status to the link. Returns the levels
+/// read, the inputs to watch and when to wake at the latest.
+fn step(
+    source: &mut impl InputSource,
+    inputs: &mut Inputs,
+    shown: &mut Shown,
+    changed: bool,
+) -> (u8, u8, Option<Instant>) {
+    let settings = LINK.input_settings();
+    if changed || LINK.take_inputs_changed() {
+        inputs.configure(&settings, now());
+        pulls(source, &settings);
+        log_roles(&settings);
+    }
+    let levels = source.levels();
+    let resting = LINK.status().mode == HeadMode::Resting;
+    inputs.update(&settings, now(), levels, resting);
+    let mut full = false;
+    while let Some(action) = inputs.pending(&settings) {
+        if COMMANDS.try_submit(action).is_err() {
+            full = true;
+            break;
+        }
+        inputs.sent();
+    }
+    let status = inputs.status(&settings);
+    LINK.publish_inputs(status);
+    if status.active != shown.active {
+        shown.active = status.active;
+        defmt::info!("inputs: active {=u8:#06b} (bit 0: input 2)", shown.active);
+    }
+    if inputs.lost() != shown.lost {
+        shown.lost = inputs.lost();
+        defmt::warn!(
+            "inputs: {=u32} action(s) lost so far: the command queue stayed full",
+            shown.lost
+        );
+    }
+    let deadline = if full {
+        Some(Instant::now() + RETRY)
+    } else {
+        inputs
+            .deadline(&settings)
+            .map(|at| Instant::from_micros(at.0))
+    };
+    (levels, settings.watched(), deadline)
+}
+
+/// Logs each input's role.
+fn log_roles(settings: &InputSettings) {
+    for (n, role) in (FIRST_INPUT..).zip(settings.roles.iter()).take(INPUTS) {
+        defmt::info!("input {=u8}: {=str}", n, role.word());
+    }
+}

@@ -1,0 +1,156 @@
+//! A head on the host: the frame engine (`behaviour::Head`) over the real
+//! loops of any seed, the frame driver on recorder channels (1 µs per
+//! duty count), every frame recorded as the servos got it.
+
+use idle_head_core::behaviour::{
+    Applied, BehaviourConfig, BehaviourParams, Head, LOOP_DURATION, LimitMode, RestState,
+};
+use idle_head_core::command::Action;
+use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, HeadTrajectories, Integral16};
+use idle_head_core::motion::{Lcg, Trajectory};
+use idle_head_core::playback::Player;
+use idle_head_core::{Axis, Playback};
+
+use crate::Recorder;
+
+/// The loops the rig plays.
+type Loops = HeadTrajectories<Integral16, DEFAULT_N>;
+
+/// The idle of a rig: its loops, replayed.
+pub type Idle = Player<'static, Trajectory<Integral16, DEFAULT_N>>;
+
+/// One frame as the servos got it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Frame {
+    /// The mixer's offsets, m°.
+    pub offsets: [i32; 3],
+    /// The angles the driver commanded, m°.
+    pub angles: [i32; 3],
+    /// The pulses written, µs (0: none, relaxed).
+    pub pulses: [u32; 3],
+    /// The limit modes the driver had for this frame.
+    pub modes: [LimitMode; 3],
+    /// Where the head was in resting after the frame.
+    pub rest: RestState,
+}
+
+/// A head on the built-in driver configuration (50 Hz, 30 s loops, 2 s
+/// fade); see the [module docs](self).
+pub struct Rig {
+    /// The frame engine.
+    pub head: Head<Idle>,
+    /// The frame driver.
+    pub driver: FrameDriver<Recorder>,
+    /// The next frame's index.
+    pub frame: u64,
+    /// Every frame played.
+    pub played: Vec<Frame>,
+}
+
+/// The loops of `seed` (pitch `seed`, roll and yaw the paper's LCG's next
+/// two values; `None`: the Table 2 set), generated once per seed.
+#[must_use]
+pub fn loops(seed: Option<u32>) -> &'static Loops {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+    static LOOPS: OnceLock<Mutex<HashMap<Option<u32>, &'static Loops>>> = OnceLock::new();
+    let mut all = LOOPS.get_or_init(Mutex::default).lock().unwrap();
+    all.entry(seed).or_insert_with(|| {
+        let mut config: HeadConfig = DEFAULT_HEAD;
+        if let Some(seed) = seed {
+            let mut lcg = Lcg::new(seed);
+            config.pitch.seed = seed;
+            config.roll.seed = lcg.next_value();
+            config.yaw.seed = lcg.next_value();
+        }
+        let mut head = Box::new(HeadTrajectories::new());
+        head.generate(&config).expect("the loops of a seed");
+        Box::leak(head)
+    })
+}
+
+impl Rig {
+    /// The built-in behaviour, the Table 2 loops.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::with(BehaviourConfig::DEFAULT, None)
+    }
+
+    /// The behaviour `config`, the loops of `seed`.
+    #[must_use]
+    pub fn with(config: BehaviourConfig, seed: Option<u32>) -> Self {
+        let driver = DriverConfig::DEFAULT.build().expect("the default driver");
+        let behaviour: BehaviourParams = config.build(&driver).expect("a valid behaviour");
+        let playback = Playback::new(LOOP_DURATION, driver.config().frame_period, DEFAULT_N)
+            .expect("the default playback");
+        let trajectories = loops(seed);
+        let idle = Player::new(playback, Axis::ALL.map(|axis| trajectories.axis(axis)));
+        Self {
+            head: Head::new(idle, behaviour),
+            driver: FrameDriver::new(
+                [
+                    Recorder::new(20_000),
+                    Recorder::new(20_000),
+                    Recorder::new(20_000),
+                ],
+                driver,
+            ),
+            frame: 0,
+            played: Vec::new(),
+        }
+    }
+
+    /// Applies `action` before the next frame, as the frame task does.
+    ///
+    /// # Panics
+    /// If the head refuses it.
+    pub fn apply(&mut self, action: Action) -> Applied {
+        self.head
+            .apply(&mut self.driver, &action)
+            .expect("the action plays")
+    }
+
+    /// Plays `frames` frames, as the frame task does (limits and relax
+    /// between frames).
+    pub fn run(&mut self, frames: u64) {
+        for _ in 0..frames {
+            self.head.sync(&mut self.driver);
+            let modes = self.head.limit_modes();
+            let played = self.head.frame(&mut self.driver, self.frame);
+            let report = played.report;
+            self.played.push(Frame {
+                offsets: played.offsets.map(idle_head_core::Angle::millidegrees),
+                angles: report.servos.map(|s| s.angle.millidegrees()),
+                pulses: report.servos.map(|s| s.pulse.0),
+                modes,
+                rest: self.head.rest_state(),
+            });
+            self.frame += 1;
+        }
+    }
+
+    /// Plays frames until `done` holds for the last one played, at most
+    /// `frames`; returns how many it played.
+    pub fn run_until(&mut self, frames: u64, done: impl Fn(&Frame) -> bool) -> u64 {
+        for n in 1..=frames {
+            self.run(1);
+            if self.played.last().is_some_and(&done) {
+                return n;
+            }
+        }
+        frames
+    }
+
+    /// One axis' angles, m°, every frame played.
+    #[must_use]
+    pub fn axis(&self, axis: Axis) -> Vec<i32> {
+        self.played.iter().map(|p| p.angles[axis.index()]).collect()
+    }
+}
+
+impl Default for Rig {
+    fn default() -> Self {
+        Self::new()
+    }
+}

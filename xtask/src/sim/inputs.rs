@@ -1,0 +1,196 @@
+//! The emulator stage of the trigger inputs: a presence script played into
+//! the shipped image, and what a visitor would see checked from the pulses.
+//!
+//! A presence sensor on GP2 looking from −20°, a rest after 2 s with relax
+//! on; nobody comes until 7 s, then someone stays until the end. From the
+//! pulses measured on the servo pins:
+//!
+//! 1. the head rests after the timeout: it reaches the rest pose (pitch
+//!    −8°) and holds it;
+//! 2. the pulses stop once it is there (relax), on every servo, until the
+//!    sensor's edge;
+//! 3. it wakes with the soft start and no jump: the first pulse after the
+//!    gap is the last one before it, and until the glance every step stays
+//!    within the idle limits (60 °/s, 600 °/s²);
+//! 4. it glances towards the sensor: yaw at −20° (the ducked idle's sway
+//!    aside), held about 2 s.
+//!
+//! And throughout, every pulse is the host trace's duty for its frame
+//! (within a count) and inside its servo's limits (`script.rs`).
+
+use std::path::Path;
+use std::time::Duration;
+
+use anyhow::{Result, bail};
+
+use super::pulses::Pulse;
+use super::run;
+use super::script;
+use crate::project::Metadata;
+
+/// The stage's name.
+pub const INPUTS_STAGE: &str = "Pico image in the RP2040 emulator: a presence sensor rests, \
+     relaxes, wakes softly and glances; every pulse the host trace's";
+
+/// The script (times from the first frame).
+pub const SCRIPT: &str = "\
+0 input 2 presence -20000
+0 rest after 2
+0 rest relax on
+7 pin 2 high
+";
+
+/// How long it runs: the glance (from about 8.1 s) held and back.
+const TIME: Duration = Duration::from_millis(12_500);
+
+/// The idle limits of the built-in driver per 20 ms frame, in counts of
+/// 312.5 ns at 11.111 µs/°: 1.2° (42.7 counts) and 0.24° (8.5 counts).
+const IDLE_STEP: f64 = 1.2 * 11.111 / 0.3125;
+const IDLE_TURN: f64 = 0.24 * 11.111 / 0.3125;
+
+/// The pulse of the rest pose's pitch, −8°, in counts: 1411.1 µs.
+const REST_PITCH: f64 = (1500.0 - 8.0 * 11.111) / 0.3125;
+
+/// `cargo xtask test`'s stage: plays [`SCRIPT`] and checks it.
+pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
+    let events = script::parse(SCRIPT)?;
+    let run = script::play(
+        root,
+        metadata,
+        events,
+        TIME,
+        super::WALL,
+        script::Against::Host,
+    )?;
+    let report = &run.report;
+    print!("{}", report.table());
+    println!("{}", report.verdict());
+    let mut problems = report.problems.clone();
+    let Some(boot) = report.boots.first() else {
+        bail!("no boot");
+    };
+    let period = f64::from(run::timing().period_counts) * run::timing().count_ns;
+    let pulses: [&Vec<Pulse>; 3] = [0, 1, 2].map(|i| &boot.servos[i].pulses);
+    let Some(&(edge, _, _)) = boot.drives.first() else {
+        bail!("the harness drove no pin");
+    };
+    // The gap: the longest stretch without a pulse on pitch.
+    let gap = pulses[0]
+        .windows(2)
+        .map(|w| (w[1].rise - w[0].rise, w[0], w[1]))
+        .fold(None, |best: Option<(f64, Pulse, Pulse)>, x| match best {
+            Some(b) if b.0 >= x.0 => Some(b),
+            _ => Some(x),
+        });
+    let Some((span, before, after)) = gap else {
+        bail!("no pulses");
+    };
+    let ms = |ns: f64| ns / 1e6;
+    println!(
+        "pitch: last pulse before the gap {:.1} µs at {:.3} s, first after {:.1} µs at {:.3} s \
+         ({:.1} s without pulses); GP2 high at {:.3} s",
+        f64::from(before.counts) * 0.3125,
+        ms(before.rise) / 1e3,
+        f64::from(after.counts) * 0.3125,
+        ms(after.rise) / 1e3,
+        ms(span) / 1e3,
+        ms(edge) / 1e3
+    );
+    // 1. Rested: at the rest pose when the pulses stopped (the glide had
+    // arrived: its last frames there too).
+    let held = pulses[0]
+        .iter()
+        .filter(|p| p.rise <= before.rise && before.rise - p.rise < 2.5 * period)
+        .all(|p| (f64::from(p.counts) - REST_PITCH).abs() <= 1.0);
+    if !held {
+        problems.push(
+            "the head did not hold the rest pose (pitch −8°) before the pulses stopped".into(),
+        );
+    }
+    // 2. Relaxed: seconds without pulses on every servo, ending after the
+    // sensor's edge.
+    if span < 1e9 || after.rise < edge {
+        problems.push(format!(
+            "the pulses did not stop until the sensor's edge: the longest gap is {:.3} s",
+            ms(span) / 1e3
+        ));
+    }
+    for (i, name) in ["roll", "yaw"].iter().enumerate() {
+        let inside = pulses[i + 1]
+            .iter()
+            .any(|p| p.rise > before.rise + period / 2.0 && p.rise < after.rise - period / 2.0);
+        if inside {
+            problems.push(format!("{name} had pulses while pitch had none"));
+        }
+    }
+    soft_start(&pulses, after.rise, period, &mut problems);
+    glance(pulses[2], after.rise, &mut problems);
+    if problems.is_empty() {
+        println!(
+            "inputs: ok: rested, relaxed {:.1} s, woke softly from the pose, glanced towards the sensor",
+            ms(span) / 1e3
+        );
+        Ok(())
+    } else {
+        bail!("{}", problems.join("\n"))
+    }
+}
+
+/// The soft start (check 3): the first pulse after the gap (at `after`) is
+/// the last before it, and the next second (the idle coming back) within
+/// the idle limits.
+fn soft_start(pulses: &[&Vec<Pulse>; 3], after: f64, period: f64, problems: &mut Vec<String>) {
+    for (i, name) in ["pitch", "roll", "yaw"].iter().enumerate() {
+        let first = pulses[i]
+            .iter()
+            .position(|p| p.rise >= after - period / 2.0);
+        let Some(first) = first else {
+            problems.push(format!("{name}: no pulse after the gap"));
+            continue;
+        };
+        let last_before = first.checked_sub(1).map(|k| pulses[i][k].counts);
+        if last_before.is_none_or(|c| c.abs_diff(pulses[i][first].counts) > 1) {
+            problems.push(format!(
+                "{name}: the first pulse after the gap is not the last before it"
+            ));
+        }
+        let wake: Vec<f64> = pulses[i][first..]
+            .iter()
+            .take(50)
+            .map(|p| f64::from(p.counts))
+            .collect();
+        let step = wake
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f64::max);
+        let turn = wake
+            .windows(3)
+            .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
+            .fold(0.0, f64::max);
+        println!(
+            "{name}: waking, steps up to {step:.0} counts a frame, changes of step up to {turn:.0}"
+        );
+        // (A count of rounding each way.)
+        if step > IDLE_STEP + 1.0 || turn > IDLE_TURN + 2.0 {
+            problems.push(format!(
+                "{name}: the wake exceeds the idle limits ({step:.0} counts/frame, {turn:.0} counts/frame²)"
+            ));
+        }
+    }
+}
+
+/// The glance (check 4): yaw at −20° (1277.8 µs) within 2.5° (the idle's
+/// sway) after the wake (at `after`), for about its 2 s hold.
+fn glance(yaw: &[Pulse], after: f64, problems: &mut Vec<String>) {
+    let target = (1500.0 - 20.0 * 11.111) / 0.3125;
+    let near = yaw
+        .iter()
+        .filter(|p| p.rise > after && (f64::from(p.counts) - target).abs() < 2.5 * 11.111 / 0.3125)
+        .count();
+    println!("yaw: {near} pulses within 2.5° of the sensor's −20°");
+    if near < 90 {
+        problems.push(format!(
+            "the head did not glance towards the sensor: {near} frames near −20°"
+        ));
+    }
+}

@@ -1,0 +1,198 @@
+//! `cargo xtask sim --script FILE`: a trace script played into the shipped
+//! Pico image in the emulator, and every pulse checked against the host
+//! trace of the same script.
+//!
+//! The script is `cargo xtask trace --script`'s (`trace/script.rs`): its
+//! pin lines drive GP2 to GP5 (each at its pull until then: the harness
+//! models the pads' pulls), its console lines (motion commands too) go to
+//! UART0 at 115200 baud, each in 2 ms before its time so that the frame due
+//! then has it, as the host trace takes a line before the frame at its
+//! time. Times count from the first frame, the enable of the pitch servo's
+//! slice. The host trace plays the same script on the same core; the
+//! emulator's pulses must be its duties frame for frame, within a count,
+//! and no pulse may leave a servo's limits.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use anyhow::{Context, Result, anyhow};
+use idle_head_core::behaviour::BehaviourConfig;
+use idle_head_core::driver::DriverConfig;
+
+use super::node::PinScript;
+use super::run::{self, Report, SERVOS};
+use crate::project::{Metadata, PICO};
+use crate::trace::{self, Event, Kind};
+
+/// The input pins the harness drives: GP2 to GP5.
+pub const INPUT_PINS: [u8; 4] = [2, 3, 4, 5];
+
+/// How much before its time a console line is in.
+const EARLY: Duration = Duration::from_millis(2);
+
+/// The first frame a console line is taken at: the board's console reads
+/// its UART once the boot's work (the first loop sets) is done, some 40 ms
+/// after the first frame; a line timed earlier is taken here, in the
+/// emulator and in the host trace it is checked against alike.
+pub const CONSOLE_UP: Duration = Duration::from_millis(100);
+
+/// What a script run gives: the emulator's run, checked.
+pub struct ScriptRun {
+    /// The emulator's run, its pulses checked against the host trace.
+    pub report: Report,
+}
+
+/// The events of the script at `path`.
+pub fn read(path: &Path) -> Result<Vec<Event>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading the script {}", path.display()))?;
+    parse(&text).map_err(|e| anyhow!("{}: {e}", path.display()))
+}
+
+/// The events of a script's `text`.
+pub fn parse(text: &str) -> Result<Vec<Event>> {
+    let driver = DriverConfig::DEFAULT
+        .build()
+        .map_err(|e| anyhow!("{}", e.message()))?;
+    let params = BehaviourConfig::DEFAULT
+        .build(&driver)
+        .map_err(|e| anyhow!("{e}"))?;
+    trace::parse_script(text, &params)
+}
+
+/// How long a script runs when not told: to 5 s after its last line.
+pub fn default_time(events: &[Event]) -> Duration {
+    let last = events.last().map_or(0, |e| e.at_us);
+    Duration::from_micros(last) + Duration::from_secs(5)
+}
+
+/// What a script run's pulses are checked against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Against {
+    /// The host trace's duties, frame for frame.
+    Host,
+    /// The duties the firmware wrote: every pulse carries its own frame's
+    /// duty, within the servos' limits and on time (for runs whose inputs
+    /// land at any phase, where the host's frame and the board's may
+    /// differ by one at an edge within microseconds of a frame).
+    Written,
+}
+
+/// Runs `events` in the shipped image (built) for `time` of virtual time
+/// from its first frame, and checks every pulse `against` the host trace or
+/// what was written (console lines before [`CONSOLE_UP`] moved there, in
+/// both).
+pub fn play(
+    root: &Path,
+    metadata: &Metadata,
+    mut events: Vec<Event>,
+    time: Duration,
+    wall: Duration,
+    against: Against,
+) -> Result<ScriptRun> {
+    let up = u64::try_from(CONSOLE_UP.as_micros()).unwrap_or(u64::MAX);
+    for event in &mut events {
+        if !matches!(event.kind, Kind::Pin { .. }) && event.at_us < up {
+            event.at_us = up;
+        }
+    }
+    // (Lines keep their order: a pin line before 0.1 s stays first.)
+    events.sort_by_key(|e| e.at_us);
+    let mut script = PinScript {
+        anchor: SERVOS[0].2,
+        early: EARLY,
+        ..PinScript::default()
+    };
+    for event in &events {
+        let at = Duration::from_micros(event.at_us);
+        match event.kind {
+            Kind::Pin { input, high } => script.pins.push((at, input, high)),
+            Kind::Act(_) | Kind::Console => {
+                script
+                    .lines
+                    .push((at, format!("{}\r\n", event.text).into_bytes()));
+            }
+        }
+    }
+    // The boot before the first frame: well under a tenth of a second.
+    let boot = Duration::from_millis(100);
+    let mut report = run::run_with(root, &PICO.elf(metadata), time + boot, wall, |config| {
+        config.inputs = INPUT_PINS.to_vec();
+        config.script = Some(script);
+        // A head relaxed at rest is silent for as long as it rests (no
+        // pulse, no log line but once a loop): the wall limit alone tells a
+        // stuck run.
+        config.silence = time + boot;
+    })?;
+    let expected: Vec<[u16; 3]> = match against {
+        Against::Host => {
+            // The host's frames outlast the emulator's (which began a
+            // little after power-on).
+            let host = trace::simulate(
+                u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX),
+                None,
+                &events,
+            )?;
+            host.rows.iter().map(|row| row.duties).collect()
+        }
+        Against::Written => written(&report),
+    };
+    run::check_with(&mut report, &expected);
+    Ok(ScriptRun { report })
+}
+
+/// The duties boot 0 wrote, frame by frame from frame 0 (its compare
+/// writes from the one its slice was enabled with on).
+fn written(report: &Report) -> Vec<[u16; 3]> {
+    let Some(boot) = report.boots.first() else {
+        return Vec::new();
+    };
+    let frames: [Vec<u16>; 3] = core::array::from_fn(|i| {
+        let train = &boot.trains[i];
+        let from = train
+            .enabled
+            .and_then(|at| train.writes.iter().rposition(|&(t, _)| t <= at))
+            .unwrap_or(0);
+        train.writes[from..].iter().map(|&(_, d)| d).collect()
+    });
+    let n = frames.iter().map(Vec::len).max().unwrap_or(0);
+    (0..n)
+        .map(|k| core::array::from_fn(|i| frames[i].get(k).copied().unwrap_or(0)))
+        .collect()
+}
+
+/// `cargo xtask sim --script FILE [--pulses CSV]`.
+pub fn command(
+    root: &Path,
+    metadata: &Metadata,
+    path: &Path,
+    time: Option<Duration>,
+    wall: Duration,
+    pulses: Option<&PathBuf>,
+) -> Result<bool> {
+    PICO.build(root)?;
+    let events = read(path)?;
+    let time = time.unwrap_or_else(|| default_time(&events));
+    let run = play(root, metadata, events, time, wall, Against::Host)?;
+    let report = &run.report;
+    print!("{}", report.log_text(false));
+    if let Some(boot) = report.boots.first() {
+        println!("UART0 replies:");
+        for reply in boot.uart_replies() {
+            println!("  < {reply}");
+        }
+    }
+    print!("{}", report.table());
+    println!(
+        "{}",
+        report
+            .verdict()
+            .replace("the host's duty", "the host trace's duty")
+    );
+    println!("{}", report.summary());
+    if let (Some(path), Some(boot)) = (pulses, report.boots.first()) {
+        let rows = super::pulses_csv::write(path, &boot.servos, &run::timing())?;
+        println!("wrote {} ({rows} frames)", path.display());
+    }
+    Ok(report.problems.is_empty())
+}
