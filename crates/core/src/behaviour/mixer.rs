@@ -38,6 +38,10 @@ use super::glide::Glide;
 use super::params::{BehaviourParams, LimitMode};
 use super::rest::{self, Rest};
 
+mod math;
+
+use math::{Countdown, Sums, both, gain_of, idle_part, look_keep};
+
 /// Gesture layers: one playing and up to two fading out under it.
 pub const LAYERS: usize = 3;
 
@@ -585,106 +589,4 @@ impl Mixer {
     pub const fn idle_amp(&self) -> Percent {
         self.idle_amp
     }
-}
-
-/// The gesture layers of one frame, per axis `[pitch, roll, yaw]`.
-struct Sums {
-    /// The gestures' offsets, m°.
-    add: [i32; 3],
-    /// The idle's duck, Q16.
-    duck: [u32; 3],
-    /// Bit `i`: a gesture plays on axis `i`.
-    active: u8,
-}
-
-impl Sums {
-    /// No gesture: nothing added, no duck.
-    const NONE: Self = Self {
-        add: [0; 3],
-        duck: [ONE; 3],
-        active: 0,
-    };
-}
-
-/// The idle kept on a look's axes at envelope `envelope` (Q16, taken
-/// within `0..=1`): `1 − duck · envelope` (1 without a look, one
-/// subtraction while it holds).
-#[inline]
-const fn look_keep(duck: u32, envelope: i32) -> u32 {
-    if envelope <= 0 {
-        ONE
-    } else if envelope >= ONE as i32 {
-        ONE - duck
-    } else {
-        ONE - mul(duck as i32, envelope as u32) as u32
-    }
-}
-
-/// The product of two Q16 fractions (a factor of 1 skipped).
-#[inline]
-const fn both(a: u32, b: u32) -> u32 {
-    if b == ONE {
-        a
-    } else if a == ONE {
-        b
-    } else {
-        mul(a as i32, b) as u32
-    }
-}
-
-/// `idle · gain · duck` (Q16 each; a factor of 1 skipped: `mul` by 1 is
-/// exact).
-#[inline]
-const fn idle_part(idle: i32, gain: u32, duck: u32) -> i32 {
-    let value = if gain == ONE { idle } else { mul(idle, gain) };
-    if duck == ONE { value } else { mul(value, duck) }
-}
-
-/// What the limit modes of one frame mixed in full follow from (see
-/// [`Mixer::events`]).
-struct Countdown {
-    /// Bit `i`: axis `i` is on at this frame.
-    on: u8,
-    /// Bit `i`: axis `i` was on at the last frame mixed in full.
-    was_on: u8,
-    /// Frames in gesture mode after an axis was last on.
-    settle: u32,
-    /// Frames since the last frame mixed, and since the last mixed in full.
-    since_prev: u32,
-    since_full: u32,
-}
-
-impl Countdown {
-    /// Axis `i`'s limit mode from the next frame on, its frames `left` in
-    /// gesture mode updated: gesture while on (and `settle` frames after) or
-    /// when a return starts (`soon`). An axis off but still settling lowers
-    /// `soonest` to the frames until it settles.
-    #[inline]
-    fn mode(&self, i: u32, left: &mut u32, soon: bool, soonest: &mut u32) -> LimitMode {
-        let bit = 1 << i;
-        if self.on & bit != 0 {
-            *left = self.settle;
-            return LimitMode::Gesture;
-        }
-        // Off since the last frame (on until then), or since the last frame
-        // mixed in full: gesture mode counts down by the frames passed.
-        *left = if self.was_on & bit != 0 {
-            self.settle.saturating_sub(self.since_prev)
-        } else {
-            left.saturating_sub(self.since_full)
-        };
-        if *left > 0 {
-            *soonest = (*soonest).min(*left);
-            LimitMode::Gesture
-        } else if soon {
-            LimitMode::Gesture
-        } else {
-            LimitMode::Idle
-        }
-    }
-}
-
-/// A percentage as a Q16 gain.
-const fn gain_of(p: Percent) -> i32 {
-    (p.get() as u32 * ONE / 100) as i32
 }
