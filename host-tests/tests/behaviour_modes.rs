@@ -42,24 +42,23 @@ struct Model {
 }
 
 impl Model {
-    fn next(&self) -> u64 {
-        self.last.map_or(0, |f| f + 1)
-    }
-
-    /// An action applied before frame `next`, as answered.
+    /// An action applied before frame `next`, as answered: a gesture starts
+    /// at the last frame played (0 before the first), so that `next` is a
+    /// step in; a gaze move starts at `next`.
     fn apply(&mut self, outcome: &Applied) {
-        let next = self.next();
+        let start = self.last.unwrap_or(0);
+        let next = self.last.map_or(0, |f| f + 1);
         match outcome {
             Applied::Gesture(plan) => {
                 for layer in &mut self.layers {
                     if !layer.released {
                         layer.released = true;
-                        layer.end = layer.end.min(next + self.blend);
+                        layer.end = layer.end.min(start + self.blend);
                     }
                 }
                 self.layers.push(Layer {
                     axis: plan.kind.axis().index(),
-                    end: next + u64::from(plan.duration.0 / FRAME_MS),
+                    end: start + u64::from(plan.duration.0 / FRAME_MS),
                     released: false,
                 });
             }
@@ -77,8 +76,8 @@ impl Model {
                             .max((look.yaw.millidegrees() - pose[2].millidegrees()).unsigned_abs());
                         let gaze = self.params.config().gaze;
                         let back_ms = gaze.base.0 + (gaze.per_degree.0 * far).div_ceil(1000);
-                        let start = end + u64::from(self.params.frames(ms).max(1));
-                        Some((start, start + u64::from(back_ms.div_ceil(FRAME_MS))))
+                        let next = end + u64::from(self.params.frames(ms).max(1));
+                        Some((next, next + u64::from(back_ms.div_ceil(FRAME_MS))))
                     }
                 };
             }

@@ -549,9 +549,10 @@ fn idle_gain_and_duck() {
     let pitch: Vec<i32> = (1..=60)
         .map(|k| mixer.frame(k, idle)[0].millidegrees())
         .collect();
+    // From frame 0, the last mixed: frame 1 (`pitch[0]`) is a step in.
     assert_eq!(pitch[0], 4000);
-    assert_eq!(pitch[25], 2000);
-    assert_eq!(pitch[50], 0);
+    assert_eq!(pitch[24], 2000);
+    assert_eq!(pitch[49], 0);
     // Half amplitude while off: still off; on again: half.
     mixer.apply(&Action::IdleAmp(Percent::HALF)).unwrap();
     mixer.apply(&Action::Idle(true)).unwrap();
@@ -566,8 +567,8 @@ fn idle_gain_and_duck() {
     let roll: Vec<i32> = (300..380)
         .map(|k| mixer.frame(k, idle)[1].millidegrees())
         .collect();
-    // Mid-tilt: 5° + 4° · 0.4.
-    assert_eq!(roll[37], 5000 + 1600);
+    // Mid-tilt (from frame 299, the last mixed): 5° + 4° · 0.4.
+    assert_eq!(roll[36], 5000 + 1600);
     // Pitch and yaw are not ducked.
     assert_eq!(mixer.frame(380, idle)[0], Angle::from_degrees(4));
 }

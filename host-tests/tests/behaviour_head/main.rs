@@ -206,12 +206,14 @@ fn a_nod_on_the_moving_idle_plays_exactly_and_safely() {
     assert_eq!(nod_alone.iter().copied().max(), Some(8000));
     assert!((200..245).any(|k| (pitch[k] - base[k]).abs() > 5000));
     // Gesture mode on pitch from the nod to 500 ms after it, idle elsewhere.
+    // The nod starts at the last frame mixed (199): frame 200 is a step in.
     assert_eq!(
         rig.played[200].modes,
         [LimitMode::Gesture, LimitMode::Idle, LimitMode::Idle]
     );
-    assert_eq!(rig.played[200 + 45 + 24].modes[0], LimitMode::Gesture);
-    assert_eq!(rig.played[200 + 45 + 26].modes[0], LimitMode::Idle);
+    assert_eq!(rig.played[199 + 45 + 24].modes[0], LimitMode::Gesture);
+    assert_eq!(rig.played[199 + 45 + 26].modes[0], LimitMode::Idle);
+    assert_ne!(pitch[200], base[200], "the nod's first frame moves");
     // After it, the same frames as without it.
     assert_eq!(pitch[300..], base[300..]);
 }

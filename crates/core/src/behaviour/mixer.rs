@@ -194,7 +194,7 @@ impl Mixer {
         self.params.set_angle_limits(axis, limits);
     }
 
-    /// Applies `action` from the next frame on.
+    /// Applies `action`: the next frame is its first.
     ///
     /// `Stop` changes nothing here and answers [`Applied::Stop`]: stopping
     /// is the driver's fade (see [`Head`](super::Head)).
@@ -212,6 +212,14 @@ impl Mixer {
     /// # Errors
     /// A [`BehaviourError`] for bad parameters (nothing changes then).
     pub fn apply_at(&mut self, action: &Action, at: [Angle; 3]) -> Result<Applied, BehaviourError> {
+        // A gesture, a rest, a wake and the idle's glide start at the last
+        // frame mixed, where they are at their start: the next frame, the
+        // first to play them, is already a step in (begun at the next frame,
+        // that frame would only repeat where the head is, and a command would
+        // show a frame later). A look and a move back to the centre start at
+        // the next frame: begun a frame earlier they cost the frame more than
+        // its ceiling allows (`cargo xtask bench`), for the frame they save.
+        let start = self.now;
         let next = self.next;
         let applied = match action {
             Action::Gesture(request) => {
@@ -238,8 +246,8 @@ impl Mixer {
                 Applied::Idle(self.glide_idle())
             }
             Action::Stop => return Ok(Applied::Stop),
-            Action::Rest => Applied::Rest(self.start_rest(next, at.map(Angle::millidegrees))),
-            Action::Wake { toward } => match self.rest.wake(&self.params, next, *toward) {
+            Action::Rest => Applied::Rest(self.start_rest(start, at.map(Angle::millidegrees))),
+            Action::Wake { toward } => match self.rest.wake(&self.params, start, *toward) {
                 Some(duration) => Applied::Wake(duration),
                 None => match toward {
                     // Awake already: the glance alone.
@@ -260,7 +268,7 @@ impl Mixer {
             // A gesture or a look wakes a resting head: it plays over the
             // wake (a gesture on top of the blend, a look under it, arriving
             // as the idle comes back).
-            self.rest.wake(&self.params, next, None);
+            self.rest.wake(&self.params, start, None);
         }
         self.resting = self.rest.active();
         self.quiet = false;
@@ -270,12 +278,12 @@ impl Mixer {
         Ok(applied)
     }
 
-    /// Starts a rest at frame `next` of a head at `at` (offsets, m°): the
+    /// Starts a rest at frame `start` of a head at `at` (offsets, m°): the
     /// pose's weight rises, and the gaze, hidden under it, goes back to the
     /// centre (a wake starts from there); returns the rest's duration.
-    fn start_rest(&mut self, next: u32, at: [i32; 3]) -> Millis {
+    fn start_rest(&mut self, start: u32, at: [i32; 3]) -> Millis {
         let pose = self.params.rest_pose;
-        let duration = self.rest.rest(&self.params, next, pose, at);
+        let duration = self.rest.rest(&self.params, start, pose, at);
         let frames = self.params.frames(duration);
         if !self.gaze.centred() {
             // Within the longest move: the built-in rest times are.
@@ -283,7 +291,7 @@ impl Mixer {
             let ms = self.params.millis(frames).min(longest);
             let _ = self
                 .gaze
-                .center(&self.params, next, Some(Millis(ms.0.max(1))));
+                .center(&self.params, start, Some(Millis(ms.0.max(1))));
         }
         duration
     }
@@ -342,18 +350,21 @@ impl Mixer {
             });
         };
         let blend = self.params.blend;
+        // The new layer starts, and the others fade, from the last frame
+        // mixed (see `apply_at`).
+        let start = self.now;
         for layer in self.layers.iter_mut().flatten() {
             if layer.release.is_none() {
-                layer.release = Some(next);
+                layer.release = Some(start);
                 // The fade ends `blend` frames on, if the plan has not ended by then.
-                let fade_end = next.wrapping_sub(layer.start).saturating_add(blend);
+                let fade_end = start.wrapping_sub(layer.start).saturating_add(blend);
                 layer.stop = layer.stop.min(fade_end);
             }
         }
         if let Some(slot) = self.layers.get_mut(free) {
             *slot = Some(Layer {
                 plan,
-                start: next,
+                start,
                 release: None,
                 stop: plan.frames,
             });
@@ -368,8 +379,8 @@ impl Mixer {
         } else {
             Percent::ZERO
         };
-        let from = self.idle_gain.state(self.next);
-        self.idle_gain = Glide::new(self.next, from, gain_of(target), self.params.idle_fade);
+        let from = self.idle_gain.state(self.now);
+        self.idle_gain = Glide::new(self.now, from, gain_of(target), self.params.idle_fade);
         target
     }
 
