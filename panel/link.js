@@ -252,10 +252,20 @@ export function fields(reply) {
   return out;
 }
 
+/** The command words of `help`'s reply. */
+export function commandWords(help) {
+  return help.replace(/^ok commands:\s*/, '').split(/\s+/);
+}
+
 /** The gesture words of `help`'s reply: between `stop` and `look`. */
 export function gestureWords(help) {
-  const words = help.replace(/^ok commands:\s*/, '').split(/\s+/);
+  const words = commandWords(help);
   const from = words.indexOf('stop');
   const to = words.indexOf('look');
   return from >= 0 && to > from ? words.slice(from + 1, to) : [];
+}
+
+/** An `err <code> <reason>` reply as the page shows it: `refused: <reason>`. */
+export function refusal(reply) {
+  return reply.replace(/^err \w+ /, 'refused: ');
 }

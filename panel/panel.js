@@ -1,16 +1,19 @@
 // The panel: connects to a head (the bridge of `cargo xtask panel` when
 // the page is served with one, else Web Serial), shows what the head is
 // told (drawing, readouts, plot, status), and offers its actions,
-// calibration and settings. Every line sent and received goes to the log.
+// calibration and settings (rest, inputs and DMX in modules of their own).
+// Every line sent and received goes to the log.
 
-import { Console, NoReply, SerialTransport, SocketTransport, fields, gestureWords } from './link.js';
+import { Console, NoReply, SerialTransport, SocketTransport, commandWords, fields, gestureWords, refusal } from './link.js';
+import { makePlot, showTelemetry } from './view.js';
+import * as rest from './rest.js';
+import * as inputs from './inputs.js';
+import * as dmx from './dmx.js';
 
 const $ = (id) => document.getElementById(id);
 const AXES = ['pitch', 'roll', 'yaw'];
 /** Telemetry lines a second while connected. */
 const WATCH_HZ = 20;
-/** The plot's window, in seconds. */
-const WINDOW_S = 10;
 
 let link = null; // {transport, console}
 let bridge = null; // what bridge.json says, when served with one
@@ -18,6 +21,8 @@ let servos = {}; // axis -> calibration as `servo <axis>` says
 let statusTimer = null;
 let pollTimer = null; // status polled for the readouts (no telemetry)
 let limitRun = null; // a "go to limit" in progress
+let hasInputs = false; // the firmware has trigger inputs
+let hasDmx = false; // the firmware answers `dmx`
 
 // ---- log ----------------------------------------------------------------
 
@@ -48,7 +53,7 @@ function banner(text, { reconnect = false, info = false } = {}) {
 }
 
 function setControls(enabled) {
-  for (const el of document.querySelectorAll('#actions button, #actions input, #calibration button, #calibration input')) {
+  for (const el of document.querySelectorAll('#actions :is(button, input), #calibration :is(button, input), #setup :is(input, select)')) {
     // Stop is for a "go to limit" in progress only.
     el.disabled = !enabled || (el.id === 'limit-stop' && !limitRun);
   }
@@ -87,8 +92,14 @@ async function connect(makeTransport) {
 async function start() {
   const help = await ask('help');
   makeGestureButtons(gestureWords(help));
+  const words = commandWords(help);
+  rest.offered(words);
+  rest.forget();
   await refreshStatus();
   for (const axis of AXES) await readServo(axis);
+  hasInputs = inputs.offered(words);
+  if (hasInputs) await inputs.read();
+  hasDmx = dmx.offered(words) && (await dmx.read());
   showServo();
   const watch = await ask(`watch ${WATCH_HZ}`);
   if (watch.startsWith('err')) {
@@ -102,7 +113,7 @@ async function start() {
   setState('connected', 'on');
   setControls(true);
   statusTimer = setInterval(() => {
-    if (!limitRun) refreshStatus().catch(fault);
+    if (!limitRun) refreshStatus().then(() => hasDmx && dmx.refresh()).catch(fault);
   }, 2000);
 }
 
@@ -192,61 +203,6 @@ async function ask(line) {
 
 // ---- what the head is told ----------------------------------------------
 
-const plotData = [[], [], [], []];
-let plot = null;
-let plotDirty = false;
-
-function makePlot() {
-  const el = $('plot');
-  plot = new uPlot(
-    {
-      width: el.clientWidth || 370,
-      height: 140,
-      legend: { show: false },
-      scales: { x: { time: false } },
-      axes: [{ label: 's', size: 30 }, { label: '°', size: 40 }],
-      series: [
-        { label: 't' },
-        { label: 'pitch', stroke: '#d6451d', width: 1.5 },
-        { label: 'roll', stroke: '#1d9b55', width: 1.5 },
-        { label: 'yaw', stroke: '#1d6fd6', width: 1.5 },
-      ],
-    },
-    plotData,
-    el,
-  );
-  setInterval(() => {
-    if (plotDirty) {
-      plot.setData(plotData);
-      plotDirty = false;
-    }
-  }, 100);
-}
-
-function showTelemetry(t) {
-  showPose(t.pitch, t.roll, t.yaw);
-  $('pulses').textContent = `pulses ${t.us.join(', ')} µs · t ${(t.t / 1000).toFixed(2)} s` + (t.lost ? ` · ${t.lost} lines lost` : '');
-  const s = t.t / 1000;
-  plotData[0].push(s);
-  plotData[1].push(t.pitch);
-  plotData[2].push(t.roll);
-  plotData[3].push(t.yaw);
-  while (plotData[0].length && plotData[0][0] < s - WINDOW_S) for (const series of plotData) series.shift();
-  plotDirty = true;
-}
-
-function showPose(pitch, roll, yaw) {
-  $('pitch').textContent = pitch.toFixed(1);
-  $('roll').textContent = roll.toFixed(1);
-  $('yaw').textContent = yaw.toFixed(1);
-  // Front: roll tilts the head; yaw turns the face sideways.
-  $('front-head').setAttribute('transform', `rotate(${-roll})`);
-  const shift = 28 * Math.sin((yaw * Math.PI) / 180);
-  $('front-face').setAttribute('transform', `translate(${shift} 0)`);
-  // Side: pitch nods the head (positive: up).
-  $('side-head').setAttribute('transform', `rotate(${-pitch})`);
-}
-
 async function refreshStatus(pose = false) {
   const reply = await ask('status');
   if (!reply.startsWith('ok')) return;
@@ -254,11 +210,13 @@ async function refreshStatus(pose = false) {
   $('status-line').textContent = reply.replace(/^ok /, 'status: ');
   $('firmware').textContent = f.fw ? `firmware ${f.fw}` : '';
   $('unsaved').hidden = f.settings !== 'changed';
+  rest.showStatus(f);
+  inputs.showStatus(f);
+  dmx.showStatus(f);
   if (f.mode && f.mode !== 'running') setState(`connected · ${f.mode}`, 'on');
   else if (link) setState('connected', 'on');
   if (pose && f.mdeg) {
     const [p, r, y] = f.mdeg.split(',').map((v) => Number(v) / 1000);
-    showPose(p, r, y);
     showTelemetry({ t: Number(f.uptime_ms ?? 0), pitch: p, roll: r, yaw: y, us: (f.us ?? '').split(','), lost: 0 });
   }
 }
@@ -469,7 +427,7 @@ async function setField(field, value) {
     servo[field.key] = value;
     if (reply.startsWith('ok warning')) why.textContent = reply.replace(/^ok warning: /, 'warning: ');
   } else {
-    why.textContent = reply.replace(/^err \w+ /, 'refused: ');
+    why.textContent = refusal(reply);
   }
   // A slider still moving has newer changes on the way: let them land.
   if (changing[field.key] !== mine) return;
@@ -484,7 +442,7 @@ async function setDirection(direction) {
   why.textContent = '';
   const reply = await ask(`servo ${axis} direction ${direction}`);
   if (reply.startsWith('ok')) servos[axis].direction = direction;
-  else why.textContent = reply.replace(/^err \w+ /, 'refused: ');
+  else why.textContent = refusal(reply);
   showServo();
   await refreshStatus();
 }
@@ -533,6 +491,10 @@ function on(id, event, handler) {
 
 async function main() {
   makeServoFields();
+  const page = { ask, refreshStatus };
+  rest.setUp(page);
+  inputs.setUp(page);
+  dmx.setUp(page);
   makePlot();
   setUpLookPad();
   setControls(false);
@@ -565,10 +527,13 @@ async function main() {
   });
   for (const id of ['load', 'defaults']) {
     on(id, 'click', async () => {
-      await ask(id);
+      const reply = await ask(id);
       for (const axis of AXES) await readServo(axis);
       showServo();
+      if (reply.startsWith('ok')) rest.forget();
       await refreshStatus();
+      if (hasInputs) await inputs.read();
+      if (hasDmx) await dmx.read();
     });
   }
   for (const radio of document.querySelectorAll('input[name=axis]')) radio.addEventListener('change', showServo);

@@ -33,7 +33,8 @@
 //               at real time (virtual time kept within a few ms of the wall clock since the
 //               start) for as long as stdin is open; each stdin line is hex digits, bytes for
 //               the USB serial port (sent once the CDC-ACM host has configured the device),
-//               or `dtr 0` / `dtr 1`: the host closes or opens the port (DTR and RTS);
+//               or `dtr 0` / `dtr 1`: the host closes or opens the port (DTR and RTS),
+//               or `pin <n> 0` / `pin <n> 1`: the outside drives input n (of `inputs`) low or high;
 //               the bytes the device sends are `usb` events, the log `rtt` events, flushed as
 //               they come; `ns`, `silence_ns`, `uart`, `usb` and the power cycles are not used,
 //   inputs:     optional, GPIOs the outside drives as inputs (GP2 to GP5): each sits at the level
@@ -407,13 +408,17 @@ const pinDue = () => (pinQueue.length ? pinQueue[0].ns : Infinity);
 function feedPins() {
   while (pinQueue.length && pinQueue[0].ns <= now()) {
     const { pin, high } = pinQueue.shift();
-    const input = inputs.get(pin);
-    if (!input) continue;
-    input.driven = high;
-    emit({ ev: 'drive', pin, high, ns: now() });
-    setInput(mcu, pin, high);
-    lastActivity = now();
+    drive(pin, high);
   }
+}
+/** The outside drives input `pin` (one of `inputs`) high or low. */
+function drive(pin, high) {
+  const input = inputs.get(pin);
+  if (!input) return;
+  input.driven = high;
+  emit({ ev: 'drive', pin, high, ns: now() });
+  setInput(mcu, pin, high);
+  lastActivity = now();
 }
 
 // UART0's scripted RX line (per boot) and the bytes it sent.
@@ -626,13 +631,16 @@ const AHEAD_NS = 5e6;
 async function runLive() {
   const pending = []; // bytes from stdin, waiting for the device
   const controls = []; // control line states from stdin, waiting for the device
+  const drives = []; // input levels from stdin: [pin, high]
   let carry = '';
   process.stdin.on('data', (chunk) => {
     const lines = (carry + chunk.toString('latin1')).split('\n');
     carry = lines.pop();
     for (const line of lines) {
       const dtr = /^dtr ([01])$/.exec(line.trim());
+      const pin = /^pin (\d+) ([01])$/.exec(line.trim());
       if (dtr) controls.push(dtr[1] === '1' ? 0x3 : 0x0);
+      else if (pin) drives.push([Number(pin[1]), pin[2] === '1']);
       else pending.push(...Buffer.from(line.trim(), 'hex'));
     }
   });
@@ -645,6 +653,7 @@ async function runLive() {
   while (!stop) {
     if (usbLive && pending.length) usbLive(pending.splice(0));
     if (usbLines && controls.length) usbLines(controls.shift());
+    for (const [pin, high] of drives.splice(0)) drive(pin, high);
     const until = wallNs() + AHEAD_NS;
     const { core, clock } = mcu;
     while (!stop && !watchdogFired && now() < until) {

@@ -10,7 +10,8 @@
 //   `navigator.serial` (addInitScript) is bridged (exposeBinding) to the
 //   shipped Pico image in the RP2040 emulator, live, over its USB serial
 //   port. The fake can also unplug the board, answer `watch` as an older
-//   firmware does, and swallow a line (a reply that never comes).
+//   firmware does, and swallow a line (a reply that never comes); the
+//   emulator's GP2 can be pressed (`pin 2 0` to the harness).
 // - bridge: the page served by `cargo xtask panel` with a bridge (QEMU, a
 //   serial port) connects over its WebSocket on load.
 //
@@ -140,14 +141,134 @@ async function session(page, { yawPulse }) {
   check(true, 'Save: the settings are stored, the unsaved mark is gone');
 }
 
+/** Rest to a pose set in the Rest group, then Wake. `pitchPulse()` is
+ * the pitch servo's pulse in µs as the session sees it. */
+async function restAndWake(page, { pitchPulse }) {
+  // The head runs on its built-in settings or has saved them since the
+  // page connected: the rest settings it cannot be asked for are the built-in ones.
+  const pose0 = await Promise.all(['pitch', 'roll', 'yaw'].map((a) => page.getByLabel(`rest pose ${a} in degrees`).inputValue()));
+  const after0 = await page.getByLabel('rest after, seconds with no one there').inputValue();
+  check(pose0.join(' ') === '-8 0 0' && after0 === '120', `rest settings on connect: the built-in pose ${pose0.join('°, ')}°, rest after ${after0} s`);
+  const after = page.getByLabel('rest after, seconds with no one there');
+  await after.fill('0');
+  await after.press('Enter');
+  const why = await until(async () => (await page.locator('#why-rest').textContent()) || null, 5000, 'the reason rest after 0 is refused');
+  await until(async () => (await after.inputValue()) === '120', 5000, 'rest after snaps back');
+  check(why.includes('1..=86400'), `rest after 0 refused, snapped back to 120: "${why}"`);
+  for (const [axis, value] of [['pitch', '-5'], ['yaw', '6']]) {
+    const field = page.getByLabel(`rest pose ${axis} in degrees`);
+    await field.fill(value);
+    await field.press('Enter');
+  }
+  await until(async () => (await page.locator('#log').textContent()).includes('rest pose -5000 0 6000'), 5000, 'the rest pose sent');
+  await page.getByRole('button', { name: 'Rest', exact: true }).click();
+  const mode = await until(async () => {
+    const text = await page.getByLabel('mode', { exact: true }).textContent();
+    return text === 'resting' ? text : null;
+  }, 3000, 'the mode readout says resting');
+  check(true, `Rest: the mode readout says ${mode}`);
+  const clicked = Date.now();
+  const pose = await until(async () => {
+    const [p, r, y] = await Promise.all(['pitch', 'roll', 'yaw'].map((a) => readout(page, a)));
+    return Math.abs(p + 5) <= 0.15 && Math.abs(r) <= 0.15 && Math.abs(y - 6) <= 0.15 ? [p, r, y] : null;
+  }, 6000, 'the head glides to the rest pose (-5°, 0°, 6°)');
+  const pulse = await pitchPulse();
+  check(Math.abs(Math.abs(pulse - 1500) - 5 * 11.111) <= 3, `at rest in ${((Date.now() - clicked) / 1000).toFixed(1)} s: readouts ${pose.join('°, ')}°, the pitch pulse ${pulse.toFixed(1)} µs (5° from 1500 µs at 11.1 µs/°)`);
+  await page.getByRole('button', { name: 'Wake', exact: true }).click();
+  const woke = await until(async () => {
+    const text = await page.getByLabel('mode', { exact: true }).textContent();
+    return /^(waking|running)$/.test(text) ? text : null;
+  }, 3000, 'the mode readout says waking or running');
+  await until(async () => Math.abs(await readout(page, 'pitch')) < 1, 4000, 'the head leaves the rest pose for its neutral pose (idle off)');
+  check(true, `Wake: the mode readout says ${woke}, the head is back at its neutral pose`);
+}
+
+/** GP2 as a button running a nod (read back; a refused action snaps back),
+ * then the DMX address (a refused one snaps back) and DMX off and on.
+ * `press(down)`, when the session can, drives GP2's pin. */
+async function inputsAndDmx(page, { press = null } = {}) {
+  await page.getByLabel('GP2 role').selectOption('button');
+  const action = page.getByLabel('GP2 button: the command a press runs');
+  await until(async () => (await action.isVisible()) && (await action.inputValue()) === 'nod', 5000, 'GP2 reads back as a button running `nod`');
+  await action.fill('nod 5000 cycles=3');
+  await action.press('Enter');
+  const readback = await until(async () => {
+    const lines = await page.locator('#log li.in').allTextContents();
+    return lines.find((l) => /^ok input 2 level=\w+ active=0 button nod 5000 cycles=3$/.test(l));
+  }, 5000, 'the read-back of input 2');
+  check((await action.inputValue()) === 'nod 5000 cycles=3', `GP2 a button running \`nod 5000 cycles=3\`: read back "${readback}"`);
+  await action.fill('nod 90000');
+  await action.press('Enter');
+  const refused = await until(async () => (await page.locator('#why-in-2').textContent()) || null, 5000, 'the reason GP2 is refused');
+  await until(async () => (await action.inputValue()) === 'nod 5000 cycles=3', 5000, 'the action snaps back');
+  check(refused.startsWith('refused:') && refused.includes('20°'), `GP2 \`nod 90000\` refused, snapped back to \`nod 5000 cycles=3\`: "${refused}"`);
+  const level = await until(async () => {
+    const text = await page.getByLabel('GP2 level').textContent();
+    return text === 'released' ? text : null;
+  }, 3000, 'the GP2 level from status');
+  check(true, `GP2's level as status reports it: ${level}`);
+  if (press) {
+    const p0 = await readout(page, 'pitch');
+    await press(true);
+    let swing = 0;
+    await until(async () => {
+      swing = Math.max(swing, Math.abs((await readout(page, 'pitch')) - p0));
+      return swing > 2 && (await page.getByLabel('GP2 level').textContent()) === 'pressed';
+    }, 3000, 'GP2 pressed: the level readout says so and the head nods');
+    await press(false);
+    check(true, `GP2 pressed in the emulator: the level readout says pressed, the pitch readout swung by ${swing.toFixed(1)}°`);
+  }
+
+  const address = page.getByLabel('DMX start address');
+  await address.fill('17');
+  await address.press('Enter');
+  await until(async () => (await page.locator('#log li.in').allTextContents()).some((l) => / address=17 /.test(l)), 5000, 'the DMX address read back');
+  const signal = await page.getByLabel('DMX signal').textContent();
+  const counters = await page.getByLabel('DMX frames received').textContent();
+  check((await address.inputValue()) === '17' && signal.startsWith('lost'), `DMX address 17 read back; signal "${signal}", "${counters}"`);
+  await address.fill('600');
+  await address.press('Enter');
+  const why = await until(async () => (await page.locator('#why-dmx').textContent()) || null, 5000, 'the reason 600 is refused');
+  await until(async () => (await address.inputValue()) === '17', 5000, 'the address snaps back');
+  check(why.includes('1..=503'), `DMX address 600 refused, snapped back to 17: "${why}"`);
+  await page.getByLabel('DMX drives the head').uncheck();
+  await until(async () => (await page.getByLabel('DMX signal').textContent()).startsWith('off'), 5000, 'DMX off');
+  await page.getByLabel('DMX drives the head').check();
+  await until(async () => (await page.getByLabel('DMX signal').textContent()).startsWith('lost'), 5000, 'DMX on again');
+  check(!(await page.locator('#unsaved').isHidden()), 'DMX off and on again: the signal readout followed; the unsaved mark is back');
+}
+
+/** The panel's log, its last lines, when a check failed: what was sent and answered. */
+async function sayLog(page) {
+  const lines = await page?.locator('#log li').allTextContents().catch(() => []);
+  if (lines?.length) say(`the panel's log, last lines:\n  ${lines.slice(-12).join('\n  ')}`);
+}
+
+/** Load: the inputs and DMX read again as saved (before they were
+ * changed), the rest settings blank (the head cannot be asked for them). */
+async function loadReadsBack(page) {
+  await page.getByRole('button', { name: 'Load' }).click();
+  await until(async () => (await page.getByLabel('GP2 role').inputValue()) === 'off', 5000, 'GP2 read again as saved: off');
+  await until(async () => (await page.getByLabel('DMX start address').inputValue()) === '1', 5000, 'the DMX address read again as saved: 1');
+  const pitch = await page.getByLabel('rest pose pitch in degrees').inputValue();
+  check(pitch === '' && (await page.locator('#rest-note').isVisible()) && (await page.locator('#unsaved').isHidden()),
+    'Load: GP2 and the DMX address read again as saved (off, 1); the rest pose blank, with the note');
+}
+
 async function browser() {
   return chromium.launch({ executablePath: CHROMIUM, args: ARGS, headless: true });
 }
 
+/** Collects the page's errors in `errors`, and says each as it comes (a
+ * check that times out after one has its cause in the output). */
 function watchErrors(page, errors) {
-  page.on('pageerror', (error) => errors.push(`page error: ${error.message}`));
+  const note = (text) => {
+    errors.push(text);
+    say(text);
+  };
+  page.on('pageerror', (error) => note(`page error: ${error.message}`));
   page.on('console', (message) => {
-    if (message.type() === 'error') errors.push(`console error: ${message.text()}`);
+    if (message.type() === 'error') note(`console error: ${message.text()}`);
   });
 }
 
@@ -279,6 +400,10 @@ async function serialSession() {
     const pitch = pitchDuties.filter((d) => d.at > Date.now() - 4000).map((d) => d.us);
     const span = Math.max(...pitch) - Math.min(...pitch);
     check(span > 2 * 11.1, `the nod in the emulator's pitch pulses on GP16: ${span.toFixed(0)} µs of swing (more than 2° at 11.1 µs/°)`);
+    await restAndWake(page, { pitchPulse: async () => (duty[0] * 20000) / 64000 });
+    // GP2 is pulled up (a button to ground): pressed is low.
+    await inputsAndDmx(page, { press: async (down) => harness.stdin.write(`pin 2 ${down ? 0 : 1}\n`) });
+    await shot(page, 'inputs');
 
     // Unplugged mid-session.
     await page.evaluate((id) => window.__unplug(id), port);
@@ -290,6 +415,13 @@ async function serialSession() {
     mode = 'old';
     await page.getByRole('button', { name: 'Reconnect' }).click();
     await until(async () => (await page.locator('#banner-text').textContent()).includes('watch'), 10000, 'the page says the firmware has no telemetry');
+    // Read on connect: the inputs and DMX as set before; the rest settings,
+    // changed and not saved, cannot be asked for.
+    const role = await page.getByLabel('GP2 role').inputValue();
+    const dmxAddress = await page.getByLabel('DMX start address').inputValue();
+    const restPitch = await page.getByLabel('rest pose pitch in degrees').inputValue();
+    check(role === 'button' && dmxAddress === '17' && restPitch === '' && (await page.locator('#rest-note').isVisible()),
+      `reconnected: GP2 read as a ${role}, DMX address ${dmxAddress}; the rest pose blank, as the head cannot be asked for it`);
     const p0 = await readout(page, 'pitch');
     await page.getByLabel('idle motion').check();
     await page.getByRole('button', { name: 'Nod' }).click();
@@ -318,6 +450,9 @@ async function serialSession() {
     harness.stdin.write('dtr 1\n');
     await sleep(500);
     check(telemetry === closed, `DTR dropped: the telemetry stopped (${telemetry - closed} lines after it)`);
+  } catch (error) {
+    await sayLog(page);
+    throw error;
   } finally {
     await chrome.close();
     harness.stdin.end();
@@ -330,8 +465,9 @@ async function serialSession() {
 async function bridgeSession() {
   const chrome = await browser();
   const errors = [];
+  let page = null;
   try {
-    const page = await chrome.newPage({ viewport: { width: 1280, height: 800 } });
+    page = await chrome.newPage({ viewport: { width: 1280, height: 800 } });
     watchErrors(page, errors);
     // The yaw pulse as the telemetry reports it.
     const yawPulse = async () => {
@@ -343,8 +479,17 @@ async function bridgeSession() {
     await until(async () => (await page.locator('#state').textContent()).startsWith('connected'), 20000, 'connected on load');
     check((await page.locator('#transport').textContent()).startsWith('bridged to'), `connected on load, no chooser: ${await page.locator('#transport').textContent()}`);
     await session(page, { yawPulse });
-    if (cfg.label === 'qemu') await gazeControls(page);
+    if (cfg.label === 'qemu') {
+      await gazeControls(page);
+      const pitchPulse = async () => Number(/pulses (\d+)/.exec(await page.locator('#pulses').textContent())?.[1]);
+      await restAndWake(page, { pitchPulse });
+      await inputsAndDmx(page);
+      await loadReadsBack(page);
+    }
     check(errors.length === 0, `no page errors${errors.length ? `: ${errors.join('; ')}` : ''}`);
+  } catch (error) {
+    await sayLog(page);
+    throw error;
   } finally {
     await chrome.close();
   }

@@ -107,15 +107,18 @@ impl Port for Uart0 {
             if UART1.read().is_some() {
                 return Err(Gone);
             }
-            let mut n = 0;
-            while let Some(slot) = buf.get_mut(n) {
-                let Some(byte) = UART0.read() else { break };
-                *slot = byte;
-                n += 1;
-            }
-            if n > 0 {
-                // Let the loop generator (same executor) run between reads.
+            if UART0.pending() {
+                // Let the loop generator (same executor) run between reads,
+                // before any byte is taken: a read dropped here (`serve`'s
+                // telemetry tick came first) has taken none, as `Port::read`
+                // requires, and no await follows the taking.
                 YieldNow(false).await;
+                let mut n = 0;
+                while let Some(slot) = buf.get_mut(n) {
+                    let Some(byte) = UART0.read() else { break };
+                    *slot = byte;
+                    n += 1;
+                }
                 return Ok(Received::Bytes(n));
             }
             UART0.listen();

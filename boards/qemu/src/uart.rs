@@ -4,11 +4,13 @@
 //!
 //! QEMU connects UART0 to its first `-serial` and UART1 to its second. The
 //! receive interrupt only wakes the console task: the handler masks it and
-//! signals, the task empties the FIFO and unmasks it again. Bytes the task
-//! has not read yet stay in the UART's 16-byte FIFO and, behind it, in
-//! QEMU's character device (which stops reading its socket while the FIFO
-//! is full): nothing is dropped, and the frame task, in a higher-priority
-//! interrupt, never waits for the console.
+//! signals, the task empties the receive register and unmasks it again.
+//! Bytes the task has not read yet stay in QEMU's character device (which
+//! stops reading its socket while the register is full): nothing is
+//! dropped, and the frame task, in a higher-priority interrupt, never
+//! waits for the console. The FIFOs stay off: QEMU empties them when they
+//! are turned on, and the host, which QEMU waits for before it starts the
+//! machine, may have sent its first byte by then.
 
 use core::ptr;
 
@@ -23,11 +25,11 @@ const CTL: usize = 0x030;
 const IM: usize = 0x038;
 const ICR: usize = 0x044;
 
-/// FR: receive FIFO empty, transmit FIFO full.
+/// FR: nothing received, transmit full (FIFO or holding register).
 const FR_RXFE: u32 = 1 << 4;
 const FR_TXFF: u32 = 1 << 5;
-/// LCRH: FIFOs on, 8 data bits (8N1).
-const LCRH_8N1_FIFO: u32 = 1 << 4 | 0b11 << 5;
+/// LCRH: 8 data bits (8N1), FIFOs off (one-byte holding registers).
+const LCRH_8N1: u32 = 0b11 << 5;
 /// CTL: UART, transmitter and receiver on.
 const CTL_ON: u32 = 1 | 1 << 8 | 1 << 9;
 /// IM / ICR: the receive interrupt.
@@ -64,26 +66,31 @@ impl Uart {
         unsafe { ptr::write_volatile((self.base + offset) as *mut u32, value) }
     }
 
-    /// 8N1 with FIFOs, receive interrupt on. (QEMU ignores the baud
+    /// 8N1, receive interrupt on. (QEMU ignores the baud
     /// rate; a board would set IBRD and FBRD for 115200 here.)
     pub fn init(self) {
         self.write_reg(CTL, 0);
-        self.write_reg(LCRH, LCRH_8N1_FIFO);
+        self.write_reg(LCRH, LCRH_8N1);
         self.write_reg(ICR, 0x7ff);
         self.write_reg(CTL, CTL_ON);
         self.listen();
     }
 
+    /// Whether a received byte waits (none is taken).
+    pub fn pending(self) -> bool {
+        self.read_reg(FR) & FR_RXFE == 0
+    }
+
     /// The next received byte, if any. A received BREAK reads as a NUL.
     pub fn read(self) -> Option<u8> {
-        if self.read_reg(FR) & FR_RXFE != 0 {
-            None
-        } else {
+        if self.pending() {
             Some((self.read_reg(DR) & 0xff) as u8)
+        } else {
+            None
         }
     }
 
-    /// Sends `bytes`, waiting while the transmit FIFO is full.
+    /// Sends `bytes`, waiting while the transmitter is full.
     pub fn write_all(self, bytes: &[u8]) {
         for &b in bytes {
             while self.read_reg(FR) & FR_TXFF != 0 {}

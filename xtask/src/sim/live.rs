@@ -40,7 +40,7 @@ pub enum LiveEvent {
 /// The harness's argument for a live run of `elf`: the settings store's
 /// flash functions as in the store run (`save` and `load` work), the servo
 /// slices' compare writes reported (`cc` events of slices 0, 1, 2: pitch,
-/// roll, yaw).
+/// roll, yaw), the trigger inputs GP2..GP5 driven by `pin <n> 0|1` lines.
 pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
     let image = PicoImage::read(elf)?;
     node::ensure(root)?;
@@ -53,6 +53,9 @@ pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
         slices: SERVOS.iter().map(|s| s.2).collect(),
         wall: Duration::from_secs(24 * 3600),
         rom: Some(WORST),
+        // GP2..GP5 at their pulls until driven, as on a board: a button's
+        // input reads released.
+        inputs: (2..=5).collect(),
         live: true,
         ..node::Config::default()
     };
