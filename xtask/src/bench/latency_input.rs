@@ -26,10 +26,11 @@
 //! The goal is a frame and the transport: p99 ≤ 25 ms. A press costs, in
 //! order: the button's debounce ([`BUTTON_DEBOUNCE`], 5 ms); the wait for
 //! the next frame, which takes the action from the queue (0 to 20 ms); the
-//! action's first frame, which plays the position it starts from (every
-//! look, gesture and `center` starts at rest: 20 ms); and the PWM's latch,
-//! which puts a frame's duty out at the next period, half a period after
-//! the frame is written (10 ms). About 35 to 55 ms in all.
+//! look's first frame, which plays the position it starts from (a look and
+//! a move to the centre start at the next frame: begun a frame earlier, as
+//! gestures are, the gesture + look frame row goes over its ceiling: 20 ms);
+//! and the PWM's latch, which puts a frame's duty out at the next period,
+//! 2 ms after the frame is written. About 27 to 47 ms in all.
 //!
 //! [`BUTTON_DEBOUNCE`]: idle_head_core::input::BUTTON_DEBOUNCE
 
@@ -115,9 +116,9 @@ impl LatencyRow {
             let _ = writeln!(
                 text,
                 "  goal: p99 within {GOAL_P99_MS} ms: missed (not enforced). Where the time goes: \
-                 debounce 5 ms, the wait for the next frame 0..20 ms, the action's first frame \
+                 debounce 5 ms, the wait for the next frame 0..20 ms, the look's first frame \
                  (it plays the position it starts from) 20 ms, the PWM's latch to the next \
-                 period 10 ms"
+                 period 2 ms"
             );
         }
         text
