@@ -4,9 +4,10 @@
 
 use crate::axis::Axis;
 use crate::driver::{MotionLimits, SlewRates};
-use crate::units::{Angle, AngleRange, Millis};
+use crate::units::{Angle, AngleRange, Millis, Percent};
 
 use super::config::{BehaviourConfig, LiveConfig};
+use super::fixed::ONE;
 
 /// The offsets `limits` leave around `pose`.
 pub(super) const fn room_around(limits: AngleRange, pose: Angle) -> AngleRange {
@@ -94,8 +95,8 @@ impl BehaviourParams {
     pub fn set_live(&mut self, live: &LiveConfig) -> bool {
         self.config.rest = live.rest;
         self.config.gaze.duck = live.look_duck;
-        self.look_duck = super::validate::q16(live.look_duck);
-        let (pose, clamped) = super::validate::rest_offsets(&self.config, &self.pose, &self.room);
+        self.look_duck = q16(live.look_duck);
+        let (pose, clamped) = rest_offsets(&self.config, &self.pose, &self.room);
         self.rest_pose = pose;
         clamped
     }
@@ -123,7 +124,7 @@ impl BehaviourParams {
         if let (Some(room), Some(&pose)) = (self.room.get_mut(i), self.pose.get(i)) {
             *room = room_around(limits, pose);
         }
-        self.rest_pose = super::validate::rest_offsets(&self.config, &self.pose, &self.room).0;
+        self.rest_pose = rest_offsets(&self.config, &self.pose, &self.room).0;
     }
 
     /// The limits of `axis` in `mode`.
@@ -187,4 +188,32 @@ impl BehaviourParams {
     pub const fn millis(&self, frames: u32) -> Millis {
         Millis(((frames as u64 * self.frame_us as u64 + 500) / 1000) as u32)
     }
+}
+
+/// A percentage as a Q16 fraction.
+pub(super) const fn q16(p: Percent) -> u32 {
+    (p.get() as u32 * ONE) / 100
+}
+
+/// `config`'s rest pose as offsets around the neutral `pose`, each clamped
+/// to the `room` its axis has there (the servos' limits), and whether it
+/// had to be. (Clamped, not refused: settings saved before the rest pose
+/// existed keep loading whatever their limits, as a look's target is
+/// clamped.)
+pub(super) const fn rest_offsets(
+    config: &BehaviourConfig,
+    pose: &[Angle; 3],
+    room: &[AngleRange; 3],
+) -> ([i32; 3], bool) {
+    let mut offsets = [0; 3];
+    let mut clamped = false;
+    let mut i = 0;
+    while i < 3 {
+        let offset = config.rest.pose[i].saturating_sub(pose[i]);
+        let inside = offset.clamp_to(room[i].min, room[i].max);
+        clamped |= inside.millidegrees() != offset.millidegrees();
+        offsets[i] = inside.millidegrees();
+        i += 1;
+    }
+    (offsets, clamped)
 }

@@ -17,9 +17,9 @@ use crate::units::{Angle, AngleRange, Percent};
 
 use super::config::{BehaviourConfig, MAX_HOLD};
 use super::error::BehaviourError;
-use super::fixed::{MAX_FRAMES, ONE, inverse};
+use super::fixed::{MAX_FRAMES, inverse};
 use super::gesture;
-use super::params::{BehaviourParams, room_around};
+use super::params::{BehaviourParams, q16, rest_offsets, room_around};
 
 const fn min(a: i64, b: i64) -> i64 {
     if a < b { a } else { b }
@@ -219,34 +219,6 @@ impl BehaviourConfig {
         params.rest_pose = rest_offsets(self, &cfg.neutral_pose, &room).0;
         Ok(params)
     }
-}
-
-/// A percentage as a Q16 fraction.
-pub(super) const fn q16(p: Percent) -> u32 {
-    (p.get() as u32 * ONE) / 100
-}
-
-/// `config`'s rest pose as offsets around the neutral `pose`, each clamped
-/// to the `room` its axis has there (the servos' limits), and whether it
-/// had to be. (Clamped, not refused: settings saved before the rest pose
-/// existed keep loading whatever their limits, as a look's target is
-/// clamped.)
-pub(super) const fn rest_offsets(
-    config: &BehaviourConfig,
-    pose: &[Angle; 3],
-    room: &[AngleRange; 3],
-) -> ([i32; 3], bool) {
-    let mut offsets = [0; 3];
-    let mut clamped = false;
-    let mut i = 0;
-    while i < 3 {
-        let offset = config.rest.pose[i].saturating_sub(pose[i]);
-        let inside = offset.clamp_to(room[i].min, room[i].max);
-        clamped |= inside.millidegrees() != offset.millidegrees();
-        offsets[i] = inside.millidegrees();
-        i += 1;
-    }
-    (offsets, clamped)
 }
 
 // The built-in configuration must be valid with the built-in driver: a
