@@ -531,10 +531,10 @@ mod tests {
                 assert_eq!(a[0], b[0], "frame {k}");
             }
         }
-        // The first dip (frame 150 + 10) is the nod's 6°, over the idle
-        // ducked by 60 %.
-        let dip = frame(&nodding, 160)[0] - frame(&idle, 160)[0];
-        let ducked = -frame(&idle, 160)[0] * 6 / 10;
+        // The first dip (10 frames from 149, the last frame mixed before
+        // the nod) is the nod's 6°, over the idle ducked by 60 %.
+        let dip = frame(&nodding, 159)[0] - frame(&idle, 159)[0];
+        let ducked = -frame(&idle, 159)[0] * 6 / 10;
         assert!(
             (dip - 6000 - ducked).abs() <= 3,
             "{dip}, ducked by {ducked}"
@@ -565,11 +565,11 @@ mod tests {
             assert_eq!(at(ms).angles, [-8000, 0, 0], "{ms} ms");
             assert_eq!(at(ms).pulses, [0; 3], "{ms} ms");
         }
-        assert!(at(8000).pulses.iter().all(|&p| p > 0));
+        assert!(at(7980).pulses.iter().all(|&p| p > 0));
         // Woken by the sensor 50 ms after its edge: the first pulse is the
         // last before the gap, and the idle comes back within the idle
         // limits until the glance starts, a second later.
-        assert_eq!(at(12_060).pulses, at(8000).pulses);
+        assert_eq!(at(12_060).pulses, at(7980).pulses);
         let wake: Vec<[i32; 3]> = (12_040..=13_060)
             .step_by(20)
             .map(|ms| at(ms).angles)
@@ -612,11 +612,12 @@ mod tests {
     fn a_button_runs_its_action_within_a_frame_of_its_debounced_edge() {
         let trace = run("0 input 3 button nod 6000\n3 pin 3 low\n", 5);
         let nod = trace.marks.iter().find(|m| m.label == "inputs:").unwrap();
-        // Pressed at 3 s, debounced at 3.005 s, played from the next frame.
+        // Pressed at 3 s, debounced at 3.005 s, taken at the next frame,
+        // which is already a step into the nod.
         assert_eq!(nod.t_ms, 3020);
         assert!(nod.reply.starts_with("ok nod 6000 mdeg"), "{}", nod.reply);
         let idle = run("", 5);
         let first = (150..250).find(|&k| trace.rows[k].angles[0] != idle.rows[k].angles[0]);
-        assert_eq!(first, Some(152));
+        assert_eq!(first, Some(151));
     }
 }
