@@ -25,22 +25,24 @@
 //! move plays on it and for `settle` after; a rest or a wake keeps to the
 //! idle limits).
 
-use crate::command::{Action, GestureRequest, Percent};
+use crate::command::{Action, Percent};
 use crate::units::{Angle, AngleRange, Millis};
 
 pub use super::rest::RestState;
 
 use super::error::BehaviourError;
-use super::fixed::{ONE, ahead, mul, progress, smootherstep};
+use super::fixed::{ONE, ahead, mul};
 use super::gaze::{Gaze, LookApplied};
-use super::gesture::{self, GesturePlan};
+use super::gesture::GesturePlan;
 use super::glide::Glide;
 use super::params::{BehaviourParams, LimitMode};
 use super::rest::{self, Rest};
 
+mod layers;
 mod math;
 
-use math::{Countdown, Sums, both, gain_of, idle_part, look_keep};
+use layers::Layer;
+use math::{Countdown, both, gain_of, idle_part, look_keep};
 
 /// Gesture layers: one playing and up to two fading out under it.
 pub const LAYERS: usize = 3;
@@ -77,17 +79,6 @@ impl BehaviourParams {
     pub fn check(&self, action: &Action) -> Result<Applied, BehaviourError> {
         Mixer::new(*self).apply(action)
     }
-}
-
-/// A gesture layer: its plan, start, and the start of its fade-out.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Layer {
-    plan: GesturePlan,
-    start: u32,
-    release: Option<u32>,
-    /// Frames from `start` to the layer's end: its plan's, or its fade's
-    /// once released.
-    stop: u32,
 }
 
 /// Idle, gestures and gaze mixed into one set of offsets; see the
@@ -328,50 +319,6 @@ impl Mixer {
         }
     }
 
-    fn gesture(&mut self, request: &GestureRequest) -> Result<GesturePlan, BehaviourError> {
-        let plan = gesture::plan(&self.params, request)?;
-        let next = self.next;
-        let Some(free) = self.layers.iter().position(Option::is_none) else {
-            // Every layer plays: the one that ends first frees first.
-            let blend = self.params.blend;
-            let left = self
-                .layers
-                .iter()
-                .flatten()
-                .map(|l| match l.release {
-                    Some(r) => blend.saturating_sub(next.wrapping_sub(r)),
-                    None => l.plan.frames.saturating_sub(next.wrapping_sub(l.start)),
-                })
-                .min()
-                .unwrap_or(0);
-            // The layer is cleared while mixing the frame it ends at.
-            return Err(BehaviourError::Busy {
-                retry_in: self.params.millis(left + 1),
-            });
-        };
-        let blend = self.params.blend;
-        // The new layer starts, and the others fade, from the last frame
-        // mixed (see `apply_at`).
-        let start = self.now;
-        for layer in self.layers.iter_mut().flatten() {
-            if layer.release.is_none() {
-                layer.release = Some(start);
-                // The fade ends `blend` frames on, if the plan has not ended by then.
-                let fade_end = start.wrapping_sub(layer.start).saturating_add(blend);
-                layer.stop = layer.stop.min(fade_end);
-            }
-        }
-        if let Some(slot) = self.layers.get_mut(free) {
-            *slot = Some(Layer {
-                plan,
-                start,
-                release: None,
-                stop: plan.frames,
-            });
-        }
-        Ok(plan)
-    }
-
     /// Glides the idle gain to its new target; returns the target.
     fn glide_idle(&mut self) -> Percent {
         let target = if self.idle_on {
@@ -533,7 +480,7 @@ impl Mixer {
     fn schedule(&mut self, from: u32) {
         let mut soonest = u32::MAX;
         for layer in self.layers.iter().flatten() {
-            soonest = soonest.min(ahead(layer.start.wrapping_add(layer.stop), from));
+            soonest = soonest.min(ahead(layer.end(), from));
         }
         soonest = soonest.min(self.gaze.next_event(from));
         if self.resting {
@@ -543,48 +490,6 @@ impl Mixer {
             soonest = soonest.min(ahead(self.idle_gain.end(), from));
         }
         self.ends = from.wrapping_add(soonest.min(1 << 30));
-    }
-
-    /// The gesture layers at frame `now`, summed per axis; clears the
-    /// layers that have ended.
-    #[inline]
-    fn layers(&mut self, now: u32) -> Sums {
-        let mut sums = Sums::NONE;
-        let params = &self.params;
-        for slot in &mut self.layers {
-            let Some(layer) = slot else { continue };
-            let t = now.wrapping_sub(layer.start);
-            if t >= layer.stop {
-                *slot = None;
-                continue;
-            }
-            // t < stop ≤ the plan's frames.
-            let (mut value, mut strength) = layer.plan.at(t);
-            if let Some(release) = layer.release {
-                // now − release < blend: before the stop.
-                let fade =
-                    ONE - smootherstep(progress(now.wrapping_sub(release), params.blend_inverse));
-                value = mul(value, fade);
-                strength = mul(strength as i32, fade) as u32;
-            }
-            let i = layer.plan.kind.axis().index();
-            if let (Some(a), Some(d)) = (sums.add.get_mut(i), sums.duck.get_mut(i)) {
-                *a += value;
-                // (`mul` by 1 is exact: the factors of 1 are skipped.)
-                let lowered = if strength == ONE {
-                    params.duck
-                } else {
-                    mul(params.duck as i32, strength) as u32
-                };
-                *d = if *d == ONE {
-                    ONE - lowered
-                } else {
-                    mul(*d as i32, ONE - lowered) as u32
-                };
-                sums.active |= 1 << i;
-            }
-        }
-        sums
     }
 
     /// The limit modes from the next frame on, `[pitch, roll, yaw]`: the
