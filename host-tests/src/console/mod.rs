@@ -6,6 +6,7 @@
 
 pub mod head;
 mod model;
+mod mutate;
 mod text;
 
 use idle_head_core::command::Command;
@@ -14,9 +15,9 @@ use proptest::prelude::RngExt as _;
 use proptest::test_runner::{RngAlgorithm, TestRng};
 
 pub use model::{count_line_ends, reference_lines};
+pub use mutate::{mutate, random_bytes, token_line};
 pub use text::{
-    EDGE_NUMBERS, VOCABULARY, command_text, mutate, random_action, random_bytes, random_command,
-    token_line, varied_text,
+    EDGE_NUMBERS, VOCABULARY, command_text, random_action, random_command, varied_text,
 };
 
 /// The line capacity the firmware uses.

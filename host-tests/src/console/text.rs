@@ -1,5 +1,5 @@
-//! Commands as text: random commands, their text in the protocol (with
-//! the variations a person or a program may type), and mutations of it.
+//! Commands as text: random commands, and their text in the protocol (with
+//! the variations a person or a program may type).
 
 use std::fmt::Write as _;
 
@@ -7,70 +7,29 @@ use idle_head_core::command::{
     Action, Command, DmxSetting, GestureKind, GestureRequest, Hold, InputRole, LookRequest,
     Percent, RestAfter, RestSetting, SeedChoice, ServoSetting,
 };
+use idle_head_core::console::KEYWORDS;
 use idle_head_core::dmx::DmxAddress;
 use idle_head_core::servo::{Direction, NanosPerDegree};
 use idle_head_core::{Angle, AngleRange, Axis, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
 use proptest::test_runner::TestRng;
 
-/// Every word of the protocol but the gestures' (those are
-/// [`GestureKind::ALL`]'s; [`vocabulary_word`] draws from both).
-pub const VOCABULARY: &[&str] = &[
-    "help",
-    "status",
-    "save",
-    "load",
-    "defaults",
-    "stop",
-    "look",
-    "center",
-    "centre",
-    "idle",
-    "seed",
-    "servo",
-    "on",
-    "off",
-    "amp",
-    "random",
-    "pitch",
-    "roll",
-    "yaw",
-    "neutral",
-    "min",
-    "max",
-    "per-degree",
-    "direction",
-    "normal",
-    "reversed",
-    "limits",
-    "stay",
-    "hold=",
-    "cycles=",
-    "intensity=",
-    "hold=stay",
-    "=",
-    "watch",
-    "dmx",
-    "address",
-    "input",
-    "button",
-    "presence",
-    "rest",
-    "wake",
-    "after",
-    "never",
-    "pose",
-    "relax",
-    "duck",
-];
+/// The fuzz's words beyond the protocol's keywords ([`KEYWORDS`]) and the
+/// gestures' ([`GestureKind::ALL`]'s): options as typed, with their `=`.
+pub const VOCABULARY: &[&str] = &["hold=", "cycles=", "intensity=", "hold=stay", "="];
 
-/// A random word of the protocol: one of [`VOCABULARY`] or a gesture's.
+/// A random word of the protocol: one of [`KEYWORDS`], a gesture's, or one
+/// of [`VOCABULARY`]; so a keyword added to the parser is fuzzed at once.
 pub fn vocabulary_word(rng: &mut TestRng) -> &'static str {
-    let i = rng.random_range(0..VOCABULARY.len() + GestureKind::COUNT);
-    VOCABULARY
-        .get(i)
-        .copied()
-        .unwrap_or_else(|| GestureKind::ALL[i - VOCABULARY.len()].name())
+    let i = rng.random_range(0..KEYWORDS.len() + GestureKind::COUNT + VOCABULARY.len());
+    if let Some(word) = KEYWORDS.get(i) {
+        return word;
+    }
+    let i = i - KEYWORDS.len();
+    if let Some(kind) = GestureKind::ALL.get(i) {
+        return kind.name();
+    }
+    VOCABULARY[i - GestureKind::COUNT]
 }
 
 /// Numbers at and past the limits of every field.
@@ -520,121 +479,4 @@ fn write_action(s: &mut Style<'_>, action: &Action) {
             s.number(i64::from(p.get()));
         }
     }
-}
-
-/// A byte a mutation inserts: mostly what the grammar is made of.
-fn random_byte(rng: &mut TestRng) -> u8 {
-    const INTERESTING: &[u8] = b" \t=-+0123456789#*aeiouxyz";
-    match rng.random_range(0..4) {
-        0 => INTERESTING[rng.random_range(0..INTERESTING.len())],
-        1 => rng.random_range(0x20..0x7f),
-        _ => rng.random(),
-    }
-}
-
-/// `line` with 1 to 4 random mutations: bytes flipped, replaced, inserted,
-/// deleted or duplicated; words dropped, repeated or swapped; a number
-/// replaced by one at or past a limit; a vocabulary word inserted.
-pub fn mutate(line: &[u8], rng: &mut TestRng) -> Vec<u8> {
-    let mut out = line.to_vec();
-    for _ in 0..rng.random_range(1..=4) {
-        let len = out.len();
-        let at = if len == 0 {
-            0
-        } else {
-            rng.random_range(0..len)
-        };
-        match rng.random_range(0..10) {
-            0 if len > 0 => out[at] ^= 1 << rng.random_range(0..8),
-            1 if len > 0 => out[at] = random_byte(rng),
-            2 => out.insert(at, random_byte(rng)),
-            3 if len > 0 => {
-                out.remove(at);
-            }
-            4 if len > 0 => {
-                let end = rng.random_range(at..=len.min(at + 12));
-                let copy = out[at..end].to_vec();
-                out.splice(end..end, copy);
-            }
-            5 => out = edit_words(&out, rng),
-            6 | 7 => out = replace_number(&out, rng),
-            8 => {
-                let word = vocabulary_word(rng);
-                let mut piece = Vec::from(b" ".as_slice());
-                piece.extend_from_slice(word.as_bytes());
-                out.splice(at..at, piece);
-            }
-            _ => out.truncate(at),
-        }
-    }
-    out
-}
-
-fn words(line: &[u8]) -> Vec<Vec<u8>> {
-    line.split(|&b| b == b' ' || b == b'\t')
-        .filter(|w| !w.is_empty())
-        .map(<[u8]>::to_vec)
-        .collect()
-}
-
-fn edit_words(line: &[u8], rng: &mut TestRng) -> Vec<u8> {
-    let mut w = words(line);
-    if w.is_empty() {
-        return line.to_vec();
-    }
-    let i = rng.random_range(0..w.len());
-    let j = rng.random_range(0..w.len());
-    match rng.random_range(0..3) {
-        0 => {
-            w.remove(i);
-        }
-        1 => w.insert(i, w[j].clone()),
-        _ => w.swap(i, j),
-    }
-    w.join(&b' ')
-}
-
-fn replace_number(line: &[u8], rng: &mut TestRng) -> Vec<u8> {
-    let mut w = words(line);
-    let numeric: Vec<usize> = (0..w.len())
-        .filter(|&i| w[i].iter().any(u8::is_ascii_digit))
-        .collect();
-    let edge = EDGE_NUMBERS[rng.random_range(0..EDGE_NUMBERS.len())].as_bytes();
-    if numeric.is_empty() {
-        w.push(edge.to_vec());
-    } else {
-        let i = numeric[rng.random_range(0..numeric.len())];
-        // Keep an option's name: `cycles=` + the new number.
-        let keep = w[i].iter().position(|&b| b == b'=').map_or(0, |p| p + 1);
-        w[i].truncate(keep);
-        w[i].extend_from_slice(edge);
-    }
-    w.join(&b' ')
-}
-
-/// 1 to 8 random words of the vocabulary and edge numbers.
-pub fn token_line(rng: &mut TestRng) -> Vec<u8> {
-    let mut out = Vec::new();
-    for i in 0..rng.random_range(1..=8) {
-        if i > 0 {
-            out.push(b' ');
-        }
-        let word = if rng.random_bool(0.7) {
-            vocabulary_word(rng)
-        } else {
-            EDGE_NUMBERS[rng.random_range(0..EDGE_NUMBERS.len())]
-        };
-        out.extend_from_slice(word.as_bytes());
-        if word.ends_with('=') {
-            out.extend_from_slice(EDGE_NUMBERS[rng.random_range(0..EDGE_NUMBERS.len())].as_bytes());
-        }
-    }
-    out
-}
-
-/// Up to `max` random bytes.
-pub fn random_bytes(rng: &mut TestRng, max: usize) -> Vec<u8> {
-    (0..rng.random_range(0..=max))
-        .map(|_| rng.random())
-        .collect()
 }

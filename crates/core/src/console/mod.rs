@@ -32,7 +32,7 @@ mod telemetry;
 pub use framer::{Framer, LineError};
 pub use link::{ConsoleLink, HeadMode, HeadStatus, Outcome, PORTS};
 pub use outcome::{outcome_reply, unanswered};
-pub use parse::{ActionLine, ParseError, ParseErrorKind, Span, parse};
+pub use parse::{ActionLine, KEYWORDS, ParseError, ParseErrorKind, Span, parse};
 pub use port::DualSession;
 pub use reply::{ErrorCode, Reply};
 pub use service::{ConsoleService, HELP, VERSION};

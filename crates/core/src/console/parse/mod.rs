@@ -65,6 +65,7 @@ mod words;
 
 pub use error::{ParseError, ParseErrorKind, Span};
 pub use line::ActionLine;
+pub use words::KEYWORDS;
 use words::{Field, Kw, Token, Word, Words, once};
 
 /// Parses one line (without its line ending); the grammar is in this

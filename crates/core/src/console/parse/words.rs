@@ -95,8 +95,9 @@ pub(super) enum Kw {
     Duck,
 }
 
-/// Every word the protocol has, lower case, in the order of [`ALL`].
-const KEYWORDS: [&str; 44] = [
+/// Every word the protocol has but the gestures' (those are
+/// [`GestureKind::ALL`]'s), lower case, in the order of [`ALL`].
+pub const KEYWORDS: [&str; 44] = [
     "help",
     "status",
     "save",
