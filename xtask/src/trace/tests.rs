@@ -1,0 +1,190 @@
+use super::*;
+
+fn run(script: &str, seconds: u64) -> Trace {
+    let driver = DriverConfig::DEFAULT.build().unwrap();
+    let params = BehaviourConfig::DEFAULT.build(&driver).unwrap();
+    let events = script::parse(script, &params).unwrap();
+    simulate(seconds * 1_000_000, None, &events).unwrap()
+}
+
+#[test]
+fn idle_only_is_the_plain_frame_loop() {
+    // No script: the same pulses as the driver fed by the playback alone.
+    let trace = run("", 3);
+    assert_eq!(trace.rows.len(), 150);
+    // The first frame: neutral pulses, 1500 µs as 4800 counts of 312.5 ns.
+    assert_eq!(trace.rows[0].angles, [0; 3]);
+    assert_eq!(trace.rows[0].pulses, [1_500_000; 3]);
+    let driver = DriverConfig::DEFAULT.build().unwrap();
+    let playback = Playback::new(LOOP_DURATION, driver.config().frame_period, DEFAULT_N).unwrap();
+    let mut source = idle(config(None), playback, None).unwrap();
+    let mut plain = FrameDriver::new([Channel(0), Channel(0), Channel(0)], driver);
+    for row in &trace.rows {
+        let report = plain.write_frame(source.offsets(row.frame));
+        assert_eq!(row.angles, report.servos.map(|s| s.angle.millidegrees()));
+    }
+}
+
+#[test]
+fn a_looks_return_is_marked_where_the_head_goes_back() {
+    // The idle motion off (it fades out in 1 s): only the gaze moves.
+    let trace = run("0 idle off\n2 look 10000 0 500 hold=1000\n", 6);
+    let back: Vec<&Mark> = trace
+        .marks
+        .iter()
+        .filter(|m| m.kind == marks::Kind::Return)
+        .collect();
+    assert_eq!(back.len(), 1, "{:?}", trace.marks);
+    let back = back[0];
+    // 500 ms there, the 1 s hold, then back.
+    assert_eq!(back.t_ms, 3500);
+    assert_eq!(back.axes, [Axis::Pitch, Axis::Yaw]);
+    let pitch = |t_ms: u64| trace.rows[usize::try_from(t_ms / 20).unwrap()].angles[0];
+    assert_eq!(pitch(back.t_ms - 20), 10_000);
+    assert_eq!(pitch(back.t_ms), 10_000);
+    assert!(pitch(back.t_ms + 20) < 10_000);
+    assert!(pitch(back.t_ms + back.span_ms - 20) > 0);
+    assert_eq!(pitch(back.t_ms + back.span_ms), 0);
+    assert_eq!(
+        back.reply,
+        format!(
+            "(the look at line 2 returns to the centre after its 1000 ms hold, in {} ms)",
+            back.span_ms
+        )
+    );
+    // The marks are in time order.
+    assert!(trace.marks.windows(2).all(|w| w[0].t_ms <= w[1].t_ms));
+}
+
+#[test]
+fn a_return_is_cut_or_left_out_by_the_next_gaze_move() {
+    let returns = |script: &str| -> Vec<(u64, u64)> {
+        run(script, 8)
+            .marks
+            .iter()
+            .filter(|m| m.kind == marks::Kind::Return)
+            .map(|m| (m.t_ms, m.span_ms))
+            .collect()
+    };
+    let look = "2 look 10000 0 500 hold=1000\n";
+    let whole = returns(look);
+    assert_eq!(whole.len(), 1);
+    assert!(whole[0].1 > 100);
+    // A center before the return starts: there is none.
+    assert_eq!(returns(&format!("{look}3 center\n")), []);
+    // Another look while it plays: it ends there.
+    assert_eq!(
+        returns(&format!("{look}3.6 look 0 5000 hold=stay\n")),
+        [(3500, 100)]
+    );
+    // A nod does not touch it; a return after the end is left out.
+    assert_eq!(returns(&format!("{look}3.6 nod\n")), whole);
+    assert_eq!(returns("7.5 look 10000 0 500 hold=1000\n"), []);
+}
+
+#[test]
+fn a_scripted_nod_moves_pitch_only_and_answers() {
+    let idle = run("", 6);
+    let nodding = run("3 nod 6000 800\n", 6);
+    assert_eq!(nodding.marks.len(), 1);
+    assert_eq!(
+        nodding.marks[0].reply,
+        "ok nod 6000 mdeg 2 cycles 800 ms intensity 50"
+    );
+    let frame = |t: &Trace, k: usize| t.rows[k].angles;
+    for k in 0..300 {
+        let (a, b) = (frame(&idle, k), frame(&nodding, k));
+        assert_eq!((a[1], a[2]), (b[1], b[2]), "frame {k}");
+        if !(150..230).contains(&k) {
+            assert_eq!(a[0], b[0], "frame {k}");
+        }
+    }
+    // The first dip (10 frames from 149, the last frame mixed before
+    // the nod) is the nod's 6°, over the idle ducked by 60 %.
+    let dip = frame(&nodding, 159)[0] - frame(&idle, 159)[0];
+    let ducked = -frame(&idle, 159)[0] * 6 / 10;
+    assert!(
+        (dip - 6000 - ducked).abs() <= 3,
+        "{dip}, ducked by {ducked}"
+    );
+}
+
+/// The idle limits of the built-in driver per 20 ms frame: 60 °/s,
+/// 600 °/s².
+const IDLE_STEP: i32 = 1200;
+const IDLE_TURN: i32 = 240;
+
+#[test]
+fn a_presence_script_rests_relaxes_wakes_and_glances() {
+    let trace = run(
+        "\
+0 input 2 presence -20000
+0 rest after 5
+0 rest relax on
+12 pin 2 high
+16 pin 2 low
+",
+        20,
+    );
+    let at = |ms: u64| trace.rows[usize::try_from(ms / 20).unwrap()];
+    // Rested 5 s in, there after the 3 s glide: the pose held, the
+    // pulses off.
+    for ms in (8020..12060).step_by(20) {
+        assert_eq!(at(ms).angles, [-8000, 0, 0], "{ms} ms");
+        assert_eq!(at(ms).pulses, [0; 3], "{ms} ms");
+    }
+    assert!(at(7980).pulses.iter().all(|&p| p > 0));
+    // Woken by the sensor 50 ms after its edge: the first pulse is the
+    // last before the gap, and the idle comes back within the idle
+    // limits until the glance starts, a second later.
+    assert_eq!(at(12_060).pulses, at(7980).pulses);
+    let wake: Vec<[i32; 3]> = (12_040..=13_060)
+        .step_by(20)
+        .map(|ms| at(ms).angles)
+        .collect();
+    for axis in 0..3 {
+        let v: Vec<i32> = wake.iter().map(|a| a[axis]).collect();
+        let step = v.windows(2).map(|w| (w[1] - w[0]).abs()).max().unwrap();
+        let turn = v
+            .windows(3)
+            .map(|w| (w[2] - 2 * w[1] + w[0]).abs())
+            .max()
+            .unwrap();
+        assert!(
+            step <= IDLE_STEP && turn <= IDLE_TURN,
+            "axis {axis}: {step} {turn}"
+        );
+    }
+    assert_ne!(at(13_060).angles, [-8000, 0, 0]);
+    // Then the glance towards the sensor: yaw at −20° (the idle's
+    // ducked sway aside), held about 2 s, then back.
+    let near = |ms: u64| (at(ms).angles[2] + 20_000).abs() < 2500;
+    let held: Vec<u64> = (13_000..17_000)
+        .step_by(20)
+        .filter(|&ms| near(ms))
+        .collect();
+    assert!(held.len() >= 100, "{} frames near -20°", held.len());
+    assert!(!near(19_000));
+    let wake = trace
+        .marks
+        .iter()
+        .find(|m| m.reply.starts_with("ok wake"))
+        .unwrap();
+    assert_eq!(
+        (wake.t_ms, wake.reply.as_str()),
+        (12_060, "ok wake 1000 ms")
+    );
+}
+
+#[test]
+fn a_button_runs_its_action_within_a_frame_of_its_debounced_edge() {
+    let trace = run("0 input 3 button nod 6000\n3 pin 3 low\n", 5);
+    let nod = trace.marks.iter().find(|m| m.label == "inputs:").unwrap();
+    // Pressed at 3 s, debounced at 3.005 s, taken at the next frame,
+    // which is already a step into the nod.
+    assert_eq!(nod.t_ms, 3020);
+    assert!(nod.reply.starts_with("ok nod 6000 mdeg"), "{}", nod.reply);
+    let idle = run("", 5);
+    let first = (150..250).find(|&k| trace.rows[k].angles[0] != idle.rows[k].angles[0]);
+    assert_eq!(first, Some(151));
+}
