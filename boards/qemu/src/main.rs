@@ -159,9 +159,7 @@ fn main() -> ! {
     }
     // Settings in Pico units (the frame task's behaviour is built for
     // them too); status reports Pico time (frames of 20 ms).
-    let Some(service) = booted.service else {
-        exit::exit(false)
-    };
+    let service = booted.service;
     let frame = embassy_time::Duration::from_micros(frame_period(mode).0.into());
     match console::console(service, frame) {
         Ok(token) => thread.spawner().spawn(token),

@@ -132,7 +132,7 @@ pub struct Booted<S: 'static> {
     /// The behaviour's parameters of the settings in effect.
     pub behaviour: BehaviourParams,
     /// The console's service, on the board's storage.
-    pub service: Option<ConsoleService<'static, S>>,
+    pub service: ConsoleService<'static, S>,
 }
 
 /// Why [`boot`] could not run.
@@ -166,16 +166,12 @@ pub fn boot<S: SettingsStorage>(
         valid,
     } = loaded;
     SHOW.dmx.set(settings.dmx);
-    let service = match ConsoleService::new(&COMMANDS, &LINK, storage, *base, settings, source) {
-        Ok(mut service) => {
-            service.add_entropy(entropy);
-            Some(service.with_show(&SHOW))
-        }
-        Err(e) => {
-            defmt::error!("console: no service: {}", e);
-            None
-        }
-    };
+    // `valid` is these settings checked with `base` (by the store, or at
+    // compile time for the built-in ones): the service takes it as it is.
+    let mut service =
+        ConsoleService::checked(&COMMANDS, &LINK, storage, *base, settings, source, &valid);
+    service.add_entropy(entropy);
+    let service = service.with_show(&SHOW);
     Ok(Booted {
         generator: Generator { head, first, spare },
         driver: valid.driver,

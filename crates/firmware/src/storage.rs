@@ -42,7 +42,6 @@ use core::task::{Context, Poll, Waker};
 
 use embassy_time::{Duration, Instant};
 use embedded_storage_async::nor_flash::NorFlash;
-use idle_head_core::console::ConsoleLink;
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::settings::{
     LoadError, Loaded as Stored, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsError,
@@ -51,7 +50,7 @@ use idle_head_core::settings::{
 
 use static_cell::StaticCell;
 
-use crate::boot::Loaded;
+use crate::boot::{LINK, Loaded};
 
 /// The watchdog timeout the frames feed while a flash operation is under
 /// way: a 400 ms sector erase, with a wide margin.
@@ -72,8 +71,6 @@ pub type Store<F> = SettingsStore<SectorWise<F>, Settings, SETTINGS_BUFFER>;
 pub struct FlashStorage<F: NorFlash> {
     /// `None` if the store could not be opened (logged at boot).
     store: Option<Store<F>>,
-    /// The frame task's status, to see a frame pass.
-    link: &'static ConsoleLink,
 }
 
 impl<F: NorFlash> FlashStorage<F> {
@@ -87,10 +84,9 @@ impl<F: NorFlash> FlashStorage<F> {
         // The frame task runs above this task: once the frame count moves,
         // that frame has fed the watchdog with the long timeout. If no frame
         // comes (the watchdog is not running yet), go on.
-        let frame = self.link.status().frame;
+        let frame = LINK.status().frame;
         let since = Instant::now();
-        while self.link.status().frame == frame
-            && since.elapsed() < Duration::from_millis(FRAME_WAIT_MS)
+        while LINK.status().frame == frame && since.elapsed() < Duration::from_millis(FRAME_WAIT_MS)
         {
             core::hint::spin_loop();
         }
@@ -122,17 +118,14 @@ impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
 /// whole erase sectors; `address` is where the range appears in the address
 /// space, for the log) in `cell`, where it stays (the console saves through
 /// it), and reads the settings in it, before the first frame (no watchdog,
-/// no frames yet), checked against `base`; the built-in settings
-/// (`defaults`, checked with `base` at compile time) if there are none or
-/// they are not usable. The log says which. `None` if `cell` was taken.
+/// no frames yet), checked against `base`; the built-in settings if there
+/// are none or they are not usable. The log says which. `None` if `cell` was taken.
 pub fn open<F>(
     cell: &'static StaticCell<FlashStorage<F>>,
     flash: F,
     range: Range<u32>,
     address: u32,
     base: &DriverConfig,
-    defaults: Validated,
-    link: &'static ConsoleLink,
 ) -> Option<Loaded<&'static mut FlashStorage<F>>>
 where
     F: NorFlash,
@@ -142,7 +135,7 @@ where
     if store.is_none() {
         defmt::error!("settings: no store: the region is not whole erase sectors");
     }
-    let storage = cell.try_init(FlashStorage { store, link })?;
+    let storage = cell.try_init(FlashStorage { store })?;
     let loaded = storage.store.as_mut().and_then(|store| {
         let loaded = at_once(store.load());
         if loaded.is_none() {
@@ -157,12 +150,7 @@ where
             source: SettingsSource::Flash,
             valid,
         },
-        None => Loaded {
-            storage,
-            settings: Settings::DEFAULT,
-            source: SettingsSource::Defaults,
-            valid: defaults,
-        },
+        None => Loaded::defaults(storage),
     })
 }
 

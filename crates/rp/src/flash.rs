@@ -10,7 +10,7 @@ use embassy_rp::Peri;
 use embassy_rp::flash::{Blocking, ERASE_SIZE, Flash};
 use embassy_rp::peripherals::FLASH;
 use idle_head_core::driver::DriverConfig;
-use idle_head_firmware::boot::{DEFAULT_SETTINGS, LINK, Loaded};
+use idle_head_firmware::boot::Loaded;
 use idle_head_firmware::storage::{self, FlashStorage};
 use static_cell::StaticCell;
 
@@ -53,13 +53,5 @@ static STORE: StaticCell<Store> = StaticCell::new();
 #[inline(never)]
 pub fn open(flash: Peri<'static, FLASH>, base: &DriverConfig) -> Option<Loaded<Storage>> {
     let flash = BlockingAsync::new(Flash::new_blocking(flash));
-    storage::open(
-        &STORE,
-        flash,
-        SETTINGS_RANGE,
-        SETTINGS_ADDRESS,
-        base,
-        DEFAULT_SETTINGS,
-        &LINK,
-    )
+    storage::open(&STORE, flash, SETTINGS_RANGE, SETTINGS_ADDRESS, base)
 }

@@ -170,16 +170,14 @@ pub fn start(spawner: Spawner, board: Board) {
     spawn_dmx(dmx, dmx_pins);
     spawn(spawner, input_task(inputs), "input");
     defmt::info!("inputs: {=str}", input_pins);
-    if let Some(service) = head.service {
-        spawn_console(spawner, uart, uart_pins, usb, service);
-    }
+    spawn_console(spawner, uart, uart_pins, usb, head.service);
 }
 
 /// What the boot leaves for the frame task and the console.
 struct Head {
     driver: DriverParams,
     behaviour: BehaviourParams,
-    service: Option<&'static Service>,
+    service: &'static Service,
 }
 
 /// Runs the boot sequence on the settings `loaded`, spawns the loop
@@ -191,9 +189,7 @@ fn boot_head(spawner: Spawner, loaded: Loaded<flash::Storage>) -> Option<Head> {
         return None;
     };
     spawn(spawner, generator(booted.generator), "generator");
-    let service = booted
-        .service
-        .map(|service| &*SERVICE.init(Mutex::new(RefCell::new(service))));
+    let service = &*SERVICE.init(Mutex::new(RefCell::new(booted.service)));
     Some(Head {
         driver: booted.driver,
         behaviour: booted.behaviour,

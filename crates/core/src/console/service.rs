@@ -92,7 +92,9 @@ use crate::command::{Action, Command, SeedChoice, ServoSetting};
 use crate::driver::DriverConfig;
 use crate::gestures::GestureKind;
 use crate::servo::{Direction, ServoCalibration, bounds};
-use crate::settings::{Settings, SettingsError, SettingsSource, SettingsStorage, StorageError};
+use crate::settings::{
+    Settings, SettingsError, SettingsSource, SettingsStorage, StorageError, Validated,
+};
 
 /// The reply to `help`: the command words, one line (the gestures' from
 /// the [gesture table](crate::gestures)).
@@ -138,7 +140,24 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         source: SettingsSource,
     ) -> Result<Self, SettingsError> {
         let valid = settings.validate(&base)?;
-        Ok(Self {
+        Ok(Self::checked(
+            queue, link, storage, base, settings, source, &valid,
+        ))
+    }
+
+    /// As [`new`](Self::new), with the settings checked already: `valid` is
+    /// what `settings.validate(&base)` gave (a boot that checked the stored
+    /// settings hands them over without checking them again).
+    pub fn checked(
+        queue: &'a CommandQueue<N>,
+        link: &'a ConsoleLink,
+        storage: S,
+        base: DriverConfig,
+        settings: Settings,
+        source: SettingsSource,
+        valid: &Validated,
+    ) -> Self {
+        Self {
             queue,
             link,
             storage,
@@ -149,7 +168,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
             entropy: 0x9e37_79b9,
             ticket: 0,
             show: None,
-        })
+        }
     }
 
     /// Mixes `bits` from the board's entropy source into `seed random`.
