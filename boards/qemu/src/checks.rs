@@ -13,6 +13,7 @@ use idle_head_core::behaviour::CommandQueue;
 use idle_head_core::driver::{DriverConfig, FrameDriver, FrameTick, Outcome};
 use idle_head_core::idle::IdleStats;
 use idle_head_core::{Angle, Axis};
+use idle_head_firmware::config::{DEFAULT_PARAMS, DEFAULT_TIMING};
 use idle_head_firmware::frame::{Flow, Frame, FrameHooks, RunStats};
 
 use crate::pwm::VirtualPwm;
@@ -22,9 +23,9 @@ use crate::script;
 pub const LOOP_FRAMES: u64 = crate::LOOP.0 as u64 * 1000 / crate::FRAME_PERIOD.0 as u64;
 /// The first join: the frames where loop set 0 blends into loop set 1.
 const JOIN: Range<u64> =
-    crate::TIMING.period() as u64..(crate::TIMING.period() + crate::TIMING.join_frames) as u64;
+    DEFAULT_TIMING.period() as u64..(DEFAULT_TIMING.period() + DEFAULT_TIMING.join_frames) as u64;
 /// Fade-in frames (the soft start).
-const FADE_FRAMES: u64 = crate::PARAMS.fade_frames() as u64;
+const FADE_FRAMES: u64 = DEFAULT_PARAMS.fade_frames() as u64;
 /// A trace line every 50 frames (1 s on the Pico) for the host's plot.
 const TRACE_EVERY: u64 = 50;
 

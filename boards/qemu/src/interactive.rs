@@ -9,23 +9,40 @@ use core::sync::atomic::Ordering;
 
 use idle_head_core::Axis;
 use idle_head_core::driver::{FrameDriver, Outcome};
+use idle_head_core::servo::ServoCalibration;
 use idle_head_firmware::frame::{Flow, Frame, FrameHooks};
 
 use crate::pwm::VirtualPwm;
 
 /// Hooks of an interactive run.
-#[derive(Default)]
 pub struct Interactive {
-    /// Pulses written outside the pulse range in effect.
-    pub violations: u32,
+    /// The calibrations the outputs judge by (the console may change them).
+    known: [ServoCalibration; 3],
+}
+
+impl Interactive {
+    /// Hooks for outputs judging by `servos`, the calibrations the run
+    /// starts with.
+    pub const fn new(servos: [ServoCalibration; 3]) -> Self {
+        Self { known: servos }
+    }
 }
 
 impl FrameHooks<VirtualPwm> for Interactive {
     fn after_frame(&mut self, frame: &Frame, driver: &mut FrameDriver<VirtualPwm>) -> Flow {
         let servos = driver.params().config().servos;
-        // The outputs judge the next pulses by the range in effect.
-        for (channel, cal) in driver.channels_mut().iter_mut().zip(&servos) {
-            channel.judge(cal);
+        // The outputs judge the next pulses by the range in effect (and
+        // count what falls outside it: the run's violations).
+        for ((known, cal), channel) in self
+            .known
+            .iter_mut()
+            .zip(&servos)
+            .zip(driver.channels_mut().iter_mut())
+        {
+            if known != cal {
+                *known = *cal;
+                channel.judge(cal);
+            }
         }
         for ((axis, servo), cal) in Axis::ALL.iter().zip(&frame.report.servos).zip(&servos) {
             if servo.outcome == Outcome::Written
@@ -39,7 +56,6 @@ impl FrameHooks<VirtualPwm> for Interactive {
                     cal.min_pulse.0,
                     cal.max_pulse.0
                 );
-                self.violations += 1;
             }
         }
         if crate::console::HUNG_UP.load(Ordering::Acquire) {

@@ -59,12 +59,11 @@ mod uart;
 use defmt_semihosting as _;
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head_core::idle::IdleTiming;
 use idle_head_core::motion::DEFAULT_N;
 use idle_head_core::settings::RamStorage;
-use idle_head_core::{Microseconds, Millis, Playback};
+use idle_head_core::{Microseconds, Millis};
 use idle_head_firmware::boot::{self, COMMANDS, EXCHANGE, Generator, Loaded};
-use idle_head_firmware::config::LOOP_DURATION;
+use idle_head_firmware::config::{DEFAULT_PARAMS, LOOP_DURATION};
 use idle_head_firmware::tasks;
 
 use crate::checks::Checks;
@@ -77,22 +76,9 @@ const SPEEDUP: u32 = 20;
 const CONFIG: DriverConfig = DriverConfig::DEFAULT;
 /// The time between frames here: the Pico's, [`SPEEDUP`] times shorter.
 const FRAME_PERIOD: Microseconds = Microseconds(CONFIG.frame_period.0 / SPEEDUP);
-const PARAMS: DriverParams = match CONFIG.build() {
-    Ok(p) => p,
-    Err(e) => panic!("{}", e.message()),
-};
-/// 30 s / 20 = 1.5 s per loop: 1500 frames of 1 ms.
+/// 30 s / 20 = 1.5 s per loop: 1500 frames of 1 ms, as many as the Pico's
+/// (the frames play the Pico's loops and timing, `DEFAULT_TIMING`).
 const LOOP: Millis = Millis(LOOP_DURATION.0 / SPEEDUP);
-const PLAYBACK: Playback = match Playback::new(LOOP, FRAME_PERIOD, DEFAULT_N) {
-    Ok(p) => p,
-    Err(_) => panic!("invalid playback parameters"),
-};
-
-/// Loops of 1500 frames joined over 100, as on the Pico.
-const TIMING: IdleTiming = match IdleTiming::new(PLAYBACK) {
-    Ok(t) => t,
-    Err(e) => panic!("{}", e.message()),
-};
 
 // The compression is exact: whole µs and ms, as many frames a loop.
 const _: () = {
@@ -117,7 +103,7 @@ fn main() -> ! {
         LOOP.0,
         checks::LOOP_FRAMES,
         DEFAULT_N,
-        PARAMS.fade_frames(),
+        DEFAULT_PARAMS.fade_frames(),
         CONFIG.faults.disable_after
     );
     defmt::info!(
@@ -191,10 +177,10 @@ async fn frame_task(params: DriverParams, behaviour: BehaviourParams) {
     let mode = console::mode();
     let (first, run) = EXCHANGE.first().await;
     if mode == console::Mode::Interactive {
-        let mut hooks = interactive::Interactive::default();
+        let mut hooks = interactive::Interactive::new(CONFIG.servos);
         let period = frame_period(mode);
         let (stats, _) = tasks::play(&mut driver, first, &behaviour, &mut hooks, period).await;
-        let violations = hooks.violations + channel_violations(&mut driver);
+        let violations = channel_violations(&mut driver);
         summary(&stats, violations, &run, &driver);
         exit::exit(violations == 0 && stats.missed == 0);
     }

@@ -50,9 +50,7 @@
 use core::hint::black_box;
 
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
-use idle_head_core::behaviour::{
-    Asker, BehaviourConfig, BehaviourParams, LiveConfig, RestConfig, ShowLink,
-};
+use idle_head_core::behaviour::{Asker, LiveConfig, RestConfig, ShowLink};
 use idle_head_core::bottango::{self, Curve, Op, line::CurveArgs};
 use idle_head_core::command::{
     Action, GestureKind, GestureRequest, Hold, InputRole, LookRequest, Percent, RestAfter,
@@ -68,7 +66,7 @@ use idle_head_core::servo::{Direction, NanosPerDegree, ServoCalibration};
 use idle_head_core::units::{Angle, AngleRange, Microseconds, Millis};
 use idle_head_core::{Axis, Playback};
 use idle_head_firmware::config::{
-    DEFAULT_PARAMS, DEFAULT_PLAYBACK, DEFAULT_TIMING, IDLE_MODE, Set,
+    DEFAULT_BEHAVIOUR, DEFAULT_PARAMS, DEFAULT_PLAYBACK, DEFAULT_TIMING, IDLE_MODE, Set,
 };
 use idle_head_firmware::dmx::{Receiver, Rx};
 use idle_head_firmware::exchange::Exchange;
@@ -158,13 +156,6 @@ fn panic(_: &core::panic::PanicInfo<'_>) -> ! {
     unsafe { frame_path_has_a_panic_path() }
 }
 
-/// The built-in behaviour (the proof hides it from the optimiser: any
-/// parameters).
-const BEHAVIOUR: BehaviourParams = match BehaviourConfig::DEFAULT.build(&PARAMS) {
-    Ok(p) => p,
-    Err(e) => panic!("{}", e.message()),
-};
-
 /// Any command, with any values.
 fn any_action() -> Action {
     let angle = || Angle::from_millidegrees(black_box(0));
@@ -224,7 +215,7 @@ fn main() -> ! {
     let Ok(mut frames) = FrameLoop::with_behaviour(
         idle,
         black_box(PLAYBACK.frame_period()),
-        black_box(BEHAVIOUR),
+        black_box(DEFAULT_BEHAVIOUR),
         black_box(1_000_000),
         black_box(0),
     )

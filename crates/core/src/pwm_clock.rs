@@ -131,6 +131,10 @@ impl SliceClock {
 /// 125 MHz from the 12 MHz crystal through `PLL_SYS`.
 pub const PICO_SYS_HZ: u32 = 125_000_000;
 
+/// The RP2350's default system clock (embassy-rp's `Config::default()`):
+/// 150 MHz (the Pico 2).
+pub const PICO2_SYS_HZ: u32 = 150_000_000;
+
 /// Servo PWM rate: 50 Hz (a 20 ms period).
 pub const SERVO_PWM_HZ: u32 = 50;
 
@@ -138,6 +142,12 @@ pub const SERVO_PWM_HZ: u32 = 50;
 pub const PICO_SERVO_CLOCK: SliceClock = match SliceClock::exact(PICO_SYS_HZ, SERVO_PWM_HZ) {
     Ok(c) => c,
     Err(_) => panic!("no 8.4 divider runs a 16-bit PWM slice at exactly 50 Hz from 125 MHz"),
+};
+
+/// Slice clock of the Pico 2's servo outputs: 150 MHz → exactly 50 Hz.
+pub const PICO2_SERVO_CLOCK: SliceClock = match SliceClock::exact(PICO2_SYS_HZ, SERVO_PWM_HZ) {
+    Ok(c) => c,
+    Err(_) => panic!("no 8.4 divider runs a 16-bit PWM slice at exactly 50 Hz from 150 MHz"),
 };
 
 // The numbers worked out in the module docs (the QEMU images and the

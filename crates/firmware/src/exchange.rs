@@ -75,32 +75,23 @@ impl Exchange {
         ExchangeSupply { exchange: self }
     }
 
-    /// The generator task's loop: waits for a free buffer, generates
-    /// `stream`'s next set into it, reports it to `done` (with the time it
-    /// took, in embassy ticks, preemption by higher-priority tasks
+    /// The generator task's loop: waits for a free buffer, takes new seeds
+    /// from `link` (the console's `seed`) if there are any, generates
+    /// `stream`'s next set into it (the set after a reseed from the new
+    /// seeds, joined in as any set is), reports it to `done` (with the time
+    /// it took, in embassy ticks, preemption by higher-priority tasks
     /// included) and hands it to the frame task. A set that cannot be
     /// generated (a degenerate walk) is reported and generated again from
     /// the next seeds.
     pub async fn generate(
         &self,
         stream: &mut LoopStream<DEFAULT_N>,
-        done: impl FnMut(&Result<SetInfo, AxisError>, u64),
-    ) -> ! {
-        self.generate_seeded(stream, None, done).await
-    }
-
-    /// As [`generate`](Self::generate), taking new seeds from `link`
-    /// (the console's `seed`) before each set: the set after a reseed is
-    /// generated from them and joined in as any set is.
-    pub async fn generate_seeded(
-        &self,
-        stream: &mut LoopStream<DEFAULT_N>,
-        link: Option<&ConsoleLink>,
+        link: &ConsoleLink,
         mut done: impl FnMut(&Result<SetInfo, AxisError>, u64),
     ) -> ! {
         loop {
             let set = self.free.wait().await;
-            if let Some(seeds) = link.and_then(ConsoleLink::take_seeds) {
+            if let Some(seeds) = link.take_seeds() {
                 stream.reseed(seeds);
             }
             loop {

@@ -242,24 +242,7 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
                 let link = self.link;
                 self.head
                     .drain_asked(driver, queue, |action, asker, outcome| {
-                        match outcome {
-                            Ok(applied) => {
-                                defmt::info!(
-                                    "frame {=u64}: {=str}: ok {}",
-                                    tick.frame,
-                                    word(action),
-                                    Started(applied)
-                                );
-                            }
-                            Err(e) => {
-                                defmt::warn!(
-                                    "frame {=u64}: {=str}: {}",
-                                    tick.frame,
-                                    word(action),
-                                    e
-                                );
-                            }
-                        }
+                        log_outcome(tick.frame, "", action, outcome);
                         // The port that asked answers its line with it.
                         if let (Some(link), Some(asker)) = (link, asker) {
                             link.answer(asker, *outcome);
@@ -428,15 +411,28 @@ fn log_show(frame: u64, events: &ShowEvents) {
         );
     }
     if let Some((action, outcome)) = &events.fired {
-        match outcome {
-            Ok(applied) => defmt::info!(
-                "frame {=u64}: dmx {=str}: ok {}",
-                frame,
-                word(action),
-                Started(applied)
-            ),
-            Err(e) => defmt::warn!("frame {=u64}: dmx {=str}: {}", frame, word(action), e),
-        }
+        log_outcome(frame, "dmx ", action, outcome);
+    }
+}
+
+/// Logs what `action` (from `via`: `""` for a console port or an input,
+/// `"dmx "` for the DMX trigger) did before frame `frame`.
+fn log_outcome(frame: u64, via: &str, action: &Action, outcome: &Result<Applied, BehaviourError>) {
+    match outcome {
+        Ok(applied) => defmt::info!(
+            "frame {=u64}: {=str}{=str}: ok {}",
+            frame,
+            via,
+            word(action),
+            Started(applied)
+        ),
+        Err(e) => defmt::warn!(
+            "frame {=u64}: {=str}{=str}: {}",
+            frame,
+            via,
+            word(action),
+            e
+        ),
     }
 }
 

@@ -49,6 +49,8 @@ pub struct BoardHooks<W> {
     peak_stack: fn() -> u32,
     /// Frames per loop of the playback.
     loop_frames: u64,
+    /// The frame the next loop ends at (its status line is due).
+    next_loop_end: u64,
     started: bool,
     max_lateness: u64,
     #[cfg(feature = "calibrate")]
@@ -61,10 +63,12 @@ impl<W: Watchdog> BoardHooks<W> {
     pub fn new(watchdog: W, playback: Playback, peak_stack: fn() -> u32) -> Self {
         let loop_ms = u64::from(playback.loop_duration().0);
         let frame_us = u64::from(playback.frame_period().0).max(1);
+        let loop_frames = (loop_ms * 1000 / frame_us).max(1);
         Self {
             watchdog,
             peak_stack,
-            loop_frames: (loop_ms * 1000 / frame_us).max(1),
+            loop_frames,
+            next_loop_end: loop_frames,
             started: false,
             max_lateness: 0,
             #[cfg(feature = "calibrate")]
@@ -108,7 +112,10 @@ impl<P: SetDutyCycle, W: Watchdog> FrameHooks<P> for BoardHooks<W> {
         #[cfg(feature = "calibrate")]
         crate::calibrate::log_frame(frame, &self.playback);
         let index = frame.tick.frame;
-        if index > 0 && index.is_multiple_of(self.loop_frames) {
+        // A comparison per frame, not a 64-bit division (a library call on
+        // the Cortex-M0+): the next loop's end is kept.
+        if index >= self.next_loop_end {
+            self.next_loop_end = self.next_loop_end.saturating_add(self.loop_frames);
             let stats = driver.stats();
             defmt::info!(
                 "loop {=u64} done: {=u64} frames written, wake-up at most {=u64} us late, faults {}, disabled {}, peak stack {=u32} B",

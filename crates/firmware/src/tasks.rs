@@ -36,9 +36,7 @@ pub async fn generate(generator: Generator, mut stopwatch: impl Stopwatch) -> ! 
             );
             EXCHANGE.start(first, info);
             EXCHANGE.give(spare);
-            EXCHANGE
-                .generate_seeded(&mut stream, Some(&LINK), log_set)
-                .await
+            EXCHANGE.generate(&mut stream, &LINK, log_set).await
         }
         IdleMode::FixedLoop => {
             defmt::info!("idle: the fixed loop, replayed every loop");

@@ -50,7 +50,6 @@ use embassy_time::Duration;
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::console::SharedService;
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head_core::pwm_clock::{SERVO_PWM_HZ, SliceClock};
 use idle_head_firmware::boot::{self, Clock, EXCHANGE, Generator, Loaded, SHOW};
 use idle_head_firmware::hooks::{BoardHooks, Watchdog};
 use static_cell::StaticCell;
@@ -62,19 +61,20 @@ use crate::uart::UartPort;
 use crate::usb::UsbPort;
 use idle_head_firmware::console::{Gone, Port, Received};
 
-/// The system clock embassy-rp's default configuration runs the RP2040 at.
-#[cfg(feature = "rp2040")]
-pub const SYS_HZ: u32 = 125_000_000;
-/// The system clock embassy-rp's default configuration runs the RP2350 at.
-#[cfg(feature = "rp235xa")]
-pub const SYS_HZ: u32 = 150_000_000;
-
 /// The servo outputs' slice clock: exactly 50 Hz from [`SYS_HZ`] (see
 /// `idle_head_core::pwm_clock`).
-pub const SERVO_CLOCK: SliceClock = match SliceClock::exact(SYS_HZ, SERVO_PWM_HZ) {
-    Ok(clock) => clock,
-    Err(_) => panic!("no exact 50 Hz slice clock"),
-};
+#[cfg(feature = "rp2040")]
+pub use idle_head_core::pwm_clock::PICO_SERVO_CLOCK as SERVO_CLOCK;
+/// The system clock embassy-rp's default configuration runs the chip at.
+#[cfg(feature = "rp2040")]
+pub use idle_head_core::pwm_clock::PICO_SYS_HZ as SYS_HZ;
+/// The servo outputs' slice clock: exactly 50 Hz from [`SYS_HZ`] (see
+/// `idle_head_core::pwm_clock`).
+#[cfg(feature = "rp235xa")]
+pub use idle_head_core::pwm_clock::PICO2_SERVO_CLOCK as SERVO_CLOCK;
+/// The system clock embassy-rp's default configuration runs the chip at.
+#[cfg(feature = "rp235xa")]
+pub use idle_head_core::pwm_clock::PICO2_SYS_HZ as SYS_HZ;
 
 /// The ports' interrupt priority: below the frame task's (`P1`), above
 /// thread mode, where the console tasks run.
