@@ -1,11 +1,10 @@
 //! `look duck <percent>`: how much a held look ducks the idle on its axes.
 
-use crate::command::{Command, Percent};
+use crate::command::Command;
 
 use super::error::ParseError;
-use super::words::{Field, Kw, Word, Words};
-
-const PERCENT: Field = Field::new("percentage", 0, 100);
+use super::words::{Kw, Word, Words};
+use super::{PERCENT, to_percent};
 
 /// Whether the next word is `duck` (after `look`).
 pub(super) fn follows(words: &mut Words<'_>) -> bool {
@@ -17,8 +16,5 @@ pub(super) fn follows(words: &mut Words<'_>) -> bool {
 /// `look duck <percent>` (after the word `look`).
 pub(super) fn look_duck(words: &mut Words<'_>) -> Result<Command, ParseError> {
     words.next();
-    let percent = words.number(&PERCENT)?;
-    Ok(Command::LookDuck(
-        Percent::new(percent as u8).unwrap_or(Percent::FULL),
-    ))
+    Ok(Command::LookDuck(to_percent(words.number(&PERCENT)?)))
 }

@@ -6,10 +6,10 @@
 
 use crate::command::{Command, InputRole};
 use crate::input::{FIRST_INPUT, INPUTS};
-use crate::units::Angle;
 
 use super::error::{ParseError, ParseErrorKind};
 use super::words::{Field, Kw, Word, Words};
+use super::{YAW, to_angle};
 
 /// The inputs' numbers, as the console names them (GP2 to GP5).
 const INPUT: Field = Field::new(
@@ -17,7 +17,8 @@ const INPUT: Field = Field::new(
     FIRST_INPUT as i64,
     FIRST_INPUT as i64 + INPUTS as i64 - 1,
 );
-const DIRECTION: Field = Field::new("yaw in mdeg", i32::MIN as i64 + 1, i32::MAX as i64);
+/// Where a presence sensor looks: a yaw, as `look` takes it.
+const DIRECTION: Field = YAW;
 
 /// What `button` takes.
 const MOTION: &str = "a motion command (a gesture, look, center, idle, stop, rest or wake)";
@@ -32,9 +33,7 @@ pub(super) fn input(words: &mut Words<'_>) -> Result<Command, ParseError> {
     let role = match word.lower() {
         Word::Is(Kw::Off) => InputRole::Off,
         Word::Is(Kw::Presence) => InputRole::Presence {
-            toward: words
-                .optional_number(&DIRECTION)?
-                .map(|v| Angle::from_millidegrees(v as i32)),
+            toward: words.optional_number(&DIRECTION)?.map(to_angle),
         },
         Word::Is(Kw::Button) => {
             // The motion command: the rest of the line, on the same words.

@@ -6,11 +6,10 @@ use crate::units::Angle;
 
 use super::error::{ParseError, ParseErrorKind};
 use super::words::{Field, Kw, Word, Words};
+use super::{MDEG, PITCH, YAW, to_angle};
 
 const SECONDS: Field = Field::new("seconds", 1, MAX_REST_AFTER as i64);
-const PITCH: Field = Field::new("pitch in mdeg", i32::MIN as i64 + 1, i32::MAX as i64);
-const ROLL: Field = Field::new("roll in mdeg", i32::MIN as i64 + 1, i32::MAX as i64);
-const YAW: Field = Field::new("yaw in mdeg", i32::MIN as i64 + 1, i32::MAX as i64);
+const ROLL: Field = Field::new("roll in mdeg", MDEG.0, MDEG.1);
 
 /// `rest after|pose|relax …` (after the word `rest`).
 pub(super) fn rest(words: &mut Words<'_>) -> Result<Command, ParseError> {
@@ -31,9 +30,8 @@ pub(super) fn rest(words: &mut Words<'_>) -> Result<Command, ParseError> {
             }
         }
         Word::Is(Kw::Pose) => {
-            let mut angle = |field| -> Result<Angle, ParseError> {
-                Ok(Angle::from_millidegrees(words.number(field)? as i32))
-            };
+            let mut angle =
+                |field| -> Result<Angle, ParseError> { Ok(to_angle(words.number(field)?)) };
             RestSetting::Pose([angle(&PITCH)?, angle(&ROLL)?, angle(&YAW)?])
         }
         Word::Is(Kw::Relax) => {

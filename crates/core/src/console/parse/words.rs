@@ -1,6 +1,8 @@
 //! The words of a line: tokens with their positions, keywords, numbers.
 
-use crate::gestures::{GestureKind, same};
+use const_format::utils::str_eq;
+
+use crate::gestures::GestureKind;
 
 use super::error::{ParseError, ParseErrorKind, Span};
 
@@ -201,7 +203,7 @@ const _: () = {
         let mut i = 0;
         while i < KEYWORDS.len() {
             assert!(
-                !same(GestureKind::ALL[k].name(), KEYWORDS[i]),
+                !str_eq(GestureKind::ALL[k].name(), KEYWORDS[i]),
                 "a gesture's word is already a console word"
             );
             i += 1;
