@@ -185,8 +185,6 @@ const fn tempo(
                 max: row.max_cycles,
             });
         }
-        // A posture has its one cycle (the defaults' count is not asked).
-        None if row.max_cycles == 1 => Some(1),
         c => c,
     };
     let (cycles, ms) = if let Some(duration) = request.duration {
@@ -207,8 +205,12 @@ const fn tempo(
         };
         (n, duration.0 as u64)
     } else {
+        // Not asked: the defaults' count, within the gesture's own (a
+        // posture has its one cycle; saved defaults may hold more).
         let n = if let Some(n) = asked {
             n as u64
+        } else if d.cycles > row.max_cycles {
+            row.max_cycles as u64
         } else {
             d.cycles as u64
         };

@@ -25,7 +25,7 @@
 //! move plays on it and for `settle` after; a rest or a wake keeps to the
 //! idle limits).
 
-use crate::command::{Action, Percent};
+use crate::command::{Action, LookRequest, Percent};
 use crate::units::{Angle, AngleRange, Millis};
 
 pub use super::rest::RestState;
@@ -35,14 +35,14 @@ use super::fixed::{ONE, ahead, mul};
 use super::gaze::{Gaze, LookApplied};
 use super::gesture::GesturePlan;
 use super::glide::Glide;
-use super::params::{BehaviourParams, LimitMode};
+use super::params::{BehaviourParams, LimitMode, q16};
 use super::rest::{self, Rest};
 
 mod layers;
 mod math;
 
 use layers::Layer;
-use math::{Countdown, both, gain_of, idle_part, look_keep};
+use math::{Countdown, both, idle_part, look_keep};
 
 /// Gesture layers: one playing and up to two fading out under it.
 pub const LAYERS: usize = 3;
@@ -143,7 +143,7 @@ impl Mixer {
             params,
             layers: [None; LAYERS],
             gaze: Gaze::new(),
-            idle_gain: Glide::rest(gain_of(amp)),
+            idle_gain: Glide::rest(q16(amp) as i32),
             idle_on: true,
             idle_amp: amp,
             gesture_left: [0; 3],
@@ -153,10 +153,10 @@ impl Mixer {
             ends: 0,
             modes: [LimitMode::Idle; 3],
             quiet: true,
-            quiet_unity: gain_of(amp) as u32 == ONE,
+            quiet_unity: q16(amp) == ONE,
             resting: false,
             glance: None,
-            quiet_gain: [gain_of(amp) as u32; 3],
+            quiet_gain: [q16(amp); 3],
             quiet_centre: [0; 2],
             rest: Rest::new(),
             now: 0,
@@ -218,11 +218,7 @@ impl Mixer {
                 self.modes[request.kind.axis().index()] = LimitMode::Gesture;
                 Applied::Gesture(plan)
             }
-            Action::Look(request) => {
-                let applied = self.gaze.look(&self.params, next, request)?;
-                self.gazing();
-                Applied::Look(applied)
-            }
+            Action::Look(request) => self.look(next, request)?,
             Action::Center { duration } => {
                 let applied = self.gaze.center(&self.params, next, *duration)?;
                 self.gazing();
@@ -242,15 +238,7 @@ impl Mixer {
                 Some(duration) => Applied::Wake(duration),
                 None => match toward {
                     // Awake already: the glance alone.
-                    Some(yaw) => {
-                        let applied = self.gaze.look(
-                            &self.params,
-                            next,
-                            &rest::glance(&self.params, *yaw),
-                        )?;
-                        self.gazing();
-                        Applied::Look(applied)
-                    }
+                    Some(yaw) => self.look(next, &rest::glance(&self.params, *yaw))?,
                     None => Applied::Wake(Millis(0)),
                 },
             },
@@ -273,13 +261,11 @@ impl Mixer {
     /// pose's weight rises, and the gaze, hidden under it, goes back to the
     /// centre (a wake starts from there); returns the rest's duration.
     fn start_rest(&mut self, start: u32, at: [i32; 3]) -> Millis {
-        let pose = self.params.rest_pose;
+        let pose = self.params.rest_offsets();
         let duration = self.rest.rest(&self.params, start, pose, at);
-        let frames = self.params.frames(duration);
         if !self.gaze.centred() {
             // Within the longest move: the built-in rest times are.
-            let longest = self.params.config().gaze.longest;
-            let ms = self.params.millis(frames).min(longest);
+            let ms = duration.min(self.params.config().gaze.longest);
             let _ = self
                 .gaze
                 .center(&self.params, start, Some(Millis(ms.0.max(1))));
@@ -310,6 +296,13 @@ impl Mixer {
             && self.rest.arrived()
     }
 
+    /// A look starts at frame `next`.
+    fn look(&mut self, next: u32, request: &LookRequest) -> Result<Applied, BehaviourError> {
+        let applied = self.gaze.look(&self.params, next, request)?;
+        self.gazing();
+        Ok(Applied::Look(applied))
+    }
+
     /// A gaze move starts: pitch and yaw in gesture mode.
     fn gazing(&mut self) {
         for axis in [crate::axis::Axis::Pitch, crate::axis::Axis::Yaw] {
@@ -327,7 +320,7 @@ impl Mixer {
             Percent::ZERO
         };
         let from = self.idle_gain.state(self.now);
-        self.idle_gain = Glide::new(self.now, from, gain_of(target), self.params.idle_fade);
+        self.idle_gain = Glide::new(self.now, from, q16(target) as i32, self.params.idle_fade);
         target
     }
 

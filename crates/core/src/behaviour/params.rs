@@ -39,8 +39,6 @@ pub struct BehaviourParams {
     pub(super) frame_us: u32,
     /// The driver's neutral pose.
     pub(super) pose: [Angle; 3],
-    /// The rest pose's offsets around the neutral pose, m°.
-    pub(crate) rest_pose: [i32; 3],
     /// Offsets each axis may take around the neutral pose (limits − pose).
     pub(super) room: [AngleRange; 3],
     /// The driver's configured limits: the idle mode.
@@ -96,18 +94,21 @@ impl BehaviourParams {
         self.config.rest = live.rest;
         self.config.gaze.duck = live.look_duck;
         self.look_duck = q16(live.look_duck);
-        let (pose, clamped) = rest_offsets(&self.config, &self.pose, &self.room);
-        self.rest_pose = pose;
-        clamped
+        rest_offsets(&self.config, &self.pose, &self.room).1
+    }
+
+    /// The rest pose's offsets around the neutral pose, m°, clamped to the
+    /// room each axis has (worked out when a rest starts, not kept).
+    pub(crate) const fn rest_offsets(&self) -> [i32; 3] {
+        rest_offsets(&self.config, &self.pose, &self.room).0
     }
 
     /// The rest pose, `[pitch, roll, yaw]` axis angles, as the head rests:
     /// within the servos' limits.
     #[must_use]
     pub fn rest_pose(&self) -> [Angle; 3] {
-        core::array::from_fn(|i| {
-            Angle::from_millidegrees(self.rest_pose[i]).saturating_add(self.pose[i])
-        })
+        let offsets = self.rest_offsets();
+        core::array::from_fn(|i| Angle::from_millidegrees(offsets[i]).saturating_add(self.pose[i]))
     }
 
     /// The offsets `axis` may take around its neutral pose.
@@ -124,7 +125,6 @@ impl BehaviourParams {
         if let (Some(room), Some(&pose)) = (self.room.get_mut(i), self.pose.get(i)) {
             *room = room_around(limits, pose);
         }
-        self.rest_pose = rest_offsets(&self.config, &self.pose, &self.room).0;
     }
 
     /// The limits of `axis` in `mode`.

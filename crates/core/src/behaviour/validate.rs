@@ -19,7 +19,7 @@ use super::config::{BehaviourConfig, MAX_HOLD};
 use super::error::BehaviourError;
 use super::fixed::{MAX_FRAMES, inverse};
 use super::gesture;
-use super::params::{BehaviourParams, q16, rest_offsets, room_around};
+use super::params::{BehaviourParams, q16, room_around};
 
 const fn min(a: i64, b: i64) -> i64 {
     if a < b { a } else { b }
@@ -187,7 +187,6 @@ impl BehaviourConfig {
             duck: q16(self.idle.duck),
             look_duck: q16(self.gaze.duck),
             pose: cfg.neutral_pose,
-            rest_pose: [0; 3],
         };
         params.rates = mode_rates(cfg, &self.gesture_limits);
         params.blend = params.frames(self.blend);
@@ -216,7 +215,6 @@ impl BehaviourConfig {
             }
             k += 1;
         }
-        params.rest_pose = rest_offsets(self, &cfg.neutral_pose, &room).0;
         Ok(params)
     }
 }

@@ -115,11 +115,7 @@ pub fn checked(line: &[u8]) -> Option<&[u8]> {
     let comma = line.windows(2).rposition(|w| w == b",h")?;
     let (body, tail) = line.split_at_checked(comma)?;
     let digits = tail.get(2..)?;
-    let hash = unsigned(digits)?;
-    let sum = body
-        .iter()
-        .fold(0_u32, |sum, &b| sum.wrapping_add(u32::from(b)));
-    (sum == hash).then_some(body)
+    (hash(body) == unsigned(digits)?).then_some(body)
 }
 
 /// The sum `line`'s hash must hold: what a sender appends as `,h<sum>`.

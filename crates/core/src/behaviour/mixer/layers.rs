@@ -39,15 +39,11 @@ impl Mixer {
         let next = self.next;
         let Some(free) = self.layers.iter().position(Option::is_none) else {
             // Every layer plays: the one that ends first frees first.
-            let blend = self.params.blend;
             let left = self
                 .layers
                 .iter()
                 .flatten()
-                .map(|l| match l.release {
-                    Some(r) => blend.saturating_sub(next.wrapping_sub(r)),
-                    None => l.plan.frames.saturating_sub(next.wrapping_sub(l.start)),
-                })
+                .map(|l| l.end().wrapping_sub(next).min(l.stop))
                 .min()
                 .unwrap_or(0);
             // The layer is cleared while mixing the frame it ends at.

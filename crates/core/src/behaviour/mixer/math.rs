@@ -1,8 +1,6 @@
 //! The mixer's per-frame arithmetic: Q16 gains and ducks, the gesture
 //! layers' sums, and the countdown behind each axis' limit mode.
 
-use crate::command::Percent;
-
 use super::super::fixed::{ONE, mul};
 use super::super::params::LimitMode;
 
@@ -101,9 +99,4 @@ impl Countdown {
             LimitMode::Idle
         }
     }
-}
-
-/// A percentage as a Q16 gain.
-pub(super) const fn gain_of(p: Percent) -> i32 {
-    (p.get() as u32 * ONE / 100) as i32
 }
