@@ -28,7 +28,7 @@
 use crate::command::{Action, LookRequest, Percent};
 use crate::units::{Angle, AngleRange, Millis};
 
-pub use super::rest::RestState;
+use super::rest::RestState;
 
 use super::error::BehaviourError;
 use super::fixed::{ONE, ahead, mul};

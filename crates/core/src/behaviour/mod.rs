@@ -68,7 +68,7 @@ pub mod shape;
 pub mod show;
 mod validate;
 
-pub use crate::gestures::{GestureDefaults, MAX_CYCLES};
+pub use crate::gestures::GestureDefaults;
 pub use crate::units::MilliHertz;
 pub use config::{BehaviourConfig, GazeConfig, IdleConfig, LiveConfig, RestConfig};
 pub use error::BehaviourError;

@@ -309,9 +309,7 @@ impl Show {
         {
             events.fired = match band {
                 Trigger::None => None,
-                Trigger::Nod => Some(gesture(GestureKind::Nod)),
-                Trigger::Shake => Some(gesture(GestureKind::Shake)),
-                Trigger::Tilt => Some(gesture(GestureKind::Tilt)),
+                Trigger::Gesture(kind) => Some(gesture(kind)),
                 Trigger::Center => Some(Action::Center { duration: None }),
             };
         }

@@ -18,6 +18,17 @@ pub struct Counters {
     pub garbled: u32,
 }
 
+impl Counters {
+    /// Nothing counted yet.
+    pub const ZERO: Self = Self {
+        good: 0,
+        short: 0,
+        long: 0,
+        bad_start: 0,
+        garbled: 0,
+    };
+}
+
 /// Where the decoder is in the stream.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -74,13 +85,7 @@ impl Decoder {
             state: State::Unsynced,
             slot: 0,
             slots: [0; FOOTPRINT as usize],
-            counters: Counters {
-                good: 0,
-                short: 0,
-                long: 0,
-                bad_start: 0,
-                garbled: 0,
-            },
+            counters: Counters::ZERO,
         }
     }
 

@@ -75,20 +75,9 @@ impl DmxLink {
             received: Mutex::new(Cell::new(Received {
                 latest: Latest {
                     seq: 0,
-                    cue: Cue {
-                        pose: [0; 3],
-                        mix: 0,
-                        trigger: 0,
-                        intensity: 0,
-                    },
+                    cue: Cue::ZERO,
                 },
-                counters: Counters {
-                    good: 0,
-                    short: 0,
-                    long: 0,
-                    bad_start: 0,
-                    garbled: 0,
-                },
+                counters: Counters::ZERO,
             })),
             signal: Mutex::new(Cell::new(Signal::Lost)),
         }

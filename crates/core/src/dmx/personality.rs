@@ -1,6 +1,8 @@
 //! The personality: what each of the head's slots means (table in the
 //! [module docs](super)).
 
+use crate::gestures::GestureKind;
+
 use super::FOOTPRINT;
 
 /// One good frame's slots, taken apart.
@@ -19,6 +21,14 @@ pub struct Cue {
 }
 
 impl Cue {
+    /// Every slot at 0.
+    pub const ZERO: Self = Self {
+        pose: [0; 3],
+        mix: 0,
+        trigger: 0,
+        intensity: 0,
+    };
+
     /// The cue of a frame's personality slots (slot 10, reserved, is not
     /// read).
     #[must_use]
@@ -50,12 +60,8 @@ const fn wide(coarse: u8, fine: u8) -> u16 {
 pub enum Trigger {
     /// 0–9 and 90–255: nothing.
     None,
-    /// 10–29.
-    Nod,
-    /// 30–49.
-    Shake,
-    /// 50–69.
-    Tilt,
+    /// 10–29 nod, 30–49 shake, 50–69 tilt.
+    Gesture(GestureKind),
     /// 70–89: back to the centre.
     Center,
 }
@@ -65,9 +71,9 @@ impl Trigger {
     #[must_use]
     pub const fn of(value: u8) -> Self {
         match value {
-            10..=29 => Self::Nod,
-            30..=49 => Self::Shake,
-            50..=69 => Self::Tilt,
+            10..=29 => Self::Gesture(GestureKind::Nod),
+            30..=49 => Self::Gesture(GestureKind::Shake),
+            50..=69 => Self::Gesture(GestureKind::Tilt),
             70..=89 => Self::Center,
             _ => Self::None,
         }
