@@ -391,12 +391,21 @@ function makeServoFields() {
   }
 }
 
-function showServo() {
+/**
+ * Shows the selected servo's calibration. A control the user is in keeps
+ * what is being typed (an answer to another field, arriving late, must not
+ * undo it), except the field whose answer this is (`answered`): a refused
+ * value snaps back there.
+ */
+function showServo(answered = null) {
   const servo = servos[axisNow()];
   if (!servo) return;
   for (const field of FIELDS) {
-    $(`r-${field.key}`).value = String(servo[field.key]);
-    $(`f-${field.key}`).value = String(servo[field.key]);
+    for (const id of [`r-${field.key}`, `f-${field.key}`]) {
+      const control = $(id);
+      if (control === document.activeElement && field.key !== answered) continue;
+      control.value = String(servo[field.key]);
+    }
   }
   for (const radio of document.querySelectorAll('input[name=direction]')) {
     radio.checked = radio.value === servo.direction;
@@ -432,7 +441,7 @@ async function setField(field, value) {
   // A slider still moving has newer changes on the way: let them land.
   if (changing[field.key] !== mine) return;
   changing[field.key] = 0;
-  showServo();
+  showServo(field.key);
   await refreshStatus();
 }
 
@@ -536,7 +545,7 @@ async function main() {
       if (hasDmx) await dmx.read();
     });
   }
-  for (const radio of document.querySelectorAll('input[name=axis]')) radio.addEventListener('change', showServo);
+  for (const radio of document.querySelectorAll('input[name=axis]')) radio.addEventListener('change', () => showServo());
   on('limit-low', 'click', () => goToLimit('low'));
   on('limit-high', 'click', () => goToLimit('high'));
   $('limit-stop').addEventListener('click', () => {

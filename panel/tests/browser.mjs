@@ -124,9 +124,24 @@ async function session(page, { yawPulse }) {
   }, 6000, 'the yaw pulse moves to the new neutral');
   check(true, `yaw neutral slider 1500 → 1520 µs: the yaw pulse went ${yaw0.toFixed(1)} → ${yaw1.toFixed(1)} µs`);
 
-  // A refused value snaps back, with the firmware's reason.
+  // A value being typed survives an answer to another field arriving
+  // meanwhile (here a neutral sent again while the max field has focus).
   const max = page.getByLabel('max pulse (µs)');
   await max.fill('3000');
+  const sent = (await page.locator('#log li').allTextContents()).length;
+  await page.evaluate(() => {
+    const neutral = document.getElementById('f-neutral');
+    neutral.dispatchEvent(new Event('change'));
+  });
+  await until(async () => {
+    const lines = (await page.locator('#log li').allTextContents()).slice(sent);
+    const at = lines.findIndex((l) => l.startsWith('servo yaw neutral'));
+    return at >= 0 && lines.slice(at + 1).some((l) => l === 'ok' || l.startsWith('ok warning')) ? true : null;
+  }, 5000, 'the neutral answered');
+  await until(async () => (await max.inputValue()) === '3000' || null, 1000, 'the typed max kept');
+  check((await max.inputValue()) === '3000', 'a max being typed is kept while another field is answered');
+
+  // A refused value snaps back, with the firmware's reason.
   await max.press('Enter');
   const why = await until(async () => (await page.locator('#why-max').textContent()) || null, 5000, 'the reason');
   check((await max.inputValue()) === '2000' && why.includes('2500'), `max pulse 3000 refused, snapped back to 2000: "${why}"`);
