@@ -42,12 +42,6 @@ impl<S: SettingsStorage> Shared<S> {
     pub const fn new(service: &'static SharedService<S>, port: u8) -> Self {
         Self { service, port }
     }
-
-    /// The port.
-    #[must_use]
-    pub const fn port(&self) -> u8 {
-        self.port
-    }
 }
 
 impl<S: SettingsStorage> Handler for Shared<S> {
