@@ -45,7 +45,7 @@ pub fn telemetry_line<'b>(
     text.fill(
         "~ t={} p={} r={} y={} us={},{},{} lost={}",
         &[
-            Uint(status.frame.saturating_mul(frame_us.into()) / 1000),
+            Uint(status.uptime_ms(frame_us)),
             Int(p.into()),
             Int(r.into()),
             Int(y.into()),
