@@ -14,7 +14,8 @@
 use super::framer::Framer;
 use super::reply::Reply;
 use super::session::{Handler, Later, Response, respond};
-use crate::bottango::{Curves, Driver, Out};
+use crate::bottango::{Curves, Driver};
+use crate::text::Out;
 
 /// Bytes of a line, as the console's protocol promises (and the Bottango
 /// modules answer reports).

@@ -14,7 +14,7 @@
 //! slowly (each tick whose line could not go out in time).
 
 use crate::text::Arg::{Int, Uint};
-use crate::text::{Text, hex_digit};
+use crate::text::Out;
 
 use super::link::HeadStatus;
 use super::session::checksum;
@@ -38,11 +38,10 @@ pub fn telemetry_line<'b>(
     lost: u32,
     out: &'b mut [u8],
 ) -> &'b [u8] {
-    let mut line = Line { buf: out, len: 0 };
+    let mut line = Out::new(out);
     let [p, r, y] = status.angles.map(crate::units::Angle::millidegrees);
     let [pp, pr, py] = status.pulses.map(|us| us.0);
-    let text: &mut dyn Text = &mut line;
-    text.fill(
+    line.text().fill(
         "~ t={} p={} r={} y={} us={},{},{} lost={}",
         &[
             Uint(status.uptime_ms(frame_us)),
@@ -55,40 +54,9 @@ pub fn telemetry_line<'b>(
             Uint(lost.into()),
         ],
     );
-    let crc = checksum(line.buf.get(..line.len).unwrap_or_default());
-    line.put_bytes(&[
-        b' ',
-        b'*',
-        hex_digit(crc >> 4),
-        hex_digit(crc),
-        b'\r',
-        b'\n',
-    ]);
-    let Line { buf, len } = line;
-    buf.get(..len).unwrap_or_default()
-}
-
-/// A line being written into a buffer.
-struct Line<'b> {
-    buf: &'b mut [u8],
-    len: usize,
-}
-
-impl Line<'_> {
-    fn put_bytes(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            if let Some(slot) = self.buf.get_mut(self.len) {
-                *slot = b;
-                self.len += 1;
-            }
-        }
-    }
-}
-
-impl Text for Line<'_> {
-    fn put(&mut self, s: &str) {
-        self.put_bytes(s.as_bytes());
-    }
+    let crc = checksum(line.written());
+    line.text().str(" *").hex2(crc).str("\r\n");
+    line.into_bytes()
 }
 
 #[cfg(test)]
