@@ -13,7 +13,7 @@ pub const VERSION: &str = "0.8.0c1";
 
 /// The longest line the port takes (the console's), as the modules answer
 /// reports it to the app.
-pub const MAX_LINE: usize = 96;
+pub const MAX_LINE: usize = crate::console::PORT_LINE;
 
 const OK: &[u8] = b"OK\n";
 

@@ -17,14 +17,10 @@ use core::cell::RefCell;
 use core::fmt::Write as _;
 
 use crate::command::Command;
-use crate::console::{ConsoleService, ErrorCode, Handler, Reply, Session};
+use crate::console::{ConsoleService, ErrorCode, Handler, Reply};
 use crate::settings::SettingsStorage;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
-
-/// A console session on a port: lines up to 96 bytes, replies up to 160,
-/// as `docs/user/protocol.md` promises.
-pub type PortSession = Session<96, 160>;
 
 /// One service for both ports, in thread mode.
 pub type SharedService<S> = Mutex<NoopRawMutex, RefCell<ConsoleService<'static, S>>>;

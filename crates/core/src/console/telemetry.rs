@@ -17,12 +17,15 @@ use crate::text::Arg::{Int, Uint};
 use crate::text::Out;
 
 use super::link::HeadStatus;
-use super::session::checksum;
+use super::session::{PORT_REPLY, checksum};
 
 /// The longest telemetry line, CR LF included:
 /// `~ t=` (4) + 20 digits, ` p=`/` r=`/` y=` 3 × (3 + 11), ` us=` (4) +
 /// 3 × 10 + 2 commas, ` lost=` (6) + 10, ` *hh` (4), CR LF (2).
 pub const TELEMETRY_LINE: usize = 4 + 20 + 3 * 14 + 4 + 32 + 6 + 10 + 4 + 2;
+
+// A port's telemetry line is written into its session's reply buffer.
+const _: () = assert!(TELEMETRY_LINE <= PORT_REPLY);
 
 /// The fastest telemetry: one line a frame at 50 Hz.
 pub const MAX_WATCH_HZ: u8 = 50;
@@ -30,7 +33,7 @@ pub const MAX_WATCH_HZ: u8 = 50;
 /// Writes the telemetry line of `status` (frames of `frame_us` µs) with
 /// `lost` lines dropped so far into `out` (at least [`TELEMETRY_LINE`]
 /// bytes: a console writes it into its session's reply buffer, free
-/// between replies, [`Session::spare`](super::Session::spare)); returns
+/// between replies, [`DualSession::spare`](super::DualSession::spare)); returns
 /// the line. (Into a shorter buffer the line is cut, without its end.)
 pub fn telemetry_line<'b>(
     status: &HeadStatus,
