@@ -7,7 +7,7 @@
 use host_tests::console::head::{service, shared};
 use idle_head_core::Axis;
 use idle_head_core::bottango::{Curves, Sample};
-use idle_head_core::console::DualSession;
+use idle_head_core::console::{DualSession, unanswered};
 
 /// The `> line` / `< reply` pairs of the document's session.
 fn transcript() -> Vec<(String, Vec<String>)> {
@@ -180,4 +180,25 @@ fn the_port_going_away_ends_the_session() {
     port.send(b"hRQ,7,h366\n");
     assert!(port.send(b"hRQ,8,h367\n").is_empty());
     assert!(port.session.bottango());
+}
+
+#[test]
+fn a_console_reply_waits_on_a_dual_port_as_on_a_session() {
+    let mut port = Port::new();
+    assert!(port.send(b"nod\n").is_empty(), "queued: the reply waits");
+    assert!(port.session.waiting().is_some());
+    assert!(port.session.spare().is_empty(), "the reply holds it");
+    assert!(port.send(b"status\n").is_empty(), "bytes not taken");
+    let reply = port.session.finish(|r| unanswered(r, 500)).map(lines);
+    assert_eq!(
+        reply,
+        Some(vec![
+            "err state no frame took the command within 500 ms: the frames are not running"
+                .to_owned()
+        ])
+    );
+    assert_eq!(port.session.waiting(), None);
+    assert_eq!(port.session.spare().len(), 160);
+    let status = port.send(b"status\n");
+    assert!(status[0].starts_with("ok mode="), "{status:?}");
 }

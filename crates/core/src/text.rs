@@ -179,20 +179,95 @@ pub(crate) const fn hex_digit(v: u8) -> u8 {
 /// # Errors
 /// The formatter's first error.
 pub fn display(message: &dyn Describe, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-    struct Out<'a, 'b> {
+    struct Fmt<'a, 'b> {
         f: &'a mut fmt::Formatter<'b>,
         result: fmt::Result,
     }
-    impl Text for Out<'_, '_> {
+    impl Text for Fmt<'_, '_> {
         fn put(&mut self, s: &str) {
             if self.result.is_ok() {
                 self.result = self.f.write_str(s);
             }
         }
     }
-    let mut out = Out { f, result: Ok(()) };
+    let mut out = Fmt { f, result: Ok(()) };
     message.describe(&mut out);
     out.result
+}
+
+/// Text written into a byte buffer, cut where the buffer ends: a Bottango
+/// answer, a telemetry line. (A console [`Reply`](crate::console::Reply)
+/// is another [`Text`]: it keeps its line whole and marks a cut.)
+///
+/// ```
+/// use idle_head_core::text::Out;
+///
+/// let mut buf = [0; 8];
+/// let mut out = Out::new(&mut buf);
+/// out.put(b"MOD,").text().u64(96).str(",1234\n");
+/// assert_eq!(out.into_bytes(), b"MOD,96,1");
+/// ```
+#[derive(Debug)]
+pub struct Out<'b> {
+    buf: &'b mut [u8],
+    len: usize,
+}
+
+impl<'b> Out<'b> {
+    /// Nothing written yet, into `buf`.
+    #[must_use]
+    pub fn new(buf: &'b mut [u8]) -> Self {
+        Self { buf, len: 0 }
+    }
+
+    /// Appends `bytes` (as much as fits).
+    #[inline(never)]
+    pub fn put(&mut self, bytes: &[u8]) -> &mut Self {
+        let room = self.buf.get_mut(self.len..).unwrap_or_default();
+        let n = room.len().min(bytes.len());
+        for (d, s) in room.iter_mut().zip(bytes) {
+            *d = *s;
+        }
+        self.len += n;
+        self
+    }
+
+    /// The same buffer as a [`Text`], for numbers and messages.
+    pub fn text(&mut self) -> &mut dyn Text {
+        self
+    }
+
+    /// How many bytes are written.
+    #[must_use]
+    pub const fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether nothing is written.
+    #[must_use]
+    pub const fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The bytes written so far.
+    #[must_use]
+    pub fn written(&self) -> &[u8] {
+        self.buf.get(..self.len).unwrap_or_default()
+    }
+
+    /// The bytes written.
+    #[must_use]
+    pub fn into_bytes(self) -> &'b [u8] {
+        let len = self.len;
+        let buf: &'b [u8] = self.buf;
+        buf.get(..len).unwrap_or_default()
+    }
+}
+
+impl Text for Out<'_> {
+    fn put(&mut self, s: &str) {
+        Out::put(self, s.as_bytes());
+    }
 }
 
 /// Implements `Display` for types that implement [`Describe`].

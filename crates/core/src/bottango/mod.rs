@@ -52,4 +52,4 @@ mod session;
 pub use curve::{Curve, INSTANT_HOLD_MS};
 pub use line::{Command, LineError, checked, hash, parse};
 pub use queue::{Curves, DEPTH, MotorError, Op, Sample};
-pub use session::{Driver, MAX_LINE, Out, TIMEOUT_MS, VERSION};
+pub use session::{Driver, MAX_LINE, TIMEOUT_MS, VERSION};

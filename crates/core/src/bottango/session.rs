@@ -4,12 +4,7 @@ use super::curve::Curve;
 use super::line::{self, Command, Motor};
 use super::queue::{Curves, DEPTH, MotorError, Op};
 use crate::console::LineError as FramerError;
-use crate::text::Text;
-
-/// `out` as the [`Text`] numbers are written into.
-fn text<'r>(out: &'r mut Out<'_>) -> &'r mut dyn Text {
-    out
-}
+use crate::text::Out;
 
 /// The driver version the handshake reports: the protocol of Bottango's
 /// Arduino driver of that version, as far as this head implements it
@@ -18,58 +13,7 @@ pub const VERSION: &str = "0.8.0c1";
 
 /// The longest line the port takes (the console's), as the modules answer
 /// reports it to the app.
-pub const MAX_LINE: usize = 96;
-
-/// Where a reply is written: the port's reply buffer.
-pub struct Out<'b> {
-    buf: &'b mut [u8],
-    len: usize,
-}
-
-impl<'b> Out<'b> {
-    /// An empty reply in `buf`.
-    pub fn new(buf: &'b mut [u8]) -> Self {
-        Self { buf, len: 0 }
-    }
-
-    /// Appends `bytes` (as much as fits).
-    #[inline(never)]
-    fn put(&mut self, bytes: &[u8]) -> &mut Self {
-        let room = self.buf.get_mut(self.len..).unwrap_or_default();
-        let n = room.len().min(bytes.len());
-        for (d, s) in room.iter_mut().zip(bytes) {
-            *d = *s;
-        }
-        self.len += n;
-        self
-    }
-
-    /// How many bytes are written.
-    #[must_use]
-    pub const fn len(&self) -> usize {
-        self.len
-    }
-
-    /// Whether nothing is written.
-    #[must_use]
-    pub const fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
-    /// The bytes written.
-    #[must_use]
-    pub fn into_bytes(self) -> &'b [u8] {
-        let len = self.len;
-        let buf: &'b [u8] = self.buf;
-        buf.get(..len).unwrap_or_default()
-    }
-}
-
-impl Text for Out<'_> {
-    fn put(&mut self, s: &str) {
-        Out::put(self, s.as_bytes());
-    }
-}
+pub const MAX_LINE: usize = crate::console::PORT_LINE;
 
 const OK: &[u8] = b"OK\n";
 
@@ -155,7 +99,7 @@ impl<'a> Driver<'a> {
             Ok(line) => line,
             Err(FramerError::TooLong { len, .. }) => {
                 out.put(b"\nerrCmdTooLong: ");
-                text(out).u64(len as u64);
+                out.text().u64(len as u64);
                 out.put(b"\n").put(OK);
                 return;
             }
@@ -244,7 +188,7 @@ impl<'a> Driver<'a> {
             // Longest line, curves kept per motor, no synchronised
             // commands, 32-bit signals.
             2 => {
-                text(out)
+                out.text()
                     .str("MOD,CMD_CFG,")
                     .u64(MAX_LINE as u64)
                     .str(",")

@@ -108,6 +108,13 @@ impl HeadStatus {
             disabled: stats.disabled,
         }
     }
+
+    /// Time since the first frame, ms, for frames of `frame_us` µs
+    /// (saturating: never wraps to a small uptime).
+    #[must_use]
+    pub fn uptime_ms(&self, frame_us: u32) -> u64 {
+        self.frame.saturating_mul(u64::from(frame_us)) / 1000
+    }
 }
 
 /// Console ports a board may have: UART (0) and USB (1).
@@ -299,5 +306,24 @@ impl core::fmt::Debug for ConsoleLink {
         f.debug_struct("ConsoleLink")
             .field("status", &self.status())
             .finish_non_exhaustive()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::HeadStatus;
+
+    #[test]
+    fn uptime_is_frames_times_period_and_saturates() {
+        let status = HeadStatus {
+            frame: 50,
+            ..HeadStatus::default()
+        };
+        assert_eq!(status.uptime_ms(20_000), 1000);
+        let late = HeadStatus {
+            frame: u64::MAX,
+            ..status
+        };
+        assert_eq!(late.uptime_ms(u32::MAX), u64::MAX / 1000);
     }
 }

@@ -37,9 +37,10 @@ pub use port::DualSession;
 pub use reply::{ErrorCode, Reply};
 pub use service::{ConsoleService, HELP, VERSION};
 pub use session::{
-    EnvelopeError, Handler, InputError, Later, MIN_REPLY, Response, Session, checksum, respond,
+    EnvelopeError, Handler, InputError, Later, MIN_REPLY, PORT_LINE, PORT_REPLY, PortSession,
+    Response, Session, checksum, respond,
 };
-pub use shared::{PortSession, Shared, SharedService};
+pub use shared::{Shared, SharedService};
 pub use telemetry::{MAX_WATCH_HZ, TELEMETRY_LINE, telemetry_line};
 
 /// How a board's USB serial port (CDC-ACM) introduces itself, so that a

@@ -1,6 +1,6 @@
 //! A console port that also speaks Bottango's driver protocol.
 //!
-//! A [`DualSession`] is a console session ([`Session`](super::Session)'s
+//! A [`DualSession`] is a console session (a [`PortSession`]: its
 //! framing and replies, the same handler) until a line is a valid
 //! Bottango handshake (`hRQ,<code>,h<sum>`): from then on the port's lines
 //! are Bottango's ([`crate::bottango::Driver`]), until `STOP` or until the
@@ -11,25 +11,18 @@
 //!
 //! [`Session`]: super::Session
 
-use super::framer::Framer;
 use super::reply::Reply;
-use super::session::{Handler, Later, Response, respond};
-use crate::bottango::{Curves, Driver, Out};
-
-/// Bytes of a line, as the console's protocol promises (and the Bottango
-/// modules answer reports).
-pub const LINE: usize = crate::bottango::MAX_LINE;
-/// Bytes of a reply line.
-pub const REPLY: usize = 160;
+use super::session::{Handler, PortSession};
+use crate::bottango::{Curves, Driver};
+use crate::text::Out;
 
 /// One port's session, console or Bottango; see the [module docs](self).
 #[derive(Debug)]
 pub struct DualSession<'a> {
-    framer: Framer<LINE>,
-    reply: [u8; REPLY],
+    /// The console session, whose framer and reply buffer the Bottango
+    /// lines use too.
+    session: PortSession,
     bottango: Driver<'a>,
-    /// The console reply that waits for the frame task, in `reply`.
-    later: Option<Later>,
 }
 
 impl<'a> DualSession<'a> {
@@ -38,10 +31,8 @@ impl<'a> DualSession<'a> {
     #[must_use]
     pub const fn new(curves: Option<&'a Curves>) -> Self {
         Self {
-            framer: Framer::new(),
-            reply: [0; REPLY],
+            session: PortSession::new(),
             bottango: Driver::new(curves),
-            later: None,
         }
     }
 
@@ -51,53 +42,40 @@ impl<'a> DualSession<'a> {
     /// ([`waiting`](Self::waiting)). While a reply waits, a byte pushed is
     /// not taken (`None`): finish the reply first.
     pub fn push<H: Handler + ?Sized>(&mut self, byte: u8, handler: &mut H) -> Option<&[u8]> {
-        if self.later.is_some() {
-            return None;
-        }
-        let outcome = self.framer.push(byte)?;
+        let ended = self.session.step(byte)?;
         if self.bottango.active() {
-            let mut out = Out::new(&mut self.reply);
-            self.bottango.line(outcome, &mut out);
+            let mut out = Out::new(ended.reply);
+            self.bottango.line(ended.line, &mut out);
             return Some(out.into_bytes());
         }
-        if let Ok(line) = outcome {
-            let mut out = Out::new(&mut self.reply);
+        if let Ok(line) = ended.line {
+            let mut out = Out::new(&mut *ended.reply);
             let took = self.bottango.handshake(line, &mut out);
             let len = out.len();
             if took {
-                return self.reply.get(..len);
+                return ended.reply.get(..len);
             }
         }
-        match respond(outcome, handler, &mut self.reply) {
-            Response::Now(line) => Some(line),
-            Response::Later(later) => {
-                self.later = Some(later);
-                None
-            }
-        }
+        ended.answer(handler)
     }
 
     /// The ticket of the queued action whose outcome the last console
     /// line's reply waits for, if it waits.
     #[must_use]
     pub fn waiting(&self) -> Option<u8> {
-        self.later.map(|later| later.ticket())
+        self.session.waiting()
     }
 
     /// Finishes the reply that waits, `write` writing its verdict, and
     /// returns it; `None` if no reply waits.
     pub fn finish(&mut self, write: impl FnOnce(&mut Reply<'_>)) -> Option<&[u8]> {
-        let later = self.later.take()?;
-        Some(later.finish(&mut self.reply, write))
+        self.session.finish(write)
     }
 
     /// The reply buffer, for a line of the console's own between replies
     /// (a telemetry line); empty while a reply waits in it.
     pub fn spare(&mut self) -> &mut [u8] {
-        if self.later.is_some() {
-            return &mut [];
-        }
-        &mut self.reply
+        self.session.spare()
     }
 
     /// Whether the port speaks Bottango's protocol.
@@ -109,17 +87,16 @@ impl<'a> DualSession<'a> {
     /// Whether a line has begun and not ended.
     #[must_use]
     pub const fn in_progress(&self) -> bool {
-        self.framer.in_progress()
+        self.session.in_progress()
     }
 
     /// In a Bottango session, a line that stopped arriving: it is dropped
     /// and answered `TIMEOUT`. `None` otherwise (a console waits for ever).
     pub fn timeout(&mut self) -> Option<&[u8]> {
-        if !(self.bottango.active() && self.framer.in_progress()) {
+        if !(self.bottango.active() && self.session.in_progress()) {
             return None;
         }
-        self.framer.reset();
-        let mut out = Out::new(&mut self.reply);
+        let mut out = Out::new(self.session.drop_line());
         self.bottango.timeout(&mut out);
         Some(out.into_bytes())
     }
@@ -127,13 +104,12 @@ impl<'a> DualSession<'a> {
     /// The port went away (or reconnects): the line in progress is
     /// forgotten and a Bottango session ends.
     pub fn reset(&mut self) {
-        self.framer.reset();
+        self.session.reset();
         self.bottango.end();
-        self.later = None;
     }
 
-    /// The port lost received bytes (see [`Framer::lose`]).
+    /// The port lost received bytes (see [`Session::lose`](super::Session::lose)).
     pub fn lose(&mut self) {
-        self.framer.lose();
+        self.session.lose();
     }
 }

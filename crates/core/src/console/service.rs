@@ -231,8 +231,6 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         let [pp, pr, py] = s.pulses.map(|us| us.0);
         let [fp, fr, fy] = s.faults;
         let off = s.disabled.iter().filter(|&&d| d).count();
-        // Frames since start × frame period, in ms.
-        let uptime = s.frame * u64::from(self.base.frame_period.0) / 1000;
         text(reply.ok()).fill(
             "mode={} mdeg={},{},{} us={},{},{} faults={},{},{} off={} uptime_ms={} fw={}{} settings={}",
             &[
@@ -247,7 +245,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
                 Uint(fr.into()),
                 Uint(fy.into()),
                 Uint(off as u64),
-                Uint(uptime),
+                Uint(s.uptime_ms(self.base.frame_period.0)),
                 Str(VERSION),
                 Str(self.dmx_status()),
                 Str(self.source.as_str()),

@@ -126,6 +126,16 @@ impl<F: FnMut(Command, &mut Reply<'_>)> Handler for F {
 /// machine-mode prefix and error code with the line's end.
 pub const MIN_REPLY: usize = 48;
 
+/// Bytes of a line on a port, as `docs/user/protocol.md` promises (and
+/// the Bottango modules answer reports, [`crate::bottango::MAX_LINE`]).
+pub const PORT_LINE: usize = 96;
+
+/// Bytes of a reply line on a port, as `docs/user/protocol.md` promises.
+pub const PORT_REPLY: usize = 160;
+
+/// A console session on a port: the sizes the protocol promises.
+pub type PortSession = Session<PORT_LINE, PORT_REPLY>;
+
 /// A console session: a line framer of `LINE` bytes and a reply buffer of
 /// `REPLY` bytes (at least [`MIN_REPLY`]), no allocation.
 ///
@@ -149,7 +159,7 @@ pub const MIN_REPLY: usize = 48;
 /// ]);
 /// ```
 #[derive(Clone, Debug)]
-pub struct Session<const LINE: usize = 96, const REPLY: usize = 160> {
+pub struct Session<const LINE: usize = PORT_LINE, const REPLY: usize = PORT_REPLY> {
     framer: Framer<LINE>,
     reply: [u8; REPLY],
     /// The reply that waits for the frame task, in `reply`.
@@ -181,17 +191,22 @@ impl<const LINE: usize, const REPLY: usize> Session<LINE, REPLY> {
     /// pushing more: a byte pushed meanwhile is not taken (`None`), as
     /// the line it belongs to could not be answered in order.
     pub fn push<H: Handler + ?Sized>(&mut self, byte: u8, handler: &mut H) -> Option<&[u8]> {
+        self.step(byte)?.answer(handler)
+    }
+
+    /// Takes one byte as [`push`](Self::push) does; at a line end, the
+    /// line with the reply buffer, for the caller to answer it
+    /// ([`Ended::answer`] as `push` does, or as it likes).
+    pub(super) fn step(&mut self, byte: u8) -> Option<Ended<'_>> {
         if self.later.is_some() {
             return None;
         }
-        let outcome = self.framer.push(byte)?;
-        match respond(outcome, handler, &mut self.reply) {
-            Response::Now(line) => Some(line),
-            Response::Later(later) => {
-                self.later = Some(later);
-                None
-            }
-        }
+        let line = self.framer.push(byte)?;
+        Some(Ended {
+            line,
+            reply: &mut self.reply,
+            later: &mut self.later,
+        })
     }
 
     /// The ticket of the action whose outcome the last line's reply waits
@@ -232,10 +247,22 @@ impl<const LINE: usize, const REPLY: usize> Session<LINE, REPLY> {
     /// The reply buffer, for a line of the console's own between replies
     /// (a telemetry line); it holds a reply that waits, if one does, so
     /// then the buffer is not handed out (an empty one is).
-    pub fn spare(&mut self) -> &mut [u8] {
+    pub(super) fn spare(&mut self) -> &mut [u8] {
         if self.later.is_some() {
             return &mut [];
         }
+        &mut self.reply
+    }
+
+    /// Whether a line has begun and not ended.
+    pub(super) const fn in_progress(&self) -> bool {
+        self.framer.in_progress()
+    }
+
+    /// Drops the line in progress, unanswered, and hands out the reply
+    /// buffer for what the caller answers instead (a Bottango `TIMEOUT`).
+    pub(super) fn drop_line(&mut self) -> &mut [u8] {
+        self.framer.reset();
         &mut self.reply
     }
 
@@ -250,6 +277,29 @@ impl<const LINE: usize, const REPLY: usize> Session<LINE, REPLY> {
     /// the line they belonged to is answered `err line bytes lost …`.
     pub fn lose(&mut self) {
         self.framer.lose();
+    }
+}
+
+/// A line a [`Session`] framed, and where its reply goes.
+pub(super) struct Ended<'s> {
+    /// The framer's outcome.
+    pub(super) line: Result<&'s [u8], LineError>,
+    /// The session's reply buffer.
+    pub(super) reply: &'s mut [u8],
+    later: &'s mut Option<Later>,
+}
+
+impl<'s> Ended<'s> {
+    /// The console's reply ([`respond`]): the line, or nothing if it
+    /// waits for the frame task (the session then keeps it).
+    pub(super) fn answer<H: Handler + ?Sized>(self, handler: &mut H) -> Option<&'s [u8]> {
+        match respond(self.line, handler, self.reply) {
+            Response::Now(line) => Some(line),
+            Response::Later(later) => {
+                *self.later = Some(later);
+                None
+            }
+        }
     }
 }
 
@@ -351,9 +401,6 @@ fn sign(mut reply: Reply<'_>) -> &[u8] {
 
 // The tail kept by every reply holds the checksum and the line end.
 const _: () = assert!(TAIL >= "…".len() + " *hh".len() + "\r\n".len());
-
-// A port's telemetry line is written into its session's reply buffer.
-const _: () = assert!(super::TELEMETRY_LINE <= 160);
 
 /// Parses `line` and carries it out, or rejects it.
 fn answer<H: Handler + ?Sized>(line: &[u8], handler: &mut H, reply: &mut Reply<'_>) {

@@ -17,14 +17,10 @@ use core::cell::RefCell;
 use core::fmt::Write as _;
 
 use crate::command::Command;
-use crate::console::{ConsoleService, ErrorCode, Handler, Reply, Session};
+use crate::console::{ConsoleService, ErrorCode, Handler, Reply};
 use crate::settings::SettingsStorage;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
-
-/// A console session on a port: lines up to 96 bytes, replies up to 160,
-/// as `docs/user/protocol.md` promises.
-pub type PortSession = Session<96, 160>;
 
 /// One service for both ports, in thread mode.
 pub type SharedService<S> = Mutex<NoopRawMutex, RefCell<ConsoleService<'static, S>>>;
@@ -41,12 +37,6 @@ impl<S: SettingsStorage> Shared<S> {
     /// [`ConsoleLink`]).
     pub const fn new(service: &'static SharedService<S>, port: u8) -> Self {
         Self { service, port }
-    }
-
-    /// The port.
-    #[must_use]
-    pub const fn port(&self) -> u8 {
-        self.port
     }
 }
 

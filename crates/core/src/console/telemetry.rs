@@ -14,15 +14,18 @@
 //! slowly (each tick whose line could not go out in time).
 
 use crate::text::Arg::{Int, Uint};
-use crate::text::{Text, hex_digit};
+use crate::text::Out;
 
 use super::link::HeadStatus;
-use super::session::checksum;
+use super::session::{PORT_REPLY, checksum};
 
 /// The longest telemetry line, CR LF included:
 /// `~ t=` (4) + 20 digits, ` p=`/` r=`/` y=` 3 × (3 + 11), ` us=` (4) +
 /// 3 × 10 + 2 commas, ` lost=` (6) + 10, ` *hh` (4), CR LF (2).
 pub const TELEMETRY_LINE: usize = 4 + 20 + 3 * 14 + 4 + 32 + 6 + 10 + 4 + 2;
+
+// A port's telemetry line is written into its session's reply buffer.
+const _: () = assert!(TELEMETRY_LINE <= PORT_REPLY);
 
 /// The fastest telemetry: one line a frame at 50 Hz.
 pub const MAX_WATCH_HZ: u8 = 50;
@@ -30,7 +33,7 @@ pub const MAX_WATCH_HZ: u8 = 50;
 /// Writes the telemetry line of `status` (frames of `frame_us` µs) with
 /// `lost` lines dropped so far into `out` (at least [`TELEMETRY_LINE`]
 /// bytes: a console writes it into its session's reply buffer, free
-/// between replies, [`Session::spare`](super::Session::spare)); returns
+/// between replies, [`DualSession::spare`](super::DualSession::spare)); returns
 /// the line. (Into a shorter buffer the line is cut, without its end.)
 pub fn telemetry_line<'b>(
     status: &HeadStatus,
@@ -38,14 +41,13 @@ pub fn telemetry_line<'b>(
     lost: u32,
     out: &'b mut [u8],
 ) -> &'b [u8] {
-    let mut line = Line { buf: out, len: 0 };
+    let mut line = Out::new(out);
     let [p, r, y] = status.angles.map(crate::units::Angle::millidegrees);
     let [pp, pr, py] = status.pulses.map(|us| us.0);
-    let text: &mut dyn Text = &mut line;
-    text.fill(
+    line.text().fill(
         "~ t={} p={} r={} y={} us={},{},{} lost={}",
         &[
-            Uint(status.frame.saturating_mul(frame_us.into()) / 1000),
+            Uint(status.uptime_ms(frame_us)),
             Int(p.into()),
             Int(r.into()),
             Int(y.into()),
@@ -55,40 +57,9 @@ pub fn telemetry_line<'b>(
             Uint(lost.into()),
         ],
     );
-    let crc = checksum(line.buf.get(..line.len).unwrap_or_default());
-    line.put_bytes(&[
-        b' ',
-        b'*',
-        hex_digit(crc >> 4),
-        hex_digit(crc),
-        b'\r',
-        b'\n',
-    ]);
-    let Line { buf, len } = line;
-    buf.get(..len).unwrap_or_default()
-}
-
-/// A line being written into a buffer.
-struct Line<'b> {
-    buf: &'b mut [u8],
-    len: usize,
-}
-
-impl Line<'_> {
-    fn put_bytes(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            if let Some(slot) = self.buf.get_mut(self.len) {
-                *slot = b;
-                self.len += 1;
-            }
-        }
-    }
-}
-
-impl Text for Line<'_> {
-    fn put(&mut self, s: &str) {
-        self.put_bytes(s.as_bytes());
-    }
+    let crc = checksum(line.written());
+    line.text().str(" *").hex2(crc).str("\r\n");
+    line.into_bytes()
 }
 
 #[cfg(test)]
