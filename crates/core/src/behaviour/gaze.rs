@@ -158,11 +158,8 @@ impl Gaze {
         let mut clamped = false;
         let targets = [request.pitch, request.yaw];
         let offsets: [i32; 2] = core::array::from_fn(|i| {
-            let (axis, target) = (AXES[i], targets[i]);
-            let room = params.room(axis);
-            let offset = target.saturating_sub(pose[axis.index()]);
-            let inside = offset.clamp_to(room.min, room.max);
-            clamped |= inside != offset;
+            let (inside, outside) = params.offset_within(AXES[i], targets[i]);
+            clamped |= outside;
             inside.millidegrees()
         });
         let frames = self.move_to(params, next, offsets, ONE as i32, request.duration);

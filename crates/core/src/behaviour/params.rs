@@ -111,6 +111,17 @@ impl BehaviourParams {
         core::array::from_fn(|i| Angle::from_millidegrees(offsets[i]).saturating_add(self.pose[i]))
     }
 
+    /// `target`, an angle of `axis`, as an offset from the neutral pose
+    /// within the room the axis has there; and whether it had to be
+    /// clamped to get there.
+    #[must_use]
+    pub fn offset_within(&self, axis: Axis, target: Angle) -> (Angle, bool) {
+        let room = self.room(axis);
+        let offset = target.saturating_sub(self.pose[axis.index()]);
+        let inside = offset.clamp_to(room.min, room.max);
+        (inside, inside != offset)
+    }
+
     /// The offsets `axis` may take around its neutral pose.
     #[must_use]
     pub const fn room(&self, axis: Axis) -> AngleRange {

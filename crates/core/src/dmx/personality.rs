@@ -99,14 +99,19 @@ mod tests {
 
     #[test]
     fn bands_and_their_edges() {
-        use Trigger::*;
+        use Trigger::{Center, Gesture, None};
+        let (nod, shake, tilt) = (
+            Gesture(GestureKind::Nod),
+            Gesture(GestureKind::Shake),
+            Gesture(GestureKind::Tilt),
+        );
         let bands: Vec<Trigger> = [0, 9, 10, 29, 30, 49, 50, 69, 70, 89, 90, 255]
             .map(Trigger::of)
             .to_vec();
         assert_eq!(
             bands,
             [
-                None, None, Nod, Nod, Shake, Shake, Tilt, Tilt, Center, Center, None, None
+                None, None, nod, nod, shake, shake, tilt, tilt, Center, Center, None, None
             ]
         );
     }

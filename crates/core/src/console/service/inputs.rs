@@ -65,14 +65,10 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
                 }
             }
             InputRole::Presence { toward: Some(yaw) } => {
-                let room = self.behaviour.room(crate::Axis::Yaw);
-                let pose = self.behaviour.neutral_pose()[2];
-                let inside = yaw.saturating_sub(pose).clamp_to(room.min, room.max);
-                if inside.saturating_add(pose) != yaw {
-                    text(reply.ok()).fill(
-                        "clamped yaw={}",
-                        &[Int(inside.saturating_add(pose).millidegrees().into())],
-                    );
+                let (inside, clamped) = self.behaviour.offset_within(crate::Axis::Yaw, yaw);
+                if clamped {
+                    let glance = inside.saturating_add(self.behaviour.neutral_pose()[2]);
+                    text(reply.ok()).fill("clamped yaw={}", &[Int(glance.millidegrees().into())]);
                 }
             }
             InputRole::Off | InputRole::Presence { toward: None } => {}
@@ -94,21 +90,17 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
             }
             RestSetting::Pose(pose) => {
                 self.settings.behaviour.rest.pose = pose;
-                let mut params = self.behaviour;
-                if params.set_live(&self.settings.behaviour.live()) {
-                    let [p, r, y] = params.rest_pose().map(Angle::millidegrees);
+                if self.push_live() {
+                    let [p, r, y] = self.behaviour.rest_pose().map(Angle::millidegrees);
                     text(reply.ok()).fill(
                         "clamped pitch={} roll={} yaw={}",
                         &[Int(p.into()), Int(r.into()), Int(y.into())],
                     );
                 }
-                self.behaviour = params;
-                self.link.set_live(self.settings.behaviour.live());
             }
             RestSetting::Relax(on) => {
                 self.settings.behaviour.rest.relax = on;
-                self.behaviour.set_live(&self.settings.behaviour.live());
-                self.link.set_live(self.settings.behaviour.live());
+                self.push_live();
             }
         }
         self.source = SettingsSource::Changed;
@@ -118,9 +110,18 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
     #[inline(never)]
     pub(super) fn set_look_duck(&mut self, duck: Percent) {
         self.settings.behaviour.gaze.duck = duck;
-        self.behaviour.set_live(&self.settings.behaviour.live());
-        self.link.set_live(self.settings.behaviour.live());
+        self.push_live();
         self.source = SettingsSource::Changed;
+    }
+
+    /// Puts the settings' live part (rest pose, relax, the look's duck) in
+    /// effect: in the console's checks and, through the link, in the frame
+    /// task. Whether the rest pose had to be clamped to the servos' limits.
+    fn push_live(&mut self) -> bool {
+        let live = self.settings.behaviour.live();
+        let clamped = self.behaviour.set_live(&live);
+        self.link.set_live(live);
+        clamped
     }
 
     /// The inputs for `status`: `-` for an input that is off, else `b`
