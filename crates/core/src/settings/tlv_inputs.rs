@@ -83,6 +83,16 @@ impl Bytes {
         self
     }
 
+    /// `value` as its field is stored ([`FieldValue`]).
+    fn value<T: FieldValue>(&mut self, value: &T) -> &mut Self {
+        let mut bytes = [0; 8];
+        let n = value.to_bytes(&mut bytes);
+        for &b in bytes.get(..n).unwrap_or_default() {
+            self.byte(b);
+        }
+        self
+    }
+
     fn bytes(&self) -> &[u8] {
         self.buf.get(..self.len).unwrap_or_default()
     }
@@ -105,8 +115,19 @@ impl Reader<'_> {
     }
 
     fn angle(&mut self) -> Option<Angle> {
-        self.word()
-            .map(|w| Angle::from_millidegrees(w.cast_signed()))
+        let (bytes, rest) = self.0.split_at_checked(<Angle as FieldValue>::MAX_LEN)?;
+        self.0 = rest;
+        Angle::from_bytes(bytes)
+    }
+
+    /// An angle that ends the value, if it is there (a wake's or a presence
+    /// sensor's direction).
+    fn optional_angle(&mut self) -> Option<Option<Angle>> {
+        if self.0.is_empty() {
+            Some(None)
+        } else {
+            self.angle().map(Some)
+        }
     }
 
     /// The value, if nothing is left over.
@@ -128,12 +149,7 @@ fn write_action(action: &Action, b: &mut Bytes) {
                 | u8::from(g.cycles.is_some()) << 2
                 | u8::from(g.intensity.is_some()) << 3;
             b.byte(0).byte(g.kind.row().settings).byte(mask);
-            b.word(
-                g.amplitude
-                    .unwrap_or(Angle::ZERO)
-                    .millidegrees()
-                    .cast_unsigned(),
-            );
+            b.value(&g.amplitude.unwrap_or(Angle::ZERO));
             b.word(g.duration.unwrap_or(Millis(0)).0);
             b.byte(g.cycles.unwrap_or(0));
             b.byte(g.intensity.map_or(0, Percent::get));
@@ -141,16 +157,9 @@ fn write_action(action: &Action, b: &mut Bytes) {
         Action::Look(l) => {
             let mask = u8::from(l.duration.is_some()) | u8::from(l.hold.is_some()) << 1;
             b.byte(1).byte(mask);
-            b.word(l.pitch.millidegrees().cast_unsigned());
-            b.word(l.yaw.millidegrees().cast_unsigned());
+            b.value(&l.pitch).value(&l.yaw);
             b.word(l.duration.unwrap_or(Millis(0)).0);
-            let mut hold = [0; 5];
-            l.hold
-                .unwrap_or(Hold::Return(Millis(0)))
-                .to_bytes(&mut hold);
-            for byte in hold {
-                b.byte(byte);
-            }
+            b.value(&l.hold.unwrap_or(Hold::Return(Millis(0))));
         }
         Action::Center { duration } => {
             b.byte(2).byte(u8::from(duration.is_some()));
@@ -171,7 +180,7 @@ fn write_action(action: &Action, b: &mut Bytes) {
         Action::Wake { toward } => {
             b.byte(7);
             if let Some(yaw) = toward {
-                b.word(yaw.millidegrees().cast_unsigned());
+                b.value(&yaw);
             }
         }
     }
@@ -235,11 +244,7 @@ fn read_action(r: &mut Reader<'_>) -> Option<Action> {
         5 => Action::Stop,
         6 => Action::Rest,
         7 => Action::Wake {
-            toward: if r.0.is_empty() {
-                None
-            } else {
-                Some(r.angle()?)
-            },
+            toward: r.optional_angle()?,
         },
         _ => return None,
     };
@@ -275,7 +280,7 @@ impl FieldValue for InputRole {
             }
             Self::Presence { toward } => {
                 if let Some(yaw) = toward {
-                    b.word(yaw.millidegrees().cast_unsigned());
+                    b.value(yaw);
                 }
                 &[2]
             }
@@ -291,11 +296,7 @@ impl FieldValue for InputRole {
             0 => Self::Off,
             1 => Self::Button(read_action(&mut r)?),
             2 => Self::Presence {
-                toward: if r.0.is_empty() {
-                    None
-                } else {
-                    Some(r.angle()?)
-                },
+                toward: r.optional_angle()?,
             },
             _ => return None,
         };
