@@ -121,12 +121,12 @@ impl Reader<'_> {
     }
 
     /// An angle that ends the value, if it is there (a wake's or a presence
-    /// sensor's direction).
-    fn optional_angle(&mut self) -> Option<Option<Angle>> {
+    /// sensor's direction); `Err` for bytes that are no angle.
+    fn optional_angle(&mut self) -> Result<Option<Angle>, ()> {
         if self.0.is_empty() {
-            Some(None)
+            Ok(None)
         } else {
-            self.angle().map(Some)
+            self.angle().map(Some).ok_or(())
         }
     }
 
@@ -244,7 +244,7 @@ fn read_action(r: &mut Reader<'_>) -> Option<Action> {
         5 => Action::Stop,
         6 => Action::Rest,
         7 => Action::Wake {
-            toward: r.optional_angle()?,
+            toward: r.optional_angle().ok()?,
         },
         _ => return None,
     };
@@ -296,7 +296,7 @@ impl FieldValue for InputRole {
             0 => Self::Off,
             1 => Self::Button(read_action(&mut r)?),
             2 => Self::Presence {
-                toward: r.optional_angle()?,
+                toward: r.optional_angle().ok()?,
             },
             _ => return None,
         };
