@@ -6,7 +6,7 @@ use idle_head_core::behaviour::{
     Applied, BehaviourConfig, BehaviourParams, Head, LOOP_DURATION, LimitMode, RestState,
 };
 use idle_head_core::command::Action;
-use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, HeadTrajectories, Integral16};
 use idle_head_core::motion::{Lcg, Trajectory};
 use idle_head_core::playback::Player;
@@ -70,6 +70,54 @@ pub fn loops(seed: Option<u32>) -> &'static Loops {
     })
 }
 
+/// The idle of the loops of `seed` (see [`loops`]) played at `driver`'s
+/// frame period.
+///
+/// # Panics
+/// If the playback of the built-in loop length is refused.
+#[must_use]
+pub fn idle(driver: &DriverParams, seed: Option<u32>) -> Idle {
+    let playback = Playback::new(LOOP_DURATION, driver.config().frame_period, DEFAULT_N)
+        .expect("the default playback");
+    let trajectories = loops(seed);
+    Player::new(playback, Axis::ALL.map(|axis| trajectories.axis(axis)))
+}
+
+/// Asserts that every step and change of step of `frames` (angles, m°, and
+/// the limit modes each axis had, one entry a frame of 20 ms) is within
+/// the speed and acceleration limits of `behaviour` for that mode (+1 m°
+/// and +2 m° for rounding): the limiter's guarantee.
+///
+/// # Panics
+/// At the first frame past them.
+pub fn assert_steps_within_limits(
+    behaviour: &BehaviourParams,
+    frames: &[([i32; 3], [LimitMode; 3])],
+) {
+    for axis in Axis::ALL {
+        let i = axis.index();
+        for (k, w) in frames.windows(3).enumerate() {
+            let limits = behaviour.limits(axis, w[2].1[i]);
+            // deg/s · 20 ms, deg/s² · (20 ms)², in m°.
+            let step = i64::from(limits.max_speed.0) * 20 + 1;
+            let turn = i64::from(limits.max_accel.0) * 2 / 5 + 2;
+            let [a, b, c] = [w[0].0, w[1].0, w[2].0].map(|angles| i64::from(angles[i]));
+            assert!(
+                (c - b).abs() <= step,
+                "{axis:?} frame {}: step {}",
+                k + 2,
+                c - b
+            );
+            assert!(
+                (c - 2 * b + a).abs() <= turn,
+                "{axis:?} frame {}: Δ² {}",
+                k + 2,
+                c - 2 * b + a
+            );
+        }
+    }
+}
+
 impl Rig {
     /// The built-in behaviour, the Table 2 loops.
     #[must_use]
@@ -82,12 +130,8 @@ impl Rig {
     pub fn with(config: BehaviourConfig, seed: Option<u32>) -> Self {
         let driver = DriverConfig::DEFAULT.build().expect("the default driver");
         let behaviour: BehaviourParams = config.build(&driver).expect("a valid behaviour");
-        let playback = Playback::new(LOOP_DURATION, driver.config().frame_period, DEFAULT_N)
-            .expect("the default playback");
-        let trajectories = loops(seed);
-        let idle = Player::new(playback, Axis::ALL.map(|axis| trajectories.axis(axis)));
         Self {
-            head: Head::new(idle, behaviour),
+            head: Head::new(idle(&driver, seed), behaviour),
             driver: FrameDriver::new(
                 [
                     Recorder::new(20_000),

@@ -4,34 +4,18 @@
 //! and console ports fill. Every frame within the speed and acceleration
 //! limits of the mode its axis had.
 
+use host_tests::rig::assert_steps_within_limits;
 use host_tests::{Recorder, params};
+use idle_head_core::Axis;
 use idle_head_core::behaviour::{
-    BehaviourConfig, BehaviourParams, Head, LOOP_DURATION, LimitMode, ShowEvents, ShowLink, Source,
+    BehaviourConfig, BehaviourParams, Head, LimitMode, ShowEvents, ShowLink, Source,
 };
 use idle_head_core::bottango::{Curve, Op, line::CurveArgs};
 use idle_head_core::command::{Action, GestureKind};
 use idle_head_core::dmx::{Counters, Cue, DmxAddress, DmxSettings, Signal};
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16};
-use idle_head_core::playback::Player;
-use idle_head_core::{Axis, Playback};
 
-fn loops() -> &'static HeadTrajectories<Integral16, DEFAULT_N> {
-    use std::sync::OnceLock;
-    static LOOPS: OnceLock<Box<HeadTrajectories<Integral16, DEFAULT_N>>> = OnceLock::new();
-    LOOPS.get_or_init(|| {
-        let mut head = Box::new(HeadTrajectories::new());
-        head.generate(&DEFAULT_HEAD).unwrap();
-        head
-    })
-}
-
-type Idle = Player<'static, idle_head_core::motion::Trajectory<Integral16, DEFAULT_N>>;
-
-fn idle(driver: &DriverParams) -> Idle {
-    let playback = Playback::new(LOOP_DURATION, driver.config().frame_period, DEFAULT_N).unwrap();
-    Player::new(playback, Axis::ALL.map(|axis| loops().axis(axis)))
-}
+type Idle = host_tests::rig::Idle;
 
 fn behaviour(driver: &DriverParams) -> BehaviourParams {
     BehaviourConfig::DEFAULT.build(driver).unwrap()
@@ -53,12 +37,10 @@ struct Played {
 struct Rig {
     head: Head<Idle>,
     driver: FrameDriver<Recorder>,
-    twin: Head<Idle>,
-    twin_driver: FrameDriver<Recorder>,
+    twin: host_tests::rig::Rig,
     link: &'static ShowLink,
     frame: u64,
     played: Vec<Played>,
-    own: Vec<[i32; 3]>,
 }
 
 impl Rig {
@@ -68,14 +50,12 @@ impl Rig {
         let link: &'static ShowLink = Box::leak(Box::new(ShowLink::new()));
         link.dmx.set(DmxSettings::DEFAULT);
         Self {
-            head: Head::new(idle(&driver), behaviour(&driver)),
+            head: Head::new(host_tests::rig::idle(&driver, None), behaviour(&driver)),
             driver: FrameDriver::new(channels(), driver),
-            twin: Head::new(idle(&driver), behaviour(&driver)),
-            twin_driver: FrameDriver::new(channels(), driver),
+            twin: host_tests::rig::Rig::new(),
             link,
             frame: 0,
             played: Vec::new(),
-            own: Vec::new(),
         }
     }
 
@@ -97,9 +77,7 @@ impl Rig {
                 modes,
                 events,
             });
-            self.twin.sync(&mut self.twin_driver);
-            let own = self.twin.frame(&mut self.twin_driver, self.frame);
-            self.own.push(own.offsets.map(|a| a.millidegrees()));
+            self.twin.run(1);
             self.frame += 1;
         }
     }
@@ -118,6 +96,11 @@ impl Rig {
         }
     }
 
+    /// The offsets of frame `k` of the head on its own (the twin's).
+    fn own(&self, k: usize) -> [i32; 3] {
+        self.twin.played[k].offsets
+    }
+
     fn angle(&self, axis: Axis) -> i32 {
         self.played.last().unwrap().angles[axis.index()]
     }
@@ -126,28 +109,8 @@ impl Rig {
 /// Every frame within the speed and acceleration limits of its axis' mode
 /// (the limiter's guarantee, so also the show layer's).
 fn assert_safe(rig: &Rig) {
-    let behaviour = *rig.head.mixer().params();
-    for axis in Axis::ALL {
-        let i = axis.index();
-        for (k, w) in rig.played.windows(3).enumerate() {
-            let limits = behaviour.limits(axis, w[2].modes[i]);
-            let step = i64::from(limits.max_speed.0) * 20 + 1;
-            let turn = i64::from(limits.max_accel.0) * 2 / 5 + 2;
-            let [a, b, c] = [w[0], w[1], w[2]].map(|p| i64::from(p.angles[i]));
-            assert!(
-                (c - b).abs() <= step,
-                "{axis:?} frame {}: step {}",
-                k + 2,
-                c - b
-            );
-            assert!(
-                (c - 2 * b + a).abs() <= turn,
-                "{axis:?} frame {}: Δ² {}",
-                k + 2,
-                c - 2 * b + a
-            );
-        }
-    }
+    let frames: Vec<_> = rig.played.iter().map(|p| (p.angles, p.modes)).collect();
+    assert_steps_within_limits(rig.head.mixer().params(), &frames);
 }
 
 /// A cue: the yaw coarse slot at `yaw`, the mix at `mix`, idle at full.
@@ -203,7 +166,7 @@ fn dropped_frames_hand_back_to_the_idle_after_a_second_without_a_jump() {
     // ...then the pose hands back over 0.5 s (25 frames): from then on the
     // offsets are the head's own, exactly.
     for k in lost + 26..rig.played.len() {
-        assert_eq!(rig.played[k].offsets, rig.own[k], "frame {k}");
+        assert_eq!(rig.played[k].offsets, rig.own(k), "frame {k}");
     }
     assert_eq!(rig.head.show_source(), Source::None);
     // No jump: the offsets glide from the pose to the head's own, each
@@ -333,14 +296,14 @@ fn a_bottango_curve_plays_and_the_idle_resumes_after_it() {
         let t = (k as u32) * 20 - 3200;
         let want = -20_000 + (40_000 * i64::from(ramp(0, 2000, 0, 8192).at(t)) / 8192) as i32;
         assert!((rig.played[k].offsets[2] - want).abs() <= 6, "frame {k}");
-        assert_eq!(rig.played[k].offsets[0], rig.own[k][0]);
-        assert_eq!(rig.played[k].offsets[1], rig.own[k][1]);
+        assert_eq!(rig.played[k].offsets[0], rig.own(k)[0]);
+        assert_eq!(rig.played[k].offsets[1], rig.own(k)[1]);
     }
     // The curve ends at frame 260; half a second later the head is on its
     // own again, exactly.
     rig.run(120);
     for k in 287..rig.played.len() {
-        assert_eq!(rig.played[k].offsets, rig.own[k], "frame {k}");
+        assert_eq!(rig.played[k].offsets, rig.own(k), "frame {k}");
     }
     assert_eq!(rig.head.show_source(), Source::None);
     assert_safe(&rig);

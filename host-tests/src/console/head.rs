@@ -7,19 +7,16 @@
 use std::convert::Infallible;
 
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
+use idle_head_core::Axis;
 use idle_head_core::behaviour::{
-    Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, LOOP_DURATION, RestState,
-    ShowLink,
+    Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, RestState, ShowLink,
 };
 use idle_head_core::console::{
     ConsoleLink, ConsoleService, HeadMode, HeadStatus, Outcome, Session, outcome_reply, unanswered,
 };
 use idle_head_core::driver::{DriverConfig, FrameDriver};
 use idle_head_core::input::{InputSettings, Inputs, Micros};
-use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16, Trajectory};
-use idle_head_core::playback::Player;
 use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
-use idle_head_core::{Axis, Playback};
 
 /// A PWM channel that keeps the last duty (1 µs per count at 50 Hz).
 #[derive(Debug, Default)]
@@ -49,18 +46,7 @@ pub const OUTCOME_FRAMES: u32 = 5;
 /// 12 s; 50 Hz frames.
 pub const RETURN_FRAMES: u64 = 13 * 50;
 
-type Idle = Player<'static, Trajectory<Integral16, DEFAULT_N>>;
-
-/// The Table 2 loops, generated once.
-fn loops() -> &'static HeadTrajectories<Integral16, DEFAULT_N> {
-    use std::sync::OnceLock;
-    static LOOPS: OnceLock<Box<HeadTrajectories<Integral16, DEFAULT_N>>> = OnceLock::new();
-    LOOPS.get_or_init(|| {
-        let mut head = Box::new(HeadTrajectories::new());
-        head.generate(&DEFAULT_HEAD).expect("the default loops");
-        head
-    })
-}
+type Idle = crate::rig::Idle;
 
 /// The frame side of a simulated head: what the frame task owns.
 pub struct SimFrames {
@@ -104,9 +90,7 @@ impl SimFrames {
     pub fn new() -> Self {
         let config = DriverConfig::DEFAULT;
         let params = config.build().expect("the default driver");
-        let playback =
-            Playback::new(LOOP_DURATION, config.frame_period, DEFAULT_N).expect("playback");
-        let idle = Player::new(playback, Axis::ALL.map(|axis| loops().axis(axis)));
+        let idle = crate::rig::idle(&params, None);
         let behaviour = BehaviourConfig::DEFAULT
             .build(&params)
             .expect("the default behaviour");

@@ -6,107 +6,25 @@
 mod properties;
 
 use embedded_hal_mock::eh1::pwm::Mock;
+use host_tests::rig::{Rig, assert_steps_within_limits};
 use host_tests::{Recorder, params, pwm, writes};
+use idle_head_core::Axis;
 use idle_head_core::behaviour::{
-    Applied, BehaviourConfig, BehaviourParams, CommandQueue, Head, IdleSource, LOOP_DURATION,
-    LimitMode, Mixer, QueueFull,
+    Applied, BehaviourConfig, BehaviourParams, CommandQueue, Head, IdleSource, LimitMode, Mixer,
+    QueueFull,
 };
 use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest};
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Integral16};
-use idle_head_core::playback::Player;
 use idle_head_core::units::{Angle, Millis};
-use idle_head_core::{Axis, Playback};
 
-/// The Table 2 loops, as the firmware keeps them.
-fn loops() -> &'static HeadTrajectories<Integral16, DEFAULT_N> {
-    use std::sync::OnceLock;
-    static LOOPS: OnceLock<Box<HeadTrajectories<Integral16, DEFAULT_N>>> = OnceLock::new();
-    LOOPS.get_or_init(|| {
-        let mut head = Box::new(HeadTrajectories::new());
-        head.generate(&DEFAULT_HEAD).unwrap();
-        head
-    })
-}
-
-type Idle = Player<'static, idle_head_core::motion::Trajectory<Integral16, DEFAULT_N>>;
+type Idle = host_tests::rig::Idle;
 
 fn idle(driver: &DriverParams) -> Idle {
-    let playback = Playback::new(LOOP_DURATION, driver.config().frame_period, DEFAULT_N).unwrap();
-    Player::new(playback, Axis::ALL.map(|axis| loops().axis(axis)))
+    host_tests::rig::idle(driver, None)
 }
 
 fn behaviour(driver: &DriverParams) -> BehaviourParams {
     BehaviourConfig::DEFAULT.build(driver).unwrap()
-}
-
-/// One frame as the servos got it.
-#[derive(Clone, Copy, Debug)]
-struct Played {
-    angles: [i32; 3],
-    pulses: [u32; 3],
-    modes: [LimitMode; 3],
-}
-
-/// A head on the default configuration (50 Hz, 30 s loops, 2 s fade),
-/// driving recorder channels with 1 µs per duty count.
-struct Rig {
-    head: Head<Idle>,
-    driver: FrameDriver<Recorder>,
-    frame: u64,
-    played: Vec<Played>,
-}
-
-impl Rig {
-    fn new() -> Self {
-        Self::with(DriverConfig::DEFAULT)
-    }
-
-    fn with(config: DriverConfig) -> Self {
-        let driver = params(&config);
-        Self::with_behaviour(config, behaviour(&driver))
-    }
-
-    fn with_behaviour(config: DriverConfig, behaviour: BehaviourParams) -> Self {
-        let driver = params(&config);
-        Self {
-            head: Head::new(idle(&driver), behaviour),
-            driver: FrameDriver::new(
-                [
-                    Recorder::new(20_000),
-                    Recorder::new(20_000),
-                    Recorder::new(20_000),
-                ],
-                driver,
-            ),
-            frame: 0,
-            played: Vec::new(),
-        }
-    }
-
-    fn apply(&mut self, action: Action) -> Applied {
-        self.head.apply(&mut self.driver, &action).unwrap()
-    }
-
-    /// Plays `frames` frames, as the frame task does (limits between frames).
-    fn run(&mut self, frames: u64) {
-        for _ in 0..frames {
-            self.head.sync(&mut self.driver);
-            // The limits the driver has for this frame.
-            let modes = self.head.limit_modes();
-            let report = self.head.frame(&mut self.driver, self.frame).report;
-            self.played.push(Played {
-                angles: report.servos.map(|s| s.angle.millidegrees()),
-                pulses: report.servos.map(|s| s.pulse.0),
-                modes,
-            });
-            self.frame += 1;
-        }
-    }
-
-    fn axis(&self, axis: Axis) -> Vec<i32> {
-        self.played.iter().map(|p| p.angles[axis.index()]).collect()
-    }
 }
 
 /// Every frame inside the safety stages: angles within the servo's limits,
@@ -114,7 +32,6 @@ impl Rig {
 /// speed and acceleration limits of the mode the axis had.
 fn assert_safe(rig: &Rig) {
     let cfg = rig.driver.params().config();
-    let behaviour = *rig.head.mixer().params();
     for axis in Axis::ALL {
         let i = axis.index();
         let servo = cfg.servos[i];
@@ -129,26 +46,9 @@ fn assert_safe(rig: &Rig) {
                 p.pulses[i]
             );
         }
-        for (k, w) in rig.played.windows(3).enumerate() {
-            let limits = behaviour.limits(axis, w[2].modes[i]);
-            // deg/s · 20 ms, deg/s² · (20 ms)², in m°; +1 m° for rounding.
-            let step = i64::from(limits.max_speed.0) * 20 + 1;
-            let turn = i64::from(limits.max_accel.0) * 2 / 5 + 2;
-            let [a, b, c] = [w[0], w[1], w[2]].map(|p| i64::from(p.angles[i]));
-            assert!(
-                (c - b).abs() <= step,
-                "{axis:?} frame {}: step {}",
-                k + 2,
-                c - b
-            );
-            assert!(
-                (c - 2 * b + a).abs() <= turn,
-                "{axis:?} frame {}: Δ² {}",
-                k + 2,
-                c - 2 * b + a
-            );
-        }
     }
+    let frames: Vec<_> = rig.played.iter().map(|p| (p.angles, p.modes)).collect();
+    assert_steps_within_limits(rig.head.mixer().params(), &frames);
 }
 
 fn nod(amplitude: i32, ms: u32) -> Action {
@@ -456,10 +356,9 @@ fn idle_limits_wait_until_the_axis_can_stop_within_them() {
     ];
     // Found with the idle at full swing around the look: without the look's
     // duck, as then.
-    let driver = params(&DriverConfig::DEFAULT);
     let mut config = BehaviourConfig::DEFAULT;
     config.gaze.duck = idle_head_core::command::Percent::ZERO;
-    let mut rig = Rig::with_behaviour(DriverConfig::DEFAULT, config.build(&driver).unwrap());
+    let mut rig = Rig::with(config, None);
     rig.run(100);
     for (wait, action) in script {
         rig.run(wait);
