@@ -38,7 +38,7 @@ use std::{fmt::Write as _, path::Path, time::Duration};
 use anyhow::{Context, Result, bail};
 
 use crate::project::Metadata;
-use crate::sim::pulses_csv::{self, Measured};
+use crate::sim::pulses::{self, Measured};
 use crate::sim::{dmx_line, run_shipped};
 
 /// Events per row, at least.
@@ -241,7 +241,7 @@ pub fn dmx(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
             times.len()
         );
     }
-    row("dmx", &events, &pulses_csv::measure(&boot.trains[2]))
+    row("dmx", &events, &pulses::measure(&boot.trains[2]))
 }
 
 /// `latency usb look`: with the idle off, `look` lines over USB move yaw
@@ -273,7 +273,7 @@ pub fn usb_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
             usb.lines().find(|l| !l.starts_with("ok"))
         );
     }
-    row("usb look", &events, &pulses_csv::measure(&boot.trains[2]))
+    row("usb look", &events, &pulses::measure(&boot.trains[2]))
 }
 
 #[cfg(test)]
