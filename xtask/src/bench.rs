@@ -36,7 +36,6 @@ use anyhow::{Context, Result, bail};
 
 mod frame;
 pub mod latency;
-mod latency_input;
 mod telemetry;
 
 pub use frame::FrameRow;
@@ -357,10 +356,10 @@ pub fn command(options: Options) -> Result<bool> {
         }
     };
     // The latency rows: the shipped image in the RP2040 emulator
-    // (`bench/latency.rs`, `bench/latency_input.rs`).
+    // (`bench/latency.rs`).
     println!();
     let mut figures = Vec::new();
-    for path in [latency::dmx, latency::usb_look] {
+    for path in [latency::dmx, latency::usb_look, latency::input_edge] {
         match path(&root, &metadata, crate::sim::WALL) {
             Ok(row) => {
                 print!("{}", row.lines());
@@ -370,16 +369,6 @@ pub fn command(options: Options) -> Result<bool> {
                 println!("latency FAILED: {error:#}");
                 passed = false;
             }
-        }
-    }
-    match latency_input::run(&root, &metadata) {
-        Ok(row) => {
-            print!("{}", row.lines());
-            figures.push(row.figure());
-        }
-        Err(error) => {
-            println!("latency FAILED: {error:#}");
-            passed = false;
         }
     }
     record_latency(figures);
