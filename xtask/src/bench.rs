@@ -44,7 +44,7 @@ use frame::frames_over_budget;
 use crate::figures;
 use crate::{
     args::Options,
-    log::LogLine,
+    log::{LogLine, Run},
     project::{self, Image, Metadata, QEMU},
     qemu::{self, Echo},
     setup,
@@ -287,8 +287,15 @@ pub(crate) fn thousands(value: u64) -> String {
 }
 
 /// Fails if the run or the log is broken, or (unless `no_budget`) if the
-/// default row or a frame row is over its budget.
-pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Result<()> {
+/// default row or a frame row is over its budget. `smoke`: the QEMU smoke
+/// image's plain run, if the caller made it (the telemetry check compares
+/// against it; without, it runs the image itself).
+pub fn run_and_check(
+    root: &Path,
+    metadata: &Metadata,
+    options: Options,
+    smoke: Option<&Run>,
+) -> Result<()> {
     BENCH.build(root)?;
     let elf = BENCH.elf(metadata);
     let run = qemu::run(&elf, options.timeout, Echo::Problems)?;
@@ -318,7 +325,7 @@ pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Resu
     QEMU.build(root)?;
     println!(
         "{}",
-        telemetry::check(&QEMU.elf(metadata), options.timeout)?
+        telemetry::check(&QEMU.elf(metadata), options.timeout, smoke)?
     );
     if let Some(over) = frames_over_budget(&frames) {
         if options.no_budget {
@@ -348,7 +355,7 @@ pub fn command(options: Options) -> Result<bool> {
     setup::ensure_toolchain(&root)?;
     setup::ensure_qemu()?;
     let metadata = project::metadata(&root)?;
-    let mut passed = match run_and_check(&root, &metadata, options) {
+    let mut passed = match run_and_check(&root, &metadata, options, None) {
         Ok(()) => true,
         Err(error) => {
             println!("bench FAILED: {error:#}");
