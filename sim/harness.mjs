@@ -1,6 +1,9 @@
 // Runs a Raspberry Pi Pico flash image in rp2040js and reports what happened
 // as JSON lines on stdout, one event per line. It only reports raw facts;
-// `cargo xtask sim` decodes and checks them.
+// `cargo xtask sim` decodes and checks them. Here: the power-up, the boots
+// and the watchdog's resets, the RTT log, the run loops; beside it, the
+// emulator's gaps (chip.mjs, uart.mjs), the USB host (usb.mjs), DMX512
+// (dmx.mjs), what the outside scripts (script.mjs), the boot ROM (rom.mjs).
 //
 //   node harness.mjs '<config as JSON>'
 //
@@ -74,16 +77,18 @@
 //                                                   ("closed": stdin closed, in a live run)
 
 import { readFileSync } from 'node:fs';
-import { GPIOPinState, RP2040, USBCDC } from 'rp2040js';
+import { RP2040 } from 'rp2040js';
+import { roscRandomBit, sevAsOnTheChip, unmodelledCounter, xipControlAsOnTheChip } from './chip.mjs';
 import { romImage, serveRom } from './rom.mjs';
+import { scripted } from './script.mjs';
 import { uartAsOnTheChip } from './uart.mjs';
+import { usbLink } from './usb.mjs';
 import { dmxLine } from './dmx.mjs';
 
 const cfg = JSON.parse(process.argv[2] ?? '{}');
 const FLASH_START = 0x10000000;
 const RAM_START = 0x20000000;
 const NS_PER_CYCLE = 8; // 125 MHz, as rp2040js's own Simulator assumes
-const OP_SEV = 0xbf40;
 const WATCHDOG_BASE = 0x40058;
 const RTT_WRITE = 36; // offsets in `_SEGGER_RTT`: up-buffer 0's write, read, flags
 const RTT_READ = 40;
@@ -113,6 +118,17 @@ let watchdogFired = null; // {reason, scratch} once the watchdog fires in this b
 let stop = null; // why the run ends, once it does
 const level = new Map(cfg.pins.map((pin) => [pin, false]));
 const now = () => bootNs + mcu.clock.nanos;
+const active = () => {
+  lastActivity = now();
+};
+
+// The parts: the registers rp2040js lacks (chip.mjs), the USB serial port
+// (usb.mjs), what the outside scripts (script.mjs), DMX512 on UART1's RX
+// line (dmx.mjs).
+const unmodelled = unmodelledCounter();
+const usb = usbLink(cfg, { emit, now, active });
+const outside = scripted(cfg, { emit, now, active, chip: () => mcu, boot: () => boot, bootNs: () => bootNs });
+const dmx = cfg.dmx ? dmxLine(cfg.dmx, emit) : null;
 
 // The flash at power-on: the image, and `flash_fill` over it.
 function firstFlash() {
@@ -131,7 +147,7 @@ function powerUp(kept) {
   chip.logger = {
     debug() {},
     info() {},
-    warn: (name, msg) => unmodelled(name, msg) || emit({ ev: 'emu', level: 'warn', msg: `[${name}] ${msg}` }),
+    warn: (name, msg) => unmodelled.note(name, msg) || emit({ ev: 'emu', level: 'warn', msg: `[${name}] ${msg}` }),
     error: (name, msg) => emit({ ev: 'emu', level: 'error', msg: `[${name}] ${msg}` }),
   };
   chip.onBreak = (code) => {
@@ -162,12 +178,12 @@ function powerUp(kept) {
   for (const pin of cfg.pins) {
     chip.gpio[pin].addListener((state) => edge(pin, state === 1));
   }
-  watchInputs(chip);
+  outside.watchInputs(chip);
   uartAsOnTheChip(chip.uart[0], () => now());
   if (dmx) dmx.attach(chip.uart[1], () => now());
   xipControlAsOnTheChip(chip);
   roscRandomBit(chip);
-  if ((cfg.usb || cfg.live) && boot === 0) usbHost(chip);
+  if ((cfg.usb || cfg.live) && boot === 0) usb.attach(chip);
   chip.uart[0].onByte = (byte) => {
     if (uartTx.bytes.length === 0) uartTx.ns = now();
     uartTx.bytes.push(byte);
@@ -182,7 +198,7 @@ function powerUp(kept) {
       if (offset === 0x0c) emit({ ev: 'cc', slice, value: value >>> 0, ns: now() });
       if (offset === 0x00 && (channel.csr & 1) !== on) {
         emit({ ev: 'en', slice, on: !on, ns: now() });
-        if (!on && boot === 0 && slice === scriptCfg?.anchor_slice) anchor(now());
+        if (!on && boot === 0 && slice === outside.anchorSlice) outside.anchor(now());
         // On the chip a channel's output is high while the counter is below
         // the compare value, also right after the enable; rp2040js only
         // raises it at the first wrap. Set it here as the chip does (the
@@ -196,261 +212,8 @@ function powerUp(kept) {
   return chip;
 }
 
-// rp2040js warns at every access to a register it does not model (a read
-// gives 0xffffffff, a write does nothing). They are counted per register
-// instead, and reported once at the end: `cargo xtask sim` tells the known
-// ones from the others.
-const UNMODELLED = /^Unimplemented peripheral (read from|write to) 0x([0-9a-f]+)/;
-const unmodelledCounts = new Map(); // "name op offset" -> {peripheral, op, offset, count}
-function unmodelled(name, msg) {
-  const match = UNMODELLED.exec(msg);
-  if (!match) return false;
-  const op = match[1] === 'read from' ? 'read' : 'write';
-  const offset = parseInt(match[2], 16);
-  const key = `${name} ${op} ${offset}`;
-  const seen = unmodelledCounts.get(key) ?? { peripheral: name, op, offset, count: 0 };
-  seen.count += 1;
-  unmodelledCounts.set(key, seen);
-  return true;
-}
-function emitUnmodelled() {
-  for (const seen of unmodelledCounts.values()) emit({ ev: 'unmodelled', ...seen });
-  unmodelledCounts.clear();
-}
-
-// rp2040js has no XIP control registers (0x14000000..0x14000020): a read
-// gives 0xffffffff. Before a flash operation embassy-rp waits for the XIP
-// stream counter (STREAM_CTR) to reach 0, for ever at 0xffffffff. Here they
-// read as on an idle chip: enabled, no stream, the FIFO empty, the flush
-// done; writes (a flush, a stream set-up) have nothing to act on.
-const XIP_CTRL = 0x14000000;
-const XIP_CTRL_END = 0x14000020;
-const XIP_IDLE = { 0x00: 0x3, 0x08: 0x3 }; // CTRL (enabled), STAT (FIFO empty, flush ready)
-function xipControlAsOnTheChip(chip) {
-  const read = chip.readUint32.bind(chip);
-  chip.readUint32 = (address) => {
-    const a = address >>> 0;
-    return a >= XIP_CTRL && a < XIP_CTRL_END ? XIP_IDLE[a - XIP_CTRL] ?? 0 : read(address);
-  };
-  const write = chip.writeUint32.bind(chip);
-  chip.writeUint32 = (address, value) => {
-    const a = address >>> 0;
-    if (a < XIP_CTRL || a >= XIP_CTRL_END) write(address, value);
-  };
-}
-
-// rp2040js has no ring oscillator: its RANDOMBIT register (ROSC + 0x1c)
-// would read 0xffffffff, one and the same bit for ever. On the chip it is the
-// oscillator's jitter. Here it reads as the bits of a fixed-seed xorshift, so
-// that the firmware sees varied bits and a run still repeats exactly.
-const ROSC_BASE = 0x40060;
-const ROSC_RANDOMBIT = 0x1c;
-function roscRandomBit(chip) {
-  const rosc = chip.peripherals[ROSC_BASE];
-  const read = rosc.readUint32.bind(rosc);
-  let state = 0x2545f491;
-  rosc.readUint32 = (offset) => {
-    if (offset !== ROSC_RANDOMBIT) return read(offset);
-    state ^= state << 13;
-    state ^= state >>> 17;
-    state ^= state << 5;
-    return state & 1;
-  };
-}
-
-// Two gaps of rp2040js's USB device controller and its CDC-ACM host, bridged
-// as the chip and a real host behave:
-// - The controller clears an OUT buffer's AVAILABLE bit as soon as the
-//   firmware sets it, before any packet has arrived. On the chip it stays
-//   set until a packet is in the buffer. embassy-rp waits for the bit to
-//   clear and then reads the buffer with the length it wrote itself (64), so
-//   it reads stale bytes as a packet. Here the bit stays set until the host's
-//   packet is written into the buffer.
-// - The host answers every OUT transfer at once, with a zero-length packet
-//   when it has nothing to send. A real host sends nothing (the device NAKs)
-//   until it has data. Here a transfer waits until there are bytes.
-const EP0_IN_BUFFER_CONTROL = 0x80;
-const EP15_OUT_BUFFER_CONTROL = 0xfc;
-const USB_BUF_CTRL_FULL = 1 << 15;
-const USB_BUF_CTRL_AVAILABLE = 1 << 10;
-function usbHost(chip) {
-  const usb = chip.usbCtrl;
-  const view = chip.usbDPRAMView;
-  const cdc = new USBCDC(usb);
-  const updated = usb.DPRAMUpdated.bind(usb);
-  usb.DPRAMUpdated = (offset, value) => {
-    updated(offset, value);
-    const out = (offset & 4) !== 0;
-    const endpoint = (offset - EP0_IN_BUFFER_CONTROL) >> 3;
-    if (out && endpoint !== 0 && value & USB_BUF_CTRL_AVAILABLE) {
-      if (offset >= EP0_IN_BUFFER_CONTROL && offset <= EP15_OUT_BUFFER_CONTROL) {
-        const now = view.getUint32(offset, true);
-        if (!(now & USB_BUF_CTRL_FULL)) view.setUint32(offset, now | USB_BUF_CTRL_AVAILABLE, true);
-      }
-    }
-  };
-  const finish = usb.finishRead.bind(usb);
-  usb.finishRead = (endpoint, buffer) => {
-    finish(endpoint, buffer);
-    const offset = EP0_IN_BUFFER_CONTROL + endpoint * 8 + 4;
-    view.setUint32(offset, view.getUint32(offset, true) & ~USB_BUF_CTRL_AVAILABLE, true);
-  };
-  const read = usb.onEndpointRead;
-  let waiting = null; // an OUT transfer the host has not answered yet
-  usb.onEndpointRead = (endpoint, size) => {
-    if (endpoint === cdc.outEndpoint && cdc.txFIFO.empty) waiting = { endpoint, size };
-    else read(endpoint, size);
-  };
-  // Its SET_CONTROL_LINE_STATE (DTR and RTS on) goes to the device, where
-  // a real host (and the CDC-ACM class) addresses the communication
-  // interface (bmRequestType 0x21): the device never sees DTR, which says
-  // that a terminal has the port open. Sent as a host sends it.
-  cdc.cdcSetControlLineState = function (value = 0x3, interfaceNumber = 0) {
-    const setup = new Uint8Array([0x21, 0x22, value & 0xff, value >> 8, interfaceNumber, 0, 0, 0]);
-    this.usb.sendSetupPacket(setup);
-    this.initialized = true;
-  };
-  const sendBytes = (bytes) => {
-    for (const byte of bytes) cdc.sendSerialByte(byte);
-    if (waiting && !cdc.txFIFO.empty) {
-      const { endpoint, size } = waiting;
-      waiting = null;
-      read(endpoint, size);
-    }
-  };
-  cdc.onDeviceConnected = () => {
-    emit({ ev: 'usb_connected', ns: now() });
-    usbLines = (value) => cdc.cdcSetControlLineState(value);
-    if (cfg.live) usbLive = sendBytes;
-    else
-      usbSend = (chunk) => {
-        const bytes = Buffer.from(chunk.hex, 'hex');
-        sendBytes(bytes);
-        if (usbChunks.length > 1 || Array.isArray(cfg.usb)) emit({ ev: 'usb_in', ns: now(), n: bytes.length });
-      };
-  };
-  cdc.onSerialData = (bytes) => {
-    emit({ ev: 'usb', ns: now(), hex: Buffer.from(bytes).toString('hex') });
-    lastActivity = now();
-  };
-}
-let usbSend = null; // sends a chunk of the USB script, once the device is configured
-let usbLive = null; // sends bytes from stdin (a live run), once the device is configured
-let usbLines = null; // sets the host's control lines (DTR, RTS), once the device is configured
-const usbChunks = cfg.usb ? [].concat(cfg.usb).sort((a, b) => a.at_ns - b.at_ns) : [];
-const usbDue = () => (usbSend && usbChunks.length ? usbChunks[0].at_ns : Infinity);
-function feedUsb() {
-  while (usbSend && usbChunks.length && now() >= usbChunks[0].at_ns) usbSend(usbChunks.shift());
-  if (!usbChunks.length) usbSend = null;
-}
-
-// DMX512 on UART1's RX line, if scripted (dmx.mjs).
-const dmx = cfg.dmx ? dmxLine(cfg.dmx, emit) : null;
-// The inputs the outside drives (GPIO2..5): at their pads' pull until the
-// script drives them. rp2040js has no model of the pulls for an input:
-// here a pin nobody drives reads high with the pull-up on and low
-// otherwise, as on the chip (no floating inputs), and follows its pad
-// register as the firmware changes it. A level is only set when it
-// changes: rp2040js latches an edge interrupt at every set.
-const inputs = new Map(); // pin -> {driven: null|bool, level: bool}
-function inputLevel(pin, state) {
-  const input = inputs.get(pin);
-  return input.driven ?? state === GPIOPinState.InputPullUp;
-}
-function setInput(chip, pin, level) {
-  const input = inputs.get(pin);
-  if (input.level === level) return;
-  input.level = level;
-  chip.gpio[pin].setInputValue(level);
-}
-function watchInputs(chip) {
-  for (const pin of cfg.inputs ?? []) {
-    // A new chip reads low; what the outside drives it keeps driving.
-    const driven = inputs.get(pin)?.driven ?? null;
-    inputs.set(pin, { driven, level: false });
-    if (driven) setInput(chip, pin, true);
-    chip.gpio[pin].addListener((state) => setInput(chip, pin, inputLevel(pin, state)));
-  }
-}
-
-// Boot 0's script: pin levels and console lines from the first frame on.
-const scriptCfg = cfg.script ?? null;
-let anchorNs = null; // when the first frame went out
-let pinQueue = []; // [{ns, pin, high}], absolute, in order
-function anchor(at) {
-  if (anchorNs !== null || !scriptCfg) return;
-  anchorNs = at;
-  pinQueue = scriptCfg.pins.map((p) => ({ ...p, ns: at + p.at_ns })).sort((a, b) => a.ns - b.ns);
-  // Lines go out at the line rate, one after the other, each in by its
-  // time less `early_ns`: scheduled from the last one back, so that lines
-  // due together go out back to back ahead of their time.
-  const lines = scriptCfg.lines
-    .map((l) => ({ bytes: Buffer.from(l.hex, 'hex'), end: at - bootNs + l.at_ns - scriptCfg.early_ns }))
-    .sort((a, b) => a.end - b.end);
-  let next = Infinity;
-  for (let k = lines.length - 1; k >= 0; k--) {
-    const line = lines[k];
-    line.end = Math.min(line.end, next);
-    line.at_ns = Math.max(0, line.end - line.bytes.length * scriptCfg.byte_ns);
-    next = line.at_ns;
-  }
-  for (const line of lines) Object.assign(line, { boot, byte_ns: scriptCfg.byte_ns });
-  bootScripts.push(...lines);
-  bootScripts.sort((a, b) => a.at_ns - b.at_ns);
-  if (!script || scriptAt === 0) {
-    if (script) bootScripts.unshift(script);
-    bootScripts.sort((a, b) => a.at_ns - b.at_ns);
-    script = bootScripts.shift() ?? null;
-    scriptAt = 0;
-  }
-}
-const pinDue = () => (pinQueue.length ? pinQueue[0].ns : Infinity);
-function feedPins() {
-  while (pinQueue.length && pinQueue[0].ns <= now()) {
-    const { pin, high } = pinQueue.shift();
-    drive(pin, high);
-  }
-}
-/** The outside drives input `pin` (one of `inputs`) high or low. */
-function drive(pin, high) {
-  const input = inputs.get(pin);
-  if (!input) return;
-  input.driven = high;
-  emit({ ev: 'drive', pin, high, ns: now() });
-  setInput(mcu, pin, high);
-  lastActivity = now();
-}
-
-// UART0's scripted RX line (per boot) and the bytes it sent.
-const scripts = (cfg.uart ?? [])
-  .map((s) => ({ ...s, bytes: Buffer.from(s.hex, 'hex') }))
-  .sort((a, b) => a.at_ns - b.at_ns);
-let bootScripts = []; // this boot's, in order
-let script = null; // the one going out
-let scriptAt = 0;
+// UART0's bytes sent (TX), stamped with the first.
 const uartTx = { bytes: [], ns: 0 };
-function uartDue() {
-  if (!script || scriptAt >= script.bytes.length) return Infinity;
-  return bootNs + script.at_ns + scriptAt * script.byte_ns;
-}
-function feedUart() {
-  if (now() < uartDue()) return;
-  const damaged = script.errors?.includes(scriptAt) ?? false;
-  if (!mcu.uart[0].receive(script.bytes[scriptAt], damaged)) {
-    emit({ ev: 'uart_overrun', ns: now() });
-  }
-  scriptAt += 1;
-  lastActivity = now();
-  if (scriptAt === script.bytes.length) {
-    emit({ ev: 'uart_rx', ns: now(), n: scriptAt });
-    script = bootScripts.shift() ?? null;
-    scriptAt = 0;
-  }
-}
-
-// The power cycles still to come.
-const powerCycles = [...(cfg.power_cycles_ns ?? [])].sort((a, b) => a - b);
-const powerCycleDue = () => powerCycles[0] ?? Infinity;
 function flushUart() {
   if (uartTx.bytes.length === 0) return;
   emit({ ev: 'uart', ns: uartTx.ns, hex: Buffer.from(uartTx.bytes).toString('hex') });
@@ -510,9 +273,7 @@ function hex(n) {
 function startBoot(kept) {
   if (mcu) bootNs += mcu.clock.nanos;
   boot += 1;
-  bootScripts = scripts.filter((s) => s.boot === boot);
-  script = bootScripts.shift() ?? null;
-  scriptAt = 0;
+  outside.startBoot(boot);
   mcu = powerUp(kept);
   watchdogFired = null;
   emit({ ev: 'boot', n: boot, ns: bootNs });
@@ -523,6 +284,30 @@ function endBoot() {
   if (cfg.stack) emit({ ev: 'stack', n: boot, low: stackLow() });
 }
 
+// One instruction, the SEV fix after it (chip.mjs).
+function step() {
+  const { core, clock } = mcu;
+  const pc = core.PC;
+  const cycles = core.executeInstruction();
+  instructions++;
+  clock.tick(cycles * NS_PER_CYCLE);
+  sevAsOnTheChip(mcu, pc, FLASH_START, RAM_START);
+}
+
+// rp2040js leaves the reset to its user: the next boot on the chip as the
+// watchdog left it (flash and SRAM, its REASON and SCRATCH registers).
+function resetAfterWatchdog() {
+  emit({ ev: 'watchdog', ns: now(), reason: watchdogFired.reason });
+  endBoot();
+  const kept = {
+    flash: mcu.flash.slice(),
+    sram: mcu.sram.slice(),
+    reason: watchdogFired.reason,
+    scratch: watchdogFired.scratch,
+  };
+  startBoot(kept);
+}
+
 function run() {
   startBoot({ flash: firstFlash() });
   let call = null; // {ret, cycles} while the probed function runs
@@ -531,9 +316,9 @@ function run() {
     for (let i = 0; i < 4096 && !stop && !watchdogFired; i++) {
       if (core.waiting) {
         let wait = clock.nanosToNextAlarm;
-        const due = uartDue() - now(); // asleep until the next scripted byte at the latest
+        const due = outside.uartDue() - now(); // asleep until the next scripted byte at the latest
         if (due <= 0) {
-          feedUart();
+          outside.feedUart();
           continue;
         }
         if (due !== Infinity && (wait <= 0 || due < wait)) wait = due;
@@ -543,19 +328,19 @@ function run() {
           continue;
         }
         if (sending !== Infinity && (wait <= 0 || sending < wait)) wait = sending;
-        const more = Math.min(dmx ? dmx.due() : Infinity, usbDue()) - now(); // DMX, USB
+        const more = Math.min(dmx ? dmx.due() : Infinity, usb.due()) - now(); // DMX, USB
         if (more <= 0) {
           if (dmx) dmx.feed();
-          if (usbSend) feedUsb();
+          if (usb.send) usb.feed();
           continue;
         }
         if (more !== Infinity && (wait <= 0 || more < wait)) wait = more;
-        const cycle = powerCycleDue() - now();
+        const cycle = outside.powerCycleDue() - now();
         if (cycle <= 0) break;
         if (cycle !== Infinity && (wait <= 0 || cycle < wait)) wait = cycle;
-        const driving = pinDue() - now(); // asleep until the next scripted pin at the latest
+        const driving = outside.pinDue() - now(); // asleep until the next scripted pin at the latest
         if (driving <= 0) {
-          feedPins();
+          outside.feedPins();
           continue;
         }
         if (driving !== Infinity && (wait <= 0 || driving < wait)) wait = driving;
@@ -572,40 +357,25 @@ function run() {
         emit({ ev: 'call', cycles: core.cycles - call.cycles, ns: now() });
         call = null;
       }
-      const cycles = core.executeInstruction();
-      instructions++;
-      clock.tick(cycles * NS_PER_CYCLE);
-      // rp2040js treats SEV as a no-op; on one core it sets the core's own
-      // event register, so that the next WFE returns at once.
-      const inFlash = pc >= FLASH_START && pc < RAM_START;
-      const opcode = inFlash ? mcu.flash16[(pc - FLASH_START) >>> 1] : mcu.readUint16(pc);
-      if (opcode === OP_SEV) core.eventRegistered = true;
+      step();
       if ((i & 63) === 0 && cfg.rtt) drainRtt();
-      if ((i & 15) === 0 && (cfg.uart || scriptCfg)) feedUart();
-      if ((i & 15) === 0 && pinQueue.length) feedPins();
+      if ((i & 15) === 0 && (cfg.uart || cfg.script)) outside.feedUart();
+      if ((i & 15) === 0 && outside.pinsQueued()) outside.feedPins();
       if ((i & 15) === 0) mcu.uart[0].sendDue();
-      if ((i & 255) === 0 && usbSend) feedUsb();
+      if ((i & 255) === 0 && usb.send) usb.feed();
       if ((i & 15) === 0 && dmx) dmx.feed();
-      if ((i & 255) === 0 && now() >= powerCycleDue()) break;
+      if ((i & 255) === 0 && now() >= outside.powerCycleDue()) break;
     }
     if (cfg.rtt) drainRtt();
     flushRtt();
     flushUart();
     if (watchdogFired) {
-      emit({ ev: 'watchdog', ns: now(), reason: watchdogFired.reason });
-      endBoot();
-      const kept = {
-        flash: mcu.flash.slice(),
-        sram: mcu.sram.slice(),
-        reason: watchdogFired.reason,
-        scratch: watchdogFired.scratch,
-      };
       call = null;
-      startBoot(kept);
+      resetAfterWatchdog();
       continue;
     }
-    if (now() >= powerCycleDue()) {
-      powerCycles.shift();
+    if (now() >= outside.powerCycleDue()) {
+      outside.powerCycled();
       emit({ ev: 'power_cycle', ns: now() });
       endBoot();
       call = null;
@@ -618,7 +388,7 @@ function run() {
     else if (Date.now() - started > cfg.wall_ms) stop = 'wall';
   }
   endBoot();
-  emitUnmodelled();
+  unmodelled.report(emit);
   emit({ ev: 'end', why: stop, ns: now(), instructions, wall_ms: Date.now() - started });
   flush();
 }
@@ -651,9 +421,9 @@ async function runLive() {
   const t0 = process.hrtime.bigint();
   const wallNs = () => Number(process.hrtime.bigint() - t0);
   while (!stop) {
-    if (usbLive && pending.length) usbLive(pending.splice(0));
-    if (usbLines && controls.length) usbLines(controls.shift());
-    for (const [pin, high] of drives.splice(0)) drive(pin, high);
+    if (usb.live && pending.length) usb.live(pending.splice(0));
+    if (usb.lines && controls.length) usb.lines(controls.shift());
+    for (const [pin, high] of drives.splice(0)) outside.drive(pin, high);
     const until = wallNs() + AHEAD_NS;
     const { core, clock } = mcu;
     while (!stop && !watchdogFired && now() < until) {
@@ -671,13 +441,7 @@ async function runLive() {
         clock.tick(step);
         continue;
       }
-      const pc = core.PC;
-      const cycles = core.executeInstruction();
-      instructions++;
-      clock.tick(cycles * NS_PER_CYCLE);
-      const inFlash = pc >= FLASH_START && pc < RAM_START;
-      const opcode = inFlash ? mcu.flash16[(pc - FLASH_START) >>> 1] : mcu.readUint16(pc);
-      if (opcode === OP_SEV) core.eventRegistered = true;
+      step();
       if ((instructions & 63) === 0 && cfg.rtt) drainRtt();
       if ((instructions & 15) === 0) mcu.uart[0].sendDue();
     }
@@ -686,20 +450,13 @@ async function runLive() {
     flushUart();
     flush();
     if (watchdogFired) {
-      emit({ ev: 'watchdog', ns: now(), reason: watchdogFired.reason });
-      const kept = {
-        flash: mcu.flash.slice(),
-        sram: mcu.sram.slice(),
-        reason: watchdogFired.reason,
-        scratch: watchdogFired.scratch,
-      };
-      startBoot(kept);
+      resetAfterWatchdog();
       continue;
     }
     const ahead = (now() - wallNs()) / 1e6;
     await new Promise((resolve) => setTimeout(resolve, Math.max(0, ahead)));
   }
-  emitUnmodelled();
+  unmodelled.report(emit);
   emit({ ev: 'end', why: stop, ns: now(), instructions, wall_ms: Date.now() - started });
   flush();
   process.exit(0);
@@ -709,7 +466,7 @@ try {
   if (cfg.live) await runLive();
   else run();
 } catch (error) {
-  emitUnmodelled();
+  unmodelled.report(emit);
   emit({ ev: 'end', why: 'error', msg: String(error?.stack ?? error), ns: mcu ? now() : 0, instructions, wall_ms: Date.now() - started });
   flush();
   process.exitCode = 1;

@@ -36,7 +36,6 @@ use anyhow::{Context, Result, bail};
 
 mod frame;
 pub mod latency;
-mod latency_input;
 mod telemetry;
 
 pub use frame::FrameRow;
@@ -45,7 +44,7 @@ use frame::frames_over_budget;
 use crate::figures;
 use crate::{
     args::Options,
-    log::LogLine,
+    log::{LogLine, Run},
     project::{self, Image, Metadata, QEMU},
     qemu::{self, Echo},
     setup,
@@ -288,8 +287,15 @@ pub(crate) fn thousands(value: u64) -> String {
 }
 
 /// Fails if the run or the log is broken, or (unless `no_budget`) if the
-/// default row or a frame row is over its budget.
-pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Result<()> {
+/// default row or a frame row is over its budget. `smoke`: the QEMU smoke
+/// image's plain run, if the caller made it (the telemetry check compares
+/// against it; without, it runs the image itself).
+pub fn run_and_check(
+    root: &Path,
+    metadata: &Metadata,
+    options: Options,
+    smoke: Option<&Run>,
+) -> Result<()> {
     BENCH.build(root)?;
     let elf = BENCH.elf(metadata);
     let run = qemu::run(&elf, options.timeout, Echo::Problems)?;
@@ -319,7 +325,7 @@ pub fn run_and_check(root: &Path, metadata: &Metadata, options: Options) -> Resu
     QEMU.build(root)?;
     println!(
         "{}",
-        telemetry::check(&QEMU.elf(metadata), options.timeout)?
+        telemetry::check(&QEMU.elf(metadata), options.timeout, smoke)?
     );
     if let Some(over) = frames_over_budget(&frames) {
         if options.no_budget {
@@ -349,7 +355,7 @@ pub fn command(options: Options) -> Result<bool> {
     setup::ensure_toolchain(&root)?;
     setup::ensure_qemu()?;
     let metadata = project::metadata(&root)?;
-    let mut passed = match run_and_check(&root, &metadata, options) {
+    let mut passed = match run_and_check(&root, &metadata, options, None) {
         Ok(()) => true,
         Err(error) => {
             println!("bench FAILED: {error:#}");
@@ -357,10 +363,10 @@ pub fn command(options: Options) -> Result<bool> {
         }
     };
     // The latency rows: the shipped image in the RP2040 emulator
-    // (`bench/latency.rs`, `bench/latency_input.rs`).
+    // (`bench/latency.rs`).
     println!();
     let mut figures = Vec::new();
-    for path in [latency::dmx, latency::usb_look] {
+    for path in [latency::dmx, latency::usb_look, latency::input_edge] {
         match path(&root, &metadata, crate::sim::WALL) {
             Ok(row) => {
                 print!("{}", row.lines());
@@ -370,16 +376,6 @@ pub fn command(options: Options) -> Result<bool> {
                 println!("latency FAILED: {error:#}");
                 passed = false;
             }
-        }
-    }
-    match latency_input::run(&root, &metadata) {
-        Ok(row) => {
-            print!("{}", row.lines());
-            figures.push(row.figure());
-        }
-        Err(error) => {
-            println!("latency FAILED: {error:#}");
-            passed = false;
         }
     }
     record_latency(figures);

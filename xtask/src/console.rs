@@ -168,6 +168,19 @@ fn pick_pico(ports: &[serialport::SerialPortInfo]) -> Result<PathBuf> {
     }
 }
 
+/// The serial port at `path`, 115200 8N1, a read giving up after
+/// `timeout`.
+pub(crate) fn open_port(path: &Path, timeout: Duration) -> Result<Box<dyn serialport::SerialPort>> {
+    let name = path.to_string_lossy();
+    serialport::new(name.as_ref(), 115_200)
+        .data_bits(serialport::DataBits::Eight)
+        .parity(serialport::Parity::None)
+        .stop_bits(serialport::StopBits::One)
+        .timeout(timeout)
+        .open()
+        .with_context(|| format!("opening {name}"))
+}
+
 /// `input` to the port and its replies to `on_reply`, one line each
 /// ([`talk::converse`]).
 fn serial_session(
@@ -176,14 +189,7 @@ fn serial_session(
     mut on_reply: impl FnMut(&[u8]) + Send,
     wait: Duration,
 ) -> Result<Talk> {
-    let name = port.to_string_lossy();
-    let mut serial = serialport::new(name.as_ref(), 115_200)
-        .data_bits(serialport::DataBits::Eight)
-        .parity(serialport::Parity::None)
-        .stop_bits(serialport::StopBits::One)
-        .timeout(Duration::from_millis(100))
-        .open()
-        .with_context(|| format!("opening {name}"))?;
+    let mut serial = open_port(port, Duration::from_millis(100))?;
     let reader = serial.try_clone().context("a second handle on the port")?;
     // The reader ends at its next read timeout once the session is over.
     Ok(talk::converse(

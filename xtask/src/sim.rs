@@ -20,8 +20,8 @@ pub mod live;
 pub(crate) mod node;
 mod noise;
 mod planted;
-mod pulses;
-pub mod pulses_csv;
+pub mod pulses;
+mod pulses_csv;
 mod run;
 mod script;
 mod show;
@@ -148,7 +148,7 @@ pub struct Args {
     /// The show control run instead (the stage of `cargo xtask test`): DMX
     /// frames into GP9 and a Bottango session over USB, each checked from
     /// the pulses on the servo pins (see `xtask/src/sim/show.rs`).
-    #[arg(long, conflicts_with_all = ["drill", "console", "store", "noise", "flood", "dmx", "pulses", "script"])]
+    #[arg(long, conflicts_with_all = ["drill", "console", "store", "noise", "flood", "dmx", "script"])]
     pub show: bool,
     /// Play DMX512 into GP9 (UART1 RX): FILE has lines `<s> <slot>=<value>
     /// …` (slots relative to the head's address, 1-based; values hold until
@@ -162,8 +162,9 @@ pub struct Args {
     /// host trace of it. Without `--seconds`, to 5 s after its last line.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood"])]
     pub script: Option<PathBuf>,
-    /// With `--script` or `--dmx`: write the pulses measured on GP16, GP18
-    /// and GP20 to this CSV, one row per frame: `t_ms,pitch_us,roll_us,yaw_us`.
+    /// With `--script`, `--dmx` or `--show` (or alone: the plain run, the
+    /// pulses not checked): write the pulses measured on GP16, GP18 and GP20
+    /// to this CSV, one row per frame: `t_ms,pitch_us,roll_us,yaw_us`.
     #[arg(long, value_name = "FILE.csv", conflicts_with_all = ["drill", "console", "store", "noise", "flood"])]
     pub pulses: Option<PathBuf>,
 }
@@ -253,7 +254,10 @@ pub fn command(args: &Args) -> Result<bool> {
         ));
     }
     if args.show {
-        return Ok(passed("show control", show::test_show(&root, &metadata)));
+        return Ok(passed(
+            "show control",
+            show::show(&root, &metadata, args.pulses.as_deref()),
+        ));
     }
     if args.dmx.is_some() || args.pulses.is_some() {
         return show::command(&root, &metadata, args);

@@ -178,10 +178,11 @@ pub fn command(options: Options) -> Result<bool> {
     // with the peak stack measured there.
     sim_stages(&mut stages, &root, &metadata, pico_built, qemu_run.as_ref());
 
-    // 5. The boot-time benchmark in QEMU and the default set's instruction budget.
+    // 5. The boot-time benchmark in QEMU and the default set's instruction
+    // budget; its telemetry check compares against the QEMU run above.
     stages.run(bench::STAGE, || {
         setup::ensure_qemu()?;
-        bench::run_and_check(&root, &metadata, options)
+        bench::run_and_check(&root, &metadata, options, qemu_run.as_ref())
     });
 
     // The panel in a real browser (Chromium, headless).

@@ -13,7 +13,7 @@
 //!
 //! - its time: when the input has fully arrived (the path's own: the end of
 //!   the DMX frame that carries the change, the moment the USB host hands
-//!   over the line's last byte);
+//!   over the line's last byte, the harness driving a button's pin low);
 //! - the baseline: the axis at rest before it, the last two pulses before
 //!   the event of equal width (an event whose axis still moves is skipped
 //!   and counted);
@@ -30,16 +30,40 @@
 //!
 //! The goal is p99 within 25 ms (a frame and the transport); the rows
 //! report against it without failing. A path's runs live in a function of
-//! their own below ([`dmx`], [`usb_look`]); another path (an input pin's
-//! edge) adds one the same way, with its own events and axis.
+//! their own below ([`dmx`], [`usb_look`], [`input_edge`]); another path
+//! adds one the same way, with its own events and axis.
+//!
+//! # An input edge
+//!
+//! The `input edge` row plays a script (`sim --script`'s): the idle off (so
+//! that a pulse moves only because of a press), two buttons, GP2 and GP3,
+//! each with a short look (`look 0 2000 100 hold=stay`, and back to 0),
+//! pressed in turn 150 to 170 ms apart and released 30 ms later. Every
+//! pulse of the run is checked as well (`sim::script`): each carries its
+//! own frame's duty, on time, within the servos' limits; and every press
+//! must move the head. (Not against the host trace frame for frame: at
+//! random phases some debounced edges land within microseconds of a frame,
+//! where the board's input task and the host's model may disagree by a
+//! frame.)
+//!
+//! Where its time goes: the button's debounce ([`BUTTON_DEBOUNCE`], 5 ms);
+//! the wait for the next frame, which takes the action from the queue (0
+//! to 20 ms); the look's first frame, which plays the position it starts
+//! from (a look and a move to the centre start at the next frame: begun a
+//! frame earlier, as gestures are, the gesture + look frame row goes over
+//! its ceiling: 20 ms); and the PWM's latch, which puts a frame's duty out
+//! at the next period, 2 ms after the frame is written. About 27 to 47 ms
+//! in all: the row misses the goal, and says why.
+//!
+//! [`BUTTON_DEBOUNCE`]: idle_head_core::input::BUTTON_DEBOUNCE
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
 use anyhow::{Context, Result, bail};
 
 use crate::project::Metadata;
-use crate::sim::pulses_csv::{self, Measured};
-use crate::sim::{dmx_line, run_shipped};
+use crate::sim::pulses::{self, Measured};
+use crate::sim::{dmx_line, parse_script, play_script, run_shipped, script_time};
 
 /// Events per row, at least.
 pub const EVENTS: usize = 1000;
@@ -52,11 +76,23 @@ const DMX_GAP: (Duration, Duration) = (Duration::from_millis(80), Duration::from
 /// The gaps between `look` events: a move starts a frame after the line and
 /// takes two more.
 const LOOK_GAP: (Duration, Duration) = (Duration::from_millis(110), Duration::from_millis(160));
+/// The gaps between presses: a look of 100 ms and its start (up to 47 ms)
+/// are over before the next.
+const PRESS_GAP: (Duration, Duration) = (Duration::from_millis(150), Duration::from_millis(170));
+/// How long a button is held.
+const HELD: Duration = Duration::from_millis(30);
+/// The input edge's run plays a script, and computes its host trace: more
+/// wall time than the others, at least.
+const SCRIPT_WALL: Duration = Duration::from_secs(600);
+/// Where the input edge's time goes (see the [module docs](self)).
+const INPUT_EDGE_TIME: &str = "debounce 5 ms, the wait for the next frame 0..20 ms, the look's \
+     first frame (it plays the position it starts from) 20 ms, the PWM's latch to the next \
+     period 2 ms";
 
 /// One latency row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Row {
-    /// `dmx`, `usb look`.
+    /// `dmx`, `usb look`, `input edge`.
     pub name: &'static str,
     /// Latencies, ms, sorted.
     pub ms: Vec<f64>,
@@ -66,6 +102,8 @@ pub struct Row {
     pub phases: [usize; 5],
     /// The three slowest events: when (s) and their latency (ms).
     pub worst: Vec<(f64, f64)>,
+    /// Where the time goes, said when the goal is missed.
+    pub why: Option<&'static str>,
 }
 
 impl Row {
@@ -121,6 +159,9 @@ impl Row {
                 .collect::<Vec<_>>()
                 .join(", ")
         );
+        if let Some(why) = self.why.filter(|_| self.percentile(99.0) > GOAL_MS) {
+            let _ = writeln!(text, "  (where the time goes: {why})");
+        }
         text
     }
 }
@@ -177,7 +218,7 @@ pub fn response(pulses: &[Measured], at: f64, count_ns: f64) -> Response {
         .map_or(Response::Never, |p| Response::After((p.rise - at) / 1e6))
 }
 
-/// The row of `events` (ns) on the pulses of `axis`.
+/// The row of `events` (ns) on an axis' `pulses`.
 fn row(name: &'static str, events: &[f64], pulses: &[Measured]) -> Result<Row> {
     let count_ns = crate::sim::count_ns();
     let mut ms = Vec::new();
@@ -213,6 +254,7 @@ fn row(name: &'static str, events: &[f64], pulses: &[Measured]) -> Result<Row> {
         skipped,
         phases,
         worst,
+        why: None,
     })
 }
 
@@ -241,7 +283,7 @@ pub fn dmx(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
             times.len()
         );
     }
-    row("dmx", &events, &pulses_csv::measure(&boot.trains[2]))
+    row("dmx", &events, &pulses::measure(&boot.trains[2]))
 }
 
 /// `latency usb look`: with the idle off, `look` lines over USB move yaw
@@ -273,7 +315,53 @@ pub fn usb_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
             usb.lines().find(|l| !l.starts_with("ok"))
         );
     }
-    row("usb look", &events, &pulses_csv::measure(&boot.trains[2]))
+    row("usb look", &events, &pulses::measure(&boot.trains[2]))
+}
+
+/// `latency input edge`: with the idle off, two buttons with a look each
+/// pressed in turn; each press's edge against yaw's first pulse that
+/// moves (see the [module docs](self)).
+pub fn input_edge(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
+    let times = schedule(Duration::from_secs(2), SCHEDULED, PRESS_GAP, 0x2545_f491);
+    let events = parse_script(&press_script(&times))?;
+    let time = script_time(&events);
+    let report = play_script(root, metadata, events, time, wall.max(SCRIPT_WALL))?;
+    if !report.problems.is_empty() {
+        bail!(
+            "the input edge's run failed its checks:\n  {}",
+            report.problems.join("\n  ")
+        );
+    }
+    let boot = report.boots.first().context("no boot")?;
+    let edges: Vec<f64> = boot
+        .drives
+        .iter()
+        .filter(|&&(_, _, high)| !high)
+        .map(|&(ns, _, _)| ns)
+        .collect();
+    if edges.len() != times.len() {
+        bail!("{} presses went out, not {}", edges.len(), times.len());
+    }
+    Ok(Row {
+        why: Some(INPUT_EDGE_TIME),
+        ..row("input edge", &edges, &pulses::measure(&boot.trains[2]))?
+    })
+}
+
+/// The input edge's script: the idle off (it fades out in a second, before
+/// the first press), two look buttons, a press at each of `times` (from the
+/// first frame), GP2 and GP3 in turn.
+fn press_script(times: &[Duration]) -> String {
+    let mut text = String::from(
+        "0 idle off\n0 input 2 button look 0 2000 100 hold=stay\n0 input 3 button look 0 0 100 hold=stay\n",
+    );
+    let show = |at: Duration| format!("{}.{:06}", at.as_secs(), at.subsec_micros());
+    for (k, &at) in times.iter().enumerate() {
+        let pin = 2 + k % 2;
+        let _ = writeln!(text, "{} pin {pin} low", show(at));
+        let _ = writeln!(text, "{} pin {pin} high", show(at + HELD));
+    }
+    text
 }
 
 #[cfg(test)]
@@ -313,6 +401,7 @@ mod tests {
             skipped: 0,
             phases: [0; 5],
             worst: Vec::new(),
+            why: None,
         };
         assert_eq!((row.percentile(50.0), row.percentile(99.0)), (100.0, 198.0));
         assert!(
@@ -323,6 +412,68 @@ mod tests {
         assert_eq!(times, schedule(Duration::from_secs(1), 100, DMX_GAP, 7));
         for w in times.windows(2) {
             assert!((DMX_GAP.0..DMX_GAP.1).contains(&w[1].saturating_sub(w[0])));
+        }
+    }
+
+    #[test]
+    fn the_input_edge_row_says_where_its_time_goes() {
+        let row = Row {
+            name: "input edge",
+            ms: (1..=100).map(f64::from).collect(),
+            skipped: 0,
+            phases: [0; 5],
+            worst: Vec::new(),
+            why: Some(INPUT_EDGE_TIME),
+        };
+        assert_eq!(
+            (
+                row.percentile(50.0),
+                row.percentile(99.0),
+                row.figure().max_ms,
+                row.figure().events
+            ),
+            (50.0, 99.0, 100.0, 100)
+        );
+        assert_eq!(row.figure().label, "latency input edge");
+        let lines = row.lines();
+        assert!(
+            lines.starts_with(
+                "latency input edge p50=50.0 p99=99.0 max=100.0 events=100 skipped=0\n"
+            )
+        );
+        for part in [
+            "debounce 5 ms",
+            "the wait for the next frame 0..20 ms",
+            "the look's first frame (it plays the position it starts from) 20 ms",
+            "the PWM's latch to the next period 2 ms",
+        ] {
+            assert!(lines.contains(part), "no `{part}` in {lines}");
+        }
+        // Within the goal, the row says nothing of it.
+        let fast = Row {
+            ms: vec![10.0; 100],
+            ..row
+        };
+        assert!(!fast.lines().contains("debounce"));
+    }
+
+    #[test]
+    fn the_script_presses_at_random_phases() {
+        let times = schedule(Duration::from_secs(2), SCHEDULED, PRESS_GAP, 0x2545_f491);
+        let events = parse_script(&press_script(&times)).unwrap();
+        assert_eq!(events.len(), 3 + 2 * SCHEDULED);
+        let presses: Vec<u64> = events[3..].iter().step_by(2).map(|e| e.at_us).collect();
+        let releases = events[4..].iter().step_by(2).map(|e| e.at_us);
+        for (press, release) in presses.iter().zip(releases) {
+            assert_eq!(release - press, 30_000);
+        }
+        for w in presses.windows(2) {
+            assert!((150_000..170_000).contains(&(w[1] - w[0])));
+        }
+        // Spread over the frame: every fifth of it is hit.
+        let phases: Vec<u64> = presses.iter().map(|at| at % 20_000).collect();
+        for fifth in 0..5 {
+            assert!(phases.iter().any(|p| p / 4000 == fifth));
         }
     }
 }

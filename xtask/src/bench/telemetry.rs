@@ -29,7 +29,7 @@ use std::{
 use anyhow::{Context, Result, bail};
 
 use crate::console::{Pace, qemu_session};
-use crate::log::LogLine;
+use crate::log::{LogLine, Run};
 use crate::qemu::{self, Echo};
 
 /// Instructions per `SysTick` count in the smoke run: 12.5 MHz after reset
@@ -79,11 +79,15 @@ fn frame_work(log: &[LogLine]) -> Result<(u64, u64)> {
     }
 }
 
-/// Runs the QEMU smoke image `elf` plain and with `watch 50` streaming;
-/// the bench's line about it, or why the frames were not untouched.
-pub fn check(elf: &Path, timeout: Duration) -> Result<String> {
-    let plain = qemu::run(elf, timeout, Echo::Problems)?;
-    let without = frame_work(&plain.log)?;
+/// Runs the QEMU smoke image `elf` with `watch 50` streaming, against its
+/// plain run: `plain` if the caller made it (`cargo xtask test`'s QEMU
+/// stage), else run here; the bench's line about it, or why the frames
+/// were not untouched.
+pub fn check(elf: &Path, timeout: Duration, plain: Option<&Run>) -> Result<String> {
+    let without = match plain {
+        Some(run) => frame_work(&run.log)?,
+        None => frame_work(&qemu::run(elf, timeout, Echo::Problems)?.log)?,
+    };
     let seen = Arc::new(AtomicUsize::new(0));
     let counted = Arc::clone(&seen);
     let session = qemu_session(

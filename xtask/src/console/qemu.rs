@@ -4,8 +4,8 @@
 use std::{
     io::{BufRead, BufReader, Read, Write},
     os::unix::net::UnixStream,
-    path::Path,
-    process::{Command, Stdio},
+    path::{Path, PathBuf},
+    process::{Child, Command, Stdio},
     thread,
     time::{Duration, Instant},
 };
@@ -77,25 +77,12 @@ pub fn qemu_session(
     let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
     let table = Table::parse(&bytes)?.context("no defmt data in the image")?;
     let locations = table.get_locations(&bytes).ok();
-    let dir = std::env::temp_dir().join(format!("idle-head-console-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let [uart0, uart1] = ["uart0", "uart1"].map(|n| dir.join(format!("{n}.sock")));
-    for path in [&uart0, &uart1] {
-        let _ = std::fs::remove_file(path);
-    }
-    let child = qemu_command(
-        elf,
-        pace,
-        [
-            &format!("unix:{},server=on,wait=on", uart0.display()),
-            &format!("unix:{},server=on,wait=on", uart1.display()),
-        ],
-    )
-    .stdin(Stdio::null())
-    .stdout(Stdio::piped())
-    .stderr(Stdio::piped())
-    .spawn()
-    .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
+    let Sockets {
+        child,
+        dir,
+        uart0,
+        uart1,
+    } = spawn_with_sockets(elf, pace, "console", Stdio::piped)?;
     let start = Instant::now();
     let done = child::run(
         child,
@@ -121,6 +108,56 @@ pub fn qemu_session(
             elapsed: start.elapsed(),
         },
         talk: done.meanwhile?,
+    })
+}
+
+/// QEMU started by [`spawn_with_sockets`].
+pub struct Sockets {
+    /// QEMU itself.
+    pub child: Child,
+    /// The sockets' folder, for the caller to remove when QEMU is done.
+    pub dir: PathBuf,
+    /// UART0's socket: the console.
+    pub uart0: PathBuf,
+    /// UART1's socket: the hang-up line.
+    pub uart1: PathBuf,
+}
+
+/// Starts QEMU running `elf` for a console ([`qemu_command`]), UART0 and
+/// UART1 on sockets it serves, waiting for both to be connected
+/// ([`connect`]), in a folder of the temporary directory of its own
+/// (`idle-head-<tag>-<pid>`); its stdout and stderr are `output`
+/// (`Stdio::piped`, `Stdio::null`).
+pub fn spawn_with_sockets(
+    elf: &Path,
+    pace: Pace,
+    tag: &str,
+    output: fn() -> Stdio,
+) -> Result<Sockets> {
+    let dir = std::env::temp_dir().join(format!("idle-head-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    let [uart0, uart1] = ["uart0", "uart1"].map(|n| dir.join(format!("{n}.sock")));
+    for path in [&uart0, &uart1] {
+        let _ = std::fs::remove_file(path);
+    }
+    let child = qemu_command(
+        elf,
+        pace,
+        [
+            &format!("unix:{},server=on,wait=on", uart0.display()),
+            &format!("unix:{},server=on,wait=on", uart1.display()),
+        ],
+    )
+    .stdin(Stdio::null())
+    .stdout(output())
+    .stderr(output())
+    .spawn()
+    .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
+    Ok(Sockets {
+        child,
+        dir,
+        uart0,
+        uart1,
     })
 }
 

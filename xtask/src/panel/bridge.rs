@@ -15,8 +15,10 @@ use std::{
 
 use anyhow::{Context, Result};
 
-use crate::console::{Pace, qemu::connect, qemu::qemu_command};
-use crate::setup;
+use crate::console::{
+    Pace, open_port,
+    qemu::{Sockets, connect, spawn_with_sockets},
+};
 use crate::sim::live::{self, LiveEvent};
 
 /// What the head says, for each page connected.
@@ -119,25 +121,12 @@ impl Bridge {
 
     /// The QEMU image `elf`, a clean head at real time, over its UART0.
     pub fn qemu(elf: &Path) -> Result<Self> {
-        let dir = std::env::temp_dir().join(format!("idle-head-panel-{}", std::process::id()));
-        std::fs::create_dir_all(&dir)?;
-        let [uart0, uart1] = ["uart0", "uart1"].map(|n| dir.join(format!("{n}.sock")));
-        for path in [&uart0, &uart1] {
-            let _ = std::fs::remove_file(path);
-        }
-        let child = qemu_command(
-            elf,
-            Pace::RealTime,
-            [
-                &format!("unix:{},server=on,wait=on", uart0.display()),
-                &format!("unix:{},server=on,wait=on", uart1.display()),
-            ],
-        )
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
+        let Sockets {
+            child,
+            dir,
+            uart0,
+            uart1,
+        } = spawn_with_sockets(elf, Pace::RealTime, "panel", Stdio::null)?;
         let console = connect(&uart0)?;
         let hang_up = connect(&uart1)?;
         let reader = console.try_clone()?;
@@ -157,13 +146,7 @@ impl Bridge {
     /// A board's serial port at 115200 8N1.
     pub fn port(port: &Path) -> Result<Self> {
         let name = port.to_string_lossy().into_owned();
-        let serial = serialport::new(&name, 115_200)
-            .data_bits(serialport::DataBits::Eight)
-            .parity(serialport::Parity::None)
-            .stop_bits(serialport::StopBits::One)
-            .timeout(Duration::from_secs(3600))
-            .open()
-            .with_context(|| format!("opening {name}"))?;
+        let serial = open_port(port, Duration::from_secs(3600))?;
         let reader = serial.try_clone().context("a second handle on the port")?;
         let hub = Arc::new(Hub::default());
         spawn_reader(reader, Arc::clone(&hub), "the serial port closed");

@@ -82,6 +82,43 @@ pub struct Pulse {
     pub frame: usize,
 }
 
+/// One complete pulse on a pin, as measured.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measured {
+    /// Rising edge, ns since power-on.
+    pub rise: f64,
+    /// Width, ns.
+    pub width: f64,
+}
+
+/// The complete pulses of `train` from `from` (ns) on: each a rise and the
+/// fall after it. A pulse still high at the end is left out.
+pub fn spans(train: &Train, from: f64) -> Vec<Measured> {
+    let mut rise = None;
+    let mut out = Vec::new();
+    for &(t, high) in train.edges.iter().filter(|&&(t, _)| t >= from) {
+        match (high, rise) {
+            (true, None) => rise = Some(t),
+            (false, Some(r)) => {
+                out.push(Measured {
+                    rise: r,
+                    width: t - r,
+                });
+                rise = None;
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// The complete pulses of `train` from the slice's enable on, for the
+/// checks that look at the pulses themselves (show control, the latency
+/// rows, the CSV of `--pulses`).
+pub fn measure(train: &Train) -> Vec<Measured> {
+    spans(train, train.enabled.unwrap_or(f64::INFINITY))
+}
+
 /// The verdict on one servo's train.
 #[derive(Debug, Clone, Default)]
 pub struct ServoCheck {
@@ -171,28 +208,22 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
         ));
     }
 
-    // Complete pulses: a rise and the next fall.
-    let mut rise = None;
-    let mut spans = Vec::new();
-    for &(t, high) in train.edges.iter().filter(|&&(t, _)| t >= start) {
-        match (high, rise) {
-            (true, None) => rise = Some(t),
-            (false, Some(r)) => {
-                spans.push((r, t));
-                rise = None;
-            }
-            _ => {}
-        }
-    }
-    out.cut = rise.is_some() && train.reset;
+    let spans = spans(train, start);
+    // A pulse still high at the end (the last edge a rise) was cut.
+    out.cut = train.reset
+        && train
+            .edges
+            .iter()
+            .rfind(|&&(t, _)| t >= start)
+            .is_some_and(|&(_, high)| high);
 
     let (mut wrong_frame, mut wrong_duty, mut wrong_width) =
         (Kind::default(), Kind::default(), Kind::default());
     let (mut outside, mut bad_period) = (Kind::default(), Kind::default());
     let mut mismatched = vec![false; frames.len()];
-    let first_rise = spans.first().map_or(0.0, |&(r, _)| r);
+    let first_rise = spans.first().map_or(0.0, |p| p.rise);
     let mut last_period = None;
-    for &(r, f) in &spans {
+    for &Measured { rise: r, width } in &spans {
         // The period this pulse went out in (pulse `n` of a train without
         // gaps).
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // a period count, ≥ 0
@@ -202,7 +233,7 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
         let Some(frame) = latched.checked_sub(1) else {
             continue; // a rise before frame 0 was reported above
         };
-        let counts = ((f - r) / timing.count_ns).round();
+        let counts = (width / timing.count_ns).round();
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // a width, < 2^16
         let counts = counts.max(0.0) as u32;
         out.pulses.push(Pulse {
@@ -453,6 +484,34 @@ mod tests {
             "{:?}",
             check.problems
         );
+    }
+
+    #[test]
+    fn spans_from_a_time_on_without_the_one_still_high() {
+        let train = Train {
+            edges: vec![
+                (5.0, true),
+                (15.0, false), // began before `from`: its fall alone
+                (20.0, true),
+                (21.0, true), // no fall between: one pulse
+                (30.0, false),
+                (40.0, true), // still high at the end
+            ],
+            enabled: Some(10.0),
+            ..Train::default()
+        };
+        let whole = Measured {
+            rise: 20.0,
+            width: 10.0,
+        };
+        assert_eq!(measure(&train), vec![whole]);
+        let from_0 = spans(&train, 0.0);
+        let early = Measured {
+            rise: 5.0,
+            width: 10.0,
+        };
+        assert_eq!(from_0, vec![early, whole]);
+        assert!(measure(&Train::default()).is_empty());
     }
 
     fn check_wanted(t: &Train, wanted: &[u16]) -> ServoCheck {

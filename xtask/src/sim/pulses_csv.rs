@@ -12,50 +12,20 @@
 //! stopped: a head relaxed at rest). The rows end with the last period
 //! every servo's pulse is known for.
 //!
-//! [`measure`] gives a pin's complete pulses as measured, for the checks
-//! that look at them (show control, the latency rows).
+//! The widths are measured from the pin's edges ([`pulses::measure`]),
+//! whatever the run checked them against: a `--dmx` run checks nothing.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result};
 
-use super::pulses::{ServoCheck, Timing, Train};
+use super::pulses::{self, Timing, Train};
 
-/// One complete pulse on a pin.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Measured {
-    /// Rising edge, ns since power-on.
-    pub rise: f64,
-    /// Width, ns.
-    pub width: f64,
-}
-
-/// The complete pulses of `train` (a rise and the fall after it), from the
-/// slice's enable on.
-pub fn measure(train: &Train) -> Vec<Measured> {
-    let from = train.enabled.unwrap_or(f64::INFINITY);
-    let mut rise = None;
-    let mut out = Vec::new();
-    for &(t, high) in train.edges.iter().filter(|&&(t, _)| t >= from) {
-        match (high, rise) {
-            (true, None) => rise = Some(t),
-            (false, Some(r)) => {
-                out.push(Measured {
-                    rise: r,
-                    width: t - r,
-                });
-                rise = None;
-            }
-            _ => {}
-        }
-    }
-    out
-}
-
-/// Writes `servos`' pulses (`[pitch, roll, yaw]`, as checked) to `path`.
-pub fn write(path: &Path, servos: &[ServoCheck; 3], timing: &Timing) -> Result<usize> {
-    let text = rows(servos, timing);
+/// Writes the pulses on `trains`' pins (`[pitch, roll, yaw]`) to `path`;
+/// the rows written.
+pub fn write(path: &Path, trains: &[Train; 3], timing: &Timing) -> Result<usize> {
+    let text = rows(trains, timing);
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
@@ -69,20 +39,22 @@ pub fn write(path: &Path, servos: &[ServoCheck; 3], timing: &Timing) -> Result<u
     clippy::cast_possible_truncation,
     clippy::cast_sign_loss
 )] // periods and counts, far below 2^52
-fn rows(servos: &[ServoCheck; 3], timing: &Timing) -> String {
+fn rows(trains: &[Train; 3], timing: &Timing) -> String {
     let period = f64::from(timing.period_counts) * timing.count_ns;
-    let first = servos
+    let measured = trains.each_ref().map(pulses::measure);
+    let first = measured
         .iter()
-        .filter_map(|s| s.pulses.first().map(|p| p.rise))
+        .filter_map(|pulses| pulses.first().map(|p| p.rise))
         .fold(f64::INFINITY, f64::min);
     let mut widths: [Vec<Option<u32>>; 3] = Default::default();
-    for (servo, out) in servos.iter().zip(&mut widths) {
-        for pulse in &servo.pulses {
+    for (pulses, out) in measured.iter().zip(&mut widths) {
+        for pulse in pulses {
             let k = ((pulse.rise - first) / period).round().max(0.0) as usize;
             if out.len() <= k {
                 out.resize(k + 1, None);
             }
-            out[k] = Some(pulse.counts);
+            // In whole counts, as the pulse check counts them.
+            out[k] = Some((pulse.width / timing.count_ns).round().max(0.0) as u32);
         }
     }
     let frames = widths.iter().map(Vec::len).min().unwrap_or(0);
@@ -99,38 +71,61 @@ fn rows(servos: &[ServoCheck; 3], timing: &Timing) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::pulses::Pulse;
+
+    const TIMING: Timing = Timing {
+        count_ns: 312.5,
+        period_counts: 64_000,
+        frame_ns: 20e6,
+    };
+
+    /// A pin's train as the emulator reports it, unchecked: pulse `k` of
+    /// `counts` in period `k` (1 ms in), the slice enabled at 0.
+    fn train(pulses: &[(u32, u32)]) -> Train {
+        let mut edges = Vec::new();
+        for &(k, counts) in pulses {
+            let rise = 1e6 + f64::from(k) * 20e6;
+            edges.push((rise, true));
+            edges.push((rise + f64::from(counts) * TIMING.count_ns, false));
+        }
+        Train {
+            edges,
+            enabled: Some(0.0),
+            ..Train::default()
+        }
+    }
+
+    fn trains() -> [Train; 3] {
+        [
+            train(&[(0, 4800), (1, 4801), (3, 4803)]),
+            train(&[(0, 4800), (1, 4800), (3, 4800)]),
+            train(&[(0, 4800), (1, 4800), (3, 4800), (4, 1)]),
+        ]
+    }
 
     #[test]
     fn a_row_per_period_and_0_where_there_was_no_pulse() {
-        let timing = Timing {
-            count_ns: 312.5,
-            period_counts: 64_000,
-            frame_ns: 20e6,
-        };
-        let pulse = |k: u32, counts| Pulse {
-            rise: 1e6 + f64::from(k) * 20e6,
-            counts,
-            frame: k as usize,
-        };
-        let servo = |pulses: Vec<Pulse>| ServoCheck {
-            pulses,
-            ..ServoCheck::default()
-        };
-        let servos = [
-            servo(vec![pulse(0, 4800), pulse(1, 4801), pulse(3, 4803)]),
-            servo(vec![pulse(0, 4800), pulse(1, 4800), pulse(3, 4800)]),
-            servo(vec![
-                pulse(0, 4800),
-                pulse(1, 4800),
-                pulse(3, 4800),
-                pulse(4, 1),
-            ]),
-        ];
         assert_eq!(
-            rows(&servos, &timing),
+            rows(&trains(), &TIMING),
             "t_ms,pitch_us,roll_us,yaw_us\n0,1500.0,1500.0,1500.0\n20,1500.3,1500.0,1500.0\n\
              40,0.0,0.0,0.0\n60,1500.9,1500.0,1500.0\n"
+        );
+    }
+
+    /// `--dmx` and `--show` runs check no pulse: the file comes from the
+    /// edges of a boot as the run left it (once it came out a bare header).
+    #[test]
+    fn an_unchecked_boot_writes_its_rows() {
+        let boot = crate::sim::run::Boot {
+            trains: trains(),
+            ..Default::default()
+        };
+        assert!(boot.servos.iter().all(|s| s.pulses.is_empty()));
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out/pulses.csv");
+        assert_eq!(write(&path, &boot.trains, &TIMING).unwrap(), 4);
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            rows(&boot.trains, &TIMING)
         );
     }
 }

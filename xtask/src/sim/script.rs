@@ -191,7 +191,7 @@ pub fn command(
     );
     println!("{}", report.summary());
     if let (Some(path), Some(boot)) = (pulses, report.boots.first()) {
-        let rows = super::pulses_csv::write(path, &boot.servos, &run::timing())?;
+        let rows = super::pulses_csv::write(path, &boot.trains, &run::timing())?;
         println!("wrote {} ({rows} frames)", path.display());
     }
     Ok(report.problems.is_empty())

@@ -31,7 +31,8 @@ use idle_head_core::driver::DriverConfig;
 
 use super::{
     DEFAULT_TIME, dmx, expect,
-    pulses_csv::{self, Measured},
+    pulses::{self, Measured},
+    pulses_csv,
     run::{self, Boot},
     stages,
 };
@@ -102,8 +103,7 @@ pub fn command(root: &Path, metadata: &Metadata, args: &super::Args) -> Result<b
     };
     print!("{}", servo_table(boot));
     if let Some(path) = &args.pulses {
-        let rows = pulses_csv::write(path, &boot.servos, &super::run::timing())?;
-        println!("{rows} rows of pulses written to {}", path.display());
+        write_pulses(path, boot)?;
     }
     if let Some(changes) = &changes {
         println!(
@@ -119,11 +119,18 @@ pub fn command(root: &Path, metadata: &Metadata, args: &super::Args) -> Result<b
     Ok(report.problems.is_empty())
 }
 
+/// `--pulses FILE.csv`: `boot`'s pulses as measured.
+fn write_pulses(path: &Path, boot: &Boot) -> Result<()> {
+    let rows = pulses_csv::write(path, &boot.trains, &run::timing())?;
+    println!("{rows} rows of pulses written to {}", path.display());
+    Ok(())
+}
+
 /// Per servo: pulses, shortest and longest, as measured.
 fn servo_table(boot: &Boot) -> String {
     let mut text = String::from("\nservo   pulses   min µs   max µs\n");
     for ((name, ..), train) in run::SERVOS.iter().zip(&boot.trains) {
-        let pulses = pulses_csv::measure(train);
+        let pulses = pulses::measure(train);
         let widths = pulses.iter().map(|p| p.width / 1e3);
         let min = widths.clone().fold(f64::INFINITY, f64::min);
         let max = widths.fold(0.0, f64::max);
@@ -134,6 +141,12 @@ fn servo_table(boot: &Boot) -> String {
 
 /// The stage: see the [module docs](self).
 pub fn test_show(root: &Path, metadata: &Metadata) -> Result<()> {
+    show(root, metadata, None)
+}
+
+/// `cargo xtask sim --show [--pulses FILE.csv]`: the stage, its pulses
+/// written to `pulses` too.
+pub fn show(root: &Path, metadata: &Metadata, pulses: Option<&Path>) -> Result<()> {
     let changes = dmx::parse(SCRIPT)?;
     let elf = stages::shipped_image(root, metadata)?;
     let lines = bottango_lines();
@@ -147,6 +160,9 @@ pub fn test_show(root: &Path, metadata: &Metadata) -> Result<()> {
     print!("{}", report.log_text(false));
     let boot = report.boots.first().context("no boot")?;
     print!("{}", servo_table(boot));
+    if let Some(path) = pulses {
+        write_pulses(path, boot)?;
+    }
     let mut problems = report.problems.clone();
     let (text, found) = check(boot, &lines)?;
     print!("{text}");
@@ -174,7 +190,7 @@ struct Pulses {
 
 impl Pulses {
     fn of(boot: &Boot) -> Result<Self> {
-        let servos = boot.trains.each_ref().map(pulses_csv::measure);
+        let servos = boot.trains.each_ref().map(pulses::measure);
         let frames = servos.iter().map(Vec::len).max().unwrap_or(0);
         Ok(Self {
             servos,

@@ -1,0 +1,82 @@
+// rp2040js's core and chip, bridged where they differ from the RP2040: SEV,
+// the registers it does not model. (Its UART is bridged in uart.mjs, its
+// USB in usb.mjs; the watchdog reset is the harness's.)
+
+const OP_SEV = 0xbf40;
+
+// rp2040js treats SEV as a no-op; on one core it sets the core's own event
+// register, so that the next WFE returns at once. Call after executing the
+// instruction at `pc`.
+export function sevAsOnTheChip(chip, pc, flashStart, ramStart) {
+  const inFlash = pc >= flashStart && pc < ramStart;
+  const opcode = inFlash ? chip.flash16[(pc - flashStart) >>> 1] : chip.readUint16(pc);
+  if (opcode === OP_SEV) chip.core.eventRegistered = true;
+}
+
+// rp2040js warns at every access to a register it does not model (a read
+// gives 0xffffffff, a write does nothing). They are counted per register
+// instead, and reported once at the end: `cargo xtask sim` tells the known
+// ones from the others.
+const UNMODELLED = /^Unimplemented peripheral (read from|write to) 0x([0-9a-f]+)/;
+export function unmodelledCounter() {
+  const counts = new Map(); // "name op offset" -> {peripheral, op, offset, count}
+  return {
+    // Counts `msg` if it is such a warning; whether it was.
+    note(name, msg) {
+      const match = UNMODELLED.exec(msg);
+      if (!match) return false;
+      const op = match[1] === 'read from' ? 'read' : 'write';
+      const offset = parseInt(match[2], 16);
+      const key = `${name} ${op} ${offset}`;
+      const seen = counts.get(key) ?? { peripheral: name, op, offset, count: 0 };
+      seen.count += 1;
+      counts.set(key, seen);
+      return true;
+    },
+    // One `unmodelled` event per register, then the counts start again.
+    report(emit) {
+      for (const seen of counts.values()) emit({ ev: 'unmodelled', ...seen });
+      counts.clear();
+    },
+  };
+}
+
+// rp2040js has no XIP control registers (0x14000000..0x14000020): a read
+// gives 0xffffffff. Before a flash operation embassy-rp waits for the XIP
+// stream counter (STREAM_CTR) to reach 0, for ever at 0xffffffff. Here they
+// read as on an idle chip: enabled, no stream, the FIFO empty, the flush
+// done; writes (a flush, a stream set-up) have nothing to act on.
+const XIP_CTRL = 0x14000000;
+const XIP_CTRL_END = 0x14000020;
+const XIP_IDLE = { 0x00: 0x3, 0x08: 0x3 }; // CTRL (enabled), STAT (FIFO empty, flush ready)
+export function xipControlAsOnTheChip(chip) {
+  const read = chip.readUint32.bind(chip);
+  chip.readUint32 = (address) => {
+    const a = address >>> 0;
+    return a >= XIP_CTRL && a < XIP_CTRL_END ? XIP_IDLE[a - XIP_CTRL] ?? 0 : read(address);
+  };
+  const write = chip.writeUint32.bind(chip);
+  chip.writeUint32 = (address, value) => {
+    const a = address >>> 0;
+    if (a < XIP_CTRL || a >= XIP_CTRL_END) write(address, value);
+  };
+}
+
+// rp2040js has no ring oscillator: its RANDOMBIT register (ROSC + 0x1c)
+// would read 0xffffffff, one and the same bit for ever. On the chip it is the
+// oscillator's jitter. Here it reads as the bits of a fixed-seed xorshift, so
+// that the firmware sees varied bits and a run still repeats exactly.
+const ROSC_BASE = 0x40060;
+const ROSC_RANDOMBIT = 0x1c;
+export function roscRandomBit(chip) {
+  const rosc = chip.peripherals[ROSC_BASE];
+  const read = rosc.readUint32.bind(rosc);
+  let state = 0x2545f491;
+  rosc.readUint32 = (offset) => {
+    if (offset !== ROSC_RANDOMBIT) return read(offset);
+    state ^= state << 13;
+    state ^= state >>> 17;
+    state ^= state << 5;
+    return state & 1;
+  };
+}
