@@ -12,6 +12,13 @@ fn settings(roles: [InputRole; INPUTS], rest_after: RestAfter) -> InputSettings 
     InputSettings { roles, rest_after }
 }
 
+/// The settings with `role` on the first input (GP2), the others off.
+fn first(role: InputRole, rest_after: RestAfter) -> InputSettings {
+    let mut roles = [InputRole::Off; INPUTS];
+    roles[0] = role;
+    settings(roles, rest_after)
+}
+
 fn presence(deg: Option<i32>) -> InputRole {
     InputRole::Presence {
         toward: deg.map(Angle::from_degrees),
@@ -103,15 +110,7 @@ impl Run {
 
 #[test]
 fn a_press_runs_the_action_once_after_the_debounce() {
-    let s = settings(
-        [
-            InputRole::Button(NOD),
-            InputRole::Off,
-            InputRole::Off,
-            InputRole::Off,
-        ],
-        RestAfter::Never,
-    );
+    let s = first(InputRole::Button(NOD), RestAfter::Never);
     let mut run = Run::new(&s);
     run.set(100, 0, false);
     run.until(10_000);
@@ -127,15 +126,7 @@ fn a_press_runs_the_action_once_after_the_debounce() {
 
 #[test]
 fn a_bouncing_press_is_one_press() {
-    let s = settings(
-        [
-            InputRole::Button(NOD),
-            InputRole::Off,
-            InputRole::Off,
-            InputRole::Off,
-        ],
-        RestAfter::Never,
-    );
+    let s = first(InputRole::Button(NOD), RestAfter::Never);
     let mut run = Run::new(&s);
     // Bounces every 1 ms for 6 ms, then held: one press.
     for k in 0..6 {
@@ -160,15 +151,7 @@ fn a_bouncing_press_is_one_press() {
 
 #[test]
 fn nobody_there_for_rest_after_rests_the_head_once() {
-    let s = settings(
-        [
-            presence(None),
-            InputRole::Off,
-            InputRole::Off,
-            InputRole::Off,
-        ],
-        RestAfter::Seconds(5),
-    );
+    let s = first(presence(None), RestAfter::Seconds(5));
     let mut run = Run::new(&s);
     run.until(60_000);
     assert_eq!(run.actions, [(5000, Action::Rest)]);
@@ -184,15 +167,7 @@ fn nobody_there_for_rest_after_rests_the_head_once() {
 
 #[test]
 fn a_wake_from_elsewhere_starts_the_rest_timer_again() {
-    let s = settings(
-        [
-            presence(None),
-            InputRole::Off,
-            InputRole::Off,
-            InputRole::Off,
-        ],
-        RestAfter::Seconds(5),
-    );
+    let s = first(presence(None), RestAfter::Seconds(5));
     let mut run = Run::new(&s);
     run.until(6000);
     assert_eq!(run.actions, [(5000, Action::Rest)]);
@@ -210,15 +185,7 @@ fn a_wake_from_elsewhere_starts_the_rest_timer_again() {
 
 #[test]
 fn a_presence_input_stuck_high_keeps_the_head_awake() {
-    let s = settings(
-        [
-            presence(Some(-20)),
-            InputRole::Off,
-            InputRole::Off,
-            InputRole::Off,
-        ],
-        RestAfter::Seconds(5),
-    );
+    let s = first(presence(Some(-20)), RestAfter::Seconds(5));
     let mut run = Run::new(&s);
     run.set(1000, 0, true);
     run.until(3_600_000);
@@ -280,15 +247,7 @@ fn glances_are_held_off_and_two_sensors_at_once_glance_to_the_first() {
 
 #[test]
 fn without_a_presence_input_the_head_never_rests() {
-    let s = settings(
-        [
-            InputRole::Button(Action::Rest),
-            InputRole::Off,
-            InputRole::Off,
-            InputRole::Off,
-        ],
-        RestAfter::Seconds(1),
-    );
+    let s = first(InputRole::Button(Action::Rest), RestAfter::Seconds(1));
     let mut run = Run::new(&s);
     run.until(3_600_000);
     assert_eq!(run.actions, []);
@@ -299,15 +258,7 @@ fn without_a_presence_input_the_head_never_rests() {
     run.until(3_601_000);
     assert_eq!(run.actions, [(3_600_005, Action::Rest)]);
     // `never`: presence wakes, never rests.
-    let s = settings(
-        [
-            presence(None),
-            InputRole::Off,
-            InputRole::Off,
-            InputRole::Off,
-        ],
-        RestAfter::Never,
-    );
+    let s = first(presence(None), RestAfter::Never);
     let mut run = Run::new(&s);
     run.until(3_600_000);
     assert_eq!(run.actions, []);
