@@ -104,17 +104,6 @@ const fn gesture_field(id: u8) -> Option<(GestureKind, u8)> {
     None
 }
 
-/// The most bytes a gesture's block takes, headers included.
-const GESTURE_BLOCK_LEN: usize = {
-    let d = &GestureKind::DEFAULTS[0];
-    5 * HEADER
-        + max_len(&d.amplitude)
-        + max_len(&d.cycles)
-        + max_len(&d.slow)
-        + max_len(&d.brisk)
-        + max_len(&d.intensity)
-};
-
 /// The table: `id "name" => s.place;` per field, in the order they are
 /// written, then every gesture's block. It makes [`FIELDS`],
 /// [`SETTINGS_LEN`] and the [`Fields`] implementation of [`Settings`],
@@ -164,8 +153,13 @@ macro_rules! fields {
         /// Most bytes a record of [`Settings`] takes: every field at its
         /// longest, with its header.
         pub const SETTINGS_LEN: usize = {
-            let $s = &Settings::DEFAULT;
-            0 $(+ HEADER + max_len(&$place))+ + GestureKind::COUNT * GESTURE_BLOCK_LEN
+            let mut len = 0;
+            let mut i = 0;
+            while i < FIELDS.len() {
+                len += HEADER + FIELDS[i].max_len;
+                i += 1;
+            }
+            len
         };
 
         const _: () = assert!(unique(FIELDS), "two fields of the settings share an id");
