@@ -252,10 +252,10 @@ fn SysTick() {
 pub struct Instructions;
 
 impl idle_head_firmware::boot::Stopwatch for Instructions {
-    fn time(&mut self, work: &mut dyn FnMut()) -> u64 {
+    fn time<R>(&mut self, work: impl FnOnce() -> R) -> (R, u64) {
         let start = now_counts();
-        work();
-        (now_counts() - start) * INSNS_PER_COUNT
+        let result = work();
+        (result, (now_counts() - start) * INSNS_PER_COUNT)
     }
 
     fn unit(&self) -> &'static str {

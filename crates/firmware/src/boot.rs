@@ -90,8 +90,9 @@ impl<S> Loaded<S> {
 
 /// How a board times the boot precompute, and in what unit it logs it.
 pub trait Stopwatch {
-    /// Runs `work`, returning how long it took in this stopwatch's unit.
-    fn time(&mut self, work: &mut dyn FnMut()) -> u64;
+    /// Runs `work`, returning what it gave and how long it took in this
+    /// stopwatch's unit.
+    fn time<R>(&mut self, work: impl FnOnce() -> R) -> (R, u64);
     /// The unit, for the log (`"us"`, `"instructions"`).
     fn unit(&self) -> &'static str;
 }
@@ -100,10 +101,10 @@ pub trait Stopwatch {
 pub struct Clock;
 
 impl Stopwatch for Clock {
-    fn time(&mut self, work: &mut dyn FnMut()) -> u64 {
+    fn time<R>(&mut self, work: impl FnOnce() -> R) -> (R, u64) {
         let start = Instant::now();
-        work();
-        start.elapsed().as_micros()
+        let result = work();
+        (result, start.elapsed().as_micros())
     }
 
     fn unit(&self) -> &'static str {
@@ -187,8 +188,7 @@ pub(crate) fn first_set(
     head: &HeadConfig,
     stopwatch: &mut impl Stopwatch,
 ) -> FirstSet {
-    let mut generated = Err(None);
-    let precompute = stopwatch.time(&mut || generated = first.generate(head).map_err(Some));
+    let (generated, precompute) = stopwatch.time(|| first.generate(head));
     let generated = match generated {
         Ok(info) => {
             for (axis, info) in Axis::ALL.iter().zip(info.iter()) {
@@ -203,7 +203,7 @@ pub(crate) fn first_set(
             true
         }
         // The loop is left at the neutral pose: the servos hold still.
-        Err(Some(e)) => {
+        Err(e) => {
             defmt::error!(
                 "trajectory generation failed: {=str} {=str}",
                 e.axis.name(),
@@ -211,7 +211,6 @@ pub(crate) fn first_set(
             );
             false
         }
-        Err(None) => false,
     };
     let checksum = first.checksum();
     defmt::info!(
