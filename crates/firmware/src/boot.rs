@@ -193,7 +193,7 @@ pub(crate) fn first_set(
         Ok(info) => {
             for (axis, info) in Axis::ALL.iter().zip(info.iter()) {
                 defmt::info!(
-                    "{=str}: split at sample {=u16} of {=u16} zero crossings, {=u16} up-steps",
+                    "{=str}: split at sample {=u16} (drawn from {=u16} zero crossings); {=u16} up-steps in the walk",
                     axis.name(),
                     info.split,
                     info.crossings,
