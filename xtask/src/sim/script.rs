@@ -16,8 +16,6 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{Context, Result, anyhow};
-use idle_head_core::behaviour::BehaviourConfig;
-use idle_head_core::driver::DriverConfig;
 
 use super::node::PinScript;
 use super::run::{self, Report, SERVOS};
@@ -51,12 +49,7 @@ pub fn read(path: &Path) -> Result<Vec<Event>> {
 
 /// The events of a script's `text`.
 pub fn parse(text: &str) -> Result<Vec<Event>> {
-    let driver = DriverConfig::DEFAULT
-        .build()
-        .map_err(|e| anyhow!("{}", e.message()))?;
-    let params = BehaviourConfig::DEFAULT
-        .build(&driver)
-        .map_err(|e| anyhow!("{e}"))?;
+    let (_, params) = trace::built_in()?;
     trace::parse_script(text, &params)
 }
 

@@ -31,7 +31,7 @@ use idle_head_core::driver::DriverConfig;
 
 use super::{
     DEFAULT_TIME, dmx, expect,
-    pulses::{self, Measured},
+    pulses::{self, Measured, angle},
     pulses_csv,
     run::{self, Boot},
     stages,
@@ -72,14 +72,6 @@ fn bottango_lines() -> Vec<String> {
     .iter()
     .map(|body| format!("{body},h{}\n", hash(body.as_bytes())))
     .collect()
-}
-
-/// The angle, m°, of a pulse of `width` ns on `axis`' servo (the built-in
-/// calibration).
-fn angle(axis: usize, width: f64) -> f64 {
-    let servo = DriverConfig::DEFAULT.servos[axis];
-    let neutral = f64::from(servo.neutral.0) * 1e3;
-    (width - neutral) / f64::from(servo.per_degree.0) * 1e3
 }
 
 /// `cargo xtask sim --dmx FILE [--pulses FILE.csv]` (either alone too).
