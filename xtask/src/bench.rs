@@ -41,7 +41,7 @@ mod telemetry;
 pub use frame::FrameRow;
 use frame::frames_over_budget;
 
-use crate::figures;
+use crate::figures::{self, thousands};
 use crate::{
     args::Options,
     log::{LogLine, Run},
@@ -271,19 +271,6 @@ impl Verdict {
             thousands(self.fixed.max(0.0).round() as u64),
         )
     }
-}
-
-/// `1234567` as `1,234,567`.
-pub(crate) fn thousands(value: u64) -> String {
-    let digits = value.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
 }
 
 /// Fails if the run or the log is broken, or (unless `no_budget`) if the

@@ -268,6 +268,19 @@ pub struct Metrics {
     pub closures: Vec<ClosureMetrics>,
 }
 
+/// `1234567` as `1,234,567`.
+pub fn thousands(value: u64) -> String {
+    let digits = value.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
 /// Where the figures are kept: `target/figures.json` at the repository's
 /// root, beside the book (`target/book`).
 pub fn path() -> PathBuf {
@@ -333,6 +346,14 @@ mod tests {
                 stored: true,
             }],
         }
+    }
+
+    #[test]
+    fn thousands_separators() {
+        assert_eq!(thousands(0), "0");
+        assert_eq!(thousands(999), "999");
+        assert_eq!(thousands(1000), "1,000");
+        assert_eq!(thousands(133_967_040), "133,967,040");
     }
 
     #[test]

@@ -9,8 +9,7 @@ use std::{fmt::Write as _, path::Path};
 
 use anyhow::{Context, Result};
 
-use super::{Bench, Figures, Latency, Metrics, QemuRun, Source};
-use crate::bench::thousands;
+use super::{Bench, Figures, Latency, Metrics, QemuRun, Source, thousands};
 
 /// The Pico's system clock, for the time a count of instructions takes at
 /// least (one cycle each).
