@@ -53,7 +53,7 @@ const SENSOR_YAW: f64 = -20_000.0;
 /// `cargo xtask test`'s stage: plays [`SCRIPT`] and checks it.
 pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     let events = script::parse(SCRIPT)?;
-    let run = script::play(
+    let report = script::play(
         root,
         metadata,
         events,
@@ -61,7 +61,6 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
         super::WALL,
         script::Against::Host,
     )?;
-    let report = &run.report;
     print!("{}", report.table());
     println!("{}", report.verdict());
     let mut problems = report.problems.clone();
