@@ -41,7 +41,7 @@ mod telemetry;
 pub use frame::FrameRow;
 use frame::frames_over_budget;
 
-use crate::figures;
+use crate::figures::{self, thousands};
 use crate::{
     args::Options,
     log::{LogLine, Run},
@@ -273,19 +273,6 @@ impl Verdict {
     }
 }
 
-/// `1234567` as `1,234,567`.
-pub(crate) fn thousands(value: u64) -> String {
-    let digits = value.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
-}
-
 /// Fails if the run or the log is broken, or (unless `no_budget`) if the
 /// default row or a frame row is over its budget. `smoke`: the QEMU smoke
 /// image's plain run, if the caller made it (the telemetry check compares
@@ -382,12 +369,11 @@ pub fn command(options: Options) -> Result<bool> {
     Ok(passed)
 }
 
-/// The latency rows, kept beside the benchmark's other rows.
-fn record_latency(latency: Vec<figures::Latency>) {
+/// The latency rows.
+fn record_latency(rows: Vec<figures::LatencyRow>) {
+    let source = figures::Source::now();
     figures::save_section("latency", |f| {
-        if let Some(bench) = f.bench.as_mut() {
-            bench.latency = latency;
-        }
+        f.latency = Some(figures::Latency { source, rows });
     });
 }
 
@@ -406,28 +392,25 @@ fn record_figures(rows: &[Row], frames: &[FrameRow], budget: u64) {
                 direct: row.direct,
             })
             .collect(),
+        // Each with its ceiling: `FrameRow::all` refused a row without one.
         frames: frames
             .iter()
-            .map(|row| figures::FrameCost {
-                label: row.label(),
-                frames: row.frames,
-                min: row.min,
-                median: row.median,
-                max: row.max,
-                mean: row.mean,
-                median_budget: row.ceiling().map_or(0, |c| c.median),
-                max_budget: row.ceiling().map_or(0, |c| c.max),
-                // Every row with a ceiling is held to it.
-                held: row.ceiling().is_some(),
+            .filter_map(|row| {
+                let ceiling = row.ceiling()?;
+                Some(figures::FrameCost {
+                    label: row.label(),
+                    frames: row.frames,
+                    min: row.min,
+                    median: row.median,
+                    max: row.max,
+                    mean: row.mean,
+                    median_budget: ceiling.median,
+                    max_budget: ceiling.max,
+                })
             })
             .collect(),
-        latency: Vec::new(),
     };
-    // The latency rows are `cargo xtask bench`'s alone: kept as they were.
-    figures::save_section("benchmark", |f| {
-        let latency = f.bench.take().map(|b| b.latency).unwrap_or_default();
-        f.bench = Some(figures::Bench { latency, ..entry });
-    });
+    figures::save_section("benchmark", |f| f.bench = Some(entry));
 }
 
 #[cfg(test)]

@@ -1,11 +1,11 @@
 //! Reads a firmware ELF: section placement and sizes, memory budgets, and
 //! symbols that must not be linked.
 
-use std::{fmt::Write as _, path::Path};
+use std::{fmt::Write as _, ops::Range, path::Path};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, anyhow, bail};
 
-use crate::figures;
+use crate::{board::Board, figures};
 use object::read::elf::{ElfFile32, ProgramHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, SectionKind, elf};
 
@@ -21,13 +21,9 @@ pub const FLASH_BUDGET: u64 = 128 * 1024;
 pub const BOOT2_ADDRESS: u64 = 0x1000_0000;
 /// Size of the second stage: 252 bytes of code plus a 4-byte CRC32.
 pub const BOOT2_SIZE: u64 = 256;
-/// The Pico's settings store: the last four 4 KiB erase sectors of its
-/// 2 MiB flash (`SETTINGS` in memory.x, `SETTINGS_RANGE` in
-/// `src/bin/pico/settings.rs`). Nothing may be linked there.
-pub const SETTINGS_REGION: std::ops::Range<u64> = 0x101f_c000..0x1020_0000;
 /// Where the RP2040 maps its QSPI flash (XIP), and the end of the window a
 /// 16 MiB flash can occupy.
-const XIP: std::ops::Range<u64> = 0x1000_0000..0x1100_0000;
+pub const XIP: Range<u64> = 0x1000_0000..0x1100_0000;
 /// Where the emulated LM3S6965 reads its vector table at reset: the start of
 /// its flash (`FLASH` in qemu/memory.x). An image linked with another board's
 /// memory map (the Pico's flash starts at `0x1000_0000`) does not start.
@@ -68,7 +64,7 @@ pub struct Image {
     pub allocator_symbols: Vec<String>,
     /// `[__settings_start, __settings_end)` from the linker script, if
     /// the image has them (the Pico image does).
-    pub settings: Option<std::ops::Range<u64>>,
+    pub settings: Option<Range<u64>>,
     /// End of the bytes stored in the XIP flash window: the highest load
     /// address (`p_paddr + p_filesz`) of a loadable segment there, so
     /// `.data`'s initial values count where they are stored.
@@ -79,8 +75,12 @@ impl Image {
     /// Parses the ELF at `path`.
     pub fn read(path: &Path) -> Result<Self> {
         let data = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-        let file =
-            object::File::parse(&*data).with_context(|| format!("parsing {}", path.display()))?;
+        Self::parse(&data).with_context(|| format!("parsing {}", path.display()))
+    }
+
+    /// Parses the ELF `data`.
+    pub fn parse(data: &[u8]) -> Result<Self> {
+        let file = object::File::parse(data)?;
         let mut sections: Vec<Section> = file
             .sections()
             .filter(|section| match section.flags() {
@@ -115,7 +115,11 @@ impl Image {
         let settings = symbol("__settings_start")
             .zip(symbol("__settings_end"))
             .map(|(start, end)| start..end);
-        let flash_end = stored_end(&data);
+        // 0 for an ELF that is not a 32-bit one (the host's binaries).
+        let flash_end = match ElfFile32::<Endianness>::parse(data) {
+            Ok(file) => stored_end(&segments(&file).map_err(|error| anyhow!(error))?),
+            Err(_) => 0,
+        };
         Ok(Self {
             sections,
             allocator_symbols,
@@ -170,6 +174,24 @@ impl Image {
         table
     }
 
+    /// Fails unless the image has the RP2040's second stage: 256 bytes of
+    /// `.boot2` at the start of flash, where its boot ROM loads them from.
+    pub fn check_boot2(&self) -> Result<()> {
+        match self.section(".boot2") {
+            Some(boot2) if boot2.address == BOOT2_ADDRESS && boot2.size == BOOT2_SIZE => Ok(()),
+            Some(boot2) => bail!(
+                "`.boot2` is {} bytes at {:#010x}; the RP2040 boot ROM needs {BOOT2_SIZE} bytes \
+                 at {BOOT2_ADDRESS:#010x} (is `-Tlink-rp.x` passed to the linker?)",
+                boot2.size,
+                boot2.address
+            ),
+            None => bail!(
+                "no `.boot2` section: the RP2040 would not boot (is `-Tlink-rp.x` passed to the \
+                 linker?)"
+            ),
+        }
+    }
+
     /// Fails unless the image links no allocator.
     pub fn check_no_allocator(&self) -> Result<()> {
         if !self.allocator_symbols.is_empty() {
@@ -191,18 +213,8 @@ pub fn check_pico(path: &Path) -> Result<()> {
     print!("{}", image.table());
 
     let mut problems = Vec::new();
-    match image.section(".boot2") {
-        Some(boot2) if boot2.address == BOOT2_ADDRESS && boot2.size == BOOT2_SIZE => {}
-        Some(boot2) => problems.push(format!(
-            "`.boot2` is {} bytes at {:#010x}; the RP2040 boot ROM needs {BOOT2_SIZE} bytes at \
-             {BOOT2_ADDRESS:#010x} (is `-Tlink-rp.x` passed to the linker?)",
-            boot2.size, boot2.address
-        )),
-        None => problems.push(
-            "no `.boot2` section: the RP2040 would not boot (is `-Tlink-rp.x` passed to the \
-             linker?)"
-                .to_owned(),
-        ),
+    if let Err(error) = image.check_boot2() {
+        problems.push(error.to_string());
     }
 
     let flash = image.flash();
@@ -236,7 +248,7 @@ pub fn check_pico(path: &Path) -> Result<()> {
     } else {
         println!("  no allocator linked");
     }
-    if let Err(error) = check_settings_region(&image) {
+    if let Err(error) = check_settings_region(&image, Board::Pico.settings()) {
         problems.push(error.to_string());
     }
 
@@ -321,43 +333,89 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
     Ok(())
 }
 
-/// The highest load address (`p_paddr + p_filesz`) of a loadable segment
-/// in the XIP flash window of a 32-bit Arm ELF; 0 for anything else.
-fn stored_end(data: &[u8]) -> u64 {
-    let Ok(file) = ElfFile32::<Endianness>::parse(data) else {
-        return 0;
-    };
+/// The contents of one loadable segment, at its load address.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Segment {
+    /// Load (physical) address of the first byte: where it is stored.
+    pub address: u32,
+    /// The bytes stored in the file (`p_filesz` of them).
+    pub data: Vec<u8>,
+}
+
+impl Segment {
+    /// Load addresses of the contents.
+    pub fn range(&self) -> Range<u32> {
+        // The length fits: `segments` took it from a 32-bit field and
+        // checked that the end does not wrap.
+        let length = u32::try_from(self.data.len()).unwrap_or(u32::MAX);
+        self.address..self.address.saturating_add(length)
+    }
+}
+
+/// The loadable segments with contents (`PT_LOAD`, `p_filesz > 0`) of
+/// `file`, in address order: what is stored in the board's memory, each at
+/// its load address (`p_paddr`), so that `.data`'s initial values count
+/// where they are stored, not where they run.
+///
+/// # Errors
+/// A segment lies past the end of the file or wraps the address space.
+pub fn segments(file: &ElfFile32<Endianness>) -> Result<Vec<Segment>, &'static str> {
     let endian = file.endian();
-    file.elf_program_headers()
+    let mut segments = Vec::new();
+    for header in file.elf_program_headers() {
+        if header.p_type(endian) != elf::PT_LOAD || header.p_filesz(endian) == 0 {
+            continue;
+        }
+        let data = header
+            .data(endian, file.data())
+            .map_err(|()| "a segment lies past the end of the file")?;
+        let address = header.p_paddr(endian);
+        if address.checked_add(header.p_filesz(endian)).is_none() {
+            return Err("a segment wraps the address space");
+        }
+        segments.push(Segment {
+            address,
+            data: data.to_vec(),
+        });
+    }
+    segments.sort_by_key(|segment| segment.address);
+    Ok(segments)
+}
+
+/// The end of the bytes stored in the XIP flash window: the highest end of
+/// a segment that starts there; 0 if none does.
+fn stored_end(segments: &[Segment]) -> u64 {
+    segments
         .iter()
-        .filter(|header| header.p_type(endian) == elf::PT_LOAD)
-        .map(|header| {
-            let start = u64::from(header.p_paddr(endian));
-            (start, start + u64::from(header.p_filesz(endian)))
-        })
-        .filter(|&(start, end)| end > start && XIP.contains(&start))
-        .map(|(_, end)| end)
+        .map(Segment::range)
+        .filter(|range| XIP.contains(&u64::from(range.start)))
+        .map(|range| u64::from(range.end))
         .max()
         .unwrap_or(0)
 }
 
 /// Fails unless the image names the settings region of memory.x, it is
-/// [`SETTINGS_REGION`], and nothing stored in flash reaches into it.
-fn check_settings_region(image: &Image) -> Result<()> {
+/// `expected` (the board's, [`Board::settings`]), and nothing stored in
+/// flash reaches into it.
+///
+/// # Errors
+/// Which of these is not so.
+pub fn check_settings_region(image: &Image, expected: Range<u32>) -> Result<()> {
     let Some(region) = image.settings.clone() else {
         bail!(
             "no `__settings_start`/`__settings_end` symbols: memory.x must reserve the settings \
              region"
         );
     };
-    if region != SETTINGS_REGION {
+    let expected = u64::from(expected.start)..u64::from(expected.end);
+    if region != expected {
         bail!(
             "the settings region is {:#010x}..{:#010x} in memory.x, but the firmware's store \
              uses {:#010x}..{:#010x}",
             region.start,
             region.end,
-            SETTINGS_REGION.start,
-            SETTINGS_REGION.end
+            expected.start,
+            expected.end
         );
     }
     if image.flash_end > region.start {
@@ -456,7 +514,7 @@ mod tests {
         assert!(image.flash() > 0);
     }
 
-    fn image(settings: Option<std::ops::Range<u64>>, flash_end: u64) -> Image {
+    fn image(settings: Option<Range<u64>>, flash_end: u64) -> Image {
         Image {
             sections: Vec::new(),
             allocator_symbols: Vec::new(),
@@ -467,15 +525,16 @@ mod tests {
 
     #[test]
     fn the_settings_region_must_be_reserved_and_clear() {
-        assert!(check_settings_region(&image(Some(SETTINGS_REGION), 0x1000_c000)).is_ok());
-        assert!(
-            check_settings_region(&image(Some(SETTINGS_REGION), SETTINGS_REGION.start)).is_ok()
-        );
-        let into = check_settings_region(&image(Some(SETTINGS_REGION), SETTINGS_REGION.start + 4));
+        let pico = Board::Pico.settings();
+        let region = u64::from(pico.start)..u64::from(pico.end);
+        let check = |image: &Image| check_settings_region(image, pico.clone());
+        assert!(check(&image(Some(region.clone()), 0x1000_c000)).is_ok());
+        assert!(check(&image(Some(region.clone()), region.start)).is_ok());
+        let into = check(&image(Some(region.clone()), region.start + 4));
         assert!(format!("{:#}", into.unwrap_err()).contains("inside the settings region"));
-        let moved = check_settings_region(&image(Some(0x1010_0000..0x1010_4000), 0x1000_c000));
+        let moved = check(&image(Some(0x1010_0000..0x1010_4000), 0x1000_c000));
         assert!(format!("{:#}", moved.unwrap_err()).contains("the firmware's store uses"));
-        let missing = check_settings_region(&image(None, 0x1000_c000));
+        let missing = check(&image(None, 0x1000_c000));
         assert!(format!("{:#}", missing.unwrap_err()).contains("must reserve"));
     }
 }

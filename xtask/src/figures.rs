@@ -11,6 +11,7 @@
 //! | `ram` | [`elf::check_ram`](crate::elf::check_ram) → [`elf::record_ram`](crate::elf::record_ram) | `cargo xtask test` |
 //! | `qemu` | [`qemu::check_summary`](crate::qemu::check_summary) → [`qemu::record_figures`](crate::qemu::record_figures) | `cargo xtask qemu`, `cargo xtask test` |
 //! | `bench` | [`bench::run_and_check`](crate::bench::run_and_check) → its `record_figures` | `cargo xtask bench`, `cargo xtask test` |
+//! | `latency` | [`bench::command`](crate::bench::command) → its `record_latency` | `cargo xtask bench` |
 //! | `metrics` | [`metrics::command`](crate::metrics::command) → its `record_figures` | `cargo xtask metrics` |
 //!
 //! `cargo xtask book` then writes `docs/design/figures.md` (ignored by git)
@@ -46,6 +47,8 @@ pub struct Figures {
     pub qemu: Option<QemuRun>,
     /// The benchmark: boot precompute rows and frame cost rows.
     pub bench: Option<Bench>,
+    /// The latency rows, measured in the RP2040 emulator.
+    pub latency: Option<Latency>,
     /// Loop quality over many seeds.
     pub metrics: Option<Metrics>,
 }
@@ -185,8 +188,6 @@ pub struct FrameCost {
     pub median_budget: u64,
     /// Ceiling of the max.
     pub max_budget: u64,
-    /// Whether the bench fails past the ceilings (or only reports).
-    pub held: bool,
 }
 
 /// The benchmark's figures.
@@ -200,14 +201,11 @@ pub struct Bench {
     pub rows: Vec<PrecomputeRow>,
     /// The frame rows.
     pub frames: Vec<FrameCost>,
-    /// The latency rows, measured in the RP2040 emulator.
-    #[serde(default)]
-    pub latency: Vec<Latency>,
 }
 
 /// A latency row: from an event to the first pulse that shows it.
 #[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Latency {
+pub struct LatencyRow {
     /// `latency input edge`, ...
     pub label: String,
     /// Events measured.
@@ -220,6 +218,15 @@ pub struct Latency {
     pub max_ms: f64,
     /// The goal for the 99th percentile, ms.
     pub goal_p99_ms: f64,
+}
+
+/// The latency rows, measured in the RP2040 emulator.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Latency {
+    /// Who recorded them.
+    pub source: Source,
+    /// One row per path (DMX, a look over USB, an input edge).
+    pub rows: Vec<LatencyRow>,
 }
 
 /// One metric's distribution over the seeds.
@@ -259,6 +266,19 @@ pub struct Metrics {
     pub limit: f32,
     /// Per closure.
     pub closures: Vec<ClosureMetrics>,
+}
+
+/// `1234567` as `1,234,567`.
+pub fn thousands(value: u64) -> String {
+    let digits = value.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
 }
 
 /// Where the figures are kept: `target/figures.json` at the repository's
@@ -326,6 +346,28 @@ mod tests {
                 stored: true,
             }],
         }
+    }
+
+    #[test]
+    fn thousands_separators() {
+        assert_eq!(thousands(0), "0");
+        assert_eq!(thousands(999), "999");
+        assert_eq!(thousands(1000), "1,000");
+        assert_eq!(thousands(133_967_040), "133,967,040");
+    }
+
+    #[test]
+    fn a_file_from_before_the_latency_section_still_loads() {
+        // The latency rows inside `bench`, a `held` on each frame row.
+        let old = r#"{"bench": {"source": {"command": "cargo xtask bench", "commit": null},
+            "budget": 150000, "rows": [],
+            "frames": [{"label": "frame", "frames": 1601, "min": 1, "median": 2, "max": 3,
+                "mean": 2, "median_budget": 1000, "max_budget": 2000, "held": true}],
+            "latency": [{"label": "latency dmx", "events": 1, "p50_ms": 1.0, "p99_ms": 1.0,
+                "max_ms": 1.0, "goal_p99_ms": 25.0}]}}"#;
+        let figures: Figures = serde_json::from_str(old).unwrap();
+        assert_eq!(figures.bench.unwrap().frames[0].max_budget, 2000);
+        assert!(figures.latency.is_none());
     }
 
     #[test]

@@ -51,6 +51,7 @@ mod rp2350;
 mod setup;
 mod sim;
 mod snapshot;
+mod steps;
 mod test;
 mod trace;
 mod uf2;

@@ -109,6 +109,27 @@ pub fn command(args: &Args) -> Result<bool> {
     Ok(true)
 }
 
+/// The kinds of file the page is made of, by extension, and the content
+/// type each is served as: what the server serves from `panel/` and what
+/// `--export` copies.
+const PAGE_TYPES: [(&str, &str); 5] = [
+    ("html", "text/html; charset=utf-8"),
+    ("css", "text/css; charset=utf-8"),
+    ("js", "text/javascript; charset=utf-8"),
+    ("svg", "image/svg+xml"),
+    ("png", "image/png"),
+];
+
+/// The content type of `file` if it is of a kind the page is made of
+/// ([`PAGE_TYPES`]).
+pub fn content_type(file: &Path) -> Option<&'static str> {
+    let extension = file.extension()?.to_str()?;
+    PAGE_TYPES
+        .iter()
+        .find(|(kind, _)| *kind == extension)
+        .map(|(_, content_type)| *content_type)
+}
+
 /// The files of the page in `panel/` (not its tests or package files),
 /// relative to it.
 pub fn page_files(root: &Path) -> Result<Vec<PathBuf>> {
@@ -117,11 +138,7 @@ pub fn page_files(root: &Path) -> Result<Vec<PathBuf>> {
     for entry in std::fs::read_dir(&dir).with_context(|| format!("reading {}", dir.display()))? {
         let entry = entry?;
         let name = PathBuf::from(entry.file_name());
-        let page = matches!(
-            name.extension().and_then(|e| e.to_str()),
-            Some("html" | "css" | "js" | "svg")
-        );
-        if page && entry.file_type()?.is_file() {
+        if content_type(&name).is_some() && entry.file_type()?.is_file() {
             files.push(name);
         }
     }
@@ -190,4 +207,34 @@ pub fn ensure_dependencies(root: &Path) -> Result<()> {
         bail!("panel/node_modules has no uPlot after `npm ci`");
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_page_is_its_html_css_scripts_and_pictures() {
+        for (file, kind) in [
+            ("index.html", "text/html; charset=utf-8"),
+            ("panel.js", "text/javascript; charset=utf-8"),
+            ("panel.css", "text/css; charset=utf-8"),
+            ("head.svg", "image/svg+xml"),
+            ("head.png", "image/png"),
+        ] {
+            assert_eq!(content_type(Path::new(file)), Some(kind), "{file}");
+        }
+        for file in [
+            "package.json",
+            "package-lock.json",
+            "browser.mjs",
+            "tests",
+            ".html",
+        ] {
+            assert_eq!(content_type(Path::new(file)), None, "{file}");
+        }
+        let files = page_files(&project::root()).unwrap();
+        assert!(files.contains(&PathBuf::from("index.html")), "{files:?}");
+        assert!(files.iter().all(|f| content_type(f).is_some()), "{files:?}");
+    }
 }

@@ -71,26 +71,8 @@ pub fn check(path: &Path) -> Result<()> {
         ),
         Err(error) => problems.push(format!("{error:#}")),
     }
-    let settings = Board::Pico2.settings();
-    let settings = u64::from(settings.start)..u64::from(settings.end);
-    match image.settings.clone() {
-        Some(region) if region == settings && image.flash_end <= region.start => println!(
-            "  settings sectors {:#010x}..{:#010x} clear: the image ends at {:#010x}",
-            region.start, region.end, image.flash_end
-        ),
-        Some(region) if region == settings => problems.push(format!(
-            "the image's flash contents end at {:#010x}, inside the settings sectors",
-            image.flash_end
-        )),
-        Some(region) => problems.push(format!(
-            "memory.x reserves {:#010x}..{:#010x} for the settings, not the last 16 KiB of the \
-             4 MiB flash {:#010x}..{:#010x}",
-            region.start, region.end, settings.start, settings.end
-        )),
-        None => problems.push(
-            "no `__settings_start`/`__settings_end`: memory.x must reserve the settings sectors"
-                .to_owned(),
-        ),
+    if let Err(error) = elf::check_settings_region(&image, Board::Pico2.settings()) {
+        problems.push(error.to_string());
     }
     if let Err(error) = image.check_no_allocator() {
         problems.push(error.to_string());

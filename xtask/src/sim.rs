@@ -14,6 +14,7 @@ mod event;
 mod exchange;
 mod expect;
 mod flood;
+mod harness;
 mod image;
 mod inputs;
 pub mod live;
@@ -52,7 +53,7 @@ pub fn play_script(
     time: Duration,
     wall: Duration,
 ) -> Result<Report> {
-    Ok(script::play(root, metadata, events, time, wall, script::Against::Written)?.report)
+    script::play(root, metadata, events, time, wall, script::Against::Written)
 }
 pub use noise::{NOISE_STAGE, test_noise};
 pub use run::{Report, logged_peak_stack};
@@ -356,7 +357,7 @@ impl Report {
                 "period ns",
                 "mismatches"
             );
-            for ((name, pin, _), check) in run::SERVOS.iter().zip(&boot.servos) {
+            for ((name, pin, _), check) in harness::SERVOS.iter().zip(&boot.servos) {
                 let widths = check.pulses.iter().map(|p| p.counts);
                 let first = check.pulses.first().map_or(0, |p| p.counts);
                 let period = check

@@ -31,7 +31,7 @@ use std::{fs, path::PathBuf};
 
 use anyhow::{Context, Result, anyhow};
 use idle_head_core::behaviour::{BehaviourConfig, CommandQueue, Head, LOOP_DURATION};
-use idle_head_core::driver::{DriverConfig, FrameDriver};
+use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
 use idle_head_core::{Axis, Playback};
@@ -43,6 +43,8 @@ use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use marks::Mark;
 pub use script::{Event, Kind};
+
+use crate::steps::Steps;
 
 /// A script's events (see `script.rs`), checked with `params`.
 ///
@@ -162,16 +164,26 @@ fn idle(config: HeadConfig, playback: Playback, seed: Option<u32>) -> Result<Idl
     Ok(IdlePlayer::new(first, supply, timing, IDLE_MODE))
 }
 
+/// The built-in driver's parameters and the behaviour's built on them:
+/// what the board runs.
+///
+/// # Errors
+/// If a configuration is refused (never the built-in ones).
+pub fn built_in() -> Result<(DriverParams, BehaviourParams)> {
+    let driver = DriverConfig::DEFAULT
+        .build()
+        .map_err(|e| anyhow!("{}", e.message()))?;
+    let params = BehaviourConfig::DEFAULT
+        .build(&driver)
+        .map_err(|e| anyhow!("{e}"))?;
+    Ok((driver, params))
+}
+
 /// Runs `micros` of frames with `events` (sorted by time): motion lines
 /// through the queue, other console lines through the console's service,
 /// pin lines into the input task ([`host`]).
 pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trace> {
-    let driver_params = DriverConfig::DEFAULT
-        .build()
-        .map_err(|e| anyhow!("{}", e.message()))?;
-    let params = BehaviourConfig::DEFAULT
-        .build(&driver_params)
-        .map_err(|e| anyhow!("{e}"))?;
+    let (driver_params, params) = built_in()?;
     let frame_us = u64::from(driver_params.config().frame_period.0);
     let count_ps = PICO_SERVO_CLOCK.count_ps(PICO_SYS_HZ);
     let playback = Playback::new(
@@ -350,12 +362,7 @@ fn wake_until(
 
 /// `cargo xtask trace`.
 pub fn command(args: &Args) -> Result<bool> {
-    let driver_params = DriverConfig::DEFAULT
-        .build()
-        .map_err(|e| anyhow!("{}", e.message()))?;
-    let params = BehaviourConfig::DEFAULT
-        .build(&driver_params)
-        .map_err(|e| anyhow!("{e}"))?;
+    let (_, params) = built_in()?;
     let events = match &args.script {
         Some(path) => {
             let text = fs::read_to_string(path)
@@ -408,20 +415,12 @@ fn summary(trace: &Trace) {
         let (lo, hi) = values
             .iter()
             .fold((i64::MAX, i64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-        let step = values
-            .windows(2)
-            .map(|w| (w[1] - w[0]).abs())
-            .max()
-            .unwrap_or(0);
-        let turn = values
-            .windows(3)
-            .map(|w| (w[2] - 2 * w[1] + w[0]).abs())
-            .max()
-            .unwrap_or(0);
+        let angles: Vec<f64> = trace.rows.iter().map(|r| f64::from(r.angles[i])).collect();
+        let Steps { step, turn } = Steps::of(&angles);
         let pulses = trace.rows.iter().map(|r| r.pulses[i]);
         let (plo, phi) = pulses.fold((u64::MAX, 0), |(lo, hi), p| (lo.min(p), hi.max(p)));
         println!(
-            "{:<5} angle {lo}..{hi} mdeg, largest step {step} mdeg/frame, largest change of step {turn} mdeg/frame², pulses {plo}..{phi} ns",
+            "{:<5} angle {lo}..{hi} mdeg, largest step {step:.0} mdeg/frame, largest change of step {turn:.0} mdeg/frame², pulses {plo}..{phi} ns",
             axis.name()
         );
     }

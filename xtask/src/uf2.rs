@@ -23,9 +23,8 @@ mod test_elf;
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use elf2flash_core::boards::{BoardInfo, RP2040, RP2350};
-use object::{Object, ObjectSection};
 
 pub use self::format::Layout;
 use crate::{board::Board, elf, project, rp2350, setup};
@@ -82,21 +81,9 @@ pub fn make(elf: &[u8], board: Board) -> Result<Uf2> {
 /// If it has not: a board would stay in BOOTSEL mode after the copy.
 pub fn check_boot(data: &[u8], board: Board) -> Result<()> {
     match board {
-        Board::Pico => {
-            let file = object::File::parse(data).context("parsing the ELF")?;
-            let boot2 = file
-                .section_by_name(".boot2")
-                .map(|section| (section.address(), section.size()));
-            if boot2 != Some((elf::BOOT2_ADDRESS, elf::BOOT2_SIZE)) {
-                bail!(
-                    "no {}-byte `.boot2` at {:#010x}: the RP2040 would not start this image \
-                     (is it linked with -Tlink-rp.x?)",
-                    elf::BOOT2_SIZE,
-                    elf::BOOT2_ADDRESS
-                );
-            }
-            Ok(())
-        }
+        Board::Pico => elf::Image::parse(data)
+            .context("parsing the ELF")?
+            .check_boot2(),
         Board::Pico2 => rp2350::start_block(data).map(|_| ()),
     }
 }

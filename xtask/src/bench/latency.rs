@@ -108,8 +108,8 @@ pub struct Row {
 
 impl Row {
     /// The row for the measured figures.
-    pub fn figure(&self) -> crate::figures::Latency {
-        crate::figures::Latency {
+    pub fn figure(&self) -> crate::figures::LatencyRow {
+        crate::figures::LatencyRow {
             label: format!("latency {}", self.name),
             events: self.ms.len(),
             p50_ms: self.percentile(50.0),

@@ -182,11 +182,3 @@ fn a_frame_row_of_an_unknown_scenario_is_an_error() {
     assert!(err.contains("`frame (juggling)`"), "{err}");
     assert_eq!(FrameRow::all(&log[..2]).unwrap().len(), 2);
 }
-
-#[test]
-fn thousands_separators() {
-    assert_eq!(thousands(0), "0");
-    assert_eq!(thousands(999), "999");
-    assert_eq!(thousands(1000), "1,000");
-    assert_eq!(thousands(133_967_040), "133,967,040");
-}

@@ -9,8 +9,7 @@ use std::{fmt::Write as _, path::Path};
 
 use anyhow::{Context, Result};
 
-use super::{Bench, Figures, Metrics, QemuRun, Source};
-use crate::bench::thousands;
+use super::{Bench, Figures, Latency, Metrics, QemuRun, Source, thousands};
 
 /// The Pico's system clock, for the time a count of instructions takes at
 /// least (one cycle each).
@@ -35,8 +34,9 @@ pub fn render(figures: &Figures) -> (String, Vec<&'static str>) {
          do not edit. -->\n\n\
          These figures are written by the project's tools as they measure, never by \
          hand. `cargo xtask test` records the images' sizes, their RAM with the peak \
-         stack, the QEMU run and the benchmark; `cargo xtask metrics` records the loop \
-         quality; `cargo xtask book` writes this page from what they recorded \
+         stack, the QEMU run and the benchmark; `cargo xtask bench` the benchmark and \
+         the latency rows; `cargo xtask metrics` the loop quality; `cargo xtask book` \
+         writes this page from what they recorded \
          (`target/figures.json`). Each section says which command recorded it, and on \
          which commit.\n",
     );
@@ -55,12 +55,15 @@ pub fn render(figures: &Figures) -> (String, Vec<&'static str>) {
     let test = "`cargo xtask test` measures these (and builds this page again)";
     section("memory", "Memory", memory(figures), test);
     let bench = figures.bench.as_ref();
-    section(
-        "frames",
-        "Frame cost",
-        bench.map(|b| format!("{}{}", frames(b), latency(b))),
-        test,
-    );
+    let latency = figures.latency.as_ref();
+    let frame_cost = (bench.is_some() || latency.is_some()).then(|| {
+        format!(
+            "{}{}",
+            bench.map(frames).unwrap_or_default(),
+            latency.map(latency_rows).unwrap_or_default()
+        )
+    });
+    section("frames", "Frame cost", frame_cost, test);
     section("precompute", "Boot precompute", bench.map(precompute), test);
     section(
         "qemu",
@@ -180,7 +183,7 @@ fn frames(bench: &Bench) -> String {
     for row in &bench.frames {
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {} | {} | {} / {}{} | ≥ {:.1} µs |",
+            "| {} | {} | {} | {} | {} | {} | {} / {} | ≥ {:.1} µs |",
             row.label,
             thousands(row.frames),
             thousands(row.min),
@@ -189,7 +192,6 @@ fn frames(bench: &Bench) -> String {
             thousands(row.mean),
             thousands(row.median_budget),
             thousands(row.max_budget),
-            if row.held { "" } else { " (reported only)" },
             row.median as f64 / RP2040_MHZ,
         );
     }
@@ -197,18 +199,21 @@ fn frames(bench: &Bench) -> String {
 }
 
 /// The latency rows, under the frame costs.
-fn latency(bench: &Bench) -> String {
-    if bench.latency.is_empty() {
+fn latency_rows(latency: &Latency) -> String {
+    if latency.rows.is_empty() {
         return String::new();
     }
     let mut out = String::from(
         "\nLatency, measured in the RP2040 emulator on the shipped image, from an event \
          to the first servo pulse that shows it, in ms \
-         ([the emulators](../dev/emulators.md#latency-of-an-input-edge)):\n\n\
-         | row | events | p50 | p99 | max | goal (p99) |\n\
+         ([the emulators](../dev/emulators.md#latency-of-an-input-edge)). ",
+    );
+    out.push_str(&recorded_by(&latency.source));
+    out.push_str(
+        "| row | events | p50 | p99 | max | goal (p99) |\n\
          |---|---|---|---|---|---|\n",
     );
-    for row in &bench.latency {
+    for row in &latency.rows {
         let _ = writeln!(
             out,
             "| {} | {} | {:.1} | {:.1} | {:.1} | {:.0}{} |",
@@ -324,13 +329,27 @@ fn metrics(metrics: &Metrics) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{FrameCost, Image, PrecomputeRow, Section};
+    use super::super::{FrameCost, Image, LatencyRow, PrecomputeRow, Section};
     use super::*;
 
     fn source() -> Source {
         Source {
             command: "cargo xtask test".into(),
             commit: Some("abc1234".into()),
+        }
+    }
+
+    fn input_edge() -> Latency {
+        Latency {
+            source: source(),
+            rows: vec![LatencyRow {
+                label: "latency input edge".into(),
+                events: 1000,
+                p50_ms: 45.6,
+                p99_ms: 55.0,
+                max_ms: 55.1,
+                goal_p99_ms: 25.0,
+            }],
         }
     }
 
@@ -388,24 +407,29 @@ mod tests {
                 mean: 1476,
                 median_budget: 1000,
                 max_budget: 2000,
-                held: false,
-            }],
-            latency: vec![super::super::Latency {
-                label: "latency input edge".into(),
-                events: 1000,
-                p50_ms: 45.6,
-                p99_ms: 55.0,
-                max_ms: 55.1,
-                goal_p99_ms: 25.0,
             }],
         });
+        figures.latency = Some(input_edge());
         let (page, recorded) = render(&figures);
         assert!(page.contains("| latency input edge | 1,000 | 45.6 | 55.0 | 55.1 | 25 (missed) |"));
         assert_eq!(recorded, ["memory", "frames", "precompute"]);
         assert!(page.contains("| pico | 101,200 B (98.8 KiB) | 77 % of 131,072 B | 20,764 B |"));
         assert!(page.contains("Recorded by `cargo xtask test` on `abc1234`."));
         assert!(page.contains("| default | 900 | 59 | 148,960 | 37,010,000 | 248× |"));
-        assert!(page.contains("1,000 / 2,000 (reported only)"));
+        assert!(page.contains("| 1,000 / 2,000 | ≥ 11.5 µs |"));
         assert_eq!(page.matches("Not measured yet").count(), 2);
+    }
+
+    #[test]
+    fn latency_rows_are_shown_without_a_benchmark() {
+        let figures = Figures {
+            latency: Some(input_edge()),
+            ..Figures::default()
+        };
+        let (page, recorded) = render(&figures);
+        assert_eq!(recorded, ["frames"]);
+        assert!(page.contains("| latency input edge | 1,000 | 45.6 | 55.0 | 55.1 | 25 (missed) |"));
+        assert!(page.contains("Recorded by `cargo xtask test` on `abc1234`."));
+        assert!(!page.contains("| row | frames |"));
     }
 }

@@ -26,8 +26,8 @@ use std::{
 use anyhow::{Context, Result};
 use tungstenite::{Message, WebSocket, handshake::derive_accept_key, protocol::Role};
 
-use super::VENDOR;
 use super::bridge::{Bridge, Note};
+use super::{VENDOR, content_type};
 
 /// `bridge.json` of a page served without a bridge (and of an exported
 /// copy): the page offers Web Serial.
@@ -190,16 +190,15 @@ impl Site {
             }
             name if !name.contains('/') && !name.starts_with('.') => {
                 let file = self.panel.join(name);
-                let page = matches!(
-                    file.extension().and_then(|e| e.to_str()),
-                    Some("html" | "css" | "js" | "svg" | "png")
-                );
-                page.then_some(file)
+                content_type(&file).is_some().then_some(file)
             }
             _ => None,
         };
         match file.and_then(|f| std::fs::read(&f).ok().map(|bytes| (f, bytes))) {
-            Some((file, bytes)) => respond(stream, 200, content_type(&file), &bytes),
+            Some((file, bytes)) => {
+                let content_type = content_type(&file).unwrap_or("application/octet-stream");
+                respond(stream, 200, content_type, &bytes)
+            }
             None => respond(stream, 404, "text/plain", b"not found"),
         }
     }
@@ -300,16 +299,4 @@ fn respond(stream: &mut TcpStream, status: u16, content_type: &str, body: &[u8])
     stream.write_all(body)?;
     stream.flush()?;
     Ok(())
-}
-
-fn content_type(file: &Path) -> &'static str {
-    match file.extension().and_then(|e| e.to_str()) {
-        Some("html") => "text/html; charset=utf-8",
-        Some("css") => "text/css; charset=utf-8",
-        Some("js") => "text/javascript; charset=utf-8",
-        Some("svg") => "image/svg+xml",
-        Some("png") => "image/png",
-        Some("json") => "application/json",
-        _ => "application/octet-stream",
-    }
 }

@@ -5,19 +5,20 @@
 //! sections (`.boot2 .vector_table .text .rodata .data`) gives: every
 //! loadable segment placed at its load address (`p_paddr`; `.data` runs in
 //! RAM but is stored in flash behind `.rodata`), gaps filled with the erased
-//! value 0xff. It is read with the `object` crate the xtask already uses for
-//! the memory budgets, so the emulator needs no binutils.
+//! value 0xff. The segments are the ones the memory budgets and the UF2
+//! read (`elf::segments`, with the `object` crate), so the emulator needs
+//! no binutils.
 
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
-use object::read::elf::{ElfFile32, ProgramHeader};
+use anyhow::{Context, Result, anyhow, bail};
+use object::read::elf::ElfFile32;
 use object::{Endianness, Object, ObjectSymbol, elf};
 
+use crate::elf::{XIP, segments};
+
 /// Where the RP2040 maps its QSPI flash (XIP).
-pub const FLASH_START: u64 = 0x1000_0000;
-/// The window of the XIP address space a 16 MiB flash can occupy.
-const FLASH_END: u64 = 0x1100_0000;
+pub const FLASH_START: u64 = XIP.start;
 /// Where boot2 leaves the vector table: right behind its own 256 bytes.
 pub const VECTOR_TABLE: u64 = FLASH_START + 0x100;
 /// What cortex-m-rt's `paint-stack` fills the stack with before `main`.
@@ -58,7 +59,7 @@ impl PicoImage {
         if file.section_by_name(".boot2").is_none() {
             bail!("no `.boot2` section (an image for another board?)");
         }
-        let flash = flash_image(&file, data)?;
+        let flash = flash_image(&file)?;
         let symbol = |name: &str| {
             file.symbols()
                 .find(|symbol| symbol.name() == Ok(name))
@@ -92,26 +93,19 @@ impl PicoImage {
 
 /// Every loadable segment at its load address, as `objcopy -O binary` lays
 /// out the flash; checks that the vector table is where boot2 jumps to.
-fn flash_image(file: &ElfFile32<Endianness>, data: &[u8]) -> Result<Vec<u8>> {
-    let endian = file.endian();
+fn flash_image(file: &ElfFile32<Endianness>) -> Result<Vec<u8>> {
     let mut flash = Vec::new();
-    for header in file.elf_program_headers() {
-        if header.p_type(endian) != elf::PT_LOAD || header.p_filesz(endian) == 0 {
+    for segment in segments(file).map_err(|error| anyhow!(error))? {
+        let address = u64::from(segment.address);
+        if !XIP.contains(&address) {
             continue;
         }
-        let address = u64::from(header.p_paddr(endian));
-        if !(FLASH_START..FLASH_END).contains(&address) {
-            continue;
-        }
-        let bytes = header
-            .data(endian, data)
-            .map_err(|()| anyhow::anyhow!("a segment lies outside the file"))?;
         let start = usize::try_from(address - FLASH_START)?;
-        let end = start + bytes.len();
+        let end = start + segment.data.len();
         if flash.len() < end {
             flash.resize(end, 0xff);
         }
-        flash[start..end].copy_from_slice(bytes);
+        flash[start..end].copy_from_slice(&segment.data);
     }
     let vectors = usize::try_from(VECTOR_TABLE - FLASH_START)?;
     let word = |at: usize| {

@@ -11,7 +11,7 @@
 //!    sensor's edge;
 //! 3. it wakes with the soft start and no jump: the first pulse after the
 //!    gap is the last one before it, and until the glance every step stays
-//!    within the idle limits (60 °/s, 600 °/s²);
+//!    within the idle limits (`LimitMode::Idle`: 60 °/s, 600 °/s² built in);
 //! 4. it glances towards the sensor: yaw at −20° (the ducked idle's sway
 //!    aside), held about 2 s.
 //!
@@ -22,11 +22,15 @@ use std::path::Path;
 use std::time::Duration;
 
 use anyhow::{Result, bail};
+use idle_head_core::Axis;
+use idle_head_core::behaviour::{BehaviourConfig, BehaviourParams, LimitMode};
 
-use super::pulses::Pulse;
+use super::pulses::{Pulse, angle};
 use super::run;
 use super::script;
 use crate::project::Metadata;
+use crate::steps::Steps;
+use crate::trace;
 
 /// The stage's name.
 pub const INPUTS_STAGE: &str = "Pico image in the RP2040 emulator: a presence sensor rests, \
@@ -43,18 +47,13 @@ pub const SCRIPT: &str = "\
 /// How long it runs: the glance (from about 8.1 s) held and back.
 const TIME: Duration = Duration::from_millis(12_500);
 
-/// The idle limits of the built-in driver per 20 ms frame, in counts of
-/// 312.5 ns at 11.111 µs/°: 1.2° (42.7 counts) and 0.24° (8.5 counts).
-const IDLE_STEP: f64 = 1.2 * 11.111 / 0.3125;
-const IDLE_TURN: f64 = 0.24 * 11.111 / 0.3125;
-
-/// The pulse of the rest pose's pitch, −8°, in counts: 1411.1 µs.
-const REST_PITCH: f64 = (1500.0 - 8.0 * 11.111) / 0.3125;
+/// Where the sensor looks from ([`SCRIPT`]'s `presence -20000`), m°.
+const SENSOR_YAW: f64 = -20_000.0;
 
 /// `cargo xtask test`'s stage: plays [`SCRIPT`] and checks it.
 pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     let events = script::parse(SCRIPT)?;
-    let run = script::play(
+    let report = script::play(
         root,
         metadata,
         events,
@@ -62,14 +61,14 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
         super::WALL,
         script::Against::Host,
     )?;
-    let report = &run.report;
     print!("{}", report.table());
     println!("{}", report.verdict());
     let mut problems = report.problems.clone();
     let Some(boot) = report.boots.first() else {
         bail!("no boot");
     };
-    let period = f64::from(run::timing().period_counts) * run::timing().count_ns;
+    let timing = run::timing();
+    let period = f64::from(timing.period_counts) * timing.count_ns;
     let pulses: [&Vec<Pulse>; 3] = [0, 1, 2].map(|i| &boot.servos[i].pulses);
     let Some(&(edge, _, _)) = boot.drives.first() else {
         bail!("the harness drove no pin");
@@ -89,19 +88,20 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     println!(
         "pitch: last pulse before the gap {:.1} µs at {:.3} s, first after {:.1} µs at {:.3} s \
          ({:.1} s without pulses); GP2 high at {:.3} s",
-        f64::from(before.counts) * 0.3125,
+        f64::from(before.counts) * timing.count_ns / 1e3,
         ms(before.rise) / 1e3,
-        f64::from(after.counts) * 0.3125,
+        f64::from(after.counts) * timing.count_ns / 1e3,
         ms(after.rise) / 1e3,
         ms(span) / 1e3,
         ms(edge) / 1e3
     );
     // 1. Rested: at the rest pose when the pulses stopped (the glide had
-    // arrived: its last frames there too).
+    // arrived: its last frames there too), within a count.
+    let rest = f64::from(BehaviourConfig::DEFAULT.rest.pose[0].millidegrees());
     let held = pulses[0]
         .iter()
         .filter(|p| p.rise <= before.rise && before.rise - p.rise < 2.5 * period)
-        .all(|p| (f64::from(p.counts) - REST_PITCH).abs() <= 1.0);
+        .all(|p| (degrees(0, p) - rest).abs() <= count(0));
     if !held {
         problems.push(
             "the head did not hold the rest pose (pitch −8°) before the pulses stopped".into(),
@@ -123,8 +123,10 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
             problems.push(format!("{name} had pulses while pitch had none"));
         }
     }
-    soft_start(&pulses, after.rise, period, &mut problems);
-    glance(pulses[2], after.rise, &mut problems);
+    let (_, params) = trace::built_in()?;
+    soft_start(&pulses, after.rise, period, &params, &mut problems);
+    let yaw = pulses[2].iter().map(|p| (p.rise, degrees(2, p)));
+    glance(yaw, after.rise, &mut problems);
     if problems.is_empty() {
         println!(
             "inputs: ok: rested, relaxed {:.1} s, woke softly from the pose, glanced towards the sensor",
@@ -138,9 +140,16 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
 
 /// The soft start (check 3): the first pulse after the gap (at `after`) is
 /// the last before it, and the next second (the idle coming back) within
-/// the idle limits.
-fn soft_start(pulses: &[&Vec<Pulse>; 3], after: f64, period: f64, problems: &mut Vec<String>) {
-    for (i, name) in ["pitch", "roll", "yaw"].iter().enumerate() {
+/// the idle limits, with a count of rounding each way.
+fn soft_start(
+    pulses: &[&Vec<Pulse>; 3],
+    after: f64,
+    period: f64,
+    params: &BehaviourParams,
+    problems: &mut Vec<String>,
+) {
+    for axis in Axis::ALL {
+        let (i, name) = (axis.index(), axis.name());
         let first = pulses[i]
             .iter()
             .position(|p| p.rise >= after - period / 2.0);
@@ -157,35 +166,46 @@ fn soft_start(pulses: &[&Vec<Pulse>; 3], after: f64, period: f64, problems: &mut
         let wake: Vec<f64> = pulses[i][first..]
             .iter()
             .take(50)
-            .map(|p| f64::from(p.counts))
+            .map(|p| degrees(i, p))
             .collect();
-        let step = wake
-            .windows(2)
-            .map(|w| (w[1] - w[0]).abs())
-            .fold(0.0, f64::max);
-        let turn = wake
-            .windows(3)
-            .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
-            .fold(0.0, f64::max);
+        let steps = Steps::of(&wake);
         println!(
-            "{name}: waking, steps up to {step:.0} counts a frame, changes of step up to {turn:.0}"
+            "{name}: waking, steps up to {:.0} m° a frame, changes of step up to {:.0}",
+            steps.step, steps.turn
         );
-        // (A count of rounding each way.)
-        if step > IDLE_STEP + 1.0 || turn > IDLE_TURN + 2.0 {
+        // A count of rounding each way.
+        let limits = Steps::allowed(params, axis, LimitMode::Idle);
+        let allowed = Steps {
+            step: limits.step + count(i),
+            turn: limits.turn + 2.0 * count(i),
+        };
+        if !steps.within(allowed) {
             problems.push(format!(
-                "{name}: the wake exceeds the idle limits ({step:.0} counts/frame, {turn:.0} counts/frame²)"
+                "{name}: the wake exceeds the idle limits ({:.0} m°/frame, {:.0} m°/frame²)",
+                steps.step, steps.turn
             ));
         }
     }
 }
 
-/// The glance (check 4): yaw at −20° (1277.8 µs) within 2.5° (the idle's
-/// sway) after the wake (at `after`), for about its 2 s hold.
-fn glance(yaw: &[Pulse], after: f64, problems: &mut Vec<String>) {
-    let target = (1500.0 - 20.0 * 11.111) / 0.3125;
+/// The angle, m°, of `pulse` on the servo of axis `i` ([`Axis::index`]).
+fn degrees(i: usize, pulse: &Pulse) -> f64 {
+    angle(i, f64::from(pulse.counts) * run::timing().count_ns)
+}
+
+/// One count of the servo clock (312.5 ns) on the servo of axis `i`, m°
+/// (28.1): the rounding of a measured pulse.
+fn count(i: usize) -> f64 {
+    let count_ns = run::timing().count_ns;
+    angle(i, count_ns) - angle(i, 0.0)
+}
+
+/// The glance (check 4): yaw (`(rise, m°)` a pulse) at the sensor's −20°
+/// within 2.5° (the idle's sway) after the wake (at `after`), for about its
+/// 2 s hold.
+fn glance(yaw: impl Iterator<Item = (f64, f64)>, after: f64, problems: &mut Vec<String>) {
     let near = yaw
-        .iter()
-        .filter(|p| p.rise > after && (f64::from(p.counts) - target).abs() < 2.5 * 11.111 / 0.3125)
+        .filter(|&(rise, angle)| rise > after && (angle - SENSOR_YAW).abs() < 2_500.0)
         .count();
     println!("yaw: {near} pulses within 2.5° of the sensor's −20°");
     if near < 90 {

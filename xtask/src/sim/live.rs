@@ -12,8 +12,7 @@ use std::{
 use anyhow::{Context, Result};
 
 use super::event::Event;
-use super::image::{PicoImage, VECTOR_TABLE};
-use super::{node, run::SERVOS, store::WORST};
+use super::{harness, node, store::WORST};
 
 /// A live emulator run: the harness, its stdin (bytes for the USB serial
 /// port) and stdout (its events).
@@ -42,22 +41,16 @@ pub enum LiveEvent {
 /// slices' compare writes reported (`cc` events of slices 0, 1, 2: pitch,
 /// roll, yaw), the trigger inputs GP2..GP5 driven by `pin <n> 0|1` lines.
 pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
-    let image = PicoImage::read(elf)?;
+    let (_, config) = harness::config(elf, "live.bin")?;
     node::ensure(root)?;
-    let flash = elf.with_extension("live.bin");
-    std::fs::write(&flash, &image.flash).with_context(|| format!("writing {}", flash.display()))?;
     let config = node::Config {
-        flash,
-        vtor: VECTOR_TABLE,
-        rtt: image.rtt,
-        slices: SERVOS.iter().map(|s| s.2).collect(),
         wall: Duration::from_secs(24 * 3600),
         rom: Some(WORST),
-        // GP2..GP5 at their pulls until driven, as on a board: a button's
-        // input reads released.
-        inputs: (2..=5).collect(),
+        // At their pulls until driven, as on a board: a button's input
+        // reads released.
+        inputs: harness::input_pins(),
         live: true,
-        ..node::Config::default()
+        ..config
     };
     Ok(config.json())
 }

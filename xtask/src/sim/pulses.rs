@@ -28,6 +28,16 @@
 //! the last frame (frames stopped: the watchdog drill) repeat the last duty
 //! and are counted as held.
 
+use idle_head_core::driver::DriverConfig;
+
+/// The angle, m°, of a pulse of `width` ns on `axis`' servo (the built-in
+/// calibration).
+pub fn angle(axis: usize, width: f64) -> f64 {
+    let servo = DriverConfig::DEFAULT.servos[axis];
+    let neutral = f64::from(servo.neutral.0) * 1e3;
+    (width - neutral) / f64::from(servo.per_degree.0) * 1e3
+}
+
 /// PWM timing of a slice.
 #[derive(Debug, Clone, Copy)]
 pub struct Timing {

@@ -11,16 +11,12 @@ use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 use super::{
     event::{Event, FlashKind, Why},
     exchange, expect,
-    image::{PicoImage, VECTOR_TABLE},
+    harness::{self, SERVOS},
     node,
     pulses::{self, Limits, ServoCheck, Timing, Train},
     unmodelled::Unmodelled,
 };
 use crate::log::LogLine;
-
-/// The servos as wired on the Pico (`src/bin/pico/main.rs`): name, GPIO,
-/// PWM slice (channel A).
-pub const SERVOS: [(&str, u8, u8); 3] = [("pitch", 16, 0), ("roll", 18, 1), ("yaw", 20, 2)];
 
 /// Virtual time without a log byte or a pin edge after which a run is
 /// declared stuck: 50 frames.
@@ -193,27 +189,21 @@ pub fn run_with(
     wall: Duration,
     setup: impl FnOnce(&mut node::Config),
 ) -> Result<Report> {
-    let image = PicoImage::read(elf)?;
+    let (image, config) = harness::config(elf, "flash.bin")?;
     let bytes = std::fs::read(elf)?;
     let table = Table::parse(&bytes)
         .with_context(|| format!("reading the defmt table of {}", elf.display()))?
         .with_context(|| format!("{} has no defmt data", elf.display()))?;
     let locations = table.get_locations(&bytes).ok();
     node::ensure(root)?;
-    let flash = elf.with_extension("flash.bin");
-    std::fs::write(&flash, &image.flash).with_context(|| format!("writing {}", flash.display()))?;
     let mut config = node::Config {
-        flash,
-        vtor: VECTOR_TABLE,
-        rtt: image.rtt,
         pins: SERVOS.iter().map(|s| s.1).collect(),
-        slices: SERVOS.iter().map(|s| s.2).collect(),
         probe: image.frame_update.unwrap_or(0),
         stack: Some(image.stack),
         virtual_time,
         wall,
         silence: SILENCE,
-        ..node::Config::default()
+        ..config
     };
     setup(&mut config);
     println!(

@@ -16,16 +16,12 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{Context, Result, anyhow};
-use idle_head_core::behaviour::BehaviourConfig;
-use idle_head_core::driver::DriverConfig;
 
+use super::harness::{self, SERVOS};
 use super::node::PinScript;
-use super::run::{self, Report, SERVOS};
+use super::run::{self, Report};
 use crate::project::{Metadata, PICO};
 use crate::trace::{self, Event, Kind};
-
-/// The input pins the harness drives: GP2 to GP5.
-pub const INPUT_PINS: [u8; 4] = [2, 3, 4, 5];
 
 /// How much before its time a console line is in.
 const EARLY: Duration = Duration::from_millis(2);
@@ -36,12 +32,6 @@ const EARLY: Duration = Duration::from_millis(2);
 /// emulator and in the host trace it is checked against alike.
 pub const CONSOLE_UP: Duration = Duration::from_millis(100);
 
-/// What a script run gives: the emulator's run, checked.
-pub struct ScriptRun {
-    /// The emulator's run, its pulses checked against the host trace.
-    pub report: Report,
-}
-
 /// The events of the script at `path`.
 pub fn read(path: &Path) -> Result<Vec<Event>> {
     let text = std::fs::read_to_string(path)
@@ -51,12 +41,7 @@ pub fn read(path: &Path) -> Result<Vec<Event>> {
 
 /// The events of a script's `text`.
 pub fn parse(text: &str) -> Result<Vec<Event>> {
-    let driver = DriverConfig::DEFAULT
-        .build()
-        .map_err(|e| anyhow!("{}", e.message()))?;
-    let params = BehaviourConfig::DEFAULT
-        .build(&driver)
-        .map_err(|e| anyhow!("{e}"))?;
+    let (_, params) = trace::built_in()?;
     trace::parse_script(text, &params)
 }
 
@@ -81,7 +66,7 @@ pub enum Against {
 /// Runs `events` in the shipped image (built) for `time` of virtual time
 /// from its first frame, and checks every pulse `against` the host trace or
 /// what was written (console lines before [`CONSOLE_UP`] moved there, in
-/// both).
+/// both); the emulator's run, its pulses checked.
 pub fn play(
     root: &Path,
     metadata: &Metadata,
@@ -89,7 +74,7 @@ pub fn play(
     time: Duration,
     wall: Duration,
     against: Against,
-) -> Result<ScriptRun> {
+) -> Result<Report> {
     let up = u64::try_from(CONSOLE_UP.as_micros()).unwrap_or(u64::MAX);
     for event in &mut events {
         if !matches!(event.kind, Kind::Pin { .. }) && event.at_us < up {
@@ -117,7 +102,7 @@ pub fn play(
     // The boot before the first frame: well under a tenth of a second.
     let boot = Duration::from_millis(100);
     let mut report = run::run_with(root, &PICO.elf(metadata), time + boot, wall, |config| {
-        config.inputs = INPUT_PINS.to_vec();
+        config.inputs = harness::input_pins();
         config.script = Some(script);
         // A head relaxed at rest is silent for as long as it rests (no
         // pulse, no log line but once a loop): the wall limit alone tells a
@@ -138,7 +123,7 @@ pub fn play(
         Against::Written => written(&report),
     };
     run::check_with(&mut report, &expected);
-    Ok(ScriptRun { report })
+    Ok(report)
 }
 
 /// The duties boot 0 wrote, frame by frame from frame 0 (its compare
@@ -173,8 +158,7 @@ pub fn command(
     PICO.build(root)?;
     let events = read(path)?;
     let time = time.unwrap_or_else(|| default_time(&events));
-    let run = play(root, metadata, events, time, wall, Against::Host)?;
-    let report = &run.report;
+    let report = play(root, metadata, events, time, wall, Against::Host)?;
     print!("{}", report.log_text(false));
     if let Some(boot) = report.boots.first() {
         println!("UART0 replies:");

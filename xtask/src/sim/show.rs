@@ -30,8 +30,8 @@ use idle_head_core::bottango::hash;
 use idle_head_core::driver::DriverConfig;
 
 use super::{
-    DEFAULT_TIME, dmx, expect,
-    pulses::{self, Measured},
+    DEFAULT_TIME, dmx, expect, harness,
+    pulses::{self, Measured, angle},
     pulses_csv,
     run::{self, Boot},
     stages,
@@ -72,14 +72,6 @@ fn bottango_lines() -> Vec<String> {
     .iter()
     .map(|body| format!("{body},h{}\n", hash(body.as_bytes())))
     .collect()
-}
-
-/// The angle, m°, of a pulse of `width` ns on `axis`' servo (the built-in
-/// calibration).
-fn angle(axis: usize, width: f64) -> f64 {
-    let servo = DriverConfig::DEFAULT.servos[axis];
-    let neutral = f64::from(servo.neutral.0) * 1e3;
-    (width - neutral) / f64::from(servo.per_degree.0) * 1e3
 }
 
 /// `cargo xtask sim --dmx FILE [--pulses FILE.csv]` (either alone too).
@@ -129,7 +121,7 @@ fn write_pulses(path: &Path, boot: &Boot) -> Result<()> {
 /// Per servo: pulses, shortest and longest, as measured.
 fn servo_table(boot: &Boot) -> String {
     let mut text = String::from("\nservo   pulses   min µs   max µs\n");
-    for ((name, ..), train) in run::SERVOS.iter().zip(&boot.trains) {
+    for ((name, ..), train) in harness::SERVOS.iter().zip(&boot.trains) {
         let pulses = pulses::measure(train);
         let widths = pulses.iter().map(|p| p.width / 1e3);
         let min = widths.clone().fold(f64::INFINITY, f64::min);
@@ -221,7 +213,7 @@ impl Pulses {
                 if (counts - want).abs() > 1.5 {
                     off.push(format!(
                         "{} at {t:.3} s: {counts:.0} counts, not {want}",
-                        run::SERVOS[axis].0
+                        harness::SERVOS[axis].0
                     ));
                 }
             }
@@ -302,7 +294,7 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
     let jumps: Vec<String> = (0..3)
         .filter_map(|axis| {
             let f = p.fastest(axis, 5.0, 7.0);
-            (f > step).then(|| format!("{} {:.3}°", run::SERVOS[axis].0, f / 1e3))
+            (f > step).then(|| format!("{} {:.3}°", harness::SERVOS[axis].0, f / 1e3))
         })
         .collect();
     let after_loss = p.off_idle(6.8, 7.0);

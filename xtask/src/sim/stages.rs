@@ -8,7 +8,7 @@ use std::{
 use anyhow::{Context, Result, bail};
 
 use super::{
-    DEFAULT_TIME,
+    DEFAULT_TIME, harness,
     image::{FLASH_START, PicoImage, VECTOR_TABLE},
     node,
     run::{self, Report},
@@ -121,7 +121,7 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
         .enumerate()
         .filter(|(_, boot)| boot.watchdog)
     {
-        for (check, (name, ..)) in boot.servos.iter().zip(run::SERVOS) {
+        for (check, (name, ..)) in boot.servos.iter().zip(harness::SERVOS) {
             // Frames 0..=DRILL_FRAMES, each its own pulse: neutral first and
             // the 2 s fade-in (checked against the host) before the stop.
             if check.fresh != DRILL_FRAMES + 1 {

@@ -10,8 +10,8 @@
 use std::ops::Range;
 
 use super::problem::Problem;
-use super::segments::Segment;
 use crate::board::Board;
+use crate::elf::Segment;
 
 pub use super::sizes::{BLOCK_SIZE, PAYLOAD_SIZE};
 /// First magic number, `"UF2\n"`.
