@@ -18,8 +18,8 @@
 //! not) between any two frames, relax on or off at any frame, and the
 //! behaviour: any behaviour parameters and any command (gestures, looks,
 //! `center`, idle changes, stop, rest, wake) applied between any two frames
-//! ([`FrameLoop::apply`], and through the queue with any live rest and look
-//! settings from the link: [`FrameLoop::from_link`]), mixed into every
+//! ([`FrameLoop::apply`], and through the command queue with any live rest
+//! and look settings from the link: [`FrameLoop::drain`]), mixed into every
 //! frame, servo calibrations from the console's link, each command's
 //! outcome told to the console port that asked for it
 //! (`ConsoleLink::answer`, as [`FrameLoop::drain`] does), the status
@@ -50,7 +50,7 @@
 use core::hint::black_box;
 
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
-use idle_head_core::behaviour::{Asker, LiveConfig, RestConfig, ShowLink};
+use idle_head_core::behaviour::{Asker, CommandQueue, LiveConfig, RestConfig, ShowLink};
 use idle_head_core::bottango::{self, Curve, Op, line::CurveArgs};
 use idle_head_core::command::{
     Action, GestureKind, GestureRequest, Hold, InputRole, LookRequest, Percent, RestAfter,
@@ -91,6 +91,9 @@ static LINK: ConsoleLink = ConsoleLink::new();
 
 /// The show layer's inputs: DMX cues and Bottango's curves in.
 static SHOW: ShowLink = ShowLink::new();
+
+/// Actions from the console ports and the inputs, which `drain` takes.
+static COMMANDS: CommandQueue = CommandQueue::new();
 
 /// Any curve parameters.
 fn any_curve() -> Curve {
@@ -219,7 +222,12 @@ fn main() -> ! {
         black_box(1_000_000),
         black_box(0),
     )
-    .map(|frames| frames.with_link(&LINK).with_show(&SHOW)) else {
+    .map(|frames| {
+        frames
+            .with_commands(&COMMANDS)
+            .with_link(&LINK)
+            .with_show(&SHOW)
+    }) else {
         // Not reached with the built-in playback; no panic either way.
         loop {
             cortex_m::asm::wfi();
@@ -268,6 +276,15 @@ fn main() -> ! {
                     },
                     outcome,
                 );
+                // A console port's action into the queue `drain` reads.
+                black_box(COMMANDS.try_submit_from(
+                    any_action(),
+                    Asker {
+                        port: black_box(0),
+                        ticket: black_box(0),
+                    },
+                ))
+                .ok();
             }
             6 => {
                 // Calibrations the console sent, as `FrameLoop::drain` applies them.
@@ -322,13 +339,11 @@ fn main() -> ! {
             }
             10 => driver.set_relaxed(black_box(false)),
             11 => {
-                // Live settings and calibrations from the link, as the frame
-                // task takes them before a frame (`FrameLoop::drain`, whose
-                // queue is an embassy-sync channel behind a `RefCell`: the
-                // actions it holds are covered by `apply` above).
+                // The live settings, calibrations and queued actions, as
+                // the frame task takes them before a frame.
                 LINK.set_live(any_live());
                 let tick = frames.next(black_box(0));
-                frames.from_link(&mut driver, tick);
+                frames.drain(&mut driver, tick);
             }
             12 => {
                 // The inputs' state machine (the input task's, below the

@@ -41,9 +41,9 @@
 //!
 //! # No panics
 //!
-//! The work of one frame, [`FrameLoop::next`], [`FrameLoop::apply`] (as
-//! [`FrameLoop::drain`] calls it) and [`FrameLoop::write`], is the code
-//! linked by the `frame-path-proof` image
+//! The work of one frame, [`FrameLoop::next`], [`FrameLoop::drain`] (the
+//! link, the command queue, the show layer) and [`FrameLoop::write`], is the
+//! code linked by the `frame-path-proof` image
 //! against a panic handler that does not exist (see
 //! `boards/qemu/src/panic_proof.rs`): the image only links if no panic path
 //! survives optimisation.

@@ -1,18 +1,22 @@
 //! The command queue between whoever asks (the console, a script) and the
 //! frame task, which drains it every frame.
 //!
-//! An embassy-sync [`Channel`] behind a critical section: any task or
-//! interrupt may submit, and [`try_submit`](CommandQueue::try_submit) never
-//! waits. A full queue hands the action back ([`QueueFull`]): nothing is
-//! dropped silently. The frame task takes at most [`PER_FRAME`] actions a
-//! frame, so a flood of commands never delays a frame.
+//! A ring of `N` slots behind a critical section: any task or interrupt
+//! may submit, and [`try_submit`](CommandQueue::try_submit) never waits. A
+//! full queue hands the action back ([`QueueFull`]): nothing is dropped
+//! silently. The frame task takes at most [`PER_FRAME`] actions a frame, so
+//! a flood of commands never delays a frame. The slots are `Cell`s, not a
+//! `RefCell` (as in an embassy-sync `Channel`): taking an action has no
+//! borrow check and so no panic path on the frame path.
 
 use core::fmt;
 
 use crate::text::{Describe, Text, display_from_describe};
 
+use core::cell::Cell;
+
+use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
-use embassy_sync::channel::{Channel, TrySendError};
 
 use crate::command::Action;
 
@@ -62,15 +66,30 @@ impl core::error::Error for QueueFull {}
 /// assert_eq!(QUEUE.take(), Some(Action::Stop));
 /// ```
 pub struct CommandQueue<const N: usize = CAPACITY> {
-    channel: Channel<CriticalSectionRawMutex, (Action, Option<Asker>), N>,
+    ring: Mutex<CriticalSectionRawMutex, Ring<N>>,
+}
+
+/// A queued action and who asked for it.
+type Entry = (Action, Option<Asker>);
+
+/// The queue's slots: `len` entries from `head` on, wrapping.
+struct Ring<const N: usize> {
+    slots: [Cell<Option<Entry>>; N],
+    head: Cell<usize>,
+    len: Cell<usize>,
 }
 
 impl<const N: usize> CommandQueue<N> {
     /// An empty queue (usable in a `static`).
     #[must_use]
     pub const fn new() -> Self {
+        const { assert!(N > 0, "a command queue holds at least one action") };
         Self {
-            channel: Channel::new(),
+            ring: Mutex::new(Ring {
+                slots: [const { Cell::new(None) }; N],
+                head: Cell::new(0),
+                len: Cell::new(0),
+            }),
         }
     }
 
@@ -91,8 +110,17 @@ impl<const N: usize> CommandQueue<N> {
     }
 
     fn submit(&self, action: Action, asker: Option<Asker>) -> Result<(), QueueFull> {
-        self.channel.try_send((action, asker)).map_err(|e| match e {
-            TrySendError::Full((action, _)) => QueueFull(action),
+        self.ring.lock(|ring| {
+            let len = ring.len.get();
+            let tail = (ring.head.get() + len) % N;
+            match ring.slots.get(tail) {
+                Some(slot) if len < N => {
+                    slot.set(Some((action, asker)));
+                    ring.len.set(len + 1);
+                    Ok(())
+                }
+                _ => Err(QueueFull(action)),
+            }
         })
     }
 
@@ -103,17 +131,26 @@ impl<const N: usize> CommandQueue<N> {
 
     /// The oldest waiting action and who asked for it, if any.
     pub fn take_asked(&self) -> Option<(Action, Option<Asker>)> {
-        self.channel.try_receive().ok()
+        self.ring.lock(|ring| {
+            let len = ring.len.get();
+            if len == 0 {
+                return None;
+            }
+            let head = ring.head.get();
+            ring.head.set((head + 1) % N);
+            ring.len.set(len - 1);
+            ring.slots.get(head).and_then(Cell::take)
+        })
     }
 
     /// Actions waiting.
     pub fn len(&self) -> usize {
-        self.channel.len()
+        self.ring.lock(|ring| ring.len.get())
     }
 
     /// Whether none is waiting.
     pub fn is_empty(&self) -> bool {
-        self.channel.is_empty()
+        self.len() == 0
     }
 }
 
@@ -129,5 +166,52 @@ impl<const N: usize> fmt::Debug for CommandQueue<N> {
             .field("waiting", &self.len())
             .field("capacity", &N)
             .finish()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn first_in_first_out_across_the_wrap() {
+        let queue = CommandQueue::<3>::new();
+        let asker = |ticket| Some(Asker { port: 1, ticket });
+        for round in 0..5_u8 {
+            queue
+                .try_submit_from(
+                    Action::Stop,
+                    Asker {
+                        port: 1,
+                        ticket: round,
+                    },
+                )
+                .unwrap();
+            queue.try_submit(Action::Idle(round % 2 == 0)).unwrap();
+            assert_eq!(queue.len(), 2);
+            assert_eq!(queue.take_asked(), Some((Action::Stop, asker(round))));
+            assert_eq!(
+                queue.take_asked(),
+                Some((Action::Idle(round % 2 == 0), None))
+            );
+            assert!(queue.is_empty());
+            assert_eq!(queue.take_asked(), None);
+        }
+    }
+
+    #[test]
+    fn a_full_queue_hands_the_action_back_and_keeps_the_others() {
+        let queue = CommandQueue::<2>::new();
+        queue.try_submit(Action::Rest).unwrap();
+        queue.try_submit(Action::Stop).unwrap();
+        assert_eq!(
+            queue.try_submit(Action::Idle(true)),
+            Err(QueueFull(Action::Idle(true)))
+        );
+        assert_eq!(queue.take(), Some(Action::Rest));
+        queue.try_submit(Action::Idle(true)).unwrap();
+        assert_eq!(queue.take(), Some(Action::Stop));
+        assert_eq!(queue.take(), Some(Action::Idle(true)));
+        assert_eq!(queue.take(), None);
     }
 }
