@@ -53,6 +53,10 @@ pub enum Command {
         timeout: Timeout,
         #[command(flatten)]
         budget: Budget,
+        /// Run only the stages whose name contains this text (the others
+        /// are listed as skipped), e.g. `--only emulator`.
+        #[arg(long, value_name = "TEXT")]
+        only: Option<String>,
     },
     /// Run the boot-time benchmark in QEMU: a table and a verdict.
     ///
@@ -210,6 +214,7 @@ mod tests {
             bless,
             timeout,
             budget,
+            ..
         }) = parse(&["test"]).unwrap()
         else {
             panic!("not `test`");

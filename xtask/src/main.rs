@@ -76,7 +76,11 @@ fn main() -> ExitCode {
             bless,
             timeout,
             budget,
-        }) => test::command(Command::options(Some(bless), timeout, Some(budget))),
+            only,
+        }) => test::command(
+            Command::options(Some(bless), timeout, Some(budget)),
+            only.as_deref(),
+        ),
         Some(Command::Bench { timeout, budget }) => {
             bench::command(Command::options(None, timeout, Some(budget)))
         }

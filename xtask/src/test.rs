@@ -25,14 +25,17 @@ enum Outcome {
 }
 
 /// Runs stages one after another and keeps score.
-struct Stages {
+struct Stages<'a> {
     results: Vec<(String, Outcome, f64)>,
+    /// Only the stages whose name contains this run.
+    only: Option<&'a str>,
 }
 
-impl Stages {
-    fn new() -> Self {
+impl<'a> Stages<'a> {
+    fn new(only: Option<&'a str>) -> Self {
         Self {
             results: Vec::new(),
+            only,
         }
     }
 
@@ -43,6 +46,11 @@ impl Stages {
 
     /// Runs one stage that may decide to skip itself (`Ok(Some(reason))`).
     fn run_or_skip(&mut self, name: &str, stage: impl FnOnce() -> Result<Option<String>>) -> bool {
+        if self.only.is_some_and(|only| !name.contains(only)) {
+            let reason = "not chosen by --only".to_owned();
+            self.results.push((name.to_owned(), Outcome::Skipped(reason), 0.0));
+            return true;
+        }
         println!();
         println!("==> {name}");
         let start = Instant::now();
@@ -64,6 +72,11 @@ impl Stages {
 
     /// Records a stage that could not run because an earlier one failed.
     fn blocked(&mut self, name: &str, by: &str) {
+        if self.only.is_some_and(|only| !name.contains(only)) {
+            let reason = "not chosen by --only".to_owned();
+            self.results.push((name.to_owned(), Outcome::Skipped(reason), 0.0));
+            return;
+        }
         println!();
         println!("==> {name}");
         println!("--- FAILED: {name}: not run, {by} failed");
@@ -106,7 +119,7 @@ impl Stages {
 }
 
 /// `cargo xtask test`. `Ok(false)` when a stage failed.
-pub fn command(options: Options) -> Result<bool> {
+pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     let start = Instant::now();
     let root = project::root();
     setup::ensure_toolchain(&root)?;
@@ -115,7 +128,7 @@ pub fn command(options: Options) -> Result<bool> {
     let host_tests = project::shell("host-tests")?;
     let core = project::shell("crates/core")?;
     let xtask = project::shell("xtask")?;
-    let mut stages = Stages::new();
+    let mut stages = Stages::new(only);
 
     // 1. Host tests of the core, and its doc tests once they are switched on.
     stages.run("host tests (host-tests/)", || {
@@ -197,7 +210,7 @@ pub fn command(options: Options) -> Result<bool> {
     Ok(stages.finish(start))
 }
 
-fn clippy_stages(stages: &mut Stages, sh: &Shell, host_tests: &Shell, xtask: &Shell) {
+fn clippy_stages(stages: &mut Stages<'_>, sh: &Shell, host_tests: &Shell, xtask: &Shell) {
     // `--release` shares build scripts and proc-macros with the release builds below.
     stages.run("clippy: Pico image, RP support, firmware layer, core (thumbv6m)", || {
         project::run(
@@ -257,7 +270,7 @@ fn clippy_stages(stages: &mut Stages, sh: &Shell, host_tests: &Shell, xtask: &Sh
 }
 
 fn sim_stages(
-    stages: &mut Stages,
+    stages: &mut Stages<'_>,
     root: &Path,
     metadata: &Metadata,
     pico_built: bool,
@@ -300,7 +313,7 @@ fn sim_stages(
 }
 
 fn qemu_stages(
-    stages: &mut Stages,
+    stages: &mut Stages<'_>,
     root: &Path,
     metadata: &Metadata,
     options: Options,

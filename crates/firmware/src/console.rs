@@ -21,12 +21,11 @@
 //!
 //! [`CommandQueue`]: idle_head_core::behaviour::CommandQueue
 
-use embassy_futures::select::{Either, select};
-use embassy_time::{Duration, Instant, Timer, with_timeout};
+use embassy_futures::select::{Either3, select3};
+use embassy_time::{Duration, Instant, Timer};
 use idle_head_core::bottango::TIMEOUT_MS;
 use idle_head_core::console::{
-    ConsoleLink, DualSession, Handler, Outcome, Shared, SharedService, outcome_reply,
-    telemetry_line, unanswered,
+    ConsoleLink, DualSession, Handler, Outbox, PORT_REPLY, Shared, SharedService, telemetry_line,
 };
 use idle_head_core::settings::SettingsStorage;
 
@@ -92,21 +91,26 @@ pub struct Place<'a> {
 }
 
 /// Runs `session` over `port` until the port goes away: every line gets
-/// exactly one reply from `handler`. When the port reports received bytes
-/// lost, the line in progress is answered `err line bytes lost …`
-/// (docs/user/protocol.md says what a flood does to the lines around it).
+/// exactly one reply from `handler`, in the order of the lines. When the
+/// port reports received bytes lost, the line in progress is answered
+/// `err line bytes lost …` (docs/user/protocol.md says what a flood does to
+/// the lines around it).
 ///
 /// A reply that waits for the frame task (a queued action) is finished
 /// when the port's outcome with its ticket arrives, or after
-/// [`OUTCOME_FRAMES`] frames without one as [`unanswered`]; the bytes
-/// after its line wait meanwhile. Between lines the port streams
-/// telemetry at the rate `watch` set ([`telemetry_line`]), from the
-/// status the frame task published: written here, never by the frame
-/// task. A tick whose line cannot go out because the host reads too
-/// slowly is dropped and counted in the next line's `lost=`. In a
-/// Bottango session there is no telemetry (the port speaks Bottango's
+/// [`OUTCOME_FRAMES`] frames without one as [`unanswered`]. The port reads
+/// on meanwhile: the lines after it are carried out at once and their
+/// replies held behind it ([`Outbox`]); only when the outbox is full do
+/// the bytes wait (in the port's receive buffer). Between lines the port
+/// streams telemetry at the rate `watch` set ([`telemetry_line`]), from the
+/// status the frame task published: written here, never by the frame task.
+/// A tick whose line cannot go out because the host reads too slowly, or
+/// because replies wait, is dropped and counted in the next line's `lost=`.
+/// In a Bottango session there is no telemetry (the port speaks Bottango's
 /// protocol), and a line that pauses for [`TIMEOUT_MS`] is dropped and
 /// answered `TIMEOUT`.
+///
+/// [`unanswered`]: idle_head_core::console::unanswered
 pub async fn serve<P: Port, H: Handler>(
     port: &mut P,
     session: &mut DualSession<'_>,
@@ -114,9 +118,48 @@ pub async fn serve<P: Port, H: Handler>(
     place: Place<'_>,
 ) -> Gone {
     let mut buf = [0; READ_CHUNK];
+    // Bytes read and not yet taken: `buf[at..read]`.
+    let (mut at, mut read) = (0, 0);
+    let mut outbox = Outbox::new();
+    let mut out = [0; PORT_REPLY];
     let mut watch = Watch::default();
+    let wait = place.frame * OUTCOME_FRAMES;
+    let waited_ms = wait.as_millis() as u32;
     place.link.set_watch(place.port, 0);
+    place.link.forget_outcomes(place.port);
     loop {
+        while let Some(outcome) = place.link.take_outcome(place.port) {
+            outbox.resolve(&outcome);
+        }
+        outbox.expire(Instant::now().as_ticks(), waited_ms);
+        loop {
+            let n = outbox.take_ready(&mut out);
+            if n == 0 {
+                break;
+            }
+            if let Err(gone) = port.write(out.get(..n).unwrap_or_default()).await {
+                return gone;
+            }
+        }
+        // The bytes read, as long as their replies have room.
+        let was = session.bottango();
+        while at < read && outbox.has_room() {
+            let byte = buf.get(at).copied().unwrap_or_default();
+            at += 1;
+            if let Some(reply) = session.push(byte, handler)
+                && let Some(now) = outbox.reply(reply)
+                && !now.is_empty()
+                && let Err(gone) = port.write(now).await
+            {
+                return gone;
+            }
+            if let Some(later) = session.take_later() {
+                let due = (Instant::now() + wait).as_ticks();
+                // (Room was checked before the byte.)
+                let _ = outbox.wait(later, due);
+            }
+        }
+        log_mode(was, session.bottango());
         // The host closed the port (DTR dropped): its telemetry stops.
         if !port.open() {
             place.link.set_watch(place.port, 0);
@@ -126,7 +169,7 @@ pub async fn serve<P: Port, H: Handler>(
         } else {
             place.link.watch(place.port)
         };
-        let due = watch.due(rate).unwrap_or(Instant::MAX);
+        let tick = watch.due(rate).unwrap_or(Instant::MAX);
         // A Bottango line in progress times out; nothing else does.
         let armed = session.bottango() && session.in_progress();
         let timeout = if armed {
@@ -134,61 +177,51 @@ pub async fn serve<P: Port, H: Handler>(
         } else {
             Instant::MAX
         };
-        let read = match select(port.read(&mut buf), Timer::at(due.min(timeout))).await {
-            Either::First(read) => read,
-            Either::Second(()) if armed && Instant::now() >= timeout => {
+        let given_up = outbox.due().map_or(Instant::MAX, Instant::from_ticks);
+        // Bytes left over wait for room; else read more.
+        let reading = at >= read;
+        let woke = select3(
+            async {
+                if reading {
+                    port.read(&mut buf).await
+                } else {
+                    core::future::pending().await
+                }
+            },
+            place.link.answered(place.port),
+            Timer::at(tick.min(timeout).min(given_up)),
+        )
+        .await;
+        match woke {
+            Either3::First(Ok(Received::Bytes(n))) => (at, read) = (0, n),
+            Either3::First(Ok(Received::Lost)) => session.lose(),
+            Either3::First(Err(gone)) => return gone,
+            Either3::Third(()) if armed && Instant::now() >= timeout => {
                 let was = session.bottango();
                 if let Some(reply) = session.timeout()
-                    && let Err(gone) = port.write(reply).await
+                    && let Some(now) = outbox.reply(reply)
+                    && let Err(gone) = port.write(now).await
                 {
                     return gone;
                 }
                 log_mode(was, session.bottango());
-                continue;
             }
-            Either::Second(()) => {
-                // Between replies: the reply buffer is free for the line.
-                let status = place.link.status();
-                let us = place.frame.as_micros() as u32;
-                let text = telemetry_line(&status, us, watch.lost, session.spare());
-                if let Err(gone) = port.write(text).await {
-                    return gone;
+            Either3::Third(()) if Instant::now() >= tick => {
+                // Telemetry goes out between replies, never among them.
+                if !outbox.is_busy() {
+                    let status = place.link.status();
+                    let us = place.frame.as_micros() as u32;
+                    let text = telemetry_line(&status, us, watch.lost, &mut out);
+                    if let Err(gone) = port.write(text).await {
+                        return gone;
+                    }
                 }
                 watch.sent(rate);
-                continue;
             }
-        };
-        let n = match read {
-            Ok(Received::Bytes(n)) => n,
-            Ok(Received::Lost) => {
-                session.lose();
-                continue;
-            }
-            Err(gone) => return gone,
-        };
-        let was = session.bottango();
-        for &byte in buf.get(..n).unwrap_or_default() {
-            if let Some(reply) = session.push(byte, handler)
-                && !reply.is_empty()
-                && let Err(gone) = port.write(reply).await
-            {
-                return gone;
-            }
-            if let Some(ticket) = session.waiting() {
-                let outcome = outcome(place, ticket).await;
-                let wait = place.frame * OUTCOME_FRAMES;
-                let reply = session.finish(|reply| match &outcome {
-                    Some(outcome) => outcome_reply(reply, &outcome.result),
-                    None => unanswered(reply, wait.as_millis() as u32),
-                });
-                if let Some(reply) = reply
-                    && let Err(gone) = port.write(reply).await
-                {
-                    return gone;
-                }
-            }
+            // An outcome arrived, or a reply is given up on: both are
+            // taken at the top of the loop.
+            Either3::Second(()) | Either3::Third(()) => {}
         }
-        log_mode(was, session.bottango());
     }
 }
 
@@ -202,21 +235,6 @@ fn log_mode(was: bool, is: bool) {
         (true, false) => defmt::info!("console: Bottango STOP: the console again"),
         _ => {}
     }
-}
-
-/// The outcome of the port's action with `ticket`, if a frame takes it
-/// within [`OUTCOME_FRAMES`].
-async fn outcome(place: Place<'_>, ticket: u8) -> Option<Outcome> {
-    let slot = place.link.outcomes(place.port)?;
-    let mine = async {
-        loop {
-            let outcome = slot.wait().await;
-            if outcome.ticket == ticket {
-                return outcome;
-            }
-        }
-    };
-    with_timeout(place.frame * OUTCOME_FRAMES, mine).await.ok()
 }
 
 /// A port's telemetry schedule: when the next line is due, and the lines

@@ -224,13 +224,12 @@ impl SimFrames {
         port: u8,
         ticket: u8,
     ) -> Option<Outcome> {
-        let slot = link.outcomes(port)?;
         for _ in 0..OUTCOME_FRAMES {
             self.frame(queue, link);
-            if let Some(outcome) = slot.try_take()
-                && outcome.ticket == ticket
-            {
-                return Some(outcome);
+            while let Some(outcome) = link.take_outcome(port) {
+                if outcome.ticket == ticket {
+                    return Some(outcome);
+                }
             }
         }
         None

@@ -1,22 +1,17 @@
 //! The command queue between whoever asks (the console, a script) and the
 //! frame task, which drains it every frame.
 //!
-//! A ring of `N` slots behind a critical section: any task or interrupt
-//! may submit, and [`try_submit`](CommandQueue::try_submit) never waits. A
-//! full queue hands the action back ([`QueueFull`]): nothing is dropped
-//! silently. The frame task takes at most [`PER_FRAME`] actions a frame, so
-//! a flood of commands never delays a frame. The slots are `Cell`s, not a
-//! `RefCell` (as in an embassy-sync `Channel`): taking an action has no
-//! borrow check and so no panic path on the frame path.
+//! A [`Ring`]: any task or interrupt may submit, and
+//! [`try_submit`](CommandQueue::try_submit) never waits. A full queue hands
+//! the action back ([`QueueFull`]): nothing is dropped silently. The frame
+//! task takes at most [`PER_FRAME`] actions a frame, so a flood of commands
+//! never delays a frame.
 
 use core::fmt;
 
 use crate::text::{Describe, Text, display_from_describe};
 
-use core::cell::Cell;
-
-use embassy_sync::blocking_mutex::Mutex;
-use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use crate::ring::Ring;
 
 use crate::command::Action;
 
@@ -66,31 +61,14 @@ impl core::error::Error for QueueFull {}
 /// assert_eq!(QUEUE.take(), Some(Action::Stop));
 /// ```
 pub struct CommandQueue<const N: usize = CAPACITY> {
-    ring: Mutex<CriticalSectionRawMutex, Ring<N>>,
-}
-
-/// A queued action and who asked for it.
-type Entry = (Action, Option<Asker>);
-
-/// The queue's slots: `len` entries from `head` on, wrapping.
-struct Ring<const N: usize> {
-    slots: [Cell<Option<Entry>>; N],
-    head: Cell<usize>,
-    len: Cell<usize>,
+    ring: Ring<(Action, Option<Asker>), N>,
 }
 
 impl<const N: usize> CommandQueue<N> {
     /// An empty queue (usable in a `static`).
     #[must_use]
     pub const fn new() -> Self {
-        const { assert!(N > 0, "a command queue holds at least one action") };
-        Self {
-            ring: Mutex::new(Ring {
-                slots: [const { Cell::new(None) }; N],
-                head: Cell::new(0),
-                len: Cell::new(0),
-            }),
-        }
+        Self { ring: Ring::new() }
     }
 
     /// Queues `action` for the frame task.
@@ -110,18 +88,9 @@ impl<const N: usize> CommandQueue<N> {
     }
 
     fn submit(&self, action: Action, asker: Option<Asker>) -> Result<(), QueueFull> {
-        self.ring.lock(|ring| {
-            let len = ring.len.get();
-            let tail = (ring.head.get() + len) % N;
-            match ring.slots.get(tail) {
-                Some(slot) if len < N => {
-                    slot.set(Some((action, asker)));
-                    ring.len.set(len + 1);
-                    Ok(())
-                }
-                _ => Err(QueueFull(action)),
-            }
-        })
+        self.ring
+            .push((action, asker))
+            .map_err(|(action, _)| QueueFull(action))
     }
 
     /// The oldest waiting action, if any.
@@ -131,26 +100,17 @@ impl<const N: usize> CommandQueue<N> {
 
     /// The oldest waiting action and who asked for it, if any.
     pub fn take_asked(&self) -> Option<(Action, Option<Asker>)> {
-        self.ring.lock(|ring| {
-            let len = ring.len.get();
-            if len == 0 {
-                return None;
-            }
-            let head = ring.head.get();
-            ring.head.set((head + 1) % N);
-            ring.len.set(len - 1);
-            ring.slots.get(head).and_then(Cell::take)
-        })
+        self.ring.pop()
     }
 
     /// Actions waiting.
     pub fn len(&self) -> usize {
-        self.ring.lock(|ring| ring.len.get())
+        self.ring.len()
     }
 
     /// Whether none is waiting.
     pub fn is_empty(&self) -> bool {
-        self.len() == 0
+        self.ring.is_empty()
     }
 }
 
@@ -174,44 +134,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn first_in_first_out_across_the_wrap() {
-        let queue = CommandQueue::<3>::new();
-        let asker = |ticket| Some(Asker { port: 1, ticket });
-        for round in 0..5_u8 {
-            queue
-                .try_submit_from(
-                    Action::Stop,
-                    Asker {
-                        port: 1,
-                        ticket: round,
-                    },
-                )
-                .unwrap();
-            queue.try_submit(Action::Idle(round % 2 == 0)).unwrap();
-            assert_eq!(queue.len(), 2);
-            assert_eq!(queue.take_asked(), Some((Action::Stop, asker(round))));
-            assert_eq!(
-                queue.take_asked(),
-                Some((Action::Idle(round % 2 == 0), None))
-            );
-            assert!(queue.is_empty());
-            assert_eq!(queue.take_asked(), None);
-        }
-    }
-
-    #[test]
-    fn a_full_queue_hands_the_action_back_and_keeps_the_others() {
+    fn the_asker_comes_back_with_its_action_and_a_full_queue_hands_it_back() {
         let queue = CommandQueue::<2>::new();
-        queue.try_submit(Action::Rest).unwrap();
+        let asker = Asker { port: 1, ticket: 7 };
+        queue.try_submit_from(Action::Rest, asker).unwrap();
         queue.try_submit(Action::Stop).unwrap();
         assert_eq!(
             queue.try_submit(Action::Idle(true)),
             Err(QueueFull(Action::Idle(true)))
         );
-        assert_eq!(queue.take(), Some(Action::Rest));
-        queue.try_submit(Action::Idle(true)).unwrap();
-        assert_eq!(queue.take(), Some(Action::Stop));
-        assert_eq!(queue.take(), Some(Action::Idle(true)));
+        assert_eq!(queue.take_asked(), Some((Action::Rest, Some(asker))));
+        assert_eq!(queue.take_asked(), Some((Action::Stop, None)));
         assert_eq!(queue.take(), None);
     }
 }

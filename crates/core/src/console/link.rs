@@ -6,9 +6,10 @@
 //! with it), each port's telemetry rate (`watch`), and the trigger inputs'
 //! settings and levels (console → input task → console).
 //!
-//! Each is an embassy-sync blocking `Mutex` over a `Cell`, or a `Signal`
-//! (whose state is a `Cell` too): a critical section around a copy, no
-//! `RefCell` borrow, so nothing here puts a panic path on the frame path.
+//! Each is an embassy-sync blocking `Mutex` over a `Cell`, a `Signal`
+//! (whose state is a `Cell` too) or a [`Ring`] of `Cell`s: a critical
+//! section around a copy, no `RefCell` borrow, so nothing here puts a panic
+//! path on the frame path.
 
 use core::cell::Cell;
 
@@ -20,6 +21,7 @@ use crate::axis::Axis;
 use crate::behaviour::{Applied, Asker, BehaviourError, LiveConfig};
 use crate::driver::{DriverStats, FrameReport};
 use crate::input::{InputSettings, InputStatus};
+use crate::ring::Ring;
 use crate::servo::ServoCalibration;
 use crate::units::{Angle, Microseconds};
 
@@ -120,6 +122,11 @@ impl HeadStatus {
 /// Console ports a board may have: UART (0) and USB (1).
 pub const PORTS: usize = 2;
 
+/// Outcomes a port's mailbox holds: as many as the command queue holds
+/// actions, so a port whose every queued action is taken in a row loses
+/// none.
+pub const OUTCOMES: usize = crate::behaviour::queue::CAPACITY;
+
 /// What the frame task did with a port's queued action: its ticket and
 /// what the mixer answered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -136,7 +143,10 @@ pub struct ConsoleLink {
     status: Mutex<CriticalSectionRawMutex, Cell<HeadStatus>>,
     servos: Mutex<CriticalSectionRawMutex, Cell<[Option<ServoCalibration>; 3]>>,
     seeds: Signal<CriticalSectionRawMutex, [u32; 3]>,
-    outcomes: [Signal<CriticalSectionRawMutex, Outcome>; PORTS],
+    /// Each port's outcomes, in the order the frame task took its actions,
+    /// and the signal that one arrived.
+    outcomes: [Ring<Outcome, OUTCOMES>; PORTS],
+    answered: [Signal<CriticalSectionRawMutex, ()>; PORTS],
     /// Telemetry lines a second per port (0: off).
     watch: Mutex<CriticalSectionRawMutex, Cell<[u8; PORTS]>>,
     live: Signal<CriticalSectionRawMutex, LiveConfig>,
@@ -162,7 +172,8 @@ impl ConsoleLink {
             })),
             servos: Mutex::new(Cell::new([None; 3])),
             seeds: Signal::new(),
-            outcomes: [const { Signal::new() }; PORTS],
+            outcomes: [const { Ring::new() }; PORTS],
+            answered: [const { Signal::new() }; PORTS],
             watch: Mutex::new(Cell::new([0; PORTS])),
             live: Signal::new(),
             inputs: Mutex::new(Cell::new(InputSettings::DEFAULT)),
@@ -172,21 +183,45 @@ impl ConsoleLink {
     }
 
     /// The frame task: `asker`'s action was taken (or refused) with
-    /// `result`. A port beyond [`PORTS`] is ignored.
+    /// `result`. A port beyond [`PORTS`] is ignored; so is an outcome that
+    /// finds the port's mailbox full (its console stopped reading: its
+    /// reply was given up on already, [`super::unanswered`]).
     pub fn answer(&self, asker: Asker, result: Result<Applied, BehaviourError>) {
-        if let Some(slot) = self.outcomes.get(usize::from(asker.port)) {
-            slot.signal(Outcome {
+        let port = usize::from(asker.port);
+        if let (Some(outcomes), Some(answered)) = (self.outcomes.get(port), self.answered.get(port))
+        {
+            let outcome = Outcome {
                 ticket: asker.ticket,
                 result,
-            });
+            };
+            if outcomes.push(outcome).is_ok() {
+                answered.signal(());
+            }
         }
     }
 
-    /// The console of `port`: where the outcomes of its actions arrive
-    /// (`None` for a port beyond [`PORTS`]). The console resets it before
-    /// it queues an action and waits for the outcome with its ticket.
-    pub fn outcomes(&self, port: u8) -> Option<&Signal<CriticalSectionRawMutex, Outcome>> {
-        self.outcomes.get(usize::from(port))
+    /// The console of `port`: the oldest outcome of its actions not yet
+    /// taken (`None` if none is there, or for a port beyond [`PORTS`]).
+    pub fn take_outcome(&self, port: u8) -> Option<Outcome> {
+        self.outcomes.get(usize::from(port))?.pop()
+    }
+
+    /// The console of `port`: waits until an outcome arrives (at once if
+    /// one arrived since the last wait); for ever for a port beyond
+    /// [`PORTS`].
+    pub async fn answered(&self, port: u8) {
+        match self.answered.get(usize::from(port)) {
+            Some(signal) => signal.wait().await,
+            None => core::future::pending().await,
+        }
+    }
+
+    /// The console of `port`, when its host goes away: outcomes not taken
+    /// are dropped (the lines they answer are forgotten).
+    pub fn forget_outcomes(&self, port: u8) {
+        if let Some(outcomes) = self.outcomes.get(usize::from(port)) {
+            outcomes.clear();
+        }
     }
 
     /// The console: `port` streams `hz` telemetry lines a second (0: none).

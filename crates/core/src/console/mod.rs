@@ -11,6 +11,8 @@
 //!   with the frame task. The reply to a queued action waits until the
 //!   frame task has taken or refused it ([`Reply::defer`],
 //!   [`Session::finish`], [`outcome_reply`]).
+//! - [`Outbox`]: a port's replies in line order while some wait for the
+//!   frame task, so that the port reads on meanwhile.
 //! - [`telemetry_line`]: the lines `watch` streams.
 //! - [`DualSession`]: a port's session that turns into a Bottango driver
 //!   at a Bottango handshake ([`crate::bottango`]).
@@ -20,6 +22,7 @@
 
 mod framer;
 mod link;
+mod outbox;
 mod outcome;
 mod parse;
 mod port;
@@ -30,7 +33,8 @@ mod shared;
 mod telemetry;
 
 pub use framer::{Framer, LineError};
-pub use link::{ConsoleLink, HeadMode, HeadStatus, Outcome, PORTS};
+pub use link::{ConsoleLink, HeadMode, HeadStatus, OUTCOMES, Outcome, PORTS};
+pub use outbox::{HELD, Outbox, WAITING};
 pub use outcome::{outcome_reply, unanswered};
 pub use parse::{ActionLine, KEYWORDS, ParseError, ParseErrorKind, Span, parse};
 pub use port::DualSession;

@@ -72,6 +72,12 @@ impl<'a> DualSession<'a> {
         self.session.finish(write)
     }
 
+    /// Takes the reply that waits, if one does (see
+    /// [`Session::take_later`](super::Session::take_later)).
+    pub fn take_later(&mut self) -> Option<super::Later> {
+        self.session.take_later()
+    }
+
     /// The reply buffer, for a line of the console's own between replies
     /// (a telemetry line); empty while a reply waits in it.
     pub fn spare(&mut self) -> &mut [u8] {

@@ -173,18 +173,6 @@ impl<'a> Reply<'a> {
         self.verdict = Verdict::Unset;
     }
 
-    /// A reply written into `buf` after the `start` bytes already there (a
-    /// machine-mode sequence number written before the reply was
-    /// [deferred](Self::defer)).
-    #[must_use]
-    pub(super) fn resume(buf: &'a mut [u8], start: usize) -> Self {
-        let mut reply = Self::new(buf);
-        let start = start.min(reply.limit);
-        reply.start = start;
-        reply.len = start;
-        reply
-    }
-
     /// Defers the reply until the action with `ticket` has been taken or
     /// refused by the frame task (see [`Session::waiting`]); text written
     /// so far is dropped.
@@ -204,11 +192,6 @@ impl<'a> Reply<'a> {
             Verdict::Later(ticket) => Some(ticket),
             _ => None,
         }
-    }
-
-    /// Where the verdict starts (after a machine-mode sequence number).
-    pub(super) fn start(&self) -> usize {
-        self.start
     }
 
     /// Starts (or restarts) the reply as `ok`; text written next follows it.

@@ -36,7 +36,7 @@
 //! # let (action, asker) = QUEUE.take_asked().unwrap();
 //! # let params = Settings::DEFAULT.validate(&DriverConfig::DEFAULT).unwrap().behaviour;
 //! # LINK.answer(asker.unwrap(), params.check(&action));
-//! let outcome = LINK.outcomes(0).unwrap().try_take().unwrap();
+//! let outcome = LINK.take_outcome(0).unwrap();
 //! assert_eq!(outcome.ticket, ticket);
 //! let reply = session.finish(|r| idle_head_core::console::outcome_reply(r, &outcome.result));
 //! assert!(reply.unwrap().starts_with(b"ok nod amp_mdeg="));
@@ -203,11 +203,6 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
             port,
             ticket: self.ticket,
         };
-        // An outcome left from an action answered without it (a wait that
-        // timed out) is not this one's.
-        if let Some(outcomes) = self.link.outcomes(port) {
-            outcomes.reset();
-        }
         match self.queue.try_submit_from(action, asker) {
             Ok(()) => reply.defer(asker.ticket),
             Err(full) => {

@@ -224,6 +224,14 @@ impl<const LINE: usize, const REPLY: usize> Session<LINE, REPLY> {
         Some(later.finish(&mut self.reply, write))
     }
 
+    /// Takes the reply that waits, if one does, for the caller to write
+    /// once the outcome is there ([`Later::finish`]): the session takes the
+    /// next bytes meanwhile, so that the lines after it are read (and
+    /// answered, in order, by the caller) while it waits.
+    pub fn take_later(&mut self) -> Option<Later> {
+        self.later.take()
+    }
+
     /// Takes a run of bytes, calling `emit` with each reply line. For
     /// handlers that answer at once: this cannot wait for the frame task,
     /// so a reply that would wait is finished at once as
@@ -324,14 +332,14 @@ impl<'b> Response<'b> {
     }
 }
 
-/// A reply that waits for the outcome of a queued action. What it keeps
-/// of the line (a machine-mode sequence number) stays in the reply
-/// buffer: finishing it needs no second buffer.
+/// A reply that waits for the outcome of a queued action: all it needs to
+/// be written later, in any buffer (a machine-mode sequence number
+/// included).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Later {
     ticket: u8,
-    /// Bytes of the buffer already written: `#<seq> `.
-    start: usize,
+    /// The machine-mode sequence number, for a machine-mode line.
+    seq: Option<u32>,
     machine: bool,
 }
 
@@ -342,11 +350,13 @@ impl Later {
         self.ticket
     }
 
-    /// Finishes the reply in `out`, the buffer [`respond`] wrote into,
-    /// `write` writing its verdict (a reply left alone, or deferred
-    /// again, is a bare `ok`).
+    /// Writes the reply into `out`, `write` writing its verdict (a reply
+    /// left alone, or deferred again, is a bare `ok`).
     pub fn finish(self, out: &mut [u8], write: impl FnOnce(&mut Reply<'_>)) -> &[u8] {
-        let mut reply = Reply::resume(out, self.start);
+        let mut reply = Reply::new(out);
+        if let Some(seq) = self.seq {
+            reply.prefix(seq);
+        }
         write(&mut reply);
         if self.machine {
             sign(reply)
@@ -366,13 +376,15 @@ pub fn respond<'b, H: Handler + ?Sized>(
 ) -> Response<'b> {
     let mut reply = Reply::new(out);
     let machine = matches!(line, Ok(text) if text.first() == Some(&b'#'));
+    let mut seq = None;
     match line {
         Ok(text) if machine => {
-            let Envelope { seq, command } = envelope(text);
+            let envelope = envelope(text);
+            seq = envelope.seq;
             if let Some(seq) = seq {
                 reply.prefix(seq);
             }
-            match command {
+            match envelope.command {
                 Ok(command) => answer(command, handler, &mut reply),
                 Err(error) => reject(InputError::Envelope(error), &[], handler, &mut reply),
             }
@@ -383,7 +395,7 @@ pub fn respond<'b, H: Handler + ?Sized>(
     if let Some(ticket) = reply.later() {
         return Response::Later(Later {
             ticket,
-            start: reply.start(),
+            seq,
             machine,
         });
     }
