@@ -156,7 +156,7 @@ function powerUp(kept) {
       lastActivity = now();
     };
     const complain = (msg) => emit({ ev: 'emu', level: 'error', msg });
-    if (cfg.rom && serveRom(chip, code, cfg.rom, flashOp, complain)) return;
+    if (cfg.rom && serveRom(chip, code, cfg.rom, flashOp, complain, stall)) return;
     emit({ ev: 'emu', level: 'error', msg: `breakpoint ${code} at ${hex(chip.core.PC)}` });
     stop = 'break';
   };
@@ -210,6 +210,28 @@ function powerUp(kept) {
   chip.core.VTOR = cfg.vtor;
   chip.core.reset(); // SP and PC from the vector table, as boot2 hands over
   return chip;
+}
+
+// The outside's inputs due by now: UART0's RX line and its TX side, USB,
+// DMX, the input pins.
+function feedOutside() {
+  while (outside.uartDue() <= now()) outside.feedUart();
+  mcu.uart[0].sendDue();
+  if (usb.send) usb.feed();
+  if (dmx) dmx.feed();
+  if (outside.pinsQueued()) outside.feedPins();
+}
+
+// `ns` of virtual time while the CPU stalls (a flash operation in the
+// ROM), in steps of a few µs, the outside fed at each: the peripherals and
+// the DMA go on, as on the chip.
+const STALL_STEP_NS = 5000;
+function stall(ns) {
+  const end = now() + ns;
+  while (now() < end) {
+    mcu.clock.tick(Math.min(STALL_STEP_NS, end - now()));
+    feedOutside();
+  }
 }
 
 // UART0's bytes sent (TX), stamped with the first.
@@ -284,6 +306,17 @@ function endBoot() {
   if (cfg.stack) emit({ ev: 'stack', n: boot, low: stackLow() });
 }
 
+// rp2040js's `nanosToNextAlarm` is 0 both when no alarm is set and when one
+// is due now (a DMA transfer, scheduled with no delay when its DREQ rises):
+// the loops below take 0 for none. A due one fires here, at once (else a
+// sleeping chip's clock would jump past the alarms after it, their
+// interrupts taken late); true if one did.
+function alarmDue(clock) {
+  if (!clock.nextAlarm || clock.nextAlarm.nanos > clock.nanos) return false;
+  clock.tick(0);
+  return true;
+}
+
 // One instruction, the SEV fix after it (chip.mjs).
 function step() {
   const { core, clock } = mcu;
@@ -315,6 +348,7 @@ function run() {
     const { core, clock } = mcu;
     for (let i = 0; i < 4096 && !stop && !watchdogFired; i++) {
       if (core.waiting) {
+        if (alarmDue(clock)) continue;
         let wait = clock.nanosToNextAlarm;
         const due = outside.uartDue() - now(); // asleep until the next scripted byte at the latest
         if (due <= 0) {
@@ -428,6 +462,7 @@ async function runLive() {
     const { core, clock } = mcu;
     while (!stop && !watchdogFired && now() < until) {
       if (core.waiting) {
+        if (alarmDue(clock)) continue;
         const wait = clock.nanosToNextAlarm;
         const sending = mcu.uart[0].txDue() - now();
         if (sending <= 0) {

@@ -16,7 +16,9 @@
 // A sector erase and a page program take virtual time, as on the chip,
 // while the firmware holds its interrupts off: `erase_ns` per 4 KiB sector,
 // `program_ns` per 256-byte page (W25Q16JV: 45 ms and 0.4 ms typically, up
-// to 400 ms and 3 ms).
+// to 400 ms and 3 ms). The time passes through the harness's `pass`, which
+// goes on feeding the chip from outside (UART and DMX lines, USB) meanwhile,
+// as the world does while a flash operation stalls the CPU.
 
 const FLASH_START = 0x10000000;
 const SECTOR = 4096;
@@ -51,8 +53,9 @@ export function romImage() {
 
 /// Serves ROM breakpoint `number` on `chip`; false if it is not one of the
 /// ROM's. `timing` is {erase_ns, program_ns}; `report(event)` is told of
-/// every erase and program, `complain(text)` of a call it cannot serve.
-export function serveRom(chip, number, timing, report, complain) {
+/// every erase and program, `complain(text)` of a call it cannot serve;
+/// `pass(ns)` lets the virtual time of an erase or a program pass.
+export function serveRom(chip, number, timing, report, complain, pass) {
   const n = number - ROM_BREAKPOINTS;
   // Only the ROM's own breakpoints (the core has already stepped past it).
   const at = chip.core.PC - 2;
@@ -87,7 +90,7 @@ export function serveRom(chip, number, timing, report, complain) {
       chip.flash.fill(0xff, offset, offset + count);
       const ns = (count / SECTOR) * timing.erase_ns;
       report({ op: 'erase', addr: FLASH_START + offset, len: count, busy_ns: ns });
-      chip.clock.tick(ns);
+      pass(ns);
       break;
     }
     case 'RP': {
@@ -100,7 +103,7 @@ export function serveRom(chip, number, timing, report, complain) {
       for (let i = 0; i < count; i++) chip.flash[offset + i] &= chip.readUint8(data + i);
       const ns = (count / PAGE) * timing.program_ns;
       report({ op: 'program', addr: FLASH_START + offset, len: count, busy_ns: ns });
-      chip.clock.tick(ns);
+      pass(ns);
       break;
     }
     case 'C4': // memcpy44(dest, src, n)

@@ -20,13 +20,23 @@
 //   a damaged one. `uart.receive` does both as the PL011 does: a byte that
 //   finds the FIFO full is lost, and the next character read carries the
 //   overrun bit (OE, bit 11 of UARTDR); a damaged byte carries the framing
-//   error bit (FE, bit 8). embassy-rp reports either as a receive error.
+//   error bit (FE, bit 8). Both also set their raw interrupt status bits
+//   (UARTRIS: FERIS, bit 7; OERIS, bit 10), which stay until cleared.
+// - It never asks the DMA for a received character: on the chip the UART
+//   raises its RX DREQ while the receive FIFO holds a character and UARTDMACR
+//   enables receive DMA (RXDMAE), and the DMA's read of UARTDR takes it. Here
+//   the DREQ follows the FIFO the same way, so a DMA channel paced by it
+//   empties the FIFO character by character, the flags in bits 8 to 11 with
+//   each.
 
 const UARTDR = 0x00;
 const UARTFR = 0x18;
 const UARTDMACR = 0x48;
 const UARTDR_OE = 1 << 11;
 const UARTDR_FE = 1 << 8;
+const RIS_FE = 1 << 7;
+const RIS_OE = 1 << 10;
+const DMACR_RXDMAE = 1 << 0;
 const UART_TXINTR = 1 << 5;
 const FR_BUSY = 1 << 3;
 const FR_TXFF = 1 << 5;
@@ -45,6 +55,11 @@ export function uartAsOnTheChip(uart, now) {
   let txNext = Infinity; // when its first byte has left the wire
   const byteNs = () => (10 * 1e9) / (uart.baudRate || 115200);
   let overrun = false; // a byte was lost at a full receive FIFO
+  // The RX DREQ: set while receive DMA is on and a character waits.
+  const rxDreq = () => {
+    if (dmacr & DMACR_RXDMAE && !uart.rxFIFO.empty) uart.rp2040.dma.setDREQ(uart.dreq.rx);
+    else uart.rp2040.dma.clearDREQ(uart.dreq.rx);
+  };
   uart.checkInterrupts = function () {
     this.rp2040.setInterrupt(this.irq, !!(this.interruptStatus & this.interruptMask));
   };
@@ -56,9 +71,12 @@ export function uartAsOnTheChip(uart, now) {
       const full = tx.length >= TX_FIFO ? FR_TXFF : 0;
       return rx | full | (tx.length === 0 ? FR_TXFE : FR_BUSY);
     }
-    if (offset === UARTDR && overrun && !uart.rxFIFO.empty) {
-      overrun = false;
-      return read(offset) | UARTDR_OE;
+    if (offset === UARTDR) {
+      const flag = overrun && !uart.rxFIFO.empty ? UARTDR_OE : 0;
+      if (flag) overrun = false;
+      const value = read(offset) | flag;
+      rxDreq();
+      return value;
     }
     return read(offset);
   };
@@ -66,6 +84,7 @@ export function uartAsOnTheChip(uart, now) {
   uart.writeUint32 = (offset, value) => {
     if (offset === UARTDMACR) {
       dmacr = value & 0x7;
+      rxDreq();
       return;
     }
     if (offset === UARTDR) {
@@ -79,9 +98,13 @@ export function uartAsOnTheChip(uart, now) {
   uart.receive = (byte, damaged) => {
     if (uart.rxFIFO.full) {
       overrun = true;
+      uart.interruptStatus |= RIS_OE;
+      uart.checkInterrupts();
       return false;
     }
+    if (damaged) uart.interruptStatus |= RIS_FE;
     uart.feedByte(byte | (damaged ? UARTDR_FE : 0));
+    rxDreq();
     return true;
   };
   uart.txDue = () => txNext;

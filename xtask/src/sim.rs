@@ -137,9 +137,8 @@ pub struct Args {
     #[arg(long, conflicts_with = "flood")]
     pub noise: bool,
     /// A UART flood instead: 200 `status` lines
-    /// back to back at 115200 baud, more than the replies keep up with
-    /// (bytes are lost at the full receive FIFO, as on the chip), then one
-    /// more line.
+    /// back to back at 115200 baud, more than the replies keep up with,
+    /// then one more line: every line answered once, in order, none lost.
     #[arg(long)]
     pub flood: bool,
     /// List every access to a register the emulator does not model, also

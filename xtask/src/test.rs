@@ -48,7 +48,8 @@ impl<'a> Stages<'a> {
     fn run_or_skip(&mut self, name: &str, stage: impl FnOnce() -> Result<Option<String>>) -> bool {
         if self.only.is_some_and(|only| !name.contains(only)) {
             let reason = "not chosen by --only".to_owned();
-            self.results.push((name.to_owned(), Outcome::Skipped(reason), 0.0));
+            self.results
+                .push((name.to_owned(), Outcome::Skipped(reason), 0.0));
             return true;
         }
         println!();
@@ -74,7 +75,8 @@ impl<'a> Stages<'a> {
     fn blocked(&mut self, name: &str, by: &str) {
         if self.only.is_some_and(|only| !name.contains(only)) {
             let reason = "not chosen by --only".to_owned();
-            self.results.push((name.to_owned(), Outcome::Skipped(reason), 0.0));
+            self.results
+                .push((name.to_owned(), Outcome::Skipped(reason), 0.0));
             return;
         }
         println!();

@@ -48,8 +48,11 @@
 //! `boards/qemu/src/panic_proof.rs`): the image only links if no panic path
 //! survives optimisation.
 
+use core::sync::atomic::Ordering;
+
 use embassy_time::{Duration, Instant, Timer};
 use embedded_hal::pwm::SetDutyCycle;
+use portable_atomic::AtomicU32;
 
 use idle_head_core::behaviour::{
     Applied, BehaviourError, BehaviourParams, CommandQueue, Head, HeadFrame, IdleSource,
@@ -62,6 +65,10 @@ use idle_head_core::driver::{FrameClock, FrameDriver, FrameReport, FrameTick, Ze
 use idle_head_core::{Angle, Microseconds};
 
 use crate::config::DEFAULT_BEHAVIOUR;
+
+/// The latest a frame task woke after its deadline since boot, µs (for
+/// the status report).
+pub static LATEST_WAKE_US: AtomicU32 = AtomicU32::new(0);
 
 /// One frame of the loop: what [`FrameLoop::write`] played.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
@@ -362,7 +369,11 @@ where
         let woke = Instant::now().as_ticks();
         let tick = frames.next(woke);
         let lateness = woke.saturating_sub(deadline);
-        max_lateness = max_lateness.max(lateness);
+        if lateness > max_lateness {
+            max_lateness = lateness;
+            let us = Duration::from_ticks(lateness).as_micros();
+            LATEST_WAKE_US.store(u32::try_from(us).unwrap_or(u32::MAX), Ordering::Relaxed);
+        }
         if tick.skipped > 0 {
             defmt::warn!(
                 "frame {=u64}: woke {=u64} us late, skipped {=u64} frame(s)",

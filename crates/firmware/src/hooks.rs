@@ -1,5 +1,6 @@
 //! The frame hooks of a board running on its own: a watchdog fed after every
-//! frame, a log line at the first frame and one per loop.
+//! frame, and a log line at the first frame (the status report once a loop
+//! is [`crate::report`]'s, below every other task).
 //!
 //! The hardware watchdog is started just after the first frame (the neutral
 //! pulses) and fed after every frame with [`WATCHDOG_TIMEOUT`] = 100 ms (5
@@ -20,6 +21,7 @@ use core::sync::atomic::Ordering;
 use embassy_time::Duration;
 use embedded_hal::pwm::SetDutyCycle;
 use idle_head_core::driver::FrameDriver;
+#[cfg(feature = "calibrate")]
 use idle_head_core::playback::Playback;
 
 use crate::frame::{Flow, Frame, FrameHooks};
@@ -42,37 +44,22 @@ pub trait Watchdog {
     fn feed(&mut self, timeout: Duration);
 }
 
-/// Feeds the watchdog after every frame and logs a status line per loop.
+/// Feeds the watchdog after every frame.
 pub struct BoardHooks<W> {
     watchdog: W,
-    /// The deepest the stack has been, in bytes, as the board measures it.
-    peak_stack: fn() -> u32,
-    /// Frames per loop of the playback.
-    loop_frames: u64,
-    /// The frame the next loop ends at (its status line is due).
-    next_loop_end: u64,
     started: bool,
-    max_lateness: u64,
     #[cfg(feature = "calibrate")]
     playback: Playback,
 }
 
 impl<W: Watchdog> BoardHooks<W> {
-    /// Hooks feeding `watchdog`, with a status line every loop of
-    /// `playback`; `peak_stack` tells the stack's deepest use.
-    pub fn new(watchdog: W, playback: Playback, peak_stack: fn() -> u32) -> Self {
-        let loop_ms = u64::from(playback.loop_duration().0);
-        let frame_us = u64::from(playback.frame_period().0).max(1);
-        let loop_frames = (loop_ms * 1000 / frame_us).max(1);
+    /// Hooks feeding `watchdog`.
+    pub fn new(watchdog: W) -> Self {
         Self {
             watchdog,
-            peak_stack,
-            loop_frames,
-            next_loop_end: loop_frames,
             started: false,
-            max_lateness: 0,
             #[cfg(feature = "calibrate")]
-            playback,
+            playback: crate::tasks::playback(),
         }
     }
 }
@@ -89,6 +76,7 @@ fn watchdog_timeout() -> Duration {
 
 impl<P: SetDutyCycle, W: Watchdog> FrameHooks<P> for BoardHooks<W> {
     fn after_frame(&mut self, frame: &Frame, driver: &mut FrameDriver<P>) -> Flow {
+        let _ = driver;
         if self.started {
             self.watchdog.feed(watchdog_timeout());
         } else {
@@ -98,40 +86,20 @@ impl<P: SetDutyCycle, W: Watchdog> FrameHooks<P> for BoardHooks<W> {
             self.started = true;
             let [p, r, y] = frame.report.servos;
             defmt::info!(
-                "first frame: neutral pulses {=u32} {=u32} {=u32} us; watchdog armed ({=u64} ms); peak stack {=u32} B",
+                "first frame: neutral pulses {=u32} {=u32} {=u32} us; watchdog armed ({=u64} ms)",
                 p.pulse.0,
                 r.pulse.0,
                 y.pulse.0,
-                WATCHDOG_TIMEOUT.as_millis(),
-                (self.peak_stack)()
+                WATCHDOG_TIMEOUT.as_millis()
             );
         }
-        self.max_lateness = self
-            .max_lateness
-            .max(frame.woke.saturating_sub(frame.deadline));
         #[cfg(feature = "calibrate")]
         crate::calibrate::log_frame(frame, &self.playback);
-        let index = frame.tick.frame;
-        // A comparison per frame, not a 64-bit division (a library call on
-        // the Cortex-M0+): the next loop's end is kept.
-        if index >= self.next_loop_end {
-            self.next_loop_end = self.next_loop_end.saturating_add(self.loop_frames);
-            let stats = driver.stats();
-            defmt::info!(
-                "loop {=u64} done: {=u64} frames written, wake-up at most {=u64} us late, faults {}, disabled {}, peak stack {=u32} B",
-                index / self.loop_frames,
-                stats.frames,
-                Duration::from_ticks(self.max_lateness).as_micros(),
-                stats.faults,
-                stats.disabled,
-                (self.peak_stack)()
-            );
-        }
         #[cfg(feature = "watchdog-drill")]
-        if index == DRILL_FRAMES {
+        if frame.tick.frame == DRILL_FRAMES {
             defmt::warn!(
                 "watchdog drill: frames stop after frame {=u64}; the watchdog must reset the board",
-                index
+                frame.tick.frame
             );
             return Flow::Stop;
         }

@@ -8,7 +8,8 @@
 //!   body and the loop generator task.
 //! - [`exchange`]: the loop sets' round between the frame task and the loop
 //!   generator, which makes each next set in the background.
-//! - [`hooks`]: the watchdog and status log of a board running on its own.
+//! - [`hooks`]: the watchdog of a board running on its own; [`report`]: its
+//!   status log once a loop, below every other task.
 //! - [`console`]: the console's loop over a board's byte [`console::Port`]
 //!   (a Bottango driver on a port after a Bottango handshake).
 //! - [`dmx`]: the DMX512 receiver's loop over a board's [`dmx::DmxPort`].
@@ -39,5 +40,6 @@ pub mod exchange;
 pub mod frame;
 pub mod hooks;
 pub mod input;
+pub mod report;
 pub mod storage;
 pub mod tasks;

@@ -18,21 +18,34 @@
 //! firmware cannot read, gives the built-in settings with a warning. The
 //! console's `save` and `load` go through [`FlashStorage`].
 //!
-//! # `save` and the watchdog
+//! # What a `save` does to the head
 //!
-//! A sector erase takes 45 ms typically (W25Q16JV), up to 400 ms, with
-//! interrupts off: no frame runs meanwhile, and the watchdog (100 ms) would
-//! reset the board. So around every flash operation of `save` and `load`
-//! [`FlashStorage`] sets [`FLASH_BUSY`] and waits (at most
-//! [`FRAME_WAIT_MS`]) for one frame: that frame, and every frame until the
-//! operation ends, feeds the watchdog with [`FLASH_WATCHDOG_MS`] instead of
-//! 100 ms. Afterwards the next frame feeds it with 100 ms again. While the
-//! interrupts are off the PWM hardware keeps sending the last pulses, so
-//! the servos hold their pose; the frames due meanwhile are missed (the
-//! frame task's lateness shows it), and the head resumes where its clock
-//! stands. An erase of several sectors (the whole store, when a damaged one
-//! is started afresh) goes one sector at a time ([`SectorWise`]): the
-//! interrupts are never off for more than one sector.
+//! A flash erase or write runs with interrupts off (the flash cannot be
+//! read, nor code run from it, meanwhile): a page write takes about 0.4 ms
+//! (3 ms at worst), a sector erase 45 ms typically (W25Q16JV), 400 ms at
+//! worst. Most saves only write: `sequential-storage` appends the record
+//! and erases a sector only when the store has gone round its sectors.
+//! While the interrupts are off:
+//!
+//! - the PWM hardware keeps sending the last pulses: the servos hold their
+//!   pose; the frames due meanwhile are missed, and the head goes on from
+//!   where its clock stands, through the driver's limiter (no step beyond
+//!   its speed and acceleration);
+//! - console bytes on the UART keep arriving by DMA into RAM (the board's
+//!   port), USB holds what the host sends (it has flow control): none is
+//!   lost;
+//! - DMX frames are lost (the UART's FIFO overflows): they count as bad
+//!   frames, the head keeps the last cue, and a save is far shorter than
+//!   the second after which the signal counts as lost;
+//! - the watchdog (100 ms) would reset the board: [`FlashStorage`] sets
+//!   [`FLASH_BUSY`] and feeds the watchdog with [`FLASH_WATCHDOG_MS`] before
+//!   every flash operation of `save` and `load` (and every frame feeds it
+//!   that long while the flag is set); afterwards the frames feed it with
+//!   100 ms again.
+//!
+//! An erase of several sectors (the whole store, when a damaged one is
+//! started afresh) goes one sector at a time ([`SectorWise`]): the
+//! interrupts come back, and a due frame runs, between sectors.
 
 use core::future::Future;
 use core::ops::Range;
@@ -40,7 +53,7 @@ use core::pin::pin;
 use core::sync::atomic::{AtomicBool, Ordering};
 use core::task::{Context, Poll, Waker};
 
-use embassy_time::{Duration, Instant};
+use embassy_time::Duration;
 use embedded_storage_async::nor_flash::NorFlash;
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::settings::{
@@ -50,14 +63,11 @@ use idle_head_core::settings::{
 
 use static_cell::StaticCell;
 
-use crate::boot::{LINK, Loaded};
+use crate::boot::Loaded;
 
 /// The watchdog timeout the frames feed while a flash operation is under
 /// way: a 400 ms sector erase, with a wide margin.
 pub const FLASH_WATCHDOG_MS: u64 = 1000;
-/// How long a flash operation waits for the frame that feeds the watchdog
-/// with [`FLASH_WATCHDOG_MS`]: more than a frame (20 ms).
-pub const FRAME_WAIT_MS: u64 = 50;
 
 /// Set while `save` or `load` uses the flash: the frames feed the watchdog
 /// with [`FLASH_WATCHDOG_MS`] (see the [module docs](self)).
@@ -71,25 +81,21 @@ pub type Store<F> = SettingsStore<SectorWise<F>, Settings, SETTINGS_BUFFER>;
 pub struct FlashStorage<F: NorFlash> {
     /// `None` if the store could not be opened (logged at boot).
     store: Option<Store<F>>,
+    /// Feeds the board's watchdog for a timeout.
+    feed: fn(Duration),
 }
 
 impl<F: NorFlash> FlashStorage<F> {
-    /// Runs `op` on the store with the watchdog's flash timeout in force.
+    /// Runs `op` on the store with the watchdog's flash timeout in force
+    /// (see the [module docs](self)).
     fn guarded<T>(
         &mut self,
         op: impl FnOnce(&mut Store<F>) -> Result<T, StorageError>,
     ) -> Result<T, StorageError> {
         let store = self.store.as_mut().ok_or(StorageError::Device)?;
         FLASH_BUSY.store(true, Ordering::Release);
-        // The frame task runs above this task: once the frame count moves,
-        // that frame has fed the watchdog with the long timeout. If no frame
-        // comes (the watchdog is not running yet), go on.
-        let frame = LINK.status().frame;
-        let since = Instant::now();
-        while LINK.status().frame == frame && since.elapsed() < Duration::from_millis(FRAME_WAIT_MS)
-        {
-            core::hint::spin_loop();
-        }
+        // A frame from here on feeds the long timeout too.
+        (self.feed)(Duration::from_millis(FLASH_WATCHDOG_MS));
         let result = op(store);
         FLASH_BUSY.store(false, Ordering::Release);
         result
@@ -119,13 +125,16 @@ impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
 /// space, for the log) in `cell`, where it stays (the console saves through
 /// it), and reads the settings in it, before the first frame (no watchdog,
 /// no frames yet), checked against `base`; the built-in settings if there
-/// are none or they are not usable. The log says which. `None` if `cell` was taken.
+/// are none or they are not usable. The log says which. `feed` feeds the
+/// board's watchdog before each later flash operation. `None` if `cell` was
+/// taken.
 pub fn open<F>(
     cell: &'static StaticCell<FlashStorage<F>>,
     flash: F,
     range: Range<u32>,
     address: u32,
     base: &DriverConfig,
+    feed: fn(Duration),
 ) -> Option<Loaded<&'static mut FlashStorage<F>>>
 where
     F: NorFlash,
@@ -135,7 +144,7 @@ where
     if store.is_none() {
         defmt::error!("settings: no store: the region is not whole erase sectors");
     }
-    let storage = cell.try_init(FlashStorage { store })?;
+    let storage = cell.try_init(FlashStorage { store, feed })?;
     let loaded = storage.store.as_mut().and_then(|store| {
         let loaded = at_once(store.load());
         if loaded.is_none() {
@@ -154,7 +163,7 @@ where
     })
 }
 
-/// Polls `future` once: every flash operation of [`PicoFlash`] is blocking
+/// Polls `future` once: every flash operation of the boards' drivers is blocking
 /// underneath, so the store's futures complete on their first poll.
 fn at_once<F: Future>(future: F) -> Option<F::Output> {
     match pin!(future).poll(&mut Context::from_waker(Waker::noop())) {

@@ -9,6 +9,7 @@ use embassy_embedded_hal::adapter::BlockingAsync;
 use embassy_rp::Peri;
 use embassy_rp::flash::{Blocking, ERASE_SIZE, Flash};
 use embassy_rp::peripherals::FLASH;
+use embassy_time::Duration;
 use idle_head_core::driver::DriverConfig;
 use idle_head_firmware::boot::Loaded;
 use idle_head_firmware::storage::{self, FlashStorage};
@@ -47,11 +48,15 @@ pub type Storage = &'static mut Store;
 static STORE: StaticCell<Store> = StaticCell::new();
 
 /// Opens the store and reads the settings the board boots with, checked
-/// against `base` (see `idle_head_firmware::storage::open`). `None` if
-/// called twice.
+/// against `base` (see `idle_head_firmware::storage::open`); `feed` feeds
+/// the watchdog before each flash operation. `None` if called twice.
 #[must_use]
 #[inline(never)]
-pub fn open(flash: Peri<'static, FLASH>, base: &DriverConfig) -> Option<Loaded<Storage>> {
+pub fn open(
+    flash: Peri<'static, FLASH>,
+    base: &DriverConfig,
+    feed: fn(Duration),
+) -> Option<Loaded<Storage>> {
     let flash = BlockingAsync::new(Flash::new_blocking(flash));
-    storage::open(&STORE, flash, SETTINGS_RANGE, SETTINGS_ADDRESS, base)
+    storage::open(&STORE, flash, SETTINGS_RANGE, SETTINGS_ADDRESS, base, feed)
 }

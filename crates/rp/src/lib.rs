@@ -4,18 +4,19 @@
 //!
 //! A board makes the [`Board`] (the three servo outputs, the console's
 //! UART and USB driver, the flash, the watchdog) and calls [`start`], which
-//! runs the firmware layer's boot sequence and spawns
+//! runs the firmware layer's boot sequence and spawns, by priority:
 //!
-//! - the frame task, in an interrupt executor on `SWI_IRQ_1` above thread
-//!   mode, so a frame is never delayed by anything below it;
-//! - the loop generator (thread mode): generating a set takes about 2 ms of
-//!   CPU every 28 s, which frames preempt;
-//! - the console on the UART and on the USB serial port (thread mode), whose
-//!   interrupts sit below the frame task's ([`PORT_PRIORITY`]);
-//! - the DMX512 receiver ([`dmx`]): UART1's interrupt, at the highest
-//!   priority (a few microseconds per character).
-//! - the trigger inputs (thread mode, on their GPIO interrupt; see
-//!   [`input`]).
+//! | priority | what | runs |
+//! |---|---|---|
+//! | `P0` | the timer's alarm, the DMX512 receiver ([`dmx`]) | interrupts, microseconds each |
+//! | `P1` | the frame task | an interrupt executor on `SWI_IRQ_1` |
+//! | `P2` | the console on the UART and USB, the USB device, the trigger inputs ([`input`]), and their interrupts | an interrupt executor on `SWI_IRQ_0` ([`PORT_PRIORITY`]) |
+//! | thread mode | the loop generator, the status report ([`report`](idle_head_firmware::report)) | what is left |
+//!
+//! Nothing a person or a show waits for sits behind the loop generator
+//! (tens of ms of work every loop) or the stack scan: they run in thread
+//! mode, below everything else. [`waits`] measures how long the port tasks
+//! wait for the CPU.
 //!
 //! Exactly one chip feature: `rp2040` or `rp235xa`.
 #![no_std]
@@ -36,6 +37,7 @@ pub mod pico;
 pub mod pwm;
 pub mod uart;
 pub mod usb;
+pub mod waits;
 
 use core::cell::RefCell;
 
@@ -45,6 +47,7 @@ use embassy_rp::interrupt::{self, InterruptExt, Priority};
 use embassy_rp::peripherals::{FLASH, USB, WATCHDOG};
 use embassy_rp::watchdog::{ResetReason, Watchdog as RpWatchdog};
 use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_time::Duration;
 
 use idle_head_core::behaviour::BehaviourParams;
@@ -76,8 +79,8 @@ pub use idle_head_core::pwm_clock::PICO2_SERVO_CLOCK as SERVO_CLOCK;
 #[cfg(feature = "rp235xa")]
 pub use idle_head_core::pwm_clock::PICO2_SYS_HZ as SYS_HZ;
 
-/// The ports' interrupt priority: below the frame task's (`P1`), above
-/// thread mode, where the console tasks run.
+/// The port tasks' executor and their interrupts: below the frame task's
+/// (`P1`), above thread mode.
 pub const PORT_PRIORITY: Priority = Priority::P2;
 
 /// The frame driver's configuration: 50 Hz frames and PWM, hobby servos on
@@ -113,18 +116,27 @@ pub struct Board {
     pub input_pins: &'static str,
 }
 
-/// The console service, shared by the ports (thread mode only).
+/// The console service, shared by the ports (the port executor only).
 type Service = SharedService<flash::Storage>;
 static SERVICE: StaticCell<Service> = StaticCell::new();
 
 /// The frame task's executor, above thread mode.
 static FRAME_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
 
+/// The port tasks' executor, below the frame task's.
+static PORT_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
+
 #[embassy_rp::interrupt]
 unsafe fn SWI_IRQ_1() {
     // Note(unsafe): called from this interrupt only, which `start` enables
     // after the executor is set up.
     unsafe { FRAME_EXECUTOR.on_interrupt() }
+}
+
+#[embassy_rp::interrupt]
+unsafe fn SWI_IRQ_0() {
+    // Note(unsafe): as for `SWI_IRQ_1`.
+    unsafe { PORT_EXECUTOR.on_interrupt() }
 }
 
 /// Boots the head on `board` and spawns its tasks (see the crate docs);
@@ -150,7 +162,9 @@ pub fn start(spawner: Spawner, board: Board) {
         input_pins,
     } = board;
     let watchdog = RpWatchdog::new(watchdog);
-    match watchdog.reset_reason() {
+    let reason = watchdog.reset_reason();
+    WATCHDOG.lock(|cell| cell.replace(Some(watchdog)));
+    match reason {
         Some(ResetReason::TimedOut) => {
             defmt::warn!("boot: last reset by the WATCHDOG (frames had stopped); soft start again");
         }
@@ -159,18 +173,67 @@ pub fn start(spawner: Spawner, board: Board) {
     }
     log_clocks(name, servo_pins);
     // Before the first frame: nothing else runs yet while the store is read.
-    let Some(loaded) = flash::open(flash, &CONFIG) else {
+    let Some(loaded) = flash::open(flash, &CONFIG, feed_watchdog) else {
         defmt::error!("boot: called twice");
         return;
     };
     let Some(head) = boot_head(spawner, loaded) else {
         return;
     };
-    spawn_frames(servos, &head, BoardWatchdog(watchdog));
+    spawn_frames(servos, &head, BoardWatchdog);
     spawn_dmx(dmx, dmx_pins);
-    spawn(spawner, input_task(inputs), "input");
-    defmt::info!("inputs: {=str}", input_pins);
-    spawn_console(spawner, uart, uart_pins, usb, head.service);
+    interrupt::SWI_IRQ_0.set_priority(PORT_PRIORITY);
+    interrupt::IO_IRQ_BANK0.set_priority(PORT_PRIORITY);
+    interrupt::USBCTRL_IRQ.set_priority(PORT_PRIORITY);
+    let executor = PORT_EXECUTOR.start(interrupt::SWI_IRQ_0);
+    let parts = Ports {
+        inputs,
+        input_pins,
+        uart,
+        uart_pins,
+        usb,
+        service: head.service,
+    };
+    if let Ok(token) = ports_task(parts) {
+        executor.spawn(token);
+    } else {
+        defmt::error!("port tasks already running");
+    }
+    spawn(spawner, report_task(), "report");
+}
+
+/// What the port executor's tasks start from.
+struct Ports {
+    inputs: GpioInputs,
+    input_pins: &'static str,
+    uart: UartPort,
+    uart_pins: &'static str,
+    usb: embassy_rp::usb::Driver<'static, USB>,
+    service: &'static Service,
+}
+
+// Note(unsafe): the console service's mutex is a `NoopRawMutex`, for one
+// executor. Its reference goes from the boot to the port executor once,
+// before any task uses it, and every task that uses it runs there.
+unsafe impl Send for Ports {}
+
+/// Spawns the port tasks in the port executor, from within it: the USB
+/// device and its serial port are made here, as tasks of this executor
+/// only can hold them (they are not `Send`).
+#[embassy_executor::task]
+async fn ports_task(parts: Ports) {
+    // Note(unsafe): polled by the port executor, as the one way to spawn
+    // tasks that are not `Send` in an interrupt executor.
+    let spawner = unsafe { Spawner::for_current_executor() }.await;
+    spawn(spawner, input_task(parts.inputs), "input");
+    defmt::info!("inputs: {=str}", parts.input_pins);
+    spawn_console(
+        spawner,
+        parts.uart,
+        parts.uart_pins,
+        parts.usb,
+        parts.service,
+    );
 }
 
 /// What the boot leaves for the frame task and the console.
@@ -242,7 +305,6 @@ fn spawn_console(
     );
     defmt::info!("console: UART {=str}, 115200 8N1", uart_pins);
     let (device, serial) = usb::build(usb);
-    interrupt::USBCTRL_IRQ.set_priority(PORT_PRIORITY);
     spawn(spawner, usb_device(device), "usb device");
     spawn(
         spawner,
@@ -303,16 +365,37 @@ fn oscillator_jitter() -> u32 {
     bits as u32 ^ (bits >> 32) as u32
 }
 
-/// The hardware watchdog, fed by the frame task.
-struct BoardWatchdog(RpWatchdog);
+/// The hardware watchdog: fed by the frame task after every frame, and by
+/// the settings store before it holds the flash (and the interrupts) busy.
+static WATCHDOG: Mutex<CriticalSectionRawMutex, RefCell<Option<RpWatchdog>>> =
+    Mutex::new(RefCell::new(None));
+
+/// Runs `f` on the hardware watchdog, once the boot has put it in place.
+fn with_watchdog(f: impl FnOnce(&mut RpWatchdog)) {
+    WATCHDOG.lock(|cell| {
+        if let Ok(mut watchdog) = cell.try_borrow_mut()
+            && let Some(watchdog) = watchdog.as_mut()
+        {
+            f(watchdog);
+        }
+    });
+}
+
+/// Feeds the hardware watchdog for `timeout` (the settings store's guard).
+fn feed_watchdog(timeout: Duration) {
+    with_watchdog(|watchdog| watchdog.feed(timeout));
+}
+
+/// The hardware watchdog, as the frame task's hooks use it.
+struct BoardWatchdog;
 
 impl Watchdog for BoardWatchdog {
     fn start(&mut self, timeout: Duration) {
-        self.0.start(timeout);
+        with_watchdog(|watchdog| watchdog.start(timeout));
     }
 
     fn feed(&mut self, timeout: Duration) {
-        self.0.feed(timeout);
+        feed_watchdog(timeout);
     }
 }
 
@@ -331,8 +414,7 @@ async fn frame_task(
     behaviour: BehaviourParams,
     watchdog: BoardWatchdog,
 ) {
-    let playback = idle_head_firmware::tasks::playback();
-    let mut hooks = BoardHooks::new(watchdog, playback, peak_stack);
+    let mut hooks = BoardHooks::new(watchdog);
     // Loop set 0, from the generator: about 3 ms after boot.
     let (first, _) = EXCHANGE.first().await;
     let (stats, _) = idle_head_firmware::tasks::play(
@@ -340,7 +422,7 @@ async fn frame_task(
         first,
         &behaviour,
         &mut hooks,
-        playback.frame_period(),
+        idle_head_firmware::tasks::playback().frame_period(),
     )
     .await;
     // The hooks only stop in the watchdog drill; then the watchdog resets
@@ -350,6 +432,15 @@ async fn frame_task(
     // last pulse until the reset (returning would drop the driver, whose
     // slices switch off at once, mid-pulse).
     core::future::pending::<()>().await;
+}
+
+/// The status report, once a loop (thread mode: its stack scan and log
+/// wait for everything else).
+#[embassy_executor::task]
+async fn report_task() {
+    let playback = idle_head_firmware::tasks::playback();
+    idle_head_firmware::report::run(playback.loop_duration(), peak_stack, waits::port_wait_us)
+        .await;
 }
 
 /// Generates loop set 0, then each next loop set while the frames play.

@@ -7,7 +7,7 @@
 //! | roll servo  | GP18 | 24        | PWM1 A             |
 //! | yaw servo   | GP20 | 26        | PWM2 A             |
 //! | console TX  | GP0  | 1         | UART0, 115200 8N1  |
-//! | console RX  | GP1  | 2         | UART0              |
+//! | console RX  | GP1  | 2         | UART0, by DMA channel 0 |
 //! | console     | USB  |           | CDC-ACM serial port|
 //! | input 2     | GP2  | 4         | GPIO, trigger input|
 //! | input 3     | GP3  | 5         | GPIO, trigger input|
@@ -28,15 +28,14 @@
 //! A board with another pinout builds its [`Board`] the same way with its
 //! own pins.
 
-use embassy_rp::peripherals::{UART0, USB};
-use embassy_rp::{Peripherals, bind_interrupts, uart, usb};
+use embassy_rp::peripherals::USB;
+use embassy_rp::{Peripherals, bind_interrupts, usb};
 
 use crate::input::GpioInputs;
 use crate::pwm::ServoPwm;
 use crate::{Board, SERVO_CLOCK};
 
 bind_interrupts!(struct Irqs {
-    UART0_IRQ => uart::BufferedInterruptHandler<UART0>;
     USBCTRL_IRQ => usb::InterruptHandler<USB>;
 });
 
@@ -52,7 +51,7 @@ pub fn board(p: Peripherals, name: &'static str) -> Board {
             ServoPwm::new(p.PWM_SLICE2, p.PIN_20, &SERVO_CLOCK),
         ],
         servo_pins: "pitch GP16 (PWM0 A), roll GP18 (PWM1 A), yaw GP20 (PWM2 A)",
-        uart: crate::uart::console(p.UART0, p.PIN_0, p.PIN_1, Irqs),
+        uart: crate::uart::console(p.UART0, p.PIN_0, p.PIN_1, p.DMA_CH0),
         uart_pins: "UART0 GP0 TX, GP1 RX",
         dmx: crate::dmx::receiver(p.UART1, p.PIN_9),
         dmx_pins: "UART1 RX GP9",

@@ -1,0 +1,94 @@
+//! How long the port tasks wait for the CPU: from the moment something
+//! wakes one (its interrupt, a timer, another task) to the moment the port
+//! executor polls it, the longest since boot ([`port_wait_us`]).
+//!
+//! Measured with embassy-executor's trace hooks, which the executors call
+//! at every wake and poll of every task: a task's wake time is kept until
+//! it is polled; a poll that runs in the port executor's interrupt
+//! (`SWI_IRQ_0`) is a port task's.
+
+use core::cell::Cell;
+
+use cortex_m::peripheral::SCB;
+use cortex_m::peripheral::scb::VectActive;
+use embassy_rp::pac::Interrupt;
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_time::Instant;
+
+/// Tasks woken and not yet polled, at most: every task of the image.
+const TASKS: usize = 8;
+
+/// The tasks woken and not yet polled, with their wake time (µs), and the
+/// longest port wait so far (µs).
+struct Waits {
+    woken: [Cell<Option<(u32, u64)>>; TASKS],
+    longest: Cell<u32>,
+}
+
+static WAITS: Mutex<CriticalSectionRawMutex, Waits> = Mutex::new(Waits {
+    woken: [const { Cell::new(None) }; TASKS],
+    longest: Cell::new(0),
+});
+
+/// The longest a port task waited for the CPU since boot, µs.
+#[must_use]
+pub fn port_wait_us() -> u32 {
+    WAITS.lock(|w| w.longest.get())
+}
+
+/// Whether the code runs in the port executor's interrupt.
+fn in_port_executor() -> bool {
+    matches!(SCB::vect_active(), VectActive::Interrupt { irqn } if irqn == Interrupt::SWI_IRQ_0 as u8)
+}
+
+#[unsafe(no_mangle)]
+extern "Rust" fn _embassy_trace_task_ready_begin(_executor_id: u32, task_id: u32) {
+    let now = Instant::now().as_micros();
+    WAITS.lock(|w| {
+        // Woken again before its poll: the first wake counts.
+        if w.woken
+            .iter()
+            .any(|slot| slot.get().is_some_and(|(id, _)| id == task_id))
+        {
+            return;
+        }
+        if let Some(slot) = w.woken.iter().find(|slot| slot.get().is_none()) {
+            slot.set(Some((task_id, now)));
+        }
+    });
+}
+
+#[unsafe(no_mangle)]
+extern "Rust" fn _embassy_trace_task_exec_begin(_executor_id: u32, task_id: u32) {
+    let now = Instant::now().as_micros();
+    let port = in_port_executor();
+    WAITS.lock(|w| {
+        let Some(slot) = w
+            .woken
+            .iter()
+            .find(|slot| slot.get().is_some_and(|(id, _)| id == task_id))
+        else {
+            return;
+        };
+        if let (Some((_, woken)), true) = (slot.take(), port) {
+            let waited = u32::try_from(now.saturating_sub(woken)).unwrap_or(u32::MAX);
+            w.longest.set(w.longest.get().max(waited));
+        }
+    });
+}
+
+#[unsafe(no_mangle)]
+extern "Rust" fn _embassy_trace_task_exec_end(_executor_id: u32, _task_id: u32) {}
+
+#[unsafe(no_mangle)]
+extern "Rust" fn _embassy_trace_task_new(_executor_id: u32, _task_id: u32) {}
+
+#[unsafe(no_mangle)]
+extern "Rust" fn _embassy_trace_task_end(_executor_id: u32, _task_id: u32) {}
+
+#[unsafe(no_mangle)]
+extern "Rust" fn _embassy_trace_poll_start(_executor_id: u32) {}
+
+#[unsafe(no_mangle)]
+extern "Rust" fn _embassy_trace_executor_idle(_executor_id: u32) {}
