@@ -42,12 +42,11 @@ struct Model {
 }
 
 impl Model {
-    /// An action applied before frame `next`, as answered: a gesture starts
-    /// at the last frame played (0 before the first), so that `next` is a
-    /// step in; a gaze move starts at `next`.
+    /// An action applied before the next frame, as answered: it starts at
+    /// the last frame played (0 before the first), so that the next frame is
+    /// a step in.
     fn apply(&mut self, outcome: &Applied) {
         let start = self.last.unwrap_or(0);
-        let next = self.last.map_or(0, |f| f + 1);
         match outcome {
             Applied::Gesture(plan) => {
                 for layer in &mut self.layers {
@@ -63,8 +62,8 @@ impl Model {
                 });
             }
             Applied::Look(look) => {
-                let end = next + u64::from(look.duration.0 / FRAME_MS);
-                self.gaze = (next, end);
+                let end = start + u64::from(look.duration.0 / FRAME_MS);
+                self.gaze = (start, end);
                 self.back = match look.hold {
                     Hold::Stay => None,
                     Hold::Return(ms) => {
@@ -82,7 +81,7 @@ impl Model {
                 };
             }
             Applied::Center(ms) => {
-                self.gaze = (next, next + u64::from(ms.0 / FRAME_MS));
+                self.gaze = (start, start + u64::from(ms.0 / FRAME_MS));
                 self.back = None;
             }
             Applied::Idle(_) | Applied::Stop => {}

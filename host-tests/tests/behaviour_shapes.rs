@@ -463,10 +463,11 @@ fn a_new_look_while_moving_keeps_velocity_and_acceleration() {
                 Action::Look(l) => (f64::from(l.yaw.millidegrees()), mixer.apply(&action)),
                 _ => (0.0, mixer.apply(&action)),
             };
-            let k = k as f64;
-            // The new move starts where the old one is, as fast and as
-            // accelerated: continuous up to the acceleration.
-            reference = RefGlide::new(k, reference.at(k), target, frames(applied.unwrap()));
+            // The new move starts at the last frame mixed, where the old one
+            // is, as fast and as accelerated: continuous up to the
+            // acceleration; the next frame is its first step.
+            let start = k as f64 - 1.0;
+            reference = RefGlide::new(start, reference.at(start), target, frames(applied.unwrap()));
         }
         let yaw = f64::from(mixer.frame(k, [Angle::ZERO; 3])[2].millidegrees());
         let (expected, _, _) = reference.at(k as f64);
@@ -492,13 +493,14 @@ fn a_long_move_stays_on_the_minimum_jerk_profile() {
             .apply(&look(0, 32_000, None, Some(Hold::Stay)))
             .unwrap(),
     );
-    // 300 ms + 8 ms · 55° = 740 ms: 37 frames.
+    // 300 ms + 8 ms · 55° = 740 ms: 37 frames, from the last frame mixed
+    // (99): frame 100 is its first step.
     assert_eq!(applied.duration, Millis(740));
     let mj = |tau: f64| tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
     let worst = (0..=40_u32)
         .map(|t| {
             let yaw = mixer.frame(100 + u64::from(t), [Angle::ZERO; 3])[2];
-            let expected = -23_000.0 + 55_000.0 * mj((f64::from(t) / 37.0).min(1.0));
+            let expected = -23_000.0 + 55_000.0 * mj((f64::from(t + 1) / 37.0).min(1.0));
             (f64::from(yaw.millidegrees()) - expected).abs()
         })
         .fold(0.0, f64::max);

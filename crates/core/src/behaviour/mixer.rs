@@ -203,13 +203,10 @@ impl Mixer {
     /// # Errors
     /// A [`BehaviourError`] for bad parameters (nothing changes then).
     pub fn apply_at(&mut self, action: &Action, at: [Angle; 3]) -> Result<Applied, BehaviourError> {
-        // A gesture, a rest, a wake and the idle's glide start at the last
-        // frame mixed, where they are at their start: the next frame, the
-        // first to play them, is already a step in (begun at the next frame,
-        // that frame would only repeat where the head is, and a command would
-        // show a frame later). A look and a move back to the centre start at
-        // the next frame: begun a frame earlier they cost the frame more than
-        // its ceiling allows (`cargo xtask bench`), for the frame they save.
+        // Every action starts at the last frame mixed, where it is at its
+        // start: the next frame, the first to play it, is already a step in
+        // (begun at the next frame, that frame would only repeat where the
+        // head is, and a command would show a frame later).
         let start = self.now;
         let next = self.next;
         let applied = match action {
@@ -218,9 +215,9 @@ impl Mixer {
                 self.modes[request.kind.axis().index()] = LimitMode::Gesture;
                 Applied::Gesture(plan)
             }
-            Action::Look(request) => self.look(next, request)?,
+            Action::Look(request) => self.look(start, request)?,
             Action::Center { duration } => {
-                let applied = self.gaze.center(&self.params, next, *duration)?;
+                let applied = self.gaze.center(&self.params, start, *duration)?;
                 self.gazing();
                 Applied::Center(applied)
             }
@@ -238,7 +235,7 @@ impl Mixer {
                 Some(duration) => Applied::Wake(duration),
                 None => match toward {
                     // Awake already: the glance alone.
-                    Some(yaw) => self.look(next, &rest::glance(&self.params, *yaw))?,
+                    Some(yaw) => self.look(start, &rest::glance(&self.params, *yaw))?,
                     None => Applied::Wake(Millis(0)),
                 },
             },
@@ -296,9 +293,9 @@ impl Mixer {
             && self.rest.arrived()
     }
 
-    /// A look starts at frame `next`.
-    fn look(&mut self, next: u32, request: &LookRequest) -> Result<Applied, BehaviourError> {
-        let applied = self.gaze.look(&self.params, next, request)?;
+    /// A look starts at frame `start`.
+    fn look(&mut self, start: u32, request: &LookRequest) -> Result<Applied, BehaviourError> {
+        let applied = self.gaze.look(&self.params, start, request)?;
         self.gazing();
         Ok(Applied::Look(applied))
     }

@@ -183,11 +183,11 @@ impl Inputs {
         self.was_resting = resting;
         let mut woken = false;
         for (i, role) in settings.roles.iter().enumerate() {
-            let (Some(debouncer), Some(hold)) = (self.debouncers.get_mut(i), role.debounce())
+            let (Some(debouncer), Some(rule)) = (self.debouncers.get_mut(i), role.debounce())
             else {
                 continue;
             };
-            let Some(edge) = debouncer.update(now, levels & (1 << i) != 0, hold) else {
+            let Some(edge) = debouncer.update(now, levels & (1 << i) != 0, rule) else {
                 continue;
             };
             if edge != role.active_high() {
@@ -266,7 +266,7 @@ impl Inputs {
     pub fn deadline(&self, settings: &InputSettings) -> Option<Micros> {
         let mut soonest = self.rest_due(settings);
         for (d, role) in self.debouncers.iter().zip(&settings.roles) {
-            if let Some(due) = role.debounce().and_then(|hold| d.deadline(hold)) {
+            if let Some(due) = role.debounce().and_then(|rule| d.deadline(rule)) {
                 soonest = Some(soonest.map_or(due, |s| s.min(due)));
             }
         }

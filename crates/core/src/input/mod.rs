@@ -6,8 +6,9 @@
 //!
 //! - [`InputRole`]: what an input is: off, a button with an action, or a
 //!   presence sensor with an optional direction ([`role`]);
-//! - [`Debouncer`]: a level becomes an edge once it has held for the
-//!   role's debounce time ([`debounce`]);
+//! - [`Debouncer`]: a level becomes an edge by the role's rule
+//!   ([`Debounce`]): a button's press at once, a presence sensor's level
+//!   once it has held ([`debounce`]);
 //! - [`Inputs`]: every input's debouncer, what its edges do (a button's
 //!   action, a presence sensor's wake and glance), and the rest timer: the
 //!   head rests when presence inputs are configured and none has been
@@ -20,15 +21,16 @@
 //!
 //! | what | time | why |
 //! |---|---|---|
-//! | button debounce | [`BUTTON_DEBOUNCE`] = 5 ms | a switch's contacts bounce for a few ms; 5 ms is the usual figure keyboard firmware uses, short enough not to be felt |
+//! | button debounce | [`BUTTON_DEBOUNCE`] = 5 ms | a switch's contacts bounce for a few ms after the first touch; the press counts at that touch and the input is not looked at for 5 ms after it (the usual figure keyboard firmware uses) |
 //! | button hold-off | [`BUTTON_HOLD_OFF`] = 200 ms | presses closer together than that are one press (a switch that bounces longer than the debounce, a double tap) |
 //! | presence debounce | [`PRESENCE_DEBOUNCE`] = 50 ms | a PIR module's output is clean logic held for seconds (an HC-SR501 for its hold time of 3 s up, an AM312 for about 2 s): 50 ms rejects what a long cable picks up, and costs nothing a visitor would notice |
 //! | glance hold-off | [`GLANCE_HOLD_OFF`] = 10 s | a PIR module re-triggers every few seconds while someone moves in front of it (and an HC-SR501 is blind for about 3 s after each pulse): the head glances once, not at every pulse |
 //!
 //! # Chatter, stuck inputs, two sensors at once
 //!
-//! - A level that changes faster than its debounce time never holds long
-//!   enough: chatter is no edge at all.
+//! - A presence level that changes faster than its debounce time never
+//!   holds long enough: chatter is no edge at all. A button's bounces come
+//!   within the 5 ms after its edge, when it is not looked at.
 //! - A button held down (or stuck low) acts once; it acts again only after
 //!   it has been released.
 //! - A presence input held high (someone standing there, or a sensor stuck
@@ -48,7 +50,7 @@ mod inputs;
 mod role;
 mod settings;
 
-pub use debounce::Debouncer;
+pub use debounce::{Debounce, Debouncer};
 pub use inputs::{InputStatus, Inputs, Micros, OUTBOX};
 pub use role::{InputRole, Pull};
 pub use settings::{InputSettings, MAX_REST_AFTER, RestAfter};

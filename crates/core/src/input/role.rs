@@ -3,7 +3,7 @@
 
 pub use crate::command::InputRole;
 
-use super::{BUTTON_DEBOUNCE, PRESENCE_DEBOUNCE};
+use super::{BUTTON_DEBOUNCE, Debounce, PRESENCE_DEBOUNCE};
 
 /// The pull resistor an input's pin needs for its role.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -33,16 +33,16 @@ impl InputRole {
         !matches!(self, Self::Button(_))
     }
 
-    /// How long its level must hold to count, in µs (`None`: off, never
-    /// counts).
+    /// How its level becomes an edge (`None`: off, never counts): a
+    /// button's press at once, its bounces after it ignored; a presence
+    /// sensor's level once it has held.
     #[must_use]
-    pub const fn debounce(&self) -> Option<u64> {
-        let ms = match self {
-            Self::Off => return None,
-            Self::Button(_) => BUTTON_DEBOUNCE,
-            Self::Presence { .. } => PRESENCE_DEBOUNCE,
-        };
-        Some(ms.0 as u64 * 1000)
+    pub const fn debounce(&self) -> Option<Debounce> {
+        match self {
+            Self::Off => None,
+            Self::Button(_) => Some(Debounce::Leading(BUTTON_DEBOUNCE.0 as u64 * 1000)),
+            Self::Presence { .. } => Some(Debounce::Hold(PRESENCE_DEBOUNCE.0 as u64 * 1000)),
+        }
     }
 
     /// Whether it is a presence sensor.
