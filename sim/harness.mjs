@@ -42,6 +42,7 @@
 //               they come; `ns`, `silence_ns`, `uart`, `usb` and the power cycles are not used,
 //   inputs:     optional, GPIOs the outside drives as inputs (GP2 to GP5): each sits at the level
 //               its pad's pull gives it (pull-up: high, else low) until the script drives it,
+//   stream:     optional, a stream of console lines for UART0 or USB, made as they go out (stream.mjs),
 //   script:     optional, boot 0's script, its times counted from the first frame (when
 //               `anchor_slice`, a PWM slice, is enabled): {anchor_slice, pins: [{at_ns, pin,
 //               high}], lines: [{at_ns, hex}], byte_ns}: a pin driven high or low at at_ns; a
@@ -84,6 +85,7 @@ import { scripted } from './script.mjs';
 import { uartAsOnTheChip } from './uart.mjs';
 import { usbLink } from './usb.mjs';
 import { dmxLine } from './dmx.mjs';
+import { lineStream } from './stream.mjs';
 
 const cfg = JSON.parse(process.argv[2] ?? '{}');
 const FLASH_START = 0x10000000;
@@ -126,8 +128,9 @@ const active = () => {
 // (usb.mjs), what the outside scripts (script.mjs), DMX512 on UART1's RX
 // line (dmx.mjs).
 const unmodelled = unmodelledCounter();
-const usb = usbLink(cfg, { emit, now, active });
-const outside = scripted(cfg, { emit, now, active, chip: () => mcu, boot: () => boot, bootNs: () => bootNs });
+const stream = lineStream(cfg);
+const usb = usbLink(cfg, { emit, now, active }, stream);
+const outside = scripted(cfg, { emit, now, active, chip: () => mcu, boot: () => boot, bootNs: () => bootNs }, stream);
 const dmx = cfg.dmx ? dmxLine(cfg.dmx, emit) : null;
 
 // The flash at power-on: the image, and `flash_fill` over it.
@@ -183,7 +186,7 @@ function powerUp(kept) {
   if (dmx) dmx.attach(chip.uart[1], () => now());
   xipControlAsOnTheChip(chip);
   roscRandomBit(chip);
-  if ((cfg.usb || cfg.live) && boot === 0) usb.attach(chip);
+  if ((cfg.usb || cfg.live || stream?.port === 'usb') && boot === 0) usb.attach(chip);
   chip.uart[0].onByte = (byte) => {
     if (uartTx.bytes.length === 0) uartTx.ns = now();
     uartTx.bytes.push(byte);
@@ -393,7 +396,7 @@ function run() {
       }
       step();
       if ((i & 63) === 0 && cfg.rtt) drainRtt();
-      if ((i & 15) === 0 && (cfg.uart || cfg.script)) outside.feedUart();
+      if ((i & 15) === 0 && (cfg.uart || cfg.script || stream)) outside.feedUart();
       if ((i & 15) === 0 && outside.pinsQueued()) outside.feedPins();
       if ((i & 15) === 0) mcu.uart[0].sendDue();
       if ((i & 255) === 0 && usb.send) usb.feed();

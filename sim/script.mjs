@@ -9,8 +9,14 @@
 
 import { GPIOPinState } from 'rp2040js';
 
-export function scripted(cfg, h) {
+export function scripted(cfg, h, stream) {
   const { emit, now, active } = h;
+  // A line stream for UART0 (stream.mjs), in boot 0.
+  const lines = stream?.port === 'uart' ? stream : null;
+  const fromStream = (boot) => {
+    const line = boot === 0 ? lines?.next() : null;
+    return line ? { boot, bytes: line.bytes, at_ns: line.at_ns, byte_ns: lines.byteNs, streamed: true } : null;
+  };
 
   // The inputs the outside drives (GPIO2..5): at their pads' pull until the
   // script drives them. rp2040js has no model of the pulls for an input:
@@ -57,7 +63,7 @@ export function scripted(cfg, h) {
   let scriptAt = 0;
   function startBoot(boot) {
     bootScripts = scripts.filter((s) => s.boot === boot);
-    script = bootScripts.shift() ?? null;
+    script = bootScripts.shift() ?? fromStream(boot);
     scriptAt = 0;
   }
   function uartDue() {
@@ -73,8 +79,9 @@ export function scripted(cfg, h) {
     scriptAt += 1;
     active();
     if (scriptAt === script.bytes.length) {
-      emit({ ev: 'uart_rx', ns: now(), n: scriptAt });
-      script = bootScripts.shift() ?? null;
+      // (A streamed line is one of thousands: no event of its own.)
+      if (!script.streamed) emit({ ev: 'uart_rx', ns: now(), n: scriptAt });
+      script = bootScripts.shift() ?? fromStream(h.boot());
       scriptAt = 0;
     }
   }

@@ -24,8 +24,17 @@ const USB_BUF_CTRL_AVAILABLE = 1 << 10;
 
 // The host side of the port for the harness's `cfg`: `emit` reports, `now`
 // is the virtual time, `active` notes activity (the run is not silent).
-export function usbLink(cfg, { emit, now, active }) {
+export function usbLink(cfg, { emit, now, active }, stream) {
   const chunks = cfg.usb ? [].concat(cfg.usb).sort((a, b) => a.at_ns - b.at_ns) : [];
+  // A line stream for the port (stream.mjs): its next line joins the chunks
+  // when they run out, unannounced (it is one of thousands).
+  const lines = stream?.port === 'usb' ? stream : null;
+  const refill = () => {
+    if (chunks.length || !lines) return;
+    const line = lines.next();
+    if (line) chunks.push({ bytes: line.bytes, at_ns: line.at_ns, streamed: true });
+  };
+  refill();
   const link = {
     send: null, // sends a chunk of the USB script, once the device is configured
     live: null, // sends bytes from stdin (a live run), once the device is configured
@@ -82,9 +91,11 @@ export function usbLink(cfg, { emit, now, active }) {
         if (cfg.live) link.live = sendBytes;
         else
           link.send = (chunk) => {
-            const bytes = Buffer.from(chunk.hex, 'hex');
+            const bytes = chunk.bytes ?? Buffer.from(chunk.hex, 'hex');
             sendBytes(bytes);
-            if (chunks.length > 1 || Array.isArray(cfg.usb)) emit({ ev: 'usb_in', ns: now(), n: bytes.length });
+            if (!chunk.streamed && (chunks.length > 1 || Array.isArray(cfg.usb))) {
+              emit({ ev: 'usb_in', ns: now(), n: bytes.length });
+            }
           };
       };
       cdc.onSerialData = (bytes) => {
@@ -96,7 +107,10 @@ export function usbLink(cfg, { emit, now, active }) {
     due: () => (link.send && chunks.length ? chunks[0].at_ns : Infinity),
     // Sends the chunks due.
     feed() {
-      while (link.send && chunks.length && now() >= chunks[0].at_ns) link.send(chunks.shift());
+      while (link.send && chunks.length && now() >= chunks[0].at_ns) {
+        link.send(chunks.shift());
+        refill();
+      }
       if (!chunks.length) link.send = null;
     },
   };

@@ -28,6 +28,7 @@ mod script;
 mod show;
 mod stages;
 mod store;
+mod stream;
 mod unmodelled;
 
 use std::{fmt::Write as _, path::PathBuf, time::Duration};
@@ -39,6 +40,7 @@ pub use inputs::{INPUTS_STAGE, test_inputs};
 pub use node::ensure as ensure_node;
 pub use node::folder as node_folder;
 pub use script::{default_time as script_time, parse as parse_script};
+pub use stream::{LENGTH as STREAM_LENGTH, UART_STREAM_STAGE, USB_STREAM_STAGE, test_stream};
 
 /// Plays a script's `events` into the shipped image (built) for `time` from
 /// its first frame; every pulse checked against what the firmware wrote:
@@ -141,6 +143,11 @@ pub struct Args {
     /// then one more line: every line answered once, in order, none lost.
     #[arg(long)]
     pub flood: bool,
+    /// A stream instead: a line every 2 ms on UART0 (`uart`) or the USB
+    /// serial port (`usb`) for `--seconds` (default 600), every line
+    /// answered once, in order, none lost, no frame late.
+    #[arg(long, value_name = "PORT", value_parser = ["uart", "usb"], conflicts_with_all = ["flood", "noise", "store", "console", "drill"])]
+    pub stream: Option<String>,
     /// List every access to a register the emulator does not model, also
     /// the known gaps that do not matter (summed up in one line without).
     #[arg(long, short)]
@@ -228,6 +235,14 @@ pub fn command(args: &Args) -> Result<bool> {
     }
     if args.flood {
         return Ok(passed("UART flood", flood::test_flood(&root, &metadata)));
+    }
+    if let Some(port) = &args.stream {
+        let port = if port == "usb" { "usb" } else { "uart" };
+        let length = args.virtual_time.unwrap_or(stream::LENGTH);
+        return Ok(passed(
+            "stream",
+            stream::test_stream(&root, &metadata, port, length),
+        ));
     }
     if args.noise {
         return Ok(passed("UART noise", noise::test_noise(&root, &metadata)));

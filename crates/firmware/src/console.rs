@@ -178,6 +178,7 @@ pub async fn serve<P: Port, H: Handler>(
             Instant::MAX
         };
         let given_up = outbox.due().map_or(Instant::MAX, Instant::from_ticks);
+        let wake = tick.min(timeout).min(given_up);
         // Bytes left over wait for room; else read more.
         let reading = at >= read;
         let woke = select3(
@@ -189,7 +190,14 @@ pub async fn serve<P: Port, H: Handler>(
                 }
             },
             place.link.answered(place.port),
-            Timer::at(tick.min(timeout).min(given_up)),
+            async {
+                // (No timer at all when nothing is due: arming one costs.)
+                if wake == Instant::MAX {
+                    core::future::pending().await
+                } else {
+                    Timer::at(wake).await;
+                }
+            },
         )
         .await;
         match woke {

@@ -153,6 +153,34 @@ pub struct Config {
     pub inputs: Vec<u8>,
     /// Boot 0's script of pin levels and console lines, if any.
     pub script: Option<PinScript>,
+    /// A stream of console lines made as they go out (`sim/stream.mjs`).
+    pub stream: Option<LineStream>,
+}
+
+/// A stream of console lines on UART0 or USB (`sim/stream.mjs`): `count`
+/// lines, one every `every` from `start` on, cycling through `lines`.
+#[derive(Debug, Clone)]
+pub struct LineStream {
+    /// The port: `"uart"` or `"usb"`.
+    pub port: &'static str,
+    /// When the first line goes out (boot 0).
+    pub start: Duration,
+    /// The time from one line to the next.
+    pub every: Duration,
+    /// How many lines.
+    pub count: usize,
+    /// The lines, in turn: plain, or a machine-mode command (`#<n> … *<crc>`
+    /// with n the line's index mod 100000).
+    pub lines: Vec<StreamLine>,
+}
+
+/// One line of a [`LineStream`]'s cycle.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum StreamLine {
+    /// As it is.
+    Plain(&'static str),
+    /// This command in machine mode.
+    Machine(&'static str),
 }
 
 /// Boot 0's script, its times counted from the first frame (when the
@@ -264,6 +292,17 @@ impl Config {
                 })).collect::<Vec<_>>(),
                 "byte_ns": nanos(super::exchange::BYTE_TIME),
                 "early_ns": nanos(script.early),
+            })),
+            "stream": self.stream.as_ref().map(|stream| json!({
+                "port": stream.port,
+                "start_ns": nanos(stream.start),
+                "every_ns": nanos(stream.every),
+                "count": stream.count,
+                "byte_ns": nanos(super::exchange::BYTE_TIME),
+                "lines": stream.lines.iter().map(|line| match line {
+                    StreamLine::Plain(text) => json!({ "text": text }),
+                    StreamLine::Machine(command) => json!({ "machine": command }),
+                }).collect::<Vec<_>>(),
             })),
         })
     }

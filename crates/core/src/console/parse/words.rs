@@ -116,6 +116,58 @@ keywords! {
     Duck "duck",
 }
 
+/// [`KEYWORDS`]' indices with the words in byte order (they are lower case
+/// and each once: checked here), for [`Token::lower`]'s bisection.
+const SORTED: [u8; KEYWORDS.len()] = {
+    assert!(KEYWORDS.len() <= u8::MAX as usize);
+    let mut order = [0_u8; KEYWORDS.len()];
+    let mut i = 0;
+    while i < order.len() {
+        order[i] = i as u8;
+        let word = KEYWORDS[i].as_bytes();
+        let mut b = 0;
+        while b < word.len() {
+            assert!(!word[b].is_ascii_uppercase(), "a keyword is lower case");
+            b += 1;
+        }
+        i += 1;
+    }
+    // Insertion sort, at compile time.
+    let mut i = 1;
+    while i < order.len() {
+        let mut j = i;
+        while j > 0 && before(KEYWORDS[order[j] as usize], KEYWORDS[order[j - 1] as usize]) {
+            let t = order[j];
+            order[j] = order[j - 1];
+            order[j - 1] = t;
+            j -= 1;
+        }
+        i += 1;
+    }
+    let mut i = 1;
+    while i < order.len() {
+        assert!(
+            before(KEYWORDS[order[i - 1] as usize], KEYWORDS[order[i] as usize]),
+            "a keyword is listed twice"
+        );
+        i += 1;
+    }
+    order
+};
+
+/// Whether `a` comes before `b` in byte order.
+const fn before(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    let mut i = 0;
+    while i < a.len() && i < b.len() {
+        if a[i] != b[i] {
+            return a[i] < b[i];
+        }
+        i += 1;
+    }
+    a.len() < b.len()
+}
+
 // A gesture's word must not be a word the protocol already has: the
 // gesture would shadow it (or it the gesture). Checked when the crate
 // compiles.
@@ -149,13 +201,25 @@ impl<'a> Token<'a> {
         }
     }
 
-    /// The keyword this word is, ignoring ASCII case.
+    /// The keyword this word is, ignoring ASCII case (by bisection of the
+    /// keywords in byte order: a handful of comparisons, not one a keyword).
     pub(super) fn lower(&self) -> Word {
-        KEYWORDS
-            .iter()
-            .zip(ALL)
-            .find(|(k, _)| k.as_bytes().eq_ignore_ascii_case(self.text))
-            .map_or(Word::Other, |(_, kw)| Word::Is(kw))
+        let lowered = || self.text.iter().map(u8::to_ascii_lowercase);
+        let (mut low, mut high) = (0, SORTED.len());
+        while low < high {
+            let mid = low + (high - low) / 2;
+            let Some(&i) = SORTED.get(mid) else { break };
+            let (Some(word), Some(&kw)) = (KEYWORDS.get(usize::from(i)), ALL.get(usize::from(i)))
+            else {
+                break;
+            };
+            match word.bytes().cmp(lowered()) {
+                core::cmp::Ordering::Less => low = mid + 1,
+                core::cmp::Ordering::Greater => high = mid,
+                core::cmp::Ordering::Equal => return Word::Is(kw),
+            }
+        }
+        Word::Other
     }
 
     /// The gesture this word names, ignoring ASCII case.
