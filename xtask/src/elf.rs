@@ -3,7 +3,7 @@
 
 use std::{fmt::Write as _, ops::Range, path::Path};
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 
 use crate::{board::Board, figures};
 use object::read::elf::{ElfFile32, ProgramHeader};
@@ -115,11 +115,21 @@ impl Image {
         let settings = symbol("__settings_start")
             .zip(symbol("__settings_end"))
             .map(|(start, end)| start..end);
-        // 0 for an ELF that is not a 32-bit one (the host's binaries).
-        let flash_end = match ElfFile32::<Endianness>::parse(data) {
-            Ok(file) => stored_end(&segments(&file).map_err(|error| anyhow!(error))?),
-            Err(_) => 0,
-        };
+        // The highest load address (`p_paddr + p_filesz`) of a segment stored
+        // in the XIP window; 0 for an ELF that is not a 32-bit one.
+        let flash_end = ElfFile32::<Endianness>::parse(data).map_or(0, |file| {
+            let e = file.endian();
+            file.elf_program_headers()
+                .iter()
+                .filter(|h| h.p_type(e) == elf::PT_LOAD && h.p_filesz(e) > 0)
+                .map(|h| {
+                    u64::from(h.p_paddr(e))..u64::from(h.p_paddr(e)) + u64::from(h.p_filesz(e))
+                })
+                .filter(|range| XIP.contains(&range.start))
+                .map(|range| range.end)
+                .max()
+                .unwrap_or(0)
+        });
         Ok(Self {
             sections,
             allocator_symbols,
@@ -331,67 +341,6 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
         bail!("RAM use {total} B (static + peak stack) is over the {RAM_BUDGET} B budget");
     }
     Ok(())
-}
-
-/// The contents of one loadable segment, at its load address.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Segment {
-    /// Load (physical) address of the first byte: where it is stored.
-    pub address: u32,
-    /// The bytes stored in the file (`p_filesz` of them).
-    pub data: Vec<u8>,
-}
-
-impl Segment {
-    /// Load addresses of the contents.
-    pub fn range(&self) -> Range<u32> {
-        // The length fits: `segments` took it from a 32-bit field and
-        // checked that the end does not wrap.
-        let length = u32::try_from(self.data.len()).unwrap_or(u32::MAX);
-        self.address..self.address.saturating_add(length)
-    }
-}
-
-/// The loadable segments with contents (`PT_LOAD`, `p_filesz > 0`) of
-/// `file`, in address order: what is stored in the board's memory, each at
-/// its load address (`p_paddr`), so that `.data`'s initial values count
-/// where they are stored, not where they run.
-///
-/// # Errors
-/// A segment lies past the end of the file or wraps the address space.
-pub fn segments(file: &ElfFile32<Endianness>) -> Result<Vec<Segment>, &'static str> {
-    let endian = file.endian();
-    let mut segments = Vec::new();
-    for header in file.elf_program_headers() {
-        if header.p_type(endian) != elf::PT_LOAD || header.p_filesz(endian) == 0 {
-            continue;
-        }
-        let data = header
-            .data(endian, file.data())
-            .map_err(|()| "a segment lies past the end of the file")?;
-        let address = header.p_paddr(endian);
-        if address.checked_add(header.p_filesz(endian)).is_none() {
-            return Err("a segment wraps the address space");
-        }
-        segments.push(Segment {
-            address,
-            data: data.to_vec(),
-        });
-    }
-    segments.sort_by_key(|segment| segment.address);
-    Ok(segments)
-}
-
-/// The end of the bytes stored in the XIP flash window: the highest end of
-/// a segment that starts there; 0 if none does.
-fn stored_end(segments: &[Segment]) -> u64 {
-    segments
-        .iter()
-        .map(Segment::range)
-        .filter(|range| XIP.contains(&u64::from(range.start)))
-        .map(|range| u64::from(range.end))
-        .max()
-        .unwrap_or(0)
 }
 
 /// Fails unless the image names the settings region of memory.x, it is

@@ -47,7 +47,6 @@ mod project;
 mod qemu;
 mod reference;
 mod render;
-mod rp2350;
 mod setup;
 mod sim;
 mod snapshot;

@@ -14,7 +14,7 @@ use crate::{
     panel, pico2,
     project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
     qemu::{self, Echo},
-    setup, sim, snapshot, uf2,
+    setup, sim, snapshot,
 };
 
 /// How a stage ended.
@@ -141,13 +141,11 @@ pub fn command(options: Options) -> Result<bool> {
             "Pico image: .boot2 placement, memory budgets, no allocator",
             || elf::check_pico(&PICO.elf(&metadata)),
         );
-        stages.run(uf2::PICO_STAGE, || uf2::test_pico(&metadata));
     } else {
         stages.blocked(
             "Pico image: .boot2 placement, memory budgets, no allocator",
             "the Pico build",
         );
-        stages.blocked(uf2::PICO_STAGE, "the Pico build");
     }
     // The Pico 2 on its own: its embassy-rp chip feature excludes the Pico's.
     stages.run(pico2::STAGE, || pico2::test(&metadata));

@@ -41,7 +41,7 @@ pub enum LiveEvent {
 /// slices' compare writes reported (`cc` events of slices 0, 1, 2: pitch,
 /// roll, yaw), the trigger inputs GP2..GP5 driven by `pin <n> 0|1` lines.
 pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
-    let (_, config) = harness::config(elf, "live.bin")?;
+    let (_, config) = harness::config(elf, "live.uf2")?;
     node::ensure(root)?;
     let config = node::Config {
         wall: Duration::from_secs(24 * 3600),

@@ -189,7 +189,7 @@ pub fn run_with(
     wall: Duration,
     setup: impl FnOnce(&mut node::Config),
 ) -> Result<Report> {
-    let (image, config) = harness::config(elf, "flash.bin")?;
+    let (image, config) = harness::config(elf, "flash.uf2")?;
     let bytes = std::fs::read(elf)?;
     let table = Table::parse(&bytes)
         .with_context(|| format!("reading the defmt table of {}", elf.display()))?
@@ -207,8 +207,8 @@ pub fn run_with(
     };
     setup(&mut config);
     println!(
-        "$ (cd sim && node harness.mjs ...)  # {} of flash, {:.1} s of virtual time",
-        image.flash.len(),
+        "$ (cd sim && node harness.mjs ...)  # {}, {:.1} s of virtual time",
+        crate::project::relative(&config.flash).display(),
         virtual_time.as_secs_f64()
     );
     let events = node::run(root, &config)?;
