@@ -17,9 +17,7 @@ use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 
-use anyhow::{Context, Result, bail};
-use serde_json::Value;
-use xshell::cmd;
+use anyhow::{Context, Result};
 
 use crate::{project, setup};
 
@@ -174,39 +172,14 @@ fn export(root: &Path, dir: &Path) -> Result<()> {
 }
 
 /// Makes sure the page's pinned npm packages are installed in
-/// `panel/node_modules` (`npm ci`, with Playwright's browser download
-/// off: the tests use the system's Chromium).
+/// `panel/node_modules` (Playwright's browser download off: the tests use
+/// the system's Chromium).
 pub fn ensure_dependencies(root: &Path) -> Result<()> {
-    crate::sim::ensure_node(root)?;
-    let panel = root.join("panel");
-    let read = |path: PathBuf| -> Option<Value> {
-        serde_json::from_slice(&std::fs::read(path).ok()?).ok()
-    };
-    let lock = read(panel.join("package-lock.json"))
-        .context("panel/package-lock.json is missing or not JSON")?;
-    let stale = ["uplot", "playwright-core"].iter().any(|name| {
-        let pinned = &lock["packages"][format!("node_modules/{name}")]["version"];
-        let installed = read(panel.join(format!("node_modules/{name}/package.json")))
-            .map_or(Value::Null, |package| package["version"].clone());
-        pinned.is_null() || installed != *pinned
-    });
-    if stale {
-        let sh = project::shell(".")?;
-        sh.change_dir(&panel);
-        project::run(
-            &sh,
-            &[("PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD", "1")],
-            cmd!(sh, "npm ci --no-audit --no-fund"),
-        )
-        .context("installing the panel's dependencies with `npm ci` in panel/")?;
-    }
-    if !panel
-        .join("node_modules/uplot/dist/uPlot.iife.min.js")
-        .exists()
-    {
-        bail!("panel/node_modules has no uPlot after `npm ci`");
-    }
-    Ok(())
+    crate::sim::node::npm_ci(
+        &root.join("panel"),
+        &["uplot", "playwright-core"],
+        &[("PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD", "1")],
+    )
 }
 
 #[cfg(test)]

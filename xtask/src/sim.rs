@@ -18,7 +18,7 @@ mod harness;
 mod image;
 mod inputs;
 pub mod live;
-pub(crate) mod node;
+pub mod node;
 mod noise;
 mod planted;
 pub mod pulses;
@@ -36,7 +36,6 @@ use anyhow::Result;
 
 pub use flood::{FLOOD_STAGE, test_flood};
 pub use inputs::{INPUTS_STAGE, test_inputs};
-pub use node::ensure as ensure_node;
 pub use node::folder as node_folder;
 pub use script::{default_time as script_time, parse as parse_script};
 

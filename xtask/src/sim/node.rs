@@ -26,24 +26,32 @@ pub fn folder(root: &Path) -> PathBuf {
 /// Makes sure `node` and `npm` run (installing them with apt-get when root on
 /// Debian or Ubuntu) and that the pinned emulator is installed (`npm ci`).
 pub fn ensure(root: &Path) -> Result<()> {
+    npm_ci(&folder(root), &["rp2040js"], &[])
+}
+
+/// Makes sure `node` and `npm` run and that `packages` are installed in
+/// `dir`'s `node_modules` as its `package-lock.json` pins them: else
+/// `npm ci` there (with `env`).
+pub fn npm_ci(dir: &Path, packages: &[&str], env: &[(&str, &str)]) -> Result<()> {
     if version("node").is_none() || version("npm").is_none() {
         install_node()?;
     }
-    let sim = folder(root);
     let read = |path: PathBuf| -> Option<Value> {
         serde_json::from_slice(&std::fs::read(path).ok()?).ok()
     };
-    let pinned = read(sim.join("package-lock.json"))
-        .context("sim/package-lock.json is missing or not JSON")?["packages"]
-        ["node_modules/rp2040js"]["version"]
-        .clone();
-    let installed = read(sim.join("node_modules/rp2040js/package.json"))
-        .map_or(Value::Null, |package| package["version"].clone());
-    if pinned.is_null() || installed != pinned {
+    let lock = read(dir.join("package-lock.json"))
+        .with_context(|| format!("{}/package-lock.json is missing or not JSON", dir.display()))?;
+    let stale = packages.iter().any(|name| {
+        let pinned = &lock["packages"][format!("node_modules/{name}")]["version"];
+        let installed = read(dir.join(format!("node_modules/{name}/package.json")))
+            .map_or(Value::Null, |package| package["version"].clone());
+        pinned.is_null() || installed != *pinned
+    });
+    if stale {
         let sh = project::shell(".")?;
-        sh.change_dir(&sim);
-        project::run(&sh, &[], cmd!(sh, "npm ci --no-audit --no-fund"))
-            .context("installing the emulator (rp2040js) with `npm ci` in sim/")?;
+        sh.change_dir(dir);
+        project::run(&sh, env, cmd!(sh, "npm ci --no-audit --no-fund"))
+            .with_context(|| format!("installing with `npm ci` in {}", dir.display()))?;
     }
     Ok(())
 }
