@@ -31,9 +31,10 @@ pub struct Cli {
 pub enum Command {
     /// Build the QEMU image, run it under emulation and show the head's motion.
     ///
-    /// Prints the decoded defmt log, a plot of the three axes over the run and
-    /// the summary line, which it checks: no missed frame, no pulse outside a
-    /// servo's limits, and the checksum of the loops equal to the host's.
+    /// Prints the decoded defmt log and the summary line, which it checks: no
+    /// missed frame, no pulse outside a servo's limits, and the checksum of
+    /// the loops equal to the host's; draws the three axes over the run into
+    /// target/qemu/motion.png.
     Qemu {
         #[command(flatten)]
         bless: Bless,

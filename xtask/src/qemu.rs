@@ -16,8 +16,9 @@ use crate::{
     args::Options,
     child,
     log::{LogLine, Run},
+    plot::{self, BLUE, Curve, Figure, GREEN, ORANGE, Panel},
     project::{self, QEMU},
-    reference, render,
+    reference,
     setup::{self, QEMU_BINARY},
     snapshot,
 };
@@ -39,11 +40,12 @@ pub fn command(options: Options) -> Result<bool> {
     QEMU.build(&root)?;
     let run = run(&QEMU.elf(&metadata), options.timeout, Echo::All)?;
 
-    if let Some(plot) = render::plot(&run.log) {
-        println!();
-        print!("{plot}");
-    }
     println!();
+    let png = metadata.target_dir.join("qemu").join("motion.png");
+    match plot_motion(&run.log, &png) {
+        Ok(frames) => println!("motion: {frames} logged frames drawn in {}", png.display()),
+        Err(error) => println!("motion: not drawn: {error:#}"),
+    }
     println!("{}", run.describe());
     let mut ok = run.succeeded();
     match check_summary(&run.log) {
@@ -250,6 +252,53 @@ pub fn check_summary(log: &[LogLine]) -> Result<String> {
     }
 }
 
+/// Draws the three axes of the log's frame lines (`frame <n>: pitch=<deg>
+/// roll=<deg> yaw=<deg> deg, ...`: the decoder hands out text, so the log
+/// is the record) to the PNG `path`; returns how many there were.
+fn plot_motion(log: &[LogLine], path: &Path) -> Result<usize> {
+    let mut frames: Vec<(f64, [f64; 3])> =
+        log.iter().filter_map(|l| frame_line(&l.message)).collect();
+    frames.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if frames.len() < 2 {
+        bail!("fewer than two frame lines in the log");
+    }
+    let panel = |i: usize, name: &str, color| Panel {
+        title: format!("{name} (°)"),
+        x_desc: "frame".to_owned(),
+        y_desc: "angle (°)".to_owned(),
+        curves: vec![Curve::new(
+            name,
+            color,
+            frames.iter().map(|f| (f.0, f.1[i])).collect(),
+        )],
+        ..Panel::default()
+    };
+    let figure = Figure {
+        title: format!("The QEMU run's motion: {} logged frames", frames.len()),
+        notes: vec!["angles as the firmware logged them".to_owned()],
+        panels: vec![
+            panel(0, "pitch", BLUE),
+            panel(1, "roll", ORANGE),
+            panel(2, "yaw", GREEN),
+        ],
+        panel_height: 220,
+    };
+    plot::draw(&figure, path)?;
+    Ok(frames.len())
+}
+
+/// The frame number and the three angles of a frame line, if `message` is one.
+fn frame_line(message: &str) -> Option<(f64, [f64; 3])> {
+    let (frame, rest) = message.strip_prefix("frame ")?.split_once(": ")?;
+    let mut words = rest.split_whitespace();
+    let mut angles = [0.0; 3];
+    for (angle, axis) in angles.iter_mut().zip(["pitch", "roll", "yaw"]) {
+        let value = words.next()?.strip_prefix(axis)?.strip_prefix('=')?;
+        *angle = value.parse().ok()?;
+    }
+    Some((frame.parse().ok()?, angles))
+}
+
 /// The QEMU smoke run's boot precompute (`precompute_insns` of its summary
 /// line) and the loop sets its log reports. Only the smoke run's: a run
 /// with console traffic would count that traffic in its sets' times.
@@ -310,6 +359,21 @@ mod tests {
         let mut shown = Vec::new();
         forward(stderr.as_bytes(), &mut shown);
         assert_eq!(shown, b"qemu-system-arm: a real problem\n");
+    }
+
+    #[test]
+    fn reads_frame_lines_only() {
+        let line = "frame 1650: pitch=-2.440 roll=+2.285 yaw=+7.611 deg, pulses 1473 1525 1585 us \
+                    (Written Written Failed(Other))";
+        assert_eq!(frame_line(line), Some((1650.0, [-2.44, 2.285, 7.611])));
+        for other in [
+            "frame 1400: join: the next loop set blends in over 100 frames",
+            "frame 7: pitch=+1.000 roll=+2.000 deg",
+            "frame x: pitch=+1.000 roll=+2.000 yaw=+3.000 deg",
+            "summary frames=1903 missed=0",
+        ] {
+            assert!(frame_line(other).is_none(), "{other}");
+        }
     }
 
     #[test]
