@@ -1,5 +1,5 @@
 //! `cargo xtask panel`: the browser control panel (`panel/`, static files)
-//! served on localhost, bridged over a WebSocket to a head: the shipped
+//! served on localhost, bridged to a head (`server.rs`): the shipped
 //! Pico image in the RP2040 emulator (`--sim`), the QEMU image (`--qemu`)
 //! or a board's serial port (`--port`). Without a bridge the page talks to
 //! a board itself, over Web Serial. `--export DIR` writes a copy of the
@@ -47,7 +47,7 @@ pub struct Args {
     #[arg(long, value_name = "dir")]
     pub export: Option<PathBuf>,
     /// Run the panel's browser tests (the stage of `cargo xtask test`)
-    /// instead: headless Chromium over Web Serial, WebSocket and a serial
+    /// instead: headless Chromium over Web Serial, the bridge and a serial
     /// port.
     #[arg(long, conflicts_with_all = ["sim", "qemu", "port", "export"])]
     pub test: bool,
@@ -90,9 +90,10 @@ pub fn command(args: &Args) -> Result<bool> {
         let _ = ctrlc_tx.send("interrupted".to_owned());
     })
     .context("setting the Ctrl-C handler")?;
+    let name = bridge.as_ref().map(|b| b.name.clone());
     let server = server::Server::start(&root, args.listen, bridge, stop_tx)?;
-    println!("panel: http://{}/", server.address());
-    match server.bridge_name() {
+    println!("panel: http://{}/", server.address);
+    match name {
         Some(name) => eprintln!(
             "panel: bridged to {name}; open the address in a browser (Ctrl-C stops everything)"
         ),

@@ -6,7 +6,7 @@
 //!    `navigator.serial` bridged to the shipped Pico image live in the
 //!    RP2040 emulator (its USB serial port); unplugged, an older firmware,
 //!    a reply that never comes;
-//! 2. the WebSocket bridge of `cargo xtask panel --qemu`;
+//! 2. the bridge of `cargo xtask panel --qemu`;
 //! 3. a real serial port: QEMU's UART0 as a pseudo-terminal (`-serial
 //!    pty`), first through `cargo xtask console --port`, then through the
 //!    bridge of `cargo xtask panel --port`.
@@ -30,7 +30,7 @@ use crate::{setup, sim};
 
 /// The stage's name.
 pub const STAGE: &str =
-    "panel in a real browser: Web Serial (emulated Pico), WebSocket (QEMU), serial port (pty)";
+    "panel in a real browser: Web Serial (emulated Pico), bridge (QEMU), serial port (pty)";
 
 /// Debian's Chromium.
 const CHROMIUM: &str = "/usr/bin/chromium";
@@ -74,7 +74,7 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
         &chromium,
         &serde_json::json!({
             "session": "serial",
-            "url": format!("http://{}/", plain.address()),
+            "url": format!("http://{}/", plain.address),
             "harness": { "cwd": sim::node_folder(root), "arg": harness.to_string() },
             "shots": shots,
             "label": "web-serial",
@@ -82,7 +82,7 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
     )?);
     drop(plain);
 
-    // 2. The WebSocket bridge to QEMU.
+    // 2. The bridge to QEMU.
     let (stop, _) = mpsc::channel();
     let bridged = Server::start(
         root,
@@ -95,7 +95,7 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
         &chromium,
         &serde_json::json!({
             "session": "bridge",
-            "url": format!("http://{}/", bridged.address()),
+            "url": format!("http://{}/", bridged.address),
             "shots": shots,
             "label": "qemu",
         }),
@@ -197,7 +197,7 @@ fn serial_port(root: &Path, chromium: &Path, elf: &Path, shots: &Path) -> Result
         chromium,
         &serde_json::json!({
             "session": "bridge",
-            "url": format!("http://{}/", server.address()),
+            "url": format!("http://{}/", server.address),
             "shots": shots,
             "label": "serial-port",
         }),

@@ -278,7 +278,7 @@ impl Config {
 }
 
 /// `bytes` as lower-case hex digits, as the harness reads them.
-pub(super) fn hex(bytes: &[u8]) -> String {
+pub fn hex(bytes: &[u8]) -> String {
     bytes.iter().fold(String::new(), |mut text, byte| {
         let _ = write!(text, "{byte:02x}");
         text
