@@ -31,7 +31,6 @@ mod args;
 mod bench;
 mod board;
 mod book;
-mod child;
 mod cli;
 mod console;
 mod elf;

@@ -9,12 +9,10 @@ use std::{
 
 use anyhow::{Context, Result, bail};
 use defmt_decoder::{DecodeError, Locations, Table};
-use xshell::{Cmd, Shell, cmd};
 
 use crate::figures;
 use crate::{
     args::Options,
-    child,
     log::{LogLine, Run},
     plot::{self, BLUE, Curve, Figure, GREEN, ORANGE, Panel},
     project::{self, QEMU},
@@ -79,19 +77,29 @@ pub enum Echo {
     Quiet,
 }
 
-/// QEMU's command line for `elf`. `-icount shift=0` makes one instruction one
-/// nanosecond of virtual time, so timing repeats exactly run after run;
-/// `sleep=off` lets the virtual clock jump over the time the core sleeps
-/// instead of following the wall clock, which would make wake-up times (and
-/// so the log) vary from run to run, and the run slower.
-pub fn qemu_command<'a>(sh: &'a Shell, elf: &Path) -> Cmd<'a> {
-    cmd!(
-        sh,
-        "{QEMU_BINARY} -machine lm3s6965evb -cpu cortex-m0 -nographic
-            -semihosting-config enable=on,target=native
-            -icount shift=0,sleep=off
-            -kernel {elf}"
-    )
+/// QEMU running `elf` with the options `args` (display, semihosting,
+/// serial ports). `-icount shift=0` makes one instruction one nanosecond of
+/// virtual time; `sleep=off` lets the virtual clock jump over the time the
+/// core sleeps (timing, and so the log, repeat exactly run after run),
+/// `sleep=on` follows the wall clock while it sleeps (a head at its true
+/// speed, for a person).
+pub fn qemu_command(elf: &Path, sleep: bool, args: &[&str]) -> Command {
+    let mut command = Command::new(QEMU_BINARY);
+    let icount = if sleep {
+        "shift=0,sleep=on"
+    } else {
+        "shift=0,sleep=off"
+    };
+    command.args([
+        "-machine",
+        "lm3s6965evb",
+        "-cpu",
+        "cortex-m0",
+        "-icount",
+        icount,
+    ]);
+    command.args(args).arg("-kernel").arg(elf);
+    command
 }
 
 /// Runs `elf` in QEMU, decoding its defmt output as it arrives; QEMU is
@@ -105,10 +113,16 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
     // Locations need debug info; without them the log still decodes.
     let locations = table.get_locations(&bytes).ok();
 
-    let sh = project::shell(".")?;
-    let qemu = qemu_command(&sh, elf);
-    println!("$ {qemu}");
-    let mut command = Command::from(qemu);
+    let mut command = qemu_command(
+        elf,
+        false,
+        &[
+            "-nographic",
+            "-semihosting-config",
+            "enable=on,target=native",
+        ],
+    );
+    println!("$ {}", project::shown(&command));
     command
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -119,7 +133,7 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
         .with_context(|| format!("could not start {QEMU_BINARY}"))?;
     // The log is decoded while QEMU runs; its end is the end of QEMU's
     // output, which comes when QEMU exits or is killed.
-    let done = child::run(
+    let done = project::finish(
         child,
         QEMU_BINARY,
         timeout,

@@ -14,7 +14,6 @@ use anyhow::{Context, Result};
 use defmt_decoder::Table;
 
 use super::talk::{self, Talk};
-use crate::child;
 use crate::log::Run;
 use crate::qemu::{self, Echo};
 use crate::{project, setup};
@@ -84,7 +83,7 @@ pub fn qemu_session(
         uart1,
     } = spawn_with_sockets(elf, pace, "console", Stdio::piped)?;
     let start = Instant::now();
-    let done = child::run(
+    let done = project::finish(
         child,
         setup::QEMU_BINARY,
         AFTER_HANG_UP,
@@ -166,29 +165,20 @@ pub fn spawn_with_sockets(
 /// `-serial` arguments: a socket, `pty`, `null`).
 pub fn qemu_command(elf: &Path, pace: Pace, serials: [&str; 2]) -> Command {
     let (sleep, run) = match pace {
-        Pace::RealTime => ("on", "interactive"),
-        Pace::Fast => ("off", "console"),
+        Pace::RealTime => (true, "interactive"),
+        Pace::Fast => (false, "console"),
     };
-    let mut command = Command::new(setup::QEMU_BINARY);
-    command
-        .args([
-            "-machine",
-            "lm3s6965evb",
-            "-cpu",
-            "cortex-m0",
-            "-display",
-            "none",
-        ])
-        .args(["-monitor", "none"])
-        .args([
-            "-semihosting-config",
-            &format!("enable=on,target=native,arg=idle-head,arg={run}"),
-        ])
-        .args(["-icount", &format!("shift=0,sleep={sleep}")])
-        .args(["-serial", serials[0], "-serial", serials[1]])
-        .arg("-kernel")
-        .arg(elf);
-    command
+    let semihosting = format!("enable=on,target=native,arg=idle-head,arg={run}");
+    let args = [
+        "-display",
+        "none",
+        "-monitor",
+        "none",
+        "-semihosting-config",
+        &semihosting,
+    ];
+    let serials = ["-serial", serials[0], "-serial", serials[1]];
+    qemu::qemu_command(elf, sleep, &[&args[..], &serials[..]].concat())
 }
 
 /// Connects to a socket QEMU serves, waiting for it to appear.

@@ -35,29 +35,11 @@ pub const STAGE: &str =
 /// Debian's Chromium.
 const CHROMIUM: &str = "/usr/bin/chromium";
 
-/// Makes sure Chromium is installed (with apt-get, as root on Debian or
-/// Ubuntu, as QEMU is).
-pub fn ensure_chromium() -> Result<PathBuf> {
-    let path = PathBuf::from(CHROMIUM);
-    if path.exists() {
-        return Ok(path);
-    }
-    let root = Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|o| o.stdout.trim_ascii() == b"0");
-    if !Path::new("/etc/debian_version").exists() || !root {
-        bail!("Chromium was not found at {CHROMIUM}: install it (`sudo apt-get install chromium`)");
-    }
-    println!("chromium is missing: installing the `chromium` package");
-    setup::apt_install(&["chromium"])?;
-    Ok(path)
-}
-
 /// The stage: every session; a summary line of what it measured.
 pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
     let start = Instant::now();
-    let chromium = ensure_chromium()?;
+    setup::ensure_program(CHROMIUM, &["chromium"], "Chromium")?;
+    let chromium = PathBuf::from(CHROMIUM);
     ensure_dependencies(root)?;
     setup::ensure_qemu()?;
     PICO.build(root)?;

@@ -12,11 +12,8 @@ use anyhow::{Context, Result, bail};
 use serde_json::{Value, json};
 
 use super::event::Event;
-use crate::{child, log::Exit, project, setup};
+use crate::{log::Exit, project, setup};
 use xshell::cmd;
-
-/// The Debian/Ubuntu packages that bring `node` and `npm`.
-const PACKAGES: [&str; 2] = ["nodejs", "npm"];
 
 /// The folder with the harness and its `package.json`.
 pub fn folder(root: &Path) -> PathBuf {
@@ -33,8 +30,9 @@ pub fn ensure(root: &Path) -> Result<()> {
 /// `dir`'s `node_modules` as its `package-lock.json` pins them: else
 /// `npm ci` there (with `env`).
 pub fn npm_ci(dir: &Path, packages: &[&str], env: &[(&str, &str)]) -> Result<()> {
-    if version("node").is_none() || version("npm").is_none() {
-        install_node()?;
+    let what = "Node.js (20 or newer) and npm (packages `nodejs npm` on Debian and Ubuntu)";
+    for program in ["node", "npm"] {
+        setup::ensure_program(program, &["nodejs", "npm"], what)?;
     }
     let read = |path: PathBuf| -> Option<Value> {
         serde_json::from_slice(&std::fs::read(path).ok()?).ok()
@@ -54,62 +52,6 @@ pub fn npm_ci(dir: &Path, packages: &[&str], env: &[(&str, &str)]) -> Result<()>
             .with_context(|| format!("installing with `npm ci` in {}", dir.display()))?;
     }
     Ok(())
-}
-
-/// First line of `<program> --version`, if it runs.
-pub fn version(program: &str) -> Option<String> {
-    let output = Command::new(program)
-        .arg("--version")
-        .stdin(Stdio::null())
-        .output()
-        .ok()?;
-    output.status.success().then(|| {
-        String::from_utf8_lossy(&output.stdout)
-            .lines()
-            .next()
-            .unwrap_or_default()
-            .trim()
-            .to_owned()
-    })
-}
-
-/// Why Node.js cannot be installed here, if it cannot: no apt-get, or not root.
-fn cannot_install(apt: bool, root: bool) -> Option<String> {
-    let packages = PACKAGES.join(" ");
-    if !apt {
-        Some(format!(
-            "Node.js was not found: install `node` (18 or newer) and `npm` \
-             (packages `{packages}` on Debian/Ubuntu) and run the command again"
-        ))
-    } else if !root {
-        Some(format!(
-            "Node.js was not found: install it with `sudo apt-get install {packages}` \
-             and run the command again"
-        ))
-    } else {
-        None
-    }
-}
-
-fn install_node() -> Result<()> {
-    let packages = PACKAGES.join(" ");
-    let apt = Path::new("/etc/debian_version").exists() && version("apt-get").is_some();
-    if let Some(message) = cannot_install(apt, is_root()) {
-        bail!("{message}");
-    }
-    println!("node/npm are missing: installing the packages {packages}");
-    setup::apt_install(&PACKAGES)?;
-    if version("node").is_none() || version("npm").is_none() {
-        bail!("`node` or `npm` still does not run after installing {packages}");
-    }
-    Ok(())
-}
-
-fn is_root() -> bool {
-    Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|output| output.status.success() && output.stdout.trim_ascii() == b"0")
 }
 
 /// What the harness is asked to run (by default: nothing scripted, no
@@ -306,7 +248,7 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
         .context("could not start `node` (is Node.js installed?)")?;
     // The harness stops itself at `wall`; the grace covers node's start-up.
     let limit = config.wall + GRACE;
-    let done = child::run(child, "node", limit, events, read_all, || ())?;
+    let done = project::finish(child, "node", limit, events, read_all, || ())?;
     let status = match done.exit {
         Exit::Status(status) => status,
         Exit::TimedOut(_) => bail!(
@@ -350,19 +292,4 @@ fn read_all(mut stderr: impl Read) -> String {
     let mut bytes = Vec::new();
     let _ = stderr.read_to_end(&mut bytes);
     String::from_utf8_lossy(&bytes).into_owned()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_missing_node_names_the_packages_to_install() {
-        assert!(version("idle-head-no-such-program").is_none());
-        for (apt, root) in [(false, false), (false, true), (true, false)] {
-            let message = cannot_install(apt, root).unwrap();
-            assert!(message.contains("nodejs npm"), "{message}");
-        }
-        assert!(cannot_install(true, true).is_none());
-    }
 }
