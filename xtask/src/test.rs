@@ -17,90 +17,48 @@ use crate::{
     setup, sim, snapshot,
 };
 
-/// How a stage ended.
-enum Outcome {
-    Passed,
-    Failed(String),
-    Skipped(String),
-}
-
-/// Runs stages one after another and keeps score.
+/// Runs stages one after another and keeps score: each stage's name, its
+/// error if it failed, and its seconds.
 struct Stages {
-    results: Vec<(String, Outcome, f64)>,
+    results: Vec<(String, Option<String>, f64)>,
 }
 
 impl Stages {
-    fn new() -> Self {
-        Self {
-            results: Vec::new(),
-        }
-    }
-
     /// Runs one stage; `Ok(())` passes, an error fails it.
     fn run(&mut self, name: &str, stage: impl FnOnce() -> Result<()>) -> bool {
-        self.run_or_skip(name, || stage().map(|()| None))
-    }
-
-    /// Runs one stage that may decide to skip itself (`Ok(Some(reason))`).
-    fn run_or_skip(&mut self, name: &str, stage: impl FnOnce() -> Result<Option<String>>) -> bool {
-        println!();
-        println!("==> {name}");
+        println!("\n==> {name}");
         let start = Instant::now();
-        let outcome = match stage() {
-            Ok(None) => Outcome::Passed,
-            Ok(Some(reason)) => Outcome::Skipped(reason),
-            Err(error) => Outcome::Failed(format!("{error:#}")),
-        };
+        let failed = stage().err().map(|error| format!("{error:#}"));
         let seconds = start.elapsed().as_secs_f64();
-        let passed = !matches!(outcome, Outcome::Failed(_));
-        match &outcome {
-            Outcome::Passed => println!("--- ok: {name} ({seconds:.1} s)"),
-            Outcome::Skipped(reason) => println!("--- skipped: {name}: {reason}"),
-            Outcome::Failed(error) => println!("--- FAILED: {name}: {error}"),
+        match &failed {
+            None => println!("--- ok: {name} ({seconds:.1} s)"),
+            Some(error) => println!("--- FAILED: {name}: {error}"),
         }
-        self.results.push((name.to_owned(), outcome, seconds));
-        passed
+        self.results
+            .push((name.to_owned(), failed.clone(), seconds));
+        failed.is_none()
     }
 
     /// Records a stage that could not run because an earlier one failed.
     fn blocked(&mut self, name: &str, by: &str) {
-        println!();
-        println!("==> {name}");
-        println!("--- FAILED: {name}: not run, {by} failed");
-        self.results.push((
-            name.to_owned(),
-            Outcome::Failed(format!("not run, {by} failed")),
-            0.0,
-        ));
+        self.run(name, || bail!("not run, {by} failed"));
     }
 
     /// Prints the score card and the closing `N passed, M failed` line.
     fn finish(&self, start: Instant) -> bool {
-        let count = |f: fn(&Outcome) -> bool| self.results.iter().filter(|(_, o, _)| f(o)).count();
-        let passed = count(|o| matches!(o, Outcome::Passed));
-        let failed = count(|o| matches!(o, Outcome::Failed(_)));
-        let skipped = count(|o| matches!(o, Outcome::Skipped(_)));
-        println!();
-        println!("stages:");
-        for (name, outcome, seconds) in &self.results {
-            let verdict = match outcome {
-                Outcome::Passed => "ok",
-                Outcome::Failed(_) => "FAILED",
-                Outcome::Skipped(_) => "skipped",
-            };
+        let failed = self.results.iter().filter(|(_, f, _)| f.is_some()).count();
+        println!("\nstages:");
+        for (name, failure, seconds) in &self.results {
+            let verdict = if failure.is_some() { "FAILED" } else { "ok" };
             println!("  {verdict:<8} {seconds:>6.1} s  {name}");
         }
-        for (name, outcome, _) in &self.results {
-            if let Outcome::Failed(error) = outcome {
+        for (name, failure, _) in &self.results {
+            if let Some(error) = failure {
                 println!("failed: {name}: {error}");
             }
         }
         println!("total time {:.0} s", start.elapsed().as_secs_f64().round());
-        if skipped > 0 {
-            println!("{passed} passed, {failed} failed, {skipped} skipped");
-        } else {
-            println!("{passed} passed, {failed} failed");
-        }
+        println!("{} passed, {failed} failed", self.results.len() - failed);
         failed == 0
     }
 }
@@ -115,7 +73,9 @@ pub fn command(options: Options) -> Result<bool> {
     let host_tests = project::shell("host-tests")?;
     let core = project::shell("crates/core")?;
     let xtask = project::shell("xtask")?;
-    let mut stages = Stages::new();
+    let mut stages = Stages {
+        results: Vec::new(),
+    };
 
     // 1. Host tests of the core, and its doc tests once they are switched on.
     stages.run("host tests (host-tests/)", || {
