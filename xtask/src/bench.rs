@@ -1,27 +1,9 @@
-//! `cargo xtask bench`: the boot-precompute benchmark, run in QEMU.
-//!
-//! The benchmark image (bin `bench`) generates the three axes of the default
-//! set for several N and W, and times a direct-form f32 implementation of the
-//! paper's smoothing next to it, on the same emulated Cortex-M0. Under
-//! `-icount shift=0` one instruction is one nanosecond of virtual time, so the
-//! counts it logs are instruction counts, identical run after run:
-//!
-//! ```text
-//! bench row=<label> n=<N> w=<W> engine=<insns> direct=<insns> (<checksum>)
-//! ```
-//!
-//! Then it counts the instructions of every frame update of a whole loop,
-//! exactly (see `qemu/src/frame_bench.rs` for how):
-//!
-//! ```text
-//! frame bench frames=<n> min=<insns> median=<insns> max=<insns> max_at=<frame> mean=<insns>
-//! frame bench scenario=gesture+look frames=<n> min=<insns> ...
-//! ```
-//!
-//! This module decodes that log, prints the table and the `frame` rows,
-//! reports the `default` row against its [`BUDGET`] and each frame row (idle,
-//! and with a gesture and a look) against its own ceiling
-//! ([`frame::CEILINGS`]), and fails past any of them, naming the row.
+//! `cargo xtask bench`: the benchmark image in QEMU, where one instruction
+//! is one nanosecond of virtual time. It logs `bench row=<label> n=<N>
+//! w=<W> engine=<insns> direct=<insns>` (the boot precompute against a
+//! direct-form f32 smoothing) and `frame bench [scenario=…] frames=… min=…
+//! median=… max=… max_at=… mean=…`; this module prints them and holds the
+//! default row to its [`BUDGET`] and each frame row to its ceiling.
 
 // Instruction counts are far below 2^52 and positive: the float conversions are exact.
 #![allow(

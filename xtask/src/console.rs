@@ -1,14 +1,8 @@
 //! `cargo xtask console`: talk to a head, stdin to it and its replies to
-//! stdout, one per line. `--qemu` runs the firmware in QEMU with its UART0
-//! on a socket; `--port` opens a serial port; with neither, the Pico is
-//! found by its USB VID:PID. Also the flood and console stages of `cargo
-//! xtask test`.
-//!
-//! The bytes go through as they are, both ways: no line is decoded as text
-//! on the way, so a line that is not UTF-8 reaches the head, which answers
-//! it with an error (only the replies' CR LF becomes the host's LF). The
-//! replies due are counted where the head's framer ends lines (CR, LF or
-//! CR LF); whatever ends a session early is said on stderr.
+//! stdout, one per line, the bytes unchanged both ways. `--qemu` runs the
+//! firmware in QEMU, `--port` opens a serial port, neither finds the Pico
+//! by its USB VID:PID. Also the flood and console stages of `cargo xtask
+//! test`.
 
 pub mod qemu;
 mod stages;

@@ -1,23 +1,7 @@
-//! Measured figures: what the commands measure, kept in
-//! `target/figures.json`, and the book's page made from them.
-//!
-//! The figures in the docs (memory, frame cost, loop quality) are never
-//! typed by hand. The functions that measure them record them here as they
-//! go, one section each, over whatever the file held:
-//!
-//! | section | recorded by | run by |
-//! |---|---|---|
-//! | `images` | [`elf::check_pico`](crate::elf::check_pico) → [`elf::record_image`](crate::elf::record_image) | `cargo xtask test` |
-//! | `ram` | [`elf::check_ram`](crate::elf::check_ram) → [`elf::record_ram`](crate::elf::record_ram) | `cargo xtask test` |
-//! | `qemu` | [`qemu::check_summary`](crate::qemu::check_summary) → [`qemu::record_figures`](crate::qemu::record_figures) | `cargo xtask qemu`, `cargo xtask test` |
-//! | `bench` | [`bench::run_and_check`](crate::bench::run_and_check) → its `record_figures` | `cargo xtask bench`, `cargo xtask test` |
-//! | `latency` | [`bench::command`](crate::bench::command) → its `record_latency` | `cargo xtask bench` |
-//! | `metrics` | [`metrics::command`](crate::metrics::command) → its `record_figures` | `cargo xtask metrics` |
-//!
-//! `cargo xtask book` then writes `docs/design/figures.md` (ignored by git)
-//! with [`write_page`] before it builds the book. Each section says which
-//! command recorded it, on which commit; a section never recorded says how
-//! to get it.
+//! Measured figures: what the commands measure (`elf`, `qemu`, `bench`,
+//! `metrics` record their sections as they go), kept in
+//! `target/figures.json`; `cargo xtask book` writes the book's page from
+//! them ([`write_page`]). No figure in the docs is typed by hand.
 
 mod page;
 

@@ -1,13 +1,7 @@
-//! `cargo xtask panel`: the browser control panel (`panel/`, static files)
-//! served on localhost, bridged to a head (`server.rs`): the shipped
-//! Pico image in the RP2040 emulator (`--sim`), the QEMU image (`--qemu`)
-//! or a board's serial port (`--port`). Without a bridge the page talks to
-//! a board itself, over Web Serial. `--export DIR` writes a copy of the
-//! page, its dependencies included, for any static host.
-//!
-//! The page's dependencies (uPlot) come from the npm registry, pinned by
-//! `panel/package-lock.json`, installed into `panel/node_modules` (never
-//! committed) and served from there under `vendor/`.
+//! `cargo xtask panel`: the browser control panel (`panel/`, static files,
+//! uPlot from `panel/node_modules`) served on localhost, bridged to a head
+//! (`server.rs`): the emulated Pico, QEMU, or a serial port; without a
+//! bridge the page uses Web Serial. `--export DIR` writes it for any host.
 
 mod bridge;
 pub mod browser;

@@ -1,13 +1,7 @@
-//! `cargo xtask sim`: the Pico image, exactly as `cargo run --release`
-//! flashes it, in the RP2040 emulator rp2040js (Node.js, `sim/`).
-//!
-//! The harness (`sim/harness.mjs`) boots the flash image the way boot2
-//! hands over, bridges the emulator's one gap (SEV), performs watchdog resets
-//! and reports raw facts as JSON lines: RTT bytes, pin edges, PWM compare
-//! writes, the cycles of each frame update. This module decodes the log with
-//! the ELF's defmt table, rebuilds the pulse trains and checks them against
-//! the duties the host computes with the same core (`pulses.rs` explains how
-//! PWM periods map to frames).
+//! `cargo xtask sim`: the Pico image, as `cargo run --release` flashes it,
+//! in the RP2040 emulator rp2040js (Node.js, `sim/harness.mjs`, which
+//! reports raw facts as JSON lines). This module decodes the log, rebuilds
+//! the pulse trains and checks them against the host's duties.
 
 mod dmx;
 mod event;

@@ -1,17 +1,8 @@
-//! The QEMU log kept on file in the QEMU package, compared on every test run.
-//!
-//! The expected log is the decoded log, one `LEVEL message` line per frame.
-//! Where a line holds a value that changes with unrelated code changes (an
-//! instruction count, a wake-up latency), that part of the line can be
-//! replaced by `[..]` in the file, which matches any text within the line
-//! (snapbox's wildcard). Re-recording (`--bless`) keeps such a line as it is
-//! while it still matches.
-//!
-//! Snapbox pairs the lines of the two logs by position, so a line added or
-//! removed above a wildcard line would cost that line its wildcard on
-//! re-recording. So each line of the run that a wildcard line of the file
-//! matches is first replaced by that wildcard line, wherever it is; snapbox
-//! then compares, shows the difference, or re-records.
+//! The QEMU log kept on file (`boards/qemu/expected.log`), compared on every
+//! test run with snapbox. A `[..]` in a line matches any text within it;
+//! since snapbox pairs lines by position, each line of the run that a
+//! wildcard line matches is first replaced by it, so that re-recording
+//! (`--bless`) keeps the wildcards that still match.
 
 use std::path::{Path, PathBuf};
 

@@ -1,17 +1,8 @@
 //! The panel's browser tests, a stage of `cargo xtask test`: Debian's
 //! Chromium, headless, driven by playwright-core (`panel/tests/browser.mjs`)
-//! through four sessions:
-//!
-//! 1. Web Serial: the page served without a bridge, a fake
-//!    `navigator.serial` bridged to the shipped Pico image live in the
-//!    RP2040 emulator (its USB serial port); unplugged, an older firmware,
-//!    a reply that never comes;
-//! 2. the bridge of `cargo xtask panel --qemu`;
-//! 3. a real serial port: QEMU's UART0 as a pseudo-terminal (`-serial
-//!    pty`), first through `cargo xtask console --port`, then through the
-//!    bridge of `cargo xtask panel --port`.
-//!
-//! Screenshots at 1280×800 go to `target/panel/`.
+//! over Web Serial (the emulated Pico), the bridge of `panel --qemu`, and a
+//! real serial port (QEMU's UART0 on a pty, through `console --port` and
+//! `panel --port`). Screenshots go to `target/panel/`.
 
 use std::{
     io::{BufRead, BufReader, Write},
