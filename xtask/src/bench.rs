@@ -70,11 +70,8 @@ const MARGINAL_TOLERANCE: f64 = 0.1;
 /// One `bench row=...` line.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Row {
-    /// `default`, `w15`, ...
     pub label: String,
-    /// Samples per loop.
     pub n: u64,
-    /// Hann window taps.
     pub w: u64,
     /// Instructions of the engine (three axes, whole pipeline).
     pub engine: u64,

@@ -44,11 +44,8 @@ const ALLOCATOR_SYMBOLS: &[&str] = &[
 /// One allocated section of the image.
 #[derive(Debug, Clone)]
 pub struct Section {
-    /// Section name, e.g. `.text`.
     pub name: String,
-    /// Run-time address.
     pub address: u64,
-    /// Size in bytes.
     pub size: u64,
     /// Whether the section has contents in the file (and so in flash);
     /// `.bss` and `.uninit` do not.
@@ -298,7 +295,6 @@ pub fn check_qemu(path: &Path) -> Result<()> {
 pub struct Peak {
     /// Static RAM of the image it was measured with.
     pub static_ram: u64,
-    /// Deepest stack use, bytes.
     pub stack: u64,
 }
 

@@ -69,9 +69,7 @@ impl Source {
 /// One allocated section of an image.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Section {
-    /// `.text`, `.bss`, ...
     pub name: String,
-    /// Bytes.
     pub size: u64,
     /// Whether it is stored in flash.
     pub stored: bool,
@@ -80,28 +78,23 @@ pub struct Section {
 /// A firmware image's sizes.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Image {
-    /// Who recorded it.
     pub source: Source,
-    /// Bytes stored in flash.
     pub flash: u64,
     /// The flash ceiling, if the image is held to one.
     pub flash_budget: Option<u64>,
     /// `.data + .bss + .uninit`.
     pub static_ram: u64,
-    /// The allocated sections.
     pub sections: Vec<Section>,
 }
 
 /// One image's RAM with its measured peak stack.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RamRow {
-    /// The image.
     pub image: String,
     /// Where the stack was measured.
     pub measured_in: String,
     /// `.data + .bss + .uninit`.
     pub static_ram: u64,
-    /// Deepest stack use, bytes.
     pub stack: u64,
     /// The ceiling of static RAM plus the peak stack, if held to one.
     pub budget: Option<u64>,
@@ -110,7 +103,6 @@ pub struct RamRow {
 /// Static RAM plus peak stack, per image.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Ram {
-    /// Who recorded it.
     pub source: Source,
     /// One row per image measured.
     pub rows: Vec<RamRow>,
@@ -121,7 +113,6 @@ pub struct Ram {
 pub struct SetCost {
     /// The set's number (1 is the first after the boot's).
     pub set: u64,
-    /// Instructions it took.
     pub instructions: u64,
     /// Loops discarded per axis, as logged (`[0, 1, 0]`).
     pub discarded: String,
@@ -130,7 +121,6 @@ pub struct SetCost {
 /// What the QEMU smoke run measured.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct QemuRun {
-    /// Who recorded it.
     pub source: Source,
     /// Instructions of the boot's first loop set.
     pub precompute: Option<u64>,
@@ -141,11 +131,8 @@ pub struct QemuRun {
 /// A boot precompute row of the benchmark.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct PrecomputeRow {
-    /// `default`, `w15`, ...
     pub label: String,
-    /// Samples per loop.
     pub n: u64,
-    /// Hann window taps.
     pub w: u64,
     /// Instructions of the engine, three axes.
     pub engine: u64,
@@ -158,47 +145,34 @@ pub struct PrecomputeRow {
 pub struct FrameCost {
     /// `frame`, `frame (gesture + look)`.
     pub label: String,
-    /// Frames measured.
     pub frames: u64,
-    /// Fewest instructions.
     pub min: u64,
-    /// Median.
     pub median: u64,
-    /// Most instructions.
     pub max: u64,
-    /// Mean.
     pub mean: u64,
-    /// Ceiling of the median.
     pub median_budget: u64,
-    /// Ceiling of the max.
     pub max_budget: u64,
 }
 
 /// The benchmark's figures.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Bench {
-    /// Who recorded it.
     pub source: Source,
     /// Ceiling of the default set's precompute, instructions.
     pub budget: u64,
     /// The precompute rows, in table order.
     pub rows: Vec<PrecomputeRow>,
-    /// The frame rows.
     pub frames: Vec<FrameCost>,
 }
 
 /// A latency row: from an event to the first pulse that shows it.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct LatencyRow {
-    /// `latency input edge`, ...
     pub label: String,
-    /// Events measured.
     pub events: usize,
     /// Median, 99th percentile and largest, ms.
     pub p50_ms: f64,
-    /// See `p50_ms`.
     pub p99_ms: f64,
-    /// See `p50_ms`.
     pub max_ms: f64,
     /// The goal for the 99th percentile, ms.
     pub goal_p99_ms: f64,
@@ -207,7 +181,6 @@ pub struct LatencyRow {
 /// The latency rows, measured in the RP2040 emulator.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Latency {
-    /// Who recorded them.
     pub source: Source,
     /// One row per path (DMX, a look over USB, an input edge).
     pub rows: Vec<LatencyRow>,
@@ -216,39 +189,29 @@ pub struct Latency {
 /// One metric's distribution over the seeds.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct MetricRow {
-    /// The metric's name.
     pub metric: String,
-    /// min, median, p99, max.
     pub values: [f64; 4],
 }
 
 /// One closure's loop quality.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ClosureMetrics {
-    /// `seamless` or `paper`.
     pub closure: String,
-    /// The distributions.
     pub rows: Vec<MetricRow>,
     /// Loops past the continuity limit.
     pub discontinuous: usize,
-    /// Seeds the engine rejected.
     pub rejected: usize,
 }
 
 /// `cargo xtask metrics`'s figures.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Metrics {
-    /// Who recorded it.
     pub source: Source,
-    /// Seeds per closure.
     pub seeds: u32,
-    /// Samples per loop.
     pub n: usize,
-    /// Window taps.
     pub w: u16,
     /// The continuity limit the counts are against.
     pub limit: f32,
-    /// Per closure.
     pub closures: Vec<ClosureMetrics>,
 }
 

@@ -10,7 +10,6 @@ use defmt_decoder::{Frame, Locations};
 pub struct LogLine {
     /// `INFO`, `WARN`, ... (`None` for `println!`-style frames).
     pub level: Option<String>,
-    /// The formatted message.
     pub message: String,
     /// The formatted timestamp, if the firmware has one.
     pub timestamp: Option<String>,
@@ -93,9 +92,7 @@ pub enum Exit {
 /// The outcome of one QEMU run.
 #[derive(Debug)]
 pub struct Run {
-    /// Decoded log, in order.
     pub log: Vec<LogLine>,
-    /// How QEMU ended.
     pub exit: Exit,
     /// Wall time of the run.
     pub elapsed: Duration,

@@ -74,17 +74,11 @@ pub fn config(i: u32, args: Args, closure: Closure) -> (Axis, AxisConfig) {
 /// The measured values of one loop, in table order.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Measured {
-    /// max|d1| / P95|d1|.
     pub velocity: f64,
-    /// max|d2| / P95|d2|.
     pub acceleration: f64,
-    /// Liveliness.
     pub liveliness: f64,
-    /// min − α1, degrees.
     pub below: f64,
-    /// α2 − max, degrees.
     pub above: f64,
-    /// x(0), degrees.
     pub start: f64,
 }
 

@@ -80,13 +80,10 @@ fn positive_seconds(text: &str) -> Result<u64, String> {
 /// One frame of the trace.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Row {
-    /// Frame index.
     pub frame: u64,
     /// Time of the frame in ms.
     pub t_ms: u64,
-    /// Commanded angles, m°.
     pub angles: [i32; 3],
-    /// Pulse widths, ns.
     pub pulses: [u64; 3],
     /// The duties written, counts of the Pico's PWM (0: no pulse).
     pub duties: [u16; 3],
@@ -94,7 +91,6 @@ pub struct Row {
 
 /// The simulated run.
 pub struct Trace {
-    /// One row per frame.
     pub rows: Vec<Row>,
     /// The script's commands as applied, and the looks' returns, in time
     /// order.

@@ -12,7 +12,6 @@ use crate::log::LogLine;
 pub struct Ceiling {
     /// The median over the loop.
     pub median: u64,
-    /// The costliest frame.
     pub max: u64,
 }
 
@@ -44,17 +43,14 @@ pub const CEILINGS: [(Option<&str>, Ceiling); 2] = [
 pub struct FrameRow {
     /// What plays besides the idle loops (`gesture+look`), if anything.
     pub scenario: Option<String>,
-    /// Frames measured.
     pub frames: u64,
     /// Fewest instructions of a frame.
     pub min: u64,
-    /// Median over the frames.
     pub median: u64,
     /// Most instructions of a frame.
     pub max: u64,
     /// The frame that took `max`.
     pub max_at: u64,
-    /// Mean over the frames.
     pub mean: u64,
 }
 

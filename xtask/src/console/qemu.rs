@@ -112,11 +112,9 @@ pub fn qemu_session(
 
 /// QEMU started by [`spawn_with_sockets`].
 pub struct Sockets {
-    /// QEMU itself.
     pub child: Child,
     /// The sockets' folder, for the caller to remove when QEMU is done.
     pub dir: PathBuf,
-    /// UART0's socket: the console.
     pub uart0: PathBuf,
     /// UART1's socket: the hang-up line.
     pub uart1: PathBuf,

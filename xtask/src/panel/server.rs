@@ -27,7 +27,6 @@ pub const NO_BRIDGE: &str = r#"{"bridge":null}"#;
 pub struct Server {
     http: Arc<tiny_http::Server>,
     accepting: Option<thread::JoinHandle<()>>,
-    /// Where it listens.
     pub address: SocketAddr,
 }
 

@@ -22,9 +22,7 @@ use idle_head_core::{
 /// One loop to preview.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LoopSpec {
-    /// The axis (anatomical limits).
     pub axis: Axis,
-    /// Samples per loop.
     pub n: usize,
     /// Seed, window, step, range and closure.
     pub cfg: AxisConfig,
@@ -111,11 +109,8 @@ impl Trace for Recorder {
 /// All stages of one loop.
 #[derive(Debug, Clone)]
 pub struct Stages {
-    /// What was generated.
     pub spec: LoopSpec,
-    /// The engine's decisions.
     pub info: LoopInfo,
-    /// Walk, degrees, generation order.
     pub walk: Vec<f64>,
     /// Smoothed walk, degrees, generation order.
     pub smoothed: Vec<f64>,

@@ -25,7 +25,6 @@ const JITTER: Duration = Duration::from_millis(1);
 /// One line of a DMX script.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Change {
-    /// When, since power-on.
     pub at: Duration,
     /// Slots (relative to the address, 1-based) and their values.
     pub set: Vec<(u16, u8)>,

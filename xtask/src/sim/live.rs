@@ -17,7 +17,6 @@ use super::{harness, node, store::WORST};
 /// A live emulator run: the harness, its stdin (bytes for the USB serial
 /// port) and stdout (its events).
 pub struct Live {
-    /// The harness's process.
     pub child: Child,
     /// Bytes for the head's USB serial port, one line of hex digits each.
     pub stdin: ChildStdin,

@@ -58,13 +58,9 @@ pub fn npm_ci(dir: &Path, packages: &[&str], env: &[(&str, &str)]) -> Result<()>
 /// ROM, no power cycle).
 #[derive(Debug, Clone, Default)]
 pub struct Config {
-    /// The flash image file.
     pub flash: PathBuf,
-    /// Vector table address.
     pub vtor: u64,
-    /// `_SEGGER_RTT`, or 0.
     pub rtt: u64,
-    /// GPIOs to watch.
     pub pins: Vec<u8>,
     /// PWM slices whose compare writes to report.
     pub slices: Vec<u8>,
@@ -72,9 +68,7 @@ pub struct Config {
     pub probe: u64,
     /// Stack region to scan for paint, if painted.
     pub stack: Option<(u64, u64)>,
-    /// Virtual time to run.
     pub virtual_time: Duration,
-    /// Wall time allowed.
     pub wall: Duration,
     /// Virtual time without a log byte or a pin edge after which the run ends.
     pub silence: Duration,
@@ -124,16 +118,13 @@ pub struct PinScript {
 pub struct FlashTiming {
     /// One 4 KiB sector erase.
     pub erase: Duration,
-    /// One 256-byte page program.
     pub program: Duration,
 }
 
 /// Bytes the harness puts on UART0's RX line in one boot.
 #[derive(Debug, Clone)]
 pub struct UartScript {
-    /// The boot (0: power-on).
     pub boot: usize,
-    /// The bytes.
     pub bytes: Vec<u8>,
     /// Virtual time of the first, since the boot's start.
     pub start: Duration,

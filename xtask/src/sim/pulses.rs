@@ -37,9 +37,7 @@ impl Timing {
 pub struct Limits {
     /// The neutral pulse: the first pulse must be this.
     pub neutral: u16,
-    /// The servo's shortest pulse.
     pub min: u16,
-    /// The servo's longest pulse.
     pub max: u16,
 }
 
@@ -52,7 +50,6 @@ pub struct Train {
     pub writes: Vec<(f64, u16)>,
     /// When the slice was enabled.
     pub enabled: Option<f64>,
-    /// When the boot ended.
     pub end: f64,
     /// Whether a reset ended it (a pulse then in flight was cut).
     pub reset: bool,
@@ -61,9 +58,7 @@ pub struct Train {
 /// One complete pulse.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pulse {
-    /// Rising edge, ns.
     pub rise: f64,
-    /// Width in counts.
     pub counts: u32,
     /// The frame whose duty it carried.
     pub frame: usize,
@@ -74,7 +69,6 @@ pub struct Pulse {
 pub struct Measured {
     /// Rising edge, ns since power-on.
     pub rise: f64,
-    /// Width, ns.
     pub width: f64,
 }
 
@@ -109,9 +103,7 @@ pub fn measure(train: &Train) -> Vec<Measured> {
 /// The verdict on one servo's train.
 #[derive(Debug, Clone, Default)]
 pub struct ServoCheck {
-    /// Complete pulses, in order.
     pub pulses: Vec<Pulse>,
-    /// Frames written.
     pub frames: usize,
     /// Pulses that carried their own frame (pulse `n`, frame `n`).
     pub fresh: usize,

@@ -27,7 +27,6 @@ const SILENCE: Duration = Duration::from_secs(1);
 pub struct Boot {
     /// When it started and ended, ns of virtual time since power-on.
     pub start: f64,
-    /// See `start`.
     pub end: f64,
     /// Whether the watchdog ended it.
     pub watchdog: bool,
@@ -35,7 +34,6 @@ pub struct Boot {
     pub log: Vec<(f64, LogLine)>,
     /// Per servo, what the emulator reported.
     pub trains: [Train; 3],
-    /// Per servo, the verdict.
     pub servos: [ServoCheck; 3],
     /// Cycles of each frame update, in order.
     pub frame_cycles: Vec<u64>,
@@ -43,7 +41,6 @@ pub struct Boot {
     pub stack_low: Option<u64>,
     /// Peak stack use, bytes, from `stack_low`.
     pub stack_peak: Option<u64>,
-    /// Bytes UART0 sent.
     pub uart: Vec<u8>,
     /// Scripted bytes that found UART0's receive FIFO full.
     pub uart_overruns: usize,
@@ -82,7 +79,6 @@ pub struct FlashOp {
     pub erase: bool,
     /// Flash address and length, bytes.
     pub addr: u64,
-    /// See `addr`.
     pub len: u64,
     /// How long it kept the flash busy (and the interrupts off), ns.
     pub busy_ns: f64,
@@ -95,11 +91,8 @@ pub struct FlashOp {
 pub struct End {
     /// Why it stopped: [`Why::Time`] when it ran the whole virtual time.
     pub why: Why,
-    /// Virtual time reached, ns.
     pub ns: f64,
-    /// Instructions executed.
     pub instructions: u64,
-    /// Wall time, ms.
     pub wall_ms: u64,
     /// The harness's error, if it failed.
     pub error: Option<String>,
@@ -138,9 +131,7 @@ impl End {
 /// Everything one run produced.
 #[derive(Debug, Default)]
 pub struct Report {
-    /// The boots, in order.
     pub boots: Vec<Boot>,
-    /// How it ended.
     pub end: End,
     /// The emulator's complaints, each with how often it came.
     pub emulator: Vec<(String, usize)>,

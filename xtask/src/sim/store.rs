@@ -55,9 +55,7 @@ const SAVED_PITCH_US: u32 = 1520;
 
 /// A start of the settings sectors.
 struct Start {
-    /// What they hold.
     what: &'static str,
-    /// Their bytes.
     sectors: Vec<u8>,
     /// What the first boot must log about them: a level and a text.
     logged: &'static [(&'static str, &'static str)],

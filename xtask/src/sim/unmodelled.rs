@@ -12,11 +12,9 @@ use super::event::Access;
 pub struct Unmodelled {
     /// The peripheral as rp2040js names it.
     pub peripheral: String,
-    /// Read or written.
     pub op: Access,
     /// The register's offset in the peripheral.
     pub offset: u32,
-    /// How often.
     pub count: u64,
 }
 
