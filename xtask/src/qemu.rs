@@ -8,12 +8,11 @@ use std::{
 };
 
 use anyhow::{Context, Result, bail};
-use defmt_decoder::{DecodeError, Locations, Table};
 
 use crate::figures;
 use crate::{
     args::Options,
-    log::{LogLine, Run},
+    log::{Defmt, LogLine, Run},
     plot::{self, BLUE, Curve, Figure, GREEN, ORANGE, Panel},
     project::{self, QEMU},
     reference,
@@ -105,13 +104,7 @@ pub fn qemu_command(elf: &Path, sleep: bool, args: &[&str]) -> Command {
 /// Runs `elf` in QEMU, decoding its defmt output as it arrives; QEMU is
 /// killed after `timeout` of wall time.
 pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
-    let root = project::root();
-    let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
-    let table = Table::parse(&bytes)
-        .with_context(|| format!("reading the defmt table of {}", elf.display()))?
-        .with_context(|| format!("{} has no defmt data", elf.display()))?;
-    // Locations need debug info; without them the log still decodes.
-    let locations = table.get_locations(&bytes).ok();
+    let defmt = Defmt::read(elf)?;
 
     let mut command = qemu_command(
         elf,
@@ -137,7 +130,7 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
         child,
         QEMU_BINARY,
         timeout,
-        |stdout| decode(stdout, &table, locations.as_ref(), &root, echo),
+        |stdout| decode(stdout, &defmt, echo),
         |stderr| forward(stderr, &mut std::io::stderr()),
         || (),
     )?;
@@ -149,24 +142,12 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
 }
 
 /// Decodes the defmt stream `output` to its end, echoing lines as they come.
-pub(crate) fn decode(
-    mut output: impl Read,
-    table: &Table,
-    locations: Option<&Locations>,
-    root: &Path,
-    echo: Echo,
-) -> Vec<LogLine> {
-    let mut decoder = table.new_stream_decoder();
+pub(crate) fn decode(mut output: impl Read, defmt: &Defmt, echo: Echo) -> Vec<LogLine> {
+    let mut decoder = defmt.stream();
     let mut buffer = [0_u8; 4096];
     let mut log = Vec::new();
     while let Ok(n @ 1..) = output.read(&mut buffer) {
-        decoder.received(&buffer[..n]);
-        loop {
-            let line = match decoder.decode() {
-                Ok(frame) => LogLine::from_frame(&frame, locations, root),
-                Err(DecodeError::UnexpectedEof) => break,
-                Err(DecodeError::Malformed) => LogLine::malformed(),
-            };
+        for line in defmt.lines(decoder.as_mut(), &buffer[..n]) {
             if echo == Echo::All || (echo == Echo::Problems && line.is_problem()) {
                 line.print();
             }

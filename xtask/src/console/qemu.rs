@@ -11,7 +11,6 @@ use std::{
 };
 
 use anyhow::{Context, Result};
-use defmt_decoder::Table;
 
 use super::talk::{self, Talk};
 use crate::log::Run;
@@ -72,10 +71,7 @@ pub fn qemu_session(
     echo: Echo,
     wait: Duration,
 ) -> Result<QemuSession> {
-    let root = project::root();
-    let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
-    let table = Table::parse(&bytes)?.context("no defmt data in the image")?;
-    let locations = table.get_locations(&bytes).ok();
+    let defmt = crate::log::Defmt::read(elf)?;
     let Sockets {
         child,
         dir,
@@ -87,7 +83,7 @@ pub fn qemu_session(
         child,
         setup::QEMU_BINARY,
         AFTER_HANG_UP,
-        |stdout| qemu::decode(stdout, &table, locations.as_ref(), &root, echo),
+        |stdout| qemu::decode(stdout, &defmt, echo),
         |stderr| {
             // QEMU says it waits for each socket's connection: not news here.
             let mut to = std::io::stderr();

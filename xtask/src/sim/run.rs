@@ -4,7 +4,7 @@
 use std::{fmt::Write as _, path::Path, time::Duration};
 
 use anyhow::{Context, Result, bail};
-use defmt_decoder::{DecodeError, Locations, StreamDecoder, Table};
+use defmt_decoder::StreamDecoder;
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 
@@ -16,7 +16,7 @@ use super::{
     pulses::{self, Limits, ServoCheck, Timing, Train},
     unmodelled::Unmodelled,
 };
-use crate::log::LogLine;
+use crate::log::{Defmt, LogLine};
 
 /// Virtual time without a log byte or a pin edge after which a run is
 /// declared stuck: 50 frames.
@@ -181,11 +181,7 @@ pub fn run_with(
     setup: impl FnOnce(&mut node::Config),
 ) -> Result<Report> {
     let (image, config) = harness::config(elf, "flash.uf2")?;
-    let bytes = std::fs::read(elf)?;
-    let table = Table::parse(&bytes)
-        .with_context(|| format!("reading the defmt table of {}", elf.display()))?
-        .with_context(|| format!("{} has no defmt data", elf.display()))?;
-    let locations = table.get_locations(&bytes).ok();
+    let defmt = Defmt::read(elf)?;
     node::ensure(root)?;
     let mut config = node::Config {
         pins: SERVOS.iter().map(|s| s.1).collect(),
@@ -203,7 +199,7 @@ pub fn run_with(
         virtual_time.as_secs_f64()
     );
     let events = node::run(root, &config)?;
-    let mut report = sort(&events, &table, locations.as_ref(), root)?;
+    let mut report = sort(&events, &defmt)?;
     for boot in &mut report.boots {
         boot.stack_peak = boot.stack_low.map(|low| image.stack.1.saturating_sub(low));
     }
@@ -293,12 +289,7 @@ fn check_exchange(report: &mut Report) {
 }
 
 /// Sorts the events into boots and decodes each boot's log.
-fn sort(
-    events: &[Event],
-    table: &Table,
-    locations: Option<&Locations>,
-    root: &Path,
-) -> Result<Report> {
+fn sort(events: &[Event], defmt: &Defmt) -> Result<Report> {
     let mut report = Report::default();
     let mut decoder: Option<Box<dyn StreamDecoder + '_>> = None;
     let mut ended = false;
@@ -312,7 +303,7 @@ fn sort(
                     start: *ns,
                     ..Boot::default()
                 });
-                decoder = Some(table.new_stream_decoder());
+                decoder = Some(defmt.stream());
                 continue;
             }
             Event::Emu { msg, .. } => {
@@ -346,7 +337,11 @@ fn sort(
         let Some(boot) = report.boots.last_mut() else {
             bail!("harness event before the first boot: {event:?}");
         };
-        into_boot(boot, event, decoder.as_mut(), locations, root);
+        if let (Event::Rtt { ns, hex }, Some(decoder)) = (event, decoder.as_mut()) {
+            let lines = defmt.lines(decoder.as_mut(), hex);
+            boot.log.extend(lines.into_iter().map(|line| (*ns, line)));
+        }
+        into_boot(boot, event);
     }
     if !ended {
         bail!("the emulator harness ended without saying how");
@@ -359,33 +354,8 @@ fn sort(
 
 /// An event of the current boot into `boot`; its log bytes through
 /// `decoder`.
-fn into_boot(
-    boot: &mut Boot,
-    event: &Event,
-    decoder: Option<&mut Box<dyn StreamDecoder + '_>>,
-    locations: Option<&Locations>,
-    root: &Path,
-) {
+fn into_boot(boot: &mut Boot, event: &Event) {
     match event {
-        Event::Rtt { ns, hex } => {
-            let Some(decoder) = decoder else {
-                return;
-            };
-            decoder.received(hex);
-            loop {
-                let line = match decoder.decode() {
-                    Ok(frame) => line(&frame, locations, root),
-                    Err(DecodeError::UnexpectedEof) => break,
-                    Err(DecodeError::Malformed) => LogLine {
-                        level: Some("ERROR".to_owned()),
-                        message: "(malformed defmt frame: the log stream is corrupt)".to_owned(),
-                        timestamp: None,
-                        location: None,
-                    },
-                };
-                boot.log.push((*ns, line));
-            }
-        }
         Event::Edge {
             pin,
             high,
@@ -437,9 +407,10 @@ fn into_boot(
             busy_ns: *busy_ns,
             ns: *ns,
         }),
-        // A reset's pin release and a slice switched off are not
-        // needed; the rest is sorted before a boot is needed.
-        Event::Edge { reset: true, .. }
+        // The log is decoded above; a reset's pin release and a slice
+        // switched off are not needed; the rest is sorted before a boot is.
+        Event::Rtt { .. }
+        | Event::Edge { reset: true, .. }
         | Event::En { on: false, .. }
         | Event::Boot { .. }
         | Event::Emu { .. }
@@ -478,21 +449,6 @@ pub fn end_of(events: &[Event]) -> Result<End> {
         .rfind(|event| matches!(event, Event::End { .. }))
         .context("the emulator harness ended without saying how")?;
     End::from_event(event)
-}
-
-fn line(frame: &defmt_decoder::Frame<'_>, locations: Option<&Locations>, root: &Path) -> LogLine {
-    let location = locations
-        .and_then(|locations| locations.get(&frame.index()))
-        .map(|location| {
-            let file = location.file.strip_prefix(root).unwrap_or(&location.file);
-            format!("{}:{}", file.display(), location.line)
-        });
-    LogLine {
-        level: frame.level().map(|level| level.as_str().to_uppercase()),
-        message: frame.display_message().to_string(),
-        timestamp: None,
-        location,
-    }
 }
 
 /// The PWM timing of the Pico's servo slices.
