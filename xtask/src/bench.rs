@@ -348,48 +348,75 @@ pub fn command(options: Options) -> Result<bool> {
     Ok(passed)
 }
 
-/// The latency rows.
-fn record_latency(rows: Vec<figures::LatencyRow>) {
-    let source = figures::Source::now();
-    figures::save_section("latency", |f| {
-        f.latency = Some(figures::Latency { source, rows });
-    });
+/// The latency rows, for the measured figures.
+fn record_latency(rows: Vec<Vec<String>>) {
+    let intro = "Latency, measured in the RP2040 emulator on the shipped image, from an event \
+                 to the first servo pulse that shows it, in ms \
+                 ([the emulators](../dev/emulators.md#latency-of-an-input-edge)).";
+    let header = ["row", "events", "p50", "p99", "max", "goal (p99)"];
+    figures::record("latency", intro.to_owned(), &header, rows);
 }
 
-/// The benchmark's rows.
+/// The benchmark's rows, for the measured figures.
 fn record_figures(rows: &[Row], frames: &[FrameRow], budget: u64) {
-    let entry = figures::Bench {
-        source: figures::Source::now(),
-        budget,
-        rows: rows
-            .iter()
-            .map(|row| figures::PrecomputeRow {
-                label: row.label.clone(),
-                n: row.n,
-                w: row.w,
-                engine: row.engine,
-                direct: row.direct,
-            })
-            .collect(),
-        // Each with its ceiling: `FrameRow::all` refused a row without one.
-        frames: frames
-            .iter()
-            .filter_map(|row| {
-                let ceiling = row.ceiling()?;
-                Some(figures::FrameCost {
-                    label: row.label(),
-                    frames: row.frames,
-                    min: row.min,
-                    median: row.median,
-                    max: row.max,
-                    mean: row.mean,
-                    median_budget: ceiling.median,
-                    max_budget: ceiling.max,
-                })
-            })
-            .collect(),
-    };
-    figures::save_section("benchmark", |f| f.bench = Some(entry));
+    let at_125_mhz = |insns: u64| insns as f64 / RP2040_HZ * 1e6;
+    let intro = "Instructions of one frame update (`FrameLoop::write`: playback, mixer, fade, \
+                 limits, mapping, three PWM writes) over every frame of a whole loop, counted \
+                 exactly in QEMU ([what a frame costs](limiter.md#what-a-frame-costs)). A 20 ms \
+                 frame has 2,500,000 cycles of a 125 MHz RP2040.";
+    let header = [
+        "row",
+        "frames",
+        "min",
+        "median",
+        "max",
+        "mean",
+        "ceiling (median / max)",
+        "median at 125 MHz",
+    ];
+    // Each with its ceiling: `FrameRow::all` refused a row without one.
+    let cells = frames.iter().filter_map(|row| {
+        let ceiling = row.ceiling()?;
+        let counts = [row.frames, row.min, row.median, row.max, row.mean].map(thousands);
+        let mut cells = vec![row.label()];
+        cells.extend(counts);
+        cells.push(format!(
+            "{} / {}",
+            thousands(ceiling.median),
+            thousands(ceiling.max)
+        ));
+        cells.push(format!("≥ {:.1} µs", at_125_mhz(row.median)));
+        Some(cells)
+    });
+    figures::record("frames", intro.to_owned(), &header, cells.collect());
+    let intro = format!(
+        "Instructions of the three axes' loops, computed at boot, for the default set and \
+         across W and N, next to a direct-form f32 implementation of the paper's smoothing \
+         on the same core ([how it is computed](motion.md#how-it-is-computed)). The default \
+         set's ceiling is {} instructions.",
+        thousands(budget)
+    );
+    let header = [
+        "row",
+        "N",
+        "W",
+        "engine",
+        "direct f32 smoothing",
+        "ratio",
+        "engine at 125 MHz",
+    ];
+    let cells = rows.iter().map(|row| {
+        vec![
+            row.label.clone(),
+            row.n.to_string(),
+            row.w.to_string(),
+            thousands(row.engine),
+            thousands(row.direct),
+            format!("{:.0}×", row.ratio()),
+            format!("≥ {:.2} ms", at_125_mhz(row.engine) / 1000.0),
+        ]
+    });
+    figures::record("precompute", intro, &header, cells.collect());
 }
 
 #[cfg(test)]

@@ -396,54 +396,81 @@ fn kib(bytes: u64) -> f64 {
     bytes as f64 / 1024.0
 }
 
-/// The sizes of the image at `path`, held to `flash_budget`.
+/// The sizes of the image at `path`, held to `flash_budget`, for the
+/// measured figures.
 pub fn record_image(path: &Path, image: &Image, flash_budget: Option<u64>) {
-    let name = path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    let flash = image.flash();
+    let ceiling = flash_budget.map_or_else(
+        || "no ceiling".to_owned(),
+        |budget| {
+            format!(
+                "{} of {}",
+                figures::percent(flash, budget),
+                figures::bytes(budget)
+            )
+        },
     );
-    let entry = figures::Image {
-        source: figures::Source::now(),
-        flash: image.flash(),
-        flash_budget,
-        static_ram: image.static_ram(),
-        sections: image
-            .sections
-            .iter()
-            .map(|s| figures::Section {
-                name: s.name.clone(),
-                size: s.size,
-                stored: s.stored,
-            })
-            .collect(),
-    };
-    figures::save_section(&format!("sizes of `{name}`"), |f| {
-        f.images.insert(name.clone(), entry);
-    });
+    let sections: Vec<String> = image
+        .sections
+        .iter()
+        .map(|s| format!("`{}` {}", s.name, figures::bytes(s.size)))
+        .collect();
+    let intro = format!(
+        "Flash is every section stored in flash (`.data`'s initial values included); \
+         static RAM is `.data + .bss + .uninit`. Sections of `{name}`: {}.",
+        sections.join(", ")
+    );
+    let size = format!("{} ({})", figures::bytes(flash), figures::kib(flash));
+    let row = vec![
+        name.to_string(),
+        size,
+        ceiling,
+        figures::bytes(image.static_ram()),
+    ];
+    let header = ["image", "flash", "of the ceiling", "static RAM"];
+    figures::record(&format!("image {name}"), intro, &header, vec![row]);
 }
 
-/// Static RAM plus the peak stack of each image that has a measurement:
-/// `(image, where the stack was measured, the peak, the ceiling)`.
+/// Static RAM plus the peak stack of each image that has a measurement,
+/// for the measured figures: `(image, where the stack was measured, the
+/// peak, the ceiling)`.
 pub fn record_ram(rows: &[(&str, &str, Option<Peak>, Option<u64>)]) {
-    let rows: Vec<figures::RamRow> = rows
+    let rows: Vec<Vec<String>> = rows
         .iter()
         .filter_map(|&(image, measured_in, peak, budget)| {
-            peak.map(|peak| figures::RamRow {
-                image: image.to_owned(),
-                measured_in: measured_in.to_owned(),
-                static_ram: peak.static_ram,
-                stack: peak.stack,
-                budget,
-            })
+            let peak = peak?;
+            let total = peak.static_ram + peak.stack;
+            let ceiling = budget.map_or_else(
+                || "no ceiling".to_owned(),
+                |b| format!("{} of {}", figures::percent(total, b), figures::bytes(b)),
+            );
+            let total = format!("{} ({})", figures::bytes(total), figures::kib(total));
+            let (fixed, stack) = (figures::bytes(peak.static_ram), figures::bytes(peak.stack));
+            Some(vec![
+                image.to_owned(),
+                measured_in.to_owned(),
+                fixed,
+                stack,
+                total,
+                ceiling,
+            ])
         })
         .collect();
     if rows.is_empty() {
         return;
     }
-    let source = figures::Source::now();
-    figures::save_section("RAM with the peak stack", |f| {
-        f.ram = Some(figures::Ram { source, rows });
-    });
+    let intro = "RAM: static RAM plus the deepest the stack went, measured by painting it \
+                 ([Memory](memory.md#how-the-stack-is-measured)).";
+    let header = [
+        "image",
+        "stack measured in",
+        "static RAM",
+        "peak stack",
+        "total",
+        "of the ceiling",
+    ];
+    figures::record("ram", intro.to_owned(), &header, rows);
 }
 
 #[cfg(test)]

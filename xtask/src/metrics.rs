@@ -290,36 +290,43 @@ pub fn command(args: &Args) -> Result<bool> {
     Ok(true)
 }
 
-/// `cargo xtask metrics`'s distributions.
+/// `cargo xtask metrics`'s distributions, for the measured figures.
 fn record_figures(results: &[(Closure, Results)], args: Args) {
-    let closures = results
-        .iter()
-        .map(|(closure, result)| figures::ClosureMetrics {
-            closure: match closure {
-                Closure::Paper => "paper",
-                Closure::Seamless => "seamless",
-            }
-            .to_owned(),
-            rows: ROWS
-                .iter()
-                .map(|(metric, get)| figures::MetricRow {
-                    metric: (*metric).to_owned(),
-                    values: distribution(result.loops.iter().map(get).collect()),
-                })
-                .collect(),
-            discontinuous: result.loops.iter().filter(|m| m.discontinuous()).count(),
-            rejected: result.rejected.len(),
-        })
-        .collect();
-    let entry = figures::Metrics {
-        source: figures::Source::now(),
-        seeds: args.seeds,
-        n: args.shape.n(),
-        w: args.shape.w(),
-        limit: CONTINUITY_LIMIT,
-        closures,
-    };
-    figures::save_section("loop quality", |f| f.metrics = Some(entry));
+    let seeds = figures::thousands(u64::from(args.seeds));
+    for (closure, result) in results {
+        let name = match closure {
+            Closure::Paper => "paper",
+            Closure::Seamless => "seamless",
+        };
+        // The page shows the paper closure's table first: it says what the columns are.
+        let columns = if *closure == Closure::Paper {
+            format!(
+                "One loop per seed, {seeds} seeds, N = {}, W = {}, each seed on one of the \
+                 three default axes ([the motion](motion.md#two-loop-closures)); d1 and d2 are \
+                 the first and second differences of the loop taken cyclically, seam included; \
+                 liveliness is the quietest tenth of the loop's mean speed relative to the \
+                 whole loop's; the margins are to the loop's own [α1, α2]. ",
+                args.shape.n(),
+                args.shape.w()
+            )
+        } else {
+            String::new()
+        };
+        let intro = format!(
+            "{columns}**{name}**: {} of {seeds} loops past a continuity ratio of \
+             {CONTINUITY_LIMIT}, {} seeds rejected.",
+            result.loops.iter().filter(|m| m.discontinuous()).count(),
+            result.rejected.len(),
+        );
+        let rows = ROWS.iter().map(|(metric, get)| {
+            let values = distribution(result.loops.iter().map(get).collect());
+            let mut cells = vec![metric.replace('|', "\\|")];
+            cells.extend(values.map(|v| format!("{v:.3}")));
+            cells
+        });
+        let header = ["metric", "min", "median", "p99", "max"];
+        figures::record(&format!("metrics {name}"), intro, &header, rows.collect());
+    }
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@ use std::{
 
 use anyhow::{Context, Result, bail};
 
-use crate::figures;
+use crate::figures::{self, thousands};
 use crate::{
     args::Options,
     log::{Defmt, LogLine, Run},
@@ -297,20 +297,45 @@ fn frame_line(message: &str) -> Option<(f64, [f64; 3])> {
 /// The QEMU smoke run's boot precompute (`precompute_insns` of its summary
 /// line) and the loop sets its log reports. Only the smoke run's: a run
 /// with console traffic would count that traffic in its sets' times.
+#[allow(clippy::cast_precision_loss)] // instruction counts, far below 2^52
 pub fn record_figures(log: &[LogLine]) {
-    let entry = figures::QemuRun {
-        source: figures::Source::now(),
-        precompute: Summary::find(log).and_then(|s| s.number("precompute_insns").ok()),
-        sets: log
-            .iter()
+    let at_125_mhz = |insns: u64| format!("≥ {:.2} ms", insns as f64 / 125e3);
+    let boot = Summary::find(log).and_then(|s| s.number("precompute_insns").ok());
+    let boot = boot.map(|i| {
+        vec![
+            "0 (boot)".to_owned(),
+            thousands(i),
+            at_125_mhz(i),
+            "none".to_owned(),
+        ]
+    });
+    let sets =
+        log.iter()
             .filter_map(|line| set_cost(&line.message))
-            .collect(),
-    };
-    figures::save_section("QEMU run", |f| f.qemu = Some(entry));
+            .map(|(set, insns, discarded)| {
+                vec![
+                    set.to_string(),
+                    thousands(insns),
+                    at_125_mhz(insns),
+                    discarded,
+                ]
+            });
+    let intro = "The QEMU smoke run's loop sets ([never-repeating idle](idle.md#in-the-background)): \
+                 the boot's set 0, timed before the first frame, and the sets generated in the \
+                 background while the frames play, each with the loops it discarded per axis \
+                 (pitch, roll, yaw).";
+    let header = ["set", "instructions", "at 125 MHz", "loops discarded"];
+    figures::record(
+        "qemu",
+        intro.to_owned(),
+        &header,
+        boot.into_iter().chain(sets).collect(),
+    );
 }
 
-/// `loop set <n> ready in <µs> us: seeds [..] ([..] discarded), ...`
-fn set_cost(message: &str) -> Option<figures::SetCost> {
+/// `loop set <n> ready in <µs> us: seeds [..] ([..] discarded), ...`: the
+/// set, its instructions and the loops it discarded.
+fn set_cost(message: &str) -> Option<(u64, u64, String)> {
     let rest = message.strip_prefix("loop set ")?;
     let (set, rest) = rest.split_once(" ready in ")?;
     let (micros, rest) = rest.split_once(" us")?;
@@ -321,11 +346,7 @@ fn set_cost(message: &str) -> Option<figures::SetCost> {
         .split_once('(')
         .and_then(|(_, after)| after.split_once(" discarded)"))
         .map_or_else(String::new, |(list, _)| list.to_owned());
-    Some(figures::SetCost {
-        set: set.parse().ok()?,
-        instructions,
-        discarded,
-    })
+    Some((set.parse().ok()?, instructions, discarded))
 }
 
 #[cfg(test)]
@@ -379,10 +400,7 @@ mod tests {
              [1142, 1108, 1391] mdeg rms",
         )
         .unwrap();
-        assert_eq!(
-            (set.set, set.instructions, set.discarded.as_str()),
-            (2, 3_470_000, "[2, 3, 3]")
-        );
+        assert_eq!(set, (2, 3_470_000, "[2, 3, 3]".to_owned()));
         assert!(set_cost("loop set failed: range; trying the next seeds").is_none());
         assert!(set_cost("frame 1400: join").is_none());
     }
