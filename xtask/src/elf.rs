@@ -218,47 +218,26 @@ pub fn check_pico(path: &Path) -> Result<()> {
     let image = Image::read(path)?;
     println!("{}", path.display());
     print!("{}", image.table());
-
-    let mut problems = Vec::new();
-    if let Err(error) = image.check_boot2() {
-        problems.push(error.to_string());
-    }
-
-    let flash = image.flash();
-    let ram = image.static_ram();
+    let (flash, ram) = (image.flash(), image.static_ram());
     record_image(path, &image, Some(FLASH_BUDGET));
     println!(
-        "  flash      {:>6} B = {:>5.1} KiB of {} KiB budget  ({})",
-        flash,
-        kib(flash),
-        FLASH_BUDGET / 1024,
-        stored_names(&image)
+        "  flash {flash} B of its {FLASH_BUDGET} B budget; static RAM {ram} B (of {RAM_BUDGET} B \
+         with the peak stack)"
     );
-    println!(
-        "  static RAM {:>6} B = {:>5.1} KiB of {} KiB budget with the peak stack  (.data + .bss + .uninit)",
-        ram,
-        kib(ram),
-        RAM_BUDGET / 1024
-    );
+    let mut problems: Vec<String> = [
+        image.check_boot2(),
+        image.check_no_allocator(),
+        check_settings_region(&image, Board::Pico.settings()),
+    ]
+    .into_iter()
+    .filter_map(|check| check.err().map(|e| e.to_string()))
+    .collect();
     if flash > FLASH_BUDGET {
-        problems.push(format!(
-            "flash use {flash} B is over the {FLASH_BUDGET} B budget"
-        ));
+        problems.push(format!("flash use {flash} B is over the {FLASH_BUDGET} B budget"));
     }
     if ram > RAM_BUDGET {
-        problems.push(format!(
-            "static RAM use {ram} B is over the {RAM_BUDGET} B budget"
-        ));
+        problems.push(format!("static RAM use {ram} B is over the {RAM_BUDGET} B budget"));
     }
-    if let Err(error) = image.check_no_allocator() {
-        problems.push(error.to_string());
-    } else {
-        println!("  no allocator linked");
-    }
-    if let Err(error) = check_settings_region(&image, Board::Pico.settings()) {
-        problems.push(error.to_string());
-    }
-
     if problems.is_empty() {
         Ok(())
     } else {
@@ -302,23 +281,15 @@ pub struct Peak {
 /// measured in the RP2040 emulator) and the QEMU smoke image; fails if the
 /// Pico image's total is over [`RAM_BUDGET`] or its peak is unknown.
 pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
-    println!(
-        "  {:<34} {:>10} {:>11} {:>10}",
-        "image (stack measured in)", "static B", "peak stack", "total B"
-    );
-    for (name, peak) in [
-        ("Pico (RP2040 emulator)", pico),
-        ("QEMU smoke (lm3s6965evb)", qemu),
-    ] {
+    for (name, peak) in [("Pico (RP2040 emulator)", pico), ("QEMU smoke", qemu)] {
         match peak {
             Some(p) => println!(
-                "  {name:<34} {:>10} {:>11} {:>10}  = {:.1} KiB",
+                "  {name}: {} B static + {} B peak stack = {} B",
                 p.static_ram,
                 p.stack,
-                p.static_ram + p.stack,
-                kib(p.static_ram + p.stack)
+                p.static_ram + p.stack
             ),
-            None => println!("  {name:<34} (no measurement)"),
+            None => println!("  {name}: no measurement"),
         }
     }
     record_ram(&[
@@ -328,23 +299,16 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
     let pico =
         pico.context("the Pico image's peak stack was not measured (the emulator run failed)")?;
     let total = pico.static_ram + pico.stack;
-    println!(
-        "  Pico RAM {total} B = {:.1} KiB of the {} KiB budget (static + peak stack)",
-        kib(total),
-        RAM_BUDGET / 1024
-    );
     if total > RAM_BUDGET {
         bail!("RAM use {total} B (static + peak stack) is over the {RAM_BUDGET} B budget");
     }
+    println!("  Pico RAM {total} B within the {RAM_BUDGET} B budget");
     Ok(())
 }
 
 /// Fails unless the image names the settings region of memory.x, it is
 /// `expected` (the board's, [`Board::settings`]), and nothing stored in
 /// flash reaches into it.
-///
-/// # Errors
-/// Which of these is not so.
 pub fn check_settings_region(image: &Image, expected: Range<u32>) -> Result<()> {
     let Some(region) = image.settings.clone() else {
         bail!(
@@ -379,21 +343,6 @@ pub fn check_settings_region(image: &Image, expected: Range<u32>) -> Result<()> 
         image.flash_end
     );
     Ok(())
-}
-
-fn stored_names(image: &Image) -> String {
-    image
-        .sections
-        .iter()
-        .filter(|section| section.stored)
-        .map(|section| section.name.as_str())
-        .collect::<Vec<_>>()
-        .join(" + ")
-}
-
-#[allow(clippy::cast_precision_loss)] // sizes far below 2^52
-fn kib(bytes: u64) -> f64 {
-    bytes as f64 / 1024.0
 }
 
 /// The sizes of the image at `path`, held to `flash_budget`, for the

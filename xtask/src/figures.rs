@@ -140,9 +140,6 @@ fn update_at(path: &Path, key: &str, table: Table) -> Result<()> {
 /// Writes the page to `page` from the figures at `figures_path`; returns
 /// the sections that had figures. Every heading is there whether or not
 /// its figures are, so that the links to it resolve.
-///
-/// # Errors
-/// If the page cannot be written.
 pub fn write_page(figures_path: &Path, page: &Path) -> Result<Vec<&'static str>> {
     let figures = load(figures_path).unwrap_or_else(|error| {
         println!("figures: {error:#}; the page says how to measure");

@@ -115,9 +115,6 @@ pub fn bootsel_drives(board: Board, mounts: &[PathBuf]) -> Vec<PathBuf> {
 
 /// The route for `board` here: a BOOTSEL drive, else probe-rs, else
 /// instructions.
-///
-/// # Errors
-/// If more than one board of the kind is in BOOTSEL mode.
 pub fn choose(board: Board, here: &Surroundings) -> Result<Route> {
     match bootsel_drives(board, &here.mounts).as_slice() {
         [drive] => return Ok(Route::Drive(drive.clone())),
@@ -176,9 +173,6 @@ Both routes step by step: docs/user/flashing.md"
 }
 
 /// `cargo xtask flash` on this machine.
-///
-/// # Errors
-/// See [`run`].
 pub fn command(args: &Args) -> Result<bool> {
     run(args, &Surroundings::here())
 }
@@ -186,10 +180,6 @@ pub fn command(args: &Args) -> Result<bool> {
 /// Flashes `args.elf` onto the board by the route [`choose`] finds in
 /// `here`. `Ok(false)` if there was none (the message says what to do) or
 /// probe-rs failed.
-///
-/// # Errors
-/// If the UF2 cannot be made or copied, probe-rs cannot be started, or
-/// [`choose`] fails.
 pub fn run(args: &Args, here: &Surroundings) -> Result<bool> {
     let board = args.board;
     let route = choose(board, here)?;

@@ -25,9 +25,6 @@ pub const STAGE: &str = "Pico 2 build (boards/pico2): start block, settings sect
                          family RP2350 Arm Secure";
 
 /// The stage [`STAGE`]: builds the image, checks it and makes its UF2.
-///
-/// # Errors
-/// If the build fails, the image is misplaced, or its UF2 cannot be made.
 pub fn test(metadata: &Metadata) -> Result<()> {
     let board = Board::Pico2;
     board.build()?;
@@ -41,9 +38,6 @@ pub fn test(metadata: &Metadata) -> Result<()> {
 /// The addresses of the `.start_block` section of the ELF `data`, checked:
 /// inside the boot ROM's search window, opening and closing with the block
 /// markers.
-///
-/// # Errors
-/// If there is no such section, or it is misplaced or not a block.
 pub fn start_block(data: &[u8]) -> Result<Range<u64>> {
     let file = object::File::parse(data).context("parsing the ELF")?;
     let section = file.section_by_name(".start_block").context(
@@ -80,9 +74,6 @@ pub fn start_block(data: &[u8]) -> Result<Range<u64>> {
 /// Prints the image's sections and sizes; fails unless the vector table is
 /// at the start of flash, a whole block lies in the first 4 KiB, the
 /// settings sectors are reserved and clear, and no allocator is linked.
-///
-/// # Errors
-/// The problems found, all of them.
 pub fn check(path: &Path) -> Result<()> {
     let image = elf::Image::read(path)?;
     println!("{}", path.display());

@@ -94,9 +94,6 @@ pub struct Finished<O, E, R> {
 /// `stdout` and `stderr` each read their pipe on a thread of their own (so
 /// that neither fills up and stalls it), `meanwhile` runs on this thread;
 /// once it returns, `child` has `timeout` to exit before it is killed.
-///
-/// # Errors
-/// A pipe that was not set up, a failed wait, or a reader that panicked.
 pub fn finish<O: Send, E: Send, R>(
     mut child: Child,
     name: &str,

@@ -36,9 +36,6 @@ pub use script::{default_time as script_time, parse as parse_script};
 /// Plays a script's `events` into the shipped image (built) for `time` from
 /// its first frame; every pulse checked against what the firmware wrote:
 /// on time, its own frame's, within the servos' limits (see `script.rs`).
-///
-/// # Errors
-/// If the emulator cannot run.
 pub fn play_script(
     root: &std::path::Path,
     metadata: &crate::project::Metadata,

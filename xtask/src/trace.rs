@@ -30,9 +30,6 @@ pub use script::{Event, Kind};
 use crate::steps::Steps;
 
 /// A script's events (see `script.rs`), checked with `params`.
-///
-/// # Errors
-/// Every bad line, each with its number and why.
 pub fn parse_script(text: &str, params: &BehaviourParams) -> Result<Vec<Event>> {
     script::parse(text, params)
 }
@@ -145,9 +142,6 @@ fn idle(config: HeadConfig, playback: Playback, seed: Option<u32>) -> Result<Idl
 
 /// The built-in driver's parameters and the behaviour's built on them:
 /// what the board runs.
-///
-/// # Errors
-/// If a configuration is refused (never the built-in ones).
 pub fn built_in() -> Result<(DriverParams, BehaviourParams)> {
     let driver = DriverConfig::DEFAULT
         .build()

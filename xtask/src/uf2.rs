@@ -28,10 +28,6 @@ pub struct Args {
 const BLOCK: usize = 512;
 
 /// The UF2 of the ELF `elf` for `board`.
-///
-/// # Errors
-/// If the board's boot ROM would not start the image ([`check_boot`]), its
-/// flash contents reach into the settings sectors, or the writer fails.
 pub fn make(elf: &[u8], board: Board) -> Result<Vec<u8>> {
     check_boot(elf, board)?;
     let settings = board.settings().start;
@@ -54,9 +50,6 @@ pub fn make(elf: &[u8], board: Board) -> Result<Vec<u8>> {
 /// Fails unless the ELF has what the board's boot ROM starts an image
 /// from: on the Pico, the 256-byte second stage (`.boot2`) at the start of
 /// flash; on the Pico 2, a block in its first 4 KiB (`.start_block`).
-///
-/// # Errors
-/// If it has not: a board would stay in BOOTSEL mode after the copy.
 pub fn check_boot(data: &[u8], board: Board) -> Result<()> {
     match board {
         Board::Pico => elf::Image::parse(data)
@@ -68,9 +61,6 @@ pub fn check_boot(data: &[u8], board: Board) -> Result<()> {
 
 /// Makes the UF2 of the ELF at `elf` and writes it beside it (`…/pico` →
 /// `…/pico.uf2`, or another `extension`); returns its path and contents.
-///
-/// # Errors
-/// If the ELF cannot be read, [`make`] fails, or the file cannot be written.
 pub fn write(elf: &Path, board: Board, extension: &str) -> Result<(PathBuf, Vec<u8>)> {
     let data = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
     let bytes = make(&data, board).with_context(|| format!("the UF2 of {}", elf.display()))?;
@@ -92,9 +82,6 @@ pub fn describe(path: &Path, board: Board, bytes: &[u8]) -> String {
 
 /// `cargo xtask uf2`: builds the board's image unless an ELF is given,
 /// writes its UF2 beside it and says how to flash it.
-///
-/// # Errors
-/// If the build fails or the UF2 cannot be made (see [`write`]).
 pub fn command(args: &Args) -> Result<bool> {
     let elf = if let Some(elf) = &args.elf {
         elf.clone()

@@ -87,9 +87,6 @@ impl Bridge {
     }
 
     /// Writes `bytes` to the head.
-    ///
-    /// # Errors
-    /// The head's end is gone.
     pub fn write(&self, bytes: &[u8]) -> Result<()> {
         let mut writer = self
             .writer

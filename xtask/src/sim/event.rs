@@ -134,9 +134,6 @@ pub enum Why {
 
 impl Event {
     /// Reads one line of the harness's output.
-    ///
-    /// # Errors
-    /// A line that is not JSON, or not an event as this module knows them.
     pub fn parse(line: &str) -> Result<Self> {
         // Through a `Value`: defmt-decoder turns on serde_json's
         // `arbitrary_precision`, under which a number read straight into a

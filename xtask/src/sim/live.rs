@@ -76,9 +76,6 @@ pub fn start(root: &Path, elf: &Path) -> Result<Live> {
 }
 
 /// Sends `bytes` to the head's USB serial port.
-///
-/// # Errors
-/// The harness has gone.
 pub fn send(stdin: &mut impl Write, bytes: &[u8]) -> std::io::Result<()> {
     let mut line = node::hex(bytes);
     line.push('\n');
