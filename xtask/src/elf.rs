@@ -233,10 +233,14 @@ pub fn check_pico(path: &Path) -> Result<()> {
     .filter_map(|check| check.err().map(|e| e.to_string()))
     .collect();
     if flash > FLASH_BUDGET {
-        problems.push(format!("flash use {flash} B is over the {FLASH_BUDGET} B budget"));
+        problems.push(format!(
+            "flash use {flash} B is over the {FLASH_BUDGET} B budget"
+        ));
     }
     if ram > RAM_BUDGET {
-        problems.push(format!("static RAM use {ram} B is over the {RAM_BUDGET} B budget"));
+        problems.push(format!(
+            "static RAM use {ram} B is over the {RAM_BUDGET} B budget"
+        ));
     }
     if problems.is_empty() {
         Ok(())

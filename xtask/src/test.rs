@@ -5,7 +5,7 @@ use std::{path::Path, time::Instant};
 
 use anyhow::{Result, bail};
 
-use xshell::{Shell, cmd};
+use xshell::cmd;
 
 use crate::{
     args::Options,
@@ -92,7 +92,7 @@ pub fn command(options: Options) -> Result<bool> {
     stages.run("rustfmt: every package of the workspace", || {
         project::run(&sh, &[], cmd!(sh, "cargo fmt --all --check"))
     });
-    clippy_stages(&mut stages, &sh, &host_tests, &xtask);
+    clippy_stages(&mut stages);
 
     // 3. The Pico image: placement of the boot stage, memory budgets, no allocator.
     let pico_built = stages.run("Pico build (cargo build --release)", || PICO.build(&root));
@@ -155,63 +155,48 @@ pub fn command(options: Options) -> Result<bool> {
     Ok(stages.finish(start))
 }
 
-fn clippy_stages(stages: &mut Stages, sh: &Shell, host_tests: &Shell, xtask: &Shell) {
-    // `--release` shares build scripts and proc-macros with the release builds below.
-    stages.run("clippy: Pico image, RP support, firmware layer, core (thumbv6m)", || {
-        project::run(
-            sh,
-            FIRMWARE_ENV,
-            cmd!(
-                sh,
-                "cargo clippy --release --package idle-head --package idle-head-rp --package idle-head-firmware --package idle-head-core -- -D warnings"
-            ),
-        )
-    });
-    stages.run("clippy: QEMU images, boards/qemu/ (thumbv6m)", || {
-        project::run(
-            sh,
-            FIRMWARE_ENV,
-            cmd!(
-                sh,
-                "cargo clippy --release --bins --package idle-head-qemu -- -D warnings"
-            ),
-        )
-    });
-    stages.run(
+/// The clippy passes: the firmware's (thumbv6m, `--release` to share build
+/// scripts and proc-macros with the release builds), the Pico 2's, and the
+/// host crates'; `(name, folder, firmware, arguments)`.
+const CLIPPY: [(&str, &str, bool, &str); 6] = [
+    (
+        "clippy: Pico image, RP support, firmware layer, core (thumbv6m)",
+        ".",
+        true,
+        "--release --package idle-head --package idle-head-rp --package idle-head-firmware \
+         --package idle-head-core",
+    ),
+    (
+        "clippy: QEMU images, boards/qemu/ (thumbv6m)",
+        ".",
+        true,
+        "--release --bins --package idle-head-qemu",
+    ),
+    (
         "clippy: Pico 2 image, boards/pico2/ (thumbv8m.main)",
-        || {
-            let pico2 = project::shell("boards/pico2")?;
-            project::run(
-                &pico2,
-                FIRMWARE_ENV,
-                cmd!(pico2, "cargo clippy --release -- -D warnings"),
-            )
-        },
-    );
-    stages.run("clippy: core crate and its unit tests (host)", || {
-        project::run(
-            sh,
-            &[],
-            cmd!(
-                sh,
-                "cargo clippy --package idle-head-core --all-targets --target host-tuple -- -D warnings"
-            ),
-        )
-    });
-    stages.run("clippy: host-tests", || {
-        project::run(
-            host_tests,
-            &[],
-            cmd!(host_tests, "cargo clippy --all-targets -- -D warnings"),
-        )
-    });
-    stages.run("clippy: xtask", || {
-        project::run(
-            xtask,
-            &[],
-            cmd!(xtask, "cargo clippy --all-targets -- -D warnings"),
-        )
-    });
+        "boards/pico2",
+        true,
+        "--release",
+    ),
+    (
+        "clippy: core crate and its unit tests (host)",
+        ".",
+        false,
+        "--package idle-head-core --all-targets --target host-tuple",
+    ),
+    ("clippy: host-tests", "host-tests", false, "--all-targets"),
+    ("clippy: xtask", "xtask", false, "--all-targets"),
+];
+
+fn clippy_stages(stages: &mut Stages) {
+    for (name, dir, firmware, args) in CLIPPY {
+        stages.run(name, || {
+            let sh = project::shell(dir)?;
+            let args = args.split_whitespace();
+            let env = if firmware { FIRMWARE_ENV } else { &[] };
+            project::run(&sh, env, cmd!(sh, "cargo clippy {args...} -- -D warnings"))
+        });
+    }
 }
 
 fn sim_stages(
