@@ -12,7 +12,7 @@
     clippy::cast_sign_loss
 )]
 
-use std::{fmt::Write as _, path::Path};
+use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 
@@ -111,17 +111,6 @@ impl Row {
     pub fn ratio(&self) -> f64 {
         self.direct as f64 / self.engine as f64
     }
-
-    /// Engine instructions per generated sample (three axes of N samples).
-    pub fn per_sample(&self) -> f64 {
-        self.engine as f64 / (3 * self.n) as f64
-    }
-
-    /// The engine's time on a 125 MHz RP2040, in µs: a lower bound, since
-    /// every Cortex-M0+ instruction takes at least one cycle.
-    pub fn rp2040_us(&self) -> f64 {
-        self.engine as f64 / RP2040_HZ * 1e6
-    }
 }
 
 /// The rows of a benchmark log, in order; fails on a malformed line.
@@ -129,41 +118,6 @@ pub fn rows(log: &[LogLine]) -> Result<Vec<Row>> {
     log.iter()
         .filter_map(|line| Row::parse(&line.message).transpose())
         .collect()
-}
-
-/// The table of the rows, ready to print.
-pub fn table(rows: &[Row]) -> String {
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "{:<8} {:>5} {:>4} {:>12} {:>13} {:>8} {:>11} {:>13}",
-        "row", "N", "W", "engine insn", "direct f32", "ratio", "insn/sample", "RP2040 µs ≥"
-    );
-    for row in rows {
-        let _ = writeln!(
-            out,
-            "{:<8} {:>5} {:>4} {:>12} {:>13} {:>7.1}× {:>11.1} {:>13.0}",
-            row.label,
-            row.n,
-            row.w,
-            thousands(row.engine),
-            thousands(row.direct),
-            row.ratio(),
-            row.per_sample(),
-            row.rp2040_us(),
-        );
-    }
-    let _ = writeln!(
-        out,
-        "engine: walk, smoothing, scaling and loop closure of 3 axes; direct f32: \
-         the paper's smoothing only, Σ h(m)·u(n−m), of 3 walks;"
-    );
-    let _ = writeln!(
-        out,
-        "ratio = direct/engine; insn/sample = engine/(3·N); RP2040 µs = engine/125 MHz \
-         (a lower bound: each M0+ instruction takes ≥ 1 cycle)."
-    );
-    out
 }
 
 /// What the rows say: the budget, flatness in W and linearity in N.
@@ -277,16 +231,10 @@ pub fn run_and_check(
     if !missing.is_empty() {
         bail!("the benchmark reported no row for {}", missing.join(", "));
     }
-    println!();
-    print!("{}", table(&rows));
     let verdict = Verdict::of(&rows)?;
     print!("{}", verdict.lines());
     let frames = FrameRow::all(&run.log)?;
     record_figures(&rows, &frames, BUDGET);
-    for frame in &frames {
-        println!();
-        print!("{}", frame.lines());
-    }
     println!();
     QEMU.build(root)?;
     println!(

@@ -285,17 +285,6 @@ pub struct Peak {
 /// measured in the RP2040 emulator) and the QEMU smoke image; fails if the
 /// Pico image's total is over [`RAM_BUDGET`] or its peak is unknown.
 pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
-    for (name, peak) in [("Pico (RP2040 emulator)", pico), ("QEMU smoke", qemu)] {
-        match peak {
-            Some(p) => println!(
-                "  {name}: {} B static + {} B peak stack = {} B",
-                p.static_ram,
-                p.stack,
-                p.static_ram + p.stack
-            ),
-            None => println!("  {name}: no measurement"),
-        }
-    }
     record_ram(&[
         ("pico", "the RP2040 emulator", pico, Some(RAM_BUDGET)),
         ("qemu", "QEMU (lm3s6965evb)", qemu, None),

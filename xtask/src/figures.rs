@@ -78,11 +78,15 @@ pub fn percent(part: u64, whole: u64) -> String {
     format!("{:.0} %", part as f64 / whole.max(1) as f64 * 100.0)
 }
 
-/// Records the table `key` (replacing the one recorded before) as the
-/// running command's, on the working tree's commit. A table that cannot be
-/// recorded does not fail the check that measured it: it is reported, and
-/// the page shows the last one recorded.
+/// Prints the table `key` and records it (replacing the one recorded
+/// before) as the running command's, on the working tree's commit. A table
+/// that cannot be recorded does not fail the check that measured it: it is
+/// reported, and the page shows the last one recorded.
 pub fn record(key: &str, intro: String, header: &[&str], rows: Vec<Vec<String>>) {
+    println!("{key}:\n  | {} |", header.join(" | "));
+    for row in &rows {
+        println!("  | {} |", row.join(" | "));
+    }
     let args: Vec<String> = std::env::args().skip(1).collect();
     let commit = Command::new("git")
         .args(["describe", "--always", "--dirty"])

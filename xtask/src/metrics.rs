@@ -195,28 +195,10 @@ pub fn run(args: Args, closure: Closure) -> Result<Results> {
     Ok(all)
 }
 
-/// The table of both closures' distributions and the violation counts.
+/// The violation counts of both closures (their distributions are the
+/// tables [`record_figures`] prints).
 pub fn report(results: &[(Closure, Results)], args: Args) -> String {
     let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "{:<9} {:<16} {:>10} {:>10} {:>10} {:>10}",
-        "closure", "metric", "min", "median", "p99", "max"
-    );
-    for (closure, result) in results {
-        let name = match closure {
-            Closure::Paper => "paper",
-            Closure::Seamless => "seamless",
-        };
-        for (metric, get) in ROWS {
-            let [min, median, p99, max] = distribution(result.loops.iter().map(get).collect());
-            let _ = writeln!(
-                out,
-                "{name:<9} {metric:<16} {min:>10.3} {median:>10.3} {p99:>10.3} {max:>10.3}"
-            );
-        }
-    }
-    let _ = writeln!(out);
     for (closure, result) in results {
         let name = match closure {
             Closure::Paper => "paper",
@@ -280,8 +262,8 @@ pub fn command(args: &Args) -> Result<bool> {
     for closure in [Closure::Seamless, Closure::Paper] {
         results.push((closure, run(args, closure)?));
     }
-    print!("{}", report(&results, args));
     record_figures(&results, args);
+    print!("{}", report(&results, args));
     println!(
         "{} loops in {:.1} s",
         2 * u64::from(args.seeds),
@@ -406,8 +388,6 @@ mod tests {
             }
         }
         let text = report(&results, args);
-        assert!(text.contains("seamless  max|d1|/P95|d1|"));
-        assert!(text.contains("paper     liveliness"));
-        assert!(text.contains("continuity > 3"));
+        assert!(text.starts_with("seamless  continuity > 3: "), "{text}");
     }
 }
