@@ -132,81 +132,41 @@ pub fn version(program: impl AsRef<std::ffi::OsStr>) -> Option<String> {
 pub const MDBOOK_VERSION: &str = "0.5.4";
 
 /// The `mdbook` program to run: the pinned release if it is on the `PATH`
-/// or was installed into `tools` before; otherwise it is installed from
-/// crates.io with `cargo install` (a few minutes, once), into cargo's own
-/// folder of programs if no other mdBook is on the `PATH`, and into `tools`
-/// if one is (so that another project's mdBook is left as it is). Only
-/// the HTML renderer and its search are built (`--no-default-features
-/// --features search`): the book needs no `mdbook serve` or `watch`.
+/// or in `tools`; else it is installed there with `cargo install` (a few
+/// minutes, once; `tools` leaves any other mdBook as it is). Only the HTML
+/// renderer and its search are built: the book needs no `serve` or `watch`.
 pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
-    let local = tools.join("bin").join("mdbook");
     let wanted = format!("mdbook v{MDBOOK_VERSION}");
-    if version(&local).as_deref() == Some(wanted.as_str()) {
-        return Ok(local);
+    let local = tools.join("bin").join("mdbook");
+    for program in [local.clone(), PathBuf::from("mdbook")] {
+        if version(&program).as_deref() == Some(wanted.as_str()) {
+            return Ok(program);
+        }
     }
-    let on_path = version("mdbook");
-    if on_path.as_deref() == Some(wanted.as_str()) {
-        return Ok(PathBuf::from("mdbook"));
-    }
+    println!(
+        "installing mdbook v{MDBOOK_VERSION} into {} (a few minutes, once)",
+        project::relative(tools).display()
+    );
     let sh = project::shell(".")?;
     // The repository's .cargo/config.toml builds for the firmware's target:
     // mdBook is a host program.
-    let host = host_triple()?;
-    let root = if let Some(other) = &on_path {
-        println!(
-            "{other} is on the PATH, not v{MDBOOK_VERSION}: installing v{MDBOOK_VERSION} into {}",
-            project::relative(tools).display()
-        );
-        Some(tools.to_path_buf())
-    } else {
-        println!(
-            "mdbook is missing: installing v{MDBOOK_VERSION} with cargo install (a few minutes, once)"
-        );
-        None
-    };
-    let root_args: Vec<String> = root
-        .iter()
-        .flat_map(|dir| ["--root".to_owned(), dir.display().to_string()])
-        .collect();
+    let info = cmd!(sh, "rustc -vV").quiet().read()?;
+    let host = info.lines().find_map(|line| line.strip_prefix("host: "));
+    let host = host.context("`rustc -vV` names no host")?;
     let build_dir = tools.join("build");
     project::run(
         &sh,
         &[],
         cmd!(
             sh,
-            "cargo install mdbook --locked --version {MDBOOK_VERSION} --no-default-features --features search --target {host} --target-dir {build_dir} {root_args...}"
+            "cargo install mdbook --locked --version {MDBOOK_VERSION} --no-default-features --features search --target {host} --target-dir {build_dir} --root {tools}"
         ),
     )?;
-    let installed = match root {
-        Some(_) => local,
-        None => cargo_home()?.join("bin").join("mdbook"),
-    };
-    if version(&installed).as_deref() != Some(wanted.as_str()) {
+    if version(&local).as_deref() != Some(wanted.as_str()) {
         bail!(
             "installed mdBook v{MDBOOK_VERSION}, but {} does not run as it",
-            installed.display()
+            local.display()
         );
     }
-    Ok(installed)
-}
-
-/// The host's target triple (`rustc -vV`'s `host:` line).
-fn host_triple() -> Result<String> {
-    let sh = project::shell(".")?;
-    let info = cmd!(sh, "rustc -vV").quiet().read()?;
-    info.lines()
-        .find_map(|line| line.strip_prefix("host: "))
-        .map(str::to_owned)
-        .context("`rustc -vV` names no host")
-}
-
-/// Where `cargo install` puts programs without `--root`: `$CARGO_HOME`, or
-/// `~/.cargo`.
-fn cargo_home() -> Result<PathBuf> {
-    if let Some(home) = std::env::var_os("CARGO_HOME") {
-        return Ok(PathBuf::from(home));
-    }
-    std::env::var_os("HOME")
-        .map(|home| PathBuf::from(home).join(".cargo"))
-        .context("neither CARGO_HOME nor HOME is set")
+    Ok(local)
 }
