@@ -239,34 +239,27 @@ mod tests {
 
     #[test]
     fn one_loop_from_options() {
-        let args = parse(&[
-            "--seed",
-            "127",
-            "--n=450",
-            "--w",
-            "31",
-            "--range",
-            "-4.5",
-            "12",
-            "--closure",
-            "Paper",
-            "--out",
-            "tmp",
-            "--axis",
-            "pitch",
-        ])
-        .unwrap();
-        let loops = args.loops().unwrap();
-        assert_eq!(loops.len(), 1);
-        let (spec, name) = &loops[0];
-        assert_eq!(name, "loop");
-        assert_eq!(spec.axis, Axis::Pitch);
-        assert_eq!(spec.n, 450);
-        assert_eq!(spec.cfg.seed, 127);
-        assert_eq!(spec.cfg.window, 31);
-        assert_eq!(spec.cfg.range.min, Angle::from_millidegrees(-4500));
-        assert_eq!(spec.cfg.range.max, Angle::from_degrees(12));
-        assert_eq!(spec.cfg.closure, Closure::Paper);
+        let args = "--seed 127 --n=450 --w 31 --range -4.5 12 --closure Paper --axis pitch";
+        let loops = parse(&args.split(' ').collect::<Vec<_>>())
+            .unwrap()
+            .loops()
+            .unwrap();
+        let [(spec, name)] = &loops[..] else {
+            panic!("{loops:?}")
+        };
+        assert_eq!(
+            (name.as_str(), spec.axis, spec.n),
+            ("loop", Axis::Pitch, 450)
+        );
+        let range = AngleRange {
+            min: Angle::from_millidegrees(-4500),
+            max: Angle::from_degrees(12),
+        };
+        let cfg = &spec.cfg;
+        assert_eq!(
+            (cfg.seed, cfg.window, cfg.range, cfg.closure),
+            (127, 31, range, Closure::Paper)
+        );
         // The yaw default row when only --n is given.
         let loops = parse(&["--n", "450"]).unwrap().loops().unwrap();
         assert_eq!(loops[0].0.cfg, DEFAULT_HEAD.yaw);

@@ -35,13 +35,3 @@ pub fn config(elf: &Path, extension: &str) -> Result<(PicoImage, node::Config)> 
     };
     Ok((image, config))
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_inputs_are_gp2_to_gp5() {
-        assert_eq!(input_pins(), [2, 3, 4, 5]);
-    }
-}

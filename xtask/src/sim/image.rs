@@ -78,26 +78,3 @@ impl PicoImage {
         })
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_host_binary_is_not_a_pico_image() {
-        let error = PicoImage::read(&std::env::current_exe().unwrap()).unwrap_err();
-        assert!(
-            format!("{error:#}").contains("is not a Pico image"),
-            "{error:#}"
-        );
-    }
-
-    #[test]
-    fn a_missing_file_says_how_to_build_it() {
-        let error = PicoImage::read(Path::new("/nonexistent/pico")).unwrap_err();
-        assert!(
-            format!("{error:#}").contains("cargo build --release"),
-            "{error:#}"
-        );
-    }
-}
