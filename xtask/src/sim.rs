@@ -181,6 +181,9 @@ fn seconds(value: &str, max: f64) -> Result<Duration, String> {
     Ok(Duration::from_secs_f64(seconds))
 }
 
+/// A run of its own that `cargo xtask test` runs as a stage.
+type Stage = fn(&std::path::Path, &project::Metadata) -> Result<()>;
+
 /// Whether the run called `what` passed; if not, says why.
 fn passed(what: &str, result: Result<()>) -> bool {
     match result {
@@ -207,27 +210,16 @@ pub fn command(args: &Args) -> Result<bool> {
             args.pulses.as_ref(),
         );
     }
-    if args.inputs {
+    let runs: [(bool, &str, Stage); 5] = [
+        (args.inputs, "inputs", inputs::test_inputs),
+        (args.drill, "watchdog drill", stages::test_drill),
+        (args.flood, "UART flood", flood::test_flood),
+        (args.noise, "UART noise", noise::test_noise),
+        (args.store, "settings store", store::test_store),
+    ];
+    if let Some((_, what, stage)) = runs.iter().find(|run| run.0) {
         PICO.build(&root)?;
-        return Ok(passed("inputs", inputs::test_inputs(&root, &metadata)));
-    }
-    if args.drill {
-        return Ok(passed(
-            "watchdog drill",
-            stages::test_drill(&root, &metadata),
-        ));
-    }
-    if args.flood {
-        return Ok(passed("UART flood", flood::test_flood(&root, &metadata)));
-    }
-    if args.noise {
-        return Ok(passed("UART noise", noise::test_noise(&root, &metadata)));
-    }
-    if args.store {
-        return Ok(passed(
-            "settings store",
-            store::test_store(&root, &metadata),
-        ));
+        return Ok(passed(what, stage(&root, &metadata)));
     }
     if args.console {
         let time = args.virtual_time.unwrap_or(CONSOLE_TIME);
