@@ -1,8 +1,7 @@
 // The head's console as the page speaks it: two transports behind one
-// interface (Web Serial for a board, a WebSocket to `cargo xtask panel`'s
-// bridge), and a console client that sends one line at a time and waits
-// for its reply (docs/user/protocol.md), telling telemetry lines (`~ …`)
-// apart.
+// interface (Web Serial for a board, `cargo xtask panel`'s bridge), and a
+// console client that sends one line at a time and waits for its reply
+// (docs/user/protocol.md), telling telemetry lines (`~ …`) apart.
 
 /** CRC-8/SMBUS, as the firmware's machine mode and telemetry use it. */
 export function crc8(bytes) {
@@ -109,10 +108,12 @@ export class SerialTransport {
   }
 }
 
-/** A WebSocket to `cargo xtask panel`'s bridge. */
-export class SocketTransport {
-  constructor(url, name) {
-    this.url = url;
+/**
+ * `cargo xtask panel`'s bridge: the head's bytes as server-sent events
+ * (hex digits; an event `gone` when the head goes away), ours by POST.
+ */
+export class BridgeTransport {
+  constructor(name) {
     this.name = name;
     this.onBytes = () => {};
     this.onClose = () => {};
@@ -121,43 +122,42 @@ export class SocketTransport {
 
   open() {
     return new Promise((resolve, reject) => {
-      const ws = new WebSocket(this.url);
-      ws.binaryType = 'arraybuffer';
-      this.ws = ws;
+      const events = new EventSource('events');
+      this.events = events;
       let opened = false;
-      ws.onopen = () => {
+      events.onopen = () => {
         opened = true;
         resolve();
       };
-      ws.onmessage = (event) => {
-        if (typeof event.data === 'string') {
-          const note = JSON.parse(event.data);
-          if (note.gone) this.finish(`the head went away: ${note.gone}`);
-        } else {
-          this.onBytes(new Uint8Array(event.data));
-        }
+      events.onmessage = (event) => {
+        const hex = event.data;
+        const bytes = new Uint8Array(hex.length / 2);
+        for (let i = 0; i < bytes.length; i++) bytes[i] = parseInt(hex.slice(2 * i, 2 * i + 2), 16);
+        this.onBytes(bytes);
       };
-      ws.onclose = () => {
-        if (!opened) reject(new Error(`no bridge at ${this.url}`));
+      events.addEventListener('gone', (event) => this.finish(`the head went away: ${event.data}`));
+      events.onerror = () => {
+        if (!opened) reject(new Error('no bridge at this address'));
         this.finish('the bridge closed the connection');
       };
     });
   }
 
   async write(bytes) {
-    if (this.ws.readyState !== WebSocket.OPEN) throw new Error('the connection is closed');
-    this.ws.send(bytes);
+    if (this.closed) throw new Error('the connection is closed');
+    const sent = await fetch('send', { method: 'POST', body: bytes });
+    if (!sent.ok) throw new Error(await sent.text());
   }
 
   finish(why) {
     if (this.closed) return;
     this.closed = true;
+    this.events?.close();
     this.onClose(why);
   }
 
   async close() {
     this.finish('disconnected');
-    this.ws?.close();
   }
 }
 

@@ -4,7 +4,7 @@
 // calibration and settings (rest, inputs and DMX in modules of their own).
 // Every line sent and received goes to the log.
 
-import { Console, NoReply, SerialTransport, SocketTransport, commandWords, fields, gestureWords, refusal } from './link.js';
+import { BridgeTransport, Console, NoReply, SerialTransport, commandWords, fields, gestureWords, refusal } from './link.js';
 import { makePlot, showTelemetry } from './view.js';
 import * as rest from './rest.js';
 import * as inputs from './inputs.js';
@@ -171,9 +171,7 @@ function reconnect() {
 }
 
 function bridgeTransport() {
-  const url = new URL(bridge.ws, location.href);
-  url.protocol = url.protocol === 'https:' ? 'wss:' : 'ws:';
-  return new SocketTransport(url.href, `bridged to ${bridge.name}`);
+  return new BridgeTransport(`bridged to ${bridge.name}`);
 }
 
 let chosenPort = null;

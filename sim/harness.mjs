@@ -8,7 +8,8 @@
 //   node harness.mjs '<config as JSON>'
 //
 // config: {
-//   flash:      path of the flash image (binary, loaded at 0x10000000),
+//   flash:      path of the flash image: a UF2 file (`.uf2`, each block's payload at its
+//               address), or a binary loaded at 0x10000000,
 //   vtor:       vector table address (0x10000100 behind a 256-byte boot2),
 //   rtt:        address of `_SEGGER_RTT` (0 = no RTT),
 //   pins:       GPIO numbers whose edges to report,
@@ -136,7 +137,14 @@ const dmx = cfg.dmx ? dmxLine(cfg.dmx, emit) : null;
 // The flash at power-on: the image, and `flash_fill` over it.
 function firstFlash() {
   const flash = new Uint8Array(16 << 20).fill(0xff);
-  flash.set(image);
+  if (!cfg.flash.endsWith('.uf2')) flash.set(image);
+  for (let at = 0; cfg.flash.endsWith('.uf2') && at < image.length; at += 512) {
+    const word = (offset) => image.readUInt32LE(at + offset);
+    if (word(0) !== 0x0a324655 || word(4) !== 0x9e5d5157 || word(508) !== 0x0ab16f30) {
+      throw new Error(`${cfg.flash}: block ${at / 512} is not a UF2 block`);
+    }
+    flash.set(image.subarray(at + 32, at + 32 + word(16)), word(12) - FLASH_START);
+  }
   if (cfg.flash_fill) flash.set(Buffer.from(cfg.flash_fill.hex, 'hex'), cfg.flash_fill.addr - FLASH_START);
   return flash;
 }

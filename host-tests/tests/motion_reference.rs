@@ -2,11 +2,11 @@
 
 mod reference;
 
+use idle_head_core::Axis;
 use idle_head_core::motion::{
     AxisConfig, Closure, DEFAULT_HEAD, DEFAULT_N, Fnv1a, HannKernel, HeadConfig, HeadTrajectories,
     Integral16, Lcg, Mdeg16, Sample, Trajectory, generate_into,
 };
-use idle_head_core::{AngleRange, Axis};
 
 fn engine<const N: usize>(
     seed: u32,
@@ -101,11 +101,6 @@ fn paper_matches_reference() {
     );
     assert!(worst <= 0.004, "worst error {worst}");
     assert!(same_split >= 250);
-}
-
-#[test]
-fn range_type_is_used() {
-    let _ = AngleRange::degrees(-1, 1);
 }
 
 /// The three default loops, bit for bit: the checksum that the firmware

@@ -13,7 +13,7 @@
 //   firmware does, and swallow a line (a reply that never comes); the
 //   emulator's GP2 can be pressed (`pin 2 0` to the harness).
 // - bridge: the page served by `cargo xtask panel` with a bridge (QEMU, a
-//   serial port) connects over its WebSocket on load.
+//   serial port) connects over its bridge on load.
 //
 // Each prints what it checked; any failed check, page error or timeout
 // fails the run (exit 1). Screenshots at 1280×800 go to `shots`.
@@ -475,7 +475,7 @@ async function serialSession() {
   }
 }
 
-// ---- a session over the bridge's WebSocket ----------------------------
+// ---- a session over the bridge -------------------------------------------
 
 async function bridgeSession() {
   const chrome = await browser();

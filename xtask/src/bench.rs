@@ -1,27 +1,9 @@
-//! `cargo xtask bench`: the boot-precompute benchmark, run in QEMU.
-//!
-//! The benchmark image (bin `bench`) generates the three axes of the default
-//! set for several N and W, and times a direct-form f32 implementation of the
-//! paper's smoothing next to it, on the same emulated Cortex-M0. Under
-//! `-icount shift=0` one instruction is one nanosecond of virtual time, so the
-//! counts it logs are instruction counts, identical run after run:
-//!
-//! ```text
-//! bench row=<label> n=<N> w=<W> engine=<insns> direct=<insns> (<checksum>)
-//! ```
-//!
-//! Then it counts the instructions of every frame update of a whole loop,
-//! exactly (see `qemu/src/frame_bench.rs` for how):
-//!
-//! ```text
-//! frame bench frames=<n> min=<insns> median=<insns> max=<insns> max_at=<frame> mean=<insns>
-//! frame bench scenario=gesture+look frames=<n> min=<insns> ...
-//! ```
-//!
-//! This module decodes that log, prints the table and the `frame` rows,
-//! reports the `default` row against its [`BUDGET`] and each frame row (idle,
-//! and with a gesture and a look) against its own ceiling
-//! ([`frame::CEILINGS`]), and fails past any of them, naming the row.
+//! `cargo xtask bench`: the benchmark image in QEMU, where one instruction
+//! is one nanosecond of virtual time. It logs `bench row=<label> n=<N>
+//! w=<W> engine=<insns> direct=<insns>` (the boot precompute against a
+//! direct-form f32 smoothing) and `frame bench [scenario=…] frames=… min=…
+//! median=… max=… max_at=… mean=…`; this module prints them and holds the
+//! default row to its [`BUDGET`] and each frame row to its ceiling.
 
 // Instruction counts are far below 2^52 and positive: the float conversions are exact.
 #![allow(
@@ -30,7 +12,7 @@
     clippy::cast_sign_loss
 )]
 
-use std::{fmt::Write as _, path::Path};
+use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 
@@ -88,11 +70,8 @@ const MARGINAL_TOLERANCE: f64 = 0.1;
 /// One `bench row=...` line.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Row {
-    /// `default`, `w15`, ...
     pub label: String,
-    /// Samples per loop.
     pub n: u64,
-    /// Hann window taps.
     pub w: u64,
     /// Instructions of the engine (three axes, whole pipeline).
     pub engine: u64,
@@ -132,17 +111,6 @@ impl Row {
     pub fn ratio(&self) -> f64 {
         self.direct as f64 / self.engine as f64
     }
-
-    /// Engine instructions per generated sample (three axes of N samples).
-    pub fn per_sample(&self) -> f64 {
-        self.engine as f64 / (3 * self.n) as f64
-    }
-
-    /// The engine's time on a 125 MHz RP2040, in µs: a lower bound, since
-    /// every Cortex-M0+ instruction takes at least one cycle.
-    pub fn rp2040_us(&self) -> f64 {
-        self.engine as f64 / RP2040_HZ * 1e6
-    }
 }
 
 /// The rows of a benchmark log, in order; fails on a malformed line.
@@ -150,41 +118,6 @@ pub fn rows(log: &[LogLine]) -> Result<Vec<Row>> {
     log.iter()
         .filter_map(|line| Row::parse(&line.message).transpose())
         .collect()
-}
-
-/// The table of the rows, ready to print.
-pub fn table(rows: &[Row]) -> String {
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "{:<8} {:>5} {:>4} {:>12} {:>13} {:>8} {:>11} {:>13}",
-        "row", "N", "W", "engine insn", "direct f32", "ratio", "insn/sample", "RP2040 µs ≥"
-    );
-    for row in rows {
-        let _ = writeln!(
-            out,
-            "{:<8} {:>5} {:>4} {:>12} {:>13} {:>7.1}× {:>11.1} {:>13.0}",
-            row.label,
-            row.n,
-            row.w,
-            thousands(row.engine),
-            thousands(row.direct),
-            row.ratio(),
-            row.per_sample(),
-            row.rp2040_us(),
-        );
-    }
-    let _ = writeln!(
-        out,
-        "engine: walk, smoothing, scaling and loop closure of 3 axes; direct f32: \
-         the paper's smoothing only, Σ h(m)·u(n−m), of 3 walks;"
-    );
-    let _ = writeln!(
-        out,
-        "ratio = direct/engine; insn/sample = engine/(3·N); RP2040 µs = engine/125 MHz \
-         (a lower bound: each M0+ instruction takes ≥ 1 cycle)."
-    );
-    out
 }
 
 /// What the rows say: the budget, flatness in W and linearity in N.
@@ -298,16 +231,10 @@ pub fn run_and_check(
     if !missing.is_empty() {
         bail!("the benchmark reported no row for {}", missing.join(", "));
     }
-    println!();
-    print!("{}", table(&rows));
     let verdict = Verdict::of(&rows)?;
     print!("{}", verdict.lines());
     let frames = FrameRow::all(&run.log)?;
     record_figures(&rows, &frames, BUDGET);
-    for frame in &frames {
-        println!();
-        print!("{}", frame.lines());
-    }
     println!();
     QEMU.build(root)?;
     println!(
@@ -369,48 +296,75 @@ pub fn command(options: Options) -> Result<bool> {
     Ok(passed)
 }
 
-/// The latency rows.
-fn record_latency(rows: Vec<figures::LatencyRow>) {
-    let source = figures::Source::now();
-    figures::save_section("latency", |f| {
-        f.latency = Some(figures::Latency { source, rows });
-    });
+/// The latency rows, for the measured figures.
+fn record_latency(rows: Vec<Vec<String>>) {
+    let intro = "Latency, measured in the RP2040 emulator on the shipped image, from an event \
+                 to the first servo pulse that shows it, in ms \
+                 ([the emulators](../dev/emulators.md#latency-of-an-input-edge)).";
+    let header = ["row", "events", "p50", "p99", "max", "goal (p99)"];
+    figures::record("latency", intro.to_owned(), &header, rows);
 }
 
-/// The benchmark's rows.
+/// The benchmark's rows, for the measured figures.
 fn record_figures(rows: &[Row], frames: &[FrameRow], budget: u64) {
-    let entry = figures::Bench {
-        source: figures::Source::now(),
-        budget,
-        rows: rows
-            .iter()
-            .map(|row| figures::PrecomputeRow {
-                label: row.label.clone(),
-                n: row.n,
-                w: row.w,
-                engine: row.engine,
-                direct: row.direct,
-            })
-            .collect(),
-        // Each with its ceiling: `FrameRow::all` refused a row without one.
-        frames: frames
-            .iter()
-            .filter_map(|row| {
-                let ceiling = row.ceiling()?;
-                Some(figures::FrameCost {
-                    label: row.label(),
-                    frames: row.frames,
-                    min: row.min,
-                    median: row.median,
-                    max: row.max,
-                    mean: row.mean,
-                    median_budget: ceiling.median,
-                    max_budget: ceiling.max,
-                })
-            })
-            .collect(),
-    };
-    figures::save_section("benchmark", |f| f.bench = Some(entry));
+    let at_125_mhz = |insns: u64| insns as f64 / RP2040_HZ * 1e6;
+    let intro = "Instructions of one frame update (`FrameLoop::write`: playback, mixer, fade, \
+                 limits, mapping, three PWM writes) over every frame of a whole loop, counted \
+                 exactly in QEMU ([what a frame costs](limiter.md#what-a-frame-costs)). A 20 ms \
+                 frame has 2,500,000 cycles of a 125 MHz RP2040.";
+    let header = [
+        "row",
+        "frames",
+        "min",
+        "median",
+        "max",
+        "mean",
+        "ceiling (median / max)",
+        "median at 125 MHz",
+    ];
+    // Each with its ceiling: `FrameRow::all` refused a row without one.
+    let cells = frames.iter().filter_map(|row| {
+        let ceiling = row.ceiling()?;
+        let counts = [row.frames, row.min, row.median, row.max, row.mean].map(thousands);
+        let mut cells = vec![row.label()];
+        cells.extend(counts);
+        cells.push(format!(
+            "{} / {}",
+            thousands(ceiling.median),
+            thousands(ceiling.max)
+        ));
+        cells.push(format!("≥ {:.1} µs", at_125_mhz(row.median)));
+        Some(cells)
+    });
+    figures::record("frames", intro.to_owned(), &header, cells.collect());
+    let intro = format!(
+        "Instructions of the three axes' loops, computed at boot, for the default set and \
+         across W and N, next to a direct-form f32 implementation of the paper's smoothing \
+         on the same core ([how it is computed](motion.md#how-it-is-computed)). The default \
+         set's ceiling is {} instructions.",
+        thousands(budget)
+    );
+    let header = [
+        "row",
+        "N",
+        "W",
+        "engine",
+        "direct f32 smoothing",
+        "ratio",
+        "engine at 125 MHz",
+    ];
+    let cells = rows.iter().map(|row| {
+        vec![
+            row.label.clone(),
+            row.n.to_string(),
+            row.w.to_string(),
+            thousands(row.engine),
+            thousands(row.direct),
+            format!("{:.0}×", row.ratio()),
+            format!("≥ {:.2} ms", at_125_mhz(row.engine) / 1000.0),
+        ]
+    });
+    figures::record("precompute", intro, &header, cells.collect());
 }
 
 #[cfg(test)]

@@ -123,14 +123,3 @@ impl Board {
         project::run(&sh, FIRMWARE_ENV, cmd!(sh, "cargo build --release"))
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_settings_region_is_the_last_16_kib_of_each_flash() {
-        assert_eq!(Board::Pico.settings(), 0x101f_c000..0x1020_0000);
-        assert_eq!(Board::Pico2.settings(), 0x103f_c000..0x1040_0000);
-    }
-}

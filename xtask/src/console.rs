@@ -1,14 +1,8 @@
 //! `cargo xtask console`: talk to a head, stdin to it and its replies to
-//! stdout, one per line. `--qemu` runs the firmware in QEMU with its UART0
-//! on a socket; `--port` opens a serial port; with neither, the Pico is
-//! found by its USB VID:PID. Also the flood and console stages of `cargo
-//! xtask test`.
-//!
-//! The bytes go through as they are, both ways: no line is decoded as text
-//! on the way, so a line that is not UTF-8 reaches the head, which answers
-//! it with an error (only the replies' CR LF becomes the host's LF). The
-//! replies due are counted where the head's framer ends lines (CR, LF or
-//! CR LF); whatever ends a session early is said on stderr.
+//! stdout, one per line, the bytes unchanged both ways. `--qemu` runs the
+//! firmware in QEMU, `--port` opens a serial port, neither finds the Pico
+//! by its USB VID:PID. Also the flood and console stages of `cargo xtask
+//! test`.
 
 pub mod qemu;
 mod stages;
@@ -203,4 +197,70 @@ fn serial_session(
 }
 
 #[cfg(test)]
-mod port_tests;
+mod tests {
+    use super::*;
+
+    /// A USB serial port as the system lists it.
+    fn usb(name: &str, vid: u16, pid: u16, product: Option<&str>) -> serialport::SerialPortInfo {
+        serialport::SerialPortInfo {
+            port_name: name.to_owned(),
+            port_type: serialport::SerialPortType::UsbPort(serialport::UsbPortInfo {
+                vid,
+                pid,
+                serial_number: None,
+                manufacturer: None,
+                product: product.map(str::to_owned),
+            }),
+        }
+    }
+
+    #[test]
+    fn the_head_is_found_by_its_id_and_product_among_other_devices() {
+        let (vid, pid) = PICO_USB_ID;
+        let other = usb("/dev/ttyACM0", vid, pid, Some("some other gadget"));
+        let head = usb("/dev/ttyACM1", vid, pid, Some(PICO_PRODUCT));
+        let arduino = usb("/dev/ttyACM2", 0x2341, 0x0043, Some(PICO_PRODUCT));
+        let pty = serialport::SerialPortInfo {
+            port_name: "/dev/pts/3".to_owned(),
+            port_type: serialport::SerialPortType::Unknown,
+        };
+        let found = pick_pico(&[other.clone(), arduino.clone(), head, pty.clone()]);
+        assert_eq!(found.unwrap(), PathBuf::from("/dev/ttyACM1"));
+
+        // The shared ID alone is not enough when the product says otherwise.
+        let err = pick_pico(&[other.clone(), arduino.clone(), pty]).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("/dev/ttyACM0 (\"some other gadget\")"),
+            "{err}"
+        );
+        let err = pick_pico(&[arduino]).unwrap_err();
+        assert!(err.to_string().contains("is the head plugged in"), "{err}");
+
+        // Without product strings, one device of the ID is taken; two are not.
+        let bare = usb("/dev/ttyACM4", vid, pid, None);
+        assert_eq!(
+            pick_pico(&[other, bare.clone()]).unwrap(),
+            PathBuf::from("/dev/ttyACM4")
+        );
+        let bare2 = usb("/dev/ttyACM5", vid, pid, None);
+        let err = pick_pico(&[bare, bare2]).unwrap_err();
+        assert!(
+            err.to_string().contains("without a product string"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn two_heads_need_a_port() {
+        let (vid, pid) = PICO_USB_ID;
+        let a = usb("/dev/ttyACM0", vid, pid, Some(PICO_PRODUCT));
+        let b = usb("/dev/ttyACM1", vid, pid, Some(PICO_PRODUCT));
+        let err = pick_pico(&[a, b]).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("/dev/ttyACM0, /dev/ttyACM1; give --port"),
+            "{err}"
+        );
+    }
+}

@@ -3,7 +3,7 @@
 
 use std::{fmt::Write as _, ops::Range, path::Path};
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 
 use crate::{board::Board, figures};
 use object::read::elf::{ElfFile32, ProgramHeader};
@@ -44,11 +44,8 @@ const ALLOCATOR_SYMBOLS: &[&str] = &[
 /// One allocated section of the image.
 #[derive(Debug, Clone)]
 pub struct Section {
-    /// Section name, e.g. `.text`.
     pub name: String,
-    /// Run-time address.
     pub address: u64,
-    /// Size in bytes.
     pub size: u64,
     /// Whether the section has contents in the file (and so in flash);
     /// `.bss` and `.uninit` do not.
@@ -115,11 +112,21 @@ impl Image {
         let settings = symbol("__settings_start")
             .zip(symbol("__settings_end"))
             .map(|(start, end)| start..end);
-        // 0 for an ELF that is not a 32-bit one (the host's binaries).
-        let flash_end = match ElfFile32::<Endianness>::parse(data) {
-            Ok(file) => stored_end(&segments(&file).map_err(|error| anyhow!(error))?),
-            Err(_) => 0,
-        };
+        // The highest load address (`p_paddr + p_filesz`) of a segment stored
+        // in the XIP window; 0 for an ELF that is not a 32-bit one.
+        let flash_end = ElfFile32::<Endianness>::parse(data).map_or(0, |file| {
+            let e = file.endian();
+            file.elf_program_headers()
+                .iter()
+                .filter(|h| h.p_type(e) == elf::PT_LOAD && h.p_filesz(e) > 0)
+                .map(|h| {
+                    u64::from(h.p_paddr(e))..u64::from(h.p_paddr(e)) + u64::from(h.p_filesz(e))
+                })
+                .filter(|range| XIP.contains(&range.start))
+                .map(|range| range.end)
+                .max()
+                .unwrap_or(0)
+        });
         Ok(Self {
             sections,
             allocator_symbols,
@@ -211,28 +218,20 @@ pub fn check_pico(path: &Path) -> Result<()> {
     let image = Image::read(path)?;
     println!("{}", path.display());
     print!("{}", image.table());
-
-    let mut problems = Vec::new();
-    if let Err(error) = image.check_boot2() {
-        problems.push(error.to_string());
-    }
-
-    let flash = image.flash();
-    let ram = image.static_ram();
+    let (flash, ram) = (image.flash(), image.static_ram());
     record_image(path, &image, Some(FLASH_BUDGET));
     println!(
-        "  flash      {:>6} B = {:>5.1} KiB of {} KiB budget  ({})",
-        flash,
-        kib(flash),
-        FLASH_BUDGET / 1024,
-        stored_names(&image)
+        "  flash {flash} B of its {FLASH_BUDGET} B budget; static RAM {ram} B (of {RAM_BUDGET} B \
+         with the peak stack)"
     );
-    println!(
-        "  static RAM {:>6} B = {:>5.1} KiB of {} KiB budget with the peak stack  (.data + .bss + .uninit)",
-        ram,
-        kib(ram),
-        RAM_BUDGET / 1024
-    );
+    let mut problems: Vec<String> = [
+        image.check_boot2(),
+        image.check_no_allocator(),
+        check_settings_region(&image, Board::Pico.settings()),
+    ]
+    .into_iter()
+    .filter_map(|check| check.err().map(|e| e.to_string()))
+    .collect();
     if flash > FLASH_BUDGET {
         problems.push(format!(
             "flash use {flash} B is over the {FLASH_BUDGET} B budget"
@@ -243,15 +242,6 @@ pub fn check_pico(path: &Path) -> Result<()> {
             "static RAM use {ram} B is over the {RAM_BUDGET} B budget"
         ));
     }
-    if let Err(error) = image.check_no_allocator() {
-        problems.push(error.to_string());
-    } else {
-        println!("  no allocator linked");
-    }
-    if let Err(error) = check_settings_region(&image, Board::Pico.settings()) {
-        problems.push(error.to_string());
-    }
-
     if problems.is_empty() {
         Ok(())
     } else {
@@ -288,7 +278,6 @@ pub fn check_qemu(path: &Path) -> Result<()> {
 pub struct Peak {
     /// Static RAM of the image it was measured with.
     pub static_ram: u64,
-    /// Deepest stack use, bytes.
     pub stack: u64,
 }
 
@@ -296,25 +285,6 @@ pub struct Peak {
 /// measured in the RP2040 emulator) and the QEMU smoke image; fails if the
 /// Pico image's total is over [`RAM_BUDGET`] or its peak is unknown.
 pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
-    println!(
-        "  {:<34} {:>10} {:>11} {:>10}",
-        "image (stack measured in)", "static B", "peak stack", "total B"
-    );
-    for (name, peak) in [
-        ("Pico (RP2040 emulator)", pico),
-        ("QEMU smoke (lm3s6965evb)", qemu),
-    ] {
-        match peak {
-            Some(p) => println!(
-                "  {name:<34} {:>10} {:>11} {:>10}  = {:.1} KiB",
-                p.static_ram,
-                p.stack,
-                p.static_ram + p.stack,
-                kib(p.static_ram + p.stack)
-            ),
-            None => println!("  {name:<34} (no measurement)"),
-        }
-    }
     record_ram(&[
         ("pico", "the RP2040 emulator", pico, Some(RAM_BUDGET)),
         ("qemu", "QEMU (lm3s6965evb)", qemu, None),
@@ -322,84 +292,16 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
     let pico =
         pico.context("the Pico image's peak stack was not measured (the emulator run failed)")?;
     let total = pico.static_ram + pico.stack;
-    println!(
-        "  Pico RAM {total} B = {:.1} KiB of the {} KiB budget (static + peak stack)",
-        kib(total),
-        RAM_BUDGET / 1024
-    );
     if total > RAM_BUDGET {
         bail!("RAM use {total} B (static + peak stack) is over the {RAM_BUDGET} B budget");
     }
+    println!("  Pico RAM {total} B within the {RAM_BUDGET} B budget");
     Ok(())
-}
-
-/// The contents of one loadable segment, at its load address.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Segment {
-    /// Load (physical) address of the first byte: where it is stored.
-    pub address: u32,
-    /// The bytes stored in the file (`p_filesz` of them).
-    pub data: Vec<u8>,
-}
-
-impl Segment {
-    /// Load addresses of the contents.
-    pub fn range(&self) -> Range<u32> {
-        // The length fits: `segments` took it from a 32-bit field and
-        // checked that the end does not wrap.
-        let length = u32::try_from(self.data.len()).unwrap_or(u32::MAX);
-        self.address..self.address.saturating_add(length)
-    }
-}
-
-/// The loadable segments with contents (`PT_LOAD`, `p_filesz > 0`) of
-/// `file`, in address order: what is stored in the board's memory, each at
-/// its load address (`p_paddr`), so that `.data`'s initial values count
-/// where they are stored, not where they run.
-///
-/// # Errors
-/// A segment lies past the end of the file or wraps the address space.
-pub fn segments(file: &ElfFile32<Endianness>) -> Result<Vec<Segment>, &'static str> {
-    let endian = file.endian();
-    let mut segments = Vec::new();
-    for header in file.elf_program_headers() {
-        if header.p_type(endian) != elf::PT_LOAD || header.p_filesz(endian) == 0 {
-            continue;
-        }
-        let data = header
-            .data(endian, file.data())
-            .map_err(|()| "a segment lies past the end of the file")?;
-        let address = header.p_paddr(endian);
-        if address.checked_add(header.p_filesz(endian)).is_none() {
-            return Err("a segment wraps the address space");
-        }
-        segments.push(Segment {
-            address,
-            data: data.to_vec(),
-        });
-    }
-    segments.sort_by_key(|segment| segment.address);
-    Ok(segments)
-}
-
-/// The end of the bytes stored in the XIP flash window: the highest end of
-/// a segment that starts there; 0 if none does.
-fn stored_end(segments: &[Segment]) -> u64 {
-    segments
-        .iter()
-        .map(Segment::range)
-        .filter(|range| XIP.contains(&u64::from(range.start)))
-        .map(|range| u64::from(range.end))
-        .max()
-        .unwrap_or(0)
 }
 
 /// Fails unless the image names the settings region of memory.x, it is
 /// `expected` (the board's, [`Board::settings`]), and nothing stored in
 /// flash reaches into it.
-///
-/// # Errors
-/// Which of these is not so.
 pub fn check_settings_region(image: &Image, expected: Range<u32>) -> Result<()> {
     let Some(region) = image.settings.clone() else {
         bail!(
@@ -436,69 +338,81 @@ pub fn check_settings_region(image: &Image, expected: Range<u32>) -> Result<()> 
     Ok(())
 }
 
-fn stored_names(image: &Image) -> String {
-    image
+/// The sizes of the image at `path`, held to `flash_budget`, for the
+/// measured figures.
+pub fn record_image(path: &Path, image: &Image, flash_budget: Option<u64>) {
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    let flash = image.flash();
+    let ceiling = flash_budget.map_or_else(
+        || "no ceiling".to_owned(),
+        |budget| {
+            format!(
+                "{} of {}",
+                figures::percent(flash, budget),
+                figures::bytes(budget)
+            )
+        },
+    );
+    let sections: Vec<String> = image
         .sections
         .iter()
-        .filter(|section| section.stored)
-        .map(|section| section.name.as_str())
-        .collect::<Vec<_>>()
-        .join(" + ")
-}
-
-#[allow(clippy::cast_precision_loss)] // sizes far below 2^52
-fn kib(bytes: u64) -> f64 {
-    bytes as f64 / 1024.0
-}
-
-/// The sizes of the image at `path`, held to `flash_budget`.
-pub fn record_image(path: &Path, image: &Image, flash_budget: Option<u64>) {
-    let name = path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
+        .map(|s| format!("`{}` {}", s.name, figures::bytes(s.size)))
+        .collect();
+    let intro = format!(
+        "Flash is every section stored in flash (`.data`'s initial values included); \
+         static RAM is `.data + .bss + .uninit`. Sections of `{name}`: {}.",
+        sections.join(", ")
     );
-    let entry = figures::Image {
-        source: figures::Source::now(),
-        flash: image.flash(),
-        flash_budget,
-        static_ram: image.static_ram(),
-        sections: image
-            .sections
-            .iter()
-            .map(|s| figures::Section {
-                name: s.name.clone(),
-                size: s.size,
-                stored: s.stored,
-            })
-            .collect(),
-    };
-    figures::save_section(&format!("sizes of `{name}`"), |f| {
-        f.images.insert(name.clone(), entry);
-    });
+    let size = format!("{} ({})", figures::bytes(flash), figures::kib(flash));
+    let row = vec![
+        name.to_string(),
+        size,
+        ceiling,
+        figures::bytes(image.static_ram()),
+    ];
+    let header = ["image", "flash", "of the ceiling", "static RAM"];
+    figures::record(&format!("image {name}"), intro, &header, vec![row]);
 }
 
-/// Static RAM plus the peak stack of each image that has a measurement:
-/// `(image, where the stack was measured, the peak, the ceiling)`.
+/// Static RAM plus the peak stack of each image that has a measurement,
+/// for the measured figures: `(image, where the stack was measured, the
+/// peak, the ceiling)`.
 pub fn record_ram(rows: &[(&str, &str, Option<Peak>, Option<u64>)]) {
-    let rows: Vec<figures::RamRow> = rows
+    let rows: Vec<Vec<String>> = rows
         .iter()
         .filter_map(|&(image, measured_in, peak, budget)| {
-            peak.map(|peak| figures::RamRow {
-                image: image.to_owned(),
-                measured_in: measured_in.to_owned(),
-                static_ram: peak.static_ram,
-                stack: peak.stack,
-                budget,
-            })
+            let peak = peak?;
+            let total = peak.static_ram + peak.stack;
+            let ceiling = budget.map_or_else(
+                || "no ceiling".to_owned(),
+                |b| format!("{} of {}", figures::percent(total, b), figures::bytes(b)),
+            );
+            let total = format!("{} ({})", figures::bytes(total), figures::kib(total));
+            let (fixed, stack) = (figures::bytes(peak.static_ram), figures::bytes(peak.stack));
+            Some(vec![
+                image.to_owned(),
+                measured_in.to_owned(),
+                fixed,
+                stack,
+                total,
+                ceiling,
+            ])
         })
         .collect();
     if rows.is_empty() {
         return;
     }
-    let source = figures::Source::now();
-    figures::save_section("RAM with the peak stack", |f| {
-        f.ram = Some(figures::Ram { source, rows });
-    });
+    let intro = "RAM: static RAM plus the deepest the stack went, measured by painting it \
+                 ([Memory](memory.md#how-the-stack-is-measured)).";
+    let header = [
+        "image",
+        "stack measured in",
+        "static RAM",
+        "peak stack",
+        "total",
+        "of the ceiling",
+    ];
+    figures::record("ram", intro.to_owned(), &header, rows);
 }
 
 #[cfg(test)]

@@ -1,28 +1,14 @@
-//! Measured figures: what the commands measure, kept in
-//! `target/figures.json`, and the book's page made from them.
-//!
-//! The figures in the docs (memory, frame cost, loop quality) are never
-//! typed by hand. The functions that measure them record them here as they
-//! go, one section each, over whatever the file held:
-//!
-//! | section | recorded by | run by |
-//! |---|---|---|
-//! | `images` | [`elf::check_pico`](crate::elf::check_pico) → [`elf::record_image`](crate::elf::record_image) | `cargo xtask test` |
-//! | `ram` | [`elf::check_ram`](crate::elf::check_ram) → [`elf::record_ram`](crate::elf::record_ram) | `cargo xtask test` |
-//! | `qemu` | [`qemu::check_summary`](crate::qemu::check_summary) → [`qemu::record_figures`](crate::qemu::record_figures) | `cargo xtask qemu`, `cargo xtask test` |
-//! | `bench` | [`bench::run_and_check`](crate::bench::run_and_check) → its `record_figures` | `cargo xtask bench`, `cargo xtask test` |
-//! | `latency` | [`bench::command`](crate::bench::command) → its `record_latency` | `cargo xtask bench` |
-//! | `metrics` | [`metrics::command`](crate::metrics::command) → its `record_figures` | `cargo xtask metrics` |
-//!
-//! `cargo xtask book` then writes `docs/design/figures.md` (ignored by git)
-//! with [`write_page`] before it builds the book. Each section says which
-//! command recorded it, on which commit; a section never recorded says how
-//! to get it.
+//! Measured figures: the commands that measure (`elf`, `qemu`, `bench`,
+//! `metrics`) record each of their tables here as they go, kept in
+//! `target/figures.json`; `cargo xtask book` writes the book's page from
+//! them ([`write_page`]). No figure in the docs is typed by hand.
 
-mod page;
+// Sizes and counts are far below 2^52: the float conversions are exact.
+#![allow(clippy::cast_precision_loss)]
 
 use std::{
     collections::BTreeMap,
+    fmt::Write as _,
     path::{Path, PathBuf},
     process::Command,
 };
@@ -30,242 +16,38 @@ use std::{
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
-pub use page::write_page;
-
 use crate::project;
 
-/// Everything recorded so far. Sections are replaced whole by the command
-/// that measures them; the others stay as they were.
-#[derive(Debug, Default, Serialize, Deserialize)]
-#[serde(default)]
-pub struct Figures {
-    /// Flash and static RAM of each firmware image, by ELF name.
-    pub images: BTreeMap<String, Image>,
-    /// Static RAM plus the measured peak stack.
-    pub ram: Option<Ram>,
-    /// The QEMU smoke run: the boot precompute and the loop sets.
-    pub qemu: Option<QemuRun>,
-    /// The benchmark: boot precompute rows and frame cost rows.
-    pub bench: Option<Bench>,
-    /// The latency rows, measured in the RP2040 emulator.
-    pub latency: Option<Latency>,
-    /// Loop quality over many seeds.
-    pub metrics: Option<Metrics>,
-}
-
-/// Which command recorded a section, on which commit.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
-pub struct Source {
-    /// The command line, as typed (`cargo xtask test`).
+/// One table of the page, as the command that measured it recorded it.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Table {
+    /// The command line that recorded it, and the working tree's commit.
     pub command: String,
-    /// `git describe --always --dirty` of the working tree, if git answered.
     pub commit: Option<String>,
+    /// What the table shows (Markdown), said before it.
+    pub intro: String,
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<String>>,
 }
 
-impl Source {
-    /// The running command and the working tree's commit.
-    pub fn now() -> Self {
-        let args: Vec<String> = std::env::args().skip(1).collect();
-        let commit = Command::new("git")
-            .args(["describe", "--always", "--dirty"])
-            .current_dir(project::root())
-            .output()
-            .ok()
-            .filter(|out| out.status.success())
-            .and_then(|out| String::from_utf8(out.stdout).ok())
-            .map(|text| text.trim().to_owned())
-            .filter(|text| !text.is_empty());
-        Self {
-            command: format!("cargo xtask {}", args.join(" ")).trim().to_owned(),
-            commit,
-        }
-    }
-}
+/// The page's sections: the title, the keys of the tables under it (a key
+/// is a prefix: `image ` takes every image's), and how to measure them.
+const SECTIONS: [(&str, &[&str], &str); 5] = [
+    ("Memory", &["image ", "ram"], TEST),
+    ("Frame cost", &["frames", "latency"], TEST),
+    ("Boot precompute", &["precompute"], TEST),
+    ("Idle loop sets", &["qemu"], TEST),
+    (
+        "Loop quality",
+        &["metrics "],
+        "run `cargo xtask metrics`, then `cargo xtask book`",
+    ),
+];
+const TEST: &str = "`cargo xtask test` measures these (and builds this page again)";
 
-/// One allocated section of an image.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Section {
-    /// `.text`, `.bss`, ...
-    pub name: String,
-    /// Bytes.
-    pub size: u64,
-    /// Whether it is stored in flash.
-    pub stored: bool,
-}
-
-/// A firmware image's sizes.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Image {
-    /// Who recorded it.
-    pub source: Source,
-    /// Bytes stored in flash.
-    pub flash: u64,
-    /// The flash ceiling, if the image is held to one.
-    pub flash_budget: Option<u64>,
-    /// `.data + .bss + .uninit`.
-    pub static_ram: u64,
-    /// The allocated sections.
-    pub sections: Vec<Section>,
-}
-
-/// One image's RAM with its measured peak stack.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct RamRow {
-    /// The image.
-    pub image: String,
-    /// Where the stack was measured.
-    pub measured_in: String,
-    /// `.data + .bss + .uninit`.
-    pub static_ram: u64,
-    /// Deepest stack use, bytes.
-    pub stack: u64,
-    /// The ceiling of static RAM plus the peak stack, if held to one.
-    pub budget: Option<u64>,
-}
-
-/// Static RAM plus peak stack, per image.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Ram {
-    /// Who recorded it.
-    pub source: Source,
-    /// One row per image measured.
-    pub rows: Vec<RamRow>,
-}
-
-/// One loop set generated in the background during the QEMU run.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct SetCost {
-    /// The set's number (1 is the first after the boot's).
-    pub set: u64,
-    /// Instructions it took.
-    pub instructions: u64,
-    /// Loops discarded per axis, as logged (`[0, 1, 0]`).
-    pub discarded: String,
-}
-
-/// What the QEMU smoke run measured.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct QemuRun {
-    /// Who recorded it.
-    pub source: Source,
-    /// Instructions of the boot's first loop set.
-    pub precompute: Option<u64>,
-    /// The loop sets generated in the background.
-    pub sets: Vec<SetCost>,
-}
-
-/// A boot precompute row of the benchmark.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct PrecomputeRow {
-    /// `default`, `w15`, ...
-    pub label: String,
-    /// Samples per loop.
-    pub n: u64,
-    /// Hann window taps.
-    pub w: u64,
-    /// Instructions of the engine, three axes.
-    pub engine: u64,
-    /// Instructions of the direct-form f32 smoothing, three axes.
-    pub direct: u64,
-}
-
-/// A frame cost row of the benchmark.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct FrameCost {
-    /// `frame`, `frame (gesture + look)`.
-    pub label: String,
-    /// Frames measured.
-    pub frames: u64,
-    /// Fewest instructions.
-    pub min: u64,
-    /// Median.
-    pub median: u64,
-    /// Most instructions.
-    pub max: u64,
-    /// Mean.
-    pub mean: u64,
-    /// Ceiling of the median.
-    pub median_budget: u64,
-    /// Ceiling of the max.
-    pub max_budget: u64,
-}
-
-/// The benchmark's figures.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Bench {
-    /// Who recorded it.
-    pub source: Source,
-    /// Ceiling of the default set's precompute, instructions.
-    pub budget: u64,
-    /// The precompute rows, in table order.
-    pub rows: Vec<PrecomputeRow>,
-    /// The frame rows.
-    pub frames: Vec<FrameCost>,
-}
-
-/// A latency row: from an event to the first pulse that shows it.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct LatencyRow {
-    /// `latency input edge`, ...
-    pub label: String,
-    /// Events measured.
-    pub events: usize,
-    /// Median, 99th percentile and largest, ms.
-    pub p50_ms: f64,
-    /// See `p50_ms`.
-    pub p99_ms: f64,
-    /// See `p50_ms`.
-    pub max_ms: f64,
-    /// The goal for the 99th percentile, ms.
-    pub goal_p99_ms: f64,
-}
-
-/// The latency rows, measured in the RP2040 emulator.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Latency {
-    /// Who recorded them.
-    pub source: Source,
-    /// One row per path (DMX, a look over USB, an input edge).
-    pub rows: Vec<LatencyRow>,
-}
-
-/// One metric's distribution over the seeds.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct MetricRow {
-    /// The metric's name.
-    pub metric: String,
-    /// min, median, p99, max.
-    pub values: [f64; 4],
-}
-
-/// One closure's loop quality.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct ClosureMetrics {
-    /// `seamless` or `paper`.
-    pub closure: String,
-    /// The distributions.
-    pub rows: Vec<MetricRow>,
-    /// Loops past the continuity limit.
-    pub discontinuous: usize,
-    /// Seeds the engine rejected.
-    pub rejected: usize,
-}
-
-/// `cargo xtask metrics`'s figures.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Metrics {
-    /// Who recorded it.
-    pub source: Source,
-    /// Seeds per closure.
-    pub seeds: u32,
-    /// Samples per loop.
-    pub n: usize,
-    /// Window taps.
-    pub w: u16,
-    /// The continuity limit the counts are against.
-    pub limit: f32,
-    /// Per closure.
-    pub closures: Vec<ClosureMetrics>,
+/// Where the figures are kept: `target/figures.json`, beside the book.
+pub fn path() -> PathBuf {
+    project::root().join("target").join("figures.json")
 }
 
 /// `1234567` as `1,234,567`.
@@ -281,72 +63,144 @@ pub fn thousands(value: u64) -> String {
     out
 }
 
-/// Where the figures are kept: `target/figures.json` at the repository's
-/// root, beside the book (`target/book`).
-pub fn path() -> PathBuf {
-    project::root().join("target").join("figures.json")
+/// `value` bytes, with separators.
+pub fn bytes(value: u64) -> String {
+    format!("{} B", thousands(value))
 }
 
-/// Reads the figures at `path`; none recorded yet if there is no file. A
-/// file that cannot be read as figures is an error naming it.
-pub fn load(path: &Path) -> Result<Figures> {
+/// `value` bytes in KiB.
+pub fn kib(value: u64) -> String {
+    format!("{:.1} KiB", value as f64 / 1024.0)
+}
+
+/// `part` of `whole`, in percent.
+pub fn percent(part: u64, whole: u64) -> String {
+    format!("{:.0} %", part as f64 / whole.max(1) as f64 * 100.0)
+}
+
+/// Prints the table `key` and records it (replacing the one recorded
+/// before) as the running command's, on the working tree's commit. A table
+/// that cannot be recorded does not fail the check that measured it: it is
+/// reported, and the page shows the last one recorded.
+pub fn record(key: &str, intro: String, header: &[&str], rows: Vec<Vec<String>>) {
+    println!("{key}:\n  | {} |", header.join(" | "));
+    for row in &rows {
+        println!("  | {} |", row.join(" | "));
+    }
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let commit = Command::new("git")
+        .args(["describe", "--always", "--dirty"])
+        .current_dir(project::root())
+        .output()
+        .ok()
+        .filter(|out| out.status.success())
+        .map(|out| String::from_utf8_lossy(&out.stdout).trim().to_owned())
+        .filter(|text| !text.is_empty());
+    let table = Table {
+        command: format!("cargo xtask {}", args.join(" ")).trim().to_owned(),
+        commit,
+        intro,
+        header: header.iter().map(|h| (*h).to_owned()).collect(),
+        rows,
+    };
+    let path = path();
+    match update_at(&path, key, table) {
+        Ok(()) => println!(
+            "  ({key} recorded in {})",
+            project::relative(&path).display()
+        ),
+        Err(error) => println!("warning: {key} not recorded: {error:#}"),
+    }
+}
+
+/// The tables at `path`; none if there is no file.
+fn load(path: &Path) -> Result<BTreeMap<String, Table>> {
     match std::fs::read_to_string(path) {
         Ok(text) => serde_json::from_str(&text)
             .with_context(|| format!("{} holds no figures this xtask can read", path.display())),
-        Err(error) if error.kind() == std::io::ErrorKind::NotFound => Ok(Figures::default()),
+        Err(error) if error.kind() == std::io::ErrorKind::NotFound => Ok(BTreeMap::new()),
         Err(error) => Err(error).with_context(|| format!("reading {}", path.display())),
     }
 }
 
-/// Applies `change` to the figures on file and writes them back (through a
-/// temporary file, so a reader never sees half a file). A file this xtask
-/// cannot read (written by another version of it) is started afresh.
-fn update_at(path: &Path, change: impl FnOnce(&mut Figures)) -> Result<()> {
+/// Replaces the table `key` at `path` (through a temporary file, so that a
+/// reader never sees half a file); a file this xtask cannot read (another
+/// version's) is started afresh.
+fn update_at(path: &Path, key: &str, table: Table) -> Result<()> {
     let mut figures = load(path).unwrap_or_else(|error| {
         println!("figures: {error:#}; starting afresh");
-        Figures::default()
+        BTreeMap::new()
     });
-    change(&mut figures);
+    figures.insert(key.to_owned(), table);
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     let partial = path.with_extension("json.partial");
-    let text = serde_json::to_string_pretty(&figures)?;
-    std::fs::write(&partial, text).with_context(|| format!("writing {}", partial.display()))?;
+    std::fs::write(&partial, serde_json::to_string_pretty(&figures)?)
+        .with_context(|| format!("writing {}", partial.display()))?;
     std::fs::rename(&partial, path).with_context(|| format!("writing {}", path.display()))
 }
 
-/// Records a section in [`path`]. A figure that cannot be recorded does not
-/// fail the check that measured it: it is reported, and the book's page
-/// then shows the last figures recorded.
-pub fn save_section(what: &str, change: impl FnOnce(&mut Figures)) {
-    let path = path();
-    match update_at(&path, change) {
-        Ok(()) => println!(
-            "  ({what} recorded in {})",
-            project::relative(&path).display()
-        ),
-        Err(error) => println!("warning: {what} not recorded: {error:#}"),
+/// Writes the page to `page` from the figures at `figures_path`; returns
+/// the sections that had figures. Every heading is there whether or not
+/// its figures are, so that the links to it resolve.
+pub fn write_page(figures_path: &Path, page: &Path) -> Result<Vec<&'static str>> {
+    let figures = load(figures_path).unwrap_or_else(|error| {
+        println!("figures: {error:#}; the page says how to measure");
+        BTreeMap::new()
+    });
+    let (text, recorded) = render(&figures);
+    std::fs::write(page, text).with_context(|| format!("writing {}", page.display()))?;
+    Ok(recorded)
+}
+
+fn render(figures: &BTreeMap<String, Table>) -> (String, Vec<&'static str>) {
+    let mut out = String::from(
+        "# Measured figures\n\n\
+         <!-- Written by `cargo xtask book` from target/figures.json: not in git, \
+         do not edit. -->\n\n\
+         These figures are written by the project's tools as they measure, never by \
+         hand. `cargo xtask test` records the images' sizes, their RAM with the peak \
+         stack, the QEMU run and the benchmark; `cargo xtask bench` the benchmark and \
+         the latency rows; `cargo xtask metrics` the loop quality; `cargo xtask book` \
+         writes this page from what they recorded (`target/figures.json`). Each table \
+         says which command recorded it, and on which commit.\n",
+    );
+    let mut recorded = Vec::new();
+    for (title, keys, how) in SECTIONS {
+        let _ = write!(out, "\n## {title}\n");
+        let tables: Vec<&Table> = keys
+            .iter()
+            .flat_map(|key| figures.iter().filter(move |(k, _)| k.starts_with(key)))
+            .map(|(_, table)| table)
+            .collect();
+        if tables.is_empty() {
+            let _ = write!(out, "\nNot measured yet: {how}.\n");
+            continue;
+        }
+        recorded.push(title);
+        for table in tables {
+            let commit = table.commit.as_ref();
+            let on = commit.map_or_else(String::new, |commit| format!(" on `{commit}`"));
+            let _ = write!(
+                out,
+                "\n{} Recorded by `{}`{on}.\n\n",
+                table.intro, table.command
+            );
+            let line = |cells: &[String]| format!("| {} |\n", cells.join(" | "));
+            out.push_str(&line(&table.header));
+            out.push_str(&line(&vec!["---".to_owned(); table.header.len()]));
+            for row in &table.rows {
+                out.push_str(&line(row));
+            }
+        }
     }
+    (out, recorded)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn image(flash: u64) -> Image {
-        Image {
-            source: Source::default(),
-            flash,
-            flash_budget: Some(131_072),
-            static_ram: 20_000,
-            sections: vec![Section {
-                name: ".text".into(),
-                size: flash,
-                stored: true,
-            }],
-        }
-    }
 
     #[test]
     fn thousands_separators() {
@@ -357,54 +211,31 @@ mod tests {
     }
 
     #[test]
-    fn a_file_from_before_the_latency_section_still_loads() {
-        // The latency rows inside `bench`, a `held` on each frame row.
-        let old = r#"{"bench": {"source": {"command": "cargo xtask bench", "commit": null},
-            "budget": 150000, "rows": [],
-            "frames": [{"label": "frame", "frames": 1601, "min": 1, "median": 2, "max": 3,
-                "mean": 2, "median_budget": 1000, "max_budget": 2000, "held": true}],
-            "latency": [{"label": "latency dmx", "events": 1, "p50_ms": 1.0, "p99_ms": 1.0,
-                "max_ms": 1.0, "goal_p99_ms": 25.0}]}}"#;
-        let figures: Figures = serde_json::from_str(old).unwrap();
-        assert_eq!(figures.bench.unwrap().frames[0].max_budget, 2000);
-        assert!(figures.latency.is_none());
-    }
-
-    #[test]
-    fn sections_are_replaced_and_the_others_kept() {
-        let dir = std::env::temp_dir().join(format!("figures-test-{}", std::process::id()));
-        let path = dir.join("figures.json");
-        let _ = std::fs::remove_dir_all(&dir);
-        assert!(load(&path).unwrap().images.is_empty());
-        update_at(&path, |f| {
-            f.images.insert("pico".into(), image(100));
-        })
-        .unwrap();
-        update_at(&path, |f| {
-            f.qemu = Some(QemuRun {
-                source: Source::default(),
-                precompute: Some(7),
-                sets: Vec::new(),
-            });
-        })
-        .unwrap();
-        update_at(&path, |f| {
-            f.images.insert("pico".into(), image(200));
-        })
-        .unwrap();
+    fn tables_are_replaced_the_others_kept_and_every_heading_shown() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("figures.json");
+        let table = |value: &str| Table {
+            command: "cargo xtask test".into(),
+            intro: "Sizes.".into(),
+            header: vec!["image".into(), "flash".into()],
+            rows: vec![vec!["pico".into(), value.into()]],
+            ..Table::default()
+        };
+        update_at(&path, "image pico", table("100 B")).unwrap();
+        update_at(&path, "qemu", table("7")).unwrap();
+        update_at(&path, "image pico", table("200 B")).unwrap();
         let figures = load(&path).unwrap();
-        assert_eq!(figures.images["pico"].flash, 200);
-        assert_eq!(figures.qemu.unwrap().precompute, Some(7));
+        assert_eq!(figures.len(), 2);
+        let (page, recorded) = render(&figures);
+        assert_eq!(recorded, ["Memory", "Idle loop sets"]);
+        assert!(page.contains("## Memory\n\nSizes. Recorded by `cargo xtask test`.\n\n"));
+        assert!(page.contains("| image | flash |\n| --- | --- |\n| pico | 200 B |\n"));
+        assert!(!page.contains("100 B"));
+        assert!(page.contains("## Loop quality\n\nNot measured yet: run `cargo xtask metrics`"));
         // A file of another shape is started afresh, not kept half-read.
         std::fs::write(&path, "{\"images\": 3}").unwrap();
         assert!(load(&path).is_err());
-        update_at(&path, |f| {
-            f.images.insert("pico".into(), image(300));
-        })
-        .unwrap();
-        let figures = load(&path).unwrap();
-        assert_eq!(figures.images["pico"].flash, 300);
-        assert!(figures.qemu.is_none());
-        std::fs::remove_dir_all(&dir).unwrap();
+        update_at(&path, "qemu", table("8")).unwrap();
+        assert_eq!(load(&path).unwrap().len(), 1);
     }
 }

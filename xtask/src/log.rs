@@ -1,16 +1,67 @@
 //! The decoded log of one QEMU run: the types that running, plotting,
 //! snapshotting and benchmarking share.
 
-use std::{path::Path, process::ExitStatus, time::Duration};
+use std::{
+    path::{Path, PathBuf},
+    process::ExitStatus,
+    time::Duration,
+};
 
-use defmt_decoder::{Frame, Locations};
+use anyhow::{Context, Result};
+use defmt_decoder::{DecodeError, Frame, Locations, StreamDecoder, Table};
+
+/// An ELF's defmt table, and its source locations (which need debug
+/// info: without them the log still decodes).
+pub struct Defmt {
+    table: Table,
+    locations: Option<Locations>,
+    root: PathBuf,
+}
+
+impl Defmt {
+    /// The table of the ELF at `elf`.
+    pub fn read(elf: &Path) -> Result<Self> {
+        let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
+        let table = Table::parse(&bytes)
+            .with_context(|| format!("reading the defmt table of {}", elf.display()))?
+            .with_context(|| format!("{} has no defmt data", elf.display()))?;
+        let locations = table.get_locations(&bytes).ok();
+        let root = crate::project::root();
+        Ok(Self {
+            table,
+            locations,
+            root,
+        })
+    }
+
+    /// A decoder for one stream (a run, a boot).
+    pub fn stream(&self) -> Box<dyn StreamDecoder + '_> {
+        self.table.new_stream_decoder()
+    }
+
+    /// Feeds `bytes` to `decoder`; the lines they complete.
+    pub fn lines(&self, decoder: &mut dyn StreamDecoder, bytes: &[u8]) -> Vec<LogLine> {
+        decoder.received(bytes);
+        let mut lines = Vec::new();
+        loop {
+            match decoder.decode() {
+                Ok(frame) => lines.push(LogLine::from_frame(
+                    &frame,
+                    self.locations.as_ref(),
+                    &self.root,
+                )),
+                Err(DecodeError::UnexpectedEof) => return lines,
+                Err(DecodeError::Malformed) => lines.push(LogLine::malformed()),
+            }
+        }
+    }
+}
 
 /// One decoded defmt frame.
 #[derive(Debug, Clone)]
 pub struct LogLine {
     /// `INFO`, `WARN`, ... (`None` for `println!`-style frames).
     pub level: Option<String>,
-    /// The formatted message.
     pub message: String,
     /// The formatted timestamp, if the firmware has one.
     pub timestamp: Option<String>,
@@ -93,9 +144,7 @@ pub enum Exit {
 /// The outcome of one QEMU run.
 #[derive(Debug)]
 pub struct Run {
-    /// Decoded log, in order.
     pub log: Vec<LogLine>,
-    /// How QEMU ended.
     pub exit: Exit,
     /// Wall time of the run.
     pub elapsed: Duration,

@@ -1,53 +1,26 @@
-//! Host-side project commands, run as `cargo xtask <command>` from any folder
-//! of the repository (the alias in `.cargo/config.toml` builds this crate for
-//! the host). `cargo xtask help` lists them; `cli.rs` defines them.
-//!
-//! - `cargo xtask qemu`: build the QEMU image, run it and show the head's motion.
-//! - `cargo xtask test`: every check the project has (host tests, formatting,
-//!   lints, the Pico build and its memory budget, the QEMU log snapshot, the
-//!   boot-time benchmark and its budget).
-//! - `cargo xtask bench`: the boot-time benchmark in QEMU (engine against a
-//!   direct-form f32 smoothing), as a table with a verdict.
-//! - `cargo xtask preview`: CSV and PNG of a loop's stages (walk, smoothing,
-//!   normalisation, closure), for people.
-//! - `cargo xtask metrics`: loop-quality metrics over many seeds, both closures.
-//! - `cargo xtask sim`: the Pico image in the RP2040 emulator, its pulses
-//!   checked against the host frame for frame.
-//! - `cargo xtask trace`: the firmware's frames simulated on the host, with
-//!   scripted gestures and looks, as CSV and PNG.
-//! - `cargo xtask uf2`: the firmware as a UF2 file for a board's BOOTSEL drive.
-//! - `cargo xtask flash`: the runner of `cargo run --release`: BOOTSEL drive,
-//!   debug probe, or what to install.
-//! - `cargo xtask book`: the book (docs/) built with mdBook into
-//!   target/book, every link in it checked.
-//! - `cargo xtask panel`: the browser control panel, served and bridged to
-//!   a head (emulated, QEMU or a serial port).
-//!
-//! The firmware commands install what they need and is missing: the
-//! firmware's Rust target and, when running as root on Debian or Ubuntu, QEMU.
-//! `preview` and `metrics` run the core library on the host only.
+//! Host-side project commands, run as `cargo xtask <command>` from any
+//! folder of the repository (the alias in `.cargo/config.toml` builds this
+//! crate for the host). `cargo xtask help` lists them; `cli.rs` defines
+//! them, docs/dev/xtask.md describes them.
 
 mod args;
 mod bench;
 mod board;
 mod book;
-mod child;
 mod cli;
 mod console;
 mod elf;
 mod figures;
 mod flash;
-mod fonts;
 mod log;
 mod metrics;
 mod panel;
 mod pico2;
+mod plot;
 mod preview;
 mod project;
 mod qemu;
 mod reference;
-mod render;
-mod rp2350;
 mod setup;
 mod sim;
 mod snapshot;

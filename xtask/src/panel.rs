@@ -1,13 +1,7 @@
-//! `cargo xtask panel`: the browser control panel (`panel/`, static files)
-//! served on localhost, bridged over a WebSocket to a head: the shipped
-//! Pico image in the RP2040 emulator (`--sim`), the QEMU image (`--qemu`)
-//! or a board's serial port (`--port`). Without a bridge the page talks to
-//! a board itself, over Web Serial. `--export DIR` writes a copy of the
-//! page, its dependencies included, for any static host.
-//!
-//! The page's dependencies (uPlot) come from the npm registry, pinned by
-//! `panel/package-lock.json`, installed into `panel/node_modules` (never
-//! committed) and served from there under `vendor/`.
+//! `cargo xtask panel`: the browser control panel (`panel/`, static files,
+//! uPlot from `panel/node_modules`) served on localhost, bridged to a head
+//! (`server.rs`): the emulated Pico, QEMU, or a serial port; without a
+//! bridge the page uses Web Serial. `--export DIR` writes it for any host.
 
 mod bridge;
 pub mod browser;
@@ -17,9 +11,7 @@ use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 
-use anyhow::{Context, Result, bail};
-use serde_json::Value;
-use xshell::cmd;
+use anyhow::{Context, Result};
 
 use crate::{project, setup};
 
@@ -49,7 +41,7 @@ pub struct Args {
     #[arg(long, value_name = "dir")]
     pub export: Option<PathBuf>,
     /// Run the panel's browser tests (the stage of `cargo xtask test`)
-    /// instead: headless Chromium over Web Serial, WebSocket and a serial
+    /// instead: headless Chromium over Web Serial, the bridge and a serial
     /// port.
     #[arg(long, conflicts_with_all = ["sim", "qemu", "port", "export"])]
     pub test: bool,
@@ -92,9 +84,10 @@ pub fn command(args: &Args) -> Result<bool> {
         let _ = ctrlc_tx.send("interrupted".to_owned());
     })
     .context("setting the Ctrl-C handler")?;
+    let name = bridge.as_ref().map(|b| b.name.clone());
     let server = server::Server::start(&root, args.listen, bridge, stop_tx)?;
-    println!("panel: http://{}/", server.address());
-    match server.bridge_name() {
+    println!("panel: http://{}/", server.address);
+    match name {
         Some(name) => eprintln!(
             "panel: bridged to {name}; open the address in a browser (Ctrl-C stops everything)"
         ),
@@ -174,39 +167,14 @@ fn export(root: &Path, dir: &Path) -> Result<()> {
 }
 
 /// Makes sure the page's pinned npm packages are installed in
-/// `panel/node_modules` (`npm ci`, with Playwright's browser download
-/// off: the tests use the system's Chromium).
+/// `panel/node_modules` (Playwright's browser download off: the tests use
+/// the system's Chromium).
 pub fn ensure_dependencies(root: &Path) -> Result<()> {
-    crate::sim::ensure_node(root)?;
-    let panel = root.join("panel");
-    let read = |path: PathBuf| -> Option<Value> {
-        serde_json::from_slice(&std::fs::read(path).ok()?).ok()
-    };
-    let lock = read(panel.join("package-lock.json"))
-        .context("panel/package-lock.json is missing or not JSON")?;
-    let stale = ["uplot", "playwright-core"].iter().any(|name| {
-        let pinned = &lock["packages"][format!("node_modules/{name}")]["version"];
-        let installed = read(panel.join(format!("node_modules/{name}/package.json")))
-            .map_or(Value::Null, |package| package["version"].clone());
-        pinned.is_null() || installed != *pinned
-    });
-    if stale {
-        let sh = project::shell(".")?;
-        sh.change_dir(&panel);
-        project::run(
-            &sh,
-            &[("PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD", "1")],
-            cmd!(sh, "npm ci --no-audit --no-fund"),
-        )
-        .context("installing the panel's dependencies with `npm ci` in panel/")?;
-    }
-    if !panel
-        .join("node_modules/uplot/dist/uPlot.iife.min.js")
-        .exists()
-    {
-        bail!("panel/node_modules has no uPlot after `npm ci`");
-    }
-    Ok(())
+    crate::sim::node::npm_ci(
+        &root.join("panel"),
+        &["uplot", "playwright-core"],
+        &[("PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD", "1")],
+    )
 }
 
 #[cfg(test)]

@@ -1,13 +1,19 @@
-//! Where things are in the repository, how commands run, and how the firmware
-//! images are built.
+//! Where things are in the repository, how commands run (the one process
+//! runner: [`run`] to the end with inherited output, [`finish`] with its
+//! output read as it comes and a time limit), and how the firmware images
+//! are built.
 
 use std::{
     fmt::Write as _,
     path::{Path, PathBuf},
+    process::{Child, ChildStderr, ChildStdout},
+    thread,
+    time::Duration,
 };
 
 use anyhow::{Context, Result, anyhow};
 use cargo_metadata::MetadataCommand;
+use wait_timeout::ChildExt;
 use xshell::{Cmd, Shell, cmd};
 
 /// The firmware's compilation target (ARMv6-M: RP2040's Cortex-M0+, QEMU's Cortex-M0).
@@ -65,6 +71,64 @@ pub fn run(sh: &Shell, env: &[(&str, &str)], cmd: Cmd<'_>) -> Result<()> {
         .quiet()
         .run()
         .map_err(|error| anyhow!("{error}"))
+}
+
+/// `command` as a user would type it.
+pub fn shown(command: &std::process::Command) -> String {
+    let words = std::iter::once(command.get_program()).chain(command.get_args());
+    words
+        .map(|w| w.to_string_lossy())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// What a child left behind ([`finish`]).
+pub struct Finished<O, E, R> {
+    pub exit: crate::log::Exit,
+    pub stdout: O,
+    pub stderr: E,
+    pub meanwhile: R,
+}
+
+/// Runs `child` (spawned with its stdout and stderr piped) to its end:
+/// `stdout` and `stderr` each read their pipe on a thread of their own (so
+/// that neither fills up and stalls it), `meanwhile` runs on this thread;
+/// once it returns, `child` has `timeout` to exit before it is killed.
+pub fn finish<O: Send, E: Send, R>(
+    mut child: Child,
+    name: &str,
+    timeout: Duration,
+    stdout: impl FnOnce(ChildStdout) -> O + Send,
+    stderr: impl FnOnce(ChildStderr) -> E + Send,
+    meanwhile: impl FnOnce() -> R,
+) -> Result<Finished<O, E, R>> {
+    let (Some(out), Some(err)) = (child.stdout.take(), child.stderr.take()) else {
+        let _ = child.kill();
+        let _ = child.wait();
+        return Err(anyhow!(
+            "{name} was started without piped stdout and stderr"
+        ));
+    };
+    thread::scope(|scope| {
+        let out = scope.spawn(move || stdout(out));
+        let err = scope.spawn(move || stderr(err));
+        let meanwhile = meanwhile();
+        let waited = child.wait_timeout(timeout);
+        let exit = if let Some(status) = waited.with_context(|| format!("waiting for {name}"))? {
+            crate::log::Exit::Status(status)
+        } else {
+            let _ = child.kill();
+            let _ = child.wait();
+            crate::log::Exit::TimedOut(timeout)
+        };
+        let panicked = |what| anyhow!("the reader of {name}'s {what} panicked");
+        Ok(Finished {
+            exit,
+            stdout: out.join().map_err(|_| panicked("stdout"))?,
+            stderr: err.join().map_err(|_| panicked("stderr"))?,
+            meanwhile,
+        })
+    })
 }
 
 /// A package of the repository that builds firmware images, each with its
@@ -162,4 +226,50 @@ pub fn metadata(root: &Path) -> Result<Metadata> {
     Ok(Metadata {
         target_dir: main.target_directory.into(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use std::io::Read;
+    use std::process::{Command, Stdio};
+
+    use super::*;
+    use crate::log::Exit;
+
+    fn spawn(script: &str) -> Child {
+        let mut command = Command::new("sh");
+        command.args(["-c", script]).stdin(Stdio::null());
+        command.stdout(Stdio::piped()).stderr(Stdio::piped());
+        command.spawn().unwrap()
+    }
+
+    fn length(mut pipe: impl Read) -> usize {
+        let mut bytes = Vec::new();
+        pipe.read_to_end(&mut bytes).unwrap();
+        bytes.len()
+    }
+
+    #[test]
+    fn both_pipes_are_read_and_a_hung_child_is_killed_at_the_timeout() {
+        // More than a pipe holds on each stream: neither may stall the child.
+        let script = "head -c 200000 /dev/zero; head -c 100000 /dev/zero >&2; exit 3";
+        let long = Duration::from_secs(60);
+        let done = finish(spawn(script), "sh", long, length, length, || 7).unwrap();
+        assert_eq!(
+            (done.stdout, done.stderr, done.meanwhile),
+            (200_000, 100_000, 7)
+        );
+        assert!(matches!(done.exit, Exit::Status(status) if status.code() == Some(3)));
+        let short = Duration::from_millis(200);
+        let done = finish(
+            spawn("exec sleep 30"),
+            "sleep",
+            short,
+            length,
+            length,
+            || (),
+        )
+        .unwrap();
+        assert!(matches!(done.exit, Exit::TimedOut(_)));
+    }
 }

@@ -8,16 +8,14 @@ use std::{
 };
 
 use anyhow::{Context, Result, bail};
-use defmt_decoder::{DecodeError, Locations, Table};
-use xshell::{Cmd, Shell, cmd};
 
-use crate::figures;
+use crate::figures::{self, thousands};
 use crate::{
     args::Options,
-    child,
-    log::{LogLine, Run},
+    log::{Defmt, LogLine, Run},
+    plot::{self, BLUE, Curve, Figure, GREEN, ORANGE, Panel},
     project::{self, QEMU},
-    reference, render,
+    reference,
     setup::{self, QEMU_BINARY},
     snapshot,
 };
@@ -39,11 +37,12 @@ pub fn command(options: Options) -> Result<bool> {
     QEMU.build(&root)?;
     let run = run(&QEMU.elf(&metadata), options.timeout, Echo::All)?;
 
-    if let Some(plot) = render::plot(&run.log) {
-        println!();
-        print!("{plot}");
-    }
     println!();
+    let png = metadata.target_dir.join("qemu").join("motion.png");
+    match plot_motion(&run.log, &png) {
+        Ok(frames) => println!("motion: {frames} logged frames drawn in {}", png.display()),
+        Err(error) => println!("motion: not drawn: {error:#}"),
+    }
     println!("{}", run.describe());
     let mut ok = run.succeeded();
     match check_summary(&run.log) {
@@ -77,36 +76,46 @@ pub enum Echo {
     Quiet,
 }
 
-/// QEMU's command line for `elf`. `-icount shift=0` makes one instruction one
-/// nanosecond of virtual time, so timing repeats exactly run after run;
-/// `sleep=off` lets the virtual clock jump over the time the core sleeps
-/// instead of following the wall clock, which would make wake-up times (and
-/// so the log) vary from run to run, and the run slower.
-pub fn qemu_command<'a>(sh: &'a Shell, elf: &Path) -> Cmd<'a> {
-    cmd!(
-        sh,
-        "{QEMU_BINARY} -machine lm3s6965evb -cpu cortex-m0 -nographic
-            -semihosting-config enable=on,target=native
-            -icount shift=0,sleep=off
-            -kernel {elf}"
-    )
+/// QEMU running `elf` with the options `args` (display, semihosting,
+/// serial ports). `-icount shift=0` makes one instruction one nanosecond of
+/// virtual time; `sleep=off` lets the virtual clock jump over the time the
+/// core sleeps (timing, and so the log, repeat exactly run after run),
+/// `sleep=on` follows the wall clock while it sleeps (a head at its true
+/// speed, for a person).
+pub fn qemu_command(elf: &Path, sleep: bool, args: &[&str]) -> Command {
+    let mut command = Command::new(QEMU_BINARY);
+    let icount = if sleep {
+        "shift=0,sleep=on"
+    } else {
+        "shift=0,sleep=off"
+    };
+    command.args([
+        "-machine",
+        "lm3s6965evb",
+        "-cpu",
+        "cortex-m0",
+        "-icount",
+        icount,
+    ]);
+    command.args(args).arg("-kernel").arg(elf);
+    command
 }
 
 /// Runs `elf` in QEMU, decoding its defmt output as it arrives; QEMU is
 /// killed after `timeout` of wall time.
 pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
-    let root = project::root();
-    let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
-    let table = Table::parse(&bytes)
-        .with_context(|| format!("reading the defmt table of {}", elf.display()))?
-        .with_context(|| format!("{} has no defmt data", elf.display()))?;
-    // Locations need debug info; without them the log still decodes.
-    let locations = table.get_locations(&bytes).ok();
+    let defmt = Defmt::read(elf)?;
 
-    let sh = project::shell(".")?;
-    let qemu = qemu_command(&sh, elf);
-    println!("$ {qemu}");
-    let mut command = Command::from(qemu);
+    let mut command = qemu_command(
+        elf,
+        false,
+        &[
+            "-nographic",
+            "-semihosting-config",
+            "enable=on,target=native",
+        ],
+    );
+    println!("$ {}", project::shown(&command));
     command
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -117,11 +126,11 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
         .with_context(|| format!("could not start {QEMU_BINARY}"))?;
     // The log is decoded while QEMU runs; its end is the end of QEMU's
     // output, which comes when QEMU exits or is killed.
-    let done = child::run(
+    let done = project::finish(
         child,
         QEMU_BINARY,
         timeout,
-        |stdout| decode(stdout, &table, locations.as_ref(), &root, echo),
+        |stdout| decode(stdout, &defmt, echo),
         |stderr| forward(stderr, &mut std::io::stderr()),
         || (),
     )?;
@@ -133,24 +142,12 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
 }
 
 /// Decodes the defmt stream `output` to its end, echoing lines as they come.
-pub(crate) fn decode(
-    mut output: impl Read,
-    table: &Table,
-    locations: Option<&Locations>,
-    root: &Path,
-    echo: Echo,
-) -> Vec<LogLine> {
-    let mut decoder = table.new_stream_decoder();
+pub(crate) fn decode(mut output: impl Read, defmt: &Defmt, echo: Echo) -> Vec<LogLine> {
+    let mut decoder = defmt.stream();
     let mut buffer = [0_u8; 4096];
     let mut log = Vec::new();
     while let Ok(n @ 1..) = output.read(&mut buffer) {
-        decoder.received(&buffer[..n]);
-        loop {
-            let line = match decoder.decode() {
-                Ok(frame) => LogLine::from_frame(&frame, locations, root),
-                Err(DecodeError::UnexpectedEof) => break,
-                Err(DecodeError::Malformed) => LogLine::malformed(),
-            };
+        for line in defmt.lines(decoder.as_mut(), &buffer[..n]) {
             if echo == Echo::All || (echo == Echo::Problems && line.is_problem()) {
                 line.print();
             }
@@ -250,23 +247,95 @@ pub fn check_summary(log: &[LogLine]) -> Result<String> {
     }
 }
 
+/// Draws the three axes of the log's frame lines (`frame <n>: pitch=<deg>
+/// roll=<deg> yaw=<deg> deg, ...`: the decoder hands out text, so the log
+/// is the record) to the PNG `path`; returns how many there were.
+fn plot_motion(log: &[LogLine], path: &Path) -> Result<usize> {
+    let mut frames: Vec<(f64, [f64; 3])> =
+        log.iter().filter_map(|l| frame_line(&l.message)).collect();
+    frames.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if frames.len() < 2 {
+        bail!("fewer than two frame lines in the log");
+    }
+    let panel = |i: usize, name: &str, color| Panel {
+        title: format!("{name} (°)"),
+        x_desc: "frame".to_owned(),
+        y_desc: "angle (°)".to_owned(),
+        curves: vec![Curve::new(
+            name,
+            color,
+            frames.iter().map(|f| (f.0, f.1[i])).collect(),
+        )],
+        ..Panel::default()
+    };
+    let figure = Figure {
+        title: format!("The QEMU run's motion: {} logged frames", frames.len()),
+        notes: vec!["angles as the firmware logged them".to_owned()],
+        panels: vec![
+            panel(0, "pitch", BLUE),
+            panel(1, "roll", ORANGE),
+            panel(2, "yaw", GREEN),
+        ],
+        panel_height: 220,
+    };
+    plot::draw(&figure, path)?;
+    Ok(frames.len())
+}
+
+/// The frame number and the three angles of a frame line, if `message` is one.
+fn frame_line(message: &str) -> Option<(f64, [f64; 3])> {
+    let (frame, rest) = message.strip_prefix("frame ")?.split_once(": ")?;
+    let mut words = rest.split_whitespace();
+    let mut angles = [0.0; 3];
+    for (angle, axis) in angles.iter_mut().zip(["pitch", "roll", "yaw"]) {
+        let value = words.next()?.strip_prefix(axis)?.strip_prefix('=')?;
+        *angle = value.parse().ok()?;
+    }
+    Some((frame.parse().ok()?, angles))
+}
+
 /// The QEMU smoke run's boot precompute (`precompute_insns` of its summary
 /// line) and the loop sets its log reports. Only the smoke run's: a run
 /// with console traffic would count that traffic in its sets' times.
+#[allow(clippy::cast_precision_loss)] // instruction counts, far below 2^52
 pub fn record_figures(log: &[LogLine]) {
-    let entry = figures::QemuRun {
-        source: figures::Source::now(),
-        precompute: Summary::find(log).and_then(|s| s.number("precompute_insns").ok()),
-        sets: log
-            .iter()
+    let at_125_mhz = |insns: u64| format!("≥ {:.2} ms", insns as f64 / 125e3);
+    let boot = Summary::find(log).and_then(|s| s.number("precompute_insns").ok());
+    let boot = boot.map(|i| {
+        vec![
+            "0 (boot)".to_owned(),
+            thousands(i),
+            at_125_mhz(i),
+            "none".to_owned(),
+        ]
+    });
+    let sets =
+        log.iter()
             .filter_map(|line| set_cost(&line.message))
-            .collect(),
-    };
-    figures::save_section("QEMU run", |f| f.qemu = Some(entry));
+            .map(|(set, insns, discarded)| {
+                vec![
+                    set.to_string(),
+                    thousands(insns),
+                    at_125_mhz(insns),
+                    discarded,
+                ]
+            });
+    let intro = "The QEMU smoke run's loop sets ([never-repeating idle](idle.md#in-the-background)): \
+                 the boot's set 0, timed before the first frame, and the sets generated in the \
+                 background while the frames play, each with the loops it discarded per axis \
+                 (pitch, roll, yaw).";
+    let header = ["set", "instructions", "at 125 MHz", "loops discarded"];
+    figures::record(
+        "qemu",
+        intro.to_owned(),
+        &header,
+        boot.into_iter().chain(sets).collect(),
+    );
 }
 
-/// `loop set <n> ready in <µs> us: seeds [..] ([..] discarded), ...`
-fn set_cost(message: &str) -> Option<figures::SetCost> {
+/// `loop set <n> ready in <µs> us: seeds [..] ([..] discarded), ...`: the
+/// set, its instructions and the loops it discarded.
+fn set_cost(message: &str) -> Option<(u64, u64, String)> {
     let rest = message.strip_prefix("loop set ")?;
     let (set, rest) = rest.split_once(" ready in ")?;
     let (micros, rest) = rest.split_once(" us")?;
@@ -277,11 +346,7 @@ fn set_cost(message: &str) -> Option<figures::SetCost> {
         .split_once('(')
         .and_then(|(_, after)| after.split_once(" discarded)"))
         .map_or_else(String::new, |(list, _)| list.to_owned());
-    Some(figures::SetCost {
-        set: set.parse().ok()?,
-        instructions,
-        discarded,
-    })
+    Some((set.parse().ok()?, instructions, discarded))
 }
 
 #[cfg(test)]
@@ -313,6 +378,21 @@ mod tests {
     }
 
     #[test]
+    fn reads_frame_lines_only() {
+        let line = "frame 1650: pitch=-2.440 roll=+2.285 yaw=+7.611 deg, pulses 1473 1525 1585 us \
+                    (Written Written Failed(Other))";
+        assert_eq!(frame_line(line), Some((1650.0, [-2.44, 2.285, 7.611])));
+        for other in [
+            "frame 1400: join: the next loop set blends in over 100 frames",
+            "frame 7: pitch=+1.000 roll=+2.000 deg",
+            "frame x: pitch=+1.000 roll=+2.000 yaw=+3.000 deg",
+            "summary frames=1903 missed=0",
+        ] {
+            assert!(frame_line(other).is_none(), "{other}");
+        }
+    }
+
+    #[test]
     fn reads_the_loop_set_lines() {
         let set = set_cost(
             "loop set 2 ready in 3470 us: seeds [0x417b904f, 0xcbb40bbb, \
@@ -320,10 +400,7 @@ mod tests {
              [1142, 1108, 1391] mdeg rms",
         )
         .unwrap();
-        assert_eq!(
-            (set.set, set.instructions, set.discarded.as_str()),
-            (2, 3_470_000, "[2, 3, 3]")
-        );
+        assert_eq!(set, (2, 3_470_000, "[2, 3, 3]".to_owned()));
         assert!(set_cost("loop set failed: range; trying the next seeds").is_none());
         assert!(set_cost("frame 1400: join").is_none());
     }

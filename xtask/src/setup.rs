@@ -13,9 +13,8 @@ use crate::{
     project::{self, TARGET},
 };
 
-/// QEMU's system emulator for Arm, and the Debian/Ubuntu package that has it.
+/// QEMU's system emulator for Arm.
 pub const QEMU_BINARY: &str = "qemu-system-arm";
-const QEMU_PACKAGE: &str = "qemu-system-arm";
 
 /// Rustup components the checks use.
 const COMPONENTS: [&str; 2] = ["rustfmt", "clippy"];
@@ -64,38 +63,39 @@ pub fn ensure_toolchain(root: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Makes sure `qemu-system-arm` runs; installs it with apt-get when running as
-/// root on Debian or Ubuntu, and otherwise says which package to install.
+/// Makes sure `qemu-system-arm` runs (see [`ensure_program`]).
 pub fn ensure_qemu() -> Result<()> {
-    if qemu_version().is_some() {
+    ensure_program(
+        QEMU_BINARY,
+        &["qemu-system-arm"],
+        "QEMU's Arm system emulator (package `qemu-system-arm` on Debian, Ubuntu and Fedora, \
+         `qemu` on Homebrew)",
+    )
+}
+
+/// Makes sure `program` runs (`--version`): else installs `packages` with
+/// apt-get when running as root on Debian or Ubuntu, or says to install
+/// `what`.
+pub fn ensure_program(program: &str, packages: &[&str], what: &str) -> Result<()> {
+    if version(program).is_some() {
         return Ok(());
     }
-    let sh = project::shell(".")?;
-    let apt = Path::new("/etc/debian_version").exists()
-        && cmd!(sh, "apt-get --version")
-            .quiet()
-            .ignore_stdout()
-            .run()
-            .is_ok();
-    if !apt {
+    let packages_text = packages.join(" ");
+    if !Path::new("/etc/debian_version").exists() || version("apt-get").is_none() {
+        bail!("`{program}` was not found; install {what} and run the command again");
+    }
+    let root = Command::new("id").arg("-u").output();
+    if !root.is_ok_and(|out| out.stdout.trim_ascii() == b"0") {
         bail!(
-            "`{QEMU_BINARY}` was not found; install QEMU's Arm system emulator \
-             (package `{QEMU_PACKAGE}` on Debian/Ubuntu, `qemu-system-arm` on Fedora, \
-             `qemu` on Homebrew) and run the command again"
+            "`{program}` was not found; install it with `sudo apt-get install {packages_text}` \
+             and run the command again"
         );
     }
-    let root = cmd!(sh, "id -u").quiet().read().is_ok_and(|id| id == "0");
-    if !root {
-        bail!(
-            "`{QEMU_BINARY}` was not found; install it with \
-             `sudo apt-get install {QEMU_PACKAGE}` and run the command again"
-        );
-    }
-    println!("{QEMU_BINARY} is missing: installing the `{QEMU_PACKAGE}` package");
-    apt_install(&[QEMU_PACKAGE])?;
-    qemu_version()
+    println!("{program} is missing: installing {packages_text}");
+    apt_install(packages)?;
+    version(program)
         .map(|_| ())
-        .with_context(|| format!("`{QEMU_BINARY}` still does not run after installing it"))
+        .with_context(|| format!("`{program}` still does not run after installing {packages_text}"))
 }
 
 /// Installs `packages` with apt-get, non-interactively (the caller has
@@ -114,11 +114,16 @@ pub fn apt_install(packages: &[&str]) -> Result<()> {
     )
 }
 
-/// First line of `qemu-system-arm --version`, if it runs.
-pub fn qemu_version() -> Option<String> {
-    let sh = project::shell(".").ok()?;
-    let version = cmd!(sh, "{QEMU_BINARY} --version").quiet().read().ok()?;
-    Some(version.lines().next().unwrap_or_default().to_owned())
+/// First line of `<program> --version`, if it runs.
+pub fn version(program: impl AsRef<std::ffi::OsStr>) -> Option<String> {
+    let out = Command::new(program)
+        .arg("--version")
+        .stdin(std::process::Stdio::null())
+        .output()
+        .ok()
+        .filter(|out| out.status.success())?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    Some(text.lines().next().unwrap_or_default().trim().to_owned())
 }
 
 /// The mdBook release the book is built with (`cargo xtask book`): pinned,
@@ -127,89 +132,41 @@ pub fn qemu_version() -> Option<String> {
 pub const MDBOOK_VERSION: &str = "0.5.4";
 
 /// The `mdbook` program to run: the pinned release if it is on the `PATH`
-/// or was installed into `tools` before; otherwise it is installed from
-/// crates.io with `cargo install` (a few minutes, once), into cargo's own
-/// folder of programs if no other mdBook is on the `PATH`, and into `tools`
-/// if one is (so that another project's mdBook is left as it is). Only
-/// the HTML renderer and its search are built (`--no-default-features
-/// --features search`): the book needs no `mdbook serve` or `watch`.
+/// or in `tools`; else it is installed there with `cargo install` (a few
+/// minutes, once; `tools` leaves any other mdBook as it is). Only the HTML
+/// renderer and its search are built: the book needs no `serve` or `watch`.
 pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
-    let local = tools.join("bin").join("mdbook");
-    let version = |program: &Path| {
-        Command::new(program)
-            .arg("--version")
-            .output()
-            .ok()
-            .filter(|out| out.status.success())
-            .map(|out| String::from_utf8_lossy(&out.stdout).trim().to_owned())
-    };
     let wanted = format!("mdbook v{MDBOOK_VERSION}");
-    if version(&local).as_deref() == Some(wanted.as_str()) {
-        return Ok(local);
+    let local = tools.join("bin").join("mdbook");
+    for program in [local.clone(), PathBuf::from("mdbook")] {
+        if version(&program).as_deref() == Some(wanted.as_str()) {
+            return Ok(program);
+        }
     }
-    let on_path = version(Path::new("mdbook"));
-    if on_path.as_deref() == Some(wanted.as_str()) {
-        return Ok(PathBuf::from("mdbook"));
-    }
+    println!(
+        "installing mdbook v{MDBOOK_VERSION} into {} (a few minutes, once)",
+        project::relative(tools).display()
+    );
     let sh = project::shell(".")?;
     // The repository's .cargo/config.toml builds for the firmware's target:
     // mdBook is a host program.
-    let host = host_triple()?;
-    let root = if let Some(other) = &on_path {
-        println!(
-            "{other} is on the PATH, not v{MDBOOK_VERSION}: installing v{MDBOOK_VERSION} into {}",
-            project::relative(tools).display()
-        );
-        Some(tools.to_path_buf())
-    } else {
-        println!(
-            "mdbook is missing: installing v{MDBOOK_VERSION} with cargo install (a few minutes, once)"
-        );
-        None
-    };
-    let root_args: Vec<String> = root
-        .iter()
-        .flat_map(|dir| ["--root".to_owned(), dir.display().to_string()])
-        .collect();
+    let info = cmd!(sh, "rustc -vV").quiet().read()?;
+    let host = info.lines().find_map(|line| line.strip_prefix("host: "));
+    let host = host.context("`rustc -vV` names no host")?;
     let build_dir = tools.join("build");
     project::run(
         &sh,
         &[],
         cmd!(
             sh,
-            "cargo install mdbook --locked --version {MDBOOK_VERSION} --no-default-features --features search --target {host} --target-dir {build_dir} {root_args...}"
+            "cargo install mdbook --locked --version {MDBOOK_VERSION} --no-default-features --features search --target {host} --target-dir {build_dir} --root {tools}"
         ),
     )?;
-    let installed = match root {
-        Some(_) => local,
-        None => cargo_home()?.join("bin").join("mdbook"),
-    };
-    if version(&installed).as_deref() != Some(wanted.as_str()) {
+    if version(&local).as_deref() != Some(wanted.as_str()) {
         bail!(
             "installed mdBook v{MDBOOK_VERSION}, but {} does not run as it",
-            installed.display()
+            local.display()
         );
     }
-    Ok(installed)
-}
-
-/// The host's target triple (`rustc -vV`'s `host:` line).
-fn host_triple() -> Result<String> {
-    let sh = project::shell(".")?;
-    let info = cmd!(sh, "rustc -vV").quiet().read()?;
-    info.lines()
-        .find_map(|line| line.strip_prefix("host: "))
-        .map(str::to_owned)
-        .context("`rustc -vV` names no host")
-}
-
-/// Where `cargo install` puts programs without `--root`: `$CARGO_HOME`, or
-/// `~/.cargo`.
-fn cargo_home() -> Result<PathBuf> {
-    if let Some(home) = std::env::var_os("CARGO_HOME") {
-        return Ok(PathBuf::from(home));
-    }
-    std::env::var_os("HOME")
-        .map(|home| PathBuf::from(home).join(".cargo"))
-        .context("neither CARGO_HOME nor HOME is set")
+    Ok(local)
 }

@@ -1,13 +1,7 @@
-//! `cargo xtask sim`: the Pico image, exactly as `cargo run --release`
-//! flashes it, in the RP2040 emulator rp2040js (Node.js, `sim/`).
-//!
-//! The harness (`sim/harness.mjs`) boots the flash image the way boot2
-//! hands over, bridges the emulator's one gap (SEV), performs watchdog resets
-//! and reports raw facts as JSON lines: RTT bytes, pin edges, PWM compare
-//! writes, the cycles of each frame update. This module decodes the log with
-//! the ELF's defmt table, rebuilds the pulse trains and checks them against
-//! the duties the host computes with the same core (`pulses.rs` explains how
-//! PWM periods map to frames).
+//! `cargo xtask sim`: the Pico image, as `cargo run --release` flashes it,
+//! in the RP2040 emulator rp2040js (Node.js, `sim/harness.mjs`, which
+//! reports raw facts as JSON lines). This module decodes the log, rebuilds
+//! the pulse trains and checks them against the host's duties.
 
 mod dmx;
 mod event;
@@ -18,7 +12,7 @@ mod harness;
 mod image;
 mod inputs;
 pub mod live;
-pub(crate) mod node;
+pub mod node;
 mod noise;
 mod planted;
 pub mod pulses;
@@ -37,7 +31,6 @@ use anyhow::Result;
 
 pub use flood::{FLOOD_STAGE, test_flood};
 pub use inputs::{INPUTS_STAGE, test_inputs};
-pub use node::ensure as ensure_node;
 pub use node::folder as node_folder;
 pub use script::{default_time as script_time, parse as parse_script};
 pub use stream::{LENGTH as STREAM_LENGTH, UART_STREAM_STAGE, USB_STREAM_STAGE, test_stream};
@@ -45,9 +38,6 @@ pub use stream::{LENGTH as STREAM_LENGTH, UART_STREAM_STAGE, USB_STREAM_STAGE, t
 /// Plays a script's `events` into the shipped image (built) for `time` from
 /// its first frame; every pulse checked against what the firmware wrote:
 /// on time, its own frame's, within the servos' limits (see `script.rs`).
-///
-/// # Errors
-/// If the emulator cannot run.
 pub fn play_script(
     root: &std::path::Path,
     metadata: &crate::project::Metadata,
@@ -197,6 +187,9 @@ fn seconds(value: &str, max: f64) -> Result<Duration, String> {
     Ok(Duration::from_secs_f64(seconds))
 }
 
+/// A run of its own that `cargo xtask test` runs as a stage.
+type Stage = fn(&std::path::Path, &project::Metadata) -> Result<()>;
+
 /// Whether the run called `what` passed; if not, says why.
 fn passed(what: &str, result: Result<()>) -> bool {
     match result {
@@ -223,20 +216,15 @@ pub fn command(args: &Args) -> Result<bool> {
             args.pulses.as_ref(),
         );
     }
-    if args.inputs {
-        PICO.build(&root)?;
-        return Ok(passed("inputs", inputs::test_inputs(&root, &metadata)));
-    }
-    if args.drill {
-        return Ok(passed(
-            "watchdog drill",
-            stages::test_drill(&root, &metadata),
-        ));
-    }
-    if args.flood {
-        return Ok(passed("UART flood", flood::test_flood(&root, &metadata)));
-    }
+    let runs: [(bool, &str, Stage); 5] = [
+        (args.inputs, "inputs", inputs::test_inputs),
+        (args.drill, "watchdog drill", stages::test_drill),
+        (args.flood, "UART flood", flood::test_flood),
+        (args.noise, "UART noise", noise::test_noise),
+        (args.store, "settings store", store::test_store),
+    ];
     if let Some(port) = &args.stream {
+        PICO.build(&root)?;
         let port = if port == "usb" { "usb" } else { "uart" };
         let length = args.virtual_time.unwrap_or(stream::LENGTH);
         return Ok(passed(
@@ -244,14 +232,9 @@ pub fn command(args: &Args) -> Result<bool> {
             stream::test_stream(&root, &metadata, port, length),
         ));
     }
-    if args.noise {
-        return Ok(passed("UART noise", noise::test_noise(&root, &metadata)));
-    }
-    if args.store {
-        return Ok(passed(
-            "settings store",
-            store::test_store(&root, &metadata),
-        ));
+    if let Some((_, what, stage)) = runs.iter().find(|run| run.0) {
+        PICO.build(&root)?;
+        return Ok(passed(what, stage(&root, &metadata)));
     }
     if args.console {
         let time = args.virtual_time.unwrap_or(CONSOLE_TIME);

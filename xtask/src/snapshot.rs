@@ -1,17 +1,8 @@
-//! The QEMU log kept on file in the QEMU package, compared on every test run.
-//!
-//! The expected log is the decoded log, one `LEVEL message` line per frame.
-//! Where a line holds a value that changes with unrelated code changes (an
-//! instruction count, a wake-up latency), that part of the line can be
-//! replaced by `[..]` in the file, which matches any text within the line
-//! (snapbox's wildcard). Re-recording (`--bless`) keeps such a line as it is
-//! while it still matches.
-//!
-//! Snapbox pairs the lines of the two logs by position, so a line added or
-//! removed above a wildcard line would cost that line its wildcard on
-//! re-recording. So each line of the run that a wildcard line of the file
-//! matches is first replaced by that wildcard line, wherever it is; snapbox
-//! then compares, shows the difference, or re-records.
+//! The QEMU log kept on file (`boards/qemu/expected.log`), compared on every
+//! test run with snapbox. A `[..]` in a line matches any text within it;
+//! since snapbox pairs lines by position, each line of the run that a
+//! wildcard line matches is first replaced by it, so that re-recording
+//! (`--bless`) keeps the wildcards that still match.
 
 use std::path::{Path, PathBuf};
 
@@ -161,27 +152,12 @@ mod tests {
         assert!(!matches("plain", "plain text"));
     }
 
-    /// A scratch copy of an expected log.
-    struct Scratch(PathBuf);
-
-    impl Scratch {
-        fn new(name: &str, text: &str) -> Self {
-            let dir = std::env::temp_dir().join(format!("xtask-snapshot-{}", std::process::id()));
-            std::fs::create_dir_all(&dir).unwrap();
-            let path = dir.join(name);
-            std::fs::write(&path, text).unwrap();
-            Self(path)
-        }
-
-        fn text(&self) -> String {
-            std::fs::read_to_string(&self.0).unwrap()
-        }
-    }
-
-    impl Drop for Scratch {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_file(&self.0);
-        }
+    /// A scratch copy of an expected log holding `text`.
+    fn scratch(text: &str) -> (tempfile::TempDir, PathBuf) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("expected.log");
+        std::fs::write(&path, text).unwrap();
+        (dir, path)
     }
 
     const WANT: &str = "INFO  start\n\
@@ -191,19 +167,19 @@ mod tests {
 
     #[test]
     fn values_under_wildcards_may_change() {
-        let file = Scratch::new("values.log", WANT);
+        let (_dir, file) = scratch(WANT);
         let got =
             "INFO  start\nINFO  cost 42 insns\nINFO  end 1\nINFO  timing: at most 97 us late\n";
-        assert_eq!(check(&file.0, got), Ok(()));
+        assert_eq!(check(&file, got), Ok(()));
         let got = got.replace("end 1", "end 2");
-        let difference = check(&file.0, &got).unwrap_err();
+        let difference = check(&file, &got).unwrap_err();
         assert!(difference.contains("end 1") && difference.contains("end 2"));
         assert!(!difference.contains("cost 42"), "{difference}");
     }
 
     #[test]
     fn blessing_keeps_the_wildcards_that_still_match() {
-        let file = Scratch::new("bless.log", WANT);
+        let (_dir, file) = scratch(WANT);
         // A line added above both wildcard lines, one changed between them,
         // and new values under the wildcards.
         let got = "INFO  start\n\
@@ -211,9 +187,9 @@ mod tests {
                    INFO  cost 7 insns\n\
                    INFO  end 2\n\
                    INFO  timing: at most 12 us late\n";
-        assert!(record(&file.0, got).unwrap());
+        assert!(record(&file, got).unwrap());
         assert_eq!(
-            file.text(),
+            std::fs::read_to_string(&file).unwrap(),
             "INFO  start\n\
              INFO  a new line\n\
              INFO  cost [..] insns\n\
@@ -221,17 +197,17 @@ mod tests {
              INFO  timing: at most [..] us late\n"
         );
         // The re-recorded file now matches the run, and is left alone.
-        assert_eq!(check(&file.0, got), Ok(()));
-        assert!(!record(&file.0, got).unwrap());
+        assert_eq!(check(&file, got), Ok(()));
+        assert!(!record(&file, got).unwrap());
     }
 
     #[test]
     fn blessing_drops_a_wildcard_line_that_no_longer_matches() {
-        let file = Scratch::new("reworded.log", WANT);
+        let (_dir, file) = scratch(WANT);
         let got = "INFO  start\nINFO  cost: 7\nINFO  end 1\nINFO  timing: at most 3 us late\n";
-        assert!(record(&file.0, got).unwrap());
+        assert!(record(&file, got).unwrap());
         assert_eq!(
-            file.text(),
+            std::fs::read_to_string(&file).unwrap(),
             "INFO  start\nINFO  cost: 7\nINFO  end 1\nINFO  timing: at most [..] us late\n"
         );
     }

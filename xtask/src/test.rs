@@ -5,7 +5,7 @@ use std::{path::Path, time::Instant};
 
 use anyhow::{Result, bail};
 
-use xshell::{Shell, cmd};
+use xshell::cmd;
 
 use crate::{
     args::Options,
@@ -14,113 +14,69 @@ use crate::{
     panel, pico2,
     project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
     qemu::{self, Echo},
-    setup, sim, snapshot, uf2,
+    setup, sim, snapshot,
 };
 
-/// How a stage ended.
-enum Outcome {
-    Passed,
-    Failed(String),
-    Skipped(String),
-}
-
-/// Runs stages one after another and keeps score.
+/// Runs stages one after another and keeps score: each stage's name, its
+/// error if it failed, and its seconds; and how many `--only` left out.
 struct Stages<'a> {
-    results: Vec<(String, Outcome, f64)>,
+    results: Vec<(String, Option<String>, f64)>,
     /// Only the stages whose name contains this run.
     only: Option<&'a str>,
+    left_out: usize,
 }
 
-impl<'a> Stages<'a> {
-    fn new(only: Option<&'a str>) -> Self {
-        Self {
-            results: Vec::new(),
-            only,
-        }
-    }
-
-    /// Runs one stage; `Ok(())` passes, an error fails it.
+impl Stages<'_> {
+    /// Runs one stage; `Ok(())` passes, an error fails it. A stage `--only`
+    /// leaves out does not run, and counts as passed for what follows.
     fn run(&mut self, name: &str, stage: impl FnOnce() -> Result<()>) -> bool {
-        self.run_or_skip(name, || stage().map(|()| None))
-    }
-
-    /// Runs one stage that may decide to skip itself (`Ok(Some(reason))`).
-    fn run_or_skip(&mut self, name: &str, stage: impl FnOnce() -> Result<Option<String>>) -> bool {
         if self.only.is_some_and(|only| !name.contains(only)) {
-            let reason = "not chosen by --only".to_owned();
-            self.results
-                .push((name.to_owned(), Outcome::Skipped(reason), 0.0));
+            self.left_out += 1;
             return true;
         }
-        println!();
-        println!("==> {name}");
+        println!("\n==> {name}");
         let start = Instant::now();
-        let outcome = match stage() {
-            Ok(None) => Outcome::Passed,
-            Ok(Some(reason)) => Outcome::Skipped(reason),
-            Err(error) => Outcome::Failed(format!("{error:#}")),
-        };
+        let failed = stage().err().map(|error| format!("{error:#}"));
         let seconds = start.elapsed().as_secs_f64();
-        let passed = !matches!(outcome, Outcome::Failed(_));
-        match &outcome {
-            Outcome::Passed => println!("--- ok: {name} ({seconds:.1} s)"),
-            Outcome::Skipped(reason) => println!("--- skipped: {name}: {reason}"),
-            Outcome::Failed(error) => println!("--- FAILED: {name}: {error}"),
+        match &failed {
+            None => println!("--- ok: {name} ({seconds:.1} s)"),
+            Some(error) => println!("--- FAILED: {name}: {error}"),
         }
-        self.results.push((name.to_owned(), outcome, seconds));
-        passed
+        self.results
+            .push((name.to_owned(), failed.clone(), seconds));
+        failed.is_none()
     }
 
     /// Records a stage that could not run because an earlier one failed.
     fn blocked(&mut self, name: &str, by: &str) {
-        if self.only.is_some_and(|only| !name.contains(only)) {
-            let reason = "not chosen by --only".to_owned();
-            self.results
-                .push((name.to_owned(), Outcome::Skipped(reason), 0.0));
-            return;
-        }
-        println!();
-        println!("==> {name}");
-        println!("--- FAILED: {name}: not run, {by} failed");
-        self.results.push((
-            name.to_owned(),
-            Outcome::Failed(format!("not run, {by} failed")),
-            0.0,
-        ));
+        self.run(name, || bail!("not run, {by} failed"));
     }
 
     /// Prints the score card and the closing `N passed, M failed` line.
     fn finish(&self, start: Instant) -> bool {
-        let count = |f: fn(&Outcome) -> bool| self.results.iter().filter(|(_, o, _)| f(o)).count();
-        let passed = count(|o| matches!(o, Outcome::Passed));
-        let failed = count(|o| matches!(o, Outcome::Failed(_)));
-        let skipped = count(|o| matches!(o, Outcome::Skipped(_)));
-        println!();
-        println!("stages:");
-        for (name, outcome, seconds) in &self.results {
-            let verdict = match outcome {
-                Outcome::Passed => "ok",
-                Outcome::Failed(_) => "FAILED",
-                Outcome::Skipped(_) => "skipped",
-            };
+        let failed = self.results.iter().filter(|(_, f, _)| f.is_some()).count();
+        println!("\nstages:");
+        for (name, failure, seconds) in &self.results {
+            let verdict = if failure.is_some() { "FAILED" } else { "ok" };
             println!("  {verdict:<8} {seconds:>6.1} s  {name}");
         }
-        for (name, outcome, _) in &self.results {
-            if let Outcome::Failed(error) = outcome {
+        for (name, failure, _) in &self.results {
+            if let Some(error) = failure {
                 println!("failed: {name}: {error}");
             }
         }
         println!("total time {:.0} s", start.elapsed().as_secs_f64().round());
-        if skipped > 0 {
-            println!("{passed} passed, {failed} failed, {skipped} skipped");
-        } else {
-            println!("{passed} passed, {failed} failed");
-        }
+        let left_out = match self.left_out {
+            0 => String::new(),
+            n => format!(" ({n} left out by --only)"),
+        };
+        println!("{} passed, {failed} failed{left_out}", self.results.len() - failed);
         failed == 0
     }
 }
 
-/// `cargo xtask test`. `Ok(false)` when a stage failed.
+/// `cargo xtask test`, all stages or `only` those whose name contains it.
+/// `Ok(false)` when a stage failed.
 pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     let start = Instant::now();
     let root = project::root();
@@ -130,7 +86,11 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     let host_tests = project::shell("host-tests")?;
     let core = project::shell("crates/core")?;
     let xtask = project::shell("xtask")?;
-    let mut stages = Stages::new(only);
+    let mut stages = Stages {
+        results: Vec::new(),
+        only,
+        left_out: 0,
+    };
 
     // 1. Host tests of the core, and its doc tests once they are switched on.
     stages.run("host tests (host-tests/)", || {
@@ -147,7 +107,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     stages.run("rustfmt: every package of the workspace", || {
         project::run(&sh, &[], cmd!(sh, "cargo fmt --all --check"))
     });
-    clippy_stages(&mut stages, &sh, &host_tests, &xtask);
+    clippy_stages(&mut stages);
 
     // 3. The Pico image: placement of the boot stage, memory budgets, no allocator.
     let pico_built = stages.run("Pico build (cargo build --release)", || PICO.build(&root));
@@ -156,13 +116,11 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
             "Pico image: .boot2 placement, memory budgets, no allocator",
             || elf::check_pico(&PICO.elf(&metadata)),
         );
-        stages.run(uf2::PICO_STAGE, || uf2::test_pico(&metadata));
     } else {
         stages.blocked(
             "Pico image: .boot2 placement, memory budgets, no allocator",
             "the Pico build",
         );
-        stages.blocked(uf2::PICO_STAGE, "the Pico build");
     }
     // The Pico 2 on its own: its embassy-rp chip feature excludes the Pico's.
     stages.run(pico2::STAGE, || pico2::test(&metadata));
@@ -212,63 +170,48 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     Ok(stages.finish(start))
 }
 
-fn clippy_stages(stages: &mut Stages<'_>, sh: &Shell, host_tests: &Shell, xtask: &Shell) {
-    // `--release` shares build scripts and proc-macros with the release builds below.
-    stages.run("clippy: Pico image, RP support, firmware layer, core (thumbv6m)", || {
-        project::run(
-            sh,
-            FIRMWARE_ENV,
-            cmd!(
-                sh,
-                "cargo clippy --release --package idle-head --package idle-head-rp --package idle-head-firmware --package idle-head-core -- -D warnings"
-            ),
-        )
-    });
-    stages.run("clippy: QEMU images, boards/qemu/ (thumbv6m)", || {
-        project::run(
-            sh,
-            FIRMWARE_ENV,
-            cmd!(
-                sh,
-                "cargo clippy --release --bins --package idle-head-qemu -- -D warnings"
-            ),
-        )
-    });
-    stages.run(
+/// The clippy passes: the firmware's (thumbv6m, `--release` to share build
+/// scripts and proc-macros with the release builds), the Pico 2's, and the
+/// host crates'; `(name, folder, firmware, arguments)`.
+const CLIPPY: [(&str, &str, bool, &str); 6] = [
+    (
+        "clippy: Pico image, RP support, firmware layer, core (thumbv6m)",
+        ".",
+        true,
+        "--release --package idle-head --package idle-head-rp --package idle-head-firmware \
+         --package idle-head-core",
+    ),
+    (
+        "clippy: QEMU images, boards/qemu/ (thumbv6m)",
+        ".",
+        true,
+        "--release --bins --package idle-head-qemu",
+    ),
+    (
         "clippy: Pico 2 image, boards/pico2/ (thumbv8m.main)",
-        || {
-            let pico2 = project::shell("boards/pico2")?;
-            project::run(
-                &pico2,
-                FIRMWARE_ENV,
-                cmd!(pico2, "cargo clippy --release -- -D warnings"),
-            )
-        },
-    );
-    stages.run("clippy: core crate and its unit tests (host)", || {
-        project::run(
-            sh,
-            &[],
-            cmd!(
-                sh,
-                "cargo clippy --package idle-head-core --all-targets --target host-tuple -- -D warnings"
-            ),
-        )
-    });
-    stages.run("clippy: host-tests", || {
-        project::run(
-            host_tests,
-            &[],
-            cmd!(host_tests, "cargo clippy --all-targets -- -D warnings"),
-        )
-    });
-    stages.run("clippy: xtask", || {
-        project::run(
-            xtask,
-            &[],
-            cmd!(xtask, "cargo clippy --all-targets -- -D warnings"),
-        )
-    });
+        "boards/pico2",
+        true,
+        "--release",
+    ),
+    (
+        "clippy: core crate and its unit tests (host)",
+        ".",
+        false,
+        "--package idle-head-core --all-targets --target host-tuple",
+    ),
+    ("clippy: host-tests", "host-tests", false, "--all-targets"),
+    ("clippy: xtask", "xtask", false, "--all-targets"),
+];
+
+fn clippy_stages(stages: &mut Stages<'_>) {
+    for (name, dir, firmware, args) in CLIPPY {
+        stages.run(name, || {
+            let sh = project::shell(dir)?;
+            let args = args.split_whitespace();
+            let env = if firmware { FIRMWARE_ENV } else { &[] };
+            project::run(&sh, env, cmd!(sh, "cargo clippy {args...} -- -D warnings"))
+        });
+    }
 }
 
 fn sim_stages(
@@ -296,6 +239,12 @@ fn sim_stages(
     stages.run(sim::STORE_STAGE, || sim::test_store(root, metadata));
     stages.run(sim::NOISE_STAGE, || sim::test_noise(root, metadata));
     stages.run(sim::FLOOD_STAGE, || sim::test_flood(root, metadata));
+    stages.run(sim::UART_STREAM_STAGE, || {
+        sim::test_stream(root, metadata, "uart", sim::STREAM_LENGTH)
+    });
+    stages.run(sim::USB_STREAM_STAGE, || {
+        sim::test_stream(root, metadata, "usb", sim::STREAM_LENGTH)
+    });
     stages.run(sim::FAILURES_STAGE, || sim::test_failures(root, metadata));
     stages.run(sim::SHOW_STAGE, || sim::test_show(root, metadata));
     stages.run(MEMORY, || {

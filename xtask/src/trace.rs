@@ -1,26 +1,9 @@
 //! `cargo xtask trace`: the firmware's frames simulated on the host, as CSV
-//! (and PNG), for anyone to check.
-//!
-//! The core library's frame engine (`behaviour::Head`: the idle loops, the
-//! behaviour mixer, the command queue, the frame driver) runs frame by frame
-//! exactly as the frame task runs it on the board, with the built-in
-//! configuration: the Table 2 loops (or the ones of `--seed`), 30 s loops,
-//! 50 Hz frames, the default servos, driver and behaviour. A script's
-//! motion commands go through the same queue at their times, its other
-//! console lines through the console's service, its pin lines into the
-//! input task's state machine (`host.rs`): the same core as the board's.
-//! A line at a frame's time is taken before that frame.
-//!
-//! The CSV has one row per frame:
-//!
-//! ```text
-//! frame,t_ms,pitch_mdeg,roll_mdeg,yaw_mdeg,pitch_ns,roll_ns,yaw_ns
-//! ```
-//!
-//! the commanded angles after every safety stage (fade, speed and
-//! acceleration limits, angle clamps) and the pulse widths of the duties
-//! written, on PWM channels clocked as the Pico's (`idle_head_core::pwm_clock`:
-//! 64 000 counts of 312.5 ns per 20 ms period).
+//! (and PNG). The core's frame engine runs frame by frame as the frame task
+//! does, with the built-in configuration; a script's motion lines go
+//! through the same queue, its console lines through the console's
+//! service, its pin lines into the input task (`host.rs`). A row per frame:
+//! `frame,t_ms,pitch_mdeg,roll_mdeg,yaw_mdeg,pitch_ns,roll_ns,yaw_ns`.
 
 mod host;
 mod marks;
@@ -47,9 +30,6 @@ pub use script::{Event, Kind};
 use crate::steps::Steps;
 
 /// A script's events (see `script.rs`), checked with `params`.
-///
-/// # Errors
-/// Every bad line, each with its number and why.
 pub fn parse_script(text: &str, params: &BehaviourParams) -> Result<Vec<Event>> {
     script::parse(text, params)
 }
@@ -97,13 +77,10 @@ fn positive_seconds(text: &str) -> Result<u64, String> {
 /// One frame of the trace.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Row {
-    /// Frame index.
     pub frame: u64,
     /// Time of the frame in ms.
     pub t_ms: u64,
-    /// Commanded angles, m°.
     pub angles: [i32; 3],
-    /// Pulse widths, ns.
     pub pulses: [u64; 3],
     /// The duties written, counts of the Pico's PWM (0: no pulse).
     pub duties: [u16; 3],
@@ -111,7 +88,6 @@ pub struct Row {
 
 /// The simulated run.
 pub struct Trace {
-    /// One row per frame.
     pub rows: Vec<Row>,
     /// The script's commands as applied, and the looks' returns, in time
     /// order.
@@ -166,9 +142,6 @@ fn idle(config: HeadConfig, playback: Playback, seed: Option<u32>) -> Result<Idl
 
 /// The built-in driver's parameters and the behaviour's built on them:
 /// what the board runs.
-///
-/// # Errors
-/// If a configuration is refused (never the built-in ones).
 pub fn built_in() -> Result<(DriverParams, BehaviourParams)> {
     let driver = DriverConfig::DEFAULT
         .build()

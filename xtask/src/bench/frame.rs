@@ -4,7 +4,7 @@
 
 use anyhow::{Context, Result, bail};
 
-use super::{RP2040_HZ, thousands};
+use super::thousands;
 use crate::log::LogLine;
 
 /// A frame row's ceiling, in instructions of one frame update.
@@ -12,7 +12,6 @@ use crate::log::LogLine;
 pub struct Ceiling {
     /// The median over the loop.
     pub median: u64,
-    /// The costliest frame.
     pub max: u64,
 }
 
@@ -46,17 +45,14 @@ pub const CEILINGS: [(Option<&str>, Ceiling); 2] = [
 pub struct FrameRow {
     /// What plays besides the idle loops (`gesture+look`), if anything.
     pub scenario: Option<String>,
-    /// Frames measured.
     pub frames: u64,
     /// Fewest instructions of a frame.
     pub min: u64,
-    /// Median over the frames.
     pub median: u64,
     /// Most instructions of a frame.
     pub max: u64,
     /// The frame that took `max`.
     pub max_at: u64,
-    /// Mean over the frames.
     pub mean: u64,
 }
 
@@ -138,53 +134,6 @@ impl FrameRow {
             None => "frame".to_owned(),
             Some(s) => format!("frame ({})", s.replace('+', " + ")),
         }
-    }
-
-    /// The row, its header and the verdict against its own ceiling, ready
-    /// to print.
-    pub fn lines(&self) -> String {
-        let mark = |value: u64, ceiling: u64| if value <= ceiling { "ok" } else { "OVER" };
-        let label = self.label();
-        let what = match &self.scenario {
-            None => "idle loops only",
-            Some(_) => "a gesture and a gaze move playing at every frame",
-        };
-        let verdict = match self.ceiling() {
-            Some(ceiling) => format!(
-                "ceiling: median {} against {}: {}; max {} against {}: {}",
-                thousands(self.median),
-                thousands(ceiling.median),
-                mark(self.median, ceiling.median),
-                thousands(self.max),
-                thousands(ceiling.max),
-                mark(self.max, ceiling.max),
-            ),
-            None => "ceiling: none for this scenario".to_owned(),
-        };
-        format!(
-            "{:<22} {:>6} {:>6} {:>7} {:>6} {:>6} {:>9}\n\
-             {:<22} {:>6} {:>6} {:>7} {:>6} {:>6} {:>9}\n\
-             {label}: instructions of one frame update (3 servos: playback, mixer, fade, \
-             limits, mapping, PWM writes; {what}) over frames 0..{} (fade-in, a join); \
-             max at frame {}.\n\
-             \x20 {verdict}\n",
-            "row",
-            "frames",
-            "min",
-            "median",
-            "max",
-            "mean",
-            "RP2040 µs",
-            label,
-            self.frames,
-            thousands(self.min),
-            thousands(self.median),
-            thousands(self.max),
-            thousands(self.mean),
-            format!("{:.1}", self.max as f64 / RP2040_HZ * 1e6),
-            self.frames.saturating_sub(1),
-            self.max_at,
-        )
     }
 }
 

@@ -107,16 +107,18 @@ pub struct Row {
 }
 
 impl Row {
-    /// The row for the measured figures.
-    pub fn figure(&self) -> crate::figures::LatencyRow {
-        crate::figures::LatencyRow {
-            label: format!("latency {}", self.name),
-            events: self.ms.len(),
-            p50_ms: self.percentile(50.0),
-            p99_ms: self.percentile(99.0),
-            max_ms: self.ms.last().copied().unwrap_or(f64::NAN),
-            goal_p99_ms: GOAL_MS,
-        }
+    /// The row for the measured figures: label, events, p50, p99, max, goal.
+    pub fn figure(&self) -> Vec<String> {
+        let (p99, ms) = (self.percentile(99.0), |v: f64| format!("{v:.1}"));
+        let missed = if p99 <= GOAL_MS { "" } else { " (missed)" };
+        vec![
+            format!("latency {}", self.name),
+            crate::figures::thousands(self.ms.len() as u64),
+            ms(self.percentile(50.0)),
+            ms(p99),
+            ms(self.ms.last().copied().unwrap_or(f64::NAN)),
+            format!("{GOAL_MS:.0}{missed}"),
+        ]
     }
 
     /// The `p`-th percentile (nearest rank), ms.
@@ -425,16 +427,16 @@ mod tests {
             worst: Vec::new(),
             why: Some(INPUT_EDGE_TIME),
         };
-        assert_eq!(
-            (
-                row.percentile(50.0),
-                row.percentile(99.0),
-                row.figure().max_ms,
-                row.figure().events
-            ),
-            (50.0, 99.0, 100.0, 100)
-        );
-        assert_eq!(row.figure().label, "latency input edge");
+        assert_eq!((row.percentile(50.0), row.percentile(99.0)), (50.0, 99.0));
+        let figure = [
+            "latency input edge",
+            "100",
+            "50.0",
+            "99.0",
+            "100.0",
+            "25 (missed)",
+        ];
+        assert_eq!(row.figure(), figure);
         let lines = row.lines();
         assert!(
             lines.starts_with(

@@ -45,10 +45,6 @@ fn parses_bench_lines_and_skips_others() {
 fn derived_columns() {
     let row = Row::parse(LOG[0]).unwrap().unwrap();
     assert!((row.ratio() - 37_010_000.0 / 563_360.0).abs() < 1e-9);
-    // 563360 / 2700 = 208.65
-    assert!((row.per_sample() - 208.651_851).abs() < 1e-5);
-    // 563360 / 125 = 4506.88 µs
-    assert!((row.rp2040_us() - 4506.88).abs() < 1e-9);
 }
 
 #[test]
@@ -75,15 +71,6 @@ fn verdict_of_the_sample_log() {
 }
 
 #[test]
-fn table_has_a_row_per_line_default_first() {
-    let table = table(&rows(&log()).unwrap());
-    let lines: Vec<&str> = table.lines().collect();
-    assert!(lines[1].starts_with("default"));
-    assert!(lines[1].contains("563,360"));
-    assert!(lines[7].starts_with("n1800"));
-}
-
-#[test]
 fn frame_row_is_parsed_and_held_to_its_ceiling() {
     let line = "frame bench frames=1601 min=930 median=945 max=1861 max_at=1 mean=1084";
     let row = FrameRow::parse(line).unwrap().unwrap();
@@ -100,18 +87,11 @@ fn frame_row_is_parsed_and_held_to_its_ceiling() {
         }
     );
     assert!(row.within_budget());
-    assert!(row.lines().contains("frame                    1601"));
-    assert!(
-        row.lines()
-            .contains("ceiling: median 945 against 1,200: ok; max 1,861 against 4,000: ok")
-    );
-    assert!(!row.lines().contains("OVER"));
     let slow = FrameRow {
         median: 1201,
         ..row.clone()
     };
     assert!(!slow.within_budget());
-    assert!(slow.lines().contains("median 1,201 against 1,200: OVER"));
     let spiky = FrameRow { max: 4001, ..row };
     assert!(!spiky.within_budget());
     assert!(
@@ -127,7 +107,6 @@ fn frame_row_is_parsed_and_held_to_its_ceiling() {
         "frame bench scenario=gesture+look frames=1601 min=1 median=2 max=3 max_at=4 mean=5";
     let active = FrameRow::parse(active).unwrap().unwrap();
     assert_eq!(active.scenario.as_deref(), Some("gesture+look"));
-    assert!(active.lines().contains("frame (gesture + look)   1601"));
 }
 
 #[test]
@@ -144,18 +123,11 @@ fn each_frame_row_is_held_to_its_own_ceiling_and_named() {
     // 1,930 is over the idle row's 1,200 but within this row's 2,000:
     // no OVER printed for it, and the bench passes.
     assert!(busy.within_budget());
-    assert!(!busy.lines().contains("OVER"), "{}", busy.lines());
-    assert!(busy.lines().contains("median 1,930 against 2,000: ok"));
     assert_eq!(frames_over_budget(&[idle.clone(), busy.clone()]), None);
     let slow_busy = FrameRow {
         median: 2001,
         ..busy.clone()
     };
-    assert!(
-        slow_busy
-            .lines()
-            .contains("median 2,001 against 2,000: OVER")
-    );
     let message = frames_over_budget(&[idle.clone(), slow_busy]).unwrap();
     assert_eq!(
         message,

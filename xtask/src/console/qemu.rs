@@ -11,10 +11,8 @@ use std::{
 };
 
 use anyhow::{Context, Result};
-use defmt_decoder::Table;
 
 use super::talk::{self, Talk};
-use crate::child;
 use crate::log::Run;
 use crate::qemu::{self, Echo};
 use crate::{project, setup};
@@ -73,10 +71,7 @@ pub fn qemu_session(
     echo: Echo,
     wait: Duration,
 ) -> Result<QemuSession> {
-    let root = project::root();
-    let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
-    let table = Table::parse(&bytes)?.context("no defmt data in the image")?;
-    let locations = table.get_locations(&bytes).ok();
+    let defmt = crate::log::Defmt::read(elf)?;
     let Sockets {
         child,
         dir,
@@ -84,11 +79,11 @@ pub fn qemu_session(
         uart1,
     } = spawn_with_sockets(elf, pace, "console", Stdio::piped)?;
     let start = Instant::now();
-    let done = child::run(
+    let done = project::finish(
         child,
         setup::QEMU_BINARY,
         AFTER_HANG_UP,
-        |stdout| qemu::decode(stdout, &table, locations.as_ref(), &root, echo),
+        |stdout| qemu::decode(stdout, &defmt, echo),
         |stderr| {
             // QEMU says it waits for each socket's connection: not news here.
             let mut to = std::io::stderr();
@@ -113,11 +108,9 @@ pub fn qemu_session(
 
 /// QEMU started by [`spawn_with_sockets`].
 pub struct Sockets {
-    /// QEMU itself.
     pub child: Child,
     /// The sockets' folder, for the caller to remove when QEMU is done.
     pub dir: PathBuf,
-    /// UART0's socket: the console.
     pub uart0: PathBuf,
     /// UART1's socket: the hang-up line.
     pub uart1: PathBuf,
@@ -166,29 +159,20 @@ pub fn spawn_with_sockets(
 /// `-serial` arguments: a socket, `pty`, `null`).
 pub fn qemu_command(elf: &Path, pace: Pace, serials: [&str; 2]) -> Command {
     let (sleep, run) = match pace {
-        Pace::RealTime => ("on", "interactive"),
-        Pace::Fast => ("off", "console"),
+        Pace::RealTime => (true, "interactive"),
+        Pace::Fast => (false, "console"),
     };
-    let mut command = Command::new(setup::QEMU_BINARY);
-    command
-        .args([
-            "-machine",
-            "lm3s6965evb",
-            "-cpu",
-            "cortex-m0",
-            "-display",
-            "none",
-        ])
-        .args(["-monitor", "none"])
-        .args([
-            "-semihosting-config",
-            &format!("enable=on,target=native,arg=idle-head,arg={run}"),
-        ])
-        .args(["-icount", &format!("shift=0,sleep={sleep}")])
-        .args(["-serial", serials[0], "-serial", serials[1]])
-        .arg("-kernel")
-        .arg(elf);
-    command
+    let semihosting = format!("enable=on,target=native,arg=idle-head,arg={run}");
+    let args = [
+        "-display",
+        "none",
+        "-monitor",
+        "none",
+        "-semihosting-config",
+        &semihosting,
+    ];
+    let serials = ["-serial", serials[0], "-serial", serials[1]];
+    qemu::qemu_command(elf, sleep, &[&args[..], &serials[..]].concat())
 }
 
 /// Connects to a socket QEMU serves, waiting for it to appear.

@@ -21,7 +21,6 @@ pub struct LineEnds {
     /// Capacity 0: only its line ends are of use here, and every line end
     /// yields exactly one outcome, however long the line.
     framer: Framer<0>,
-    /// Lines ended so far.
     lines: usize,
     /// Bytes after the last line end: a line in progress.
     open: bool,
@@ -57,9 +56,7 @@ impl LineEnds {
 /// How a conversation went.
 #[derive(Debug)]
 pub struct Talk {
-    /// Lines sent.
     pub sent: usize,
-    /// Replies received.
     pub replies: usize,
     /// Wall time from the start to the last reply.
     pub until_last_reply: Duration,

@@ -1,17 +1,8 @@
 //! The panel's browser tests, a stage of `cargo xtask test`: Debian's
 //! Chromium, headless, driven by playwright-core (`panel/tests/browser.mjs`)
-//! through four sessions:
-//!
-//! 1. Web Serial: the page served without a bridge, a fake
-//!    `navigator.serial` bridged to the shipped Pico image live in the
-//!    RP2040 emulator (its USB serial port); unplugged, an older firmware,
-//!    a reply that never comes;
-//! 2. the WebSocket bridge of `cargo xtask panel --qemu`;
-//! 3. a real serial port: QEMU's UART0 as a pseudo-terminal (`-serial
-//!    pty`), first through `cargo xtask console --port`, then through the
-//!    bridge of `cargo xtask panel --port`.
-//!
-//! Screenshots at 1280×800 go to `target/panel/`.
+//! over Web Serial (the emulated Pico), the bridge of `panel --qemu`, and a
+//! real serial port (QEMU's UART0 on a pty, through `console --port` and
+//! `panel --port`). Screenshots go to `target/panel/`.
 
 use std::{
     io::{BufRead, BufReader, Write},
@@ -30,34 +21,16 @@ use crate::{setup, sim};
 
 /// The stage's name.
 pub const STAGE: &str =
-    "panel in a real browser: Web Serial (emulated Pico), WebSocket (QEMU), serial port (pty)";
+    "panel in a real browser: Web Serial (emulated Pico), bridge (QEMU), serial port (pty)";
 
 /// Debian's Chromium.
 const CHROMIUM: &str = "/usr/bin/chromium";
 
-/// Makes sure Chromium is installed (with apt-get, as root on Debian or
-/// Ubuntu, as QEMU is).
-pub fn ensure_chromium() -> Result<PathBuf> {
-    let path = PathBuf::from(CHROMIUM);
-    if path.exists() {
-        return Ok(path);
-    }
-    let root = Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|o| o.stdout.trim_ascii() == b"0");
-    if !Path::new("/etc/debian_version").exists() || !root {
-        bail!("Chromium was not found at {CHROMIUM}: install it (`sudo apt-get install chromium`)");
-    }
-    println!("chromium is missing: installing the `chromium` package");
-    setup::apt_install(&["chromium"])?;
-    Ok(path)
-}
-
 /// The stage: every session; a summary line of what it measured.
 pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
     let start = Instant::now();
-    let chromium = ensure_chromium()?;
+    setup::ensure_program(CHROMIUM, &["chromium"], "Chromium")?;
+    let chromium = PathBuf::from(CHROMIUM);
     ensure_dependencies(root)?;
     setup::ensure_qemu()?;
     PICO.build(root)?;
@@ -74,7 +47,7 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
         &chromium,
         &serde_json::json!({
             "session": "serial",
-            "url": format!("http://{}/", plain.address()),
+            "url": format!("http://{}/", plain.address),
             "harness": { "cwd": sim::node_folder(root), "arg": harness.to_string() },
             "shots": shots,
             "label": "web-serial",
@@ -82,7 +55,7 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
     )?);
     drop(plain);
 
-    // 2. The WebSocket bridge to QEMU.
+    // 2. The bridge to QEMU.
     let (stop, _) = mpsc::channel();
     let bridged = Server::start(
         root,
@@ -95,7 +68,7 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
         &chromium,
         &serde_json::json!({
             "session": "bridge",
-            "url": format!("http://{}/", bridged.address()),
+            "url": format!("http://{}/", bridged.address),
             "shots": shots,
             "label": "qemu",
         }),
@@ -197,7 +170,7 @@ fn serial_port(root: &Path, chromium: &Path, elf: &Path, shots: &Path) -> Result
         chromium,
         &serde_json::json!({
             "session": "bridge",
-            "url": format!("http://{}/", server.address()),
+            "url": format!("http://{}/", server.address),
             "shots": shots,
             "label": "serial-port",
         }),

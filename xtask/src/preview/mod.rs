@@ -1,35 +1,16 @@
 //! `cargo xtask preview`: the stages of a loop as CSV and PNG, for people.
+//! The core library's engine runs on the host (`generate_into` with a
+//! `Trace` observer); `<out>/<stem>.csv` has the columns
+//! `n,walk,smoothed,normalized,final` in degrees, `<out>/<stem>.png` the
+//! stages as panels in the style of the paper's Figures 6 and 7.
 //!
-//! For one axis configuration this runs the core library's engine on the host
-//! (`generate_into` with a `Trace` observer) and writes
-//!
-//! - `<out>/<stem>.csv` with the header `n,walk,smoothed,normalized,final`,
-//!   every value in degrees, one row per sample index n = 0..N−1;
-//! - `<out>/<stem>.png`, stacked panels in the style of the paper's Figures 6
-//!   and 7, and a text box with the loop's metrics ([`plot`]).
-//!
-//! The columns ([`stages`]):
-//!
-//! - `walk`: the random walk, δ = the configuration's step. Paper closure:
-//!   u(0) = 0, u(n) = u(n−1) ± δ with the sign from r(n) (the LCG value after
-//!   n draws). Seamless closure: the circular walk with e(k) = ±1 from r(k+1),
-//!   k = 0..N−1, detrended: walk(n) = δ·Σ_{k≤n} (e(k) − D/N), D = Σ e.
-//! - `smoothed`: the engine's smoothed walk (`Trace::smoothed`) in degrees,
-//!   shifted by a constant so that its mean is the walk's mean (the engine
-//!   defines it only up to an additive constant).
-//! - `normalized`: the paper's normalisation of `smoothed` into [α1, α2]:
-//!   α1 + (s − `s_min`)·(α2 − α1)/(`s_max` − `s_min`).
-//! - `final`: the stored loop (`Mdeg16`) in degrees, in playback order
-//!   (index 0 is where playback starts).
-//!
-//! The first three are in generation order, `final` in playback order: the
-//! engine starts the loop at the split point p = `LoopInfo::split`, so
-//! `final(i)` is the closure's last stage at generation index (i + p) mod N.
-//! The paper closure's last stage is the normalised loop times the length-N
-//! Hann taper ½ − ½·cos(2πn/(N−1)); its PNG shows the taper and the tapered
-//! loop too. The seamless closure scales the smoothed loop about its crossing
-//! of the neutral level instead of min-max, so its `final` is the normalised
-//! loop rotated and rescaled (the tighter side of the range is reached).
+//! - `walk`: the random walk of step δ (the seamless closure's circular
+//!   walk detrended, walk(n) = δ·Σ_{k≤n} (e(k) − D/N));
+//! - `smoothed`: the engine's smoothed walk, shifted to the walk's mean
+//!   (the engine defines it only up to a constant);
+//! - `normalized`: the paper's min-max normalisation into [α1, α2];
+//! - `final`: the stored loop in playback order, which starts at the split
+//!   point p: `final(i)` is the closure's last stage at (i + p) mod N.
 
 mod plot;
 mod stages;
@@ -210,7 +191,7 @@ pub fn command(args: &Args) -> Result<bool> {
         fs::write(&csv, stages.csv()).with_context(|| format!("writing {}", csv.display()))?;
         plot::plot(&stages, &png)?;
         println!("{}", stages.title());
-        for line in stages.metric_lines().iter().chain(&stages.split_lines()) {
+        for line in &stages.metric_lines() {
             println!("  {line}");
         }
         println!("  wrote {} and {}", shown(&csv), shown(&png));
@@ -258,34 +239,27 @@ mod tests {
 
     #[test]
     fn one_loop_from_options() {
-        let args = parse(&[
-            "--seed",
-            "127",
-            "--n=450",
-            "--w",
-            "31",
-            "--range",
-            "-4.5",
-            "12",
-            "--closure",
-            "Paper",
-            "--out",
-            "tmp",
-            "--axis",
-            "pitch",
-        ])
-        .unwrap();
-        let loops = args.loops().unwrap();
-        assert_eq!(loops.len(), 1);
-        let (spec, name) = &loops[0];
-        assert_eq!(name, "loop");
-        assert_eq!(spec.axis, Axis::Pitch);
-        assert_eq!(spec.n, 450);
-        assert_eq!(spec.cfg.seed, 127);
-        assert_eq!(spec.cfg.window, 31);
-        assert_eq!(spec.cfg.range.min, Angle::from_millidegrees(-4500));
-        assert_eq!(spec.cfg.range.max, Angle::from_degrees(12));
-        assert_eq!(spec.cfg.closure, Closure::Paper);
+        let args = "--seed 127 --n=450 --w 31 --range -4.5 12 --closure Paper --axis pitch";
+        let loops = parse(&args.split(' ').collect::<Vec<_>>())
+            .unwrap()
+            .loops()
+            .unwrap();
+        let [(spec, name)] = &loops[..] else {
+            panic!("{loops:?}")
+        };
+        assert_eq!(
+            (name.as_str(), spec.axis, spec.n),
+            ("loop", Axis::Pitch, 450)
+        );
+        let range = AngleRange {
+            min: Angle::from_millidegrees(-4500),
+            max: Angle::from_degrees(12),
+        };
+        let cfg = &spec.cfg;
+        assert_eq!(
+            (cfg.seed, cfg.window, cfg.range, cfg.closure),
+            (127, 31, range, Closure::Paper)
+        );
         // The yaw default row when only --n is given.
         let loops = parse(&["--n", "450"]).unwrap().loops().unwrap();
         assert_eq!(loops[0].0.cfg, DEFAULT_HEAD.yaw);

@@ -1,6 +1,7 @@
 //! The stages of one loop in f64 degrees, from the engine's own trace: walk,
-//! smoothed, normalised, final (see the module docs of `preview` for what
-//! each column is), with the loop's metrics and a check of the split point.
+//! smoothed, normalised, final (the module docs of `preview` say what each
+//! column is), with the loop's metrics. (Where playback starts, the split
+//! point, is held to a reference implementation by `host-tests`.)
 
 // Sample indices (< 2^13) and angles are small: float conversions are exact
 // or far below the printed resolution.
@@ -13,17 +14,15 @@ use idle_head_core::{
     Angle, Axis,
     metrics::LoopMetrics,
     motion::{
-        AxisConfig, AxisError, Closure, FINE_PER_MDEG, HannKernel, Lcg, LoopInfo, Mdeg16, Trace,
-        generate_into, step_of,
+        AxisConfig, AxisError, Closure, HannKernel, Lcg, LoopInfo, Mdeg16, Trace, generate_into,
+        step_of,
     },
 };
 
 /// One loop to preview.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LoopSpec {
-    /// The axis (anatomical limits).
     pub axis: Axis,
-    /// Samples per loop.
     pub n: usize,
     /// Seed, window, step, range and closure.
     pub cfg: AxisConfig,
@@ -96,56 +95,22 @@ fn mean(values: &[f64]) -> f64 {
     values.iter().sum::<f64>() / values.len().max(1) as f64
 }
 
-/// Records the engine's intermediate stages (generation order).
-struct Recorder {
-    /// The smoothed walk in walk steps δ.
-    smoothed: Vec<f64>,
-    /// The scaled loop before closure, fine units (1/256 m°).
-    scaled: Vec<i32>,
-}
+/// Records the engine's smoothed walk (generation order), in walk steps δ.
+struct Recorder(Vec<f64>);
 
 impl Trace for Recorder {
     fn smoothed(&mut self, n: usize, walk_steps: f32) {
-        if let Some(slot) = self.smoothed.get_mut(n) {
+        if let Some(slot) = self.0.get_mut(n) {
             *slot = f64::from(walk_steps);
         }
     }
-
-    fn normalized(&mut self, n: usize, fine: i32) {
-        if let Some(slot) = self.scaled.get_mut(n) {
-            *slot = fine;
-        }
-    }
-}
-
-/// What the data say about the split point p.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SplitCheck {
-    /// max |final(i) − last(i + p mod N)| over i, degrees: ≈ 0 if index 0 of
-    /// the stored loop is sample p of the closure's last stage.
-    pub forward: f64,
-    /// The same for the other reading, final(i) = last(i − p mod N).
-    pub backward: f64,
-    /// Where the closure's split stage crosses zero: p with the stage's
-    /// value there (degrees), and p's neighbour across zero with its value,
-    /// if one is. Paper closure: the tapered loop as stored, whose sign
-    /// changes from p to p + 1. Seamless closure: the normalised loop, whose
-    /// zero is the level the engine splits at; p is the sample the engine
-    /// found nearer to that level.
-    pub crossing: ((usize, f64), Option<(usize, f64)>),
-    /// max |normalized − the engine's own scaled stage|, degrees (≈ 0 for
-    /// the paper closure, whose engine normalises exactly so).
-    pub formula_vs_engine: f64,
 }
 
 /// All stages of one loop.
 #[derive(Debug, Clone)]
 pub struct Stages {
-    /// What was generated.
     pub spec: LoopSpec,
-    /// The engine's decisions.
     pub info: LoopInfo,
-    /// Walk, degrees, generation order.
     pub walk: Vec<f64>,
     /// Smoothed walk, degrees, generation order.
     pub smoothed: Vec<f64>,
@@ -157,8 +122,6 @@ pub struct Stages {
     pub final_loop: Vec<f64>,
     /// Metrics of the stored loop.
     pub metrics: LoopMetrics,
-    /// The split point, checked against the data.
-    pub split: SplitCheck,
 }
 
 impl Stages {
@@ -167,10 +130,7 @@ impl Stages {
         let LoopSpec { axis, n, cfg } = spec;
         let kernel = HannKernel::new(cfg.window).map_err(|error| AxisError { axis, error })?;
         let mut stored = vec![Mdeg16(0); n];
-        let mut recorder = Recorder {
-            smoothed: vec![0.0; n],
-            scaled: vec![0; n],
-        };
+        let mut recorder = Recorder(vec![0.0; n]);
         let info = generate_into(&mut stored, &cfg, axis, &kernel, &mut recorder)
             .map_err(|error| AxisError { axis, error })?;
 
@@ -179,7 +139,7 @@ impl Stages {
             Closure::Paper => paper_walk(cfg.seed, n, delta),
             Closure::Seamless => seamless_walk(cfg.seed, n, delta),
         };
-        let mut smoothed: Vec<f64> = recorder.smoothed.iter().map(|s| s * delta).collect();
+        let mut smoothed: Vec<f64> = recorder.0.iter().map(|s| s * delta).collect();
         let shift = mean(&walk) - mean(&smoothed);
         for s in &mut smoothed {
             *s += shift;
@@ -188,41 +148,11 @@ impl Stages {
         let normalized = normalize(&smoothed, a1, a2);
         let final_loop: Vec<f64> = stored.iter().map(|s| f64::from(s.0) / 1000.0).collect();
 
-        // The closure's last stage before the exchange, from the engine's own
-        // scaled values (fine units), in degrees.
-        let fine_to_deg = |fine: i32| f64::from(fine) / f64::from(FINE_PER_MDEG * Angle::SCALE);
-        let scaled: Vec<f64> = recorder.scaled.iter().map(|&f| fine_to_deg(f)).collect();
-        let (last, tapered) = match cfg.closure {
-            Closure::Paper => {
-                let h = taper(n);
-                let last: Vec<f64> = scaled.iter().zip(&h).map(|(x, h)| x * h).collect();
-                let mine: Vec<f64> = normalized.iter().zip(&h).map(|(x, h)| x * h).collect();
-                (last, Some((h, mine)))
-            }
-            Closure::Seamless => (scaled.clone(), None),
-        };
-        let p = usize::from(info.split);
-        let distance = |offset: usize| {
-            final_loop
-                .iter()
-                .enumerate()
-                .map(|(i, f)| (f - last[(i + offset) % n]).abs())
-                .fold(0.0, f64::max)
-        };
-        let split = SplitCheck {
-            forward: distance(p),
-            backward: distance((n - p % n) % n),
-            crossing: match cfg.closure {
-                Closure::Paper => ((p, final_loop[0]), Some(((p + 1) % n, final_loop[1 % n]))),
-                Closure::Seamless => ((p, normalized[p]), across_zero(&normalized, p)),
-            },
-            formula_vs_engine: normalized
-                .iter()
-                .zip(&scaled)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max),
-        };
-
+        let tapered = (cfg.closure == Closure::Paper).then(|| {
+            let h = taper(n);
+            let tapered = normalized.iter().zip(&h).map(|(x, h)| x * h).collect();
+            (h, tapered)
+        });
         let mut scratch = vec![0; n];
         let metrics = LoopMetrics::measure(&stored, &mut scratch)
             .context("the loop is too short to measure")?;
@@ -235,7 +165,6 @@ impl Stages {
             tapered,
             final_loop,
             metrics,
-            split,
         })
     }
 
@@ -303,66 +232,6 @@ impl Stages {
             },
         ]
     }
-
-    /// What the split check found, in words.
-    pub fn split_lines(&self) -> Vec<String> {
-        let s = &self.split;
-        let ((p, at_p), across) = s.crossing;
-        let paper = self.spec.cfg.closure == Closure::Paper;
-        let (stage, split_stage) = if paper {
-            ("the tapered loop", "tapered")
-        } else {
-            ("the engine's scaled loop", "normalized")
-        };
-        let crossing = match across {
-            Some((q, at_q)) => {
-                // In sample order, p first where the sign changes after it.
-                let (first, second) = if q == (p + 1) % self.spec.n {
-                    ((p, at_p), (q, at_q))
-                } else {
-                    ((q, at_q), (p, at_p))
-                };
-                let nearer = !paper && at_p.abs() <= at_q.abs();
-                format!(
-                    "{split_stage} changes sign between samples {} and {} ({:+.4}° and {:+.4}°), \
-                     p = {p}{}",
-                    first.0,
-                    second.0,
-                    first.1,
-                    second.1,
-                    if nearer { ", the one nearer 0°" } else { "" }
-                )
-            }
-            None => format!("{split_stage}(p = {p}) = {at_p:+.4}°, no neighbour across 0°"),
-        };
-        let scaling = if paper {
-            "paper formula vs the engine's normalisation"
-        } else {
-            "the engine scales about p (played from exactly 0°), the paper formula min to max"
-        };
-        vec![
-            format!(
-                "split check: final(i) = {stage}((i + p) mod N) within {:.4}° \
-                 (the reading (i − p) mod N is off by up to {:.3}°)",
-                s.forward, s.backward
-            ),
-            format!(
-                "             {crossing}; {scaling}: max diff {:.4}°",
-                s.formula_vs_engine
-            ),
-        ]
-    }
-}
-
-/// The neighbour of sample `p` (cyclic) on the other side of zero, with its
-/// value: the one before if that is across, else the one after if that is.
-fn across_zero(values: &[f64], p: usize) -> Option<(usize, f64)> {
-    let n = values.len();
-    let sign = |i: usize| values[i] > 0.0;
-    [(p + n - 1) % n, (p + 1) % n]
-        .into_iter()
-        .find(|&q| sign(q) != sign(p))
-        .map(|q| (q, values[q]))
 }
 
 pub fn closure_name(closure: Closure) -> &'static str {
@@ -423,20 +292,12 @@ mod tests {
                 cfg: DEFAULT_HEAD.pitch.with_closure(closure),
             };
             let stages = Stages::compute(spec).unwrap();
-            // Playback starts at the split point of the last stage.
-            assert!(stages.split.forward <= 0.001, "{:?}", stages.split);
-            // p and its neighbour lie on either side of zero.
-            let ((_, at_p), across) = stages.split.crossing;
-            let (_, at_q) = across.unwrap();
-            assert!((at_p > 0.0) != (at_q > 0.0), "{:?}", stages.split);
             let (lo, hi) = stages
                 .normalized
                 .iter()
                 .fold((f64::MAX, f64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
             assert!((lo + 4.0).abs() < 1e-9 && (hi - 12.0).abs() < 1e-9);
-            if closure == Closure::Paper {
-                assert!(stages.split.formula_vs_engine < 0.01, "{:?}", stages.split);
-            }
+            assert_eq!(stages.tapered.is_some(), closure == Closure::Paper);
             let csv = stages.csv();
             let mut lines = csv.lines();
             assert_eq!(lines.next(), Some("n,walk,smoothed,normalized,final"));
@@ -444,35 +305,5 @@ mod tests {
             let smoothed_mean = mean(&stages.smoothed);
             assert!((smoothed_mean - mean(&stages.walk)).abs() < 1e-9);
         }
-    }
-
-    #[test]
-    fn a_coarse_loop_is_split_beside_its_crossing() {
-        // 17 samples, W = 3: steps of several degrees, so p is a whole
-        // sample away from where the loop crosses 0°.
-        let spec = LoopSpec {
-            axis: Axis::Yaw,
-            n: 17,
-            cfg: DEFAULT_HEAD.yaw.with_window(3),
-        };
-        let stages = Stages::compute(spec).unwrap();
-        let ((p, at_p), across) = stages.split.crossing;
-        let (q, at_q) = across.unwrap();
-        assert_eq!(p, usize::from(stages.info.split));
-        assert!(q == (p + 1) % 17 || p == (q + 1) % 17);
-        assert!((at_p > 0.0) != (at_q > 0.0));
-        // The engine picks the sample nearer the crossing, and plays it as 0°.
-        assert!(at_p.abs() <= at_q.abs());
-        assert_eq!(stages.final_loop[0], 0.0);
-        let lines = stages.split_lines().join("\n");
-        assert_eq!((p, q), (9, 8));
-        assert!(
-            lines.contains(
-                "normalized changes sign between samples 8 and 9 (+2.7859° and -1.5000°), \
-                 p = 9, the one nearer 0°"
-            ),
-            "{lines}"
-        );
-        assert!(!lines.contains("sits at"), "{lines}");
     }
 }

@@ -1,22 +1,7 @@
-//! `cargo xtask sim --dmx FILE`: the Pico image with a lighting console on
-//! its DMX input (UART1 RX, GP9), frames as `sim/dmx.mjs` sends them.
-//!
-//! FILE holds one change a line: the time in seconds since power-on, then
-//! the slots to set, relative to the head's address (1-based, the
-//! personality's numbering), or `dmx stop` to stop the frames:
-//!
-//! ```text
-//! # seconds  slot=value ...
-//! 3.0        7=0 9=255
-//! 3.5        7=255 1=200
-//! 5.0        dmx stop
-//! ```
-//!
-//! Values hold until changed; slots never set are 0. Frames run from the
-//! first line's time on, back to back at about 44 Hz (a full universe of
-//! 512 slots with a 176 µs break and a 12 µs mark after break, and a random
-//! gap of up to 1 ms between frames), until `dmx stop`; a later line starts
-//! them again. The image runs on its built-in settings: DMX on, address 1.
+//! `cargo xtask sim --dmx FILE`: a lighting console on the DMX input
+//! (UART1 RX, GP9), frames as `sim/dmx.mjs` sends them. A line is
+//! `<seconds> <slot>=<value> …` (slots relative to the head's address,
+//! 1-based; values hold until changed) or `<seconds> dmx stop`.
 
 use std::{path::Path, time::Duration};
 
@@ -40,7 +25,6 @@ const JITTER: Duration = Duration::from_millis(1);
 /// One line of a DMX script.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Change {
-    /// When, since power-on.
     pub at: Duration,
     /// Slots (relative to the address, 1-based) and their values.
     pub set: Vec<(u16, u8)>,

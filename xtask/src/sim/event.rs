@@ -12,199 +12,99 @@ use serde::{Deserialize, Deserializer};
 #[serde(tag = "ev", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Event {
     /// A boot starts (0: power-on).
-    Boot {
-        /// Which boot.
-        n: usize,
-        /// When.
-        ns: f64,
-    },
+    Boot { n: usize, ns: f64 },
     /// Bytes from the RTT up-buffer (the defmt log), stamped with the first.
     Rtt {
-        /// When the first byte came.
         ns: f64,
-        /// The bytes.
         #[serde(deserialize_with = "from_hex")]
         hex: Vec<u8>,
     },
     /// A watched pin changed level.
     Edge {
-        /// The GPIO.
         pin: u8,
-        /// Its new level.
         high: bool,
-        /// When.
         ns: f64,
-        /// Whether a reset released it (not the firmware).
         #[serde(default)]
         reset: bool,
     },
     /// The script drove an input pin.
-    Drive {
-        /// The GPIO.
-        pin: u8,
-        /// Its new level.
-        high: bool,
-        /// When.
-        ns: f64,
-    },
+    Drive { pin: u8, high: bool, ns: f64 },
     /// A PWM compare register write.
-    Cc {
-        /// The slice.
-        slice: u8,
-        /// The register's new value (channel A in the low half).
-        value: u32,
-        /// When.
-        ns: f64,
-    },
+    Cc { slice: u8, value: u32, ns: f64 },
     /// A PWM slice enabled or disabled.
-    En {
-        /// The slice.
-        slice: u8,
-        /// Whether it is on now.
-        on: bool,
-        /// When.
-        ns: f64,
-    },
+    En { slice: u8, on: bool, ns: f64 },
     /// One call of the probed function (the frame update).
-    Call {
-        /// Its cycles.
-        cycles: u64,
-        /// When it returned.
-        ns: f64,
-    },
+    Call { cycles: u64, ns: f64 },
     /// The watchdog fired.
-    Watchdog {
-        /// When.
-        ns: f64,
-        /// Why: 1 its timer, 2 forced.
-        reason: u32,
-    },
+    Watchdog { ns: f64, reason: u32 },
     /// The power went off; the next boot follows.
-    PowerCycle {
-        /// When.
-        ns: f64,
-    },
+    PowerCycle { ns: f64 },
     /// The boot ROM erased or programmed flash.
     Flash {
-        /// Which.
         op: FlashKind,
-        /// Flash address.
         addr: u64,
-        /// Bytes.
         len: u64,
-        /// How long it kept the flash busy.
         busy_ns: f64,
-        /// When.
         ns: f64,
     },
     /// The lowest stack address written in a boot.
-    Stack {
-        /// The boot.
-        n: usize,
-        /// The address.
-        low: u64,
-    },
+    Stack { n: usize, low: u64 },
     /// Bytes UART0 sent, stamped with the first.
     Uart {
-        /// When the first left.
         ns: f64,
-        /// The bytes.
         #[serde(deserialize_with = "from_hex")]
         hex: Vec<u8>,
     },
     /// The last scripted byte went onto UART0's RX line.
-    UartRx {
-        /// When.
-        ns: f64,
-        /// Bytes of the script.
-        n: usize,
-    },
+    UartRx { ns: f64, n: usize },
     /// A scripted byte found UART0's RX FIFO full.
-    UartOverrun {
-        /// When.
-        ns: f64,
-    },
+    UartOverrun { ns: f64 },
     /// The CDC-ACM host configured the device.
-    UsbConnected {
-        /// When.
-        ns: f64,
-    },
+    UsbConnected { ns: f64 },
     /// Bytes the device sent on its CDC-ACM IN endpoint.
     Usb {
-        /// When.
         ns: f64,
-        /// The bytes.
         #[serde(deserialize_with = "from_hex")]
         hex: Vec<u8>,
     },
     /// The USB host sent a scripted chunk (a list of chunks only).
-    UsbIn {
-        /// When.
-        ns: f64,
-        /// Its bytes.
-        n: usize,
-    },
+    UsbIn { ns: f64, n: usize },
     /// A DMX frame carrying a change ended (its last byte went out).
-    Dmx {
-        /// When.
-        ns: f64,
-        /// The frame's number since the line started.
-        frame: u64,
-        /// Always true: only frames with a change are reported.
-        changed: bool,
-    },
+    Dmx { ns: f64, frame: u64, changed: bool },
     /// Accesses to a register rp2040js does not model, counted over the
     /// run.
     Unmodelled {
-        /// The peripheral as rp2040js names it (`ROSC_BASE`, `USB`, ...).
         peripheral: String,
-        /// Read or written.
         op: Access,
-        /// The register's offset in the peripheral.
         offset: u32,
-        /// How often.
         count: u64,
     },
     /// A complaint of the emulator.
-    Emu {
-        /// How serious.
-        level: Level,
-        /// What it said.
-        msg: String,
-    },
+    Emu { level: Level, msg: String },
     /// The run is over.
     End {
-        /// Why.
         why: Why,
-        /// When.
         ns: f64,
-        /// Instructions executed.
         instructions: u64,
-        /// Wall time, ms.
         wall_ms: u64,
-        /// The harness's error, when `why` is `error`.
         #[serde(default)]
         msg: Option<String>,
     },
 }
 
-/// What the boot ROM did to the flash.
+/// What the boot ROM did to the flash: a sector erase, a page program.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FlashKind {
-    /// A sector erase.
     Erase,
-    /// A page program.
     Program,
 }
 
-/// A read or a write.
+/// A read (rp2040js answers 0xffffffff) or a write (it drops it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Access {
-    /// A read (rp2040js answers 0xffffffff).
     Read,
-    /// A write (rp2040js drops it).
     Write,
 }
 
@@ -212,38 +112,28 @@ pub enum Access {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Level {
-    /// A warning.
     Warn,
-    /// An error.
     Error,
 }
 
-/// Why the harness stopped.
+/// Why the harness stopped (`Silent`: no log byte or pin edge for the
+/// silence time; `Asleep`: the core sleeps with nothing left to wake it;
+/// `Closed`: a live run's stdin closed).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Why {
-    /// It ran the whole virtual time.
     Time,
-    /// Nothing happened (no log byte, no pin edge) for the silence time.
     Silent,
-    /// The core sleeps with nothing left to wake it.
     Asleep,
-    /// The wall-time limit.
     Wall,
-    /// The firmware hit a breakpoint.
     Break,
-    /// Its stdin closed (a live run).
     Closed,
-    /// The harness failed.
     #[default]
     Error,
 }
 
 impl Event {
     /// Reads one line of the harness's output.
-    ///
-    /// # Errors
-    /// A line that is not JSON, or not an event as this module knows them.
     pub fn parse(line: &str) -> Result<Self> {
         // Through a `Value`: defmt-decoder turns on serde_json's
         // `arbitrary_precision`, under which a number read straight into a
@@ -276,70 +166,30 @@ mod tests {
 
     #[test]
     fn every_event_of_the_harness_reads() {
-        let lines = [
-            (
-                r#"{"ev":"boot","n":0,"ns":0}"#,
-                Event::Boot { n: 0, ns: 0.0 },
-            ),
-            (
-                r#"{"ev":"rtt","ns":12.5,"hex":"00ff10"}"#,
-                Event::Rtt {
-                    ns: 12.5,
-                    hex: vec![0, 0xff, 0x10],
-                },
-            ),
-            (
-                r#"{"ev":"edge","pin":16,"high":true,"ns":3}"#,
-                Event::Edge {
-                    pin: 16,
-                    high: true,
-                    ns: 3.0,
-                    reset: false,
-                },
-            ),
-            (
-                r#"{"ev":"edge","pin":16,"high":false,"ns":3,"reset":true}"#,
-                Event::Edge {
-                    pin: 16,
-                    high: false,
-                    ns: 3.0,
-                    reset: true,
-                },
-            ),
-            (
-                r#"{"ev":"flash","op":"program","addr":270532608,"len":256,"busy_ns":400000,"ns":9}"#,
-                Event::Flash {
-                    op: FlashKind::Program,
-                    addr: 0x1020_0000,
-                    len: 256,
-                    busy_ns: 400_000.0,
-                    ns: 9.0,
-                },
-            ),
-            (
-                r#"{"ev":"unmodelled","peripheral":"ROSC_BASE","op":"write","offset":16,"count":3}"#,
-                Event::Unmodelled {
-                    peripheral: "ROSC_BASE".to_owned(),
-                    op: Access::Write,
-                    offset: 0x10,
-                    count: 3,
-                },
-            ),
-            (
-                r#"{"ev":"end","why":"error","msg":"boom","ns":0,"instructions":0,"wall_ms":5}"#,
-                Event::End {
-                    why: Why::Error,
-                    ns: 0.0,
-                    instructions: 0,
-                    wall_ms: 5,
-                    msg: Some("boom".to_owned()),
-                },
-            ),
-        ];
-        for (line, want) in lines {
-            assert_eq!(Event::parse(line).unwrap(), want, "{line}");
-        }
+        let rtt = Event::parse(r#"{"ev":"rtt","ns":12.5,"hex":"00ff10"}"#).unwrap();
+        assert_eq!(
+            rtt,
+            Event::Rtt {
+                ns: 12.5,
+                hex: vec![0, 0xff, 0x10]
+            }
+        );
+        let edge = Event::parse(r#"{"ev":"edge","pin":16,"high":false,"ns":3,"reset":true}"#);
+        assert_eq!(
+            edge.unwrap(),
+            Event::Edge {
+                pin: 16,
+                high: false,
+                ns: 3.0,
+                reset: true
+            }
+        );
         for line in [
+            r#"{"ev":"boot","n":0,"ns":0}"#,
+            r#"{"ev":"edge","pin":16,"high":true,"ns":3}"#,
+            r#"{"ev":"flash","op":"program","addr":270532608,"len":256,"busy_ns":400000,"ns":9}"#,
+            r#"{"ev":"unmodelled","peripheral":"ROSC_BASE","op":"write","offset":16,"count":3}"#,
+            r#"{"ev":"end","why":"error","msg":"boom","ns":0,"instructions":0,"wall_ms":5}"#,
             r#"{"ev":"cc","slice":0,"value":4800,"ns":1}"#,
             r#"{"ev":"en","slice":1,"on":true,"ns":1}"#,
             r#"{"ev":"call","cycles":900,"ns":1}"#,

@@ -1,39 +1,8 @@
-//! A scripted console exchange over the Pico's UART0 and its USB serial
-//! port in the emulator.
-//!
-//! The harness puts [`SCRIPT`] on the RX line (GP1) at 115200 baud, one
-//! byte every 86.8 µs, from [`START`] on, one line every [`LINE_GAP`] (a
-//! controller that waits for each reply: the UART has no flow control,
-//! and the replies leave at the line rate too): after the fade-in, while
-//! the idle motion plays; at [`USB_START`] the emulator's CDC-ACM host (which
-//! has enumerated and configured the device at boot) sends it again over
-//! USB. Every byte sent back is recorded. The check, for each port:
-//! exactly one reply line per script line, each the reply the host
-//! computes with the same core `Session` and the firmware's own handler
-//! (`src/bin/pico/handler.rs`, compiled here too: the core's
-//! `ConsoleService`, shared by both ports, here over a `RamStorage`), in
-//! order. The two ports share one service on the board as here: the USB
-//! run's replies follow the UART run's changes (`status` then says
-//! `settings=changed`).
-//!
-//! The frames are checked as always, so the exchange must not change a
-//! pulse: the script's one motion command, `center`, asks for the pose the
-//! head already holds; `servo yaw neutral 1500` sets the neutral the yaw
-//! servo already has; `seed 7` takes effect with the next loop set, which
-//! is generated after the first join (28 s), past the run's end.
-//!
-//! `status` reports the head as the last frame left it: `mode`, `faults`,
-//! `off`, `fw` and `settings` are compared exactly (the host's link says
-//! `running`, as the head is after its fade-in), while the angles, the
-//! pulses and the uptime depend on the frame at which the line arrives:
-//! for them the check accepts any value of the right form (a
-//! comma-separated list of integers), a wildcard written `*` in the
-//! transcript's expectations ([`mask`]).
-//!
-//! `save` is not in the script: it has a run of its own, with a stand-in
-//! for the boot ROM's flash functions and a power cycle (`store.rs`).
-//! `load` is: the emulator's store is empty, so it answers `err storage
-//! load: no settings saved`.
+//! A scripted console exchange over the Pico's UART0, then over its USB
+//! serial port, in the emulator: one reply per line, each the one the host
+//! computes with the same core `Session` and `ConsoleService`, in order
+//! (fields that depend on the frame a line arrives at are wildcards, `*`).
+//! The script moves nothing, so the pulses are checked as always.
 
 use std::fmt::Write as _;
 use std::time::Duration;

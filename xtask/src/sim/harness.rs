@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use idle_head_core::input::{FIRST_INPUT, INPUTS};
 
 use super::image::{PicoImage, VECTOR_TABLE};
@@ -20,12 +20,12 @@ pub fn input_pins() -> Vec<u8> {
 }
 
 /// The harness's configuration for the Pico image `elf`, and the image:
-/// its flash contents written beside it (`<elf>.<extension>`), its vector
-/// table and RTT log, the servo slices' compare writes reported.
+/// its UF2 written beside it (`<elf>.<extension>`, `cargo xtask uf2`'s
+/// file), its vector table and RTT log, the servo slices' compare writes
+/// reported.
 pub fn config(elf: &Path, extension: &str) -> Result<(PicoImage, node::Config)> {
     let image = PicoImage::read(elf)?;
-    let flash = elf.with_extension(extension);
-    std::fs::write(&flash, &image.flash).with_context(|| format!("writing {}", flash.display()))?;
+    let (flash, _) = crate::uf2::write(elf, crate::board::Board::Pico, extension)?;
     let config = node::Config {
         flash,
         vtor: VECTOR_TABLE,
@@ -34,14 +34,4 @@ pub fn config(elf: &Path, extension: &str) -> Result<(PicoImage, node::Config)> 
         ..node::Config::default()
     };
     Ok((image, config))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_inputs_are_gp2_to_gp5() {
-        assert_eq!(input_pins(), [2, 3, 4, 5]);
-    }
 }

@@ -1,21 +1,13 @@
-//! What the emulator needs from the Pico ELF: the flash contents and the
-//! addresses of a few symbols.
-//!
-//! The flash image is what `arm-none-eabi-objcopy -O binary` of the stored
-//! sections (`.boot2 .vector_table .text .rodata .data`) gives: every
-//! loadable segment placed at its load address (`p_paddr`; `.data` runs in
-//! RAM but is stored in flash behind `.rodata`), gaps filled with the erased
-//! value 0xff. The segments are the ones the memory budgets and the UF2
-//! read (`elf::segments`, with the `object` crate), so the emulator needs
-//! no binutils.
+//! What the emulator needs from the Pico ELF: the addresses of a few
+//! symbols (the flash contents come from its UF2, `harness.rs`).
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 use object::read::elf::ElfFile32;
 use object::{Endianness, Object, ObjectSymbol, elf};
 
-use crate::elf::{XIP, segments};
+use crate::elf::XIP;
 
 /// Where the RP2040 maps its QSPI flash (XIP).
 pub const FLASH_START: u64 = XIP.start;
@@ -27,8 +19,6 @@ pub const STACK_PAINT: u32 = 0xcccc_cccc;
 /// The parts of a Pico ELF the emulator run uses.
 #[derive(Debug)]
 pub struct PicoImage {
-    /// Flash contents from `FLASH_START` on.
-    pub flash: Vec<u8>,
     /// Address of the RTT control block `_SEGGER_RTT`.
     pub rtt: u64,
     /// The stack region `[_stack_end, _stack_start)`.
@@ -59,7 +49,6 @@ impl PicoImage {
         if file.section_by_name(".boot2").is_none() {
             bail!("no `.boot2` section (an image for another board?)");
         }
-        let flash = flash_image(&file)?;
         let symbol = |name: &str| {
             file.symbols()
                 .find(|symbol| symbol.name() == Ok(name))
@@ -83,66 +72,9 @@ impl PicoImage {
             // Thumb: the low bit of a function symbol is the mode bit.
             .map(|symbol| symbol.address() & !1);
         Ok(Self {
-            flash,
             rtt,
             stack,
             frame_update,
         })
-    }
-}
-
-/// Every loadable segment at its load address, as `objcopy -O binary` lays
-/// out the flash; checks that the vector table is where boot2 jumps to.
-fn flash_image(file: &ElfFile32<Endianness>) -> Result<Vec<u8>> {
-    let mut flash = Vec::new();
-    for segment in segments(file).map_err(|error| anyhow!(error))? {
-        let address = u64::from(segment.address);
-        if !XIP.contains(&address) {
-            continue;
-        }
-        let start = usize::try_from(address - FLASH_START)?;
-        let end = start + segment.data.len();
-        if flash.len() < end {
-            flash.resize(end, 0xff);
-        }
-        flash[start..end].copy_from_slice(&segment.data);
-    }
-    let vectors = usize::try_from(VECTOR_TABLE - FLASH_START)?;
-    let word = |at: usize| {
-        flash
-            .get(at..at + 4)
-            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-    };
-    match (word(vectors), word(vectors + 4)) {
-        (Some(sp), Some(reset)) if sp >> 28 == 2 && u64::from(reset) >> 24 == FLASH_START >> 24 => {
-            Ok(flash)
-        }
-        _ => bail!(
-            "no vector table at {VECTOR_TABLE:#010x} (initial stack pointer in RAM, reset \
-             handler in flash), where boot2 hands over"
-        ),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_host_binary_is_not_a_pico_image() {
-        let error = PicoImage::read(&std::env::current_exe().unwrap()).unwrap_err();
-        assert!(
-            format!("{error:#}").contains("is not a Pico image"),
-            "{error:#}"
-        );
-    }
-
-    #[test]
-    fn a_missing_file_says_how_to_build_it() {
-        let error = PicoImage::read(Path::new("/nonexistent/pico")).unwrap_err();
-        assert!(
-            format!("{error:#}").contains("cargo build --release"),
-            "{error:#}"
-        );
     }
 }

@@ -1,22 +1,7 @@
-//! The emulator stage of the trigger inputs: a presence script played into
-//! the shipped image, and what a visitor would see checked from the pulses.
-//!
-//! A presence sensor on GP2 looking from −20°, a rest after 2 s with relax
-//! on; nobody comes until 7 s, then someone stays until the end. From the
-//! pulses measured on the servo pins:
-//!
-//! 1. the head rests after the timeout: it reaches the rest pose (pitch
-//!    −8°) and holds it;
-//! 2. the pulses stop once it is there (relax), on every servo, until the
-//!    sensor's edge;
-//! 3. it wakes with the soft start and no jump: the first pulse after the
-//!    gap is the last one before it, and until the glance every step stays
-//!    within the idle limits (`LimitMode::Idle`: 60 °/s, 600 °/s² built in);
-//! 4. it glances towards the sensor: yaw at −20° (the ducked idle's sway
-//!    aside), held about 2 s.
-//!
-//! And throughout, every pulse is the host trace's duty for its frame
-//! (within a count) and inside its servo's limits (`script.rs`).
+//! The trigger inputs' stage: a presence script (a sensor on GP2, a rest
+//! after 2 s with relax on, someone at 7 s) played into the shipped image;
+//! from the pulses, the rest, the pulses stopping, the soft wake and the
+//! glance towards the sensor, every pulse the host trace's duty.
 
 use std::path::Path;
 use std::time::Duration;

@@ -17,7 +17,6 @@ use super::{harness, node, store::WORST};
 /// A live emulator run: the harness, its stdin (bytes for the USB serial
 /// port) and stdout (its events).
 pub struct Live {
-    /// The harness's process.
     pub child: Child,
     /// Bytes for the head's USB serial port, one line of hex digits each.
     pub stdin: ChildStdin,
@@ -41,7 +40,7 @@ pub enum LiveEvent {
 /// slices' compare writes reported (`cc` events of slices 0, 1, 2: pitch,
 /// roll, yaw), the trigger inputs GP2..GP5 driven by `pin <n> 0|1` lines.
 pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
-    let (_, config) = harness::config(elf, "live.bin")?;
+    let (_, config) = harness::config(elf, "live.uf2")?;
     node::ensure(root)?;
     let config = node::Config {
         wall: Duration::from_secs(24 * 3600),
@@ -77,9 +76,6 @@ pub fn start(root: &Path, elf: &Path) -> Result<Live> {
 }
 
 /// Sends `bytes` to the head's USB serial port.
-///
-/// # Errors
-/// The harness has gone.
 pub fn send(stdin: &mut impl Write, bytes: &[u8]) -> std::io::Result<()> {
     let mut line = node::hex(bytes);
     line.push('\n');

@@ -12,11 +12,8 @@ use anyhow::{Context, Result, bail};
 use serde_json::{Value, json};
 
 use super::event::Event;
-use crate::{child, log::Exit, project, setup};
+use crate::{log::Exit, project, setup};
 use xshell::cmd;
-
-/// The Debian/Ubuntu packages that bring `node` and `npm`.
-const PACKAGES: [&str; 2] = ["nodejs", "npm"];
 
 /// The folder with the harness and its `package.json`.
 pub fn folder(root: &Path) -> PathBuf {
@@ -26,95 +23,44 @@ pub fn folder(root: &Path) -> PathBuf {
 /// Makes sure `node` and `npm` run (installing them with apt-get when root on
 /// Debian or Ubuntu) and that the pinned emulator is installed (`npm ci`).
 pub fn ensure(root: &Path) -> Result<()> {
-    if version("node").is_none() || version("npm").is_none() {
-        install_node()?;
+    npm_ci(&folder(root), &["rp2040js"], &[])
+}
+
+/// Makes sure `node` and `npm` run and that `packages` are installed in
+/// `dir`'s `node_modules` as its `package-lock.json` pins them: else
+/// `npm ci` there (with `env`).
+pub fn npm_ci(dir: &Path, packages: &[&str], env: &[(&str, &str)]) -> Result<()> {
+    let what = "Node.js (20 or newer) and npm (packages `nodejs npm` on Debian and Ubuntu)";
+    for program in ["node", "npm"] {
+        setup::ensure_program(program, &["nodejs", "npm"], what)?;
     }
-    let sim = folder(root);
     let read = |path: PathBuf| -> Option<Value> {
         serde_json::from_slice(&std::fs::read(path).ok()?).ok()
     };
-    let pinned = read(sim.join("package-lock.json"))
-        .context("sim/package-lock.json is missing or not JSON")?["packages"]
-        ["node_modules/rp2040js"]["version"]
-        .clone();
-    let installed = read(sim.join("node_modules/rp2040js/package.json"))
-        .map_or(Value::Null, |package| package["version"].clone());
-    if pinned.is_null() || installed != pinned {
+    let lock = read(dir.join("package-lock.json"))
+        .with_context(|| format!("{}/package-lock.json is missing or not JSON", dir.display()))?;
+    let stale = packages.iter().any(|name| {
+        let pinned = &lock["packages"][format!("node_modules/{name}")]["version"];
+        let installed = read(dir.join(format!("node_modules/{name}/package.json")))
+            .map_or(Value::Null, |package| package["version"].clone());
+        pinned.is_null() || installed != *pinned
+    });
+    if stale {
         let sh = project::shell(".")?;
-        sh.change_dir(&sim);
-        project::run(&sh, &[], cmd!(sh, "npm ci --no-audit --no-fund"))
-            .context("installing the emulator (rp2040js) with `npm ci` in sim/")?;
+        sh.change_dir(dir);
+        project::run(&sh, env, cmd!(sh, "npm ci --no-audit --no-fund"))
+            .with_context(|| format!("installing with `npm ci` in {}", dir.display()))?;
     }
     Ok(())
-}
-
-/// First line of `<program> --version`, if it runs.
-pub fn version(program: &str) -> Option<String> {
-    let output = Command::new(program)
-        .arg("--version")
-        .stdin(Stdio::null())
-        .output()
-        .ok()?;
-    output.status.success().then(|| {
-        String::from_utf8_lossy(&output.stdout)
-            .lines()
-            .next()
-            .unwrap_or_default()
-            .trim()
-            .to_owned()
-    })
-}
-
-/// Why Node.js cannot be installed here, if it cannot: no apt-get, or not root.
-fn cannot_install(apt: bool, root: bool) -> Option<String> {
-    let packages = PACKAGES.join(" ");
-    if !apt {
-        Some(format!(
-            "Node.js was not found: install `node` (18 or newer) and `npm` \
-             (packages `{packages}` on Debian/Ubuntu) and run the command again"
-        ))
-    } else if !root {
-        Some(format!(
-            "Node.js was not found: install it with `sudo apt-get install {packages}` \
-             and run the command again"
-        ))
-    } else {
-        None
-    }
-}
-
-fn install_node() -> Result<()> {
-    let packages = PACKAGES.join(" ");
-    let apt = Path::new("/etc/debian_version").exists() && version("apt-get").is_some();
-    if let Some(message) = cannot_install(apt, is_root()) {
-        bail!("{message}");
-    }
-    println!("node/npm are missing: installing the packages {packages}");
-    setup::apt_install(&PACKAGES)?;
-    if version("node").is_none() || version("npm").is_none() {
-        bail!("`node` or `npm` still does not run after installing {packages}");
-    }
-    Ok(())
-}
-
-fn is_root() -> bool {
-    Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|output| output.status.success() && output.stdout.trim_ascii() == b"0")
 }
 
 /// What the harness is asked to run (by default: nothing scripted, no
 /// ROM, no power cycle).
 #[derive(Debug, Clone, Default)]
 pub struct Config {
-    /// The flash image file.
     pub flash: PathBuf,
-    /// Vector table address.
     pub vtor: u64,
-    /// `_SEGGER_RTT`, or 0.
     pub rtt: u64,
-    /// GPIOs to watch.
     pub pins: Vec<u8>,
     /// PWM slices whose compare writes to report.
     pub slices: Vec<u8>,
@@ -122,9 +68,7 @@ pub struct Config {
     pub probe: u64,
     /// Stack region to scan for paint, if painted.
     pub stack: Option<(u64, u64)>,
-    /// Virtual time to run.
     pub virtual_time: Duration,
-    /// Wall time allowed.
     pub wall: Duration,
     /// Virtual time without a log byte or a pin edge after which the run ends.
     pub silence: Duration,
@@ -202,16 +146,13 @@ pub struct PinScript {
 pub struct FlashTiming {
     /// One 4 KiB sector erase.
     pub erase: Duration,
-    /// One 256-byte page program.
     pub program: Duration,
 }
 
 /// Bytes the harness puts on UART0's RX line in one boot.
 #[derive(Debug, Clone)]
 pub struct UartScript {
-    /// The boot (0: power-on).
     pub boot: usize,
-    /// The bytes.
     pub bytes: Vec<u8>,
     /// Virtual time of the first, since the boot's start.
     pub start: Duration,
@@ -309,7 +250,7 @@ impl Config {
 }
 
 /// `bytes` as lower-case hex digits, as the harness reads them.
-pub(super) fn hex(bytes: &[u8]) -> String {
+pub fn hex(bytes: &[u8]) -> String {
     bytes.iter().fold(String::new(), |mut text, byte| {
         let _ = write!(text, "{byte:02x}");
         text
@@ -337,7 +278,7 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
         .context("could not start `node` (is Node.js installed?)")?;
     // The harness stops itself at `wall`; the grace covers node's start-up.
     let limit = config.wall + GRACE;
-    let done = child::run(child, "node", limit, events, read_all, || ())?;
+    let done = project::finish(child, "node", limit, events, read_all, || ())?;
     let status = match done.exit {
         Exit::Status(status) => status,
         Exit::TimedOut(_) => bail!(
@@ -381,19 +322,4 @@ fn read_all(mut stderr: impl Read) -> String {
     let mut bytes = Vec::new();
     let _ = stderr.read_to_end(&mut bytes);
     String::from_utf8_lossy(&bytes).into_owned()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_missing_node_names_the_packages_to_install() {
-        assert!(version("idle-head-no-such-program").is_none());
-        for (apt, root) in [(false, false), (false, true), (true, false)] {
-            let message = cannot_install(apt, root).unwrap();
-            assert!(message.contains("nodejs npm"), "{message}");
-        }
-        assert!(cannot_install(true, true).is_none());
-    }
 }

@@ -1,14 +1,6 @@
-//! Line noise on the Pico image's UART in the emulator: a byte received
-//! with a framing error.
-//!
-//! At 3 s the harness sends `sta`, then a byte with a framing error (as a
-//! glitch on the RX wire gives), then `tus` and a line end, then
-//! `status` on a line of its own. embassy-rp drops the damaged byte and
-//! reports a framing error after the bytes before it; the console marks
-//! the line in progress as having lost bytes. The check: the first line is
-//! answered `err line bytes lost …` (not carried out as the `status` its
-//! surviving bytes spell), the second `ok mode=…`, nothing else; and every
-//! frame's pulses are the host's, on time.
+//! Line noise on UART0: `sta`, a byte with a framing error, `tus`, then
+//! `status`. The first line must be answered `err line bytes lost …`, the
+//! second `ok mode=…`, and every pulse stays the host's.
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 

@@ -1,13 +1,7 @@
-//! Settings sectors as an earlier firmware would have left them:
-//!
-//! - [`version_1_sectors`]: the fixture `host-tests/fixtures/settings-v1-sectors.bin`,
-//!   the sectors as the firmware of layout version 1 wrote them;
-//! - [`store_of_version`]: a store written by the core's own
-//!   `SettingsStore` on the host, over a NOR flash in RAM with the Pico's
-//!   geometry (4 KiB sectors, bytes written one at a time), holding a
-//!   record of any layout version. (sequential-storage's own mock flash,
-//!   which the host tests use, sits behind its internal `_test` feature;
-//!   this tool keeps its own small one, [`RamFlash`].)
+//! Settings sectors as an earlier firmware would have left them: the
+//! version 1 fixture, or a record of any layout version written by the
+//! core's own `SettingsStore` over a NOR flash in RAM with the Pico's
+//! geometry.
 
 use std::{
     future::Future,

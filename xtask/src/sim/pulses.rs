@@ -1,32 +1,9 @@
 //! Checks one servo's pulse train from the emulator against the duties the
-//! host computes, frame for frame.
-//!
-//! # How PWM periods map to frames
-//!
-//! Frame `k` is due at `start + k · 20 ms`; the firmware writes its duty a
-//! little later (`δ_k`: wake-up and the frame update). The slice's period
-//! `P` is exactly 20 ms (64 000 counts of 312.5 ns), from the same crystal
-//! as the frames' timer.
-//!
-//! - Frame 0 writes the compare value, sets the counter half a period in
-//!   (above the compare value: the output stays low) and enables the slice
-//!   (at time `e`). Wrap `j` comes at `e + (j − ½) · P`.
-//! - A compare write while running is latched at the next wrap. Frame `k`
-//!   is written at `e + k · P + (δ_k − δ_0)`, between wraps `k` and `k + 1`
-//!   as long as `|δ_k − δ_0| < P / 2` (10 ms; the frame update takes
-//!   microseconds): it is latched at wrap `k + 1`, and the pulse starting
-//!   there, the `k`-th, carries it.
-//!
-//! So the pulse of period `n` must carry frame `n`, and the check verifies
-//! exactly that from the write times instead of assuming it: for every
-//! pulse it finds the last compare write before the pulse's rising edge,
-//! and its period from its rise (`n = (rise − first rise) / P`, rounded). A
-//! frame written with duty 0 (the pulses stopped: a head relaxed at rest)
-//! has no pulse; its period stays empty. A frame written late
-//! (after its wrap) shows up as a pulse carrying the previous frame, a frame
-//! lost as a pulse carrying the next one; either is a problem. Pulses after
-//! the last frame (frames stopped: the watchdog drill) repeat the last duty
-//! and are counted as held.
+//! host computes, frame for frame: each pulse carries the duty of the last
+//! compare write before its rise, and the pulse of PWM period `n` must
+//! carry frame `n` (a late or lost frame shows as a pulse carrying another;
+//! pulses after the last frame repeat it and count as held). Why the
+//! periods map to frames so: docs/dev/emulators.md.
 
 use idle_head_core::driver::DriverConfig;
 
@@ -60,9 +37,7 @@ impl Timing {
 pub struct Limits {
     /// The neutral pulse: the first pulse must be this.
     pub neutral: u16,
-    /// The servo's shortest pulse.
     pub min: u16,
-    /// The servo's longest pulse.
     pub max: u16,
 }
 
@@ -75,7 +50,6 @@ pub struct Train {
     pub writes: Vec<(f64, u16)>,
     /// When the slice was enabled.
     pub enabled: Option<f64>,
-    /// When the boot ended.
     pub end: f64,
     /// Whether a reset ended it (a pulse then in flight was cut).
     pub reset: bool,
@@ -84,9 +58,7 @@ pub struct Train {
 /// One complete pulse.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pulse {
-    /// Rising edge, ns.
     pub rise: f64,
-    /// Width in counts.
     pub counts: u32,
     /// The frame whose duty it carried.
     pub frame: usize,
@@ -97,7 +69,6 @@ pub struct Pulse {
 pub struct Measured {
     /// Rising edge, ns since power-on.
     pub rise: f64,
-    /// Width, ns.
     pub width: f64,
 }
 
@@ -132,9 +103,7 @@ pub fn measure(train: &Train) -> Vec<Measured> {
 /// The verdict on one servo's train.
 #[derive(Debug, Clone, Default)]
 pub struct ServoCheck {
-    /// Complete pulses, in order.
     pub pulses: Vec<Pulse>,
-    /// Frames written.
     pub frames: usize,
     /// Pulses that carried their own frame (pulse `n`, frame `n`).
     pub fresh: usize,

@@ -1,19 +1,7 @@
 //! `--pulses FILE.csv`: the pulses an emulator run measured on the servo
-//! pins, one row per frame:
-//!
-//! ```text
-//! t_ms,pitch_us,roll_us,yaw_us
-//! ```
-//!
-//! Row `k` is frame `k`: the PWM period `k` from the first pulse on (the
-//! neutral pulse of frame 0), at `t_ms = 20·k`. Each width is the pulse
-//! that rose in that period, rising to falling edge, in µs (to 0.1 µs: a
-//! count is 0.3125 µs), or 0 where the period had none (the pulses
-//! stopped: a head relaxed at rest). The rows end with the last period
-//! every servo's pulse is known for.
-//!
-//! The widths are measured from the pin's edges ([`pulses::measure`]),
-//! whatever the run checked them against: a `--dmx` run checks nothing.
+//! pins, one row per frame (`t_ms,pitch_us,roll_us,yaw_us`): row `k` is the
+//! PWM period `k` from the first pulse on, each width the pulse that rose
+//! in it (µs, to 0.1), or 0 where the period had none.
 
 use std::fmt::Write as _;
 use std::path::Path;

@@ -4,7 +4,7 @@
 use std::{fmt::Write as _, path::Path, time::Duration};
 
 use anyhow::{Context, Result, bail};
-use defmt_decoder::{DecodeError, Locations, StreamDecoder, Table};
+use defmt_decoder::StreamDecoder;
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
 
@@ -16,7 +16,7 @@ use super::{
     pulses::{self, Limits, ServoCheck, Timing, Train},
     unmodelled::Unmodelled,
 };
-use crate::log::LogLine;
+use crate::log::{Defmt, LogLine};
 
 /// Virtual time without a log byte or a pin edge after which a run is
 /// declared stuck: 50 frames.
@@ -27,7 +27,6 @@ const SILENCE: Duration = Duration::from_secs(1);
 pub struct Boot {
     /// When it started and ended, ns of virtual time since power-on.
     pub start: f64,
-    /// See `start`.
     pub end: f64,
     /// Whether the watchdog ended it.
     pub watchdog: bool,
@@ -35,7 +34,6 @@ pub struct Boot {
     pub log: Vec<(f64, LogLine)>,
     /// Per servo, what the emulator reported.
     pub trains: [Train; 3],
-    /// Per servo, the verdict.
     pub servos: [ServoCheck; 3],
     /// Cycles of each frame update, in order.
     pub frame_cycles: Vec<u64>,
@@ -43,7 +41,6 @@ pub struct Boot {
     pub stack_low: Option<u64>,
     /// Peak stack use, bytes, from `stack_low`.
     pub stack_peak: Option<u64>,
-    /// Bytes UART0 sent.
     pub uart: Vec<u8>,
     /// Scripted bytes that found UART0's receive FIFO full.
     pub uart_overruns: usize,
@@ -82,7 +79,6 @@ pub struct FlashOp {
     pub erase: bool,
     /// Flash address and length, bytes.
     pub addr: u64,
-    /// See `addr`.
     pub len: u64,
     /// How long it kept the flash busy (and the interrupts off), ns.
     pub busy_ns: f64,
@@ -95,11 +91,8 @@ pub struct FlashOp {
 pub struct End {
     /// Why it stopped: [`Why::Time`] when it ran the whole virtual time.
     pub why: Why,
-    /// Virtual time reached, ns.
     pub ns: f64,
-    /// Instructions executed.
     pub instructions: u64,
-    /// Wall time, ms.
     pub wall_ms: u64,
     /// The harness's error, if it failed.
     pub error: Option<String>,
@@ -138,9 +131,7 @@ impl End {
 /// Everything one run produced.
 #[derive(Debug, Default)]
 pub struct Report {
-    /// The boots, in order.
     pub boots: Vec<Boot>,
-    /// How it ended.
     pub end: End,
     /// The emulator's complaints, each with how often it came.
     pub emulator: Vec<(String, usize)>,
@@ -189,12 +180,8 @@ pub fn run_with(
     wall: Duration,
     setup: impl FnOnce(&mut node::Config),
 ) -> Result<Report> {
-    let (image, config) = harness::config(elf, "flash.bin")?;
-    let bytes = std::fs::read(elf)?;
-    let table = Table::parse(&bytes)
-        .with_context(|| format!("reading the defmt table of {}", elf.display()))?
-        .with_context(|| format!("{} has no defmt data", elf.display()))?;
-    let locations = table.get_locations(&bytes).ok();
+    let (image, config) = harness::config(elf, "flash.uf2")?;
+    let defmt = Defmt::read(elf)?;
     node::ensure(root)?;
     let mut config = node::Config {
         pins: SERVOS.iter().map(|s| s.1).collect(),
@@ -207,12 +194,12 @@ pub fn run_with(
     };
     setup(&mut config);
     println!(
-        "$ (cd sim && node harness.mjs ...)  # {} of flash, {:.1} s of virtual time",
-        image.flash.len(),
+        "$ (cd sim && node harness.mjs ...)  # {}, {:.1} s of virtual time",
+        crate::project::relative(&config.flash).display(),
         virtual_time.as_secs_f64()
     );
     let events = node::run(root, &config)?;
-    let mut report = sort(&events, &table, locations.as_ref(), root)?;
+    let mut report = sort(&events, &defmt)?;
     for boot in &mut report.boots {
         boot.stack_peak = boot.stack_low.map(|low| image.stack.1.saturating_sub(low));
     }
@@ -302,12 +289,7 @@ fn check_exchange(report: &mut Report) {
 }
 
 /// Sorts the events into boots and decodes each boot's log.
-fn sort(
-    events: &[Event],
-    table: &Table,
-    locations: Option<&Locations>,
-    root: &Path,
-) -> Result<Report> {
+fn sort(events: &[Event], defmt: &Defmt) -> Result<Report> {
     let mut report = Report::default();
     let mut decoder: Option<Box<dyn StreamDecoder + '_>> = None;
     let mut ended = false;
@@ -321,7 +303,7 @@ fn sort(
                     start: *ns,
                     ..Boot::default()
                 });
-                decoder = Some(table.new_stream_decoder());
+                decoder = Some(defmt.stream());
                 continue;
             }
             Event::Emu { msg, .. } => {
@@ -355,7 +337,11 @@ fn sort(
         let Some(boot) = report.boots.last_mut() else {
             bail!("harness event before the first boot: {event:?}");
         };
-        into_boot(boot, event, decoder.as_mut(), locations, root);
+        if let (Event::Rtt { ns, hex }, Some(decoder)) = (event, decoder.as_mut()) {
+            let lines = defmt.lines(decoder.as_mut(), hex);
+            boot.log.extend(lines.into_iter().map(|line| (*ns, line)));
+        }
+        into_boot(boot, event);
     }
     if !ended {
         bail!("the emulator harness ended without saying how");
@@ -368,33 +354,8 @@ fn sort(
 
 /// An event of the current boot into `boot`; its log bytes through
 /// `decoder`.
-fn into_boot(
-    boot: &mut Boot,
-    event: &Event,
-    decoder: Option<&mut Box<dyn StreamDecoder + '_>>,
-    locations: Option<&Locations>,
-    root: &Path,
-) {
+fn into_boot(boot: &mut Boot, event: &Event) {
     match event {
-        Event::Rtt { ns, hex } => {
-            let Some(decoder) = decoder else {
-                return;
-            };
-            decoder.received(hex);
-            loop {
-                let line = match decoder.decode() {
-                    Ok(frame) => line(&frame, locations, root),
-                    Err(DecodeError::UnexpectedEof) => break,
-                    Err(DecodeError::Malformed) => LogLine {
-                        level: Some("ERROR".to_owned()),
-                        message: "(malformed defmt frame: the log stream is corrupt)".to_owned(),
-                        timestamp: None,
-                        location: None,
-                    },
-                };
-                boot.log.push((*ns, line));
-            }
-        }
         Event::Edge {
             pin,
             high,
@@ -446,9 +407,10 @@ fn into_boot(
             busy_ns: *busy_ns,
             ns: *ns,
         }),
-        // A reset's pin release and a slice switched off are not
-        // needed; the rest is sorted before a boot is needed.
-        Event::Edge { reset: true, .. }
+        // The log is decoded above; a reset's pin release and a slice
+        // switched off are not needed; the rest is sorted before a boot is.
+        Event::Rtt { .. }
+        | Event::Edge { reset: true, .. }
         | Event::En { on: false, .. }
         | Event::Boot { .. }
         | Event::Emu { .. }
@@ -487,21 +449,6 @@ pub fn end_of(events: &[Event]) -> Result<End> {
         .rfind(|event| matches!(event, Event::End { .. }))
         .context("the emulator harness ended without saying how")?;
     End::from_event(event)
-}
-
-fn line(frame: &defmt_decoder::Frame<'_>, locations: Option<&Locations>, root: &Path) -> LogLine {
-    let location = locations
-        .and_then(|locations| locations.get(&frame.index()))
-        .map(|location| {
-            let file = location.file.strip_prefix(root).unwrap_or(&location.file);
-            format!("{}:{}", file.display(), location.line)
-        });
-    LogLine {
-        level: frame.level().map(|level| level.as_str().to_uppercase()),
-        message: frame.display_message().to_string(),
-        timestamp: None,
-        location,
-    }
 }
 
 /// The PWM timing of the Pico's servo slices.

@@ -1,16 +1,7 @@
 //! `cargo xtask sim --script FILE`: a trace script played into the shipped
-//! Pico image in the emulator, and every pulse checked against the host
-//! trace of the same script.
-//!
-//! The script is `cargo xtask trace --script`'s (`trace/script.rs`): its
-//! pin lines drive GP2 to GP5 (each at its pull until then: the harness
-//! models the pads' pulls), its console lines (motion commands too) go to
-//! UART0 at 115200 baud, each in 2 ms before its time so that the frame due
-//! then has it, as the host trace takes a line before the frame at its
-//! time. Times count from the first frame, the enable of the pitch servo's
-//! slice. The host trace plays the same script on the same core; the
-//! emulator's pulses must be its duties frame for frame, within a count,
-//! and no pulse may leave a servo's limits.
+//! image (pin lines drive GP2 to GP5, console lines go to UART0 2 ms before
+//! their time, times from the first frame), every pulse checked against
+//! the host trace of the same script.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;

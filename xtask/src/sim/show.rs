@@ -1,27 +1,7 @@
-//! Show control in the emulator: `cargo xtask sim --dmx FILE [--pulses
-//! FILE.csv]`, and the stage of `cargo xtask test` that checks the show
-//! issue's acceptance on the shipped image, from the pulses on the pins.
-//!
-//! The stage's run (14 s of virtual time): DMX frames from 3 s on, mix 0;
-//! at 3.5 s mix 255 and yaw coarse 200; at 5 s the frames stop; at 7 s
-//! they come back with mix 0, at 7.5 s the trigger enters the nod band; at
-//! 9 s they stop again. At 10.5 s a Bottango session over USB: handshake,
-//! time sync, two motors (yaw, pitch), a curve each; at 12.6 s `STOP`.
-//! What it checks:
-//!
-//! - with the mix at 255, yaw goes to 200/255 of its way across its limits
-//!   (coarse 200, fine 0: 51 200 of 65 535) and stays there, every step
-//!   within the gesture speed limit;
-//! - the frames dropped, the log says the signal is lost 1 s later, the
-//!   head glides back (every step within the limits) and from then on every
-//!   pulse is the idle's own, the host's duty within a count;
-//! - the band entry plays exactly one nod (one `dmx nod: ok` in the log,
-//!   pitch away from the idle's pulses during it, on them again after);
-//! - the Bottango session is answered (handshake, every `OK`), yaw follows
-//!   the curve (halfway at its middle, 20° at its end), and the idle's own
-//!   pulses come back after it;
-//! - the run's RAM (static and the peak stack measured here) within the
-//!   budget.
+//! Show control in the emulator: `cargo xtask sim --dmx FILE`, and the
+//! stage that checks on the shipped image, from the pulses, that DMX and a
+//! Bottango session drive the head and that lost frames and the end of a
+//! curve hand it back to the idle (docs/dev/emulators.md, "Show control").
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 

@@ -1,41 +1,8 @@
-//! The Pico image's settings store on the emulated chip: `save` through
-//! the boot ROM's flash functions, a power cycle, and the next boot on the
-//! saved settings.
-//!
-//! The emulator has no boot ROM; the harness stands in for its flash
-//! functions (`sim/rom.mjs`) and gives each erase and program the
-//! datasheet's **worst** time (W25Q16JV: 400 ms a 4 KiB sector, 3 ms a
-//! 256-byte page), during which the firmware keeps its interrupts off.
-//!
-//! It runs three times, from three starts of the settings sectors:
-//!
-//! - full of noise, as another firmware may leave them: no settings of this
-//!   one there, so the boot log says the head starts on the built-in
-//!   settings (`settings: defaults (empty store …)`);
-//! - holding a record this firmware cannot read (layout version 0, written
-//!   by the core's own store on the host, `planted.rs`), as a foreign or
-//!   damaged store would: the boot log **warns** (`… holds settings of
-//!   version 0, not 2`) and the head starts on the built-in settings;
-//! - holding the settings a firmware of layout version 1 saved (the
-//!   fixture `host-tests/fixtures/settings-v1-sectors.bin`): the boot log
-//!   says they were loaded and migrated, and the first frame's neutral
-//!   pulses are the saved ones (1520 1480 1510 µs), before any command.
-//!
-//! Then, in each run:
-//!
-//! - At 3 s, over UART0: `servo pitch neutral 1520`, `save`, `status`. The
-//!   save writes the settings (over foreign data it first erases sectors):
-//!   no watchdog reset while the flash is busy with the interrupts off
-//!   (400 ms a sector), and `status` says `settings=flash`.
-//! - At 5 s the power goes off and on. The next boot logs the settings
-//!   loaded from flash and its first frame's neutral pulses: 1520 on pitch,
-//!   roll and yaw as the run started (the version 1 record's survive its
-//!   save in today's layout); its first pulses on the pins are the same.
-//!   At 2.5 s into it, over UART0, `servo pitch neutral 1540` and then
-//!   `load` bring the saved 1520 back from flash: `servo pitch` and
-//!   `status` say so.
-//! - The console image's RAM, static plus the peak stack of the run, is
-//!   within the budget.
+//! The settings store on the emulated chip, from three starts of the
+//! settings sectors (noise, a record of an unknown version, a version 1
+//! record): `save` through the boot ROM's flash functions at their worst
+//! times, a power cycle, and the next boot on the saved settings
+//! (docs/dev/emulators.md, "Settings through a power cycle").
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
@@ -88,9 +55,7 @@ const SAVED_PITCH_US: u32 = 1520;
 
 /// A start of the settings sectors.
 struct Start {
-    /// What they hold.
     what: &'static str,
-    /// Their bytes.
     sectors: Vec<u8>,
     /// What the first boot must log about them: a level and a text.
     logged: &'static [(&'static str, &'static str)],

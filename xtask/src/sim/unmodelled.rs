@@ -1,7 +1,7 @@
 //! Registers rp2040js does not model (a read gives 0xffffffff, a write is
 //! dropped), as the harness counts the accesses to them: the gaps known not
-//! to matter for these images, each with the reason, and any other, which a
-//! run shows in full.
+//! to matter for these images, with the reason, and any other, which a run
+//! shows in full.
 
 use std::fmt::Write as _;
 
@@ -12,131 +12,104 @@ use super::event::Access;
 pub struct Unmodelled {
     /// The peripheral as rp2040js names it.
     pub peripheral: String,
-    /// Read or written.
     pub op: Access,
     /// The register's offset in the peripheral.
     pub offset: u32,
-    /// How often.
     pub count: u64,
 }
 
-/// A gap of the emulator known not to matter here.
-struct Known {
-    /// The peripheral as rp2040js names it.
-    peripheral: &'static str,
-    /// The accesses it covers: `None` any, else these writes only.
-    writes: Option<&'static [u32]>,
-    /// Why it does not matter.
-    why: &'static str,
-}
-
-/// The known gaps. embassy-rp's start-up touches each of them; none changes
-/// what the firmware does in the emulator, which the pulse, console and
-/// store checks of the same runs show.
-const KNOWN: [Known; 5] = [
-    Known {
-        peripheral: "ROSC_BASE",
-        writes: None,
-        why: "the ring oscillator's set-up by the clock init (the emulator's clocks need \
-              none; the harness answers its RANDOMBIT register)",
-    },
-    Known {
-        peripheral: "VREG_AND_CHIP_RESET_BASE",
-        writes: None,
-        why: "the core voltage and the brown-out detector (nothing to regulate in an emulator)",
-    },
-    Known {
-        peripheral: "UART0",
-        // UARTIFLS.
-        writes: Some(&[0x34]),
-        why: "UARTIFLS, the FIFO trigger levels: the transmit level set is the reset value \
-              that sim/uart.mjs models, and the receive side interrupts at every byte, \
-              sooner than the chip",
-    },
-    Known {
-        peripheral: "UART1",
-        // UARTIFLS.
-        writes: Some(&[0x34]),
-        why: "UARTIFLS of the DMX receiver: the receive side interrupts at every byte, \
-              sooner than the chip's trigger level, and the handler reads whatever is \
-              in the FIFO either way",
-    },
-    Known {
-        peripheral: "USB",
-        // SOF_RD, BUFF_CPU_SHOULD_HANDLE, USBPHY_DIRECT, USBPHY_DIRECT_OVERRIDE,
-        // USBPHY_TRIM, (reserved), INTR, INTS.
-        writes: Some(&[0x48, 0x5c, 0x7c, 0x80, 0x84, 0x88, 0x8c, 0x98]),
-        why: "zeros written when the USB driver clears the controller's registers at \
-              start-up (PHY control, read-only status)",
-    },
+/// The known gaps, which embassy-rp's start-up touches: the peripheral, the
+/// writes covered (`None`: any access), why it does not matter. None
+/// changes what the firmware does here, which the pulse, console and store
+/// checks of the same runs show.
+const KNOWN: [(&str, Option<&[u32]>, &str); 5] = [
+    (
+        "ROSC_BASE",
+        None,
+        "the ring oscillator's set-up by the clock init (the harness answers its RANDOMBIT)",
+    ),
+    (
+        "VREG_AND_CHIP_RESET_BASE",
+        None,
+        "the core voltage and the brown-out detector",
+    ),
+    (
+        "UART0",
+        Some(&[0x34]),
+        "UARTIFLS, the FIFO trigger levels: the transmit level set is the reset value \
+         sim/uart.mjs models; the receive side interrupts at every byte, sooner than the chip",
+    ),
+    (
+        "UART1",
+        Some(&[0x34]),
+        "UARTIFLS of the DMX receiver, whose handler reads whatever the FIFO holds",
+    ),
+    (
+        "USB",
+        // SOF_RD, BUFF_CPU_SHOULD_HANDLE, USBPHY_DIRECT, _OVERRIDE, _TRIM,
+        // (reserved), INTR, INTS.
+        Some(&[0x48, 0x5c, 0x7c, 0x80, 0x84, 0x88, 0x8c, 0x98]),
+        "zeros written when the USB driver clears the controller at start-up",
+    ),
 ];
 
 impl Unmodelled {
     /// Why this access does not matter, if it is a known gap.
     fn known(&self) -> Option<&'static str> {
+        let covers = |writes: Option<&[u32]>| {
+            writes.is_none_or(|offsets| self.op == Access::Write && offsets.contains(&self.offset))
+        };
         KNOWN
             .iter()
-            .find(|known| {
-                known.peripheral == self.peripheral
-                    && known.writes.is_none_or(|offsets| {
-                        self.op == Access::Write && offsets.contains(&self.offset)
-                    })
-            })
-            .map(|known| known.why)
-    }
-
-    /// `[USB] write to 0x48 (3x)`.
-    fn describe(&self) -> String {
-        let op = match self.op {
-            Access::Read => "read from",
-            Access::Write => "write to",
-        };
-        format!(
-            "[{}] {op} 0x{:x} ({}x)",
-            self.peripheral, self.offset, self.count
-        )
+            .find(|(peripheral, writes, _)| *peripheral == self.peripheral && covers(*writes))
+            .map(|(.., why)| *why)
     }
 }
 
 /// The lines a run prints about `accesses`: with `verbose`, each access and
-/// why a known one does not matter; without, one line for the known ones
-/// and each unknown one in full.
+/// why a known one does not matter; without, one line for the known ones;
+/// each unknown one in full.
 pub fn lines(accesses: &[Unmodelled], verbose: bool) -> String {
-    let (known, unknown): (Vec<&Unmodelled>, Vec<&Unmodelled>) =
-        accesses.iter().partition(|access| access.known().is_some());
     let mut text = String::new();
-    if verbose {
-        for access in &known {
-            let why = access.known().unwrap_or_default();
-            let _ = writeln!(
-                text,
-                "emulator: unmodelled register, {}: known, {why}",
-                access.describe()
-            );
-        }
-    } else if !known.is_empty() {
-        let mut peripherals: Vec<&str> = Vec::new();
-        for access in &known {
-            if !peripherals.contains(&access.peripheral.as_str()) {
-                peripherals.push(&access.peripheral);
+    let mut known = (0, 0, Vec::new());
+    for access in accesses {
+        let op = match access.op {
+            Access::Read => "read from",
+            Access::Write => "write to",
+        };
+        let what = format!(
+            "[{}] {op} 0x{:x} ({}x)",
+            access.peripheral, access.offset, access.count
+        );
+        match access.known() {
+            Some(why) if verbose => {
+                let _ = writeln!(text, "emulator: unmodelled register, {what}: known, {why}");
+            }
+            Some(_) => {
+                known.0 += access.count;
+                known.1 += 1;
+                if !known.2.contains(&access.peripheral.as_str()) {
+                    known.2.push(&access.peripheral);
+                }
+            }
+            None => {
+                let _ = writeln!(
+                    text,
+                    "emulator: unmodelled register, {what}: NOT a known gap (a read gives \
+                     0xffffffff, a write is dropped; see sim/unmodelled.rs)"
+                );
             }
         }
-        let _ = writeln!(
-            text,
-            "emulator: {} accesses to {} registers it does not model, all known gaps that do not \
-             matter here ({}; --verbose lists them)",
-            known.iter().map(|a| a.count).sum::<u64>(),
-            known.len(),
-            peripherals.join(", ")
-        );
     }
-    for access in unknown {
-        let _ = writeln!(
-            text,
-            "emulator: unmodelled register, {}: NOT a known gap (a read gives 0xffffffff, a \
-             write is dropped; see sim/unmodelled.rs)",
-            access.describe()
+    if known.1 > 0 {
+        let summary = format!(
+            "emulator: {} accesses to {} registers it does not model, all known gaps that do not \
+             matter here ({}; --verbose lists them)\n",
+            known.0,
+            known.1,
+            known.2.join(", ")
         );
+        text.insert_str(0, &summary);
     }
     text
 }
@@ -146,8 +119,9 @@ mod tests {
     use super::*;
 
     fn access(peripheral: &str, op: Access, offset: u32, count: u64) -> Unmodelled {
+        let peripheral = peripheral.to_owned();
         Unmodelled {
-            peripheral: peripheral.to_owned(),
+            peripheral,
             op,
             offset,
             count,
@@ -162,19 +136,14 @@ mod tests {
             access("VREG_AND_CHIP_RESET_BASE", Access::Read, 0x0, 2),
             access("USB", Access::Write, 0x48, 1),
         ];
-        let quiet = lines(&accesses, false);
         assert_eq!(
-            quiet,
+            lines(&accesses, false),
             "emulator: 5 accesses to 4 registers it does not model, all known gaps that do not \
              matter here (ROSC_BASE, VREG_AND_CHIP_RESET_BASE, USB; --verbose lists them)\n"
         );
         let verbose = lines(&accesses, true);
         assert_eq!(verbose.lines().count(), 4, "{verbose}");
-        assert!(
-            verbose
-                .contains("[VREG_AND_CHIP_RESET_BASE] read from 0x0 (2x): known, the core voltage")
-        );
-
+        assert!(verbose.contains("[VREG_AND_CHIP_RESET_BASE] read from 0x0 (2x): known, the core"));
         // A register of a known peripheral that is not on the list, a read
         // of a register only known as written, another peripheral: shown.
         let surprises = [

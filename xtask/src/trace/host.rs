@@ -1,14 +1,7 @@
 //! What runs beside the frame task on a board, on the host: the console's
-//! service (for the script's console lines) and the input task (for its
-//! pin lines), the same core code as the firmware's, on the same queue and
-//! link as the frames.
-//!
-//! The input task is played as the firmware runs it: woken at every change
-//! of a pin, at every deadline its state machine asks for, and when the
-//! console changes the inputs' settings; each wake reads the levels (an
-//! input no line has driven sits at its idle level: a button's pull-up
-//! keeps it high, a presence sensor's pull-down low), updates the state
-//! machine with whether the head rests, and queues what it sends.
+//! service and the input task, the same core code as the firmware's, on the
+//! trace's queue and link. The input task wakes as on the board: at a pin's
+//! change, at its deadlines, and when the console changes its settings.
 
 use idle_head_core::behaviour::{CommandQueue, RestState};
 use idle_head_core::console::{ActionLine, ConsoleLink, ConsoleService, Response, respond};

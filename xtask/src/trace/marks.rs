@@ -30,9 +30,7 @@ pub struct Mark {
     pub t_ms: u64,
     /// How long its motion lasts, in ms (0: a switch).
     pub span_ms: u64,
-    /// The axes it moves.
     pub axes: Vec<Axis>,
-    /// What it is.
     pub kind: Kind,
     /// A short label (`nod`, `look clamped`, `return`, ...).
     pub label: String,

@@ -1,0 +1,306 @@
+//! The one plotting path of the PNGs (`preview`, `trace`, `qemu`): a
+//! figure of stacked panels, each with curves, shaded spans and labelled
+//! markers, drawn by plotters with a built-in font (`DejaVu Sans`), so a plot
+//! looks the same on every machine. A curve with more points than its
+//! panel has pixel columns is drawn as each column's range and mean.
+
+// Sample counts and pixel positions are far below f64's exact range.
+#![allow(
+    clippy::cast_precision_loss,
+    clippy::cast_possible_truncation,
+    clippy::cast_possible_wrap,
+    clippy::cast_sign_loss
+)]
+
+use std::{path::Path, sync::Once};
+
+use anyhow::{Result, anyhow};
+use plotters::{coord::Shift, prelude::*, style::FontStyle};
+
+/// The family name the plots ask for; [`draw`] registers `DejaVu Sans` as it.
+const FONT: &str = "sans-serif";
+const WIDTH: u32 = 1400;
+/// Pixels between a marker and its label, and the labels' size.
+const GAP: i32 = 4;
+const LABEL_SIZE: u32 = 13;
+
+pub const BLUE: RGBColor = RGBColor(31, 119, 180);
+pub const ORANGE: RGBColor = RGBColor(255, 127, 14);
+pub const GREEN: RGBColor = RGBColor(44, 160, 44);
+pub const RED: RGBColor = RGBColor(214, 39, 40);
+pub const PURPLE: RGBColor = RGBColor(148, 103, 189);
+pub const GREY: RGBColor = RGBColor(110, 110, 110);
+pub const LIGHT: RGBColor = RGBColor(190, 190, 190);
+
+/// A figure: a title, lines of text under it, and panels one above the other.
+pub struct Figure {
+    pub title: String,
+    pub notes: Vec<String>,
+    pub panels: Vec<Panel>,
+    /// Height of each panel, pixels.
+    pub panel_height: u32,
+}
+
+/// One panel: its curves over a shared x axis.
+#[derive(Default)]
+pub struct Panel {
+    pub title: String,
+    pub x_desc: String,
+    pub y_desc: String,
+    pub curves: Vec<Curve>,
+    /// Shaded x ranges, behind the curves.
+    pub spans: Vec<(f64, f64, RGBColor)>,
+    /// Dashed vertical lines with a label at the top.
+    pub markers: Vec<(f64, String, RGBColor)>,
+}
+
+/// One curve; a dashed one is a reference line (a range's ends). A curve
+/// without a label has no entry in the legend.
+pub struct Curve {
+    pub label: String,
+    pub color: RGBColor,
+    pub points: Vec<(f64, f64)>,
+    pub dashed: bool,
+}
+
+impl Curve {
+    /// A solid curve of `values`, one per index.
+    pub fn indexed(label: impl Into<String>, color: RGBColor, values: &[f64]) -> Self {
+        let points = values.iter().enumerate().map(|(i, &v)| (i as f64, v));
+        Self::new(label, color, points.collect())
+    }
+
+    /// A solid curve through `points`.
+    pub fn new(label: impl Into<String>, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            label: label.into(),
+            color,
+            points,
+            dashed: false,
+        }
+    }
+}
+
+/// Draws `figure` to the PNG `path`, creating its folder.
+pub fn draw(figure: &Figure, path: &Path) -> Result<()> {
+    register_font()?;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)?;
+    }
+    let header = 50 + 20 * u32::try_from(figure.notes.len())?;
+    let height = header + figure.panel_height * u32::try_from(figure.panels.len())?;
+    let root = BitMapBackend::new(path, (WIDTH, height)).into_drawing_area();
+    paint(&root, figure, header).map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
+    root.present()
+        .map_err(|e| anyhow!("writing {}: {e}", path.display()))
+}
+
+fn register_font() -> Result<()> {
+    static ONCE: Once = Once::new();
+    let mut result = Ok(());
+    ONCE.call_once(|| {
+        for (style, bytes) in [
+            (FontStyle::Normal, dejavu::sans::regular()),
+            (FontStyle::Bold, dejavu::sans::bold()),
+        ] {
+            if plotters::style::register_font(FONT, style, bytes).is_err() {
+                result = Err(anyhow!("the DejaVu Sans font did not load"));
+            }
+        }
+    });
+    result
+}
+
+type Drawn = Result<(), Box<dyn std::error::Error>>;
+
+fn paint(root: &DrawingArea<BitMapBackend<'_>, Shift>, figure: &Figure, header: u32) -> Drawn {
+    root.fill(&WHITE)?;
+    let (top, body) = root.split_vertically(header);
+    let bold = |size| (FONT, size).into_font().style(FontStyle::Bold);
+    top.draw(&Text::new(figure.title.clone(), (20, 14), bold(22)))?;
+    for (i, note) in figure.notes.iter().enumerate() {
+        let y = 46 + 20 * i as i32;
+        top.draw(&Text::new(
+            note.clone(),
+            (20, y),
+            (FONT, 15).into_font().color(&GREY),
+        ))?;
+    }
+    for (area, panel) in body
+        .split_evenly((figure.panels.len(), 1))
+        .iter()
+        .zip(&figure.panels)
+    {
+        draw_panel(area, panel)?;
+    }
+    Ok(())
+}
+
+fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, panel: &Panel) -> Drawn {
+    let points = || panel.curves.iter().flat_map(|c| c.points.iter());
+    let (x0, x1, lo, hi) = points().fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |(x0, x1, lo, hi), &(x, y)| (x0.min(x), x1.max(x), lo.min(y), hi.max(y)),
+    );
+    let (x0, x1) = if x1 > x0 { (x0, x1) } else { (0.0, 1.0) };
+    let (lo, hi) = if hi >= lo { (lo, hi) } else { (-1.0, 1.0) };
+    // Room above the curves for two rows of labels.
+    let pad = ((hi - lo) * 0.1).max(0.5);
+    let (lo, hi) = (lo - pad, hi + 2.5 * pad);
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, (FONT, 17).into_font().style(FontStyle::Bold))
+        .margin(8)
+        .margin_right(24)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, lo..hi)?;
+    chart
+        .configure_mesh()
+        .x_desc(&panel.x_desc)
+        .y_desc(&panel.y_desc)
+        .axis_desc_style((FONT, 14))
+        .label_style((FONT, 13))
+        .x_label_formatter(&|x| format!("{x:.1}"))
+        .y_label_formatter(&|y| format!("{y:.1}"))
+        .max_light_lines(1)
+        .light_line_style(RGBColor(240, 240, 240))
+        .bold_line_style(RGBColor(218, 218, 218))
+        .draw()?;
+    for &(from, to, color) in &panel.spans {
+        chart.draw_series([Rectangle::new([(from, lo), (to, hi)], color.filled())])?;
+    }
+    let columns = chart.plotting_area().get_pixel_range().0.len().max(1);
+    for curve in &panel.curves {
+        let style = curve.color.stroke_width(if curve.dashed { 1 } else { 2 });
+        let drawn = if curve.dashed {
+            chart.draw_series(DashedLineSeries::new(curve.points.clone(), 8, 6, style))?
+        } else if curve.points.len() > 2 * columns {
+            let bands = bands(&curve.points, columns);
+            let outline = bands.iter().map(|b| (b.0, b.2));
+            let outline = outline.chain(bands.iter().rev().map(|b| (b.0, b.1)));
+            let band = curve.color.mix(0.3).filled();
+            chart.draw_series([Polygon::new(outline.collect::<Vec<_>>(), band)])?;
+            let mean = bands.iter().map(|b| (b.0, b.3));
+            chart.draw_series(LineSeries::new(mean, curve.color.stroke_width(1)))?
+        } else {
+            chart.draw_series(LineSeries::new(curve.points.clone(), style))?
+        };
+        let color = curve.color;
+        if !curve.label.is_empty() {
+            drawn.label(&curve.label).legend(move |(x, y)| {
+                PathElement::new([(x, y), (x + 20, y)], color.stroke_width(3))
+            });
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .label_font((FONT, 13))
+        .background_style(WHITE.mix(0.85))
+        .border_style(GREY.mix(0.6))
+        .draw()?;
+    markers(&mut chart, area, panel, hi)
+}
+
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    BitMapBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// Each marker's dashed line, and its label right of it in the first of
+/// two rows at the top where it covers no other label, on white (left out
+/// where there is none).
+fn markers(
+    chart: &mut Chart<'_, '_>,
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    panel: &Panel,
+    hi: f64,
+) -> Drawn {
+    let lo = chart.y_range().start;
+    let font = (FONT, LABEL_SIZE).into_font();
+    let mut rows = [i32::MIN; 2];
+    for (x, label, color) in &panel.markers {
+        let line = [(*x, lo), (*x, hi)];
+        chart.draw_series(DashedLineSeries::new(line, 5, 4, color.stroke_width(1)))?;
+        let (width, height) = area.estimate_text_size(label, &TextStyle::from(font.clone()))?;
+        let (width, height) = (width as i32, height as i32);
+        let left = chart.backend_coord(&(*x, hi)).0 + GAP;
+        let Some(row) = rows.iter().position(|&end| end < left) else {
+            continue;
+        };
+        rows[row] = left + width + GAP;
+        let y = 2 + row as i32 * height;
+        chart.plotting_area().draw(
+            &(EmptyElement::at((*x, hi))
+                + Rectangle::new(
+                    [(GAP - 1, y), (GAP + width + 1, y + height)],
+                    WHITE.mix(0.85).filled(),
+                )
+                + Text::new(label.clone(), (GAP, y), font.color(color))),
+        )?;
+    }
+    Ok(())
+}
+
+/// `points` in `columns` columns of as many points each: per column its
+/// middle x, its lowest, highest and mean y.
+fn bands(points: &[(f64, f64)], columns: usize) -> Vec<(f64, f64, f64, f64)> {
+    let per = points.len().div_ceil(columns).max(1);
+    points
+        .chunks(per)
+        .map(|chunk| {
+            let (min, max, sum) = chunk.iter().fold(
+                (f64::INFINITY, f64::NEG_INFINITY, 0.0),
+                |(lo, hi, sum), &(_, y)| (lo.min(y), hi.max(y), sum + y),
+            );
+            (chunk[chunk.len() / 2].0, min, max, sum / chunk.len() as f64)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_long_curve_is_drawn_as_each_columns_range_and_mean() {
+        // A saw tooth of 10 points, 0 to 9, over 180,000 points.
+        let points: Vec<(f64, f64)> = (0..180_000)
+            .map(|i| (f64::from(i), f64::from(i % 10)))
+            .collect();
+        let bands = bands(&points, 1300);
+        assert!(bands.len() <= 1300 && bands.len() > 1200, "{}", bands.len());
+        for &(_, min, max, mean) in &bands {
+            assert_eq!((min, max), (0.0, 9.0));
+            assert!((mean - 4.5).abs() < 0.1, "{mean}");
+        }
+        assert!(bands.windows(2).all(|w| w[0].0 < w[1].0));
+    }
+
+    #[test]
+    fn a_figure_is_drawn() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a/figure.png");
+        let panel = Panel {
+            title: "a panel".into(),
+            curves: vec![Curve::indexed("sine", BLUE, &[0.0, 1.0, 0.0, -1.0])],
+            markers: vec![(1.0, "here".into(), RED)],
+            spans: vec![(1.0, 2.0, LIGHT)],
+            ..Panel::default()
+        };
+        let figure = Figure {
+            title: "a figure".into(),
+            notes: vec!["a note".into()],
+            panels: vec![panel],
+            panel_height: 200,
+        };
+        draw(&figure, &path).unwrap();
+        assert!(std::fs::read(&path).unwrap().starts_with(b"\x89PNG"));
+    }
+}
