@@ -55,10 +55,11 @@ pub mod pwm_clock;
 pub mod servo;
 pub mod settings;
 pub mod text;
+pub mod track;
 pub mod units;
 
 pub use axis::Axis;
 pub use driver::{DriverConfig, FrameClock, FrameDriver, FrameReport};
 pub use playback::{LoopSource, Playback};
 pub use servo::{Direction, PwmTiming, ServoCalibration};
-pub use units::{Angle, AngleRange, Microseconds, Millis};
+pub use units::{Angle, AngleRange, Microseconds, Millimetres, Millis};
