@@ -52,6 +52,7 @@ pub mod metrics;
 pub mod motion;
 pub mod playback;
 pub mod pwm_clock;
+pub mod seed;
 pub mod servo;
 pub mod settings;
 pub mod text;

@@ -114,6 +114,15 @@ keywords! {
     Pose "pose",
     Relax "relax",
     Duck "duck",
+    Radar "radar",
+    Track "track",
+    Height "height",
+    Mount "mount",
+    Prefer "prefer",
+    Nearest "nearest",
+    Newest "newest",
+    Board "board",
+    Paper "paper",
 }
 
 // A gesture's word must not be a word the protocol already has: the
