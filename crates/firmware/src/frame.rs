@@ -53,7 +53,7 @@ use embedded_hal::pwm::SetDutyCycle;
 
 use idle_head_core::behaviour::{
     Applied, BehaviourError, BehaviourParams, CommandQueue, Head, HeadFrame, IdleSource,
-    ShowEvents, ShowLink,
+    ShowEvents, ShowLink, TrackEvent,
 };
 use idle_head_core::command::{Action, Hold};
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
@@ -276,6 +276,16 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         if let Some(signal) = events.signal {
             show.dmx.set_signal(signal);
         }
+        // The tracker's sighting (a radar's), if one came.
+        let sighting = show.track.take();
+        if let Some(event) = self.head.track(
+            driver,
+            tick.frame,
+            &show.track.settings(),
+            sighting.as_ref(),
+        ) {
+            log_track(tick.frame, event);
+        }
         Some(events)
     }
 
@@ -412,6 +422,18 @@ fn log_show(frame: u64, events: &ShowEvents) {
     }
     if let Some((action, outcome)) = &events.fired {
         log_outcome(frame, "dmx ", action, outcome);
+    }
+}
+
+/// Logs what the tracker did before frame `frame`.
+fn log_track(frame: u64, event: TrackEvent) {
+    match event {
+        TrackEvent::Turned(yaw) => {
+            defmt::info!("frame {=u64}: track: turned to yaw {}", frame, yaw)
+        }
+        TrackEvent::Released => {
+            defmt::info!("frame {=u64}: track: nobody left, back to centre", frame)
+        }
     }
 }
 

@@ -72,9 +72,16 @@ impl TrackLink {
     /// A sighting the frame task has not taken yet is replaced, and
     /// counted as dropped.
     pub fn publish(&self, sighting: Option<Sighting>, counters: Counters) {
+        self.publish_after(sighting, 0, counters);
+    }
+
+    /// [`publish`](Self::publish) of the last of several sightings that
+    /// came at once, `older` of them before it (never seen by the frame
+    /// task: counted as dropped).
+    pub fn publish_after(&self, sighting: Option<Sighting>, older: u32, counters: Counters) {
         self.received.lock(|cell| {
             let mut r = cell.get();
-            let dropped = r.counters.dropped;
+            let dropped = r.counters.dropped.wrapping_add(older);
             if let Some(s) = sighting {
                 let replaced = !r.taken;
                 r.sighting = s;
