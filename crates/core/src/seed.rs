@@ -7,7 +7,7 @@
 //! The board reads its unique id once at boot (the RP2040's flash unique
 //! id, the RP2350's chip id: the board layer's business) and hands it to
 //! the core as a [`BoardId`]. The seed `n` is the id folded to 32 bits
-//! through SplitMix64's finaliser (every bit of the id moves every bit of
+//! through the `SplitMix64` finaliser (every bit of the id moves every bit of
 //! `n`, so ids that differ in one digit give unrelated motion), and the
 //! three seeds are those `seed <n>` gives ([`Settings::seeds_from`]): a
 //! person who likes a head's motion can give another head the same with

@@ -429,10 +429,10 @@ fn log_show(frame: u64, events: &ShowEvents) {
 fn log_track(frame: u64, event: TrackEvent) {
     match event {
         TrackEvent::Turned(yaw) => {
-            defmt::info!("frame {=u64}: track: turned to yaw {}", frame, yaw)
+            defmt::info!("frame {=u64}: track: turned to yaw {}", frame, yaw);
         }
         TrackEvent::Released => {
-            defmt::info!("frame {=u64}: track: nobody left, back to centre", frame)
+            defmt::info!("frame {=u64}: track: nobody left, back to centre", frame);
         }
     }
 }

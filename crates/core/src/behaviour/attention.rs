@@ -163,7 +163,7 @@ impl Attention {
                 let gate = GATE_MM
                     .saturating_add(since_ms.saturating_mul(GATE_PER_MS))
                     .min(GATE_MAX_MM);
-                let d = apart(&t.at, person);
+                let d = apart(t.at, *person);
                 if d <= gate && best.is_none_or(|(_, b)| d < b) {
                     best = Some((i, d));
                 }
@@ -331,7 +331,7 @@ impl Attention {
 }
 
 /// How far apart two positions are, mm.
-fn apart(a: &Person, b: &Person) -> u32 {
+fn apart(a: Person, b: Person) -> u32 {
     distance(&Person {
         x: crate::units::Millimetres(a.x.0.saturating_sub(b.x.0)),
         y: crate::units::Millimetres(a.y.0.saturating_sub(b.y.0)),

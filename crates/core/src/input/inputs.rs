@@ -125,10 +125,17 @@ pub struct Inputs {
     /// The radar as presence (see [`Inputs::sense`]): whether it counts,
     /// its count of sightings with somebody, when one last came, and
     /// whether presence began since the last update.
-    radar: bool,
-    radar_seen: u32,
-    radar_last: Micros,
-    radar_rose: bool,
+    radar: Radar,
+}
+
+/// The radar as presence: whether it counts (`None`: off), its count of
+/// sightings with somebody, when one last came, and whether presence
+/// began since the last update.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Radar {
+    seen: Option<u32>,
+    last: Micros,
+    rose: bool,
 }
 
 /// How long the radar's presence lasts after the last sighting with
@@ -156,10 +163,11 @@ impl Inputs {
             first: 0,
             waiting: 0,
             lost: 0,
-            radar: false,
-            radar_seen: 0,
-            radar_last: NEVER,
-            radar_rose: false,
+            radar: Radar {
+                seen: None,
+                last: NEVER,
+                rose: false,
+            },
         };
         inputs.configure(settings, now);
         inputs
@@ -194,28 +202,27 @@ impl Inputs {
     /// tracker turns the head to the person).
     pub fn sense(&mut self, now: Micros, seen: Option<u32>) {
         let Some(seen) = seen else {
-            self.radar = false;
-            self.radar_last = NEVER;
+            self.radar.seen = None;
+            self.radar.last = NEVER;
             return;
         };
-        if !self.radar {
+        let Some(before) = self.radar.seen.replace(seen) else {
             // Switched on: the count so far is no one new.
-            self.radar = true;
-            self.radar_seen = seen;
             return;
-        }
-        if seen != self.radar_seen {
-            self.radar_seen = seen;
+        };
+        if seen != before {
             if !self.radar_present(now) {
-                self.radar_rose = true;
+                self.radar.rose = true;
             }
-            self.radar_last = now;
+            self.radar.last = now;
         }
     }
 
     /// Whether the radar saw somebody within [`RADAR_HOLD_MS`] of `now`.
     fn radar_present(&self, now: Micros) -> bool {
-        self.radar && self.radar_last != NEVER && !now.passed(self.radar_last, RADAR_HOLD_MS)
+        self.radar.seen.is_some()
+            && self.radar.last != NEVER
+            && !now.passed(self.radar.last, RADAR_HOLD_MS)
     }
 
     /// The inputs' levels at `now` (bit `i`: input `i` high), with whether
@@ -260,7 +267,7 @@ impl Inputs {
                 InputRole::Off => {}
             }
         }
-        if core::mem::take(&mut self.radar_rose) && resting && !woken {
+        if core::mem::take(&mut self.radar.rose) && resting && !woken {
             self.push(Pending::Wake(None));
         }
         if self.present(settings) {
@@ -302,7 +309,7 @@ impl Inputs {
 
     /// When the rest is due, if it is to come.
     fn rest_due(&self, settings: &InputSettings) -> Option<Micros> {
-        if self.rest_sent || !(settings.presence() || self.radar) {
+        if self.rest_sent || !(settings.presence() || self.radar.seen.is_some()) {
             return None;
         }
         let after = settings.rest_after.micros()?;
@@ -324,7 +331,7 @@ impl Inputs {
                 soonest = Some(soonest.map_or(due, |s| s.min(due)));
             }
         }
-        if self.radar {
+        if self.radar.seen.is_some() {
             let poll = self.now.after_ms(RADAR_POLL_MS);
             soonest = Some(soonest.map_or(poll, |s| s.min(poll)));
         }

@@ -288,13 +288,13 @@ impl SightingSource for Decoder {
 mod tests {
     use super::*;
 
-    fn person(x: i32, y: i32) -> Option<Target> {
-        Some(Target {
+    fn person(x: i32, y: i32) -> Target {
+        Target {
             x: Millimetres(x),
             y: Millimetres(y),
             speed: -16,
             resolution: 320,
-        })
+        }
     }
 
     #[test]
@@ -311,7 +311,7 @@ mod tests {
 
     #[test]
     fn a_frame_round_trips_and_empty_slots_are_none() {
-        let targets = [person(-782, 1713), None, person(1200, 3000)];
+        let targets = [Some(person(-782, 1713)), None, Some(person(1200, 3000))];
         let bytes = frame(&targets);
         let mut d = Decoder::new();
         let got: Vec<_> = bytes.iter().filter_map(|&b| d.push(b)).collect();
@@ -323,7 +323,7 @@ mod tests {
 
     #[test]
     fn a_false_header_in_a_bad_frame_does_not_hide_the_real_one() {
-        let good = frame(&[person(100, 2000), None, None]);
+        let good = frame(&[Some(person(100, 2000)), None, None]);
         // A header, 10 bytes of it, then the real frame: the false frame's
         // 30 bytes end inside the real one.
         let mut stream = HEADER.to_vec();
