@@ -222,7 +222,7 @@ fn two_people_side_by_side_do_not_make_it_flick() {
     let mut k = 0_u32;
     rig.run_tracked(400, &on, |_| {
         k += 1;
-        let wobble = if (k / 3) % 2 == 0 { 30 } else { -30 };
+        let wobble = if (k / 3).is_multiple_of(2) { 30 } else { -30 };
         sighting(&[(-300, 2000 + wobble), (300, 2000 - wobble)])
     });
     // Glances come and go (at most every 2.6 s), but between them the head

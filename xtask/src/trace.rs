@@ -233,12 +233,7 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
             }
             next += 1;
         }
-        // The radar's frames due by now, through the receiver's link.
-        while radar_frames * RADAR_US <= t_us {
-            show.track
-                .publish(Some(people), idle_head_core::track::Counters::default());
-            radar_frames += 1;
-        }
+        send_radar(&show, people, &mut radar_frames, t_us);
         task.radar(show.track.presence());
         wake_until(&mut task, t_us, rest, &link, &queue, &mut origins);
         // What the console sent through the link, then the queue.
@@ -297,6 +292,16 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
 
 /// The radar's frame period, µs (the LD2450 reports ten times a second).
 const RADAR_US: u64 = 100_000;
+
+/// The radar's frames due by `t_us` (`sent` so far), seeing `people`,
+/// through the receiver's link.
+fn send_radar(show: &ShowLink, people: Sighting, sent: &mut u64, t_us: u64) {
+    while *sent * RADAR_US <= t_us {
+        show.track
+            .publish(Some(people), idle_head_core::track::Counters::default());
+        *sent += 1;
+    }
+}
 
 /// A sighting of a radar line's people.
 fn sighting(seen: &[Option<(i32, i32)>; 3]) -> Sighting {
