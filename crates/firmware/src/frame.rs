@@ -329,7 +329,11 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
                 driver.is_stopping(),
                 self.head.rest_state(),
             );
-            link.publish(HeadStatus::of(report, driver.stats(), mode));
+            let mut status = HeadStatus::of(report, driver.stats(), mode);
+            if self.show.is_some_and(|show| show.track.settings().radar) {
+                status.track = Some(self.head.track_view());
+            }
+            link.publish(status);
         }
     }
 

@@ -293,6 +293,15 @@ impl<I: IdleSource> Head<I> {
         self.tracker.aiming()
     }
 
+    /// The tracker for `watch`: people in the latest sighting, and the yaw
+    /// the head aims at.
+    pub const fn track_view(&self) -> crate::track::TrackView {
+        crate::track::TrackView {
+            targets: self.tracker.targets(),
+            at: self.tracker.aiming(),
+        }
+    }
+
     /// What drives the show layer.
     pub const fn show_source(&self) -> Source {
         self.show.source()

@@ -53,6 +53,8 @@ pub(crate) struct Tracker {
     last: u64,
     /// The aim's yaw, for `watch`.
     at: Option<Angle>,
+    /// People in the latest sighting, for `watch`.
+    targets: u8,
 }
 
 impl Tracker {
@@ -64,12 +66,18 @@ impl Tracker {
             attended: None,
             last: 0,
             at: None,
+            targets: 0,
         }
     }
 
     /// The yaw the tracker aims at, if it holds the gaze.
     pub(crate) const fn aiming(&self) -> Option<Angle> {
         self.at
+    }
+
+    /// People in the latest sighting.
+    pub(crate) const fn targets(&self) -> u8 {
+        self.targets
     }
 
     /// Between frames, at `now` µs: the sighting that came (if any) with
@@ -87,6 +95,7 @@ impl Tracker {
         let dt_ms = (now.saturating_sub(self.last) / 1000).min(u64::from(u32::MAX)) as u32;
         match sighting {
             Some(s) => {
+                self.targets = s.count();
                 self.attention.sight(now, s, settings.prefer);
                 self.last = now;
             }

@@ -31,6 +31,16 @@ pub use link::{Received, TrackLink};
 
 use crate::units::{Angle, Millimetres};
 
+/// The tracker as the last frame left it, for `watch`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TrackView {
+    /// People in the latest sighting.
+    pub targets: u8,
+    /// The yaw the head aims at (an axis angle), if it follows someone.
+    pub at: Option<Angle>,
+}
+
 /// People a sighting holds at most (the LD2450 tracks three).
 pub const PEOPLE: usize = 3;
 
