@@ -19,7 +19,7 @@
 //! motion rejects as flat ([`MotionError::Degenerate`]) cannot stop the
 //! head: the loop generator moves on to the next seeds, as it does for
 //! any set (`idle::LoopStream`); `host-tests/tests/seeds.rs` generates the
-//! loops of thousands of ids and finds none.
+//! loops of hundreds of ids and finds none.
 //!
 //! [`Settings::seeds_from`]: crate::settings::Settings::seeds_from
 //! [`MotionError::Degenerate`]: crate::motion::MotionError::Degenerate
