@@ -3,6 +3,7 @@
 pub mod behaviour;
 pub mod console;
 pub mod rig;
+pub mod tracked;
 
 use embedded_hal_mock::eh1::MockError;
 use embedded_hal_mock::eh1::pwm::{Mock, Transaction};

@@ -78,6 +78,7 @@ fn the_telemetry_figures_in_the_protocol_document_hold() {
         pulses: [1483, 1499, 1497].map(Microseconds),
         faults: [0; 3],
         disabled: [false; 3],
+        track: None,
     };
     let mut out = [0; TELEMETRY_LINE];
     let line = telemetry_line(&status, 20_000, 0, &mut out);

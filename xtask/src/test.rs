@@ -70,7 +70,10 @@ impl Stages<'_> {
             0 => String::new(),
             n => format!(" ({n} left out by --only)"),
         };
-        println!("{} passed, {failed} failed{left_out}", self.results.len() - failed);
+        println!(
+            "{} passed, {failed} failed{left_out}",
+            self.results.len() - failed
+        );
         failed == 0
     }
 }

@@ -13,10 +13,12 @@ mod script;
 use std::{fs, path::PathBuf};
 
 use anyhow::{Context, Result, anyhow};
-use idle_head_core::behaviour::{BehaviourConfig, CommandQueue, Head, LOOP_DURATION};
+use idle_head_core::Millimetres;
+use idle_head_core::behaviour::{BehaviourConfig, CommandQueue, Head, LOOP_DURATION, ShowLink};
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
+use idle_head_core::track::{Person, Sighting};
 use idle_head_core::{Axis, Playback};
 use idle_head_firmware::config::IDLE_MODE;
 
@@ -170,8 +172,12 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
     let mut driver = FrameDriver::new([Channel(0), Channel(0), Channel(0)], driver_params);
     let queue: CommandQueue = CommandQueue::new();
     let link = ConsoleLink::new();
-    let mut console = host::Console::new(&queue, &link)?;
+    let show = ShowLink::new();
+    let mut console = host::Console::new(&queue, &link, &show)?;
     let mut task = host::Task::new(&link);
+    // What the radar sees (a script's radar lines), sent at its 10 Hz.
+    let mut people = Sighting::NOBODY;
+    let mut radar_frames = 0_u64;
 
     let frames = micros / frame_us;
     let mut rows = Vec::with_capacity(usize::try_from(frames).unwrap_or(0));
@@ -184,6 +190,11 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
         let rest = head.rest_state();
         // The script's lines due, and the input task's wakes between them.
         while let Some(event) = events.get(next).filter(|e| e.at_us <= t_us) {
+            if let Kind::Radar(seen) = event.kind {
+                people = sighting(&seen);
+                next += 1;
+                continue;
+            }
             wake_until(&mut task, event.at_us, rest, &link, &queue, &mut origins);
             let lines = Lines {
                 queue: &queue,
@@ -195,6 +206,8 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
             }
             next += 1;
         }
+        send_radar(&show, people, &mut radar_frames, t_us);
+        task.radar(show.track.presence());
         wake_until(&mut task, t_us, rest, &link, &queue, &mut origins);
         // What the console sent through the link, then the queue.
         from_link(&link, &mut head, &mut driver, t_us);
@@ -215,6 +228,13 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
             marks.extend(marks::marks(&event, t_us / 1000, outcome, &params));
         });
         origins.extend(taken);
+        let sighting = show.track.take();
+        head.track(
+            &mut driver,
+            frame,
+            &show.track.settings(),
+            sighting.as_ref(),
+        );
         let played = head.frame(&mut driver, frame);
         let report = played.report;
         let mode = HeadMode::of(driver.is_stopped(), driver.is_stopping(), head.rest_state());
@@ -241,6 +261,31 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
         );
     }
     Ok(Trace { rows, marks })
+}
+
+/// The radar's frame period, µs (the LD2450 reports ten times a second).
+const RADAR_US: u64 = 100_000;
+
+/// The radar's frames due by `t_us` (`sent` so far), seeing `people`,
+/// through the receiver's link.
+fn send_radar(show: &ShowLink, people: Sighting, sent: &mut u64, t_us: u64) {
+    while *sent * RADAR_US <= t_us {
+        show.track
+            .publish(Some(people), idle_head_core::track::Counters::default());
+        *sent += 1;
+    }
+}
+
+/// A sighting of a radar line's people.
+fn sighting(seen: &[Option<(i32, i32)>; 3]) -> Sighting {
+    let mut s = Sighting::NOBODY;
+    for (slot, p) in s.people.iter_mut().zip(seen) {
+        *slot = p.map(|(x, y)| Person {
+            x: Millimetres(x),
+            y: Millimetres(y),
+        });
+    }
+    s
 }
 
 /// Where a script's lines go.
@@ -288,6 +333,8 @@ impl Lines<'_> {
                 task.drive(input, high);
                 task.wake(event.at_us, rest, self.link, self.queue, self.origins);
             }
+            // Taken by the frame loop.
+            Kind::Radar(_) => {}
         }
         true
     }

@@ -29,7 +29,11 @@
 //! levels; the show layer ([`FrameLoop::show`]: any DMX cue, DMX on or off,
 //! any Bottango curves sampled at any time, blended into every frame), the
 //! DMX receiver (`idle_head_firmware::dmx::Receiver`, the UART interrupt's
-//! work: any character, break or error at any address) and Bottango's side
+//! work: any character, break or error at any address), the radar's
+//! receiver (`idle_head_firmware::radar::feed`: the LD2450 decoder on any
+//! bytes, any receive error) and the tracker (`FrameLoop::show` hands any
+//! sighting, with any tracking settings, to attention and the gaze), the
+//! inputs' radar presence (`Inputs::sense`) and Bottango's side
 //! of the console (its line parser on any line, any motor command on the
 //! shared curves, any curve built from any parameters). Its panic handler calls `frame_path_has_a_panic_path`, a function
 //! that exists nowhere. If any panic (index, division, overflow check,
@@ -50,6 +54,7 @@
 use core::hint::black_box;
 
 use embedded_hal::pwm::{ErrorKind, ErrorType, SetDutyCycle};
+use idle_head_core::Millimetres;
 use idle_head_core::behaviour::{Asker, CommandQueue, LiveConfig, RestConfig, ShowLink};
 use idle_head_core::bottango::{self, Curve, Op, line::CurveArgs};
 use idle_head_core::command::{
@@ -63,6 +68,8 @@ use idle_head_core::driver::{
 use idle_head_core::idle::{IdlePlayer, IdleTiming};
 use idle_head_core::input::{InputSettings, Inputs, Micros};
 use idle_head_core::servo::{Direction, NanosPerDegree, ServoCalibration};
+use idle_head_core::track::ld2450::Decoder;
+use idle_head_core::track::{Person, Prefer, Sighting, SightingSource, TrackSettings};
 use idle_head_core::units::{Angle, AngleRange, Microseconds, Millis};
 use idle_head_core::{Axis, Playback};
 use idle_head_firmware::config::{
@@ -234,6 +241,7 @@ fn main() -> ! {
         }
     };
     let mut receiver = Receiver::new();
+    let mut radar = Decoder::new();
     let mut inputs = Inputs::new(&InputSettings::DEFAULT, Micros(0));
     loop {
         let axis = Axis::ALL[usize::from(black_box(0_u8) % 3)];
@@ -368,6 +376,40 @@ fn main() -> ! {
                     inputs.status(&settings),
                 ));
                 inputs.sent();
+            }
+            13 => {
+                // The radar's receiver on any bytes, any receive error, and
+                // any sighting with any tracking settings for the frame task.
+                let bytes = black_box([0_u8; 64]);
+                let len = usize::from(black_box(0_u8)) % (bytes.len() + 1);
+                idle_head_firmware::radar::feed(
+                    &mut radar,
+                    bytes.get(..len).unwrap_or_default(),
+                    &SHOW.track,
+                );
+                if black_box(false) {
+                    radar.error();
+                }
+                let mut any = Sighting::NOBODY;
+                for slot in &mut any.people {
+                    *slot = black_box(Some(Person {
+                        x: Millimetres(black_box(0)),
+                        y: Millimetres(black_box(0)),
+                    }));
+                }
+                SHOW.track.publish(black_box(Some(any)), radar.counters());
+                SHOW.track.set(TrackSettings {
+                    radar: black_box(true),
+                    gaze: black_box(true),
+                    height: Millimetres(black_box(0)),
+                    mount: Angle::from_millidegrees(black_box(0)),
+                    prefer: if black_box(false) {
+                        Prefer::Newest
+                    } else {
+                        Prefer::Nearest
+                    },
+                });
+                inputs.sense(Micros(black_box(0)), SHOW.track.presence());
             }
             _ => {}
         }

@@ -107,6 +107,10 @@ pub enum SeedChoice {
     Value(u32),
     /// A seed drawn from the board's entropy source.
     Random,
+    /// The seed derived from the board's unique id (the default).
+    Board,
+    /// The paper's Table 2 seeds.
+    Paper,
 }
 
 /// One field of a servo's calibration.
@@ -229,6 +233,26 @@ pub enum Command {
     Rest(RestSetting),
     /// How much a held look ducks the idle on its axes.
     LookDuck(Percent),
+    /// Show the seed in use.
+    SeedQuery,
+    /// Show the radar's state and counters (`None`), or switch it on or off.
+    Radar(Option<bool>),
+    /// Show (`None`) or change a tracking setting.
+    Track(Option<TrackSetting>),
+}
+
+/// A tracking setting (`track …`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum TrackSetting {
+    /// The head looks at people (`true`), or the radar is presence only.
+    Gaze(bool),
+    /// The height of a visitor's eyes above the head's pivot.
+    Height(crate::units::Millimetres),
+    /// The radar's bearing when the head is at yaw 0.
+    Mount(Angle),
+    /// Whom the head attends to first.
+    Prefer(crate::track::Prefer),
 }
 
 /// A DMX setting (`dmx on|off`, `dmx address <n>`).

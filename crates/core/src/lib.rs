@@ -53,13 +53,15 @@ pub mod motion;
 pub mod playback;
 pub mod pwm_clock;
 pub mod ring;
+pub mod seed;
 pub mod servo;
 pub mod settings;
 pub mod text;
+pub mod track;
 pub mod units;
 
 pub use axis::Axis;
 pub use driver::{DriverConfig, FrameClock, FrameDriver, FrameReport};
 pub use playback::{LoopSource, Playback};
 pub use servo::{Direction, PwmTiming, ServoCalibration};
-pub use units::{Angle, AngleRange, Microseconds, Millis};
+pub use units::{Angle, AngleRange, Microseconds, Millimetres, Millis};

@@ -169,6 +169,20 @@ impl Millis {
     }
 }
 
+/// A length in millimetres (the trackers' positions, the height of a
+/// visitor's eyes).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Millimetres(pub i32);
+
+impl Millimetres {
+    /// The value in millimetres.
+    #[must_use]
+    pub const fn get(self) -> i32 {
+        self.0
+    }
+}
+
 /// Angular speed in whole degrees per second.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

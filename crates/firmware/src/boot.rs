@@ -22,6 +22,7 @@ use idle_head_core::console::{ConsoleLink, ConsoleService};
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::driver::DriverParams;
 use idle_head_core::motion::{DEFAULT_HEAD, HeadConfig};
+use idle_head_core::seed::BoardId;
 use idle_head_core::settings::{Settings, SettingsSource, SettingsStorage, Validated};
 use static_cell::ConstStaticCell;
 
@@ -77,13 +78,15 @@ impl<S> Loaded<S> {
         }
     }
 
-    /// The idle motion's configuration with these settings' seeds.
+    /// The idle motion's configuration with these settings' seeds on a
+    /// board of `id` (see `idle_head_core::seed`).
     #[must_use]
-    pub const fn head(&self) -> HeadConfig {
+    pub const fn head(&self, id: BoardId) -> HeadConfig {
+        let seeds = self.settings.idle_seeds(id);
         let mut head = DEFAULT_HEAD;
-        head.pitch.seed = self.settings.seeds[0];
-        head.roll.seed = self.settings.seeds[1];
-        head.yaw.seed = self.settings.seeds[2];
+        head.pitch.seed = seeds[0];
+        head.roll.seed = seeds[1];
+        head.yaw.seed = seeds[2];
         head
     }
 }
@@ -145,19 +148,35 @@ pub enum BootError {
 
 /// The boot sequence (see the [module docs](self)) on the board's driver
 /// configuration `base`, with the settings `loaded`; `entropy` is mixed into
-/// the console's `seed random`.
+/// the console's `seed random`. A board without a unique id: see
+/// [`boot_on`].
 ///
 /// # Errors
 /// [`BootError::AlreadyBooted`] if called a second time.
-#[inline(never)]
 pub fn boot<S: SettingsStorage>(
     base: &DriverConfig,
     loaded: Loaded<S>,
     entropy: u32,
 ) -> Result<Booted<S>, BootError> {
+    boot_on(base, loaded, entropy, BoardId::NONE)
+}
+
+/// [`boot`] on a board whose unique id is `id` (the RP2040's flash unique
+/// id, the RP2350's chip id; [`BoardId::NONE`] if it cannot read one): the
+/// idle's seeds of `seed board`, the default, come from it.
+///
+/// # Errors
+/// [`BootError::AlreadyBooted`] if called a second time.
+#[inline(never)]
+pub fn boot_on<S: SettingsStorage>(
+    base: &DriverConfig,
+    loaded: Loaded<S>,
+    entropy: u32,
+    id: BoardId,
+) -> Result<Booted<S>, BootError> {
     log_servos(&loaded);
     let [first, spare] = SETS.try_take().ok_or(BootError::AlreadyBooted)?;
-    let head = loaded.head();
+    let head = loaded.head(id);
     // The input task reads its settings from the link.
     LINK.set_inputs(loaded.settings.inputs);
     let Loaded {
@@ -167,12 +186,13 @@ pub fn boot<S: SettingsStorage>(
         valid,
     } = loaded;
     SHOW.dmx.set(settings.dmx);
+    SHOW.track.set(settings.track);
     // `valid` is these settings checked with `base` (by the store, or at
     // compile time for the built-in ones): the service takes it as it is.
     let mut service =
         ConsoleService::checked(&COMMANDS, &LINK, storage, *base, settings, source, &valid);
     service.add_entropy(entropy);
-    let service = service.with_show(&SHOW);
+    let service = service.with_show(&SHOW).with_board(id);
     Ok(Booted {
         generator: Generator { head, first, spare },
         driver: valid.driver,

@@ -21,6 +21,8 @@
 //!
 //! [`CommandQueue`]: idle_head_core::behaviour::CommandQueue
 
+use core::future::pending;
+
 use embassy_futures::select::{Either3, select3};
 use embassy_time::{Duration, Instant, Timer};
 use idle_head_core::bottango::TIMEOUT_MS;
@@ -120,46 +122,30 @@ pub async fn serve<P: Port, H: Handler>(
     let mut buf = [0; READ_CHUNK];
     // Bytes read and not yet taken: `buf[at..read]`.
     let (mut at, mut read) = (0, 0);
-    let mut outbox = Outbox::new();
-    let mut out = [0; PORT_REPLY];
+    let mut replies = Replies {
+        outbox: Outbox::new(),
+        out: [0; PORT_REPLY],
+        wait: place.frame * OUTCOME_FRAMES,
+    };
     let mut watch = Watch::default();
-    let wait = place.frame * OUTCOME_FRAMES;
-    let waited_ms = wait.as_millis() as u32;
     place.link.set_watch(place.port, 0);
     place.link.forget_outcomes(place.port);
     loop {
-        while let Some(outcome) = place.link.take_outcome(place.port) {
-            outbox.resolve(&outcome);
+        if let Err(gone) = replies.flush(port, place).await {
+            return gone;
         }
-        outbox.expire(Instant::now().as_ticks(), waited_ms);
-        loop {
-            let n = outbox.take_ready(&mut out);
-            if n == 0 {
-                break;
-            }
-            if let Err(gone) = port.write(out.get(..n).unwrap_or_default()).await {
-                return gone;
-            }
+        match replies
+            .take(
+                port,
+                session,
+                handler,
+                buf.get(at..read).unwrap_or_default(),
+            )
+            .await
+        {
+            Ok(taken) => at += taken,
+            Err(gone) => return gone,
         }
-        // The bytes read, as long as their replies have room.
-        let was = session.bottango();
-        while at < read && outbox.has_room() {
-            let byte = buf.get(at).copied().unwrap_or_default();
-            at += 1;
-            if let Some(reply) = session.push(byte, handler)
-                && let Some(now) = outbox.reply(reply)
-                && !now.is_empty()
-                && let Err(gone) = port.write(now).await
-            {
-                return gone;
-            }
-            if let Some(later) = session.take_later() {
-                let due = (Instant::now() + wait).as_ticks();
-                // (Room was checked before the byte.)
-                let _ = outbox.wait(later, due);
-            }
-        }
-        log_mode(was, session.bottango());
         // The host closed the port (DTR dropped): its telemetry stops.
         if !port.open() {
             place.link.set_watch(place.port, 0);
@@ -177,37 +163,32 @@ pub async fn serve<P: Port, H: Handler>(
         } else {
             Instant::MAX
         };
-        let given_up = outbox.due().map_or(Instant::MAX, Instant::from_ticks);
-        let wake = tick.min(timeout).min(given_up);
+        let given_up = replies
+            .outbox
+            .due()
+            .map_or(Instant::MAX, Instant::from_ticks);
         // Bytes left over wait for room; else read more.
         let reading = at >= read;
-        let woke = select3(
+        let event = select3(
             async {
                 if reading {
                     port.read(&mut buf).await
                 } else {
-                    core::future::pending().await
+                    pending().await
                 }
             },
             place.link.answered(place.port),
-            async {
-                // (No timer at all when nothing is due: arming one costs.)
-                if wake == Instant::MAX {
-                    core::future::pending().await
-                } else {
-                    Timer::at(wake).await;
-                }
-            },
+            at_or_never(tick.min(timeout).min(given_up)),
         )
         .await;
-        match woke {
+        match event {
             Either3::First(Ok(Received::Bytes(n))) => (at, read) = (0, n),
             Either3::First(Ok(Received::Lost)) => session.lose(),
             Either3::First(Err(gone)) => return gone,
             Either3::Third(()) if armed && Instant::now() >= timeout => {
                 let was = session.bottango();
                 if let Some(reply) = session.timeout()
-                    && let Some(now) = outbox.reply(reply)
+                    && let Some(now) = replies.outbox.reply(reply)
                     && let Err(gone) = port.write(now).await
                 {
                     return gone;
@@ -216,10 +197,10 @@ pub async fn serve<P: Port, H: Handler>(
             }
             Either3::Third(()) if Instant::now() >= tick => {
                 // Telemetry goes out between replies, never among them.
-                if !outbox.is_busy() {
+                if !replies.outbox.is_busy() {
                     let status = place.link.status();
                     let us = place.frame.as_micros() as u32;
-                    let text = telemetry_line(&status, us, watch.lost, &mut out);
+                    let text = telemetry_line(&status, us, watch.lost, &mut replies.out);
                     if let Err(gone) = port.write(text).await {
                         return gone;
                     }
@@ -230,6 +211,76 @@ pub async fn serve<P: Port, H: Handler>(
             // taken at the top of the loop.
             Either3::Second(()) | Either3::Third(()) => {}
         }
+    }
+}
+
+/// Waits until `at`; for ever if `at` is [`Instant::MAX`] (no timer then:
+/// arming one costs).
+async fn at_or_never(at: Instant) {
+    if at == Instant::MAX {
+        pending::<()>().await;
+    } else {
+        Timer::at(at).await;
+    }
+}
+
+/// A port's replies on their way out ([`Outbox`]), with the buffer they
+/// are written from and how long one waits for the frame task.
+struct Replies {
+    outbox: Outbox,
+    out: [u8; PORT_REPLY],
+    wait: Duration,
+}
+
+impl Replies {
+    /// Takes the outcomes that arrived and gives up on the replies past
+    /// their time, then writes every reply whose turn has come.
+    async fn flush(&mut self, port: &mut impl Port, place: Place<'_>) -> Result<(), Gone> {
+        while let Some(outcome) = place.link.take_outcome(place.port) {
+            self.outbox.resolve(&outcome);
+        }
+        let waited_ms = self.wait.as_millis() as u32;
+        self.outbox.expire(Instant::now().as_ticks(), waited_ms);
+        loop {
+            let n = self.outbox.take_ready(&mut self.out);
+            if n == 0 {
+                return Ok(());
+            }
+            port.write(self.out.get(..n).unwrap_or_default()).await?;
+        }
+    }
+
+    /// Takes `bytes` into `session` for as long as their replies have room:
+    /// a reply goes out at once or is held, a reply that waits for the
+    /// frame task joins the outbox. Returns how many bytes it took.
+    async fn take<H: Handler>(
+        &mut self,
+        port: &mut impl Port,
+        session: &mut DualSession<'_>,
+        handler: &mut H,
+        bytes: &[u8],
+    ) -> Result<usize, Gone> {
+        let was = session.bottango();
+        let mut taken = 0;
+        for &byte in bytes {
+            if !self.outbox.has_room() {
+                break;
+            }
+            taken += 1;
+            if let Some(reply) = session.push(byte, handler)
+                && let Some(now) = self.outbox.reply(reply)
+                && !now.is_empty()
+            {
+                port.write(now).await?;
+            }
+            if let Some(later) = session.take_later() {
+                let due = (Instant::now() + self.wait).as_ticks();
+                // (Room was checked before the byte.)
+                let _ = self.outbox.wait(later, due);
+            }
+        }
+        log_mode(was, session.bottango());
+        Ok(taken)
     }
 }
 

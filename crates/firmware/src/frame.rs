@@ -56,7 +56,7 @@ use portable_atomic::AtomicU32;
 
 use idle_head_core::behaviour::{
     Applied, BehaviourError, BehaviourParams, CommandQueue, Head, HeadFrame, IdleSource,
-    ShowEvents, ShowLink,
+    ShowEvents, ShowLink, TrackEvent,
 };
 use idle_head_core::command::{Action, Hold};
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
@@ -283,6 +283,16 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         if let Some(signal) = events.signal {
             show.dmx.set_signal(signal);
         }
+        // The tracker's sighting (a radar's), if one came.
+        let sighting = show.track.take();
+        if let Some(event) = self.head.track(
+            driver,
+            tick.frame,
+            &show.track.settings(),
+            sighting.as_ref(),
+        ) {
+            log_track(tick.frame, event);
+        }
         Some(events)
     }
 
@@ -326,7 +336,11 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
                 driver.is_stopping(),
                 self.head.rest_state(),
             );
-            link.publish(HeadStatus::of(report, driver.stats(), mode));
+            let mut status = HeadStatus::of(report, driver.stats(), mode);
+            if self.show.is_some_and(|show| show.track.settings().radar) {
+                status.track = Some(self.head.track_view());
+            }
+            link.publish(status);
         }
     }
 
@@ -423,6 +437,18 @@ fn log_show(frame: u64, events: &ShowEvents) {
     }
     if let Some((action, outcome)) = &events.fired {
         log_outcome(frame, "dmx ", action, outcome);
+    }
+}
+
+/// Logs what the tracker did before frame `frame`.
+fn log_track(frame: u64, event: TrackEvent) {
+    match event {
+        TrackEvent::Turned(yaw) => {
+            defmt::info!("frame {=u64}: track: turned to yaw {}", frame, yaw);
+        }
+        TrackEvent::Released => {
+            defmt::info!("frame {=u64}: track: nobody left, back to centre", frame);
+        }
     }
 }
 

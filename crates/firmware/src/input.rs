@@ -28,7 +28,7 @@ use embassy_time::{Duration, Instant, Timer};
 use idle_head_core::console::HeadMode;
 use idle_head_core::input::{FIRST_INPUT, INPUTS, InputSettings, Inputs, Micros, Pull};
 
-use crate::boot::{COMMANDS, LINK};
+use crate::boot::{COMMANDS, LINK, SHOW};
 
 /// How long the task waits before it tries a full queue again.
 pub const RETRY: Duration = Duration::from_millis(5);
@@ -127,6 +127,8 @@ fn step(
     }
     let levels = source.levels();
     let resting = LINK.status().mode == HeadMode::Resting;
+    // The radar counts as presence while it is on.
+    inputs.sense(now(), SHOW.track.presence());
     inputs.update(&settings, now(), levels, resting);
     let mut full = false;
     while let Some(action) = inputs.pending(&settings) {

@@ -14,6 +14,7 @@
 //!   (a Bottango driver on a port after a Bottango handshake).
 //! - [`dmx`]: the DMX512 receiver's loop over a board's [`dmx::DmxPort`].
 //! - [`input`]: the trigger inputs' task over a board's [`input::InputSource`].
+//! - [`radar`]: the radar's receiver, fed by a board's UART or PIO.
 //! - [`storage`]: the settings store in a board's flash.
 //!
 //! What a board adds is its hardware: the PWM outputs, the ports, the flash,
@@ -40,6 +41,7 @@ pub mod exchange;
 pub mod frame;
 pub mod hooks;
 pub mod input;
+pub mod radar;
 pub mod report;
 pub mod storage;
 pub mod tasks;

@@ -5,12 +5,13 @@ use std::fmt::Write as _;
 
 use idle_head_core::command::{
     Action, Command, DmxSetting, GestureKind, GestureRequest, Hold, InputRole, LookRequest,
-    Percent, RestAfter, RestSetting, SeedChoice, ServoSetting,
+    Percent, RestAfter, RestSetting, SeedChoice, ServoSetting, TrackSetting,
 };
 use idle_head_core::console::KEYWORDS;
 use idle_head_core::dmx::DmxAddress;
 use idle_head_core::servo::{Direction, NanosPerDegree};
-use idle_head_core::{Angle, AngleRange, Axis, Microseconds, Millis};
+use idle_head_core::track::Prefer;
+use idle_head_core::{Angle, AngleRange, Axis, Microseconds, Millimetres, Millis};
 use proptest::prelude::RngExt as _;
 use proptest::test_runner::TestRng;
 
@@ -190,11 +191,26 @@ pub fn random_command(rng: &mut TestRng) -> Command {
             2 => Command::Rest(RestSetting::Relax(rng.random_bool(0.5))),
             _ => Command::LookDuck(percent(rng)),
         },
-        10 => Command::Seed(if rng.random_bool(0.2) {
-            SeedChoice::Random
-        } else {
-            SeedChoice::Value(u32_any(rng))
-        }),
+        10 => match rng.random_range(0..10) {
+            0 => Command::Seed(SeedChoice::Random),
+            1 => Command::Seed(SeedChoice::Board),
+            2 => Command::Seed(SeedChoice::Paper),
+            3 => Command::SeedQuery,
+            4 => Command::Radar(maybe(rng, |r| r.random_bool(0.5))),
+            5 => Command::Track(maybe(rng, |r| match r.random_range(0..4) {
+                0 => TrackSetting::Gaze(r.random_bool(0.5)),
+                1 => TrackSetting::Height(Millimetres(r.random_range(-3000..=3000))),
+                2 => TrackSetting::Mount(Angle::from_millidegrees(
+                    r.random_range(-180_000..=180_000),
+                )),
+                _ => TrackSetting::Prefer(if r.random_bool(0.5) {
+                    Prefer::Nearest
+                } else {
+                    Prefer::Newest
+                }),
+            })),
+            _ => Command::Seed(SeedChoice::Value(u32_any(rng))),
+        },
         11 => Command::Dmx(maybe(rng, |r| match r.random_range(0..3) {
             0 => DmxSetting::On(true),
             1 => DmxSetting::On(false),
@@ -379,6 +395,40 @@ fn write_command(s: &mut Style<'_>, command: &Command) {
         Command::Seed(SeedChoice::Value(v)) => {
             s.word("seed");
             s.number(i64::from(v));
+        }
+        Command::Seed(SeedChoice::Board) => {
+            s.word("seed");
+            s.word("board");
+        }
+        Command::Seed(SeedChoice::Paper) => {
+            s.word("seed");
+            s.word("paper");
+        }
+        Command::SeedQuery => s.word("seed"),
+        Command::Radar(on) => {
+            s.word("radar");
+            if let Some(on) = on {
+                s.word(if on { "on" } else { "off" });
+            }
+        }
+        Command::Track(setting) => {
+            s.word("track");
+            match setting {
+                None => {}
+                Some(TrackSetting::Gaze(on)) => s.word(if on { "on" } else { "off" }),
+                Some(TrackSetting::Height(mm)) => {
+                    s.word("height");
+                    s.number(i64::from(mm.0));
+                }
+                Some(TrackSetting::Mount(yaw)) => {
+                    s.word("mount");
+                    s.mdeg(yaw);
+                }
+                Some(TrackSetting::Prefer(p)) => {
+                    s.word("prefer");
+                    s.word(p.word());
+                }
+            }
         }
         Command::Watch(None) => {
             s.word("watch");

@@ -370,8 +370,44 @@ fn a_record_without_a_field_loads_with_every_other_value() {
         // The saved record with field `id` taken from the defaults.
         let mut expected = fields.clone();
         expected[i] = defaults[i].clone();
+        if *id == SEED_MODE {
+            // The one field migrated rather than defaulted: these seeds
+            // were chosen (see the test below).
+            expected[i] = (SEED_MODE, vec![2]);
+        }
         assert_eq!(entries(&encode(&settings)), expected, "without {id}");
     }
+}
+
+/// The id of the seeds' source (`seed.mode`).
+const SEED_MODE: u8 = 95;
+
+/// A record saved before seeds had a source: the paper's seeds (what
+/// every board had unless a person chose) become the board's own, so
+/// that an upgraded crowd of heads stops moving in step; seeds a person
+/// chose (`seed <n>`) are kept.
+#[test]
+fn an_older_record_keeps_chosen_seeds_and_moves_the_papers_to_the_board() {
+    use idle_head_core::seed::{BoardId, PAPER, Seeding};
+    let chosen = fixture_v1();
+    let without = |s: &Settings| {
+        let older: Vec<_> = entries(&encode(s))
+            .into_iter()
+            .filter(|(id, _)| *id != SEED_MODE)
+            .collect();
+        load_stored(&stored(&older)).0.unwrap()
+    };
+    let loaded = without(&chosen);
+    assert_eq!(loaded.seeding, Seeding::Chosen);
+    assert_eq!(loaded.idle_seeds(BoardId(99)), chosen.seeds);
+    let mut paper = chosen;
+    paper.seeds = PAPER;
+    let loaded = without(&paper);
+    assert_eq!(loaded.seeding, Seeding::Board);
+    assert_ne!(loaded.idle_seeds(BoardId(99)), PAPER);
+    assert_eq!(loaded.idle_seeds(BoardId::NONE), PAPER);
+    // The version 1 fixture (seeds 42, …) loads with its seeds chosen.
+    assert_eq!(fixture_v1().seeding, Seeding::Chosen);
 }
 
 /// A record saved by a firmware with a field this one does not have, at

@@ -88,6 +88,11 @@ pub fn play(
                     .lines
                     .push((at, format!("{}\r\n", event.text).into_bytes()));
             }
+            Kind::Radar(_) => anyhow::bail!(
+                "line {}: radar lines play in the host trace (`cargo xtask trace`); \
+                 the emulator has no radar on GP13 yet",
+                event.line
+            ),
         }
     }
     // The boot before the first frame: well under a tenth of a second.

@@ -3,7 +3,7 @@
 //! trace's queue and link. The input task wakes as on the board: at a pin's
 //! change, at its deadlines, and when the console changes its settings.
 
-use idle_head_core::behaviour::{CommandQueue, RestState};
+use idle_head_core::behaviour::{CommandQueue, RestState, ShowLink};
 use idle_head_core::console::{ActionLine, ConsoleLink, ConsoleService, Response, respond};
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::input::{INPUTS, InputSettings, Inputs, Micros, Pull};
@@ -26,7 +26,11 @@ pub struct Console<'a> {
 
 impl<'a> Console<'a> {
     /// The service on the built-in settings.
-    pub fn new(queue: &'a CommandQueue, link: &'a ConsoleLink) -> anyhow::Result<Self> {
+    pub fn new(
+        queue: &'a CommandQueue,
+        link: &'a ConsoleLink,
+        show: &'a ShowLink,
+    ) -> anyhow::Result<Self> {
         let service = ConsoleService::new(
             queue,
             link,
@@ -35,7 +39,8 @@ impl<'a> Console<'a> {
             Settings::DEFAULT,
             SettingsSource::Defaults,
         )
-        .map_err(|e| anyhow::anyhow!("the built-in settings: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("the built-in settings: {e}"))?
+        .with_show(show);
         Ok(Self { service, queue })
     }
 
@@ -68,6 +73,8 @@ pub struct Task {
     driven: [Option<bool>; INPUTS],
     /// When the task wakes next at the latest, µs.
     deadline: Option<u64>,
+    /// The radar's presence as the link says (`None`: off).
+    radar: Option<u32>,
 }
 
 impl Task {
@@ -77,6 +84,7 @@ impl Task {
             inputs: Inputs::new(&link.input_settings(), Micros(0)),
             driven: [None; INPUTS],
             deadline: Some(0),
+            radar: None,
         }
     }
 
@@ -86,6 +94,11 @@ impl Task {
         if let Some(level) = self.driven.get_mut(i) {
             *level = Some(high);
         }
+    }
+
+    /// The radar's presence the task reads at its next wakes.
+    pub const fn radar(&mut self, presence: Option<u32>) {
+        self.radar = presence;
     }
 
     /// When the task wakes next without a change, µs.
@@ -120,6 +133,7 @@ impl Task {
             self.inputs.configure(&settings, Micros(now));
         }
         let levels = self.levels(&settings);
+        self.inputs.sense(Micros(now), self.radar);
         self.inputs
             .update(&settings, Micros(now), levels, rest == RestState::Resting);
         let mut full = false;

@@ -44,6 +44,9 @@ pub enum Kind {
         /// Its level.
         high: bool,
     },
+    /// What the radar sees from now on: up to three people at `(x, y)` mm
+    /// in its frame, held until the next radar line.
+    Radar([Option<(i32, i32)>; 3]),
 }
 
 #[cfg(test)]
@@ -52,7 +55,7 @@ impl Event {
     pub fn action(&self) -> Option<Action> {
         match self.kind {
             Kind::Act(action) => Some(action),
-            Kind::Console | Kind::Pin { .. } => None,
+            Kind::Console | Kind::Pin { .. } | Kind::Radar(_) => None,
         }
     }
 }
@@ -126,11 +129,18 @@ fn event(line: usize, text: &str, params: &BehaviourParams) -> Result<Event, Str
         .map(|(t, c)| (t, c.trim()))
         .ok_or_else(|| format!("`{text}`: expected `<seconds> <command>`"))?;
     let at_us = seconds(time).map_err(|e| e.to_string())?;
+    let radar = command
+        .strip_prefix("radar")
+        .filter(|rest| rest.starts_with(char::is_whitespace))
+        .map(str::trim)
+        .filter(|rest| *rest == "none" || rest.contains(','));
     let kind = if let Some(pin) = command
         .strip_prefix("pin")
         .filter(|rest| rest.starts_with(char::is_whitespace))
     {
         self::pin(pin.trim())?
+    } else if let Some(people) = radar {
+        self::radar(people)?
     } else {
         match console::parse(command.as_bytes()) {
             Ok(Command::Act(action)) => {
@@ -164,6 +174,26 @@ fn pin(text: &str) -> Result<Kind, String> {
         _ => return Err(usage()),
     };
     Ok(Kind::Pin { input, high })
+}
+
+/// `none` or up to three `<x_mm>,<y_mm>` (after `radar`).
+fn radar(text: &str) -> Result<Kind, String> {
+    let usage =
+        || format!("`radar {text}`: expected `radar none` or `radar <x_mm>,<y_mm>` (up to three)");
+    let mut people = [None; 3];
+    if text == "none" {
+        return Ok(Kind::Radar(people));
+    }
+    let words: Vec<&str> = text.split_whitespace().collect();
+    if words.len() > people.len() {
+        return Err(usage());
+    }
+    let mm = |s: &str| s.parse::<i32>().ok().filter(|v| v.unsigned_abs() <= 32_767);
+    for (slot, word) in people.iter_mut().zip(words) {
+        let (x, y) = word.split_once(',').ok_or_else(usage)?;
+        *slot = Some((mm(x).ok_or_else(usage)?, mm(y).ok_or_else(usage)?));
+    }
+    Ok(Kind::Radar(people))
 }
 
 #[cfg(test)]

@@ -66,6 +66,20 @@ pub(crate) struct Gaze {
     axes: [Glide; 3],
     /// The planned return `[pitch, yaw]` (the envelope falls along it).
     back: Option<[Glide; 2]>,
+    /// What moved the gaze last.
+    by: By,
+}
+
+/// What moved the gaze last: a tracker follows only a gaze that a look
+/// does not hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum By {
+    /// `center`, a rest, or a look's return under way: the centre.
+    Centre,
+    /// A look, until its return starts.
+    Look,
+    /// The tracker.
+    Track,
 }
 
 impl Gaze {
@@ -74,6 +88,7 @@ impl Gaze {
         Self {
             axes: [Glide::rest(0); 3],
             back: None,
+            by: By::Centre,
         }
     }
 
@@ -88,6 +103,7 @@ impl Gaze {
         {
             let envelope = pitch.falling(ONE as i32);
             self.axes = [pitch, yaw, envelope];
+            self.by = By::Centre;
         }
         Glide::trio_at(&mut self.axes, now)
     }
@@ -163,6 +179,7 @@ impl Gaze {
             inside.millidegrees()
         });
         let frames = self.move_to(params, next, offsets, ONE as i32, request.duration);
+        self.by = By::Look;
         self.back = match hold {
             Hold::Stay => None,
             Hold::Return(ms) => {
@@ -194,7 +211,30 @@ impl Gaze {
         check_duration(params, "center duration", given)?;
         let frames = self.move_to(params, next, [0, 0], 0, given);
         self.back = None;
+        self.by = By::Centre;
         Ok(params.millis(frames))
+    }
+
+    /// What moved the gaze last.
+    pub(crate) const fn by(&self) -> By {
+        self.by
+    }
+
+    /// The tracker's move at frame `next` to `offsets` (m° around the
+    /// neutral pose, within the axes' room), in `given` or the rule's
+    /// time (lengthened to fit the gesture limits), the idle ducked as
+    /// under a held look; returns its duration in frames.
+    pub(crate) fn follow(
+        &mut self,
+        params: &BehaviourParams,
+        next: u32,
+        offsets: [i32; 2],
+        given: Option<Millis>,
+    ) -> u32 {
+        let frames = self.move_to(params, next, offsets, ONE as i32, given);
+        self.back = None;
+        self.by = By::Track;
+        frames
     }
 
     /// Glides both axes from where they are at `next` to `offsets`, and the

@@ -35,8 +35,10 @@ use super::params::{BehaviourParams, LimitMode};
 use super::queue::{Asker, CommandQueue, PER_FRAME};
 use super::rest::RestState;
 use super::show::{Show, ShowEvents, Source};
+use super::tracker::{TrackEvent, Tracker};
 use crate::bottango::Sample;
 use crate::dmx::{Latest, Signal};
+use crate::track::{Sighting, TrackSettings};
 
 /// What one frame did.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,6 +59,8 @@ pub struct Head<I> {
     show: Show,
     /// The limit mode the driver has, per axis.
     modes: [LimitMode; 3],
+    /// The tracker (a radar's sightings to gaze moves).
+    tracker: Tracker,
 }
 
 impl<I> Head<I> {
@@ -67,6 +71,7 @@ impl<I> Head<I> {
             mixer: Mixer::new(params),
             show: Show::new(&params),
             modes: [LimitMode::Idle; 3],
+            tracker: Tracker::new(),
         }
     }
 }
@@ -261,6 +266,40 @@ impl<I: IdleSource> Head<I> {
         }
         self.sync(driver);
         events
+    }
+
+    /// Between frames, before frame `frame`: the tracker's `sighting`
+    /// that came since the last frame (if any), with `settings` (see
+    /// [`tracker`](super::tracker)); what it did, for the log. Cheap when
+    /// nothing came and nothing is due.
+    pub fn track<P: SetDutyCycle>(
+        &mut self,
+        driver: &mut FrameDriver<P>,
+        frame: u64,
+        settings: &TrackSettings,
+        sighting: Option<&Sighting>,
+    ) -> Option<TrackEvent> {
+        let now = frame.saturating_mul(u64::from(self.mixer.params().frame_us()));
+        let event = self.tracker.step(&mut self.mixer, now, settings, sighting);
+        if event.is_some() || sighting.is_some() {
+            self.sync(driver);
+        }
+        event
+    }
+
+    /// The yaw the tracker aims the head at (an axis angle, before the
+    /// limits), if it holds the gaze.
+    pub const fn tracking(&self) -> Option<Angle> {
+        self.tracker.aiming()
+    }
+
+    /// The tracker for `watch`: people in the latest sighting, and the yaw
+    /// the head aims at.
+    pub const fn track_view(&self) -> crate::track::TrackView {
+        crate::track::TrackView {
+            targets: self.tracker.targets(),
+            at: self.tracker.aiming(),
+        }
     }
 
     /// What drives the show layer.

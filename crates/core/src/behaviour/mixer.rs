@@ -40,6 +40,7 @@ use super::rest::{self, Rest};
 
 mod layers;
 mod math;
+mod tracking;
 
 use layers::Layer;
 use math::{Countdown, both, idle_part, look_keep};

@@ -52,9 +52,11 @@
 //! assert_eq!(pitch[40], 0);
 //! ```
 
+pub mod attention;
 pub mod config;
 pub mod error;
 mod fixed;
+pub mod follow;
 pub mod gaze;
 pub mod gesture;
 mod glide;
@@ -66,6 +68,7 @@ pub mod queue;
 pub mod rest;
 pub mod shape;
 pub mod show;
+pub mod tracker;
 mod validate;
 
 pub use crate::gestures::GestureDefaults;
@@ -81,3 +84,4 @@ pub use params::{BehaviourParams, LimitMode};
 pub use queue::{Asker, CommandQueue, QueueFull};
 pub use rest::RestState;
 pub use show::{ShowEvents, ShowLink, Source};
+pub use tracker::TrackEvent;

@@ -42,6 +42,7 @@
 use crate::bottango::{Curves, Sample};
 use crate::command::{Action, GestureKind, GestureRequest, Percent};
 use crate::dmx::{Cue, DmxLink, Latest, Signal, Trigger};
+use crate::track::TrackLink;
 use crate::units::{Angle, Millis};
 
 use super::error::BehaviourError;
@@ -75,6 +76,10 @@ pub struct ShowLink {
     pub dmx: DmxLink,
     /// The Bottango session's curves.
     pub curves: Curves,
+    /// The tracker's sightings and settings (a radar's): the gaze's input,
+    /// not the show layer's, carried here so that every receiver's data
+    /// reaches the frame task and the console through one link.
+    pub track: TrackLink,
 }
 
 impl ShowLink {
@@ -84,6 +89,7 @@ impl ShowLink {
         Self {
             dmx: DmxLink::new(),
             curves: Curves::new(),
+            track: TrackLink::new(),
         }
     }
 }

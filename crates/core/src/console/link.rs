@@ -23,6 +23,7 @@ use crate::driver::{DriverStats, FrameReport};
 use crate::input::{InputSettings, InputStatus};
 use crate::ring::Ring;
 use crate::servo::ServoCalibration;
+use crate::track::TrackView;
 use crate::units::{Angle, Microseconds};
 
 /// What the driver is doing.
@@ -75,6 +76,8 @@ pub struct HeadStatus {
     pub faults: [u32; 3],
     /// Servos switched off.
     pub disabled: [bool; 3],
+    /// The tracker, while the radar is on (`None`: off).
+    pub track: Option<TrackView>,
 }
 
 impl HeadMode {
@@ -108,6 +111,7 @@ impl HeadStatus {
             pulses: report.servos.map(|s| s.pulse),
             faults: stats.faults,
             disabled: stats.disabled,
+            track: None,
         }
     }
 
@@ -169,6 +173,7 @@ impl ConsoleLink {
                 pulses: [Microseconds(0); 3],
                 faults: [0; 3],
                 disabled: [false; 3],
+                track: None,
             })),
             servos: Mutex::new(Cell::new([None; 3])),
             seeds: Signal::new(),

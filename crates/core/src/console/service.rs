@@ -81,6 +81,7 @@ use crate::text::Text;
 
 mod dmx;
 mod inputs;
+mod track;
 
 use super::link::{ConsoleLink, HeadStatus};
 use super::outcome::behaviour_code;
@@ -88,7 +89,7 @@ use super::reply::{ErrorCode, Reply};
 use super::session::Handler;
 use crate::axis::Axis;
 use crate::behaviour::{Asker, BehaviourParams, CommandQueue, ShowLink};
-use crate::command::{Action, Command, SeedChoice, ServoSetting};
+use crate::command::{Action, Command, ServoSetting};
 use crate::driver::DriverConfig;
 use crate::gestures::GestureKind;
 use crate::servo::{Direction, ServoCalibration, bounds};
@@ -101,7 +102,7 @@ use crate::settings::{
 pub const HELP: &str = const_format::concatcp!(
     "commands: help status stop",
     GestureKind::WORDS,
-    " look center idle rest wake input seed servo save load defaults watch dmx"
+    " look center idle rest wake input seed servo save load defaults watch dmx radar track"
 );
 
 /// The firmware version `status` reports.
@@ -123,6 +124,8 @@ pub struct ConsoleService<'a, S, const N: usize = { crate::behaviour::queue::CAP
     /// The show layer's inputs (DMX settings and signal), on a board that
     /// has them.
     show: Option<&'a ShowLink>,
+    /// The board's unique id (`seed board`).
+    board: crate::seed::BoardId,
 }
 
 impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
@@ -168,6 +171,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
             entropy: 0x9e37_79b9,
             ticket: 0,
             show: None,
+            board: crate::seed::BoardId::NONE,
         }
     }
 
@@ -247,6 +251,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
             ],
         );
         self.status_inputs(text(reply));
+        self.status_track(text(reply));
     }
 
     fn show_servo(&self, axis: Axis, reply: &mut Reply<'_>) {
@@ -321,26 +326,6 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         }
     }
 
-    fn seed(&mut self, choice: SeedChoice, reply: &mut Reply<'_>) {
-        let n = match choice {
-            SeedChoice::Value(n) => n,
-            SeedChoice::Random => {
-                // xorshift32, stirred with the frame count.
-                let mut x = self.entropy ^ (self.link.status().frame as u32);
-                x ^= x << 13;
-                x ^= x >> 17;
-                x ^= x << 5;
-                self.entropy = x | 1;
-                x
-            }
-        };
-        let seeds = Settings::seeds_from(n);
-        self.link.reseed(seeds);
-        self.settings.seeds = seeds;
-        self.source = SettingsSource::Changed;
-        text(reply.ok()).str("seed=").u64(n.into());
-    }
-
     /// Puts `settings` in effect: idle amplitude through the queue (so a
     /// full queue changes nothing), servos and seeds through the link.
     fn adopt(
@@ -371,11 +356,12 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
                 self.link.set_servo(*axis, *new);
             }
         }
-        if settings.seeds != self.settings.seeds {
-            self.link.reseed(settings.seeds);
+        if settings.idle_seeds(self.board) != self.settings.idle_seeds(self.board) {
+            self.link.reseed(settings.idle_seeds(self.board));
         }
         if let Some(show) = self.show {
             show.dmx.set(settings.dmx);
+            show.track.set(settings.track);
         }
         self.settings = *settings;
         self.behaviour = valid.behaviour;
@@ -434,6 +420,9 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
             } => self.set_input(input, role, reply),
             Command::Rest(setting) => self.set_rest(setting, reply),
             Command::LookDuck(duck) => self.set_look_duck(duck),
+            Command::SeedQuery => self.show_seed(text(reply.ok())),
+            Command::Radar(on) => self.radar(on, reply),
+            Command::Track(setting) => self.track(setting, reply),
         }
     }
 }

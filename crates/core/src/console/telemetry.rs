@@ -22,7 +22,8 @@ use super::session::{PORT_REPLY, checksum};
 /// The longest telemetry line, CR LF included:
 /// `~ t=` (4) + 20 digits, ` p=`/` r=`/` y=` 3 × (3 + 11), ` us=` (4) +
 /// 3 × 10 + 2 commas, ` lost=` (6) + 10, ` *hh` (4), CR LF (2).
-pub const TELEMETRY_LINE: usize = 4 + 20 + 3 * 14 + 4 + 32 + 6 + 10 + 4 + 2;
+/// With the radar on, ` targets=` (9) + 3 digits and ` at=` (4) + 11.
+pub const TELEMETRY_LINE: usize = 4 + 20 + 3 * 14 + 4 + 32 + 6 + 10 + 4 + 2 + 12 + 15;
 
 // A port's telemetry line is written into its session's reply buffer.
 const _: () = assert!(TELEMETRY_LINE <= PORT_REPLY);
@@ -57,6 +58,16 @@ pub fn telemetry_line<'b>(
             Uint(lost.into()),
         ],
     );
+    if let Some(track) = status.track {
+        line.text()
+            .str(" targets=")
+            .u64(track.targets.into())
+            .str(" at=");
+        match track.at {
+            Some(yaw) => line.text().i64(yaw.millidegrees().into()),
+            None => line.text().str("-"),
+        };
+    }
     let crc = checksum(line.written());
     line.text().str(" *").hex2(crc).str("\r\n");
     line.into_bytes()
@@ -78,6 +89,7 @@ mod tests {
             pulses: [1483, 1499, 1497].map(Microseconds),
             faults: [0; 3],
             disabled: [false; 3],
+            track: None,
         };
         let line = telemetry_line(&status, 20_000, 3, &mut out).to_vec();
         let text = std::str::from_utf8(&line).unwrap();
@@ -92,6 +104,22 @@ mod tests {
             angles: [Angle::from_millidegrees(i32::MIN + 1); 3],
             pulses: [Microseconds(u32::MAX); 3],
             ..status
+        };
+        let radar = HeadStatus {
+            track: Some(crate::track::TrackView {
+                targets: 2,
+                at: Some(Angle::from_millidegrees(-14_036)),
+            }),
+            ..status
+        };
+        let line = telemetry_line(&radar, 20_000, 3, &mut out).to_vec();
+        assert!(String::from_utf8_lossy(&line).contains(" lost=3 targets=2 at=-14036 *"));
+        let worst = HeadStatus {
+            track: Some(crate::track::TrackView {
+                targets: u8::MAX,
+                at: Some(Angle::from_millidegrees(i32::MIN + 1)),
+            }),
+            ..worst
         };
         let line = telemetry_line(&worst, u32::MAX, u32::MAX, &mut out);
         assert!(line.ends_with(b"\r\n"), "{}", String::from_utf8_lossy(line));

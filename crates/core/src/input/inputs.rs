@@ -122,7 +122,28 @@ pub struct Inputs {
     first: u8,
     waiting: u8,
     lost: u32,
+    /// The radar as presence (see [`Inputs::sense`]): whether it counts,
+    /// its count of sightings with somebody, when one last came, and
+    /// whether presence began since the last update.
+    radar: Radar,
 }
+
+/// The radar as presence: whether it counts (`None`: off), its count of
+/// sightings with somebody, when one last came, and whether presence
+/// began since the last update.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Radar {
+    seen: Option<u32>,
+    last: Micros,
+    rose: bool,
+}
+
+/// How long the radar's presence lasts after the last sighting with
+/// somebody in it: a person standing still can drop out of a few of its
+/// frames.
+pub const RADAR_HOLD_MS: u32 = 3000;
+/// How often the input task looks at the radar while it counts, ms.
+pub const RADAR_POLL_MS: u32 = 250;
 
 impl Inputs {
     /// Inputs with `settings`, starting at `now`.
@@ -142,6 +163,11 @@ impl Inputs {
             first: 0,
             waiting: 0,
             lost: 0,
+            radar: Radar {
+                seen: None,
+                last: NEVER,
+                rose: false,
+            },
         };
         inputs.configure(settings, now);
         inputs
@@ -166,6 +192,37 @@ impl Inputs {
         if self.empty_since != NEVER {
             self.empty_since = now;
         }
+    }
+
+    /// The radar at `now`, before [`update`](Self::update): `seen`, its
+    /// count of sightings with somebody in them (`TrackLink::presence`),
+    /// or `None` while it does not count (`radar off`). A change of the
+    /// count is somebody there; presence lasts [`RADAR_HOLD_MS`] after the
+    /// last one, and its start wakes a resting head (no glance: the
+    /// tracker turns the head to the person).
+    pub fn sense(&mut self, now: Micros, seen: Option<u32>) {
+        let Some(seen) = seen else {
+            self.radar.seen = None;
+            self.radar.last = NEVER;
+            return;
+        };
+        let Some(before) = self.radar.seen.replace(seen) else {
+            // Switched on: the count so far is no one new.
+            return;
+        };
+        if seen != before {
+            if !self.radar_present(now) {
+                self.radar.rose = true;
+            }
+            self.radar.last = now;
+        }
+    }
+
+    /// Whether the radar saw somebody within [`RADAR_HOLD_MS`] of `now`.
+    fn radar_present(&self, now: Micros) -> bool {
+        self.radar.seen.is_some()
+            && self.radar.last != NEVER
+            && !now.passed(self.radar.last, RADAR_HOLD_MS)
     }
 
     /// The inputs' levels at `now` (bit `i`: input `i` high), with whether
@@ -210,6 +267,9 @@ impl Inputs {
                 InputRole::Off => {}
             }
         }
+        if core::mem::take(&mut self.radar.rose) && resting && !woken {
+            self.push(Pending::Wake(None));
+        }
         if self.present(settings) {
             self.empty_since = NEVER;
             self.rest_sent = resting;
@@ -237,18 +297,19 @@ impl Inputs {
         self.push(Pending::Button(i as u8));
     }
 
-    /// Whether a presence input is active.
+    /// Whether a presence input is active, or the radar sees somebody.
     fn present(&self, settings: &InputSettings) -> bool {
-        settings
-            .roles
-            .iter()
-            .zip(&self.debouncers)
-            .any(|(role, d)| role.is_presence() && d.level())
+        self.radar_present(self.now)
+            || settings
+                .roles
+                .iter()
+                .zip(&self.debouncers)
+                .any(|(role, d)| role.is_presence() && d.level())
     }
 
     /// When the rest is due, if it is to come.
     fn rest_due(&self, settings: &InputSettings) -> Option<Micros> {
-        if self.rest_sent || !settings.presence() {
+        if self.rest_sent || !(settings.presence() || self.radar.seen.is_some()) {
             return None;
         }
         let after = settings.rest_after.micros()?;
@@ -269,6 +330,10 @@ impl Inputs {
             if let Some(due) = role.debounce().and_then(|rule| d.deadline(rule)) {
                 soonest = Some(soonest.map_or(due, |s| s.min(due)));
             }
+        }
+        if self.radar.seen.is_some() {
+            let poll = self.now.after_ms(RADAR_POLL_MS);
+            soonest = Some(soonest.map_or(poll, |s| s.min(poll)));
         }
         if (self.was_resting || self.rest_sent) && settings.presence() {
             let poll = self.now.after_ms(1000);

@@ -51,7 +51,7 @@ mod role;
 mod settings;
 
 pub use debounce::{Debounce, Debouncer};
-pub use inputs::{InputStatus, Inputs, Micros, OUTBOX};
+pub use inputs::{InputStatus, Inputs, Micros, OUTBOX, RADAR_HOLD_MS, RADAR_POLL_MS};
 pub use role::{InputRole, Pull};
 pub use settings::{InputSettings, MAX_REST_AFTER, RestAfter};
 

@@ -287,3 +287,59 @@ fn a_full_outbox_counts_what_it_lost() {
     }
     assert_eq!(sent, OUTBOX);
 }
+
+/// The radar as presence: somebody seen wakes a resting head (once), keeps
+/// it awake, and nobody for the rest time rests it, with no input set.
+#[test]
+fn the_radar_is_presence_for_rest_and_wake() {
+    use crate::command::Action;
+    use crate::input::{InputSettings, Inputs, Micros, RADAR_HOLD_MS};
+    let settings = InputSettings {
+        rest_after: crate::command::RestAfter::Seconds(10),
+        ..InputSettings::DEFAULT
+    };
+    let ms = |t: u64| Micros(t * 1000);
+    let mut inputs = Inputs::new(&settings, ms(0));
+    inputs.sense(ms(0), Some(5));
+    inputs.update(&settings, ms(0), 0, false);
+    assert!(
+        inputs.deadline(&settings).is_some(),
+        "polls while the radar counts"
+    );
+    // Nobody for 10 s: rest.
+    inputs.sense(ms(10_000), Some(5));
+    inputs.update(&settings, ms(10_000), 0, false);
+    assert_eq!(inputs.pending(&settings), Some(Action::Rest));
+    inputs.sent();
+    // Somebody: a wake, once.
+    inputs.sense(ms(12_000), Some(6));
+    inputs.update(&settings, ms(12_000), 0, true);
+    assert_eq!(
+        inputs.pending(&settings),
+        Some(Action::Wake { toward: None })
+    );
+    inputs.sent();
+    inputs.sense(ms(12_100), Some(7));
+    inputs.update(&settings, ms(12_100), 0, false);
+    assert_eq!(inputs.pending(&settings), None);
+    // Still seen 30 s on: no rest while somebody is there.
+    for t in (12_200..42_000).step_by(250) {
+        inputs.sense(ms(t), Some(t as u32));
+        inputs.update(&settings, ms(t), 0, false);
+        assert_eq!(inputs.pending(&settings), None, "at {t} ms");
+    }
+    // Gone: the rest comes 10 s after the hold.
+    let gone = 41_950 + u64::from(RADAR_HOLD_MS);
+    inputs.sense(ms(gone), Some(41_950));
+    inputs.update(&settings, ms(gone), 0, false);
+    assert_eq!(inputs.pending(&settings), None);
+    inputs.sense(ms(gone + 10_000), Some(41_950));
+    inputs.update(&settings, ms(gone + 10_000), 0, false);
+    assert_eq!(inputs.pending(&settings), Some(Action::Rest));
+    // Off: no rest timer without presence inputs.
+    let mut off = Inputs::new(&settings, ms(0));
+    off.sense(ms(0), None);
+    off.update(&settings, ms(100_000), 0, false);
+    assert_eq!(off.pending(&settings), None);
+    assert_eq!(off.deadline(&settings), None);
+}

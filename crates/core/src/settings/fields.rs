@@ -275,7 +275,22 @@ fields! { s;
     64 "input.3" => s.inputs.roles[1];
     65 "input.4" => s.inputs.roles[2];
     66 "input.5" => s.inputs.roles[3];
+    // The radar and the tracking (ids from 90: 67 and up are left for
+    // other fields): switches, the eyes' height (mm), the radar's bearing
+    // (m°), whom first (0 nearest, 1 newest).
+    90 "radar.on" => s.track.radar;
+    91 "track.gaze" => s.track.gaze;
+    92 "track.height" => s.track.height;
+    93 "track.mount" => s.track.mount;
+    94 "track.prefer" => s.track.prefer;
+    // Where the idle's seeds come from (0 the board's id, 1 the paper's,
+    // 2 `seed.*` as chosen). A record without it is migrated: see
+    // `Settings::seeding_of_older`.
+    95 "seed.mode" => s.seeding;
 }
+
+/// The id of the seeds' source, which records of older firmware lack.
+const SEED_MODE: u8 = 95;
 
 /// The field `id` of the table, if there is one.
 #[must_use]
@@ -333,11 +348,14 @@ impl Record for Settings {
         bytes: &[u8],
         report: &mut FieldReport,
     ) -> Result<Self, DecodeError<SettingsError>> {
-        let settings: Self = match version {
+        let mut settings: Self = match version {
             1 => decode_fields(v1::entries(bytes)?, report)?,
             2 => decode_fields(Entries::new(bytes), report)?,
             _ => return Err(DecodeError::Version),
         };
+        if report.missing.contains(SEED_MODE) {
+            settings.seeding = Self::seeding_of_older(settings.seeds);
+        }
         match settings.validate(&DriverConfig::DEFAULT) {
             Ok(_) => Ok(settings),
             Err(e) => Err(DecodeError::Invalid(e)),

@@ -126,6 +126,7 @@ mod fields;
 mod record;
 mod report;
 mod sectors;
+mod seeding;
 mod storage;
 mod store;
 mod tlv;

@@ -318,6 +318,59 @@ impl FieldValue for DmxAddress {
     }
 }
 
+/// Four little-endian bytes (two's complement).
+impl FieldValue for crate::units::Millimetres {
+    const MAX_LEN: usize = 4;
+
+    fn to_bytes(&self, out: &mut [u8]) -> usize {
+        self.0.cast_unsigned().to_bytes(out)
+    }
+
+    fn from_bytes(bytes: &[u8]) -> Option<Self> {
+        u32_of(bytes).map(|v| Self(v.cast_signed()))
+    }
+}
+
+/// One byte: 0 the board's id, 1 the paper's, 2 chosen.
+impl FieldValue for crate::seed::Seeding {
+    const MAX_LEN: usize = 1;
+
+    fn to_bytes(&self, out: &mut [u8]) -> usize {
+        let byte: u8 = match self {
+            Self::Board => 0,
+            Self::Paper => 1,
+            Self::Chosen => 2,
+        };
+        byte.to_bytes(out)
+    }
+
+    fn from_bytes(bytes: &[u8]) -> Option<Self> {
+        match u8_of(bytes)? {
+            0 => Some(Self::Board),
+            1 => Some(Self::Paper),
+            2 => Some(Self::Chosen),
+            _ => None,
+        }
+    }
+}
+
+/// One byte: 0 nearest, 1 newest.
+impl FieldValue for crate::track::Prefer {
+    const MAX_LEN: usize = 1;
+
+    fn to_bytes(&self, out: &mut [u8]) -> usize {
+        u8::from(*self == Self::Newest).to_bytes(out)
+    }
+
+    fn from_bytes(bytes: &[u8]) -> Option<Self> {
+        match u8_of(bytes)? {
+            0 => Some(Self::Nearest),
+            1 => Some(Self::Newest),
+            _ => None,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

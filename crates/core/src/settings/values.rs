@@ -19,7 +19,9 @@ use crate::dmx::DmxSettings;
 use crate::driver::{ConfigError, DriverConfig, DriverParams};
 use crate::input::{FIRST_INPUT, InputSettings};
 use crate::motion::DEFAULT_HEAD;
+use crate::seed::Seeding;
 use crate::servo::ServoCalibration;
+use crate::track::TrackSettings;
 
 /// Everything a person may change and save; see the [module docs](self).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -35,6 +37,11 @@ pub struct Settings {
     pub dmx: DmxSettings,
     /// The trigger inputs' roles and the rest timer.
     pub inputs: InputSettings,
+    /// Where the idle's seeds come from ([`crate::seed`]): `seeds` is used
+    /// only when chosen.
+    pub seeding: Seeding,
+    /// The radar and the tracking ([`crate::track`]).
+    pub track: TrackSettings,
 }
 
 /// Why settings are not valid.
@@ -84,6 +91,8 @@ impl Settings {
         ],
         dmx: DmxSettings::DEFAULT,
         inputs: InputSettings::DEFAULT,
+        seeding: Seeding::Board,
+        track: TrackSettings::DEFAULT,
     };
 
     /// `base` with these settings' servos.

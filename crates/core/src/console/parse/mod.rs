@@ -17,7 +17,9 @@
 //! rest | wake | rest after <seconds>|never | rest pose <pitch> <roll> <yaw>
 //! rest relax on|off
 //! input <2..5> [off | button <motion command> | presence [<yaw_mdeg>]]
-//! seed <n> | seed random
+//! seed [<n> | random | board | paper]
+//! radar [on | off]
+//! track [on | off | height <mm> | mount <yaw_mdeg> | prefer nearest|newest]
 //! servo <pitch|roll|yaw> [neutral <us> | per-degree <ns> | direction <normal|reversed>
 //!                        | min <us> | max <us> | limits <min_mdeg> <max_mdeg>]
 //! watch <hz> | watch off                                (hz 1..=50)
@@ -61,6 +63,7 @@ mod error;
 mod input;
 mod line;
 mod rest;
+mod track;
 mod words;
 
 pub use error::{ParseError, ParseErrorKind, Span};
@@ -94,6 +97,8 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
             Word::Is(Kw::Look) => duck::look_duck(&mut words)?,
             Word::Is(Kw::Watch) => watch(&mut words)?,
             Word::Is(Kw::Dmx) => dmx::dmx(&mut words)?,
+            Word::Is(Kw::Radar) => track::radar(&mut words)?,
+            Word::Is(Kw::Track) => track::track(&mut words)?,
             _ => return Err(first.error(ParseErrorKind::UnknownCommand)),
         }
     };
@@ -221,16 +226,18 @@ fn idle(words: &mut Words<'_>) -> Result<Action, ParseError> {
     Ok(action)
 }
 
-/// `seed <n>|random`.
+/// `seed [<n>|random|board|paper]` (alone: the seed in use).
 fn seed(words: &mut Words<'_>) -> Result<Command, ParseError> {
-    const EXPECTED: &str = "a seed or `random`";
     let Some(word) = words.next() else {
-        return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
+        return Ok(Command::SeedQuery);
     };
-    if word.lower() == Word::Is(Kw::Random) {
-        return Ok(Command::Seed(SeedChoice::Random));
-    }
-    Ok(Command::Seed(SeedChoice::Value(word.number(&SEED)? as u32)))
+    let choice = match word.lower() {
+        Word::Is(Kw::Random) => SeedChoice::Random,
+        Word::Is(Kw::Board) => SeedChoice::Board,
+        Word::Is(Kw::Paper) => SeedChoice::Paper,
+        _ => SeedChoice::Value(word.number(&SEED)? as u32),
+    };
+    Ok(Command::Seed(choice))
 }
 
 /// `watch <hz>|off`.

@@ -114,6 +114,15 @@ keywords! {
     Pose "pose",
     Relax "relax",
     Duck "duck",
+    Radar "radar",
+    Track "track",
+    Height "height",
+    Mount "mount",
+    Prefer "prefer",
+    Nearest "nearest",
+    Newest "newest",
+    Board "board",
+    Paper "paper",
 }
 
 /// [`KEYWORDS`]' indices with the words in byte order (they are lower case

@@ -16,6 +16,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
     #[must_use]
     pub fn with_show(mut self, show: &'a ShowLink) -> Self {
         show.dmx.set(self.settings.dmx);
+        show.track.set(self.settings.track);
         self.show = Some(show);
         self
     }

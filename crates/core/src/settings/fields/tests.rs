@@ -70,6 +70,9 @@ fn calibrated() -> Settings {
     s.behaviour.idle.amplitude = Percent::new(70).unwrap();
     s.behaviour.gaze.hold = crate::command::Hold::Stay;
     s.seeds = [1, 2, 3];
+    // Seeds a person chose (a record of an older firmware that holds them
+    // loads so).
+    s.seeding = crate::seed::Seeding::Chosen;
     s.validate(&DriverConfig::DEFAULT).unwrap();
     s
 }
