@@ -5,7 +5,7 @@
 // emulator's gaps (chip.mjs, uart.mjs), the USB host (usb.mjs), DMX512
 // (dmx.mjs), what the outside scripts (script.mjs), the boot ROM (rom.mjs).
 //
-//   node harness.mjs '<config as JSON>'
+//   node harness.mjs '<config as JSON>'    (or @<file> holding it)
 //
 // config: {
 //   flash:      path of the flash image: a UF2 file (`.uf2`, each block's payload at its
@@ -88,7 +88,9 @@ import { usbLink } from './usb.mjs';
 import { dmxLine } from './dmx.mjs';
 import { lineStream } from './stream.mjs';
 
-const cfg = JSON.parse(process.argv[2] ?? '{}');
+// The configuration, as JSON or `@<file>` with the JSON in it.
+const arg = process.argv[2] ?? '{}';
+const cfg = JSON.parse(arg.startsWith('@') ? readFileSync(arg.slice(1), 'utf8') : arg);
 const FLASH_START = 0x10000000;
 const RAM_START = 0x20000000;
 const NS_PER_CYCLE = 8; // 125 MHz, as rp2040js's own Simulator assumes

@@ -33,7 +33,10 @@ pub use flood::{FLOOD_STAGE, test_flood};
 pub use inputs::{INPUTS_STAGE, test_inputs};
 pub use node::folder as node_folder;
 pub use script::{default_time as script_time, parse as parse_script};
-pub use stream::{LENGTH as STREAM_LENGTH, UART_STREAM_STAGE, USB_STREAM_STAGE, test_stream};
+pub use stream::{
+    DMX_STREAM_STAGE, LENGTH as STREAM_LENGTH, UART_STREAM_STAGE, USB_STREAM_STAGE, test_dmx,
+    test_stream,
+};
 
 /// Plays a script's `events` into the shipped image (built) for `time` from
 /// its first frame; every pulse checked against what the firmware wrote:
@@ -47,8 +50,10 @@ pub fn play_script(
 ) -> Result<Report> {
     script::play(root, metadata, events, time, wall, script::Against::Written)
 }
+pub use exchange::BYTE_TIME;
+pub use node::UartScript;
 pub use noise::{NOISE_STAGE, test_noise};
-pub use run::{Report, logged_peak_stack};
+pub use run::{Boot, Report, logged_peak_stack};
 pub use show::{SHOW_STAGE, test_show};
 
 /// The harness's DMX line for a DMX script's text (see `sim/dmx.rs`).
@@ -59,6 +64,11 @@ pub fn dmx_line(script: &str) -> Result<serde_json::Value> {
 /// One PWM count of the servo slices, ns.
 pub fn count_ns() -> f64 {
     run::timing().count_ns
+}
+
+/// The frame period, ns.
+pub fn frame_ns() -> f64 {
+    run::timing().frame_ns
 }
 
 /// Builds the shipped Pico image and runs it for `time` (at most `wall`),

@@ -156,6 +156,9 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
 
     // 5. The boot-time benchmark in QEMU and the default set's instruction
     // budget; its telemetry check compares against the QEMU run above.
+    stages.run(bench::LATENCY_STAGE, || {
+        bench::latency_stage(&root, &metadata)
+    });
     stages.run(bench::STAGE, || {
         setup::ensure_qemu()?;
         bench::run_and_check(&root, &metadata, options, qemu_run.as_ref())
@@ -248,6 +251,7 @@ fn sim_stages(
     stages.run(sim::USB_STREAM_STAGE, || {
         sim::test_stream(root, metadata, "usb", sim::STREAM_LENGTH)
     });
+    stages.run(sim::DMX_STREAM_STAGE, || sim::test_dmx(root, metadata));
     stages.run(sim::FAILURES_STAGE, || sim::test_failures(root, metadata));
     stages.run(sim::SHOW_STAGE, || sim::test_show(root, metadata));
     stages.run(MEMORY, || {

@@ -34,6 +34,14 @@
 //! that many counts, so a written pulse is short by 1/64 000 of its width,
 //! 0.03 µs at 2000 µs: a tenth of a count.
 
+/// A frame's duty goes out at the PWM wrap a period over this after the
+/// frame's deadline (a tenth: 2 ms of a 20 ms frame): the boards set the
+/// phase of their PWM so (`crates/rp/src/pwm.rs`), and a frame written later
+/// than that misses its pulse ([`FrameClock::with_latch`]).
+///
+/// [`FrameClock::with_latch`]: crate::driver::FrameClock::with_latch
+pub const WRAP_MARGIN_DIVISOR: u32 = 10;
+
 /// Clock settings of one PWM slice.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

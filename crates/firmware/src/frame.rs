@@ -161,7 +161,10 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         // µs · ticks/s / 10^6 µs/s; frame period < 2^32 µs, tick_hz < 2^32
         // for any real timer: no overflow.
         let period = u64::from(frame_period.get()) * tick_hz / 1_000_000;
-        let clock = FrameClock::new(period, start)?;
+        // A frame written later than the PWM's margin before its wrap
+        // misses its pulse: the clock skips to the next one.
+        let latch = period / u64::from(idle_head_core::pwm_clock::WRAP_MARGIN_DIVISOR);
+        let clock = FrameClock::new(period, start)?.with_latch(latch);
         Ok(Self {
             head: Head::new(idle, params),
             clock,
@@ -356,6 +359,10 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         driver: &mut FrameDriver<P>,
         tick: FrameTick,
     ) -> HeadFrame {
+        if tick.skipped > 0 {
+            // The servos held their pulses through the frames missed.
+            driver.held();
+        }
         self.head.frame(driver, tick.frame)
     }
 }

@@ -1,6 +1,7 @@
 //! The status report of a board running on its own: once a loop, the
 //! frames written, their latest wake-up, the faults, the peak stack and the
-//! longest wait of a port task.
+//! longest wait of a port task; and whenever that wait grows, at once (a
+//! second at the latest), so that the log always holds the longest.
 //!
 //! It runs in thread mode, below every other task: the stack scan (it reads
 //! the unused stack, a few hundred microseconds) and the log wait for the
@@ -14,24 +15,37 @@ use idle_head_core::Millis;
 use crate::boot::LINK;
 use crate::frame::LATEST_WAKE_US;
 
+/// How often the report looks at the port tasks' longest wait.
+const LOOK: Duration = Duration::from_secs(1);
+
 /// Logs a report every `every` (a loop), with the board's `peak_stack`
-/// (bytes) and `port_wait` (µs) measures. Never returns.
+/// (bytes) and `port_wait` (µs) measures, and the port wait whenever it
+/// grows. Never returns.
 pub async fn run(every: Millis, peak_stack: fn() -> u32, port_wait: fn() -> u32) -> ! {
-    let mut ticker = Ticker::every(Duration::from_millis(u64::from(every.0.max(1))));
-    let mut loops: u32 = 0;
+    let looks_per_loop = (u64::from(every.0) / LOOK.as_millis()).max(1);
+    let mut ticker = Ticker::every(LOOK);
+    let (mut seconds, mut loops, mut waited): (u64, u32, u32) = (0, 0, 0);
     loop {
         ticker.next().await;
+        seconds += 1;
+        let wait = port_wait();
+        if wait > waited {
+            waited = wait;
+            defmt::info!("port tasks waited at most {=u32} us", wait);
+        }
+        if seconds % looks_per_loop != 0 {
+            continue;
+        }
         loops = loops.wrapping_add(1);
         let status = LINK.status();
         defmt::info!(
-            "loop {=u32} done: {=u64} frames written, wake-up at most {=u32} us late, faults {}, disabled {}, peak stack {=u32} B, port tasks waited at most {=u32} us",
+            "loop {=u32} done: {=u64} frames written, wake-up at most {=u32} us late, faults {}, disabled {}, peak stack {=u32} B",
             loops,
             status.frame,
             LATEST_WAKE_US.load(Ordering::Relaxed),
             status.faults,
             status.disabled,
             peak_stack(),
-            port_wait()
         );
     }
 }

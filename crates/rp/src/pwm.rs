@@ -44,7 +44,7 @@ use idle_head_core::pwm_clock::SliceClock;
 
 /// The wrap that latches a frame's duty comes a period over this after the
 /// write (a tenth: 2 ms of a 20 ms frame); see the module docs.
-pub const WRAP_MARGIN_DIVISOR: u32 = 10;
+pub use idle_head_core::pwm_clock::WRAP_MARGIN_DIVISOR;
 
 /// One servo output: channel A of a PWM slice of its own.
 pub struct ServoPwm {

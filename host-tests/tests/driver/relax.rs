@@ -70,3 +70,29 @@ fn a_servo_switched_off_stays_off_when_relaxed() {
     assert_eq!(r.servos[2].outcome, Outcome::Off);
     assert_eq!(d.channels_mut()[2].written.len(), writes);
 }
+
+#[test]
+fn after_frames_missed_the_servos_start_again_from_rest() {
+    // A head moving at speed, then frames missed (the PWM held the last
+    // pulses: the servos stood still), then the target far on.
+    let mut d = FrameDriver::new(recorders(), params(&DriverConfig::DEFAULT));
+    d.start();
+    let ramp: Vec<i32> = (0..100).map(|k| k * 200).collect();
+    let mut last = 0;
+    for &x in &ramp {
+        last = angles(&d.write_frame(mdeg([x, 0, 0])))[0];
+    }
+    d.held();
+    // From rest: the first step is within one frame's acceleration (0.24°
+    // a frame, a frame), never the speed it had before the gap.
+    let mut step_before = 0;
+    for k in 0..40 {
+        let x = angles(&d.write_frame(mdeg([25_000, 0, 0])))[0];
+        let step = x - last;
+        assert!(
+            (step - step_before).abs() <= 241 && step.abs() <= 1200,
+            "frame {k} after the gap: {last} → {x}"
+        );
+        (last, step_before) = (x, step);
+    }
+}

@@ -265,10 +265,24 @@ pub fn nanos(duration: Duration) -> u64 {
 /// started, exits with an error, prints a line that is not a known event,
 /// or outlives the wall time (plus a grace).
 pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
+    // The configuration goes in a file: a run of a thousand scripted
+    // chunks is more than a command line may carry.
+    static RUNS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let n = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let file = std::env::temp_dir().join(format!("idle-head-sim-{}-{n}.json", std::process::id()));
+    std::fs::write(&file, config.json().to_string())
+        .with_context(|| format!("writing {}", file.display()))?;
+    let events = run_with_file(root, config, &file);
+    let _ = std::fs::remove_file(&file);
+    events
+}
+
+/// [`run`], its configuration in `file`.
+fn run_with_file(root: &Path, config: &Config, file: &Path) -> Result<Vec<Event>> {
     let mut command = Command::new("node");
     command
         .arg("harness.mjs")
-        .arg(config.json().to_string())
+        .arg(format!("@{}", file.display()))
         .current_dir(folder(root))
         .stdin(Stdio::null())
         .stdout(Stdio::piped())

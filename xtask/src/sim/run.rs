@@ -46,6 +46,8 @@ pub struct Boot {
     pub uart_overruns: usize,
     /// When the last scripted byte went onto the RX line, ns.
     pub uart_sent: Option<f64>,
+    /// When each UART script's last byte went onto the RX line, ns.
+    pub uart_lines: Vec<f64>,
     /// When the emulator's USB host had configured the device, ns.
     pub usb_connected: Option<f64>,
     /// Bytes the device sent on its CDC-ACM port.
@@ -56,8 +58,11 @@ pub struct Boot {
     pub power_cycled: bool,
     /// When each scripted USB chunk went to the device (a list of chunks).
     pub usb_in: Vec<f64>,
-    /// When each DMX frame that carried a change ended.
+    /// When each DMX frame that carried a change ended, and its number
+    /// (from 0).
     pub dmx_changes: Vec<f64>,
+    /// See `dmx_changes`.
+    pub dmx_frames: Vec<u64>,
     /// The input pins the script drove: when, which GPIO, high or low.
     pub drives: Vec<(f64, u8, bool)>,
 }
@@ -389,11 +394,17 @@ fn into_boot(boot: &mut Boot, event: &Event) {
         Event::Uart { hex, .. } => boot.uart.extend(hex),
         Event::Usb { hex, .. } => boot.usb.extend(hex),
         Event::UartOverrun { .. } => boot.uart_overruns += 1,
-        Event::UartRx { ns, .. } => boot.uart_sent = Some(*ns),
+        Event::UartRx { ns, .. } => {
+            boot.uart_sent = Some(*ns);
+            boot.uart_lines.push(*ns);
+        }
         Event::UsbConnected { ns } => boot.usb_connected = Some(*ns),
         Event::PowerCycle { .. } => boot.power_cycled = true,
         Event::UsbIn { ns, .. } => boot.usb_in.push(*ns),
-        Event::Dmx { ns, .. } => boot.dmx_changes.push(*ns),
+        Event::Dmx { ns, frame, .. } => {
+            boot.dmx_changes.push(*ns);
+            boot.dmx_frames.push(*frame);
+        }
         Event::Flash {
             op,
             addr,

@@ -3,6 +3,11 @@
 //! record): `save` through the boot ROM's flash functions at their worst
 //! times, a power cycle, and the next boot on the saved settings
 //! (docs/dev/emulators.md, "Settings through a power cycle").
+//!
+//! What a save does to the head is checked too: lines that arrive on
+//! UART0 while the flash is erased (and the interrupts are off) are all
+//! answered after it, and the servos, held still meanwhile, go on within
+//! the limiter's idle speed and acceleration, no jump.
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
@@ -27,6 +32,10 @@ pub const WORST: FlashTiming = FlashTiming {
 };
 /// When the script goes out in each boot (after the 2 s fade-in).
 const SCRIPT_AT: [Duration; 2] = [Duration::from_secs(3), Duration::from_millis(2_500)];
+/// Lines sent while the save erases the flash (boot 0), and when.
+const DURING_SAVE: &[u8] = b"servo pitch\r\n";
+const DURING_SAVE_LINES: usize = 20;
+const DURING_SAVE_AT: Duration = Duration::from_millis(3_030);
 /// When the power goes off and on.
 const POWER_CYCLE: Duration = Duration::from_secs(5);
 /// The whole run: two boots.
@@ -36,18 +45,18 @@ const SCRIPTS: [&[u8]; 2] = [
     b"servo pitch neutral 1520\r\nsave\r\nstatus\r\n",
     b"servo pitch neutral 1540\r\nload\r\nservo pitch\r\nstatus\r\n",
 ];
-/// What each reply must start or end with, in order, per boot.
+/// What each reply must start with and hold, in order, per boot.
 const REPLIES: [&[(&str, &str)]; 2] = [
     &[
         ("ok", ""),
         ("ok", ""),
-        ("ok mode=", " settings=flash inputs=-,-,-,-"),
+        ("ok mode=", " settings=flash inputs=-,-,-,- seed="),
     ],
     &[
         ("ok", ""),
         ("ok", ""),
         ("ok pitch neutral=1520 ", ""),
-        ("ok mode=", " settings=flash inputs=-,-,-,-"),
+        ("ok mode=", " settings=flash inputs=-,-,-,- seed="),
     ],
 ];
 /// The neutral pulse the script saves on pitch.
@@ -128,6 +137,11 @@ fn run_from(root: &Path, elf_path: &Path, at: u64, start: Start) -> Result<Vec<S
         config.power_cycles = vec![POWER_CYCLE];
         config.uart = (0..2)
             .map(|boot| UartScript::new(boot, SCRIPTS[boot].to_vec(), SCRIPT_AT[boot]))
+            .chain([UartScript::new(
+                0,
+                DURING_SAVE.repeat(DURING_SAVE_LINES),
+                DURING_SAVE_AT,
+            )])
             .collect();
     })?;
     print!("{}", report.log_text(false));
@@ -161,21 +175,27 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
         }
         let _ = writeln!(text, "boot {b}, UART0:");
         let replies = boot.uart_replies();
+        let during = if b == 0 { DURING_SAVE_LINES } else { 0 };
+        let expected = |i: usize| {
+            REPLIES[b].get(i).copied().or_else(|| {
+                (i < REPLIES[b].len() + during).then_some(("ok pitch neutral=1520 ", ""))
+            })
+        };
         for (i, line) in replies.iter().enumerate() {
             let _ = writeln!(text, "  < {line}");
-            match REPLIES[b].get(i) {
-                Some((start, end)) if line.starts_with(start) && line.ends_with(end) => {}
-                Some((start, end)) => problems.push(format!(
-                    "boot {b}: reply {i} `{line}` is not `{start}…{end}`"
+            match expected(i) {
+                Some((start, part)) if line.starts_with(start) && line.contains(part) => {}
+                Some((start, part)) => problems.push(format!(
+                    "boot {b}: reply {i} `{line}` is not `{start}…{part}…`"
                 )),
                 None => problems.push(format!("boot {b}: an extra reply `{line}`")),
             }
         }
-        if replies.len() < REPLIES[b].len() {
+        if replies.len() < REPLIES[b].len() + during {
             problems.push(format!(
                 "boot {b}: {} replies, not {}",
                 replies.len(),
-                REPLIES[b].len()
+                REPLIES[b].len() + during
             ));
         }
     }
@@ -198,6 +218,9 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
         "boot 0: longest gap between frames {:.0} ms",
         longest_gap(first) / 1e6
     );
+    let (steps, over) = steps_around_the_save(first);
+    text.push_str(&steps);
+    problems.extend(over);
     if !says(second, "settings: loaded from flash") {
         problems.push("boot 1 did not log the settings loaded from flash".to_owned());
     }
@@ -248,6 +271,57 @@ fn flash_summary(ops: &[FlashOp]) -> String {
 }
 
 /// The longest time between two frames' compare writes of the pitch servo, ns.
+/// The largest change of each axis' angle from one pulse to the next, and
+/// of that change, from before the save to a second after it: within the
+/// limiter's idle speed and acceleration (a frame's worth, and a few counts
+/// of rounding), also where the motion goes on after a stall. A summary
+/// and the problems.
+fn steps_around_the_save(boot: &Boot) -> (String, Vec<String>) {
+    let config = idle_head_core::driver::DriverConfig::DEFAULT;
+    let frame_s = f64::from(config.frame_period.0) / 1e6;
+    let (from, to) = (
+        SCRIPT_AT[0].as_secs_f64() - 0.5,
+        POWER_CYCLE.as_secs_f64() - 0.2,
+    );
+    let mut text = String::new();
+    let mut problems = Vec::new();
+    for (axis, train) in boot.trains.iter().enumerate() {
+        let limits = config.motion[axis];
+        let count_mdeg = super::count_ns() / f64::from(config.servos[axis].per_degree.0) * 1e3;
+        // Each pulse is the angle rounded to a count, and the pulse map's
+        // rounding wobbles by a count or two more: a few counts of slack.
+        let speed = f64::from(limits.max_speed.0) * 1e3 * frame_s + 2.0 * count_mdeg;
+        let accel = f64::from(limits.max_accel.0) * 1e3 * frame_s * frame_s + 5.0 * count_mdeg;
+        let angles: Vec<f64> = super::pulses::measure(train)
+            .iter()
+            .filter(|p| (from * 1e9..to * 1e9).contains(&p.rise))
+            .map(|p| super::pulses::angle(axis, p.width))
+            .collect();
+        let steps: Vec<f64> = angles.windows(2).map(|w| w[1] - w[0]).collect();
+        let fastest = steps.iter().fold(0.0_f64, |m, s| m.max(s.abs()));
+        // A step of nothing is a pulse repeated: the CPU stalled (a flash
+        // write or erase holds the interrupts off) and the servo held where
+        // it was. That stop is the stall's; what is checked is how the
+        // motion goes on from it.
+        let sharpest = steps
+            .windows(2)
+            .filter(|w| w[1] != 0.0)
+            .fold(0.0_f64, |m, w| m.max((w[1] - w[0]).abs()));
+        let _ = writeln!(
+            text,
+            "boot 0, axis {axis} around the save: steps up to {fastest:.0} m° a frame (limit \
+             {speed:.0}), their change up to {sharpest:.0} m° (limit {accel:.0})"
+        );
+        if fastest > speed || sharpest > accel {
+            problems.push(format!(
+                "axis {axis} jumped around the save: {fastest:.0} m° in a frame, a change of \
+                 {sharpest:.0} m° (limits {speed:.0}, {accel:.0})"
+            ));
+        }
+    }
+    (text, problems)
+}
+
 fn longest_gap(boot: &Boot) -> f64 {
     boot.trains[0]
         .writes
@@ -312,7 +386,10 @@ mod tests {
                 "settings: defaults (empty store at 0x101fc000)",
                 "first frame: neutral pulses 1500 1500 1500 us; watchdog armed (100 ms)",
             ],
-            "ok\r\nok\r\nok mode=running settings=flash inputs=-,-,-,-\r\n",
+            &format!(
+                "ok\r\nok\r\nok mode=running settings=flash inputs=-,-,-,- seed=board\r\n{}",
+                "ok pitch neutral=1520 per-degree=11111\r\n".repeat(DURING_SAVE_LINES)
+            ),
             [1500.0; 3],
         );
         first.power_cycled = true;
@@ -328,7 +405,7 @@ mod tests {
                 "settings: loaded from flash (version 2) at 0x101fc000",
                 "first frame: neutral pulses 1520 1500 1500 us; watchdog armed (100 ms)",
             ],
-            "ok\r\nok\r\nok pitch neutral=1520 per-degree=11111\r\nok mode=running settings=flash inputs=-,-,-,-\r\n",
+            "ok\r\nok\r\nok pitch neutral=1520 per-degree=11111\r\nok mode=running settings=flash inputs=-,-,-,- seed=board\r\n",
             [1520.0, 1500.0, 1500.0],
         );
         Report {
@@ -403,5 +480,36 @@ mod tests {
                 .any(|p| p
                     .contains("boot 1's first pulses are [Some(1520), Some(1500), Some(1500)]"))
         );
+    }
+
+    #[test]
+    fn a_jump_around_the_save_is_found_and_a_steady_start_is_not_one() {
+        // Pulses every 20 ms from 2.6 s: steady at 1500 µs, then moving
+        // off at 0.2° a frame (within 600 °/s²: 0.24° a frame more each).
+        let train = |widths: &[f64]| {
+            let mut train = super::super::pulses::Train::default();
+            train.enabled = Some(2.6e9);
+            for (k, us) in widths.iter().enumerate() {
+                let rise = 2.6e9 + 20e6 * k as f64;
+                train.edges.extend([(rise, true), (rise + us * 1e3, false)]);
+            }
+            train
+        };
+        let per_mdeg = 11.111 / 1000.0;
+        let smooth: Vec<f64> = (0..40)
+            .map(|k| 1500.0 + per_mdeg * 200.0 * f64::from((k - 20).max(0)))
+            .collect();
+        let mut boot = Boot::default();
+        boot.trains = [train(&smooth), train(&smooth), train(&smooth)];
+        assert_eq!(steps_around_the_save(&boot).1, Vec::<String>::new());
+        // A step of 1.5° out of a standstill: a jump.
+        let mut jump = smooth.clone();
+        for w in &mut jump[25..] {
+            *w += per_mdeg * 1500.0;
+        }
+        boot.trains[2] = train(&jump);
+        let problems = steps_around_the_save(&boot).1;
+        assert_eq!(problems.len(), 1, "{problems:?}");
+        assert!(problems[0].starts_with("axis 2 jumped around the save"));
     }
 }

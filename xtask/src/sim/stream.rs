@@ -18,14 +18,21 @@
 //! - every frame's pulses are the host's duties, on time: the stream never
 //!   delays a frame;
 //! - the port tasks' longest wait for the CPU, as the image measured it.
+//!
+//! And DMX512 at the full universe rate (512 slots, about 44 frames a
+//! second) for a minute, across two loop generations, with a change in
+//! every tenth frame: the head's decoder counts every frame good, none
+//! short, long, of another start code or garbled (its `dmx` counters,
+//! asked over UART0 at the end), and every frame's pulses are on time.
 
-use std::{path::Path, time::Duration};
+use std::{fmt::Write as _, path::Path, time::Duration};
 
 use anyhow::Result;
 use idle_head_core::console::checksum;
 
 use super::{
-    node::{LineStream, StreamLine},
+    dmx,
+    node::{LineStream, StreamLine, UartScript},
     run::{self, Boot, Report},
     stages::{conclude, shipped_image},
 };
@@ -37,6 +44,10 @@ pub const UART_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: a line e
 /// See [`UART_STREAM_STAGE`].
 pub const USB_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: a line every 2 ms on \
      USB for 10 minutes: every line answered once, in order, none lost, no frame late";
+
+/// Stage name.
+pub const DMX_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: DMX512 at the full \
+     universe rate for a minute across two loop generations: every frame decoded, none lost";
 
 /// When the stream starts (the fade-in is over), the time between lines,
 /// how long it lasts.
@@ -69,9 +80,7 @@ pub fn test_stream(
     let elf = shipped_image(root, metadata)?;
     let count = usize::try_from(length.as_micros() / EVERY.as_micros()).unwrap_or(usize::MAX);
     let time = START + length + Duration::from_secs(1);
-    // The emulator runs about as fast as the chip with a line every 2 ms.
-    let wall = time * 3 + Duration::from_secs(120);
-    let mut report = run::run_with(root, &elf, time, wall, |config| {
+    let mut report = run::run_with(root, &elf, time, wall(length), |config| {
         config.stream = Some(LineStream {
             port,
             start: START,
@@ -166,6 +175,85 @@ fn check(report: &Report, port: &str, count: usize) -> (String, Vec<String>) {
         EVERY.as_millis(),
         replies.len(),
         boot.uart_overruns,
+    );
+    (summary, problems)
+}
+
+/// How long DMX streams.
+const DMX_LENGTH: Duration = Duration::from_secs(60);
+
+/// DMX at the full universe rate for a minute (see the module docs).
+pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
+    let elf = shipped_image(root, metadata)?;
+    // A change every 0.23 s (about every tenth frame): the frames that
+    // carry one are counted by the harness; the last one at the end.
+    let end = START + DMX_LENGTH;
+    let mut text = String::new();
+    let mut at = START;
+    let mut k = 0_u32;
+    while at < end {
+        let _ = writeln!(text, "{:.3} 1={}", at.as_secs_f64(), k % 2 * 100);
+        at += Duration::from_millis(230);
+        k += 1;
+    }
+    let changes = dmx::parse(&text)?;
+    let query = end + Duration::from_millis(50);
+    let mut report = run::run_with(
+        root,
+        &elf,
+        query + Duration::from_secs(1),
+        wall(DMX_LENGTH),
+        |config| {
+            dmx::configure(config, &changes);
+            config.uart = vec![UartScript::new(0, b"dmx\n".to_vec(), query)];
+        },
+    )?;
+    run::check(&mut report)?;
+    print!("{}", report.table());
+    let found = report.boots.first().map_or_else(
+        || (String::new(), vec!["no boot".to_owned()]),
+        |boot| check_dmx(boot, changes.len()),
+    );
+    conclude(&report, found)
+}
+
+/// The wall time a run of `length` may take.
+fn wall(length: Duration) -> Duration {
+    (START + length) * 3 + Duration::from_secs(120)
+}
+
+/// The `dmx` counters against the frames sent: every one good.
+fn check_dmx(boot: &Boot, changes: usize) -> (String, Vec<String>) {
+    let mut problems = Vec::new();
+    let reply = boot.uart_replies().into_iter().next().unwrap_or_default();
+    let counter = |name: &str| -> Option<u64> {
+        reply
+            .split(' ')
+            .find_map(|field| field.strip_prefix(name)?.strip_prefix('=')?.parse().ok())
+    };
+    let good = counter("good").unwrap_or(0);
+    for name in ["short", "long", "start_code", "garbled"] {
+        if counter(name) != Some(0) {
+            problems.push(format!("`{name}` is not 0 in `{reply}`"));
+        }
+    }
+    // The harness numbers the frames from 0: the last change's frame, and
+    // the few sent between it and the query, were all counted.
+    let sent = boot.dmx_frames.last().map_or(0, |&frame| frame + 1);
+    if boot.dmx_changes.len() != changes || good < sent {
+        problems.push(format!(
+            "{good} good frames, {sent} sent by the last change ({} of {changes} changes seen)",
+            boot.dmx_changes.len()
+        ));
+    }
+    let sets = boot
+        .log
+        .iter()
+        .filter(|(_, line)| line.message.starts_with("loop set "))
+        .count();
+    let summary = format!(
+        "DMX: {sent} frames of 512 slots sent by the last change, {good} counted good; \
+         {sets} loop sets generated meanwhile; `{reply}`\n"
     );
     (summary, problems)
 }

@@ -196,6 +196,17 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         }
     }
 
+    /// Frames were missed (the frame task woke late: a flash erase held the
+    /// interrupts off, say): the PWM repeated the last pulses meanwhile, so
+    /// the servos stood still. Every limiter stops where it is, and the
+    /// next frame accelerates from rest within the limits instead of going
+    /// on at the speed it had before.
+    pub fn held(&mut self) {
+        for servo in &mut self.servos {
+            servo.slew.halt();
+        }
+    }
+
     /// Whether the pulses are stopped ([`set_relaxed`](Self::set_relaxed)).
     #[must_use]
     pub const fn is_relaxed(&self) -> bool {

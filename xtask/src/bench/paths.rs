@@ -1,0 +1,193 @@
+//! The latency rows of the console's ports and of Bottango: a `look` over
+//! USB and over UART0 (each line's last byte against yaw's first pulse
+//! that moves), and a Bottango curve over USB (its start against the
+//! same). See `latency.rs` for the method and the other paths.
+
+use std::{fmt::Write as _, path::Path, time::Duration};
+
+use anyhow::{Context, Result, bail};
+use idle_head_core::bottango::hash;
+
+use super::latency::{self, LOOK_GAP, Row, SCHEDULED, schedule};
+use crate::project::Metadata;
+use crate::sim::{BYTE_TIME, UartScript, run_shipped};
+
+/// A path's run, for its row.
+pub type Measure = fn(&Path, &Metadata, Duration) -> Result<Row>;
+
+/// Every latency path, in the order the bench prints them.
+pub const PATHS: [Measure; 5] = [
+    latency::dmx,
+    usb_look,
+    uart_look,
+    latency::input_edge,
+    bottango,
+];
+
+/// The `look` events' lines: with the idle off, yaw a degree there and back.
+fn look_line(k: usize) -> Vec<u8> {
+    let yaw = if k.is_multiple_of(2) { 1000 } else { 0 };
+    format!("look 0 {yaw} 40 hold=stay\n").into_bytes()
+}
+
+/// Fails if a line of `replies` refused its line (`err …`, or Bottango's
+/// `HASH_FAIL` and `TIMEOUT`).
+fn all_ok(replies: &[u8], what: &str) -> Result<()> {
+    let text = String::from_utf8_lossy(replies);
+    let refused = |l: &&str| l.starts_with("err") || l.contains("FAIL") || l.contains("TIMEOUT");
+    if let Some(line) = text.lines().find(refused) {
+        bail!("{what}: a line refused: {line:?}");
+    }
+    Ok(())
+}
+
+/// `latency usb look`: `look` lines over USB.
+pub fn usb_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
+    let start = Duration::from_secs(4);
+    let times = schedule(start, SCHEDULED, LOOK_GAP, 0x1007_c0de);
+    let mut chunks = vec![(b"idle off\n".to_vec(), Duration::from_millis(2500))];
+    chunks.extend(times.iter().enumerate().map(|(k, at)| (look_line(k), *at)));
+    let end = times.last().copied().unwrap_or(start) + Duration::from_millis(500);
+    let report = run_shipped(root, metadata, end, wall, |config| {
+        config.usb_chunks = chunks;
+        Ok(())
+    })?;
+    let boot = report.boots.first().context("no boot")?;
+    let events: Vec<f64> = boot.usb_in.iter().skip(1).copied().collect();
+    if events.len() != times.len() {
+        bail!("{} USB lines went out, not {}", events.len(), times.len());
+    }
+    all_ok(&boot.usb, "usb look")?;
+    latency::row("usb look", &events, boot)
+}
+
+/// `latency uart look`: `look` lines over UART0 at 115200 baud, each in by
+/// its time.
+pub fn uart_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
+    let start = Duration::from_secs(4);
+    let times = schedule(start, SCHEDULED, LOOK_GAP, 0x0a47_100c);
+    let mut scripts = vec![UartScript::new(
+        0,
+        b"idle off\n".to_vec(),
+        Duration::from_millis(2500),
+    )];
+    scripts.extend(times.iter().enumerate().map(|(k, &at)| {
+        let line = look_line(k);
+        let on_the_wire = BYTE_TIME * u32::try_from(line.len()).unwrap_or(u32::MAX);
+        UartScript::new(0, line, at.saturating_sub(on_the_wire))
+    }));
+    let end = times.last().copied().unwrap_or(start) + Duration::from_millis(500);
+    let report = run_shipped(root, metadata, end, wall, |config| {
+        config.uart = scripts;
+        Ok(())
+    })?;
+    let boot = report.boots.first().context("no boot")?;
+    let events: Vec<f64> = boot.uart_lines.iter().skip(1).copied().collect();
+    if events.len() != times.len() {
+        bail!("{} UART lines went out, not {}", events.len(), times.len());
+    }
+    all_ok(&boot.uart, "uart look")?;
+    latency::row("uart look", &events, boot)
+}
+
+/// The gaps between Bottango's curves: a 40 ms step, then a hold.
+const CURVE_GAP: (Duration, Duration) = (Duration::from_millis(150), Duration::from_millis(200));
+/// How long before its start a curve is sent (Bottango sends ahead).
+const AHEAD: Duration = Duration::from_millis(120);
+/// The step, in Bottango's movement (0 to 8192 over the motor's range,
+/// −20° to 20°): 256 is 1.25°.
+const STEP: i32 = 256;
+
+/// A Bottango line with its hash.
+fn bottango_line(body: &str) -> String {
+    format!("{body},h{}\n", hash(body.as_bytes()))
+}
+
+/// `latency bottango`: a Bottango session over USB steps yaw by 1.25° and
+/// holds it, curve after curve, each sent ahead of its start; each step's
+/// start (on the head's clock, which `tSYN` ties to a frame) against yaw's
+/// first pulse that moves.
+pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
+    // When the first frame goes out: the head's clock counts from it.
+    let first = run_shipped(root, metadata, Duration::from_secs(1), wall, |_| Ok(()))?;
+    let t0 = first
+        .boots
+        .first()
+        .and_then(|boot| boot.trains[2].enabled)
+        .context("no first frame")?;
+    let frame = crate::sim::frame_ns();
+    // The sync in the middle of a frame after 2.6 s: the clock it marks is
+    // the frame before, whatever the line's few µs of transport.
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let k = ((2.6e9 - t0) / frame).ceil() as u64;
+    #[allow(clippy::cast_precision_loss)]
+    let sync = Duration::from_nanos((t0 + (k as f64 + 0.5) * frame) as u64);
+    #[allow(
+        clippy::cast_precision_loss,
+        clippy::cast_possible_truncation,
+        clippy::cast_sign_loss
+    )]
+    let clock_ms = (k as f64 * frame / 1e6).round() as u64;
+    // The curves' starts, whole ms after the sync's clock.
+    let times = schedule(
+        Duration::from_secs(4),
+        SCHEDULED + 1,
+        CURVE_GAP,
+        0xb077_a160,
+    );
+    let ms_after = |at: Duration| -> u64 {
+        #[allow(
+            clippy::cast_precision_loss,
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss
+        )]
+        let since_first = ((at.as_secs_f64() * 1e9 - t0) / 1e6).round() as u64;
+        since_first - clock_ms
+    };
+    let mut chunks = vec![
+        (b"idle off\n".to_vec(), Duration::from_secs(2)),
+        (
+            [
+                bottango_line("hRQ,144"),
+                bottango_line("rMTR,yaw,-20000,20000,3000,4096"),
+            ]
+            .concat()
+            .into_bytes(),
+            Duration::from_millis(2300),
+        ),
+        (bottango_line("tSYN,0").into_bytes(), sync),
+    ];
+    let mut events = Vec::new();
+    for (i, pair) in times.windows(2).enumerate() {
+        let (start, next) = (ms_after(pair[0]), ms_after(pair[1]));
+        let (from, to) = if i % 2 == 0 {
+            (4096, 4096 + STEP)
+        } else {
+            (4096 + STEP, 4096)
+        };
+        let mut text = bottango_line(&format!(
+            "sC,yaw,{start},40,{from},0,{},{to},0,0",
+            to - from
+        ));
+        let _ = write!(
+            text,
+            "{}",
+            bottango_line(&format!(
+                "sC,yaw,{},{},{to},0,0,{to},0,0",
+                start + 40,
+                next - start - 40
+            ))
+        );
+        chunks.push((text.into_bytes(), pair[0].saturating_sub(AHEAD)));
+        #[allow(clippy::cast_precision_loss)]
+        events.push(t0 + (clock_ms + start) as f64 * 1e6);
+    }
+    let end = times.last().copied().unwrap_or_default() + Duration::from_millis(500);
+    let report = run_shipped(root, metadata, end, wall, |config| {
+        config.usb_chunks = chunks;
+        Ok(())
+    })?;
+    let boot = report.boots.first().context("no boot")?;
+    all_ok(&boot.usb, "bottango")?;
+    latency::row("bottango", &events, boot)
+}
