@@ -487,20 +487,24 @@ mod tests {
         // Pulses every 20 ms from 2.6 s: steady at 1500 µs, then moving
         // off at 0.2° a frame (within 600 °/s²: 0.24° a frame more each).
         let train = |widths: &[f64]| {
-            let mut train = super::super::pulses::Train::default();
-            train.enabled = Some(2.6e9);
-            for (k, us) in widths.iter().enumerate() {
+            let edges = widths.iter().enumerate().flat_map(|(k, us)| {
                 let rise = 2.6e9 + 20e6 * k as f64;
-                train.edges.extend([(rise, true), (rise + us * 1e3, false)]);
+                [(rise, true), (rise + us * 1e3, false)]
+            });
+            super::super::pulses::Train {
+                enabled: Some(2.6e9),
+                edges: edges.collect(),
+                ..Default::default()
             }
-            train
         };
         let per_mdeg = 11.111 / 1000.0;
         let smooth: Vec<f64> = (0..40)
             .map(|k| 1500.0 + per_mdeg * 200.0 * f64::from((k - 20).max(0)))
             .collect();
-        let mut boot = Boot::default();
-        boot.trains = [train(&smooth), train(&smooth), train(&smooth)];
+        let mut boot = Boot {
+            trains: [train(&smooth), train(&smooth), train(&smooth)],
+            ..Boot::default()
+        };
         assert_eq!(steps_around_the_save(&boot).1, Vec::<String>::new());
         // A step of 1.5° out of a standstill: a jump.
         let mut jump = smooth.clone();
