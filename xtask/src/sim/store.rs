@@ -487,8 +487,8 @@ mod tests {
         // Pulses every 20 ms from 2.6 s: steady at 1500 µs, then moving
         // off at 0.2° a frame (within 600 °/s²: 0.24° a frame more each).
         let train = |widths: &[f64]| {
-            let edges = widths.iter().enumerate().flat_map(|(k, us)| {
-                let rise = 2.6e9 + 20e6 * k as f64;
+            let edges = (0_u32..).zip(widths).flat_map(|(k, us)| {
+                let rise = 2.6e9 + 20e6 * f64::from(k);
                 [(rise, true), (rise + us * 1e3, false)]
             });
             super::super::pulses::Train {
