@@ -24,13 +24,15 @@ const LOOK: Duration = Duration::from_secs(1);
 pub async fn run(every: Millis, peak_stack: fn() -> u32, port_wait: fn() -> u32) -> ! {
     let looks_per_loop = (u64::from(every.0) / LOOK.as_millis()).max(1);
     let mut ticker = Ticker::every(LOOK);
-    let (mut seconds, mut loops, mut waited): (u64, u32, u32) = (0, 0, 0);
+    let (mut seconds, mut loops): (u64, u32) = (0, 0);
+    // (None: not logged yet; the first look logs it whatever it is.)
+    let mut waited: Option<u32> = None;
     loop {
         ticker.next().await;
         seconds += 1;
         let wait = port_wait();
-        if wait > waited {
-            waited = wait;
+        if waited.is_none_or(|w| wait > w) {
+            waited = Some(wait);
             defmt::info!("port tasks waited at most {=u32} us", wait);
         }
         if seconds % looks_per_loop != 0 {

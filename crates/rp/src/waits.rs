@@ -5,7 +5,8 @@
 //! Measured with embassy-executor's trace hooks, which the executors call
 //! at every wake and poll of every task: a task's wake time is kept until
 //! it is polled; a poll that runs in the port executor's interrupt
-//! (`SWI_IRQ_0`) is a port task's.
+//! (`SWI_IRQ_0`) is a port task's. A task's first poll is no wake: at boot
+//! the task that spawns the others runs to its end before they start.
 
 use core::cell::Cell;
 
@@ -23,11 +24,14 @@ const TASKS: usize = 8;
 /// longest port wait so far (µs).
 struct Waits {
     woken: [Cell<Option<(u32, u64)>>; TASKS],
+    /// The tasks polled once already.
+    started: [Cell<Option<u32>>; TASKS],
     longest: Cell<u32>,
 }
 
 static WAITS: Mutex<CriticalSectionRawMutex, Waits> = Mutex::new(Waits {
     woken: [const { Cell::new(None) }; TASKS],
+    started: [const { Cell::new(None) }; TASKS],
     longest: Cell::new(0),
 });
 
@@ -71,7 +75,11 @@ extern "Rust" fn _embassy_trace_task_exec_begin(_executor_id: u32, task_id: u32)
         else {
             return;
         };
-        if let (Some((_, woken)), true) = (slot.take(), port) {
+        let first = !w.started.iter().any(|s| s.get() == Some(task_id));
+        if first && let Some(free) = w.started.iter().find(|s| s.get().is_none()) {
+            free.set(Some(task_id));
+        }
+        if let (Some((_, woken)), true, false) = (slot.take(), port, first) {
             let waited = u32::try_from(now.saturating_sub(woken)).unwrap_or(u32::MAX);
             w.longest.set(w.longest.get().max(waited));
         }
