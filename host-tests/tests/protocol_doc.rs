@@ -68,11 +68,12 @@ fn the_protocol_document_lists_every_gesture() {
 #[test]
 fn the_telemetry_figures_in_the_protocol_document_hold() {
     use idle_head_core::console::{HeadMode, HeadStatus, TELEMETRY_LINE, telemetry_line};
-    use idle_head_core::{Angle, Microseconds};
+    use idle_head_core::{Angle, Microseconds, Timestamp};
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/user/protocol.md");
     let doc = std::fs::read_to_string(path).expect("docs/user/protocol.md");
     let status = HeadStatus {
         frame: 123_440 / 20,
+        time: Timestamp(123_440_000),
         mode: HeadMode::Running,
         angles: [-1505, -119, -236].map(Angle::from_millidegrees),
         pulses: [1483, 1499, 1497].map(Microseconds),
@@ -80,7 +81,7 @@ fn the_telemetry_figures_in_the_protocol_document_hold() {
         disabled: [false; 3],
     };
     let mut out = [0; TELEMETRY_LINE];
-    let line = telemetry_line(&status, 20_000, 0, &mut out);
+    let line = telemetry_line(&status, 0, &mut out);
     let text = std::str::from_utf8(line).unwrap();
     assert!(
         doc.contains(text.trim_end()),

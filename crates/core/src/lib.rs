@@ -61,4 +61,4 @@ pub use axis::Axis;
 pub use driver::{DriverConfig, FrameClock, FrameDriver, FrameReport};
 pub use playback::{LoopSource, Playback};
 pub use servo::{Direction, PwmTiming, ServoCalibration};
-pub use units::{Angle, AngleRange, Microseconds, Millis};
+pub use units::{Angle, AngleRange, Microseconds, Millis, Timestamp};

@@ -149,8 +149,7 @@ pub async fn serve<P: Port, H: Handler>(
             Either::Second(()) => {
                 // Between replies: the reply buffer is free for the line.
                 let status = place.link.status();
-                let us = place.frame.as_micros() as u32;
-                let text = telemetry_line(&status, us, watch.lost, session.spare());
+                let text = telemetry_line(&status, watch.lost, session.spare());
                 if let Err(gone) = port.write(text).await {
                     return gone;
                 }

@@ -9,7 +9,16 @@
 //!
 //! Frames are due at `start + k · period` exactly ([`FrameClock`]), and the
 //! task sleeps with [`Timer::at`] until the next deadline. The deadlines
-//! never drift. A frame that wakes up a whole period or more late is counted
+//! never drift. The frame engine plays each frame at its own time (the sum
+//! of the periods before it, µs: [`FrameTick::at`]), so that the motion is
+//! the same at any rate.
+//!
+//! # The servos' rate
+//!
+//! `servo rate` reaches the frame task through the link: before a frame
+//! ([`FrameLoop::take_rate`]) the outputs take the new period from that
+//! frame's write on; after it ([`FrameLoop::write`]) the frames come the
+//! new period apart. See the driver's `frame/rate.rs`. A frame that wakes up a whole period or more late is counted
 //! as missed and skipped, together with any other frame whose deadline has
 //! passed: the next deadline lies in the future, so a stall is never followed
 //! by a burst of catch-up writes (which `embassy_time::Ticker` would do).
@@ -50,6 +59,7 @@
 
 use embassy_time::{Duration, Instant, Timer};
 use embedded_hal::pwm::SetDutyCycle;
+use idle_head_core::servo::SetPeriod;
 
 use idle_head_core::behaviour::{
     Applied, BehaviourError, BehaviourParams, CommandQueue, Head, HeadFrame, IdleSource,
@@ -59,7 +69,7 @@ use idle_head_core::command::{Action, Hold};
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::dmx::Signal;
 use idle_head_core::driver::{FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod};
-use idle_head_core::{Angle, Microseconds};
+use idle_head_core::{Angle, Microseconds, Timestamp};
 
 use crate::config::DEFAULT_BEHAVIOUR;
 
@@ -119,8 +129,19 @@ pub struct FrameLoop<'a, I> {
     commands: Option<&'a CommandQueue>,
     link: Option<&'a ConsoleLink>,
     show: Option<&'a ShowLink>,
-    /// The behaviour's frame period in whole ms: the show clock's step.
-    frame_ms: u32,
+    /// The board's ticks for `scale_us` of the frames' time (the periods'
+    /// ratio: 1 µs a µs on a board, faster in the QEMU smoke run).
+    scale_ticks: u64,
+    scale_us: u32,
+    /// A new frame period whose outputs' part was taken before this
+    /// frame: the frames' part follows it.
+    retime: Option<Microseconds>,
+    /// A frame period the frames refused after their outputs took it (the
+    /// configuration was checked at both, so never), logged before the
+    /// next frame: the frame path does not log.
+    refused: Option<Microseconds>,
+    /// The last frame's time.
+    at: Timestamp,
 }
 
 impl<'a, I: IdleSource> FrameLoop<'a, I> {
@@ -154,14 +175,18 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         // µs · ticks/s / 10^6 µs/s; frame period < 2^32 µs, tick_hz < 2^32
         // for any real timer: no overflow.
         let period = u64::from(frame_period.get()) * tick_hz / 1_000_000;
-        let clock = FrameClock::new(period, start)?;
+        let clock = FrameClock::new(period, start, Microseconds(params.frame_us()))?;
         Ok(Self {
             head: Head::new(idle, params),
             clock,
             commands: None,
             link: None,
             show: None,
-            frame_ms: params.frame_us().div_ceil(1000),
+            scale_ticks: period,
+            scale_us: params.frame_us(),
+            retime: None,
+            refused: None,
+            at: Timestamp(0),
         })
     }
 
@@ -268,11 +293,10 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         let show = self.show?;
         // The frame task's clock, ms (wrapping): Bottango's curves are
         // timed on it.
-        let now_ms = (tick.frame as u32).wrapping_mul(self.frame_ms);
-        let curves = show.curves.sample(now_ms);
+        let curves = show.curves.sample(tick.ms);
         let events = self
             .head
-            .show(driver, tick.frame, Some(show.dmx.latest()), curves);
+            .show(driver, tick.at, Some(show.dmx.latest()), curves);
         if let Some(signal) = events.signal {
             show.dmx.set_signal(signal);
         }
@@ -319,12 +343,40 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
                 driver.is_stopping(),
                 self.head.rest_state(),
             );
-            link.publish(HeadStatus::of(report, driver.stats(), mode));
+            link.publish(HeadStatus::of(report, driver.stats(), mode, self.at));
+        }
+    }
+
+    /// Before frame `tick`: the servos' rate the console set, if linked
+    /// and it did: the outputs run at its period from this frame's write
+    /// on, and the frames come that far apart after it (in
+    /// [`write`](Self::write)).
+    pub fn take_rate<P: SetPeriod>(&mut self, driver: &mut FrameDriver<P>, tick: FrameTick) {
+        if let Some(period) = self.refused.take() {
+            defmt::error!("frames at {=u32} us refused by the driver", period.0);
+        }
+        let Some(rate) = self.link.and_then(ConsoleLink::take_rate) else {
+            return;
+        };
+        let period = rate.period();
+        match driver.set_pwm_period(period) {
+            Ok(()) => {
+                self.retime = Some(period);
+                defmt::info!(
+                    "frame {=u64}: servo rate {=u16} Hz: pulses every {=u32} us from this frame on",
+                    tick.frame,
+                    rate.hz(),
+                    period.0
+                );
+            }
+            Err(e) => defmt::warn!("frame {=u64}: servo rate refused: {}", tick.frame, e),
         }
     }
 
     /// Writes frame `tick`: idle, gaze and gestures mixed, through `driver`.
-    /// The first call starts the driver (neutral pulses) instead.
+    /// The first call starts the driver (neutral pulses) instead. After a
+    /// new rate's outputs were set ([`take_rate`](Self::take_rate)), the
+    /// frames come its period apart from the next one on.
     ///
     /// This is the whole frame update (playback, mixer, fade, limits,
     /// mapping and the PWM writes), kept out of line so that it can be
@@ -335,7 +387,32 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         driver: &mut FrameDriver<P>,
         tick: FrameTick,
     ) -> HeadFrame {
-        self.head.frame(driver, tick.frame)
+        self.at = tick.at;
+        let frame = self.head.frame(driver, tick.at);
+        if let Some(period) = self.retime.take() {
+            self.retime_frames(driver, period);
+        }
+        frame
+    }
+
+    /// After the frame the new period's outputs were set before: the
+    /// frames `period` apart from the next one on (the divisions of a
+    /// change of rate happen here, once).
+    #[inline(never)]
+    fn retime_frames<P: SetDutyCycle>(
+        &mut self,
+        driver: &mut FrameDriver<P>,
+        period: Microseconds,
+    ) {
+        if self.head.set_frame_period(driver, period).is_err() {
+            self.refused = Some(period);
+            return;
+        }
+        let ticks = u64::from(period.0)
+            .saturating_mul(self.scale_ticks)
+            .checked_div(u64::from(self.scale_us))
+            .unwrap_or(1);
+        self.clock.set_period(ticks.max(1), period);
     }
 }
 
@@ -351,7 +428,7 @@ pub async fn run<P, I, H>(
     hooks: &mut H,
 ) -> RunStats
 where
-    P: SetDutyCycle,
+    P: SetPeriod,
     I: IdleSource,
     H: FrameHooks<P>,
 {
@@ -373,6 +450,7 @@ where
         }
         hooks.before_frame(&tick, driver);
         frames.drain(driver, tick);
+        frames.take_rate(driver, tick);
         let HeadFrame { offsets, report } = frames.write(driver, tick);
         frames.publish(driver, &report);
         if report.should_log {

@@ -47,10 +47,12 @@ pub struct BoardHooks<W> {
     watchdog: W,
     /// The deepest the stack has been, in bytes, as the board measures it.
     peak_stack: fn() -> u32,
-    /// Frames per loop of the playback.
-    loop_frames: u64,
-    /// The frame the next loop ends at (its status line is due).
+    /// A loop of the playback, µs of the frames' time (whatever the rate).
+    loop_us: u64,
+    /// The time the next loop ends at (its status line is due), and the
+    /// loops done.
     next_loop_end: u64,
+    loops: u64,
     started: bool,
     max_lateness: u64,
     #[cfg(feature = "calibrate")]
@@ -61,14 +63,13 @@ impl<W: Watchdog> BoardHooks<W> {
     /// Hooks feeding `watchdog`, with a status line every loop of
     /// `playback`; `peak_stack` tells the stack's deepest use.
     pub fn new(watchdog: W, playback: Playback, peak_stack: fn() -> u32) -> Self {
-        let loop_ms = u64::from(playback.loop_duration().0);
-        let frame_us = u64::from(playback.frame_period().0).max(1);
-        let loop_frames = (loop_ms * 1000 / frame_us).max(1);
+        let loop_us = (u64::from(playback.loop_duration().0) * 1000).max(1);
         Self {
             watchdog,
             peak_stack,
-            loop_frames,
-            next_loop_end: loop_frames,
+            loop_us,
+            next_loop_end: loop_us,
+            loops: 0,
             started: false,
             max_lateness: 0,
             #[cfg(feature = "calibrate")]
@@ -111,15 +112,15 @@ impl<P: SetDutyCycle, W: Watchdog> FrameHooks<P> for BoardHooks<W> {
             .max(frame.woke.saturating_sub(frame.deadline));
         #[cfg(feature = "calibrate")]
         crate::calibrate::log_frame(frame, &self.playback);
-        let index = frame.tick.frame;
         // A comparison per frame, not a 64-bit division (a library call on
         // the Cortex-M0+): the next loop's end is kept.
-        if index >= self.next_loop_end {
-            self.next_loop_end = self.next_loop_end.saturating_add(self.loop_frames);
+        if frame.tick.at.0 >= self.next_loop_end {
+            self.next_loop_end = self.next_loop_end.saturating_add(self.loop_us);
+            self.loops += 1;
             let stats = driver.stats();
             defmt::info!(
                 "loop {=u64} done: {=u64} frames written, wake-up at most {=u64} us late, faults {}, disabled {}, peak stack {=u32} B",
-                index / self.loop_frames,
+                self.loops,
                 stats.frames,
                 Duration::from_ticks(self.max_lateness).as_micros(),
                 stats.faults,
@@ -128,10 +129,10 @@ impl<P: SetDutyCycle, W: Watchdog> FrameHooks<P> for BoardHooks<W> {
             );
         }
         #[cfg(feature = "watchdog-drill")]
-        if index == DRILL_FRAMES {
+        if frame.tick.frame == DRILL_FRAMES {
             defmt::warn!(
                 "watchdog drill: frames stop after frame {=u64}; the watchdog must reset the board",
-                index
+                frame.tick.frame
             );
             return Flow::Stop;
         }

@@ -116,6 +116,7 @@ pub fn play(
             let host = trace::simulate(
                 u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX),
                 None,
+                idle_head_core::servo::ServoRate::DEFAULT,
                 &events,
             )?;
             host.rows.iter().map(|row| row.duties).collect()

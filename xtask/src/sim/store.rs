@@ -74,13 +74,13 @@ const REPLIES: [&[(&str, &str)]; 2] = [
     &[
         ("ok", ""),
         ("ok", ""),
-        ("ok mode=", " settings=flash inputs=-,-,-,-"),
+        ("ok mode=", " settings=flash inputs=-,-,-,- rate=50"),
     ],
     &[
         ("ok", ""),
         ("ok", ""),
         ("ok pitch neutral=1520 ", ""),
-        ("ok mode=", " settings=flash inputs=-,-,-,-"),
+        ("ok mode=", " settings=flash inputs=-,-,-,- rate=50"),
     ],
 ];
 /// The neutral pulse the script saves on pitch.
@@ -347,7 +347,7 @@ mod tests {
                 "settings: defaults (empty store at 0x101fc000)",
                 "first frame: neutral pulses 1500 1500 1500 us; watchdog armed (100 ms)",
             ],
-            "ok\r\nok\r\nok mode=running settings=flash inputs=-,-,-,-\r\n",
+            "ok\r\nok\r\nok mode=running settings=flash inputs=-,-,-,- rate=50\r\n",
             [1500.0; 3],
         );
         first.power_cycled = true;
@@ -363,7 +363,7 @@ mod tests {
                 "settings: loaded from flash (version 2) at 0x101fc000",
                 "first frame: neutral pulses 1520 1500 1500 us; watchdog armed (100 ms)",
             ],
-            "ok\r\nok\r\nok pitch neutral=1520 per-degree=11111\r\nok mode=running settings=flash inputs=-,-,-,-\r\n",
+            "ok\r\nok\r\nok pitch neutral=1520 per-degree=11111\r\nok mode=running settings=flash inputs=-,-,-,- rate=50\r\n",
             [1520.0, 1500.0, 1500.0],
         );
         Report {

@@ -363,6 +363,8 @@ mod tests {
             .map(|frame| Row {
                 frame,
                 t_ms: frame * 20,
+                t_us: frame * 20_000,
+                period_us: 20_000,
                 // A saw tooth of 10 frames: 0..9 °.
                 angles: [i32::try_from(frame % 10).unwrap() * 1000; 3],
                 pulses: [0; 3],

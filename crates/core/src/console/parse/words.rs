@@ -114,6 +114,7 @@ keywords! {
     Pose "pose",
     Relax "relax",
     Duck "duck",
+    Rate "rate",
 }
 
 // A gesture's word must not be a word the protocol already has: the
