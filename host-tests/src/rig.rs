@@ -128,6 +128,43 @@ pub fn assert_steps_within_limits(
     }
 }
 
+/// Asserts that `frames` (as a rig played them, at any rate and across
+/// changes of it) keep the speed and acceleration limits of `behaviour`
+/// in °/s and °/s², in the mode each axis had: each step within the speed
+/// limit over the time since the last frame (+1 m° for rounding), and each
+/// step within the acceleration limit of the last step carried over to the
+/// new frame period (`Δₖ₋₁ · dtₖ / dtₖ₋₁`, the speed it was) (+3 m°).
+///
+/// # Panics
+/// At the first frame past them.
+pub fn assert_physical_limits(behaviour: &BehaviourParams, frames: &[Frame]) {
+    for axis in Axis::ALL {
+        let i = axis.index();
+        for w in frames.windows(3) {
+            let limits = behaviour.limits(axis, w[2].modes[i]);
+            let (dt0, dt1) = ((w[1].at - w[0].at) as f64, (w[2].at - w[1].at) as f64);
+            let [a, b, c] = [w[0], w[1], w[2]].map(|f| f64::from(f.angles[i]));
+            // °/s · µs = µ°; /1000: m°.
+            let step = f64::from(limits.max_speed.0) * dt1 / 1000.0 + 1.0;
+            let turn = f64::from(limits.max_accel.0) * dt1 * dt1 / 1e9 + 3.0;
+            let was = (b - a) * dt1 / dt0;
+            assert!(
+                (c - b).abs() <= step,
+                "{axis:?} at {} µs: step {} m° over {dt1} µs",
+                w[2].at,
+                c - b
+            );
+            assert!(
+                (c - b - was).abs() <= turn,
+                "{axis:?} at {} µs: step {} m° after {b} − {a} over {dt0} µs: change {:.1} m°",
+                w[2].at,
+                c - b,
+                c - b - was
+            );
+        }
+    }
+}
+
 impl Rig {
     /// The built-in behaviour, the Table 2 loops.
     #[must_use]

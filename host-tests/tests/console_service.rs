@@ -149,6 +149,67 @@ fn every_command_does_what_it_says() {
 }
 
 #[test]
+fn the_servo_rate_is_answered_set_saved_and_played() {
+    let mut c = Console::new();
+    let r = c.say(
+        "servo rate
+servo rate 333
+servo rate
+status",
+    );
+    assert_eq!(r[0], "ok servo rate=50 period_us=20000");
+    assert_eq!(r[1], "ok servo rate=333 period_us=3003");
+    assert_eq!(r[2], r[1]);
+    assert!(
+        r[3].ends_with(" settings=changed inputs=-,-,-,- rate=333"),
+        "{}",
+        r[3]
+    );
+    // The frames come 3003 µs apart from the frame after the one the rate
+    // came before; the uptime counts them.
+    assert_eq!(c.frames.config().frame_period.0, 3003);
+    let before = c.link.status().time.0;
+    c.play(1000);
+    assert_eq!(c.link.status().time.0 - before, 1000 * 3003);
+    // Out of the range: refused by the parser, nothing changes.
+    let r = c.say(
+        "servo rate 334
+servo rate 49
+servo rate fast",
+    );
+    assert!(r[0].starts_with("err range "), "{}", r[0]);
+    assert!(r[1].starts_with("err range "), "{}", r[1]);
+    assert!(r[2].starts_with("err syntax "), "{}", r[2]);
+    assert_eq!(c.frames.config().frame_period.0, 3003);
+    // Saved and loaded with the settings; `defaults` goes back to 50 Hz.
+    let r = c.say(
+        "save
+servo rate 200
+load
+servo rate
+defaults
+servo rate",
+    );
+    assert_eq!(r[0], "ok");
+    assert_eq!(r[3], "ok servo rate=333 period_us=3003");
+    assert_eq!(r[5], "ok servo rate=50 period_us=20000");
+    c.play(2);
+    assert_eq!(c.frames.config().frame_period.0, 20_000);
+    // Motion plays on through every change, within the limits.
+    let r = c.say(
+        "servo rate 250
+nod
+look 5000 9000
+servo rate 60
+shake",
+    );
+    assert_eq!(r[0], "ok servo rate=250 period_us=4000");
+    assert_eq!(r[3], "ok servo rate=60 period_us=16667");
+    c.play(300);
+    assert_eq!(c.frames.violations, 0);
+}
+
+#[test]
 fn new_servo_limits_reach_the_gestures_and_the_looks() {
     let mut c = Console::new();
     // Built in, pitch may go -12°..20°: a 22° nod is too much, and a look

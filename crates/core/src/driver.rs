@@ -49,6 +49,7 @@ mod report;
 pub use crate::units::{DegreesPerSecond, DegreesPerSecondSquared};
 pub use clock::{FrameClock, FrameTick, ZeroPeriod};
 pub use config::{DriverConfig, DriverParams, FaultPolicy, MotionLimits};
+pub use envelope::START_HOLD;
 pub use error::{ConfigError, RateError};
 pub use frame::FrameDriver;
 pub use report::{DriverStats, FrameReport, Outcome, ServoReport};

@@ -9,7 +9,7 @@ use idle_head_core::command::{GestureKind, Hold, InputRole, Percent, RestAfter};
 use idle_head_core::driver::{
     ConfigError, DegreesPerSecond, DegreesPerSecondSquared, DriverConfig,
 };
-use idle_head_core::servo::{NanosPerDegree, ServoError};
+use idle_head_core::servo::{NanosPerDegree, ServoError, ServoRate};
 use idle_head_core::settings::{
     DecodeError, FIELDS, FieldReport, FieldSet, Loaded, RamStorage, Record, SETTINGS_BUFFER,
     SETTINGS_LEN, Settings, SettingsError, SettingsStorage, SettingsStore, StorageError,
@@ -86,6 +86,7 @@ fn every_field_round_trips() {
         s.behaviour.rest.pose = [0; 3].map(|_| Angle::from_millidegrees(rng.random()));
         s.behaviour.rest.relax = rng.random_bool(0.5);
         s.behaviour.gaze.duck = Percent::new(rng.random_range(0..=100)).unwrap();
+        s.rate = ServoRate::new(rng.random_range(50..=333)).unwrap();
         s.inputs.rest_after = if rng.random_bool(0.2) {
             RestAfter::Never
         } else {
@@ -371,6 +372,40 @@ fn a_record_without_a_field_loads_with_every_other_value() {
         let mut expected = fields.clone();
         expected[i] = defaults[i].clone();
         assert_eq!(entries(&encode(&settings)), expected, "without {id}");
+    }
+}
+
+/// The servos' rate (field 90, two bytes of Hz): a record saved before it
+/// existed boots at 50 Hz; one with a rate outside 50..=333 Hz loads at
+/// 50 Hz too, the field reported as rejected; a rate saved loads as saved.
+#[test]
+fn the_rate_loads_as_saved_and_older_records_run_at_50_hz() {
+    let saved = fixture_v1();
+    let fields = entries(&encode(&saved));
+    assert!(
+        fields
+            .iter()
+            .any(|(id, value)| *id == 90 && value == &[50, 0])
+    );
+    let without: Vec<_> = fields.iter().filter(|(id, _)| *id != 90).cloned().collect();
+    let (loaded, report) = load_stored(&stored(&without));
+    assert_eq!(loaded.map(|s| s.rate), Ok(ServoRate::DEFAULT));
+    assert_eq!(report.missing, FieldSet::of(&[90]));
+    for (bytes, rate) in [
+        ([77, 1], Some(333)),
+        ([200, 0], Some(200)),
+        ([78, 1], None),
+        ([49, 0], None),
+        ([0, 0], None),
+    ] {
+        let mut record = without.clone();
+        record.push((90, bytes.to_vec()));
+        let (loaded, report) = load_stored(&stored(&record));
+        let hz = loaded.unwrap().rate.hz();
+        match rate {
+            Some(rate) => assert_eq!((hz, report.rejected), (rate, FieldSet::EMPTY)),
+            None => assert_eq!((hz, report.rejected), (50, FieldSet::of(&[90]))),
+        }
     }
 }
 

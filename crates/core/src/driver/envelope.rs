@@ -1,21 +1,32 @@
 //! Fade envelope: smoothstep gain that fades the idle motion in and out.
 //!
 //! The gain at level `l` µs into a fade of `n` µs is `S(x) = x²(3 − 2x)` at
-//! `x = ⌊l·2¹⁶/n⌋` (Q16), rounded down. The envelope keeps `x` and the
-//! remainder `l·2¹⁶ mod n` as the level moves by one frame period `F` a
-//! frame, adding or taking away `⌊F·2¹⁶/n⌋` and `F·2¹⁶ mod n` (worked out
-//! with the envelope, and again when the frame period changes) with a
-//! carry: exactly the quotient, and no division on the frame path. A step
-//! that would pass an end stops on it. `S` is formed from 16-bit halves:
-//! `x² = qₕ·2¹⁶ + qₗ`, `c = 3·2¹⁶ − 2x = cₕ·2¹⁶ + cₗ`, `⌊x²c/2³²⌋ = ⌊(qₕc +
-//! qₗcₕ + ⌊qₗcₗ/2¹⁶⌋)/2¹⁶⌋`. Every partial sum is at most `x²c/2¹⁶ =
-//! 2³²·S(x/2¹⁶) < 2³²` for `x < 2¹⁶`: `u32` throughout.
+//! `x = ⌊l·2¹⁶/n⌋` (Q16), rounded down (0 for `l ≤ 0`, 1 from `l = n` on).
+//! The envelope keeps `x` and the remainder `l·2¹⁶ mod n` as the level
+//! moves by one frame period `F` a frame, adding or taking away
+//! `⌊F·2¹⁶/n⌋` and `F·2¹⁶ mod n` (worked out with the envelope, and again
+//! when the frame period changes) with a carry: exactly the quotient, and
+//! no division on the frame path. A step that would pass an end stops on
+//! it. `S` is formed from 16-bit halves: `x² = qₕ·2¹⁶ + qₗ`, `c = 3·2¹⁶ −
+//! 2x = cₕ·2¹⁶ + cₗ`, `⌊x²c/2³²⌋ = ⌊(qₕc + qₗcₕ + ⌊qₗcₗ/2¹⁶⌋)/2¹⁶⌋`. Every
+//! partial sum is at most `x²c/2¹⁶ = 2³²·S(x/2¹⁶) < 2³²` for `x < 2¹⁶`:
+//! `u32` throughout.
+//!
+//! The level is time: the fade-in after the start begins [`START_HOLD`]
+//! after the start frame (its level starts that far below 0), whatever the
+//! frame rate.
+
+use crate::units::Microseconds;
 
 /// Gain scale: Q16, 1.0 = 65 536.
 pub(crate) const UNITY: u32 = 1 << 16;
 
 /// The longest fade, µs (about 35 minutes).
 pub(crate) const MAX_FADE: u32 = (1 << 31) - 1;
+
+/// How long the neutral pulses hold after the start frame before the
+/// fade-in begins: one frame at 50 Hz, the same time at any rate.
+pub const START_HOLD: Microseconds = Microseconds(20_000);
 
 /// A gain ramping between 0 and 1 over `fade` µs along a smoothstep
 /// (3x² − 2x³: continuous in value and slope, flat at both ends), one
@@ -26,8 +37,9 @@ pub(crate) struct Envelope {
     /// The fade, µs (below 2³¹: the remainders' sums fit `u32`; 0: no
     /// fade).
     fade: u32,
-    /// µs into the fade, `0..=fade`.
-    level: u32,
+    /// µs into the fade, `−START_HOLD..=fade` (below 0 only before the
+    /// fade-in begins).
+    level: i32,
     /// The frame period, µs.
     frame: u32,
     stopping: bool,
@@ -35,8 +47,8 @@ pub(crate) struct Envelope {
     /// end, and not held since).
     stepped: bool,
     /// `⌊level·2¹⁶/fade⌋` and `level·2¹⁶ mod fade` (0 and 0 when `fade`
-    /// is 0).
-    x: u32,
+    /// is 0; `x` below 0 before the fade-in begins).
+    x: i32,
     rem: u32,
     /// `⌊F·2¹⁶/fade⌋` and `F·2¹⁶ mod fade`: what one frame adds.
     step: u32,
@@ -62,13 +74,34 @@ impl Envelope {
         envelope
     }
 
+    /// The start frame was written (the neutral pulses, at time 0): the
+    /// fade-in begins [`START_HOLD`] after it, and the next frame comes a
+    /// frame period after it.
+    pub(crate) const fn start(&mut self) {
+        if self.fade == 0 || self.stopping {
+            return;
+        }
+        self.set_level(-(START_HOLD.0 as i64));
+        self.advance();
+    }
+
     /// Frames come `frame` µs apart from the next frame on. The last frame
     /// moved the level by the old period towards the next frame's; if it
     /// moved a whole period, the level moves by the difference too, so that
     /// the next frame's gain is the one `frame` µs after the last's.
     pub(crate) const fn set_frame_period(&mut self, frame: u32) {
         if self.stepped {
-            self.shift(frame as i64 - self.frame as i64);
+            let by = frame as i64 - self.frame as i64;
+            let by = if self.stopping { -by } else { by };
+            let level = self.level as i64 + by;
+            let top = self.fade as i64;
+            self.set_level(if level < 0 && self.stopping {
+                0
+            } else if level > top {
+                top
+            } else {
+                level
+            });
         }
         self.frame = frame;
         // F·2¹⁶ < 2⁴⁸: u64, divided here, not on the frame path.
@@ -89,33 +122,24 @@ impl Envelope {
         self.step_rem = step_rem as u32;
     }
 
-    /// Puts the level `by` µs further along the way it moves (negative:
-    /// back). Divides (between frames, once per change of the frame
-    /// period).
-    const fn shift(&mut self, by: i64) {
-        let moving = if self.stopping {
-            self.level > 0
-        } else {
-            self.level < self.fade
-        };
-        if !moving {
+    /// Puts the level at `level` µs (within `−START_HOLD..=fade`), `x` and
+    /// the remainder with it. Divides (between frames).
+    const fn set_level(&mut self, level: i64) {
+        let fade = self.fade as i64;
+        if fade == 0 {
             return;
         }
-        let by = if self.stopping { -by } else { by };
-        let level = self.level as i64 + by;
-        let level = if level < 0 {
-            0
-        } else if level > self.fade as i64 {
-            self.fade as i64
-        } else {
-            level
-        };
-        self.level = level as u32;
-        let scaled = (level as u64) << 16;
-        let fade = self.fade as u64;
-        (self.x, self.rem) = match (scaled.checked_div(fade), scaled.checked_rem(fade)) {
-            (Some(q), Some(r)) => (q as u32, r as u32),
+        self.level = level as i32;
+        // ⌊level·2¹⁶/fade⌋ rounded down, also below 0.
+        let scaled = level << 16;
+        let (q, r) = match (scaled.checked_div(fade), scaled.checked_rem(fade)) {
+            (Some(q), Some(r)) => (q, r),
             _ => (0, 0),
+        };
+        (self.x, self.rem) = if r < 0 {
+            ((q - 1) as i32, (r + fade) as u32)
+        } else {
+            (q as i32, r as u32)
         };
     }
 
@@ -125,7 +149,7 @@ impl Envelope {
     /// comparison.
     #[inline]
     pub(crate) const fn next_gain(&mut self) -> u32 {
-        if self.level >= self.fade && !self.stopping {
+        if self.level >= self.fade as i32 && !self.stopping {
             return UNITY;
         }
         let gain = self.gain();
@@ -135,18 +159,18 @@ impl Envelope {
 
     /// The current gain in Q16 (`0..=65 536`).
     pub(crate) const fn gain(&self) -> u32 {
-        if self.level >= self.fade {
+        if self.level >= self.fade as i32 {
             return if self.fade == 0 && self.stopping {
                 0
             } else {
                 UNITY
             };
         }
-        if self.level == 0 {
+        if self.level <= 0 {
             return 0;
         }
         // 0 < level < fade, so 0 < x < 2¹⁶.
-        smoothstep(self.x)
+        smoothstep(self.x as u32)
     }
 
     /// Moves the level one frame on (towards zero while stopping), onto an
@@ -154,35 +178,36 @@ impl Envelope {
     pub(crate) const fn advance(&mut self) {
         self.stepped = false;
         if self.stopping {
-            if self.level <= self.frame {
+            if self.level <= self.frame as i32 {
                 (self.level, self.x, self.rem) = (0, 0, 0);
             } else {
                 self.stepped = true;
-                self.level -= self.frame;
+                self.level -= self.frame as i32;
                 // (x, rem) − (step, step_rem), borrowing `fade` from x; the
                 // result is level·2¹⁶ ≥ 0 divided by fade.
                 if self.rem < self.step_rem {
                     self.rem += self.fade - self.step_rem;
-                    self.x -= self.step + 1;
+                    self.x -= self.step as i32 + 1;
                 } else {
                     self.rem -= self.step_rem;
-                    self.x -= self.step;
+                    self.x -= self.step as i32;
                 }
             }
-        } else if self.level < self.fade {
-            if self.fade - self.level <= self.frame {
-                (self.level, self.x, self.rem) = (self.fade, UNITY, 0);
+        } else if self.level < self.fade as i32 {
+            // fade − level < 2³¹ + START_HOLD: u32.
+            if (self.fade as i64 - self.level as i64) <= self.frame as i64 {
+                (self.level, self.x, self.rem) = (self.fade as i32, UNITY as i32, 0);
             } else {
                 self.stepped = true;
-                self.level += self.frame;
+                self.level += self.frame as i32;
                 // (x, rem) + (step, step_rem), carrying when rem reaches
                 // fade (both below it: no overflow as written).
                 if self.rem >= self.fade - self.step_rem {
                     self.rem -= self.fade - self.step_rem;
-                    self.x += self.step + 1;
+                    self.x += self.step as i32 + 1;
                 } else {
                     self.rem += self.step_rem;
-                    self.x += self.step;
+                    self.x += self.step as i32;
                 }
             }
         }

@@ -129,13 +129,16 @@ impl<P: SetDutyCycle> FrameDriver<P> {
     }
 
     /// Writes every servo's neutral pulse (0°): the first pulse a servo ever
-    /// receives. The idle motion then fades in from the next frame on.
-    /// Once started, it writes nothing and returns the last frame's report.
+    /// receives. The idle motion then fades in, from
+    /// [`START_HOLD`](super::START_HOLD) on (at 50 Hz: from the next frame
+    /// on). Once started, it writes nothing and returns the last frame's
+    /// report.
     pub fn start(&mut self) -> FrameReport {
         if self.started {
             return self.last;
         }
         self.started = true;
+        self.envelope.start();
         for i in 0..3 {
             let report = self.write_servo(i, Angle::ZERO);
             if let Some(slot) = self.last.servos.get_mut(i) {
