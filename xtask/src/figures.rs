@@ -172,8 +172,15 @@ pub struct PrecomputeRow {
 /// A frame cost row of the benchmark.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct FrameCost {
-    /// `frame`, `frame (gesture + look)`.
+    /// `frame`, `frame (gesture + look)`, `frame at 333 Hz`.
     pub label: String,
+    /// The servo rate it was measured at, Hz (absent in older figures: 50).
+    #[serde(default)]
+    pub rate: Option<u32>,
+    /// The CPU load of the mean frame at that rate, % (1 ns an
+    /// instruction).
+    #[serde(default)]
+    pub load_percent: Option<f64>,
     /// Frames measured.
     pub frames: u64,
     /// Fewest instructions.

@@ -166,6 +166,44 @@ fn join_frames_lie_between_the_two_loops_and_inside_the_ranges() {
 }
 
 #[test]
+fn at_333_hz_a_frame_does_not_depend_on_the_frames_before_it_either() {
+    // 3003 µs frames: a join's start falls between two frames; the set
+    // taken over is entered where the cursor stands (no division), which
+    // must be where its time puts it (located from the time, after a skip).
+    let period = 3003;
+    let timing_at = |t: IdleTiming| IdleTiming {
+        playback: t.playback.with_frame_period(Microseconds(period)),
+        ..t
+    };
+    let fresh = || {
+        let t = timing_at(timing());
+        let mut stream = Stream::new(DEFAULT_HEAD, &t);
+        let mut first = Box::new(Set::new());
+        stream.next_into(&mut first).unwrap();
+        let supply = GenerateOnTake::new(stream, Box::new(Set::new()));
+        IdlePlayer::new(first, supply, t, IdleMode::NeverRepeating)
+    };
+    let at = |k: u64| Timestamp(k * u64::from(period));
+    // Through two joins (28 s and 56 s).
+    let frames = 60_000_000 / u64::from(period);
+    let mut p = fresh();
+    let all: Vec<[i32; 3]> = (0..frames)
+        .map(|k| p.offsets(at(k)).map(|a| a.millidegrees()))
+        .collect();
+    assert_eq!(p.stats().joins, 2);
+    let mut p = fresh();
+    let mut k = 0u64;
+    while k < frames {
+        assert_eq!(
+            p.offsets(at(k)).map(|a| a.millidegrees()),
+            all[k as usize],
+            "frame {k}"
+        );
+        k += 1 + (k * 7 + 3) % 5;
+    }
+}
+
+#[test]
 fn a_frame_does_not_depend_on_the_frames_skipped_before_it() {
     let all = play(DEFAULT_HEAD, IdleMode::NeverRepeating, 4500);
     let mut p = player(DEFAULT_HEAD, IdleMode::NeverRepeating);

@@ -90,6 +90,7 @@ fn frame_row_is_parsed_and_held_to_its_ceiling() {
     assert_eq!(
         row,
         FrameRow {
+            rate: 50,
             scenario: None,
             frames: 1601,
             min: 930,
@@ -100,20 +101,43 @@ fn frame_row_is_parsed_and_held_to_its_ceiling() {
         }
     );
     assert!(row.within_budget());
-    assert!(row.lines().contains("frame                    1601"));
     assert!(
         row.lines()
-            .contains("ceiling: median 945 against 1,000: ok; max 1,861 against 2,000: ok")
+            .contains(&format!("{:<32} {:>6}", "frame", 1601))
+    );
+    assert!(
+        row.lines()
+            .contains("ceiling: median 945 against 1,200: ok; max 1,861 against 4,000: ok")
     );
     assert!(!row.lines().contains("OVER"));
+    // 1084 instructions of 1 ns in 20 ms.
+    assert!(row.lines().contains("CPU load 0.0054 %"), "{}", row.lines());
     let slow = FrameRow {
-        median: 1001,
+        median: 1201,
         ..row.clone()
     };
     assert!(!slow.within_budget());
-    assert!(slow.lines().contains("median 1,001 against 1,000: OVER"));
-    let spiky = FrameRow { max: 2001, ..row };
+    assert!(slow.lines().contains("median 1,201 against 1,200: OVER"));
+    let spiky = FrameRow { max: 4001, ..row };
     assert!(!spiky.within_budget());
+    // At 333 Hz: its own label, the period rounded to 3003 µs, the load
+    // over it.
+    let fast = FrameRow::parse(
+        "frame bench rate=333 frames=1601 min=930 median=945 max=1861 max_at=7 mean=1084",
+    )
+    .unwrap()
+    .unwrap();
+    assert_eq!(
+        (fast.rate, fast.label()),
+        (333, "frame at 333 Hz".to_owned())
+    );
+    assert_eq!(fast.period_us(), 3003);
+    assert!((fast.load_percent() - 0.0361).abs() < 1e-4);
+    assert!(
+        fast.lines().contains("CPU load 0.0361 %"),
+        "{}",
+        fast.lines()
+    );
     assert!(
         FrameRow::parse("bench row=default n=900")
             .unwrap()
@@ -127,7 +151,11 @@ fn frame_row_is_parsed_and_held_to_its_ceiling() {
         "frame bench scenario=gesture+look frames=1601 min=1 median=2 max=3 max_at=4 mean=5";
     let active = FrameRow::parse(active).unwrap().unwrap();
     assert_eq!(active.scenario.as_deref(), Some("gesture+look"));
-    assert!(active.lines().contains("frame (gesture + look)   1601"));
+    assert!(
+        active
+            .lines()
+            .contains(&format!("{:<32} {:>6}", "frame (gesture + look)", 1601))
+    );
 }
 
 #[test]
@@ -141,38 +169,45 @@ fn each_frame_row_is_held_to_its_own_ceiling_and_named() {
     )
     .unwrap()
     .unwrap();
-    // 1,430 is over the idle row's 1,000 but within this row's 1,500:
+    let busy = FrameRow {
+        median: 1830,
+        ..busy
+    };
+    // 1,830 is over the idle row's 1,200 but within this row's 2,000:
     // no OVER printed for it, and the bench passes.
     assert!(busy.within_budget());
     assert!(!busy.lines().contains("OVER"), "{}", busy.lines());
-    assert!(busy.lines().contains("median 1,430 against 1,500: ok"));
+    assert!(busy.lines().contains("median 1,830 against 2,000: ok"));
     assert_eq!(frames_over_budget(&[idle.clone(), busy.clone()]), None);
     let slow_busy = FrameRow {
-        median: 1501,
+        median: 2001,
+        rate: 333,
         ..busy.clone()
     };
     assert!(
         slow_busy
             .lines()
-            .contains("median 1,501 against 1,500: OVER")
+            .contains("median 2,001 against 2,000: OVER")
     );
     let message = frames_over_budget(&[idle.clone(), slow_busy]).unwrap();
     assert_eq!(
         message,
-        "frame update over its ceiling: row `frame (gesture + look)` takes 1,501 \
-         instructions at the median and 1,900 at most (ceiling 1,500 and 2,000)"
+        "frame update over its ceiling: row `frame (gesture + look) at 333 Hz` takes 2,001 \
+         instructions at the median and 1,900 at most (ceiling 2,000 and 4,000)"
     );
-    let spiky_idle = FrameRow { max: 2001, ..idle };
+    let spiky_idle = FrameRow { max: 4001, ..idle };
     let message = frames_over_budget(&[spiky_idle, busy]).unwrap();
-    assert!(message.contains("`frame` takes 890 instructions at the median and 2,001"));
+    assert!(message.contains("`frame` takes 890 instructions at the median and 4,001"));
     assert!(!message.contains("gesture"), "{message}");
 }
 
 #[test]
-fn a_frame_row_of_an_unknown_scenario_is_an_error() {
+fn a_frame_row_of_an_unknown_scenario_or_a_missing_rate_is_an_error() {
     let log: Vec<LogLine> = [
-        "frame bench frames=2 min=1 median=1 max=1 max_at=0 mean=1",
-        "frame bench scenario=gesture+look frames=2 min=1 median=1 max=1 max_at=0 mean=1",
+        "frame bench rate=50 frames=2 min=1 median=1 max=1 max_at=0 mean=1",
+        "frame bench rate=50 scenario=gesture+look frames=2 min=1 median=1 max=1 max_at=0 mean=1",
+        "frame bench rate=333 frames=2 min=1 median=1 max=1 max_at=0 mean=1",
+        "frame bench rate=333 scenario=gesture+look frames=2 min=1 median=1 max=1 max_at=0 mean=1",
         "frame bench scenario=juggling frames=2 min=1 median=1 max=1 max_at=0 mean=1",
     ]
     .into_iter()
@@ -180,5 +215,10 @@ fn a_frame_row_of_an_unknown_scenario_is_an_error() {
     .collect();
     let err = FrameRow::all(&log).unwrap_err().to_string();
     assert!(err.contains("`frame (juggling)`"), "{err}");
-    assert_eq!(FrameRow::all(&log[..2]).unwrap().len(), 2);
+    assert_eq!(FrameRow::all(&log[..4]).unwrap().len(), 4);
+    let err = FrameRow::all(&log[..3]).unwrap_err().to_string();
+    assert!(
+        err.contains("no `frame bench rate=333 scenario=gesture+look` line"),
+        "{err}"
+    );
 }

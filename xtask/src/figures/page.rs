@@ -174,22 +174,28 @@ fn frames(bench: &Bench) -> String {
     let mut out = recorded_by(&bench.source);
     out.push_str(
         "Instructions of one frame update (`FrameLoop::write`: playback, mixer, fade, \
-         limits, mapping, three PWM writes) over every frame of a whole loop, counted \
-         exactly in QEMU ([what a frame costs](limiter.md#what-a-frame-costs)). A 20 ms \
-         frame has 2,500,000 cycles of a 125 MHz RP2040.\n\n\
-         | row | frames | min | median | max | mean | ceiling (median / max) | median at 125 MHz |\n\
-         |---|---|---|---|---|---|---|---|\n",
+         limits, mapping, three PWM writes) over the frames of a whole loop (the fade-in \
+         and a join), counted exactly in QEMU ([what a frame costs](limiter.md#what-a-frame-costs)), \
+         at the servo rates 50 Hz (20 ms frames: 2,500,000 cycles of a 125 MHz RP2040) and \
+         333 Hz (3003 µs: 375,375 cycles). The CPU load is the mean frame's work over the \
+         frame period, an instruction taken as 1 ns (QEMU's time under `-icount shift=0`; a \
+         Cortex-M0+ at 125 MHz takes about ten times that).\n\n\
+         | row | rate | frames | min | median | max | mean | CPU load | ceiling (median / max) | median at 125 MHz |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
     );
     for row in &bench.frames {
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {} | {} | {} / {} | ≥ {:.1} µs |",
+            "| {} | {} Hz | {} | {} | {} | {} | {} | {} | {} / {} | ≥ {:.1} µs |",
             row.label,
+            row.rate.unwrap_or(50),
             thousands(row.frames),
             thousands(row.min),
             thousands(row.median),
             thousands(row.max),
             thousands(row.mean),
+            row.load_percent
+                .map_or_else(|| "–".to_owned(), |load| format!("{load:.4} %")),
             thousands(row.median_budget),
             thousands(row.max_budget),
             row.median as f64 / RP2040_MHZ,
@@ -400,6 +406,8 @@ mod tests {
             }],
             frames: vec![FrameCost {
                 label: "frame (gesture + look)".into(),
+                rate: Some(50),
+                load_percent: Some(0.0074),
                 frames: 1601,
                 min: 1292,
                 median: 1433,

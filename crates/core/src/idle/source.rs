@@ -56,16 +56,16 @@ pub struct IdlePlayer<H, S> {
     /// else the next join (`u64::MAX`: never).
     event: u64,
     cursor: Cursor,
-    /// A cursor at time 0 with nothing read, for each new set (made once,
-    /// and again when the frame rate changes: making one divides in 64
-    /// bits).
-    fresh: Cursor,
     supply: S,
     timing: IdleTiming,
     /// [`IdleTiming::join_read_us`], worked out once (it divides in 64
     /// bits, which would otherwise cost the frame a join starts at some
     /// 300 instructions).
     join_read: u64,
+    /// Where a set stands when the next one takes over (at `L − J`), as
+    /// the cursor keeps it ([`Cursor::position_of`]): the new set's
+    /// position is the cursor's less this, without a division.
+    join_shift: (u32, u32),
     /// Whether sets follow each other.
     stream: bool,
     stats: IdleStats,
@@ -116,10 +116,10 @@ where
             joining: false,
             event,
             cursor: fresh,
-            fresh,
             supply,
             timing,
             join_read: timing.join_read_us(),
+            join_shift: fresh.position_of(timing.period_us()),
             stream,
             stats: IdleStats {
                 joins: 0,
@@ -138,11 +138,10 @@ where
         self.cursor.offsets(at, &*self.current)
     }
 
-    /// Frames come `period` apart after the last one played: the cursors
-    /// take the new step (between frames: the divisions happen here).
+    /// Frames come `period` apart after the last one played: the cursor
+    /// takes the new step (between frames: the divisions happen here).
     pub const fn set_frame_period(&mut self, period: Microseconds) {
         self.timing.playback = self.timing.playback.with_frame_period(period);
-        self.fresh = Cursor::new(self.timing.playback);
         self.cursor.set_frame_period(period);
     }
 
@@ -192,8 +191,9 @@ where
         self.supply.give_back(outgoing);
         self.origin = self.origin.wrapping_add(self.event);
         let local = local - self.event;
-        self.cursor = self.fresh;
-        self.cursor.restart_at(self.origin);
+        // The new set from where the cursor stands (same loop length and
+        // samples: the same steps), or, after a late frame, from its time.
+        self.cursor.rebase(self.origin, self.join_shift);
         self.joining = true;
         self.event = self.join_read;
         self.stats.joins = self.stats.joins.saturating_add(1);

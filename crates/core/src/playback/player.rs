@@ -131,9 +131,20 @@ pub struct Cursor {
     incremental: bool,
     /// Whether `pos` and `rem` belong to `here`.
     positioned: bool,
-    /// Whether `windows` hold the segment around `pos` (else only its first
-    /// sample, `pos` being on it).
-    loaded: bool,
+    /// What `windows` hold.
+    read: Read,
+}
+
+/// What a [`Cursor`]'s windows hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Read {
+    /// The first sample of `pos`'s segment only (`pos` on it).
+    Sample,
+    /// The segment around `pos`.
+    Segment,
+    /// Other loops' samples (after [`Cursor::rebase`]): the next frame
+    /// reads whole windows.
+    Stale,
 }
 
 impl Cursor {
@@ -165,10 +176,57 @@ impl Cursor {
             ahead: 0,
             incremental,
             positioned: false,
-            loaded: false,
+            read: Read::Sample,
         };
         cursor.set_frame_period(playback.frame_period());
         cursor
+    }
+
+    /// The position of time `at` (µs from the loops' start) as the cursor
+    /// keeps it: `⌊X/L⌋` and `(X mod L)/g` (see the module docs; divides).
+    #[must_use]
+    pub const fn position_of(&self, at: u64) -> (u32, u32) {
+        let (pos, rem) = self.playback.locate_at(at, T_BITS);
+        let g = match self.playback.loop_us.get().checked_div(self.den as u64) {
+            Some(g) => g,
+            None => 1,
+        };
+        let rem = match rem.checked_div(g) {
+            Some(r) => r,
+            None => 0,
+        };
+        (pos as u32, rem as u32)
+    }
+
+    /// Plays other loops of the same playback from time `origin` on, where
+    /// these loops stood at `shift` (a [`position_of`](Self::position_of)):
+    /// the position goes on from where it is, less `shift`, and the next
+    /// frame reads whole windows of the new loops; no division (a join
+    /// lands between two frames at most rates). Not positioned yet, the
+    /// next frame is located from its time.
+    pub const fn rebase(&mut self, origin: u64, shift: (u32, u32)) {
+        self.origin = origin;
+        if !self.positioned || !self.incremental {
+            return;
+        }
+        let wrap = (self.playback.samples.get() as u32) << T_BITS;
+        // (pos, rem) − shift, borrowing from pos, modulo the loop.
+        let (mut pos, mut rem) = (self.pos, self.rem);
+        if rem < shift.1 {
+            rem += self.den - shift.1;
+            pos = if pos == 0 { wrap - 1 } else { pos - 1 };
+        } else {
+            rem -= shift.1;
+        }
+        let shift = if shift.0 >= wrap { 0 } else { shift.0 };
+        pos = if pos >= shift {
+            pos - shift
+        } else {
+            pos + wrap - shift
+        };
+        self.pos = pos;
+        self.rem = rem;
+        self.read = Read::Stale;
     }
 
     /// Frames come `period` apart from the last frame played on: the step
@@ -228,12 +286,12 @@ impl Cursor {
             let before = self.pos;
             self.advance();
             self.here = at;
-            if self.loaded {
-                self.follow(before, loops);
-            } else {
-                self.complete(before, loops);
+            match self.read {
+                Read::Segment => self.follow(before, loops),
+                Read::Sample => self.complete(before, loops),
+                Read::Stale => self.load((self.pos >> T_BITS) as usize, loops),
             }
-        } else if at != self.here || !self.positioned {
+        } else if at != self.here || !self.positioned || self.read == Read::Stale {
             self.seek(at, loops);
         }
         let t = self.pos & ((1 << T_BITS) - 1);
@@ -290,7 +348,7 @@ impl Cursor {
                 *window = Window::flat(loops.axis(i).angle(index).millidegrees());
             }
             self.ahead = 0;
-            self.loaded = false;
+            self.read = Read::Sample;
         } else {
             self.load(index, loops);
         }
@@ -354,7 +412,7 @@ impl Cursor {
             window.complete(loops.axis(i), n, index);
         }
         self.ahead = 0;
-        self.loaded = true;
+        self.read = Read::Segment;
     }
 
     /// Reads the windows around sample `index`.
@@ -364,7 +422,7 @@ impl Cursor {
             *window = Window::load(loops.axis(i), n, index);
         }
         self.ahead = 0;
-        self.loaded = true;
+        self.read = Read::Segment;
     }
 }
 
