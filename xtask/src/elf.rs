@@ -12,10 +12,10 @@ use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, Sect
 /// RAM budget of the Pico image: static RAM (`.data + .bss + .uninit`) plus
 /// the peak stack measured in the RP2040 emulator (the boot precompute's
 /// stack frame is most of it).
-pub const RAM_BUDGET: u64 = 32 * 1024;
+pub const RAM_BUDGET: u64 = 48 * 1024;
 /// Flash budget of the Pico image: everything stored in flash
 /// (`.boot2 + .vector_table + .text + .rodata` and `.data`'s initial values).
-pub const FLASH_BUDGET: u64 = 128 * 1024;
+pub const FLASH_BUDGET: u64 = 192 * 1024;
 /// Where the RP2040 boot ROM looks for the 256-byte second-stage bootloader:
 /// the first flash page (XIP base `0x1000_0000`).
 pub const BOOT2_ADDRESS: u64 = 0x1000_0000;
