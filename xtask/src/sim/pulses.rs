@@ -3,19 +3,21 @@
 //!
 //! # How PWM periods map to frames
 //!
-//! Frame `k` is due at `start + k · 20 ms`; the firmware writes its duty a
-//! little later (`δ_k`: wake-up and the frame update). The slice's period
-//! `P` is exactly 20 ms (64 000 counts of 312.5 ns), from the same crystal
-//! as the frames' timer.
+//! Frame `k` is due at `start + k · P`, `P` the frame period of the run's
+//! servo rate (20 ms at 50 Hz, 3003 µs at 333 Hz: [`Timing`]); the firmware
+//! writes its duty a little later (`δ_k`: wake-up and the frame update).
+//! The slice's period is exactly `P` (64 000 counts of 312.5 ns at 50 Hz),
+//! from the same crystal as the frames' timer.
 //!
-//! - Frame 0 writes the compare value, sets the counter half a period in
-//!   (above the compare value: the output stays low) and enables the slice
-//!   (at time `e`). Wrap `j` comes at `e + (j − ½) · P`.
+//! - Frame 0 writes the compare value, sets the counter a tenth of a
+//!   period before its wrap (above the compare value: the output stays
+//!   low) and enables the slice (at time `e`). Wrap `j` comes at
+//!   `e + (j − 0.9) · P`.
 //! - A compare write while running is latched at the next wrap. Frame `k`
 //!   is written at `e + k · P + (δ_k − δ_0)`, between wraps `k` and `k + 1`
-//!   as long as `|δ_k − δ_0| < P / 2` (10 ms; the frame update takes
-//!   microseconds): it is latched at wrap `k + 1`, and the pulse starting
-//!   there, the `k`-th, carries it.
+//!   as long as `δ_k − δ_0` stays within a tenth of a period (the frame
+//!   update takes microseconds): it is latched at wrap `k + 1`, and the
+//!   pulse starting there, the `k`-th, carries it.
 //!
 //! So the pulse of period `n` must carry frame `n`, and the check verifies
 //! exactly that from the write times instead of assuming it: for every

@@ -5,21 +5,31 @@
 //! The script is `cargo xtask trace --script`'s (`trace/script.rs`): its
 //! pin lines drive GP2 to GP5 (each at its pull until then: the harness
 //! models the pads' pulls), its console lines (motion commands too) go to
-//! UART0 at 115200 baud, each in 2 ms before its time so that the frame due
-//! then has it, as the host trace takes a line before the frame at its
-//! time. Times count from the first frame, the enable of the pitch servo's
-//! slice. The host trace plays the same script on the same core; the
-//! emulator's pulses must be its duties frame for frame, within a count,
-//! and no pulse may leave a servo's limits.
+//! UART0 at 115200 baud, each in 2 ms before the first frame at or after
+//! its time so that that frame has it, as the host trace takes a line
+//! before the first frame at or after its time. Times count from the first
+//! frame, the enable of the pitch servo's slice. The host trace plays the
+//! same script on the same core; the emulator's pulses must be its duties
+//! frame for frame, within a count, and no pulse may leave a servo's
+//! limits.
+//!
+//! At another servo rate than 50 Hz (`--rate`), the image boots on
+//! settings of that rate, planted in its settings sectors (as a `save`
+//! leaves them), and the host trace and the check run at it.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{Context, Result, anyhow};
 
+use idle_head_core::servo::ServoRate;
+use idle_head_core::settings::Settings;
+
 use super::harness::{self, SERVOS};
 use super::node::PinScript;
+use super::planted;
 use super::run::{self, Report};
+use crate::elf;
 use crate::project::{Metadata, PICO};
 use crate::trace::{self, Event, Kind};
 
@@ -70,11 +80,34 @@ pub enum Against {
 pub fn play(
     root: &Path,
     metadata: &Metadata,
-    mut events: Vec<Event>,
+    events: Vec<Event>,
     time: Duration,
     wall: Duration,
     against: Against,
 ) -> Result<Report> {
+    play_at(
+        root,
+        metadata,
+        events,
+        time,
+        wall,
+        against,
+        ServoRate::DEFAULT,
+    )
+}
+
+/// [`play`] with the servos at `rate` from the first frame (the image
+/// boots on settings of that rate).
+pub fn play_at(
+    root: &Path,
+    metadata: &Metadata,
+    mut events: Vec<Event>,
+    time: Duration,
+    wall: Duration,
+    against: Against,
+    rate: ServoRate,
+) -> Result<Report> {
+    let period = u64::from(rate.period().0);
     let up = u64::try_from(CONSOLE_UP.as_micros()).unwrap_or(u64::MAX);
     for event in &mut events {
         if !matches!(event.kind, Kind::Pin { .. }) && event.at_us < up {
@@ -93,17 +126,33 @@ pub fn play(
         match event.kind {
             Kind::Pin { input, high } => script.pins.push((at, input, high)),
             Kind::Act(_) | Kind::Console => {
+                // In before the frame that takes it in the host trace.
+                let frame = Duration::from_micros(event.at_us.next_multiple_of(period));
                 script
                     .lines
-                    .push((at, format!("{}\r\n", event.text).into_bytes()));
+                    .push((frame, format!("{}\r\n", event.text).into_bytes()));
             }
         }
     }
+    let planted = if rate == ServoRate::DEFAULT {
+        None
+    } else {
+        let region = elf::Image::read(&PICO.elf(metadata))?
+            .settings
+            .context("the image has no settings region")?;
+        let settings = Settings {
+            rate,
+            ..Settings::DEFAULT
+        };
+        let len = usize::try_from(region.end - region.start)?;
+        Some((region.start, planted::settings_sectors(&settings, len)?))
+    };
     // The boot before the first frame: well under a tenth of a second.
     let boot = Duration::from_millis(100);
     let mut report = run::run_with(root, &PICO.elf(metadata), time + boot, wall, |config| {
         config.inputs = harness::input_pins();
         config.script = Some(script);
+        config.flash_fill = planted;
         // A head relaxed at rest is silent for as long as it rests (no
         // pulse, no log line but once a loop): the wall limit alone tells a
         // stuck run.
@@ -116,14 +165,14 @@ pub fn play(
             let host = trace::simulate(
                 u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX),
                 None,
-                idle_head_core::servo::ServoRate::DEFAULT,
+                rate,
                 &events,
             )?;
             host.rows.iter().map(|row| row.duties).collect()
         }
         Against::Written => written(&report),
     };
-    run::check_with(&mut report, &expected);
+    run::check_at(&mut report, &expected, rate);
     Ok(report)
 }
 
@@ -147,19 +196,19 @@ fn written(report: &Report) -> Vec<[u16; 3]> {
         .collect()
 }
 
-/// `cargo xtask sim --script FILE [--pulses CSV]`.
+/// `cargo xtask sim --script FILE [--rate HZ] [--pulses CSV]`.
 pub fn command(
     root: &Path,
     metadata: &Metadata,
     path: &Path,
-    time: Option<Duration>,
-    wall: Duration,
+    (time, wall): (Option<Duration>, Duration),
+    rate: ServoRate,
     pulses: Option<&PathBuf>,
 ) -> Result<bool> {
     PICO.build(root)?;
     let events = read(path)?;
     let time = time.unwrap_or_else(|| default_time(&events));
-    let report = play(root, metadata, events, time, wall, Against::Host)?;
+    let report = play_at(root, metadata, events, time, wall, Against::Host, rate)?;
     print!("{}", report.log_text(false));
     if let Some(boot) = report.boots.first() {
         println!("UART0 replies:");
@@ -176,7 +225,7 @@ pub fn command(
     );
     println!("{}", report.summary());
     if let (Some(path), Some(boot)) = (pulses, report.boots.first()) {
-        let rows = super::pulses_csv::write(path, &boot.trains, &run::timing())?;
+        let rows = super::pulses_csv::write(path, &boot.trains, &run::timing_at(rate))?;
         println!("wrote {} ({rows} frames)", path.display());
     }
     Ok(report.problems.is_empty())
