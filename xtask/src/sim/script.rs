@@ -20,7 +20,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Context, Result, anyhow, bail};
 
 use idle_head_core::servo::ServoRate;
 use idle_head_core::settings::Settings;
@@ -107,6 +107,14 @@ pub fn play_at(
     against: Against,
     rate: ServoRate,
 ) -> Result<Report> {
+    if let Some(e) = events.iter().find(|e| changes_rate(&e.text)) {
+        bail!(
+            "{:.3} s `{}`: the emulator's pulse check runs at one servo rate; \
+             give it with --rate (`cargo xtask trace` plays a change of rate)",
+            Duration::from_micros(e.at_us).as_secs_f64(),
+            e.text
+        );
+    }
     let period = u64::from(rate.period().0);
     let up = u64::try_from(CONSOLE_UP.as_micros()).unwrap_or(u64::MAX);
     for event in &mut events {
@@ -176,6 +184,15 @@ pub fn play_at(
     Ok(report)
 }
 
+/// Whether a console line sets the servo rate (`servo rate <hz>`).
+fn changes_rate(line: &str) -> bool {
+    let words: Vec<String> = line
+        .split_whitespace()
+        .map(str::to_ascii_lowercase)
+        .collect();
+    matches!(words.as_slice(), [servo, rate, _, ..] if servo == "servo" && rate == "rate")
+}
+
 /// The duties boot 0 wrote, frame by frame from frame 0 (its compare
 /// writes from the one its slice was enabled with on).
 fn written(report: &Report) -> Vec<[u16; 3]> {
@@ -229,4 +246,15 @@ pub fn command(
         println!("wrote {} ({rows} frames)", path.display());
     }
     Ok(report.problems.is_empty())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_rate_change_is_told_from_a_rate_query() {
+        assert!(super::changes_rate("servo rate 333"));
+        assert!(super::changes_rate("SERVO  Rate 60"));
+        assert!(!super::changes_rate("servo rate"));
+        assert!(!super::changes_rate("servo yaw neutral 1500"));
+    }
 }
