@@ -11,14 +11,8 @@
 //! task sleeps with [`Timer::at`] until the next deadline. The deadlines
 //! never drift. The frame engine plays each frame at its own time (the sum
 //! of the periods before it, µs: [`FrameTick::at`]), so that the motion is
-//! the same at any rate.
-//!
-//! # The servos' rate
-//!
-//! `servo rate` reaches the frame task through the link: before a frame
-//! ([`FrameLoop::take_rate`]) the outputs take the new period from that
-//! frame's write on; after it ([`FrameLoop::write`]) the frames come the
-//! new period apart. See the driver's `frame/rate.rs`. A frame that wakes up a whole period or more late is counted
+//! the same at any servo rate (`servo rate`: [`FrameLoop::take_rate`]).
+//! A frame that wakes up a whole period or more late is counted
 //! as missed and skipped, together with any other frame whose deadline has
 //! passed: the next deadline lies in the future, so a stall is never followed
 //! by a burst of catch-up writes (which `embassy_time::Ticker` would do).
@@ -72,6 +66,8 @@ use idle_head_core::driver::{FrameClock, FrameDriver, FrameReport, FrameTick, Ze
 use idle_head_core::{Angle, Microseconds, Timestamp};
 
 use crate::config::DEFAULT_BEHAVIOUR;
+
+mod rate;
 
 /// One frame of the loop: what [`FrameLoop::write`] played.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
@@ -129,17 +125,8 @@ pub struct FrameLoop<'a, I> {
     commands: Option<&'a CommandQueue>,
     link: Option<&'a ConsoleLink>,
     show: Option<&'a ShowLink>,
-    /// The board's ticks for `scale_us` of the frames' time (the periods'
-    /// ratio: 1 µs a µs on a board, faster in the QEMU smoke run).
-    scale_ticks: u64,
-    scale_us: u32,
-    /// A new frame period whose outputs' part was taken before this
-    /// frame: the frames' part follows it.
-    retime: Option<Microseconds>,
-    /// A frame period the frames refused after their outputs took it (the
-    /// configuration was checked at both, so never), logged before the
-    /// next frame: the frame path does not log.
-    refused: Option<Microseconds>,
+    /// A change of servo rate between its two steps.
+    retime: rate::Retime,
     /// The last frame's time.
     at: Timestamp,
 }
@@ -182,10 +169,7 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
             commands: None,
             link: None,
             show: None,
-            scale_ticks: period,
-            scale_us: params.frame_us(),
-            retime: None,
-            refused: None,
+            retime: rate::Retime::new(period, params.frame_us()),
             at: Timestamp(0),
         })
     }
@@ -347,32 +331,6 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         }
     }
 
-    /// Before frame `tick`: the servos' rate the console set, if linked
-    /// and it did: the outputs run at its period from this frame's write
-    /// on, and the frames come that far apart after it (in
-    /// [`write`](Self::write)).
-    pub fn take_rate<P: SetPeriod>(&mut self, driver: &mut FrameDriver<P>, tick: FrameTick) {
-        if let Some(period) = self.refused.take() {
-            defmt::error!("frames at {=u32} us refused by the driver", period.0);
-        }
-        let Some(rate) = self.link.and_then(ConsoleLink::take_rate) else {
-            return;
-        };
-        let period = rate.period();
-        match driver.set_pwm_period(period) {
-            Ok(()) => {
-                self.retime = Some(period);
-                defmt::info!(
-                    "frame {=u64}: servo rate {=u16} Hz: pulses every {=u32} us from this frame on",
-                    tick.frame,
-                    rate.hz(),
-                    period.0
-                );
-            }
-            Err(e) => defmt::warn!("frame {=u64}: servo rate refused: {}", tick.frame, e),
-        }
-    }
-
     /// Writes frame `tick`: idle, gaze and gestures mixed, through `driver`.
     /// The first call starts the driver (neutral pulses) instead. After a
     /// new rate's outputs were set ([`take_rate`](Self::take_rate)), the
@@ -389,30 +347,10 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
     ) -> HeadFrame {
         self.at = tick.at;
         let frame = self.head.frame(driver, tick.at);
-        if let Some(period) = self.retime.take() {
+        if let Some(period) = self.retime.pending.take() {
             self.retime_frames(driver, period);
         }
         frame
-    }
-
-    /// After the frame the new period's outputs were set before: the
-    /// frames `period` apart from the next one on (the divisions of a
-    /// change of rate happen here, once).
-    #[inline(never)]
-    fn retime_frames<P: SetDutyCycle>(
-        &mut self,
-        driver: &mut FrameDriver<P>,
-        period: Microseconds,
-    ) {
-        if self.head.set_frame_period(driver, period).is_err() {
-            self.refused = Some(period);
-            return;
-        }
-        let ticks = u64::from(period.0)
-            .saturating_mul(self.scale_ticks)
-            .checked_div(u64::from(self.scale_us))
-            .unwrap_or(1);
-        self.clock.set_period(ticks.max(1), period);
     }
 }
 
