@@ -12,7 +12,7 @@ use idle_head_core::driver::{
 use idle_head_core::servo::{NanosPerDegree, ServoError, ServoRate};
 use idle_head_core::settings::{
     DecodeError, FIELDS, FieldReport, FieldSet, Loaded, RamStorage, Record, SETTINGS_BUFFER,
-    SETTINGS_LEN, Settings, SettingsError, SettingsStorage, SettingsStore, StorageError,
+    SETTINGS_LEN, Settings, SettingsError, SettingsStorage, SettingsStore, StorageError, field,
 };
 use idle_head_core::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
@@ -375,22 +375,28 @@ fn a_record_without_a_field_loads_with_every_other_value() {
     }
 }
 
-/// The servos' rate (field 90, two bytes of Hz): a record saved before it
+/// The servos' rate (field 67, two bytes of Hz): a record saved before it
 /// existed boots at 50 Hz; one with a rate outside 50..=333 Hz loads at
 /// 50 Hz too, the field reported as rejected; a rate saved loads as saved.
 #[test]
 fn the_rate_loads_as_saved_and_older_records_run_at_50_hz() {
+    const RATE: u8 = 67;
+    assert_eq!(field(RATE).map(|f| f.name), Some("servo.rate"));
     let saved = fixture_v1();
     let fields = entries(&encode(&saved));
     assert!(
         fields
             .iter()
-            .any(|(id, value)| *id == 90 && value == &[50, 0])
+            .any(|(id, value)| *id == RATE && value == &[50, 0])
     );
-    let without: Vec<_> = fields.iter().filter(|(id, _)| *id != 90).cloned().collect();
+    let without: Vec<_> = fields
+        .iter()
+        .filter(|(id, _)| *id != RATE)
+        .cloned()
+        .collect();
     let (loaded, report) = load_stored(&stored(&without));
     assert_eq!(loaded.map(|s| s.rate), Ok(ServoRate::DEFAULT));
-    assert_eq!(report.missing, FieldSet::of(&[90]));
+    assert_eq!(report.missing, FieldSet::of(&[RATE]));
     for (bytes, rate) in [
         ([77, 1], Some(333)),
         ([200, 0], Some(200)),
@@ -399,12 +405,12 @@ fn the_rate_loads_as_saved_and_older_records_run_at_50_hz() {
         ([0, 0], None),
     ] {
         let mut record = without.clone();
-        record.push((90, bytes.to_vec()));
+        record.push((RATE, bytes.to_vec()));
         let (loaded, report) = load_stored(&stored(&record));
         let hz = loaded.unwrap().rate.hz();
         match rate {
             Some(rate) => assert_eq!((hz, report.rejected), (rate, FieldSet::EMPTY)),
-            None => assert_eq!((hz, report.rejected), (50, FieldSet::of(&[90]))),
+            None => assert_eq!((hz, report.rejected), (50, FieldSet::of(&[RATE]))),
         }
     }
 }

@@ -204,7 +204,7 @@ macro_rules! fields {
 }
 
 // Ids 1 to 56 are the fields of layout version 1, in its order (`v1.rs`).
-// A new field takes the next free id (now 67), at the end; a new gesture's
+// A new field takes the next free id (now 68), at the end; a new gesture's
 // block of five takes the next five free ids. (Ids 80 and up are taken in
 // blocks: 80 the DMX receiver's, 90 the servos' outputs'.)
 fields! { s;
@@ -263,9 +263,6 @@ fields! { s;
     // The DMX receiver (ids from 80: 57 and up are other fields').
     80 "dmx.on" => s.dmx.on;
     81 "dmx.address" => s.dmx.address;
-    // The servos' PWM rate and the frame rate, Hz (ids from 90; a record
-    // without it runs at 50 Hz).
-    90 "servo.rate" => s.rate;
     // Rest: the timer (s, 0 for never), the pose (m°), relax (0 or 1).
     57 "rest.after" => s.inputs.rest_after;
     58 "rest.pose.pitch" => s.behaviour.rest.pose[0];
@@ -279,6 +276,9 @@ fields! { s;
     64 "input.3" => s.inputs.roles[1];
     65 "input.4" => s.inputs.roles[2];
     66 "input.5" => s.inputs.roles[3];
+    // The servos' PWM rate and the frame rate, Hz (a record without it
+    // runs at 50 Hz).
+    67 "servo.rate" => s.rate;
 }
 
 /// The field `id` of the table, if there is one.
