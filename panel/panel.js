@@ -1,7 +1,8 @@
 // The panel: connects to a head (the bridge of `cargo xtask panel` when
 // the page is served with one, else Web Serial), shows what the head is
 // told (drawing, readouts, plot, status), and offers its actions,
-// calibration and settings (rest, inputs and DMX in modules of their own).
+// calibration and settings (servo rate, rest, inputs and DMX in modules of
+// their own).
 // Every line sent and received goes to the log.
 
 import { BridgeTransport, Console, NoReply, SerialTransport, commandWords, fields, gestureWords, refusal } from './link.js';
@@ -9,6 +10,7 @@ import { makePlot, showTelemetry } from './view.js';
 import * as rest from './rest.js';
 import * as inputs from './inputs.js';
 import * as dmx from './dmx.js';
+import * as rate from './rate.js';
 
 const $ = (id) => document.getElementById(id);
 const AXES = ['pitch', 'roll', 'yaw'];
@@ -97,6 +99,7 @@ async function start() {
   rest.forget();
   await refreshStatus();
   for (const axis of AXES) await readServo(axis);
+  await rate.read();
   hasInputs = inputs.offered(words);
   if (hasInputs) await inputs.read();
   hasDmx = dmx.offered(words) && (await dmx.read());
@@ -211,6 +214,7 @@ async function refreshStatus(pose = false) {
   rest.showStatus(f);
   inputs.showStatus(f);
   dmx.showStatus(f);
+  rate.showStatus(f);
   if (f.mode && f.mode !== 'running') setState(`connected · ${f.mode}`, 'on');
   else if (link) setState('connected', 'on');
   if (pose && f.mdeg) {
@@ -502,6 +506,7 @@ async function main() {
   rest.setUp(page);
   inputs.setUp(page);
   dmx.setUp(page);
+  rate.setUp(page);
   makePlot();
   setUpLookPad();
   setControls(false);
@@ -537,6 +542,7 @@ async function main() {
       const reply = await ask(id);
       for (const axis of AXES) await readServo(axis);
       showServo();
+      await rate.read();
       if (reply.startsWith('ok')) rest.forget();
       await refreshStatus();
       if (hasInputs) await inputs.read();

@@ -1,10 +1,10 @@
 //! Shared helpers for the behaviour tests.
 
-use idle_head_core::Angle;
 use idle_head_core::behaviour::{BehaviourConfig, BehaviourParams};
 use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest};
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::units::Millis;
+use idle_head_core::{Angle, Timestamp};
 
 /// The built-in behaviour on the built-in driver configuration (panics if
 /// either is invalid: tests only).
@@ -12,6 +12,12 @@ use idle_head_core::units::Millis;
 pub fn default_params() -> BehaviourParams {
     let driver = DriverConfig::DEFAULT.build().unwrap();
     BehaviourConfig::DEFAULT.build(&driver).unwrap()
+}
+
+/// The time of frame `k` at the built-in 50 Hz (20 ms frames).
+#[must_use]
+pub const fn frame(k: u64) -> Timestamp {
+    Timestamp(k * 20_000)
 }
 
 /// A gesture request of `kind`: amplitude in m°, duration in ms and cycles

@@ -88,6 +88,9 @@ pub struct Recorder {
     pub fail_next: u32,
     /// Then fail write `n` (counting all writes) if `fail_pattern[n % len]`.
     pub fail_pattern: Vec<bool>,
+    /// Every period set ([`SetPeriod`](idle_head_core::servo::SetPeriod)),
+    /// with the number of writes before it.
+    pub periods: Vec<(usize, u32)>,
 }
 
 impl Recorder {
@@ -113,6 +116,15 @@ impl embedded_hal::pwm::Error for Broken {
 
 impl embedded_hal::pwm::ErrorType for Recorder {
     type Error = Broken;
+}
+
+/// A recorder counts 1 µs a tick at any period (the rig's channels).
+impl idle_head_core::servo::SetPeriod for Recorder {
+    fn set_period(&mut self, period: idle_head_core::Microseconds) -> Result<(), Broken> {
+        self.max_duty = u16::try_from(period.0).map_err(|_| Broken)?;
+        self.periods.push((self.written.len(), period.0));
+        Ok(())
+    }
 }
 
 impl embedded_hal::pwm::SetDutyCycle for Recorder {
@@ -234,7 +246,7 @@ pub mod strategies {
             motion in [limits(), limits(), limits()],
             pose in [0.0f64..=1.0, 0.0f64..=1.0, 0.0f64..=1.0],
             fade in 0u32..3000,
-            disable_after in 1u16..30,
+            disable_after in 1u32..600,
             frame_us in prop_oneof![Just(20_000u32), Just(10_000), Just(3_000)],
         ) -> DriverConfig {
             let mut cfg = DriverConfig::DEFAULT;
@@ -247,7 +259,7 @@ pub mod strategies {
                 cfg.neutral_pose[i] = Angle::from_millidegrees((lo + pose[i] * (hi - lo)).round() as i32);
             }
             cfg.fade = Millis(fade);
-            cfg.faults.disable_after = disable_after;
+            cfg.faults.disable_after = Millis(disable_after);
             cfg
         }
     }

@@ -1,8 +1,8 @@
 //! A rig whose radar sees scripted people: sightings at the radar's 10 Hz,
 //! handed to the head between frames as the frame task does.
 
-use idle_head_core::Millimetres;
 use idle_head_core::track::{PEOPLE, Person, Sighting, TrackSettings};
+use idle_head_core::{Millimetres, Timestamp};
 
 use crate::rig::Rig;
 
@@ -41,15 +41,19 @@ impl Rig {
         settings: &TrackSettings,
         mut people: impl FnMut(u64) -> Sighting,
     ) {
-        let frame_us = u64::from(self.head.mixer().params().frame_us());
         for _ in 0..frames {
-            let now = self.frame * frame_us;
+            let frame_us = u64::from(self.period);
+            let now = self.at;
             // The radar's frames fall between the head's: each is handed
             // over before the first head frame at or after it.
             let due = now.div_ceil(RADAR_US) * RADAR_US;
             let sighting = (due < now + frame_us).then(|| people(due));
-            self.head
-                .track(&mut self.driver, self.frame, settings, sighting.as_ref());
+            self.head.track(
+                &mut self.driver,
+                Timestamp(now),
+                settings,
+                sighting.as_ref(),
+            );
             self.run(1);
         }
     }

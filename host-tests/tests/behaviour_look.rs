@@ -54,3 +54,89 @@ fn a_held_look_stays_within_a_few_degrees_of_its_target_and_sways() {
     // Alive: never frozen on the target.
     assert!(sway >= 300, "{sway}");
 }
+
+/// The mixer on a still idle, frames `period` µs apart from `from` µs on,
+/// for `span` µs.
+fn yaw_from(
+    mixer: &mut idle_head_core::behaviour::Mixer,
+    from: u64,
+    span: u64,
+    period: u64,
+) -> Vec<(u64, i32)> {
+    use idle_head_core::{Angle, Timestamp};
+    (0..span / period)
+        .map(|k| {
+            let at = from + k * period;
+            (
+                at,
+                mixer.frame(Timestamp(at), [Angle::ZERO; 3])[2].millidegrees(),
+            )
+        })
+        .collect()
+}
+
+/// The frame path keeps its times in 32 bits of µs, which wrap every 71.6
+/// minutes: a look held 40 minutes (past the half round a difference
+/// tells) returns when it should, and a look, a gesture and a return
+/// across the wrap play as anywhere else.
+#[test]
+fn long_holds_and_the_clocks_wrap_play_on_time() {
+    use idle_head_core::behaviour::{Applied, Mixer};
+    use idle_head_core::command::GestureKind;
+    use idle_head_core::units::Millis;
+    let params = host_tests::behaviour::default_params();
+    let period = 20_000;
+    let minutes = |m: u64| m * 60_000_000;
+    for start in [0, (1 << 32) - 1_200_000] {
+        let mut mixer = Mixer::new(params);
+        // Frames from `start` on; a look held 40 minutes.
+        yaw_from(&mut mixer, start, 2 * period, period);
+        let hold = Hold::Return(Millis(40 * 60_000));
+        let Ok(Applied::Look(applied)) = mixer.apply(&look(0, -15_000, None, Some(hold))) else {
+            panic!("the look plays");
+        };
+        let next = start + 2 * period;
+        let there = yaw_from(&mut mixer, next, 2_000_000, period);
+        assert_eq!(there.last().unwrap().1, -15_000);
+        // Then a frame a second (late frames: the mixer takes any gap)
+        // until just before the return: still there.
+        let back = next + u64::from(applied.duration.0) * 1000 + minutes(40);
+        let mut at = next + 2_000_000;
+        while at + 1_000_000 < back {
+            assert_eq!(
+                yaw_from(&mut mixer, at, period, period)[0].1,
+                -15_000,
+                "at {at}"
+            );
+            at += 1_000_000;
+        }
+        // Frames again: the return starts on time, and ends at the centre.
+        let frames = yaw_from(&mut mixer, back - 200_000, 2_000_000, period);
+        let moved = frames.iter().find(|(_, yaw)| *yaw != -15_000).unwrap().0;
+        assert!(
+            (back..back + 2 * period).contains(&moved),
+            "{start}: {moved} vs {back}"
+        );
+        assert_eq!(frames.last().unwrap().1, 0);
+        // A shake across the next wrap of the clock plays as it does at 0.
+        let wrap = (back + 3_000_000).next_multiple_of(1 << 32);
+        let shake = |mixer: &mut Mixer, from: u64| {
+            yaw_from(mixer, from - period, period, period);
+            mixer
+                .apply(&host_tests::behaviour::gesture(
+                    GestureKind::Shake,
+                    None,
+                    None,
+                    None,
+                ))
+                .unwrap();
+            yaw_from(mixer, from, 2_000_000, period)
+                .into_iter()
+                .map(|(_, yaw)| yaw)
+                .collect::<Vec<_>>()
+        };
+        let across = shake(&mut mixer, wrap - 600_000);
+        let fresh = shake(&mut Mixer::new(params), 40 * period);
+        assert_eq!(across, fresh, "{start}");
+    }
+}

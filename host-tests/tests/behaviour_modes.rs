@@ -1,7 +1,7 @@
 //! The mixer's limit modes against the rule they follow, counted frame by
 //! frame: an axis is in gesture mode while a gesture plays on it or a gaze
-//! move moves it, and for `settle` frames after (counted down by the frames
-//! passed, late frames included). The mixer works the modes out only at
+//! move moves it, and for `settle` after (counted down by the time passed,
+//! late frames included). The mixer works the modes out only at
 //! events (a layer or a move ends, an action is applied, a return is due, a
 //! settle time runs out); this checks that it gives the modes of every frame
 //! exactly, for random scripts of gestures, looks (held, or returning after
@@ -13,12 +13,12 @@ use idle_head_core::command::{Action, GestureKind, Hold};
 use idle_head_core::units::Millis;
 use proptest::prelude::*;
 
-use host_tests::behaviour::{default_params as params, gesture, look};
+use host_tests::behaviour::{default_params as params, frame as time_of, gesture, look};
 
-/// Frame period of the default configuration, ms.
-const FRAME_MS: u32 = 20;
+/// Frame period of the default configuration, µs.
+const FRAME_US: u64 = 20_000;
 
-/// A gesture layer as the rule sees it: its axis and end frame.
+/// A gesture layer as the rule sees it: its axis and end time (µs).
 #[derive(Clone, Copy, Debug)]
 struct Layer {
     axis: usize,
@@ -26,12 +26,13 @@ struct Layer {
     released: bool,
 }
 
-/// The modes counted frame by frame from what the actions answered.
+/// The modes counted frame by frame from what the actions answered, all
+/// times in µs.
 struct Model {
     layers: Vec<Layer>,
-    /// The gaze move: start and end frame (moving in `start..end`).
+    /// The gaze move: start and end (moving in `start..end`).
     gaze: (u64, u64),
-    /// The planned return: its start and end frame.
+    /// The planned return: its start and end.
     back: Option<(u64, u64)>,
     params: BehaviourParams,
     left: [u64; 3],
@@ -39,6 +40,11 @@ struct Model {
     settle: u64,
     /// The last frame played, if any.
     last: Option<u64>,
+}
+
+/// `ms` in µs.
+fn us(ms: Millis) -> u64 {
+    u64::from(ms.0) * 1000
 }
 
 impl Model {
@@ -57,12 +63,12 @@ impl Model {
                 }
                 self.layers.push(Layer {
                     axis: plan.kind.axis().index(),
-                    end: start + u64::from(plan.duration.0 / FRAME_MS),
+                    end: start + us(plan.duration),
                     released: false,
                 });
             }
             Applied::Look(look) => {
-                let end = start + u64::from(look.duration.0 / FRAME_MS);
+                let end = start + us(look.duration);
                 self.gaze = (start, end);
                 self.back = match look.hold {
                     Hold::Stay => None,
@@ -75,13 +81,13 @@ impl Model {
                             .max((look.yaw.millidegrees() - pose[2].millidegrees()).unsigned_abs());
                         let gaze = self.params.config().gaze;
                         let back_ms = gaze.base.0 + (gaze.per_degree.0 * far).div_ceil(1000);
-                        let next = end + u64::from(self.params.frames(ms).max(1));
-                        Some((next, next + u64::from(back_ms.div_ceil(FRAME_MS))))
+                        let next = end + us(ms).max(1);
+                        Some((next, next + us(Millis(back_ms))))
                     }
                 };
             }
             Applied::Center(ms) => {
-                self.gaze = (start, start + u64::from(ms.0 / FRAME_MS));
+                self.gaze = (start, start + us(*ms));
                 self.back = None;
             }
             Applied::Idle(_) | Applied::Stop => {}
@@ -91,7 +97,8 @@ impl Model {
         }
     }
 
-    /// The modes after frame `frame` is played (for the next frame).
+    /// The modes after the frame at `frame` (µs) is played (for the next
+    /// frame).
     fn frame(&mut self, frame: u64) -> [LimitMode; 3] {
         let elapsed = self.last.map_or(1, |last| (frame - last).max(1));
         self.last = Some(frame);
@@ -110,7 +117,7 @@ impl Model {
         on[0] |= moving;
         on[2] |= moving;
         // The return starts next frame: pitch and yaw in gesture mode now.
-        let soon = self.back.is_some_and(|back| frame + 1 >= back.0);
+        let soon = self.back.is_some_and(|back| frame + FRAME_US >= back.0);
         core::array::from_fn(|i| {
             self.left[i] = if on[i] {
                 self.settle
@@ -189,8 +196,8 @@ proptest! {
             back: None,
             params,
             left: [0; 3],
-            blend: u64::from(params.frames(config.blend)),
-            settle: u64::from(params.frames(config.settle)),
+            blend: us(config.blend),
+            settle: us(config.settle),
             last: None,
         };
         let mut mixer = Mixer::new(params);
@@ -206,8 +213,8 @@ proptest! {
                     prop_assert_eq!(wanted[plan.kind.axis().index()], LimitMode::Gesture);
                 }
             }
-            mixer.frame(frame, [Angle::ZERO; 3]);
-            let expected = model.frame(frame);
+            mixer.frame(time_of(frame), [Angle::ZERO; 3]);
+            let expected = model.frame(frame * FRAME_US);
             prop_assert_eq!(mixer.modes(), expected, "step {} at frame {}", k, frame);
             frame += step.gap;
         }

@@ -10,7 +10,7 @@ use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookReq
 use idle_head_core::gestures::Shape;
 use idle_head_core::units::Millis;
 
-use host_tests::behaviour::{default_params as params, gesture};
+use host_tests::behaviour::{default_params as params, frame, gesture};
 
 fn plan_of(applied: Applied) -> GesturePlan {
     match applied {
@@ -22,7 +22,7 @@ fn plan_of(applied: Applied) -> GesturePlan {
 /// Frames of one axis from the mixer over a still idle, `frames` long.
 fn run(mixer: &mut Mixer, from: u64, frames: u64, axis: usize) -> Vec<f64> {
     (from..from + frames)
-        .map(|k| f64::from(mixer.frame(k, [Angle::ZERO; 3])[axis].millidegrees()))
+        .map(|k| f64::from(mixer.frame(frame(k), [Angle::ZERO; 3])[axis].millidegrees()))
         .collect()
 }
 
@@ -31,11 +31,12 @@ fn smootherstep(x: f64) -> f64 {
     x * x * x * (x * (6.0 * x - 15.0) + 10.0)
 }
 
-/// The shape of the gesture module's docs, in f64: frame `t` of `plan`.
-fn reference(plan: &GesturePlan, frames: u32, t: u32) -> f64 {
+/// The shape of the gesture module's docs, in f64: `plan` `t` µs after
+/// its start.
+fn reference(plan: &GesturePlan, t: f64) -> f64 {
     let n = f64::from(plan.cycles);
     let a = f64::from(plan.amplitude.millidegrees());
-    let phi = n * f64::from(t) / f64::from(frames);
+    let phi = n * t / (f64::from(plan.duration.0) * 1000.0);
     let ramp = match plan.kind.shape() {
         Shape::Dip | Shape::Swing => 2.0,
         Shape::Lean => 3.0,
@@ -60,8 +61,9 @@ fn reference(plan: &GesturePlan, frames: u32, t: u32) -> f64 {
     envelope * profile * carrier
 }
 
+/// Frames (of 20 ms) that start before `plan` ends.
 fn frames_of(plan: &GesturePlan) -> u32 {
-    plan.duration.0 / 20
+    plan.duration.0.div_ceil(20)
 }
 
 #[test]
@@ -85,16 +87,16 @@ fn shapes_follow_the_documented_formula() {
             u64::from(frames) + 5,
             plan.kind.axis().index(),
         );
-        for (t, &value) in played.iter().enumerate() {
-            let t = t as u32;
-            let expected = if t < frames {
-                reference(&plan, frames, t)
+        for (k, &value) in played.iter().enumerate() {
+            let t = k as f64 * 20_000.0;
+            let expected = if (k as u32) < frames {
+                reference(&plan, t)
             } else {
                 0.0
             };
             assert!(
                 (value - expected).abs() <= 2.0,
-                "{plan:?} frame {t}: {value} m°, formula {expected:.1} m°"
+                "{plan:?} frame {k}: {value} m°, formula {expected:.1} m°"
             );
         }
     }
@@ -110,15 +112,15 @@ fn defaults_resolve_as_documented() {
         (2, Millis(800), 6300)
     );
     let shake = resolve(&gesture(GestureKind::Shake, None, None, None));
-    // 3 cycles at 1.85 Hz: 1622 ms, played as 81 frames; 8° × 1.1.
+    // 3 cycles at 1.85 Hz: 1622 ms; 8° × 1.1.
     assert_eq!(
         (shake.cycles, shake.duration, shake.amplitude.millidegrees()),
-        (3, Millis(1620), 8800)
+        (3, Millis(1622), 8800)
     );
     let tilt = resolve(&gesture(GestureKind::Tilt, None, None, None));
     assert_eq!(
         (tilt.cycles, tilt.duration, tilt.amplitude.millidegrees()),
-        (1, Millis(1420), 10_000)
+        (1, Millis(1429), 10_000)
     );
     // Intensity: 100 % is faster and fuller, 0 % slower and softer.
     let brisk = GestureRequest {
@@ -128,7 +130,7 @@ fn defaults_resolve_as_documented() {
     let brisk = resolve(&Action::Gesture(brisk));
     assert_eq!(
         (brisk.duration, brisk.amplitude.millidegrees()),
-        (Millis(580), 7875)
+        (Millis(571), 7875)
     );
     let soft = GestureRequest {
         intensity: Some(Percent::ZERO),
@@ -137,7 +139,7 @@ fn defaults_resolve_as_documented() {
     let soft = resolve(&Action::Gesture(soft));
     assert_eq!(
         (soft.duration, soft.amplitude.millidegrees()),
-        (Millis(1340), 4725)
+        (Millis(1333), 4725)
     );
     // A duration alone: cycles from the tempo (0.9 s · 2.5 Hz = 2.25 → 2).
     let timed = resolve(&gesture(GestureKind::Nod, Some(6000), Some(900), None));
@@ -287,7 +289,7 @@ fn an_interrupted_gesture_blends_into_the_new_one() {
         if k == 30 || k == 50 {
             mixer.apply(&nod).unwrap();
         }
-        let o = mixer.frame(k, [Angle::ZERO; 3]);
+        let o = mixer.frame(frame(k), [Angle::ZERO; 3]);
         pitch.push(f64::from(o[0].millidegrees()));
         yaw.push(f64::from(o[2].millidegrees()));
     }
@@ -326,17 +328,18 @@ fn three_layers_then_busy() {
     }
     let err = mixer.apply(&nod).unwrap_err();
     assert_eq!(err.code(), "busy");
-    // The oldest two fade out over the blend (13 frames, from the next
-    // frame on): free after 14 frames, not before.
+    // The oldest two fade out over the blend (250 ms from the last frame
+    // mixed): free at the first frame at or past it (frame 13, 260 ms), not
+    // before; the answer is an upper bound, a frame past the blend.
     assert_eq!(
         err.to_string(),
-        "gestures: every layer is busy; try again in 280 ms"
+        "gestures: every layer is busy; try again in 270 ms"
     );
     for k in 0..13 {
-        mixer.frame(k, [Angle::ZERO; 3]);
+        mixer.frame(frame(k), [Angle::ZERO; 3]);
     }
     assert!(mixer.apply(&nod).is_err());
-    mixer.frame(13, [Angle::ZERO; 3]);
+    mixer.frame(frame(13), [Angle::ZERO; 3]);
     assert!(mixer.apply(&nod).is_ok());
 }
 
@@ -373,7 +376,7 @@ fn a_look_is_a_minimum_jerk_move_then_a_hold_then_the_return() {
     for k in 0..200_u64 {
         // The modes in effect for frame k: asked for before it.
         modes.push(mixer.modes());
-        let offsets = mixer.frame(k, [Angle::ZERO; 3]);
+        let offsets = mixer.frame(frame(k), [Angle::ZERO; 3]);
         let [p, r, y] = offsets.map(|a| f64::from(a.millidegrees()));
         assert_eq!(r, 0.0);
         let tau = (k as f64 / frames).min(1.0);
@@ -469,7 +472,7 @@ fn a_new_look_while_moving_keeps_velocity_and_acceleration() {
             let start = k as f64 - 1.0;
             reference = RefGlide::new(start, reference.at(start), target, frames(applied.unwrap()));
         }
-        let yaw = f64::from(mixer.frame(k, [Angle::ZERO; 3])[2].millidegrees());
+        let yaw = f64::from(mixer.frame(frame(k), [Angle::ZERO; 3])[2].millidegrees());
         let (expected, _, _) = reference.at(k as f64);
         worst = worst.max((yaw - expected).abs());
     }
@@ -486,7 +489,7 @@ fn a_long_move_stays_on_the_minimum_jerk_profile() {
         .apply(&look(0, -23_000, None, Some(Hold::Stay)))
         .unwrap();
     for k in 0..100 {
-        mixer.frame(k, [Angle::ZERO; 3]);
+        mixer.frame(frame(k), [Angle::ZERO; 3]);
     }
     let applied = look_applied(
         mixer
@@ -499,7 +502,7 @@ fn a_long_move_stays_on_the_minimum_jerk_profile() {
     let mj = |tau: f64| tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
     let worst = (0..=40_u32)
         .map(|t| {
-            let yaw = mixer.frame(100 + u64::from(t), [Angle::ZERO; 3])[2];
+            let yaw = mixer.frame(frame(100 + u64::from(t)), [Angle::ZERO; 3])[2];
             let expected = -23_000.0 + 55_000.0 * mj((f64::from(t + 1) / 37.0).min(1.0));
             (f64::from(yaw.millidegrees()) - expected).abs()
         })
@@ -519,7 +522,7 @@ fn targets_outside_the_limits_are_clamped_and_said_so() {
     );
     assert_eq!(applied.hold, Hold::Return(Millis(3000)));
     let last = (0..200)
-        .map(|k| mixer.frame(k, [Angle::ZERO; 3]))
+        .map(|k| mixer.frame(frame(k), [Angle::ZERO; 3]))
         .nth(60)
         .unwrap();
     assert_eq!(last[0], Angle::from_degrees(20));
@@ -530,9 +533,9 @@ fn targets_outside_the_limits_are_clamped_and_said_so() {
 fn a_short_given_look_duration_is_lengthened_to_the_limits() {
     let mut mixer = Mixer::new(params());
     // 27° in 100 ms would need 506 °/s: the 250 °/s gesture limit makes it
-    // 1.875 · 27 / 250 = 203 ms, 11 whole frames.
+    // 1.875 · 27 / 250 = 202.5 ms, 203 whole ms.
     let applied = look_applied(mixer.apply(&look(0, 27_000, Some(100), None)).unwrap());
-    assert_eq!(applied.duration, Millis(220));
+    assert_eq!(applied.duration, Millis(203));
     // Long enough: as given.
     let applied = look_applied(mixer.apply(&look(0, 26_000, Some(1000), None)).unwrap());
     assert_eq!(applied.duration, Millis(1000));
@@ -542,14 +545,14 @@ fn a_short_given_look_duration_is_lengthened_to_the_limits() {
 fn idle_gain_and_duck() {
     let idle = [Angle::from_degrees(4); 3];
     let mut mixer = Mixer::new(params());
-    assert_eq!(mixer.frame(0, idle), idle);
+    assert_eq!(mixer.frame(frame(0), idle), idle);
     // Off over 1 s (50 frames), minimum jerk.
     assert_eq!(
         mixer.apply(&Action::Idle(false)).unwrap(),
         Applied::Idle(Percent::ZERO)
     );
     let pitch: Vec<i32> = (1..=60)
-        .map(|k| mixer.frame(k, idle)[0].millidegrees())
+        .map(|k| mixer.frame(frame(k), idle)[0].millidegrees())
         .collect();
     // From frame 0, the last mixed: frame 1 (`pitch[0]`) is a step in.
     assert_eq!(pitch[0], 4000);
@@ -558,19 +561,19 @@ fn idle_gain_and_duck() {
     // Half amplitude while off: still off; on again: half.
     mixer.apply(&Action::IdleAmp(Percent::HALF)).unwrap();
     mixer.apply(&Action::Idle(true)).unwrap();
-    assert_eq!(mixer.frame(200, idle)[1], Angle::from_degrees(2));
+    assert_eq!(mixer.frame(frame(200), idle)[1], Angle::from_degrees(2));
     // A tilt ducks roll's idle by 60 % at full strength, smoothly.
     mixer.apply(&Action::IdleAmp(Percent::FULL)).unwrap();
     for k in 201..300 {
-        mixer.frame(k, idle);
+        mixer.frame(frame(k), idle);
     }
     let tilt = gesture(GestureKind::Tilt, Some(5000), Some(1500), None);
     mixer.apply(&tilt).unwrap();
     let roll: Vec<i32> = (300..380)
-        .map(|k| mixer.frame(k, idle)[1].millidegrees())
+        .map(|k| mixer.frame(frame(k), idle)[1].millidegrees())
         .collect();
     // Mid-tilt (from frame 299, the last mixed): 5° + 4° · 0.4.
     assert_eq!(roll[36], 5000 + 1600);
     // Pitch and yaw are not ducked.
-    assert_eq!(mixer.frame(380, idle)[0], Angle::from_degrees(4));
+    assert_eq!(mixer.frame(frame(380), idle)[0], Angle::from_degrees(4));
 }

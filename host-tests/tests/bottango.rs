@@ -198,7 +198,7 @@ fn a_console_reply_waits_on_a_dual_port_as_on_a_session() {
         ])
     );
     assert_eq!(port.session.waiting(), None);
-    assert_eq!(port.session.spare().len(), 160);
+    assert_eq!(port.session.spare().len(), host_tests::console::REPLY);
     let status = port.send(b"status\n");
     assert!(status[0].starts_with("ok mode="), "{status:?}");
 }

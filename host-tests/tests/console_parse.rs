@@ -204,7 +204,7 @@ fn errors_name_the_word_and_the_rule() {
         ),
         (
             "servo neck",
-            "syntax `neck`: expected `pitch`, `roll` or `yaw`",
+            "syntax `neck`: expected `pitch`, `roll`, `yaw` or `rate`",
         ),
         (
             "servo yaw trim 5",

@@ -149,6 +149,67 @@ fn every_command_does_what_it_says() {
 }
 
 #[test]
+fn the_servo_rate_is_answered_set_saved_and_played() {
+    let mut c = Console::new();
+    let r = c.say(
+        "servo rate
+servo rate 333
+servo rate
+status",
+    );
+    assert_eq!(r[0], "ok servo rate=50 period_us=20000");
+    assert_eq!(r[1], "ok servo rate=333 period_us=3003");
+    assert_eq!(r[2], r[1]);
+    assert!(
+        r[3].ends_with(" settings=changed inputs=-,-,-,- seed=board rate=333"),
+        "{}",
+        r[3]
+    );
+    // The frames come 3003 µs apart from the frame after the one the rate
+    // came before; the uptime counts them.
+    assert_eq!(c.frames.config().frame_period.0, 3003);
+    let before = c.link.status().time.0;
+    c.play(1000);
+    assert_eq!(c.link.status().time.0 - before, 1000 * 3003);
+    // Out of the range: refused by the parser, nothing changes.
+    let r = c.say(
+        "servo rate 334
+servo rate 49
+servo rate fast",
+    );
+    assert!(r[0].starts_with("err range "), "{}", r[0]);
+    assert!(r[1].starts_with("err range "), "{}", r[1]);
+    assert!(r[2].starts_with("err syntax "), "{}", r[2]);
+    assert_eq!(c.frames.config().frame_period.0, 3003);
+    // Saved and loaded with the settings; `defaults` goes back to 50 Hz.
+    let r = c.say(
+        "save
+servo rate 200
+load
+servo rate
+defaults
+servo rate",
+    );
+    assert_eq!(r[0], "ok");
+    assert_eq!(r[3], "ok servo rate=333 period_us=3003");
+    assert_eq!(r[5], "ok servo rate=50 period_us=20000");
+    c.play(2);
+    assert_eq!(c.frames.config().frame_period.0, 20_000);
+    // Motion plays on through every change, within the limits.
+    let r = c.say(
+        "servo rate 250
+nod
+look 5000 9000
+servo rate 60
+shake",
+    );
+    assert_eq!(r[0], "ok servo rate=250 period_us=4000");
+    assert_eq!(r[3], "ok servo rate=60 period_us=16667");
+    c.play(300);
+    assert_eq!(c.frames.violations, 0);
+}
+
+#[test]
 fn new_servo_limits_reach_the_gestures_and_the_looks() {
     let mut c = Console::new();
     // Built in, pitch may go -12°..20°: a 22° nod is too much, and a look
@@ -446,4 +507,29 @@ fn check_verdict(line: &[u8], reply: &[u8]) -> Verdict {
             Verdict::Refused
         }
     }
+}
+
+/// `status` with every field at its widest (angles and pulses past any
+/// calibration, counters at their ends, the longest mode and seed) fits a
+/// port's reply whole: no `…`.
+#[test]
+fn the_widest_status_fits_a_reply() {
+    use idle_head_core::console::{HeadMode, HeadStatus, PORT_REPLY};
+    use idle_head_core::{Angle, Microseconds, Timestamp};
+    let mut c = Console::new();
+    c.say("seed 4294967295\nservo rate 333\ninput 2 button nod\ninput 3 button nod\ninput 4 button nod\ninput 5 button nod");
+    c.link.publish(HeadStatus {
+        frame: u64::MAX,
+        time: Timestamp(u64::MAX),
+        mode: HeadMode::Stopping,
+        angles: [Angle::from_millidegrees(i32::MIN); 3],
+        pulses: [Microseconds(u32::MAX); 3],
+        faults: [u32::MAX; 3],
+        disabled: [true; 3],
+        track: None,
+    });
+    let status = c.say("status").remove(0);
+    assert!(!status.contains('…'), "{status}");
+    assert!(status.ends_with(" seed=4294967295 rate=333"), "{status}");
+    assert!(status.len() + 2 <= PORT_REPLY, "{} bytes", status.len() + 2);
 }

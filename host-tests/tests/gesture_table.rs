@@ -4,7 +4,7 @@
 //! runs over `GestureKind::ALL`, so a new row is tested without a word
 //! added here.
 
-use host_tests::behaviour::{default_params, gesture};
+use host_tests::behaviour::{default_params, frame, gesture};
 use host_tests::console::head::{SimFrames, service, shared};
 use idle_head_core::behaviour::{Applied, BehaviourConfig, Mixer};
 use idle_head_core::command::{Action, Command, GestureKind, GestureRequest, Percent};
@@ -83,10 +83,11 @@ fn the_head_plays_every_gesture_on_its_axis_alone() {
         };
         assert_eq!((plan.kind, plan.cycles), (kind, cycles));
         assert_eq!(plan.intensity, defaults.intensity);
-        let frames = u64::from(plan.duration.0 / 20);
+        // The frames (of 20 ms) that start before its end.
+        let frames = u64::from(plan.duration.0.div_ceil(20));
         let mut peak = 0;
         for k in 0..frames + 3 {
-            let offsets = mixer.frame(k, [Angle::ZERO; 3]);
+            let offsets = mixer.frame(frame(k), [Angle::ZERO; 3]);
             for axis in Axis::ALL {
                 let value = offsets[axis.index()].millidegrees();
                 if axis == kind.axis() {

@@ -65,12 +65,13 @@ impl Rig {
         for _ in 0..frames {
             let curves = self.link.curves.sample((self.frame * 20) as u32);
             let dmx = Some(self.link.dmx.latest());
-            let events = self.head.show(&mut self.driver, self.frame, dmx, curves);
+            let at = host_tests::behaviour::frame(self.frame);
+            let events = self.head.show(&mut self.driver, at, dmx, curves);
             if let Some(signal) = events.signal {
                 self.link.dmx.set_signal(signal);
             }
             let modes = self.head.limit_modes();
-            let frame = self.head.frame(&mut self.driver, self.frame);
+            let frame = self.head.frame(&mut self.driver, at);
             self.played.push(Played {
                 offsets: frame.offsets.map(|a| a.millidegrees()),
                 angles: frame.report.servos.map(|s| s.angle.millidegrees()),

@@ -102,6 +102,9 @@ async function session(page, { yawPulse }) {
     return text.includes('mode=') ? text : null;
   }, 5000, 'the status line');
   check(/mode=(running|starting)/.test(status), `status read: ${status}`);
+  const rate = await until(async () => page.getByLabel('servo rate in Hz').inputValue(), 5000, 'the servo rate read');
+  const period = await page.getByLabel('servo period').textContent();
+  check(rate === '50' && period === 'period 20000 µs', `servo rate read on connect: ${rate} Hz, ${period}`);
   const gestures = await page.locator('#gestures button').allTextContents();
   check(gestures.includes('Nod') && gestures.includes('Shake') && gestures.includes('Tilt'), `gesture buttons from help: ${gestures.join(', ')}`);
 
@@ -253,6 +256,28 @@ async function inputsAndDmx(page, { press = null } = {}) {
   check(!(await page.locator('#unsaved').isHidden()), 'DMX off and on again: the signal readout followed; the unsaved mark is back');
 }
 
+/** The servo rate set to 333 Hz: read back with its period (whole µs),
+ * in status; the still head's pulses do not move; 400 Hz refused, snapped
+ * back. `pulses()` is the three pulses in µs as the session sees them. */
+async function servoRate(page, { pulses }) {
+  const before = await pulses();
+  const field = page.getByLabel('servo rate in Hz');
+  await field.fill('333');
+  await field.press('Enter');
+  await until(async () => (await page.locator('#log li.in').allTextContents()).includes('ok servo rate=333 period_us=3003'), 5000, 'the rate read back');
+  await until(async () => (await page.locator('#status-line').textContent()).endsWith(' rate=333'), 5000, 'status says rate=333');
+  const period = await page.getByLabel('servo period').textContent();
+  check((await field.inputValue()) === '333' && period === 'period 3003 µs', `servo rate 333 Hz read back, ${period}; status ends rate=333`);
+  await sleep(1000);
+  const after = await pulses();
+  const moved = Math.max(...after.map((us, i) => Math.abs(us - before[i])));
+  check(moved <= 1, `the still head's pulses across the change: ${before.join(', ')} → ${after.join(', ')} µs`);
+  await field.fill('400');
+  await field.press('Enter');
+  const why = await until(async () => (await page.locator('#why-rate').textContent()) || null, 5000, 'the reason 400 Hz is refused');
+  check((await field.inputValue()) === '333' && why.includes('50..=333'), `servo rate 400 refused, snapped back to 333: "${why}"`);
+}
+
 /** The panel's log, its last lines, when a check failed: what was sent and answered. */
 async function sayLog(page) {
   const lines = await page?.locator('#log li').allTextContents().catch(() => []);
@@ -265,9 +290,10 @@ async function loadReadsBack(page) {
   await page.getByRole('button', { name: 'Load' }).click();
   await until(async () => (await page.getByLabel('GP2 role').inputValue()) === 'off', 5000, 'GP2 read again as saved: off');
   await until(async () => (await page.getByLabel('DMX start address').inputValue()) === '1', 5000, 'the DMX address read again as saved: 1');
+  await until(async () => (await page.getByLabel('servo rate in Hz').inputValue()) === '50', 5000, 'the servo rate read again as saved: 50');
   const pitch = await page.getByLabel('rest pose pitch in degrees').inputValue();
   check(pitch === '' && (await page.locator('#rest-note').isVisible()) && (await page.locator('#unsaved').isHidden()),
-    'Load: GP2 and the DMX address read again as saved (off, 1); the rest pose blank, with the note');
+    'Load: GP2, the DMX address and the servo rate read again as saved (off, 1, 50 Hz); the rest pose blank, with the note');
 }
 
 async function browser() {
@@ -499,6 +525,8 @@ async function bridgeSession() {
       const pitchPulse = async () => Number(/pulses (\d+)/.exec(await page.locator('#pulses').textContent())?.[1]);
       await restAndWake(page, { pitchPulse });
       await inputsAndDmx(page);
+      const pulses = async () => (/pulses (\d+), (\d+), (\d+)/.exec(await page.locator('#pulses').textContent()) ?? []).slice(1).map(Number);
+      await servoRate(page, { pulses });
       await loadReadsBack(page);
     }
     check(errors.length === 0, `no page errors${errors.length ? `: ${errors.join('; ')}` : ''}`);

@@ -87,8 +87,8 @@ pub fn run_shipped(
     outcome.map(|()| report)
 }
 pub use stages::{
-    CONSOLE_STAGE, CONSOLE_TIME, DRILL_STAGE, FAILURES_STAGE, PULSES_STAGE, WALL, test_console,
-    test_drill, test_failures, test_pulses,
+    CONSOLE_STAGE, CONSOLE_TIME, DRILL_STAGE, FAILURES_STAGE, PULSES_STAGE, RATE_STAGE, WALL,
+    test_console, test_drill, test_failures, test_pulses, test_rate,
 };
 pub use store::{STORE_STAGE, test_store};
 
@@ -169,6 +169,12 @@ pub struct Args {
     /// host trace of it. Without `--seconds`, to 5 s after its last line.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood"])]
     pub script: Option<PathBuf>,
+    /// With `--script`: the servos' rate, Hz (50 to 333), from the first
+    /// frame: the image boots on settings of that rate (planted in its
+    /// settings sectors), and the host trace runs at it.
+    #[arg(long, value_name = "HZ", requires = "script", default_value_t = 50,
+          value_parser = clap::value_parser!(u16).range(50..=333))]
+    pub rate: u16,
     /// With `--script`, `--dmx` or `--show` (or alone: the plain run, the
     /// pulses not checked): write the pulses measured on GP16, GP18 and GP20
     /// to this CSV, one row per frame: `t_ms,pitch_us,roll_us,yaw_us`.
@@ -217,12 +223,14 @@ pub fn command(args: &Args) -> Result<bool> {
     setup::ensure_toolchain(&root)?;
     let metadata = project::metadata(&root)?;
     if let Some(path) = &args.script {
+        let rate = idle_head_core::servo::ServoRate::new(args.rate)
+            .ok_or_else(|| anyhow::anyhow!("{} Hz: not a servo rate", args.rate))?;
         return script::command(
             &root,
             &metadata,
             path,
-            args.virtual_time,
-            args.timeout,
+            (args.virtual_time, args.timeout),
+            rate,
             args.pulses.as_ref(),
         );
     }
@@ -344,7 +352,7 @@ impl Report {
     /// Per boot and servo: pulses, frames, widths, periods; then the frame
     /// update's cycles and the stack.
     pub fn table(&self) -> String {
-        let timing = run::timing();
+        let timing = run::timing_at(self.rate);
         let us = |counts: u32| f64::from(counts) * timing.count_ns / 1e3;
         let mut text = String::new();
         for (b, boot) in self.boots.iter().enumerate() {
@@ -451,7 +459,7 @@ impl Report {
 
     /// The closing `sim summary ...` line.
     pub fn summary(&self) -> String {
-        let timing = run::timing();
+        let timing = run::timing_at(self.rate);
         let pulses: usize = self
             .boots
             .iter()

@@ -237,6 +237,7 @@ fn sim_stages(
     } else {
         stages.blocked(sim::PULSES_STAGE, "the Pico build");
     }
+    stages.run(sim::RATE_STAGE, || sim::test_rate(root, metadata));
     stages.run(sim::DRILL_STAGE, || sim::test_drill(root, metadata));
     stages.run(sim::INPUTS_STAGE, || sim::test_inputs(root, metadata));
     stages.run(sim::CONSOLE_STAGE, || {

@@ -1,9 +1,12 @@
 //! `cargo xtask trace`: the firmware's frames simulated on the host, as CSV
 //! (and PNG). The core's frame engine runs frame by frame as the frame task
-//! does, with the built-in configuration; a script's motion lines go
-//! through the same queue, its console lines through the console's
-//! service, its pin lines into the input task (`host.rs`). A row per frame:
-//! `frame,t_ms,pitch_mdeg,roll_mdeg,yaw_mdeg,pitch_ns,roll_ns,yaw_ns`.
+//! does, with the built-in configuration at 50 Hz or `--rate` (a script's
+//! `servo rate` changes it between two frames, as on the board); a
+//! script's motion lines go through the same queue, its console lines
+//! through the console's service, its pin lines into the input task
+//! (`host.rs`). A row per frame:
+//! `frame,t_ms,pitch_mdeg,roll_mdeg,yaw_mdeg,pitch_ns,roll_ns,yaw_ns`
+//! (`t_ms` with µs decimals where it has them).
 
 mod host;
 mod marks;
@@ -15,17 +18,19 @@ use std::{fs, path::PathBuf};
 use anyhow::{Context, Result, anyhow};
 use idle_head_core::Millimetres;
 use idle_head_core::behaviour::{BehaviourConfig, CommandQueue, Head, LOOP_DURATION, ShowLink};
-use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
+use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver, FrameReport};
 use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
+use idle_head_core::pwm_clock::SliceClock;
+use idle_head_core::servo::{ServoRate, SetPeriod};
 use idle_head_core::track::{Person, Sighting};
-use idle_head_core::{Axis, Playback};
+use idle_head_core::{Axis, Microseconds, Playback, Timestamp};
 use idle_head_firmware::config::IDLE_MODE;
 
 use host::Origin;
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
-use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
+use idle_head_core::pwm_clock::PICO_SYS_HZ;
 use marks::Mark;
 pub use script::{Event, Kind};
 
@@ -49,6 +54,10 @@ pub struct Args {
     /// The commands and their times, one per line: `<seconds> <command>`.
     #[arg(long, value_name = "file")]
     pub script: Option<PathBuf>,
+    /// The servos' rate (and the frame rate) from the first frame, Hz
+    /// (50 to 333; a script's `servo rate` changes it later).
+    #[arg(long, value_name = "hz", default_value_t = 50, value_parser = rate)]
+    pub rate: u16,
     /// The CSV to write [default: trace/trace.csv in the target directory].
     #[arg(long, value_name = "csv")]
     pub out: Option<PathBuf>,
@@ -67,6 +76,20 @@ fn default_dir() -> Result<PathBuf> {
         .join("trace"))
 }
 
+/// `--rate`: a servo rate.
+fn rate(text: &str) -> Result<u16, String> {
+    let hz: u16 = text
+        .parse()
+        .map_err(|_| format!("`{text}`: a rate in Hz, such as 50 or 333"))?;
+    ServoRate::new(hz).map(ServoRate::hz).ok_or_else(|| {
+        format!(
+            "{hz} Hz: the servo rate is {} to {} Hz",
+            ServoRate::MIN.hz(),
+            ServoRate::MAX.hz()
+        )
+    })
+}
+
 /// `--seconds`: more than 0, in µs.
 fn positive_seconds(text: &str) -> Result<u64, String> {
     match script::seconds(text) {
@@ -80,12 +103,17 @@ fn positive_seconds(text: &str) -> Result<u64, String> {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Row {
     pub frame: u64,
-    /// Time of the frame in ms.
+    /// Time of the frame in ms (rounded down).
     pub t_ms: u64,
+    /// Time of the frame in µs.
+    pub t_us: u64,
+    /// Commanded angles, m°.
     pub angles: [i32; 3],
     pub pulses: [u64; 3],
     /// The duties written, counts of the Pico's PWM (0: no pulse).
     pub duties: [u16; 3],
+    /// The frame period after this frame, µs.
+    pub period_us: u32,
 }
 
 /// The simulated run.
@@ -96,20 +124,40 @@ pub struct Trace {
     pub marks: Vec<Mark>,
 }
 
-/// A PWM channel that keeps the last duty.
-struct Channel(u16);
+/// A PWM channel that keeps the last duty, counted as the Pico's slice
+/// counts its period.
+struct Channel {
+    duty: u16,
+    clock: SliceClock,
+}
+
+impl Channel {
+    fn at(period: Microseconds) -> Result<Self> {
+        let clock = SliceClock::for_period(PICO_SYS_HZ, period)
+            .map_err(|_| anyhow!("no Pico clock for {} µs", period.0))?;
+        Ok(Self { duty: 0, clock })
+    }
+}
 
 impl embedded_hal::pwm::ErrorType for Channel {
-    type Error = core::convert::Infallible;
+    type Error = embedded_hal::pwm::ErrorKind;
 }
 
 impl embedded_hal::pwm::SetDutyCycle for Channel {
     fn max_duty_cycle(&self) -> u16 {
-        PICO_SERVO_CLOCK.top
+        self.clock.top
     }
 
     fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Self::Error> {
-        self.0 = duty;
+        self.duty = duty;
+        Ok(())
+    }
+}
+
+impl SetPeriod for Channel {
+    fn set_period(&mut self, period: Microseconds) -> Result<(), Self::Error> {
+        self.clock = SliceClock::for_period(PICO_SYS_HZ, period)
+            .map_err(|_| embedded_hal::pwm::ErrorKind::Other)?;
         Ok(())
     }
 }
@@ -145,48 +193,62 @@ fn idle(config: HeadConfig, playback: Playback, seed: Option<u32>) -> Result<Idl
 /// The built-in driver's parameters and the behaviour's built on them:
 /// what the board runs.
 pub fn built_in() -> Result<(DriverParams, BehaviourParams)> {
-    let driver = DriverConfig::DEFAULT
-        .build()
-        .map_err(|e| anyhow!("{}", e.message()))?;
+    at_rate(ServoRate::DEFAULT)
+}
+
+/// The built-in driver's parameters at `rate`, and the behaviour's built
+/// on them.
+///
+/// # Errors
+/// If a configuration is refused at that rate.
+pub fn at_rate(rate: ServoRate) -> Result<(DriverParams, BehaviourParams)> {
+    let mut config = DriverConfig::DEFAULT;
+    config.frame_period = rate.period();
+    config.pwm.period = rate.period();
+    let driver = config.build().map_err(|e| anyhow!("{}", e.message()))?;
     let params = BehaviourConfig::DEFAULT
         .build(&driver)
         .map_err(|e| anyhow!("{e}"))?;
     Ok((driver, params))
 }
 
-/// Runs `micros` of frames with `events` (sorted by time): motion lines
-/// through the queue, other console lines through the console's service,
-/// pin lines into the input task ([`host`]).
-pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trace> {
-    let (driver_params, params) = built_in()?;
-    let frame_us = u64::from(driver_params.config().frame_period.0);
-    let count_ps = PICO_SERVO_CLOCK.count_ps(PICO_SYS_HZ);
-    let playback = Playback::new(
-        LOOP_DURATION,
-        driver_params.config().frame_period,
-        DEFAULT_N,
-    )
-    .map_err(|e| anyhow!("playback: {e:?}"))?;
+/// Runs `micros` of frames at `rate` with `events` (sorted by time):
+/// motion lines through the queue, other console lines through the
+/// console's service, pin lines into the input task ([`host`]).
+pub fn simulate(
+    micros: u64,
+    seed: Option<u32>,
+    rate: ServoRate,
+    events: &[Event],
+) -> Result<Trace> {
+    let (driver_params, params) = at_rate(rate)?;
+    let period = driver_params.config().frame_period;
+    let playback =
+        Playback::new(LOOP_DURATION, period, DEFAULT_N).map_err(|e| anyhow!("playback: {e:?}"))?;
     let idle = idle(config(seed), playback, seed)?;
     let mut head = Head::new(idle, params);
-    let mut driver = FrameDriver::new([Channel(0), Channel(0), Channel(0)], driver_params);
+    let channels = [
+        Channel::at(period)?,
+        Channel::at(period)?,
+        Channel::at(period)?,
+    ];
+    let mut driver = FrameDriver::new(channels, driver_params);
     let queue: CommandQueue = CommandQueue::new();
     let link = ConsoleLink::new();
     let show = ShowLink::new();
-    let mut console = host::Console::new(&queue, &link, &show)?;
+    let mut console = host::Console::new(&queue, &link, &show, rate)?;
     let mut task = host::Task::new(&link);
     // What the radar sees (a script's radar lines), sent at its 10 Hz.
     let mut people = Sighting::NOBODY;
     let mut radar_frames = 0_u64;
 
-    let frames = micros / frame_us;
-    let mut rows = Vec::with_capacity(usize::try_from(frames).unwrap_or(0));
+    let mut rows = Vec::with_capacity(usize::try_from(micros / u64::from(period.0)).unwrap_or(0));
     let mut marks = Vec::new();
     let mut next = 0;
     // Where each queued action came from, oldest first.
     let mut origins: Vec<Origin> = Vec::new();
-    for frame in 0..frames {
-        let t_us = frame * frame_us;
+    let (mut frame, mut t_us) = (0, 0);
+    while t_us < micros {
         let rest = head.rest_state();
         // The script's lines due, and the input task's wakes between them.
         while let Some(event) = events.get(next).filter(|e| e.at_us <= t_us) {
@@ -211,48 +273,48 @@ pub fn simulate(micros: u64, seed: Option<u32>, events: &[Event]) -> Result<Trac
         wake_until(&mut task, t_us, rest, &link, &queue, &mut origins);
         // What the console sent through the link, then the queue.
         from_link(&link, &mut head, &mut driver, t_us);
-        let mut taken = origins.drain(..).collect::<std::collections::VecDeque<_>>();
-        head.drain(&mut driver, &queue, |action, outcome| {
-            let Some(origin) = taken.pop_front() else {
-                return;
-            };
-            let event = match origin {
-                Origin::Line(i) => events[i].clone(),
-                Origin::Other(text) => Event {
-                    line: 0,
-                    at_us: t_us,
-                    text,
-                    kind: Kind::Act(*action),
-                },
-            };
-            marks.extend(marks::marks(&event, t_us / 1000, outcome, &params));
-        });
-        origins.extend(taken);
+        // A new rate: the outputs from this frame on, the frames after it.
+        let retime = link.take_rate().map(ServoRate::period);
+        if let Some(period) = retime {
+            driver
+                .set_pwm_period(period)
+                .map_err(|e| anyhow!("{} ms: servo rate refused: {e}", t_us / 1000))?;
+        }
+        drain(
+            &mut head,
+            &mut driver,
+            &queue,
+            &mut origins,
+            events,
+            t_us,
+            &mut marks,
+        );
         let sighting = show.track.take();
         head.track(
             &mut driver,
-            frame,
+            Timestamp(t_us),
             &show.track.settings(),
             sighting.as_ref(),
         );
-        let played = head.frame(&mut driver, frame);
+        let played = head.frame(&mut driver, Timestamp(t_us));
+        if let Some(period) = retime {
+            head.set_frame_period(&mut driver, period)
+                .map_err(|e| anyhow!("{} ms: servo rate refused: {e}", t_us / 1000))?;
+        }
         let report = played.report;
         let mode = HeadMode::of(driver.is_stopped(), driver.is_stopping(), head.rest_state());
-        link.publish(HeadStatus::of(&report, driver.stats(), mode));
-        let servos = report.servos;
-        rows.push(Row {
-            frame,
-            t_ms: t_us / 1000,
-            angles: servos.map(|s| s.angle.millidegrees()),
-            pulses: servos.map(|s| (u64::from(s.duty.0) * count_ps + 500) / 1000),
-            duties: servos.map(|s| s.duty.0),
-        });
+        link.publish(HeadStatus::of(
+            &report,
+            driver.stats(),
+            mode,
+            Timestamp(t_us),
+        ));
+        let period_us = driver.params().config().frame_period.0;
+        rows.push(row(frame, t_us, &report, &mut driver));
+        frame += 1;
+        t_us += u64::from(period_us);
     }
-    marks::settle(
-        &mut marks,
-        params.config().blend.0,
-        frames * frame_us / 1000,
-    );
+    marks::settle(&mut marks, params.config().blend.0, t_us / 1000);
     for event in &events[next..] {
         println!(
             "line {}: at {} s, after the trace's end: not run",
@@ -340,7 +402,54 @@ impl Lines<'_> {
     }
 }
 
-/// Between frames: the live settings and calibrations the console sent.
+/// The row of frame `frame` at `t_us` that wrote `report`.
+fn row(frame: u64, t_us: u64, report: &FrameReport, driver: &mut FrameDriver<Channel>) -> Row {
+    let servos = report.servos;
+    let count_ps = driver.channels_mut()[0].clock.count_ps(PICO_SYS_HZ);
+    Row {
+        frame,
+        t_ms: t_us / 1000,
+        t_us,
+        angles: servos.map(|s| s.angle.millidegrees()),
+        pulses: servos.map(|s| (u64::from(s.duty.0) * count_ps + 500) / 1000),
+        duties: servos.map(|s| s.duty.0),
+        period_us: driver.params().config().frame_period.0,
+    }
+}
+
+/// The queue's actions taken before the frame at `t_us`, each marked with
+/// the line (or other source) it came from.
+fn drain(
+    head: &mut Head<Idle>,
+    driver: &mut FrameDriver<Channel>,
+    queue: &CommandQueue,
+    origins: &mut Vec<Origin>,
+    events: &[Event],
+    t_us: u64,
+    marks: &mut Vec<Mark>,
+) {
+    let params = *head.mixer().params();
+    let mut taken = origins.drain(..).collect::<std::collections::VecDeque<_>>();
+    head.drain(driver, queue, |action, outcome| {
+        let Some(origin) = taken.pop_front() else {
+            return;
+        };
+        let event = match origin {
+            Origin::Line(i) => events[i].clone(),
+            Origin::Other(text) => Event {
+                line: 0,
+                at_us: t_us,
+                text,
+                kind: Kind::Act(*action),
+            },
+        };
+        marks.extend(marks::marks(&event, t_us / 1000, outcome, &params));
+    });
+    origins.extend(taken);
+}
+
+/// Between frames: the live settings and calibrations the console sent
+/// (the rate is the frame's, [`simulate`]).
 fn from_link<I: idle_head_core::behaviour::IdleSource>(
     link: &ConsoleLink,
     head: &mut Head<I>,
@@ -382,7 +491,8 @@ fn wake_until(
 
 /// `cargo xtask trace`.
 pub fn command(args: &Args) -> Result<bool> {
-    let (_, params) = built_in()?;
+    let rate = ServoRate::new(args.rate).ok_or_else(|| anyhow!("{} Hz: not a rate", args.rate))?;
+    let (_, params) = at_rate(rate)?;
     let events = match &args.script {
         Some(path) => {
             let text = fs::read_to_string(path)
@@ -391,7 +501,7 @@ pub fn command(args: &Args) -> Result<bool> {
         }
         None => Vec::new(),
     };
-    let trace = simulate(args.micros, args.seed, &events)?;
+    let trace = simulate(args.micros, args.seed, rate, &events)?;
     let out = match &args.out {
         Some(out) => out.clone(),
         None => default_dir()?.join("trace.csv"),
@@ -420,7 +530,11 @@ fn write_csv(trace: &Trace, path: &std::path::Path) -> Result<()> {
     for row in &trace.rows {
         let [p, r, y] = row.angles;
         let [pn, rn, yn] = row.pulses;
-        let _ = writeln!(csv, "{},{},{p},{r},{y},{pn},{rn},{yn}", row.frame, row.t_ms);
+        let t_ms = match row.t_us % 1000 {
+            0 => format!("{}", row.t_us / 1000),
+            us => format!("{}.{us:03}", row.t_us / 1000),
+        };
+        let _ = writeln!(csv, "{},{t_ms},{p},{r},{y},{pn},{rn},{yn}", row.frame);
     }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -440,7 +554,7 @@ fn summary(trace: &Trace) {
         let pulses = trace.rows.iter().map(|r| r.pulses[i]);
         let (plo, phi) = pulses.fold((u64::MAX, 0), |(lo, hi), p| (lo.min(p), hi.max(p)));
         println!(
-            "{:<5} angle {lo}..{hi} mdeg, largest step {step:.0} mdeg/frame, largest change of step {turn:.0} mdeg/frame², pulses {plo}..{phi} ns",
+            "{:<5} angle {lo}..{hi} mdeg, largest step {step:.0} mdeg/frame, largest change of step {turn:.0} mdeg/frame² (frames as they came), pulses {plo}..{phi} ns",
             axis.name()
         );
     }

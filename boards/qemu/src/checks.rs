@@ -21,9 +21,11 @@ use crate::script;
 
 /// Frames per loop: 1.5 s / 1 ms (= 30 s / 20 ms on the Pico).
 pub const LOOP_FRAMES: u64 = crate::LOOP.0 as u64 * 1000 / crate::FRAME_PERIOD.0 as u64;
+/// The Pico's frame period, µs: frame `k` here plays the Pico's frame `k`.
+const PICO_FRAME_US: u64 = crate::CONFIG.frame_period.0 as u64;
 /// The first join: the frames where loop set 0 blends into loop set 1.
-const JOIN: Range<u64> =
-    DEFAULT_TIMING.period() as u64..(DEFAULT_TIMING.period() + DEFAULT_TIMING.join_frames) as u64;
+const JOIN: Range<u64> = DEFAULT_TIMING.period_us() / PICO_FRAME_US
+    ..(DEFAULT_TIMING.period_us() + DEFAULT_TIMING.join_us) / PICO_FRAME_US;
 /// Fade-in frames (the soft start).
 const FADE_FRAMES: u64 = DEFAULT_PARAMS.fade_frames() as u64;
 /// A trace line every 50 frames (1 s on the Pico) for the host's plot.
@@ -41,7 +43,7 @@ const FAULTY: Axis = Axis::Yaw;
 /// `FADE_FRAMES..FADE_FRAMES + LOOP_FRAMES` = 100..1600).
 const BURST: Range<u64> = 1650..1660;
 /// From here on every write fails: the servo is switched off after
-/// `disable_after` (25) failed frames in a row, at frame 1724.
+/// `disable_after` (0.5 s: 25) failed frames in a row, at frame 1724.
 const PERSISTENT_FROM: u64 = 1700;
 /// Fade-out (soft stop) requested here; it takes `FADE_FRAMES` frames.
 const STOP_AT: u64 = 1800;
@@ -53,9 +55,9 @@ const _: () = {
         BURST.start >= FADE_FRAMES + LOOP_FRAMES,
         "faults only after a whole loop"
     );
-    assert!(((BURST.end - BURST.start) as u16) < crate::CONFIG.faults.disable_after);
+    assert!(((BURST.end - BURST.start) as u16) < DEFAULT_PARAMS.disable_frames());
     assert!(BURST.end < PERSISTENT_FROM);
-    assert!(PERSISTENT_FROM + (crate::CONFIG.faults.disable_after as u64) < STOP_AT);
+    assert!(PERSISTENT_FROM + (DEFAULT_PARAMS.disable_frames() as u64) < STOP_AT);
     assert!(
         script::QUIET_FROM <= JOIN.start,
         "the script's motion ends before the join"
@@ -65,7 +67,7 @@ const _: () = {
 /// Faults the schedule injects: the burst, then the failed frames up to the
 /// switch-off.
 const EXPECTED_FAULTS: u32 =
-    (BURST.end - BURST.start) as u32 + crate::CONFIG.faults.disable_after as u32;
+    (BURST.end - BURST.start) as u32 + DEFAULT_PARAMS.disable_frames() as u32;
 
 /// Largest frame-to-frame change of the offsets (velocity, d1) and of that
 /// change (acceleration, d2), per axis: inside the loops (the script's frames
@@ -208,7 +210,7 @@ impl Checks {
             );
             self.fail();
         }
-        let want_at = PERSISTENT_FROM + self.config.faults.disable_after as u64 - 1;
+        let want_at = PERSISTENT_FROM + DEFAULT_PARAMS.disable_frames() as u64 - 1;
         if self.disabled_at != Some(want_at) {
             defmt::error!(
                 "check: {=str} not switched off at frame {=u64}",

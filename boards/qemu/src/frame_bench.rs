@@ -1,19 +1,23 @@
 //! The frame benchmark: exact instruction counts of one frame update,
 //! [`FrameLoop::write`] (playback, fade, limits, mapping, the three PWM
-//! writes), for every frame of a whole loop with the seam and the fade-in.
+//! writes), for every frame of a whole loop with the seam and the fade-in,
+//! at 50 Hz and at 333 Hz (`servo rate`).
 //!
 //! # Setting
 //!
-//! The default driver configuration and playback of the Pico (50 Hz frames,
-//! 30 s loops of the Table 2 set: 1500 frames a loop, a 2 s fade-in), the
-//! never-repeating idle: loop set 0 (the default set, checked against the
-//! benchmark rows' checksum) and loop set 1 of its stream, generated before
-//! (its generation is counted too, as `stream set`), handed over on the
-//! frame its join is due. Three PWM channels that accept every duty (the
-//! Pico's 64 000 counts per period), frames 0 (the start, neutral pulses) to
-//! 1600: the fade-in, the join over frames 1400..1500 (set 1 taken over at
-//! 1400, its join samples read until frame 1502) and 100 frames past it. No
-//! logging.
+//! The default driver configuration and playback of the Pico (30 s loops of
+//! the Table 2 set, a 2 s fade-in), the never-repeating idle: loop set 0
+//! (the default set, checked against the benchmark rows' checksum) and loop
+//! set 1 of its stream, generated before (its generation is counted too, as
+//! `stream set`), handed over on the frame its join is due. Three PWM
+//! channels that accept every duty (the Pico's counts per period: 64 000 at
+//! 50 Hz, 60 060 at 333 Hz). At 50 Hz, frames 0 (the start, neutral
+//! pulses) to 1600: the fade-in, the join over frames 1400..1500 (set 1
+//! taken over at 1400 = 28 s, its join samples read until frame 1502) and
+//! 100 frames past it. At 333 Hz (3003 µs), the same times in 1601
+//! frames: those of the first 2.1 s (the start and the fade-in) and from
+//! 27.7 s on (the join and past it); the frames between are played, not
+//! measured. No logging.
 //!
 //! # Method
 //!
@@ -37,8 +41,10 @@
 //!
 //! ```text
 //! stream set=1 insns=<insns>
-//! frame bench frames=<n> min=<insns> median=<insns> max=<insns> max_at=<frame> mean=<insns>
-//! frame bench scenario=gesture+look frames=<n> min=<insns> ...
+//! frame bench rate=50 frames=<n> min=<insns> median=<insns> max=<insns> max_at=<frame> mean=<insns>
+//! frame bench rate=50 scenario=gesture+look frames=<n> min=<insns> ...
+//! frame bench rate=333 frames=<n> ...
+//! frame bench rate=333 scenario=gesture+look frames=<n> ...
 //! ```
 //!
 //! The second line measures the same frames with a gesture and a gaze move
@@ -60,12 +66,11 @@ use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookReq
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver, FrameTick};
 use idle_head_core::idle::{IdleMode, IdlePlayer, IdleTiming, LoopStream, LoopSupply};
 use idle_head_core::motion::DEFAULT_HEAD;
+use idle_head_core::pwm_clock::{PICO_SYS_HZ, SliceClock};
+use idle_head_core::servo::ServoRate;
 use idle_head_core::units::Angle;
-use idle_head_firmware::config::{DEFAULT_PARAMS, DEFAULT_PLAYBACK, DEFAULT_TIMING};
+use idle_head_firmware::config::{DEFAULT_BEHAVIOUR, DEFAULT_TIMING};
 use idle_head_firmware::frame::FrameLoop;
-
-use idle_head_core::Playback;
-use idle_head_core::pwm_clock::PICO_SERVO_CLOCK;
 
 use crate::systick;
 
@@ -85,9 +90,12 @@ const INSNS_PER_FAST_COUNT: u64 = 5;
 const SYSCTL_RCC: *mut u32 = 0x400F_E060 as *mut u32;
 const RCC_SYSDIV: u32 = 0xF << 23;
 
-const PARAMS: DriverParams = DEFAULT_PARAMS;
-const PLAYBACK: Playback = DEFAULT_PLAYBACK;
 const TIMING: IdleTiming = DEFAULT_TIMING;
+
+/// The rates measured, and for each the frames' times left unmeasured
+/// (µs): none at 50 Hz (1601 frames are 32 s), the middle of the loop at
+/// 333 Hz (the fade-in and the join are measured, as at 50 Hz).
+const RATES: [(u16, core::ops::Range<u64>); 2] = [(50, 0..0), (333, 2_100_000..27_700_000)];
 
 /// A loop set of the default length.
 pub use idle_head_firmware::config::Set;
@@ -104,9 +112,10 @@ impl<'a> LoopSupply<&'a Set> for Ready<'a> {
     fn give_back(&mut self, _set: &'a Set) {}
 }
 
-/// A PWM channel that accepts every duty, with the Pico's counts per period.
+/// A PWM channel that accepts every duty, with the Pico's counts per
+/// period (its `TOP`).
 #[derive(Clone)]
-struct AcceptAll(u16);
+struct AcceptAll(u16, u16);
 
 impl ErrorType for AcceptAll {
     type Error = core::convert::Infallible;
@@ -114,7 +123,7 @@ impl ErrorType for AcceptAll {
 
 impl SetDutyCycle for AcceptAll {
     fn max_duty_cycle(&self) -> u16 {
-        PICO_SERVO_CLOCK.top
+        self.1
     }
 
     fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Self::Error> {
@@ -204,22 +213,47 @@ pub fn run(syst: &mut SYST, sets: &mut [Set; 2], default_checksum: u32) -> bool 
         );
         return false;
     }
-    let idle = IdlePlayer::new(first, Ready(Some(second)), TIMING, IdleMode::NeverRepeating);
-    let Ok(frames) = FrameLoop::new(idle, PLAYBACK.frame_period(), 1_000_000, 0) else {
-        return false;
-    };
-    let channels = [AcceptAll(0), AcceptAll(0), AcceptAll(0)];
-    let state = State {
-        frames,
-        driver: FrameDriver::new(channels, PARAMS),
-    };
-    // One table of counts on the stack at a time (6.4 KB each).
-    if !measure(syst, state.clone(), None, &mut |_, _| {}) {
-        return false;
+    for (hz, skip) in RATES {
+        // One state and one table of counts on the stack at a time.
+        let ok = state_at(hz, first, second)
+            .is_some_and(|state| measure(syst, state, hz, &skip, None, &mut |_, _| {}));
+        let mut busy = Busy::default();
+        let keep = &mut |state: &mut State<'_>, at: u64| busy.keep(state, at);
+        if !ok
+            || !state_at(hz, first, second)
+                .is_some_and(|state| measure(syst, state, hz, &skip, Some("gesture+look"), keep))
+        {
+            defmt::error!("frame bench: the frames at {=u16} Hz were not measured", hz);
+            return false;
+        }
     }
-    let mut busy = Busy::default();
-    measure(syst, state, Some("gesture+look"), &mut |state, frame| {
-        busy.keep(state, frame);
+    true
+}
+
+/// The frame loop and the driver of the default configuration at `hz`,
+/// playing loop set `first`, then `second`.
+fn state_at<'a>(hz: u16, first: &'a Set, second: &'a Set) -> Option<State<'a>> {
+    let period = ServoRate::new(hz)?.period();
+    let mut config = DriverConfig::DEFAULT;
+    config.frame_period = period;
+    config.pwm.period = period;
+    let params: DriverParams = config.build().ok()?;
+    // The built-in behaviour at that rate, as `servo rate` makes it.
+    let mut behaviour = DEFAULT_BEHAVIOUR;
+    behaviour.set_frame_period(period);
+    let timing = IdleTiming {
+        playback: TIMING.playback.with_frame_period(period),
+        ..TIMING
+    };
+    let idle = IdlePlayer::new(first, Ready(Some(second)), timing, IdleMode::NeverRepeating);
+    let frames = FrameLoop::with_behaviour(idle, period, behaviour, 1_000_000, 0).ok()?;
+    let top = SliceClock::for_period(PICO_SYS_HZ, period).ok()?.top;
+    Some(State {
+        frames,
+        driver: FrameDriver::new(
+            [AcceptAll(0, top), AcceptAll(0, top), AcceptAll(0, top)],
+            params,
+        ),
     })
 }
 
@@ -230,6 +264,7 @@ const TARGETS: [(i32, i32); 2] = [(-6, 12), (0, -5)];
 /// Keeps a gesture and a gaze move playing (see the module docs).
 #[derive(Default)]
 struct Busy {
+    /// The times (µs) the gesture and the look end.
     gesture_until: u64,
     look_until: u64,
     gestures: u32,
@@ -237,19 +272,18 @@ struct Busy {
 }
 
 impl Busy {
-    /// Starts what has ended before frame `frame`.
-    fn keep(&mut self, state: &mut State<'_>, frame: u64) {
-        let frame_ms = u64::from(DriverConfig::DEFAULT.frame_period.0 / 1000);
-        if frame >= self.gesture_until {
+    /// Starts what has ended before the frame at `at` µs.
+    fn keep(&mut self, state: &mut State<'_>, at: u64) {
+        if at >= self.gesture_until {
             let kind = [GestureKind::Nod, GestureKind::Shake, GestureKind::Tilt]
                 [(self.gestures % 3) as usize];
             self.gestures += 1;
             let action = Action::Gesture(GestureRequest::new(kind));
             if let Ok(Applied::Gesture(plan)) = state.frames.apply(&mut state.driver, &action) {
-                self.gesture_until = frame + u64::from(plan.duration.0) / frame_ms;
+                self.gesture_until = at + u64::from(plan.duration.0) * 1000;
             }
         }
-        if frame >= self.look_until {
+        if at >= self.look_until {
             let (pitch, yaw) = TARGETS[(self.looks % 2) as usize];
             self.looks += 1;
             let action = Action::Look(LookRequest {
@@ -259,27 +293,40 @@ impl Busy {
                 hold: Some(Hold::Stay),
             });
             if let Ok(Applied::Look(look)) = state.frames.apply(&mut state.driver, &action) {
-                self.look_until = frame + u64::from(look.duration.0) / frame_ms;
+                self.look_until = at + u64::from(look.duration.0) * 1000;
             }
         }
     }
 }
 
-/// Measures every frame of `state` (`before` runs, uncounted, before each)
-/// and logs the `frame bench` line of `scenario`; `false` if the
-/// measurement cannot be trusted.
+/// Measures [`FRAMES`] frames of `state` at `hz` (`before` runs,
+/// uncounted, before each; the frames whose time lies in `skip` are
+/// played, not measured) and logs the `frame bench` line of `scenario`;
+/// `false` if the measurement cannot be trusted.
 fn measure(
     syst: &mut SYST,
     mut state: State<'_>,
+    hz: u16,
+    skip: &core::ops::Range<u64>,
     scenario: Option<&str>,
     before: &mut dyn FnMut(&mut State<'_>, u64),
 ) -> bool {
-    let mut insns = [0u32; FRAMES];
+    // Below 2¹⁶ a frame (the ceilings are 4,000): 3.2 KB of stack.
+    let mut insns = [0u16; FRAMES];
+    // The costliest frame so far: its count and index.
+    let mut costliest = (0, 0);
     // The copy's cost outside and inside the join.
     let mut copy_insns: [Option<u64>; 2] = [None, None];
-    for (frame, slot) in insns.iter_mut().enumerate() {
-        let tick = state.frames.next(state.frames.deadline());
-        before(&mut state, tick.frame);
+    for slot in &mut insns {
+        let mut tick = state.frames.next(state.frames.deadline());
+        while skip.contains(&tick.at.0) {
+            before(&mut state, tick.at.0);
+            state.frames.drain(&mut state.driver, tick);
+            black_box(state.frames.write(&mut state.driver, tick));
+            tick = state.frames.next(state.frames.deadline());
+        }
+        let frame = tick.frame;
+        before(&mut state, tick.at.0);
         // Between frames, as the frame task: the limit modes asked for.
         state.frames.drain(&mut state.driver, tick);
         let copy = per_rep(syst, |reps| copies(reps, &state));
@@ -287,7 +334,7 @@ fn measure(
         let first = *copy_insns[joining].get_or_insert(copy);
         if first != copy {
             defmt::error!(
-                "frame bench: frame {=usize}: a copy of the state took {=u64} instructions, before {=u64}",
+                "frame bench: frame {=u64}: a copy of the state took {=u64} instructions, before {=u64}",
                 frame,
                 copy,
                 first
@@ -295,7 +342,10 @@ fn measure(
             return false;
         }
         let both = per_rep(syst, |reps| copies_and_frames(reps, &state, tick));
-        *slot = both.saturating_sub(copy) as u32;
+        *slot = u16::try_from(both.saturating_sub(copy)).unwrap_or(u16::MAX);
+        if *slot > costliest.0 {
+            costliest = (*slot, frame);
+        }
         black_box(state.frames.write(&mut state.driver, tick));
     }
     let idle = state.frames.idle_mut().stats();
@@ -303,22 +353,23 @@ fn measure(
         defmt::error!("frame bench: the measured frames did not join loop set 1");
         return false;
     }
-    log(scenario, &mut insns);
+    log(hz, scenario, &mut insns, costliest.1);
     true
 }
 
-/// The `frame bench` line of `insns` (sorted in place: a second table of
-/// 6.4 KB on the stack would leave the frame state too little room).
-fn log(scenario: Option<&str>, insns: &mut [u32; FRAMES]) {
+/// The `frame bench` line of `insns`, the costliest frame being `max_at`
+/// (sorted in place: a second table on the stack would leave the frame
+/// state too little room).
+fn log(hz: u16, scenario: Option<&str>, insns: &mut [u16; FRAMES], max_at: u64) {
     let total: u64 = insns.iter().map(|&n| u64::from(n)).sum();
-    let max = insns.iter().copied().max().unwrap_or(0);
-    let max_at = insns.iter().position(|&n| n == max).unwrap_or(0);
     let sorted = insns;
     sorted.sort_unstable();
+    let max = sorted[FRAMES - 1];
     let (min, median, mean) = (sorted[0], sorted[FRAMES / 2], total / FRAMES as u64);
     match scenario {
         None => defmt::info!(
-            "frame bench frames={=usize} min={=u32} median={=u32} max={=u32} max_at={=usize} mean={=u64}",
+            "frame bench rate={=u16} frames={=usize} min={=u16} median={=u16} max={=u16} max_at={=u64} mean={=u64}",
+            hz,
             FRAMES,
             min,
             median,
@@ -327,7 +378,8 @@ fn log(scenario: Option<&str>, insns: &mut [u32; FRAMES]) {
             mean
         ),
         Some(name) => defmt::info!(
-            "frame bench scenario={=str} frames={=usize} min={=u32} median={=u32} max={=u32} max_at={=usize} mean={=u64}",
+            "frame bench rate={=u16} scenario={=str} frames={=usize} min={=u16} median={=u16} max={=u16} max_at={=u64} mean={=u64}",
+            hz,
             name,
             FRAMES,
             min,

@@ -104,7 +104,7 @@ fn main() -> ! {
         checks::LOOP_FRAMES,
         DEFAULT_N,
         DEFAULT_PARAMS.fade_frames(),
-        CONFIG.faults.disable_after
+        DEFAULT_PARAMS.disable_frames()
     );
     defmt::info!(
         "virtual PWM: {=u16} counts per {=u32} us (the Pico's TOP), pulse limits [{=u32}, {=u32}] us",

@@ -35,7 +35,10 @@
 //! sighting, with any tracking settings, to attention and the gaze), the
 //! inputs' radar presence (`Inputs::sense`) and Bottango's side
 //! of the console (its line parser on any line, any motor command on the
-//! shared curves, any curve built from any parameters). Its panic handler calls `frame_path_has_a_panic_path`, a function
+//! shared curves, any curve built from any parameters), and a change of
+//! the servos' rate at any frame to any period of the range
+//! ([`FrameLoop::take_rate`] before a frame, the frames' part of it in
+//! [`FrameLoop::write`]) on outputs that take it or not. Its panic handler calls `frame_path_has_a_panic_path`, a function
 //! that exists nowhere. If any panic (index, division, overflow check,
 //! `unwrap`, ...) remains reachable after optimisation, the call survives
 //! and the link fails:
@@ -67,7 +70,7 @@ use idle_head_core::driver::{
 };
 use idle_head_core::idle::{IdlePlayer, IdleTiming};
 use idle_head_core::input::{InputSettings, Inputs, Micros};
-use idle_head_core::servo::{Direction, NanosPerDegree, ServoCalibration};
+use idle_head_core::servo::{Direction, NanosPerDegree, ServoCalibration, ServoRate, SetPeriod};
 use idle_head_core::track::ld2450::Decoder;
 use idle_head_core::track::{Person, Prefer, Sighting, SightingSource, TrackSettings};
 use idle_head_core::units::{Angle, AngleRange, Microseconds, Millis};
@@ -132,6 +135,16 @@ impl SetDutyCycle for OpaquePwm {
 
     fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Self::Error> {
         if black_box(duty) == black_box(0) {
+            Err(ErrorKind::Other)
+        } else {
+            Ok(())
+        }
+    }
+}
+
+impl SetPeriod for OpaquePwm {
+    fn set_period(&mut self, period: Microseconds) -> Result<(), Self::Error> {
+        if black_box(period.0) == black_box(0) {
             Err(ErrorKind::Other)
         } else {
             Ok(())
@@ -410,6 +423,11 @@ fn main() -> ! {
                     },
                 });
                 inputs.sense(Micros(black_box(0)), SHOW.track.presence());
+                // A new servo rate from the console, taken before a frame.
+                let rate = ServoRate::new(black_box(50)).unwrap_or(ServoRate::DEFAULT);
+                LINK.set_rate(rate);
+                let tick = frames.next(black_box(0));
+                frames.take_rate(&mut driver, tick);
             }
             _ => {}
         }

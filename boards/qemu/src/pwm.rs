@@ -1,10 +1,13 @@
 //! Virtual servo PWM channels: they record every duty written and check it
 //! against their servo's pulse limits, independently of the frame driver's
-//! own clamping; one can be told to fail its writes (fault injection).
+//! own clamping; one can be told to fail its writes (fault injection). A
+//! new period (`servo rate`) is counted as the Pico's slice counts it
+//! ([`SliceClock::for_period`] at its 125 MHz).
 
 use embedded_hal::pwm::{Error, ErrorKind, ErrorType, SetDutyCycle};
 use idle_head_core::Microseconds;
-use idle_head_core::servo::{ServoCalibration, bounds};
+use idle_head_core::pwm_clock::{PICO_SYS_HZ, SliceClock};
+use idle_head_core::servo::{ServoCalibration, SetPeriod, bounds};
 
 /// Why a virtual channel rejected a write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
@@ -13,6 +16,8 @@ pub enum VirtualPwmError {
     Injected,
     /// The duty was above the channel's maximum (as embassy-rp rejects it).
     AboveMax,
+    /// No clock of the Pico's slice makes the period.
+    Period,
 }
 
 impl Error for VirtualPwmError {
@@ -38,6 +43,8 @@ pub struct ChannelLog {
     /// The duty the output is producing now (0 before the first write:
     /// the output starts low).
     pub current: u16,
+    /// Periods set after the first (changes of `servo rate`).
+    pub periods: u32,
 }
 
 /// One servo's PWM output in the emulated board.
@@ -51,6 +58,8 @@ pub struct VirtualPwm {
     period: Microseconds,
     /// Smallest and largest duty whose pulse is within the servo's limits.
     allowed: (u16, u16),
+    /// The pulse range judged (for a new period's duties).
+    judged: (Microseconds, Microseconds),
     inject: bool,
     log: ChannelLog,
 }
@@ -66,6 +75,7 @@ impl VirtualPwm {
             max_duty,
             period,
             allowed: allowed_duties(max_duty, period, servo.min_pulse, servo.max_pulse),
+            judged: (servo.min_pulse, servo.max_pulse),
             inject: false,
             log: ChannelLog {
                 accepted: 0,
@@ -74,6 +84,7 @@ impl VirtualPwm {
                 violations: 0,
                 first: None,
                 current: 0,
+                periods: 0,
             },
         }
     }
@@ -91,6 +102,7 @@ impl VirtualPwm {
         } else {
             servo.max_pulse
         };
+        self.judged = (min, max);
         self.allowed = allowed_duties(self.max_duty, self.period, min, max);
     }
 
@@ -135,6 +147,25 @@ const fn allowed_duties(
     let hi = (2 * max.0 as u64 * m + p) / (2 * p);
     let hi = if hi > m { m } else { hi };
     (lo as u16, hi as u16)
+}
+
+/// The Pico's slice at `period`: its counts per period, from the next
+/// write on (the frame driver counts the duties in them).
+impl SetPeriod for VirtualPwm {
+    fn set_period(&mut self, period: Microseconds) -> Result<(), Self::Error> {
+        let Ok(clock) = SliceClock::for_period(PICO_SYS_HZ, period) else {
+            return Err(VirtualPwmError::Period);
+        };
+        if (clock.top, period) == (self.max_duty, self.period) {
+            return Ok(());
+        }
+        self.max_duty = clock.top;
+        self.period = period;
+        let (min, max) = self.judged;
+        self.allowed = allowed_duties(self.max_duty, period, min, max);
+        self.log.periods += 1;
+        Ok(())
+    }
 }
 
 impl ErrorType for VirtualPwm {

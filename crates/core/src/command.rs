@@ -202,6 +202,9 @@ pub enum Command {
     Act(Action),
     /// Restart the idle motion's random stream.
     Seed(SeedChoice),
+    /// Show (`None`) or set the servos' PWM rate, and with it the frame
+    /// rate (`servo rate [hz]`).
+    ServoRate(Option<crate::servo::ServoRate>),
     /// Show (`None`) or change one field of a servo's calibration.
     Servo {
         /// The servo's axis.

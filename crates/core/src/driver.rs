@@ -9,17 +9,24 @@
 //! 4. converted to a pulse (clamped to the servo's pulse limits) and duty ticks;
 //! 5. written; a write error is counted and reported, the other servos carry on
 //!    and the servo is written again next frame, its limiter continuing from
-//!    the last pulse it actually received; a servo that fails
-//!    [`FaultPolicy::disable_after`] frames in a row gets duty 0 once (no
-//!    pulses: it goes limp) and is never written again.
+//!    the last pulse it actually received; a servo whose writes fail for
+//!    [`FaultPolicy::disable_after`] in a row gets duty 0 once (no pulses:
+//!    it goes limp) and is never written again.
 //!
 //! The first pulse any servo receives is its neutral pulse (0°).
 //!
 //! Configuration is in physical units ([`DriverConfig`]); [`DriverConfig::build`]
 //! validates it into the integer [`DriverParams`] the frame path uses.
 //! [`FrameDriver::set_motion_limits`] and [`FrameDriver::set_servo`] change
-//! an axis' limits or calibration at run time, validated the same way.
-//! [`FrameClock`] keeps the frame deadlines and skips late frames.
+//! an axis' limits or calibration at run time, validated the same way, and
+//! [`FrameDriver::set_pwm_period`] with [`FrameDriver::set_frame_period`]
+//! the servos' rate (`servo rate`, see `frame/rate.rs`).
+//! [`FrameClock`] keeps the frame deadlines and the frames' time, and
+//! skips late frames.
+//!
+//! Everything physical is in time, not frames: the limits in °/s and
+//! °/s², the fade and the fault policy in ms. Their per-frame forms are
+//! worked out for the frame period, and again when it changes.
 //!
 //! # Cost
 //!
@@ -42,7 +49,8 @@ mod report;
 pub use crate::units::{DegreesPerSecond, DegreesPerSecondSquared};
 pub use clock::{FrameClock, FrameTick, ZeroPeriod};
 pub use config::{DriverConfig, DriverParams, FaultPolicy, MotionLimits};
-pub use error::ConfigError;
+pub use envelope::START_HOLD;
+pub use error::{ConfigError, RateError};
 pub use frame::FrameDriver;
 pub use report::{DriverStats, FrameReport, Outcome, ServoReport};
 

@@ -64,4 +64,4 @@ pub use axis::Axis;
 pub use driver::{DriverConfig, FrameClock, FrameDriver, FrameReport};
 pub use playback::{LoopSource, Playback};
 pub use servo::{Direction, PwmTiming, ServoCalibration};
-pub use units::{Angle, AngleRange, Microseconds, Millimetres, Millis};
+pub use units::{Angle, AngleRange, Microseconds, Millimetres, Millis, Timestamp};

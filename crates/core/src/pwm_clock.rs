@@ -1,4 +1,5 @@
-//! Clocking of an RP2040 PWM slice for servo pulses, worked out in `const fn`s.
+//! Clocking of an RP2040 PWM slice for servo pulses, worked out in `const fn`s
+//! (and at run time, when `servo rate` changes the period).
 //!
 //! A slice counts from 0 to `TOP` and wraps, one count every `DIV` system
 //! clock cycles, where `DIV` is an 8.4 fixed-point divider (`INT + FRAC/16`,
@@ -6,13 +7,18 @@
 //! channel's compare value, so a pulse is `compare` counts long and the PWM
 //! period is `(TOP + 1) · DIV` system clock cycles.
 //!
-//! The period is made **exactly** one frame (20 ms): the system clock and
-//! the timer that schedules the frames both come from the board's 12 MHz
-//! crystal, so a PWM period of exactly 20 ms never drifts against the frames
-//! and every frame's duty goes out as exactly one pulse (`servo_pwm.rs`
-//! sets the phase). Among the dividers that give a whole number of counts
-//! per period, the smallest one (the finest pulse resolution) that still
-//! fits the 16-bit counter (`TOP + 1 ≤ 65 536`):
+//! The period is made **exactly** one frame: the system clock and the timer
+//! that schedules the frames both come from the board's 12 MHz crystal, so
+//! a PWM period of exactly one frame never drifts against the frames and
+//! every frame's duty goes out as exactly one pulse (`crates/rp/src/pwm.rs`
+//! sets the phase). A frame is a whole number of µs (the timer ticks at
+//! 1 MHz; a `servo rate` is rounded to the nearest µs: 333 Hz is 3003 µs,
+//! [`ServoRate::period`](crate::servo::ServoRate::period)), and both boards'
+//! system clocks make whole cycles per µs (125 and 150), so every period
+//! is a whole number of cycles ([`SliceClock::for_period`]). Among the
+//! dividers that give a whole number of counts per period, the smallest
+//! one (the finest pulse resolution) that still fits the 16-bit counter
+//! (`TOP + 1 ≤ 65 536`), at 50 Hz:
 //!
 //! - 125 MHz system clock, 50 Hz: 125 000 000 / 50 = 2 500 000 cycles per
 //!   period, 40 000 000 in sixteenths of a cycle.
@@ -22,6 +28,13 @@
 //! - Counts per period: 2 500 000 / 39.0625 = 64 000 exactly, `TOP` = 63 999.
 //! - One count: 39.0625 / 125 MHz = 312.5 ns, the pulse resolution (about
 //!   0.03° of a typical servo).
+//!
+//! At 333 Hz (3003 µs, 375 375 cycles): `DIV` ≥ 5.73, and the first
+//! sixteenth from there that divides the period is 6.25: 60 060 counts of
+//! 50 ns. (The Pico 2's 150 MHz: 46.875 and 64 000 counts at 50 Hz, 6.875
+//! and 65 520 counts at 333 Hz.) A divider of 125 (1 count a µs) divides
+//! every whole-µs period up to 65.5 ms at 125 MHz, 150 at 150 MHz: every
+//! rate of the range has a clock.
 //!
 //! With a fractional `DIV` the RP2040 spaces the counts 39 or 40 cycles
 //! apart so that they average 39.0625 cycles (the sixteenths add up to
@@ -34,12 +47,14 @@
 //! that many counts, so a written pulse is short by 1/64 000 of its width,
 //! 0.03 µs at 2000 µs: a tenth of a count.
 
+use crate::units::Microseconds;
+
 /// A frame's duty goes out at the PWM wrap a period over this after the
 /// frame's deadline (a tenth: 2 ms of a 20 ms frame): the boards set the
 /// phase of their PWM so (`crates/rp/src/pwm.rs`), and a frame written later
-/// than that misses its pulse ([`FrameClock::with_latch`]).
+/// than that misses its pulse ([`FrameClock::with_latch_divisor`]).
 ///
-/// [`FrameClock::with_latch`]: crate::driver::FrameClock::with_latch
+/// [`FrameClock::with_latch_divisor`]: crate::driver::FrameClock::with_latch_divisor
 pub const WRAP_MARGIN_DIVISOR: u32 = 10;
 
 /// Clock settings of one PWM slice.
@@ -82,7 +97,47 @@ impl SliceClock {
         if !cycles_16.is_multiple_of(pwm_hz as u64) {
             return Err(RateUnreachable);
         }
-        let cycles_16 = cycles_16 / pwm_hz as u64;
+        Self::split(cycles_16 / pwm_hz as u64)
+    }
+
+    /// The smallest divider, and the `TOP` for it, that make a period of
+    /// exactly `period` µs from a `sys_hz` system clock (as
+    /// [`exact`](Self::exact)); a `servo rate` change works it out at run
+    /// time, between two frames (tens of `u32` remainders at the most for
+    /// the boards' clocks).
+    ///
+    /// ```
+    /// use idle_head_core::pwm_clock::{PICO_SYS_HZ, SliceClock};
+    /// use idle_head_core::Microseconds;
+    /// let clock = SliceClock::for_period(PICO_SYS_HZ, Microseconds(3003)).unwrap();
+    /// assert_eq!((clock.divider_int(), clock.divider_frac(), clock.top), (6, 4, 60_059));
+    /// assert_eq!(clock.period_ns(PICO_SYS_HZ), 3_003_000);
+    /// ```
+    ///
+    /// # Errors
+    /// [`RateUnreachable`] if the period is not a whole number of
+    /// sixteenths of a cycle, or no divider in 1..256 splits it into at
+    /// most 65 536 (and at least two) whole counts.
+    pub const fn for_period(sys_hz: u32, period: Microseconds) -> Result<Self, RateUnreachable> {
+        // sys_hz · 16 · period < 2^32 · 2^4 · 2^32: fits u128, and u64
+        // once divided by 10^6 (for any period below 70 minutes).
+        let cycles_16 = sys_hz as u128 * 16 * period.0 as u128;
+        if cycles_16 == 0 || !cycles_16.is_multiple_of(1_000_000) {
+            return Err(RateUnreachable);
+        }
+        let cycles_16 = cycles_16 / 1_000_000;
+        if cycles_16 > u64::MAX as u128 {
+            return Err(RateUnreachable);
+        }
+        Self::split(cycles_16 as u64)
+    }
+
+    /// The smallest divider (in sixteenths, within 1..256) that splits
+    /// `cycles_16` sixteenths of a cycle into whole counts of at most 65 536
+    /// (and at least two), with its `TOP`: in `u32` when the period fits it
+    /// (every servo period of the boards), a library call less per try on
+    /// the Cortex-M0+.
+    const fn split(cycles_16: u64) -> Result<Self, RateUnreachable> {
         // The fewest sixteenths that fit the counter, then up to the first
         // that divides the period.
         let mut div = cycles_16.div_ceil(MAX_COUNTS);
@@ -90,8 +145,17 @@ impl SliceClock {
             div = MIN_DIVIDER_16THS;
         }
         while div <= MAX_DIVIDER_16THS {
-            if cycles_16.is_multiple_of(div) {
-                let counts = cycles_16 / div;
+            let divides = if cycles_16 <= u32::MAX as u64 {
+                (cycles_16 as u32).is_multiple_of(div as u32)
+            } else {
+                cycles_16.is_multiple_of(div)
+            };
+            if divides {
+                let counts = if cycles_16 <= u32::MAX as u64 {
+                    (cycles_16 as u32 / div as u32) as u64
+                } else {
+                    cycles_16 / div
+                };
                 if counts < 2 {
                     return Err(RateUnreachable);
                 }
@@ -165,4 +229,30 @@ const _: () = {
     assert!(PICO_SERVO_CLOCK.top == 63_999);
     assert!(PICO_SERVO_CLOCK.count_ps(PICO_SYS_HZ) == 312_500);
     assert!(PICO_SERVO_CLOCK.period_ns(PICO_SYS_HZ) == 20_000_000);
+    let Ok(pico_333) = SliceClock::for_period(PICO_SYS_HZ, Microseconds(3003)) else {
+        panic!("no clock for 3003 µs at 125 MHz")
+    };
+    assert!(pico_333.divider_16ths == 100 && pico_333.top == 60_059);
+    assert!(pico_333.count_ps(PICO_SYS_HZ) == 50_000);
+    let Ok(pico2_333) = SliceClock::for_period(PICO2_SYS_HZ, Microseconds(3003)) else {
+        panic!("no clock for 3003 µs at 150 MHz")
+    };
+    assert!(pico2_333.divider_16ths == 110 && pico2_333.top == 65_519);
+    // 50 Hz by period is 50 Hz by rate.
+    assert!(
+        PICO_SERVO_CLOCK.top
+            == match SliceClock::for_period(PICO_SYS_HZ, Microseconds(20_000)) {
+                Ok(c) => c.top,
+                Err(_) => 0,
+            }
+    );
+    // Every rate of `servo rate` has a clock on both boards.
+    let mut hz = crate::servo::ServoRate::MIN.hz();
+    while hz <= crate::servo::ServoRate::MAX.hz() {
+        if let Some(rate) = crate::servo::ServoRate::new(hz) {
+            assert!(SliceClock::for_period(PICO_SYS_HZ, rate.period()).is_ok());
+            assert!(SliceClock::for_period(PICO2_SYS_HZ, rate.period()).is_ok());
+        }
+        hz += 1;
+    }
 };

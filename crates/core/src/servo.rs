@@ -22,9 +22,11 @@
 
 mod calibration;
 mod map;
+mod rate;
 
 pub(crate) use calibration::Degrees;
 pub use calibration::{
     Direction, Duty, NanosPerDegree, PwmTiming, ServoCalibration, ServoError, bounds, defaults,
 };
 pub use map::ServoMap;
+pub use rate::{ServoRate, SetPeriod};

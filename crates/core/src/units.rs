@@ -156,6 +156,40 @@ impl Microseconds {
     }
 }
 
+/// A frame's time: microseconds since the head's first frame. The frame
+/// engine is timed on it, not on frame counts, so that the motion is the
+/// same in time at any frame rate.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Timestamp(pub u64);
+
+impl Timestamp {
+    /// The time of frame `frame` of frames `period` apart (saturating).
+    #[must_use]
+    pub const fn of_frame(frame: u64, period: Microseconds) -> Self {
+        Self(frame.saturating_mul(period.0 as u64))
+    }
+
+    /// The value in microseconds.
+    #[must_use]
+    pub const fn micros(self) -> u64 {
+        self.0
+    }
+
+    /// The value in whole milliseconds.
+    #[must_use]
+    pub const fn millis(self) -> u64 {
+        self.0 / 1000
+    }
+
+    /// The low 32 bits: the frame path's wrapping clock (71 minutes
+    /// round), on which every time it keeps is compared by difference.
+    #[must_use]
+    pub const fn wrapping(self) -> u32 {
+        self.0 as u32
+    }
+}
+
 /// A duration in milliseconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

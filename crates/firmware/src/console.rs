@@ -199,8 +199,7 @@ pub async fn serve<P: Port, H: Handler>(
                 // Telemetry goes out between replies, never among them.
                 if !replies.outbox.is_busy() {
                     let status = place.link.status();
-                    let us = place.frame.as_micros() as u32;
-                    let text = telemetry_line(&status, us, watch.lost, &mut replies.out);
+                    let text = telemetry_line(&status, watch.lost, &mut replies.out);
                     if let Err(gone) = port.write(text).await {
                         return gone;
                     }

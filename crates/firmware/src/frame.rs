@@ -9,7 +9,10 @@
 //!
 //! Frames are due at `start + k · period` exactly ([`FrameClock`]), and the
 //! task sleeps with [`Timer::at`] until the next deadline. The deadlines
-//! never drift. A frame that wakes up a whole period or more late is counted
+//! never drift. The frame engine plays each frame at its own time (the sum
+//! of the periods before it, µs: [`FrameTick::at`]), so that the motion is
+//! the same at any servo rate (`servo rate`: [`FrameLoop::take_rate`]).
+//! A frame that wakes up a whole period or more late is counted
 //! as missed and skipped, together with any other frame whose deadline has
 //! passed: the next deadline lies in the future, so a stall is never followed
 //! by a burst of catch-up writes (which `embassy_time::Ticker` would do).
@@ -52,6 +55,7 @@ use core::sync::atomic::Ordering;
 
 use embassy_time::{Duration, Instant, Timer};
 use embedded_hal::pwm::SetDutyCycle;
+use idle_head_core::servo::SetPeriod;
 use portable_atomic::AtomicU32;
 
 use idle_head_core::behaviour::{
@@ -62,9 +66,11 @@ use idle_head_core::command::{Action, Hold};
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::dmx::Signal;
 use idle_head_core::driver::{FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod};
-use idle_head_core::{Angle, Microseconds};
+use idle_head_core::{Angle, Microseconds, Timestamp};
 
 use crate::config::DEFAULT_BEHAVIOUR;
+
+mod rate;
 
 /// The latest a frame task woke after its deadline since boot, µs (for
 /// the status report).
@@ -126,8 +132,10 @@ pub struct FrameLoop<'a, I> {
     commands: Option<&'a CommandQueue>,
     link: Option<&'a ConsoleLink>,
     show: Option<&'a ShowLink>,
-    /// The behaviour's frame period in whole ms: the show clock's step.
-    frame_ms: u32,
+    /// A change of servo rate between its two steps.
+    retime: rate::Retime,
+    /// The last frame's time.
+    at: Timestamp,
 }
 
 impl<'a, I: IdleSource> FrameLoop<'a, I> {
@@ -163,15 +171,17 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         let period = u64::from(frame_period.get()) * tick_hz / 1_000_000;
         // A frame written later than the PWM's margin before its wrap
         // misses its pulse: the clock skips to the next one.
-        let latch = period / u64::from(idle_head_core::pwm_clock::WRAP_MARGIN_DIVISOR);
-        let clock = FrameClock::new(period, start)?.with_latch(latch);
+        let margin = u64::from(idle_head_core::pwm_clock::WRAP_MARGIN_DIVISOR);
+        let clock = FrameClock::new(period, start, Microseconds(params.frame_us()))?
+            .with_latch_divisor(margin);
         Ok(Self {
             head: Head::new(idle, params),
             clock,
             commands: None,
             link: None,
             show: None,
-            frame_ms: params.frame_us().div_ceil(1000),
+            retime: rate::Retime::new(period, params.frame_us()),
+            at: Timestamp(0),
         })
     }
 
@@ -278,22 +288,19 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         let show = self.show?;
         // The frame task's clock, ms (wrapping): Bottango's curves are
         // timed on it.
-        let now_ms = (tick.frame as u32).wrapping_mul(self.frame_ms);
-        let curves = show.curves.sample(now_ms);
+        let curves = show.curves.sample(tick.ms);
         let events = self
             .head
-            .show(driver, tick.frame, Some(show.dmx.latest()), curves);
+            .show(driver, tick.at, Some(show.dmx.latest()), curves);
         if let Some(signal) = events.signal {
             show.dmx.set_signal(signal);
         }
         // The tracker's sighting (a radar's), if one came.
         let sighting = show.track.take();
-        if let Some(event) = self.head.track(
-            driver,
-            tick.frame,
-            &show.track.settings(),
-            sighting.as_ref(),
-        ) {
+        if let Some(event) =
+            self.head
+                .track(driver, tick.at, &show.track.settings(), sighting.as_ref())
+        {
             log_track(tick.frame, event);
         }
         Some(events)
@@ -339,7 +346,7 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
                 driver.is_stopping(),
                 self.head.rest_state(),
             );
-            let mut status = HeadStatus::of(report, driver.stats(), mode);
+            let mut status = HeadStatus::of(report, driver.stats(), mode, self.at);
             if self.show.is_some_and(|show| show.track.settings().radar) {
                 status.track = Some(self.head.track_view());
             }
@@ -348,7 +355,9 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
     }
 
     /// Writes frame `tick`: idle, gaze and gestures mixed, through `driver`.
-    /// The first call starts the driver (neutral pulses) instead.
+    /// The first call starts the driver (neutral pulses) instead. After a
+    /// new rate's outputs were set ([`take_rate`](Self::take_rate)), the
+    /// frames come its period apart from the next one on.
     ///
     /// This is the whole frame update (playback, mixer, fade, limits,
     /// mapping and the PWM writes), kept out of line so that it can be
@@ -363,7 +372,12 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
             // The servos held their pulses through the frames missed.
             driver.held();
         }
-        self.head.frame(driver, tick.frame)
+        self.at = tick.at;
+        let frame = self.head.frame(driver, tick.at);
+        if let Some(period) = self.retime.pending.take() {
+            self.retime_frames(driver, period);
+        }
+        frame
     }
 }
 
@@ -379,7 +393,7 @@ pub async fn run<P, I, H>(
     hooks: &mut H,
 ) -> RunStats
 where
-    P: SetDutyCycle,
+    P: SetPeriod,
     I: IdleSource,
     H: FrameHooks<P>,
 {
@@ -405,6 +419,7 @@ where
         }
         hooks.before_frame(&tick, driver);
         frames.drain(driver, tick);
+        frames.take_rate(driver, tick);
         let HeadFrame { offsets, report } = frames.write(driver, tick);
         frames.publish(driver, &report);
         if report.should_log {

@@ -85,6 +85,9 @@ impl<P: SetDutyCycle, W: Watchdog> FrameHooks<P> for BoardHooks<W> {
             self.watchdog.start(WATCHDOG_TIMEOUT);
             self.started = true;
             let [p, r, y] = frame.report.servos;
+            // (Not the peak stack: its scan of the painted stack takes
+            // milliseconds, more than a frame at 333 Hz has before the
+            // next; the loop lines have it.)
             defmt::info!(
                 "first frame: neutral pulses {=u32} {=u32} {=u32} us; watchdog armed ({=u64} ms)",
                 p.pulse.0,

@@ -6,12 +6,12 @@
 //! panic proof included, whether it is spawned or not.
 
 use embassy_time::Duration;
-use embedded_hal::pwm::SetDutyCycle;
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::driver::FrameDriver;
 use idle_head_core::idle::{IdleMode, IdleStats, LoopStream, SetInfo};
 use idle_head_core::motion::AxisError;
 use idle_head_core::playback::Playback;
+use idle_head_core::servo::SetPeriod;
 
 use crate::boot::{COMMANDS, EXCHANGE, Generator, LINK, SHOW, Stopwatch, first_set};
 use crate::config::{DEFAULT_TIMING, IDLE_MODE, SetRef};
@@ -30,9 +30,9 @@ pub async fn generate(generator: Generator, mut stopwatch: impl Stopwatch) -> ! 
             let mut stream = LoopStream::new(head, &DEFAULT_TIMING);
             stream.adopt(first);
             defmt::info!(
-                "idle: never repeating, a new loop set every {=u32} frames, joined over {=u32}",
-                DEFAULT_TIMING.period(),
-                DEFAULT_TIMING.join_frames
+                "idle: never repeating, a new loop set every {=u64} ms, joined over {=u64} ms",
+                DEFAULT_TIMING.period_us() / 1000,
+                DEFAULT_TIMING.join_us / 1000
             );
             EXCHANGE.start(first, info);
             EXCHANGE.give(spare);
@@ -85,25 +85,31 @@ pub const fn playback() -> Playback {
 /// generator's sets after it), with `behaviour` and the console's commands,
 /// through `driver`, each frame on the timer of `tick_hz` ticks a second,
 /// until `hooks` says stop (the frames of a board never stop but in the
-/// watchdog drill). `frame_period` is the board's time between frames (the
-/// QEMU smoke run plays faster than real time). Returns the frames' and the
-/// idle's totals.
-pub async fn play<P: SetDutyCycle, H: FrameHooks<P>>(
+/// watchdog drill). `frame_period` is the board's time between frames at
+/// the driver's rate (the QEMU smoke run plays faster than real time): the
+/// outputs and the idle start at the driver's period, the settings' rate.
+/// Returns the frames' and the idle's totals.
+pub async fn play<P: SetPeriod, H: FrameHooks<P>>(
     driver: &mut FrameDriver<P>,
     first: SetRef,
     behaviour: &BehaviourParams,
     hooks: &mut H,
     frame_period: idle_head_core::Microseconds,
 ) -> (RunStats, IdleStats) {
+    let period = driver.params().config().frame_period;
+    if let Err(e) = driver.set_pwm_period(period) {
+        defmt::error!("servo outputs refused {=u32} us: {}", period.0, e);
+    }
     let start = embassy_time::Instant::now().as_ticks();
     #[cfg(not(feature = "calibrate"))]
-    let idle =
+    let mut idle =
         idle_head_core::idle::IdlePlayer::new(first, EXCHANGE.supply(), DEFAULT_TIMING, IDLE_MODE);
     #[cfg(feature = "calibrate")]
-    let idle = {
+    let mut idle = {
         let _ = first;
         crate::calibrate::player()
     };
+    idle.set_frame_period(period);
     let frames =
         FrameLoop::with_behaviour(idle, frame_period, *behaviour, embassy_time::TICK_HZ, start);
     let Ok(frames) = frames else {

@@ -64,15 +64,17 @@ use crate::uart::UartPort;
 use crate::usb::UsbPort;
 use idle_head_firmware::console::{Gone, Port, Received};
 
-/// The servo outputs' slice clock: exactly 50 Hz from [`SYS_HZ`] (see
-/// `idle_head_core::pwm_clock`).
+/// The servo outputs' slice clock at boot: exactly 50 Hz from [`SYS_HZ`]
+/// (see `idle_head_core::pwm_clock`; the frame task sets the settings'
+/// rate before the first pulse).
 #[cfg(feature = "rp2040")]
 pub use idle_head_core::pwm_clock::PICO_SERVO_CLOCK as SERVO_CLOCK;
 /// The system clock embassy-rp's default configuration runs the chip at.
 #[cfg(feature = "rp2040")]
 pub use idle_head_core::pwm_clock::PICO_SYS_HZ as SYS_HZ;
-/// The servo outputs' slice clock: exactly 50 Hz from [`SYS_HZ`] (see
-/// `idle_head_core::pwm_clock`).
+/// The servo outputs' slice clock at boot: exactly 50 Hz from [`SYS_HZ`]
+/// (see `idle_head_core::pwm_clock`; the frame task sets the settings'
+/// rate before the first pulse).
 #[cfg(feature = "rp235xa")]
 pub use idle_head_core::pwm_clock::PICO2_SERVO_CLOCK as SERVO_CLOCK;
 /// The system clock embassy-rp's default configuration runs the chip at.
@@ -417,14 +419,10 @@ async fn frame_task(
     let mut hooks = BoardHooks::new(watchdog);
     // Loop set 0, from the generator: about 3 ms after boot.
     let (first, _) = EXCHANGE.first().await;
-    let (stats, _) = idle_head_firmware::tasks::play(
-        &mut driver,
-        first,
-        &behaviour,
-        &mut hooks,
-        idle_head_firmware::tasks::playback().frame_period(),
-    )
-    .await;
+    // Frames at the settings' rate, as the driver was built.
+    let period = driver.params().config().frame_period;
+    let (stats, _) =
+        idle_head_firmware::tasks::play(&mut driver, first, &behaviour, &mut hooks, period).await;
     // The hooks only stop in the watchdog drill; then the watchdog resets
     // the board.
     defmt::error!("frame task ended: {}", stats);

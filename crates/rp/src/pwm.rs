@@ -20,12 +20,13 @@
 //!
 //! The PWM period is exactly one frame (`idle_head_core::pwm_clock`) and
 //! both come from the same crystal, so the frames' writes keep the phase the
-//! first one set: each lands 2 ms (a period over [`WRAP_MARGIN_DIVISOR`]) before the wrap that
-//! latches it, whatever the frame's wake-up latency or cost, as long as it
-//! is below that (it is tens of microseconds: the frame task runs above
-//! everything but the timer's alarm). Frame `k` is latched at wrap `k + 1`
-//! and goes out as the `k`-th pulse: no frame is ever overwritten before it
-//! went out, none goes out twice.
+//! first one set: each lands a tenth of a period ([`WRAP_MARGIN_DIVISOR`];
+//! 2 ms at 50 Hz, 0.3 ms at 333 Hz) before the wrap that latches it,
+//! whatever the frame's wake-up latency or cost, as long as it is below
+//! that (it is tens of microseconds: the frame task runs above everything
+//! but the timer's alarm). Frame `k` is latched at wrap `k + 1` and goes out
+//! as the `k`-th pulse: no frame is ever overwritten before it went out,
+//! none goes out twice.
 //!
 //! The margin is what a frame's pulse waits after its write: the smaller,
 //! the sooner a command shows on the servo. Half a period (10 ms) would
@@ -33,6 +34,19 @@
 //! latency; 2 ms forgives a hundred times the lateness measured and costs
 //! 2 ms. A frame written later still goes out, a period late, as the
 //! previous frame's pulse repeated once.
+//!
+//! # A new period (`servo rate`)
+//!
+//! [`SetPeriod::set_period`] only keeps the new divider and `TOP`; the next
+//! duty written starts the slice over as the first one does: slice off, the
+//! new divider, `TOP` and compare value, the counter a tenth of the new
+//! period before its wrap, slice on (which latches `TOP` and the compare
+//! value). That write is the last frame's at the old spacing, a tenth of
+//! the old period before the old wrap: the old period's pulse has ended
+//! (every pulse is at most 2.5 ms, below nine tenths of any period of the
+//! range), the output is low, and it stays low until the new first wrap a
+//! tenth of the new period later, where that frame's pulse starts. The
+//! frames after it come one new period apart: the phase rule holds on.
 
 use embassy_rp::Peri;
 use embassy_rp::pwm::{ChannelAPin, Config, Pwm, PwmError, Slice};
@@ -40,10 +54,15 @@ use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use fixed::FixedU16;
 use fixed::types::extra::U4;
 
+use idle_head_core::Microseconds;
 use idle_head_core::pwm_clock::SliceClock;
+use idle_head_core::servo::SetPeriod;
+
+use crate::SYS_HZ;
 
 /// The wrap that latches a frame's duty comes a period over this after the
-/// write (a tenth: 2 ms of a 20 ms frame); see the module docs.
+/// write (a tenth: 2 ms of a 20 ms frame, 0.3 ms at 333 Hz); see the module
+/// docs.
 pub use idle_head_core::pwm_clock::WRAP_MARGIN_DIVISOR;
 
 /// One servo output: channel A of a PWM slice of its own.
@@ -91,9 +110,11 @@ impl SetDutyCycle for ServoPwm {
         if duty > self.config.top {
             return Err(PwmError::InvalidDutyCycle);
         }
-        // First duty: compare value, the counter a tenth of a period
-        // before its wrap, then run.
+        // First duty at this period: slice off, compare value, the counter
+        // a tenth of a period before its wrap, then run (the slice's start
+        // latches `TOP` and the compare value).
         self.config.compare_a = duty;
+        self.config.enable = false;
         self.pwm.set_config(&self.config);
         let counts = u32::from(self.config.top) + 1;
         let margin = counts / WRAP_MARGIN_DIVISOR;
@@ -101,6 +122,24 @@ impl SetDutyCycle for ServoPwm {
         self.config.enable = true;
         self.pwm.set_config(&self.config);
         self.running = true;
+        Ok(())
+    }
+}
+
+impl SetPeriod for ServoPwm {
+    /// The clock of `period` from the system clock, exactly (see the
+    /// module docs): it takes effect at the next duty written.
+    fn set_period(&mut self, period: Microseconds) -> Result<(), PwmError> {
+        let Ok(clock) = SliceClock::for_period(SYS_HZ, period) else {
+            return Err(PwmError::InvalidDutyCycle);
+        };
+        let divider = FixedU16::<U4>::from_bits(clock.divider_16ths);
+        if divider == self.config.divider && clock.top == self.config.top {
+            return Ok(());
+        }
+        self.config.divider = divider;
+        self.config.top = clock.top;
+        self.running = false;
         Ok(())
     }
 }

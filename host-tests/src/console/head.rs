@@ -1,13 +1,13 @@
 //! A simulated head behind the console service: the frame task's code
-//! (queue drain, servo calibrations and live settings from the link,
-//! frame, status) and the input task's (its inputs at their idle levels)
+//! (queue drain, servo calibrations, the servos' rate and live settings
+//! from the link, frame, status) and the input task's (its inputs at their
+//! idle levels)
 //! on the host, with PWM channels that keep the last duty, and a check of every
 //! frame against the servos' limits as they are at that frame.
 
 use std::convert::Infallible;
 
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
-use idle_head_core::Axis;
 use idle_head_core::behaviour::{
     Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, RestState, ShowLink,
 };
@@ -16,11 +16,19 @@ use idle_head_core::console::{
 };
 use idle_head_core::driver::{DriverConfig, FrameDriver};
 use idle_head_core::input::{InputSettings, Inputs, Micros};
+use idle_head_core::servo::SetPeriod;
 use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
+use idle_head_core::{Axis, Timestamp};
 
-/// A PWM channel that keeps the last duty (1 µs per count at 50 Hz).
-#[derive(Debug, Default)]
-pub struct LastDuty(pub u16);
+/// A PWM channel that keeps the last duty (1 µs per count at any rate).
+#[derive(Debug)]
+pub struct LastDuty(pub u16, u16);
+
+impl Default for LastDuty {
+    fn default() -> Self {
+        Self(0, 20_000)
+    }
+}
 
 impl ErrorType for LastDuty {
     type Error = Infallible;
@@ -28,11 +36,18 @@ impl ErrorType for LastDuty {
 
 impl SetDutyCycle for LastDuty {
     fn max_duty_cycle(&self) -> u16 {
-        20_000
+        self.1
     }
 
     fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Infallible> {
         self.0 = duty;
+        Ok(())
+    }
+}
+
+impl SetPeriod for LastDuty {
+    fn set_period(&mut self, period: idle_head_core::Microseconds) -> Result<(), Infallible> {
+        self.1 = u16::try_from(period.0).unwrap_or(u16::MAX);
         Ok(())
     }
 }
@@ -53,6 +68,8 @@ pub struct SimFrames {
     head: Head<Idle>,
     driver: FrameDriver<LastDuty>,
     frame: u64,
+    /// The next frame's time, µs.
+    at: u64,
     /// Frames played.
     pub frames: u64,
     /// Frames with a pulse or an angle outside the servo's limits.
@@ -105,6 +122,7 @@ impl SimFrames {
                 params,
             ),
             frame: 0,
+            at: 0,
             frames: 0,
             violations: 0,
             calibrations: 0,
@@ -123,7 +141,7 @@ impl SimFrames {
     /// The input task's part, as it would run at this frame: new settings
     /// from `link`, the levels, actions into `queue`, the status published.
     fn inputs<const N: usize>(&mut self, queue: &CommandQueue<N>, link: &ConsoleLink) {
-        let now = Micros(self.frame * 20_000);
+        let now = Micros(self.at);
         let settings = link.input_settings();
         if link.take_inputs_changed() {
             self.inputs.configure(&settings, now);
@@ -186,7 +204,20 @@ impl SimFrames {
         self.applied += applied;
         self.refused += refused;
         self.refused_not_busy += not_busy;
-        let report = self.head.frame(&mut self.driver, self.frame).report;
+        // A new rate: the outputs from this frame on, the frames after it.
+        let retime = link.take_rate().map(|rate| rate.period());
+        if let Some(period) = retime {
+            self.driver
+                .set_pwm_period(period)
+                .expect("the service sends only rates the settings take");
+        }
+        let at = Timestamp(self.at);
+        let report = self.head.frame(&mut self.driver, at).report;
+        if let Some(period) = retime {
+            self.head
+                .set_frame_period(&mut self.driver, period)
+                .expect("the service sends only rates the settings take");
+        }
         let servos = self.driver.params().config().servos;
         for ((s, cal), changed) in report.servos.iter().zip(&servos).zip(&self.changed) {
             // Pulse limits are hard. A new calibration may leave a servo
@@ -209,9 +240,10 @@ impl SimFrames {
             self.driver.is_stopping(),
             self.head.rest_state(),
         );
-        link.publish(HeadStatus::of(&report, self.driver.stats(), mode));
+        link.publish(HeadStatus::of(&report, self.driver.stats(), mode, at));
         self.frame += 1;
         self.frames += 1;
+        self.at += u64::from(self.driver.params().config().frame_period.0);
     }
 
     /// Plays frames until the frame task's outcome for `port`'s action

@@ -21,9 +21,9 @@ pub use text::{
 };
 
 /// The line capacity the firmware uses.
-pub const LINE: usize = 96;
+pub const LINE: usize = idle_head_core::console::PORT_LINE;
 /// The reply buffer the firmware uses.
-pub const REPLY: usize = 160;
+pub const REPLY: usize = idle_head_core::console::PORT_REPLY;
 
 /// A seeded generator (the same seed, the same cases, on every machine).
 ///
@@ -299,7 +299,7 @@ fn check_machine_reply(text: &str) -> &str {
 }
 
 /// A handler that accepts every command and replies with its debug form
-/// (long enough to exercise truncation), counting what it saw.
+/// twice (long enough to exercise truncation), counting what it saw.
 #[derive(Debug, Default)]
 pub struct Recorder {
     /// Commands carried out.
@@ -316,7 +316,7 @@ impl Handler for Recorder {
     fn command(&mut self, command: Command, reply: &mut Reply<'_>) {
         use std::fmt::Write as _;
         self.commands += 1;
-        write!(reply.ok(), "{command:?}").unwrap();
+        write!(reply.ok(), "{command:?} {command:?}").unwrap();
     }
 
     fn rejected(&mut self, error: &InputError) {

@@ -9,7 +9,7 @@ use idle_head_core::command::{
 };
 use idle_head_core::console::KEYWORDS;
 use idle_head_core::dmx::DmxAddress;
-use idle_head_core::servo::{Direction, NanosPerDegree};
+use idle_head_core::servo::{Direction, NanosPerDegree, ServoRate};
 use idle_head_core::track::Prefer;
 use idle_head_core::{Angle, AngleRange, Axis, Microseconds, Millimetres, Millis};
 use proptest::prelude::RngExt as _;
@@ -163,7 +163,11 @@ pub fn random_action(rng: &mut TestRng) -> Action {
 /// A random command, every field anywhere in its parseable range.
 pub fn random_command(rng: &mut TestRng) -> Command {
     // Motion about half the time, as a show controller sends it.
-    match rng.random_range(0..21) {
+    match rng.random_range(0..22) {
+        21 => Command::ServoRate(maybe(rng, |r| {
+            let hz = pick_i64(r, 50, 333, &[50, 51, 200, 332, 333]) as u16;
+            ServoRate::new(hz).unwrap_or(ServoRate::DEFAULT)
+        })),
         14 => Command::Watch(maybe(rng, |r| r.random_range(1..=50))),
         0 => Command::Help,
         1 => Command::Status,
@@ -437,6 +441,13 @@ fn write_command(s: &mut Style<'_>, command: &Command) {
         Command::Watch(Some(hz)) => {
             s.word("watch");
             s.number(i64::from(hz));
+        }
+        Command::ServoRate(rate) => {
+            s.word("servo");
+            s.word("rate");
+            if let Some(rate) = rate {
+                s.number(i64::from(rate.hz()));
+            }
         }
         Command::Servo { axis, setting } => {
             s.word("servo");

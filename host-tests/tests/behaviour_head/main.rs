@@ -6,6 +6,7 @@
 mod properties;
 
 use embedded_hal_mock::eh1::pwm::Mock;
+use host_tests::behaviour::frame;
 use host_tests::rig::{Rig, assert_steps_within_limits};
 use host_tests::{Recorder, params, pwm, writes};
 use idle_head_core::Axis;
@@ -15,7 +16,7 @@ use idle_head_core::behaviour::{
 };
 use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest};
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head_core::units::{Angle, Millis};
+use idle_head_core::units::{Angle, Millis, Timestamp};
 
 type Idle = host_tests::rig::Idle;
 
@@ -69,7 +70,7 @@ fn layer(actions: &[(u64, Action)], frames: u64, axis: Axis) -> Vec<i32> {
                     mixer.apply(action).unwrap();
                 }
             }
-            mixer.frame(k, [Angle::ZERO; 3])[axis.index()].millidegrees()
+            mixer.frame(frame(k), [Angle::ZERO; 3])[axis.index()].millidegrees()
         })
         .collect()
 }
@@ -95,7 +96,7 @@ fn a_nod_on_the_moving_idle_plays_exactly_and_safely() {
         if k == 200 {
             mixer.apply(&nod(8000, 900)).unwrap();
         }
-        let expected = mixer.frame(k, player.offsets(k))[0].millidegrees();
+        let expected = mixer.frame(frame(k), player.offsets(k))[0].millidegrees();
         // After the start frame and the 2 s fade-in.
         if k > 100 {
             assert_eq!(pitch[k as usize], expected, "frame {k}");
@@ -261,12 +262,12 @@ fn commands_come_through_the_queue_two_a_frame() {
     }
     assert_eq!(queue.try_submit(Action::Stop), Err(QueueFull(Action::Stop)));
     let mut answers = Vec::new();
-    for frame in 0..3 {
+    for k in 0..3 {
         let n = head.drain(&mut fd, &queue, |action, outcome| {
             answers.push((*action, outcome.as_ref().map(|_| ()).map_err(|e| e.code())));
         });
-        assert_eq!(n, if frame < 2 { 2 } else { 0 });
-        head.frame(&mut fd, frame);
+        assert_eq!(n, if k < 2 { 2 } else { 0 });
+        head.frame(&mut fd, frame(k));
     }
     assert_eq!(
         answers,
@@ -283,7 +284,7 @@ fn commands_come_through_the_queue_two_a_frame() {
 struct Still;
 
 impl IdleSource for Still {
-    fn offsets(&mut self, _: u64) -> [Angle; 3] {
+    fn offsets(&mut self, _: Timestamp) -> [Angle; 3] {
         [Angle::ZERO; 3]
     }
 }
@@ -305,10 +306,10 @@ fn exact_duties_of_a_look_through_the_mock() {
     let mut mixer = Mixer::new(behaviour);
     let frames = 20;
     let mut expected = [vec![1500_u16], vec![1500], vec![1500]];
-    mixer.frame(0, [Angle::ZERO; 3]);
+    mixer.frame(frame(0), [Angle::ZERO; 3]);
     mixer.apply(&look).unwrap();
     for k in 1..frames {
-        let offsets = mixer.frame(k, [Angle::ZERO; 3]);
+        let offsets = mixer.frame(frame(k), [Angle::ZERO; 3]);
         for (i, list) in expected.iter_mut().enumerate() {
             let pulse = driver.config().servos[i].pulse(offsets[i]);
             list.push(u16::try_from(pulse.0).unwrap());
@@ -319,11 +320,11 @@ fn exact_duties_of_a_look_through_the_mock() {
     let channels: [Mock; 3] = [0, 1, 2].map(|i| pwm(20_000, &writes(&expected[i])));
     let mut fd = FrameDriver::new(channels, driver);
     let mut head = Head::new(Still, behaviour);
-    head.frame(&mut fd, 0);
+    head.frame(&mut fd, frame(0));
     head.apply(&mut fd, &look).unwrap();
     for k in 1..frames {
         head.sync(&mut fd);
-        head.frame(&mut fd, k);
+        head.frame(&mut fd, frame(k));
     }
     for mut channel in fd.release() {
         channel.done();

@@ -6,7 +6,7 @@ use idle_head_core::driver::{
     ConfigError, DegreesPerSecond, DegreesPerSecondSquared, DriverConfig, MotionLimits,
 };
 use idle_head_core::servo::ServoError;
-use idle_head_core::{Angle, AngleRange, Axis, Microseconds};
+use idle_head_core::{Angle, AngleRange, Axis, Microseconds, Millis};
 
 #[test]
 fn config_errors_name_the_field() {
@@ -30,7 +30,7 @@ fn config_errors_name_the_field() {
         "`pwm.period`",
     );
     check(
-        &|c| c.faults.disable_after = 0,
+        &|c| c.faults.disable_after = Millis(0),
         ConfigError::ZeroDisableAfter,
         "`faults.disable_after`",
     );
@@ -132,8 +132,8 @@ fn config_errors_read_in_the_users_units() {
         "pwm.period must be longer than 0 µs"
     );
     assert_eq!(
-        shown(&|c| c.faults.disable_after = 0),
-        "faults.disable_after must be at least 1 frame"
+        shown(&|c| c.faults.disable_after = Millis(0)),
+        "faults.disable_after must be at least 1 ms"
     );
     assert_eq!(
         shown(&|c| c.servos[1].min_pulse = Microseconds(2500)),

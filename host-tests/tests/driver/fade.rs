@@ -150,3 +150,68 @@ fn the_fade_stays_exact_when_it_reverses() {
         }
     }
 }
+
+/// The gain `t` µs after the start frame for a fade of `fade` µs, as the
+/// driver specifies it: the smoothstep of `x = ⌊(t − 20 ms)·2¹⁶/fade⌋`
+/// (in 64 bits here; 0 before the fade-in begins, 1 once it ended).
+fn gain_at(t: u64, fade: u64) -> u64 {
+    let Some(level) = t.checked_sub(20_000) else {
+        return 0;
+    };
+    if level >= fade {
+        return 65_536;
+    }
+    let x = (level << 16) / fade;
+    (x * x * (3 * 65_536 - 2 * x)) >> 32
+}
+
+#[test]
+fn the_fade_is_the_same_in_time_at_any_rate_and_across_a_change() {
+    use idle_head_core::Microseconds;
+    // Frame periods (µs) one after the other, each for a while: the gain
+    // at each frame is the fade's at the frame's time since the start.
+    let plans: [&[(u32, u64)]; 4] = [
+        &[(20_000, 3_000_000)],
+        &[(3003, 3_000_000)],
+        &[
+            (5000, 700_000),
+            (3003, 1_300_000),
+            (20_000, 2_200_000),
+            (16_667, 3_000_000),
+        ],
+        &[(3003, 10_000), (20_000, 3_000_000)],
+    ];
+    for plan in plans {
+        let mut cfg = direct_config();
+        cfg.frame_period = Microseconds(plan[0].0);
+        cfg.pwm.period = Microseconds(plan[0].0);
+        cfg.fade = Millis(2000);
+        let fade = 2_000_000;
+        let mut d = FrameDriver::new(
+            [0; 3].map(|_| host_tests::Recorder::new(plan[0].0 as u16)),
+            params(&cfg),
+        );
+        d.start();
+        let mut t = u64::from(plan[0].0);
+        for &(period, until) in plan {
+            if Microseconds(period) != d.params().config().frame_period {
+                d.set_pwm_period(Microseconds(period)).unwrap();
+            }
+            while t < until {
+                let r = d.write_frame(mdeg(FADE_OFFSETS));
+                if Microseconds(period) != d.params().config().frame_period {
+                    d.set_frame_period(Microseconds(period)).unwrap();
+                }
+                for (i, &o) in FADE_OFFSETS.iter().enumerate() {
+                    let want = (i64::from(o) * gain_at(t, fade) as i64 + (1 << 15)) >> 16;
+                    assert_eq!(
+                        i64::from(r.servos[i].angle.millidegrees()),
+                        want,
+                        "{plan:?} at {t} µs"
+                    );
+                }
+                t += u64::from(d.params().config().frame_period.0);
+            }
+        }
+    }
+}

@@ -14,7 +14,7 @@ use super::{done, pitch_angles, recorders};
 #[test]
 fn a_write_error_is_counted_others_keep_moving_and_it_is_retried() {
     let mut cfg = direct_config();
-    cfg.faults.disable_after = 3;
+    cfg.faults.disable_after = Millis(60); // 3 frames
     let pitch = pwm(
         20_000,
         &[
@@ -96,7 +96,7 @@ fn a_failing_start_is_retried_with_the_next_frame() {
 fn fault_logs_are_rate_limited() {
     let mut cfg = direct_config();
     cfg.faults = FaultPolicy {
-        disable_after: 1000,
+        disable_after: Millis(20_000),
         log_interval: Millis(100),
     }; // 5 frames
     let mut ch = [
@@ -126,7 +126,7 @@ fn fault_logs_are_rate_limited() {
 #[test]
 fn a_servo_that_never_works_is_switched_off_after_k_frames() {
     let mut cfg = direct_config();
-    cfg.faults.disable_after = 25;
+    cfg.faults.disable_after = Millis(500); // 25 frames
     let mut ch = [
         Recorder::new(20_000),
         Recorder::new(20_000),

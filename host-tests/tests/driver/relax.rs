@@ -2,6 +2,7 @@
 //! come back from there.
 
 use host_tests::{mdeg, params};
+use idle_head_core::Millis;
 use idle_head_core::driver::{DriverConfig, FrameDriver, Outcome};
 
 use super::{angles, duties, pitch_angles, recorders};
@@ -59,7 +60,7 @@ fn a_servo_switched_off_stays_off_when_relaxed() {
     let mut rec = recorders();
     rec[2].fail_next = 1000;
     let mut cfg = DriverConfig::DEFAULT;
-    cfg.faults.disable_after = 3;
+    cfg.faults.disable_after = Millis(60); // 3 frames
     let mut d = FrameDriver::new(rec, params(&cfg));
     d.start();
     pitch_angles(&mut d, [0; 3], 10);

@@ -11,10 +11,18 @@ use idle_head_core::idle::{
     Pace, Paces, Spread, after_loop, join_weight,
 };
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
-use idle_head_core::{Axis, Microseconds, Millis, Playback};
+use idle_head_core::{Axis, Microseconds, Millis, Playback, Timestamp};
 
 type Set = LoopSet<DEFAULT_N>;
 type Stream = LoopStream<DEFAULT_N>;
+
+/// The frame period of the tests: 20 ms (50 Hz).
+const FRAME_US: u64 = 20_000;
+
+/// The time of frame `k`.
+const fn at(k: u64) -> Timestamp {
+    Timestamp(k * FRAME_US)
+}
 
 /// The boards' timing: 30 s loops of 900 samples, 20 ms frames.
 fn timing() -> IdleTiming {
@@ -39,7 +47,7 @@ fn player(
 fn play(config: HeadConfig, mode: IdleMode, frames: usize) -> Vec<[i32; 3]> {
     let mut p = player(config, mode);
     (0..frames as u64)
-        .map(|k| p.offsets(k).map(|a| a.millidegrees()))
+        .map(|k| p.offsets(at(k)).map(|a| a.millidegrees()))
         .collect()
 }
 
@@ -116,7 +124,7 @@ fn the_first_set_is_the_boot_loops_and_plays_as_the_fixed_loop_until_the_first_j
     assert_eq!(ia, ib);
     assert_eq!(a.checksum(), b.checksum());
 
-    let period = t.period() as usize;
+    let period = (t.period_us() / FRAME_US) as usize;
     let stream_frames = play(DEFAULT_HEAD, IdleMode::NeverRepeating, period + 200);
     let fixed = play(DEFAULT_HEAD, IdleMode::FixedLoop, period + 200);
     assert_eq!(stream_frames[0], [0; 3]);
@@ -130,7 +138,7 @@ fn the_first_set_is_the_boot_loops_and_plays_as_the_fixed_loop_until_the_first_j
 #[test]
 fn join_frames_lie_between_the_two_loops_and_inside_the_ranges() {
     let t = timing();
-    let period = t.period() as usize;
+    let period = (t.period_us() / FRAME_US) as usize;
     for index in 0..4 {
         let config = config_for(index);
         let frames = play(config, IdleMode::NeverRepeating, 6 * period);
@@ -158,13 +166,51 @@ fn join_frames_lie_between_the_two_loops_and_inside_the_ranges() {
 }
 
 #[test]
+fn at_333_hz_a_frame_does_not_depend_on_the_frames_before_it_either() {
+    // 3003 µs frames: a join's start falls between two frames; the set
+    // taken over is entered where the cursor stands (no division), which
+    // must be where its time puts it (located from the time, after a skip).
+    let period = 3003;
+    let timing_at = |t: IdleTiming| IdleTiming {
+        playback: t.playback.with_frame_period(Microseconds(period)),
+        ..t
+    };
+    let fresh = || {
+        let t = timing_at(timing());
+        let mut stream = Stream::new(DEFAULT_HEAD, &t);
+        let mut first = Box::new(Set::new());
+        stream.next_into(&mut first).unwrap();
+        let supply = GenerateOnTake::new(stream, Box::new(Set::new()));
+        IdlePlayer::new(first, supply, t, IdleMode::NeverRepeating)
+    };
+    let at = |k: u64| Timestamp(k * u64::from(period));
+    // Through two joins (28 s and 56 s).
+    let frames = 60_000_000 / u64::from(period);
+    let mut p = fresh();
+    let all: Vec<[i32; 3]> = (0..frames)
+        .map(|k| p.offsets(at(k)).map(|a| a.millidegrees()))
+        .collect();
+    assert_eq!(p.stats().joins, 2);
+    let mut p = fresh();
+    let mut k = 0u64;
+    while k < frames {
+        assert_eq!(
+            p.offsets(at(k)).map(|a| a.millidegrees()),
+            all[k as usize],
+            "frame {k}"
+        );
+        k += 1 + (k * 7 + 3) % 5;
+    }
+}
+
+#[test]
 fn a_frame_does_not_depend_on_the_frames_skipped_before_it() {
     let all = play(DEFAULT_HEAD, IdleMode::NeverRepeating, 4500);
     let mut p = player(DEFAULT_HEAD, IdleMode::NeverRepeating);
     let mut k = 0u64;
     while k < 4500 {
         assert_eq!(
-            p.offsets(k).map(|a| a.millidegrees()),
+            p.offsets(at(k)).map(|a| a.millidegrees()),
             all[k as usize],
             "frame {k}"
         );
@@ -268,14 +314,17 @@ impl LoopSupply<Box<Set>> for Late {
 #[test]
 fn a_late_set_leaves_the_current_loop_playing_and_joins_a_loop_later() {
     let t = timing();
-    let (loop_frames, period) = (t.loop_frames as usize, t.period() as usize);
+    let (loop_frames, period) = (
+        (t.loop_us / FRAME_US) as usize,
+        (t.period_us() / FRAME_US) as usize,
+    );
     let mut stream = Stream::new(DEFAULT_HEAD, &t);
     let mut first = Box::new(Set::new());
     stream.next_into(&mut first).unwrap();
     let inner = GenerateOnTake::new(stream, Box::new(Set::new()));
     let mut p = IdlePlayer::new(first, Late { inner, late: 1 }, t, IdleMode::NeverRepeating);
     let frames: Vec<[i32; 3]> = (0..(period + loop_frames + 200) as u64)
-        .map(|k| p.offsets(k).map(|a| a.millidegrees()))
+        .map(|k| p.offsets(at(k)).map(|a| a.millidegrees()))
         .collect();
     let fixed = play(DEFAULT_HEAD, IdleMode::FixedLoop, frames.len());
     let on_time = play(DEFAULT_HEAD, IdleMode::NeverRepeating, period + 200);
@@ -294,7 +343,7 @@ fn a_late_set_leaves_the_current_loop_playing_and_joins_a_loop_later() {
     first.generate(&DEFAULT_HEAD).unwrap();
     let mut p = IdlePlayer::new(first, NoSupply, t, IdleMode::NeverRepeating);
     let frames: Vec<[i32; 3]> = (0..3000u64)
-        .map(|k| p.offsets(k).map(|a| a.millidegrees()))
+        .map(|k| p.offsets(at(k)).map(|a| a.millidegrees()))
         .collect();
     assert_eq!(frames, play(DEFAULT_HEAD, IdleMode::FixedLoop, 3000));
 }

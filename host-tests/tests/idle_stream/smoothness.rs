@@ -4,10 +4,10 @@
 use std::thread;
 
 use idle_head_core::Axis;
-use idle_head_core::idle::{IdleMode, IdlePlayer, JOIN_FRAMES, MAX_DRAWS, NoSupply};
+use idle_head_core::idle::{IdleMode, IdlePlayer, MAX_DRAWS, NoSupply};
 use idle_head_core::motion::HeadConfig;
 
-use super::{Set, Stream, config_for, play, timing};
+use super::{FRAME_US, Set, Stream, at, config_for, play, timing};
 
 /// The ratios of a window `x`: max|d1|/P95|d1| and max|d2|/P95|d2| over
 /// the whole window, then the same maxima taken over `region` only (the
@@ -127,7 +127,7 @@ fn each_loop_alone(
             s.fallbacks += u64::from(d + 1 == MAX_DRAWS);
         }
         let mut p = IdlePlayer::new(&set, NoSupply, t, IdleMode::FixedLoop);
-        frames.extend((0..loop_frames as u64).map(|k| p.offsets(k).map(|a| a.millidegrees())));
+        frames.extend((0..loop_frames as u64).map(|k| p.offsets(at(k)).map(|a| a.millidegrees())));
     }
     frames
 }
@@ -138,8 +138,9 @@ fn each_loop_alone(
 /// those loops played alone, one loop, with the region in its middle.
 fn measure(from: u64, to: u64) -> Smoothness {
     let t = timing();
-    let (loop_frames, period) = (t.loop_frames as usize, t.period() as usize);
-    let join = t.join_frames as usize;
+    let frames_of = |us: u64| (us / FRAME_US) as usize;
+    let (loop_frames, period) = (frames_of(t.loop_us), frames_of(t.period_us()));
+    let join = frames_of(t.join_us);
     // One loop more, for the longest stretch.
     let frames = period * (JOINS + 1) + loop_frames;
     let region = loop_frames / 2 - join / 2 - MARGIN..loop_frames / 2 + join / 2 + MARGIN;
@@ -227,7 +228,7 @@ fn joins_are_as_smooth_as_a_loops_interior_over_1000_seeds_and_50_joins() {
         "seeds {from} to {} x {JOINS} joins x 3 axes; frames in m°, 1500-frame windows centred on each join \
          (join region: its {} frames and {MARGIN} either side); each loop alone: one loop, region in its middle",
         to - 1,
-        JOIN_FRAMES
+        timing().join_us / FRAME_US
     );
     for i in 0..4 {
         let (j, a) = (all.join[i], all.alone[i]);

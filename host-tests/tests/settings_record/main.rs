@@ -9,10 +9,10 @@ use idle_head_core::command::{GestureKind, Hold, InputRole, Percent, RestAfter};
 use idle_head_core::driver::{
     ConfigError, DegreesPerSecond, DegreesPerSecondSquared, DriverConfig,
 };
-use idle_head_core::servo::{NanosPerDegree, ServoError};
+use idle_head_core::servo::{NanosPerDegree, ServoError, ServoRate};
 use idle_head_core::settings::{
     DecodeError, FIELDS, FieldReport, FieldSet, Loaded, RamStorage, Record, SETTINGS_BUFFER,
-    SETTINGS_LEN, Settings, SettingsError, SettingsStorage, SettingsStore, StorageError,
+    SETTINGS_LEN, Settings, SettingsError, SettingsStorage, SettingsStore, StorageError, field,
 };
 use idle_head_core::{Angle, AngleRange, Axis, Direction, Microseconds, Millis};
 use proptest::prelude::RngExt as _;
@@ -86,6 +86,7 @@ fn every_field_round_trips() {
         s.behaviour.rest.pose = [0; 3].map(|_| Angle::from_millidegrees(rng.random()));
         s.behaviour.rest.relax = rng.random_bool(0.5);
         s.behaviour.gaze.duck = Percent::new(rng.random_range(0..=100)).unwrap();
+        s.rate = ServoRate::new(rng.random_range(50..=333)).unwrap();
         s.inputs.rest_after = if rng.random_bool(0.2) {
             RestAfter::Never
         } else {
@@ -408,6 +409,46 @@ fn an_older_record_keeps_chosen_seeds_and_moves_the_papers_to_the_board() {
     assert_eq!(loaded.idle_seeds(BoardId::NONE), PAPER);
     // The version 1 fixture (seeds 42, …) loads with its seeds chosen.
     assert_eq!(fixture_v1().seeding, Seeding::Chosen);
+}
+
+/// The servos' rate (field 67, two bytes of Hz): a record saved before it
+/// existed boots at 50 Hz; one with a rate outside 50..=333 Hz loads at
+/// 50 Hz too, the field reported as rejected; a rate saved loads as saved.
+#[test]
+fn the_rate_loads_as_saved_and_older_records_run_at_50_hz() {
+    const RATE: u8 = 67;
+    assert_eq!(field(RATE).map(|f| f.name), Some("servo.rate"));
+    let saved = fixture_v1();
+    let fields = entries(&encode(&saved));
+    assert!(
+        fields
+            .iter()
+            .any(|(id, value)| *id == RATE && value == &[50, 0])
+    );
+    let without: Vec<_> = fields
+        .iter()
+        .filter(|(id, _)| *id != RATE)
+        .cloned()
+        .collect();
+    let (loaded, report) = load_stored(&stored(&without));
+    assert_eq!(loaded.map(|s| s.rate), Ok(ServoRate::DEFAULT));
+    assert_eq!(report.missing, FieldSet::of(&[RATE]));
+    for (bytes, rate) in [
+        ([77, 1], Some(333)),
+        ([200, 0], Some(200)),
+        ([78, 1], None),
+        ([49, 0], None),
+        ([0, 0], None),
+    ] {
+        let mut record = without.clone();
+        record.push((RATE, bytes.to_vec()));
+        let (loaded, report) = load_stored(&stored(&record));
+        let hz = loaded.unwrap().rate.hz();
+        match rate {
+            Some(rate) => assert_eq!((hz, report.rejected), (rate, FieldSet::EMPTY)),
+            None => assert_eq!((hz, report.rejected), (50, FieldSet::of(&[RATE]))),
+        }
+    }
 }
 
 /// A record saved by a firmware with a field this one does not have, at

@@ -77,6 +77,7 @@ fn frame_row_is_parsed_and_held_to_its_ceiling() {
     assert_eq!(
         row,
         FrameRow {
+            rate: 50,
             scenario: None,
             frames: 1601,
             min: 930,
@@ -87,6 +88,12 @@ fn frame_row_is_parsed_and_held_to_its_ceiling() {
         }
     );
     assert!(row.within_budget());
+    // 1,084 instructions of one 125 MHz cycle each in 20 ms.
+    assert!(
+        (row.load_percent() - 0.043_36).abs() < 1e-4,
+        "{}",
+        row.load_percent()
+    );
     let slow = FrameRow {
         median: 1201,
         ..row.clone()
@@ -94,6 +101,24 @@ fn frame_row_is_parsed_and_held_to_its_ceiling() {
     assert!(!slow.within_budget());
     let spiky = FrameRow { max: 4001, ..row };
     assert!(!spiky.within_budget());
+    // At 333 Hz: its own label, the period rounded to 3003 µs, the load
+    // over it.
+    let fast = FrameRow::parse(
+        "frame bench rate=333 frames=1601 min=930 median=945 max=1861 max_at=7 mean=1084",
+    )
+    .unwrap()
+    .unwrap();
+    assert_eq!(
+        (fast.rate, fast.label()),
+        (333, "frame at 333 Hz".to_owned())
+    );
+    assert_eq!(fast.period_us(), 3003);
+    // 8.672 µs in 3003 µs.
+    assert!(
+        (fast.load_percent() - 0.288_78).abs() < 1e-4,
+        "{}",
+        fast.load_percent()
+    );
     assert!(
         FrameRow::parse("bench row=default n=900")
             .unwrap()
@@ -120,18 +145,23 @@ fn each_frame_row_is_held_to_its_own_ceiling_and_named() {
     )
     .unwrap()
     .unwrap();
-    // 1,930 is over the idle row's 1,200 but within this row's 2,000:
+    let busy = FrameRow {
+        median: 1830,
+        ..busy
+    };
+    // 1,830 is over the idle row's 1,200 but within this row's 2,000:
     // no OVER printed for it, and the bench passes.
     assert!(busy.within_budget());
     assert_eq!(frames_over_budget(&[idle.clone(), busy.clone()]), None);
     let slow_busy = FrameRow {
         median: 2001,
+        rate: 333,
         ..busy.clone()
     };
     let message = frames_over_budget(&[idle.clone(), slow_busy]).unwrap();
     assert_eq!(
         message,
-        "frame update over its ceiling: row `frame (gesture + look)` takes 2,001 \
+        "frame update over its ceiling: row `frame (gesture + look) at 333 Hz` takes 2,001 \
          instructions at the median and 3,900 at most (ceiling 2,000 and 4,000)"
     );
     let spiky_idle = FrameRow { max: 4001, ..idle };
@@ -141,10 +171,12 @@ fn each_frame_row_is_held_to_its_own_ceiling_and_named() {
 }
 
 #[test]
-fn a_frame_row_of_an_unknown_scenario_is_an_error() {
+fn a_frame_row_of_an_unknown_scenario_or_a_missing_rate_is_an_error() {
     let log: Vec<LogLine> = [
-        "frame bench frames=2 min=1 median=1 max=1 max_at=0 mean=1",
-        "frame bench scenario=gesture+look frames=2 min=1 median=1 max=1 max_at=0 mean=1",
+        "frame bench rate=50 frames=2 min=1 median=1 max=1 max_at=0 mean=1",
+        "frame bench rate=50 scenario=gesture+look frames=2 min=1 median=1 max=1 max_at=0 mean=1",
+        "frame bench rate=333 frames=2 min=1 median=1 max=1 max_at=0 mean=1",
+        "frame bench rate=333 scenario=gesture+look frames=2 min=1 median=1 max=1 max_at=0 mean=1",
         "frame bench scenario=juggling frames=2 min=1 median=1 max=1 max_at=0 mean=1",
     ]
     .into_iter()
@@ -152,5 +184,10 @@ fn a_frame_row_of_an_unknown_scenario_is_an_error() {
     .collect();
     let err = FrameRow::all(&log).unwrap_err().to_string();
     assert!(err.contains("`frame (juggling)`"), "{err}");
-    assert_eq!(FrameRow::all(&log[..2]).unwrap().len(), 2);
+    assert_eq!(FrameRow::all(&log[..4]).unwrap().len(), 4);
+    let err = FrameRow::all(&log[..3]).unwrap_err().to_string();
+    assert!(
+        err.contains("no `frame bench rate=333 scenario=gesture+look` line"),
+        "{err}"
+    );
 }

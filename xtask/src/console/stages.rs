@@ -119,17 +119,24 @@ pub fn flood(elf: &Path) -> Result<String> {
 /// into its stdin; one reply per line on stdout, then the summary line. The
 /// script has a line that is not UTF-8 (it must reach the firmware and be
 /// answered, and the lines after it too), and its last line has no line end.
+/// It changes the servos' rate while the head moves (to 333 Hz, saved,
+/// back to 50 Hz with `defaults`, 333 Hz again with `load`): the run's
+/// summary says no frame was missed and no pulse left its servo's limits.
 pub fn piped_script() -> Result<String> {
     const SCRIPT: &[u8] = b"help\nstatus\nservo yaw\nservo yaw neutral 1520\nservo yaw\n\
-                            idle amp 60\nseed 42\nsave\ndefaults\nload\nservo yaw\nnodd\n\
+                            idle amp 60\nservo rate 333\nnod\nservo rate\nseed 42\nsave\n\
+                            defaults\nload\nservo yaw\nnodd\n\
                             nod \xff\nservo yaw min 2600\nstatus";
-    const WANT: [&str; 15] = [
+    const WANT: [&str; 18] = [
         "ok commands:",
         "ok mode=running",
         "ok yaw neutral=1500 ",
         "ok",
         "ok yaw neutral=1520 ",
         "ok idle=60",
+        "ok servo rate=333 period_us=3003",
+        "ok nod ",
+        "ok servo rate=333 period_us=3003",
         "ok seed=42",
         "ok",
         "ok",
@@ -164,6 +171,12 @@ pub fn piped_script() -> Result<String> {
         if !(got.starts_with(want) && (want != "ok" || *got == "ok")) {
             bail!("line {i}: {got:?}, want {want:?}");
         }
+    }
+    if !lines[WANT.len() - 1].ends_with(" rate=333") {
+        bail!(
+            "the last status {:?} is not at the loaded 333 Hz",
+            lines[WANT.len() - 1]
+        );
     }
     let summary = lines[WANT.len()];
     if !summary.starts_with("summary ") || !summary.contains(" missed=0 pulse_violations=0 ") {

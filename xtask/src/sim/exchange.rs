@@ -237,7 +237,8 @@ mod tests {
         assert!(
             text(&uart[1])
                 .starts_with("ok mode=running mdeg=* us=* faults=0,0,0 off=0 uptime_ms=* fw=")
-                && text(&uart[1]).ends_with(" settings=defaults inputs=-,-,-,- seed=board\r\n"),
+                && text(&uart[1])
+                    .ends_with(" settings=defaults inputs=-,-,-,- seed=board rate=50\r\n"),
             "{}",
             text(&uart[1])
         );
@@ -248,9 +249,9 @@ mod tests {
         );
         assert_eq!(text(&uart[7]), "ok seed=7\r\n");
         assert_eq!(text(&uart[8]), "err storage load: no settings saved\r\n");
-        assert!(text(&uart[9]).ends_with(" settings=changed inputs=-,-,-,- seed=7\r\n"));
+        assert!(text(&uart[9]).ends_with(" settings=changed inputs=-,-,-,- seed=7 rate=50\r\n"));
         // The USB run finds the settings the UART run changed.
-        assert!(text(&usb[1]).ends_with(" settings=changed inputs=-,-,-,- seed=7\r\n"));
+        assert!(text(&usb[1]).ends_with(" settings=changed inputs=-,-,-,- seed=7 rate=50\r\n"));
     }
 
     #[test]

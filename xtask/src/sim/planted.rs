@@ -14,7 +14,7 @@ use anyhow::{Context as _, Result, bail};
 use embedded_storage_async::nor_flash::{
     ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash,
 };
-use idle_head_core::settings::{RawRecord, SettingsStore};
+use idle_head_core::settings::{RawRecord, SETTINGS_BUFFER, Settings, SettingsStore};
 
 /// The Pico's flash: erase sector and write unit.
 const SECTOR: usize = 4096;
@@ -48,6 +48,20 @@ pub fn store_of_version<const V: u16>(payload: &[u8], len: usize) -> Result<Vec<
     match ready(store.save(&record)).context("the store's save waited")? {
         Ok(()) => Ok(store.into_flash().0),
         Err(e) => bail!("planting a version {V} record: {e:?}"),
+    }
+}
+
+/// `len` bytes of settings sectors holding `settings`, as a `save` leaves
+/// them (a board boots on them: at their servo rate, say).
+pub fn settings_sectors(settings: &Settings, len: usize) -> Result<Vec<u8>> {
+    let flash = RamFlash(vec![0xff; len]);
+    let range = 0..u32::try_from(len)?;
+    let mut store: SettingsStore<RamFlash, Settings, SETTINGS_BUFFER> =
+        SettingsStore::new(flash, range)
+            .map_err(|e| anyhow::anyhow!("the settings store refused the range: {e:?}"))?;
+    match ready(store.save(settings)).context("the store's save waited")? {
+        Ok(()) => Ok(store.into_flash().0),
+        Err(e) => bail!("planting the settings: {e:?}"),
     }
 }
 

@@ -1,7 +1,7 @@
 //! Checks one servo's pulse train from the emulator against the duties the
 //! host computes, frame for frame: each pulse carries the duty of the last
 //! compare write before its rise, and the pulse of PWM period `n` must
-//! carry frame `n` (a late or lost frame shows as a pulse carrying another;
+//! carry frame `n` (at the run's servo rate: a late or lost frame shows as a pulse carrying another;
 //! pulses after the last frame repeat it and count as held). Why the
 //! periods map to frames so: docs/dev/emulators.md.
 

@@ -1,7 +1,8 @@
 //! `--pulses FILE.csv`: the pulses an emulator run measured on the servo
 //! pins, one row per frame (`t_ms,pitch_us,roll_us,yaw_us`): row `k` is the
 //! PWM period `k` from the first pulse on, each width the pulse that rose
-//! in it (µs, to 0.1), or 0 where the period had none.
+//! in it (µs, to 0.1), or 0 where the period had none; `t_ms` has µs
+//! decimals where the period has them (3.003·k at 333 Hz).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -49,9 +50,16 @@ fn rows(trains: &[Train; 3], timing: &Timing) -> String {
     let us = |counts: Option<u32>| counts.map_or(0.0, |c| f64::from(c) * timing.count_ns / 1e3);
     let mut text = String::from("t_ms,pitch_us,roll_us,yaw_us\n");
     let [pitch, roll, yaw] = &widths;
+    let period_us = (timing.frame_ns / 1e3).round() as u64;
     for (k, ((p, r), y)) in pitch.iter().zip(roll).zip(yaw).take(frames).enumerate() {
         let [p, r, y] = [*p, *r, *y].map(us);
-        let _ = writeln!(text, "{},{p:.1},{r:.1},{y:.1}", k * 20);
+        let t_us = k as u64 * period_us;
+        if t_us.is_multiple_of(1000) {
+            let _ = write!(text, "{}", t_us / 1000);
+        } else {
+            let _ = write!(text, "{}.{:03}", t_us / 1000, t_us % 1000);
+        }
+        let _ = writeln!(text, ",{p:.1},{r:.1},{y:.1}");
     }
     text
 }
@@ -96,6 +104,31 @@ mod tests {
             rows(&trains(), &TIMING),
             "t_ms,pitch_us,roll_us,yaw_us\n0,1500.0,1500.0,1500.0\n20,1500.3,1500.0,1500.0\n\
              40,0.0,0.0,0.0\n60,1500.9,1500.0,1500.0\n"
+        );
+    }
+
+    /// At 333 Hz a row is 3003 µs after the one before.
+    #[test]
+    fn the_rows_are_a_period_apart_at_any_rate() {
+        let timing = crate::sim::run::timing_at(idle_head_core::servo::ServoRate::MAX);
+        let train = |k: u32| {
+            let rise = 1e5 + f64::from(k) * timing.frame_ns;
+            (rise, rise + 30_000.0 * timing.count_ns)
+        };
+        let trains = [(); 3].map(|()| Train {
+            edges: (0..3)
+                .flat_map(|k| {
+                    let (rise, fall) = train(k);
+                    [(rise, true), (fall, false)]
+                })
+                .collect(),
+            enabled: Some(0.0),
+            ..Train::default()
+        });
+        assert_eq!(
+            rows(&trains, &timing),
+            "t_ms,pitch_us,roll_us,yaw_us\n0,1500.0,1500.0,1500.0\n3.003,1500.0,1500.0,1500.0\n\
+             6.006,1500.0,1500.0,1500.0\n"
         );
     }
 

@@ -6,7 +6,8 @@ use std::{fmt::Write as _, path::Path, time::Duration};
 use anyhow::{Context, Result, bail};
 use defmt_decoder::StreamDecoder;
 use idle_head_core::driver::DriverConfig;
-use idle_head_core::pwm_clock::{PICO_SERVO_CLOCK, PICO_SYS_HZ};
+use idle_head_core::pwm_clock::{PICO_SYS_HZ, SliceClock};
+use idle_head_core::servo::ServoRate;
 
 use super::{
     event::{Event, FlashKind, Why},
@@ -146,6 +147,9 @@ pub struct Report {
     pub problems: Vec<String>,
     /// The UART exchange as a transcript, if the run had one.
     pub exchange: Option<String>,
+    /// The servos' rate the pulses were checked at (50 Hz unless
+    /// [`check_at`] said).
+    pub rate: ServoRate,
 }
 
 /// Runs `elf` for `virtual_time` (at most `wall` of wall time) and checks
@@ -462,20 +466,36 @@ pub fn end_of(events: &[Event]) -> Result<End> {
     End::from_event(event)
 }
 
-/// The PWM timing of the Pico's servo slices.
-#[allow(clippy::cast_precision_loss)] // 312 500 ps
+/// The PWM timing of the Pico's servo slices at 50 Hz.
 pub fn timing() -> Timing {
+    timing_at(ServoRate::DEFAULT)
+}
+
+/// The Pico's slice clock at `rate` (every rate has one:
+/// `idle_head_core::pwm_clock` checks it).
+fn clock(rate: ServoRate) -> SliceClock {
+    SliceClock::for_period(PICO_SYS_HZ, rate.period()).unwrap_or(SliceClock {
+        divider_16ths: 0,
+        top: 0,
+    })
+}
+
+/// The PWM timing of the Pico's servo slices at `rate`.
+#[allow(clippy::cast_precision_loss)] // 312 500 ps
+pub fn timing_at(rate: ServoRate) -> Timing {
+    let clock = clock(rate);
     Timing {
-        count_ns: PICO_SERVO_CLOCK.count_ps(PICO_SYS_HZ) as f64 / 1e3,
-        period_counts: u32::from(PICO_SERVO_CLOCK.top) + 1,
-        frame_ns: f64::from(DriverConfig::DEFAULT.frame_period.0) * 1e3,
+        count_ns: clock.count_ps(PICO_SYS_HZ) as f64 / 1e3,
+        period_counts: u32::from(clock.top) + 1,
+        frame_ns: f64::from(rate.period().0) * 1e3,
     }
 }
 
-/// Neutral, shortest and longest pulse of each servo, in counts.
-pub fn limits() -> [Limits; 3] {
-    let config = DriverConfig::DEFAULT;
-    let top = PICO_SERVO_CLOCK.top;
+/// Neutral, shortest and longest pulse of each servo, in counts, at `rate`.
+pub fn limits_at(rate: ServoRate) -> [Limits; 3] {
+    let mut config = DriverConfig::DEFAULT;
+    config.pwm.period = rate.period();
+    let top = clock(rate).top;
     config.servos.map(|servo| Limits {
         neutral: config.pwm.duty(servo.neutral, top).0,
         min: config.pwm.duty(servo.min_pulse, top).0,
@@ -497,9 +517,15 @@ pub fn check(report: &mut Report) -> Result<()> {
 }
 
 /// Checks every boot's pulses against `expected`, the duties the host
-/// computed for each frame from frame 0 (`[pitch, roll, yaw]`).
+/// computed for each frame from frame 0 (`[pitch, roll, yaw]`), at 50 Hz.
 pub fn check_with(report: &mut Report, expected: &[[u16; 3]]) {
-    let (timing, limits) = (timing(), limits());
+    check_at(report, expected, ServoRate::DEFAULT);
+}
+
+/// [`check_with`] for a run at `rate` from its first frame.
+pub fn check_at(report: &mut Report, expected: &[[u16; 3]], rate: ServoRate) {
+    report.rate = rate;
+    let (timing, limits) = (timing_at(rate), limits_at(rate));
     let boots = report.boots.len();
     for (b, boot) in report.boots.iter_mut().enumerate() {
         for (i, train) in boot.trains.iter_mut().enumerate() {

@@ -1,16 +1,23 @@
 //! `cargo xtask sim --script FILE`: a trace script played into the shipped
 //! image (pin lines drive GP2 to GP5, console lines go to UART0 2 ms before
 //! their time, times from the first frame), every pulse checked against
-//! the host trace of the same script.
+//! the host trace of the same script; at another
+//! servo rate (`--rate`) the image boots on settings of that rate planted
+//! in its settings sectors, and the trace and the check run at it.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Context, Result, anyhow, bail};
+
+use idle_head_core::servo::ServoRate;
+use idle_head_core::settings::Settings;
 
 use super::harness::{self, SERVOS};
 use super::node::PinScript;
+use super::planted;
 use super::run::{self, Report};
+use crate::elf;
 use crate::project::{Metadata, PICO};
 use crate::trace::{self, Event, Kind};
 
@@ -61,11 +68,42 @@ pub enum Against {
 pub fn play(
     root: &Path,
     metadata: &Metadata,
-    mut events: Vec<Event>,
+    events: Vec<Event>,
     time: Duration,
     wall: Duration,
     against: Against,
 ) -> Result<Report> {
+    play_at(
+        root,
+        metadata,
+        events,
+        time,
+        wall,
+        against,
+        ServoRate::DEFAULT,
+    )
+}
+
+/// [`play`] with the servos at `rate` from the first frame (the image
+/// boots on settings of that rate).
+pub fn play_at(
+    root: &Path,
+    metadata: &Metadata,
+    mut events: Vec<Event>,
+    time: Duration,
+    wall: Duration,
+    against: Against,
+    rate: ServoRate,
+) -> Result<Report> {
+    if let Some(e) = events.iter().find(|e| changes_rate(&e.text)) {
+        bail!(
+            "{:.3} s `{}`: the emulator's pulse check runs at one servo rate; \
+             give it with --rate (`cargo xtask trace` plays a change of rate)",
+            Duration::from_micros(e.at_us).as_secs_f64(),
+            e.text
+        );
+    }
+    let period = u64::from(rate.period().0);
     let up = u64::try_from(CONSOLE_UP.as_micros()).unwrap_or(u64::MAX);
     for event in &mut events {
         if !matches!(event.kind, Kind::Pin { .. }) && event.at_us < up {
@@ -84,9 +122,11 @@ pub fn play(
         match event.kind {
             Kind::Pin { input, high } => script.pins.push((at, input, high)),
             Kind::Act(_) | Kind::Console => {
+                // In before the frame that takes it in the host trace.
+                let frame = Duration::from_micros(event.at_us.next_multiple_of(period));
                 script
                     .lines
-                    .push((at, format!("{}\r\n", event.text).into_bytes()));
+                    .push((frame, format!("{}\r\n", event.text).into_bytes()));
             }
             Kind::Radar(_) => anyhow::bail!(
                 "line {}: radar lines play in the host trace (`cargo xtask trace`); \
@@ -95,11 +135,25 @@ pub fn play(
             ),
         }
     }
+    let planted = if rate == ServoRate::DEFAULT {
+        None
+    } else {
+        let region = elf::Image::read(&PICO.elf(metadata))?
+            .settings
+            .context("the image has no settings region")?;
+        let settings = Settings {
+            rate,
+            ..Settings::DEFAULT
+        };
+        let len = usize::try_from(region.end - region.start)?;
+        Some((region.start, planted::settings_sectors(&settings, len)?))
+    };
     // The boot before the first frame: well under a tenth of a second.
     let boot = Duration::from_millis(100);
     let mut report = run::run_with(root, &PICO.elf(metadata), time + boot, wall, |config| {
         config.inputs = harness::input_pins();
         config.script = Some(script);
+        config.flash_fill = planted;
         // A head relaxed at rest is silent for as long as it rests (no
         // pulse, no log line but once a loop): the wall limit alone tells a
         // stuck run.
@@ -112,14 +166,24 @@ pub fn play(
             let host = trace::simulate(
                 u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX),
                 None,
+                rate,
                 &events,
             )?;
             host.rows.iter().map(|row| row.duties).collect()
         }
         Against::Written => written(&report),
     };
-    run::check_with(&mut report, &expected);
+    run::check_at(&mut report, &expected, rate);
     Ok(report)
+}
+
+/// Whether a console line sets the servo rate (`servo rate <hz>`).
+fn changes_rate(line: &str) -> bool {
+    let words: Vec<String> = line
+        .split_whitespace()
+        .map(str::to_ascii_lowercase)
+        .collect();
+    matches!(words.as_slice(), [servo, rate, _, ..] if servo == "servo" && rate == "rate")
 }
 
 /// The duties boot 0 wrote, frame by frame from frame 0 (its compare
@@ -142,19 +206,19 @@ fn written(report: &Report) -> Vec<[u16; 3]> {
         .collect()
 }
 
-/// `cargo xtask sim --script FILE [--pulses CSV]`.
+/// `cargo xtask sim --script FILE [--rate HZ] [--pulses CSV]`.
 pub fn command(
     root: &Path,
     metadata: &Metadata,
     path: &Path,
-    time: Option<Duration>,
-    wall: Duration,
+    (time, wall): (Option<Duration>, Duration),
+    rate: ServoRate,
     pulses: Option<&PathBuf>,
 ) -> Result<bool> {
     PICO.build(root)?;
     let events = read(path)?;
     let time = time.unwrap_or_else(|| default_time(&events));
-    let report = play(root, metadata, events, time, wall, Against::Host)?;
+    let report = play_at(root, metadata, events, time, wall, Against::Host, rate)?;
     print!("{}", report.log_text(false));
     if let Some(boot) = report.boots.first() {
         println!("UART0 replies:");
@@ -171,8 +235,19 @@ pub fn command(
     );
     println!("{}", report.summary());
     if let (Some(path), Some(boot)) = (pulses, report.boots.first()) {
-        let rows = super::pulses_csv::write(path, &boot.trains, &run::timing())?;
+        let rows = super::pulses_csv::write(path, &boot.trains, &run::timing_at(rate))?;
         println!("wrote {} ({rows} frames)", path.display());
     }
     Ok(report.problems.is_empty())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_rate_change_is_told_from_a_rate_query() {
+        assert!(super::changes_rate("servo rate 333"));
+        assert!(super::changes_rate("SERVO  Rate 60"));
+        assert!(!super::changes_rate("servo rate"));
+        assert!(!super::changes_rate("servo yaw neutral 1500"));
+    }
 }

@@ -31,6 +31,9 @@ pub const DRILL_STAGE: &str =
 pub const CONSOLE_STAGE: &str = "Pico image in the RP2040 emulator: the console's UART and USB \
      exchanges; its RAM within budget";
 /// See [`PULSES_STAGE`].
+pub const RATE_STAGE: &str = "Pico image in the RP2040 emulator at 333 Hz (booted on saved \
+     settings): every pulse the host trace's duty, frame for frame";
+/// See [`PULSES_STAGE`].
 pub const FAILURES_STAGE: &str =
     "RP2040 emulator: a hung, a sleeping and a wrong image each fail clearly";
 
@@ -48,6 +51,47 @@ const DRILL_TIME: Duration = Duration::from_millis(6_500);
 /// The console run: both scripts (UART at 3 s, USB at 4 s) and a second
 /// for the last replies.
 pub const CONSOLE_TIME: Duration = Duration::from_secs(6);
+
+/// The script of [`RATE_STAGE`]: the fade-in, then a nod, a look and its
+/// return over a shake, an idle change and a move back, all at 333 Hz.
+const RATE_SCRIPT: &str = "\
+2.2 nod
+2.6 look 8000 -15000 hold=700
+3.0 shake intensity=80
+4.1 idle amp 50
+4.6 tilt -9000 1200
+5.4 center
+";
+
+/// [`RATE_STAGE`]: the shipped image booted on settings of 333 Hz and
+/// [`RATE_SCRIPT`] played into it; every pulse checked against the host
+/// trace at 333 Hz (its 3003 µs period, 60 060 counts of 50 ns).
+pub fn test_rate(root: &Path, metadata: &Metadata) -> Result<()> {
+    let events = super::script::parse(RATE_SCRIPT)?;
+    let rate = idle_head_core::servo::ServoRate::MAX;
+    let time = Duration::from_secs(7);
+    let report = super::script::play_at(
+        root,
+        metadata,
+        events,
+        time,
+        WALL,
+        super::script::Against::Host,
+        rate,
+    )?;
+    print!("{}", report.table());
+    println!("{}", report.verdict());
+    let frames = report.boots.first().map_or(0, |boot| boot.servos[0].frames);
+    // 7 s at 3003 µs, from the first frame.
+    if frames < 2300 {
+        bail!("{frames} frames checked, not the 2,300 of 7 s at 333 Hz");
+    }
+    if report.problems.is_empty() {
+        Ok(())
+    } else {
+        bail!("{}", report.problems.join("; "))
+    }
+}
 
 /// The shipped Pico image (already built) for [`DEFAULT_TIME`]; fails unless
 /// every check passes over at least [`MIN_FRAMES`] frames and the loops'

@@ -387,7 +387,7 @@ mod tests {
                 "first frame: neutral pulses 1500 1500 1500 us; watchdog armed (100 ms)",
             ],
             &format!(
-                "ok\r\nok\r\nok mode=running settings=flash inputs=-,-,-,- seed=board\r\n{}",
+                "ok\r\nok\r\nok mode=running settings=flash inputs=-,-,-,- seed=board rate=50\r\n{}",
                 "ok pitch neutral=1520 per-degree=11111\r\n".repeat(DURING_SAVE_LINES)
             ),
             [1500.0; 3],
@@ -405,7 +405,7 @@ mod tests {
                 "settings: loaded from flash (version 2) at 0x101fc000",
                 "first frame: neutral pulses 1520 1500 1500 us; watchdog armed (100 ms)",
             ],
-            "ok\r\nok\r\nok pitch neutral=1520 per-degree=11111\r\nok mode=running settings=flash inputs=-,-,-,- seed=board\r\n",
+            "ok\r\nok\r\nok pitch neutral=1520 per-degree=11111\r\nok mode=running settings=flash inputs=-,-,-,- seed=board rate=50\r\n",
             [1520.0, 1500.0, 1500.0],
         );
         Report {

@@ -7,6 +7,7 @@ use idle_head_core::behaviour::{CommandQueue, RestState, ShowLink};
 use idle_head_core::console::{ActionLine, ConsoleLink, ConsoleService, Response, respond};
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::input::{INPUTS, InputSettings, Inputs, Micros, Pull};
+use idle_head_core::servo::ServoRate;
 use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
 
 /// Where an action in the queue came from.
@@ -25,19 +26,29 @@ pub struct Console<'a> {
 }
 
 impl<'a> Console<'a> {
-    /// The service on the built-in settings.
+    /// The service on the built-in settings at `rate`.
     pub fn new(
         queue: &'a CommandQueue,
         link: &'a ConsoleLink,
         show: &'a ShowLink,
+        rate: ServoRate,
     ) -> anyhow::Result<Self> {
+        let settings = Settings {
+            rate,
+            ..Settings::DEFAULT
+        };
+        let source = if rate == ServoRate::DEFAULT {
+            SettingsSource::Defaults
+        } else {
+            SettingsSource::Changed
+        };
         let service = ConsoleService::new(
             queue,
             link,
             RamStorage::new(),
             DriverConfig::DEFAULT,
-            Settings::DEFAULT,
-            SettingsSource::Defaults,
+            settings,
+            source,
         )
         .map_err(|e| anyhow::anyhow!("the built-in settings: {e}"))?
         .with_show(show);

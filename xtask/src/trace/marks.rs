@@ -135,13 +135,10 @@ pub fn marks(
         && let Hold::Return(hold) = look.hold
         && let Some(back) = return_duration(params, look.pitch, look.yaw)
     {
-        // As the gaze plans it: the move's frames, then the hold's (at
-        // least one), then the move back at the rule's duration.
-        let frame_ms = u64::from(params.frame_us()) / 1000;
-        let frames =
-            u64::from(params.frames(look.duration)) + u64::from(params.frames(hold).max(1));
+        // As the gaze plans it: the move, then the hold, then the move
+        // back at the rule's duration.
         marks.push(Mark {
-            t_ms: t_ms + frames * frame_ms,
+            t_ms: t_ms + u64::from(look.duration.0) + u64::from(hold.0),
             span_ms: u64::from(back.0),
             axes: vec![Axis::Pitch, Axis::Yaw],
             kind: Kind::Return,

@@ -4,7 +4,7 @@ use idle_head_core::behaviour::LimitMode;
 fn run(script: &str, seconds: u64) -> Trace {
     let (_, params) = built_in().unwrap();
     let events = script::parse(script, &params).unwrap();
-    simulate(seconds * 1_000_000, None, &events).unwrap()
+    simulate(seconds * 1_000_000, None, ServoRate::DEFAULT, &events).unwrap()
 }
 
 #[test]
@@ -18,9 +18,11 @@ fn idle_only_is_the_plain_frame_loop() {
     let driver = DriverConfig::DEFAULT.build().unwrap();
     let playback = Playback::new(LOOP_DURATION, driver.config().frame_period, DEFAULT_N).unwrap();
     let mut source = idle(config(None), playback, None).unwrap();
-    let mut plain = FrameDriver::new([Channel(0), Channel(0), Channel(0)], driver);
+    let period = driver.config().frame_period;
+    let channel = || Channel::at(period).unwrap();
+    let mut plain = FrameDriver::new([channel(), channel(), channel()], driver);
     for row in &trace.rows {
-        let report = plain.write_frame(source.offsets(row.frame));
+        let report = plain.write_frame(source.offsets(Timestamp(row.t_us)));
         assert_eq!(row.angles, report.servos.map(|s| s.angle.millidegrees()));
     }
 }

@@ -64,8 +64,8 @@ pub struct LookApplied {
 pub(crate) struct Gaze {
     /// `[pitch, yaw, envelope]`, on one clock.
     axes: [Glide; 3],
-    /// The planned return `[pitch, yaw]` (the envelope falls along it).
-    back: Option<[Glide; 2]>,
+    /// The planned return.
+    back: Option<Back>,
     /// What moved the gaze last.
     by: By,
 }
@@ -82,6 +82,24 @@ pub(crate) enum By {
     Track,
 }
 
+/// A planned return: `[pitch, yaw]` back to the centre (the envelope
+/// falls along it), starting `wait` µs after `from`. (Kept as a wait, not
+/// a time: a hold may last up to an hour, longer than the clock's half
+/// round, and the wait is compared unsigned.)
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Back {
+    glides: [Glide; 2],
+    from: u32,
+    wait: u32,
+}
+
+impl Back {
+    /// Whether the return starts at or before `now`.
+    const fn due(&self, now: u32) -> bool {
+        now.wrapping_sub(self.from) >= self.wait
+    }
+}
+
 impl Gaze {
     /// At the centre, at rest.
     pub(crate) const fn new() -> Self {
@@ -92,14 +110,17 @@ impl Gaze {
         }
     }
 
-    /// The centre's offsets (m°) and the look's envelope (Q16) at frame
+    /// The centre's offsets (m°) and the look's envelope (Q16) at time
     /// `now`: `[pitch, yaw, envelope]`. (A move that starts while another
     /// plays may overshoot its ends a little: the envelope may pass 0 or 1
     /// by a few counts.)
     #[inline]
     pub(crate) fn at(&mut self, now: u32) -> [i32; 3] {
         if self.returns_by(now)
-            && let Some([pitch, yaw]) = self.back.take()
+            && let Some(Back {
+                glides: [pitch, yaw],
+                ..
+            }) = self.back.take()
         {
             let envelope = pitch.falling(ONE as i32);
             self.axes = [pitch, yaw, envelope];
@@ -114,18 +135,16 @@ impl Gaze {
         self.back.is_none() && self.axes.iter().all(|g| !g.moving() && g.target() == 0)
     }
 
-    /// Whether the planned return starts at or before frame `frame`.
-    pub(crate) fn returns_by(&self, frame: u32) -> bool {
-        self.back
-            .as_ref()
-            .is_some_and(|back| frame.wrapping_sub(back[0].start) as i32 >= 0)
+    /// Whether the planned return starts at or before time `now`.
+    pub(crate) fn returns_by(&self, now: u32) -> bool {
+        self.back.as_ref().is_some_and(|back| back.due(now))
     }
 
-    /// Frames from `from` to the next frame after it at which a move ends,
-    /// the planned return is due next frame, or it starts (`u32::MAX`:
-    /// none). A return due at `from` or before counts as one frame on (a
-    /// move then starts whose end is not known yet).
-    pub(crate) fn next_event(&self, from: u32) -> u32 {
+    /// µs from `from` to the next time after it at which a move ends, the
+    /// planned return is due next frame, or it starts (`u32::MAX`: none).
+    /// A return due at `from` or before counts as 1 µs on (a move then
+    /// starts whose end is not known yet).
+    pub(crate) fn next_event(&self, from: u32, period: u32) -> u32 {
         let mut soonest = u32::MAX;
         // (The envelope ends with the axes.)
         for axis in &self.axes[..2] {
@@ -134,8 +153,13 @@ impl Gaze {
             }
         }
         if let Some(back) = &self.back {
-            let start = back[0].start.wrapping_sub(from);
-            soonest = soonest.min(if start as i32 > 1 { start - 1 } else { 1 });
+            // Due next frame: one period before it starts.
+            let start = if back.due(from) {
+                0
+            } else {
+                back.wait - from.wrapping_sub(back.from)
+            };
+            soonest = soonest.min(start.saturating_sub(period).max(1));
         }
         soonest
     }
@@ -151,7 +175,7 @@ impl Gaze {
         [self.axes[0].moving(), self.axes[1].moving()]
     }
 
-    /// Starts a look at frame `next`.
+    /// Starts a look at time `next`.
     pub(crate) fn look(
         &mut self,
         params: &BehaviourParams,
@@ -178,16 +202,20 @@ impl Gaze {
             clamped |= outside;
             inside.millidegrees()
         });
-        let frames = self.move_to(params, next, offsets, ONE as i32, request.duration);
+        let us = self.move_to(params, next, offsets, ONE as i32, request.duration);
         self.by = By::Look;
         self.back = match hold {
             Hold::Stay => None,
             Hold::Return(ms) => {
-                let at = next
-                    .wrapping_add(frames)
-                    .wrapping_add(params.frames(ms).max(1));
-                let back_frames = duration(params, offsets.map(i32::unsigned_abs), None);
-                Some(offsets.map(|o| Glide::new(at, State::rest(o), 0, back_frames)))
+                // Within an hour and 10 s: no wrap of the unsigned wait.
+                let wait = us.saturating_add(BehaviourParams::micros(ms).max(1));
+                let at = next.wrapping_add(wait);
+                let back_us = duration(params, offsets.map(i32::unsigned_abs), None);
+                Some(Back {
+                    glides: offsets.map(|o| Glide::new(at, State::rest(o), 0, back_us)),
+                    from: next,
+                    wait,
+                })
             }
         };
         let absolute =
@@ -196,12 +224,12 @@ impl Gaze {
             pitch: absolute(0),
             yaw: absolute(1),
             clamped,
-            duration: params.millis(frames),
+            duration: BehaviourParams::millis(us),
             hold,
         })
     }
 
-    /// Starts a move back to the centre at frame `next`; returns its duration.
+    /// Starts a move back to the centre at time `next`; returns its duration.
     pub(crate) fn center(
         &mut self,
         params: &BehaviourParams,
@@ -209,10 +237,10 @@ impl Gaze {
         given: Option<Millis>,
     ) -> Result<Millis, BehaviourError> {
         check_duration(params, "center duration", given)?;
-        let frames = self.move_to(params, next, [0, 0], 0, given);
+        let us = self.move_to(params, next, [0, 0], 0, given);
         self.back = None;
         self.by = By::Centre;
-        Ok(params.millis(frames))
+        Ok(BehaviourParams::millis(us))
     }
 
     /// What moved the gaze last.
@@ -220,10 +248,10 @@ impl Gaze {
         self.by
     }
 
-    /// The tracker's move at frame `next` to `offsets` (m° around the
+    /// The tracker's move at time `next` to `offsets` (m° around the
     /// neutral pose, within the axes' room), in `given` or the rule's
     /// time (lengthened to fit the gesture limits), the idle ducked as
-    /// under a held look; returns its duration in frames.
+    /// under a held look; returns its duration in µs.
     pub(crate) fn follow(
         &mut self,
         params: &BehaviourParams,
@@ -231,14 +259,14 @@ impl Gaze {
         offsets: [i32; 2],
         given: Option<Millis>,
     ) -> u32 {
-        let frames = self.move_to(params, next, offsets, ONE as i32, given);
+        let us = self.move_to(params, next, offsets, ONE as i32, given);
         self.back = None;
         self.by = By::Track;
-        frames
+        us
     }
 
     /// Glides both axes from where they are at `next` to `offsets`, and the
-    /// envelope to `envelope`; returns the duration in frames.
+    /// envelope to `envelope`; returns the duration in µs.
     fn move_to(
         &mut self,
         params: &BehaviourParams,
@@ -251,11 +279,11 @@ impl Gaze {
         let _ = self.at(next);
         let from = self.axes.map(|g| g.state(next));
         let distance: [u32; 2] = core::array::from_fn(|i| offsets[i].abs_diff(from[i].pos));
-        let frames = duration(params, distance, given);
+        let us = duration(params, distance, given);
         let [pitch, yaw] = offsets;
         let to = [pitch, yaw, envelope];
-        self.axes = core::array::from_fn(|i| Glide::new(next, from[i], to[i], frames));
-        frames
+        self.axes = core::array::from_fn(|i| Glide::new(next, from[i], to[i], us));
+        us
     }
 }
 
@@ -277,7 +305,7 @@ fn check_duration(
     }
 }
 
-/// Frames of a move of `distance` (m°, `[pitch, yaw]`): the given duration or
+/// µs of a move of `distance` (m°, `[pitch, yaw]`): the given duration or
 /// the rule's, lengthened until it fits the gesture limits.
 fn duration(params: &BehaviourParams, distance: [u32; 2], given: Option<Millis>) -> u32 {
     let gaze = params.config().gaze;
@@ -286,11 +314,11 @@ fn duration(params: &BehaviourParams, distance: [u32; 2], given: Option<Millis>)
         Some(ms) => u64::from(ms.0),
         None => u64::from(gaze.base.0) + (u64::from(gaze.per_degree.0) * far).div_ceil(1000),
     };
-    let mut frames = 2;
+    let mut us = 2;
     for (axis, d) in AXES.iter().zip(distance) {
         let limits = params.limits(*axis, LimitMode::Gesture);
-        let fit = params.move_frames(ms, d, limits.max_speed.0, limits.max_accel.0);
-        frames = frames.max(fit);
+        let fit = BehaviourParams::move_us(ms, d, limits.max_speed.0, limits.max_accel.0);
+        us = us.max(fit);
     }
-    frames
+    us
 }

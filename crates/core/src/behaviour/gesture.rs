@@ -63,7 +63,7 @@
 //! # Fixed point
 //!
 //! Per frame: `u = t/D` in Q16 from a reciprocal computed when the gesture
-//! starts, `φ = n·u`, the carrier from `idsp::cossin` (32-bit phase
+//! starts (`t` and `D` in µs: the same motion at any frame rate), `φ = n·u`, the carrier from `idsp::cossin` (32-bit phase
 //! `frac(φ)·2³²`), envelope and profile in Q16: a handful of 32-bit
 //! multiplies, no division.
 
@@ -72,7 +72,7 @@ use crate::driver::{DegreesPerSecond, DegreesPerSecondSquared};
 use crate::units::{Angle, Millis, Percent};
 
 use super::error::BehaviourError;
-use super::fixed::{ONE, inverse, mul, progress, smootherstep};
+use super::fixed::{ONE, Span, mul, smootherstep};
 use super::params::{BehaviourParams, LimitMode};
 use super::shape::Shape;
 
@@ -90,15 +90,14 @@ pub struct GesturePlan {
     pub amplitude: Angle,
     /// Cycles.
     pub cycles: u8,
-    /// Duration, as played (whole frames).
+    /// Duration.
     pub duration: Millis,
     /// Intensity.
     pub intensity: Percent,
-    /// Frames.
-    pub(crate) frames: u32,
+    /// The duration on the frame path's clock.
+    pub(crate) span: Span,
     /// The gesture's shape (its row's, kept for the frame path).
     shape: Shape,
-    inverse: u32,
     /// Profile at `u = 0` and its fall over the gesture (m°).
     start: i32,
     fall: i32,
@@ -132,8 +131,7 @@ pub(crate) const fn plan(
     if let Err(e) = check_peaks(params, kind, a, cycles, duration_ms) {
         return Err(e);
     }
-    let frames = params.frames(Millis(duration_ms as u32));
-    let frames = if frames < 2 { 2 } else { frames };
+    let span = Span::new(BehaviourParams::micros(Millis(duration_ms as u32)));
     // Declination A·(1 − (φ − ½)/(4n)) = A·(1 + 1/(8n)) − (A/4)·u.
     let (start, fall, lower_from) = if cycles >= 2 {
         let den = 8 * cycles as i64;
@@ -150,10 +148,9 @@ pub(crate) const fn plan(
         kind,
         amplitude: Angle::from_millidegrees(a),
         cycles: cycles as u8,
-        duration: params.millis(frames),
+        duration: Millis(duration_ms as u32),
         intensity,
-        frames,
-        inverse: inverse(frames),
+        span,
         start,
         fall,
         lower_from,
@@ -332,12 +329,12 @@ const fn clamp_u32(v: u64) -> u32 {
 }
 
 impl GesturePlan {
-    /// The layer at `t` frames after the start, for `t` before its end
-    /// (`t < frames`; the caller ends the layer at `frames`): its offset
-    /// (m°) and its envelope `E` (Q16).
+    /// The layer `t` µs after the start, for `t` before its end (`t <
+    /// span`; the caller ends the layer there): its offset (m°) and its
+    /// envelope `E` (Q16).
     #[inline]
     pub(crate) fn at(&self, t: u32) -> (i32, u32) {
-        let u = progress(t, self.inverse);
+        let u = self.span.progress(t);
         let n = self.cycles as u32;
         // φ < n: u < 1.
         let phi = n * u;

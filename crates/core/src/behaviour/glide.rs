@@ -18,23 +18,24 @@
 //!
 //! (at `s = 1`: `r₀ + r₁ + r₂ = D`, `h′ = 3r₀ + 4r₁ + 5r₂ = v`,
 //! `−h″ = −(6r₀ + 12r₁ + 20r₂) = a`; from rest this is the profile above).
-//! Per frame: `s` in Q16 from a precomputed reciprocal and five rounded
-//! Q16 multiplies (Horner for the quadratic, then `· s` three times): within
-//! 2.5 m° of the polynomial whatever the distance, and the start and the end
-//! are exact.
+//! Times are µs on the frame path's clock (see `fixed.rs`), so a glide
+//! moves the same in time whatever the frame rate. Per frame: `s` in Q16
+//! from a precomputed reciprocal ([`Span`]) and five rounded Q16 multiplies
+//! (Horner for the quadratic, then `· s` three times): within 2.5 m° of the
+//! polynomial whatever the distance, and the start and the end are exact.
 
-use super::fixed::{MAX_FRAMES, ONE, inverse, mul, progress};
+use super::fixed::{ONE, Span, mul};
 
-/// Where a value is and how it moves, at one frame: the position and the
+/// Where a value is and how it moves, at one time: the position and the
 /// first two derivatives in units of the move it comes from (`dp/dτ`,
-/// `d²p/dτ²` over that move's `frames`).
+/// `d²p/dτ²` over that move's `len` µs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct State {
     /// The value (as the frame path computes it).
     pub(crate) pos: i32,
     slope: i64,
     curve: i64,
-    frames: u32,
+    len: u32,
 }
 
 impl State {
@@ -44,7 +45,7 @@ impl State {
             pos,
             slope: 0,
             curve: 0,
-            frames: 1,
+            len: 1,
         }
     }
 }
@@ -58,11 +59,10 @@ const FAR: i64 = 1 << 40;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(crate) struct Glide {
-    /// Frame of `τ = 0`.
+    /// Time of `τ = 0`, µs.
     pub(crate) start: u32,
-    /// `T` in frames; 0 once arrived.
-    frames: u32,
-    inverse: u32,
+    /// `T`; of length 0 once arrived.
+    span: Span,
     target: i32,
     r: [i32; 3],
 }
@@ -72,23 +72,22 @@ impl Glide {
     pub(crate) const fn rest(value: i32) -> Self {
         Self {
             start: 0,
-            frames: 0,
-            inverse: 0,
+            span: Span::ENDED,
             target: value,
             r: [0; 3],
         }
     }
 
-    /// A move from `from` at frame `start` to `target`, arriving `frames`
-    /// frames later (`2..=MAX_FRAMES`).
-    pub(crate) fn new(start: u32, from: State, target: i32, frames: u32) -> Self {
-        let frames = frames.clamp(2, MAX_FRAMES);
-        let (span, old) = (i64::from(frames), i64::from(from.frames.max(1)));
+    /// A move from `from` at time `start` to `target`, arriving `len` µs
+    /// later (within `2..=MAX_SPAN`).
+    pub(crate) fn new(start: u32, from: State, target: i32, len: u32) -> Self {
+        let span = Span::new(len);
+        let (len, old) = (i64::from(span.len()), i64::from(from.len.max(1)));
         let dist = i64::from(target) - i64::from(from.pos);
         // Velocity and acceleration in units of this move (saturating: a
         // coefficient past the bound is clamped anyway).
-        let vel = from.slope.saturating_mul(span) / old;
-        let acc = (from.curve.saturating_mul(span) / old).saturating_mul(span) / old;
+        let vel = from.slope.saturating_mul(len) / old;
+        let acc = (from.curve.saturating_mul(len) / old).saturating_mul(len) / old;
         // Far past the bound either way; below it the sums stay exact.
         let (vel, acc) = (vel.clamp(-FAR, FAR), acc.clamp(-FAR, FAR));
         let r = [
@@ -99,8 +98,7 @@ impl Glide {
         .map(|c| c.clamp(-BOUND, BOUND) as i32);
         Self {
             start,
-            frames,
-            inverse: inverse(frames),
+            span,
             target,
             r,
         }
@@ -114,8 +112,7 @@ impl Glide {
         let r = |k: i64| (k * d).clamp(-BOUND, BOUND) as i32;
         Self {
             start: self.start,
-            frames: self.frames,
-            inverse: self.inverse,
+            span: self.span,
             target: 0,
             r: [r(10), r(-15), r(6)],
         }
@@ -126,35 +123,35 @@ impl Glide {
         self.target
     }
 
-    /// The frame the move arrives at (meaningful while [`moving`](Self::moving)).
+    /// The time the move arrives at (meaningful while [`moving`](Self::moving)).
     pub(crate) const fn end(&self) -> u32 {
-        self.start.wrapping_add(self.frames)
+        self.start.wrapping_add(self.span.len())
     }
 
     /// Whether the move is still under way (as of the last [`at`](Self::at)).
     pub(crate) const fn moving(&self) -> bool {
-        self.frames != 0
+        self.span.len() != 0
     }
 
-    /// The value at frame `now` (not before `start`). Once arrived the glide
+    /// The value at time `now` (not before `start`). Once arrived the glide
     /// rests at its target for good.
     #[inline]
     pub(crate) fn at(&mut self, now: u32) -> i32 {
         let t = now.wrapping_sub(self.start);
-        if t >= self.frames {
-            self.frames = 0;
+        if t >= self.span.len() {
+            self.span = Span::ENDED;
             return self.target;
         }
         let [r0, r1, r2] = self.r;
         if t == 0 {
             return self.target - (r0 + r1 + r2);
         }
-        // 1 ≤ t < T: 0 < s < 1.
-        self.at_s(ONE - progress(t, self.inverse))
+        // 0 < t < T: 0 < s ≤ 1 (s = 1 only for t below the span's unit).
+        self.at_s(ONE - self.span.progress(t))
     }
 
     /// The values of three glides on one clock (the same start and
-    /// duration, as the gaze's axes and its envelope always are) at frame
+    /// duration, as the gaze's axes and its envelope always are) at time
     /// `now`, each as [`at`](Self::at) gives it: `s` is worked out once,
     /// and a third glide that holds its value (the gaze's envelope from
     /// one look to the next) costs nothing.
@@ -162,22 +159,22 @@ impl Glide {
     pub(crate) fn trio_at(trio: &mut [Self; 3], now: u32) -> [i32; 3] {
         let [one, two, three] = trio;
         debug_assert!(
-            one.start == three.start && one.frames == three.frames,
+            one.start == three.start && one.span == three.span,
             "not on one clock"
         );
-        if one.start != two.start || one.frames != two.frames {
+        if one.start != two.start || one.span != two.span {
             return [one.at(now), two.at(now), three.at(now)];
         }
         let t = now.wrapping_sub(one.start);
-        if t >= one.frames {
-            (one.frames, two.frames, three.frames) = (0, 0, 0);
+        if t >= one.span.len() {
+            (one.span, two.span, three.span) = (Span::ENDED, Span::ENDED, Span::ENDED);
             return [one.target, two.target, three.target];
         }
         if t == 0 {
             return [one.at(now), two.at(now), three.at(now)];
         }
-        // The same frames, the same reciprocal.
-        let s = ONE - progress(t, one.inverse);
+        // The same span, the same reciprocal.
+        let s = ONE - one.span.progress(t);
         let [r0, r1, r2] = three.r;
         let held = if r0 == 0 && r1 == 0 && r2 == 0 {
             three.target
@@ -187,7 +184,7 @@ impl Glide {
         [one.at_s(s), two.at_s(s), held]
     }
 
-    /// The value at `s = 1 − τ` (Q16, `0 < s < 1`). Each multiply rounds to
+    /// The value at `s = 1 − τ` (Q16, `0 < s ≤ 1`). Each multiply rounds to
     /// the unit: the value is within 2.5 units of the exact polynomial at
     /// this `s`.
     #[inline]
@@ -197,17 +194,17 @@ impl Glide {
         self.target - mul(mul(mul(q, s), s), s)
     }
 
-    /// The state at frame `now`: the position exactly as [`at`](Self::at)
+    /// The state at time `now`: the position exactly as [`at`](Self::at)
     /// gives it, velocity and acceleration from the derivatives (for a new
     /// move to start from).
     pub(crate) fn state(&self, now: u32) -> State {
         let mut copy = *self;
         let pos = copy.at(now);
         let t = now.wrapping_sub(self.start);
-        if t >= self.frames {
+        if t >= self.span.len() {
             return State::rest(pos);
         }
-        let s = i64::from(ONE - progress(t, self.inverse));
+        let s = i64::from(ONE - self.span.progress(t));
         let [r0, r1, r2] = self.r.map(i64::from);
         // Horner in Q16 steps (|r| ≤ 2²⁹: every product below 2⁵²):
         // h′(s) = s²·(3r₀ + s·(4r₁ + s·5r₂)), h″(s) = s·(6r₀ + s·(12r₁ + s·20r₂)).
@@ -218,7 +215,7 @@ impl Glide {
             pos,
             slope,
             curve,
-            frames: self.frames,
+            len: self.span.len(),
         }
     }
 }

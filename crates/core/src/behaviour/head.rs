@@ -23,9 +23,9 @@ use embedded_hal::pwm::SetDutyCycle;
 
 use crate::axis::Axis;
 use crate::command::Action;
-use crate::driver::{ConfigError, FrameDriver, FrameReport};
+use crate::driver::{ConfigError, FrameDriver, FrameReport, RateError};
 use crate::servo::ServoCalibration;
-use crate::units::Angle;
+use crate::units::{Angle, Microseconds, Timestamp};
 
 use super::config::LiveConfig;
 use super::error::BehaviourError;
@@ -161,6 +161,27 @@ impl<I: IdleSource> Head<I> {
         Ok(())
     }
 
+    /// Between frames: the frames come `period` apart from the next one on
+    /// (`servo rate`: the second step, after the frame that
+    /// [`FrameDriver::set_pwm_period`] came before; see the driver's
+    /// `frame/rate.rs`). The driver's per-frame limits, speed and fade, the
+    /// mixer's clock and its limit modes' rates, and the idle source's step
+    /// take the new period; everything else is timed in µs and goes on as
+    /// it was: the same motion, sampled at the new rate.
+    ///
+    /// # Errors
+    /// The [`RateError`] the driver refused it with; nothing changes then.
+    pub fn set_frame_period<P: SetDutyCycle>(
+        &mut self,
+        driver: &mut FrameDriver<P>,
+        period: Microseconds,
+    ) -> Result<(), RateError> {
+        driver.set_frame_period(period)?;
+        self.mixer.set_frame_period(period);
+        self.idle.set_frame_period(period);
+        Ok(())
+    }
+
     /// Between frames: gives the driver the limits of the modes the mixer
     /// asks for from the next frame on (see the [module docs](self)), stops
     /// or brings back the pulses as the rest asks (relaxed at the rest
@@ -223,19 +244,23 @@ impl<I: IdleSource> Head<I> {
         count
     }
 
-    /// Plays frame `frame`: idle offsets, mixed, through `driver` (which
-    /// starts with neutral pulses on its first frame).
-    pub fn frame<P: SetDutyCycle>(&mut self, driver: &mut FrameDriver<P>, frame: u64) -> HeadFrame {
-        let idle = self.idle.offsets(frame);
-        let mut offsets = self.mixer.frame(frame, idle);
-        self.show.blend(frame as u32, &mut offsets);
+    /// Plays the frame at `at`: idle offsets, mixed, through `driver`
+    /// (which starts with neutral pulses on its first frame).
+    pub fn frame<P: SetDutyCycle>(
+        &mut self,
+        driver: &mut FrameDriver<P>,
+        at: Timestamp,
+    ) -> HeadFrame {
+        let idle = self.idle.offsets(at);
+        let mut offsets = self.mixer.frame(at, idle);
+        self.show.blend(at.wrapping(), &mut offsets);
         HeadFrame {
             offsets,
             report: driver.write_frame(offsets),
         }
     }
 
-    /// Between frames, before frame `frame`: the show layer's inputs (see
+    /// Between frames, before the frame at `at`: the show layer's inputs (see
     /// [`show`](super::show)): the DMX link's state and latest cue (`None`
     /// on a board without DMX) and Bottango's curves as sampled for this
     /// frame (`None` without a session). A gesture the DMX trigger fires
@@ -244,11 +269,11 @@ impl<I: IdleSource> Head<I> {
     pub fn show<P: SetDutyCycle>(
         &mut self,
         driver: &mut FrameDriver<P>,
-        frame: u64,
+        at: Timestamp,
         dmx: Option<(bool, Latest)>,
         curves: Option<Sample>,
     ) -> ShowEvents {
-        let now = frame as u32;
+        let now = at.wrapping();
         self.show
             .bottango(now, curves, self.mixer.params().neutral_pose());
         let mut events = ShowEvents::default();
@@ -268,19 +293,20 @@ impl<I: IdleSource> Head<I> {
         events
     }
 
-    /// Between frames, before frame `frame`: the tracker's `sighting`
+    /// Between frames, before the frame at `at`: the tracker's `sighting`
     /// that came since the last frame (if any), with `settings` (see
     /// [`tracker`](super::tracker)); what it did, for the log. Cheap when
     /// nothing came and nothing is due.
     pub fn track<P: SetDutyCycle>(
         &mut self,
         driver: &mut FrameDriver<P>,
-        frame: u64,
+        at: Timestamp,
         settings: &TrackSettings,
         sighting: Option<&Sighting>,
     ) -> Option<TrackEvent> {
-        let now = frame.saturating_mul(u64::from(self.mixer.params().frame_us()));
-        let event = self.tracker.step(&mut self.mixer, now, settings, sighting);
+        let event = self
+            .tracker
+            .step(&mut self.mixer, at.micros(), settings, sighting);
         if event.is_some() || sighting.is_some() {
             self.sync(driver);
         }

@@ -20,13 +20,17 @@
 //!   gesture takes a free layer and every older one fades out under it
 //!   along `1 − S(t/blend)` (a smootherstep, C2), still playing: never a jump.
 //!
+//! Times are µs on the frame path's clock (`fixed.rs`): a frame is mixed
+//! at its [`Timestamp`], and every layer moves the same in time whatever
+//! the frame rate.
+//!
 //! The mixer also says which limit mode each axis needs from the next frame
 //! on ([`Mixer::modes`]: [`LimitMode::Gesture`] while a gesture or a gaze
 //! move plays on it and for `settle` after; a rest or a wake keeps to the
 //! idle limits).
 
 use crate::command::{Action, LookRequest, Percent};
-use crate::units::{Angle, AngleRange, Millis};
+use crate::units::{Angle, AngleRange, Microseconds, Millis, Timestamp};
 
 use super::rest::RestState;
 
@@ -91,10 +95,14 @@ impl BehaviourParams {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(C)]
 pub struct Mixer {
-    /// The last frame mixed, and the frame actions start at.
+    /// The time of the last frame mixed, and of the next frame (at which
+    /// actions start), µs.
     now: u32,
     next: u32,
-    /// The first frame that must be mixed in full: nothing but the values
+    /// The frame period, µs (the parameters'), kept where it is cheap to
+    /// reach.
+    period: u32,
+    /// The first time that must be mixed in full: nothing but the values
     /// changes before it (no layer or move starts or ends, no return is
     /// due, no settle time runs out).
     until: u32,
@@ -116,13 +124,13 @@ pub struct Mixer {
     /// The limit modes from the next frame on.
     modes: [LimitMode; 3],
     idle_amp: Percent,
-    /// The last frame mixed in full.
+    /// The time of the last frame mixed in full.
     full: u32,
-    /// The next frame at which a layer or a gaze move ends, a return is due
+    /// The next time at which a layer or a gaze move ends, a return is due
     /// or starts, or the idle gain's glide ends, as last found (see
     /// `schedule`); events in between are settle times running out.
     ends: u32,
-    /// Frames each axis stays in gesture mode after it was last on, as of
+    /// µs each axis stays in gesture mode after it was last on, as of
     /// the last frame mixed in full (see [`Mixer::events`]).
     gesture_left: [u32; 3],
     /// Idle gain, Q16.
@@ -162,7 +170,25 @@ impl Mixer {
             rest: Rest::new(),
             now: 0,
             next: 0,
+            period: params.frame_us(),
         }
+    }
+
+    /// Plays frames `period` apart after the last one mixed (see
+    /// [`BehaviourParams::set_frame_period`]): the next frame comes
+    /// `period` after it.
+    pub(crate) fn set_frame_period(&mut self, period: Microseconds) {
+        if period.0 == 0 {
+            return;
+        }
+        self.params.set_frame_period(period);
+        self.period = period.0;
+        self.next = self.now.wrapping_add(period.0);
+        // The next frame is mixed in full, and finds the events again (a
+        // return is prepared one period before it starts).
+        self.quiet = false;
+        self.until = self.next;
+        self.ends = self.next;
     }
 
     /// The parameters in use.
@@ -255,7 +281,7 @@ impl Mixer {
         Ok(applied)
     }
 
-    /// Starts a rest at frame `start` of a head at `at` (offsets, m°): the
+    /// Starts a rest at time `start` of a head at `at` (offsets, m°): the
     /// pose's weight rises, and the gaze, hidden under it, goes back to the
     /// centre (a wake starts from there); returns the rest's duration.
     fn start_rest(&mut self, start: u32, at: [i32; 3]) -> Millis {
@@ -294,7 +320,7 @@ impl Mixer {
             && self.rest.arrived()
     }
 
-    /// A look starts at frame `start`.
+    /// A look starts at time `start` (µs).
     fn look(&mut self, start: u32, request: &LookRequest) -> Result<Applied, BehaviourError> {
         let applied = self.gaze.look(&self.params, start, request)?;
         self.gazing();
@@ -322,18 +348,18 @@ impl Mixer {
         target
     }
 
-    /// The offsets of frame `frame` for the driver, `[pitch, roll, yaw]`,
-    /// over `idle` (the idle source's offsets of that frame).
+    /// The offsets of the frame at `at` for the driver, `[pitch, roll,
+    /// yaw]`, over `idle` (the idle source's offsets of that frame).
     #[inline]
-    pub fn frame(&mut self, frame: u64, idle: [Angle; 3]) -> [Angle; 3] {
-        let now = frame as u32;
+    pub fn frame(&mut self, at: Timestamp, idle: [Angle; 3]) -> [Angle; 3] {
+        let now = at.wrapping();
         if !self.quiet {
             return self.mix(now, idle);
         }
         // Nothing moves but the idle: at its quiet gains, around the quiet
         // centre (within the limits: no overflow).
         self.now = now;
-        self.next = now.wrapping_add(1);
+        self.next = now.wrapping_add(self.period);
         let [pitch, roll, yaw] = idle.map(Angle::millidegrees);
         let [centre_pitch, centre_yaw] = self.quiet_centre;
         let [pitch, roll, yaw] = if self.quiet_unity {
@@ -356,7 +382,7 @@ impl Mixer {
     fn mix(&mut self, now: u32, idle: [Angle; 3]) -> [Angle; 3] {
         let prev = self.now;
         self.now = now;
-        self.next = now.wrapping_add(1);
+        self.next = now.wrapping_add(self.period);
         let sums = self.layers(now);
 
         let [centre_pitch, centre_yaw, envelope] = self.gaze.at(now);
@@ -379,7 +405,7 @@ impl Mixer {
             [pitch, roll, yaw]
         };
         let offsets = [pitch + sums.add[0], roll + sums.add[1], yaw + sums.add[2]];
-        // `now < until` (frames only increase).
+        // `now < until` (times only increase).
         if self.until.wrapping_sub(now) as i32 <= 0 {
             self.events(
                 now,
@@ -396,11 +422,11 @@ impl Mixer {
     /// whether the mixer comes to rest, and the next such frame.
     ///
     /// The modes: gesture while anything plays on the axis (or the return
-    /// starts next frame) and `settle` frames after. An axis' state can only
+    /// starts next frame) and `settle` after. An axis' state can only
     /// change at an *event*: a layer or a gaze move ends, the return is due
     /// or starts, the idle gain's glide ends, a settle time runs out, or an
     /// action is applied. Between two events each axis stays on or off, so
-    /// its frames left in gesture mode follow from the frames passed: this
+    /// its time left in gesture mode follows from the time passed: this
     /// gives the modes of every frame exactly as counting them down frame by
     /// frame would.
     ///
@@ -418,7 +444,7 @@ impl Mixer {
         let returning = self.gaze.returns_by(self.next);
         let on = active | u8::from(moving[0]) | (u8::from(moving[1]) << 2);
         let settle = self.params.settle;
-        // Frames since the last frame mixed, and since the last mixed in full.
+        // Time since the last frame mixed, and since the last mixed in full.
         let since_prev = now.wrapping_sub(prev).max(1);
         let since_full = now.wrapping_sub(self.full).max(1);
         let was_on = self.on;
@@ -456,13 +482,13 @@ impl Mixer {
         }
         soonest = soonest.min(self.ends.wrapping_sub(now));
         // Every event lies ahead (at least the next frame); at rest, or
-        // nothing due for 2³⁰ frames (about 8 months), the next frame mixed
-        // in full is the first after an action or 2³⁰ frames on.
+        // nothing due for 2³⁰ µs (about 18 minutes), the next frame mixed
+        // in full is the first after an action or 2³⁰ µs on.
         self.full = now;
         self.until = now.wrapping_add(soonest.clamp(1, 1 << 30));
     }
 
-    /// Finds the next frame after `from` at which a layer or a gaze move
+    /// Finds the next time after `from` at which a layer or a gaze move
     /// ends, the return is due next frame or starts, or the idle gain's
     /// glide ends (`from + 2³⁰` if none). What ends at `from` or before is
     /// left to the frame mixed in full at `from` (an action's next frame,
@@ -473,7 +499,7 @@ impl Mixer {
         for layer in self.layers.iter().flatten() {
             soonest = soonest.min(ahead(layer.end(), from));
         }
-        soonest = soonest.min(self.gaze.next_event(from));
+        soonest = soonest.min(self.gaze.next_event(from, self.period));
         if self.resting {
             soonest = soonest.min(self.rest.next_event(from));
         }

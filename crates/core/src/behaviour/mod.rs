@@ -37,15 +37,17 @@
 //! use idle_head_core::behaviour::{BehaviourConfig, Mixer};
 //! use idle_head_core::command::{Action, GestureKind, GestureRequest};
 //! use idle_head_core::driver::DriverConfig;
-//! use idle_head_core::Angle;
+//! use idle_head_core::{Angle, Timestamp};
 //!
 //! let driver = DriverConfig::DEFAULT.build().unwrap();
 //! let mut mixer = Mixer::new(BehaviourConfig::DEFAULT.build(&driver).unwrap());
 //! mixer.apply(&Action::Gesture(GestureRequest::new(GestureKind::Nod))).unwrap();
-//! // The default nod: 2 cycles at 2.5 Hz in 800 ms; its first dip peaks at frame 10 at
-//! // 6.3° (6° × 1.05: a default amplitude rises with the number of cycles).
+//! // The default nod: 2 cycles at 2.5 Hz in 800 ms; its first dip peaks at 200 ms
+//! // (frame 10 at 50 Hz) at 6.3° (6° × 1.05: a default amplitude rises with the
+//! // number of cycles).
+//! let frame = |k: u64| Timestamp(k * 20_000);
 //! let pitch: Vec<i32> = (0..45)
-//!     .map(|k| mixer.frame(k, [Angle::ZERO; 3])[0].millidegrees())
+//!     .map(|k| mixer.frame(frame(k), [Angle::ZERO; 3])[0].millidegrees())
 //!     .collect();
 //! assert_eq!(pitch[0], 0);
 //! assert_eq!(pitch[10], 6300);

@@ -4,10 +4,10 @@
 
 use crate::axis::Axis;
 use crate::driver::{MotionLimits, SlewRates};
-use crate::units::{Angle, AngleRange, Millis, Percent};
+use crate::units::{Angle, AngleRange, Microseconds, Millis, Percent};
 
 use super::config::{BehaviourConfig, LiveConfig};
-use super::fixed::ONE;
+use super::fixed::{MAX_SPAN, ONE, Span};
 
 /// The offsets `limits` leave around `pose`.
 pub(super) const fn room_around(limits: AngleRange, pose: Angle) -> AngleRange {
@@ -25,17 +25,18 @@ pub(super) const fn room_around(limits: AngleRange, pose: Angle) -> AngleRange {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[repr(C)]
 pub struct BehaviourParams {
-    /// Frames of a gesture's fade-out under a newer one, and its reciprocal.
-    pub(crate) blend: u32,
-    pub(crate) blend_inverse: u32,
+    /// A gesture's fade-out under a newer one.
+    pub(crate) blend: Span,
     /// Idle duck depth, Q16.
     pub(crate) duck: u32,
     /// The idle's duck on the look's axes while a look holds, Q16.
     pub(crate) look_duck: u32,
-    /// Frames in gesture mode after the motion.
+    /// Time in gesture mode after the motion, µs.
     pub(crate) settle: u32,
-    /// Frames of an idle change.
+    /// Time of an idle change, µs.
     pub(crate) idle_fade: u32,
+    /// The frame period, µs: the step of the frame path's clock, and the
+    /// period of the per-frame `rates`.
     pub(super) frame_us: u32,
     /// The driver's neutral pose.
     pub(super) pose: [Angle; 3],
@@ -44,8 +45,10 @@ pub struct BehaviourParams {
     /// The driver's configured limits: the idle mode.
     pub(super) idle_limits: [MotionLimits; 3],
     /// The per-frame rates of both modes' limits (`[idle, gesture]` per
-    /// axis) at `frame_us`, computed here so that a switch between the modes
-    /// divides nothing (`None`: the driver refuses those limits).
+    /// axis) at `frame_us`, computed here (and again when the frame rate
+    /// changes, [`set_frame_period`](Self::set_frame_period)) so that a
+    /// switch between the modes divides nothing (`None`: the driver refuses
+    /// those limits).
     pub(super) rates: [[Option<SlewRates>; 2]; 3],
     pub(super) config: BehaviourConfig,
 }
@@ -79,6 +82,19 @@ impl BehaviourParams {
     #[must_use]
     pub const fn frame_us(&self) -> u32 {
         self.frame_us
+    }
+
+    /// Plays frames `period` apart from now on (`servo rate`): the step of
+    /// the clock and the per-frame rates of both limit modes (the
+    /// durations are in µs and stay). The driver takes the same period
+    /// ([`FrameDriver::set_frame_period`](crate::driver::FrameDriver::set_frame_period)).
+    pub fn set_frame_period(&mut self, period: Microseconds) {
+        if period.0 == 0 {
+            return;
+        }
+        self.frame_us = period.0;
+        self.rates =
+            super::validate::mode_rates(&self.idle_limits, &self.config.gesture_limits, period);
     }
 
     /// The driver's neutral pose, `[pitch, roll, yaw]`: the gaze's centre.
@@ -153,29 +169,25 @@ impl BehaviourParams {
         self.rates[axis.index()][mode as usize]
     }
 
-    /// Whole frames in `duration` (rounded, at least 1).
+    /// `duration` in µs on the frame path's clock (at least 1, saturating).
     #[must_use]
-    pub const fn frames(&self, duration: Millis) -> u32 {
-        let frame_us = if self.frame_us == 0 {
+    pub const fn micros(duration: Millis) -> u32 {
+        let us = duration.0 as u64 * 1000;
+        if us == 0 {
             1
-        } else {
-            self.frame_us as u64
-        };
-        let frames = (duration.0 as u64 * 1000 + frame_us / 2) / frame_us;
-        if frames == 0 {
-            1
-        } else if frames > u32::MAX as u64 {
+        } else if us > u32::MAX as u64 {
             u32::MAX
         } else {
-            frames as u32
+            us as u32
         }
     }
 
-    /// Whole frames of a move of `distance` m° that takes at least `ms`,
-    /// lengthened until its minimum-jerk profile fits `speed` °/s and
-    /// `accel` °/s² (it peaks at `1.875·D/T` and `5.774·D/T²`); rounded up,
-    /// at least 2: never faster than the limits allow.
-    pub(crate) fn move_frames(&self, ms: u64, distance: u32, speed: u32, accel: u32) -> u32 {
+    /// The duration in µs of a move of `distance` m° that takes at least
+    /// `ms`, lengthened to whole ms until its minimum-jerk profile fits
+    /// `speed` °/s and `accel` °/s² (it peaks at `1.875·D/T` and
+    /// `5.774·D/T²`): never faster than the limits allow (but at most
+    /// `MAX_SPAN`).
+    pub(crate) fn move_us(ms: u64, distance: u32, speed: u32, accel: u32) -> u32 {
         let d = u64::from(distance);
         let (speed, accel) = (u64::from(speed.max(1)), u64::from(accel.max(1)));
         // T ≥ 1.875·D/v and T² ≥ 5.774·D/a (D in m°, T in ms).
@@ -188,16 +200,15 @@ impl BehaviourParams {
             } else {
                 root
             });
-        let frame_us = u64::from(self.frame_us.max(1));
-        u32::try_from((ms * 1000).div_ceil(frame_us))
-            .unwrap_or(u32::MAX)
+        u32::try_from(ms.saturating_mul(1000).min(u64::from(MAX_SPAN)))
+            .unwrap_or(MAX_SPAN)
             .max(2)
     }
 
-    /// The duration of `frames` frames, rounded to ms.
+    /// `us` µs, rounded to ms.
     #[must_use]
-    pub const fn millis(&self, frames: u32) -> Millis {
-        Millis(((frames as u64 * self.frame_us as u64 + 500) / 1000) as u32)
+    pub const fn millis(us: u32) -> Millis {
+        Millis(((us as u64 + 500) / 1000) as u32)
     }
 }
 

@@ -120,7 +120,7 @@ impl Rest {
         self.arrived
     }
 
-    /// Starts (or redirects) a rest at frame `next` towards `pose`
+    /// Starts (or redirects) a rest at time `next` towards `pose`
     /// (offsets around the neutral pose), from the head at `at` (the
     /// offsets of the last frame, when awake); returns its duration.
     pub(crate) fn rest(
@@ -135,29 +135,29 @@ impl Rest {
         if resting && self.pose.iter().zip(pose).all(|(g, p)| g.target() == p) {
             // There already (0), or on the way.
             let left = self.next_event(next);
-            return params.millis(if left == u32::MAX { 0 } else { left });
+            return BehaviourParams::millis(if left == u32::MAX { 0 } else { left });
         }
-        let frames = if self.active() {
+        let us = if self.active() {
             // The pose glides to the new one as the weight goes on rising
             // (or turns round): each part fits the limits on its own.
             let from: [State; 3] = core::array::from_fn(|i| self.pose[i].state(next));
             let shift = far(from.map(|s| s.pos), pose, 0);
-            let frames = fit(params, REST_TIME, shift.max(far(pose, self.base, DRIFT)));
-            self.pose = core::array::from_fn(|i| Glide::new(next, from[i], pose[i], frames));
-            frames
+            let us = fit(params, REST_TIME, shift.max(far(pose, self.base, DRIFT)));
+            self.pose = core::array::from_fn(|i| Glide::new(next, from[i], pose[i], us));
+            us
         } else {
             // The blend starts from the head as it is.
             self.base = at;
             self.pose = pose.map(Glide::rest);
             fit(params, REST_TIME, far(pose, at, DRIFT))
         };
-        self.weight = Glide::new(next, weight, ONE as i32, frames);
+        self.weight = Glide::new(next, weight, ONE as i32, us);
         self.state = RestState::Resting;
         self.arrived = false;
-        params.millis(frames)
+        BehaviourParams::millis(us)
     }
 
-    /// Starts a wake at frame `next` (if resting); once awake the head
+    /// Starts a wake at time `next` (if resting); once awake the head
     /// glances towards `glance`, if given. Returns the wake's duration
     /// (`None` if the head was awake).
     pub(crate) fn wake(
@@ -173,17 +173,19 @@ impl Rest {
             self.glance = glance;
         }
         if self.state == RestState::Waking {
-            return Some(params.millis(self.weight.end().wrapping_sub(next)));
+            return Some(BehaviourParams::millis(
+                self.weight.end().wrapping_sub(next),
+            ));
         }
         let pose = self.pose.map(|g| g.target());
-        let frames = fit(params, WAKE_TIME, far(pose, self.base, DRIFT));
-        self.weight = Glide::new(next, self.weight.state(next), 0, frames);
+        let us = fit(params, WAKE_TIME, far(pose, self.base, DRIFT));
+        self.weight = Glide::new(next, self.weight.state(next), 0, us);
         self.state = RestState::Waking;
         self.arrived = false;
-        Some(params.millis(frames))
+        Some(BehaviourParams::millis(us))
     }
 
-    /// Frame `now`'s offsets over `base` (idle and gaze): the blend. (Out
+    /// The offsets at time `now` over `base` (idle and gaze): the blend. (Out
     /// of line: it plays only while resting or waking, and the frames of a
     /// head awake should not carry its registers.)
     #[inline(never)]
@@ -201,7 +203,7 @@ impl Rest {
         core::array::from_fn(|i| base[i] + mul_signed(pose[i] - base[i], w))
     }
 
-    /// At a frame mixed in full: the state after frame `now`. Returns the
+    /// At a frame mixed in full: the state after it. Returns the
     /// glance to start, once a wake has ended.
     pub(crate) fn settle(&mut self) -> Option<Angle> {
         let moving = self.weight.moving() || self.pose.iter().any(Glide::moving);
@@ -218,8 +220,8 @@ impl Rest {
         }
     }
 
-    /// Frames from `from` to the next frame after it at which a glide of
-    /// the blend ends (`u32::MAX`: none).
+    /// µs from `from` to the next time after it at which a glide of the
+    /// blend ends (`u32::MAX`: none).
     pub(crate) fn next_event(&self, from: u32) -> u32 {
         let mut soonest = u32::MAX;
         if self.weight.moving() {
@@ -262,15 +264,15 @@ fn far(a: [i32; 3], b: [i32; 3], extra: u32) -> u32 {
     d.saturating_add(extra)
 }
 
-/// Frames of a blend over `distance` m°: at least `least`, and long enough
-/// for the idle limits of every axis (see the [module docs](self#how-long)).
+/// µs of a blend over `distance` m°: at least `least`, and long enough for
+/// the idle limits of every axis (see the [module docs](self#how-long)).
 fn fit(params: &BehaviourParams, least: Millis, distance: u32) -> u32 {
-    let mut frames = 2;
+    let mut us = 2;
     for axis in crate::axis::Axis::ALL {
         let limits = params.limits(axis, LimitMode::Idle);
         let speed = limits.max_speed.0.saturating_sub(IDLE_SPEED);
-        let fit = params.move_frames(least.0.into(), distance, speed, limits.max_accel.0 / 2);
-        frames = frames.max(fit);
+        let fit = BehaviourParams::move_us(least.0.into(), distance, speed, limits.max_accel.0 / 2);
+        us = us.max(fit);
     }
-    frames
+    us
 }

@@ -128,7 +128,7 @@ pub(crate) struct Show {
     /// The hand-back: `w` gliding to 0.
     handback: Option<Glide>,
     source: Source,
-    /// The last DMX cue's number, and the frame it came at.
+    /// The last DMX cue's number, and the time it came at (µs).
     seq: u32,
     cue_at: u32,
     signal: Signal,
@@ -138,9 +138,9 @@ pub(crate) struct Show {
     /// own to give back.
     dmx_amp: Option<Percent>,
     own_amp: Percent,
-    /// [`LOSS`] and [`HANDBACK`] in frames.
+    /// [`LOSS`] and [`HANDBACK`] in µs.
     loss: u32,
-    handback_frames: u32,
+    handback_us: u32,
 }
 
 impl Show {
@@ -158,8 +158,8 @@ impl Show {
             band: None,
             dmx_amp: None,
             own_amp: params.config().idle.amplitude,
-            loss: params.frames(LOSS),
-            handback_frames: params.frames(HANDBACK),
+            loss: BehaviourParams::micros(LOSS),
+            handback_us: BehaviourParams::micros(HANDBACK),
         }
     }
 
@@ -173,7 +173,7 @@ impl Show {
         self.axes
     }
 
-    /// Frame `now`'s offsets: the mixer's, `offsets`, blended with the
+    /// The offsets at time `now`: the mixer's, `offsets`, blended with the
     /// show's pose in place.
     #[inline]
     pub(crate) fn blend(&mut self, now: u32, offsets: &mut [Angle; 3]) {
@@ -209,7 +209,7 @@ impl Show {
         }
     }
 
-    /// Between frames, before frame `now`: hands back from the current
+    /// Between frames, before the frame at `now`: hands back from the current
     /// `w` (no change if already handing back or off).
     fn release(&mut self, now: u32) {
         if self.axes == 0 || self.handback.is_some() {
@@ -224,11 +224,11 @@ impl Show {
             now,
             State::rest(self.weight as i32),
             0,
-            self.handback_frames,
+            self.handback_us,
         ));
     }
 
-    /// Between frames, before frame `now`: Bottango's curves as sampled for
+    /// Between frames, before the frame at `now`: Bottango's curves as sampled for
     /// it. While they play they drive the axes they have.
     pub(crate) fn bottango(&mut self, now: u32, sample: Option<Sample>, neutral: [Angle; 3]) {
         match sample {
@@ -253,7 +253,7 @@ impl Show {
         }
     }
 
-    /// Between frames, before frame `now`: the DMX link's state (`on`, and
+    /// Between frames, before the frame at `now`: the DMX link's state (`on`, and
     /// its latest cue), the mixer's idle amplitude `amp`; `room` is each
     /// axis' offsets around the neutral pose.
     pub(crate) fn dmx(

@@ -13,11 +13,11 @@ use crate::axis::Axis;
 use crate::command::{GestureRequest, Hold};
 use crate::driver::{DriverParams, MotionLimits, SlewRates, slew_rates};
 use crate::gestures::{GestureKind, MAX_CYCLES};
-use crate::units::{Angle, AngleRange, Percent};
+use crate::units::{Angle, AngleRange, Microseconds, Percent};
 
 use super::config::{BehaviourConfig, MAX_HOLD};
 use super::error::BehaviourError;
-use super::fixed::{MAX_FRAMES, inverse};
+use super::fixed::{MAX_SPAN, Span};
 use super::gesture;
 use super::params::{BehaviourParams, q16, room_around};
 
@@ -119,8 +119,8 @@ impl BehaviourConfig {
         let frame_us = cfg.frame_period.0;
         // Frame rate in mHz: at least 8 frames per cycle at the cap.
         let top_mhz = (1_000_000_000 / frame_us as u64 / 8) as i64;
-        // Every timed move fits the frame path's reciprocals.
-        let most_ms = MAX_FRAMES as i64 * frame_us as i64 / 1000;
+        // Every timed move fits the frame path's clock.
+        let most_ms = MAX_SPAN as i64 / 1000;
         check!("max_frequency", "mHz", self.max_frequency.0, 500, top_mhz);
         check!(
             "longest_gesture",
@@ -174,25 +174,19 @@ impl BehaviourConfig {
             i += 1;
         }
 
-        let mut params = BehaviourParams {
+        let params = BehaviourParams {
             config: *self,
             frame_us,
             room,
             idle_limits: cfg.motion,
-            rates: [[None; 2]; 3],
-            blend: 0,
-            blend_inverse: 0,
-            settle: 0,
-            idle_fade: 0,
+            rates: mode_rates(&cfg.motion, &self.gesture_limits, cfg.frame_period),
+            blend: Span::new(BehaviourParams::micros(self.blend)),
+            settle: BehaviourParams::micros(self.settle),
+            idle_fade: BehaviourParams::micros(self.idle.fade),
             duck: q16(self.idle.duck),
             look_duck: q16(self.gaze.duck),
             pose: cfg.neutral_pose,
         };
-        params.rates = mode_rates(cfg, &self.gesture_limits);
-        params.blend = params.frames(self.blend);
-        params.blend_inverse = inverse(params.blend);
-        params.settle = params.frames(self.settle);
-        params.idle_fade = params.frames(self.idle.fade);
 
         // Each gesture's defaults, at both ends of the intensity range.
         let mut k = 0;
@@ -227,18 +221,18 @@ const _: () = match crate::driver::DriverConfig::DEFAULT.build() {
 };
 
 /// The per-frame rates of both modes' limits, `[idle, gesture]` per axis,
-/// at the driver's frame period (`None` where the driver refuses them).
-const fn mode_rates(
-    cfg: &crate::driver::DriverConfig,
+/// at the frame period `period` (`None` where the driver refuses them).
+pub(super) const fn mode_rates(
+    idle: &[MotionLimits; 3],
     gesture: &[MotionLimits; 3],
+    period: Microseconds,
 ) -> [[Option<SlewRates>; 2]; 3] {
     let mut rates = [[None; 2]; 3];
     let mut i = 0;
     while i < 3 {
         let axis = Axis::ALL[i];
-        let period = cfg.frame_period;
         rates[i] = [
-            match slew_rates(axis, cfg.motion[i], period) {
+            match slew_rates(axis, idle[i], period) {
                 Ok(r) => Some(r),
                 Err(_) => None,
             },

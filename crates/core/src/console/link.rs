@@ -1,6 +1,7 @@
 //! What the console task and the frame task share, besides the command
-//! queue: the head's status (frame task → console), servo calibrations
-//! and the live behaviour settings to apply (console → frame task), new
+//! queue: the head's status (frame task → console), servo calibrations,
+//! the servos' rate and the live behaviour settings to apply (console →
+//! frame task), new
 //! idle seeds (console → loop generator), the outcome of each port's
 //! queued action (frame task → the port's console, which answers the line
 //! with it), each port's telemetry rate (`watch`), and the trigger inputs'
@@ -22,9 +23,9 @@ use crate::behaviour::{Applied, Asker, BehaviourError, LiveConfig};
 use crate::driver::{DriverStats, FrameReport};
 use crate::input::{InputSettings, InputStatus};
 use crate::ring::Ring;
-use crate::servo::ServoCalibration;
+use crate::servo::{ServoCalibration, ServoRate};
 use crate::track::TrackView;
-use crate::units::{Angle, Microseconds};
+use crate::units::{Angle, Microseconds, Timestamp};
 
 /// What the driver is doing.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -66,6 +67,9 @@ impl HeadMode {
 pub struct HeadStatus {
     /// The driver's frame count.
     pub frame: u64,
+    /// The last frame's time since the first frame (whatever the frame
+    /// rate was meanwhile).
+    pub time: Timestamp,
     /// What the driver is doing.
     pub mode: HeadMode,
     /// Commanded angles `[pitch, roll, yaw]`.
@@ -101,11 +105,12 @@ impl HeadMode {
 }
 
 impl HeadStatus {
-    /// The status after a frame that wrote `report`.
+    /// The status after the frame at `time` that wrote `report`.
     #[must_use]
-    pub fn of(report: &FrameReport, stats: &DriverStats, mode: HeadMode) -> Self {
+    pub fn of(report: &FrameReport, stats: &DriverStats, mode: HeadMode, time: Timestamp) -> Self {
         Self {
             frame: report.frame,
+            time,
             mode,
             angles: report.servos.map(|s| s.angle),
             pulses: report.servos.map(|s| s.pulse),
@@ -115,11 +120,10 @@ impl HeadStatus {
         }
     }
 
-    /// Time since the first frame, ms, for frames of `frame_us` µs
-    /// (saturating: never wraps to a small uptime).
+    /// Time since the first frame, ms.
     #[must_use]
-    pub fn uptime_ms(&self, frame_us: u32) -> u64 {
-        self.frame.saturating_mul(u64::from(frame_us)) / 1000
+    pub const fn uptime_ms(&self) -> u64 {
+        self.time.millis()
     }
 }
 
@@ -154,6 +158,8 @@ pub struct ConsoleLink {
     /// Telemetry lines a second per port (0: off).
     watch: Mutex<CriticalSectionRawMutex, Cell<[u8; PORTS]>>,
     live: Signal<CriticalSectionRawMutex, LiveConfig>,
+    /// The servos' rate to take (`servo rate`).
+    rate: Signal<CriticalSectionRawMutex, ServoRate>,
     /// The inputs' settings in effect (one copy, which the input task
     /// reads at every wake), and whether they changed.
     inputs: Mutex<CriticalSectionRawMutex, Cell<InputSettings>>,
@@ -168,6 +174,7 @@ impl ConsoleLink {
         Self {
             status: Mutex::new(Cell::new(HeadStatus {
                 frame: 0,
+                time: Timestamp(0),
                 mode: HeadMode::Starting,
                 angles: [Angle::ZERO; 3],
                 pulses: [Microseconds(0); 3],
@@ -181,6 +188,7 @@ impl ConsoleLink {
             answered: [const { Signal::new() }; PORTS],
             watch: Mutex::new(Cell::new([0; PORTS])),
             live: Signal::new(),
+            rate: Signal::new(),
             inputs: Mutex::new(Cell::new(InputSettings::DEFAULT)),
             inputs_changed: Signal::new(),
             input_status: Mutex::new(Cell::new(InputStatus { high: 0, active: 0 })),
@@ -301,6 +309,18 @@ impl ConsoleLink {
         self.live.try_take()
     }
 
+    /// The console: the servos run at `rate` from a frame boundary on (the
+    /// newest replaces one not yet taken).
+    pub fn set_rate(&self, rate: ServoRate) {
+        self.rate.signal(rate);
+    }
+
+    /// The frame task: the servos' rate, if the console set one since the
+    /// last call.
+    pub fn take_rate(&self) -> Option<ServoRate> {
+        self.rate.try_take()
+    }
+
     /// The boot, then the console: the inputs' roles and the rest timer in
     /// effect, for the input task.
     pub fn set_inputs(&self, inputs: InputSettings) {
@@ -354,16 +374,12 @@ mod tests {
     use super::HeadStatus;
 
     #[test]
-    fn uptime_is_frames_times_period_and_saturates() {
+    fn uptime_is_the_last_frames_time() {
         let status = HeadStatus {
             frame: 50,
+            time: crate::Timestamp(1_000_999),
             ..HeadStatus::default()
         };
-        assert_eq!(status.uptime_ms(20_000), 1000);
-        let late = HeadStatus {
-            frame: u64::MAX,
-            ..status
-        };
-        assert_eq!(late.uptime_ms(u32::MAX), u64::MAX / 1000);
+        assert_eq!(status.uptime_ms(), 1000);
     }
 }

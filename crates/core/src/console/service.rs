@@ -55,13 +55,20 @@
 //! - `watch <hz>|off`: the port's telemetry rate, in the link (the
 //!   port's console streams the lines);
 //! - `status`: the head as the last frame left it ([`HeadStatus`]),
-//!   uptime, firmware version, where the settings came from;
+//!   uptime, firmware version, where the settings came from, the servos'
+//!   rate;
 //! - `servo <axis> <field> <value>`: the settings with that field
 //!   changed are validated as the typed configuration is
 //!   ([`Settings::validate`]); `err invalid` for a calibration the
 //!   driver refuses, `err limit` if the behaviour would then drive the
 //!   servo past its new limits; otherwise the frame task applies it
 //!   between two frames through the limiter ([`FrameDriver::set_servo`]);
+//! - `servo rate <hz>`: the settings at that rate are validated as any
+//!   change is (`err invalid` if the servos' calibrations do not fit its
+//!   period, `err limit` if the behaviour does not hold at it); the frame
+//!   task takes it at a frame boundary, without a jump (the motion is timed
+//!   in µs, see `FrameDriver::set_pwm_period`); `servo rate` alone answers
+//!   the rate and its period;
 //! - `seed`: the next loop set is generated from the new seeds and
 //!   joined in as any set is (no jump);
 //! - `input`, `rest after|pose|relax`, `look duck`: the settings changed
@@ -92,7 +99,7 @@ use crate::behaviour::{Asker, BehaviourParams, CommandQueue, ShowLink};
 use crate::command::{Action, Command, ServoSetting};
 use crate::driver::DriverConfig;
 use crate::gestures::GestureKind;
-use crate::servo::{Direction, ServoCalibration, bounds};
+use crate::servo::{Direction, ServoCalibration, ServoRate, bounds};
 use crate::settings::{
     Settings, SettingsError, SettingsSource, SettingsStorage, StorageError, Validated,
 };
@@ -244,7 +251,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
                 Uint(fr.into()),
                 Uint(fy.into()),
                 Uint(off as u64),
-                Uint(s.uptime_ms(self.base.frame_period.0)),
+                Uint(s.uptime_ms()),
                 Str(VERSION),
                 Str(self.dmx_status()),
                 Str(self.source.as_str()),
@@ -252,6 +259,11 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         );
         self.status_inputs(text(reply));
         self.status_track(text(reply));
+        // The servos' rate, as set (the frame task takes it at the next
+        // frame boundary).
+        text(reply)
+            .str(" rate=")
+            .u64(self.settings.rate.hz().into());
     }
 
     fn show_servo(&self, axis: Axis, reply: &mut Reply<'_>) {
@@ -326,6 +338,40 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         }
     }
 
+    /// `servo rate`: the rate, and the period it runs at (whole µs).
+    fn show_rate(&self, reply: &mut Reply<'_>) {
+        let rate = self.settings.rate;
+        text(reply.ok()).fill(
+            "servo rate={} period_us={}",
+            &[Uint(rate.hz().into()), Uint(rate.period().0.into())],
+        );
+    }
+
+    /// `servo rate <hz>`: checked as the settings at that rate, then sent
+    /// to the frame task, which takes it at a frame boundary.
+    fn set_rate(&mut self, rate: ServoRate, reply: &mut Reply<'_>) {
+        let mut next = self.settings;
+        next.rate = rate;
+        match next.validate(&self.base) {
+            Ok(valid) if Self::inputs_refused(&next, &valid.behaviour, reply) => {}
+            Ok(valid) => {
+                self.link.set_rate(rate);
+                self.settings = next;
+                self.behaviour = valid.behaviour;
+                self.source = SettingsSource::Changed;
+                self.show_rate(reply);
+            }
+            Err(SettingsError::Driver(e)) => {
+                text(reply.err(ErrorCode::Invalid)).with(&e);
+            }
+            Err(SettingsError::Behaviour(e)) => {
+                text(reply.err(ErrorCode::Limit))
+                    .str("the behaviour does not hold at that rate: ")
+                    .with(&e);
+            }
+        }
+    }
+
     /// Puts `settings` in effect: idle amplitude through the queue (so a
     /// full queue changes nothing), servos and seeds through the link.
     fn adopt(
@@ -358,6 +404,9 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         }
         if settings.idle_seeds(self.board) != self.settings.idle_seeds(self.board) {
             self.link.reseed(settings.idle_seeds(self.board));
+        }
+        if settings.rate != self.settings.rate {
+            self.link.set_rate(settings.rate);
         }
         if let Some(show) = self.show {
             show.dmx.set(settings.dmx);
@@ -399,6 +448,8 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
             Command::Act(action) => self.act(port, action, reply),
             Command::Watch(hz) => self.watch(port, hz, reply),
             Command::Seed(choice) => self.seed(choice, reply),
+            Command::ServoRate(None) => self.show_rate(reply),
+            Command::ServoRate(Some(rate)) => self.set_rate(rate, reply),
             Command::Servo {
                 axis,
                 setting: None,

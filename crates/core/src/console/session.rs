@@ -130,8 +130,9 @@ pub const MIN_REPLY: usize = 48;
 /// the Bottango modules answer reports, [`crate::bottango::MAX_LINE`]).
 pub const PORT_LINE: usize = 96;
 
-/// Bytes of a reply line on a port, as `docs/user/protocol.md` promises.
-pub const PORT_REPLY: usize = 160;
+/// Bytes of a reply line on a port, as `docs/user/protocol.md` promises:
+/// the longest `status` (every field at its widest) fits.
+pub const PORT_REPLY: usize = 256;
 
 /// A console session on a port: the sizes the protocol promises.
 pub type PortSession = Session<PORT_LINE, PORT_REPLY>;

@@ -31,24 +31,19 @@ const _: () = assert!(TELEMETRY_LINE <= PORT_REPLY);
 /// The fastest telemetry: one line a frame at 50 Hz.
 pub const MAX_WATCH_HZ: u8 = 50;
 
-/// Writes the telemetry line of `status` (frames of `frame_us` µs) with
-/// `lost` lines dropped so far into `out` (at least [`TELEMETRY_LINE`]
+/// Writes the telemetry line of `status` with `lost` lines dropped so far
+/// into `out` (at least [`TELEMETRY_LINE`]
 /// bytes: a console writes it into its session's reply buffer, free
 /// between replies, [`DualSession::spare`](super::DualSession::spare)); returns
 /// the line. (Into a shorter buffer the line is cut, without its end.)
-pub fn telemetry_line<'b>(
-    status: &HeadStatus,
-    frame_us: u32,
-    lost: u32,
-    out: &'b mut [u8],
-) -> &'b [u8] {
+pub fn telemetry_line<'b>(status: &HeadStatus, lost: u32, out: &'b mut [u8]) -> &'b [u8] {
     let mut line = Out::new(out);
     let [p, r, y] = status.angles.map(crate::units::Angle::millidegrees);
     let [pp, pr, py] = status.pulses.map(|us| us.0);
     line.text().fill(
         "~ t={} p={} r={} y={} us={},{},{} lost={}",
         &[
-            Uint(status.uptime_ms(frame_us)),
+            Uint(status.uptime_ms()),
             Int(p.into()),
             Int(r.into()),
             Int(y.into()),
@@ -84,6 +79,7 @@ mod tests {
         let mut out = [0; TELEMETRY_LINE];
         let status = HeadStatus {
             frame: 50,
+            time: crate::Timestamp(1_000_000),
             mode: HeadMode::Running,
             angles: [-1505, -119, 236].map(Angle::from_millidegrees),
             pulses: [1483, 1499, 1497].map(Microseconds),
@@ -91,7 +87,7 @@ mod tests {
             disabled: [false; 3],
             track: None,
         };
-        let line = telemetry_line(&status, 20_000, 3, &mut out).to_vec();
+        let line = telemetry_line(&status, 3, &mut out).to_vec();
         let text = std::str::from_utf8(&line).unwrap();
         let (body, tail) = text.rsplit_once(" *").unwrap();
         assert_eq!(
@@ -101,6 +97,7 @@ mod tests {
         assert_eq!(tail, format!("{:02x}\r\n", checksum(body.as_bytes())));
         let worst = HeadStatus {
             frame: u64::MAX,
+            time: crate::Timestamp(u64::MAX),
             angles: [Angle::from_millidegrees(i32::MIN + 1); 3],
             pulses: [Microseconds(u32::MAX); 3],
             ..status
@@ -112,7 +109,7 @@ mod tests {
             }),
             ..status
         };
-        let line = telemetry_line(&radar, 20_000, 3, &mut out).to_vec();
+        let line = telemetry_line(&radar, 3, &mut out).to_vec();
         assert!(String::from_utf8_lossy(&line).contains(" lost=3 targets=2 at=-14036 *"));
         let worst = HeadStatus {
             track: Some(crate::track::TrackView {
@@ -121,7 +118,7 @@ mod tests {
             }),
             ..worst
         };
-        let line = telemetry_line(&worst, u32::MAX, u32::MAX, &mut out);
+        let line = telemetry_line(&worst, u32::MAX, &mut out);
         assert!(line.ends_with(b"\r\n"), "{}", String::from_utf8_lossy(line));
     }
 }

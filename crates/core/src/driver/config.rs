@@ -43,19 +43,21 @@ impl MotionLimits {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FaultPolicy {
-    /// Consecutive failed frames after which a servo is switched off (≥ 1).
-    pub disable_after: u16,
+    /// How long a servo's writes may fail in a row before it is switched
+    /// off (at least 1 ms; counted in whole frames, at least one:
+    /// [`DriverParams::disable_frames`]).
+    pub disable_after: Millis,
     /// Shortest time between two fault log suggestions
     /// ([`FrameReport::should_log`](super::FrameReport::should_log)).
     pub log_interval: Millis,
 }
 
 impl FaultPolicy {
-    /// Switch a servo off after 25 failed frames in a row (25 · 20 ms = 0.5 s at
-    /// 50 Hz: long enough to ride out a glitch, short enough that a stuck
+    /// Switch a servo off after 0.5 s of failed writes in a row (25 frames
+    /// at 50 Hz: long enough to ride out a glitch, short enough that a stuck
     /// channel does not hold the servo at a stale pulse); log at most once a second.
     pub const DEFAULT: Self = Self {
-        disable_after: 25,
+        disable_after: Millis(500),
         log_interval: Millis(1000),
     };
 }
@@ -164,7 +166,7 @@ impl DriverConfig {
         if self.pwm.period.0 == 0 {
             return Err(ConfigError::ZeroPwmPeriod);
         }
-        if self.faults.disable_after == 0 {
+        if self.faults.disable_after.0 == 0 {
             return Err(ConfigError::ZeroDisableAfter);
         }
         let mut i = 0;
@@ -179,11 +181,13 @@ impl DriverConfig {
             }
             i += 1;
         }
-        Ok(DriverParams {
+        let mut params = DriverParams {
             config: *self,
-            fade_frames: frames_in(self.fade.0 as u64 * 1000, frame_us),
-            log_frames: frames_in(self.faults.log_interval.0 as u64 * 1000, frame_us),
-        })
+            log_frames: 0,
+            disable_frames: 0,
+        };
+        params.count_frames();
+        Ok(params)
     }
 }
 
@@ -282,7 +286,7 @@ pub(crate) const fn slew_rates(
 
 /// Whole frames in `us` microseconds, rounded up, saturating at `u32::MAX`.
 const fn frames_in(us: u64, frame_us: u32) -> u32 {
-    let f = us.div_ceil(frame_us as u64);
+    let f = us.div_ceil(if frame_us == 0 { 1 } else { frame_us as u64 });
     if f > u32::MAX as u64 {
         u32::MAX
     } else {
@@ -295,8 +299,8 @@ const fn frames_in(us: u64, frame_us: u32) -> u32 {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DriverParams {
     pub(crate) config: DriverConfig,
-    pub(crate) fade_frames: u32,
     pub(crate) log_frames: u32,
+    pub(crate) disable_frames: u16,
 }
 
 impl DriverParams {
@@ -306,10 +310,40 @@ impl DriverParams {
         &self.config
     }
 
-    /// Frames of the fade-in and fade-out.
+    /// The fade's duration, µs (at most about 35 minutes).
+    #[must_use]
+    pub const fn fade_us(&self) -> u32 {
+        let us = self.config.fade.0 as u64 * 1000;
+        let most = super::envelope::MAX_FADE as u64;
+        if us > most { most as u32 } else { us as u32 }
+    }
+
+    /// Frames of the fade-in and fade-out at the frame period (rounded up).
     #[must_use]
     pub const fn fade_frames(&self) -> u32 {
-        self.fade_frames
+        frames_in(self.fade_us() as u64, self.config.frame_period.0)
+    }
+
+    /// Failed frames in a row after which a servo is switched off: the
+    /// fault policy's time at the frame period, rounded up, at least 1.
+    #[must_use]
+    pub const fn disable_frames(&self) -> u16 {
+        self.disable_frames
+    }
+
+    /// Works out the frame counts of the fault policy for the frame period.
+    pub(crate) const fn count_frames(&mut self) {
+        let frame_us = self.config.frame_period.0;
+        let faults = self.config.faults;
+        self.log_frames = frames_in(faults.log_interval.0 as u64 * 1000, frame_us);
+        let disable = frames_in(faults.disable_after.0 as u64 * 1000, frame_us);
+        self.disable_frames = if disable == 0 {
+            1
+        } else if disable > u16::MAX as u32 {
+            u16::MAX
+        } else {
+            disable as u16
+        };
     }
 
     /// Largest change of the commanded angle of `axis` from one frame to the

@@ -25,7 +25,7 @@ pub enum ConfigError {
     ZeroFramePeriod,
     /// `pwm.period` is zero.
     ZeroPwmPeriod,
-    /// `faults.disable_after` is zero.
+    /// `faults.disable_after` is zero ms.
     ZeroDisableAfter,
     /// A servo calibration is invalid.
     Servo {
@@ -180,7 +180,7 @@ impl Describe for ConfigError {
         match *self {
             Self::ZeroFramePeriod => out.str("frame_period must be longer than 0 µs"),
             Self::ZeroPwmPeriod => out.str("pwm.period must be longer than 0 µs"),
-            Self::ZeroDisableAfter => out.str("faults.disable_after must be at least 1 frame"),
+            Self::ZeroDisableAfter => out.str("faults.disable_after must be at least 1 ms"),
             Self::Servo { axis, error } => {
                 out.fill("{} servo: {}", &[Str(axis.name()), Text(&error)])
             }
@@ -317,3 +317,38 @@ fn least_accel(frame_period: Microseconds) -> u64 {
     let f = u64::from(frame_period.0).max(1);
     1_000_000_u64.div_ceil(f.saturating_mul(f))
 }
+
+/// Why the servos did not change their period
+/// ([`FrameDriver::set_pwm_period`](super::FrameDriver::set_pwm_period)):
+/// nothing changed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RateError {
+    /// The configuration does not hold at that period.
+    Config(ConfigError),
+    /// A servo's output cannot run at that period exactly.
+    Output {
+        /// The servo's axis.
+        axis: Axis,
+        /// The period it refused.
+        period: Microseconds,
+    },
+}
+
+impl Describe for RateError {
+    fn describe(&self, out: &mut dyn text::Text) {
+        match *self {
+            Self::Config(e) => e.describe(out),
+            Self::Output { axis, period } => {
+                out.fill(
+                    "the {} servo's output cannot run at {} µs",
+                    &[Str(axis.name()), Uint(period.0.into())],
+                );
+            }
+        }
+    }
+}
+
+display_from_describe!(RateError);
+
+impl core::error::Error for RateError {}

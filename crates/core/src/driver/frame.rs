@@ -11,6 +11,7 @@ use super::envelope::{Envelope, UNITY};
 use super::limiter::{Slew, SlewParams};
 use super::{DriverParams, DriverStats, FrameReport, Outcome, ServoReport};
 
+mod rate;
 mod retune;
 
 /// Per-servo runtime state: everything a frame reads of one servo but its
@@ -81,8 +82,10 @@ const NEVER: u64 = u64::MAX;
 
 impl<P: SetDutyCycle> FrameDriver<P> {
     /// A driver for `channels` (`[pitch, roll, yaw]`). Reads each channel's
-    /// maximum duty once (pitch, roll, yaw), so the PWM period must be set up
-    /// before and not change afterwards; writes nothing until [`start`](Self::start).
+    /// maximum duty once (pitch, roll, yaw), so the channels' PWM period
+    /// must be the configuration's `pwm.period` (an output that can change
+    /// it is set with [`set_pwm_period`](Self::set_pwm_period)); writes
+    /// nothing until [`start`](Self::start).
     pub fn new(channels: [P; 3], params: DriverParams) -> Self {
         let config = &params.config;
         let servo = |i: usize| {
@@ -107,7 +110,7 @@ impl<P: SetDutyCycle> FrameDriver<P> {
             channels,
             params,
             servos,
-            envelope: Envelope::new(params.fade_frames),
+            envelope: Envelope::new(params.fade_us(), config.frame_period.0),
             last: FrameReport {
                 frame: 0,
                 servos: [IDLE; 3],
@@ -126,13 +129,16 @@ impl<P: SetDutyCycle> FrameDriver<P> {
     }
 
     /// Writes every servo's neutral pulse (0°): the first pulse a servo ever
-    /// receives. The idle motion then fades in from the next frame on.
-    /// Once started, it writes nothing and returns the last frame's report.
+    /// receives. The idle motion then fades in, from
+    /// [`START_HOLD`](super::START_HOLD) on (at 50 Hz: from the next frame
+    /// on). Once started, it writes nothing and returns the last frame's
+    /// report.
     pub fn start(&mut self) -> FrameReport {
         if self.started {
             return self.last;
         }
         self.started = true;
+        self.envelope.start();
         for i in 0..3 {
             let report = self.write_servo(i, Angle::ZERO);
             if let Some(slot) = self.last.servos.get_mut(i) {
@@ -166,6 +172,7 @@ impl<P: SetDutyCycle> FrameDriver<P> {
     #[inline]
     fn servo_frame(&mut self, i: usize, offset: Angle, gain: u32) {
         let config = &self.params.config;
+        let disable_after = self.params.disable_frames;
         let (Some(servo), Some(cal), Some(channel), Some(&pose), Some(slot)) = (
             self.servos.get_mut(i),
             config.servos.get(i),
@@ -176,7 +183,7 @@ impl<P: SetDutyCycle> FrameDriver<P> {
             return;
         };
         let target = pose.saturating_add(scale(offset, gain));
-        servo.frame(cal, channel, target, config.faults.disable_after, slot);
+        servo.frame(cal, channel, target, disable_after, slot);
     }
 
     /// Stops the pulses from the next frame on (once started): each servo
@@ -223,7 +230,8 @@ impl<P: SetDutyCycle> FrameDriver<P> {
     /// A frame without pulses: duty 0 on every servo still on.
     #[inline(never)]
     fn relaxed_frame(&mut self) -> FrameReport {
-        let disable_after = self.params.config.faults.disable_after;
+        self.envelope.hold();
+        let disable_after = self.params.disable_frames;
         for ((servo, channel), slot) in self
             .servos
             .iter_mut()
@@ -299,13 +307,7 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         ) else {
             return IDLE;
         };
-        map_and_write(
-            servo,
-            cal,
-            channel,
-            angle,
-            self.params.config.faults.disable_after,
-        )
+        map_and_write(servo, cal, channel, angle, self.params.disable_frames)
     }
 
     /// Completes the report of the servos just written: totals, fault log
@@ -428,7 +430,8 @@ fn map_and_write<P: SetDutyCycle>(
 }
 
 /// Writes `duty` to a servo that is still on, and counts the outcome: a
-/// servo whose writes fail `disable_after` frames in a row is switched off.
+/// servo whose writes fail `disable_after` frames in a row is switched off
+/// (the fault policy's time in frames).
 #[inline]
 fn write_duty<P: SetDutyCycle>(
     servo: &mut ServoState,

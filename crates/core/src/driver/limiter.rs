@@ -238,6 +238,21 @@ impl Slew {
         self.vel
     }
 
+    /// The frames come `to` µs apart instead of `from`: the last step as
+    /// the same speed in the new frames (`vel · to / from`, rounded), so
+    /// that a target moving at that speed is followed on as it was.
+    pub(crate) fn rescale(&mut self, to: u32, from: u32) {
+        if from == 0 || to == from {
+            return;
+        }
+        // |vel| ≤ SPAN < 2³⁰, to < 2³²: the product fits i64.
+        let num = i64::from(self.vel) * i64::from(to);
+        let den = i64::from(from);
+        let half = if num < 0 { -(den / 2) } else { den / 2 };
+        let vel = (num + half).checked_div(den).unwrap_or(0);
+        self.vel = vel.clamp(-i64::from(SPAN), i64::from(SPAN)) as i32;
+    }
+
     /// Whether the limits `p` can take over from the next frame on without a
     /// step beyond them: the speed is within `p`'s and, decelerating at `p`'s
     /// acceleration, the axis can still stop before the angle limit it moves

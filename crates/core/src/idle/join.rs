@@ -1,11 +1,12 @@
 //! The join between two loops: its length, the blend weight, and the
-//! frame timing a stream of loops follows.
+//! timing a stream of loops follows (in µs: the same at any frame rate).
 
 use crate::playback::Playback;
+use crate::units::Millis;
 
-/// Frames over which an outgoing loop is blended into the incoming one:
-/// 2 s at 50 frames per second (60 samples of a 900-sample, 30 s loop).
-pub const JOIN_FRAMES: u32 = 100;
+/// How long an outgoing loop is blended into the incoming one: 2 s (60
+/// samples of a 900-sample, 30 s loop; 100 frames at 50 Hz).
+pub const JOIN: Millis = Millis(2000);
 
 /// Largest join in samples the generator keeps an exit segment for.
 pub const MAX_JOIN_SAMPLES: usize = 64;
@@ -15,9 +16,7 @@ pub const MAX_JOIN_SAMPLES: usize = 64;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum IdleError {
-    /// The loop duration is not a whole number of frames.
-    FramesPerLoop,
-    /// The loop is shorter than four joins ([`JOIN_FRAMES`] each).
+    /// The loop is shorter than four joins ([`JOIN`] each).
     LoopTooShort,
     /// The join covers fewer than 2 or more than [`MAX_JOIN_SAMPLES`]
     /// samples of the loop.
@@ -29,25 +28,24 @@ impl IdleError {
     #[must_use]
     pub const fn message(self) -> &'static str {
         match self {
-            Self::FramesPerLoop => "the loop duration must be a whole number of frame periods",
-            Self::LoopTooShort => "the loop must last at least four joins (400 frames)",
+            Self::LoopTooShort => "the loop must last at least four joins (8 s)",
             Self::JoinSamples => {
-                "a join (100 frames) must cover 2 to 64 samples of the loop: change N or the loop duration"
+                "a join (2 s) must cover 2 to 64 samples of the loop: change N or the loop duration"
             }
         }
     }
 }
 
-/// How a stream of loops is laid out in frames and samples.
+/// How a stream of loops is laid out in time and samples.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct IdleTiming {
     /// The playback of one loop.
     pub playback: Playback,
-    /// Frames per loop (`L`).
-    pub loop_frames: u32,
-    /// Frames per join ([`JOIN_FRAMES`], `J`).
-    pub join_frames: u32,
+    /// A loop's duration, µs (`L`).
+    pub loop_us: u64,
+    /// A join's duration, µs ([`JOIN`], `J`).
+    pub join_us: u64,
     /// Samples of a loop the join covers: `J·N/L`, rounded down.
     pub join_samples: usize,
 }
@@ -56,50 +54,41 @@ impl IdleTiming {
     /// The timing of loops played by `playback`.
     ///
     /// # Errors
-    /// An [`IdleError`] if the loop is not a whole number of frames, shorter
-    /// than four joins, or its join covers too few or too many samples.
+    /// An [`IdleError`] if the loop is shorter than four joins, or its join
+    /// covers too few or too many samples.
     pub const fn new(playback: Playback) -> Result<Self, IdleError> {
         let loop_us = playback.loop_duration().0 as u64 * 1000;
-        let frame_us = playback.frame_period().0 as u64;
-        if frame_us == 0
-            || !loop_us.is_multiple_of(frame_us)
-            || loop_us / frame_us > u32::MAX as u64
-        {
-            return Err(IdleError::FramesPerLoop);
-        }
-        let loop_frames = (loop_us / frame_us) as u32;
-        if loop_frames < 4 * JOIN_FRAMES {
+        let join_us = JOIN.0 as u64 * 1000;
+        if loop_us < 4 * join_us {
             return Err(IdleError::LoopTooShort);
         }
-        let join_samples =
-            (JOIN_FRAMES as u64 * playback.samples() as u64 / loop_frames as u64) as usize;
+        let join_samples = (join_us * playback.samples() as u64 / loop_us) as usize;
         if join_samples < 2 || join_samples > MAX_JOIN_SAMPLES {
             return Err(IdleError::JoinSamples);
         }
         Ok(Self {
             playback,
-            loop_frames,
-            join_frames: JOIN_FRAMES,
+            loop_us,
+            join_us,
             join_samples,
         })
     }
 
-    /// Frames during which a set still reads its join: until no spline
-    /// window reaches back before the join's last sample `J` (the window of
-    /// a frame starts one sample before it), the first frame `f` with
-    /// `f·N/L ≥ J + 1`.
+    /// How long a set still reads its join: until no spline window reaches
+    /// back before the join's last sample `J` (the window of a frame starts
+    /// one sample before it), the first time `t` with `t·N/L ≥ J + 1`, µs.
     #[must_use]
-    pub const fn join_read_frames(&self) -> u32 {
+    pub const fn join_read_us(&self) -> u64 {
         let n = self.playback.samples() as u64;
-        let need = (self.join_samples as u64 + 1) * self.loop_frames as u64;
-        need.div_ceil(n) as u32
+        let need = (self.join_samples as u64 + 1) * self.loop_us;
+        need.div_ceil(n)
     }
 
-    /// Frames from one join's start to the next: `L − J` (each loop's
-    /// first `J` frames are its join in, its last `J` its join out).
+    /// Time from one join's start to the next: `L − J` (each loop's
+    /// first `J` are its join in, its last `J` its join out), µs.
     #[must_use]
-    pub const fn period(&self) -> u32 {
-        self.loop_frames - self.join_frames
+    pub const fn period_us(&self) -> u64 {
+        self.loop_us - self.join_us
     }
 }
 

@@ -60,20 +60,23 @@
 //!
 //! # The join
 //!
-//! Every loop is played once through, N samples in `L` frames (1500 at the
-//! defaults), and its first and last `J` frames ([`JOIN_FRAMES`] = 100,
+//! Every loop is played once through, N samples in `L` (30 s at the
+//! defaults: 1500 frames at 50 Hz), and its first and last `J` ([`JOIN`],
 //! 2 s) overlap the loops before and after it: over a join the outgoing
-//! loop plays its last `J` frames, the incoming loop its first `J`, and the
-//! frame shows
+//! loop plays its last `J`, the incoming loop its first `J`, and the
+//! frame at `t` into the join shows
 //!
 //! ```text
-//! out + s(j/J)·(in − out),   s(u) = 10u³ − 15u⁴ + 6u⁵,   j = 0..J−1
+//! out + s(t/J)·(in − out),   s(u) = 10u³ − 15u⁴ + 6u⁵,   0 ≤ t < J
 //! ```
+//!
+//! (blended on the samples the join covers, and interpolated between them
+//! as any sample is: all in time, so the frame rate changes nothing)
 //!
 //! a convex combination (the angle stays inside both loops' ranges, so
 //! inside [α1, α2]) whose weight has zero first and second derivatives at
 //! both ends, so velocity and acceleration stay continuous. Joins come
-//! every `L − J` frames (1400: 28 s). No sample of a loop is played
+//! every `L − J` (28 s). No sample of a loop is played
 //! twice, so no part of a loop returns at the next join.
 //!
 //! The blend has little to hide because the incoming loop is entered where
@@ -92,7 +95,7 @@
 //! smoke run and shown on the book's measured figures page) into a
 //! [`LoopSet`] buffer;
 //! [`IdlePlayer`] plays the sets frame by frame and takes the next one
-//! through a [`LoopSupply`] on the frame its join is due. The firmware
+//! through a [`LoopSupply`] at the first frame its join is due. The firmware
 //! generates in a low-priority task and passes `&'static mut` buffers
 //! through channels (`frame_task`); the host calls the generator on the
 //! spot. Both play the same frames. Should a set not be ready in time, the
@@ -102,7 +105,7 @@
 //! # The fixed loop
 //!
 //! [`IdleMode::FixedLoop`] plays set 0 for ever: the paper's behaviour,
-//! one loop per axis replayed every `L` frames.
+//! one loop per axis replayed every `L`.
 
 mod join;
 mod pace;
@@ -111,7 +114,7 @@ mod stream;
 mod supply;
 
 pub use crate::behaviour::IdleSource;
-pub use join::{IdleError, IdleTiming, JOIN_FRAMES, MAX_JOIN_SAMPLES, join_weight};
+pub use join::{IdleError, IdleTiming, JOIN, MAX_JOIN_SAMPLES, join_weight};
 pub use pace::{
     MAX_DRAWS, MAX_JOIN_TURN_RATIO, MAX_SPEED_RATIO, MAX_TURN_RATIO, Pace, Paces, Spread,
 };

@@ -5,7 +5,7 @@ use core::ops::Deref;
 
 use crate::behaviour::IdleSource;
 use crate::playback::Cursor;
-use crate::units::Angle;
+use crate::units::{Angle, Microseconds, Timestamp};
 
 use super::join::IdleTiming;
 use super::stream::LoopSet;
@@ -34,7 +34,8 @@ pub struct IdleStats {
     pub set: u32,
 }
 
-/// Plays loop sets (`H` derefs to a [`LoopSet`]) frame by frame: in
+/// Plays loop sets (`H` derefs to a [`LoopSet`]) frame by frame, on the
+/// frames' times (µs): in
 /// [`IdleMode::NeverRepeating`] each set is followed by the next from
 /// `supply`, entered through its join; in [`IdleMode::FixedLoop`] the first
 /// set plays for ever. See the [module docs](super).
@@ -43,27 +44,28 @@ pub struct IdleStats {
 // on the Cortex-M0).
 #[repr(C)]
 pub struct IdlePlayer<H, S> {
-    /// The frame from which on [`on_event`](Self::on_event) plays the
+    /// The time from which on [`on_event`](Self::on_event) plays the
     /// frames: every frame of a join, else the next join (`u64::MAX`: never).
     slow_from: u64,
-    /// The frame of `current`'s first frame (its local frame 0).
+    /// The time of `current`'s start (its local time 0).
     origin: u64,
     current: H,
     /// Whether `current` is still playing its join.
     joining: bool,
-    /// The local frame of the next event: the join's end (while `joining`),
+    /// The local time of the next event: the join's end (while `joining`),
     /// else the next join (`u64::MAX`: never).
     event: u64,
     cursor: Cursor,
-    /// A cursor at frame 0 with nothing read, for each new set (made once:
-    /// making one divides in 64 bits).
-    fresh: Cursor,
     supply: S,
     timing: IdleTiming,
-    /// [`IdleTiming::join_read_frames`], worked out once (it divides in 64
+    /// [`IdleTiming::join_read_us`], worked out once (it divides in 64
     /// bits, which would otherwise cost the frame a join starts at some
     /// 300 instructions).
-    join_read: u32,
+    join_read: u64,
+    /// Where a set stands when the next one takes over (at `L − J`), as
+    /// the cursor keeps it ([`Cursor::position_of`]): the new set's
+    /// position is the cursor's less this, without a division.
+    join_shift: (u32, u32),
     /// Whether sets follow each other.
     stream: bool,
     stats: IdleStats,
@@ -100,17 +102,13 @@ where
     H: Deref<Target = LoopSet<N, CAP>>,
     S: LoopSupply<H>,
 {
-    /// Plays `first` from frame 0, then (in [`IdleMode::NeverRepeating`])
+    /// Plays `first` from time 0, then (in [`IdleMode::NeverRepeating`])
     /// the sets of `supply`.
     #[must_use]
     pub const fn new(first: H, supply: S, timing: IdleTiming, mode: IdleMode) -> Self {
         let stream = matches!(mode, IdleMode::NeverRepeating);
         let fresh = Cursor::new(timing.playback);
-        let event = if stream {
-            timing.period() as u64
-        } else {
-            u64::MAX
-        };
+        let event = if stream { timing.period_us() } else { u64::MAX };
         Self {
             slow_from: event,
             origin: 0,
@@ -118,10 +116,10 @@ where
             joining: false,
             event,
             cursor: fresh,
-            fresh,
             supply,
             timing,
-            join_read: timing.join_read_frames(),
+            join_read: timing.join_read_us(),
+            join_shift: fresh.position_of(timing.period_us()),
             stream,
             stats: IdleStats {
                 joins: 0,
@@ -131,32 +129,39 @@ where
         }
     }
 
-    /// The idle offsets of frame `frame`.
+    /// The idle offsets of the frame at `at`.
     #[inline]
-    pub fn offsets(&mut self, frame: u64) -> [Angle; 3] {
-        if frame >= self.slow_from {
-            return self.slow(frame);
+    pub fn offsets(&mut self, at: Timestamp) -> [Angle; 3] {
+        if at.0 >= self.slow_from {
+            return self.slow(at);
         }
-        self.cursor.offsets(frame, &*self.current)
+        self.cursor.offsets(at, &*self.current)
+    }
+
+    /// Frames come `period` apart after the last one played: the cursor
+    /// takes the new step (between frames: the divisions happen here).
+    pub const fn set_frame_period(&mut self, period: Microseconds) {
+        self.timing.playback = self.timing.playback.with_frame_period(period);
+        self.cursor.set_frame_period(period);
     }
 
     /// A frame of a join, or one at or past an event.
     #[inline(never)]
-    fn slow(&mut self, frame: u64) -> [Angle; 3] {
-        let local = frame.wrapping_sub(self.origin);
+    fn slow(&mut self, at: Timestamp) -> [Angle; 3] {
+        let local = at.0.wrapping_sub(self.origin);
         if local >= self.event {
             self.on_event(local);
         }
         // Every frame of a join comes here; after it, the next join.
         self.slow_from = if self.joining {
-            frame.wrapping_add(1)
+            at.0
         } else {
             self.origin.saturating_add(self.event)
         };
         if self.joining {
-            return self.cursor.offsets(frame, &self.current.views());
+            return self.cursor.offsets(at, &self.current.views());
         }
-        self.cursor.offsets(frame, &*self.current)
+        self.cursor.offsets(at, &*self.current)
     }
 
     /// A frame at or past an event: the end of a join (the set plays on
@@ -167,7 +172,7 @@ where
             // the set reads its own samples from now on: from the join's
             // last sample on they are the same.
             self.joining = false;
-            self.event = u64::from(self.timing.period());
+            self.event = self.timing.period_us();
             return;
         }
         if !self.stream {
@@ -178,9 +183,7 @@ where
             // Not ready: the current set is seamless and plays once more;
             // its join out falls on the same samples a loop later.
             self.stats.late = self.stats.late.saturating_add(1);
-            self.event = self
-                .event
-                .saturating_add(u64::from(self.timing.loop_frames));
+            self.event = self.event.saturating_add(self.timing.loop_us);
             return;
         };
         // The outgoing set's exit is in the new set's join: it is read no more.
@@ -188,10 +191,11 @@ where
         self.supply.give_back(outgoing);
         self.origin = self.origin.wrapping_add(self.event);
         let local = local - self.event;
-        self.cursor = self.fresh;
-        self.cursor.restart_at(self.origin);
+        // The new set from where the cursor stands (same loop length and
+        // samples: the same steps), or, after a late frame, from its time.
+        self.cursor.rebase(self.origin, self.join_shift);
         self.joining = true;
-        self.event = u64::from(self.join_read);
+        self.event = self.join_read;
         self.stats.joins = self.stats.joins.saturating_add(1);
         self.stats.set = self.current.number();
         if local >= self.event {
@@ -207,7 +211,11 @@ where
     S: LoopSupply<H>,
 {
     #[inline]
-    fn offsets(&mut self, frame: u64) -> [Angle; 3] {
-        IdlePlayer::offsets(self, frame)
+    fn offsets(&mut self, at: Timestamp) -> [Angle; 3] {
+        IdlePlayer::offsets(self, at)
+    }
+
+    fn set_frame_period(&mut self, period: Microseconds) {
+        IdlePlayer::set_frame_period(self, period);
     }
 }

@@ -3,19 +3,19 @@
 //!
 //! # The position
 //!
-//! Frame `k` lies at time `t = k·F mod L` in the loop (`F`: frame period,
-//! `L`: loop duration, µs) and at `X/L` samples with `X = t·n·2¹²` (`n`
-//! samples, Q12). The player keeps `⌊X/L⌋` and the remainder. One frame adds
-//! `S = (F mod L)·n·2¹²`, i.e. `⌊S/L⌋` to the position and `S mod L` to the
-//! remainder (a carry when it reaches `L`), and the position wraps at
-//! `n·2¹²` when `t` passes `L`. Every remainder is a multiple of
-//! `g = gcd(S, L)` (it is `k·S mod L`), so it is kept in units of `g`, below
-//! `L/g`. With `n < 2¹⁹` and `L/g < 2³¹` (any loop up to 35 minutes, and
-//! longer ones unless their duration is almost prime to the frame
-//! period) the sums fit `u32`. A frame that does not follow the last one
-//! (frames skipped while late, or a jump) is located from its index with
-//! 64-bit long division, as [`Playback::position`] does: exact either way,
-//! without drift over any run length.
+//! A frame at time `t` lies at `t mod L` in the loop (`L`: loop duration,
+//! µs) and at `X/L` samples with `X = (t mod L)·n·2¹²` (`n` samples, Q12).
+//! The player keeps `⌊X/L⌋` and the remainder. A frame `F` µs after the
+//! last adds `S = (F mod L)·n·2¹²`, i.e. `⌊S/L⌋` to the position and `S mod
+//! L` to the remainder (a carry when it reaches `L`), and the position wraps
+//! at `n·2¹²` when `t` passes `L`. Every remainder is a multiple of `g =
+//! gcd(n·2¹², L)` (whatever the time, and whatever the frame period), so it
+//! is kept in units of `g`, below `L/g`. With `n < 2¹⁹` and `L/g < 2³¹` (any
+//! loop up to 35 minutes) the sums fit `u32`. A frame that does not follow
+//! the last one by `F` (frames skipped while late, or a jump) is located
+//! from its time with 64-bit long division, as [`Playback::position_at`]
+//! does: exact either way, without drift over any run length. A change of
+//! the frame period ([`Cursor::set_frame_period`]) changes `S` alone.
 //!
 //! # The windows
 //!
@@ -23,15 +23,15 @@
 //! and up to two samples past it, read ahead. A frame that stays in its
 //! segment reads ahead (the frame has the time: it moves no window); a
 //! frame that moves on shifts the windows and uses the samples read ahead,
-//! reading only those it lacks. At 1.67 frames per sample (the defaults)
-//! two of five frames stay and three move on: after the first samples,
-//! every read happens on a frame that stays. A frame that moves more than
-//! three samples, or jumps, reads whole windows. A frame located exactly on
-//! a sample (such as frame 0) needs only that sample, and the next frame
-//! reads the other three.
+//! reading only those it lacks. At 1.67 frames per sample (the defaults at
+//! 50 Hz) two of five frames stay and three move on: after the first
+//! samples, every read happens on a frame that stays. A frame that moves
+//! more than three samples, or jumps, reads whole windows. A frame located
+//! exactly on a sample (such as frame 0) needs only that sample, and the
+//! next frame reads the other three.
 
 use super::timing::{LoopSource, Playback, T_BITS, Weights, Window, mul_div_rem, wrap};
-use crate::units::Angle;
+use crate::units::{Angle, Microseconds, Timestamp};
 
 /// Plays three loops frame by frame; the same offsets as
 /// [`Playback::offsets`], see the [module docs](self).
@@ -79,25 +79,40 @@ impl<'a, L: LoopSource + ?Sized> Player<'a, L> {
         self.cursor.playback()
     }
 
-    /// The three offsets (pitch, roll, yaw) of frame `frame`: those of
-    /// [`Playback::offsets`], cheapest when `frame` follows the last one.
+    /// The three offsets (pitch, roll, yaw) of frame `frame` (at `frame`
+    /// frame periods): those of [`Playback::offsets`], cheapest when
+    /// `frame` follows the last one.
     #[inline]
     pub fn offsets(&mut self, frame: u64) -> [Angle; 3] {
-        self.cursor.offsets(frame, &self.loops)
+        let at = Timestamp::of_frame(frame, self.cursor.playback.frame_period());
+        self.offsets_at(at)
+    }
+
+    /// The three offsets of the frame at `at`, cheapest when it comes one
+    /// frame period after the last.
+    #[inline]
+    pub fn offsets_at(&mut self, at: Timestamp) -> [Angle; 3] {
+        self.cursor.offsets(at, &self.loops)
+    }
+
+    /// Frames come `period` apart after the last one played (see
+    /// [`Cursor::set_frame_period`]).
+    pub const fn set_frame_period(&mut self, period: Microseconds) {
+        self.cursor.set_frame_period(period);
     }
 }
 
 /// The state of a [`Player`] without its loops: the position and the
 /// spline windows, for callers that hold the loops themselves (and change
 /// them: a cursor must be given the same loops from one call to the next,
-/// or be [`reset`](Self::reset)).
+/// or be [`restart_at`](Self::restart_at) another time).
 #[derive(Clone, Copy, Debug)]
 pub struct Cursor {
     playback: Playback,
-    /// The frame played as the loops' frame 0.
+    /// The time played as the loops' time 0, µs.
     origin: u64,
-    /// The frame after the one `pos` and `rem` belong to.
-    next: u64,
+    /// The time `pos` and `rem` belong to, µs.
+    here: u64,
     /// `⌊X/L⌋`: the sample index (above 12 bits) and `t` (Q12).
     pos: u32,
     /// `(X mod L)/g`.
@@ -112,54 +127,138 @@ pub struct Cursor {
     windows: [Window; 3],
     /// Samples read ahead in each window (0..=2).
     ahead: u8,
-    /// Whether the sums fit `u32` (else every frame is [`Playback::offsets`]).
+    /// Whether the sums fit `u32` (else every frame is [`Playback::offsets_at`]).
     incremental: bool,
-    /// Whether `pos` and `rem` belong to the frame before `next`.
+    /// Whether `pos` and `rem` belong to `here`.
     positioned: bool,
-    /// Whether `windows` hold the segment around `pos` (else only its first
-    /// sample, `pos` being on it).
-    loaded: bool,
+    /// What `windows` hold.
+    read: Read,
+}
+
+/// What a [`Cursor`]'s windows hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Read {
+    /// The first sample of `pos`'s segment only (`pos` on it).
+    Sample,
+    /// The segment around `pos`.
+    Segment,
+    /// Other loops' samples (after [`Cursor::rebase`]): the next frame
+    /// reads whole windows.
+    Stale,
 }
 
 impl Cursor {
-    /// A cursor for `playback`, at frame 0, with nothing read yet.
+    /// A cursor for `playback`, at time 0, with nothing read yet.
     #[must_use]
     pub const fn new(playback: Playback) -> Self {
         let loop_us = playback.loop_us.get();
         let samples = playback.samples.get() as u64;
-        // S = (F mod L)·n·2¹²: ⌊S/L⌋ and S mod L; g = gcd(S, L) = gcd(S mod L, L).
-        let (step, s_rem) = mul_div_rem(
-            playback.frame_us as u64 % loop_us,
-            samples << T_BITS,
-            loop_us,
-        );
-        // g ≥ 1 as L ≥ 1.
-        let g = gcd(s_rem, loop_us);
-        let (step_rem, den) = match (s_rem.checked_div(g), loop_us.checked_div(g)) {
-            (Some(rem), Some(den)) => (rem, den),
-            _ => (0, 1),
+        // g = gcd(n·2¹², L): every X mod L is a multiple of it.
+        let g = match (samples << T_BITS).checked_rem(loop_us) {
+            Some(r) => gcd(r, loop_us),
+            None => 1,
+        };
+        let den = match loop_us.checked_div(g) {
+            Some(den) => den,
+            None => 1,
         };
         let incremental = samples < 1 << 19 && den < 1 << 31;
-        Self {
+        let mut cursor = Self {
             playback,
             origin: 0,
-            next: 0,
+            here: 0,
             pos: 0,
             rem: 0,
-            step: if incremental { step as u32 } else { 0 },
-            step_rem: if incremental { step_rem as u32 } else { 0 },
+            step: 0,
+            step_rem: 0,
             den: if incremental { den as u32 } else { 1 },
             windows: [Window::EMPTY; 3],
             ahead: 0,
             incremental,
             positioned: false,
-            loaded: false,
+            read: Read::Sample,
+        };
+        cursor.set_frame_period(playback.frame_period());
+        cursor
+    }
+
+    /// The position of time `at` (µs from the loops' start) as the cursor
+    /// keeps it: `⌊X/L⌋` and `(X mod L)/g` (see the module docs; divides).
+    #[must_use]
+    pub const fn position_of(&self, at: u64) -> (u32, u32) {
+        let (pos, rem) = self.playback.locate_at(at, T_BITS);
+        let g = match self.playback.loop_us.get().checked_div(self.den as u64) {
+            Some(g) => g,
+            None => 1,
+        };
+        let rem = match rem.checked_div(g) {
+            Some(r) => r,
+            None => 0,
+        };
+        (pos as u32, rem as u32)
+    }
+
+    /// Plays other loops of the same playback from time `origin` on, where
+    /// these loops stood at `shift` (a [`position_of`](Self::position_of)):
+    /// the position goes on from where it is, less `shift`, and the next
+    /// frame reads whole windows of the new loops; no division (a join
+    /// lands between two frames at most rates). Not positioned yet, the
+    /// next frame is located from its time.
+    pub const fn rebase(&mut self, origin: u64, shift: (u32, u32)) {
+        self.origin = origin;
+        if !self.positioned || !self.incremental {
+            return;
+        }
+        let wrap = (self.playback.samples.get() as u32) << T_BITS;
+        // (pos, rem) − shift, borrowing from pos, modulo the loop.
+        let (mut pos, mut rem) = (self.pos, self.rem);
+        if rem < shift.1 {
+            rem += self.den - shift.1;
+            pos = if pos == 0 { wrap - 1 } else { pos - 1 };
+        } else {
+            rem -= shift.1;
+        }
+        let shift = if shift.0 >= wrap { 0 } else { shift.0 };
+        pos = if pos >= shift {
+            pos - shift
+        } else {
+            pos + wrap - shift
+        };
+        self.pos = pos;
+        self.rem = rem;
+        self.read = Read::Stale;
+    }
+
+    /// Frames come `period` apart from the last frame played on: the step
+    /// `S` for it (its divisions happen here, not on the frame path). The
+    /// position stays where it is.
+    pub const fn set_frame_period(&mut self, period: Microseconds) {
+        self.playback = self.playback.with_frame_period(period);
+        let loop_us = self.playback.loop_us.get();
+        let samples = self.playback.samples.get() as u64;
+        // S = (F mod L)·n·2¹²: ⌊S/L⌋ and (S mod L)/g.
+        let f = match (self.playback.frame_us as u64).checked_rem(loop_us) {
+            Some(f) => f,
+            None => 0,
+        };
+        let (step, s_rem) = mul_div_rem(f, samples << T_BITS, loop_us);
+        let g = match loop_us.checked_div(self.den as u64) {
+            Some(g) => g,
+            None => 1,
+        };
+        let step_rem = match s_rem.checked_div(g) {
+            Some(r) => r,
+            None => 0,
+        };
+        if self.incremental {
+            self.step = step as u32;
+            self.step_rem = step_rem as u32;
         }
     }
 
-    /// Forgets the position and the samples read and plays frame `origin`
-    /// as the loops' frame 0: the next call locates its frame from its index
-    /// and reads whole windows.
+    /// Forgets the position and the samples read and plays the time
+    /// `origin` (µs) as the loops' time 0: the next call locates its frame
+    /// from its time and reads whole windows.
     pub const fn restart_at(&mut self, origin: u64) {
         self.origin = origin;
         self.positioned = false;
@@ -171,28 +270,29 @@ impl Cursor {
         &self.playback
     }
 
-    /// The three offsets (pitch, roll, yaw) of frame `frame` of `loops`:
-    /// those of [`Playback::offsets`], cheapest when `frame` follows the
-    /// last one.
+    /// The three offsets (pitch, roll, yaw) of the frame at `at` of
+    /// `loops`: those of [`Playback::offsets_at`] at `at − origin`,
+    /// cheapest when `at` follows the last frame by the frame period.
     #[inline(never)]
-    pub fn offsets<A: Axes + ?Sized>(&mut self, frame: u64, loops: &A) -> [Angle; 3] {
+    pub fn offsets<A: Axes + ?Sized>(&mut self, at: Timestamp, loops: &A) -> [Angle; 3] {
+        let at = at.0;
         if !self.incremental {
-            let local = frame.wrapping_sub(self.origin);
+            let local = Timestamp(at.wrapping_sub(self.origin));
             return self
                 .playback
-                .offsets(local, [loops.axis(0), loops.axis(1), loops.axis(2)]);
+                .offsets_at(local, [loops.axis(0), loops.axis(1), loops.axis(2)]);
         }
-        if frame == self.next && self.positioned {
+        if self.positioned && at == self.here.wrapping_add(u64::from(self.playback.frame_us)) {
             let before = self.pos;
             self.advance();
-            self.next = frame.wrapping_add(1);
-            if self.loaded {
-                self.follow(before, loops);
-            } else {
-                self.complete(before, loops);
+            self.here = at;
+            match self.read {
+                Read::Segment => self.follow(before, loops),
+                Read::Sample => self.complete(before, loops),
+                Read::Stale => self.load((self.pos >> T_BITS) as usize, loops),
             }
-        } else if frame.wrapping_add(1) != self.next || !self.positioned {
-            self.seek(frame, loops);
+        } else if at != self.here || !self.positioned || self.read == Read::Stale {
+            self.seek(at, loops);
         }
         let t = self.pos & ((1 << T_BITS) - 1);
         // One set of weights for the three axes.
@@ -222,24 +322,24 @@ impl Cursor {
         }
     }
 
-    /// Goes to `frame` from its index, exactly, and reads its windows (only
-    /// the sample it lies on, if it lies on one).
+    /// Goes to time `at` exactly, and reads its windows (only the sample
+    /// it lies on, if it lies on one).
     #[inline(never)]
-    fn seek<A: Axes + ?Sized>(&mut self, frame: u64, loops: &A) {
-        let (pos, rem) = match frame.wrapping_sub(self.origin) {
+    fn seek<A: Axes + ?Sized>(&mut self, at: u64, loops: &A) {
+        let (pos, rem) = match at.wrapping_sub(self.origin) {
             0 => (0, 0),
-            local => self.playback.locate(local, T_BITS),
+            local => self.playback.locate_at(local, T_BITS),
         };
         // pos < n·2¹² < 2³¹; the remainder in units of g = L/den is below den.
         self.pos = pos as u32;
-        // (A remainder of 0, as at frame 0, needs no 64-bit division.)
+        // (A remainder of 0, as at time 0, needs no 64-bit division.)
         self.rem = if rem == 0 {
             0
         } else {
             let g = self.playback.loop_us.get().checked_div(u64::from(self.den));
             rem.checked_div(g.unwrap_or(1)).unwrap_or(0) as u32
         };
-        self.next = frame.wrapping_add(1);
+        self.here = at;
         self.positioned = true;
         let index = (self.pos >> T_BITS) as usize;
         if self.pos & ((1 << T_BITS) - 1) == 0 {
@@ -248,7 +348,7 @@ impl Cursor {
                 *window = Window::flat(loops.axis(i).angle(index).millidegrees());
             }
             self.ahead = 0;
-            self.loaded = false;
+            self.read = Read::Sample;
         } else {
             self.load(index, loops);
         }
@@ -312,7 +412,7 @@ impl Cursor {
             window.complete(loops.axis(i), n, index);
         }
         self.ahead = 0;
-        self.loaded = true;
+        self.read = Read::Segment;
     }
 
     /// Reads the windows around sample `index`.
@@ -322,7 +422,7 @@ impl Cursor {
             *window = Window::load(loops.axis(i), n, index);
         }
         self.ahead = 0;
-        self.loaded = true;
+        self.read = Read::Segment;
     }
 }
 

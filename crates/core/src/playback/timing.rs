@@ -4,7 +4,7 @@
 
 use core::num::{NonZeroU64, NonZeroUsize};
 
-use crate::units::{Angle, Microseconds, Millis};
+use crate::units::{Angle, Microseconds, Millis, Timestamp};
 
 /// A looping sequence of angles (one axis' trajectory).
 pub trait LoopSource {
@@ -138,6 +138,17 @@ impl Playback {
         (index, frac)
     }
 
+    /// The loop's position at time `at` (µs from its start, any number of
+    /// loops on): the sample index at or before it and the fraction towards
+    /// the next sample in Q16 (`0..65 536`). Exact.
+    #[must_use]
+    pub const fn position_at(&self, at: Timestamp) -> (usize, u32) {
+        let pos = self.locate_at(at.0, FRAC_BITS).0;
+        let index = (pos >> FRAC_BITS) as usize; // < samples
+        let frac = (pos & ((1 << FRAC_BITS) - 1)) as u32;
+        (index, frac)
+    }
+
     /// `X = t·n·2^bits` for frame `frame` (`t`: its time in the loop, µs):
     /// `(⌊X/L⌋, X mod L)`, exactly. `bits ≤ 16`.
     pub(crate) const fn locate(&self, frame: u64, bits: u32) -> (u64, u64) {
@@ -151,12 +162,45 @@ impl Playback {
         mul_div_rem(t, (self.samples.get() as u64) << bits, l)
     }
 
+    /// As [`locate`](Self::locate), for the time `at` µs from the loop's
+    /// start.
+    pub(crate) const fn locate_at(&self, at: u64, bits: u32) -> (u64, u64) {
+        let l = self.loop_us.get();
+        let Some(t) = at.checked_rem(l) else {
+            return (0, 0);
+        };
+        mul_div_rem(t, (self.samples.get() as u64) << bits, l)
+    }
+
+    /// This playback with frames `period` apart.
+    #[must_use]
+    pub const fn with_frame_period(mut self, period: Microseconds) -> Self {
+        if period.0 != 0 {
+            self.frame_us = period.0;
+        }
+        self
+    }
+
     /// The three offsets (pitch, roll, yaw) of frame `frame`, interpolated
     /// between samples with a cyclic Catmull-Rom spline. [`Player`](super::Player) gives
     /// the same values frame by frame at a fraction of the cost.
     #[must_use]
     pub fn offsets<L: LoopSource + ?Sized>(&self, frame: u64, loops: [&L; 3]) -> [Angle; 3] {
-        let (index, frac) = self.position(frame);
+        self.offsets_of(self.position(frame), loops)
+    }
+
+    /// The three offsets at time `at` (µs from the loop's start), as
+    /// [`offsets`](Self::offsets) gives them for a frame.
+    #[must_use]
+    pub fn offsets_at<L: LoopSource + ?Sized>(&self, at: Timestamp, loops: [&L; 3]) -> [Angle; 3] {
+        self.offsets_of(self.position_at(at), loops)
+    }
+
+    fn offsets_of<L: LoopSource + ?Sized>(
+        &self,
+        (index, frac): (usize, u32),
+        loops: [&L; 3],
+    ) -> [Angle; 3] {
         let t = frac >> (FRAC_BITS - T_BITS);
         let n = self.samples.get();
         loops.map(|l| {

@@ -204,8 +204,9 @@ macro_rules! fields {
 }
 
 // Ids 1 to 56 are the fields of layout version 1, in its order (`v1.rs`).
-// A new field takes the next free id (now 67), at the end; a new gesture's
-// block of five takes the next five free ids.
+// A new field takes the next free id (now 68), at the end; a new gesture's
+// block of five takes the next five free ids. (Ids 80 and up are taken in
+// blocks: 80 the DMX receiver's, 90 the servos' outputs'.)
 fields! { s;
     // The servos: pulses in µs, the scale in ns per degree, the direction,
     // the angle limits in millidegrees.
@@ -275,7 +276,10 @@ fields! { s;
     64 "input.3" => s.inputs.roles[1];
     65 "input.4" => s.inputs.roles[2];
     66 "input.5" => s.inputs.roles[3];
-    // The radar and the tracking (ids from 90: 67 and up are left for
+    // The servos' PWM rate and the frame rate, Hz (a record without it
+    // runs at 50 Hz).
+    67 "servo.rate" => s.rate;
+    // The radar and the tracking (ids from 90: 68 and up are left for
     // other fields): switches, the eyes' height (mm), the radar's bearing
     // (m°), whom first (0 nearest, 1 newest).
     90 "radar.on" => s.track.radar;

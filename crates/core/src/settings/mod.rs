@@ -81,7 +81,7 @@
 //!    an older firmware saved.
 //! 2. Add one row to the table in `fields.rs`, with the next free id (the
 //!    comment above the table says which):
-//!    `67 "look.speed" => s.behaviour.gaze.speed;`.
+//!    `68 "look.speed" => s.behaviour.gaze.speed;`.
 //! 3. Only if its type is new to the record: implement `FieldValue` for it
 //!    in `tlv.rs` (its bytes, and which bytes are a value).
 //!

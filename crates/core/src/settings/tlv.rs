@@ -7,7 +7,7 @@ use crate::behaviour::MilliHertz;
 use crate::command::{Hold, Percent};
 use crate::dmx::DmxAddress;
 use crate::driver::{DegreesPerSecond, DegreesPerSecondSquared};
-use crate::servo::{Direction, NanosPerDegree};
+use crate::servo::{Direction, NanosPerDegree, ServoRate};
 use crate::units::{Angle, Microseconds, Millis};
 
 use super::record::EncodeError;
@@ -368,6 +368,20 @@ impl FieldValue for crate::track::Prefer {
             1 => Some(Self::Newest),
             _ => None,
         }
+    }
+}
+
+/// Two little-endian bytes, the rate in Hz (50 to 333).
+impl FieldValue for ServoRate {
+    const MAX_LEN: usize = 2;
+
+    fn to_bytes(&self, out: &mut [u8]) -> usize {
+        put(out, &self.hz().to_le_bytes())
+    }
+
+    fn from_bytes(bytes: &[u8]) -> Option<Self> {
+        let pair = <[u8; 2]>::try_from(bytes).ok()?;
+        Self::new(u16::from_le_bytes(pair))
     }
 }
 

@@ -20,7 +20,7 @@ use crate::driver::{ConfigError, DriverConfig, DriverParams};
 use crate::input::{FIRST_INPUT, InputSettings};
 use crate::motion::DEFAULT_HEAD;
 use crate::seed::Seeding;
-use crate::servo::ServoCalibration;
+use crate::servo::{ServoCalibration, ServoRate};
 use crate::track::TrackSettings;
 
 /// Everything a person may change and save; see the [module docs](self).
@@ -42,6 +42,8 @@ pub struct Settings {
     pub seeding: Seeding,
     /// The radar and the tracking ([`crate::track`]).
     pub track: TrackSettings,
+    /// The servos' PWM rate, and so the frame rate.
+    pub rate: ServoRate,
 }
 
 /// Why settings are not valid.
@@ -93,18 +95,22 @@ impl Settings {
         inputs: InputSettings::DEFAULT,
         seeding: Seeding::Board,
         track: TrackSettings::DEFAULT,
+        rate: ServoRate::DEFAULT,
     };
 
-    /// `base` with these settings' servos.
+    /// `base` with these settings' servos, and their rate's period for the
+    /// frames and the PWM.
     #[must_use]
     pub const fn driver_config(&self, base: &DriverConfig) -> DriverConfig {
         let mut config = *base;
         config.servos = self.servos;
+        config.frame_period = self.rate.period();
+        config.pwm.period = self.rate.period();
         config
     }
 
-    /// Checks the settings with `base`'s frame period, PWM, neutral pose
-    /// and speed limits, as the typed configurations are checked.
+    /// Checks the settings at their rate with `base`'s neutral pose and
+    /// speed limits, as the typed configurations are checked.
     ///
     /// # Errors
     /// The first problem found: [`SettingsError::Driver`] for a servo,

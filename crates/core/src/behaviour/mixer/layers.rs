@@ -4,24 +4,26 @@
 use crate::command::GestureRequest;
 
 use super::super::error::BehaviourError;
-use super::super::fixed::{ONE, mul, progress, smootherstep};
+use super::super::fixed::{ONE, mul, smootherstep};
 use super::super::gesture::{self, GesturePlan};
+use super::super::params::BehaviourParams;
 use super::Mixer;
 use super::math::Sums;
 
-/// A gesture layer: its plan, start, and the start of its fade-out.
+/// A gesture layer: its plan, start, and the start of its fade-out
+/// (times in µs on the frame path's clock).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) struct Layer {
     plan: GesturePlan,
     start: u32,
     release: Option<u32>,
-    /// Frames from `start` to the layer's end: its plan's, or its fade's
-    /// once released.
+    /// µs from `start` to the layer's end: its plan's, or its fade's once
+    /// released.
     stop: u32,
 }
 
 impl Layer {
-    /// The frame the layer ends at (its plan's end, or its fade's).
+    /// The time the layer ends at (its plan's end, or its fade's).
     #[inline]
     pub(super) const fn end(&self) -> u32 {
         self.start.wrapping_add(self.stop)
@@ -46,19 +48,20 @@ impl Mixer {
                 .map(|l| l.end().wrapping_sub(next).min(l.stop))
                 .min()
                 .unwrap_or(0);
-            // The layer is cleared while mixing the frame it ends at.
+            // The layer is cleared while mixing the first frame at or
+            // past its end.
             return Err(BehaviourError::Busy {
-                retry_in: self.params.millis(left + 1),
+                retry_in: BehaviourParams::millis(left.saturating_add(self.period)),
             });
         };
-        let blend = self.params.blend;
+        let blend = self.params.blend.len();
         // The new layer starts, and the others fade, from the last frame
         // mixed (see `apply_at`).
         let start = self.now;
         for layer in self.layers.iter_mut().flatten() {
             if layer.release.is_none() {
                 layer.release = Some(start);
-                // The fade ends `blend` frames on, if the plan has not ended by then.
+                // The fade ends `blend` on, if the plan has not ended by then.
                 let fade_end = start.wrapping_sub(layer.start).saturating_add(blend);
                 layer.stop = layer.stop.min(fade_end);
             }
@@ -68,13 +71,13 @@ impl Mixer {
                 plan,
                 start,
                 release: None,
-                stop: plan.frames,
+                stop: plan.span.len(),
             });
         }
         Ok(plan)
     }
 
-    /// The gesture layers at frame `now`, summed per axis; clears the
+    /// The gesture layers at time `now`, summed per axis; clears the
     /// layers that have ended.
     #[inline]
     pub(super) fn layers(&mut self, now: u32) -> Sums {
@@ -87,12 +90,11 @@ impl Mixer {
                 *slot = None;
                 continue;
             }
-            // t < stop ≤ the plan's frames.
+            // t < stop ≤ the plan's span.
             let (mut value, mut strength) = layer.plan.at(t);
             if let Some(release) = layer.release {
                 // now − release < blend: before the stop.
-                let fade =
-                    ONE - smootherstep(progress(now.wrapping_sub(release), params.blend_inverse));
+                let fade = ONE - smootherstep(params.blend.progress(now.wrapping_sub(release)));
                 value = mul(value, fade);
                 strength = mul(strength as i32, fade) as u32;
             }

@@ -64,18 +64,18 @@ pub(super) struct Countdown {
     pub(super) on: u8,
     /// Bit `i`: axis `i` was on at the last frame mixed in full.
     pub(super) was_on: u8,
-    /// Frames in gesture mode after an axis was last on.
+    /// µs in gesture mode after an axis was last on.
     pub(super) settle: u32,
-    /// Frames since the last frame mixed, and since the last mixed in full.
+    /// µs since the last frame mixed, and since the last mixed in full.
     pub(super) since_prev: u32,
     pub(super) since_full: u32,
 }
 
 impl Countdown {
-    /// Axis `i`'s limit mode from the next frame on, its frames `left` in
-    /// gesture mode updated: gesture while on (and `settle` frames after) or
-    /// when a return starts (`soon`). An axis off but still settling lowers
-    /// `soonest` to the frames until it settles.
+    /// Axis `i`'s limit mode from the next frame on, its time `left` in
+    /// gesture mode updated: gesture while on (and `settle` after) or when a
+    /// return starts (`soon`). An axis off but still settling lowers
+    /// `soonest` to the time until it settles.
     #[inline]
     pub(super) fn mode(&self, i: u32, left: &mut u32, soon: bool, soonest: &mut u32) -> LimitMode {
         let bit = 1 << i;
@@ -84,7 +84,7 @@ impl Countdown {
             return LimitMode::Gesture;
         }
         // Off since the last frame (on until then), or since the last frame
-        // mixed in full: gesture mode counts down by the frames passed.
+        // mixed in full: gesture mode counts down by the time passed.
         *left = if self.was_on & bit != 0 {
             self.settle.saturating_sub(self.since_prev)
         } else {

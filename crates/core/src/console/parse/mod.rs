@@ -22,6 +22,7 @@
 //! track [on | off | height <mm> | mount <yaw_mdeg> | prefer nearest|newest]
 //! servo <pitch|roll|yaw> [neutral <us> | per-degree <ns> | direction <normal|reversed>
 //!                        | min <us> | max <us> | limits <min_mdeg> <max_mdeg>]
+//! servo rate [<hz>]                                     (hz 50..=333)
 //! watch <hz> | watch off                                (hz 1..=50)
 //! dmx [on | off | address <1..503>]
 //! ```
@@ -54,7 +55,7 @@ use crate::command::{
     Action, Command, GestureKind, GestureRequest, Hold, LookRequest, Percent, SeedChoice,
     ServoSetting,
 };
-use crate::servo::{Direction, NanosPerDegree};
+use crate::servo::{Direction, NanosPerDegree, ServoRate};
 use crate::units::{Angle, AngleRange, Microseconds, Millis};
 
 mod dmx;
@@ -144,6 +145,11 @@ const SEED: Field = Field::new("seed", 0, u32::MAX as i64);
 const PULSE: Field = Field::new("pulse in us", 0, u32::MAX as i64);
 const PER_DEGREE: Field = Field::new("ns per degree", 0, u32::MAX as i64);
 const WATCH_HZ: Field = Field::new("lines a second", 1, crate::console::MAX_WATCH_HZ as i64);
+const RATE_HZ: Field = Field::new(
+    "servo rate in Hz",
+    ServoRate::MIN.hz() as i64,
+    ServoRate::MAX.hz() as i64,
+);
 
 fn to_angle(v: i64) -> Angle {
     Angle::from_millidegrees(v as i32)
@@ -252,9 +258,9 @@ fn watch(words: &mut Words<'_>) -> Result<Command, ParseError> {
     Ok(Command::Watch(Some(word.number(&WATCH_HZ)? as u8)))
 }
 
-/// `servo <axis> [<field> <value>...]`.
+/// `servo <axis> [<field> <value>...]`, `servo rate [<hz>]`.
 fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
-    const AXES: &str = "`pitch`, `roll` or `yaw`";
+    const AXES: &str = "`pitch`, `roll`, `yaw` or `rate`";
     const FIELDS: &str = "`neutral`, `per-degree`, `direction`, `min`, `max` or `limits`";
     let Some(word) = words.next() else {
         return Err(words.error_here(ParseErrorKind::Missing(AXES)));
@@ -263,6 +269,13 @@ fn servo(words: &mut Words<'_>) -> Result<Command, ParseError> {
         Word::Is(Kw::Pitch) => Axis::Pitch,
         Word::Is(Kw::Roll) => Axis::Roll,
         Word::Is(Kw::Yaw) => Axis::Yaw,
+        Word::Is(Kw::Rate) => {
+            let hz = words.optional_number(&RATE_HZ)?;
+            // Within the field's range: a rate.
+            return Ok(Command::ServoRate(
+                hz.and_then(|hz| ServoRate::new(hz as u16)),
+            ));
+        }
         _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: AXES })),
     };
     let Some(field) = words.next() else {

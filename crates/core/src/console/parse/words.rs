@@ -123,6 +123,7 @@ keywords! {
     Newest "newest",
     Board "board",
     Paper "paper",
+    Rate "rate",
 }
 
 /// [`KEYWORDS`]' indices with the words in byte order (they are lower case

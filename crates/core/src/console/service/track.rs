@@ -122,8 +122,8 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
         };
     }
 
-    /// ` seed=board|paper|<n>` for `status` (short: the line is near its
-    /// 160 bytes; `seed` alone gives the board's `n`).
+    /// ` seed=board|paper|<n>` for `status` (short: `seed` alone gives the
+    /// board's `n`).
     pub(super) fn status_track(&self, out: &mut dyn Text) {
         out.str(" seed=");
         match self.settings.shown_seed(self.board) {
