@@ -169,11 +169,7 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         // µs · ticks/s / 10^6 µs/s; frame period < 2^32 µs, tick_hz < 2^32
         // for any real timer: no overflow.
         let period = u64::from(frame_period.get()) * tick_hz / 1_000_000;
-        // A frame written later than the PWM's margin before its wrap
-        // misses its pulse: the clock skips to the next one.
-        let margin = u64::from(idle_head_core::pwm_clock::WRAP_MARGIN_DIVISOR);
-        let clock = FrameClock::new(period, start, Microseconds(params.frame_us()))?
-            .with_latch_divisor(margin);
+        let clock = FrameClock::new(period, start, Microseconds(params.frame_us()))?;
         Ok(Self {
             head: Head::new(idle, params),
             clock,
@@ -183,6 +179,15 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
             retime: rate::Retime::new(period, params.frame_us()),
             at: Timestamp(0),
         })
+    }
+
+    /// Outputs that latch a duty a `1/divisor` of a period after the
+    /// frame's deadline ([`SetPeriod::LATCH_DIVISOR`]): a frame that wakes
+    /// later misses its pulse, and the clock skips to the next one.
+    #[must_use]
+    pub const fn with_latch_divisor(mut self, divisor: u32) -> Self {
+        self.clock = self.clock.with_latch_divisor(divisor as u64);
+        self
     }
 
     /// Takes commands from `queue` (at most two a frame).

@@ -117,6 +117,7 @@ pub async fn play<P: SetPeriod, H: FrameHooks<P>>(
         return (RunStats::default(), IdleStats::default());
     };
     let mut frames = frames
+        .with_latch_divisor(P::LATCH_DIVISOR)
         .with_commands(&COMMANDS)
         .with_link(&LINK)
         .with_show(&SHOW);

@@ -127,6 +127,8 @@ impl SetDutyCycle for ServoPwm {
 }
 
 impl SetPeriod for ServoPwm {
+    const LATCH_DIVISOR: u32 = WRAP_MARGIN_DIVISOR;
+
     /// The clock of `period` from the system clock, exactly (see the
     /// module docs): it takes effect at the next duty written.
     fn set_period(&mut self, period: Microseconds) -> Result<(), PwmError> {

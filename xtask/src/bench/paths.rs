@@ -16,12 +16,13 @@ use crate::sim::{BYTE_TIME, UartScript, run_shipped};
 pub type Measure = fn(&Path, &Metadata, Duration) -> Result<Row>;
 
 /// Every latency path, in the order the bench prints them.
-pub const PATHS: [Measure; 5] = [
+pub const PATHS: [Measure; 6] = [
     latency::dmx,
     usb_look,
     uart_look,
     latency::input_edge,
     bottango,
+    uart_look_200_hz,
 ];
 
 /// The `look` events' lines: with the idle off, yaw a degree there and back.
@@ -64,11 +65,48 @@ pub fn usb_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
 /// `latency uart look`: `look` lines over UART0 at 115200 baud, each in by
 /// its time.
 pub fn uart_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
+    let times = schedule(Duration::from_secs(4), SCHEDULED, LOOK_GAP, 0x0a47_100c);
+    let boot = uart_looks(root, metadata, wall, b"idle off\n", &times)?;
+    let events: Vec<f64> = boot.uart_lines.iter().skip(1).copied().collect();
+    latency::row("uart look", &events, &boot)
+}
+
+/// `latency uart look at 200 Hz`: the same after `servo rate 200`, against
+/// its own goal (a 5 ms frame and the transport).
+pub fn uart_look_200_hz(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
+    let times = schedule(Duration::from_secs(4), SCHEDULED, LOOK_GAP, 0x200_100c);
+    let boot = uart_looks(root, metadata, wall, b"idle off\nservo rate 200\n", &times)?;
+    if !boot
+        .uart
+        .starts_with(b"ok\r\nok servo rate=200 period_us=5000\r\n")
+    {
+        bail!(
+            "uart look at 200 Hz: the rate was not taken: {:?}",
+            String::from_utf8_lossy(&boot.uart[..boot.uart.len().min(80)])
+        );
+    }
+    let events: Vec<f64> = boot.uart_lines.iter().skip(1).copied().collect();
+    latency::row_at(
+        "uart look at 200 Hz",
+        &events,
+        &boot,
+        (5e6, latency::GOAL_200_HZ_MS),
+    )
+}
+
+/// A run of `look` lines over UART0 at `times` after `setup` (one or more
+/// lines, at 2.5 s); its boot, every line answered `ok`.
+fn uart_looks(
+    root: &Path,
+    metadata: &Metadata,
+    wall: Duration,
+    setup: &[u8],
+    times: &[Duration],
+) -> Result<crate::sim::Boot> {
     let start = Duration::from_secs(4);
-    let times = schedule(start, SCHEDULED, LOOK_GAP, 0x0a47_100c);
     let mut scripts = vec![UartScript::new(
         0,
-        b"idle off\n".to_vec(),
+        setup.to_vec(),
         Duration::from_millis(2500),
     )];
     scripts.extend(times.iter().enumerate().map(|(k, &at)| {
@@ -81,13 +119,17 @@ pub fn uart_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row
         config.uart = scripts;
         Ok(())
     })?;
-    let boot = report.boots.first().context("no boot")?;
-    let events: Vec<f64> = boot.uart_lines.iter().skip(1).copied().collect();
-    if events.len() != times.len() {
-        bail!("{} UART lines went out, not {}", events.len(), times.len());
+    let boot = report.boots.into_iter().next().context("no boot")?;
+    // One script for the setup, one for each look.
+    if boot.uart_lines.len() != times.len() + 1 {
+        bail!(
+            "{} UART scripts went out, not {}",
+            boot.uart_lines.len(),
+            times.len() + 1
+        );
     }
     all_ok(&boot.uart, "uart look")?;
-    latency::row("uart look", &events, boot)
+    Ok(boot)
 }
 
 /// The gaps between Bottango's curves: a 40 ms step, then a hold.

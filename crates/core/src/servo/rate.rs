@@ -92,6 +92,14 @@ const _: () = {
 /// no pulse is cut or stretched, and the old period's last pulse is the
 /// last one at the old rate.
 pub trait SetPeriod: SetDutyCycle {
+    /// How late after its deadline a frame's duty may still be written for
+    /// its own pulse, as a divisor of the period: the RP boards' outputs
+    /// latch a duty a tenth of a period after the deadline
+    /// ([`WRAP_MARGIN_DIVISOR`](crate::pwm_clock::WRAP_MARGIN_DIVISOR)); an
+    /// output with no such latch (a simulated one) takes a duty any time
+    /// in the period (1, the default).
+    const LATCH_DIVISOR: u32 = 1;
+
     /// Runs the output at `period` from the next duty written on.
     ///
     /// # Errors
