@@ -123,3 +123,21 @@ fn the_telemetry_figures_in_the_protocol_document_hold() {
         );
     }
 }
+
+/// The show document's DMX personality gives every gesture of the table
+/// its trigger band, as the core reads slot 8.
+#[test]
+fn the_show_document_gives_every_gesture_its_dmx_band() {
+    use idle_head_core::dmx::Trigger;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/user/show.md");
+    let doc = std::fs::read_to_string(path).expect("docs/user/show.md");
+    let row = doc
+        .lines()
+        .find(|line| line.starts_with("| 8 | gesture trigger:"))
+        .expect("the trigger slot's row");
+    for kind in idle_head_core::command::GestureKind::ALL {
+        let band = Trigger::band(kind);
+        let text = format!("{}–{} {}", band.start(), band.end(), kind.name());
+        assert!(row.contains(&text), "`{text}` missing from {row:?}");
+    }
+}

@@ -53,30 +53,67 @@ const fn wide(coarse: u8, fine: u8) -> u16 {
     (coarse as u16) << 8 | fine as u16
 }
 
-/// The gesture trigger's bands (slot 8). A gesture fires when the slot
-/// enters its band, and not again until the slot has left it.
+/// The gesture trigger's bands (slot 8), [`BAND`] values wide: one per
+/// gesture of the table ([`GestureKind::ALL`]), in its order, from 10 on,
+/// around the centre's band (70–89, where it always was). A gesture fires
+/// when the slot enters its band, and not again until the slot has left it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Trigger {
-    /// 0–9 and 90–255: nothing.
+    /// Below 10, and above the last gesture's band: nothing.
     None,
-    /// 10–29 nod, 30–49 shake, 50–69 tilt.
+    /// A gesture's band (10–29 nod, 30–49 shake, 50–69 tilt, then from 90
+    /// on the gestures after them).
     Gesture(GestureKind),
     /// 70–89: back to the centre.
     Center,
 }
 
+/// The width of a band.
+pub const BAND: u8 = 20;
+/// Where the first gesture's band starts.
+const FIRST: u8 = 10;
+/// Where the centre's band starts.
+const CENTER: u8 = 70;
+
+/// How many gestures the bands have room for: up to 255 past the centre's.
+const ROOM: usize = ((u8::MAX - FIRST + 1 - BAND) / BAND) as usize;
+const _: () = assert!(
+    GestureKind::ALL.len() <= ROOM,
+    "the DMX trigger slot is full: a gesture past the eleventh has no band"
+);
+
 impl Trigger {
     /// The band `value` lies in.
     #[must_use]
     pub const fn of(value: u8) -> Self {
-        match value {
-            10..=29 => Self::Gesture(GestureKind::Nod),
-            30..=49 => Self::Gesture(GestureKind::Shake),
-            50..=69 => Self::Gesture(GestureKind::Tilt),
-            70..=89 => Self::Center,
-            _ => Self::None,
+        if value >= CENTER && value < CENTER + BAND {
+            return Self::Center;
         }
+        if value < FIRST {
+            return Self::None;
+        }
+        // The bands as if the centre's were not there.
+        let packed = if value >= CENTER { value - BAND } else { value };
+        let index = ((packed - FIRST) / BAND) as usize;
+        if index < GestureKind::ALL.len() {
+            Self::Gesture(GestureKind::ALL[index])
+        } else {
+            Self::None
+        }
+    }
+
+    /// The values of gesture `kind`'s band.
+    #[must_use]
+    pub const fn band(kind: GestureKind) -> core::ops::RangeInclusive<u8> {
+        let mut index = 0;
+        while index < GestureKind::ALL.len() && GestureKind::ALL[index] as u8 != kind as u8 {
+            index += 1;
+        }
+        // `ROOM` bands fit: the start stays below 255 - BAND.
+        let start = FIRST + BAND * index as u8;
+        let start = if start >= CENTER { start + BAND } else { start };
+        start..=start + (BAND - 1)
     }
 }
 
@@ -114,5 +151,24 @@ mod tests {
                 None, None, nod, nod, shake, shake, tilt, tilt, Center, Center, None, None
             ]
         );
+    }
+
+    /// Every gesture of the table has a band of its own, and every value
+    /// of a band fires its gesture.
+    #[test]
+    fn every_gesture_has_its_band() {
+        let mut seen = Vec::new();
+        for kind in GestureKind::ALL {
+            let band = Trigger::band(kind);
+            assert_eq!(band.end() - band.start(), BAND - 1);
+            for value in band.clone() {
+                assert_eq!(Trigger::of(value), Trigger::Gesture(kind), "{value}");
+            }
+            assert!(!(70..=89).contains(band.start()));
+            seen.push(band);
+        }
+        assert_eq!(seen.len(), GestureKind::ALL.len());
+        assert_eq!(Trigger::band(GestureKind::Nod), 10..=29);
+        assert_eq!(Trigger::band(GestureKind::Tilt), 50..=69);
     }
 }
