@@ -11,8 +11,8 @@ import { fields, refusal } from './link.js';
 
 const $ = (id) => document.getElementById(id);
 
-/** The built-in rest settings (`rest after 120`, `rest pose -8000 0 0`, `rest relax off`). */
-const BUILT_IN = { seconds: 120, never: false, pose: [-8, 0, 0], relax: false };
+/** The built-in rest settings (`rest after 120`, `rest pose 8000 0 0`, `rest relax off`). */
+const BUILT_IN = { seconds: 120, never: false, pose: [8, 0, 0], relax: false };
 const POSE = ['pitch', 'roll', 'yaw'];
 
 let page = null; // {ask, refreshStatus}

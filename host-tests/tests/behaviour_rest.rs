@@ -65,9 +65,9 @@ fn rest_glides_to_the_pose_within_the_idle_limits_and_holds_it() {
     let frames = u64::from(duration.0 / 20);
     rig.run(frames + 200);
     within_idle_limits(&rig.played[299..], "rest");
-    // There at the end of the glide, and held exactly: pitch −8°.
+    // There at the end of the glide, and held exactly: pitch 8° (nose down).
     for f in &rig.played[(300 + frames) as usize..] {
-        assert_eq!(f.angles, [-8000, 0, 0]);
+        assert_eq!(f.angles, [8000, 0, 0]);
         assert_eq!(f.rest, RestState::Resting);
         assert!(f.pulses.iter().all(|&p| p > 0), "pulses on without relax");
     }
@@ -109,7 +109,7 @@ fn relaxed_the_pulses_stop_and_a_wake_brings_them_back_softly_from_the_pose() {
     assert_eq!(woke[0].pulses, last_pulses);
     // The wake's first frame is a step in from the pose (the wake starts at
     // the last frame played): a few m°.
-    let from_pose = [-8000, 0, 0];
+    let from_pose = [8000, 0, 0];
     assert!(
         (0..3).all(|i| (woke[0].angles[i] - from_pose[i]).abs() <= 5),
         "{:?}",
@@ -202,10 +202,10 @@ fn a_button_pressed_while_the_head_rests_wakes_it_and_plays() {
     assert_eq!(woke[0].pulses, last);
     assert_eq!(woke[0].rest, RestState::Waking);
     let pitch: Vec<i32> = woke.iter().map(|f| f.angles[0]).collect();
-    // The nod's dips show: pitch goes well above the rest pose's −8°.
+    // The nod's dips show: pitch goes well below the rest pose's 8° (the dips add to it).
     let frames = (nod.duration.0 / 20) as usize;
     let highest = *pitch[..frames].iter().max().unwrap();
-    assert!(highest > -8000 + 4000, "{highest}");
+    assert!(highest > 8000 + 4000, "{highest}");
     assert_eq!(woke.last().unwrap().rest, RestState::Awake);
     // A look wakes it too.
     let mut rig = Rig::with(relaxing(), None);
@@ -240,14 +240,14 @@ fn a_new_pose_while_resting_is_glided_to() {
     rig.run(200);
     rig.apply(Action::Rest);
     rig.run(300);
-    assert_eq!(rig.played.last().unwrap().angles, [-8000, 0, 0]);
+    assert_eq!(rig.played.last().unwrap().angles, [8000, 0, 0]);
     let mut config = BehaviourConfig::DEFAULT;
     config.rest.pose = [-12_000, 5000, 10_000].map(Angle::from_millidegrees);
     let start = rig.played.len();
     rig.head.set_live(&mut rig.driver, &config.live());
     // The new pose at the next rest: `rest` again glides there.
     rig.run(5);
-    assert_eq!(rig.played.last().unwrap().angles, [-8000, 0, 0]);
+    assert_eq!(rig.played.last().unwrap().angles, [8000, 0, 0]);
     rig.apply(Action::Rest);
     rig.run(300);
     within_idle_limits(&rig.played[start..], "new pose");
@@ -270,7 +270,7 @@ fn stop_and_idle_changes_leave_the_rest_alone() {
     rig.apply(Action::Center { duration: None });
     rig.run(100);
     let f = rig.played.last().unwrap();
-    assert_eq!((f.angles, f.rest), ([-8000, 0, 0], RestState::Resting));
+    assert_eq!((f.angles, f.rest), ([8000, 0, 0], RestState::Resting));
     // Awake with nothing to do: a wake without a direction is nothing.
     let mut awake = Rig::new();
     awake.run(10);

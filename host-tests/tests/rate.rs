@@ -155,7 +155,7 @@ fn the_motion_is_the_same_in_time_at_50_200_and_333_hz() {
     let held = reference.iter().find(|f| f.at == 1_500_000).unwrap();
     assert!((held.offsets[0] - 10_000).abs() < 1500, "{held:?}");
     let pitch = |t: u64| angles_at(&reference, t)[0];
-    assert!((pitch(3 * MEET + 9_000_000) + 8000.0).abs() < 100.0);
+    assert!((pitch(3 * MEET + 9_000_000) - 8000.0).abs() < 100.0);
 }
 
 /// The frame driver alone at `hz`, its target jumping and swinging far

@@ -166,7 +166,7 @@ async function restAndWake(page, { pitchPulse }) {
   // page connected: the rest settings it cannot be asked for are the built-in ones.
   const pose0 = await Promise.all(['pitch', 'roll', 'yaw'].map((a) => page.getByLabel(`rest pose ${a} in degrees`).inputValue()));
   const after0 = await page.getByLabel('rest after, seconds with no one there').inputValue();
-  check(pose0.join(' ') === '-8 0 0' && after0 === '120', `rest settings on connect: the built-in pose ${pose0.join('°, ')}°, rest after ${after0} s`);
+  check(pose0.join(' ') === '8 0 0' && after0 === '120', `rest settings on connect: the built-in pose ${pose0.join('°, ')}°, rest after ${after0} s`);
   const after = page.getByLabel('rest after, seconds with no one there');
   await after.fill('0');
   await after.press('Enter');

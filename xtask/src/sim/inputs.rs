@@ -89,7 +89,7 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
         .all(|p| (degrees(0, p) - rest).abs() <= count(0));
     if !held {
         problems.push(
-            "the head did not hold the rest pose (pitch −8°) before the pulses stopped".into(),
+            "the head did not hold the rest pose (pitch 8°) before the pulses stopped".into(),
         );
     }
     // 2. Relaxed: seconds without pulses on every servo, ending after the

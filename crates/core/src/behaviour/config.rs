@@ -134,7 +134,7 @@ impl BehaviourConfig {
     /// ducked by 80 % on the look's axes while a look holds. Idle at
     /// 100 %, ducked by 60 % under a gesture, changes over 1 s. Gesture
     /// mode 250 °/s and 5000 °/s², for 500 ms after the motion. Rest with a
-    /// slight droop (pitch −8°), the pulses on.
+    /// slight droop (pitch 8°, nose down), the pulses on.
     pub const DEFAULT: Self = Self {
         gestures: GestureKind::DEFAULTS,
         max_frequency: MilliHertz(4000),
@@ -155,7 +155,7 @@ impl BehaviourConfig {
         gesture_limits: [GESTURE_LIMITS; 3],
         settle: Millis(500),
         rest: RestConfig {
-            pose: [Angle::from_millidegrees(-8000), Angle::ZERO, Angle::ZERO],
+            pose: [Angle::from_millidegrees(8000), Angle::ZERO, Angle::ZERO],
             relax: false,
         },
     };
