@@ -76,9 +76,11 @@ pub fn uart_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row
 pub fn uart_look_200_hz(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
     let times = schedule(Duration::from_secs(4), SCHEDULED, LOOK_GAP, 0x200_100c);
     let boot = uart_looks(root, metadata, wall, b"idle off\nservo rate 200\n", &times)?;
-    if !boot
-        .uart
-        .starts_with(b"ok\r\nok servo rate=200 period_us=5000\r\n")
+    let answered = String::from_utf8_lossy(&boot.uart);
+    if !answered
+        .lines()
+        .take(2)
+        .any(|line| line.trim_end() == "ok servo rate=200 period_us=5000")
     {
         bail!(
             "uart look at 200 Hz: the rate was not taken: {:?}",
