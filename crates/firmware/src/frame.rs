@@ -62,22 +62,20 @@ use idle_head_core::behaviour::{
     Applied, BehaviourError, BehaviourParams, CommandQueue, Head, HeadFrame, IdleSource,
     ShowEvents, ShowLink, TrackEvent,
 };
-use idle_head_core::command::{Action, Hold};
+use idle_head_core::command::Action;
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::dmx::Signal;
 use idle_head_core::driver::{FrameClock, FrameDriver, FrameReport, FrameTick, ZeroPeriod};
 use idle_head_core::{Angle, Microseconds, Timestamp};
 
 use crate::config::DEFAULT_BEHAVIOUR;
+use crate::log;
 
 mod rate;
 
-/// The latest a frame task woke after its deadline since boot, µs (for
-/// the status report).
-pub static LATEST_WAKE_US: AtomicU32 = AtomicU32::new(0);
-
 /// One frame of the loop: what [`FrameLoop::write`] played.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Frame {
     /// Frame index and frames skipped just before it.
     pub tick: FrameTick,
@@ -93,7 +91,8 @@ pub struct Frame {
 }
 
 /// What the frame task should do after a frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Flow {
     /// Play the next frame.
     Continue,
@@ -113,7 +112,8 @@ pub trait FrameHooks<P: SetDutyCycle> {
 }
 
 /// Totals returned by [`run`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, defmt::Format)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RunStats {
     /// Frames written (the start frame included).
     pub frames: u64,
@@ -320,19 +320,19 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
         };
         if let Some(live) = link.take_live() {
             self.head.set_live(driver, &live);
-            defmt::info!("frame {=u64}: rest and look settings changed", tick.frame);
+            log::info!("frame {=u64}: rest and look settings changed", tick.frame);
         }
         for (axis, cal) in idle_head_core::Axis::ALL.iter().zip(link.take_servos()) {
             let Some(cal) = cal else { continue };
             match self.head.set_servo(driver, *axis, cal) {
-                Ok(()) => defmt::info!(
+                Ok(()) => log::info!(
                     "frame {=u64}: {=str} servo calibration changed",
                     tick.frame,
                     axis.name()
                 ),
                 // `{}` of the error, not its `message()`: the per-axis
                 // message texts would take 2.5 KB of flash.
-                Err(e) => defmt::warn!(
+                Err(e) => log::warn!(
                     "frame {=u64}: {=str} servo calibration refused: {}",
                     tick.frame,
                     axis.name(),
@@ -386,7 +386,9 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
     }
 }
 
-/// Plays `frames` through `driver` until `hooks` says stop.
+/// Plays `frames` through `driver` until `hooks` says stop; the latest
+/// wake-up after a deadline goes to `latest_wake_us` (µs, for the status
+/// report).
 ///
 /// The first frame is due at once and writes the neutral pose
 /// ([`FrameDriver::start`]); the motion then fades in. Late frames and PWM
@@ -396,6 +398,7 @@ pub async fn run<P, I, H>(
     driver: &mut FrameDriver<P>,
     frames: &mut FrameLoop<'_, I>,
     hooks: &mut H,
+    latest_wake_us: &AtomicU32,
 ) -> RunStats
 where
     P: SetPeriod,
@@ -412,10 +415,10 @@ where
         if lateness > max_lateness {
             max_lateness = lateness;
             let us = Duration::from_ticks(lateness).as_micros();
-            LATEST_WAKE_US.store(u32::try_from(us).unwrap_or(u32::MAX), Ordering::Relaxed);
+            latest_wake_us.store(u32::try_from(us).unwrap_or(u32::MAX), Ordering::Relaxed);
         }
         if tick.skipped > 0 {
-            defmt::warn!(
+            log::warn!(
                 "frame {=u64}: woke {=u64} us late, skipped {=u64} frame(s)",
                 tick.frame,
                 Duration::from_ticks(lateness).as_micros(),
@@ -451,7 +454,7 @@ where
 /// signal's changes, the gestures its trigger fired.
 fn log_show(frame: u64, events: &ShowEvents) {
     if let Some(signal) = events.signal {
-        defmt::info!(
+        log::info!(
             "frame {=u64}: dmx: signal {=str}{=str}",
             frame,
             signal.as_str(),
@@ -471,10 +474,10 @@ fn log_show(frame: u64, events: &ShowEvents) {
 fn log_track(frame: u64, event: TrackEvent) {
     match event {
         TrackEvent::Turned(yaw) => {
-            defmt::info!("frame {=u64}: track: turned to yaw {}", frame, yaw);
+            log::info!("frame {=u64}: track: turned to yaw {}", frame, yaw);
         }
         TrackEvent::Released => {
-            defmt::info!("frame {=u64}: track: nobody left, back to centre", frame);
+            log::info!("frame {=u64}: track: nobody left, back to centre", frame);
         }
     }
 }
@@ -483,14 +486,14 @@ fn log_track(frame: u64, event: TrackEvent) {
 /// `"dmx "` for the DMX trigger) did before frame `frame`.
 fn log_outcome(frame: u64, via: &str, action: &Action, outcome: &Result<Applied, BehaviourError>) {
     match outcome {
-        Ok(applied) => defmt::info!(
+        Ok(applied) => log::info!(
             "frame {=u64}: {=str}{=str}: ok {}",
             frame,
             via,
             word(action),
             Started(applied)
         ),
-        Err(e) => defmt::warn!(
+        Err(e) => log::warn!(
             "frame {=u64}: {=str}{=str}: {}",
             frame,
             via,
@@ -504,14 +507,14 @@ fn log_faults(report: &FrameReport) {
     use idle_head_core::driver::Outcome;
     for (axis, servo) in idle_head_core::Axis::ALL.iter().zip(report.servos.iter()) {
         match servo.outcome {
-            Outcome::Failed(kind) => defmt::warn!(
+            Outcome::Failed(kind) => log::warn!(
                 "frame {=u64}: {=str} PWM write failed ({}); {=u32} fault(s) since the last report",
                 report.frame,
                 axis.name(),
                 kind,
                 report.unlogged_faults
             ),
-            Outcome::Disabled(kind) => defmt::error!(
+            Outcome::Disabled(kind) => log::error!(
                 "frame {=u64}: {=str} PWM keeps failing ({}): servo switched off",
                 report.frame,
                 axis.name(),
@@ -539,13 +542,17 @@ const fn word(action: &Action) -> &'static str {
 
 /// What an action started, for the log: the resolved figures in the
 /// user's units (the frame path's own fields left out).
+// (Read by the log's formatting only, which the `defmt` feature brings.)
+#[cfg_attr(not(feature = "defmt"), allow(dead_code))]
 struct Started<'a>(&'a Applied);
 
+#[cfg(feature = "defmt")]
 impl defmt::Format for Started<'_> {
     // defmt keeps each text in a symbol of its own: arms that differ in
     // their text alone look the same to clippy.
     #[allow(clippy::match_same_arms)]
     fn format(&self, f: defmt::Formatter<'_>) {
+        use idle_head_core::command::Hold;
         match self.0 {
             Applied::Gesture(plan) => {
                 defmt::write!(

@@ -41,6 +41,7 @@ pub mod exchange;
 pub mod frame;
 pub mod hooks;
 pub mod input;
+pub mod log;
 pub mod radar;
 pub mod report;
 pub mod storage;

@@ -64,14 +64,49 @@ use idle_head_core::settings::{
 use static_cell::StaticCell;
 
 use crate::boot::Loaded;
+use crate::log::{self, Loggable};
 
 /// The watchdog timeout the frames feed while a flash operation is under
 /// way: a 400 ms sector erase, with a wide margin.
 pub const FLASH_WATCHDOG_MS: u64 = 1000;
 
-/// Set while `save` or `load` uses the flash: the frames feed the watchdog
-/// with [`FLASH_WATCHDOG_MS`] (see the [module docs](self)).
-pub static FLASH_BUSY: AtomicBool = AtomicBool::new(false);
+/// Whether `save` or `load` uses the flash: while it does, the frames
+/// feed the watchdog with [`FLASH_WATCHDOG_MS`] (see the [module
+/// docs](self)). One lives in [`FLASH_BUSY`](crate::boot::FLASH_BUSY).
+pub struct FlashBusy(AtomicBool);
+
+impl FlashBusy {
+    /// Not busy.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self(AtomicBool::new(false))
+    }
+
+    /// Whether the flash is in use.
+    pub fn is_busy(&self) -> bool {
+        self.0.load(Ordering::Acquire)
+    }
+
+    /// The watchdog timeout the frames feed: `normal`, or
+    /// [`FLASH_WATCHDOG_MS`] while the flash is in use.
+    pub fn timeout(&self, normal: Duration) -> Duration {
+        if self.is_busy() {
+            Duration::from_millis(FLASH_WATCHDOG_MS)
+        } else {
+            normal
+        }
+    }
+
+    fn set(&self, busy: bool) {
+        self.0.store(busy, Ordering::Release);
+    }
+}
+
+impl Default for FlashBusy {
+    fn default() -> Self {
+        Self::new()
+    }
+}
 
 /// The store on flash driver `F`, with a work buffer for the settings
 /// record; erases go one sector at a time.
@@ -83,6 +118,8 @@ pub struct FlashStorage<F: NorFlash> {
     store: Option<Store<F>>,
     /// Feeds the board's watchdog for a timeout.
     feed: fn(Duration),
+    /// Set while an operation runs.
+    busy: &'static FlashBusy,
 }
 
 impl<F: NorFlash> FlashStorage<F> {
@@ -93,11 +130,11 @@ impl<F: NorFlash> FlashStorage<F> {
         op: impl FnOnce(&mut Store<F>) -> Result<T, StorageError>,
     ) -> Result<T, StorageError> {
         let store = self.store.as_mut().ok_or(StorageError::Device)?;
-        FLASH_BUSY.store(true, Ordering::Release);
+        self.busy.set(true);
         // A frame from here on feeds the long timeout too.
         (self.feed)(Duration::from_millis(FLASH_WATCHDOG_MS));
         let result = op(store);
-        FLASH_BUSY.store(false, Ordering::Release);
+        self.busy.set(false);
         result
     }
 }
@@ -126,8 +163,8 @@ impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
 /// it), and reads the settings in it, before the first frame (no watchdog,
 /// no frames yet), checked against `base`; the built-in settings if there
 /// are none or they are not usable. The log says which. `feed` feeds the
-/// board's watchdog before each later flash operation. `None` if `cell` was
-/// taken.
+/// board's watchdog before each later flash operation, and `busy` tells
+/// the frames that it runs. `None` if `cell` was taken.
 pub fn open<F>(
     cell: &'static StaticCell<FlashStorage<F>>,
     flash: F,
@@ -135,20 +172,21 @@ pub fn open<F>(
     address: u32,
     base: &DriverConfig,
     feed: fn(Duration),
+    busy: &'static FlashBusy,
 ) -> Option<Loaded<&'static mut FlashStorage<F>>>
 where
     F: NorFlash,
-    F::Error: defmt::Format,
+    F::Error: Loggable,
 {
     let store = Store::new(SectorWise(flash), range).ok();
     if store.is_none() {
-        defmt::error!("settings: no store: the region is not whole erase sectors");
+        log::error!("settings: no store: the region is not whole erase sectors");
     }
-    let storage = cell.try_init(FlashStorage { store, feed })?;
+    let storage = cell.try_init(FlashStorage { store, feed, busy })?;
     let loaded = storage.store.as_mut().and_then(|store| {
         let loaded = at_once(store.load());
         if loaded.is_none() {
-            defmt::error!("settings: defaults; the blocking flash driver waited");
+            log::error!("settings: defaults; the blocking flash driver waited");
         }
         loaded.and_then(|loaded| loaded_settings(loaded, base, address))
     });
@@ -173,7 +211,7 @@ fn at_once<F: Future>(future: F) -> Option<F::Output> {
 }
 
 /// The stored settings if they can be used with `base`, logged either way.
-fn loaded_settings<E: defmt::Format>(
+fn loaded_settings<E: Loggable>(
     loaded: Result<Stored<Settings>, LoadError<E, SettingsError>>,
     base: &DriverConfig,
     at: u32,
@@ -185,67 +223,67 @@ fn loaded_settings<E: defmt::Format>(
             fields,
         }) => match settings.validate(base) {
             Ok(valid) => {
-                defmt::info!(
+                log::info!(
                     "settings: loaded from flash (version {=u16}) at {=u32:#010x}",
                     version,
                     at
                 );
                 if version != Settings::VERSION {
-                    defmt::info!(
+                    log::info!(
                         "settings: migrated from version {=u16} to {=u16}",
                         version,
                         Settings::VERSION
                     );
                 }
                 if !fields.missing.is_empty() {
-                    defmt::info!(
+                    log::info!(
                         "settings: fields not in the stored record, on their defaults: {}",
                         fields.missing
                     );
                 }
                 if !fields.unknown.is_empty() {
-                    defmt::warn!(
+                    log::warn!(
                         "settings: fields of a newer firmware skipped (a save leaves them out): {}",
                         fields.unknown
                     );
                 }
                 if !fields.rejected.is_empty() {
-                    defmt::warn!(
+                    log::warn!(
                         "settings: fields with values out of range, on their defaults: {}",
                         fields.rejected
                     );
                 }
                 return Some((settings, valid));
             }
-            Err(e) => defmt::warn!(
+            Err(e) => log::warn!(
                 "settings: defaults; the stored settings fail validation: {}",
                 e
             ),
         },
         Err(LoadError::Empty) => {
-            defmt::info!("settings: defaults (empty store at {=u32:#010x})", at);
+            log::info!("settings: defaults (empty store at {=u32:#010x})", at);
         }
-        Err(LoadError::Older { found } | LoadError::Newer { found }) => defmt::warn!(
+        Err(LoadError::Older { found } | LoadError::Newer { found }) => log::warn!(
             "settings: defaults; the store at {=u32:#010x} holds settings of version {=u16}, not {=u16}",
             at,
             found,
             Settings::VERSION
         ),
-        Err(LoadError::TooLong { needs }) => defmt::warn!(
+        Err(LoadError::TooLong { needs }) => log::warn!(
             "settings: defaults; the record at {=u32:#010x} needs {=usize} B, more than this firmware reads",
             at,
             needs
         ),
-        Err(LoadError::Invalid(e)) => defmt::warn!(
+        Err(LoadError::Invalid(e)) => log::warn!(
             "settings: defaults; the stored settings fail validation: {}",
             e
         ),
-        Err(LoadError::Flash(e)) => defmt::warn!(
+        Err(LoadError::Flash(e)) => log::warn!(
             "settings: defaults; reading the store at {=u32:#010x} failed: {}",
             at,
             e
         ),
-        Err(LoadError::Corrupt) => defmt::warn!(
+        Err(LoadError::Corrupt) => log::warn!(
             "settings: defaults; the store at {=u32:#010x} is damaged",
             at
         ),
