@@ -76,16 +76,9 @@ fn micros(at: Instant) -> Micros {
 /// Never returns.
 pub async fn run(source: &mut impl InputSource, links: &Links) -> ! {
     let link = &links.console;
-    // (The settings are read into short scopes, not kept across an
+    // (The settings are read in `start` and `step`, not kept across an
     // `.await`: the task's future holds no copy of them.)
-    let mut inputs = {
-        // The boot's settings are these: no change to take.
-        let _ = link.take_inputs_changed();
-        let settings = link.input_settings();
-        pulls(source, &settings);
-        log_roles(&settings);
-        Inputs::new(&settings, micros(Instant::now()))
-    };
+    let mut inputs = start(source, links, Instant::now());
     let mut shown = Shown::default();
     let mut changed = false;
     loop {
@@ -109,6 +102,17 @@ pub async fn run(source: &mut impl InputSource, links: &Links) -> ! {
         // (The wait took the signal of a change of settings.)
         changed = matches!(woke, Either3::Third(()));
     }
+}
+
+/// The input task's start at `now`: the pulls for the settings in
+/// `links` (the boot's: no change to take), and the state machine.
+fn start(source: &mut impl InputSource, links: &Links, now: Instant) -> Inputs {
+    let link = &links.console;
+    let _ = link.take_inputs_changed();
+    let settings = link.input_settings();
+    pulls(source, &settings);
+    log_roles(&settings);
+    Inputs::new(&settings, micros(now))
 }
 
 /// What the log last said of the inputs.
@@ -188,3 +192,6 @@ fn log_roles(settings: &InputSettings) {
         log::info!("input {=u8}: {=str}", n, role.word());
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -19,7 +19,7 @@
 //!
 //! What a board adds is its hardware: the PWM outputs, the ports, the flash,
 //! the watchdog, the executors (see `idle-head-rp`, `boards/qemu`).
-#![no_std]
+#![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 #![warn(clippy::pedantic)]
 #![allow(
