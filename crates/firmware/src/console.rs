@@ -365,3 +365,6 @@ pub async fn run<P: Port, S: SettingsStorage>(
         log::info!("console {=str}: the host went away", name);
     }
 }
+
+#[cfg(test)]
+mod tests;

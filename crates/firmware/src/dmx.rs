@@ -91,3 +91,6 @@ impl Default for Receiver {
         Self::new()
     }
 }
+
+#[cfg(test)]
+mod tests;
