@@ -129,3 +129,6 @@ impl LoopSupply<SetRef> for ExchangeSupply {
         self.exchange.free.signal(set);
     }
 }
+
+#[cfg(test)]
+mod tests;

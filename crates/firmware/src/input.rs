@@ -93,14 +93,14 @@ pub async fn run(source: &mut impl InputSource, links: &Links) -> ! {
                 None => core::future::pending().await,
             }
         };
-        let woke = select3(
+        let event = select3(
             source.changed(levels, watched),
             timer,
             link.inputs_changed(),
         )
         .await;
         // (The wait took the signal of a change of settings.)
-        changed = matches!(woke, Either3::Third(()));
+        changed = matches!(event, Either3::Third(()));
     }
 }
 

@@ -23,16 +23,16 @@ macro_rules! level {
     ($name:ident, $local:ident, $dollar:tt) => {
         #[cfg(feature = "defmt")]
         macro_rules! $local {
-                    ($dollar($dollar t:tt)*) => { defmt::$name!($dollar($dollar t)*) };
-                }
+                            ($dollar($dollar t:tt)*) => { defmt::$name!($dollar($dollar t)*) };
+                        }
         #[cfg(not(feature = "defmt"))]
         macro_rules! $local {
-                    ($dollar fmt:literal $dollar(, $dollar arg:expr)* $dollar(,)?) => {{
-                        let _ = || {
-                            $dollar(let _ = &$dollar arg;)*
-                        };
-                    }};
-                }
+                            ($dollar fmt:literal $dollar(, $dollar arg:expr)* $dollar(,)?) => {{
+                                let _ = || {
+                                    $dollar(let _ = &$dollar arg;)*
+                                };
+                            }};
+                        }
         // (Under another name first: `warn` alone is also an attribute.)
         pub(crate) use $local as $name;
     };

@@ -290,3 +290,6 @@ fn loaded_settings<E: Loggable>(
     }
     None
 }
+
+#[cfg(test)]
+mod tests;

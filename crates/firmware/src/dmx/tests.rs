@@ -128,7 +128,12 @@ fn a_break_right_after_a_break_is_a_short_frame() {
 fn a_frame_of_more_than_a_universe_is_long() {
     let link = link(1);
     let mut receiver = synced(&link);
-    feed(&mut receiver, &link, &frame(0, usize::from(UNIVERSE) + 1), None);
+    feed(
+        &mut receiver,
+        &link,
+        &frame(0, usize::from(UNIVERSE) + 1),
+        None,
+    );
     receiver.take(Rx::Break, &link);
     assert_eq!(link.latest().1.seq, 0);
     assert_eq!(link.counters().long, 1);

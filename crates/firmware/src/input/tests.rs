@@ -127,7 +127,11 @@ const PRESSED: u8 = 0b0000;
 fn the_pulls_follow_the_roles_and_only_configured_inputs_are_watched() {
     let task = Task::new(button(), RELEASED);
     assert_eq!(task.source.pulls[0], Some(Pull::Up));
-    assert!(task.source.pulls[1..].iter().all(|p| *p == Some(Pull::Down)));
+    assert!(
+        task.source.pulls[1..]
+            .iter()
+            .all(|p| *p == Some(Pull::Down))
+    );
     let (levels, watched, _) = task.last;
     assert_eq!(levels, RELEASED);
     assert_eq!(watched, 0b0001);
