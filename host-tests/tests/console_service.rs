@@ -297,15 +297,7 @@ fn storage_errors_are_replies() {
         }
     }
     let (queue, link) = shared();
-    let mut svc = idle_head_core::console::ConsoleService::new(
-        queue,
-        link,
-        Broken,
-        idle_head_core::DriverConfig::DEFAULT,
-        idle_head_core::settings::Settings::DEFAULT,
-        idle_head_core::settings::SettingsSource::Defaults,
-    )
-    .unwrap();
+    let mut svc = idle_head_core::console::ConsoleService::with_defaults(queue, link, Broken);
     let mut out = [0; REPLY];
     assert_eq!(
         respond(Ok(b"save"), &mut svc, &mut out).now(),

@@ -98,13 +98,6 @@ pub static FLASH_BUSY: FlashBusy = FlashBusy::new();
 /// fills the other. All zero (the neutral pose) until generated.
 static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::new()]);
 
-/// The built-in settings, checked with the built-in driver configuration at
-/// compile time.
-pub const DEFAULT_SETTINGS: Validated = match Settings::DEFAULT.validate(&DriverConfig::DEFAULT) {
-    Ok(v) => v,
-    Err(_) => panic!("the built-in settings fail validation"),
-};
-
 /// The settings a board boots with, and the storage the console saves to.
 pub struct Loaded<S> {
     /// The console's storage.
@@ -124,7 +117,7 @@ impl<S> Loaded<S> {
             storage,
             settings: Settings::DEFAULT,
             source: SettingsSource::Defaults,
-            valid: DEFAULT_SETTINGS,
+            valid: Validated::DEFAULT,
         }
     }
 

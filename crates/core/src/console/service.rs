@@ -10,14 +10,12 @@
 //! use idle_head_core::behaviour::CommandQueue;
 //! use idle_head_core::console::{ConsoleLink, ConsoleService, Session};
 //! use idle_head_core::driver::DriverConfig;
-//! use idle_head_core::settings::{RamStorage, SETTINGS_BUFFER, Settings, SettingsSource};
+//! use idle_head_core::settings::{RamStorage, SETTINGS_BUFFER, Settings};
 //!
 //! static QUEUE: CommandQueue = CommandQueue::new();
 //! static LINK: ConsoleLink = ConsoleLink::new();
-//! let mut service = ConsoleService::new(
-//!     &QUEUE, &LINK, RamStorage::<SETTINGS_BUFFER>::new(), DriverConfig::DEFAULT,
-//!     Settings::DEFAULT, SettingsSource::Defaults,
-//! ).unwrap();
+//! let mut service =
+//!     ConsoleService::with_defaults(&QUEUE, &LINK, RamStorage::<SETTINGS_BUFFER>::new());
 //! let mut session = Session::<96, 160>::new();
 //! let mut replies = Vec::new();
 //! session.feed(b"servo yaw min 2600\nsave\n", &mut service, |r| replies.push(r.to_vec()));
@@ -180,6 +178,21 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
             show: None,
             board: crate::seed::BoardId::NONE,
         }
+    }
+
+    /// A service on the built-in settings and driver configuration
+    /// ([`Settings::DEFAULT`], [`DriverConfig::DEFAULT`], checked at compile
+    /// time), saving to `storage`: a head as it leaves the factory.
+    pub fn with_defaults(queue: &'a CommandQueue<N>, link: &'a ConsoleLink, storage: S) -> Self {
+        Self::checked(
+            queue,
+            link,
+            storage,
+            DriverConfig::DEFAULT,
+            Settings::DEFAULT,
+            SettingsSource::Defaults,
+            &Validated::DEFAULT,
+        )
     }
 
     /// Mixes `bits` from the board's entropy source into `seed random`.
