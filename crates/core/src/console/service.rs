@@ -92,6 +92,7 @@ use super::link::{ConsoleLink, HeadStatus};
 use super::outcome::behaviour_code;
 use super::reply::{ErrorCode, Reply};
 use super::session::Handler;
+use super::telemetry::{Angles, write_pose};
 use crate::axis::Axis;
 use crate::behaviour::{Asker, BehaviourParams, CommandQueue, ShowLink};
 use crate::command::{Action, Command, ServoSetting};
@@ -246,20 +247,13 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
 
     fn status(&self, reply: &mut Reply<'_>) {
         let s: HeadStatus = self.link.status();
-        let [p, r, y] = s.angles.map(crate::units::Angle::millidegrees);
-        let [pp, pr, py] = s.pulses.map(|us| us.0);
         let [fp, fr, fy] = s.faults;
         let off = s.disabled.iter().filter(|&&d| d).count();
-        text(reply.ok()).fill(
-            "mode={} mdeg={},{},{} us={},{},{} faults={},{},{} off={} uptime_ms={} fw={}{} settings={}",
+        text(reply.ok()).str("mode=").str(s.mode.as_str());
+        write_pose(text(reply), &s, Angles::Joined);
+        text(reply).fill(
+            " faults={},{},{} off={} uptime_ms={} fw={}{} settings={}",
             &[
-                Str(s.mode.as_str()),
-                Int(p.into()),
-                Int(r.into()),
-                Int(y.into()),
-                Uint(pp.into()),
-                Uint(pr.into()),
-                Uint(py.into()),
                 Uint(fp.into()),
                 Uint(fr.into()),
                 Uint(fy.into()),
