@@ -57,7 +57,7 @@ use embassy_time::Duration;
 use embedded_storage_async::nor_flash::NorFlash;
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::settings::{
-    LoadError, Loaded as Stored, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsError,
+    FlashFailed, Loaded as Stored, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsError,
     SettingsSource, SettingsStorage, SettingsStore, StorageError, Validated,
 };
 
@@ -129,7 +129,10 @@ impl<F: NorFlash> FlashStorage<F> {
         &mut self,
         op: impl FnOnce(&mut Store<F>) -> Result<T, StorageError>,
     ) -> Result<T, StorageError> {
-        let store = self.store.as_mut().ok_or(StorageError::Device)?;
+        let store = self
+            .store
+            .as_mut()
+            .ok_or(StorageError::Flash(FlashFailed))?;
         self.busy.set(true);
         // A frame from here on feeds the long timeout too.
         (self.feed)(Duration::from_millis(FLASH_WATCHDOG_MS));
@@ -143,7 +146,7 @@ impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
     fn save(&mut self, settings: &Settings) -> Result<(), StorageError> {
         self.guarded(|store| match at_once(store.save(settings)) {
             Some(result) => result.map_err(StorageError::from),
-            None => Err(StorageError::Device),
+            None => Err(StorageError::Flash(FlashFailed)),
         })
     }
 
@@ -151,8 +154,8 @@ impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
         self.guarded(|store| match at_once(store.load()) {
             Some(result) => result
                 .map(|loaded| loaded.record)
-                .map_err(StorageError::from),
-            None => Err(StorageError::Device),
+                .map_err(StorageError::forget_flash),
+            None => Err(StorageError::Flash(FlashFailed)),
         })
     }
 }
@@ -212,7 +215,7 @@ fn at_once<F: Future>(future: F) -> Option<F::Output> {
 
 /// The stored settings if they can be used with `base`, logged either way.
 fn loaded_settings<E: Loggable>(
-    loaded: Result<Stored<Settings>, LoadError<E, SettingsError>>,
+    loaded: Result<Stored<Settings>, StorageError<E, SettingsError>>,
     base: &DriverConfig,
     at: u32,
 ) -> Option<(Settings, Validated)> {
@@ -260,30 +263,34 @@ fn loaded_settings<E: Loggable>(
                 e
             ),
         },
-        Err(LoadError::Empty) => {
+        Err(StorageError::Empty) => {
             log::info!("settings: defaults (empty store at {=u32:#010x})", at);
         }
-        Err(LoadError::Older { found } | LoadError::Newer { found }) => log::warn!(
+        Err(StorageError::Older { found } | StorageError::Newer { found }) => log::warn!(
             "settings: defaults; the store at {=u32:#010x} holds settings of version {=u16}, not {=u16}",
             at,
             found,
             Settings::VERSION
         ),
-        Err(LoadError::TooLong { needs }) => log::warn!(
+        Err(StorageError::TooLong { needs: Some(needs) }) => log::warn!(
             "settings: defaults; the record at {=u32:#010x} needs {=usize} B, more than this firmware reads",
             at,
             needs
         ),
-        Err(LoadError::Invalid(e)) => log::warn!(
+        Err(StorageError::TooLong { needs: None }) => log::warn!(
+            "settings: defaults; the record at {=u32:#010x} is longer than this firmware reads",
+            at
+        ),
+        Err(StorageError::Invalid(e)) => log::warn!(
             "settings: defaults; the stored settings fail validation: {}",
             e
         ),
-        Err(LoadError::Flash(e)) => log::warn!(
+        Err(StorageError::Flash(e)) => log::warn!(
             "settings: defaults; reading the store at {=u32:#010x} failed: {}",
             at,
             e
         ),
-        Err(LoadError::Corrupt) => log::warn!(
+        Err(StorageError::Corrupt) => log::warn!(
             "settings: defaults; the store at {=u32:#010x} is damaged",
             at
         ),

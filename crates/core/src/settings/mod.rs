@@ -50,12 +50,12 @@
 //!   percentage over 100, a direction 2) keeps its default:
 //!   [`FieldReport::rejected`], a warning in the boot log;
 //! - an entry that runs past the end of the record, or a field stored
-//!   twice, makes the whole record [`LoadError::Corrupt`].
+//!   twice, makes the whole record [`StorageError::Corrupt`].
 //!
 //! Then the settings as a whole are checked as [`Settings::validate`]
 //! checks them, with the built-in driver configuration. If they fail, the
 //! **whole record is refused** with the reason
-//! ([`LoadError::Invalid`]`(`[`SettingsError`]`)`) and the board keeps
+//! ([`StorageError::Invalid`]`(`[`SettingsError`]`)`) and the board keeps
 //! its built-in settings: a calibration that is valid field by field but
 //! not as a whole (a neutral pulse outside the pulse range) has no single
 //! field to blame, and guessing one could point a servo past its stop.
@@ -69,8 +69,8 @@
 //! itself changes, and then the new firmware keeps a migration from the
 //! old one, as it does for version 1 (`v1.rs`: the 56 fields' values one
 //! after the other, without ids and lengths, read as the same fields). A
-//! record of a version with no migration is [`LoadError::Older`], of a
-//! version above this firmware's [`LoadError::Newer`]: the board keeps
+//! record of a version with no migration is [`StorageError::Older`], of a
+//! version above this firmware's [`StorageError::Newer`]: the board keeps
 //! its built-in settings, with a warning.
 //!
 //! # Adding a field
@@ -96,7 +96,7 @@
 //! [`SETTINGS_BUFFER`]: the longest record ([`SETTINGS_LEN`]), the map's
 //! key and the version, plus [`NEWER_FIELDS`] bytes for fields a newer
 //! firmware may have added (a newer record that is longer still is
-//! [`LoadError::TooLong`]; the built-in settings are used, and the next
+//! [`StorageError::TooLong`]; the built-in settings are used, and the next
 //! `save` starts the store afresh). Each field added makes the buffer
 //! grow by its value's length plus two bytes.
 //!
@@ -113,8 +113,8 @@
 //!
 //! **Damage.** An item whose CRC fails is skipped, so a damaged newest
 //! record loads as the one saved before it, or as
-//! [`LoadError::Empty`] if none is left; damage the map cannot repair is
-//! [`LoadError::Corrupt`]. A load never returns bytes that were not saved
+//! [`StorageError::Empty`] if none is left; damage the map cannot repair is
+//! [`StorageError::Corrupt`]. A load never returns bytes that were not saved
 //! as a record. A save reads its record back and writes it again past a
 //! damaged spot if needed.
 //!
@@ -122,6 +122,7 @@
 //! saving are not free of panic paths; they run at boot and on `save` or
 //! `load`, never on the frame path.
 
+mod error;
 mod fields;
 mod record;
 mod report;
@@ -134,14 +135,15 @@ mod tlv_inputs;
 mod v1;
 mod values;
 
+pub use error::{FlashFailed, StorageError};
 pub use fields::{FIELDS, Field, SETTINGS_LEN, field};
 pub use record::{DecodeError, EncodeError, RawRecord, Record};
 #[cfg(feature = "postcard")]
 pub use record::{decode_postcard, encode_postcard};
-pub use report::{FieldReport, FieldSet, LoadError, Loaded};
+pub use report::{FieldReport, FieldSet, Loaded};
 pub use sectors::SectorWise;
 pub use sequential_storage::map::MapConfigError;
-pub use storage::{RamStorage, SettingsStorage, StorageError};
+pub use storage::{RamStorage, SettingsStorage};
 pub use store::{SaveError, SettingsStore, buffer_len};
 pub use values::{Settings, SettingsError, SettingsSource, Validated};
 

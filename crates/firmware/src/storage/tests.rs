@@ -9,7 +9,9 @@ use embedded_storage_async::nor_flash::{
     ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash,
 };
 use idle_head_core::driver::DriverConfig;
-use idle_head_core::settings::{Settings, SettingsSource, SettingsStorage, StorageError};
+use idle_head_core::settings::{
+    FlashFailed, Settings, SettingsSource, SettingsStorage, StorageError,
+};
 use static_cell::StaticCell;
 
 use super::{FLASH_WATCHDOG_MS, FlashBusy, FlashStorage, open};
@@ -176,7 +178,10 @@ fn a_failing_flash_still_restores_the_normal_timeout() {
     let (storage, busy) = opened(WHOLE);
     let _ = events();
     storage.store.as_mut().unwrap().flash().0.broken = true;
-    assert_eq!(storage.save(&Settings::DEFAULT), Err(StorageError::Device));
+    assert_eq!(
+        storage.save(&Settings::DEFAULT),
+        Err(StorageError::Flash(FlashFailed))
+    );
     assert_guarded(&events());
     assert!(!busy.is_busy());
     assert!(storage.load().is_err());
@@ -188,8 +193,11 @@ fn no_store_is_a_device_error_without_touching_the_watchdog() {
     // A range of part of a sector: no store.
     let (storage, busy) = opened(0..100);
     let _ = events();
-    assert_eq!(storage.save(&Settings::DEFAULT), Err(StorageError::Device));
-    assert_eq!(storage.load(), Err(StorageError::Device));
+    assert_eq!(
+        storage.save(&Settings::DEFAULT),
+        Err(StorageError::Flash(FlashFailed))
+    );
+    assert_eq!(storage.load(), Err(StorageError::Flash(FlashFailed)));
     assert_eq!(events(), []);
     assert!(!busy.is_busy());
 }
