@@ -56,6 +56,7 @@ pub mod ring;
 pub mod seed;
 pub mod servo;
 pub mod settings;
+pub mod shared;
 pub mod text;
 pub mod track;
 pub mod units;
