@@ -21,17 +21,9 @@
 //! in the project's book (`docs/`, built by `cargo xtask book`): the user
 //! guide for the hardware and the console, the design notes for the method.
 #![cfg_attr(not(test), no_std)]
+// The core holds no unsafe code (the other lints are the workspace's, in
+// crates/Cargo.toml).
 #![forbid(unsafe_code)]
-#![deny(missing_docs)]
-#![warn(clippy::pedantic)]
-#![allow(
-    clippy::module_name_repetitions,
-    clippy::cast_possible_truncation,
-    clippy::cast_possible_wrap,
-    clippy::cast_sign_loss,
-    clippy::cast_lossless,
-    clippy::cast_precision_loss
-)]
 
 // A bare `cargo test` builds for the firmware's target, where no test can
 // run: say where the tests are instead of failing on each doc test.

@@ -20,16 +20,6 @@
 //! What a board adds is its hardware: the PWM outputs, the ports, the flash,
 //! the watchdog, the executors (see `idle-head-rp`, `boards/qemu`).
 #![cfg_attr(not(test), no_std)]
-#![deny(missing_docs)]
-#![warn(clippy::pedantic)]
-#![allow(
-    clippy::module_name_repetitions,
-    clippy::cast_possible_truncation,
-    clippy::cast_possible_wrap,
-    clippy::cast_sign_loss,
-    clippy::cast_lossless,
-    clippy::cast_precision_loss
-)]
 
 pub mod boot;
 #[cfg(feature = "calibrate")]

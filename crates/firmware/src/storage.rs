@@ -214,6 +214,9 @@ fn at_once<F: Future>(future: F) -> Option<F::Output> {
 }
 
 /// The stored settings if they can be used with `base`, logged either way.
+// defmt keeps each text in a symbol of its own: arms that differ in their
+// text alone look the same to clippy.
+#[allow(clippy::match_same_arms)]
 fn loaded_settings<E: Loggable>(
     loaded: Result<Stored<Settings>, StorageError<E, SettingsError>>,
     base: &DriverConfig,

@@ -20,9 +20,6 @@
 //!
 //! Exactly one chip feature: `rp2040` or `rp235xa`.
 #![no_std]
-#![deny(missing_docs)]
-#![warn(clippy::pedantic)]
-#![allow(clippy::cast_possible_truncation)]
 
 #[cfg(all(feature = "rp2040", feature = "rp235xa"))]
 compile_error!("choose one chip: the `rp2040` or the `rp235xa` feature");
