@@ -2,7 +2,7 @@
 //! allocation, no `unsafe`): motion generation after Kocoń's idle-loop method
 //! ([`motion`]), servo mapping ([`servo`]), frame playback ([`playback`]) and
 //! the frame driver ([`driver`]). The Raspberry Pi Pico image is
-//! `src/bin/pico/`; the QEMU images are a package of their own, `qemu/`.
+//! `src/main.rs`; the QEMU images are a package of their own, `boards/qemu/`.
 //!
 //! ```
 //! use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Mdeg16};
