@@ -50,7 +50,7 @@ impl std::fmt::Display for Missing {
 /// The comment of a source line, if it has one: what follows `//` in a
 /// Rust file, `#` in a manifest (a rough cut: a `//` or `#` inside a
 /// string counts too, which only makes the scan look at more text).
-fn comment<'l>(line: &'l str, rust: bool) -> Option<&'l str> {
+fn comment(line: &str, rust: bool) -> Option<&str> {
     let marker = if rust { "//" } else { "#" };
     line.find(marker).map(|at| &line[at + marker.len()..])
 }
@@ -123,7 +123,7 @@ fn collect(dir: &Path, files: &mut Vec<PathBuf>) -> anyhow::Result<()> {
             if name != "target" && !name.starts_with('.') {
                 collect(&path, files)?;
             }
-        } else if name.ends_with(".rs") || name == "Cargo.toml" {
+        } else if path.extension().is_some_and(|e| e == "rs") || name == "Cargo.toml" {
             files.push(path);
         }
     }
