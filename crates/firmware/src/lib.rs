@@ -12,7 +12,7 @@
 //!   status log once a loop, below every other task.
 //! - [`console`]: the console's loop over a board's byte [`console::Port`]
 //!   (a Bottango driver on a port after a Bottango handshake).
-//! - [`dmx`]: the DMX512 receiver's loop over a board's [`dmx::DmxPort`].
+//! - [`dmx`]: the DMX512 receiver ([`dmx::Receiver`]), fed by a board's UART.
 //! - [`input`]: the trigger inputs' task over a board's [`input::InputSource`].
 //! - [`radar`]: the radar's receiver, fed by a board's UART or PIO.
 //! - [`storage`]: the settings store in a board's flash.

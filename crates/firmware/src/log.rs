@@ -3,14 +3,14 @@
 //! that the layer runs on the host with no defmt logger. The arguments are
 //! still type-checked and count as used either way.
 
-/// A value the log can show: [`defmt::Format`] with the `defmt` feature,
+/// A value the log can show: `defmt::Format` with the `defmt` feature,
 /// anything without it.
 #[cfg(feature = "defmt")]
 pub trait Loggable: defmt::Format {}
 #[cfg(feature = "defmt")]
 impl<T: defmt::Format + ?Sized> Loggable for T {}
 
-/// A value the log can show: [`defmt::Format`] with the `defmt` feature,
+/// A value the log can show: `defmt::Format` with the `defmt` feature,
 /// anything without it.
 #[cfg(not(feature = "defmt"))]
 pub trait Loggable {}

@@ -1,51 +1,17 @@
 //! The settings store in a board's flash: a range of whole erase sectors
-//! that the board's memory map keeps code out of (the last four 4 KiB
-//! sectors on the RP boards), kept by `sequential-storage` through
-//! [`SettingsStore`].
+//! that the board's memory map keeps code out of, kept by
+//! `sequential-storage` through [`SettingsStore`].
 //!
-//! The flash driver is the board's, blocking underneath and made async
-//! (embassy-embedded-hal's `BlockingAsync` on the RP boards): reads are plain
-//! reads of the memory-mapped flash, and an erase or a write runs from RAM
-//! with interrupts off, as the flash cannot be read (nor code run from it)
-//! meanwhile. [`SectorWise`] splits every erase into one call per sector, so
-//! the interrupts come back (and a due frame runs) between sectors.
+//! At boot ([`open`]) the store is read before the first frame and the
+//! settings it holds are put in effect (or the built-in ones, with a
+//! warning, if it holds none that can be used). The console's `save` and
+//! `load` go through [`FlashStorage`], which feeds the watchdog the long
+//! [`FLASH_WATCHDOG_MS`] before every flash operation and sets
+//! [`FlashBusy`] meanwhile (the frames feed the long timeout too); erases
+//! go one sector at a time ([`SectorWise`]).
 //!
-//! At boot ([`open`]) the store is read before the first frame: stored
-//! settings are put in effect (servo calibrations, behaviour, seeds) and
-//! logged with their version (an older layout is migrated), with the
-//! fields the load skipped or left on their defaults; an empty store gives
-//! the built-in settings; a damaged store, or one of a version this
-//! firmware cannot read, gives the built-in settings with a warning. The
-//! console's `save` and `load` go through [`FlashStorage`].
-//!
-//! # What a `save` does to the head
-//!
-//! A flash erase or write runs with interrupts off (the flash cannot be
-//! read, nor code run from it, meanwhile): a page write takes about 0.4 ms
-//! (3 ms at worst), a sector erase 45 ms typically (W25Q16JV), 400 ms at
-//! worst. Most saves only write: `sequential-storage` appends the record
-//! and erases a sector only when the store has gone round its sectors.
-//! While the interrupts are off:
-//!
-//! - the PWM hardware keeps sending the last pulses: the servos hold their
-//!   pose; the frames due meanwhile are missed, and the head goes on from
-//!   where its clock stands, through the driver's limiter (no step beyond
-//!   its speed and acceleration);
-//! - console bytes on the UART keep arriving by DMA into RAM (the board's
-//!   port), USB holds what the host sends (it has flow control): none is
-//!   lost;
-//! - DMX frames are lost (the UART's FIFO overflows): they count as bad
-//!   frames, the head keeps the last cue, and a save is far shorter than
-//!   the second after which the signal counts as lost;
-//! - the watchdog (100 ms) would reset the board: [`FlashStorage`] sets
-//!   [`FLASH_BUSY`] and feeds the watchdog with [`FLASH_WATCHDOG_MS`] before
-//!   every flash operation of `save` and `load` (and every frame feeds it
-//!   that long while the flag is set); afterwards the frames feed it with
-//!   100 ms again.
-//!
-//! An erase of several sectors (the whole store, when a damaged one is
-//! started afresh) goes one sector at a time ([`SectorWise`]): the
-//! interrupts come back, and a due frame runs, between sectors.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “The settings store in flash”).
 
 use core::future::Future;
 use core::ops::Range;
