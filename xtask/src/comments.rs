@@ -114,6 +114,38 @@ pub fn missing(root: &Path) -> anyhow::Result<Vec<Missing>> {
     Ok(found)
 }
 
+/// The longest a module doc in `crates/` may be: what the module is and
+/// its invariants; the reasoning goes to the book (`docs/design/code.md`).
+pub const MODULE_DOC_LINES: usize = 30;
+
+/// The Rust files under `root`'s `crates/` whose module doc (the `//!`
+/// lines it opens with) is [`MODULE_DOC_LINES`] long or longer, with its
+/// length.
+///
+/// # Errors
+/// A folder or file that cannot be read.
+pub fn long_module_docs(root: &Path) -> anyhow::Result<Vec<(PathBuf, usize)>> {
+    let mut files = Vec::new();
+    collect(&root.join("crates"), &mut files)?;
+    files.sort();
+    let mut long = Vec::new();
+    for file in files
+        .iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "rs"))
+    {
+        let text = fs::read_to_string(file)?;
+        let lines = text
+            .lines()
+            .skip_while(|l| !l.starts_with("//!"))
+            .take_while(|l| l.starts_with("//!"))
+            .count();
+        if lines >= MODULE_DOC_LINES {
+            long.push((file.strip_prefix(root).unwrap_or(file).to_path_buf(), lines));
+        }
+    }
+    Ok(long)
+}
+
 /// The Rust files and manifests under `dir`, build output left out.
 fn collect(dir: &Path, files: &mut Vec<PathBuf>) -> anyhow::Result<()> {
     for entry in fs::read_dir(dir)? {
@@ -166,6 +198,21 @@ mod tests {
         ));
         assert!(!exists(&root, &file, "crates/core/src/gone.rs"));
         assert!(!exists(&root, &file, "src/bin/pico/"));
+    }
+
+    #[test]
+    fn module_docs_are_short() {
+        let long = long_module_docs(&crate::project::root()).unwrap();
+        let list: Vec<String> = long
+            .iter()
+            .map(|(file, n)| format!("{}: {n} lines", file.display()))
+            .collect();
+        assert!(
+            list.is_empty(),
+            "module docs of {MODULE_DOC_LINES} lines or more (say what the module is; \
+             the reasoning goes to docs/design/code.md):\n{}",
+            list.join("\n")
+        );
     }
 
     #[test]
