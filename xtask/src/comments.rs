@@ -1,7 +1,9 @@
 //! The paths the source's comments name must exist: a comment that points
-//! at a file since moved or renamed misleads the next reader. [`missing`] scans the comments of the Rust files and
-//! manifests under [`SCANNED`] for repository paths and lists those that
-//! are not there; the unit test below fails naming them.
+//! at a file since moved or renamed misleads the next reader. [`missing`]
+//! scans the comments of the Rust files and manifests under [`SCANNED`]
+//! for repository paths and lists those that are not there; the unit test
+//! below fails naming them. Module docs in `crates/` stay short too
+//! ([`long_module_docs`]).
 
 use std::fs;
 use std::path::{Path, PathBuf};
