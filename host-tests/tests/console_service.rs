@@ -15,7 +15,7 @@ use idle_head_core::behaviour::{Applied, CommandQueue};
 use idle_head_core::console::{
     ConsoleLink, ConsoleService, ErrorCode, Response, Session, outcome_reply, parse, respond,
 };
-use idle_head_core::settings::{RamStorage, SettingsStorage, StorageError};
+use idle_head_core::settings::{FlashFailed, RamStorage, SettingsStorage, StorageError};
 use proptest::prelude::RngExt as _;
 
 /// The console service of a simulated head, talked to line by line.
@@ -290,22 +290,14 @@ fn storage_errors_are_replies() {
     struct Broken;
     impl SettingsStorage for Broken {
         fn save(&mut self, _: &idle_head_core::settings::Settings) -> Result<(), StorageError> {
-            Err(StorageError::Device)
+            Err(StorageError::Flash(FlashFailed))
         }
         fn load(&mut self) -> Result<idle_head_core::settings::Settings, StorageError> {
             Err(StorageError::Older { found: 0 })
         }
     }
     let (queue, link) = shared();
-    let mut svc = idle_head_core::console::ConsoleService::new(
-        queue,
-        link,
-        Broken,
-        idle_head_core::DriverConfig::DEFAULT,
-        idle_head_core::settings::Settings::DEFAULT,
-        idle_head_core::settings::SettingsSource::Defaults,
-    )
-    .unwrap();
+    let mut svc = idle_head_core::console::ConsoleService::with_defaults(queue, link, Broken);
     let mut out = [0; REPLY];
     assert_eq!(
         respond(Ok(b"save"), &mut svc, &mut out).now(),

@@ -1,7 +1,7 @@
 //! The seamless closure's wrap correction E fits `i32`, for every window and
 //! every loop length.
 //!
-//! The engine sums E (`src/motion/engine/sweep.rs`, `initial_window`) in
+//! The engine sums E (`crates/core/src/motion/engine/sweep.rs`, `initial_window`) in
 //! wrapping `i32` arithmetic and forms the detrend from it in 32-bit steps
 //! (`seamless.rs`); both are exact only if |E| < 2²⁴ (the bound its docs
 //! state). E is a sum over the first W−1 steps of b(k)·term(k),

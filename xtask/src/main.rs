@@ -8,6 +8,8 @@ mod bench;
 mod board;
 mod book;
 mod cli;
+#[cfg(test)]
+mod comments;
 mod console;
 mod elf;
 mod figures;

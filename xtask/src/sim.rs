@@ -56,7 +56,7 @@ pub use noise::{NOISE_STAGE, test_noise};
 pub use run::{Boot, Report, logged_peak_stack};
 pub use show::{SHOW_STAGE, test_show};
 
-/// The harness's DMX line for a DMX script's text (see `sim/dmx.rs`).
+/// The harness's DMX line for a DMX script's text (see `xtask/src/sim/dmx.rs`).
 pub fn dmx_line(script: &str) -> Result<serde_json::Value> {
     Ok(dmx::line(&dmx::parse(script)?))
 }

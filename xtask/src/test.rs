@@ -88,6 +88,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     let sh = project::shell(".")?;
     let host_tests = project::shell("host-tests")?;
     let core = project::shell("crates/core")?;
+    let firmware = project::shell("crates/firmware")?;
     let xtask = project::shell("xtask")?;
     let mut stages = Stages {
         results: Vec::new(),
@@ -95,12 +96,15 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         left_out: 0,
     };
 
-    // 1. Host tests of the core, and its doc tests once they are switched on.
+    // 1. Host tests of the core, the firmware layer and the project commands.
     stages.run("host tests (host-tests/)", || {
         project::run(&host_tests, &[], cmd!(host_tests, "cargo test"))
     });
     stages.run("core crate: unit and doc tests (crates/core, host)", || {
         project::run(&core, &[], cmd!(core, "cargo test"))
+    });
+    stages.run("firmware layer: host tests (crates/firmware)", || {
+        project::run(&firmware, &[], cmd!(firmware, "cargo test"))
     });
     stages.run("xtask unit tests", || {
         project::run(&xtask, &[], cmd!(xtask, "cargo test --profile xtask"))
@@ -179,7 +183,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
 /// The clippy passes: the firmware's (thumbv6m, `--release` to share build
 /// scripts and proc-macros with the release builds), the Pico 2's, and the
 /// host crates'; `(name, folder, firmware, arguments)`.
-const CLIPPY: [(&str, &str, bool, &str); 6] = [
+const CLIPPY: [(&str, &str, bool, &str); 7] = [
     (
         "clippy: Pico image, RP support, firmware layer, core (thumbv6m)",
         ".",
@@ -204,6 +208,12 @@ const CLIPPY: [(&str, &str, bool, &str); 6] = [
         ".",
         false,
         "--package idle-head-core --all-targets --target host-tuple",
+    ),
+    (
+        "clippy: firmware layer and its unit tests (host)",
+        ".",
+        false,
+        "--package idle-head-firmware --all-targets --target host-tuple",
     ),
     ("clippy: host-tests", "host-tests", false, "--all-targets"),
     ("clippy: xtask", "xtask", false, "--all-targets"),

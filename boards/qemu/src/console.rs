@@ -25,7 +25,7 @@ use core::task::{Context, Poll};
 use embassy_time::Duration;
 use idle_head_core::console::{ConsoleService, DualSession};
 use idle_head_core::settings::RamStorage;
-use idle_head_firmware::boot::{COMMANDS as QUEUE, LINK};
+use idle_head_firmware::boot::LINKS;
 use idle_head_firmware::console::{Gone, Place, Port, Received, serve};
 
 use crate::uart::{RX_READY, UART0, UART1};
@@ -143,16 +143,16 @@ pub async fn console(mut service: Service, frame: Duration) {
     let mut session = DualSession::new(None);
     let place = Place {
         port: 0,
-        link: &LINK,
+        link: &LINKS.console,
         frame,
     };
     let Gone = serve(&mut Uart0, &mut session, &mut service, place).await;
     defmt::info!(
         "console: the host hung up at frame {=u64}",
-        LINK.status().frame
+        LINKS.console.status().frame
     );
     // The queued commands are played before the run ends.
-    while !QUEUE.is_empty() || LINK.servos_pending() {
+    while !LINKS.commands.is_empty() || LINKS.console.servos_pending() {
         YieldNow(false).await;
     }
     HUNG_UP.store(true, Ordering::Release);

@@ -62,7 +62,7 @@ use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head_core::motion::DEFAULT_N;
 use idle_head_core::settings::RamStorage;
 use idle_head_core::{Microseconds, Millis};
-use idle_head_firmware::boot::{self, COMMANDS, EXCHANGE, Generator, Loaded};
+use idle_head_firmware::boot::{self, Generator, LINKS, Loaded};
 use idle_head_firmware::config::{DEFAULT_PARAMS, LOOP_DURATION};
 use idle_head_firmware::tasks;
 
@@ -175,19 +175,27 @@ async fn frame_task(params: DriverParams, behaviour: BehaviourParams) {
         .map(|servo| VirtualPwm::new(PICO_TOP, CONFIG.pwm.period, &servo));
     let mut driver = FrameDriver::new(channels, params);
     let mode = console::mode();
-    let (first, run) = EXCHANGE.first().await;
+    let (first, run) = LINKS.exchange.first().await;
     if mode == console::Mode::Interactive {
         let mut hooks = interactive::Interactive::new(CONFIG.servos);
         let period = frame_period(mode);
-        let (stats, _) = tasks::play(&mut driver, first, &behaviour, &mut hooks, period).await;
+        let (stats, _) =
+            tasks::play(&mut driver, first, &behaviour, &mut hooks, period, &LINKS).await;
         let violations = channel_violations(&mut driver);
         summary(&stats, violations, &run, &driver);
         exit::exit(violations == 0 && stats.missed == 0);
     }
     // The script's commands share the console's queue, as a board's would.
-    let mut checks = Checks::new(CONFIG, &COMMANDS, mode.held());
-    let (stats, idle) =
-        tasks::play(&mut driver, first, &behaviour, &mut checks, FRAME_PERIOD).await;
+    let mut checks = Checks::new(CONFIG, &LINKS.commands, mode.held());
+    let (stats, idle) = tasks::play(
+        &mut driver,
+        first,
+        &behaviour,
+        &mut checks,
+        FRAME_PERIOD,
+        &LINKS,
+    )
+    .await;
     defmt::info!(
         "frame timing: {=u64} frames, {=u64} missed, wake-up at most {=u64} us after the deadline",
         stats.frames,

@@ -2,7 +2,7 @@
 //! allocation, no `unsafe`): motion generation after Kocoń's idle-loop method
 //! ([`motion`]), servo mapping ([`servo`]), frame playback ([`playback`]) and
 //! the frame driver ([`driver`]). The Raspberry Pi Pico image is
-//! `src/bin/pico/`; the QEMU images are a package of their own, `qemu/`.
+//! `src/main.rs`; the QEMU images are a package of their own, `boards/qemu/`.
 //!
 //! ```
 //! use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadTrajectories, Mdeg16};
@@ -21,17 +21,9 @@
 //! in the project's book (`docs/`, built by `cargo xtask book`): the user
 //! guide for the hardware and the console, the design notes for the method.
 #![cfg_attr(not(test), no_std)]
+// The core holds no unsafe code (the other lints are the workspace's, in
+// crates/Cargo.toml).
 #![forbid(unsafe_code)]
-#![deny(missing_docs)]
-#![warn(clippy::pedantic)]
-#![allow(
-    clippy::module_name_repetitions,
-    clippy::cast_possible_truncation,
-    clippy::cast_possible_wrap,
-    clippy::cast_sign_loss,
-    clippy::cast_lossless,
-    clippy::cast_precision_loss
-)]
 
 // A bare `cargo test` builds for the firmware's target, where no test can
 // run: say where the tests are instead of failing on each doc test.
@@ -56,6 +48,7 @@ pub mod ring;
 pub mod seed;
 pub mod servo;
 pub mod settings;
+pub mod shared;
 pub mod text;
 pub mod track;
 pub mod units;

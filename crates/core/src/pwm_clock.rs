@@ -1,51 +1,14 @@
 //! Clocking of an RP2040 PWM slice for servo pulses, worked out in `const fn`s
 //! (and at run time, when `servo rate` changes the period).
 //!
-//! A slice counts from 0 to `TOP` and wraps, one count every `DIV` system
-//! clock cycles, where `DIV` is an 8.4 fixed-point divider (`INT + FRAC/16`,
-//! 1 ≤ `DIV` < 256). The output is high while the count is below the
-//! channel's compare value, so a pulse is `compare` counts long and the PWM
-//! period is `(TOP + 1) · DIV` system clock cycles.
+//! The PWM period is made exactly one frame ([`SliceClock::for_period`]):
+//! every frame is a whole number of µs and of system clock cycles, and the
+//! divider is the smallest 8.4 fixed-point one that gives a whole number of
+//! counts per period within the 16-bit counter (at 50 Hz on 125 MHz: 39.0625,
+//! `TOP` = 63 999, 312.5 ns a count).
 //!
-//! The period is made **exactly** one frame: the system clock and the timer
-//! that schedules the frames both come from the board's 12 MHz crystal, so
-//! a PWM period of exactly one frame never drifts against the frames and
-//! every frame's duty goes out as exactly one pulse (`crates/rp/src/pwm.rs`
-//! sets the phase). A frame is a whole number of µs (the timer ticks at
-//! 1 MHz; a `servo rate` is rounded to the nearest µs: 333 Hz is 3003 µs,
-//! [`ServoRate::period`](crate::servo::ServoRate::period)), and both boards'
-//! system clocks make whole cycles per µs (125 and 150), so every period
-//! is a whole number of cycles ([`SliceClock::for_period`]). Among the
-//! dividers that give a whole number of counts per period, the smallest
-//! one (the finest pulse resolution) that still fits the 16-bit counter
-//! (`TOP + 1 ≤ 65 536`), at 50 Hz:
-//!
-//! - 125 MHz system clock, 50 Hz: 125 000 000 / 50 = 2 500 000 cycles per
-//!   period, 40 000 000 in sixteenths of a cycle.
-//! - `DIV` ≥ 2 500 000 / 65 536 = 38.15, i.e. at least 611/16; the first
-//!   sixteenth from there that divides 40 000 000 = 2⁹ · 5⁷ is 625/16 =
-//!   39 + 1/16 = 39.0625.
-//! - Counts per period: 2 500 000 / 39.0625 = 64 000 exactly, `TOP` = 63 999.
-//! - One count: 39.0625 / 125 MHz = 312.5 ns, the pulse resolution (about
-//!   0.03° of a typical servo).
-//!
-//! At 333 Hz (3003 µs, 375 375 cycles): `DIV` ≥ 5.73, and the first
-//! sixteenth from there that divides the period is 6.25: 60 060 counts of
-//! 50 ns. (The Pico 2's 150 MHz: 46.875 and 64 000 counts at 50 Hz, 6.875
-//! and 65 520 counts at 333 Hz.) A divider of 125 (1 count a µs) divides
-//! every whole-µs period up to 65.5 ms at 125 MHz, 150 at 150 MHz: every
-//! rate of the range has a clock.
-//!
-//! With a fractional `DIV` the RP2040 spaces the counts 39 or 40 cycles
-//! apart so that they average 39.0625 cycles (the sixteenths add up to
-//! whole cycles every 16 counts, so the period itself is exact): a pulse
-//! edge moves by at most one system clock cycle (8 ns), far below a servo's
-//! dead band (~1 µs).
-//!
-//! `embedded_hal::pwm::SetDutyCycle::max_duty_cycle` of an embassy-rp output
-//! is `TOP` (63 999). The frame driver maps the servo period (20 000 µs) to
-//! that many counts, so a written pulse is short by 1/64 000 of its width,
-//! 0.03 µs at 2000 µs: a tenth of a count.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “Clocking a PWM slice”).
 
 use crate::units::Microseconds;
 

@@ -15,6 +15,10 @@
 //! stack of the boot (the generation) on the generator's own, shallow
 //! frame, instead of on top of everything the boot sequence holds.
 
+use core::cell::RefCell;
+
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_time::Instant;
 use idle_head_core::Axis;
 use idle_head_core::behaviour::{BehaviourParams, CommandQueue, ShowLink};
@@ -24,36 +28,75 @@ use idle_head_core::driver::DriverParams;
 use idle_head_core::motion::{DEFAULT_HEAD, HeadConfig};
 use idle_head_core::seed::BoardId;
 use idle_head_core::settings::{Settings, SettingsSource, SettingsStorage, Validated};
+use portable_atomic::AtomicU32;
 use static_cell::ConstStaticCell;
 
 use crate::config::{Set, SetRef};
+use crate::dmx::Receiver;
 use crate::exchange::{Exchange, FirstSet};
+use crate::log;
+use crate::radar::Radar;
+use crate::storage::FlashBusy;
 
-/// Actions from the console ports (and the inputs) to the frame task, which
-/// it drains between frames.
-pub static COMMANDS: CommandQueue = CommandQueue::new();
+/// What the firmware's tasks share: one of these lives in [`LINKS`], and
+/// each task is handed the part it needs (a host test makes its own).
+pub struct Links {
+    /// Actions from the console ports (and the inputs) to the frame task,
+    /// which it drains between frames.
+    pub commands: CommandQueue,
+    /// Status, servo calibrations and seeds between the console and the
+    /// frame task (and the loop generator).
+    pub console: ConsoleLink,
+    /// The show layer's inputs: the DMX receiver's cues and settings, the
+    /// radar's sightings and a Bottango session's curves (receivers and
+    /// console ports → frame task).
+    pub show: ShowLink,
+    /// The channels the loop set buffers go round through.
+    pub exchange: Exchange,
+    /// The latest a frame task woke after its deadline since boot, µs
+    /// (for the status report).
+    pub latest_wake_us: AtomicU32,
+}
 
-/// Status, servo calibrations and seeds between the console and the frame
-/// task (and the loop generator).
-pub static LINK: ConsoleLink = ConsoleLink::new();
+impl Links {
+    /// Nothing shared yet.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self {
+            commands: CommandQueue::new(),
+            console: ConsoleLink::new(),
+            show: ShowLink::new(),
+            exchange: Exchange::new(),
+            latest_wake_us: AtomicU32::new(0),
+        }
+    }
+}
 
-/// The channels the loop set buffers go round through.
-pub static EXCHANGE: Exchange = Exchange::new();
+impl Default for Links {
+    fn default() -> Self {
+        Self::new()
+    }
+}
 
-/// The show layer's inputs: the DMX receiver's cues and settings, and a
-/// Bottango session's curves (console ports → frame task).
-pub static SHOW: ShowLink = ShowLink::new();
+/// The board's shared state, which [`boot`] sets up and hands on.
+pub static LINKS: Links = Links::new();
+
+/// The DMX receiver, for the board's UART interrupt: taken under a
+/// critical section, borrowed with `try_borrow_mut` (never re-entered:
+/// only that interrupt takes it).
+pub static RECEIVER: Mutex<CriticalSectionRawMutex, RefCell<Receiver>> =
+    Mutex::new(RefCell::new(Receiver::new()));
+
+/// The radar's decoder, for the board's receiver ([`Radar::receive`]).
+pub static RADAR: Radar = Radar::new();
+
+/// Set while the settings store holds the flash: the board's store and its
+/// frame hooks share it.
+pub static FLASH_BUSY: FlashBusy = FlashBusy::new();
 
 /// The two loop set buffers, 2 · 5.4 KB: one plays while the generator
 /// fills the other. All zero (the neutral pose) until generated.
 static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::new()]);
-
-/// The built-in settings, checked with the built-in driver configuration at
-/// compile time.
-pub const DEFAULT_SETTINGS: Validated = match Settings::DEFAULT.validate(&DriverConfig::DEFAULT) {
-    Ok(v) => v,
-    Err(_) => panic!("the built-in settings fail validation"),
-};
 
 /// The settings a board boots with, and the storage the console saves to.
 pub struct Loaded<S> {
@@ -74,7 +117,7 @@ impl<S> Loaded<S> {
             storage,
             settings: Settings::DEFAULT,
             source: SettingsSource::Defaults,
-            valid: DEFAULT_SETTINGS,
+            valid: Validated::DEFAULT,
         }
     }
 
@@ -124,6 +167,8 @@ pub struct Generator {
     pub first: SetRef,
     /// The other buffer.
     pub spare: SetRef,
+    /// Where the sets go, and the console's seeds come from.
+    pub links: &'static Links,
 }
 
 /// What the boot sequence hands the board's tasks.
@@ -137,10 +182,13 @@ pub struct Booted<S: 'static> {
     pub behaviour: BehaviourParams,
     /// The console's service, on the board's storage.
     pub service: ConsoleService<'static, S>,
+    /// What the tasks share ([`LINKS`]).
+    pub links: &'static Links,
 }
 
 /// Why [`boot`] could not run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum BootError {
     /// The loop set buffers were taken already: `boot` runs once.
     AlreadyBooted,
@@ -177,27 +225,41 @@ pub fn boot_on<S: SettingsStorage>(
     log_servos(&loaded);
     let [first, spare] = SETS.try_take().ok_or(BootError::AlreadyBooted)?;
     let head = loaded.head(id);
+    let links = &LINKS;
     // The input task reads its settings from the link.
-    LINK.set_inputs(loaded.settings.inputs);
+    links.console.set_inputs(loaded.settings.inputs);
     let Loaded {
         storage,
         settings,
         source,
         valid,
     } = loaded;
-    SHOW.dmx.set(settings.dmx);
-    SHOW.track.set(settings.track);
+    links.show.dmx.set(settings.dmx);
+    links.show.track.set(settings.track);
     // `valid` is these settings checked with `base` (by the store, or at
     // compile time for the built-in ones): the service takes it as it is.
-    let mut service =
-        ConsoleService::checked(&COMMANDS, &LINK, storage, *base, settings, source, &valid);
+    let mut service = ConsoleService::checked(
+        &links.commands,
+        &links.console,
+        storage,
+        *base,
+        settings,
+        source,
+        &valid,
+    );
     service.add_entropy(entropy);
-    let service = service.with_show(&SHOW).with_board(id);
+    let service = service.with_show(&links.show).with_board(id);
     Ok(Booted {
-        generator: Generator { head, first, spare },
+        generator: Generator {
+            head,
+            first,
+            spare,
+            links,
+        },
         driver: valid.driver,
         behaviour: valid.behaviour,
         service,
+        links,
     })
 }
 
@@ -212,7 +274,7 @@ pub(crate) fn first_set(
     let generated = match generated {
         Ok(info) => {
             for (axis, info) in Axis::ALL.iter().zip(info.iter()) {
-                defmt::info!(
+                log::info!(
                     "{=str}: split at sample {=u16} (drawn from {=u16} zero crossings); {=u16} up-steps in the walk",
                     axis.name(),
                     info.split,
@@ -224,7 +286,7 @@ pub(crate) fn first_set(
         }
         // The loop is left at the neutral pose: the servos hold still.
         Err(e) => {
-            defmt::error!(
+            log::error!(
                 "trajectory generation failed: {=str} {=str}",
                 e.axis.name(),
                 e.error.message()
@@ -233,7 +295,7 @@ pub(crate) fn first_set(
         }
     };
     let checksum = first.checksum();
-    defmt::info!(
+    log::info!(
         "precompute: {=u64} {=str}; checksum {=u32:#010x}",
         precompute,
         stopwatch.unit(),
@@ -249,7 +311,7 @@ pub(crate) fn first_set(
 /// Logs each servo's calibration as the head starts with it.
 fn log_servos<S>(loaded: &Loaded<S>) {
     for (axis, servo) in Axis::ALL.iter().zip(loaded.settings.servos.iter()) {
-        defmt::info!(
+        log::info!(
             "{=str}: neutral {=u32} us, {=u32} ns/deg, pulses [{=u32}, {=u32}] us, limits [{=i32}, {=i32}] mdeg",
             axis.name(),
             servo.neutral.0,

@@ -25,6 +25,8 @@ use idle_head_core::driver::Outcome;
 use idle_head_core::{Angle, AngleRange, Axis, LoopSource, Microseconds, Millis, Playback};
 use static_cell::StaticCell;
 
+use crate::log;
+
 use crate::frame::Frame;
 
 /// Samples per second of the sweep timeline (one sample = 100 ms).
@@ -137,7 +139,7 @@ pub fn log_frame(frame: &Frame, playback: &Playback) {
     }
     if next == HOLD_NEUTRAL && sample + 1 == HOLD_NEUTRAL {
         let [p, r, y] = frame.report.servos;
-        defmt::info!(
+        log::info!(
             "calibration: neutral pulses pitch {=u32} roll {=u32} yaw {=u32} us; sweep starts",
             p.pulse.0,
             r.pulse.0,
@@ -161,7 +163,7 @@ pub fn log_frame(frame: &Frame, playback: &Playback) {
                     "lower"
                 };
                 if servo.outcome == Outcome::Written {
-                    defmt::info!(
+                    log::info!(
                         "calibration: {=str} at its {=str} limit {=i32} mdeg: pulse {=u32} us, duty {=u16}",
                         axis.name(),
                         name,
@@ -170,7 +172,7 @@ pub fn log_frame(frame: &Frame, playback: &Playback) {
                         servo.duty.0
                     );
                 } else {
-                    defmt::warn!(
+                    log::warn!(
                         "calibration: {=str} at its {=str} limit: not written ({})",
                         axis.name(),
                         name,

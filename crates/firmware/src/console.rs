@@ -25,13 +25,13 @@ use core::future::pending;
 
 use embassy_futures::select::{Either3, select3};
 use embassy_time::{Duration, Instant, Timer};
-use idle_head_core::bottango::TIMEOUT_MS;
+use idle_head_core::bottango::{Curves, TIMEOUT_MS};
 use idle_head_core::console::{
     ConsoleLink, DualSession, Handler, Outbox, PORT_REPLY, Shared, SharedService, telemetry_line,
 };
 use idle_head_core::settings::SettingsStorage;
 
-use crate::boot::SHOW;
+use crate::log;
 
 /// The console's baud rate on a UART (8 data bits, no parity, 1 stop bit).
 pub const UART_BAUD: u32 = 115_200;
@@ -75,7 +75,8 @@ pub trait Port {
 }
 
 /// The port went away: the session ends.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Gone;
 
 /// Where a port's console is: its number (`0..PORTS`, for the outcomes
@@ -146,16 +147,8 @@ pub async fn serve<P: Port, H: Handler>(
             Ok(taken) => at += taken,
             Err(gone) => return gone,
         }
-        // The host closed the port (DTR dropped): its telemetry stops.
-        if !port.open() {
-            place.link.set_watch(place.port, 0);
-        }
-        let rate = if session.bottango() {
-            0
-        } else {
-            place.link.watch(place.port)
-        };
-        let tick = watch.due(rate).unwrap_or(Instant::MAX);
+        let rate = telemetry_rate(port.open(), session.bottango(), place);
+        let tick = watch.due(rate, Instant::now()).unwrap_or(Instant::MAX);
         // A Bottango line in progress times out; nothing else does.
         let armed = session.bottango() && session.in_progress();
         let timeout = if armed {
@@ -204,12 +197,26 @@ pub async fn serve<P: Port, H: Handler>(
                         return gone;
                     }
                 }
-                watch.sent(rate);
+                watch.sent(rate, Instant::now());
             }
             // An outcome arrived, or a reply is given up on: both are
             // taken at the top of the loop.
             Either3::Second(()) | Either3::Third(()) => {}
         }
+    }
+}
+
+/// The telemetry lines a second the port streams now: none in a Bottango
+/// session; none once the host closed the port (DTR dropped), which stops
+/// the port's `watch` for good.
+fn telemetry_rate(open: bool, bottango: bool, place: Place<'_>) -> u8 {
+    if !open {
+        place.link.set_watch(place.port, 0);
+    }
+    if bottango {
+        0
+    } else {
+        place.link.watch(place.port)
     }
 }
 
@@ -286,11 +293,11 @@ impl Replies {
 /// Logs a port switching to Bottango's protocol or back.
 fn log_mode(was: bool, is: bool) {
     match (was, is) {
-        (false, true) => defmt::info!(
+        (false, true) => log::info!(
             "console: Bottango handshake: a Bottango driver (protocol {=str}) until STOP",
             idle_head_core::bottango::VERSION
         ),
-        (true, false) => defmt::info!("console: Bottango STOP: the console again"),
+        (true, false) => log::info!("console: Bottango STOP: the console again"),
         _ => {}
     }
 }
@@ -306,8 +313,9 @@ struct Watch {
 }
 
 impl Watch {
-    /// When the next line is due at `rate` lines a second (`None`: off).
-    fn due(&mut self, rate: u8) -> Option<Instant> {
+    /// When the next line is due at `rate` lines a second (`None`: off),
+    /// `now`.
+    fn due(&mut self, rate: u8, now: Instant) -> Option<Instant> {
         if rate == 0 {
             self.next = None;
             self.rate = 0;
@@ -315,18 +323,18 @@ impl Watch {
         }
         if rate != self.rate || self.next.is_none() {
             self.rate = rate;
-            self.next = Some(Instant::now());
+            self.next = Some(now);
         }
         self.next
     }
 
-    /// A line went out: the next is due a period after this one; ticks
-    /// that passed meanwhile (the write waited for a slow host) are lost.
-    fn sent(&mut self, rate: u8) {
+    /// A line went out, and it is `now`: the next is due a period after
+    /// this one; ticks that passed meanwhile (the write waited for a slow
+    /// host) are lost.
+    fn sent(&mut self, rate: u8, now: Instant) {
         let period = Duration::from_hz(u64::from(rate.max(1)));
         let Some(mut next) = self.next else { return };
         next += period;
-        let now = Instant::now();
         while next <= now {
             next += period;
             self.lost = self.lost.saturating_add(1);
@@ -338,14 +346,15 @@ impl Watch {
 /// Runs the console on `port` for as long as the board runs: a session per
 /// connection (the half-typed line of a host that went away is forgotten,
 /// its telemetry stops and a Bottango session ends), commands carried out
-/// by the shared `service`.
+/// by the shared `service`, a Bottango session's curves to `curves`.
 pub async fn run<P: Port, S: SettingsStorage>(
     port: &mut P,
     service: &'static SharedService<S>,
     name: &'static str,
     place: Place<'_>,
+    curves: &Curves,
 ) -> ! {
-    let mut session = DualSession::new(Some(&SHOW.curves));
+    let mut session = DualSession::new(Some(curves));
     let mut handler = Shared::new(service, place.port);
     loop {
         port.connected().await;
@@ -353,6 +362,9 @@ pub async fn run<P: Port, S: SettingsStorage>(
         let Gone = serve(port, &mut session, &mut handler, place).await;
         session.reset();
         place.link.set_watch(place.port, 0);
-        defmt::info!("console {=str}: the host went away", name);
+        log::info!("console {=str}: the host went away", name);
     }
 }
+
+#[cfg(test)]
+mod tests;

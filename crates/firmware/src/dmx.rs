@@ -2,22 +2,19 @@
 //! breaks, receive errors, character by character as its FIFO holds them)
 //! goes through the core's [`Decoder`], which keeps the head's slots, and
 //! each good frame's cue goes to the frame task through the show link
-//! ([`SHOW`](crate::boot::SHOW)): a few bytes copied in a critical section,
+//! (`dmx`, in [`Links`](crate::boot::Links)): a few bytes copied in a critical section,
 //! which the frame task reads between two frames. The receiver never waits
 //! for the frame task, nor the frame task for it.
 //!
-//! A board feeds [`RECEIVER`] from its UART's receive interrupt
+//! A board feeds [`RECEIVER`](crate::boot::RECEIVER) from its UART's receive interrupt
 //! (`idle-head-rp`: UART1 on GP9, below the frame task's priority): no
 //! task, no buffer, no DMA.
 
-use core::cell::RefCell;
-
-use embassy_sync::blocking_mutex::Mutex;
-use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use idle_head_core::dmx::{Cue, Decoder, DmxAddress, DmxLink};
 
 /// One character of a UART's receive FIFO, as the DMX receiver sees it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Rx {
     /// A byte received without error.
     Byte(u8),
@@ -95,8 +92,5 @@ impl Default for Receiver {
     }
 }
 
-/// The receiver, for the board's UART interrupt: taken under a critical
-/// section, borrowed with `try_borrow_mut` (never re-entered: only that
-/// interrupt takes it).
-pub static RECEIVER: Mutex<CriticalSectionRawMutex, RefCell<Receiver>> =
-    Mutex::new(RefCell::new(Receiver::new()));
+#[cfg(test)]
+mod tests;

@@ -19,7 +19,8 @@ use idle_head_core::motion::{AxisError, DEFAULT_N};
 use crate::config::SetRef;
 
 /// What generating loop set 0 gave, for the boards' logs and checks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FirstSet {
     /// Its checksum (the host computes the same).
     pub checksum: u32,
@@ -128,3 +129,6 @@ impl LoopSupply<SetRef> for ExchangeSupply {
         self.exchange.free.signal(set);
     }
 }
+
+#[cfg(test)]
+mod tests;

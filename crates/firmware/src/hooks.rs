@@ -5,7 +5,7 @@
 //! The hardware watchdog is started just after the first frame (the neutral
 //! pulses) and fed after every frame with [`WATCHDOG_TIMEOUT`] = 100 ms (5
 //! frames), or longer while `save` or `load` uses the flash
-//! ([`crate::storage::FLASH_BUSY`]). If frames stop, the board resets; the
+//! ([`FlashBusy`]). If frames stop, the board resets; the
 //! next boot logs that the last reset came from the watchdog and starts
 //! softly again: outputs low, neutral pulses first, motion faded in.
 //!
@@ -16,8 +16,6 @@
 //! resets the board; `cargo xtask test` runs it in the RP2040 emulator and
 //! checks the next boot.
 
-use core::sync::atomic::Ordering;
-
 use embassy_time::Duration;
 use embedded_hal::pwm::SetDutyCycle;
 use idle_head_core::driver::FrameDriver;
@@ -25,7 +23,8 @@ use idle_head_core::driver::FrameDriver;
 use idle_head_core::playback::Playback;
 
 use crate::frame::{Flow, Frame, FrameHooks};
-use crate::storage::{FLASH_BUSY, FLASH_WATCHDOG_MS};
+use crate::log;
+use crate::storage::FlashBusy;
 
 /// Watchdog timeout: 100 ms = 5 frames of 20 ms. Long enough for a frame
 /// that runs late, short enough that a stuck board stops driving its servos
@@ -47,16 +46,19 @@ pub trait Watchdog {
 /// Feeds the watchdog after every frame.
 pub struct BoardHooks<W> {
     watchdog: W,
+    /// Whether the settings store holds the flash.
+    flash: &'static FlashBusy,
     started: bool,
     #[cfg(feature = "calibrate")]
     playback: Playback,
 }
 
 impl<W: Watchdog> BoardHooks<W> {
-    /// Hooks feeding `watchdog`.
-    pub fn new(watchdog: W) -> Self {
+    /// Hooks feeding `watchdog`, longer while `flash` is busy.
+    pub fn new(watchdog: W, flash: &'static FlashBusy) -> Self {
         Self {
             watchdog,
+            flash,
             started: false,
             #[cfg(feature = "calibrate")]
             playback: crate::tasks::playback(),
@@ -64,21 +66,11 @@ impl<W: Watchdog> BoardHooks<W> {
     }
 }
 
-/// The watchdog timeout the frames feed: [`WATCHDOG_TIMEOUT`], or longer
-/// while the console's `save` or `load` uses the flash.
-fn watchdog_timeout() -> Duration {
-    if FLASH_BUSY.load(Ordering::Acquire) {
-        Duration::from_millis(FLASH_WATCHDOG_MS)
-    } else {
-        WATCHDOG_TIMEOUT
-    }
-}
-
 impl<P: SetDutyCycle, W: Watchdog> FrameHooks<P> for BoardHooks<W> {
     fn after_frame(&mut self, frame: &Frame, driver: &mut FrameDriver<P>) -> Flow {
         let _ = driver;
         if self.started {
-            self.watchdog.feed(watchdog_timeout());
+            self.watchdog.feed(self.flash.timeout(WATCHDOG_TIMEOUT));
         } else {
             // The first frame (neutral pulses) is out: from now on frames
             // must keep coming.
@@ -88,7 +80,7 @@ impl<P: SetDutyCycle, W: Watchdog> FrameHooks<P> for BoardHooks<W> {
             // (Not the peak stack: its scan of the painted stack takes
             // milliseconds, more than a frame at 333 Hz has before the
             // next; the loop lines have it.)
-            defmt::info!(
+            log::info!(
                 "first frame: neutral pulses {=u32} {=u32} {=u32} us; watchdog armed ({=u64} ms)",
                 p.pulse.0,
                 r.pulse.0,
@@ -100,7 +92,7 @@ impl<P: SetDutyCycle, W: Watchdog> FrameHooks<P> for BoardHooks<W> {
         crate::calibrate::log_frame(frame, &self.playback);
         #[cfg(feature = "watchdog-drill")]
         if frame.tick.frame == DRILL_FRAMES {
-            defmt::warn!(
+            log::warn!(
                 "watchdog drill: frames stop after frame {=u64}; the watchdog must reset the board",
                 frame.tick.frame
             );

@@ -9,8 +9,9 @@
 //! input configured it never wakes but for a change of settings, and the
 //! board behaves as it does without inputs. What a level means (debounce,
 //! roles, the rest timer) is the core's ([`idle_head_core::input`]); the
-//! actions go to the frame task's queue ([`COMMANDS`]) like the console's,
-//! and the levels to the console's `status` through the link ([`LINK`]).
+//! actions go to the frame task's queue like the console's, and the levels
+//! to the console's `status` through the console's link (both in
+//! [`Links`]).
 //!
 //! The task runs in thread mode, below the frame task, as the console
 //! tasks do. Like every embassy task, it is defined by the board (a task
@@ -28,7 +29,8 @@ use embassy_time::{Duration, Instant, Timer};
 use idle_head_core::console::HeadMode;
 use idle_head_core::input::{FIRST_INPUT, INPUTS, InputSettings, Inputs, Micros, Pull};
 
-use crate::boot::{COMMANDS, LINK, SHOW};
+use crate::boot::Links;
+use crate::log;
 
 /// How long the task waits before it tries a full queue again.
 pub const RETRY: Duration = Duration::from_millis(5);
@@ -62,45 +64,55 @@ fn pulls(source: &mut impl InputSource, settings: &InputSettings) {
     }
 }
 
-/// Now, as the core's state machine counts time.
-fn now() -> Micros {
-    Micros(Instant::now().as_micros())
+/// `at`, as the core's state machine counts time.
+fn micros(at: Instant) -> Micros {
+    Micros(at.as_micros())
 }
 
-/// The input task's body: reads `source` with the roles in the link's
-/// settings (the boot's, then the console's, see
+/// The input task's body: reads `source` with the roles in the console
+/// link's settings (the boot's, then the console's, see
 /// [`ConsoleLink::set_inputs`](idle_head_core::console::ConsoleLink::set_inputs)),
-/// and sends what the inputs do to the frame task. Never returns.
-pub async fn run(source: &mut impl InputSource) -> ! {
-    // (The settings are read into short scopes, not kept across an
+/// and sends what the inputs do to the frame task, all through `links`.
+/// Never returns.
+pub async fn run(source: &mut impl InputSource, links: &Links) -> ! {
+    let link = &links.console;
+    // (The settings are read in `start` and `step`, not kept across an
     // `.await`: the task's future holds no copy of them.)
-    let mut inputs = {
-        // The boot's settings are these: no change to take.
-        let _ = LINK.take_inputs_changed();
-        let settings = LINK.input_settings();
-        pulls(source, &settings);
-        log_roles(&settings);
-        Inputs::new(&settings, now())
-    };
+    let mut inputs = start(source, links, Instant::now());
     let mut shown = Shown::default();
     let mut changed = false;
     loop {
-        let (levels, watched, deadline) = step(source, &mut inputs, &mut shown, changed);
+        let wake = Wake {
+            changed,
+            now: Instant::now(),
+        };
+        let (levels, watched, deadline) = step(source, &mut inputs, &mut shown, wake, links);
         let timer = async {
             match deadline {
                 Some(at) => Timer::at(at).await,
                 None => core::future::pending().await,
             }
         };
-        let woke = select3(
+        let event = select3(
             source.changed(levels, watched),
             timer,
-            LINK.inputs_changed(),
+            link.inputs_changed(),
         )
         .await;
         // (The wait took the signal of a change of settings.)
-        changed = matches!(woke, Either3::Third(()));
+        changed = matches!(event, Either3::Third(()));
     }
+}
+
+/// The input task's start at `now`: the pulls for the settings in
+/// `links` (the boot's: no change to take), and the state machine.
+fn start(source: &mut impl InputSource, links: &Links, now: Instant) -> Inputs {
+    let link = &links.console;
+    let _ = link.take_inputs_changed();
+    let settings = link.input_settings();
+    pulls(source, &settings);
+    log_roles(&settings);
+    Inputs::new(&settings, micros(now))
 }
 
 /// What the log last said of the inputs.
@@ -110,49 +122,62 @@ struct Shown {
     lost: u32,
 }
 
-/// One wake of the input task: new settings (if `changed`), the levels,
-/// the actions to the queue, the status to the link. Returns the levels
-/// read, the inputs to watch and when to wake at the latest.
+/// Why and when the input task woke.
+#[derive(Clone, Copy)]
+struct Wake {
+    /// The inputs' settings changed (the wait took the signal).
+    changed: bool,
+    /// The time of the wake.
+    now: Instant,
+}
+
+/// One wake of the input task: new settings (if they changed), the
+/// levels, the actions to the queue, the status to the link, all in
+/// `links`. Returns the levels read, the inputs to watch and when to wake
+/// at the latest.
 fn step(
     source: &mut impl InputSource,
     inputs: &mut Inputs,
     shown: &mut Shown,
-    changed: bool,
+    wake: Wake,
+    links: &Links,
 ) -> (u8, u8, Option<Instant>) {
-    let settings = LINK.input_settings();
-    if changed || LINK.take_inputs_changed() {
-        inputs.configure(&settings, now());
+    let link = &links.console;
+    let now = micros(wake.now);
+    let settings = link.input_settings();
+    if wake.changed || link.take_inputs_changed() {
+        inputs.configure(&settings, now);
         pulls(source, &settings);
         log_roles(&settings);
     }
     let levels = source.levels();
-    let resting = LINK.status().mode == HeadMode::Resting;
+    let resting = link.status().mode == HeadMode::Resting;
     // The radar counts as presence while it is on.
-    inputs.sense(now(), SHOW.track.presence());
-    inputs.update(&settings, now(), levels, resting);
+    inputs.sense(now, links.show.track.presence());
+    inputs.update(&settings, now, levels, resting);
     let mut full = false;
     while let Some(action) = inputs.pending(&settings) {
-        if COMMANDS.try_submit(action).is_err() {
+        if links.commands.try_submit(action).is_err() {
             full = true;
             break;
         }
         inputs.sent();
     }
     let status = inputs.status(&settings);
-    LINK.publish_inputs(status);
+    link.publish_inputs(status);
     if status.active != shown.active {
         shown.active = status.active;
-        defmt::info!("inputs: active {=u8:#06b} (bit 0: input 2)", shown.active);
+        log::info!("inputs: active {=u8:#06b} (bit 0: input 2)", shown.active);
     }
     if inputs.lost() != shown.lost {
         shown.lost = inputs.lost();
-        defmt::warn!(
+        log::warn!(
             "inputs: {=u32} action(s) lost so far: the command queue stayed full",
             shown.lost
         );
     }
     let deadline = if full {
-        Some(Instant::now() + RETRY)
+        Some(wake.now + RETRY)
     } else {
         inputs
             .deadline(&settings)
@@ -164,6 +189,9 @@ fn step(
 /// Logs each input's role.
 fn log_roles(settings: &InputSettings) {
     for (n, role) in (FIRST_INPUT..).zip(settings.roles.iter()).take(INPUTS) {
-        defmt::info!("input {=u8}: {=str}", n, role.word());
+        log::info!("input {=u8}: {=str}", n, role.word());
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,51 +1,17 @@
 //! The settings store in a board's flash: a range of whole erase sectors
-//! that the board's memory map keeps code out of (the last four 4 KiB
-//! sectors on the RP boards), kept by `sequential-storage` through
-//! [`SettingsStore`].
+//! that the board's memory map keeps code out of, kept by
+//! `sequential-storage` through [`SettingsStore`].
 //!
-//! The flash driver is the board's, blocking underneath and made async
-//! (embassy-embedded-hal's `BlockingAsync` on the RP boards): reads are plain
-//! reads of the memory-mapped flash, and an erase or a write runs from RAM
-//! with interrupts off, as the flash cannot be read (nor code run from it)
-//! meanwhile. [`SectorWise`] splits every erase into one call per sector, so
-//! the interrupts come back (and a due frame runs) between sectors.
+//! At boot ([`open`]) the store is read before the first frame and the
+//! settings it holds are put in effect (or the built-in ones, with a
+//! warning, if it holds none that can be used). The console's `save` and
+//! `load` go through [`FlashStorage`], which feeds the watchdog the long
+//! [`FLASH_WATCHDOG_MS`] before every flash operation and sets
+//! [`FlashBusy`] meanwhile (the frames feed the long timeout too); erases
+//! go one sector at a time ([`SectorWise`]).
 //!
-//! At boot ([`open`]) the store is read before the first frame: stored
-//! settings are put in effect (servo calibrations, behaviour, seeds) and
-//! logged with their version (an older layout is migrated), with the
-//! fields the load skipped or left on their defaults; an empty store gives
-//! the built-in settings; a damaged store, or one of a version this
-//! firmware cannot read, gives the built-in settings with a warning. The
-//! console's `save` and `load` go through [`FlashStorage`].
-//!
-//! # What a `save` does to the head
-//!
-//! A flash erase or write runs with interrupts off (the flash cannot be
-//! read, nor code run from it, meanwhile): a page write takes about 0.4 ms
-//! (3 ms at worst), a sector erase 45 ms typically (W25Q16JV), 400 ms at
-//! worst. Most saves only write: `sequential-storage` appends the record
-//! and erases a sector only when the store has gone round its sectors.
-//! While the interrupts are off:
-//!
-//! - the PWM hardware keeps sending the last pulses: the servos hold their
-//!   pose; the frames due meanwhile are missed, and the head goes on from
-//!   where its clock stands, through the driver's limiter (no step beyond
-//!   its speed and acceleration);
-//! - console bytes on the UART keep arriving by DMA into RAM (the board's
-//!   port), USB holds what the host sends (it has flow control): none is
-//!   lost;
-//! - DMX frames are lost (the UART's FIFO overflows): they count as bad
-//!   frames, the head keeps the last cue, and a save is far shorter than
-//!   the second after which the signal counts as lost;
-//! - the watchdog (100 ms) would reset the board: [`FlashStorage`] sets
-//!   [`FLASH_BUSY`] and feeds the watchdog with [`FLASH_WATCHDOG_MS`] before
-//!   every flash operation of `save` and `load` (and every frame feeds it
-//!   that long while the flag is set); afterwards the frames feed it with
-//!   100 ms again.
-//!
-//! An erase of several sectors (the whole store, when a damaged one is
-//! started afresh) goes one sector at a time ([`SectorWise`]): the
-//! interrupts come back, and a due frame runs, between sectors.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “The settings store in flash”).
 
 use core::future::Future;
 use core::ops::Range;
@@ -57,21 +23,56 @@ use embassy_time::Duration;
 use embedded_storage_async::nor_flash::NorFlash;
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::settings::{
-    LoadError, Loaded as Stored, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsError,
+    FlashFailed, Loaded as Stored, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsError,
     SettingsSource, SettingsStorage, SettingsStore, StorageError, Validated,
 };
 
 use static_cell::StaticCell;
 
 use crate::boot::Loaded;
+use crate::log::{self, Loggable};
 
 /// The watchdog timeout the frames feed while a flash operation is under
 /// way: a 400 ms sector erase, with a wide margin.
 pub const FLASH_WATCHDOG_MS: u64 = 1000;
 
-/// Set while `save` or `load` uses the flash: the frames feed the watchdog
-/// with [`FLASH_WATCHDOG_MS`] (see the [module docs](self)).
-pub static FLASH_BUSY: AtomicBool = AtomicBool::new(false);
+/// Whether `save` or `load` uses the flash: while it does, the frames
+/// feed the watchdog with [`FLASH_WATCHDOG_MS`] (see the [module
+/// docs](self)). One lives in [`FLASH_BUSY`](crate::boot::FLASH_BUSY).
+pub struct FlashBusy(AtomicBool);
+
+impl FlashBusy {
+    /// Not busy.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self(AtomicBool::new(false))
+    }
+
+    /// Whether the flash is in use.
+    pub fn is_busy(&self) -> bool {
+        self.0.load(Ordering::Acquire)
+    }
+
+    /// The watchdog timeout the frames feed: `normal`, or
+    /// [`FLASH_WATCHDOG_MS`] while the flash is in use.
+    pub fn timeout(&self, normal: Duration) -> Duration {
+        if self.is_busy() {
+            Duration::from_millis(FLASH_WATCHDOG_MS)
+        } else {
+            normal
+        }
+    }
+
+    fn set(&self, busy: bool) {
+        self.0.store(busy, Ordering::Release);
+    }
+}
+
+impl Default for FlashBusy {
+    fn default() -> Self {
+        Self::new()
+    }
+}
 
 /// The store on flash driver `F`, with a work buffer for the settings
 /// record; erases go one sector at a time.
@@ -83,6 +84,8 @@ pub struct FlashStorage<F: NorFlash> {
     store: Option<Store<F>>,
     /// Feeds the board's watchdog for a timeout.
     feed: fn(Duration),
+    /// Set while an operation runs.
+    busy: &'static FlashBusy,
 }
 
 impl<F: NorFlash> FlashStorage<F> {
@@ -92,12 +95,15 @@ impl<F: NorFlash> FlashStorage<F> {
         &mut self,
         op: impl FnOnce(&mut Store<F>) -> Result<T, StorageError>,
     ) -> Result<T, StorageError> {
-        let store = self.store.as_mut().ok_or(StorageError::Device)?;
-        FLASH_BUSY.store(true, Ordering::Release);
+        let store = self
+            .store
+            .as_mut()
+            .ok_or(StorageError::Flash(FlashFailed))?;
+        self.busy.set(true);
         // A frame from here on feeds the long timeout too.
         (self.feed)(Duration::from_millis(FLASH_WATCHDOG_MS));
         let result = op(store);
-        FLASH_BUSY.store(false, Ordering::Release);
+        self.busy.set(false);
         result
     }
 }
@@ -106,7 +112,7 @@ impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
     fn save(&mut self, settings: &Settings) -> Result<(), StorageError> {
         self.guarded(|store| match at_once(store.save(settings)) {
             Some(result) => result.map_err(StorageError::from),
-            None => Err(StorageError::Device),
+            None => Err(StorageError::Flash(FlashFailed)),
         })
     }
 
@@ -114,8 +120,8 @@ impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
         self.guarded(|store| match at_once(store.load()) {
             Some(result) => result
                 .map(|loaded| loaded.record)
-                .map_err(StorageError::from),
-            None => Err(StorageError::Device),
+                .map_err(StorageError::forget_flash),
+            None => Err(StorageError::Flash(FlashFailed)),
         })
     }
 }
@@ -126,8 +132,8 @@ impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
 /// it), and reads the settings in it, before the first frame (no watchdog,
 /// no frames yet), checked against `base`; the built-in settings if there
 /// are none or they are not usable. The log says which. `feed` feeds the
-/// board's watchdog before each later flash operation. `None` if `cell` was
-/// taken.
+/// board's watchdog before each later flash operation, and `busy` tells
+/// the frames that it runs. `None` if `cell` was taken.
 pub fn open<F>(
     cell: &'static StaticCell<FlashStorage<F>>,
     flash: F,
@@ -135,20 +141,21 @@ pub fn open<F>(
     address: u32,
     base: &DriverConfig,
     feed: fn(Duration),
+    busy: &'static FlashBusy,
 ) -> Option<Loaded<&'static mut FlashStorage<F>>>
 where
     F: NorFlash,
-    F::Error: defmt::Format,
+    F::Error: Loggable,
 {
     let store = Store::new(SectorWise(flash), range).ok();
     if store.is_none() {
-        defmt::error!("settings: no store: the region is not whole erase sectors");
+        log::error!("settings: no store: the region is not whole erase sectors");
     }
-    let storage = cell.try_init(FlashStorage { store, feed })?;
+    let storage = cell.try_init(FlashStorage { store, feed, busy })?;
     let loaded = storage.store.as_mut().and_then(|store| {
         let loaded = at_once(store.load());
         if loaded.is_none() {
-            defmt::error!("settings: defaults; the blocking flash driver waited");
+            log::error!("settings: defaults; the blocking flash driver waited");
         }
         loaded.and_then(|loaded| loaded_settings(loaded, base, address))
     });
@@ -173,8 +180,11 @@ fn at_once<F: Future>(future: F) -> Option<F::Output> {
 }
 
 /// The stored settings if they can be used with `base`, logged either way.
-fn loaded_settings<E: defmt::Format>(
-    loaded: Result<Stored<Settings>, LoadError<E, SettingsError>>,
+// defmt keeps each text in a symbol of its own: arms that differ in their
+// text alone look the same to clippy.
+#[allow(clippy::match_same_arms)]
+fn loaded_settings<E: Loggable>(
+    loaded: Result<Stored<Settings>, StorageError<E, SettingsError>>,
     base: &DriverConfig,
     at: u32,
 ) -> Option<(Settings, Validated)> {
@@ -185,70 +195,77 @@ fn loaded_settings<E: defmt::Format>(
             fields,
         }) => match settings.validate(base) {
             Ok(valid) => {
-                defmt::info!(
+                log::info!(
                     "settings: loaded from flash (version {=u16}) at {=u32:#010x}",
                     version,
                     at
                 );
                 if version != Settings::VERSION {
-                    defmt::info!(
+                    log::info!(
                         "settings: migrated from version {=u16} to {=u16}",
                         version,
                         Settings::VERSION
                     );
                 }
                 if !fields.missing.is_empty() {
-                    defmt::info!(
+                    log::info!(
                         "settings: fields not in the stored record, on their defaults: {}",
                         fields.missing
                     );
                 }
                 if !fields.unknown.is_empty() {
-                    defmt::warn!(
+                    log::warn!(
                         "settings: fields of a newer firmware skipped (a save leaves them out): {}",
                         fields.unknown
                     );
                 }
                 if !fields.rejected.is_empty() {
-                    defmt::warn!(
+                    log::warn!(
                         "settings: fields with values out of range, on their defaults: {}",
                         fields.rejected
                     );
                 }
                 return Some((settings, valid));
             }
-            Err(e) => defmt::warn!(
+            Err(e) => log::warn!(
                 "settings: defaults; the stored settings fail validation: {}",
                 e
             ),
         },
-        Err(LoadError::Empty) => {
-            defmt::info!("settings: defaults (empty store at {=u32:#010x})", at);
+        Err(StorageError::Empty) => {
+            log::info!("settings: defaults (empty store at {=u32:#010x})", at);
         }
-        Err(LoadError::Older { found } | LoadError::Newer { found }) => defmt::warn!(
+        Err(StorageError::Older { found } | StorageError::Newer { found }) => log::warn!(
             "settings: defaults; the store at {=u32:#010x} holds settings of version {=u16}, not {=u16}",
             at,
             found,
             Settings::VERSION
         ),
-        Err(LoadError::TooLong { needs }) => defmt::warn!(
+        Err(StorageError::TooLong { needs: Some(needs) }) => log::warn!(
             "settings: defaults; the record at {=u32:#010x} needs {=usize} B, more than this firmware reads",
             at,
             needs
         ),
-        Err(LoadError::Invalid(e)) => defmt::warn!(
+        Err(StorageError::TooLong { needs: None }) => log::warn!(
+            "settings: defaults; the record at {=u32:#010x} is longer than this firmware reads",
+            at
+        ),
+        Err(StorageError::Invalid(e)) => log::warn!(
             "settings: defaults; the stored settings fail validation: {}",
             e
         ),
-        Err(LoadError::Flash(e)) => defmt::warn!(
+        Err(StorageError::Flash(e)) => log::warn!(
             "settings: defaults; reading the store at {=u32:#010x} failed: {}",
             at,
             e
         ),
-        Err(LoadError::Corrupt) => defmt::warn!(
+        Err(StorageError::Corrupt) => log::warn!(
             "settings: defaults; the store at {=u32:#010x} is damaged",
             at
         ),
     }
     None
 }
+
+#[cfg(test)]
+mod tests;

@@ -13,15 +13,22 @@ use idle_head_core::motion::AxisError;
 use idle_head_core::playback::Playback;
 use idle_head_core::servo::SetPeriod;
 
-use crate::boot::{COMMANDS, EXCHANGE, Generator, LINK, SHOW, Stopwatch, first_set};
+use crate::boot::{Generator, Links, Stopwatch, first_set};
 use crate::config::{DEFAULT_TIMING, IDLE_MODE, SetRef};
 use crate::frame::{FrameHooks, FrameLoop, RunStats};
+use crate::log;
 
 /// The generator task's body: generates loop set 0 (timed by `stopwatch`)
 /// and hands it to the frame task, then each next set while the frames
 /// play (thread mode, below the frame task), logging each.
 pub async fn generate(generator: Generator, mut stopwatch: impl Stopwatch) -> ! {
-    let Generator { head, first, spare } = generator;
+    let Generator {
+        head,
+        first,
+        spare,
+        links,
+    } = generator;
+    let exchange = &links.exchange;
     let info = first_set(first, &head, &mut stopwatch);
     match IDLE_MODE {
         IdleMode::NeverRepeating => {
@@ -29,18 +36,20 @@ pub async fn generate(generator: Generator, mut stopwatch: impl Stopwatch) -> ! 
             // (a fixed loop has no stream and skips that).
             let mut stream = LoopStream::new(head, &DEFAULT_TIMING);
             stream.adopt(first);
-            defmt::info!(
+            log::info!(
                 "idle: never repeating, a new loop set every {=u64} ms, joined over {=u64} ms",
                 DEFAULT_TIMING.period_us() / 1000,
                 DEFAULT_TIMING.join_us / 1000
             );
-            EXCHANGE.start(first, info);
-            EXCHANGE.give(spare);
-            EXCHANGE.generate(&mut stream, &LINK, log_set).await
+            exchange.start(first, info);
+            exchange.give(spare);
+            exchange
+                .generate(&mut stream, &links.console, log_set)
+                .await
         }
         IdleMode::FixedLoop => {
-            defmt::info!("idle: the fixed loop, replayed every loop");
-            EXCHANGE.start(first, info);
+            log::info!("idle: the fixed loop, replayed every loop");
+            exchange.start(first, info);
             core::future::pending().await
         }
     }
@@ -49,7 +58,7 @@ pub async fn generate(generator: Generator, mut stopwatch: impl Stopwatch) -> ! 
 /// Logs a loop set the generator made.
 fn log_set(result: &Result<SetInfo, AxisError>, ticks: u64) {
     match result {
-        Ok(info) => defmt::info!(
+        Ok(info) => log::info!(
             "loop set {=u32} ready in {=u64} us: seeds {:#010x} ({} discarded), entered at {}, join mismatch {} mdeg rms",
             info.number,
             Duration::from_ticks(ticks).as_micros(),
@@ -58,7 +67,7 @@ fn log_set(result: &Result<SetInfo, AxisError>, ticks: u64) {
             info.starts,
             info.mismatch
         ),
-        Err(e) => defmt::error!(
+        Err(e) => log::error!(
             "loop set failed: {=str} {=str}; trying the next seeds",
             e.axis.name(),
             e.error.message()
@@ -88,22 +97,28 @@ pub const fn playback() -> Playback {
 /// watchdog drill). `frame_period` is the board's time between frames at
 /// the driver's rate (the QEMU smoke run plays faster than real time): the
 /// outputs and the idle start at the driver's period, the settings' rate.
-/// Returns the frames' and the idle's totals.
+/// The commands, the console's link, the show's inputs and the loop sets
+/// come through `links`. Returns the frames' and the idle's totals.
 pub async fn play<P: SetPeriod, H: FrameHooks<P>>(
     driver: &mut FrameDriver<P>,
     first: SetRef,
     behaviour: &BehaviourParams,
     hooks: &mut H,
     frame_period: idle_head_core::Microseconds,
+    links: &'static Links,
 ) -> (RunStats, IdleStats) {
     let period = driver.params().config().frame_period;
     if let Err(e) = driver.set_pwm_period(period) {
-        defmt::error!("servo outputs refused {=u32} us: {}", period.0, e);
+        log::error!("servo outputs refused {=u32} us: {}", period.0, e);
     }
     let start = embassy_time::Instant::now().as_ticks();
     #[cfg(not(feature = "calibrate"))]
-    let mut idle =
-        idle_head_core::idle::IdlePlayer::new(first, EXCHANGE.supply(), DEFAULT_TIMING, IDLE_MODE);
+    let mut idle = idle_head_core::idle::IdlePlayer::new(
+        first,
+        links.exchange.supply(),
+        DEFAULT_TIMING,
+        IDLE_MODE,
+    );
     #[cfg(feature = "calibrate")]
     let mut idle = {
         let _ = first;
@@ -113,15 +128,15 @@ pub async fn play<P: SetPeriod, H: FrameHooks<P>>(
     let frames =
         FrameLoop::with_behaviour(idle, frame_period, *behaviour, embassy_time::TICK_HZ, start);
     let Ok(frames) = frames else {
-        defmt::error!("frame period below one timer tick");
+        log::error!("frame period below one timer tick");
         return (RunStats::default(), IdleStats::default());
     };
     let mut frames = frames
         .with_latch_divisor(P::LATCH_DIVISOR)
-        .with_commands(&COMMANDS)
-        .with_link(&LINK)
-        .with_show(&SHOW);
-    let run = crate::frame::run(driver, &mut frames, hooks).await;
+        .with_commands(&links.commands)
+        .with_link(&links.console)
+        .with_show(&links.show);
+    let run = crate::frame::run(driver, &mut frames, hooks, &links.latest_wake_us).await;
     #[cfg(not(feature = "calibrate"))]
     let idle = frames.idle_mut().stats();
     #[cfg(feature = "calibrate")]

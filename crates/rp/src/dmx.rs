@@ -29,8 +29,8 @@ use embassy_rp::interrupt::{self, InterruptExt, Priority};
 use embassy_rp::pac;
 use embassy_rp::peripherals::UART1;
 use embassy_rp::uart::{self, Blocking, DataBits, Parity, RxPin, StopBits, UartRx};
-use idle_head_firmware::boot::SHOW;
-use idle_head_firmware::dmx::{RECEIVER, Rx};
+use idle_head_firmware::boot::{LINKS, RECEIVER};
+use idle_head_firmware::dmx::Rx;
 
 /// DMX512's line rate.
 pub const BAUD: u32 = 250_000;
@@ -84,7 +84,7 @@ unsafe fn UART1_IRQ() {
             } else {
                 Rx::Byte(dr.data())
             };
-            receiver.take(rx, &SHOW.dmx);
+            receiver.take(rx, &LINKS.show.dmx);
         }
         receiver.flush();
     });

@@ -12,7 +12,7 @@ use embassy_rp::peripherals::FLASH;
 use embassy_time::Duration;
 use idle_head_core::driver::DriverConfig;
 use idle_head_firmware::boot::Loaded;
-use idle_head_firmware::storage::{self, FlashStorage};
+use idle_head_firmware::storage::{self, FlashBusy, FlashStorage};
 use static_cell::StaticCell;
 
 /// The board's flash: the Raspberry Pi Pico's 2 MiB (W25Q16JV).
@@ -49,14 +49,24 @@ static STORE: StaticCell<Store> = StaticCell::new();
 
 /// Opens the store and reads the settings the board boots with, checked
 /// against `base` (see `idle_head_firmware::storage::open`); `feed` feeds
-/// the watchdog before each flash operation. `None` if called twice.
+/// the watchdog before each flash operation, while `busy` is set. `None` if
+/// called twice.
 #[must_use]
 #[inline(never)]
 pub fn open(
     flash: Peri<'static, FLASH>,
     base: &DriverConfig,
     feed: fn(Duration),
+    busy: &'static FlashBusy,
 ) -> Option<Loaded<Storage>> {
     let flash = BlockingAsync::new(Flash::new_blocking(flash));
-    storage::open(&STORE, flash, SETTINGS_RANGE, SETTINGS_ADDRESS, base, feed)
+    storage::open(
+        &STORE,
+        flash,
+        SETTINGS_RANGE,
+        SETTINGS_ADDRESS,
+        base,
+        feed,
+        busy,
+    )
 }

@@ -20,9 +20,6 @@
 //!
 //! Exactly one chip feature: `rp2040` or `rp235xa`.
 #![no_std]
-#![deny(missing_docs)]
-#![warn(clippy::pedantic)]
-#![allow(clippy::cast_possible_truncation)]
 
 #[cfg(all(feature = "rp2040", feature = "rp235xa"))]
 compile_error!("choose one chip: the `rp2040` or the `rp235xa` feature");
@@ -53,7 +50,7 @@ use embassy_time::Duration;
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::console::SharedService;
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
-use idle_head_firmware::boot::{self, Clock, EXCHANGE, Generator, Loaded, SHOW};
+use idle_head_firmware::boot::{self, Clock, FLASH_BUSY, Generator, LINKS, Loaded};
 use idle_head_firmware::hooks::{BoardHooks, Watchdog};
 use static_cell::StaticCell;
 
@@ -175,7 +172,7 @@ pub fn start(spawner: Spawner, board: Board) {
     }
     log_clocks(name, servo_pins);
     // Before the first frame: nothing else runs yet while the store is read.
-    let Some(loaded) = flash::open(flash, &CONFIG, feed_watchdog) else {
+    let Some(loaded) = flash::open(flash, &CONFIG, feed_watchdog, &FLASH_BUSY) else {
         defmt::error!("boot: called twice");
         return;
     };
@@ -281,7 +278,7 @@ fn spawn_frames(servos: [ServoPwm; 3], head: &Head, watchdog: BoardWatchdog) {
 #[inline(never)]
 fn spawn_dmx(dmx: DmxUart, pins: &'static str) {
     dmx::listen(dmx);
-    let settings = SHOW.dmx.settings();
+    let settings = LINKS.show.dmx.settings();
     defmt::info!(
         "dmx: {=str}, {=u32} baud 8N2, {=str}, address {=u16}",
         pins,
@@ -416,13 +413,14 @@ async fn frame_task(
     behaviour: BehaviourParams,
     watchdog: BoardWatchdog,
 ) {
-    let mut hooks = BoardHooks::new(watchdog);
+    let mut hooks = BoardHooks::new(watchdog, &FLASH_BUSY);
     // Loop set 0, from the generator: about 3 ms after boot.
-    let (first, _) = EXCHANGE.first().await;
+    let (first, _) = LINKS.exchange.first().await;
     // Frames at the settings' rate, as the driver was built.
     let period = driver.params().config().frame_period;
     let (stats, _) =
-        idle_head_firmware::tasks::play(&mut driver, first, &behaviour, &mut hooks, period).await;
+        idle_head_firmware::tasks::play(&mut driver, first, &behaviour, &mut hooks, period, &LINKS)
+            .await;
     // The hooks only stop in the watchdog drill; then the watchdog resets
     // the board.
     defmt::error!("frame task ended: {}", stats);
@@ -437,8 +435,13 @@ async fn frame_task(
 #[embassy_executor::task]
 async fn report_task() {
     let playback = idle_head_firmware::tasks::playback();
-    idle_head_firmware::report::run(playback.loop_duration(), peak_stack, waits::port_wait_us)
-        .await;
+    idle_head_firmware::report::run(
+        playback.loop_duration(),
+        peak_stack,
+        waits::port_wait_us,
+        &LINKS,
+    )
+    .await;
 }
 
 /// Generates loop set 0, then each next loop set while the frames play.
@@ -450,7 +453,7 @@ async fn generator(generator: Generator) {
 /// The trigger inputs, for as long as the board runs.
 #[embassy_executor::task]
 async fn input_task(mut inputs: GpioInputs) {
-    idle_head_firmware::input::run(&mut inputs).await;
+    idle_head_firmware::input::run(&mut inputs, &LINKS).await;
 }
 
 /// The USB device: enumeration, control requests, bus resets.
@@ -463,7 +466,7 @@ async fn usb_device(mut device: usb::Device) {
 const fn place(port: u8) -> idle_head_firmware::console::Place<'static> {
     idle_head_firmware::console::Place {
         port,
-        link: &boot::LINK,
+        link: &LINKS.console,
         frame: Duration::from_micros(CONFIG.frame_period.0 as u64),
     }
 }
@@ -477,7 +480,8 @@ async fn console(mut port: ConsolePort, service: &'static Service) {
         ConsolePort::Uart(_) => ("uart", 0),
         ConsolePort::Usb(_) => ("usb", 1),
     };
-    idle_head_firmware::console::run(&mut port, service, name, place(number)).await;
+    idle_head_firmware::console::run(&mut port, service, name, place(number), &LINKS.show.curves)
+        .await;
 }
 
 /// Either of the console's ports, as one type: the console's loop (the

@@ -1,52 +1,15 @@
 //! A servo output on its own RP2040 PWM slice, silent until its first duty.
 //!
-//! # No pulse before the first valid frame
+//! The pin is low from reset until the first [`SetDutyCycle::set_duty_cycle`]
+//! (the neutral pulse), which starts the slice a tenth of a period
+//! ([`WRAP_MARGIN_DIVISOR`]) before its wrap: the first pulse is whole. The
+//! PWM period is exactly one frame, so each frame's duty is latched at the
+//! next wrap and goes out as exactly one pulse, none cut, none twice. A new
+//! period ([`SetPeriod::set_period`]) is taken the same way at the next
+//! duty written.
 //!
-//! - From reset until [`ServoPwm::new`] the pin is an unconnected GPIO
-//!   (function NULL) with the RP2040's reset pad setting, pull-down enabled:
-//!   the servo input sees a low level.
-//! - [`ServoPwm::new`] gives the pin to the slice with the slice *disabled*,
-//!   its counter at 0 and its compare value at 0, so the output is driven low
-//!   (the output is high only while the counter is below the compare value).
-//! - The first [`SetDutyCycle::set_duty_cycle`] (the frame driver's neutral
-//!   pulse) writes the compare value, sets the counter a tenth of a period
-//!   ([`WRAP_MARGIN_DIVISOR`]) before its wrap (above any servo's compare value, so the output
-//!   stays low) and only then enables the slice. The first wrap comes that
-//!   much later and starts the first pulse: the whole neutral pulse.
-//! - Later writes change the compare value while the slice runs; the RP2040
-//!   latches it at the next wrap, so a pulse is never cut or stretched.
-//!
-//! # One frame, one pulse
-//!
-//! The PWM period is exactly one frame (`idle_head_core::pwm_clock`) and
-//! both come from the same crystal, so the frames' writes keep the phase the
-//! first one set: each lands a tenth of a period ([`WRAP_MARGIN_DIVISOR`];
-//! 2 ms at 50 Hz, 0.3 ms at 333 Hz) before the wrap that latches it,
-//! whatever the frame's wake-up latency or cost, as long as it is below
-//! that (it is tens of microseconds: the frame task runs above everything
-//! but the timer's alarm). Frame `k` is latched at wrap `k + 1` and goes out
-//! as the `k`-th pulse: no frame is ever overwritten before it went out,
-//! none goes out twice.
-//!
-//! The margin is what a frame's pulse waits after its write: the smaller,
-//! the sooner a command shows on the servo. Half a period (10 ms) would
-//! forgive any lateness below 10 ms and put 10 ms into every command's
-//! latency; 2 ms forgives a hundred times the lateness measured and costs
-//! 2 ms. A frame written later still goes out, a period late, as the
-//! previous frame's pulse repeated once.
-//!
-//! # A new period (`servo rate`)
-//!
-//! [`SetPeriod::set_period`] only keeps the new divider and `TOP`; the next
-//! duty written starts the slice over as the first one does: slice off, the
-//! new divider, `TOP` and compare value, the counter a tenth of the new
-//! period before its wrap, slice on (which latches `TOP` and the compare
-//! value). That write is the last frame's at the old spacing, a tenth of
-//! the old period before the old wrap: the old period's pulse has ended
-//! (every pulse is at most 2.5 ms, below nine tenths of any period of the
-//! range), the output is low, and it stays low until the new first wrap a
-//! tenth of the new period later, where that frame's pulse starts. The
-//! frames after it come one new period apart: the phase rule holds on.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “Servo outputs on RP2040 PWM”).
 
 use embassy_rp::Peri;
 use embassy_rp::pwm::{ChannelAPin, Config, Pwm, PwmError, Slice};

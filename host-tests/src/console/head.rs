@@ -17,7 +17,7 @@ use idle_head_core::console::{
 use idle_head_core::driver::{DriverConfig, FrameDriver};
 use idle_head_core::input::{InputSettings, Inputs, Micros};
 use idle_head_core::servo::SetPeriod;
-use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
+use idle_head_core::settings::RamStorage;
 use idle_head_core::{Axis, Timestamp};
 
 /// A PWM channel that keeps the last duty (1 µs per count at any rate).
@@ -318,14 +318,6 @@ pub fn service(
     queue: &'static CommandQueue,
     link: &'static ConsoleLink,
 ) -> ConsoleService<'static, RamStorage> {
-    ConsoleService::new(
-        queue,
-        link,
-        RamStorage::new(),
-        DriverConfig::DEFAULT,
-        Settings::DEFAULT,
-        SettingsSource::Defaults,
-    )
-    .expect("the built-in settings")
-    .with_show(Box::leak(Box::new(ShowLink::new())))
+    ConsoleService::with_defaults(queue, link, RamStorage::new())
+        .with_show(Box::leak(Box::new(ShowLink::new())))
 }

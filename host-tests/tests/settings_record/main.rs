@@ -307,11 +307,17 @@ fn damaged_older_and_newer_records_are_typed_errors() {
     );
     // A store too small refuses the save and keeps what it holds.
     let mut tiny = RamStorage::<64>::new();
-    assert_eq!(tiny.save(&Settings::DEFAULT), Err(StorageError::TooLong));
+    assert_eq!(
+        tiny.save(&Settings::DEFAULT),
+        Err(StorageError::TooLong { needs: None })
+    );
     assert_eq!(tiny.load(), Err(StorageError::Empty));
     let mut short = RamStorage::<{ SETTINGS_LEN + 1 }>::new();
     short.set_raw(V1_RECORD).unwrap();
-    assert_eq!(short.save(&Settings::DEFAULT), Err(StorageError::TooLong));
+    assert_eq!(
+        short.save(&Settings::DEFAULT),
+        Err(StorageError::TooLong { needs: None })
+    );
     assert_eq!(short.load(), Ok(fixture_v1()));
 }
 

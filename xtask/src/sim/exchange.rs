@@ -14,8 +14,7 @@ use std::cell::RefCell;
 use embassy_sync::blocking_mutex::Mutex;
 use idle_head_core::behaviour::{CommandQueue, ShowLink};
 use idle_head_core::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
-use idle_head_core::driver::DriverConfig;
-use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
+use idle_head_core::settings::{RamStorage, Validated};
 
 use idle_head_core::console::{PortSession, Shared, SharedService, outcome_reply};
 
@@ -77,26 +76,15 @@ pub fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
         mode: HeadMode::Running,
         ..HeadStatus::default()
     });
-    let service = ConsoleService::new(
-        queue,
-        link,
-        RamStorage::new(),
-        DriverConfig::DEFAULT,
-        Settings::DEFAULT,
-        SettingsSource::Defaults,
-    )
-    .expect("the built-in settings are valid")
-    // As on the board: DMX on, no frames in this run (`dmx=lost`).
-    .with_show(Box::leak(Box::new(ShowLink::new())));
+    let service = ConsoleService::with_defaults(queue, link, RamStorage::new())
+        // As on the board: DMX on, no frames in this run (`dmx=lost`).
+        .with_show(Box::leak(Box::new(ShowLink::new())));
     let service: &'static SharedService<RamStorage> =
         Box::leak(Box::new(Mutex::new(RefCell::new(service))));
     // What the frame task answers a queued action: the mixer's answer on
     // a head whose gaze is at the centre and plays no gesture, as the
     // emulated head's is when the script's one motion (`center`) arrives.
-    let behaviour = Settings::DEFAULT
-        .validate(&DriverConfig::DEFAULT)
-        .expect("the built-in settings are valid")
-        .behaviour;
+    let behaviour = Validated::DEFAULT.behaviour;
     [0, 1].map(|port| {
         let mut session = PortSession::new();
         let mut handler = Shared::new(service, port);

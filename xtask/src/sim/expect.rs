@@ -15,7 +15,7 @@ use idle_head_core::pwm_clock::PICO_SERVO_CLOCK;
 const TICK_HZ: u64 = 1_000_000;
 
 /// The duties `[pitch, roll, yaw]` of frames `0..frames` of the Pico image
-/// (`src/bin/pico/main.rs`: `DriverConfig::DEFAULT`, the default loops,
+/// (`crates/rp/src/lib.rs`: `DriverConfig::DEFAULT`, the default loops,
 /// `LOOP_DURATION` loops in its idle mode, never-repeating unless built
 /// with `fixed-loop`), every frame on time: the same `FrameLoop`,
 /// `IdlePlayer` and `FrameDriver` over channels whose maximum duty is the

@@ -10,7 +10,7 @@ use idle_head_core::input::{FIRST_INPUT, INPUTS};
 use super::image::{PicoImage, VECTOR_TABLE};
 use super::node;
 
-/// The servos as wired on the Pico (`src/bin/pico/main.rs`): name, GPIO,
+/// The servos as wired on the Pico (`crates/rp/src/pico.rs`): name, GPIO,
 /// PWM slice (channel A).
 pub const SERVOS: [(&str, u8, u8); 3] = [("pitch", 16, 0), ("roll", 18, 1), ("yaw", 20, 2)];
 

@@ -42,9 +42,9 @@ const MIN_FRAMES: usize = 1600;
 /// Wall-time limit of one emulator run.
 pub const WALL: Duration = Duration::from_secs(120);
 /// The drill image stops its frames after this many frames of each boot
-/// (`DRILL_FRAMES` in `src/bin/pico/main.rs`).
+/// (`DRILL_FRAMES` in `crates/firmware/src/hooks.rs`).
 const DRILL_FRAMES: usize = 150;
-/// The Pico's watchdog timeout (`WATCHDOG_TIMEOUT` in `src/bin/pico/main.rs`).
+/// The Pico's watchdog timeout (`WATCHDOG_TIMEOUT` in `crates/firmware/src/hooks.rs`).
 const WATCHDOG_MS: f64 = 100.0;
 /// Two drill boots: each 3 s of frames and the 100 ms timeout.
 const DRILL_TIME: Duration = Duration::from_millis(6_500);

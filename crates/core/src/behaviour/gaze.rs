@@ -1,33 +1,14 @@
 //! Gaze: where the head's centre is (pitch and yaw), moved by `look` and
 //! `center` along minimum-jerk glides ([`super::glide`]).
 //!
-//! # Durations
+//! A move takes `base + per_degree · d` unless a duration is given, and is
+//! lengthened until it fits the axes' gesture limits; a target outside the
+//! limits is clamped (and the answer says so); after its hold the head
+//! returns to the centre, or stays (`hold=stay`). The look's envelope
+//! ducks the idle on pitch and yaw while the look holds.
 //!
-//! A move takes `base + per_degree · d` (default 300 ms + 8 ms per degree),
-//! `d` the larger of its pitch and yaw distances in degrees, unless a
-//! duration is given. Either way it is lengthened, if need be, until the
-//! profile's peaks fit the axes' gesture limits: a minimum-jerk move of `D`
-//! in `T` peaks at `1.875·D/T` and `5.774·D/T²`. (The default rule never
-//! needs it: its speed stays below 1.875 / 8 ms = 234 °/s and its
-//! acceleration peaks at 601 °/s² for a 37.5° move.)
-//!
-//! # Targets and holds
-//!
-//! Targets are axis angles, like the servo limits; the neutral pose is the
-//! centre. A target outside an axis' limits is clamped to them and the
-//! answer says so. After arriving the head stays for the hold time (default
-//! 3 s), then returns to the centre with the rule's duration, or stays until
-//! told (`hold=stay`). The return is planned when the look is applied, so the
-//! frame path never divides.
-//!
-//! # The look's envelope
-//!
-//! Beside its two axes the gaze keeps an envelope `E` (Q16, 0 to 1) on the
-//! same clock: it rises to 1 along the move of a look, stays 1 while the
-//! look holds and falls to 0 along the return or a `center`. The mixer
-//! ducks the idle on pitch and yaw by `duck · E` ([`super::mixer`]), so that
-//! a look lands where it was asked, and the duck comes and goes as smoothly
-//! as the move itself.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “Gaze”).
 
 use crate::axis::Axis;
 use crate::command::{Hold, LookRequest};

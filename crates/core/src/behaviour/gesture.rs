@@ -3,69 +3,14 @@
 //!
 //! Which gestures there are, their axes and defaults, is the
 //! [gesture table](crate::gestures); how each moves is its
-//! [`Shape`](super::shape) (nod: a dip, shake: a swing, tilt: a lean).
+//! [`Shape`](super::shape). A gesture adds `E(φ) · A(φ) · c(φ)`: a C2
+//! envelope, a cycle profile and the shape's carrier. A plan that plays
+//! never exceeds its axis' gesture limits: faster cycles are refused
+//! ([`BehaviourError::TooFrequent`], [`BehaviourError::TooFast`],
+//! [`BehaviourError::TooBrisk`]). Per frame: 32-bit multiplies, no division.
 //!
-//! # The shape
-//!
-//! A gesture of amplitude `A`, `n` cycles and duration `D` adds to its axis
-//!
-//! ```text
-//! g(t) = E(φ) · A(φ) · c(φ),      φ = n·t/D ∈ [0, n]  (cycle position)
-//! ```
-//!
-//! - **Carrier** `c`: the shape's ([`super::shape`]): a dip
-//!   `(1 − cos 2πφ)/2`, a swing `sin 2πφ`, a lean `1` (a posture).
-//! - **Envelope** `E`: a smootherstep `S(x) = 6x⁵ − 15x⁴ + 10x³` over the
-//!   first and the last half cycle (a lean: third), 1 between. `S` has zero
-//!   first and second derivatives at both ends, so the layer comes in and
-//!   goes out with angle, velocity and acceleration continuous (C2).
-//! - **Profile** `A(φ)`, for `n ≥ 2`, after the structure Mori, Den & Jokinen
-//!   found in conversational nods (*Structure of nods in conversation*, PLOS
-//!   One 2025, e0323448), applied to every shape that repeats:
-//!   - *declination*: `A(φ) = A·(1 − (φ − ½)/(4n))`, the cycle at position
-//!     `k` peaks at `A·(1 − k/(4n))`, a quarter less over the gesture;
-//!   - *final lowering*: the last cycle is 0.6 times that trend (a
-//!     smootherstep from the middle of the second-last cycle to the middle of
-//!     the last);
-//!   - *anticipatory rising*: a **default** amplitude grows with the number
-//!     of cycles, `× (1 + (n − 1)/20)` up to `× 1.25`; an amplitude that is
-//!     asked for is the first cycle's peak as asked.
-//!
-//!   A default 3-cycle nod dips 1.0, 0.92 and 0.5 times its first peak; a
-//!   2-cycle nod 1.0 and 0.53.
-//!
-//! # Tempo and intensity
-//!
-//! Fast listener nods run at 2.6–6.5 Hz (Hale et al., *Are you on my
-//! wavelength?*, J. Nonverbal Behav. 2020). The intensity `p` (0–100 %)
-//! sets the cycle frequency `f = slow + (brisk − slow)·p/100` (default nod
-//! 1.5–3.5 Hz, shake 1.2–2.5 Hz; a posture's "cycle" is its duration, tilt 2.5–1 s)
-//! and scales a default amplitude by `0.75 + p/200` (0.75 to 1.25).
-//! Duration and cycles: both given, as given; only cycles, `n/f`; only a
-//! duration, `round(D·f)` cycles (at least 1); neither, the default cycles
-//! at `f`.
-//!
-//! **Frequency cap** (`max_frequency`, default 4 Hz, at most an eighth of
-//! the frame rate): at 50 Hz a 4 Hz cycle is drawn by 12.5 frames; fewer and
-//! the cycle shows its frame steps. And a hobby servo (about 0.1 s per 60°
-//! plus the lag of its position loop) cannot follow a few-degree
-//! oscillation much faster: beyond a few hertz a nod blurs into a shiver of
-//! reduced amplitude. Cycles faster than the cap are refused
-//! ([`BehaviourError::TooFrequent`]).
-//!
-//! **Speed check.** The shape's peak speed and acceleration are at most
-//! `Kv·ω·a` and `Ka·ω²·a` (`ω = 2πf`, `(Kv, Ka)` and the carrier's
-//! amplitude `a` the shape's, see [`super::shape`]). A gesture whose bound
-//! exceeds its axis' gesture limits is refused ([`BehaviourError::TooFast`],
-//! [`BehaviourError::TooBrisk`]), so the limiter never flattens one that
-//! plays.
-//!
-//! # Fixed point
-//!
-//! Per frame: `u = t/D` in Q16 from a reciprocal computed when the gesture
-//! starts (`t` and `D` in µs: the same motion at any frame rate), `φ = n·u`, the carrier from `idsp::cossin` (32-bit phase
-//! `frac(φ)·2³²`), envelope and profile in Q16: a handful of 32-bit
-//! multiplies, no division.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “Gestures”).
 
 use crate::command::{GestureKind, GestureRequest};
 use crate::driver::{DegreesPerSecond, DegreesPerSecondSquared};

@@ -7,27 +7,13 @@
 //! offset = base + w · (pose − base) + Σ gestureᵢ
 //! ```
 //!
-//! - `centre`: the gaze (pitch and yaw; roll stays 0), [`super::gaze`];
-//! - `idle`: the idle source's offset, scaled by the idle gain (`idle on|off`,
-//!   `idle amp`, a minimum-jerk glide over `idle.fade`) and ducked under each
-//!   gesture on the axis by its envelope `Eᵢ` (so the duck is as smooth as the
-//!   gesture's own ramps), and on pitch and yaw by the look's envelope
-//!   `E_look` while a look holds (`gaze.duck`, see [`super::gaze`]): the
-//!   head points where it was asked, with a small sway left;
-//! - `w · (pose − base)`: the rest layer, [`super::rest`]: 0 while awake,
-//!   1 at rest, where the offsets are the rest pose;
-//! - `gestureᵢ`: up to [`LAYERS`] gesture layers, [`super::gesture`]. A new
-//!   gesture takes a free layer and every older one fades out under it
-//!   along `1 − S(t/blend)` (a smootherstep, C2), still playing: never a jump.
+//! (gaze, the idle ducked under the gestures and the look, the rest layer,
+//! up to [`LAYERS`] gesture layers, an older one fading out under a new one:
+//! never a jump). Times are µs on the frame path's clock. The mixer also
+//! says which limit mode each axis needs ([`Mixer::modes`]).
 //!
-//! Times are µs on the frame path's clock (`fixed.rs`): a frame is mixed
-//! at its [`Timestamp`], and every layer moves the same in time whatever
-//! the frame rate.
-//!
-//! The mixer also says which limit mode each axis needs from the next frame
-//! on ([`Mixer::modes`]: [`LimitMode::Gesture`] while a gesture or a gaze
-//! move plays on it and for `settle` after; a rest or a wake keeps to the
-//! idle limits).
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “The mixer”).
 
 use crate::command::{Action, LookRequest, Percent};
 use crate::units::{Angle, AngleRange, Microseconds, Millis, Timestamp};
@@ -88,6 +74,27 @@ impl BehaviourParams {
 
 /// Idle, gestures and gaze mixed into one set of offsets; see the
 /// [module docs](self).
+///
+/// ```
+/// use idle_head_core::behaviour::{BehaviourConfig, Mixer};
+/// use idle_head_core::command::{Action, GestureKind, GestureRequest};
+/// use idle_head_core::driver::DriverConfig;
+/// use idle_head_core::{Angle, Timestamp};
+///
+/// let driver = DriverConfig::DEFAULT.build().unwrap();
+/// let mut mixer = Mixer::new(BehaviourConfig::DEFAULT.build(&driver).unwrap());
+/// mixer.apply(&Action::Gesture(GestureRequest::new(GestureKind::Nod))).unwrap();
+/// // The default nod: 2 cycles at 2.5 Hz in 800 ms; its first dip peaks at 200 ms
+/// // (frame 10 at 50 Hz) at 6.3° (6° × 1.05: a default amplitude rises with the
+/// // number of cycles).
+/// let frame = |k: u64| Timestamp(k * 20_000);
+/// let pitch: Vec<i32> = (0..45)
+///     .map(|k| mixer.frame(frame(k), [Angle::ZERO; 3])[0].millidegrees())
+///     .collect();
+/// assert_eq!(pitch[0], 0);
+/// assert_eq!(pitch[10], 6300);
+/// assert_eq!(pitch[40], 0);
+/// ```
 ///
 /// The fields are laid out in the order written (`repr(C)`), those every
 /// frame reads first: on ARMv6-M a load reaches 124 bytes past a pointer,

@@ -7,52 +7,20 @@
 //!                                   └── limit mode per axis (idle | gesture)   (DMX, Bottango)
 //! ```
 //!
-//! - [`gesture`]: gestures as they play (human-like, C2 envelopes); which
-//!   gestures there are is the [gesture table](crate::gestures), how each
-//!   moves its [`shape`].
-//! - [`glide`](self#gaze-and-idle-changes): minimum-jerk moves that start
-//!   from any state (gaze, idle gain).
-//! - [`gaze`]: `look` and `center`, holds and returns.
-//! - [`mixer`]: where the layers meet, and the limit mode per axis.
-//! - [`show`]: the show layer (DMX, Bottango) over all of it.
-//! - [`config`]: [`BehaviourConfig`] in physical units, validated
-//!   (`validate.rs`) into [`BehaviourParams`] ([`params`]).
-//! - [`queue`]: the command queue; [`head`]: the frame engine.
+//! - [`gesture`], [`shape`]: gestures as they play; [`gaze`]: `look` and
+//!   `center`; [`rest`]: rest and wake; [`show`]: DMX and Bottango.
+//! - [`mixer`]: where the layers meet, and the limit mode per axis (an
+//!   example on [`Mixer`]); [`head`]: the frame engine; [`queue`]: the
+//!   command queue.
+//! - [`config`]: [`BehaviourConfig`] in physical units, validated into
+//!   [`BehaviourParams`] ([`params`]).
 //!
-//! # Gaze and idle changes
+//! Gaze and idle changes glide from the current position, velocity and
+//! acceleration, gestures come in along C2 envelopes: nothing jumps. The frame path is integer
+//! arithmetic with 32-bit multiplies only (Q16 fractions, millidegrees).
 //!
-//! Both move along minimum-jerk glides that start from the current
-//! position, velocity and acceleration (see `glide.rs`), so a new `look`
-//! or `center` while the head moves, or an `idle amp` while the gain
-//! changes, never jumps in angle, velocity or acceleration.
-//!
-//! # Fixed point
-//!
-//! The frame path is integer arithmetic with 32-bit multiplies only
-//! (ARMv6-M has neither a 64-bit multiply nor a divide instruction):
-//! fractions are Q16 (`u32`, 65 536 = 1) unless named Q32, angles are
-//! millidegrees; every reciprocal is computed when an action is applied.
-//!
-//! ```
-//! use idle_head_core::behaviour::{BehaviourConfig, Mixer};
-//! use idle_head_core::command::{Action, GestureKind, GestureRequest};
-//! use idle_head_core::driver::DriverConfig;
-//! use idle_head_core::{Angle, Timestamp};
-//!
-//! let driver = DriverConfig::DEFAULT.build().unwrap();
-//! let mut mixer = Mixer::new(BehaviourConfig::DEFAULT.build(&driver).unwrap());
-//! mixer.apply(&Action::Gesture(GestureRequest::new(GestureKind::Nod))).unwrap();
-//! // The default nod: 2 cycles at 2.5 Hz in 800 ms; its first dip peaks at 200 ms
-//! // (frame 10 at 50 Hz) at 6.3° (6° × 1.05: a default amplitude rises with the
-//! // number of cycles).
-//! let frame = |k: u64| Timestamp(k * 20_000);
-//! let pitch: Vec<i32> = (0..45)
-//!     .map(|k| mixer.frame(frame(k), [Angle::ZERO; 3])[0].millidegrees())
-//!     .collect();
-//! assert_eq!(pitch[0], 0);
-//! assert_eq!(pitch[10], 6300);
-//! assert_eq!(pitch[40], 0);
-//! ```
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “Behaviour”).
 
 pub mod attention;
 pub mod config;

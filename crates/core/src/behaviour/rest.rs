@@ -1,42 +1,12 @@
 //! Rest and wake: the head settles into a rest pose when nobody is there,
 //! and comes back to life when someone comes.
 //!
-//! # The blend
+//! The rest layer's weight glides from 0 (awake) to 1 (at the rest pose)
+//! and back along a minimum-jerk move, under the idle limits; a rest may
+//! relax (no pulses) once there, and a wake may glance towards who woke it.
 //!
-//! Resting is a layer over the mixed idle and gaze (gestures stay on top):
-//!
-//! ```text
-//! offset = base + w · (pose − base) + Σ gesture,   base = centre + idle · gain · duck
-//! ```
-//!
-//! with a weight `w` (Q16) that glides from 0 to 1 to rest and back to 0 to
-//! wake, along minimum-jerk glides that start from any state (`glide.rs`):
-//! a rest that is interrupted by a wake, or the other way round, turns
-//! around without a jump in angle, speed or acceleration. At `w = 1` the
-//! offsets are the pose exactly: the idle has faded out under it, and it
-//! fades back in as `w` falls. The pose itself is three glides, so that a
-//! new pose given while the head rests is glided to as well.
-//!
-//! # How long
-//!
-//! A rest takes at least [`REST_TIME`], a wake at least [`WAKE_TIME`]
-//! (the idle is back within about a second), each lengthened until the
-//! blend fits the *idle* limits of every axis with room to spare for the
-//! idle's own motion: neither switches an axis to the gesture limits, and
-//! the limiter never has to flatten them. With `D` the largest distance
-//! between the pose and the base (plus [`DRIFT`], what the idle may move
-//! meanwhile), the blend's own speed peaks at `1.875·D/T` and its
-//! acceleration at `5.774·D/T²`; `T` is chosen so that these stay within
-//! the idle limits less [`IDLE_SPEED`] and half of the acceleration limit.
-//!
-//! # Relax and the glance
-//!
-//! Once the head has arrived at its pose, it may *relax* (the setting
-//! `rest.relax`): the driver stops the pulses (see
-//! [`Head`](super::Head)), and a wake brings them back from the pose it
-//! stands at, so the first pulse after the gap is the last before it. A
-//! wake may carry a direction: once awake, the head glances there, a look
-//! held [`GLANCE_HOLD`] before it returns.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “Rest and wake”).
 
 use crate::command::{Hold, LookRequest};
 use crate::units::{Angle, Millis};

@@ -1,34 +1,14 @@
 //! How a gesture moves: the [`Shape`]s a row of the
 //! [gesture table](crate::gestures) can name.
 //!
-//! A gesture adds `E(φ) · A(φ) · c(φ)` to its axis (see
-//! [`gesture`](super::gesture) for the envelope `E` and the profile `A`);
-//! the shape gives the carrier `c`, how long the envelope's ramps are, which
-//! amplitudes an axis allows, and the bounds of its peak speed and
-//! acceleration:
+//! A shape gives a gesture's carrier (a dip, a swing, a lean), the length
+//! of its envelope's ramps, the amplitudes an axis allows, and the bounds
+//! `(Kv, Ka)` of its peak speed and acceleration that the plan checks. A new
+//! shape is a new variant here with an arm in each `match` below, and a row
+//! of the gesture table that names it.
 //!
-//! | shape | carrier `c(φ)` | ramps | amplitude | `(Kv, Ka)` | gestures |
-//! |---|---|---|---|---|---|
-//! | [`Dip`](Shape::Dip) | `(1 − cos 2πφ)/2` | ½ cycle | positive, up to the axis' upper limit | (1.45, 1.85), on `A/2` | nod |
-//! | [`Swing`](Shape::Swing) | `sin 2πφ` | ½ cycle | positive, up to the nearer limit | (1.05, 1.65) | shake |
-//! | [`Lean`](Shape::Lean) | `1` (a posture, one cycle) | ⅓ of it | either sign, within the limits | (0.9, 1.32) | tilt |
-//!
-//! - **Dip**: each cycle dips towards positive angles and comes back: a
-//!   cycle is a down and an up movement and its magnitude is the dip, as
-//!   Mori, Den & Jokinen measure nods. The first downstroke is the ramp and
-//!   still reaches the full first dip at `φ = ½`.
-//! - **Swing**: to either side of the centre.
-//! - **Lean**: up over the first third along the envelope, held, down over
-//!   the last third; the amplitude's sign chooses the side.
-//!
-//! **Speed check.** A shape's peak speed and acceleration are at most
-//! `Kv·ω·a` and `Ka·ω²·a` (`ω = 2πf`, `a` the carrier's amplitude): measured
-//! on the continuous shape over 1 to 32 cycles and rounded up (the
-//! envelope's ramps make the first and the last half cycle steeper than the
-//! bare carrier).
-//!
-//! A new shape is a new variant here with an arm in each `match` below, and
-//! a row of the gesture table that names it.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “Gesture shapes”).
 
 use crate::units::{Angle, AngleRange};
 

@@ -2,42 +2,14 @@
 //! from Bottango's curves ([`crate::bottango`]), blended over everything
 //! else the mixer made (idle, gestures, gaze).
 //!
-//! Per axis the layer drives, and frame:
+//! The blend weight follows the source (DMX's mix slot, Bottango's
+//! session) and moves without a jump; when the source goes away the head
+//! hands back to the mixer smoothly. The inputs arrive through the
+//! [`ShowLink`], which the receivers and the console ports write and the
+//! frame task reads between frames.
 //!
-//! ```text
-//! offset = mixed + (pose − mixed) · w
-//! ```
-//!
-//! - `pose`: the DMX cue's 16-bit positions across each axis' angle limits,
-//!   or the angles Bottango's curves give (as offsets from the neutral
-//!   pose);
-//! - `w`: the DMX position mix (slot 7, 0–255 → 0–1) while the signal is
-//!   there, or 1 while Bottango's curves play (they take precedence over
-//!   DMX).
-//!
-//! When the source goes away (DMX lost for [`LOSS`], `dmx off`, Bottango's
-//! last curve ended or its session closed), the pose holds and `w` glides
-//! to 0 along a minimum-jerk move over [`HANDBACK`] (as the idle gain
-//! does, `glide.rs`): the head returns to its own motion with no jump in
-//! angle, velocity or acceleration. The result goes through the frame
-//! driver's limiter like every layer, and the axes the layer drives are
-//! in gesture mode ([`LimitMode::Gesture`](super::LimitMode)): a console
-//! that snaps a channel moves the servo as fast as the gesture limits allow,
-//! never faster.
-//!
-//! With nothing to show (the usual case) a frame costs one test of a
-//! byte ([`Show::blend`]).
-//!
-//! # DMX's other slots
-//!
-//! The gesture trigger (slot 8) fires its gesture when the slot enters a
-//! band, and not again until it has left that band; the band the slot is in
-//! when the head first hears the console does not fire (a head switched on
-//! in the middle of a cue does not replay it). The idle intensity (slot 9)
-//! sets the idle amplitude while the signal is there (through the same
-//! glide as `idle amp`); when the signal is lost or DMX is switched off,
-//! the amplitude goes back to the head's own (the last `idle amp`, or the
-//! settings'). Neither wakes a head that `stop` stopped.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “The show layer”).
 
 use crate::bottango::{Curves, Sample};
 use crate::command::{Action, GestureKind, GestureRequest, Percent};

@@ -1,21 +1,10 @@
 //! Bytes → lines: the line discipline of the console.
 //!
-//! A line ends at CR, at LF, or at CR LF (one end, also when the CR and
-//! the LF arrive in separate calls), so every terminal's Enter key works:
-//! picocom and screen send CR, the Arduino serial monitor sends LF or
-//! CR LF as configured, programs usually send LF.
-//!
-//! While a line is being typed, backspace (0x08) and DEL (0x7F) delete the
-//! previous character (all bytes of a multi-byte UTF-8 character), as the
-//! terminals send either for the backspace key; at the start of a line they
-//! do nothing. Every other byte is kept as it is, and the completed line is
-//! checked as a whole: a control byte other than tab (NUL, ESC, ...), then
-//! UTF-8 validity.
-//!
-//! A line longer than the buffer (`N` bytes after editing) is discarded up
-//! to its end and reported once, as [`LineError::TooLong`]. Whatever
-//! arrives, every line end yields exactly one outcome ([`Framer::push`]);
-//! bytes after the last line end are a line in progress, not a line.
+//! A line ends at CR, LF or CR LF; backspace and DEL edit the line in
+//! progress; a completed line is checked for control bytes and UTF-8. A
+//! line longer than the buffer is discarded and reported once
+//! ([`LineError::TooLong`]). Every line end yields exactly one outcome
+//! ([`Framer::push`]).
 //!
 //! ```
 //! use idle_head_core::console::{Framer, LineError};
@@ -32,6 +21,9 @@
 //!     Err(LineError::TooLong { len: 25, max: 16 }),
 //! ]);
 //! ```
+//!
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “The line discipline”).
 
 use crate::text::{Describe, Text, display_from_describe};
 

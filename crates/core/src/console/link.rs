@@ -7,14 +7,10 @@
 //! with it), each port's telemetry rate (`watch`), and the trigger inputs'
 //! settings and levels (console → input task → console).
 //!
-//! Each is an embassy-sync blocking `Mutex` over a `Cell`, a `Signal`
-//! (whose state is a `Cell` too) or a [`Ring`] of `Cell`s: a critical
-//! section around a copy, no `RefCell` borrow, so nothing here puts a panic
-//! path on the frame path.
+//! Each is a [`SharedCell`], a `Signal` (whose state is a `Cell` too) or a
+//! [`Ring`] of `Cell`s: a critical section around a copy, no `RefCell`
+//! borrow, so nothing here puts a panic path on the frame path.
 
-use core::cell::Cell;
-
-use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 
@@ -24,6 +20,7 @@ use crate::driver::{DriverStats, FrameReport};
 use crate::input::{InputSettings, InputStatus};
 use crate::ring::Ring;
 use crate::servo::{ServoCalibration, ServoRate};
+use crate::shared::SharedCell;
 use crate::track::TrackView;
 use crate::units::{Angle, Microseconds, Timestamp};
 
@@ -148,23 +145,23 @@ pub struct Outcome {
 
 /// The shared state; see the [module docs](self). Lives in a `static`.
 pub struct ConsoleLink {
-    status: Mutex<CriticalSectionRawMutex, Cell<HeadStatus>>,
-    servos: Mutex<CriticalSectionRawMutex, Cell<[Option<ServoCalibration>; 3]>>,
+    status: SharedCell<HeadStatus>,
+    servos: SharedCell<[Option<ServoCalibration>; 3]>,
     seeds: Signal<CriticalSectionRawMutex, [u32; 3]>,
     /// Each port's outcomes, in the order the frame task took its actions,
     /// and the signal that one arrived.
     outcomes: [Ring<Outcome, OUTCOMES>; PORTS],
     answered: [Signal<CriticalSectionRawMutex, ()>; PORTS],
     /// Telemetry lines a second per port (0: off).
-    watch: Mutex<CriticalSectionRawMutex, Cell<[u8; PORTS]>>,
+    watch: SharedCell<[u8; PORTS]>,
     live: Signal<CriticalSectionRawMutex, LiveConfig>,
     /// The servos' rate to take (`servo rate`).
     rate: Signal<CriticalSectionRawMutex, ServoRate>,
     /// The inputs' settings in effect (one copy, which the input task
     /// reads at every wake), and whether they changed.
-    inputs: Mutex<CriticalSectionRawMutex, Cell<InputSettings>>,
+    inputs: SharedCell<InputSettings>,
     inputs_changed: Signal<CriticalSectionRawMutex, ()>,
-    input_status: Mutex<CriticalSectionRawMutex, Cell<InputStatus>>,
+    input_status: SharedCell<InputStatus>,
 }
 
 impl ConsoleLink {
@@ -172,7 +169,7 @@ impl ConsoleLink {
     #[must_use]
     pub const fn new() -> Self {
         Self {
-            status: Mutex::new(Cell::new(HeadStatus {
+            status: SharedCell::new(HeadStatus {
                 frame: 0,
                 time: Timestamp(0),
                 mode: HeadMode::Starting,
@@ -181,17 +178,17 @@ impl ConsoleLink {
                 faults: [0; 3],
                 disabled: [false; 3],
                 track: None,
-            })),
-            servos: Mutex::new(Cell::new([None; 3])),
+            }),
+            servos: SharedCell::new([None; 3]),
             seeds: Signal::new(),
             outcomes: [const { Ring::new() }; PORTS],
             answered: [const { Signal::new() }; PORTS],
-            watch: Mutex::new(Cell::new([0; PORTS])),
+            watch: SharedCell::new([0; PORTS]),
             live: Signal::new(),
             rate: Signal::new(),
-            inputs: Mutex::new(Cell::new(InputSettings::DEFAULT)),
+            inputs: SharedCell::new(InputSettings::DEFAULT),
             inputs_changed: Signal::new(),
-            input_status: Mutex::new(Cell::new(InputStatus { high: 0, active: 0 })),
+            input_status: SharedCell::new(InputStatus { high: 0, active: 0 }),
         }
     }
 
@@ -239,53 +236,51 @@ impl ConsoleLink {
 
     /// The console: `port` streams `hz` telemetry lines a second (0: none).
     pub fn set_watch(&self, port: u8, hz: u8) {
-        self.watch.lock(|cell| {
-            let mut rates = cell.get();
+        self.watch.update(|rates| {
             if let Some(rate) = rates.get_mut(usize::from(port)) {
                 *rate = hz;
             }
-            cell.set(rates);
         });
     }
 
     /// The console: `port`'s telemetry rate in lines a second (0: none).
     pub fn watch(&self, port: u8) -> u8 {
         self.watch
-            .lock(|cell| cell.get().get(usize::from(port)).copied().unwrap_or(0))
+            .get()
+            .get(usize::from(port))
+            .copied()
+            .unwrap_or(0)
     }
 
     /// The frame task: the head after the last frame.
     pub fn publish(&self, status: HeadStatus) {
-        self.status.lock(|cell| cell.set(status));
+        self.status.set(status);
     }
 
     /// The console: the head after the last frame.
     pub fn status(&self) -> HeadStatus {
-        self.status.lock(Cell::get)
+        self.status.get()
     }
 
     /// The console: `cal` for `axis`' servo from the next frame on. A
     /// calibration not yet applied is replaced (each is a whole
     /// calibration: the newest is the one asked for).
     pub fn set_servo(&self, axis: Axis, cal: ServoCalibration) {
-        self.servos.lock(|cell| {
-            let mut pending = cell.get();
+        self.servos.update(|pending| {
             if let Some(slot) = pending.get_mut(axis.index()) {
                 *slot = Some(cal);
             }
-            cell.set(pending);
         });
     }
 
     /// The frame task: the calibrations to apply, `[pitch, roll, yaw]`.
     pub fn take_servos(&self) -> [Option<ServoCalibration>; 3] {
-        self.servos.lock(|cell| cell.replace([None; 3]))
+        self.servos.replace([None; 3])
     }
 
     /// Whether calibrations wait for the frame task.
     pub fn servos_pending(&self) -> bool {
-        self.servos
-            .lock(|cell| cell.get().iter().any(Option::is_some))
+        self.servos.get().iter().any(Option::is_some)
     }
 
     /// The console: generate the next loop set from `seeds`.
@@ -324,13 +319,13 @@ impl ConsoleLink {
     /// The boot, then the console: the inputs' roles and the rest timer in
     /// effect, for the input task.
     pub fn set_inputs(&self, inputs: InputSettings) {
-        self.inputs.lock(|cell| cell.set(inputs));
+        self.inputs.set(inputs);
         self.inputs_changed.signal(());
     }
 
     /// The input task: the inputs' settings in effect.
     pub fn input_settings(&self) -> InputSettings {
-        self.inputs.lock(Cell::get)
+        self.inputs.get()
     }
 
     /// The input task: waits until the inputs' settings change.
@@ -346,12 +341,12 @@ impl ConsoleLink {
 
     /// The input task: the inputs' levels as they are now.
     pub fn publish_inputs(&self, status: InputStatus) {
-        self.input_status.lock(|cell| cell.set(status));
+        self.input_status.set(status);
     }
 
     /// The console: the inputs' levels.
     pub fn inputs(&self) -> InputStatus {
-        self.input_status.lock(Cell::get)
+        self.input_status.get()
     }
 }
 

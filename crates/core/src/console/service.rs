@@ -1,87 +1,16 @@
-//! The console service: the [`Handler`] that carries out every command.
+//! The console service: the [`Handler`] that carries out every command
+//! ([`ConsoleService`], an example on it).
 //!
 //! Board-neutral: a board gives it the frame task's [`CommandQueue`], the
 //! [`ConsoleLink`] shared with the frame task and the loop generator, its
-//! [`SettingsStorage`] and its base driver configuration, and runs a
-//! [`Session`](super::Session) over its transport with the service as
-//! handler:
+//! [`SettingsStorage`] and its base driver configuration. Every line gets
+//! one reply; motions are checked as the mixer would
+//! ([`BehaviourParams::check`]) and queued, their reply deferred until the
+//! frame task answers; settings are validated as a whole
+//! ([`Settings::validate`]) before anything changes.
 //!
-//! ```
-//! use idle_head_core::behaviour::CommandQueue;
-//! use idle_head_core::console::{ConsoleLink, ConsoleService, Session};
-//! use idle_head_core::driver::DriverConfig;
-//! use idle_head_core::settings::{RamStorage, SETTINGS_BUFFER, Settings, SettingsSource};
-//!
-//! static QUEUE: CommandQueue = CommandQueue::new();
-//! static LINK: ConsoleLink = ConsoleLink::new();
-//! let mut service = ConsoleService::new(
-//!     &QUEUE, &LINK, RamStorage::<SETTINGS_BUFFER>::new(), DriverConfig::DEFAULT,
-//!     Settings::DEFAULT, SettingsSource::Defaults,
-//! ).unwrap();
-//! let mut session = Session::<96, 160>::new();
-//! let mut replies = Vec::new();
-//! session.feed(b"servo yaw min 2600\nsave\n", &mut service, |r| replies.push(r.to_vec()));
-//! assert!(replies[0].starts_with(b"err invalid "));
-//! assert_eq!(replies[1], b"ok\r\n");
-//!
-//! // A motion's reply waits for the frame task: it is queued, with a
-//! // ticket, and answered with what the frame task did.
-//! assert_eq!(session.push(b'n', &mut service), None);
-//! for &b in b"od\n" {
-//!     assert_eq!(session.push(b, &mut service), None);
-//! }
-//! let ticket = session.waiting().unwrap();
-//! assert_eq!(QUEUE.len(), 1);
-//! // (the frame task takes it, and answers through the link:)
-//! # let (action, asker) = QUEUE.take_asked().unwrap();
-//! # let params = Settings::DEFAULT.validate(&DriverConfig::DEFAULT).unwrap().behaviour;
-//! # LINK.answer(asker.unwrap(), params.check(&action));
-//! let outcome = LINK.take_outcome(0).unwrap();
-//! assert_eq!(outcome.ticket, ticket);
-//! let reply = session.finish(|r| idle_head_core::console::outcome_reply(r, &outcome.result));
-//! assert!(reply.unwrap().starts_with(b"ok nod amp_mdeg="));
-//! ```
-//!
-//! What each command does:
-//!
-//! - motion (`nod`, `look`, `stop`, `idle …`): checked as the mixer
-//!   would ([`BehaviourParams::check`]) and queued for the frame task
-//!   with the port's ticket; a full queue is `err busy` (nothing queued,
-//!   send it again). The reply is deferred ([`Reply::defer`]): the
-//!   port's console answers once the frame task has taken or refused the
-//!   action ([`ConsoleLink::answer`], [`super::outcome_reply`]): `ok`
-//!   with what it started, or `err busy` when every gesture layer is
-//!   busy;
-//! - `watch <hz>|off`: the port's telemetry rate, in the link (the
-//!   port's console streams the lines);
-//! - `status`: the head as the last frame left it ([`HeadStatus`]),
-//!   uptime, firmware version, where the settings came from, the servos'
-//!   rate;
-//! - `servo <axis> <field> <value>`: the settings with that field
-//!   changed are validated as the typed configuration is
-//!   ([`Settings::validate`]); `err invalid` for a calibration the
-//!   driver refuses, `err limit` if the behaviour would then drive the
-//!   servo past its new limits; otherwise the frame task applies it
-//!   between two frames through the limiter ([`FrameDriver::set_servo`]);
-//! - `servo rate <hz>`: the settings at that rate are validated as any
-//!   change is (`err invalid` if the servos' calibrations do not fit its
-//!   period, `err limit` if the behaviour does not hold at it); the frame
-//!   task takes it at a frame boundary, without a jump (the motion is timed
-//!   in µs, see `FrameDriver::set_pwm_period`); `servo rate` alone answers
-//!   the rate and its period;
-//! - `seed`: the next loop set is generated from the new seeds and
-//!   joined in as any set is (no jump);
-//! - `input`, `rest after|pose|relax`, `look duck`: the settings changed
-//!   and sent through the link, to the input task (the roles and the rest
-//!   timer) or to the frame task (the rest pose, relax, the look's duck;
-//!   see `service/inputs.rs`); `rest` and `wake` alone are motions;
-//! - `save`, `load`, `defaults`: the [`SettingsStorage`]; a loaded or
-//!   default set is applied as `servo` and `seed` are, and its idle
-//!   amplitude through the queue, its inputs and live behaviour settings
-//!   through the link. (The other gesture and gaze defaults take effect at
-//!   the next boot: the frame task's behaviour is built once.)
-//!
-//! [`FrameDriver::set_servo`]: crate::driver::FrameDriver::set_servo
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “The console service”).
 
 use crate::text::Arg::{Int, Str, Uint};
 use crate::text::Text;
@@ -94,6 +23,7 @@ use super::link::{ConsoleLink, HeadStatus};
 use super::outcome::behaviour_code;
 use super::reply::{ErrorCode, Reply};
 use super::session::Handler;
+use super::telemetry::{Angles, write_pose};
 use crate::axis::Axis;
 use crate::behaviour::{Asker, BehaviourParams, CommandQueue, ShowLink};
 use crate::command::{Action, Command, ServoSetting};
@@ -115,7 +45,41 @@ pub const HELP: &str = const_format::concatcp!(
 /// The firmware version `status` reports.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 
-/// The console service; see the [module docs](self).
+/// The console service; see the [module docs](self). On a RAM store:
+///
+/// ```
+/// use idle_head_core::behaviour::CommandQueue;
+/// use idle_head_core::console::{ConsoleLink, ConsoleService, Session};
+/// use idle_head_core::driver::DriverConfig;
+/// use idle_head_core::settings::{RamStorage, SETTINGS_BUFFER, Settings};
+///
+/// static QUEUE: CommandQueue = CommandQueue::new();
+/// static LINK: ConsoleLink = ConsoleLink::new();
+/// let mut service =
+///     ConsoleService::with_defaults(&QUEUE, &LINK, RamStorage::<SETTINGS_BUFFER>::new());
+/// let mut session = Session::<96, 160>::new();
+/// let mut replies = Vec::new();
+/// session.feed(b"servo yaw min 2600\nsave\n", &mut service, |r| replies.push(r.to_vec()));
+/// assert!(replies[0].starts_with(b"err invalid "));
+/// assert_eq!(replies[1], b"ok\r\n");
+///
+/// // A motion's reply waits for the frame task: it is queued, with a
+/// // ticket, and answered with what the frame task did.
+/// assert_eq!(session.push(b'n', &mut service), None);
+/// for &b in b"od\n" {
+///     assert_eq!(session.push(b, &mut service), None);
+/// }
+/// let ticket = session.waiting().unwrap();
+/// assert_eq!(QUEUE.len(), 1);
+/// // (the frame task takes it, and answers through the link:)
+/// # let (action, asker) = QUEUE.take_asked().unwrap();
+/// # let params = Settings::DEFAULT.validate(&DriverConfig::DEFAULT).unwrap().behaviour;
+/// # LINK.answer(asker.unwrap(), params.check(&action));
+/// let outcome = LINK.take_outcome(0).unwrap();
+/// assert_eq!(outcome.ticket, ticket);
+/// let reply = session.finish(|r| idle_head_core::console::outcome_reply(r, &outcome.result));
+/// assert!(reply.unwrap().starts_with(b"ok nod amp_mdeg="));
+/// ```
 pub struct ConsoleService<'a, S, const N: usize = { crate::behaviour::queue::CAPACITY }> {
     queue: &'a CommandQueue<N>,
     link: &'a ConsoleLink,
@@ -182,6 +146,21 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         }
     }
 
+    /// A service on the built-in settings and driver configuration
+    /// ([`Settings::DEFAULT`], [`DriverConfig::DEFAULT`], checked at compile
+    /// time), saving to `storage`: a head as it leaves the factory.
+    pub fn with_defaults(queue: &'a CommandQueue<N>, link: &'a ConsoleLink, storage: S) -> Self {
+        Self::checked(
+            queue,
+            link,
+            storage,
+            DriverConfig::DEFAULT,
+            Settings::DEFAULT,
+            SettingsSource::Defaults,
+            &Validated::DEFAULT,
+        )
+    }
+
     /// Mixes `bits` from the board's entropy source into `seed random`.
     pub fn add_entropy(&mut self, bits: u32) {
         self.entropy = (self.entropy ^ bits) | 1;
@@ -233,20 +212,13 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
 
     fn status(&self, reply: &mut Reply<'_>) {
         let s: HeadStatus = self.link.status();
-        let [p, r, y] = s.angles.map(crate::units::Angle::millidegrees);
-        let [pp, pr, py] = s.pulses.map(|us| us.0);
         let [fp, fr, fy] = s.faults;
         let off = s.disabled.iter().filter(|&&d| d).count();
-        text(reply.ok()).fill(
-            "mode={} mdeg={},{},{} us={},{},{} faults={},{},{} off={} uptime_ms={} fw={}{} settings={}",
+        text(reply.ok()).str("mode=").str(s.mode.as_str());
+        write_pose(text(reply), &s, Angles::Joined);
+        text(reply).fill(
+            " faults={},{},{} off={} uptime_ms={} fw={}{} settings={}",
             &[
-                Str(s.mode.as_str()),
-                Int(p.into()),
-                Int(r.into()),
-                Int(y.into()),
-                Uint(pp.into()),
-                Uint(pr.into()),
-                Uint(py.into()),
                 Uint(fp.into()),
                 Uint(fr.into()),
                 Uint(fy.into()),

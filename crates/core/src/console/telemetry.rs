@@ -13,8 +13,7 @@
 //! `lost` the lines this port dropped so far because the host read too
 //! slowly (each tick whose line could not go out in time).
 
-use crate::text::Arg::{Int, Uint};
-use crate::text::Out;
+use crate::text::{Out, Text};
 
 use super::link::HeadStatus;
 use super::session::{PORT_REPLY, checksum};
@@ -38,21 +37,9 @@ pub const MAX_WATCH_HZ: u8 = 50;
 /// the line. (Into a shorter buffer the line is cut, without its end.)
 pub fn telemetry_line<'b>(status: &HeadStatus, lost: u32, out: &'b mut [u8]) -> &'b [u8] {
     let mut line = Out::new(out);
-    let [p, r, y] = status.angles.map(crate::units::Angle::millidegrees);
-    let [pp, pr, py] = status.pulses.map(|us| us.0);
-    line.text().fill(
-        "~ t={} p={} r={} y={} us={},{},{} lost={}",
-        &[
-            Uint(status.uptime_ms()),
-            Int(p.into()),
-            Int(r.into()),
-            Int(y.into()),
-            Uint(pp.into()),
-            Uint(pr.into()),
-            Uint(py.into()),
-            Uint(lost.into()),
-        ],
-    );
+    line.text().str("~ t=").u64(status.uptime_ms());
+    write_pose(line.text(), status, Angles::Apart);
+    line.text().str(" lost=").u64(lost.into());
     if let Some(track) = status.track {
         line.text()
             .str(" targets=")
@@ -66,6 +53,28 @@ pub fn telemetry_line<'b>(status: &HeadStatus, lost: u32, out: &'b mut [u8]) -> 
     let crc = checksum(line.written());
     line.text().str(" *").hex2(crc).str("\r\n");
     line.into_bytes()
+}
+
+/// How a line names the angles of [`write_pose`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Angles {
+    /// ` mdeg=<pitch>,<roll>,<yaw>` (`status`).
+    Joined,
+    /// ` p=<pitch> r=<roll> y=<yaw>` (telemetry).
+    Apart,
+}
+
+/// Writes the fields `status` and telemetry lines share, from `status`:
+/// the commanded angles in mdeg (named as `angles` says), then the pulses
+/// written, ` us=<pitch>,<roll>,<yaw>`.
+pub(crate) fn write_pose(out: &mut dyn Text, status: &HeadStatus, angles: Angles) {
+    let [p, r, y] = status.angles.map(|a| i64::from(a.millidegrees()));
+    match angles {
+        Angles::Joined => out.str(" mdeg=").i64(p).str(",").i64(r).str(",").i64(y),
+        Angles::Apart => out.str(" p=").i64(p).str(" r=").i64(r).str(" y=").i64(y),
+    };
+    let [pp, pr, py] = status.pulses.map(|us| u64::from(us.0));
+    out.str(" us=").u64(pp).str(",").u64(pr).str(",").u64(py);
 }
 
 #[cfg(test)]

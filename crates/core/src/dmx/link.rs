@@ -1,14 +1,9 @@
 //! What the DMX receiver, the frame task and the console share.
 //!
-//! Each part is an embassy-sync blocking `Mutex` over a `Cell`: a critical
-//! section around a copy of a few bytes, no borrow that could fail, so the
-//! frame task reads it between frames without a panic path and without
-//! waiting for anyone.
+//! Each part is a [`SharedCell`] of a few bytes: the frame task reads it
+//! between frames without a panic path and without waiting for anyone.
 
-use core::cell::Cell;
-
-use embassy_sync::blocking_mutex::Mutex;
-use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use crate::shared::SharedCell;
 
 use super::{Counters, Cue, DmxAddress, DmxSettings};
 
@@ -60,9 +55,9 @@ struct Received {
 /// settings.
 pub struct DmxLink {
     /// Whether on, and the address less one.
-    settings: Mutex<CriticalSectionRawMutex, Cell<(bool, u16)>>,
-    received: Mutex<CriticalSectionRawMutex, Cell<Received>>,
-    signal: Mutex<CriticalSectionRawMutex, Cell<Signal>>,
+    settings: SharedCell<(bool, u16)>,
+    received: SharedCell<Received>,
+    signal: SharedCell<Signal>,
 }
 
 impl DmxLink {
@@ -71,27 +66,27 @@ impl DmxLink {
     #[must_use]
     pub const fn new() -> Self {
         Self {
-            settings: Mutex::new(Cell::new((false, 0))),
-            received: Mutex::new(Cell::new(Received {
+            settings: SharedCell::new((false, 0)),
+            received: SharedCell::new(Received {
                 latest: Latest {
                     seq: 0,
                     cue: Cue::ZERO,
                 },
                 counters: Counters::ZERO,
-            })),
-            signal: Mutex::new(Cell::new(Signal::Lost)),
+            }),
+            signal: SharedCell::new(Signal::Lost),
         }
     }
 
     /// The console (and the boot): DMX on or off, and the address.
     pub fn set(&self, settings: DmxSettings) {
         let raw = (settings.on, settings.address.get() - 1);
-        self.settings.lock(|cell| cell.set(raw));
+        self.settings.set(raw);
     }
 
     /// The settings in effect.
     pub fn settings(&self) -> DmxSettings {
-        let (on, less_one) = self.settings.lock(Cell::get);
+        let (on, less_one) = self.settings.get();
         DmxSettings {
             on,
             address: DmxAddress::new(less_one + 1).unwrap_or(DmxAddress::FIRST),
@@ -101,8 +96,7 @@ impl DmxLink {
     /// The receiver, at a frame's end: the counters, and the frame's cue if
     /// it was a good one.
     pub fn record(&self, cue: Option<Cue>, counters: Counters) {
-        self.received.lock(|cell| {
-            let mut received = cell.get();
+        self.received.update(|received| {
             if let Some(cue) = cue {
                 received.latest = Latest {
                     seq: received.latest.seq.wrapping_add(1),
@@ -110,29 +104,28 @@ impl DmxLink {
                 };
             }
             received.counters = counters;
-            cell.set(received);
         });
     }
 
     /// The frame task: whether DMX is on, and the latest cue.
     pub fn latest(&self) -> (bool, Latest) {
-        let on = self.settings.lock(Cell::get).0;
-        (on, self.received.lock(Cell::get).latest)
+        let on = self.settings.get().0;
+        (on, self.received.get().latest)
     }
 
     /// The console: what became of the frames so far.
     pub fn counters(&self) -> Counters {
-        self.received.lock(Cell::get).counters
+        self.received.get().counters
     }
 
     /// The frame task: the signal as it judges it.
     pub fn set_signal(&self, signal: Signal) {
-        self.signal.lock(|cell| cell.set(signal));
+        self.signal.set(signal);
     }
 
     /// The console: the signal as the frame task last judged it.
     pub fn signal(&self) -> Signal {
-        self.signal.lock(Cell::get)
+        self.signal.get()
     }
 }
 

@@ -1,40 +1,13 @@
 //! DMX512 input: a lighting console drives the head like any fixture.
 //!
-//! - [`Decoder`]: a universe's bytes and breaks (as a UART reports them)
-//!   in, the head's few slots out; every frame that is not used is counted
-//!   ([`Counters`]) and ignored. Nothing is buffered but the slots of the
-//!   personality: a frame of 513 bytes goes through ten bytes of state.
-//! - [`Cue`]: the personality, the slots taken apart (table below);
-//!   [`Trigger`]: the gesture trigger's bands.
-//! - [`DmxLink`]: what the receiver, the frame task and the console share
-//!   (the latest cue, the counters, whether DMX is on and at which
-//!   address).
+//! The head takes [`FOOTPRINT`] slots from its [`DmxAddress`] (its
+//! personality: the pose, the mix, a gesture trigger, the idle intensity);
+//! the [`Decoder`] keeps those slots of each frame and counts every frame by
+//! what became of it ([`Counters`]); only a good frame (start code 0, long
+//! enough, no receive error) gives a [`Cue`].
 //!
-//! What the head does with a cue (the show layer over the idle, the
-//! gestures it fires, signal loss) is [`crate::behaviour::show`]'s.
-//!
-//! # The personality
-//!
-//! Ten slots from the head's start address (`dmx address`, 1 to 503):
-//!
-//! | slot | meaning |
-//! |---|---|
-//! | 1–2 | yaw, 16 bit (coarse, fine): 0 the lower angle limit, 65 535 the upper |
-//! | 3–4 | pitch, likewise |
-//! | 5–6 | roll, likewise |
-//! | 7 | position mix: 0 the head's own motion only, 255 the DMX pose fully |
-//! | 8 | gesture trigger: 0–9 none, 10–29 nod, 30–49 shake, 50–69 tilt, 70–89 center, 90–255 none |
-//! | 9 | idle intensity, 0–255 → 0–100 % |
-//! | 10 | reserved (wake and rest, once the head has them): ignored |
-//!
-//! # Frames
-//!
-//! A frame is a break, the start code and up to 512 slots. Only start code
-//! 0 (dimmer data) is used; a frame with another start code (RDM, text,
-//! system information) is counted and skipped. A frame that ends before
-//! slot 9 of the personality is *short*, one with more than 512 slots
-//! *long*, one in which the UART saw a framing, parity or overrun error
-//! *garbled*: each is counted and ignored.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “DMX512”).
 
 mod decoder;
 mod link;

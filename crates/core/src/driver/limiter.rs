@@ -1,57 +1,15 @@
 //! Speed and acceleration limiter on the commanded angle of one axis.
 //!
-//! State in microdegrees (µ°) and µ° per frame, so that limits stay exact at
-//! high frame rates; the output is rounded to millidegrees.
+//! State in microdegrees (µ°) and µ° per frame, `i32` throughout (angle
+//! limits within ±360°, [`MAX_LIMIT_MDEG`]; distances within [`SPAN`]); the
+//! output is rounded to millidegrees. The braking speed is exact (the
+//! largest speed whose decelerating steps fit the distance), and the
+//! position limits are braked for like a target, so the head never reaches
+//! a limit faster than it can stop there. A target tracked exactly within
+//! the clear band takes the common case: one comparison, no braking.
 //!
-//! # 32 bits
-//!
-//! Angle limits lie within ±360° ([`MAX_LIMIT_MDEG`]), so every position is
-//! within ±3.6·10⁸ µ° and every distance and speed within [`SPAN`] = 7.2·10⁸
-//! µ°. The per-frame limits are capped without changing any result: a step of
-//! [`SPAN`] already crosses any range (the position clamp gives the same
-//! position), and an acceleration of 2·[`SPAN`] both contains the whole speed
-//! window around any speed and stops any distance in one step (so the braking
-//! speed is the distance itself, as for any larger acceleration). The
-//! largest sum formed is a target speed plus a closing speed, below
-//! 2·[`SPAN`] < 2³¹: `i32` throughout.
-//!
-//! # Exact braking
-//!
-//! The braking speed for a distance `d` at acceleration `a` is the largest `v`
-//! whose steps `v, v − a, v − 2a, …` (the positive ones) sum to at most `d`.
-//! At `v = k·a` the sum is `T(k) = a·k(k+1)/2`; on `v ∈ (k·a, (k+1)·a]` it is
-//! `(k+1)·v − T(k)`. With `k` the largest integer with `T(k) ≤ d` the answer
-//! is `⌊(d + T(k))/(k+1)⌋`, which lies in `[k·a, (k+1)·a)` because
-//! `T(k+1) > d`. `T(k) ≤ d` is `k(k+1)/2 ≤ q` with `q = ⌊d/a⌋`, i.e. `k` is
-//! `r = ⌊√(2q)⌋` or `r − 1` (`k² ≤ 2q < (k+2)²`). With `d ≤ SPAN` every term
-//! fits `u32`: two divisions and a `u32` square root, and only off the
-//! common case, and only when the braking speed can matter: it is at least
-//! `min(d, a)`, and at least `v` when `2·a·d ≥ (v + a)²` (the steps
-//! `v, v − a, …` sum to at most `(v + a)²/2a`), two 64-bit products.
-//!
-//! # Braking for the limits
-//!
-//! The position limits are braked for like a target: a step towards a limit
-//! is at most the braking speed for the distance left to it, so the head
-//! never reaches a limit faster than it can stop there, and the position
-//! clamp never cuts a step short (which would be a deceleration beyond the
-//! limit). The step of a target that moves within the limits is always
-//! within that bound when it is at most one acceleration step: the braking
-//! speed for a distance `d` is at least `min(d, a)`.
-//!
-//! # The common case
-//!
-//! A target that moves within the limits and is tracked exactly (error 0)
-//! is followed as it is: one comparison of its step against the speed and
-//! acceleration limits and of its change against the acceleration limit,
-//! no braking. A faster step (up to the speed limit) is followed as it is
-//! too while the position lies in the *clear band*, at least the braking
-//! distance of the fastest step, `⌈(max_step + a)²/2a⌉`, from both position
-//! limits (computed with the limits): there the braking speed for either
-//! limit is at least the step (and the step stays inside them), so the full
-//! path would give the same step. Fast gestures and gaze moves, whose steps
-//! exceed one acceleration step, stay on the common case away from the
-//! limits.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “The limiter's arithmetic”).
 
 use crate::units::Angle;
 

@@ -1,34 +1,13 @@
 //! Frame-by-frame playback: the exact position kept with additions only,
 //! and each loop's spline window reused until the position leaves it.
 //!
-//! # The position
+//! The position is exact at every frame, kept with `u32` additions (a frame
+//! that does not follow the last is located from its time, as
+//! [`Playback::position_at`] does); samples are read ahead, so a frame that
+//! moves on to the next segment reads none.
 //!
-//! A frame at time `t` lies at `t mod L` in the loop (`L`: loop duration,
-//! µs) and at `X/L` samples with `X = (t mod L)·n·2¹²` (`n` samples, Q12).
-//! The player keeps `⌊X/L⌋` and the remainder. A frame `F` µs after the
-//! last adds `S = (F mod L)·n·2¹²`, i.e. `⌊S/L⌋` to the position and `S mod
-//! L` to the remainder (a carry when it reaches `L`), and the position wraps
-//! at `n·2¹²` when `t` passes `L`. Every remainder is a multiple of `g =
-//! gcd(n·2¹², L)` (whatever the time, and whatever the frame period), so it
-//! is kept in units of `g`, below `L/g`. With `n < 2¹⁹` and `L/g < 2³¹` (any
-//! loop up to 35 minutes) the sums fit `u32`. A frame that does not follow
-//! the last one by `F` (frames skipped while late, or a jump) is located
-//! from its time with 64-bit long division, as [`Playback::position_at`]
-//! does: exact either way, without drift over any run length. A change of
-//! the frame period ([`Cursor::set_frame_period`]) changes `S` alone.
-//!
-//! # The windows
-//!
-//! Each loop's window holds the four samples of the current spline segment
-//! and up to two samples past it, read ahead. A frame that stays in its
-//! segment reads ahead (the frame has the time: it moves no window); a
-//! frame that moves on shifts the windows and uses the samples read ahead,
-//! reading only those it lacks. At 1.67 frames per sample (the defaults at
-//! 50 Hz) two of five frames stay and three move on: after the first
-//! samples, every read happens on a frame that stays. A frame that moves
-//! more than three samples, or jumps, reads whole windows. A frame located
-//! exactly on a sample (such as frame 0) needs only that sample, and the
-//! next frame reads the other three.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “Playback”).
 
 use super::timing::{LoopSource, Playback, T_BITS, Weights, Window, mul_div_rem, wrap};
 use crate::units::{Angle, Microseconds, Timestamp};

@@ -1,34 +1,12 @@
 //! The frame path's angle → pulse → duty conversion: one servo's calibration
 //! and its channel's duty scale, worked out once into 32-bit integer steps.
 //!
-//! # Pulse: exact
+//! The pulse is exactly [`ServoCalibration::pulse`]'s and the duty within
+//! one count of [`PwmTiming::duty`]'s, in `i32` without a division for any
+//! usual calibration (in 64 bits beyond).
 //!
-//! [`ServoCalibration::pulse`] is `neutral + r(a·s / 10⁶)` clamped to
-//! `[min_pulse, max_pulse]`, with the angle `a` in m°, `s = ±per_degree` in
-//! ns/° (so `a·s` is in picoseconds) and `r` rounding halves away from zero.
-//! The map first clamps `a` to the angles whose pulse can lie in the pulse
-//! range (widened by 1 µs each side, so the clamp never changes a clamped
-//! pulse). For a calibration whose pulses stay within about ±2100 µs of
-//! neutral, `|a·s| < 2³¹ − 2²⁰` on that domain: the product is exact in
-//! `i32`, and the division by 10⁶ takes a reciprocal estimate, which is low
-//! by at most 2, and a remainder correction (see `div_1e6`). The pulse is
-//! then exactly the calibration's.
-//!
-//! # Duty: within one count
-//!
-//! [`PwmTiming::duty`] is `d(p) = ⌊(p·M + ⌊T/2⌋)/T⌋` for `M` counts per
-//! period `T`. With `p = min_pulse + δ` and `min_pulse·M + ⌊T/2⌋ = b·T + r`
-//! (`0 ≤ r < T`), `d = b + ⌊(r + δ·M)/T⌋`, and the map computes
-//! `b + ⌊(c + δ·k)/2ˢ⌋` with `k = ⌈M·2ˢ/T⌉` and `c = ⌈r·2ˢ/T⌉`, `s` as large as
-//! keeps `c + span·k` below 2³² (`span` = `max_pulse − min_pulse`). Rounded
-//! up, the fraction exceeds the true one by less than `(1 + span)/2ˢ`, which
-//! construction holds to ¼ count: the duty is `d(p)`, except when the true
-//! fraction lies within that distance below a whole count, where it is one
-//! count more. It is clamped to `[d(min_pulse), d(max_pulse)]`.
-//!
-//! A calibration outside these bounds (pulses thousands of µs from neutral,
-//! tens of thousands of duty counts per pulse range) takes
-//! [`ServoCalibration::pulse`] and [`PwmTiming::duty`] themselves, in 64 bits.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “Angle to pulse to duty”).
 
 use super::calibration::{Direction, Duty, PwmTiming, ServoCalibration};
 use crate::units::{Angle, Microseconds};

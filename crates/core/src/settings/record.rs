@@ -1,6 +1,7 @@
 //! The record trait: a settings type, its bytes and its layout version.
 
-use super::report::{FieldReport, LoadError, Loaded};
+use super::error::StorageError;
+use super::report::{FieldReport, Loaded};
 
 /// Bytes of the version in front of a stored record.
 pub(super) const VERSION_LEN: usize = 2;
@@ -10,9 +11,9 @@ pub(super) const VERSION_LEN: usize = 2;
 /// The store writes [`VERSION`](Self::VERSION) next to the bytes of
 /// [`encode`](Self::encode), and hands both to [`decode`](Self::decode) on
 /// a load. A record of a newer version than `VERSION` is refused before
-/// `decode` sees it ([`LoadError::Newer`](super::LoadError::Newer)); an
+/// `decode` sees it ([`StorageError::Newer`](super::StorageError::Newer)); an
 /// older one is `decode`'s to migrate, or to refuse with
-/// [`DecodeError::Version`] ([`LoadError::Older`](super::LoadError::Older)).
+/// [`DecodeError::Version`] ([`StorageError::Older`](super::StorageError::Older)).
 /// The [`Settings`](super::Settings) record is a list of tagged fields
 /// whose layout does not change when a field is added (see the [module
 /// docs](super)).
@@ -73,17 +74,17 @@ pub enum DecodeError<I> {
 /// [`RamStorage`]: super::RamStorage
 ///
 /// # Errors
-/// A [`LoadError`] saying why it cannot be used (never `Empty`, `TooLong`
+/// A [`StorageError`] saying why it cannot be used (never `Empty`, `TooLong`
 /// or `Flash`).
 pub(super) fn open_record<R: Record, E>(
     stored: &[u8],
-) -> Result<Loaded<R>, LoadError<E, R::Invalid>> {
+) -> Result<Loaded<R>, StorageError<E, R::Invalid>> {
     let Some((version, bytes)) = stored.split_first_chunk::<VERSION_LEN>() else {
-        return Err(LoadError::Corrupt);
+        return Err(StorageError::Corrupt);
     };
     let version = u16::from_le_bytes(*version);
     if version > R::VERSION {
-        return Err(LoadError::Newer { found: version });
+        return Err(StorageError::Newer { found: version });
     }
     let mut fields = FieldReport::default();
     match R::decode(version, bytes, &mut fields) {
@@ -92,9 +93,9 @@ pub(super) fn open_record<R: Record, E>(
             version,
             fields,
         }),
-        Err(DecodeError::Malformed) => Err(LoadError::Corrupt),
-        Err(DecodeError::Version) => Err(LoadError::Older { found: version }),
-        Err(DecodeError::Invalid(why)) => Err(LoadError::Invalid(why)),
+        Err(DecodeError::Malformed) => Err(StorageError::Corrupt),
+        Err(DecodeError::Version) => Err(StorageError::Older { found: version }),
+        Err(DecodeError::Invalid(why)) => Err(StorageError::Invalid(why)),
     }
 }
 

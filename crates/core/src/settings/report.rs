@@ -175,35 +175,3 @@ mod tests {
         assert!(!report.is_clean());
     }
 }
-
-/// Why no record was loaded: `E` is the flash driver's error, `I` why a
-/// record is invalid ([`Record::Invalid`](super::Record::Invalid)).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum LoadError<E, I> {
-    /// Nothing was ever saved (or the range was erased).
-    Empty,
-    /// The stored bytes are damaged beyond what the store repairs, or do
-    /// not decode as the record.
-    Corrupt,
-    /// A record of an older layout that this firmware cannot migrate.
-    Older {
-        /// Its version.
-        found: u16,
-    },
-    /// A record saved by firmware with a newer layout.
-    Newer {
-        /// Its version.
-        found: u16,
-    },
-    /// A stored item longer than the work buffer: a record saved by a
-    /// firmware with more fields than this one can read at once.
-    TooLong {
-        /// The buffer it needs, in bytes.
-        needs: usize,
-    },
-    /// A record that decodes but fails validation, and why.
-    Invalid(I),
-    /// The flash driver failed.
-    Flash(E),
-}

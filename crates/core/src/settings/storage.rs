@@ -2,82 +2,18 @@
 //! implements ([`SettingsStorage`]), and [`RamStorage`], a record kept in
 //! RAM (the QEMU image's store; tests).
 
-use crate::text::{Describe, Text, display_from_describe};
-
+use super::error::{FlashFailed, StorageError};
 use super::record::{Record, VERSION_LEN, open_record};
-use super::report::LoadError;
 use super::store::SaveError;
-use super::values::{Settings, SettingsError};
+use super::values::Settings;
 use super::{SETTINGS_BUFFER, SETTINGS_LEN};
-
-/// Why `save` or `load` failed: the board-neutral form of the store's
-/// errors, for the console's `err storage` reply.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum StorageError {
-    /// Nothing saved yet.
-    Empty,
-    /// The stored bytes are damaged or not a record.
-    Corrupt,
-    /// A record of an older layout version that cannot be migrated.
-    Older {
-        /// Its version.
-        found: u16,
-    },
-    /// A record of a newer layout version.
-    Newer {
-        /// Its version.
-        found: u16,
-    },
-    /// A record that fails validation, and why.
-    Invalid(SettingsError),
-    /// The record does not fit the store (or a stored one does not fit the
-    /// buffer that reads it).
-    TooLong,
-    /// The flash (or whatever holds the record) failed.
-    Device,
-}
-
-impl Describe for StorageError {
-    fn describe(&self, out: &mut dyn Text) {
-        match *self {
-            Self::Empty => out.str("no settings saved"),
-            Self::Corrupt => out.str("stored settings are damaged"),
-            Self::Older { found } => out
-                .str("stored settings are of older version ")
-                .u64(found.into()),
-            Self::Newer { found } => out
-                .str("stored settings are of newer version ")
-                .u64(found.into()),
-            Self::Invalid(e) => out.str("stored settings fail validation: ").with(&e),
-            Self::TooLong => out.str("settings do not fit the store"),
-            Self::Device => out.str("the flash failed"),
-        };
-    }
-}
-
-display_from_describe!(StorageError);
-
-impl<E> From<LoadError<E, SettingsError>> for StorageError {
-    fn from(e: LoadError<E, SettingsError>) -> Self {
-        match e {
-            LoadError::Empty => Self::Empty,
-            LoadError::Corrupt => Self::Corrupt,
-            LoadError::Older { found } => Self::Older { found },
-            LoadError::Newer { found } => Self::Newer { found },
-            LoadError::TooLong { .. } => Self::TooLong,
-            LoadError::Invalid(e) => Self::Invalid(e),
-            LoadError::Flash(_) => Self::Device,
-        }
-    }
-}
 
 impl<E> From<SaveError<E>> for StorageError {
     fn from(e: SaveError<E>) -> Self {
         match e {
-            SaveError::TooLong | SaveError::Encode => Self::TooLong,
+            SaveError::TooLong | SaveError::Encode => Self::TooLong { needs: None },
             SaveError::Corrupt => Self::Corrupt,
-            SaveError::Flash(_) => Self::Device,
+            SaveError::Flash(_) => Self::Flash(FlashFailed),
         }
     }
 }
@@ -150,7 +86,7 @@ impl<const N: usize> RamStorage<N> {
         let slot = self
             .bytes
             .get_mut(..raw.len())
-            .ok_or(StorageError::TooLong)?;
+            .ok_or(StorageError::TooLong { needs: None })?;
         slot.copy_from_slice(raw);
         self.len = raw.len();
         Ok(())
@@ -169,13 +105,15 @@ impl<const N: usize> SettingsStorage for RamStorage<N> {
     /// version).
     fn save(&mut self, settings: &Settings) -> Result<(), StorageError> {
         if N < VERSION_LEN + SETTINGS_LEN {
-            return Err(StorageError::TooLong);
+            return Err(StorageError::TooLong { needs: None });
         }
         let (version, body) = self
             .bytes
             .split_at_mut_checked(VERSION_LEN)
-            .ok_or(StorageError::TooLong)?;
-        let used = settings.encode(body).map_err(|_| StorageError::TooLong)?;
+            .ok_or(StorageError::TooLong { needs: None })?;
+        let used = settings
+            .encode(body)
+            .map_err(|_| StorageError::TooLong { needs: None })?;
         version.copy_from_slice(&Settings::VERSION.to_le_bytes());
         self.len = VERSION_LEN + used;
         Ok(())
@@ -186,7 +124,7 @@ impl<const N: usize> SettingsStorage for RamStorage<N> {
             [] => Err(StorageError::Empty),
             stored => open_record::<Settings, ()>(stored)
                 .map(|loaded| loaded.record)
-                .map_err(StorageError::from),
+                .map_err(StorageError::forget_flash),
         }
     }
 }

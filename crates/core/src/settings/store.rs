@@ -14,8 +14,9 @@ use sequential_storage::Error;
 use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapConfigError, MapStorage, SerializationError, Value};
 
+use super::error::StorageError;
 use super::record::{EncodeError, Record, VERSION_LEN, open_record};
-use super::report::{LoadError, Loaded};
+use super::report::Loaded;
 
 /// The map key of the record.
 const KEY: u8 = 0;
@@ -84,15 +85,15 @@ impl<F: NorFlash, R: Record, const BUF: usize> SettingsStore<F, R, BUF> {
     /// with the fields the load skipped or left on their defaults.
     ///
     /// # Errors
-    /// A [`LoadError`] saying why there is none to use.
-    pub async fn load(&mut self) -> Result<Loaded<R>, LoadError<F::Error, R::Invalid>> {
+    /// A [`StorageError`] saying why there is none to use.
+    pub async fn load(&mut self) -> Result<Loaded<R>, StorageError<F::Error, R::Invalid>> {
         match self.map.fetch_item::<&[u8]>(&mut self.buf.0, &KEY).await {
             Ok(Some(stored)) => open_record(stored),
-            Ok(None) => Err(LoadError::Empty),
-            Err(Error::Storage { value, .. }) => Err(LoadError::Flash(value)),
-            Err(Error::BufferTooSmall(needs)) => Err(LoadError::TooLong { needs }),
+            Ok(None) => Err(StorageError::Empty),
+            Err(Error::Storage { value, .. }) => Err(StorageError::Flash(value)),
+            Err(Error::BufferTooSmall(needs)) => Err(StorageError::TooLong { needs: Some(needs) }),
             // Damage the map could not repair.
-            Err(_) => Err(LoadError::Corrupt),
+            Err(_) => Err(StorageError::Corrupt),
         }
     }
 

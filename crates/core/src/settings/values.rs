@@ -79,6 +79,15 @@ pub struct Validated {
     pub behaviour: BehaviourParams,
 }
 
+impl Validated {
+    /// The built-in settings checked with the built-in driver
+    /// configuration, at compile time.
+    pub const DEFAULT: Self = match Settings::DEFAULT.validate(&DriverConfig::DEFAULT) {
+        Ok(v) => v,
+        Err(_) => panic!("the built-in settings fail validation"),
+    };
+}
+
 impl Settings {
     /// The built-in configuration: the hobby servos of
     /// [`DriverConfig::DEFAULT`], [`BehaviourConfig::DEFAULT`] and the

@@ -1,15 +1,11 @@
 //! What the tracker's receiver, the frame task, the input task and the
 //! console share.
 //!
-//! Each part is an embassy-sync blocking `Mutex` over a `Cell`: a critical
-//! section around a copy of a few dozen bytes, no borrow that could fail,
-//! so the frame task reads it between frames without a panic path and
-//! without waiting for the receiver (an interrupt) or the console.
+//! Each part is a [`SharedCell`] of a few dozen bytes: the frame task reads
+//! it between frames without a panic path and without waiting for the
+//! receiver (an interrupt) or the console.
 
-use core::cell::Cell;
-
-use embassy_sync::blocking_mutex::Mutex;
-use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use crate::shared::SharedCell;
 
 use super::{Counters, Sighting, TrackSettings};
 
@@ -33,8 +29,8 @@ pub struct Received {
 /// The shared tracker state; lives in a `static`. All zero at first (off,
 /// nothing received).
 pub struct TrackLink {
-    settings: Mutex<CriticalSectionRawMutex, Cell<TrackSettings>>,
-    received: Mutex<CriticalSectionRawMutex, Cell<Received>>,
+    settings: SharedCell<TrackSettings>,
+    received: SharedCell<Received>,
 }
 
 impl TrackLink {
@@ -42,8 +38,8 @@ impl TrackLink {
     #[must_use]
     pub const fn new() -> Self {
         Self {
-            settings: Mutex::new(Cell::new(TrackSettings::DEFAULT)),
-            received: Mutex::new(Cell::new(Received {
+            settings: SharedCell::new(TrackSettings::DEFAULT),
+            received: SharedCell::new(Received {
                 sighting: Sighting::NOBODY,
                 seq: 0,
                 seen: 0,
@@ -54,18 +50,18 @@ impl TrackLink {
                     dropped: 0,
                     skipped: 0,
                 },
-            })),
+            }),
         }
     }
 
     /// The boot and the console: the settings in effect.
     pub fn set(&self, settings: TrackSettings) {
-        self.settings.lock(|cell| cell.set(settings));
+        self.settings.set(settings);
     }
 
     /// The settings in effect.
     pub fn settings(&self) -> TrackSettings {
-        self.settings.lock(Cell::get)
+        self.settings.get()
     }
 
     /// The receiver: a new sighting (if any) and the tracker's counters.
@@ -79,8 +75,7 @@ impl TrackLink {
     /// came at once, `older` of them before it (never seen by the frame
     /// task: counted as dropped).
     pub fn publish_after(&self, sighting: Option<Sighting>, older: u32, counters: Counters) {
-        self.received.lock(|cell| {
-            let mut r = cell.get();
+        self.received.update(|r| {
             let dropped = r.counters.dropped.wrapping_add(older);
             if let Some(s) = sighting {
                 let replaced = !r.taken;
@@ -96,27 +91,24 @@ impl TrackLink {
                 r.counters = counters;
                 r.counters.dropped = dropped;
             }
-            cell.set(r);
         });
     }
 
     /// The frame task: the sighting published since the last call, if
     /// any.
     pub fn take(&self) -> Option<Sighting> {
-        self.received.lock(|cell| {
-            let mut r = cell.get();
+        self.received.update(|r| {
             if r.taken {
                 return None;
             }
             r.taken = true;
-            cell.set(r);
             Some(r.sighting)
         })
     }
 
     /// The console and the input task: what was received so far.
     pub fn received(&self) -> Received {
-        self.received.lock(Cell::get)
+        self.received.get()
     }
 
     /// The input task: sightings with somebody in them so far, while the

@@ -11,6 +11,8 @@ use idle_head_core::servo::SetPeriod;
 
 use super::FrameLoop;
 
+use crate::log;
+
 /// A change of rate between its two steps, and the clock's scale.
 #[derive(Clone, Debug)]
 pub(super) struct Retime {
@@ -45,7 +47,7 @@ impl<I: IdleSource> FrameLoop<'_, I> {
     /// [`write`](Self::write)).
     pub fn take_rate<P: SetPeriod>(&mut self, driver: &mut FrameDriver<P>, tick: FrameTick) {
         if let Some(period) = self.retime.refused.take() {
-            defmt::error!("frames at {=u32} us refused by the driver", period.0);
+            log::error!("frames at {=u32} us refused by the driver", period.0);
         }
         let Some(rate) = self.link.and_then(ConsoleLink::take_rate) else {
             return;
@@ -54,14 +56,14 @@ impl<I: IdleSource> FrameLoop<'_, I> {
         match driver.set_pwm_period(period) {
             Ok(()) => {
                 self.retime.pending = Some(period);
-                defmt::info!(
+                log::info!(
                     "frame {=u64}: servo rate {=u16} Hz: pulses every {=u32} us from this frame on",
                     tick.frame,
                     rate.hz(),
                     period.0
                 );
             }
-            Err(e) => defmt::warn!("frame {=u64}: servo rate refused: {}", tick.frame, e),
+            Err(e) => log::warn!("frame {=u64}: servo rate refused: {}", tick.frame, e),
         }
     }
 

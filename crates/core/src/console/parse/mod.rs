@@ -1,37 +1,11 @@
 //! One line of the console protocol → a [`Command`].
 //!
 //! Words are separated by spaces or tabs and compared without regard to
-//! ASCII case. Numbers are decimal integers with an optional sign, in the
-//! project's units. Optional trailing options are `name=value` words, in
-//! any order after the positional arguments.
-//!
-//! ```text
-//! help | status | save | load | defaults | stop
-//! nod   [amp_mdeg] [ms] [cycles=N] [intensity=PCT]     (each gesture of the
-//! shake [amp_mdeg] [ms] [cycles=N] [intensity=PCT]      gesture table;
-//! tilt  [amp_mdeg] [ms] [intensity=PCT]                 cycles= if it repeats)
-//! look <pitch_mdeg> <yaw_mdeg> [ms] [hold=MS|hold=stay]
-//! center [ms]
-//! idle on | idle off | idle amp <percent>
-//! look duck <percent>
-//! rest | wake | rest after <seconds>|never | rest pose <pitch> <roll> <yaw>
-//! rest relax on|off
-//! input <2..5> [off | button <motion command> | presence [<yaw_mdeg>]]
-//! seed [<n> | random | board | paper]
-//! radar [on | off]
-//! track [on | off | height <mm> | mount <yaw_mdeg> | prefer nearest|newest]
-//! servo <pitch|roll|yaw> [neutral <us> | per-degree <ns> | direction <normal|reversed>
-//!                        | min <us> | max <us> | limits <min_mdeg> <max_mdeg>]
-//! servo rate [<hz>]                                     (hz 50..=333)
-//! watch <hz> | watch off                                (hz 1..=50)
-//! dmx [on | off | address <1..503>]
-//! ```
-//!
-//! The parser checks the syntax and that each number fits its type
-//! (a percentage is at most 100, a duration is positive); whether a value
-//! suits the head (an amplitude inside the axis' limits, a calibration
-//! that validates) is for the behaviour and the settings to decide. It
-//! never panics and allocates nothing.
+//! ASCII case; numbers are decimal integers in the project's units;
+//! options are `name=value` words after the positional arguments. The
+//! parser checks the syntax and that each number fits its type (whether a
+//! value suits the head is for the behaviour and the settings); it never
+//! panics and allocates nothing. The grammar: `docs/user/protocol.md`.
 //!
 //! ```
 //! use idle_head_core::command::{Action, Command, GestureKind};
@@ -49,6 +23,9 @@
 //! let err = parse(b"nod six").unwrap_err();
 //! assert_eq!(err.describe(b"nod six").to_string(), "`six`: amplitude in mdeg must be a whole number");
 //! ```
+//!
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “The console's grammar”).
 
 use crate::axis::Axis;
 use crate::command::{

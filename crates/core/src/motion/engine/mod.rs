@@ -1,55 +1,13 @@
 //! The integer pipeline: walk → Hann smoothing → scaling → loop closure.
 //!
-//! # Smoothing in O(N), independent of W
+//! The smoothing works on the walk's steps with sliding sums over absolute
+//! time (O(N), independent of W, exact integers: no drift), and the
+//! integral of the quantised velocity is exact at every sample
+//! ([`Quantiser`]). No scratch memory beyond the output buffer and the
+//! W-tap ring; every intermediate fits `i32`.
 //!
-//! Smoothing the walk u with the Hann kernel h equals smoothing its steps
-//! e(k) = u(k) − u(k−1) ∈ {−1, 0, +1} and integrating, because convolution
-//! commutes with summation. With h(m) = ½ − ½·cos(ωm), ω = 2π/W, the smoothed
-//! velocity at n is
-//!
-//! ```text
-//! v(n) = Σₘ h(m)·e(n−m) = ½·B(n) − ½·Σₖ e(k)·cos(ω(n−k))          (k over the window)
-//!      = ½·B(n) − ½·[cos ωn · Σₖ e(k) cos ωk  +  sin ωn · Σₖ e(k) sin ωk]
-//! ```
-//!
-//! where B(n) is the plain window sum. B and the two phasor sums P꜀, Pₛ are
-//! *sliding sums over absolute time*: when the window moves by one sample the
-//! entering and the leaving step share the same residue n mod W, so each sum
-//! changes by (`e_new` − `e_old`)·T[n mod W] — one table entry, no rotation, no
-//! rounding. The sums are therefore exact integers at every n: there is no
-//! drift to re-anchor. Only the table rounding (≈ 1/Q per tap) separates the
-//! result from the real-valued Hann smoothing; `host-tests` measures it against
-//! a direct-form f64 convolution.
-//!
-//! # What the buffer holds
-//!
-//! The smoothed velocity V is quantised to a step 2^shift by an
-//! error-feedback [`Quantiser`], so the integral X of the quantised velocity
-//! equals ⌊(exact integral)/2^shift⌋ at every sample: no drift.
-//!
-//! - Seamless closure: the buffer receives X itself, wrapping in 16 bits,
-//!   with a step (`raw_shift` in `seamless.rs`) that makes a typical loop span 2¹⁵..2¹⁶
-//!   units (a wider one is quantised again); a [`LoopScale`] maps it to
-//!   angles about the loop's start. [`Integral16`](super::Integral16) storage keeps it as
-//!   it is: no pass after the sweep touches every sample.
-//! - Paper closure (taper and split need the angles): the buffer holds the
-//!   *second difference* ΔΔX as `i16` (see `x_shift` in `paper.rs`) and a scaling pass
-//!   integrates it twice into angles.
-//!
-//! No scratch memory beyond the output buffer and the W-tap ring.
-//!
-//! # Magnitudes (all fit `i32`)
-//!
-//! With table scale Q (Q²·W < 2²⁹) and bits b ∈ {0,1} of the steps:
-//! - `Pb = Σ b(k)·T[k mod W]` is a 2-vector of length ≤ W·(Q+1);
-//! - `cp = T꜀[j]·Pb꜀ + Tₛ[j]·Pbₛ` ≤ (Q+1)²·W (Cauchy–Schwarz) < 2²⁹·(1 + 3/Q);
-//! - `V = Q²·Bb − cp` = 2Q²·Σ h·b ∈ [0, Q²W] up to rounding, |V| < 2³⁰;
-//! - `V − q` with the detrend q ≤ Q²W, plus the quantiser's residue: < 2³¹;
-//! - ΔX = (V − q)/2^shift with 2^shift ≥ 2N, so |X| < 2³⁰ over the loop;
-//! - seamless: 2^shift ≥ 2¹⁵, so |ΔX| < 2¹⁵ and neighbouring samples differ
-//!   by an exact `i16`; the scale multiplies offsets < 2¹⁶ by m < 2¹⁵;
-//! - paper: |ΔΔX| < 2¹⁴ (see `x_shift` in `paper.rs`), stored as `i16`; the scaling pass
-//!   forms ΔX·m with m sized by the largest |ΔX|: < 2³¹.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “The integer pipeline”).
 #![allow(clippy::many_single_char_names)] // the notation of the derivation above
 
 mod paper;

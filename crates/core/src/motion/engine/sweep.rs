@@ -1,34 +1,12 @@
 //! The seamless closure's circular sweep: the window slides around the loop
 //! over a ring of W taps, and the quantised integral X is stored.
 //!
-//! It is the engine's inner loop, run N times per axis, and it keeps the
-//! shapes that make it cheap on the Cortex-M0+; each says what it saves in
-//! the default row of `cargo xtask bench` (three axes, N = 900, W = 59,
-//! with the pinned compiler).
+//! The wrap correction E, summed in wrapping `i32`, stays below 2²⁴ for
+//! every window and loop length (`host-tests/tests/wrap_correction.rs`
+//! checks it), so the sweep is exact.
 //!
-//! # The wrap correction E
-//!
-//! The part of Σₙ cp(n) that the zero-sum table does not cancel.
-//!
-//! Over the circular sweep (outputs n = W−1..N+W−2) each absolute step index
-//! k contributes b(k)·T\[k\]·Σ_{n∋k} T\[n\]. Steps k = W−1..N−1 are in W
-//! consecutive windows, a full period of the table: zero. The first W−1
-//! steps appear twice, as k and k+N, each in part of its windows; with an
-//! exact cosine the two parts would again form one full period, but the
-//! table's rounding at the two phases differs. E collects exactly that:
-//!
-//! ```text
-//! E = Σ_{k<W−1} b(k)·( T[k]·SA(k) + T[(k+N) mod W]·SB(k) )
-//! SA(k) = Σ_{n=W−1}^{k+W−1} T[n mod W],  SB(k) = Σ_{n=k+N}^{N+W−2} T[n mod W]
-//! ```
-//!
-//! (products of 2-vectors are dot products). Each step's two parts cover
-//! the W lags 0..W−1 once, so its term is a sum of W rounding errors of the
-//! table's products, and |E| stays far inside `i32`: below 2²⁴ for every
-//! W ≤ 511 and every N mod W, whatever the steps (`host-tests` checks all
-//! of them). The partial sums may leave `i32`, so they wrap: the final sum
-//! is exact. O(W), once per axis, summed by [`initial_window`] while it
-//! fills the window.
+//! Why it is built so: the book's notes on the code
+//! (`docs/design/code.md`, “The seamless sweep”).
 
 use crate::motion::lcg::Lcg;
 use crate::motion::storage::Sample;

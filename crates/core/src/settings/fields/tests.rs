@@ -2,7 +2,7 @@
 //! firmware with one field more.
 use super::*;
 use crate::command::Percent;
-use crate::settings::{LoadError, Loaded, RamStorage, SettingsStorage, record::open_record};
+use crate::settings::{Loaded, RamStorage, SettingsStorage, StorageError, record::open_record};
 use crate::units::{Microseconds, Millis};
 
 /// An id the table will not reach for a long time: the field a test
@@ -85,7 +85,7 @@ fn stored<R: Record>(record: &R) -> Vec<u8> {
     buf[..2 + n].to_vec()
 }
 
-fn open<R: Record>(stored: &[u8]) -> Result<Loaded<R>, LoadError<(), R::Invalid>> {
+fn open<R: Record>(stored: &[u8]) -> Result<Loaded<R>, StorageError<(), R::Invalid>> {
     open_record::<R, ()>(stored)
 }
 
@@ -205,7 +205,7 @@ fn settings_that_fail_as_a_whole_are_refused_with_the_reason() {
     let Err(why) = bad.validate(&DriverConfig::DEFAULT) else {
         panic!("valid")
     };
-    assert_eq!(err, LoadError::Invalid(why));
+    assert_eq!(err, StorageError::Invalid(why));
     // A missing field whose default does not fit the others: refused too.
     let mut narrow = Settings::DEFAULT;
     narrow.servos[0].min_pulse = Microseconds(1600);
@@ -215,7 +215,7 @@ fn settings_that_fail_as_a_whole_are_refused_with_the_reason() {
     let without_neutral = edited(&stored(&narrow), |id, v| (id != 1).then(|| v.to_vec()));
     assert!(matches!(
         open::<Settings>(&without_neutral),
-        Err(LoadError::Invalid(SettingsError::Driver(_)))
+        Err(StorageError::Invalid(SettingsError::Driver(_)))
     ));
 }
 
@@ -228,19 +228,19 @@ fn a_cut_entry_or_a_field_twice_is_corrupt() {
         // validation may accept (the built-in values fit).
         let between = Entries::new(&bytes[2..cut]).all(|e| e.is_ok());
         match loaded {
-            Err(LoadError::Corrupt) => assert!(!between, "cut at {cut}"),
+            Err(StorageError::Corrupt) => assert!(!between, "cut at {cut}"),
             Ok(l) => assert!(between && !l.fields.missing.is_empty(), "cut at {cut}"),
-            Err(LoadError::Invalid(_)) => assert!(between, "cut at {cut}"),
+            Err(StorageError::Invalid(_)) => assert!(between, "cut at {cut}"),
             Err(e) => panic!("cut at {cut}: {e:?}"),
         }
     }
     let mut twice = bytes.clone();
     twice.extend([1, 4, 0xdc, 5, 0, 0]);
-    assert_eq!(open::<Settings>(&twice), Err(LoadError::Corrupt));
+    assert_eq!(open::<Settings>(&twice), Err(StorageError::Corrupt));
     let mut unknown_twice = bytes;
     unknown_twice.extend([NEW, 0, NEW, 1, 7]);
-    assert_eq!(open::<Settings>(&unknown_twice), Err(LoadError::Corrupt));
-    assert_eq!(open::<Settings>(&[2]), Err(LoadError::Corrupt));
+    assert_eq!(open::<Settings>(&unknown_twice), Err(StorageError::Corrupt));
+    assert_eq!(open::<Settings>(&[2]), Err(StorageError::Corrupt));
 }
 
 #[test]
@@ -253,14 +253,14 @@ fn versions() {
     };
     assert_eq!(
         open::<Settings>(&with(3)),
-        Err(LoadError::Newer { found: 3 })
+        Err(StorageError::Newer { found: 3 })
     );
     assert_eq!(
         open::<Settings>(&with(0)),
-        Err(LoadError::Older { found: 0 })
+        Err(StorageError::Older { found: 0 })
     );
     // Version 2's bytes are not a version 1 record.
-    assert_eq!(open::<Settings>(&with(1)), Err(LoadError::Corrupt));
+    assert_eq!(open::<Settings>(&with(1)), Err(StorageError::Corrupt));
     // An empty record of version 2: every field on its default.
     let empty = open::<Settings>(&2_u16.to_le_bytes()).unwrap();
     assert_eq!(empty.record, Settings::DEFAULT);
@@ -296,10 +296,13 @@ fn version_1_is_migrated_field_by_field() {
         );
         // A version 1 record of another length is not one.
         for n in [0, 1, v1.len() - 1] {
-            assert_eq!(open::<Settings>(&v1[..n.max(2)]), Err(LoadError::Corrupt));
+            assert_eq!(
+                open::<Settings>(&v1[..n.max(2)]),
+                Err(StorageError::Corrupt)
+            );
         }
         let mut long = v1.clone();
         long.push(0);
-        assert_eq!(open::<Settings>(&long), Err(LoadError::Corrupt));
+        assert_eq!(open::<Settings>(&long), Err(StorageError::Corrupt));
     }
 }
