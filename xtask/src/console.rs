@@ -1,8 +1,7 @@
 //! `cargo xtask console`: talk to a head, stdin to it and its replies to
 //! stdout, one per line, the bytes unchanged both ways. `--qemu` runs the
 //! firmware in QEMU, `--port` opens a serial port, neither finds the Pico
-//! by its USB VID:PID. Also the flood and console stages of `cargo xtask
-//! test`.
+//! by its USB VID:PID. Also the console stage of `cargo xtask test`.
 
 pub mod qemu;
 mod stages;
@@ -15,7 +14,7 @@ use std::time::Duration;
 use anyhow::{Context, Result, bail};
 
 pub use qemu::{Pace, qemu_session};
-pub use stages::{flood, piped_script};
+pub use stages::piped_script;
 use talk::Talk;
 
 use crate::qemu::Echo;

@@ -281,7 +281,6 @@ fn qemu_stages(
     const RUN: &str = "QEMU run: firmware exits with success";
     const SNAPSHOT: &str = "QEMU log matches boards/qemu/expected.log";
     const SUMMARY: &str = "QEMU summary: missed=0 pulse_violations=0, checksum = host's";
-    const FLOOD: &str = "QEMU flood: 10,000 console lines during a run, one reply each, missed=0";
     const CONSOLE: &str = "cargo xtask console --qemu with a piped script";
 
     let built = stages.run(BUILD, || {
@@ -323,10 +322,6 @@ fn qemu_stages(
         } else {
             snapshot::compare(&run, &metadata.target_dir.join("qemu-actual.log"))
         }
-    });
-    stages.run(FLOOD, || {
-        println!("{}", console::flood(&QEMU.elf(metadata))?);
-        Ok(())
     });
     stages.run(CONSOLE, || {
         println!("{}", console::piped_script()?);

@@ -58,8 +58,6 @@ impl LineEnds {
 pub struct Talk {
     pub sent: usize,
     pub replies: usize,
-    /// Wall time from the start to the last reply.
-    pub until_last_reply: Duration,
     /// What ended the conversation before its end, if anything did.
     pub early: Option<String>,
 }
@@ -139,16 +137,13 @@ pub fn converse(
 ) -> Talk {
     let received = AtomicUsize::new(0);
     let stop = AtomicBool::new(false);
-    let start = Instant::now();
     let mut ends = LineEnds::default();
     let mut early = None;
     thread::scope(|scope| {
         let (received, stop) = (&received, &stop);
         let reading = scope.spawn(move || {
-            let mut last = Instant::now();
             let end = read_replies(replies, stop, |reply| {
                 on_reply(reply);
-                last = Instant::now();
                 received.fetch_add(1, Ordering::AcqRel);
             });
             // Before the hang-up, the port must not end.
@@ -157,7 +152,7 @@ pub fn converse(
                 Ok(()) if !stop.load(Ordering::Acquire) => Some("the port closed".to_owned()),
                 Ok(()) => None,
             };
-            (last, why)
+            why
         });
         let mut buf = [0_u8; 4096];
         loop {
@@ -194,9 +189,9 @@ pub fn converse(
         }
         stop.store(true, Ordering::Release);
         let hang_up_result = hang_up();
-        let (last, why) = reading
+        let why = reading
             .join()
-            .unwrap_or_else(|_| (start, Some("the reader of the port panicked".to_owned())));
+            .unwrap_or_else(|_| Some("the reader of the port panicked".to_owned()));
         // The first thing that went wrong is the one to report.
         early = early.take().or(why).or_else(|| {
             hang_up_result
@@ -206,7 +201,6 @@ pub fn converse(
         Talk {
             sent: ends.lines(),
             replies: received.load(Ordering::Acquire),
-            until_last_reply: last.saturating_duration_since(start),
             early,
         }
     })
