@@ -13,7 +13,7 @@ use crate::figures::{self, thousands};
 use crate::{
     args::Options,
     log::{Defmt, LogLine, Run},
-    plot::{self, BLUE, Curve, Figure, GREEN, ORANGE, Panel},
+    plot,
     project::{self, QEMU},
     reference,
     setup::{self, QEMU_BINARY},
@@ -257,28 +257,9 @@ fn plot_motion(log: &[LogLine], path: &Path) -> Result<usize> {
     if frames.len() < 2 {
         bail!("fewer than two frame lines in the log");
     }
-    let panel = |i: usize, name: &str, color| Panel {
-        title: format!("{name} (°)"),
-        x_desc: "frame".to_owned(),
-        y_desc: "angle (°)".to_owned(),
-        curves: vec![Curve::new(
-            name,
-            color,
-            frames.iter().map(|f| (f.0, f.1[i])).collect(),
-        )],
-        ..Panel::default()
-    };
-    let figure = Figure {
-        title: format!("The QEMU run's motion: {} logged frames", frames.len()),
-        notes: vec!["angles as the firmware logged them".to_owned()],
-        panels: vec![
-            panel(0, "pitch", BLUE),
-            panel(1, "roll", ORANGE),
-            panel(2, "yaw", GREEN),
-        ],
-        panel_height: 220,
-    };
-    plot::draw(&figure, path)?;
+    let title = format!("The QEMU run's motion: {} logged frames", frames.len());
+    let notes = vec!["angles as the firmware logged them".to_owned()];
+    plot::motion(path, title, notes, "frame", &frames, &[])?;
     Ok(frames.len())
 }
 

@@ -10,7 +10,6 @@
 
 mod host;
 mod marks;
-mod plot;
 mod script;
 
 use std::{fs, path::PathBuf};
@@ -517,7 +516,7 @@ pub fn command(args: &Args) -> Result<bool> {
             Some(png) => png.clone(),
             None => default_dir()?.join("trace.png"),
         };
-        plot::draw(&trace, args.seed, &png)?;
+        marks::draw(&trace, args.seed, &png)?;
         println!("wrote {}", png.display());
     }
     Ok(true)

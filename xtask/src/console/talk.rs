@@ -147,12 +147,11 @@ pub fn converse(
                 received.fetch_add(1, Ordering::AcqRel);
             });
             // Before the hang-up, the port must not end.
-            let why = match end {
+            match end {
                 Err(e) => Some(format!("reading the port failed: {e}")),
                 Ok(()) if !stop.load(Ordering::Acquire) => Some("the port closed".to_owned()),
                 Ok(()) => None,
-            };
-            why
+            }
         });
         let mut buf = [0_u8; 4096];
         loop {

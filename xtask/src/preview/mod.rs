@@ -12,7 +12,6 @@
 //! - `final`: the stored loop in playback order, which starts at the split
 //!   point p: `final(i)` is the closure's last stage at (i + p) mod N.
 
-mod plot;
 mod stages;
 
 use std::{
@@ -28,7 +27,8 @@ use idle_head_core::{
 };
 
 use crate::{args::LoopShape, project};
-use stages::{LoopSpec, Stages};
+use stages::LoopSpec;
+pub use stages::{Stages, deg};
 
 /// Options of `cargo xtask preview` (its help text is in `cli.rs`).
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
@@ -189,7 +189,7 @@ pub fn command(args: &Args) -> Result<bool> {
         let csv = out.join(format!("{stem}.csv"));
         let png = out.join(format!("{stem}.png"));
         fs::write(&csv, stages.csv()).with_context(|| format!("writing {}", csv.display()))?;
-        plot::plot(&stages, &png)?;
+        crate::plot::stages(&stages, &png)?;
         println!("{}", stages.title());
         for line in &stages.metric_lines() {
             println!("  {line}");
