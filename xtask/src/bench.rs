@@ -266,10 +266,8 @@ pub fn run_and_check(
 
 /// `cargo xtask bench`. `Ok(false)` when the benchmark failed.
 pub fn command(options: Options) -> Result<bool> {
-    let root = project::root();
-    setup::ensure_toolchain(&root)?;
+    let (root, metadata) = project::prepare()?;
     setup::ensure_qemu()?;
-    let metadata = project::metadata(&root)?;
     let mut passed = match run_and_check(&root, &metadata, options, None) {
         Ok(()) => true,
         Err(error) => {

@@ -73,9 +73,15 @@ pub fn kib(value: u64) -> String {
     format!("{:.1} KiB", value as f64 / 1024.0)
 }
 
-/// `part` of `whole`, in percent.
-pub fn percent(part: u64, whole: u64) -> String {
-    format!("{:.0} %", part as f64 / whole.max(1) as f64 * 100.0)
+/// `part` bytes against a ceiling, if there is one: `62 % of 196,608 B`.
+pub fn of_ceiling(part: u64, ceiling: Option<u64>) -> String {
+    ceiling.map_or_else(
+        || "no ceiling".to_owned(),
+        |whole| {
+            let percent = part as f64 / whole.max(1) as f64 * 100.0;
+            format!("{percent:.0} % of {}", bytes(whole))
+        },
+    )
 }
 
 /// Prints the table `key` and records it (replacing the one recorded

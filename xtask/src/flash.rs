@@ -200,7 +200,7 @@ pub fn run(args: &Args, here: &Surroundings) -> Result<bool> {
         return Ok(false);
     };
     println!("{}", uf2::describe(&path, board, &bytes));
-    let target = drive.join(format!("{}.uf2", board.bin()));
+    let target = drive.join(format!("{}.uf2", board.image().bin));
     let mut file =
         std::fs::File::create(&target).with_context(|| format!("creating {}", target.display()))?;
     file.write_all(&bytes)

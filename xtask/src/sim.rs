@@ -93,7 +93,6 @@ pub use stages::{
 pub use store::{STORE_STAGE, test_store};
 
 use crate::project::{self, PICO};
-use crate::setup;
 
 /// Options of `cargo xtask sim`.
 // The runs are flags that exclude each other (clap checks it).
@@ -219,9 +218,7 @@ fn passed(what: &str, result: Result<()>) -> bool {
 
 /// `cargo xtask sim`. `Ok(false)` when a check failed.
 pub fn command(args: &Args) -> Result<bool> {
-    let root = project::root();
-    setup::ensure_toolchain(&root)?;
-    let metadata = project::metadata(&root)?;
+    let (root, metadata) = project::prepare()?;
     if let Some(path) = &args.script {
         let rate = idle_head_core::servo::ServoRate::new(args.rate)
             .ok_or_else(|| anyhow::anyhow!("{} Hz: not a servo rate", args.rate))?;

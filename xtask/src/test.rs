@@ -82,9 +82,7 @@ impl Stages<'_> {
 /// `Ok(false)` when a stage failed.
 pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     let start = Instant::now();
-    let root = project::root();
-    setup::ensure_toolchain(&root)?;
-    let metadata = project::metadata(&root)?;
+    let (root, metadata) = project::prepare()?;
     let sh = project::shell(".")?;
     let host_tests = project::shell("host-tests")?;
     let core = project::shell("crates/core")?;

@@ -85,7 +85,7 @@ pub fn check(elf: &Path, timeout: Duration, plain: Option<&Run>) -> Result<Strin
             seen: Arc::clone(&seen),
             deadline: Instant::now() + timeout,
         },
-        move |line| {
+        &mut move |line: &[u8]| {
             if line.starts_with(b"~ ") {
                 counted.fetch_add(1, Ordering::AcqRel);
             }
