@@ -118,6 +118,14 @@ pub fn finish<O: Send, E: Send, R>(
     })
 }
 
+/// Writes `contents` to `path`, creating its folder.
+pub fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    std::fs::write(path, contents).with_context(|| format!("writing {}", path.display()))
+}
+
 /// Fails with every one of `problems`, if there are any.
 pub fn verdict(problems: &[String]) -> Result<()> {
     match problems {
