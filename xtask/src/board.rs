@@ -1,21 +1,9 @@
 //! The boards a user flashes: what the tools need to know to build an
 //! image for each, turn it into a UF2 and put it on the board.
 
-use std::{ops::Range, path::PathBuf};
+use std::ops::Range;
 
-use anyhow::Result;
-use xshell::cmd;
-
-use crate::project::{self, FIRMWARE_ENV, Metadata};
-
-/// UF2 family of the RP2040 (`RP2040_FAMILY_ID` of the UF2 specification's
-/// family list, `rp2040` in picotool): its boot ROM ignores blocks of any
-/// other family.
-pub const RP2040_FAMILY_ID: u32 = 0xe48b_ff56;
-/// UF2 family of an RP2350 image for its Arm cores in Secure mode
-/// (`RP2350_ARM_S_FAMILY_ID`, `rp2350-arm-s` in picotool), the mode
-/// embassy-rp's start block declares.
-pub const RP2350_ARM_S_FAMILY_ID: u32 = 0xe48b_ff59;
+use crate::project::{Image, PICO};
 
 /// The Pico 2's compilation target: the RP2350's Cortex-M33 (ARMv8-M
 /// Mainline, with its single-precision FPU).
@@ -40,36 +28,26 @@ impl Board {
         }
     }
 
-    /// Its compilation target.
-    pub fn target(self) -> &'static str {
+    /// Its release image (`cargo build --release` in its package's folder).
+    pub fn image(self) -> Image {
         match self {
-            Self::Pico => project::TARGET,
-            Self::Pico2 => PICO2_TARGET,
+            Self::Pico => PICO,
+            Self::Pico2 => Image {
+                bin: "pico2",
+                dir: "boards/pico2",
+                target: PICO2_TARGET,
+                package: None,
+            },
         }
     }
 
-    /// Its image's bin name, also the ELF's file name.
-    pub fn bin(self) -> &'static str {
-        match self {
-            Self::Pico => "pico",
-            Self::Pico2 => "pico2",
-        }
-    }
-
-    /// The folder of its package, relative to the repository root, where
-    /// `cargo build --release` builds its image.
-    pub fn package_dir(self) -> &'static str {
-        match self {
-            Self::Pico => ".",
-            Self::Pico2 => "boards/pico2",
-        }
-    }
-
-    /// The family its boot ROM accepts in a UF2 block.
+    /// The UF2 family its boot ROM accepts: `rp2040`, or `rp2350-arm-s`
+    /// (its Arm cores in Secure mode, which embassy-rp's start block
+    /// declares); the boot ROM ignores blocks of any other family.
     pub fn family_id(self) -> u32 {
         match self {
-            Self::Pico => RP2040_FAMILY_ID,
-            Self::Pico2 => RP2350_ARM_S_FAMILY_ID,
+            Self::Pico => 0xe48b_ff56,
+            Self::Pico2 => 0xe48b_ff59,
         }
     }
 
@@ -90,36 +68,15 @@ impl Board {
         }
     }
 
-    /// Where its flash appears (execute-in-place window), as far as the
-    /// chip on the board reaches: 2 MiB on the Pico, 4 MiB on the Pico 2.
-    pub fn flash(self) -> Range<u32> {
-        const XIP_BASE: u32 = 0x1000_0000;
-        match self {
-            Self::Pico => XIP_BASE..XIP_BASE + (2 << 20),
-            Self::Pico2 => XIP_BASE..XIP_BASE + (4 << 20),
-        }
-    }
-
     /// The settings store: the last four 4 KiB erase sectors of the flash
-    /// (`SETTINGS` in the board's memory.x). No image reaches into it.
+    /// (2 MiB on the Pico, 4 MiB on the Pico 2, from `0x1000_0000`;
+    /// `SETTINGS` in the board's memory.x). No image reaches into it.
     pub fn settings(self) -> Range<u32> {
-        let end = self.flash().end;
+        let end = 0x1000_0000
+            + match self {
+                Self::Pico => 2 << 20,
+                Self::Pico2 => 4 << 20,
+            };
         end - 16 * 1024..end
-    }
-
-    /// The release ELF of its image.
-    pub fn elf(self, metadata: &Metadata) -> PathBuf {
-        metadata
-            .target_dir
-            .join(self.target())
-            .join("release")
-            .join(self.bin())
-    }
-
-    /// `cargo build --release` in the board's package folder, as a user
-    /// types it there (the folder's `.cargo/config.toml` picks the target).
-    pub fn build(self) -> Result<()> {
-        let sh = project::shell(self.package_dir())?;
-        project::run(&sh, FIRMWARE_ENV, cmd!(sh, "cargo build --release"))
     }
 }

@@ -69,8 +69,7 @@ pub fn stage(root: &Path, smoke: Option<&Run>) -> Result<()> {
 
 /// `cargo xtask book`. `Ok(false)` when the build or the link check failed.
 pub fn command() -> Result<bool> {
-    let root = project::root();
-    setup::ensure_toolchain(&root)?;
+    let (root, _) = project::prepare()?;
     match stage(&root, None) {
         Ok(()) => Ok(true),
         Err(error) => {

@@ -5,7 +5,7 @@ use std::{fmt::Write as _, ops::Range, path::Path};
 
 use anyhow::{Context, Result, bail};
 
-use crate::{board::Board, figures};
+use crate::{board::Board, figures, project};
 use object::read::elf::{ElfFile32, ProgramHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, SectionKind, elf};
 
@@ -16,18 +16,10 @@ pub const RAM_BUDGET: u64 = 48 * 1024;
 /// Flash budget of the Pico image: everything stored in flash
 /// (`.boot2 + .vector_table + .text + .rodata` and `.data`'s initial values).
 pub const FLASH_BUDGET: u64 = 192 * 1024;
-/// Where the RP2040 boot ROM looks for the 256-byte second-stage bootloader:
-/// the first flash page (XIP base `0x1000_0000`).
-pub const BOOT2_ADDRESS: u64 = 0x1000_0000;
-/// Size of the second stage: 252 bytes of code plus a 4-byte CRC32.
-pub const BOOT2_SIZE: u64 = 256;
 /// Where the RP2040 maps its QSPI flash (XIP), and the end of the window a
-/// 16 MiB flash can occupy.
+/// 16 MiB flash can occupy. Its boot ROM loads the 256-byte second stage
+/// (252 bytes of code and a CRC32) from the first page.
 pub const XIP: Range<u64> = 0x1000_0000..0x1100_0000;
-/// Where the emulated LM3S6965 reads its vector table at reset: the start of
-/// its flash (`FLASH` in qemu/memory.x). An image linked with another board's
-/// memory map (the Pico's flash starts at `0x1000_0000`) does not start.
-pub const LM3S6965_VECTOR_TABLE: u64 = 0x0000_0000;
 
 /// Parts of the names of symbols that are only present when an allocator is
 /// linked (`alloc`'s shims and the `#[global_allocator]` glue). Recent
@@ -53,14 +45,14 @@ pub struct Section {
 }
 
 /// What the checks need to know about a firmware ELF.
-#[derive(Debug)]
+#[derive(Debug, Default)]
 pub struct Image {
     /// Allocated sections in address order.
     pub sections: Vec<Section>,
     /// Allocator symbols found (there should be none).
     pub allocator_symbols: Vec<String>,
     /// `[__settings_start, __settings_end)` from the linker script, if
-    /// the image has them (the Pico image does).
+    /// the image has them (the Pico images do).
     pub settings: Option<Range<u64>>,
     /// End of the bytes stored in the XIP flash window: the highest load
     /// address (`p_paddr + p_filesz`) of a loadable segment there, so
@@ -75,29 +67,40 @@ impl Image {
         Self::parse(&data).with_context(|| format!("parsing {}", path.display()))
     }
 
+    /// Parses the ELF at `path` and prints its sections and sizes.
+    pub fn show(path: &Path) -> Result<Self> {
+        let image = Self::read(path)?;
+        println!("{}", path.display());
+        println!("  {:<16} {:>10}  {:>7}", "section", "address", "bytes");
+        for s in &image.sections {
+            println!("  {:<16} {:#010x}  {:>7}", s.name, s.address, s.size);
+        }
+        println!(
+            "  flash {} B, static RAM {} B (.data + .bss + .uninit)",
+            image.flash(),
+            image.static_ram()
+        );
+        Ok(image)
+    }
+
     /// Parses the ELF `data`.
     pub fn parse(data: &[u8]) -> Result<Self> {
         let file = object::File::parse(data)?;
-        let mut sections: Vec<Section> = file
-            .sections()
-            .filter(|section| match section.flags() {
-                SectionFlags::Elf { sh_flags } => sh_flags & u64::from(elf::SHF_ALLOC) != 0,
-                _ => false,
-            })
-            .filter(|section| section.size() > 0)
-            .map(|section| Section {
-                name: section.name().unwrap_or("?").to_owned(),
-                address: section.address(),
-                size: section.size(),
+        let allocated = |s: &object::Section<'_, '_>| matches!(s.flags(), SectionFlags::Elf { sh_flags } if sh_flags & u64::from(elf::SHF_ALLOC) != 0);
+        let mut sections: Vec<Section> = (file.sections())
+            .filter(|s| allocated(s) && s.size() > 0)
+            .map(|s| Section {
+                name: s.name().unwrap_or("?").to_owned(),
+                address: s.address(),
+                size: s.size(),
                 stored: !matches!(
-                    section.kind(),
+                    s.kind(),
                     SectionKind::UninitializedData | SectionKind::UninitializedTls
                 ),
             })
             .collect();
         sections.sort_by_key(|section| section.address);
-        let mut allocator_symbols: Vec<String> = file
-            .symbols()
+        let mut allocator_symbols: Vec<String> = (file.symbols())
             .filter_map(|symbol| symbol.name().ok())
             .filter(|name| ALLOCATOR_SYMBOLS.iter().any(|part| name.contains(part)))
             .map(str::to_owned)
@@ -106,24 +109,20 @@ impl Image {
         allocator_symbols.dedup();
         let symbol = |name: &str| {
             file.symbols()
-                .find(|symbol| symbol.name() == Ok(name))
-                .map(|symbol| symbol.address())
+                .find(|s| s.name() == Ok(name))
+                .map(|s| s.address())
         };
         let settings = symbol("__settings_start")
             .zip(symbol("__settings_end"))
             .map(|(start, end)| start..end);
-        // The highest load address (`p_paddr + p_filesz`) of a segment stored
-        // in the XIP window; 0 for an ELF that is not a 32-bit one.
+        // The highest load address of a segment stored in the XIP window;
+        // 0 for an ELF that is not a 32-bit one.
         let flash_end = ElfFile32::<Endianness>::parse(data).map_or(0, |file| {
             let e = file.endian();
-            file.elf_program_headers()
-                .iter()
+            (file.elf_program_headers().iter())
                 .filter(|h| h.p_type(e) == elf::PT_LOAD && h.p_filesz(e) > 0)
-                .map(|h| {
-                    u64::from(h.p_paddr(e))..u64::from(h.p_paddr(e)) + u64::from(h.p_filesz(e))
-                })
-                .filter(|range| XIP.contains(&range.start))
-                .map(|range| range.end)
+                .filter(|h| XIP.contains(&u64::from(h.p_paddr(e))))
+                .map(|h| u64::from(h.p_paddr(e)) + u64::from(h.p_filesz(e)))
                 .max()
                 .unwrap_or(0)
         });
@@ -140,17 +139,10 @@ impl Image {
         self.sections.iter().find(|section| section.name == name)
     }
 
-    fn size_of(&self, names: &[&str]) -> u64 {
-        names
-            .iter()
-            .filter_map(|name| self.section(name))
-            .map(|section| section.size)
-            .sum()
-    }
-
     /// Bytes of RAM taken before `main` runs: `.data + .bss + .uninit`.
     pub fn static_ram(&self) -> u64 {
-        self.size_of(&[".data", ".bss", ".uninit"])
+        let ram = |s: &&Section| [".data", ".bss", ".uninit"].contains(&s.name.as_str());
+        self.sections.iter().filter(ram).map(|s| s.size).sum()
     }
 
     /// Bytes written to flash: every allocated section with contents
@@ -158,44 +150,39 @@ impl Image {
     pub fn flash(&self) -> u64 {
         self.sections
             .iter()
-            .filter(|section| section.stored)
-            .map(|section| section.size)
+            .filter(|s| s.stored)
+            .map(|s| s.size)
             .sum()
     }
 
-    /// A table of the sections with their addresses and sizes.
-    pub fn table(&self) -> String {
-        let mut table = String::new();
-        let _ = writeln!(
-            table,
-            "  {:<16} {:>10}  {:>7}",
-            "section", "address", "bytes"
-        );
-        for section in &self.sections {
-            let _ = writeln!(
-                table,
-                "  {:<16} {:#010x}  {:>7}",
-                section.name, section.address, section.size
-            );
+    /// Fails unless the vector table is at `address`, where `chip` starts
+    /// an image from.
+    pub fn check_vector_table(&self, address: u64, chip: &str) -> Result<()> {
+        match self.section(".vector_table") {
+            Some(table) if table.address == address => Ok(()),
+            Some(table) => bail!(
+                "`.vector_table` is at {:#010x}; the {chip} starts the image from {address:#010x} \
+                 (was the image linked with another board's memory.x?)",
+                table.address
+            ),
+            None => bail!("no `.vector_table` section: the image cannot boot"),
         }
-        table
     }
 
     /// Fails unless the image has the RP2040's second stage: 256 bytes of
     /// `.boot2` at the start of flash, where its boot ROM loads them from.
     pub fn check_boot2(&self) -> Result<()> {
+        let hint = "is `-Tlink-rp.x` passed to the linker?";
         match self.section(".boot2") {
-            Some(boot2) if boot2.address == BOOT2_ADDRESS && boot2.size == BOOT2_SIZE => Ok(()),
+            Some(boot2) if boot2.address == XIP.start && boot2.size == 256 => Ok(()),
             Some(boot2) => bail!(
-                "`.boot2` is {} bytes at {:#010x}; the RP2040 boot ROM needs {BOOT2_SIZE} bytes \
-                 at {BOOT2_ADDRESS:#010x} (is `-Tlink-rp.x` passed to the linker?)",
+                "`.boot2` is {} bytes at {:#010x}; the RP2040 boot ROM needs 256 bytes at \
+                 {:#010x} ({hint})",
                 boot2.size,
-                boot2.address
+                boot2.address,
+                XIP.start
             ),
-            None => bail!(
-                "no `.boot2` section: the RP2040 would not boot (is `-Tlink-rp.x` passed to the \
-                 linker?)"
-            ),
+            None => bail!("no `.boot2` section: the RP2040 would not boot ({hint})"),
         }
     }
 
@@ -209,29 +196,62 @@ impl Image {
         }
         Ok(())
     }
+
+    /// Fails unless the image names the settings region of memory.x, it is
+    /// `board`'s ([`Board::settings`]), and nothing stored in flash reaches
+    /// into it.
+    pub fn check_settings_region(&self, board: Board) -> Result<()> {
+        let Some(region) = self.settings.clone() else {
+            bail!(
+                "no `__settings_start`/`__settings_end` symbols: memory.x must reserve the \
+                 settings region"
+            );
+        };
+        let expected = board.settings();
+        let expected = u64::from(expected.start)..u64::from(expected.end);
+        if region != expected {
+            bail!(
+                "the settings region is {region:#010x?} in memory.x, but the firmware's store \
+                 uses {expected:#010x?}"
+            );
+        }
+        if self.flash_end > region.start {
+            bail!(
+                "the image's flash contents end at {:#010x}, inside the settings region at \
+                 {:#010x}",
+                self.flash_end,
+                region.start
+            );
+        }
+        println!(
+            "  settings region {region:#010x?} ({} KiB) clear: the image ends at {:#010x}",
+            (region.end - region.start) / 1024,
+            self.flash_end
+        );
+        Ok(())
+    }
+}
+
+/// The errors of `checks`, as problems.
+pub fn problems(checks: impl IntoIterator<Item = Result<()>>) -> Vec<String> {
+    (checks.into_iter())
+        .filter_map(|check| check.err().map(|e| format!("{e:#}")))
+        .collect()
 }
 
 /// Prints the Pico image's sections and budgets; fails if `.boot2` is misplaced,
 /// a budget is exceeded, an allocator is linked or the image reaches into the
 /// settings region.
 pub fn check_pico(path: &Path) -> Result<()> {
-    let image = Image::read(path)?;
-    println!("{}", path.display());
-    print!("{}", image.table());
+    let image = Image::show(path)?;
     let (flash, ram) = (image.flash(), image.static_ram());
-    record_image(path, &image, Some(FLASH_BUDGET));
-    println!(
-        "  flash {flash} B of its {FLASH_BUDGET} B budget; static RAM {ram} B (of {RAM_BUDGET} B \
-         with the peak stack)"
-    );
-    let mut problems: Vec<String> = [
+    record_image(path, &image);
+    println!("  budgets: flash {FLASH_BUDGET} B; RAM {RAM_BUDGET} B with the peak stack");
+    let mut problems = problems([
         image.check_boot2(),
         image.check_no_allocator(),
-        check_settings_region(&image, Board::Pico.settings()),
-    ]
-    .into_iter()
-    .filter_map(|check| check.err().map(|e| e.to_string()))
-    .collect();
+        image.check_settings_region(Board::Pico),
+    ]);
     if flash > FLASH_BUDGET {
         problems.push(format!(
             "flash use {flash} B is over the {FLASH_BUDGET} B budget"
@@ -242,53 +262,60 @@ pub fn check_pico(path: &Path) -> Result<()> {
             "static RAM use {ram} B is over the {RAM_BUDGET} B budget"
         ));
     }
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", problems.join("; "))
-    }
+    project::verdict(&problems)
 }
 
 /// Prints the QEMU image's sections and sizes (no budget: it is a test image);
-/// fails if the vector table is not where the LM3S6965 boots from or an
-/// allocator is linked.
+/// fails if the vector table is not where the LM3S6965 boots from (the start
+/// of its flash, `FLASH` in boards/qemu/memory.x) or an allocator is linked.
 pub fn check_qemu(path: &Path) -> Result<()> {
-    let image = Image::read(path)?;
-    println!("{}", path.display());
-    print!("{}", image.table());
-    println!(
-        "  flash {} B, static RAM {} B (no budget for the QEMU image)",
-        image.flash(),
-        image.static_ram()
-    );
-    match image.section(".vector_table") {
-        Some(table) if table.address == LM3S6965_VECTOR_TABLE => {}
-        Some(table) => bail!(
-            "`.vector_table` is at {:#010x}; the LM3S6965 boots from {LM3S6965_VECTOR_TABLE:#010x} \
-             (was the image linked with another board's memory.x?)",
-            table.address
-        ),
-        None => bail!("no `.vector_table` section: the image cannot boot"),
-    }
+    let image = Image::show(path)?;
+    image.check_vector_table(0, "LM3S6965")?;
     image.check_no_allocator()
 }
 
-/// A peak stack and where it was measured.
+/// A peak stack and the static RAM of the image it was measured with.
 #[derive(Debug, Clone, Copy)]
 pub struct Peak {
-    /// Static RAM of the image it was measured with.
     pub static_ram: u64,
     pub stack: u64,
 }
 
-/// Prints static RAM, peak stack and their total for the Pico image (stack
+/// Records static RAM, peak stack and their total for the Pico image (stack
 /// measured in the RP2040 emulator) and the QEMU smoke image; fails if the
 /// Pico image's total is over [`RAM_BUDGET`] or its peak is unknown.
 pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
-    record_ram(&[
+    let rows = [
         ("pico", "the RP2040 emulator", pico, Some(RAM_BUDGET)),
         ("qemu", "QEMU (lm3s6965evb)", qemu, None),
-    ]);
+    ];
+    let rows: Vec<Vec<String>> = (rows.into_iter())
+        .filter_map(|(image, measured_in, peak, budget)| {
+            let Peak { static_ram, stack } = peak?;
+            let total = static_ram + stack;
+            Some(vec![
+                image.to_owned(),
+                measured_in.to_owned(),
+                figures::bytes(static_ram),
+                figures::bytes(stack),
+                format!("{} ({})", figures::bytes(total), figures::kib(total)),
+                figures::of_ceiling(total, budget),
+            ])
+        })
+        .collect();
+    if !rows.is_empty() {
+        let intro = "RAM: static RAM plus the deepest the stack went, measured by painting it \
+                     ([Memory](memory.md#how-the-stack-is-measured)).";
+        let header = [
+            "image",
+            "stack measured in",
+            "static RAM",
+            "peak stack",
+            "total",
+            "of the ceiling",
+        ];
+        figures::record("ram", intro.to_owned(), &header, rows);
+    }
     let pico =
         pico.context("the Pico image's peak stack was not measured (the emulator run failed)")?;
     let total = pico.static_ram + pico.stack;
@@ -299,120 +326,32 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
     Ok(())
 }
 
-/// Fails unless the image names the settings region of memory.x, it is
-/// `expected` (the board's, [`Board::settings`]), and nothing stored in
-/// flash reaches into it.
-pub fn check_settings_region(image: &Image, expected: Range<u32>) -> Result<()> {
-    let Some(region) = image.settings.clone() else {
-        bail!(
-            "no `__settings_start`/`__settings_end` symbols: memory.x must reserve the settings \
-             region"
-        );
-    };
-    let expected = u64::from(expected.start)..u64::from(expected.end);
-    if region != expected {
-        bail!(
-            "the settings region is {:#010x}..{:#010x} in memory.x, but the firmware's store \
-             uses {:#010x}..{:#010x}",
-            region.start,
-            region.end,
-            expected.start,
-            expected.end
-        );
-    }
-    if image.flash_end > region.start {
-        bail!(
-            "the image's flash contents end at {:#010x}, inside the settings region at \
-             {:#010x}",
-            image.flash_end,
-            region.start
-        );
-    }
-    println!(
-        "  settings region {:#010x}..{:#010x} ({} KiB) clear: the image ends at {:#010x}",
-        region.start,
-        region.end,
-        (region.end - region.start) / 1024,
-        image.flash_end
-    );
-    Ok(())
-}
-
-/// The sizes of the image at `path`, held to `flash_budget`, for the
-/// measured figures.
-pub fn record_image(path: &Path, image: &Image, flash_budget: Option<u64>) {
+/// The sizes of the Pico image at `path`, for the measured figures.
+fn record_image(path: &Path, image: &Image) {
     let name = path.file_name().unwrap_or_default().to_string_lossy();
     let flash = image.flash();
-    let ceiling = flash_budget.map_or_else(
-        || "no ceiling".to_owned(),
-        |budget| {
-            format!(
-                "{} of {}",
-                figures::percent(flash, budget),
-                figures::bytes(budget)
-            )
-        },
-    );
-    let sections: Vec<String> = image
-        .sections
-        .iter()
-        .map(|s| format!("`{}` {}", s.name, figures::bytes(s.size)))
-        .collect();
+    let mut sections = String::new();
+    for s in &image.sections {
+        let _ = write!(
+            sections,
+            "{}`{}` {}",
+            if sections.is_empty() { "" } else { ", " },
+            s.name,
+            figures::bytes(s.size)
+        );
+    }
     let intro = format!(
         "Flash is every section stored in flash (`.data`'s initial values included); \
-         static RAM is `.data + .bss + .uninit`. Sections of `{name}`: {}.",
-        sections.join(", ")
+         static RAM is `.data + .bss + .uninit`. Sections of `{name}`: {sections}."
     );
-    let size = format!("{} ({})", figures::bytes(flash), figures::kib(flash));
     let row = vec![
         name.to_string(),
-        size,
-        ceiling,
+        format!("{} ({})", figures::bytes(flash), figures::kib(flash)),
+        figures::of_ceiling(flash, Some(FLASH_BUDGET)),
         figures::bytes(image.static_ram()),
     ];
     let header = ["image", "flash", "of the ceiling", "static RAM"];
     figures::record(&format!("image {name}"), intro, &header, vec![row]);
-}
-
-/// Static RAM plus the peak stack of each image that has a measurement,
-/// for the measured figures: `(image, where the stack was measured, the
-/// peak, the ceiling)`.
-pub fn record_ram(rows: &[(&str, &str, Option<Peak>, Option<u64>)]) {
-    let rows: Vec<Vec<String>> = rows
-        .iter()
-        .filter_map(|&(image, measured_in, peak, budget)| {
-            let peak = peak?;
-            let total = peak.static_ram + peak.stack;
-            let ceiling = budget.map_or_else(
-                || "no ceiling".to_owned(),
-                |b| format!("{} of {}", figures::percent(total, b), figures::bytes(b)),
-            );
-            let total = format!("{} ({})", figures::bytes(total), figures::kib(total));
-            let (fixed, stack) = (figures::bytes(peak.static_ram), figures::bytes(peak.stack));
-            Some(vec![
-                image.to_owned(),
-                measured_in.to_owned(),
-                fixed,
-                stack,
-                total,
-                ceiling,
-            ])
-        })
-        .collect();
-    if rows.is_empty() {
-        return;
-    }
-    let intro = "RAM: static RAM plus the deepest the stack went, measured by painting it \
-                 ([Memory](memory.md#how-the-stack-is-measured)).";
-    let header = [
-        "image",
-        "stack measured in",
-        "static RAM",
-        "peak stack",
-        "total",
-        "of the ceiling",
-    ];
-    figures::record("ram", intro.to_owned(), &header, rows);
 }
 
 #[cfg(test)]
@@ -428,27 +367,30 @@ mod tests {
         assert!(image.flash() > 0);
     }
 
-    fn image(settings: Option<Range<u64>>, flash_end: u64) -> Image {
-        Image {
-            sections: Vec::new(),
-            allocator_symbols: Vec::new(),
-            settings,
-            flash_end,
-        }
-    }
-
     #[test]
     fn the_settings_region_must_be_reserved_and_clear() {
         let pico = Board::Pico.settings();
         let region = u64::from(pico.start)..u64::from(pico.end);
-        let check = |image: &Image| check_settings_region(image, pico.clone());
-        assert!(check(&image(Some(region.clone()), 0x1000_c000)).is_ok());
-        assert!(check(&image(Some(region.clone()), region.start)).is_ok());
-        let into = check(&image(Some(region.clone()), region.start + 4));
-        assert!(format!("{:#}", into.unwrap_err()).contains("inside the settings region"));
-        let moved = check(&image(Some(0x1010_0000..0x1010_4000), 0x1000_c000));
-        assert!(format!("{:#}", moved.unwrap_err()).contains("the firmware's store uses"));
-        let missing = check(&image(None, 0x1000_c000));
-        assert!(format!("{:#}", missing.unwrap_err()).contains("must reserve"));
+        let check = |settings: Option<Range<u64>>, flash_end| {
+            let image = Image {
+                settings,
+                flash_end,
+                ..Image::default()
+            };
+            image
+                .check_settings_region(Board::Pico)
+                .map_err(|e| format!("{e:#}"))
+        };
+        assert!(check(Some(region.clone()), 0x1000_c000).is_ok());
+        assert!(check(Some(region.clone()), region.start).is_ok());
+        let into = check(Some(region.clone()), region.start + 4);
+        assert!(into.unwrap_err().contains("inside the settings region"));
+        let moved = check(Some(0x1010_0000..0x1010_4000), 0x1000_c000);
+        assert!(moved.unwrap_err().contains("the firmware's store uses"));
+        assert!(
+            check(None, 0x1000_c000)
+                .unwrap_err()
+                .contains("must reserve")
+        );
     }
 }

@@ -18,13 +18,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::project;
 
-/// One table of the page, as the command that measured it recorded it.
+/// One table of the page, as the command that measured it recorded it: the
+/// command line and the working tree's commit, what the table shows
+/// (Markdown, said before it), its header and rows.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Table {
-    /// The command line that recorded it, and the working tree's commit.
     pub command: String,
     pub commit: Option<String>,
-    /// What the table shows (Markdown), said before it.
     pub intro: String,
     pub header: Vec<String>,
     pub rows: Vec<Vec<String>>,
@@ -73,9 +73,16 @@ pub fn kib(value: u64) -> String {
     format!("{:.1} KiB", value as f64 / 1024.0)
 }
 
-/// `part` of `whole`, in percent.
-pub fn percent(part: u64, whole: u64) -> String {
-    format!("{:.0} %", part as f64 / whole.max(1) as f64 * 100.0)
+/// `part` bytes against a ceiling, if there is one: `62 % of 196,608 B`.
+pub fn of_ceiling(part: u64, ceiling: Option<u64>) -> String {
+    let of = |whole: u64| {
+        format!(
+            "{:.0} % of {}",
+            part as f64 / whole.max(1) as f64 * 100.0,
+            bytes(whole)
+        )
+    };
+    ceiling.map_or_else(|| "no ceiling".to_owned(), of)
 }
 
 /// Prints the table `key` and records it (replacing the one recorded
@@ -88,17 +95,15 @@ pub fn record(key: &str, intro: String, header: &[&str], rows: Vec<Vec<String>>)
         println!("  | {} |", row.join(" | "));
     }
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let commit = Command::new("git")
+    let git = Command::new("git")
         .args(["describe", "--always", "--dirty"])
         .current_dir(project::root())
-        .output()
-        .ok()
-        .filter(|out| out.status.success())
-        .map(|out| String::from_utf8_lossy(&out.stdout).trim().to_owned())
-        .filter(|text| !text.is_empty());
+        .output();
+    let commit = git.ok().filter(|out| out.status.success());
+    let commit = commit.map(|out| String::from_utf8_lossy(&out.stdout).trim().to_owned());
     let table = Table {
         command: format!("cargo xtask {}", args.join(" ")).trim().to_owned(),
-        commit,
+        commit: commit.filter(|text| !text.is_empty()),
         intro,
         header: header.iter().map(|h| (*h).to_owned()).collect(),
         rows,
@@ -132,12 +137,8 @@ fn update_at(path: &Path, key: &str, table: Table) -> Result<()> {
         BTreeMap::new()
     });
     figures.insert(key.to_owned(), table);
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
     let partial = path.with_extension("json.partial");
-    std::fs::write(&partial, serde_json::to_string_pretty(&figures)?)
-        .with_context(|| format!("writing {}", partial.display()))?;
+    project::write(&partial, serde_json::to_string_pretty(&figures)?)?;
     std::fs::rename(&partial, path).with_context(|| format!("writing {}", path.display()))
 }
 
@@ -169,8 +170,7 @@ fn render(figures: &BTreeMap<String, Table>) -> (String, Vec<&'static str>) {
     let mut recorded = Vec::new();
     for (title, keys, how) in SECTIONS {
         let _ = write!(out, "\n## {title}\n");
-        let tables: Vec<&Table> = keys
-            .iter()
+        let tables: Vec<&Table> = (keys.iter())
             .flat_map(|key| figures.iter().filter(move |(k, _)| k.starts_with(key)))
             .map(|(_, table)| table)
             .collect();
@@ -180,8 +180,10 @@ fn render(figures: &BTreeMap<String, Table>) -> (String, Vec<&'static str>) {
         }
         recorded.push(title);
         for table in tables {
-            let commit = table.commit.as_ref();
-            let on = commit.map_or_else(String::new, |commit| format!(" on `{commit}`"));
+            let on = table
+                .commit
+                .as_ref()
+                .map_or_else(String::new, |c| format!(" on `{c}`"));
             let _ = write!(
                 out,
                 "\n{} Recorded by `{}`{on}.\n\n",
@@ -203,15 +205,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn thousands_separators() {
-        assert_eq!(thousands(0), "0");
-        assert_eq!(thousands(999), "999");
-        assert_eq!(thousands(1000), "1,000");
-        assert_eq!(thousands(133_967_040), "133,967,040");
-    }
-
-    #[test]
     fn tables_are_replaced_the_others_kept_and_every_heading_shown() {
+        assert_eq!(
+            [0, 999, 1000, 133_967_040].map(thousands),
+            ["0", "999", "1,000", "133,967,040"]
+        );
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("figures.json");
         let table = |value: &str| Table {

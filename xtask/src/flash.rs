@@ -16,12 +16,6 @@ use anyhow::{Context, Result, bail};
 
 use crate::{board::Board, project, uf2};
 
-/// The file a board's boot ROM shows on its BOOTSEL drive, with the line
-/// `Board-ID: <label>`.
-const INFO_FILE: &str = "INFO_UF2.TXT";
-/// The command that installs probe-rs.
-const INSTALL_PROBE_RS: &str = "cargo install probe-rs-tools --locked";
-
 /// `cargo xtask flash`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -62,86 +56,72 @@ impl Surroundings {
             let user = std::env::var_os("USER").or_else(|| std::env::var_os("LOGNAME"));
             // udisks' /media/<user> (Debian, Ubuntu) and /run/media/<user>
             // (Fedora, Arch), then other Linux setups and macOS.
-            let udisks = user.iter().flat_map(|user| {
-                [
-                    Path::new("/media").join(user),
-                    Path::new("/run/media").join(user),
-                ]
-            });
+            let udisks = user
+                .iter()
+                .flat_map(|user| ["/media", "/run/media"].map(|m| Path::new(m).join(user)));
             udisks
                 .chain(["/media", "/mnt", "/Volumes"].map(PathBuf::from))
                 .collect()
         };
-        Self {
-            path: std::env::var_os("PATH"),
-            cwd: std::env::current_dir().unwrap_or_default(),
-            mounts,
-        }
+        let (path, cwd) = (
+            std::env::var_os("PATH"),
+            std::env::current_dir().unwrap_or_default(),
+        );
+        Self { path, cwd, mounts }
     }
 }
 
-/// How the image goes onto the board.
+/// How the image goes onto the board: copied onto this mounted BOOTSEL
+/// drive, through this `probe-rs`, or no way found (say what to do).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Route {
-    /// Copy the UF2 onto this mounted BOOTSEL drive.
     Drive(PathBuf),
-    /// Run this `probe-rs`.
     Probe(PathBuf),
-    /// No way found: say what to do.
     Instructions,
 }
 
-/// The BOOTSEL drives of `board` in `mounts` (each mount itself, or a
-/// folder in it): those whose `INFO_UF2.TXT` names the board's chip.
-pub fn bootsel_drives(board: Board, mounts: &[PathBuf]) -> Vec<PathBuf> {
+/// The route for `board` here: a BOOTSEL drive (one of `here`'s mounts, or
+/// a folder in one, whose `INFO_UF2.TXT` says `Board-ID: <label>`), else
+/// probe-rs, else instructions.
+pub fn choose(board: Board, here: &Surroundings) -> Result<Route> {
     let id = format!("Board-ID: {}", board.drive_label());
-    let is_drive = |dir: &Path| {
-        std::fs::read_to_string(dir.join(INFO_FILE))
-            .is_ok_and(|info| info.lines().any(|line| line.trim() == id))
+    let is_drive = |dir: &PathBuf| {
+        let info = std::fs::read_to_string(dir.join("INFO_UF2.TXT"));
+        info.is_ok_and(|info| info.lines().any(|line| line.trim() == id))
     };
-    let mut drives: Vec<PathBuf> = mounts
-        .iter()
+    let mut drives: Vec<PathBuf> = (here.mounts.iter())
         .flat_map(|mount| {
             let inside = std::fs::read_dir(mount).into_iter().flatten().flatten();
             std::iter::once(mount.clone()).chain(inside.map(|entry| entry.path()))
         })
-        .filter(|dir| is_drive(dir))
+        .filter(is_drive)
         .collect();
     // One drive may be reached through two mounts (a symbolic link).
     drives.sort();
     drives.dedup();
-    drives
-}
-
-/// The route for `board` here: a BOOTSEL drive, else probe-rs, else
-/// instructions.
-pub fn choose(board: Board, here: &Surroundings) -> Result<Route> {
-    match bootsel_drives(board, &here.mounts).as_slice() {
-        [drive] => return Ok(Route::Drive(drive.clone())),
-        [] => {}
-        several => bail!(
-            "{} boards in BOOTSEL mode ({}): unplug all but the one to flash",
-            several.len(),
-            several
-                .iter()
-                .map(|drive| drive.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
+    match drives.as_slice() {
+        [drive] => Ok(Route::Drive(drive.clone())),
+        [] => Ok(
+            match which::which_in("probe-rs", here.path.as_deref(), &here.cwd) {
+                Ok(probe) => Route::Probe(probe),
+                Err(_) => Route::Instructions,
+            },
         ),
+        several => {
+            let list: Vec<String> = several.iter().map(|d| d.display().to_string()).collect();
+            bail!(
+                "{} boards in BOOTSEL mode ({}): unplug all but the one to flash",
+                several.len(),
+                list.join(", ")
+            )
+        }
     }
-    Ok(
-        match which::which_in("probe-rs", here.path.as_deref(), &here.cwd) {
-            Ok(probe) => Route::Probe(probe),
-            Err(_) => Route::Instructions,
-        },
-    )
 }
 
 /// What to do when nothing could flash the board; `uf2` is the image's UF2,
 /// ready to copy, and `mounts` where the runner looked for the board.
 pub fn instructions(board: Board, uf2: &Path, mounts: &[PathBuf]) -> String {
-    let (name, label) = (board.name(), board.drive_label());
-    let uf2 = project::relative(uf2);
+    let (name, label, uf2) = (board.name(), board.drive_label(), project::relative(uf2));
     let uf2 = uf2.display();
     let looked = if cfg!(windows) {
         "on every drive letter".to_owned()
@@ -151,7 +131,7 @@ pub fn instructions(board: Board, uf2: &Path, mounts: &[PathBuf]) -> String {
     };
     format!(
         "Nothing was flashed: no {name} is in BOOTSEL mode, and probe-rs is not installed.
-(No drive whose {INFO_FILE} says `Board-ID: {label}` {looked}.)
+(No drive whose INFO_UF2.TXT says `Board-ID: {label}` {looked}.)
 
 The image is ready as a UF2 file: {uf2}
 
@@ -165,7 +145,7 @@ Flash it over USB, with nothing else to buy:
 Or flash it through a debug probe, which also shows the firmware's log (a
 Raspberry Pi Debug Probe or any CMSIS-DAP probe, wired to the board's SWCLK,
 SWDIO and GND):
-  install probe-rs once with:  {INSTALL_PROBE_RS}
+  install probe-rs once with:  cargo install probe-rs-tools --locked
   then run `cargo run --release` again.
 
 Both routes step by step: docs/user/flashing.md"
@@ -186,13 +166,14 @@ pub fn run(args: &Args, here: &Surroundings) -> Result<bool> {
     if let Route::Probe(probe) = route {
         let chip = board.probe_rs_chip();
         eprintln!("$ probe-rs run --chip {chip} {}", args.elf.display());
-        let status = Command::new(&probe)
+        let run = Command::new(&probe)
             .args(["run", "--chip", chip])
             .arg(&args.elf)
             .args(&args.rest)
-            .status()
-            .with_context(|| format!("running {}", probe.display()))?;
-        return Ok(status.success());
+            .status();
+        return Ok(run
+            .with_context(|| format!("running {}", probe.display()))?
+            .success());
     }
     let (path, bytes) = uf2::write(&args.elf, board, "uf2")?;
     let Route::Drive(drive) = route else {
@@ -200,7 +181,7 @@ pub fn run(args: &Args, here: &Surroundings) -> Result<bool> {
         return Ok(false);
     };
     println!("{}", uf2::describe(&path, board, &bytes));
-    let target = drive.join(format!("{}.uf2", board.bin()));
+    let target = drive.join(format!("{}.uf2", board.image().bin));
     let mut file =
         std::fs::File::create(&target).with_context(|| format!("creating {}", target.display()))?;
     file.write_all(&bytes)
@@ -232,71 +213,58 @@ mod tests {
     /// A folder of mounts with one drive `label` whose info file says `info`.
     fn mount_with(label: &str, info: &str) -> tempfile::TempDir {
         let mounts = tempfile::tempdir().unwrap();
-        let drive = mounts.path().join(label);
-        std::fs::create_dir(&drive).unwrap();
-        std::fs::write(drive.join(INFO_FILE), info).unwrap();
+        std::fs::create_dir(mounts.path().join(label)).unwrap();
+        std::fs::write(mounts.path().join(label).join("INFO_UF2.TXT"), info).unwrap();
         mounts
     }
 
     fn here(path: &Path, mounts: &[&Path]) -> Surroundings {
+        let mounts = mounts.iter().map(|m| m.to_path_buf()).collect();
         Surroundings {
             path: Some(path.as_os_str().to_owned()),
             cwd: path.to_owned(),
-            mounts: mounts.iter().map(|m| m.to_path_buf()).collect(),
+            mounts,
         }
     }
 
     #[test]
-    fn a_bootsel_drive_is_known_by_its_board_id() {
-        let pico = mount_with("RPI-RP2", PICO_INFO);
-        let pico2 = mount_with("RP2350", PICO2_INFO);
-        let roots = [pico.path().to_owned(), pico2.path().to_owned()];
+    fn the_route_is_a_bootsel_drive_known_by_its_board_id_then_instructions() {
+        let no_path = tempfile::tempdir().unwrap();
+        let (pico, pico2) = (
+            mount_with("RPI-RP2", PICO_INFO),
+            mount_with("RP2350", PICO2_INFO),
+        );
+        let both = here(no_path.path(), &[pico.path(), pico2.path()]);
         assert_eq!(
-            bootsel_drives(Board::Pico, &roots),
-            [pico.path().join("RPI-RP2")]
+            choose(Board::Pico, &both).unwrap(),
+            Route::Drive(pico.path().join("RPI-RP2"))
         );
         assert_eq!(
-            bootsel_drives(Board::Pico2, &roots),
-            [pico2.path().join("RP2350")]
+            choose(Board::Pico2, &both).unwrap(),
+            Route::Drive(pico2.path().join("RP2350"))
         );
         // A drive called RPI-RP2 without the info file, or with another
         // board's, is not one; a mount that is itself the drive is.
         let plain = tempfile::tempdir().unwrap();
         std::fs::create_dir(plain.path().join("RPI-RP2")).unwrap();
         let other = mount_with("RPI-RP2", PICO2_INFO);
-        let roots = [plain.path().to_owned(), other.path().to_owned()];
-        assert!(bootsel_drives(Board::Pico, &roots).is_empty());
+        let neither = here(no_path.path(), &[plain.path(), other.path()]);
+        assert_eq!(choose(Board::Pico, &neither).unwrap(), Route::Instructions);
         let letter = pico.path().join("RPI-RP2");
+        let itself = here(no_path.path(), &[&letter]);
         assert_eq!(
-            bootsel_drives(Board::Pico, std::slice::from_ref(&letter)),
-            [letter]
+            choose(Board::Pico, &itself).unwrap(),
+            Route::Drive(letter.clone())
         );
-        assert!(bootsel_drives(Board::Pico, &[PathBuf::from("/no/such/mount")]).is_empty());
-    }
-
-    #[test]
-    fn the_route_is_a_drive_then_probe_rs_then_instructions() {
-        let empty_path = tempfile::tempdir().unwrap();
-        let no_drives = tempfile::tempdir().unwrap();
-        let nothing = here(empty_path.path(), &[no_drives.path()]);
-        assert_eq!(choose(Board::Pico, &nothing).unwrap(), Route::Instructions);
-        let text = instructions(Board::Pico2, Path::new("pico2.uf2"), &nothing.mounts);
+        let text = instructions(Board::Pico2, Path::new("pico2.uf2"), &neither.mounts);
         assert!(
-            text.contains(INSTALL_PROBE_RS) && text.contains("called RP2350"),
+            text.contains("probe-rs-tools") && text.contains("called RP2350"),
             "{text}"
         );
-
-        let mounts = mount_with("RPI-RP2", PICO_INFO);
-        let drive = here(empty_path.path(), &[mounts.path()]);
-        let want = Route::Drive(mounts.path().join("RPI-RP2"));
-        assert_eq!(choose(Board::Pico, &drive).unwrap(), want);
-        // Not for a Pico 2 image: that board is not plugged in.
-        assert_eq!(choose(Board::Pico2, &drive).unwrap(), Route::Instructions);
-
         let two = mount_with("RPI-RP2 1", PICO_INFO);
         let error = choose(
             Board::Pico,
-            &here(empty_path.path(), &[mounts.path(), two.path()]),
+            &here(no_path.path(), &[pico.path(), two.path()]),
         );
         assert!(format!("{:#}", error.unwrap_err()).contains("2 boards in BOOTSEL mode"));
     }
@@ -308,33 +276,35 @@ mod tests {
     fn probe_rs_flashes_when_no_board_is_in_bootsel_mode() {
         use std::os::unix::fs::PermissionsExt;
         let bin = tempfile::tempdir().unwrap();
-        let probe = bin.path().join("probe-rs");
-        let log = bin.path().join("args.txt");
-        let script = format!("#!/bin/sh\nprintf '%s\\n' \"$@\" > '{}'\n", log.display());
-        std::fs::write(&probe, script).unwrap();
+        let (probe, log) = (bin.path().join("probe-rs"), bin.path().join("args.txt"));
+        std::fs::write(
+            &probe,
+            format!("#!/bin/sh\nprintf '%s\\n' \"$@\" > '{}'\n", log.display()),
+        )
+        .unwrap();
         std::fs::set_permissions(&probe, std::fs::Permissions::from_mode(0o755)).unwrap();
         let no_drives = tempfile::tempdir().unwrap();
         let here = here(bin.path(), &[no_drives.path()]);
         assert_eq!(choose(Board::Pico2, &here).unwrap(), Route::Probe(probe));
+        let rest = vec!["--no-location".into()];
         let args = Args {
             board: Board::Pico2,
             elf: PathBuf::from("pico2"),
-            rest: vec!["--no-location".into()],
+            rest,
         };
         assert!(run(&args, &here).unwrap());
         let passed = std::fs::read_to_string(log).unwrap();
-        let passed: Vec<&str> = passed.lines().collect();
         assert_eq!(
-            passed,
+            passed.lines().collect::<Vec<_>>(),
             ["run", "--chip", "RP235x", "pico2", "--no-location"]
         );
         let mounts = mount_with("RP2350", PICO2_INFO);
-        let here = Surroundings {
+        let drive = Surroundings {
             mounts: vec![mounts.path().to_owned()],
             ..here
         };
         assert!(matches!(
-            choose(Board::Pico2, &here).unwrap(),
+            choose(Board::Pico2, &drive).unwrap(),
             Route::Drive(_)
         ));
     }

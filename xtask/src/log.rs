@@ -179,17 +179,54 @@ impl Run {
     }
 }
 
+/// The message of the last line of `log` that starts with `summary` (the
+/// firmware's closing `summary key=value ...` line).
+pub fn summary(log: &[LogLine]) -> Option<&str> {
+    let line = log.iter().rfind(|line| line.message.starts_with("summary"));
+    line.map(|line| line.message.as_str())
+}
+
+/// The value of `key=` among the words of `message` (separated by spaces
+/// or commas).
+pub fn field<'a>(message: &'a str, key: &str) -> Option<&'a str> {
+    let mut words = message.split(|c: char| c.is_whitespace() || c == ',');
+    words.find_map(|word| word.strip_prefix(key)?.strip_prefix('='))
+}
+
+/// The [`field`] `key` of `message` as a number: decimal, or hexadecimal
+/// with `0x`, `_` separators allowed; an error names what is missing or wrong.
+pub fn number(message: &str, key: &str) -> Result<u64> {
+    let value = field(message, key).with_context(|| format!("`{message}` has no `{key}=`"))?;
+    let digits = value.replace('_', "");
+    let parsed = match digits.strip_prefix("0x") {
+        Some(hex) => u64::from_str_radix(hex, 16),
+        None => digits.parse(),
+    };
+    parsed.with_context(|| format!("`{key}={value}` in `{message}` is not a whole number"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn snapshot_lines_have_level_and_message_only() {
+    fn the_last_summary_line_and_its_numbers() {
+        let log = [
+            "frame 0 pitch=0 roll=0 yaw=0",
+            "summary frames=10 missed=3",
+            "summary frames=900 missed=0 pulse_violations=0, checksum=0x1a2b_3c4d",
+        ]
+        .map(|message| LogLine::new("INFO", message));
+        let line = summary(&log).unwrap();
+        assert_eq!(number(line, "frames").unwrap(), 900);
+        assert_eq!(number(line, "missed").unwrap(), 0);
+        assert_eq!(number(line, "checksum").unwrap(), 0x1a2b_3c4d);
+        assert!(number(line, "absent").is_err());
+        assert!(number("x=1e3", "x").is_err());
+        assert!(summary(&log[..1]).is_none());
+        // The expected log keeps level and message only.
         let mut line = LogLine::new("INFO", "hello");
         line.timestamp = Some("1.000000".to_owned());
-        line.location = Some("src/main.rs:3".to_owned());
         assert_eq!(line.snapshot(), "INFO  hello");
-        assert!(!line.is_problem());
-        assert!(LogLine::malformed().is_problem());
     }
 }

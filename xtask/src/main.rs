@@ -31,33 +31,33 @@ mod test;
 mod trace;
 mod uf2;
 
-use std::process::ExitCode;
+use std::{process::ExitCode, time::Duration};
 
-use anyhow::Result;
 use clap::{CommandFactory, Parser};
 
+use args::Options;
 use cli::{Cli, Command};
 
 fn main() -> ExitCode {
-    let result: Result<bool> = match Cli::parse().command {
+    let options = |bless, timeout: args::Timeout, no_budget| Options {
+        bless,
+        timeout: Duration::from_secs(timeout.timeout),
+        no_budget,
+    };
+    let result = match Cli::parse().command {
         None => Cli::command()
             .print_long_help()
             .map(|()| true)
             .map_err(Into::into),
-        Some(Command::Qemu { bless, timeout }) => {
-            qemu::command(Command::options(Some(bless), timeout, None))
-        }
+        Some(Command::Qemu { bless, timeout }) => qemu::command(options(bless, timeout, false)),
         Some(Command::Test {
             bless,
             timeout,
-            budget,
+            no_budget,
             only,
-        }) => test::command(
-            Command::options(Some(bless), timeout, Some(budget)),
-            only.as_deref(),
-        ),
-        Some(Command::Bench { timeout, budget }) => {
-            bench::command(Command::options(None, timeout, Some(budget)))
+        }) => test::command(options(bless, timeout, no_budget), only.as_deref()),
+        Some(Command::Bench { timeout, no_budget }) => {
+            bench::command(options(false, timeout, no_budget))
         }
         Some(Command::Preview(args)) => preview::command(&args),
         Some(Command::Metrics(args)) => metrics::command(&args),

@@ -51,8 +51,7 @@ pub struct Args {
 pub fn command(args: &Args) -> Result<bool> {
     let root = project::root();
     if args.test {
-        setup::ensure_toolchain(&root)?;
-        let metadata = project::metadata(&root)?;
+        let (root, metadata) = project::prepare()?;
         println!("{}", browser::stage(&root, &metadata)?);
         return Ok(true);
     }
@@ -63,14 +62,12 @@ pub fn command(args: &Args) -> Result<bool> {
         return Ok(true);
     }
     let bridge = if args.sim {
-        setup::ensure_toolchain(&root)?;
-        let metadata = project::metadata(&root)?;
+        let (root, metadata) = project::prepare()?;
         project::PICO.build(&root)?;
         Some(Bridge::sim(&root, &project::PICO.elf(&metadata))?)
     } else if args.qemu {
-        setup::ensure_toolchain(&root)?;
+        let (root, metadata) = project::prepare()?;
         setup::ensure_qemu()?;
-        let metadata = project::metadata(&root)?;
         project::QEMU.build(&root)?;
         Some(Bridge::qemu(&project::QEMU.elf(&metadata))?)
     } else if let Some(port) = &args.port {

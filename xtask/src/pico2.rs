@@ -5,17 +5,13 @@
 //! No emulator runs this image: these checks are all that is known of it
 //! before it meets a board.
 
-use std::{ops::Range, path::Path};
+use std::ops::Range;
 
 use anyhow::{Context, Result, bail};
 use object::{Object, ObjectSection};
 
-use crate::{board::Board, elf, project::Metadata, uf2};
+use crate::{board::Board, elf, project, uf2};
 
-/// Where the vector table must be: the start of flash.
-const VECTOR_TABLE: u64 = 0x1000_0000;
-/// Where the boot ROM searches for the image's first block.
-const BLOCK_SEARCH: Range<u64> = 0x1000_0000..0x1000_1000;
 /// A block's first and last words (`PICOBIN_BLOCK_MARKER_START`, `_END`).
 const MARKERS: (u32, u32) = (0xffff_ded3, 0xab12_3579);
 
@@ -24,20 +20,34 @@ const MARKERS: (u32, u32) = (0xffff_ded3, 0xab12_3579);
 pub const STAGE: &str = "Pico 2 build (boards/pico2): start block, settings sectors clear, UF2 \
                          family RP2350 Arm Secure";
 
-/// The stage [`STAGE`]: builds the image, checks it and makes its UF2.
-pub fn test(metadata: &Metadata) -> Result<()> {
+/// The stage [`STAGE`]: builds the image and prints its sections and
+/// sizes; fails unless the vector table is at the start of flash, a whole
+/// block lies in the first 4 KiB, the settings sectors are reserved and
+/// clear, and no allocator is linked; then makes its UF2.
+pub fn test(metadata: &project::Metadata) -> Result<()> {
     let board = Board::Pico2;
-    board.build()?;
-    let path = board.elf(metadata);
-    check(&path)?;
+    board.image().build(&project::root())?;
+    let path = board.image().elf(metadata);
+    let image = elf::Image::show(&path)?;
+    let data = std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;
+    let block = start_block(&data).map(|block| {
+        let size = block.end - block.start;
+        println!("  start block: {size} B at {:#010x}", block.start);
+    });
+    project::verdict(&elf::problems([
+        image.check_vector_table(elf::XIP.start, "RP2350"),
+        block,
+        image.check_settings_region(board),
+        image.check_no_allocator(),
+    ]))?;
     let (uf2, bytes) = uf2::write(&path, board, "uf2")?;
     println!("  {}", uf2::describe(&uf2, board, &bytes));
     Ok(())
 }
 
 /// The addresses of the `.start_block` section of the ELF `data`, checked:
-/// inside the boot ROM's search window, opening and closing with the block
-/// markers.
+/// inside the first 4 KiB of flash, where the boot ROM searches, opening
+/// and closing with the block markers.
 pub fn start_block(data: &[u8]) -> Result<Range<u64>> {
     let file = object::File::parse(data).context("parsing the ELF")?;
     let section = file.section_by_name(".start_block").context(
@@ -45,19 +55,15 @@ pub fn start_block(data: &[u8]) -> Result<Range<u64>> {
          place `.start_block`, and does embassy-rp link its IMAGE_DEF?)",
     )?;
     let range = section.address()..section.address() + section.size();
-    if range.start < BLOCK_SEARCH.start || range.end > BLOCK_SEARCH.end {
+    let search = elf::XIP.start..elf::XIP.start + 0x1000;
+    if range.start < search.start || range.end > search.end {
         bail!(
-            "`.start_block` is at {:#010x}..{:#010x}, outside the first 4 KiB of flash where the \
-             boot ROM searches",
-            range.start,
-            range.end
+            "`.start_block` is at {range:#010x?}, outside the first 4 KiB of flash where the boot \
+             ROM searches"
         );
     }
     let bytes = section.data().context("reading `.start_block`")?;
-    let word = |at: usize| {
-        let w = bytes.get(at..at + 4)?;
-        Some(u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
-    };
+    let word = |at: usize| Some(u32::from_le_bytes(bytes.get(at..at + 4)?.try_into().ok()?));
     let last = bytes.len().checked_sub(4).and_then(word);
     if word(0) != Some(MARKERS.0) || last != Some(MARKERS.1) {
         bail!(
@@ -69,47 +75,4 @@ pub fn start_block(data: &[u8]) -> Result<Range<u64>> {
         );
     }
     Ok(range)
-}
-
-/// Prints the image's sections and sizes; fails unless the vector table is
-/// at the start of flash, a whole block lies in the first 4 KiB, the
-/// settings sectors are reserved and clear, and no allocator is linked.
-pub fn check(path: &Path) -> Result<()> {
-    let image = elf::Image::read(path)?;
-    println!("{}", path.display());
-    print!("{}", image.table());
-    println!(
-        "  flash {} B, static RAM {} B (.data + .bss + .uninit)",
-        image.flash(),
-        image.static_ram()
-    );
-    let mut problems = Vec::new();
-    match image.section(".vector_table") {
-        Some(table) if table.address == VECTOR_TABLE => {}
-        Some(table) => problems.push(format!(
-            "`.vector_table` is at {:#010x}; the RP2350 starts the image from {VECTOR_TABLE:#010x}",
-            table.address
-        )),
-        None => problems.push("no `.vector_table` section".to_owned()),
-    }
-    let data = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-    match start_block(&data) {
-        Ok(block) => println!(
-            "  start block: {} B at {:#010x}",
-            block.end - block.start,
-            block.start
-        ),
-        Err(error) => problems.push(format!("{error:#}")),
-    }
-    if let Err(error) = elf::check_settings_region(&image, Board::Pico2.settings()) {
-        problems.push(error.to_string());
-    }
-    if let Err(error) = image.check_no_allocator() {
-        problems.push(error.to_string());
-    }
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", problems.join("; "))
-    }
 }

@@ -1,8 +1,9 @@
-//! The one plotting path of the PNGs (`preview`, `trace`, `qemu`): a
-//! figure of stacked panels, each with curves, shaded spans and labelled
-//! markers, drawn by plotters with a built-in font (`DejaVu Sans`), so a plot
-//! looks the same on every machine. A curve with more points than its
-//! panel has pixel columns is drawn as each column's range and mean.
+//! Every PNG of the project commands: a figure of stacked panels (curves,
+//! shaded spans, labelled markers), drawn by plotters with a built-in font
+//! (`DejaVu Sans`) so that a plot looks the same on every machine; the
+//! three axes over time (`trace`, `qemu`) and a loop's stages (`preview`).
+//! A curve with more points than its panel has pixel columns is drawn as
+//! each column's range and mean.
 
 // Sample counts and pixel positions are far below f64's exact range.
 #![allow(
@@ -15,14 +16,15 @@
 use std::{path::Path, sync::Once};
 
 use anyhow::{Result, anyhow};
+use idle_head_core::{Axis, motion::Closure};
 use plotters::{coord::Shift, prelude::*, style::FontStyle};
+
+use crate::preview::{Stages, deg};
 
 /// The family name the plots ask for; [`draw`] registers `DejaVu Sans` as it.
 const FONT: &str = "sans-serif";
-const WIDTH: u32 = 1400;
-/// Pixels between a marker and its label, and the labels' size.
+/// Pixels between a marker and its label.
 const GAP: i32 = 4;
-const LABEL_SIZE: u32 = 13;
 
 pub const BLUE: RGBColor = RGBColor(31, 119, 180);
 pub const ORANGE: RGBColor = RGBColor(255, 127, 14);
@@ -41,21 +43,20 @@ pub struct Figure {
     pub panel_height: u32,
 }
 
-/// One panel: its curves over a shared x axis.
+/// One panel: its curves over a shared x axis, shaded x ranges behind them
+/// and dashed vertical markers with a label at the top.
 #[derive(Default)]
 pub struct Panel {
     pub title: String,
     pub x_desc: String,
     pub y_desc: String,
     pub curves: Vec<Curve>,
-    /// Shaded x ranges, behind the curves.
     pub spans: Vec<(f64, f64, RGBColor)>,
-    /// Dashed vertical lines with a label at the top.
     pub markers: Vec<(f64, String, RGBColor)>,
 }
 
-/// One curve; a dashed one is a reference line (a range's ends). A curve
-/// without a label has no entry in the legend.
+/// One curve; a dashed one is a reference line. A curve without a label
+/// has no entry in the legend.
 pub struct Curve {
     pub label: String,
     pub color: RGBColor,
@@ -64,81 +65,224 @@ pub struct Curve {
 }
 
 impl Curve {
-    /// A solid curve of `values`, one per index.
-    pub fn indexed(label: impl Into<String>, color: RGBColor, values: &[f64]) -> Self {
-        let points = values.iter().enumerate().map(|(i, &v)| (i as f64, v));
-        Self::new(label, color, points.collect())
-    }
-
     /// A solid curve through `points`.
     pub fn new(label: impl Into<String>, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
+        let (label, dashed) = (label.into(), false);
         Self {
-            label: label.into(),
+            label,
             color,
             points,
-            dashed: false,
+            dashed,
         }
     }
+
+    /// A solid curve of `values`, one per index.
+    pub fn indexed(label: impl Into<String>, color: RGBColor, values: &[f64]) -> Self {
+        Self::new(
+            label,
+            color,
+            (0..).map(f64::from).zip(values.iter().copied()).collect(),
+        )
+    }
+}
+
+/// A command on the motion plot: where it starts and ends (x), the axes it
+/// shades (none: only its marker, on every panel), its label and colours.
+pub struct Mark {
+    pub from: f64,
+    pub to: f64,
+    pub axes: Vec<Axis>,
+    pub label: String,
+    pub line: RGBColor,
+    pub shade: RGBColor,
+}
+
+/// Draws the three axes' angles (°) over x (`rows`: x and the pitch, roll
+/// and yaw angles) to `path`, each panel with the `marks` on its axis.
+pub fn motion(
+    path: &Path,
+    title: String,
+    notes: Vec<String>,
+    x_desc: &str,
+    rows: &[(f64, [f64; 3])],
+    marks: &[Mark],
+) -> Result<()> {
+    let panel = |axis: Axis, color| {
+        let i = axis.index();
+        let points = rows.iter().map(|r| (r.0, r.1[i])).collect();
+        let on = |m: &&Mark| m.axes.contains(&axis);
+        Panel {
+            title: format!("{} (°)", axis.name()),
+            x_desc: x_desc.to_owned(),
+            y_desc: "angle (°)".to_owned(),
+            curves: vec![Curve::new(axis.name(), color, points)],
+            spans: marks
+                .iter()
+                .filter(on)
+                .map(|m| (m.from, m.to, m.shade))
+                .collect(),
+            markers: (marks.iter())
+                .filter(|m| m.axes.is_empty() || m.axes.contains(&axis))
+                .map(|m| (m.from, m.label.clone(), m.line))
+                .collect(),
+        }
+    };
+    let panels = vec![
+        panel(Axis::Pitch, BLUE),
+        panel(Axis::Roll, ORANGE),
+        panel(Axis::Yaw, GREEN),
+    ];
+    draw(
+        &Figure {
+            title,
+            notes,
+            panels,
+            panel_height: 250,
+        },
+        path,
+    )
+}
+
+/// Draws a loop's stages (`cargo xtask preview`) to `path`: stacked panels
+/// in the style of the paper's Figures 6 and 7, the split point marked, the
+/// loop's metrics under the title.
+pub fn stages(stages: &Stages, path: &Path) -> Result<()> {
+    let (n, cfg, p) = (stages.spec.n, stages.spec.cfg, stages.info.split);
+    let (a1, a2) = (deg(cfg.range.min), deg(cfg.range.max));
+    let (walk, window) = match cfg.closure {
+        Closure::Paper => ("random walk u(n) = u(n−1) ± δ", "causal"),
+        Closure::Seamless => ("periodic random walk (mean step removed)", "circular"),
+    };
+    let split = (f64::from(p), format!("split p = {p}"), RED);
+    // A panel of `curves` (label, colour, values); in the range's ends
+    // (dashed) if `marker` says where to mark it.
+    let panel = |title: String, curves: &[(&str, RGBColor, &[f64])], marker: Option<_>| {
+        let mut curves: Vec<Curve> = (curves.iter())
+            .map(|&(label, color, values)| Curve::indexed(label, color, values))
+            .collect();
+        let range = format!("[α1, α2] = [{a1}°, {a2}°]");
+        for (label, y) in marker
+            .iter()
+            .flat_map(|_| [(range.clone(), a1), (String::new(), a2)])
+        {
+            let points = vec![(0.0, y), ((n.max(2) - 1) as f64, y)];
+            curves.push(Curve {
+                dashed: true,
+                ..Curve::new(label, GREY, points)
+            });
+        }
+        let x_desc = "sample index n (generation order)".to_owned();
+        let y_desc = "angle (°)".to_owned();
+        let markers = marker.into_iter().collect();
+        Panel {
+            title,
+            x_desc,
+            y_desc,
+            curves,
+            markers,
+            spans: Vec::new(),
+        }
+    };
+    let mut panels = vec![
+        panel(format!("1. {walk}"), &[("walk", GREY, &stages.walk)], None),
+        panel(
+            format!(
+                "2. smoothed with a {}-tap Hann window ({window})",
+                cfg.window
+            ),
+            &[
+                ("walk", LIGHT, &stages.walk),
+                ("smoothed", BLUE, &stages.smoothed),
+            ],
+            None,
+        ),
+        panel(
+            "3. normalised into [α1, α2]".to_owned(),
+            &[("normalised", ORANGE, &stages.normalized)],
+            Some(split.clone()),
+        ),
+    ];
+    if let Some((taper, tapered)) = &stages.tapered {
+        let title = "4. Hann taper ½ − ½·cos(2πn/(N−1))".to_owned();
+        let mut weights = panel(title, &[("taper", PURPLE, taper)], None);
+        "weight".clone_into(&mut weights.y_desc);
+        panels.push(weights);
+        let title = "5. normalised × taper: both ends at zero".to_owned();
+        panels.push(panel(title, &[("tapered", GREEN, tapered)], Some(split)));
+    }
+    let title = format!(
+        "{}. final loop, stored (0.001° steps), in playback order: halves exchanged at p",
+        panels.len() + 1
+    );
+    let start = (0.0, format!("start = sample p = {p}"), RED);
+    let mut stored = panel(title, &[("final", RED, &stages.final_loop)], Some(start));
+    "playback index i (final(i) = stage(i + p mod N))".clone_into(&mut stored.x_desc);
+    let seam = (n - usize::from(p) % n) % n;
+    if seam != 0 {
+        let label = format!("seam: samples N−1 | 0 (index {seam})");
+        stored.markers.push((seam as f64, label, GREY));
+    }
+    panels.push(stored);
+    let note = "Idle-loop generation after Kocoń, section 3 (stages as in Figures 6 and 7)";
+    let mut notes = vec![note.to_owned()];
+    notes.extend(stages.metric_lines());
+    let figure = Figure {
+        title: stages.title(),
+        notes,
+        panels,
+        panel_height: 240,
+    };
+    draw(&figure, path)
 }
 
 /// Draws `figure` to the PNG `path`, creating its folder.
 pub fn draw(figure: &Figure, path: &Path) -> Result<()> {
-    register_font()?;
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)?;
-    }
-    let header = 50 + 20 * u32::try_from(figure.notes.len())?;
-    let height = header + figure.panel_height * u32::try_from(figure.panels.len())?;
-    let root = BitMapBackend::new(path, (WIDTH, height)).into_drawing_area();
-    paint(&root, figure, header).map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
-    root.present()
-        .map_err(|e| anyhow!("writing {}: {e}", path.display()))
-}
-
-fn register_font() -> Result<()> {
-    static ONCE: Once = Once::new();
-    let mut result = Ok(());
-    ONCE.call_once(|| {
+    static FONT_ONCE: Once = Once::new();
+    let mut font = Ok(());
+    FONT_ONCE.call_once(|| {
         for (style, bytes) in [
             (FontStyle::Normal, dejavu::sans::regular()),
             (FontStyle::Bold, dejavu::sans::bold()),
         ] {
             if plotters::style::register_font(FONT, style, bytes).is_err() {
-                result = Err(anyhow!("the DejaVu Sans font did not load"));
+                font = Err(anyhow!("the DejaVu Sans font did not load"));
             }
         }
     });
-    result
+    font?;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)?;
+    }
+    let header = 50 + 20 * u32::try_from(figure.notes.len())?;
+    let height = header + figure.panel_height * u32::try_from(figure.panels.len())?;
+    let root = BitMapBackend::new(path, (1400, height)).into_drawing_area();
+    let fail = |e| anyhow!("drawing {}: {e}", path.display());
+    paint(&root, figure, header).map_err(fail)?;
+    root.present().map_err(|e| fail(e.into()))
 }
 
+type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 type Drawn = Result<(), Box<dyn std::error::Error>>;
 
-fn paint(root: &DrawingArea<BitMapBackend<'_>, Shift>, figure: &Figure, header: u32) -> Drawn {
+fn paint(root: &Area<'_>, figure: &Figure, header: u32) -> Drawn {
     root.fill(&WHITE)?;
     let (top, body) = root.split_vertically(header);
-    let bold = |size| (FONT, size).into_font().style(FontStyle::Bold);
-    top.draw(&Text::new(figure.title.clone(), (20, 14), bold(22)))?;
+    let title = (FONT, 22).into_font().style(FontStyle::Bold);
+    top.draw(&Text::new(figure.title.clone(), (20, 14), title))?;
     for (i, note) in figure.notes.iter().enumerate() {
-        let y = 46 + 20 * i as i32;
-        top.draw(&Text::new(
-            note.clone(),
-            (20, y),
-            (FONT, 15).into_font().color(&GREY),
-        ))?;
+        let style = (FONT, 15).into_font().color(&GREY);
+        top.draw(&Text::new(note.clone(), (20, 46 + 20 * i as i32), style))?;
     }
-    for (area, panel) in body
-        .split_evenly((figure.panels.len(), 1))
-        .iter()
-        .zip(&figure.panels)
-    {
+    let areas = body.split_evenly((figure.panels.len(), 1));
+    for (area, panel) in areas.iter().zip(&figure.panels) {
         draw_panel(area, panel)?;
     }
     Ok(())
 }
 
-fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, panel: &Panel) -> Drawn {
-    let points = || panel.curves.iter().flat_map(|c| c.points.iter());
-    let (x0, x1, lo, hi) = points().fold(
+fn draw_panel(area: &Area<'_>, panel: &Panel) -> Drawn {
+    let points = panel.curves.iter().flat_map(|c| c.points.iter());
+    let (x0, x1, lo, hi) = points.fold(
         (
             f64::INFINITY,
             f64::NEG_INFINITY,
@@ -176,25 +320,25 @@ fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, panel: &Panel) -> Dr
     }
     let columns = chart.plotting_area().get_pixel_range().0.len().max(1);
     for curve in &panel.curves {
-        let style = curve.color.stroke_width(if curve.dashed { 1 } else { 2 });
+        let color = curve.color;
         let drawn = if curve.dashed {
-            chart.draw_series(DashedLineSeries::new(curve.points.clone(), 8, 6, style))?
+            let line = DashedLineSeries::new(curve.points.clone(), 8, 6, color.stroke_width(1));
+            chart.draw_series(line)?
         } else if curve.points.len() > 2 * columns {
             let bands = bands(&curve.points, columns);
             let outline = bands.iter().map(|b| (b.0, b.2));
-            let outline = outline.chain(bands.iter().rev().map(|b| (b.0, b.1)));
-            let band = curve.color.mix(0.3).filled();
-            chart.draw_series([Polygon::new(outline.collect::<Vec<_>>(), band)])?;
+            let outline = outline
+                .chain(bands.iter().rev().map(|b| (b.0, b.1)))
+                .collect::<Vec<_>>();
+            chart.draw_series([Polygon::new(outline, color.mix(0.3).filled())])?;
             let mean = bands.iter().map(|b| (b.0, b.3));
-            chart.draw_series(LineSeries::new(mean, curve.color.stroke_width(1)))?
+            chart.draw_series(LineSeries::new(mean, color.stroke_width(1)))?
         } else {
-            chart.draw_series(LineSeries::new(curve.points.clone(), style))?
+            chart.draw_series(LineSeries::new(curve.points.clone(), color.stroke_width(2)))?
         };
-        let color = curve.color;
         if !curve.label.is_empty() {
-            drawn.label(&curve.label).legend(move |(x, y)| {
-                PathElement::new([(x, y), (x + 20, y)], color.stroke_width(3))
-            });
+            let key = move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(3));
+            drawn.label(&curve.label).legend(key);
         }
     }
     chart
@@ -204,26 +348,9 @@ fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, panel: &Panel) -> Dr
         .background_style(WHITE.mix(0.85))
         .border_style(GREY.mix(0.6))
         .draw()?;
-    markers(&mut chart, area, panel, hi)
-}
-
-type Chart<'a, 'b> = ChartContext<
-    'a,
-    BitMapBackend<'b>,
-    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
->;
-
-/// Each marker's dashed line, and its label right of it in the first of
-/// two rows at the top where it covers no other label, on white (left out
-/// where there is none).
-fn markers(
-    chart: &mut Chart<'_, '_>,
-    area: &DrawingArea<BitMapBackend<'_>, Shift>,
-    panel: &Panel,
-    hi: f64,
-) -> Drawn {
-    let lo = chart.y_range().start;
-    let font = (FONT, LABEL_SIZE).into_font();
+    // Each marker's dashed line, and its label right of it in the first of
+    // two rows at the top where it covers no other label (else left out).
+    let font = (FONT, 13).into_font();
     let mut rows = [i32::MIN; 2];
     for (x, label, color) in &panel.markers {
         let line = [(*x, lo), (*x, hi)];
@@ -236,14 +363,14 @@ fn markers(
         };
         rows[row] = left + width + GAP;
         let y = 2 + row as i32 * height;
-        chart.plotting_area().draw(
-            &(EmptyElement::at((*x, hi))
-                + Rectangle::new(
-                    [(GAP - 1, y), (GAP + width + 1, y + height)],
-                    WHITE.mix(0.85).filled(),
-                )
-                + Text::new(label.clone(), (GAP, y), font.color(color))),
-        )?;
+        let back = Rectangle::new(
+            [(GAP - 1, y), (GAP + width + 1, y + height)],
+            WHITE.mix(0.85).filled(),
+        );
+        let text = Text::new(label.clone(), (GAP, y), font.color(color));
+        chart
+            .plotting_area()
+            .draw(&(EmptyElement::at((*x, hi)) + back + text))?;
     }
     Ok(())
 }
@@ -252,16 +379,14 @@ fn markers(
 /// middle x, its lowest, highest and mean y.
 fn bands(points: &[(f64, f64)], columns: usize) -> Vec<(f64, f64, f64, f64)> {
     let per = points.len().div_ceil(columns).max(1);
-    points
-        .chunks(per)
-        .map(|chunk| {
-            let (min, max, sum) = chunk.iter().fold(
-                (f64::INFINITY, f64::NEG_INFINITY, 0.0),
-                |(lo, hi, sum), &(_, y)| (lo.min(y), hi.max(y), sum + y),
-            );
-            (chunk[chunk.len() / 2].0, min, max, sum / chunk.len() as f64)
-        })
-        .collect()
+    let band = |chunk: &[(f64, f64)]| {
+        let (min, max, sum) = chunk.iter().fold(
+            (f64::INFINITY, f64::NEG_INFINITY, 0.0),
+            |(lo, hi, sum), &(_, y)| (lo.min(y), hi.max(y), sum + y),
+        );
+        (chunk[chunk.len() / 2].0, min, max, sum / chunk.len() as f64)
+    };
+    points.chunks(per).map(band).collect()
 }
 
 #[cfg(test)]
@@ -269,7 +394,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_long_curve_is_drawn_as_each_columns_range_and_mean() {
+    fn a_long_curve_is_drawn_as_each_columns_range_and_mean_and_a_figure_is_drawn() {
         // A saw tooth of 10 points, 0 to 9, over 180,000 points.
         let points: Vec<(f64, f64)> = (0..180_000)
             .map(|i| (f64::from(i), f64::from(i % 10)))
@@ -281,26 +406,26 @@ mod tests {
             assert!((mean - 4.5).abs() < 0.1, "{mean}");
         }
         assert!(bands.windows(2).all(|w| w[0].0 < w[1].0));
-    }
-
-    #[test]
-    fn a_figure_is_drawn() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("a/figure.png");
-        let panel = Panel {
-            title: "a panel".into(),
-            curves: vec![Curve::indexed("sine", BLUE, &[0.0, 1.0, 0.0, -1.0])],
-            markers: vec![(1.0, "here".into(), RED)],
-            spans: vec![(1.0, 2.0, LIGHT)],
-            ..Panel::default()
+        let mark = Mark {
+            from: 1.0,
+            to: 2.0,
+            axes: vec![Axis::Yaw],
+            label: "here".into(),
+            line: RED,
+            shade: LIGHT,
         };
-        let figure = Figure {
-            title: "a figure".into(),
-            notes: vec!["a note".into()],
-            panels: vec![panel],
-            panel_height: 200,
-        };
-        draw(&figure, &path).unwrap();
+        let rows = [(0.0, [0.0; 3]), (1.0, [1.0, 2.0, 3.0]), (3.0, [0.0; 3])];
+        motion(
+            &path,
+            "a figure".into(),
+            vec!["a note".into()],
+            "s",
+            &rows,
+            &[mark],
+        )
+        .unwrap();
         assert!(std::fs::read(&path).unwrap().starts_with(b"\x89PNG"));
     }
 }

@@ -1,31 +1,27 @@
 //! Where things are in the repository, how commands run (the one process
 //! runner: [`run`] to the end with inherited output, [`finish`] with its
-//! output read as it comes and a time limit), and how the firmware images
-//! are built.
+//! output read as it comes and a time limit), and the firmware images.
 
 use std::{
-    fmt::Write as _,
     path::{Path, PathBuf},
     process::{Child, ChildStderr, ChildStdout},
     thread,
     time::Duration,
 };
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Context, Result, anyhow, bail};
 use cargo_metadata::MetadataCommand;
 use wait_timeout::ChildExt;
 use xshell::{Cmd, Shell, cmd};
 
+use crate::log::Exit;
+
 /// The firmware's compilation target (ARMv6-M: RP2040's Cortex-M0+, QEMU's Cortex-M0).
 pub const TARGET: &str = "thumbv6m-none-eabi";
 
-/// The defmt log level the firmware images are built with (`DEFMT_LOG`). The
-/// expected QEMU log on file is recorded at this level.
-pub const DEFMT_LOG: &str = "info";
-
-/// The environment of every firmware build: the project's defmt level, over
-/// whatever the caller's environment says.
-pub const FIRMWARE_ENV: &[(&str, &str)] = &[("DEFMT_LOG", DEFMT_LOG)];
+/// The environment of every firmware build: the defmt level the expected
+/// QEMU log is recorded at, over whatever the caller's environment says.
+pub const FIRMWARE_ENV: &[(&str, &str)] = &[("DEFMT_LOG", "info")];
 
 /// The repository root: the parent of this crate's directory. Commands run
 /// from any folder of the repository, so every path starts here.
@@ -33,13 +29,22 @@ pub fn root() -> PathBuf {
     let xtask = Path::new(env!("CARGO_MANIFEST_DIR"));
     xtask
         .parent()
-        .expect("xtask/ lives inside the repository")
-        .to_path_buf()
+        .expect("xtask/ lives in the repository")
+        .into()
 }
 
 /// `path` relative to the repository root, for messages.
 pub fn relative(path: &Path) -> PathBuf {
     path.strip_prefix(root()).unwrap_or(path).to_path_buf()
+}
+
+/// What a command that builds starts from: the toolchain made complete
+/// (`setup::ensure_toolchain`), the repository root and cargo's metadata.
+pub fn prepare() -> Result<(PathBuf, Metadata)> {
+    let root = root();
+    crate::setup::ensure_toolchain(&root)?;
+    let metadata = metadata(&root)?;
+    Ok((root, metadata))
 }
 
 /// A shell whose commands run in `dir`, relative to the repository root.
@@ -49,42 +54,24 @@ pub fn shell(dir: &str) -> Result<Shell> {
     Ok(sh)
 }
 
-/// Echoes `cmd` the way a user would type it from the repository root
-/// (`(cd dir && VAR=value program args)`), then runs it with `env` and
-/// inherited output; fails unless it exits with 0.
+/// Echoes `cmd` on stderr the way a user would type it from the repository
+/// root (`(cd dir && VAR=value program args)`; stdout is for results), then
+/// runs it with `env` and inherited output; fails unless it exits with 0.
 pub fn run(sh: &Shell, env: &[(&str, &str)], cmd: Cmd<'_>) -> Result<()> {
-    let mut line = String::new();
-    for (key, value) in env {
-        let _ = write!(line, "{key}={value} ");
-    }
-    let _ = write!(line, "{cmd}");
-    let dir = sh.current_dir();
-    if let Ok(sub) = dir.strip_prefix(root())
-        && !sub.as_os_str().is_empty()
-    {
-        line = format!("(cd {} && {line})", sub.display());
-    }
-    // On stderr: stdout is for results (`cargo xtask console` prints only
-    // the head's replies there).
+    let vars: Vec<String> = env.iter().map(|(k, v)| format!("{k}={v} ")).collect();
+    let vars = vars.concat();
+    let line = match sh.current_dir().strip_prefix(root()) {
+        Ok(sub) if !sub.as_os_str().is_empty() => format!("(cd {} && {vars}{cmd})", sub.display()),
+        _ => format!("{vars}{cmd}"),
+    };
     eprintln!("$ {line}");
-    cmd.envs(env.iter().copied())
-        .quiet()
-        .run()
-        .map_err(|error| anyhow!("{error}"))
-}
-
-/// `command` as a user would type it.
-pub fn shown(command: &std::process::Command) -> String {
-    let words = std::iter::once(command.get_program()).chain(command.get_args());
-    words
-        .map(|w| w.to_string_lossy())
-        .collect::<Vec<_>>()
-        .join(" ")
+    let cmd = cmd.envs(env.iter().copied()).quiet();
+    cmd.run().map_err(|error| anyhow!("{error}"))
 }
 
 /// What a child left behind ([`finish`]).
 pub struct Finished<O, E, R> {
-    pub exit: crate::log::Exit,
+    pub exit: Exit,
     pub stdout: O,
     pub stderr: E,
     pub meanwhile: R,
@@ -105,9 +92,7 @@ pub fn finish<O: Send, E: Send, R>(
     let (Some(out), Some(err)) = (child.stdout.take(), child.stderr.take()) else {
         let _ = child.kill();
         let _ = child.wait();
-        return Err(anyhow!(
-            "{name} was started without piped stdout and stderr"
-        ));
+        bail!("{name} was started without piped stdout and stderr");
     };
     thread::scope(|scope| {
         let out = scope.spawn(move || stdout(out));
@@ -115,95 +100,94 @@ pub fn finish<O: Send, E: Send, R>(
         let meanwhile = meanwhile();
         let waited = child.wait_timeout(timeout);
         let exit = if let Some(status) = waited.with_context(|| format!("waiting for {name}"))? {
-            crate::log::Exit::Status(status)
+            Exit::Status(status)
         } else {
             let _ = child.kill();
             let _ = child.wait();
-            crate::log::Exit::TimedOut(timeout)
+            Exit::TimedOut(timeout)
         };
         let panicked = |what| anyhow!("the reader of {name}'s {what} panicked");
+        let stdout = out.join().map_err(|_| panicked("stdout"))?;
+        let stderr = err.join().map_err(|_| panicked("stderr"))?;
         Ok(Finished {
             exit,
-            stdout: out.join().map_err(|_| panicked("stdout"))?,
-            stderr: err.join().map_err(|_| panicked("stderr"))?,
+            stdout,
+            stderr,
             meanwhile,
         })
     })
 }
 
-/// A package of the repository that builds firmware images, each with its
-/// own memory map (`memory.x`), in the one workspace and target directory.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Package {
-    /// The root package `idle-head`: the Pico image.
-    Root,
-    /// `boards/qemu/`, the package `idle-head-qemu`: the QEMU `lm3s6965evb` images.
-    Qemu,
+/// Writes `contents` to `path`, creating its folder.
+pub fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    std::fs::write(path, contents).with_context(|| format!("writing {}", path.display()))
 }
 
-impl Package {
-    /// Cargo arguments that select the package from the repository root
-    /// (where cargo is run, so the root `.cargo/config.toml` applies).
-    pub fn manifest_args(self) -> &'static [&'static str] {
-        match self {
-            Self::Root => &[],
-            Self::Qemu => &["--package", "idle-head-qemu"],
-        }
+/// Fails with every one of `problems`, if there are any.
+pub fn verdict(problems: &[String]) -> Result<()> {
+    match problems {
+        [] => Ok(()),
+        _ => bail!("{}", problems.join("; ")),
     }
 }
 
-/// A board image of the firmware: one `[[bin]]` of one of the packages.
+/// A firmware image: one `[[bin]]` of a package of the repository, built
+/// with `cargo build --release` in its folder into the one target directory.
 #[derive(Debug, Clone, Copy)]
 pub struct Image {
-    /// The package the image belongs to.
-    pub package: Package,
     /// Bin target name, also the ELF file name.
     pub bin: &'static str,
+    /// The package's folder (its `.cargo/config.toml` picks the target).
+    pub dir: &'static str,
+    pub target: &'static str,
+    /// The package to select from the folder (`--package … --bin …`), if
+    /// it is not the folder's own.
+    pub package: Option<&'static str>,
 }
 
-/// The Raspberry Pi Pico image: the default features, so plain `cargo build --release`.
+/// The Raspberry Pi Pico image: plain `cargo build --release`.
 pub const PICO: Image = Image {
-    package: Package::Root,
     bin: "pico",
+    dir: ".",
+    target: TARGET,
+    package: None,
 };
 
 /// The QEMU `lm3s6965evb` smoke image (`boards/qemu/src/main.rs`).
 pub const QEMU: Image = Image::qemu("qemu");
 
 impl Image {
-    /// Bin `bin` of the QEMU package.
+    /// Bin `bin` of the QEMU package (`boards/qemu/`), built from the root.
     pub const fn qemu(bin: &'static str) -> Self {
+        let package = Some("idle-head-qemu");
         Self {
-            package: Package::Qemu,
             bin,
+            dir: ".",
+            target: TARGET,
+            package,
         }
     }
 
     /// Release ELF of this image in the target directory.
     pub fn elf(&self, metadata: &Metadata) -> PathBuf {
-        metadata
-            .target_dir
-            .join(TARGET)
-            .join("release")
-            .join(self.bin)
+        let dir = metadata.target_dir.join(self.target).join("release");
+        dir.join(self.bin)
     }
 
-    /// `cargo build --release` for this image, run in the repository root,
-    /// with the project's defmt level. The Pico image is the root package's
-    /// only bin, so its command is the one users type.
+    /// `cargo build --release` for this image, as a user types it, with
+    /// the project's defmt level.
     pub fn build(&self, root: &Path) -> Result<()> {
         let sh = Shell::new()?;
-        sh.change_dir(root);
-        let manifest = self.package.manifest_args();
-        let bin = match self.package {
-            Package::Root => None,
-            Package::Qemu => Some(["--bin", self.bin]),
-        };
-        let bin = bin.iter().flatten();
+        sh.change_dir(root.join(self.dir));
+        let select = self.package.map(|p| ["--package", p, "--bin", self.bin]);
+        let select = select.iter().flatten();
         run(
             &sh,
             FIRMWARE_ENV,
-            cmd!(sh, "cargo build --release {manifest...} {bin...}"),
+            cmd!(sh, "cargo build --release {select...}"),
         )
     }
 }
@@ -234,42 +218,26 @@ mod tests {
     use std::process::{Command, Stdio};
 
     use super::*;
-    use crate::log::Exit;
-
-    fn spawn(script: &str) -> Child {
-        let mut command = Command::new("sh");
-        command.args(["-c", script]).stdin(Stdio::null());
-        command.stdout(Stdio::piped()).stderr(Stdio::piped());
-        command.spawn().unwrap()
-    }
-
-    fn length(mut pipe: impl Read) -> usize {
-        let mut bytes = Vec::new();
-        pipe.read_to_end(&mut bytes).unwrap();
-        bytes.len()
-    }
 
     #[test]
     fn both_pipes_are_read_and_a_hung_child_is_killed_at_the_timeout() {
+        let run = |script: &str, timeout| {
+            let mut command = Command::new("sh");
+            command.args(["-c", script]).stdin(Stdio::null());
+            let child = command.stdout(Stdio::piped()).stderr(Stdio::piped());
+            let length = |mut pipe: Box<dyn Read>| pipe.read_to_end(&mut Vec::new()).unwrap();
+            let (out, err) = (|p| length(Box::new(p)), |p| length(Box::new(p)));
+            finish(child.spawn().unwrap(), "sh", timeout, out, err, || 7).unwrap()
+        };
         // More than a pipe holds on each stream: neither may stall the child.
         let script = "head -c 200000 /dev/zero; head -c 100000 /dev/zero >&2; exit 3";
-        let long = Duration::from_secs(60);
-        let done = finish(spawn(script), "sh", long, length, length, || 7).unwrap();
+        let done = run(script, Duration::from_secs(60));
         assert_eq!(
             (done.stdout, done.stderr, done.meanwhile),
             (200_000, 100_000, 7)
         );
         assert!(matches!(done.exit, Exit::Status(status) if status.code() == Some(3)));
-        let short = Duration::from_millis(200);
-        let done = finish(
-            spawn("exec sleep 30"),
-            "sleep",
-            short,
-            length,
-            length,
-            || (),
-        )
-        .unwrap();
+        let done = run("exec sleep 30", Duration::from_millis(200));
         assert!(matches!(done.exit, Exit::TimedOut(_)));
     }
 }

@@ -1,9 +1,9 @@
 //! Runs the QEMU image and decodes its defmt log; `cargo xtask qemu`.
 
 use std::{
-    io::{BufRead, BufReader, Read, Write},
+    io::{BufRead, BufReader, Read},
     path::Path,
-    process::{Command, Stdio},
+    process::{Child, Command, Stdio},
     time::{Duration, Instant},
 };
 
@@ -12,57 +12,43 @@ use anyhow::{Context, Result, bail};
 use crate::figures::{self, thousands};
 use crate::{
     args::Options,
-    log::{Defmt, LogLine, Run},
-    plot::{self, BLUE, Curve, Figure, GREEN, ORANGE, Panel},
+    log::{Defmt, LogLine, Run, number, summary},
+    plot,
     project::{self, QEMU},
     reference,
     setup::{self, QEMU_BINARY},
     snapshot,
 };
 
-/// What QEMU 7.2 prints at every start of the `lm3s6965evb` machine, before
-/// the firmware runs: the board's watchdog model starts its timer at reset,
-/// while the system clock that drives it still reads 0 Hz (it is set a moment
-/// later). The watchdog then stays stopped until a program loads it, which
-/// these images never do, so the line says nothing about the run and is not
-/// shown. Later QEMU releases no longer start the watchdog at reset.
-const RESET_NOISE: &str = "Timer with period zero, disabling";
-
 /// `cargo xtask qemu`: build, run, show. `Ok(false)` when the run failed.
 pub fn command(options: Options) -> Result<bool> {
-    let root = project::root();
-    setup::ensure_toolchain(&root)?;
+    let (root, metadata) = project::prepare()?;
     setup::ensure_qemu()?;
-    let metadata = project::metadata(&root)?;
     QEMU.build(&root)?;
     let run = run(&QEMU.elf(&metadata), options.timeout, Echo::All)?;
-
-    println!();
     let png = metadata.target_dir.join("qemu").join("motion.png");
     match plot_motion(&run.log, &png) {
-        Ok(frames) => println!("motion: {frames} logged frames drawn in {}", png.display()),
-        Err(error) => println!("motion: not drawn: {error:#}"),
+        Ok(frames) => println!(
+            "\nmotion: {frames} logged frames drawn in {}",
+            png.display()
+        ),
+        Err(error) => println!("\nmotion: not drawn: {error:#}"),
     }
     println!("{}", run.describe());
-    let mut ok = run.succeeded();
-    match check_summary(&run.log) {
+    let checked = check_summary(&run.log);
+    match &checked {
         Ok(line) => {
             println!("{line}");
             record_figures(&run.log);
         }
-        Err(error) => {
-            println!("summary check failed: {error:#}");
-            ok = false;
-        }
+        Err(error) => println!("summary check failed: {error:#}"),
     }
-    if options.bless {
-        if run.succeeded() {
-            snapshot::bless(&run)?;
-        } else {
-            println!("not re-recording the expected log: the run failed");
-        }
+    if options.bless && run.succeeded() {
+        snapshot::bless(&run)?;
+    } else if options.bless {
+        println!("not re-recording the expected log: the run failed");
     }
-    Ok(ok)
+    Ok(run.succeeded() && checked.is_ok())
 }
 
 /// How much of the log to print while QEMU runs.
@@ -104,127 +90,86 @@ pub fn qemu_command(elf: &Path, sleep: bool, args: &[&str]) -> Command {
 /// Runs `elf` in QEMU, decoding its defmt output as it arrives; QEMU is
 /// killed after `timeout` of wall time.
 pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
-    let defmt = Defmt::read(elf)?;
-
-    let mut command = qemu_command(
-        elf,
-        false,
-        &[
-            "-nographic",
-            "-semihosting-config",
-            "enable=on,target=native",
-        ],
-    );
-    println!("$ {}", project::shown(&command));
-    command
+    let semihosting = [
+        "-nographic",
+        "-semihosting-config",
+        "enable=on,target=native",
+    ];
+    let mut command = qemu_command(elf, false, &semihosting);
+    let words = std::iter::once(command.get_program()).chain(command.get_args());
+    let words: Vec<_> = words.map(|w| w.to_string_lossy()).collect();
+    println!("$ {}", words.join(" "));
+    let piped = command
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
-    let start = Instant::now();
-    let child = command
+    let child = piped
         .spawn()
         .with_context(|| format!("could not start {QEMU_BINARY}"))?;
-    // The log is decoded while QEMU runs; its end is the end of QEMU's
-    // output, which comes when QEMU exits or is killed.
-    let done = project::finish(
-        child,
-        QEMU_BINARY,
-        timeout,
-        |stdout| decode(stdout, &defmt, echo),
-        |stderr| forward(stderr, &mut std::io::stderr()),
-        || (),
-    )?;
-    Ok(Run {
-        log: done.stdout,
-        exit: done.exit,
-        elapsed: start.elapsed(),
-    })
+    Ok(finish(child, elf, timeout, echo, || ())?.0)
 }
 
-/// Decodes the defmt stream `output` to its end, echoing lines as they come.
-pub(crate) fn decode(mut output: impl Read, defmt: &Defmt, echo: Echo) -> Vec<LogLine> {
-    let mut decoder = defmt.stream();
-    let mut buffer = [0_u8; 4096];
-    let mut log = Vec::new();
-    while let Ok(n @ 1..) = output.read(&mut buffer) {
-        for line in defmt.lines(decoder.as_mut(), &buffer[..n]) {
-            if echo == Echo::All || (echo == Echo::Problems && line.is_problem()) {
-                line.print();
+/// Runs QEMU (`child`, running `elf`, its stdout and stderr piped) to its
+/// end, decoding its defmt log as it comes (echoed as `echo` says) and
+/// passing its messages on, while `meanwhile` runs; QEMU has `timeout`
+/// once `meanwhile` returns. What QEMU 7.2 prints at every start of the
+/// `lm3s6965evb` machine (its watchdog model's timer started at reset while
+/// the clock that drives it still reads 0 Hz; it stays stopped, as these
+/// images never load it) and its notes on waiting for a socket's
+/// connection say nothing about a run and are dropped.
+pub fn finish<R>(
+    child: Child,
+    elf: &Path,
+    timeout: Duration,
+    echo: Echo,
+    meanwhile: impl FnOnce() -> R,
+) -> Result<(Run, R)> {
+    let defmt = Defmt::read(elf)?;
+    let start = Instant::now();
+    let decode = |mut output: std::process::ChildStdout| {
+        let (mut decoder, mut log) = (defmt.stream(), Vec::new());
+        let mut buffer = [0_u8; 4096];
+        while let Ok(n @ 1..) = output.read(&mut buffer) {
+            for line in defmt.lines(decoder.as_mut(), &buffer[..n]) {
+                if echo == Echo::All || (echo == Echo::Problems && line.is_problem()) {
+                    line.print();
+                }
+                log.push(line);
             }
-            log.push(line);
         }
-    }
-    log
-}
-
-/// Whether `line` is QEMU's [`RESET_NOISE`].
-pub(crate) fn is_reset_noise(line: &str) -> bool {
-    line == RESET_NOISE
-}
-
-/// Passes QEMU's messages on, all but [`RESET_NOISE`].
-fn forward(stderr: impl Read, to: &mut impl Write) {
-    for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-        if line != RESET_NOISE {
-            let _ = writeln!(to, "{line}");
+        log
+    };
+    let forward = |stderr| {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let noise = [
+                "Timer with period zero, disabling",
+                "QEMU waiting for connection",
+            ];
+            if !noise.iter().any(|n| line.contains(n)) {
+                eprintln!("{line}");
+            }
         }
-    }
-}
-
-/// The firmware's closing `summary key=value ...` line, as fields.
-#[derive(Debug)]
-pub struct Summary {
-    fields: Vec<(String, String)>,
-}
-
-impl Summary {
-    /// Finds the last line of `log` whose message starts with `summary`.
-    pub fn find(log: &[LogLine]) -> Option<Self> {
-        let line = log
-            .iter()
-            .rev()
-            .find(|line| line.message.trim_start().starts_with("summary"))?;
-        let fields = line
-            .message
-            .split(|c: char| c.is_whitespace() || c == ',')
-            .filter_map(|token| token.split_once('='))
-            .map(|(key, value)| (key.to_owned(), value.to_owned()))
-            .collect();
-        Some(Self { fields })
-    }
-
-    /// The value of `key`, if present.
-    pub fn get(&self, key: &str) -> Option<&str> {
-        self.fields
-            .iter()
-            .find(|(k, _)| k == key)
-            .map(|(_, value)| value.as_str())
-    }
-
-    /// The value of `key` as a number (decimal, or hexadecimal with `0x`).
-    pub fn number(&self, key: &str) -> Result<u64> {
-        let value = self
-            .get(key)
-            .with_context(|| format!("the summary line has no `{key}=`"))?;
-        let parsed = match value
-            .strip_prefix("0x")
-            .or_else(|| value.strip_prefix("0X"))
-        {
-            Some(hex) => u64::from_str_radix(&hex.replace('_', ""), 16),
-            None => value.replace('_', "").parse(),
-        };
-        parsed.with_context(|| format!("`{key}={value}` in the summary line is not a number"))
-    }
+    };
+    let done = project::finish(child, QEMU_BINARY, timeout, decode, forward, meanwhile)?;
+    let elapsed = start.elapsed();
+    Ok((
+        Run {
+            log: done.stdout,
+            exit: done.exit,
+            elapsed,
+        },
+        done.meanwhile,
+    ))
 }
 
 /// Checks the summary line: no missed frames, no pulse violations, and the
 /// checksum of the loops the firmware generated equals the one generated on
 /// the host by the same core library. Returns a one-line verdict.
 pub fn check_summary(log: &[LogLine]) -> Result<String> {
-    let summary = Summary::find(log).context("the log has no `summary ...` line")?;
-    let missed = summary.number("missed")?;
-    let violations = summary.number("pulse_violations")?;
-    let firmware = summary.number("checksum")?;
+    let summary = summary(log).context("the log has no `summary ...` line")?;
+    let get = |key| number(summary, key);
+    let (missed, violations, firmware) =
+        (get("missed")?, get("pulse_violations")?, get("checksum")?);
     let host = reference::checksum()?;
     let mut problems = Vec::new();
     if missed != 0 {
@@ -238,13 +183,10 @@ pub fn check_summary(log: &[LogLine]) -> Result<String> {
             "checksum={firmware:#010x} but the host computes {host:#010x}"
         ));
     }
-    if problems.is_empty() {
-        Ok(format!(
-            "summary ok: missed=0 pulse_violations=0 checksum={host:#010x} (matches the host)"
-        ))
-    } else {
-        bail!("{}", problems.join(", "))
-    }
+    project::verdict(&problems)?;
+    Ok(format!(
+        "summary ok: missed=0 pulse_violations=0 checksum={host:#010x} (matches the host)"
+    ))
 }
 
 /// Draws the three axes of the log's frame lines (`frame <n>: pitch=<deg>
@@ -257,28 +199,9 @@ fn plot_motion(log: &[LogLine], path: &Path) -> Result<usize> {
     if frames.len() < 2 {
         bail!("fewer than two frame lines in the log");
     }
-    let panel = |i: usize, name: &str, color| Panel {
-        title: format!("{name} (°)"),
-        x_desc: "frame".to_owned(),
-        y_desc: "angle (°)".to_owned(),
-        curves: vec![Curve::new(
-            name,
-            color,
-            frames.iter().map(|f| (f.0, f.1[i])).collect(),
-        )],
-        ..Panel::default()
-    };
-    let figure = Figure {
-        title: format!("The QEMU run's motion: {} logged frames", frames.len()),
-        notes: vec!["angles as the firmware logged them".to_owned()],
-        panels: vec![
-            panel(0, "pitch", BLUE),
-            panel(1, "roll", ORANGE),
-            panel(2, "yaw", GREEN),
-        ],
-        panel_height: 220,
-    };
-    plot::draw(&figure, path)?;
+    let title = format!("The QEMU run's motion: {} logged frames", frames.len());
+    let notes = vec!["angles as the firmware logged them".to_owned()];
+    plot::motion(path, title, notes, "frame", &frames, &[])?;
     Ok(frames.len())
 }
 
@@ -295,87 +218,49 @@ fn frame_line(message: &str) -> Option<(f64, [f64; 3])> {
 }
 
 /// The QEMU smoke run's boot precompute (`precompute_insns` of its summary
-/// line) and the loop sets its log reports. Only the smoke run's: a run
-/// with console traffic would count that traffic in its sets' times.
+/// line) and the loop sets its log reports (`loop set <n> ready in <µs> us:
+/// … ([..] discarded) …`), for the measured figures. Only the smoke run's:
+/// a run with console traffic would count that traffic in its sets' times.
 #[allow(clippy::cast_precision_loss)] // instruction counts, far below 2^52
 pub fn record_figures(log: &[LogLine]) {
-    let at_125_mhz = |insns: u64| format!("≥ {:.2} ms", insns as f64 / 125e3);
-    let boot = Summary::find(log).and_then(|s| s.number("precompute_insns").ok());
-    let boot = boot.map(|i| {
+    let row = |set: String, insns: u64, discarded: String| {
         vec![
-            "0 (boot)".to_owned(),
-            thousands(i),
-            at_125_mhz(i),
-            "none".to_owned(),
+            set,
+            thousands(insns),
+            format!("≥ {:.2} ms", insns as f64 / 125e3),
+            discarded,
         ]
+    };
+    let boot = summary(log).and_then(|s| number(s, "precompute_insns").ok());
+    let boot = boot.map(|i| row("0 (boot)".to_owned(), i, "none".to_owned()));
+    let sets = log.iter().filter_map(|line| {
+        let rest = line.message.strip_prefix("loop set ")?;
+        let (set, rest) = rest.split_once(" ready in ")?;
+        let (micros, rest) = rest.split_once(" us")?;
+        // Virtual time under `-icount shift=0`: one instruction a
+        // nanosecond, the frames that preempt the generator included.
+        let insns = micros.parse::<u64>().ok()?.checked_mul(1000)?;
+        let discarded = rest
+            .split_once('(')
+            .and_then(|(_, a)| a.split_once(" discarded)"));
+        Some(row(
+            set.to_owned(),
+            insns,
+            discarded.map_or("", |d| d.0).to_owned(),
+        ))
     });
-    let sets =
-        log.iter()
-            .filter_map(|line| set_cost(&line.message))
-            .map(|(set, insns, discarded)| {
-                vec![
-                    set.to_string(),
-                    thousands(insns),
-                    at_125_mhz(insns),
-                    discarded,
-                ]
-            });
     let intro = "The QEMU smoke run's loop sets ([never-repeating idle](idle.md#in-the-background)): \
                  the boot's set 0, timed before the first frame, and the sets generated in the \
                  background while the frames play, each with the loops it discarded per axis \
                  (pitch, roll, yaw).";
     let header = ["set", "instructions", "at 125 MHz", "loops discarded"];
-    figures::record(
-        "qemu",
-        intro.to_owned(),
-        &header,
-        boot.into_iter().chain(sets).collect(),
-    );
-}
-
-/// `loop set <n> ready in <µs> us: seeds [..] ([..] discarded), ...`: the
-/// set, its instructions and the loops it discarded.
-fn set_cost(message: &str) -> Option<(u64, u64, String)> {
-    let rest = message.strip_prefix("loop set ")?;
-    let (set, rest) = rest.split_once(" ready in ")?;
-    let (micros, rest) = rest.split_once(" us")?;
-    // Virtual time under `-icount shift=0`: one instruction a nanosecond,
-    // the frames that preempt the generator included.
-    let instructions = micros.parse::<u64>().ok()?.checked_mul(1000)?;
-    let discarded = rest
-        .split_once('(')
-        .and_then(|(_, after)| after.split_once(" discarded)"))
-        .map_or_else(String::new, |(list, _)| list.to_owned());
-    Some((set.parse().ok()?, instructions, discarded))
+    let rows = boot.into_iter().chain(sets).collect();
+    figures::record("qemu", intro.to_owned(), &header, rows);
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn reads_the_last_summary_line() {
-        let log = [
-            "frame 0 pitch=0 roll=0 yaw=0",
-            "summary frames=10 missed=3",
-            "summary frames=900 missed=0 pulse_violations=0, checksum=0x1a2B_3c4d",
-        ]
-        .map(|message| LogLine::new("INFO", message));
-        let summary = Summary::find(&log).unwrap();
-        assert_eq!(summary.number("frames").unwrap(), 900);
-        assert_eq!(summary.number("missed").unwrap(), 0);
-        assert_eq!(summary.number("checksum").unwrap(), 0x1a2b_3c4d);
-        assert!(summary.number("absent").is_err());
-        assert!(Summary::find(&log[..1]).is_none());
-    }
-
-    #[test]
-    fn only_the_reset_noise_is_dropped() {
-        let stderr = format!("{RESET_NOISE}\nqemu-system-arm: a real problem\n");
-        let mut shown = Vec::new();
-        forward(stderr.as_bytes(), &mut shown);
-        assert_eq!(shown, b"qemu-system-arm: a real problem\n");
-    }
 
     #[test]
     fn reads_frame_lines_only() {
@@ -390,18 +275,5 @@ mod tests {
         ] {
             assert!(frame_line(other).is_none(), "{other}");
         }
-    }
-
-    #[test]
-    fn reads_the_loop_set_lines() {
-        let set = set_cost(
-            "loop set 2 ready in 3470 us: seeds [0x417b904f, 0xcbb40bbb, \
-             0xd00c5039] ([2, 3, 3] discarded), entered at [407, 233, 791], join mismatch \
-             [1142, 1108, 1391] mdeg rms",
-        )
-        .unwrap();
-        assert_eq!(set, (2, 3_470_000, "[2, 3, 3]".to_owned()));
-        assert!(set_cost("loop set failed: range; trying the next seeds").is_none());
-        assert!(set_cost("frame 1400: join").is_none());
     }
 }

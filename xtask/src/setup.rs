@@ -2,63 +2,40 @@
 
 use std::{
     path::{Path, PathBuf},
-    process::Command,
+    process::{Command, Stdio},
 };
 
 use anyhow::{Context, Result, bail};
 use xshell::{Shell, cmd};
 
-use crate::{
-    board::PICO2_TARGET,
-    project::{self, TARGET},
-};
+use crate::{board::PICO2_TARGET, project};
 
 /// QEMU's system emulator for Arm.
 pub const QEMU_BINARY: &str = "qemu-system-arm";
 
-/// Rustup components the checks use.
-const COMPONENTS: [&str; 2] = ["rustfmt", "clippy"];
-
 /// Adds the firmware targets, rustfmt and clippy to the toolchain the
 /// repository uses (the one named by `rust-toolchain.toml`, so rustup runs in
-/// the repository root).
+/// the repository root). Without rustup, a toolchain installed some other
+/// way must bring these itself; the build says so if it does not.
 pub fn ensure_toolchain(root: &Path) -> Result<()> {
     let sh = Shell::new()?;
     sh.change_dir(root);
-    let installed = |what: &str| {
-        // No rustup: a toolchain installed some other way must bring these
-        // itself; the build says so if it does not.
-        cmd!(sh, "rustup {what} list --installed")
-            .quiet()
-            .read()
-            .ok()
-            .map(|list| {
-                list.lines()
-                    .map(|line| line.trim().to_owned())
-                    .collect::<Vec<_>>()
-            })
-    };
-    let Some(targets) = installed("target") else {
-        return Ok(());
-    };
-    let missing: Vec<&str> = [TARGET, PICO2_TARGET]
-        .into_iter()
-        .filter(|wanted| !targets.iter().any(|target| target == wanted))
-        .collect();
-    if !missing.is_empty() {
-        project::run(&sh, &[], cmd!(sh, "rustup target add {missing...}"))?;
-    }
-    let components = installed("component").unwrap_or_default();
-    let missing: Vec<&str> = COMPONENTS
-        .into_iter()
-        .filter(|name| {
-            !components
-                .iter()
-                .any(|component| component.split('-').next() == Some(name))
-        })
-        .collect();
-    if !missing.is_empty() {
-        project::run(&sh, &[], cmd!(sh, "rustup component add {missing...}"))?;
+    for (what, wanted) in [
+        ("target", [project::TARGET, PICO2_TARGET]),
+        ("component", ["rustfmt", "clippy"]),
+    ] {
+        let Ok(list) = cmd!(sh, "rustup {what} list --installed").quiet().read() else {
+            return Ok(());
+        };
+        // Components are listed with their host (`clippy-x86_64-…`).
+        let installed = |name: &&str| {
+            list.lines()
+                .any(|l| l.trim() == *name || l.trim().split('-').next() == Some(name))
+        };
+        let missing: Vec<&str> = wanted.into_iter().filter(|name| !installed(name)).collect();
+        if !missing.is_empty() {
+            project::run(&sh, &[], cmd!(sh, "rustup {what} add {missing...}"))?;
+        }
     }
     Ok(())
 }
@@ -80,27 +57,17 @@ pub fn ensure_program(program: &str, packages: &[&str], what: &str) -> Result<()
     if version(program).is_some() {
         return Ok(());
     }
-    let packages_text = packages.join(" ");
+    let list = packages.join(" ");
     if !Path::new("/etc/debian_version").exists() || version("apt-get").is_none() {
         bail!("`{program}` was not found; install {what} and run the command again");
     }
     let root = Command::new("id").arg("-u").output();
     if !root.is_ok_and(|out| out.stdout.trim_ascii() == b"0") {
         bail!(
-            "`{program}` was not found; install it with `sudo apt-get install {packages_text}` \
-             and run the command again"
+            "`{program}` was not found; install it with `sudo apt-get install {list}` and run the command again"
         );
     }
-    println!("{program} is missing: installing {packages_text}");
-    apt_install(packages)?;
-    version(program)
-        .map(|_| ())
-        .with_context(|| format!("`{program}` still does not run after installing {packages_text}"))
-}
-
-/// Installs `packages` with apt-get, non-interactively (the caller has
-/// checked that apt-get exists and that this runs as root).
-pub fn apt_install(packages: &[&str]) -> Result<()> {
+    println!("{program} is missing: installing {list}");
     let sh = project::shell(".")?;
     let env = [("DEBIAN_FRONTEND", "noninteractive")];
     project::run(&sh, &env, cmd!(sh, "apt-get update -q"))?;
@@ -111,17 +78,19 @@ pub fn apt_install(packages: &[&str]) -> Result<()> {
             sh,
             "apt-get install -y -q --no-install-recommends {packages...}"
         ),
-    )
+    )?;
+    let ran = version(program).map(|_| ());
+    ran.with_context(|| format!("`{program}` still does not run after installing {list}"))
 }
 
 /// First line of `<program> --version`, if it runs.
 pub fn version(program: impl AsRef<std::ffi::OsStr>) -> Option<String> {
     let out = Command::new(program)
         .arg("--version")
-        .stdin(std::process::Stdio::null())
+        .stdin(Stdio::null())
         .output()
-        .ok()
-        .filter(|out| out.status.success())?;
+        .ok();
+    let out = out.filter(|out| out.status.success())?;
     let text = String::from_utf8_lossy(&out.stdout);
     Some(text.lines().next().unwrap_or_default().trim().to_owned())
 }
@@ -138,14 +107,17 @@ pub const MDBOOK_VERSION: &str = "0.5.4";
 pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
     let wanted = format!("mdbook v{MDBOOK_VERSION}");
     let local = tools.join("bin").join("mdbook");
-    for program in [local.clone(), PathBuf::from("mdbook")] {
-        if version(&program).as_deref() == Some(wanted.as_str()) {
-            return Ok(program);
-        }
+    let pinned = |program: &PathBuf| version(program).as_deref() == Some(wanted.as_str());
+    if let Some(program) = [local.clone(), PathBuf::from("mdbook")]
+        .into_iter()
+        .find(pinned)
+    {
+        return Ok(program);
     }
+    let tools_dir = project::relative(tools);
     println!(
-        "installing mdbook v{MDBOOK_VERSION} into {} (a few minutes, once)",
-        project::relative(tools).display()
+        "installing {wanted} into {} (a few minutes, once)",
+        tools_dir.display()
     );
     let sh = project::shell(".")?;
     // The repository's .cargo/config.toml builds for the firmware's target:
@@ -154,17 +126,14 @@ pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
     let host = info.lines().find_map(|line| line.strip_prefix("host: "));
     let host = host.context("`rustc -vV` names no host")?;
     let build_dir = tools.join("build");
-    project::run(
-        &sh,
-        &[],
-        cmd!(
-            sh,
-            "cargo install mdbook --locked --version {MDBOOK_VERSION} --no-default-features --features search --target {host} --target-dir {build_dir} --root {tools}"
-        ),
-    )?;
-    if version(&local).as_deref() != Some(wanted.as_str()) {
+    let install = cmd!(
+        sh,
+        "cargo install mdbook --locked --version {MDBOOK_VERSION} --no-default-features --features search --target {host} --target-dir {build_dir} --root {tools}"
+    );
+    project::run(&sh, &[], install)?;
+    if !pinned(&local) {
         bail!(
-            "installed mdBook v{MDBOOK_VERSION}, but {} does not run as it",
+            "installed {wanted}, but {} does not run as it",
             local.display()
         );
     }

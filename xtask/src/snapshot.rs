@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Result, anyhow, bail};
 use snapbox::{Assert, Data, filter::NormalizeToExpected};
 
 use crate::{log::Run, project};
@@ -15,11 +15,8 @@ use crate::{log::Run, project};
 /// written to the target directory.
 const MAX_DIFF_LINES: usize = 200;
 
-/// Snapbox's wildcard within a line.
-const WILDCARD: &str = "[..]";
-
-/// `qemu/expected.log`.
-pub fn expected_path() -> PathBuf {
+/// `boards/qemu/expected.log`.
+fn expected_path() -> PathBuf {
     project::root().join("boards/qemu/expected.log")
 }
 
@@ -27,16 +24,16 @@ pub fn expected_path() -> PathBuf {
 /// still match.
 pub fn bless(run: &Run) -> Result<()> {
     let path = expected_path();
-    let name = project::relative(&path);
-    if record(&path, &run.text())? {
-        println!("re-recorded {} ({} lines)", name.display(), run.log.len());
+    let done = if record(&path, &run.text())? {
+        "re-recorded"
     } else {
-        println!(
-            "{} already matches this run ({} lines)",
-            name.display(),
-            run.log.len()
-        );
-    }
+        "already matches this run"
+    };
+    println!(
+        "{} {done} ({} lines)",
+        project::relative(&path).display(),
+        run.log.len()
+    );
     Ok(())
 }
 
@@ -44,18 +41,15 @@ pub fn bless(run: &Run) -> Result<()> {
 /// one. The actual log is also written to `actual` for inspection.
 pub fn compare(run: &Run, actual: &Path) -> Result<()> {
     let path = expected_path();
-    let expected_name = project::relative(&path).display().to_string();
-    let actual_name = project::relative(actual).display().to_string();
+    let [expected, actual_name] =
+        [&path, actual].map(|p| project::relative(p).display().to_string());
     let got = run.text();
-    if let Some(dir) = actual.parent() {
-        std::fs::create_dir_all(dir).ok();
-    }
-    std::fs::write(actual, &got).with_context(|| format!("writing {}", actual.display()))?;
+    project::write(actual, &got)?;
     if !path.exists() {
-        bail!("no expected log at {expected_name}; record one with `cargo xtask test --bless`");
+        bail!("no expected log at {expected}; record one with `cargo xtask test --bless`");
     }
     let Err(difference) = check(&path, &got) else {
-        println!("log matches {expected_name} ({} lines)", run.log.len());
+        println!("log matches {expected} ({} lines)", run.log.len());
         return Ok(());
     };
     let lines: Vec<&str> = difference.lines().collect();
@@ -63,14 +57,12 @@ pub fn compare(run: &Run, actual: &Path) -> Result<()> {
         println!("{line}");
     }
     if lines.len() > MAX_DIFF_LINES {
-        println!(
-            "... {} more lines of difference; see {actual_name}",
-            lines.len() - MAX_DIFF_LINES
-        );
+        let more = lines.len() - MAX_DIFF_LINES;
+        println!("... {more} more lines of difference; see {actual_name}");
     }
     bail!(
-        "the QEMU log differs from {expected_name} (full log in {actual_name}); \
-         if the change is intended, re-record with `cargo xtask test --bless`"
+        "the QEMU log differs from {expected} (full log in {actual_name}); if the change is \
+         intended, re-record with `cargo xtask test --bless`"
     )
 }
 
@@ -78,13 +70,11 @@ pub fn compare(run: &Run, actual: &Path) -> Result<()> {
 /// holds the difference.
 fn check(path: &Path, got: &str) -> Result<(), String> {
     let want = std::fs::read_to_string(path).unwrap_or_default();
-    assert()
-        .try_eq(
-            Some(&"this run"),
-            Data::text(with_wildcards(&want, got)),
-            Data::read_from(path, None),
-        )
-        .map_err(|error| error.to_string())
+    let got = Data::text(with_wildcards(&want, got));
+    let assert = Assert::new().normalize_paths(false);
+    assert
+        .try_eq(Some(&"this run"), got, Data::read_from(path, None))
+        .map_err(|e| e.to_string())
 }
 
 /// Writes the log `got` to `path` as snapbox reads it against the file there
@@ -92,10 +82,10 @@ fn check(path: &Path, got: &str) -> Result<(), String> {
 /// Returns whether it wrote.
 fn record(path: &Path, got: &str) -> Result<bool> {
     let want = std::fs::read_to_string(path).unwrap_or_default();
-    let (actual, expected) = assert().normalize(
-        Data::text(with_wildcards(&want, got)),
-        Data::read_from(path, None),
-    );
+    let got = Data::text(with_wildcards(&want, got));
+    let (actual, expected) = Assert::new()
+        .normalize_paths(false)
+        .normalize(got, Data::read_from(path, None));
     if actual == expected {
         return Ok(false);
     }
@@ -105,28 +95,17 @@ fn record(path: &Path, got: &str) -> Result<bool> {
     Ok(true)
 }
 
-/// Snapbox, reading the log as text (no path separators to normalise).
-fn assert() -> Assert {
-    Assert::new().normalize_paths(false)
-}
-
 /// `got` with each line that a wildcard line of `want` matches replaced by
 /// that wildcard line (the first one that matches).
 fn with_wildcards(want: &str, got: &str) -> String {
-    let patterns: Vec<&str> = want
-        .lines()
-        .filter(|line| line.contains(WILDCARD))
-        .collect();
-    got.lines()
-        .map(|line| {
-            patterns
-                .iter()
-                .copied()
-                .find(|pattern| matches(pattern, line))
-                .unwrap_or(line)
-        })
-        .flat_map(|line| [line, "\n"])
-        .collect()
+    let patterns: Vec<&str> = want.lines().filter(|line| line.contains("[..]")).collect();
+    let line = |line| {
+        *patterns
+            .iter()
+            .find(|pattern| matches(pattern, line))
+            .unwrap_or(&line)
+    };
+    got.lines().flat_map(|l| [line(l), "\n"]).collect()
 }
 
 /// Whether snapbox matches `line` against the expected line `pattern`.
@@ -141,74 +120,54 @@ fn matches(pattern: &str, line: &str) -> bool {
 mod tests {
     use super::*;
 
+    const WANT: &str =
+        "INFO  start\nINFO  cost [..] insns\nINFO  end 1\nINFO  timing: at most [..] us late\n";
+
     #[test]
     fn wildcards_match_within_a_line() {
-        assert!(matches("a [..] c", "a b c"));
-        assert!(matches("a [..] c", "a  c"));
-        assert!(matches("[..]", "anything"));
-        assert!(matches("x=[..] y=[..]", "x=1 y=22"));
-        assert!(!matches("x=[..] y=[..]", "x=1 z=22"));
-        assert!(!matches("a [..] c", "a b d"));
-        assert!(!matches("plain", "plain text"));
-    }
-
-    /// A scratch copy of an expected log holding `text`.
-    fn scratch(text: &str) -> (tempfile::TempDir, PathBuf) {
+        for (pattern, line, matched) in [
+            ("a [..] c", "a b c", true),
+            ("a [..] c", "a  c", true),
+            ("[..]", "anything", true),
+            ("x=[..] y=[..]", "x=1 y=22", true),
+            ("x=[..] y=[..]", "x=1 z=22", false),
+            ("a [..] c", "a b d", false),
+            ("plain", "plain text", false),
+        ] {
+            assert_eq!(matches(pattern, line), matched, "{pattern} / {line}");
+        }
         let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("expected.log");
-        std::fs::write(&path, text).unwrap();
-        (dir, path)
-    }
-
-    const WANT: &str = "INFO  start\n\
-                        INFO  cost [..] insns\n\
-                        INFO  end 1\n\
-                        INFO  timing: at most [..] us late\n";
-
-    #[test]
-    fn values_under_wildcards_may_change() {
-        let (_dir, file) = scratch(WANT);
+        let file = dir.path().join("expected.log");
+        std::fs::write(&file, WANT).unwrap();
+        // Values under wildcards may change; a line without one may not.
         let got =
             "INFO  start\nINFO  cost 42 insns\nINFO  end 1\nINFO  timing: at most 97 us late\n";
         assert_eq!(check(&file, got), Ok(()));
-        let got = got.replace("end 1", "end 2");
-        let difference = check(&file, &got).unwrap_err();
+        let difference = check(&file, &got.replace("end 1", "end 2")).unwrap_err();
         assert!(difference.contains("end 1") && difference.contains("end 2"));
         assert!(!difference.contains("cost 42"), "{difference}");
     }
 
     #[test]
-    fn blessing_keeps_the_wildcards_that_still_match() {
-        let (_dir, file) = scratch(WANT);
+    fn blessing_keeps_the_wildcards_that_still_match_and_drops_the_others() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("expected.log");
+        std::fs::write(&file, WANT).unwrap();
         // A line added above both wildcard lines, one changed between them,
         // and new values under the wildcards.
-        let got = "INFO  start\n\
-                   INFO  a new line\n\
-                   INFO  cost 7 insns\n\
-                   INFO  end 2\n\
-                   INFO  timing: at most 12 us late\n";
+        let got = "INFO  start\nINFO  a new line\nINFO  cost 7 insns\nINFO  end 2\nINFO  timing: at most 12 us late\n";
         assert!(record(&file, got).unwrap());
         assert_eq!(
             std::fs::read_to_string(&file).unwrap(),
-            "INFO  start\n\
-             INFO  a new line\n\
-             INFO  cost [..] insns\n\
-             INFO  end 2\n\
-             INFO  timing: at most [..] us late\n"
+            "INFO  start\nINFO  a new line\nINFO  cost [..] insns\nINFO  end 2\nINFO  timing: at most [..] us late\n"
         );
         // The re-recorded file now matches the run, and is left alone.
         assert_eq!(check(&file, got), Ok(()));
         assert!(!record(&file, got).unwrap());
-    }
-
-    #[test]
-    fn blessing_drops_a_wildcard_line_that_no_longer_matches() {
-        let (_dir, file) = scratch(WANT);
+        std::fs::write(&file, WANT).unwrap();
         let got = "INFO  start\nINFO  cost: 7\nINFO  end 1\nINFO  timing: at most 3 us late\n";
         assert!(record(&file, got).unwrap());
-        assert_eq!(
-            std::fs::read_to_string(&file).unwrap(),
-            "INFO  start\nINFO  cost: 7\nINFO  end 1\nINFO  timing: at most [..] us late\n"
-        );
+        let want = "INFO  start\nINFO  cost: 7\nINFO  end 1\nINFO  timing: at most [..] us late\n";
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), want);
     }
 }

@@ -10,7 +10,6 @@
 
 mod host;
 mod marks;
-mod plot;
 mod script;
 
 use std::{fs, path::PathBuf};
@@ -26,6 +25,7 @@ use idle_head_core::servo::{ServoRate, SetPeriod};
 use idle_head_core::track::{Person, Sighting};
 use idle_head_core::{Axis, Microseconds, Playback, Timestamp};
 use idle_head_firmware::config::IDLE_MODE;
+use std::fmt::Write as _;
 
 use host::Origin;
 use idle_head_core::behaviour::BehaviourParams;
@@ -34,7 +34,7 @@ use idle_head_core::pwm_clock::PICO_SYS_HZ;
 use marks::Mark;
 pub use script::{Event, Kind};
 
-use crate::steps::Steps;
+use crate::{project, steps::Steps};
 
 /// A script's events (see `script.rs`), checked with `params`.
 pub fn parse_script(text: &str, params: &BehaviourParams) -> Result<Vec<Event>> {
@@ -56,7 +56,8 @@ pub struct Args {
     pub script: Option<PathBuf>,
     /// The servos' rate (and the frame rate) from the first frame, Hz
     /// (50 to 333; a script's `servo rate` changes it later).
-    #[arg(long, value_name = "hz", default_value_t = 50, value_parser = rate)]
+    #[arg(long, value_name = "hz", default_value_t = 50,
+          value_parser = clap::value_parser!(u16).range(50..=333))]
     pub rate: u16,
     /// The CSV to write [default: trace/trace.csv in the target directory].
     #[arg(long, value_name = "csv")]
@@ -66,28 +67,6 @@ pub struct Args {
     #[arg(long, value_name = "file")]
     #[allow(clippy::option_option)] // absent, present without a value, with one
     pub png: Option<Option<PathBuf>>,
-}
-
-/// Where the trace goes without `--out` or a `--png` file: build output,
-/// not the repository (`target/trace/` unless cargo is told otherwise).
-fn default_dir() -> Result<PathBuf> {
-    Ok(crate::project::metadata(&crate::project::root())?
-        .target_dir
-        .join("trace"))
-}
-
-/// `--rate`: a servo rate.
-fn rate(text: &str) -> Result<u16, String> {
-    let hz: u16 = text
-        .parse()
-        .map_err(|_| format!("`{text}`: a rate in Hz, such as 50 or 333"))?;
-    ServoRate::new(hz).map(ServoRate::hz).ok_or_else(|| {
-        format!(
-            "{hz} Hz: the servo rate is {} to {} Hz",
-            ServoRate::MIN.hz(),
-            ServoRate::MAX.hz()
-        )
-    })
 }
 
 /// `--seconds`: more than 0, in µs.
@@ -489,74 +468,75 @@ fn wake_until(
     }
 }
 
-/// `cargo xtask trace`.
+/// `cargo xtask trace`: the CSV, and the PNG if asked for, to trace/ in the
+/// target directory (build output, not the repository) unless told otherwise.
 pub fn command(args: &Args) -> Result<bool> {
-    let rate = ServoRate::new(args.rate).ok_or_else(|| anyhow!("{} Hz: not a rate", args.rate))?;
+    let rate = ServoRate::new(args.rate).context("not a servo rate")?;
     let (_, params) = at_rate(rate)?;
     let events = match &args.script {
         Some(path) => {
             let text = fs::read_to_string(path)
                 .with_context(|| format!("reading the script {}", path.display()))?;
-            script::parse(&text, &params).map_err(|e| anyhow!("{}: {e}", path.display()))?
+            script::parse(&text, &params).with_context(|| format!("{}", path.display()))?
         }
         None => Vec::new(),
     };
     let trace = simulate(args.micros, args.seed, rate, &events)?;
-    let out = match &args.out {
-        Some(out) => out.clone(),
-        None => default_dir()?.join("trace.csv"),
+    let dir = || -> Result<PathBuf> {
+        Ok(project::metadata(&project::root())?
+            .target_dir
+            .join("trace"))
     };
-    write_csv(&trace, &out)?;
-    for mark in &trace.marks {
-        println!("{:>9} ms  {}", mark.t_ms, mark.reply);
-    }
-    summary(&trace);
-    println!("wrote {} ({} frames)", out.display(), trace.rows.len());
-    if let Some(png) = &args.png {
-        let png = match png {
-            Some(png) => png.clone(),
-            None => default_dir()?.join("trace.png"),
-        };
-        plot::draw(&trace, args.seed, &png)?;
-        println!("wrote {}", png.display());
-    }
-    Ok(true)
-}
-
-fn write_csv(trace: &Trace, path: &std::path::Path) -> Result<()> {
-    use std::fmt::Write as _;
+    let out = args
+        .out
+        .clone()
+        .map_or_else(|| Ok(dir()?.join("trace.csv")), Ok::<_, anyhow::Error>)?;
     let mut csv =
         String::from("frame,t_ms,pitch_mdeg,roll_mdeg,yaw_mdeg,pitch_ns,roll_ns,yaw_ns\n");
     for row in &trace.rows {
-        let [p, r, y] = row.angles;
-        let [pn, rn, yn] = row.pulses;
-        let t_ms = match row.t_us % 1000 {
-            0 => format!("{}", row.t_us / 1000),
-            us => format!("{}.{us:03}", row.t_us / 1000),
-        };
-        let _ = writeln!(csv, "{},{t_ms},{p},{r},{y},{pn},{rn},{yn}", row.frame);
+        let ([p, r, y], [pn, rn, yn]) = (row.angles, row.pulses);
+        let _ = writeln!(
+            csv,
+            "{},{},{p},{r},{y},{pn},{rn},{yn}",
+            row.frame,
+            ms(row.t_us)
+        );
     }
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    project::write(&out, csv)?;
+    for mark in &trace.marks {
+        println!("{:>9} ms  {}", mark.t_ms, mark.reply);
     }
-    fs::write(path, csv).with_context(|| format!("writing {}", path.display()))
-}
-
-/// Range, largest step and largest change of step per axis.
-fn summary(trace: &Trace) {
-    for (i, axis) in Axis::ALL.iter().enumerate() {
-        let values: Vec<i64> = trace.rows.iter().map(|r| i64::from(r.angles[i])).collect();
-        let (lo, hi) = values
-            .iter()
-            .fold((i64::MAX, i64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    // Range, largest step and largest change of step per axis.
+    for axis in Axis::ALL {
+        let i = axis.index();
+        let (lo, hi) = (trace.rows.iter().map(|r| r.angles[i]))
+            .fold((i32::MAX, i32::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)));
         let angles: Vec<f64> = trace.rows.iter().map(|r| f64::from(r.angles[i])).collect();
         let Steps { step, turn } = Steps::of(&angles);
         let pulses = trace.rows.iter().map(|r| r.pulses[i]);
         let (plo, phi) = pulses.fold((u64::MAX, 0), |(lo, hi), p| (lo.min(p), hi.max(p)));
         println!(
-            "{:<5} angle {lo}..{hi} mdeg, largest step {step:.0} mdeg/frame, largest change of step {turn:.0} mdeg/frame² (frames as they came), pulses {plo}..{phi} ns",
+            "{:<5} angle {lo}..{hi} mdeg, largest step {step:.0} mdeg/frame, largest change of step \
+             {turn:.0} mdeg/frame² (frames as they came), pulses {plo}..{phi} ns",
             axis.name()
         );
+    }
+    println!("wrote {} ({} frames)", out.display(), trace.rows.len());
+    if let Some(png) = &args.png {
+        let png = png
+            .clone()
+            .map_or_else(|| Ok(dir()?.join("trace.png")), Ok::<_, anyhow::Error>)?;
+        marks::draw(&trace, args.seed, &png)?;
+        println!("wrote {}", png.display());
+    }
+    Ok(true)
+}
+
+/// `t_us` in ms, with µs decimals where it has them (`2500`, `2498.496`).
+pub fn ms(t_us: u64) -> String {
+    match t_us % 1000 {
+        0 => format!("{}", t_us / 1000),
+        us => format!("{}.{us:03}", t_us / 1000),
     }
 }
 

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use elf2flash_core::boards::{BoardInfo, RP2040, RP2350};
 
-use crate::{board::Board, elf, pico2, project, setup};
+use crate::{board::Board, elf, pico2, project};
 
 /// `cargo xtask uf2`.
 #[derive(Debug, clap::Args)]
@@ -86,10 +86,9 @@ pub fn command(args: &Args) -> Result<bool> {
     let elf = if let Some(elf) = &args.elf {
         elf.clone()
     } else {
-        let root = project::root();
-        setup::ensure_toolchain(&root)?;
-        args.board.build()?;
-        args.board.elf(&project::metadata(&root)?)
+        let (root, metadata) = project::prepare()?;
+        args.board.image().build(&root)?;
+        args.board.image().elf(&metadata)
     };
     let board = args.board;
     let (path, bytes) = write(&elf, board, "uf2")?;

@@ -8,8 +8,8 @@
 //! - nothing: the smoke run (`cargo xtask qemu`): the script, the injected
 //!   faults and the checks, at 20 times real time, ending on its schedule;
 //!   the console answers whatever arrives;
-//! - `console`: the smoke run *held* for its console (the flood stage of
-//!   `cargo xtask test`): its fade-out waits until the host hangs up,
+//! - `console`: the smoke run *held* for its console (the telemetry check
+//!   of `cargo xtask bench`): its fade-out waits until the host hangs up,
 //!   which it signals with any byte on UART1 (as a modem's DTR line would);
 //! - `interactive`: a clean head for a person (`cargo xtask console
 //!   --qemu`, `cargo xtask panel --qemu`): no script, no injected fault,

@@ -3,14 +3,21 @@
 //! that moves), and a Bottango curve over USB (its start against the
 //! same). See `latency.rs` for the method and the other paths.
 
-use std::{fmt::Write as _, path::Path, time::Duration};
+// Times in ns of virtual time, far below 2^52, and positive.
+#![allow(
+    clippy::cast_precision_loss,
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss
+)]
+
+use std::{path::Path, time::Duration};
 
 use anyhow::{Context, Result, bail};
 use idle_head_core::bottango::hash;
 
 use super::latency::{self, LOOK_GAP, Row, SCHEDULED, schedule};
 use crate::project::Metadata;
-use crate::sim::{BYTE_TIME, UartScript, run_shipped};
+use crate::sim::{BYTE_TIME, Boot, Chunk, UartScript, run_shipped};
 
 /// A path's run, for its row.
 pub type Measure = fn(&Path, &Metadata, Duration) -> Result<Row>;
@@ -36,58 +43,73 @@ fn look_line(k: usize) -> Vec<u8> {
 fn all_ok(replies: &[u8], what: &str) -> Result<()> {
     let text = String::from_utf8_lossy(replies);
     let refused = |l: &&str| l.starts_with("err") || l.contains("FAIL") || l.contains("TIMEOUT");
-    if let Some(line) = text.lines().find(refused) {
-        bail!("{what}: a line refused: {line:?}");
+    match text.lines().find(refused) {
+        Some(line) => bail!("{what}: a line refused: {line:?}"),
+        None => Ok(()),
     }
-    Ok(())
+}
+
+/// The first boot of the shipped image run until 0.5 s after `last`, its
+/// USB port sent `chunks`, every reply `ok`.
+fn usb_run(
+    root: &Path,
+    metadata: &Metadata,
+    (wall, last): (Duration, Duration),
+    chunks: Vec<Chunk>,
+    what: &str,
+) -> Result<Boot> {
+    let end = last + Duration::from_millis(500);
+    let report = run_shipped(root, metadata, end, wall, |config| config.usb = chunks)?;
+    let boot = report.boots.into_iter().next().context("no boot")?;
+    all_ok(&boot.usb, what)?;
+    Ok(boot)
 }
 
 /// `latency usb look`: `look` lines over USB.
 pub fn usb_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
-    let start = Duration::from_secs(4);
-    let times = schedule(start, SCHEDULED, LOOK_GAP, 0x1007_c0de);
-    let mut chunks = vec![(b"idle off\n".to_vec(), Duration::from_millis(2500))];
-    chunks.extend(times.iter().enumerate().map(|(k, at)| (look_line(k), *at)));
-    let end = times.last().copied().unwrap_or(start) + Duration::from_millis(500);
-    let report = run_shipped(root, metadata, end, wall, |config| {
-        config.usb_chunks = chunks;
-        Ok(())
-    })?;
-    let boot = report.boots.first().context("no boot")?;
+    let times = schedule(Duration::from_secs(4), SCHEDULED, LOOK_GAP, 0x1007_c0de);
+    let mut chunks = vec![Chunk::new(b"idle off\n", Duration::from_millis(2500))];
+    chunks.extend(
+        times
+            .iter()
+            .enumerate()
+            .map(|(k, at)| Chunk::new(look_line(k), *at)),
+    );
+    let last = times.last().copied().unwrap_or_default();
+    let boot = usb_run(root, metadata, (wall, last), chunks, "usb look")?;
     let events: Vec<f64> = boot.usb_in.iter().skip(1).copied().collect();
     if events.len() != times.len() {
         bail!("{} USB lines went out, not {}", events.len(), times.len());
     }
-    all_ok(&boot.usb, "usb look")?;
-    latency::row("usb look", &events, boot)
+    latency::row("usb look", &events, &boot)
 }
 
 /// `latency uart look`: `look` lines over UART0 at 115200 baud, each in by
 /// its time.
 pub fn uart_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
-    let times = schedule(Duration::from_secs(4), SCHEDULED, LOOK_GAP, 0x0a47_100c);
-    let boot = uart_looks(root, metadata, wall, b"idle off\n", &times)?;
-    let events: Vec<f64> = boot.uart_lines.iter().skip(1).copied().collect();
+    let (events, boot) = uart_looks(root, metadata, wall, b"idle off\n", 0x0a47_100c)?;
     latency::row("uart look", &events, &boot)
 }
 
 /// `latency uart look at 200 Hz`: the same after `servo rate 200`, against
 /// its own goal (a 5 ms frame and the transport).
 pub fn uart_look_200_hz(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
-    let times = schedule(Duration::from_secs(4), SCHEDULED, LOOK_GAP, 0x200_100c);
-    let boot = uart_looks(root, metadata, wall, b"idle off\nservo rate 200\n", &times)?;
+    let (events, boot) = uart_looks(
+        root,
+        metadata,
+        wall,
+        b"idle off\nservo rate 200\n",
+        0x200_100c,
+    )?;
     let answered = String::from_utf8_lossy(&boot.uart);
     if !answered
         .lines()
         .take(2)
         .any(|line| line.trim_end() == "ok servo rate=200 period_us=5000")
     {
-        bail!(
-            "uart look at 200 Hz: the rate was not taken: {:?}",
-            String::from_utf8_lossy(&boot.uart[..boot.uart.len().min(80)])
-        );
+        let start = String::from_utf8_lossy(&boot.uart[..boot.uart.len().min(80)]);
+        bail!("uart look at 200 Hz: the rate was not taken: {start:?}");
     }
-    let events: Vec<f64> = boot.uart_lines.iter().skip(1).copied().collect();
     latency::row_at(
         "uart look at 200 Hz",
         &events,
@@ -96,31 +118,25 @@ pub fn uart_look_200_hz(root: &Path, metadata: &Metadata, wall: Duration) -> Res
     )
 }
 
-/// A run of `look` lines over UART0 at `times` after `setup` (one or more
-/// lines, at 2.5 s); its boot, every line answered `ok`.
+/// A run of `look` lines over UART0 at times seeded by `seed` after `setup`
+/// (one or more lines, at 2.5 s): each line's arrival, and the boot, every
+/// line answered `ok`.
 fn uart_looks(
     root: &Path,
     metadata: &Metadata,
     wall: Duration,
     setup: &[u8],
-    times: &[Duration],
-) -> Result<crate::sim::Boot> {
-    let start = Duration::from_secs(4);
-    let mut scripts = vec![UartScript::new(
-        0,
-        setup.to_vec(),
-        Duration::from_millis(2500),
-    )];
+    seed: u32,
+) -> Result<(Vec<f64>, Boot)> {
+    let times = schedule(Duration::from_secs(4), SCHEDULED, LOOK_GAP, seed);
+    let mut scripts = vec![UartScript::new(0, setup, Duration::from_millis(2500))];
     scripts.extend(times.iter().enumerate().map(|(k, &at)| {
         let line = look_line(k);
         let on_the_wire = BYTE_TIME * u32::try_from(line.len()).unwrap_or(u32::MAX);
         UartScript::new(0, line, at.saturating_sub(on_the_wire))
     }));
-    let end = times.last().copied().unwrap_or(start) + Duration::from_millis(500);
-    let report = run_shipped(root, metadata, end, wall, |config| {
-        config.uart = scripts;
-        Ok(())
-    })?;
+    let end = times.last().copied().unwrap_or_default() + Duration::from_millis(500);
+    let report = run_shipped(root, metadata, end, wall, |config| config.uart = scripts)?;
     let boot = report.boots.into_iter().next().context("no boot")?;
     // One script for the setup, one for each look.
     if boot.uart_lines.len() != times.len() + 1 {
@@ -131,7 +147,7 @@ fn uart_looks(
         );
     }
     all_ok(&boot.uart, "uart look")?;
-    Ok(boot)
+    Ok((boot.uart_lines.iter().skip(1).copied().collect(), boot))
 }
 
 /// The gaps between Bottango's curves: a 40 ms step, then a hold.
@@ -142,9 +158,12 @@ const AHEAD: Duration = Duration::from_millis(120);
 /// −20° to 20°): 256 is 1.25°.
 const STEP: i32 = 256;
 
-/// A Bottango line with its hash.
-fn bottango_line(body: &str) -> String {
-    format!("{body},h{}\n", hash(body.as_bytes()))
+/// Bottango lines with their hashes.
+fn bottango_lines(bodies: &[&str]) -> Vec<u8> {
+    let lines = bodies
+        .iter()
+        .map(|body| format!("{body},h{}\n", hash(body.as_bytes())));
+    lines.collect::<String>().into_bytes()
 }
 
 /// `latency bottango`: a Bottango session over USB steps yaw by 1.25° and
@@ -153,25 +172,14 @@ fn bottango_line(body: &str) -> String {
 /// first pulse that moves.
 pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
     // When the first frame goes out: the head's clock counts from it.
-    let first = run_shipped(root, metadata, Duration::from_secs(1), wall, |_| Ok(()))?;
-    let t0 = first
-        .boots
-        .first()
-        .and_then(|boot| boot.trains[2].enabled)
-        .context("no first frame")?;
+    let first = run_shipped(root, metadata, Duration::from_secs(1), wall, |_| {})?;
+    let t0 = first.first()?.trains[2].enabled.context("no first frame")?;
     let frame = crate::sim::frame_ns();
     // The sync in the middle of a frame after 2.6 s: the clock it marks is
     // the frame before, whatever the line's few µs of transport.
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-    let k = ((2.6e9 - t0) / frame).ceil() as u64;
-    #[allow(clippy::cast_precision_loss)]
-    let sync = Duration::from_nanos((t0 + (k as f64 + 0.5) * frame) as u64);
-    #[allow(
-        clippy::cast_precision_loss,
-        clippy::cast_possible_truncation,
-        clippy::cast_sign_loss
-    )]
-    let clock_ms = (k as f64 * frame / 1e6).round() as u64;
+    let k = ((2.6e9 - t0) / frame).ceil();
+    let sync = Duration::from_nanos((t0 + (k + 0.5) * frame) as u64);
+    let clock_ms = (k * frame / 1e6).round() as u64;
     // The curves' starts, whole ms after the sync's clock.
     let times = schedule(
         Duration::from_secs(4),
@@ -179,27 +187,14 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
         CURVE_GAP,
         0xb077_a160,
     );
-    let ms_after = |at: Duration| -> u64 {
-        #[allow(
-            clippy::cast_precision_loss,
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss
-        )]
-        let since_first = ((at.as_secs_f64() * 1e9 - t0) / 1e6).round() as u64;
-        since_first - clock_ms
-    };
+    let ms_after = |at: Duration| ((at.as_secs_f64() * 1e9 - t0) / 1e6).round() as u64 - clock_ms;
     let mut chunks = vec![
-        (b"idle off\n".to_vec(), Duration::from_secs(2)),
-        (
-            [
-                bottango_line("hRQ,144"),
-                bottango_line("rMTR,yaw,-20000,20000,3000,4096"),
-            ]
-            .concat()
-            .into_bytes(),
+        Chunk::new(b"idle off\n", Duration::from_secs(2)),
+        Chunk::new(
+            bottango_lines(&["hRQ,144", "rMTR,yaw,-20000,20000,3000,4096"]),
             Duration::from_millis(2300),
         ),
-        (bottango_line("tSYN,0").into_bytes(), sync),
+        Chunk::new(bottango_lines(&["tSYN,0"]), sync),
     ];
     let mut events = Vec::new();
     for (i, pair) in times.windows(2).enumerate() {
@@ -209,29 +204,19 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
         } else {
             (4096 + STEP, 4096)
         };
-        let mut text = bottango_line(&format!(
-            "sC,yaw,{start},40,{from},0,{},{to},0,0",
-            to - from
-        ));
-        let _ = write!(
-            text,
-            "{}",
-            bottango_line(&format!(
-                "sC,yaw,{},{},{to},0,0,{to},0,0",
-                start + 40,
-                next - start - 40
-            ))
+        let step = format!("sC,yaw,{start},40,{from},0,{},{to},0,0", to - from);
+        let hold = format!(
+            "sC,yaw,{},{},{to},0,0,{to},0,0",
+            start + 40,
+            next - start - 40
         );
-        chunks.push((text.into_bytes(), pair[0].saturating_sub(AHEAD)));
-        #[allow(clippy::cast_precision_loss)]
+        chunks.push(Chunk::new(
+            bottango_lines(&[&step, &hold]),
+            pair[0].saturating_sub(AHEAD),
+        ));
         events.push(t0 + (clock_ms + start) as f64 * 1e6);
     }
-    let end = times.last().copied().unwrap_or_default() + Duration::from_millis(500);
-    let report = run_shipped(root, metadata, end, wall, |config| {
-        config.usb_chunks = chunks;
-        Ok(())
-    })?;
-    let boot = report.boots.first().context("no boot")?;
-    all_ok(&boot.usb, "bottango")?;
-    latency::row("bottango", &events, boot)
+    let last = times.last().copied().unwrap_or_default();
+    let boot = usb_run(root, metadata, (wall, last), chunks, "bottango")?;
+    latency::row("bottango", &events, &boot)
 }

@@ -1,16 +1,14 @@
 //! The frame work with telemetry streaming: `watch 50` on the QEMU image's
 //! UART0 through the smoke schedule must leave the frame work the smoke run
-//! logs (average and worst) within one `SysTick` count (80 instructions)
+//! logs (average and worst) within one `SysTick` count (80 instructions:
+//! 12.5 MHz after reset under `-icount shift=0`, `boards/qemu/src/systick.rs`)
 //! of the run without it, and miss no frame: telemetry is written by the
 //! console task, never on the frame path.
 
 use std::{
     io::Read,
     path::Path,
-    sync::{
-        Arc,
-        atomic::{AtomicUsize, Ordering},
-    },
+    sync::atomic::{AtomicUsize, Ordering},
     time::{Duration, Instant},
 };
 
@@ -20,8 +18,7 @@ use crate::console::{Pace, qemu_session};
 use crate::log::{LogLine, Run};
 use crate::qemu::{self, Echo};
 
-/// Instructions per `SysTick` count in the smoke run: 12.5 MHz after reset
-/// under `-icount shift=0` (`boards/qemu/src/systick.rs`).
+/// Instructions per `SysTick` count in the smoke run.
 const INSNS_PER_COUNT: u64 = 80;
 
 /// Telemetry lines to see before the host hangs up: the schedule's
@@ -31,13 +28,13 @@ const LINES: usize = 80;
 /// The console's input: `watch 50`, then nothing until [`LINES`]
 /// telemetry lines came (or the deadline passed), then the end (the host
 /// hangs up, and the schedule fades out).
-struct Streaming {
+struct Streaming<'a> {
     sent: bool,
-    seen: Arc<AtomicUsize>,
+    seen: &'a AtomicUsize,
     deadline: Instant,
 }
 
-impl Read for Streaming {
+impl Read for Streaming<'_> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         if !std::mem::replace(&mut self.sent, true) {
             let line = b"watch 50\n";
@@ -55,12 +52,12 @@ impl Read for Streaming {
 fn frame_work(log: &[LogLine]) -> Result<(u64, u64)> {
     let line = log
         .iter()
-        .find_map(|l| l.message.strip_prefix("frame work: "))
-        .context("the run logged no frame work")?;
+        .find_map(|l| l.message.strip_prefix("frame work: "));
+    let line = line.context("the run logged no frame work")?;
     let mut numbers = line
         .split(|c: char| !c.is_ascii_digit())
         .filter(|w| !w.is_empty())
-        .map(str::parse::<u64>);
+        .map(str::parse);
     match (numbers.next(), numbers.next()) {
         (Some(Ok(average)), Some(Ok(most))) => Ok((average, most)),
         _ => bail!("unreadable frame work line: {line}"),
@@ -76,24 +73,19 @@ pub fn check(elf: &Path, timeout: Duration, plain: Option<&Run>) -> Result<Strin
         Some(run) => frame_work(&run.log)?,
         None => frame_work(&qemu::run(elf, timeout, Echo::Problems)?.log)?,
     };
-    let seen = Arc::new(AtomicUsize::new(0));
-    let counted = Arc::clone(&seen);
-    let session = qemu_session(
-        elf,
-        Streaming {
-            sent: false,
-            seen: Arc::clone(&seen),
-            deadline: Instant::now() + timeout,
-        },
-        move |line| {
-            if line.starts_with(b"~ ") {
-                counted.fetch_add(1, Ordering::AcqRel);
-            }
-        },
-        Pace::Fast,
-        Echo::Problems,
-        Duration::from_secs(5),
-    )?;
+    let seen = AtomicUsize::new(0);
+    let input = Streaming {
+        sent: false,
+        seen: &seen,
+        deadline: Instant::now() + timeout,
+    };
+    let mut count = |line: &[u8]| {
+        if line.starts_with(b"~ ") {
+            seen.fetch_add(1, Ordering::AcqRel);
+        }
+    };
+    let wait = Duration::from_secs(5);
+    let session = qemu_session(elf, input, &mut count, Pace::Fast, Echo::Problems, wait)?;
     let lines = seen.load(Ordering::Acquire);
     let with = frame_work(&session.run.log)?;
     let verdict = qemu::check_summary(&session.run.log)?;

@@ -2,7 +2,7 @@
 //! conversation, UART1 on another for the hang-up.
 
 use std::{
-    io::{BufRead, BufReader, Read, Write},
+    io::{Read, Write},
     os::unix::net::UnixStream,
     path::{Path, PathBuf},
     process::{Child, Command, Stdio},
@@ -15,7 +15,7 @@ use anyhow::{Context, Result};
 use super::talk::{self, Talk};
 use crate::log::Run;
 use crate::qemu::{self, Echo};
-use crate::{project, setup};
+use crate::setup;
 
 /// Which run the image plays, and how QEMU's virtual clock runs while the
 /// core sleeps.
@@ -33,24 +33,11 @@ pub enum Pace {
     Fast,
 }
 
-/// A QEMU run with its console.
+/// A QEMU run with its console: the firmware's log and exit, and the
+/// conversation (lines sent, replies, what ended it early).
 pub struct QemuSession {
-    /// The firmware's log and exit.
     pub run: Run,
-    /// The conversation: lines sent, replies, what ended it early.
     pub talk: Talk,
-}
-
-impl QemuSession {
-    /// The firmware's summary line.
-    pub fn summary(&self) -> Option<String> {
-        self.run
-            .log
-            .iter()
-            .rev()
-            .find(|line| line.message.starts_with("summary"))
-            .map(|line| line.message.clone())
-    }
 }
 
 /// How long QEMU has to stop after the hang-up (the firmware fades out for
@@ -58,52 +45,47 @@ impl QemuSession {
 /// reply reader waits for a byte after it.
 const AFTER_HANG_UP: Duration = Duration::from_secs(120);
 
-/// Runs `elf` in QEMU held for its console (semihosting argument
-/// `console`): sends `input` to UART0 as it comes, byte for byte, hands
-/// each reply line to `on_reply`, waits up to `wait` for the replies still
-/// due, then hangs up (a byte on UART1), so that the firmware fades out and
-/// prints its summary.
+/// Runs `elf` in QEMU held for its console: sends `input` to UART0 as it
+/// comes, byte for byte, hands each reply line to `on_reply`, waits up to
+/// `wait` for the replies still due, then hangs up (a byte on UART1), so
+/// that the firmware fades out and prints its summary.
 pub fn qemu_session(
     elf: &Path,
     input: impl Read,
-    mut on_reply: impl FnMut(&[u8]) + Send,
+    on_reply: &mut (impl FnMut(&[u8]) + Send),
     pace: Pace,
     echo: Echo,
     wait: Duration,
 ) -> Result<QemuSession> {
-    let defmt = crate::log::Defmt::read(elf)?;
     let Sockets {
         child,
         dir,
         uart0,
         uart1,
     } = spawn_with_sockets(elf, pace, "console", Stdio::piped)?;
-    let start = Instant::now();
-    let done = project::finish(
-        child,
-        setup::QEMU_BINARY,
-        AFTER_HANG_UP,
-        |stdout| qemu::decode(stdout, &defmt, echo),
-        |stderr| {
-            // QEMU says it waits for each socket's connection: not news here.
-            let mut to = std::io::stderr();
-            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-                if !line.contains("QEMU waiting for connection") && !qemu::is_reset_noise(&line) {
-                    let _ = writeln!(to, "{line}");
-                }
-            }
-        },
-        || talk(&uart0, &uart1, input, &mut on_reply, wait),
-    )?;
+    let (run, talk) = qemu::finish(child, elf, AFTER_HANG_UP, echo, || {
+        // The conversation on UART0, then the hang-up on UART1: the
+        // firmware fades out, prints its summary and exits, which closes
+        // the socket and ends the reader.
+        let mut console = connect(&uart0)?;
+        let mut hang_up = connect(&uart1)?;
+        let (reader, timeout) = (console.try_clone()?, console.try_clone()?);
+        Ok::<_, anyhow::Error>(talk::converse(
+            input,
+            &mut console,
+            reader,
+            on_reply,
+            wait,
+            || {
+                hang_up.write_all(b"\0")?;
+                // A firmware that does not stop must not hold the reader for ever.
+                timeout.set_read_timeout(Some(AFTER_HANG_UP))?;
+                Ok(())
+            },
+        ))
+    })?;
     let _ = std::fs::remove_dir_all(&dir);
-    Ok(QemuSession {
-        run: Run {
-            log: done.stdout,
-            exit: done.exit,
-            elapsed: start.elapsed(),
-        },
-        talk: done.meanwhile?,
-    })
+    Ok(QemuSession { run, talk: talk? })
 }
 
 /// QEMU started by [`spawn_with_sockets`].
@@ -133,19 +115,13 @@ pub fn spawn_with_sockets(
     for path in [&uart0, &uart1] {
         let _ = std::fs::remove_file(path);
     }
-    let child = qemu_command(
-        elf,
-        pace,
-        [
-            &format!("unix:{},server=on,wait=on", uart0.display()),
-            &format!("unix:{},server=on,wait=on", uart1.display()),
-        ],
-    )
-    .stdin(Stdio::null())
-    .stdout(output())
-    .stderr(output())
-    .spawn()
-    .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
+    let serial = |path: &PathBuf| format!("unix:{},server=on,wait=on", path.display());
+    let child = qemu_command(elf, pace, [&serial(&uart0), &serial(&uart1)])
+        .stdin(Stdio::null())
+        .stdout(output())
+        .stderr(output())
+        .spawn()
+        .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
     Ok(Sockets {
         child,
         dir,
@@ -163,6 +139,7 @@ pub fn qemu_command(elf: &Path, pace: Pace, serials: [&str; 2]) -> Command {
         Pace::Fast => (false, "console"),
     };
     let semihosting = format!("enable=on,target=native,arg=idle-head,arg={run}");
+    let [uart0, uart1] = serials;
     let args = [
         "-display",
         "none",
@@ -171,8 +148,11 @@ pub fn qemu_command(elf: &Path, pace: Pace, serials: [&str; 2]) -> Command {
         "-semihosting-config",
         &semihosting,
     ];
-    let serials = ["-serial", serials[0], "-serial", serials[1]];
-    qemu::qemu_command(elf, sleep, &[&args[..], &serials[..]].concat())
+    qemu::qemu_command(
+        elf,
+        sleep,
+        &[&args[..], &["-serial", uart0, "-serial", uart1]].concat(),
+    )
 }
 
 /// Connects to a socket QEMU serves, waiting for it to appear.
@@ -187,33 +167,4 @@ pub fn connect(path: &Path) -> Result<UnixStream> {
             Err(_) => thread::sleep(Duration::from_millis(20)),
         }
     }
-}
-
-/// The conversation on UART0 ([`talk::converse`]), then the hang-up on
-/// UART1: the firmware fades out, prints its summary and exits, which
-/// closes the socket and ends the reader.
-fn talk(
-    uart0: &Path,
-    uart1: &Path,
-    input: impl Read,
-    on_reply: &mut (impl FnMut(&[u8]) + Send),
-    wait: Duration,
-) -> Result<Talk> {
-    let mut console = connect(uart0)?;
-    let mut hangup = connect(uart1)?;
-    let reader = console.try_clone()?;
-    let timeout = console.try_clone()?;
-    Ok(talk::converse(
-        input,
-        &mut console,
-        reader,
-        on_reply,
-        wait,
-        || {
-            hangup.write_all(b"\0")?;
-            // A firmware that does not stop must not hold the reader for ever.
-            timeout.set_read_timeout(Some(AFTER_HANG_UP))?;
-            Ok(())
-        },
-    ))
 }

@@ -19,7 +19,7 @@ use crate::console::{
     Pace, open_port,
     qemu::{Sockets, connect, spawn_with_sockets},
 };
-use crate::sim::live::{self, LiveEvent};
+use crate::sim::live;
 
 /// What the head says, for each page connected.
 #[derive(Debug, Clone)]
@@ -99,17 +99,18 @@ impl Bridge {
     /// The shipped Pico image `elf` live in the RP2040 emulator, over its
     /// USB serial port.
     pub fn sim(root: &Path, elf: &Path) -> Result<Self> {
-        let live = live::start(root, elf)?;
+        let mut child = live::start(root, elf)?;
+        let (stdin, stdout) = (child.stdin.take(), child.stdout.take());
+        let (stdin, stdout) = stdin
+            .zip(stdout)
+            .context("the harness's stdin and stdout")?;
         let name = "the shipped Pico image in the RP2040 emulator (USB serial port)";
-        let mut bridge = Self::new(name.to_owned(), "sim", Box::new(HexLines(live.stdin)));
-        bridge.child = Some(live.child);
+        let mut bridge = Self::new(name.to_owned(), "sim", Box::new(HexLines(stdin)));
+        bridge.child = Some(child);
         let hub = std::sync::Arc::clone(&bridge.hub);
         thread::spawn(move || {
-            live::events(live.stdout, |event| match event {
-                LiveEvent::Bytes(bytes) => hub.tell(&Note::Bytes(bytes)),
-                LiveEvent::End(why) => hub.tell(&Note::Gone(why)),
-                LiveEvent::Connected => {}
-            });
+            let why = live::events(stdout, |bytes| hub.tell(&Note::Bytes(bytes)));
+            hub.tell(&Note::Gone(why));
         });
         Ok(bridge)
     }

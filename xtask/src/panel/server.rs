@@ -161,7 +161,9 @@ fn events(mut out: Box<dyn Write + Send>, notes: &mpsc::Receiver<Note>) -> std::
     out.flush()?;
     for note in notes {
         match note {
-            Note::Bytes(bytes) => write!(out, "data: {}\n\n", crate::sim::node::hex(&bytes))?,
+            Note::Bytes(bytes) => {
+                write!(out, "data: {}\n\n", crate::sim::node::hex_string(&bytes))?;
+            }
             Note::Gone(why) => {
                 write!(out, "event: gone\ndata: {why}\n\n")?;
                 return out.flush();

@@ -1,7 +1,12 @@
-//! The stages of one loop in f64 degrees, from the engine's own trace: walk,
-//! smoothed, normalised, final (the module docs of `preview` say what each
-//! column is), with the loop's metrics. (Where playback starts, the split
-//! point, is held to a reference implementation by `host-tests`.)
+//! The stages of one loop in f64 degrees, from the engine's own trace, with
+//! the loop's metrics: `walk`, the random walk of step δ (the seamless
+//! closure's circular walk detrended, walk(n) = δ·Σ_{k≤n} (e(k) − D/N));
+//! `smoothed`, the engine's smoothed walk shifted to the walk's mean (the
+//! engine defines it only up to a constant); `normalized`, the paper's
+//! min-max normalisation into [α1, α2]; `final`, the stored loop in
+//! playback order, from the split point p: `final(i)` is the closure's last
+//! stage at (i + p) mod N. (The split point is held to a reference
+//! implementation by `host-tests`.)
 
 // Sample indices (< 2^13) and angles are small: float conversions are exact
 // or far below the printed resolution.
@@ -244,66 +249,55 @@ pub fn closure_name(closure: Closure) -> &'static str {
 #[cfg(test)]
 #[allow(clippy::float_cmp)] // exact values by construction
 mod tests {
-    use idle_head_core::{
-        Axis,
-        motion::{DEFAULT_HEAD, DEFAULT_N},
-    };
+    use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N};
 
     use super::*;
 
     #[test]
-    fn paper_walk_steps_by_the_top_bit_of_r_n() {
+    fn the_walks_normalisation_and_taper() {
+        // The paper's walk steps by the top bit of r(n).
         let walk = paper_walk(127, 6, 0.5);
-        assert_eq!(walk[0], 0.0);
         let mut lcg = Lcg::new(127);
+        assert_eq!(walk[0], 0.0);
         for i in 1..6 {
-            let r = lcg.next_value();
-            let step = if r >= 1 << 31 { 0.5 } else { -0.5 };
+            let step = if lcg.next_value() >= 1 << 31 {
+                0.5
+            } else {
+                -0.5
+            };
             assert_eq!(walk[i] - walk[i - 1], step);
         }
-    }
-
-    #[test]
-    fn seamless_walk_is_periodic() {
+        // The seamless walk is periodic; its first step e(0) − D/N, e(0) from r(1).
         let walk = seamless_walk(8821, 900, 1.0);
         assert!(walk[899].abs() < 1e-9, "ends at zero: {}", walk[899]);
-        // The first step is e(0) − D/N, with e(0) from r(1).
-        let mut lcg = Lcg::new(8821);
-        let e0 = f64::from(step_of(lcg.next_value()));
-        assert!((walk[0] - e0).abs() < 1.0);
-    }
-
-    #[test]
-    fn normalisation_and_taper() {
+        assert!((walk[0] - f64::from(step_of(Lcg::new(8821).next_value()))).abs() < 1.0);
         assert_eq!(normalize(&[2.0, 4.0, 3.0], -4.0, 12.0), [-4.0, 12.0, 4.0]);
         assert_eq!(normalize(&[1.0, 1.0], -1.0, 1.0), [-1.0, -1.0]);
         let h = taper(5);
-        assert!(h[0].abs() < 1e-12 && h[4].abs() < 1e-12);
-        assert!((h[2] - 1.0).abs() < 1e-12);
+        assert!(h[0].abs() < 1e-12 && h[4].abs() < 1e-12 && (h[2] - 1.0).abs() < 1e-12);
         assert!((h[1] - 0.5).abs() < 1e-12);
     }
 
     #[test]
     fn stages_of_a_default_axis() {
         for closure in [Closure::Paper, Closure::Seamless] {
-            let spec = LoopSpec {
+            let cfg = DEFAULT_HEAD.pitch.with_closure(closure);
+            let stages = Stages::compute(LoopSpec {
                 axis: Axis::Pitch,
                 n: DEFAULT_N,
-                cfg: DEFAULT_HEAD.pitch.with_closure(closure),
-            };
-            let stages = Stages::compute(spec).unwrap();
-            let (lo, hi) = stages
-                .normalized
+                cfg,
+            })
+            .unwrap();
+            let norm = &stages.normalized;
+            let (lo, hi) = norm
                 .iter()
                 .fold((f64::MAX, f64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
             assert!((lo + 4.0).abs() < 1e-9 && (hi - 12.0).abs() < 1e-9);
             assert_eq!(stages.tapered.is_some(), closure == Closure::Paper);
             let csv = stages.csv();
-            let mut lines = csv.lines();
-            assert_eq!(lines.next(), Some("n,walk,smoothed,normalized,final"));
-            assert_eq!(lines.count(), DEFAULT_N);
-            let smoothed_mean = mean(&stages.smoothed);
-            assert!((smoothed_mean - mean(&stages.walk)).abs() < 1e-9);
+            assert_eq!(csv.lines().next(), Some("n,walk,smoothed,normalized,final"));
+            assert_eq!(csv.lines().count(), DEFAULT_N + 1);
+            assert!((mean(&stages.smoothed) - mean(&stages.walk)).abs() < 1e-9);
         }
     }
 }

@@ -8,7 +8,7 @@ use std::{path::Path, time::Duration};
 use anyhow::{Context, Result, bail};
 use serde_json::{Value, json};
 
-use super::node::{self, nanos};
+use super::node::nanos;
 
 /// The head's address in the image as built (the built-in settings).
 pub const ADDRESS: u16 = 1;
@@ -125,11 +125,6 @@ pub fn read(path: &Path) -> Result<Vec<Change>> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("reading the DMX script {}", path.display()))?;
     parse(&text).with_context(|| format!("in {}", path.display()))
-}
-
-/// Sets up `config` to play `changes`.
-pub fn configure(config: &mut node::Config, changes: &[Change]) {
-    config.dmx = Some(line(changes));
 }
 
 #[cfg(test)]

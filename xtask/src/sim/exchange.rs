@@ -4,19 +4,18 @@
 //! (fields that depend on the frame a line arrives at are wildcards, `*`).
 //! The script moves nothing, so the pulses are checked as always.
 
-use std::fmt::Write as _;
-use std::time::Duration;
-
-use idle_head_core::console::checksum;
-
-use std::cell::RefCell;
+use std::{cell::RefCell, fmt::Write as _, time::Duration};
 
 use embassy_sync::blocking_mutex::Mutex;
 use idle_head_core::behaviour::{CommandQueue, ShowLink};
-use idle_head_core::console::{ConsoleLink, ConsoleService, HeadMode, HeadStatus};
+use idle_head_core::console::{
+    ConsoleLink, ConsoleService, HeadMode, HeadStatus, PortSession, Shared, SharedService,
+    checksum, outcome_reply,
+};
 use idle_head_core::settings::{RamStorage, Validated};
 
-use idle_head_core::console::{PortSession, Shared, SharedService, outcome_reply};
+use super::node::{Chunk, Config, UartScript};
+use super::run::Report;
 
 /// When the first byte goes out: 3 s, after the 2 s fade-in.
 pub const START: Duration = Duration::from_secs(3);
@@ -24,9 +23,7 @@ pub const START: Duration = Duration::from_secs(3);
 pub const USB_START: Duration = Duration::from_secs(4);
 /// Between the starts of two lines on the UART: more than the longest
 /// reply (160 bytes, 13.9 ms) takes to go out.
-pub const LINE_GAP: Duration = Duration::from_millis(40);
-/// One byte at 115200 baud, 8N1: 10 bits.
-pub const BYTE_TIME: Duration = Duration::from_nanos(1_000_000_000 * 10 / 115_200);
+const LINE_GAP: Duration = Duration::from_millis(40);
 
 /// The lines sent, each with its line end: good and bad commands, every
 /// line end, an overlong line, a control byte and a machine-mode line
@@ -47,13 +44,68 @@ const SCRIPT: &[&[u8]] = &[
     b"seed 4294967296\n",
 ];
 
-/// The bytes of the whole script.
-pub fn script() -> Vec<u8> {
-    script_lines().concat()
+/// The exchange on the harness's lines: the script's lines on UART0 from
+/// [`START`], [`LINE_GAP`] apart, and all of it over USB at [`USB_START`].
+pub fn configure(config: &mut Config) {
+    let lines = script_lines();
+    config.uart = (0_u32..)
+        .zip(&lines)
+        .map(|(i, line)| UartScript::new(0, line.clone(), START + LINE_GAP * i))
+        .collect();
+    config.usb = vec![Chunk::new(lines.concat(), USB_START)];
+}
+
+/// The exchange of boot 0 against the host's replies, into `report`: its
+/// transcript, and the problems: a wrong or missing reply, a byte that found
+/// UART0's receive FIFO full, a device the emulator's USB host did not
+/// configure, or a `center` the frame task did not log as applied (it goes
+/// through the queue).
+pub fn check(report: &mut Report) {
+    let Some(boot) = report.boots.first() else {
+        return;
+    };
+    let script = script_lines().concat();
+    let [uart_want, usb_want] = expected(&script);
+    let (transcript, problems) = compare(&script, &uart_want, &boot.uart);
+    let (len, out) = (script.len(), boot.uart.len());
+    let start = START.as_secs_f64();
+    let mut text = format!(
+        "UART0 exchange ({len} bytes in from {start:.1} s at 115200 baud, {out} bytes out):\n{transcript}"
+    );
+    let mut found: Vec<String> = problems.into_iter().map(|p| format!("UART: {p}")).collect();
+    match boot.uart_lines.last() {
+        Some(ns) => {
+            let _ = writeln!(text, "  (last byte in at {:.4} s)", ns / 1e9);
+        }
+        None => found.push("the harness did not send the whole UART script".to_owned()),
+    }
+    if boot.uart_overruns > 0 {
+        let n = boot.uart_overruns;
+        found.push(format!(
+            "{n} UART bytes found the receive FIFO full (the firmware did not read in time)"
+        ));
+    }
+    let (usb, usb_problems) = compare(&script, &usb_want, &boot.usb);
+    match boot.usb_connected {
+        Some(ns) => {
+            let (at, start, out) = (ns / 1e9, USB_START.as_secs_f64(), boot.usb.len());
+            let _ = write!(
+                text,
+                "USB CDC-ACM exchange (enumerated and configured at {at:.4} s; {len} bytes in at {start:.1} s, {out} bytes out):\n{usb}"
+            );
+            found.extend(usb_problems.into_iter().map(|p| format!("USB: {p}")));
+        }
+        None => found.push("the emulator's USB host did not configure the device".to_owned()),
+    }
+    if !boot.says(": center: ok") {
+        found.push("the frame task did not log the UART's `center` as applied (`frame <n>: center: ok ...`)".to_owned());
+    }
+    report.problems.extend(found);
+    report.exchange = Some(text);
 }
 
 /// The script's lines, each with its line end.
-pub fn script_lines() -> Vec<Vec<u8>> {
+fn script_lines() -> Vec<Vec<u8>> {
     let mut lines: Vec<Vec<u8>> = SCRIPT.iter().map(|line| line.to_vec()).collect();
     // An overlong line: one byte past the protocol's 96.
     let mut long = vec![b'a'; 97];
@@ -68,7 +120,7 @@ pub fn script_lines() -> Vec<Vec<u8>> {
 
 /// The replies the firmware must send for `script`, one per line: first
 /// on the UART, then on the USB port, with one service as on the board.
-pub fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
+fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
     let queue: &'static CommandQueue = Box::leak(Box::new(CommandQueue::new()));
     let link: &'static ConsoleLink = Box::leak(Box::new(ConsoleLink::new()));
     // As on the board from its fade-in on; the rest is masked ([`mask`]).
@@ -108,7 +160,7 @@ pub fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
 /// `reply` with the values that depend on the frame it was answered at
 /// (the angles, pulses and uptime of `status`) replaced by `*`, if they
 /// have their form: a comma-separated list of integers.
-pub fn mask(reply: &[u8]) -> Vec<u8> {
+fn mask(reply: &[u8]) -> Vec<u8> {
     if !reply.starts_with(b"ok mode=") {
         return reply.to_vec();
     }
@@ -141,7 +193,7 @@ pub fn mask(reply: &[u8]) -> Vec<u8> {
 
 /// What a port sent against `want` (from [`expected`]); the transcript
 /// and the problems found.
-pub fn check(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>) {
+fn compare(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>) {
     let got: Vec<Vec<u8>> = sent
         .split_inclusive(|&b| b == b'\n')
         .filter(|line| !line.is_empty())
@@ -214,7 +266,7 @@ mod tests {
 
     #[test]
     fn one_expected_reply_per_script_line() {
-        let script = script();
+        let script = script_lines().concat();
         let [uart, usb] = expected(&script);
         for want in [&uart, &usb] {
             assert_eq!(want.len(), SCRIPT.len() + 2);
@@ -259,15 +311,15 @@ mod tests {
 
     #[test]
     fn a_missing_or_wrong_reply_is_a_problem() {
-        let script = script();
+        let script = script_lines().concat();
         let [want, _] = expected(&script);
         let all: Vec<u8> = want.concat();
-        assert!(check(&script, &want, &all).1.is_empty());
+        assert!(compare(&script, &want, &all).1.is_empty());
         let short = &all[..all.len() - 3];
-        assert!(!check(&script, &want, short).1.is_empty());
+        assert!(!compare(&script, &want, short).1.is_empty());
         let mut wrong = all.clone();
         wrong[0] = b'x';
-        assert!(!check(&script, &want, &wrong).1.is_empty());
-        assert!(!check(&script, &want, &[]).1.is_empty());
+        assert!(!compare(&script, &want, &wrong).1.is_empty());
+        assert!(!compare(&script, &want, &[]).1.is_empty());
     }
 }

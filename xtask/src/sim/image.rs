@@ -1,20 +1,31 @@
-//! What the emulator needs from the Pico ELF: the addresses of a few
-//! symbols (the flash contents come from its UF2, `harness.rs`).
+//! The Pico image as the emulator's harness runs it: where its servos and
+//! trigger inputs are wired, what it needs from the ELF (the addresses of a
+//! few symbols; the flash contents come from its UF2), and the
+//! configuration every run of it starts from.
 
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+use idle_head_core::input::{FIRST_INPUT, INPUTS};
 use object::read::elf::ElfFile32;
 use object::{Endianness, Object, ObjectSymbol, elf};
 
-use crate::elf::XIP;
+use super::node::Config;
+use crate::{board::Board, elf::XIP, uf2};
 
-/// Where the RP2040 maps its QSPI flash (XIP).
-pub const FLASH_START: u64 = XIP.start;
 /// Where boot2 leaves the vector table: right behind its own 256 bytes.
-pub const VECTOR_TABLE: u64 = FLASH_START + 0x100;
+pub const VECTOR_TABLE: u64 = XIP.start + 0x100;
 /// What cortex-m-rt's `paint-stack` fills the stack with before `main`.
 pub const STACK_PAINT: u32 = 0xcccc_cccc;
+
+/// The servos as wired on the Pico (`crates/rp/src/pico.rs`): name, GPIO,
+/// PWM slice (channel A).
+pub const SERVOS: [(&str, u8, u8); 3] = [("pitch", 16, 0), ("roll", 18, 1), ("yaw", 20, 2)];
+
+/// The trigger inputs' GPIOs, as wired on the Pico: GP2 to GP5.
+pub fn input_pins() -> Vec<u8> {
+    (FIRST_INPUT..).take(INPUTS).collect()
+}
 
 /// The parts of a Pico ELF the emulator run uses.
 #[derive(Debug)]
@@ -32,10 +43,8 @@ impl PicoImage {
     /// Reads `path`; a file that is not a Pico image gets an error saying why.
     pub fn read(path: &Path) -> Result<Self> {
         let data = std::fs::read(path).with_context(|| {
-            format!(
-                "the Pico ELF {} is missing (build it with `cargo build --release`)",
-                path.display()
-            )
+            let path = path.display();
+            format!("the Pico ELF {path} is missing (build it with `cargo build --release`)")
         })?;
         Self::parse(&data).with_context(|| format!("{} is not a Pico image", path.display()))
     }
@@ -51,8 +60,8 @@ impl PicoImage {
         }
         let symbol = |name: &str| {
             file.symbols()
-                .find(|symbol| symbol.name() == Ok(name))
-                .map(|symbol| symbol.address())
+                .find(|s| s.name() == Ok(name))
+                .map(|s| s.address())
         };
         let rtt =
             symbol("_SEGGER_RTT").context("no `_SEGGER_RTT` symbol: the image has no RTT log")?;
@@ -60,8 +69,7 @@ impl PicoImage {
             symbol("_stack_end").context("no `_stack_end` symbol")?,
             symbol("_stack_start").context("no `_stack_start` symbol")?,
         );
-        let frame_update = file
-            .symbols()
+        let frame_update = (file.symbols())
             .filter(|symbol| symbol.kind() == object::SymbolKind::Text)
             .find(|symbol| {
                 symbol.name().is_ok_and(|name| {
@@ -77,4 +85,25 @@ impl PicoImage {
             frame_update,
         })
     }
+}
+
+/// The harness's configuration for the Pico image `elf`, and the image:
+/// its UF2 written beside it (`<elf>.<extension>`, `cargo xtask uf2`'s
+/// file), its vector table and RTT log, the servo slices' compare writes
+/// reported.
+pub fn config(elf: &Path, extension: &str) -> Result<(PicoImage, Config)> {
+    let image = PicoImage::read(elf)?;
+    let (flash, _) = uf2::write(elf, Board::Pico, extension)?;
+    let slices = SERVOS.iter().map(|s| s.2).collect();
+    let (vtor, rtt) = (VECTOR_TABLE, image.rtt);
+    Ok((
+        image,
+        Config {
+            flash,
+            vtor,
+            rtt,
+            slices,
+            ..Config::default()
+        },
+    ))
 }

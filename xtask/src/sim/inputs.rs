@@ -6,13 +6,13 @@
 use std::path::Path;
 use std::time::Duration;
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result};
 use idle_head_core::Axis;
-use idle_head_core::behaviour::{BehaviourConfig, BehaviourParams, LimitMode};
+use idle_head_core::behaviour::{BehaviourConfig, LimitMode};
+use idle_head_core::servo::ServoRate;
 
 use super::pulses::{Pulse, angle};
-use super::run;
-use super::script;
+use super::{run, script};
 use crate::project::Metadata;
 use crate::steps::Steps;
 use crate::trace;
@@ -29,65 +29,53 @@ pub const SCRIPT: &str = "\
 7 pin 2 high
 ";
 
-/// How long it runs: the glance (from about 8.1 s) held and back.
-const TIME: Duration = Duration::from_millis(12_500);
-
-/// Where the sensor looks from ([`SCRIPT`]'s `presence -20000`), m°.
-const SENSOR_YAW: f64 = -20_000.0;
-
-/// `cargo xtask test`'s stage: plays [`SCRIPT`] and checks it.
+/// `cargo xtask test`'s stage: plays [`SCRIPT`] for 12.5 s (the glance, from
+/// about 8.1 s, held and back) and checks it.
+#[allow(clippy::too_many_lines)] // the four checks of the module docs, in order
 pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     let events = script::parse(SCRIPT)?;
-    let report = script::play(
-        root,
-        metadata,
-        events,
-        TIME,
-        super::WALL,
-        script::Against::Host,
-    )?;
+    let time = (Duration::from_millis(12_500), super::WALL);
+    let against = script::Against::Host;
+    let report = script::play(root, metadata, events, time, against, ServoRate::DEFAULT)?;
     print!("{}", report.table());
-    println!("{}", report.verdict());
-    let mut problems = report.problems.clone();
-    let Some(boot) = report.boots.first() else {
-        bail!("no boot");
-    };
+    let boot = report.first()?;
     let timing = run::timing();
     let period = f64::from(timing.period_counts) * timing.count_ns;
     let pulses: [&Vec<Pulse>; 3] = [0, 1, 2].map(|i| &boot.servos[i].pulses);
-    let Some(&(edge, _, _)) = boot.drives.first() else {
-        bail!("the harness drove no pin");
-    };
+    // The angle of a pulse on axis `i`, and a count of the servo clock
+    // there (the rounding of a measured pulse), m°.
+    let degrees = |i: usize, p: &Pulse| angle(i, f64::from(p.counts) * timing.count_ns);
+    let count = |i: usize| angle(i, timing.count_ns) - angle(i, 0.0);
+    let &(edge, _, _) = boot.drives.first().context("the harness drove no pin")?;
     // The gap: the longest stretch without a pulse on pitch.
-    let gap = pulses[0]
+    let gaps = pulses[0]
         .windows(2)
-        .map(|w| (w[1].rise - w[0].rise, w[0], w[1]))
-        .fold(None, |best: Option<(f64, Pulse, Pulse)>, x| match best {
-            Some(b) if b.0 >= x.0 => Some(b),
-            _ => Some(x),
-        });
-    let Some((span, before, after)) = gap else {
-        bail!("no pulses");
-    };
-    let ms = |ns: f64| ns / 1e6;
+        .map(|w| (w[1].rise - w[0].rise, w[0], w[1]));
+    let (span, before, after) = gaps
+        .reduce(|a, b| if b.0 > a.0 { b } else { a })
+        .context("no pulses")?;
+    let us = |p: Pulse| f64::from(p.counts) * timing.count_ns / 1e3;
     println!(
         "pitch: last pulse before the gap {:.1} µs at {:.3} s, first after {:.1} µs at {:.3} s \
          ({:.1} s without pulses); GP2 high at {:.3} s",
-        f64::from(before.counts) * timing.count_ns / 1e3,
-        ms(before.rise) / 1e3,
-        f64::from(after.counts) * timing.count_ns / 1e3,
-        ms(after.rise) / 1e3,
-        ms(span) / 1e3,
-        ms(edge) / 1e3
+        us(before),
+        before.rise / 1e9,
+        us(after),
+        after.rise / 1e9,
+        span / 1e9,
+        edge / 1e9
     );
+    let mut problems = Vec::new();
     // 1. Rested: at the rest pose when the pulses stopped (the glide had
     // arrived: its last frames there too), within a count.
     let rest = f64::from(BehaviourConfig::DEFAULT.rest.pose[0].millidegrees());
-    let held = pulses[0]
+    let last = pulses[0]
         .iter()
-        .filter(|p| p.rise <= before.rise && before.rise - p.rise < 2.5 * period)
-        .all(|p| (degrees(0, p) - rest).abs() <= count(0));
-    if !held {
+        .filter(|p| p.rise <= before.rise && before.rise - p.rise < 2.5 * period);
+    if !last
+        .into_iter()
+        .all(|p| (degrees(0, p) - rest).abs() <= count(0))
+    {
         problems.push(
             "the head did not hold the rest pose (pitch 8°) before the pulses stopped".into(),
         );
@@ -95,50 +83,27 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     // 2. Relaxed: seconds without pulses on every servo, ending after the
     // sensor's edge.
     if span < 1e9 || after.rise < edge {
+        let gap = span / 1e9;
         problems.push(format!(
-            "the pulses did not stop until the sensor's edge: the longest gap is {:.3} s",
-            ms(span) / 1e3
+            "the pulses did not stop until the sensor's edge: the longest gap is {gap:.3} s"
         ));
     }
-    for (i, name) in ["roll", "yaw"].iter().enumerate() {
-        let inside = pulses[i + 1]
-            .iter()
-            .any(|p| p.rise > before.rise + period / 2.0 && p.rise < after.rise - period / 2.0);
-        if inside {
+    for (i, name) in [(1, "roll"), (2, "yaw")] {
+        let gap = before.rise + period / 2.0..after.rise - period / 2.0;
+        if pulses[i].iter().any(|p| gap.contains(&p.rise)) {
             problems.push(format!("{name} had pulses while pitch had none"));
         }
     }
+    // 3. The soft start: the first pulse after the gap is the last before
+    // it, and the next second (the idle coming back) within the idle
+    // limits, with a count of rounding each way.
     let (_, params) = trace::built_in()?;
-    soft_start(&pulses, after.rise, period, &params, &mut problems);
-    let yaw = pulses[2].iter().map(|p| (p.rise, degrees(2, p)));
-    glance(yaw, after.rise, &mut problems);
-    if problems.is_empty() {
-        println!(
-            "inputs: ok: rested, relaxed {:.1} s, woke softly from the pose, glanced towards the sensor",
-            ms(span) / 1e3
-        );
-        Ok(())
-    } else {
-        bail!("{}", problems.join("\n"))
-    }
-}
-
-/// The soft start (check 3): the first pulse after the gap (at `after`) is
-/// the last before it, and the next second (the idle coming back) within
-/// the idle limits, with a count of rounding each way.
-fn soft_start(
-    pulses: &[&Vec<Pulse>; 3],
-    after: f64,
-    period: f64,
-    params: &BehaviourParams,
-    problems: &mut Vec<String>,
-) {
     for axis in Axis::ALL {
         let (i, name) = (axis.index(), axis.name());
-        let first = pulses[i]
+        let Some(first) = pulses[i]
             .iter()
-            .position(|p| p.rise >= after - period / 2.0);
-        let Some(first) = first else {
+            .position(|p| p.rise >= after.rise - period / 2.0)
+        else {
             problems.push(format!("{name}: no pulse after the gap"));
             continue;
         };
@@ -154,43 +119,25 @@ fn soft_start(
             .map(|p| degrees(i, p))
             .collect();
         let steps = Steps::of(&wake);
+        let (step, turn) = (steps.step, steps.turn);
         println!(
-            "{name}: waking, steps up to {:.0} m° a frame, changes of step up to {:.0}",
-            steps.step, steps.turn
+            "{name}: waking, steps up to {step:.0} m° a frame, changes of step up to {turn:.0}"
         );
-        // A count of rounding each way.
-        let limits = Steps::allowed(params, axis, LimitMode::Idle);
+        let limits = Steps::allowed(&params, axis, LimitMode::Idle);
         let allowed = Steps {
             step: limits.step + count(i),
             turn: limits.turn + 2.0 * count(i),
         };
         if !steps.within(allowed) {
             problems.push(format!(
-                "{name}: the wake exceeds the idle limits ({:.0} m°/frame, {:.0} m°/frame²)",
-                steps.step, steps.turn
+                "{name}: the wake exceeds the idle limits ({step:.0} m°/frame, {turn:.0} m°/frame²)"
             ));
         }
     }
-}
-
-/// The angle, m°, of `pulse` on the servo of axis `i` ([`Axis::index`]).
-fn degrees(i: usize, pulse: &Pulse) -> f64 {
-    angle(i, f64::from(pulse.counts) * run::timing().count_ns)
-}
-
-/// One count of the servo clock (312.5 ns) on the servo of axis `i`, m°
-/// (28.1): the rounding of a measured pulse.
-fn count(i: usize) -> f64 {
-    let count_ns = run::timing().count_ns;
-    angle(i, count_ns) - angle(i, 0.0)
-}
-
-/// The glance (check 4): yaw (`(rise, m°)` a pulse) at the sensor's −20°
-/// within 2.5° (the idle's sway) after the wake (at `after`), for about its
-/// 2 s hold.
-fn glance(yaw: impl Iterator<Item = (f64, f64)>, after: f64, problems: &mut Vec<String>) {
-    let near = yaw
-        .filter(|&(rise, angle)| rise > after && (angle - SENSOR_YAW).abs() < 2_500.0)
+    // 4. The glance: yaw at the sensor's −20° within 2.5° (the idle's sway)
+    // after the wake, for about its 2 s hold.
+    let near = (pulses[2].iter())
+        .filter(|p| p.rise > after.rise && (degrees(2, p) + 20_000.0).abs() < 2_500.0)
         .count();
     println!("yaw: {near} pulses within 2.5° of the sensor's −20°");
     if near < 90 {
@@ -198,4 +145,5 @@ fn glance(yaw: impl Iterator<Item = (f64, f64)>, after: f64, problems: &mut Vec<
             "the head did not glance towards the sensor: {near} frames near −20°"
         ));
     }
+    report.conclude(problems)
 }

@@ -1,7 +1,7 @@
-//! Node, the emulator package and one run of `sim/harness.mjs`.
+//! Node, the emulator package and one run of `sim/harness.mjs`, whose
+//! configuration ([`Config`]) is the JSON its header describes.
 
 use std::{
-    fmt::Write as _,
     io::{BufRead, BufReader, Read},
     path::{Path, PathBuf},
     process::{Command, Stdio},
@@ -9,11 +9,12 @@ use std::{
 };
 
 use anyhow::{Context, Result, bail};
-use serde_json::{Value, json};
+use serde::{Serialize, Serializer};
+use serde_json::Value;
+use xshell::{Shell, cmd};
 
 use super::event::Event;
 use crate::{log::Exit, project, setup};
-use xshell::cmd;
 
 /// The folder with the harness and its `package.json`.
 pub fn folder(root: &Path) -> PathBuf {
@@ -34,19 +35,23 @@ pub fn npm_ci(dir: &Path, packages: &[&str], env: &[(&str, &str)]) -> Result<()>
     for program in ["node", "npm"] {
         setup::ensure_program(program, &["nodejs", "npm"], what)?;
     }
-    let read = |path: PathBuf| -> Option<Value> {
-        serde_json::from_slice(&std::fs::read(path).ok()?).ok()
+    let read = |path: PathBuf| -> Value {
+        let json = std::fs::read(path)
+            .ok()
+            .and_then(|b| serde_json::from_slice(&b).ok());
+        json.unwrap_or_default()
     };
-    let lock = read(dir.join("package-lock.json"))
-        .with_context(|| format!("{}/package-lock.json is missing or not JSON", dir.display()))?;
+    let lock = read(dir.join("package-lock.json"));
+    if lock.is_null() {
+        bail!("{}/package-lock.json is missing or not JSON", dir.display());
+    }
     let stale = packages.iter().any(|name| {
         let pinned = &lock["packages"][format!("node_modules/{name}")]["version"];
-        let installed = read(dir.join(format!("node_modules/{name}/package.json")))
-            .map_or(Value::Null, |package| package["version"].clone());
-        pinned.is_null() || installed != *pinned
+        let installed = read(dir.join(format!("node_modules/{name}/package.json")));
+        pinned.is_null() || installed["version"] != *pinned
     });
     if stale {
-        let sh = project::shell(".")?;
+        let sh = Shell::new()?;
         sh.change_dir(dir);
         project::run(&sh, env, cmd!(sh, "npm ci --no-audit --no-fund"))
             .with_context(|| format!("installing with `npm ci` in {}", dir.display()))?;
@@ -55,8 +60,8 @@ pub fn npm_ci(dir: &Path, packages: &[&str], env: &[(&str, &str)]) -> Result<()>
 }
 
 /// What the harness is asked to run (by default: nothing scripted, no
-/// ROM, no power cycle).
-#[derive(Debug, Clone, Default)]
+/// ROM, no power cycle). Times go to it in ns, bytes as hex digits.
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct Config {
     pub flash: PathBuf,
     pub vtor: u64,
@@ -68,31 +73,31 @@ pub struct Config {
     pub probe: u64,
     /// Stack region to scan for paint, if painted.
     pub stack: Option<(u64, u64)>,
+    #[serde(rename = "ns", serialize_with = "ns")]
     pub virtual_time: Duration,
+    #[serde(rename = "wall_ms", serialize_with = "ms")]
     pub wall: Duration,
     /// Virtual time without a log byte or a pin edge after which the run ends.
+    #[serde(rename = "silence_ns", serialize_with = "ns")]
     pub silence: Duration,
     /// Bytes for UART0's RX line, per boot.
     pub uart: Vec<UartScript>,
-    /// Bytes for the USB serial port (CDC-ACM), if any, and when to send
-    /// them (boot 0).
-    pub usb: Option<(Vec<u8>, Duration)>,
-    /// A boot ROM with the flash functions (`sim/rom.mjs`), if any: how
-    /// long a 4 KiB sector erase and a 256-byte page program keep the flash
-    /// busy.
+    /// Chunks for the USB serial port (CDC-ACM), each sent at its time
+    /// (boot 0).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub usb: Vec<Chunk>,
+    /// DMX512 frames on UART1's RX line (`sim/dmx.mjs`).
+    pub dmx: Option<Value>,
+    /// A boot ROM with the flash functions (`sim/rom.mjs`), if any.
     pub rom: Option<FlashTiming>,
     /// Bytes written over the image's flash before power-on, and where.
-    pub flash_fill: Option<(u64, Vec<u8>)>,
+    pub flash_fill: Option<Fill>,
     /// Virtual times at which the power goes off and on again.
+    #[serde(rename = "power_cycles_ns", serialize_with = "ns_each")]
     pub power_cycles: Vec<Duration>,
     /// A live run: real time, stdin to the USB serial port, for as long
     /// as stdin is open (`live.rs`).
     pub live: bool,
-    /// Chunks for the USB serial port, each sent at its time (instead of
-    /// `usb`).
-    pub usb_chunks: Vec<(Vec<u8>, Duration)>,
-    /// DMX512 frames on UART1's RX line (`sim/dmx.mjs`).
-    pub dmx: Option<Value>,
     /// GPIOs the outside drives as inputs (at their pull until driven).
     pub inputs: Vec<u8>,
     /// Boot 0's script of pin levels and console lines, if any.
@@ -101,165 +106,161 @@ pub struct Config {
     pub stream: Option<LineStream>,
 }
 
+/// Bytes sent at a time.
+#[derive(Debug, Clone, Serialize)]
+pub struct Chunk {
+    #[serde(rename = "hex", serialize_with = "hex")]
+    pub bytes: Vec<u8>,
+    #[serde(rename = "at_ns", serialize_with = "ns")]
+    pub at: Duration,
+}
+
+impl Chunk {
+    pub fn new(bytes: impl Into<Vec<u8>>, at: Duration) -> Self {
+        let bytes = bytes.into();
+        Self { bytes, at }
+    }
+}
+
+/// Bytes for the flash, at an address.
+#[derive(Debug, Clone, Serialize)]
+pub struct Fill {
+    pub addr: u64,
+    #[serde(serialize_with = "hex")]
+    pub hex: Vec<u8>,
+}
+
 /// A stream of console lines on UART0 or USB (`sim/stream.mjs`): `count`
 /// lines, one every `every` from `start` on, cycling through `lines`.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize)]
 pub struct LineStream {
     /// The port: `"uart"` or `"usb"`.
     pub port: &'static str,
-    /// When the first line goes out (boot 0).
+    #[serde(rename = "start_ns", serialize_with = "ns")]
     pub start: Duration,
-    /// The time from one line to the next.
+    #[serde(rename = "every_ns", serialize_with = "ns")]
     pub every: Duration,
-    /// How many lines.
     pub count: usize,
-    /// The lines, in turn: plain, or a machine-mode command (`#<n> … *<crc>`
-    /// with n the line's index mod 100000).
     pub lines: Vec<StreamLine>,
 }
 
-/// One line of a [`LineStream`]'s cycle.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// One line of a [`LineStream`]'s cycle: as it is, or a command in machine
+/// mode (`#<n> … *<crc>` with n the line's index mod 100000).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum StreamLine {
-    /// As it is.
+    #[serde(rename = "text")]
     Plain(&'static str),
-    /// This command in machine mode.
     Machine(&'static str),
 }
 
 /// Boot 0's script, its times counted from the first frame (when the
-/// slice `anchor` is enabled).
-#[derive(Debug, Clone, Default)]
+/// slice `anchor_slice` is enabled): pin levels, and console lines for
+/// UART0, each in `early` before its time.
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct PinScript {
-    /// The PWM slice whose enable is the first frame.
-    pub anchor: u8,
-    /// Pin levels: when, which GPIO, high or low.
-    pub pins: Vec<(Duration, u8, bool)>,
-    /// Console lines (with their line end) for UART0: when each must be in.
-    pub lines: Vec<(Duration, Vec<u8>)>,
-    /// How much before its time a line's last byte goes in.
+    pub anchor_slice: u8,
+    pub pins: Vec<PinLevel>,
+    pub lines: Vec<Chunk>,
+    #[serde(rename = "early_ns", serialize_with = "ns")]
     pub early: Duration,
 }
 
-/// How long the flash is busy per operation.
-#[derive(Debug, Clone, Copy)]
+/// A pin driven high or low at a time.
+#[derive(Debug, Clone, Serialize)]
+pub struct PinLevel {
+    #[serde(rename = "at_ns", serialize_with = "ns")]
+    pub at: Duration,
+    pub pin: u8,
+    pub high: bool,
+}
+
+/// How long the flash is busy: one 4 KiB sector erase, one page program.
+#[derive(Debug, Clone, Copy, Serialize)]
 pub struct FlashTiming {
-    /// One 4 KiB sector erase.
+    #[serde(rename = "erase_ns", serialize_with = "ns")]
     pub erase: Duration,
+    #[serde(rename = "program_ns", serialize_with = "ns")]
     pub program: Duration,
 }
 
-/// Bytes the harness puts on UART0's RX line in one boot.
-#[derive(Debug, Clone)]
+/// Bytes the harness puts on UART0's RX line in one boot, from `start`
+/// (since the boot's start) on, one every `byte_time` (the line rate); the
+/// bytes at the indices in `errors` with a framing error (line noise).
+#[derive(Debug, Clone, Serialize)]
 pub struct UartScript {
     pub boot: usize,
+    #[serde(rename = "hex", serialize_with = "hex")]
     pub bytes: Vec<u8>,
-    /// Virtual time of the first, since the boot's start.
+    #[serde(rename = "at_ns", serialize_with = "ns")]
     pub start: Duration,
-    /// Time per byte (the line rate).
+    #[serde(rename = "byte_ns", serialize_with = "ns")]
     pub byte_time: Duration,
-    /// Indices of the bytes received with a framing error (line noise).
     pub errors: Vec<usize>,
 }
 
 impl UartScript {
     /// `bytes` in boot `boot` from `start` on, at 115200 baud, undamaged.
-    pub fn new(boot: usize, bytes: Vec<u8>, start: Duration) -> Self {
+    pub fn new(boot: usize, bytes: impl Into<Vec<u8>>, start: Duration) -> Self {
+        let (bytes, byte_time) = (bytes.into(), BYTE_TIME);
         Self {
             boot,
             bytes,
             start,
-            byte_time: super::exchange::BYTE_TIME,
+            byte_time,
             errors: Vec::new(),
         }
     }
 }
 
+/// One byte at 115200 baud, 8N1: 10 bits.
+pub const BYTE_TIME: Duration = Duration::from_nanos(1_000_000_000 * 10 / 115_200);
+
 impl Config {
-    /// The harness's command-line argument.
+    /// The harness's configuration, as JSON.
     pub fn json(&self) -> Value {
-        json!({
-            "flash": self.flash,
-            "vtor": self.vtor,
-            "rtt": self.rtt,
-            "pins": self.pins,
-            "slices": self.slices,
-            "probe": self.probe,
-            "stack": self.stack.map(|(low, high)| [low, high]),
-            "paint": super::image::STACK_PAINT,
-            "ns": nanos(self.virtual_time),
-            "wall_ms": self.wall.as_millis(),
-            "silence_ns": nanos(self.silence),
-            "uart": self.uart.iter().map(|uart| json!({
-                "boot": uart.boot,
-                "hex": hex(&uart.bytes),
-                "at_ns": nanos(uart.start),
-                "byte_ns": nanos(uart.byte_time),
-                "errors": uart.errors,
-            })).collect::<Vec<_>>(),
-            "usb": if self.usb_chunks.is_empty() {
-                self.usb.as_ref().map(|(bytes, at)| json!({
-                    "hex": hex(bytes),
-                    "at_ns": nanos(*at),
-                }))
-            } else {
-                Some(Value::Array(self.usb_chunks.iter().map(|(bytes, at)| json!({
-                    "hex": hex(bytes),
-                    "at_ns": nanos(*at),
-                })).collect()))
-            },
-            "dmx": self.dmx,
-            "rom": self.rom.map(|rom| json!({
-                "erase_ns": nanos(rom.erase),
-                "program_ns": nanos(rom.program),
-            })),
-            "flash_fill": self.flash_fill.as_ref().map(|(addr, bytes)| json!({
-                "addr": addr,
-                "hex": hex(bytes),
-            })),
-            "power_cycles_ns": self.power_cycles.iter().map(|at| nanos(*at)).collect::<Vec<_>>(),
-            "live": self.live,
-            "inputs": self.inputs,
-            "script": self.script.as_ref().map(|script| json!({
-                "anchor_slice": script.anchor,
-                "pins": script.pins.iter().map(|(at, pin, high)| json!({
-                    "at_ns": nanos(*at),
-                    "pin": pin,
-                    "high": high,
-                })).collect::<Vec<_>>(),
-                "lines": script.lines.iter().map(|(at, bytes)| json!({
-                    "at_ns": nanos(*at),
-                    "hex": hex(bytes),
-                })).collect::<Vec<_>>(),
-                "byte_ns": nanos(super::exchange::BYTE_TIME),
-                "early_ns": nanos(script.early),
-            })),
-            "stream": self.stream.as_ref().map(|stream| json!({
-                "port": stream.port,
-                "start_ns": nanos(stream.start),
-                "every_ns": nanos(stream.every),
-                "count": stream.count,
-                "byte_ns": nanos(super::exchange::BYTE_TIME),
-                "lines": stream.lines.iter().map(|line| match line {
-                    StreamLine::Plain(text) => json!({ "text": text }),
-                    StreamLine::Machine(command) => json!({ "machine": command }),
-                }).collect::<Vec<_>>(),
-            })),
-        })
+        let mut json = serde_json::to_value(self).unwrap_or_default();
+        json["paint"] = super::image::STACK_PAINT.into();
+        for key in ["script", "stream"] {
+            if json[key].is_object() {
+                json[key]["byte_ns"] = nanos(BYTE_TIME).into();
+            }
+        }
+        json
     }
 }
 
 /// `bytes` as lower-case hex digits, as the harness reads them.
-pub fn hex(bytes: &[u8]) -> String {
-    bytes.iter().fold(String::new(), |mut text, byte| {
-        let _ = write!(text, "{byte:02x}");
-        text
-    })
+pub fn hex_string(bytes: &[u8]) -> String {
+    bytes
+        .iter()
+        .map(|byte| format!("{byte:02x}"))
+        .collect::<Vec<_>>()
+        .concat()
 }
 
 pub fn nanos(duration: Duration) -> u64 {
     u64::try_from(duration.as_nanos()).unwrap_or(u64::MAX)
 }
+
+fn ns<S: Serializer>(duration: &Duration, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_u64(nanos(*duration))
+}
+
+fn ms<S: Serializer>(duration: &Duration, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_u128(duration.as_millis())
+}
+
+fn ns_each<S: Serializer>(durations: &[Duration], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(durations.iter().map(|d| nanos(*d)))
+}
+
+fn hex<S: Serializer>(bytes: &[u8], s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(&hex_string(bytes))
+}
+
+/// Wall time the harness has beyond its own limit: node's start-up.
+const GRACE: Duration = Duration::from_secs(15);
 
 /// Runs the harness; returns its events, in order. Fails if node cannot be
 /// started, exits with an error, prints a line that is not a known event,
@@ -272,33 +273,36 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     let file = std::env::temp_dir().join(format!("idle-head-sim-{}-{n}.json", std::process::id()));
     std::fs::write(&file, config.json().to_string())
         .with_context(|| format!("writing {}", file.display()))?;
-    let events = run_with_file(root, config, &file);
-    let _ = std::fs::remove_file(&file);
-    events
-}
-
-/// [`run`], its configuration in `file`.
-fn run_with_file(root: &Path, config: &Config, file: &Path) -> Result<Vec<Event>> {
-    let mut command = Command::new("node");
-    command
+    let child = Command::new("node")
         .arg("harness.mjs")
         .arg(format!("@{}", file.display()))
         .current_dir(folder(root))
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    let child = command
+        .stderr(Stdio::piped())
         .spawn()
-        .context("could not start `node` (is Node.js installed?)")?;
-    // The harness stops itself at `wall`; the grace covers node's start-up.
+        .context("could not start `node` (is Node.js installed?)");
+    // The events, read to the end of the output (also past a bad line, so
+    // that node never waits on a full pipe); the first bad line is the error.
+    let events = |stdout| -> Result<Vec<Event>> {
+        let lines = BufReader::new(stdout).lines().map_while(Result::ok);
+        let events: Vec<Result<Event>> = lines.map(|line| Event::parse(&line)).collect();
+        events.into_iter().collect()
+    };
+    let all = |mut stderr: std::process::ChildStderr| {
+        let mut text = String::new();
+        let _ = stderr.read_to_string(&mut text);
+        text
+    };
     let limit = config.wall + GRACE;
-    let done = project::finish(child, "node", limit, events, read_all, || ())?;
-    let status = match done.exit {
-        Exit::Status(status) => status,
-        Exit::TimedOut(_) => bail!(
+    let done = child.and_then(|child| project::finish(child, "node", limit, events, all, || ()));
+    let _ = std::fs::remove_file(&file);
+    let done = done?;
+    let Exit::Status(status) = done.exit else {
+        bail!(
             "the emulator made no progress: node was killed after {} s of wall time",
             limit.as_secs()
-        ),
+        );
     };
     let events = done.stdout?;
     if !status.success() && !matches!(events.last(), Some(Event::End { .. })) {
@@ -308,32 +312,4 @@ fn run_with_file(root: &Path, config: &Config, file: &Path) -> Result<Vec<Event>
         );
     }
     Ok(events)
-}
-
-/// Wall time the harness has beyond its own limit: node's start-up.
-const GRACE: Duration = Duration::from_secs(15);
-
-/// The harness's events, one JSON line each, read to the end of its output
-/// (also past a bad line, so that node never waits on a full pipe); the
-/// first line that is not a known event is the error.
-fn events(stdout: impl Read) -> Result<Vec<Event>> {
-    let mut events = Vec::new();
-    let mut bad = None;
-    for line in BufReader::new(stdout).lines() {
-        let line = line.context("reading the harness's output")?;
-        match Event::parse(&line) {
-            Ok(event) => events.push(event),
-            Err(e) => {
-                bad.get_or_insert(e);
-            }
-        }
-    }
-    bad.map_or(Ok(events), Err)
-}
-
-/// All of `stderr`, as text.
-fn read_all(mut stderr: impl Read) -> String {
-    let mut bytes = Vec::new();
-    let _ = stderr.read_to_end(&mut bytes);
-    String::from_utf8_lossy(&bytes).into_owned()
 }

@@ -1,41 +1,31 @@
 //! `cargo xtask sim --script FILE`: a trace script played into the shipped
 //! image (pin lines drive GP2 to GP5, console lines go to UART0 2 ms before
 //! their time, times from the first frame), every pulse checked against
-//! the host trace of the same script; at another
-//! servo rate (`--rate`) the image boots on settings of that rate planted
-//! in its settings sectors, and the trace and the check run at it.
+//! the host trace of the same script; at another servo rate (`--rate`) the
+//! image boots on settings of that rate planted in its settings sectors,
+//! and the trace and the check run at it.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 
 use idle_head_core::servo::ServoRate;
 use idle_head_core::settings::Settings;
 
-use super::harness::{self, SERVOS};
-use super::node::PinScript;
-use super::planted;
+use super::image::{SERVOS, input_pins};
+use super::node::{Chunk, Fill, PinLevel, PinScript};
 use super::run::{self, Report};
+use super::{planted, pulses_csv};
 use crate::elf;
 use crate::project::{Metadata, PICO};
 use crate::trace::{self, Event, Kind};
-
-/// How much before its time a console line is in.
-const EARLY: Duration = Duration::from_millis(2);
 
 /// The first frame a console line is taken at: the board's console reads
 /// its UART once the boot's work (the first loop sets) is done, some 40 ms
 /// after the first frame; a line timed earlier is taken here, in the
 /// emulator and in the host trace it is checked against alike.
 pub const CONSOLE_UP: Duration = Duration::from_millis(100);
-
-/// The events of the script at `path`.
-pub fn read(path: &Path) -> Result<Vec<Event>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("reading the script {}", path.display()))?;
-    parse(&text).map_err(|e| anyhow!("{}: {e}", path.display()))
-}
 
 /// The events of a script's `text`.
 pub fn parse(text: &str) -> Result<Vec<Event>> {
@@ -62,43 +52,22 @@ pub enum Against {
 }
 
 /// Runs `events` in the shipped image (built) for `time` of virtual time
-/// from its first frame, and checks every pulse `against` the host trace or
-/// what was written (console lines before [`CONSOLE_UP`] moved there, in
-/// both); the emulator's run, its pulses checked.
+/// from its first frame (at most `wall` of wall time), the servos at `rate`
+/// from the first frame (the image boots on settings of that rate), and
+/// checks every pulse `against` the host trace or what was written
+/// (console lines before [`CONSOLE_UP`] moved there, in both).
 pub fn play(
     root: &Path,
     metadata: &Metadata,
-    events: Vec<Event>,
-    time: Duration,
-    wall: Duration,
-    against: Against,
-) -> Result<Report> {
-    play_at(
-        root,
-        metadata,
-        events,
-        time,
-        wall,
-        against,
-        ServoRate::DEFAULT,
-    )
-}
-
-/// [`play`] with the servos at `rate` from the first frame (the image
-/// boots on settings of that rate).
-pub fn play_at(
-    root: &Path,
-    metadata: &Metadata,
     mut events: Vec<Event>,
-    time: Duration,
-    wall: Duration,
+    (time, wall): (Duration, Duration),
     against: Against,
     rate: ServoRate,
 ) -> Result<Report> {
     if let Some(e) = events.iter().find(|e| changes_rate(&e.text)) {
         bail!(
-            "{:.3} s `{}`: the emulator's pulse check runs at one servo rate; \
-             give it with --rate (`cargo xtask trace` plays a change of rate)",
+            "{:.3} s `{}`: the emulator's pulse check runs at one servo rate; give it with \
+             --rate (`cargo xtask trace` plays a change of rate)",
             Duration::from_micros(e.at_us).as_secs_f64(),
             e.text
         );
@@ -112,25 +81,30 @@ pub fn play_at(
     }
     // (Lines keep their order: a pin line before 0.1 s stays first.)
     events.sort_by_key(|e| e.at_us);
+    let early = Duration::from_millis(2);
     let mut script = PinScript {
-        anchor: SERVOS[0].2,
-        early: EARLY,
+        anchor_slice: SERVOS[0].2,
+        early,
         ..PinScript::default()
     };
     for event in &events {
         let at = Duration::from_micros(event.at_us);
         match event.kind {
-            Kind::Pin { input, high } => script.pins.push((at, input, high)),
+            Kind::Pin { input, high } => script.pins.push(PinLevel {
+                at,
+                pin: input,
+                high,
+            }),
             Kind::Act(_) | Kind::Console => {
                 // In before the frame that takes it in the host trace.
                 let frame = Duration::from_micros(event.at_us.next_multiple_of(period));
                 script
                     .lines
-                    .push((frame, format!("{}\r\n", event.text).into_bytes()));
+                    .push(Chunk::new(format!("{}\r\n", event.text), frame));
             }
-            Kind::Radar(_) => anyhow::bail!(
-                "line {}: radar lines play in the host trace (`cargo xtask trace`); \
-                 the emulator has no radar on GP13 yet",
+            Kind::Radar(_) => bail!(
+                "line {}: radar lines play in the host trace (`cargo xtask trace`); the emulator \
+                 has no radar on GP13 yet",
                 event.line
             ),
         }
@@ -138,20 +112,23 @@ pub fn play_at(
     let planted = if rate == ServoRate::DEFAULT {
         None
     } else {
-        let region = elf::Image::read(&PICO.elf(metadata))?
-            .settings
-            .context("the image has no settings region")?;
+        let image = elf::Image::read(&PICO.elf(metadata))?;
+        let region = image.settings.context("the image has no settings region")?;
         let settings = Settings {
             rate,
             ..Settings::DEFAULT
         };
         let len = usize::try_from(region.end - region.start)?;
-        Some((region.start, planted::settings_sectors(&settings, len)?))
+        let hex = planted::settings_sectors(&settings, len)?;
+        Some(Fill {
+            addr: region.start,
+            hex,
+        })
     };
     // The boot before the first frame: well under a tenth of a second.
     let boot = Duration::from_millis(100);
     let mut report = run::run_with(root, &PICO.elf(metadata), time + boot, wall, |config| {
-        config.inputs = harness::input_pins();
+        config.inputs = input_pins();
         config.script = Some(script);
         config.flash_fill = planted;
         // A head relaxed at rest is silent for as long as it rests (no
@@ -163,12 +140,8 @@ pub fn play_at(
         Against::Host => {
             // The host's frames outlast the emulator's (which began a
             // little after power-on).
-            let host = trace::simulate(
-                u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX),
-                None,
-                rate,
-                &events,
-            )?;
+            let micros = u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX);
+            let host = trace::simulate(micros, None, rate, &events)?;
             host.rows.iter().map(|row| row.duties).collect()
         }
         Against::Written => written(&report),
@@ -192,50 +165,49 @@ fn written(report: &Report) -> Vec<[u16; 3]> {
     let Some(boot) = report.boots.first() else {
         return Vec::new();
     };
-    let frames: [Vec<u16>; 3] = core::array::from_fn(|i| {
-        let train = &boot.trains[i];
-        let from = train
+    let frames = boot.trains.each_ref().map(|train| {
+        let enabled = train
             .enabled
-            .and_then(|at| train.writes.iter().rposition(|&(t, _)| t <= at))
-            .unwrap_or(0);
-        train.writes[from..].iter().map(|&(_, d)| d).collect()
+            .and_then(|at| train.writes.iter().rposition(|w| w.0 <= at));
+        train.writes[enabled.unwrap_or(0)..]
+            .iter()
+            .map(|&(_, d)| d)
+            .collect::<Vec<u16>>()
     });
     let n = frames.iter().map(Vec::len).max().unwrap_or(0);
-    (0..n)
-        .map(|k| core::array::from_fn(|i| frames[i].get(k).copied().unwrap_or(0)))
-        .collect()
+    let duty = |k: usize| core::array::from_fn(|i| frames[i].get(k).copied().unwrap_or(0));
+    (0..n).map(duty).collect()
 }
 
 /// `cargo xtask sim --script FILE [--rate HZ] [--pulses CSV]`.
-pub fn command(
-    root: &Path,
-    metadata: &Metadata,
-    path: &Path,
-    (time, wall): (Option<Duration>, Duration),
-    rate: ServoRate,
-    pulses: Option<&PathBuf>,
-) -> Result<bool> {
-    PICO.build(root)?;
-    let events = read(path)?;
-    let time = time.unwrap_or_else(|| default_time(&events));
-    let report = play_at(root, metadata, events, time, wall, Against::Host, rate)?;
+pub fn command(root: &Path, metadata: &Metadata, path: &Path, args: &super::Args) -> Result<bool> {
+    let rate =
+        ServoRate::new(args.rate).with_context(|| format!("{} Hz: not a servo rate", args.rate))?;
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading the script {}", path.display()))?;
+    let events = parse(&text).with_context(|| format!("{}", path.display()))?;
+    let time = args.virtual_time.unwrap_or_else(|| default_time(&events));
+    let report = play(
+        root,
+        metadata,
+        events,
+        (time, args.timeout),
+        Against::Host,
+        rate,
+    )?;
     print!("{}", report.log_text(false));
-    if let Some(boot) = report.boots.first() {
-        println!("UART0 replies:");
-        for reply in boot.uart_replies() {
-            println!("  < {reply}");
-        }
+    let boot = report.first()?;
+    println!("UART0 replies:");
+    for reply in boot.uart_replies() {
+        println!("  < {reply}");
     }
     print!("{}", report.table());
-    println!(
-        "{}",
-        report
-            .verdict()
-            .replace("the host's duty", "the host trace's duty")
-    );
-    println!("{}", report.summary());
-    if let (Some(path), Some(boot)) = (pulses, report.boots.first()) {
-        let rows = super::pulses_csv::write(path, &boot.trains, &run::timing_at(rate))?;
+    let verdict = report
+        .verdict()
+        .replace("the host's duty", "the host trace's duty");
+    println!("{verdict}\n{}", report.summary());
+    if let Some(path) = &args.pulses {
+        let rows = pulses_csv::write(path, &boot.trains, &run::timing_at(rate))?;
         println!("wrote {} ({rows} frames)", path.display());
     }
     Ok(report.problems.is_empty())

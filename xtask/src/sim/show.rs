@@ -5,18 +5,20 @@
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
-use anyhow::{Context, Result, bail};
+use anyhow::Result;
 use idle_head_core::bottango::hash;
 use idle_head_core::driver::DriverConfig;
 
 use super::{
-    DEFAULT_TIME, dmx, expect, harness,
+    DEFAULT_TIME, dmx, expect,
+    image::SERVOS,
+    node::Chunk,
     pulses::{self, Measured, angle},
     pulses_csv,
     run::{self, Boot},
     stages,
 };
-use crate::project::Metadata;
+use crate::project::{self, Metadata};
 
 /// Stage name.
 pub const SHOW_STAGE: &str = "Pico image in the RP2040 emulator: DMX and Bottango drive the \
@@ -35,54 +37,45 @@ const SCRIPT: &str = "\
 /// When the Bottango session starts, and `STOP`.
 const BOTTANGO: Duration = Duration::from_millis(10_500);
 const STOP: Duration = Duration::from_millis(12_600);
-/// The stage's virtual time.
-const TIME: Duration = Duration::from_secs(14);
 
-/// The session's lines, with their hashes.
+/// The session's lines, with their hashes: the handshake, the sync, yaw
+/// and pitch registered, a curve each 200 ms after the sync, 1 s, eased in
+/// and out.
 fn bottango_lines() -> Vec<String> {
     [
         "hRQ,144",
         "tSYN,0",
         "rMTR,yaw,-20000,20000,3000,4096",
         "rMTR,pitch,-10000,10000,3000,4096",
-        // 200 ms after the sync, 1 s, eased in and out.
         "sC,yaw,200,1000,4096,333,0,8192,-333,0",
         "sC,pitch,200,1000,4096,333,0,6144,-333,0",
     ]
-    .iter()
     .map(|body| format!("{body},h{}\n", hash(body.as_bytes())))
-    .collect()
+    .to_vec()
 }
 
-/// `cargo xtask sim --dmx FILE [--pulses FILE.csv]` (either alone too).
+/// `cargo xtask sim --dmx FILE [--pulses FILE.csv]` (either alone too):
+/// the run's log and pulses, not checked against the host.
 pub fn command(root: &Path, metadata: &Metadata, args: &super::Args) -> Result<bool> {
     let changes = args.dmx.as_deref().map(dmx::read).transpose()?;
-    let time = args.virtual_time.unwrap_or_else(|| {
-        changes
-            .as_ref()
-            .and_then(|c| c.last())
-            .map_or(DEFAULT_TIME, |last| last.at + Duration::from_secs(3))
-    });
+    let last = changes
+        .as_ref()
+        .and_then(|c| c.last())
+        .map(|last| last.at + Duration::from_secs(3));
+    let time = args.virtual_time.or(last).unwrap_or(DEFAULT_TIME);
     let elf = stages::shipped_image(root, metadata)?;
     let report = run::run_with(root, &elf, time, args.timeout, |config| {
-        if let Some(changes) = &changes {
-            dmx::configure(config, changes);
-        }
+        config.dmx = changes.as_deref().map(dmx::line);
     })?;
     print!("{}", report.log_text(args.verbose));
-    let Some(boot) = report.boots.first() else {
-        bail!("no boot");
-    };
-    print!("{}", servo_table(boot));
-    if let Some(path) = &args.pulses {
-        write_pulses(path, boot)?;
-    }
+    let boot = report.first()?;
+    print_pulses(boot, args.pulses.as_deref())?;
     if let Some(changes) = &changes {
+        let from = changes.first().map_or(0.0, |c| c.at.as_secs_f64());
+        let carried = boot.dmx_changes.len();
         println!(
-            "dmx: {} change(s) from {:.3} s on, {} frame(s) carrying one",
-            changes.len(),
-            changes.first().map_or(0.0, |c| c.at.as_secs_f64()),
-            boot.dmx_changes.len()
+            "dmx: {} change(s) from {from:.3} s on, {carried} frame(s) carrying one",
+            changes.len()
         );
     }
     for problem in &report.problems {
@@ -91,24 +84,24 @@ pub fn command(root: &Path, metadata: &Metadata, args: &super::Args) -> Result<b
     Ok(report.problems.is_empty())
 }
 
-/// `--pulses FILE.csv`: `boot`'s pulses as measured.
-fn write_pulses(path: &Path, boot: &Boot) -> Result<()> {
-    let rows = pulses_csv::write(path, &boot.trains, &run::timing())?;
-    println!("{rows} rows of pulses written to {}", path.display());
-    Ok(())
-}
-
-/// Per servo: pulses, shortest and longest, as measured.
-fn servo_table(boot: &Boot) -> String {
-    let mut text = String::from("\nservo   pulses   min µs   max µs\n");
-    for ((name, ..), train) in harness::SERVOS.iter().zip(&boot.trains) {
-        let pulses = pulses::measure(train);
-        let widths = pulses.iter().map(|p| p.width / 1e3);
-        let min = widths.clone().fold(f64::INFINITY, f64::min);
-        let max = widths.fold(0.0, f64::max);
-        let _ = writeln!(text, "{name:<6} {:>7} {min:>8.1} {max:>8.1}", pulses.len());
+/// Per servo: pulses, shortest and longest, as measured; and with
+/// `--pulses`, the CSV of them.
+fn print_pulses(boot: &Boot, csv: Option<&Path>) -> Result<()> {
+    println!("\nservo   pulses   min µs   max µs");
+    for ((name, ..), train) in SERVOS.iter().zip(&boot.trains) {
+        let widths: Vec<f64> = pulses::measure(train)
+            .iter()
+            .map(|p| p.width / 1e3)
+            .collect();
+        let min = widths.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = widths.iter().copied().fold(0.0, f64::max);
+        println!("{name:<6} {:>7} {min:>8.1} {max:>8.1}", widths.len());
     }
-    text
+    if let Some(path) = csv {
+        let rows = pulses_csv::write(path, &boot.trains, &run::timing())?;
+        println!("{rows} rows of pulses written to {}", path.display());
+    }
+    Ok(())
 }
 
 /// The stage: see the [module docs](self).
@@ -122,23 +115,25 @@ pub fn show(root: &Path, metadata: &Metadata, pulses: Option<&Path>) -> Result<(
     let changes = dmx::parse(SCRIPT)?;
     let elf = stages::shipped_image(root, metadata)?;
     let lines = bottango_lines();
-    let report = run::run_with(root, &elf, TIME, stages::WALL, |config| {
-        dmx::configure(config, &changes);
-        config.usb_chunks = vec![
-            (lines.concat().into_bytes(), BOTTANGO),
-            (b"STOP,h326\n".to_vec(), STOP),
-        ];
-    })?;
+    let report = run::run_with(
+        root,
+        &elf,
+        Duration::from_secs(14),
+        stages::WALL,
+        |config| {
+            config.dmx = Some(dmx::line(&changes));
+            config.usb = vec![
+                Chunk::new(lines.concat(), BOTTANGO),
+                Chunk::new(b"STOP,h326\n", STOP),
+            ];
+        },
+    )?;
     print!("{}", report.log_text(false));
-    let boot = report.boots.first().context("no boot")?;
-    print!("{}", servo_table(boot));
-    if let Some(path) = pulses {
-        write_pulses(path, boot)?;
-    }
-    let mut problems = report.problems.clone();
-    let (text, found) = check(boot, &lines)?;
+    let boot = report.first()?;
+    print_pulses(boot, pulses)?;
+    let (text, mut problems) = check(boot, &lines)?;
     print!("{text}");
-    problems.extend(found);
+    problems.extend(report.problems.iter().cloned());
     problems.extend(stages::console_ram(&elf, &report)?);
     if report.boots.len() != 1 {
         problems.push(format!(
@@ -146,37 +141,20 @@ pub fn show(root: &Path, metadata: &Metadata, pulses: Option<&Path>) -> Result<(
             report.boots.len()
         ));
     }
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", problems.join("; "))
-    }
+    project::verdict(&problems)
 }
 
 /// The pulses of one run, per servo, with the host's idle duties.
 struct Pulses {
     servos: [Vec<Measured>; 3],
     idle: Vec<[u16; 3]>,
-    count_ns: f64,
 }
 
 impl Pulses {
-    fn of(boot: &Boot) -> Result<Self> {
-        let servos = boot.trains.each_ref().map(pulses::measure);
-        let frames = servos.iter().map(Vec::len).max().unwrap_or(0);
-        Ok(Self {
-            servos,
-            idle: expect::pico_duties(frames)?,
-            count_ns: run::timing().count_ns,
-        })
-    }
-
     /// `axis`' pulses rising within `[from, to)` s: their index, time (s)
     /// and angle (m°).
     fn window(&self, axis: usize, from: f64, to: f64) -> Vec<(usize, f64, f64)> {
-        self.servos[axis]
-            .iter()
-            .enumerate()
+        (self.servos[axis].iter().enumerate())
             .filter(|(_, p)| (from * 1e9..to * 1e9).contains(&p.rise))
             .map(|(n, p)| (n, p.rise / 1e9, angle(axis, p.width)))
             .collect()
@@ -188,12 +166,12 @@ impl Pulses {
         let mut off = Vec::new();
         for axis in 0..3 {
             for (n, t, _) in self.window(axis, from, to) {
-                let counts = self.servos[axis][n].width / self.count_ns;
+                let counts = self.servos[axis][n].width / run::timing().count_ns;
                 let want = self.idle.get(n).map_or(0.0, |d| f64::from(d[axis]));
                 if (counts - want).abs() > 1.5 {
                     off.push(format!(
                         "{} at {t:.3} s: {counts:.0} counts, not {want}",
-                        harness::SERVOS[axis].0
+                        SERVOS[axis].0
                     ));
                 }
             }
@@ -204,17 +182,31 @@ impl Pulses {
     /// The largest change of `axis`' angle from one pulse to the next within
     /// `[from, to)` s, m°.
     fn fastest(&self, axis: usize, from: f64, to: f64) -> f64 {
-        self.window(axis, from, to)
+        let window = self.window(axis, from, to);
+        window
             .windows(2)
             .map(|w| (w[1].2 - w[0].2).abs())
             .fold(0.0, f64::max)
+    }
+
+    /// The highest angle of `axis` within `[from, to)` s, m°.
+    fn top(&self, axis: usize, from: f64, to: f64) -> f64 {
+        self.window(axis, from, to)
+            .iter()
+            .map(|w| w.2)
+            .fold(f64::MIN, f64::max)
     }
 }
 
 /// The acceptance checks on boot 0: what they found, and the problems.
 #[allow(clippy::too_many_lines)] // one check after another, in the order of the module docs
 fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
-    let p = Pulses::of(boot)?;
+    let servos = boot.trains.each_ref().map(pulses::measure);
+    let frames = servos.iter().map(Vec::len).max().unwrap_or(0);
+    let p = Pulses {
+        servos,
+        idle: expect::pico_duties(frames)?,
+    };
     let (mut text, mut problems) = (String::new(), Vec::new());
     let (yaw, pitch) = (2, 0);
     // The gesture limit, 250 °/s, in m° a frame, and a count of rounding.
@@ -230,11 +222,13 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
     let held = p.window(yaw, 4.3, 5.0);
     let worst = held.iter().map(|w| (w.2 - want).abs()).fold(0.0, f64::max);
     let fastest = p.fastest(yaw, 3.4, 5.0);
+    let at = held.last().map_or(f64::NAN, |w| w.2);
     let _ = writeln!(
         text,
-        "dmx mix 255, yaw coarse 200: yaw at {:.3}° ({:.4} of its way, 200/255 = {:.4}), at most {:.3}° off over {} pulses; fastest step {:.2}° a frame (limit {:.2}°)",
-        held.last().map_or(f64::NAN, |w| w.2 / 1e3),
-        held.last().map_or(f64::NAN, |w| (w.2 - lo) / (hi - lo)),
+        "dmx mix 255, yaw coarse 200: yaw at {:.3}° ({:.4} of its way, 200/255 = {:.4}), at most \
+         {:.3}° off over {} pulses; fastest step {:.2}° a frame (limit {:.2}°)",
+        at / 1e3,
+        (at - lo) / (hi - lo),
         200.0 / 255.0,
         worst / 1e3,
         held.len(),
@@ -242,10 +236,9 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
         step / 1e3
     );
     if held.len() < 30 || worst > 100.0 {
+        let (want, worst) = (want / 1e3, worst / 1e3);
         problems.push(format!(
-            "yaw did not hold {:.3}° under DMX (off by {:.3}°)",
-            want / 1e3,
-            worst / 1e3
+            "yaw did not hold {want:.3}° under DMX (off by {worst:.3}°)"
         ));
     }
     if fastest > step {
@@ -256,9 +249,7 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
     }
 
     // 2. The frames dropped at 5 s: lost at 6 s, and the idle's own pulses.
-    let lost: Vec<f64> = boot
-        .log
-        .iter()
+    let lost: Vec<f64> = (boot.log.iter())
         .filter(|(_, l)| l.message.contains("dmx: signal lost"))
         .map(|(ns, _)| ns / 1e9)
         .collect();
@@ -272,20 +263,14 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
         ));
     }
     let jumps: Vec<String> = (0..3)
-        .filter_map(|axis| {
-            let f = p.fastest(axis, 5.0, 7.0);
-            (f > step).then(|| format!("{} {:.3}°", harness::SERVOS[axis].0, f / 1e3))
-        })
+        .map(|axis| (SERVOS[axis].0, p.fastest(axis, 5.0, 7.0)))
+        .filter(|&(_, fastest)| fastest > step)
+        .map(|(name, fastest)| format!("{name} {:.3}°", fastest / 1e3))
         .collect();
     let after_loss = p.off_idle(6.8, 7.0);
     let _ = writeln!(
         text,
-        "hand-back: fastest steps within the limit ({}), pulses off the idle's from 6.8 s to 7.0 s: {}",
-        if jumps.is_empty() {
-            "yes".to_owned()
-        } else {
-            jumps.join(", ")
-        },
+        "hand-back: jumps past the limit: {jumps:?}; pulses off the idle's from 6.8 s to 7.0 s: {}",
         after_loss.len()
     );
     if !jumps.is_empty() {
@@ -294,10 +279,9 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
             jumps.join(", ")
         ));
     }
-    if !after_loss.is_empty() {
+    if let Some(first) = after_loss.first() {
         problems.push(format!(
-            "not the idle's own pulses after the hand-back: {}",
-            after_loss[0]
+            "not the idle's own pulses after the hand-back: {first}"
         ));
     }
 
@@ -311,7 +295,8 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
     let after = p.off_idle(9.3, 10.5);
     let _ = writeln!(
         text,
-        "dmx trigger 20 (nod band) at 7.5 s: {nods} nod(s) logged, {during} pulses off the idle's during it, {} after it (9.3 s to 10.5 s)",
+        "dmx trigger 20 (nod band) at 7.5 s: {nods} nod(s) logged, {during} pulses off the idle's \
+         during it, {} after it (9.3 s to 10.5 s)",
         after.len()
     );
     if nods != 1 {
@@ -326,14 +311,14 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
         problems.push(format!("the nod went on: {first}"));
     }
 
-    // 4. Bottango over USB.
+    // 4. Bottango over USB: yaw past 10° 0.7 s after the lines (0.2 s and
+    // half the curve, a frame either way), at the curve's 20° at its top.
     let usb = String::from_utf8_lossy(&boot.usb).into_owned();
     let oks = usb.matches("OK\n").count();
     let handshake = usb.contains("btngoHSK,0.8.0c1,144\nOK\n");
     let sent = boot.usb_in.first().map_or(f64::NAN, |ns| ns / 1e9);
     let curve = p.window(yaw, sent, sent + 2.0);
-    let top = curve.iter().map(|w| w.2).fold(f64::MIN, f64::max);
-    // Halfway (10°) half-way through the curve: 0.7 s after the sync.
+    let top = p.top(yaw, sent, sent + 2.0);
     let crossing = curve
         .iter()
         .find(|w| w.2 >= 10_000.0)
@@ -341,8 +326,9 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
     let back = p.off_idle(sent + 1.9, STOP.as_secs_f64() + 1.3);
     let _ = writeln!(
         text,
-        "Bottango (USB from {sent:.3} s): handshake {}, {oks} OK for {} lines; yaw past 10° {crossing:.3} s after the lines (0.7 s: 0.2 s and half the curve, a frame either way), top {:.3}° (20°); pulses off the idle's after the hand-back: {}",
-        if handshake { "answered" } else { "MISSING" },
+        "Bottango (USB from {sent:.3} s): handshake {handshake}, {oks} OK for {} lines; yaw past \
+         10° {crossing:.3} s after the lines, top {:.3}°; pulses off the idle's after the \
+         hand-back: {}",
         lines.len() + 1,
         top / 1e3,
         back.len()
@@ -357,25 +343,17 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
             "yaw crossed 10° {crossing:.3} s after the curve was sent, not about 0.7 s"
         ));
     }
-    if (top - 20_000.0).abs() > 150.0 {
-        problems.push(format!(
-            "yaw topped at {:.3}°, not the curve's 20°",
-            top / 1e3
-        ));
+    for (axis, want) in [(yaw, 20_000.0), (pitch, 5_000.0)] {
+        let top = p.top(axis, sent, sent + 2.0);
+        if (top - want).abs() > 150.0 {
+            let (name, top, want) = (SERVOS[axis].0, top / 1e3, want / 1e3);
+            problems.push(format!(
+                "{name} topped at {top:.3}°, not the curve's {want}°"
+            ));
+        }
     }
     if let Some(first) = back.first() {
         problems.push(format!("the idle did not resume after the curve: {first}"));
-    }
-    let pitch_top = p
-        .window(pitch, sent, sent + 2.0)
-        .iter()
-        .map(|w| w.2)
-        .fold(f64::MIN, f64::max);
-    if (pitch_top - 5_000.0).abs() > 150.0 {
-        problems.push(format!(
-            "pitch topped at {:.3}°, not the curve's 5°",
-            pitch_top / 1e3
-        ));
     }
     Ok((text, problems))
 }

@@ -1,20 +1,23 @@
-//! The emulator's stages of `cargo xtask test`.
+//! The emulator's stages of `cargo xtask test` that need no scenario file
+//! of their own: the pulses at 50 and 333 Hz, the watchdog drill, the
+//! console's exchanges and the emulator's own failures.
 
 use std::{
     path::{Path, PathBuf},
     time::Duration,
 };
 
-use anyhow::{Context, Result, bail};
-
-use super::{
-    DEFAULT_TIME, harness,
-    image::{FLASH_START, PicoImage, VECTOR_TABLE},
-    node,
-    run::{self, Report},
-};
+use anyhow::{Context, Result};
+use idle_head_core::servo::ServoRate;
 use xshell::cmd;
 
+use super::{
+    DEFAULT_TIME, exchange,
+    image::{PicoImage, SERVOS, VECTOR_TABLE},
+    node,
+    run::{self, End, Report},
+    script::{self, Against},
+};
 use crate::{
     elf,
     project::{self, Metadata, PICO, TARGET},
@@ -46,8 +49,6 @@ pub const WALL: Duration = Duration::from_secs(120);
 const DRILL_FRAMES: usize = 150;
 /// The Pico's watchdog timeout (`WATCHDOG_TIMEOUT` in `crates/firmware/src/hooks.rs`).
 const WATCHDOG_MS: f64 = 100.0;
-/// Two drill boots: each 3 s of frames and the 100 ms timeout.
-const DRILL_TIME: Duration = Duration::from_millis(6_500);
 /// The console run: both scripts (UART at 3 s, USB at 4 s) and a second
 /// for the last replies.
 pub const CONSOLE_TIME: Duration = Duration::from_secs(6);
@@ -64,45 +65,26 @@ const RATE_SCRIPT: &str = "\
 ";
 
 /// [`RATE_STAGE`]: the shipped image booted on settings of 333 Hz and
-/// [`RATE_SCRIPT`] played into it; every pulse checked against the host
-/// trace at 333 Hz (its 3003 µs period, 60 060 counts of 50 ns).
+/// [`RATE_SCRIPT`] played into it for 7 s; every pulse checked against the
+/// host trace at 333 Hz (its 3003 µs period, 60 060 counts of 50 ns).
 pub fn test_rate(root: &Path, metadata: &Metadata) -> Result<()> {
-    let events = super::script::parse(RATE_SCRIPT)?;
-    let rate = idle_head_core::servo::ServoRate::MAX;
-    let time = Duration::from_secs(7);
-    let report = super::script::play_at(
-        root,
-        metadata,
-        events,
-        time,
-        WALL,
-        super::script::Against::Host,
-        rate,
-    )?;
+    let events = script::parse(RATE_SCRIPT)?;
+    let time = (Duration::from_secs(7), WALL);
+    let report = script::play(root, metadata, events, time, Against::Host, ServoRate::MAX)?;
     print!("{}", report.table());
-    println!("{}", report.verdict());
     let frames = report.boots.first().map_or(0, |boot| boot.servos[0].frames);
-    // 7 s at 3003 µs, from the first frame.
-    if frames < 2300 {
-        bail!("{frames} frames checked, not the 2,300 of 7 s at 333 Hz");
-    }
-    if report.problems.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", report.problems.join("; "))
-    }
+    let few = format!("{frames} frames checked, not the 2,300 of 7 s at 333 Hz");
+    report.conclude((frames < 2300).then_some(few))
 }
 
 /// The shipped Pico image (already built) for [`DEFAULT_TIME`]; fails unless
 /// every check passes over at least [`MIN_FRAMES`] frames and the loops'
 /// checksum is the host's. Returns the run for the memory stage.
 pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
-    let report = run::simulate(root, &PICO.elf(metadata), DEFAULT_TIME, WALL, false)?;
-    print!("{}", report.log_text(false));
-    print!("{}", report.table());
-    println!("{}", report.verdict());
-    println!("{}", report.summary());
-    let mut problems = report.problems.clone();
+    let mut report = run::run_with(root, &PICO.elf(metadata), DEFAULT_TIME, WALL, |_| {})?;
+    run::check(&mut report)?;
+    print!("{}{}", report.log_text(false), report.table());
+    let mut problems = Vec::new();
     if report.frames() < MIN_FRAMES {
         problems.push(format!(
             "{} frames checked, fewer than {MIN_FRAMES}",
@@ -112,52 +94,46 @@ pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
     if report.watchdog_resets() > 0 {
         problems.push("the watchdog reset the shipped image".to_owned());
     }
-    let host = reference::checksum()?;
-    let want = format!("checksum {host:#010x}");
-    let logged = report
-        .boots
-        .iter()
-        .flat_map(|b| &b.log)
-        .any(|(_, l)| l.message.contains(&want));
-    if !logged {
+    let want = format!("checksum {:#010x}", reference::checksum()?);
+    if !report.boots.iter().any(|b| b.says(&want)) {
         problems.push(format!(
             "no `precompute: ...; {want}` line, the host's checksum"
         ));
     }
-    fail_if_any(&problems)?;
+    report.conclude(problems)?;
     Ok(report)
 }
 
 /// Builds the drill image (`--features watchdog-drill`, in a target
 /// directory of its own so that the shipped ELF is never overwritten), runs
-/// two of its boots and checks the reset and the soft start after it.
+/// two of its boots (each 3 s of frames and the timeout) and checks the
+/// reset and the soft start after it.
 pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
     let elf = build_variant(root, metadata, "watchdog-drill")?;
-    let report = run::simulate(root, &elf, DRILL_TIME, WALL, false)?;
-    print!("{}", report.log_text(false));
-    print!("{}", report.table());
-    println!("{}", report.verdict());
-    println!("{}", report.summary());
-
-    let mut problems = report.problems.clone();
-    let says = |boot: usize, text: &str| {
-        report
-            .boots
-            .get(boot)
-            .is_some_and(|b| b.log.iter().any(|(_, l)| l.message.contains(text)))
+    let mut report = run::run_with(root, &elf, Duration::from_millis(6_500), WALL, |_| {})?;
+    run::check(&mut report)?;
+    print!("{}{}", report.log_text(false), report.table());
+    let mut problems = Vec::new();
+    let says = |boot: usize, text: &str| report.boots.get(boot).is_some_and(|b| b.says(text));
+    let mut want = |boot, text: &str, problem: &str| {
+        if !says(boot, text) {
+            problems.push(format!("boot {boot} did not log {problem}"));
+        }
     };
-    let first = report.boots.first().context("no boot at all")?;
-    if !first.watchdog {
+    want(0, "boot: power-on", "a power-on boot");
+    want(
+        0,
+        &format!("frames stop after frame {DRILL_FRAMES}"),
+        "the drill's stop",
+    );
+    want(1, "last reset by the WATCHDOG", "the watchdog reset");
+    want(
+        1,
+        "first frame: neutral pulses 1500 1500 1500 us",
+        "neutral first pulses",
+    );
+    if !report.first()?.watchdog {
         problems.push("the watchdog did not reset the board after the frames stopped".to_owned());
-    }
-    if !says(0, "boot: power-on") || !says(0, &format!("frames stop after frame {DRILL_FRAMES}")) {
-        problems.push("boot 0 did not log a power-on boot and the drill's stop".to_owned());
-    }
-    if !says(1, "last reset by the WATCHDOG") {
-        problems.push("boot 1 did not log the watchdog reset".to_owned());
-    }
-    if !says(1, "first frame: neutral pulses 1500 1500 1500 us") {
-        problems.push("boot 1 did not log neutral first pulses".to_owned());
     }
     for (b, boot) in report
         .boots
@@ -165,14 +141,14 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
         .enumerate()
         .filter(|(_, boot)| boot.watchdog)
     {
-        for (check, (name, ..)) in boot.servos.iter().zip(harness::SERVOS) {
+        for (check, (name, ..)) in boot.servos.iter().zip(SERVOS) {
             // Frames 0..=DRILL_FRAMES, each its own pulse: neutral first and
             // the 2 s fade-in (checked against the host) before the stop.
             if check.fresh != DRILL_FRAMES + 1 {
+                let want = DRILL_FRAMES + 1;
                 problems.push(format!(
-                    "boot {b}, {name}: {} frames went out, not {}",
-                    check.fresh,
-                    DRILL_FRAMES + 1
+                    "boot {b}, {name}: {} frames went out, not {want}",
+                    check.fresh
                 ));
             }
             // The last duty is held until the reset, 100 ms: 5 periods.
@@ -192,7 +168,7 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
             ));
         }
     }
-    fail_if_any(&problems)
+    report.conclude(problems)
 }
 
 /// Builds the shipped Pico image (`cargo build --release`, at once if it is
@@ -207,16 +183,13 @@ pub fn shipped_image(root: &Path, metadata: &Metadata) -> Result<PathBuf> {
 /// returns its ELF.
 pub fn build_variant(root: &Path, metadata: &Metadata, feature: &str) -> Result<PathBuf> {
     let target = metadata.target_dir.join(feature);
-    let sh = project::shell(".")?;
+    let sh = xshell::Shell::new()?;
     sh.change_dir(root);
-    project::run(
-        &sh,
-        project::FIRMWARE_ENV,
-        cmd!(
-            sh,
-            "cargo build --release --features {feature} --target-dir {target}"
-        ),
-    )?;
+    let build = cmd!(
+        sh,
+        "cargo build --release --features {feature} --target-dir {target}"
+    );
+    project::run(&sh, project::FIRMWARE_ENV, build)?;
     Ok(target.join(TARGET).join("release").join(PICO.bin))
 }
 
@@ -230,15 +203,16 @@ pub fn test_console(
     wall: Duration,
 ) -> Result<()> {
     let elf = shipped_image(root, metadata)?;
-    let report = run::simulate(root, &elf, virtual_time, wall, true)?;
+    let mut report = run::run_with(root, &elf, virtual_time, wall, exchange::configure)?;
+    run::check(&mut report)?;
+    exchange::check(&mut report);
     print!("{}", report.log_text(false));
-    print!("{}", report.exchange.as_deref().unwrap_or_default());
-    print!("{}", report.table());
-    println!("{}", report.verdict());
-    println!("{}", report.summary());
-    let mut problems = report.problems.clone();
-    problems.extend(console_ram(&elf, &report)?);
-    fail_if_any(&problems)
+    print!(
+        "{}{}",
+        report.exchange.as_deref().unwrap_or_default(),
+        report.table()
+    );
+    report.conclude(console_ram(&elf, &report)?)
 }
 
 /// Prints the Pico image's RAM in `report`'s run, static plus the
@@ -247,21 +221,15 @@ pub fn test_console(
 pub fn console_ram(elf: &Path, report: &Report) -> Result<Option<String>> {
     let static_ram = elf::Image::read(elf)?.static_ram();
     let Some(stack) = report.peak_stack() else {
+        let problem = "its peak stack was not measured";
         return Ok(Some(format!(
-            "Pico image RAM: {static_ram} B static, but its peak stack was not measured"
+            "Pico image RAM: {static_ram} B static, but {problem}"
         )));
     };
-    let ram = static_ram + stack;
-    println!(
-        "Pico image RAM: {static_ram} B static + {stack} B peak stack = {ram} B of the {} B budget",
-        elf::RAM_BUDGET
-    );
-    Ok((ram > elf::RAM_BUDGET).then(|| {
-        format!(
-            "Pico image RAM {ram} B (static {static_ram} B + peak stack {stack} B) is over the {} B budget",
-            elf::RAM_BUDGET
-        )
-    }))
+    let (ram, budget) = (static_ram + stack, elf::RAM_BUDGET);
+    let sum = format!("{ram} B (static {static_ram} B + peak stack {stack} B)");
+    println!("Pico image RAM: {sum} of the {budget} B budget");
+    Ok((ram > budget).then(|| format!("Pico image RAM {sum} is over the {budget} B budget")))
 }
 
 /// A hung image, an image that sleeps for ever, a run out of wall time and
@@ -270,41 +238,44 @@ pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
     node::ensure(root)?;
     let dir = metadata.target_dir.join("sim-failures");
     std::fs::create_dir_all(&dir)?;
-    let cases: [(&str, &[u16], Duration, &str); 3] = [
-        ("hung", &[B_SELF], WALL, "no log byte and no pin edge"),
+    // Thumb `b .` (a loop on itself) and `wfi`; the runs' virtual time,
+    // wall time and silence.
+    let (b_self, wfi) = (0xe7fe, 0xbf30);
+    let (short, long) = (Duration::from_millis(50), Duration::from_secs(3600));
+    let cases: [(&str, &[u16], [Duration; 3], &str); 3] = [
+        (
+            "hung",
+            &[b_self],
+            [Duration::from_secs(2), WALL, short],
+            "no log byte and no pin edge",
+        ),
         (
             "asleep",
-            &[WFI, B_SELF],
-            WALL,
+            &[wfi, b_self],
+            [Duration::from_secs(2), WALL, short],
             "sleeps with nothing left to wake it",
         ),
         (
             "slow",
-            &[B_SELF],
-            Duration::from_millis(200),
+            &[b_self],
+            [long, Duration::from_millis(200), long],
             "stopped after",
         ),
     ];
     let mut problems = Vec::new();
-    for (name, code, wall, want) in cases {
+    for (name, code, [virtual_time, wall, silence], want) in cases {
         let flash = dir.join(format!("{name}.bin"));
-        std::fs::write(&flash, synthetic(code))?;
-        let silence = if name == "slow" {
-            Duration::from_secs(3600)
-        } else {
-            Duration::from_millis(50)
-        };
+        std::fs::write(&flash, synthetic(code)).context("writing a test image")?;
+        let vtor = VECTOR_TABLE;
         let config = node::Config {
             flash,
-            vtor: VECTOR_TABLE,
-            virtual_time: Duration::from_secs(if name == "slow" { 3600 } else { 2 }),
+            vtor,
+            virtual_time,
             wall,
             silence,
             ..node::Config::default()
         };
-        let events = node::run(root, &config)?;
-        let end = run::end_of(&events)?;
-        match end.problem(silence) {
+        match End::of(&node::run(root, &config)?)?.problem(silence) {
             Some(message) if message.contains(want) => println!("{name}: {message}"),
             other => problems.push(format!("{name}: expected `{want}`, got {other:?}")),
         }
@@ -324,40 +295,17 @@ pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
             )),
         }
     }
-    fail_if_any(&problems)
+    project::verdict(&problems)
 }
-
-/// Thumb `b .`: a loop on itself.
-const B_SELF: u16 = 0xe7fe;
-/// Thumb `wfi`.
-const WFI: u16 = 0xbf30;
 
 /// A flash image: 256 bytes where boot2 would be, a vector table (stack at
 /// the top of RAM, reset handler right behind it) and `code`.
 fn synthetic(code: &[u16]) -> Vec<u8> {
-    let mut flash = vec![0xff; usize::try_from(VECTOR_TABLE - FLASH_START).unwrap_or(0x100)];
+    let mut flash = vec![0xff; 0x100];
     #[allow(clippy::cast_possible_truncation)] // addresses of the RP2040, 32 bits
     let reset = (VECTOR_TABLE + 8) as u32 | 1;
     flash.extend(0x2004_0000_u32.to_le_bytes());
     flash.extend(reset.to_le_bytes());
     flash.extend(code.iter().flat_map(|half| half.to_le_bytes()));
     flash
-}
-
-/// Prints `report`'s verdict and summary and a scenario's own `text`;
-/// fails with the run's problems and the scenario's `found`, if any.
-pub fn conclude(report: &Report, (text, found): (String, Vec<String>)) -> Result<()> {
-    println!("{}", report.verdict());
-    println!("{}", report.summary());
-    print!("{text}");
-    let problems: Vec<String> = report.problems.iter().cloned().chain(found).collect();
-    fail_if_any(&problems)
-}
-
-fn fail_if_any(problems: &[String]) -> Result<()> {
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", problems.join("; "))
-    }
 }

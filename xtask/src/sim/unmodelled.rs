@@ -5,14 +5,14 @@
 
 use std::fmt::Write as _;
 
-use super::event::Access;
+use super::event::Op;
 
 /// Accesses to one register the emulator does not model.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Unmodelled {
     /// The peripheral as rp2040js names it.
     pub peripheral: String,
-    pub op: Access,
+    pub op: Op,
     /// The register's offset in the peripheral.
     pub offset: u32,
     pub count: u64,
@@ -57,7 +57,7 @@ impl Unmodelled {
     /// Why this access does not matter, if it is a known gap.
     fn known(&self) -> Option<&'static str> {
         let covers = |writes: Option<&[u32]>| {
-            writes.is_none_or(|offsets| self.op == Access::Write && offsets.contains(&self.offset))
+            writes.is_none_or(|offsets| self.op == Op::Write && offsets.contains(&self.offset))
         };
         KNOWN
             .iter()
@@ -74,8 +74,8 @@ pub fn lines(accesses: &[Unmodelled], verbose: bool) -> String {
     let mut known = (0, 0, Vec::new());
     for access in accesses {
         let op = match access.op {
-            Access::Read => "read from",
-            Access::Write => "write to",
+            Op::Read => "read from",
+            _ => "write to",
         };
         let what = format!(
             "[{}] {op} 0x{:x} ({}x)",
@@ -118,7 +118,7 @@ pub fn lines(accesses: &[Unmodelled], verbose: bool) -> String {
 mod tests {
     use super::*;
 
-    fn access(peripheral: &str, op: Access, offset: u32, count: u64) -> Unmodelled {
+    fn access(peripheral: &str, op: Op, offset: u32, count: u64) -> Unmodelled {
         let peripheral = peripheral.to_owned();
         Unmodelled {
             peripheral,
@@ -131,10 +131,10 @@ mod tests {
     #[test]
     fn known_gaps_are_one_line_and_others_stay_visible() {
         let accesses = [
-            access("ROSC_BASE", Access::Write, 0x4, 1),
-            access("ROSC_BASE", Access::Write, 0x8, 1),
-            access("VREG_AND_CHIP_RESET_BASE", Access::Read, 0x0, 2),
-            access("USB", Access::Write, 0x48, 1),
+            access("ROSC_BASE", Op::Write, 0x4, 1),
+            access("ROSC_BASE", Op::Write, 0x8, 1),
+            access("VREG_AND_CHIP_RESET_BASE", Op::Read, 0x0, 2),
+            access("USB", Op::Write, 0x48, 1),
         ];
         assert_eq!(
             lines(&accesses, false),
@@ -147,9 +147,9 @@ mod tests {
         // A register of a known peripheral that is not on the list, a read
         // of a register only known as written, another peripheral: shown.
         let surprises = [
-            access("USB", Access::Write, 0x40, 1),
-            access("UART0", Access::Read, 0x34, 1),
-            access("PIO0", Access::Write, 0x0, 7),
+            access("USB", Op::Write, 0x40, 1),
+            access("UART0", Op::Read, 0x34, 1),
+            access("PIO0", Op::Write, 0x0, 7),
         ];
         let text = lines(&surprises, false);
         assert_eq!(text.lines().count(), 3, "{text}");

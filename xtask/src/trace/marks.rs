@@ -1,12 +1,14 @@
 //! What the script's commands did, as marks for the summary and the plot:
 //! when each was applied, how long its motion lasts and on which axes, and
-//! the return to the centre a look plans after its hold.
+//! the return to the centre a look plans after its hold; and the plot.
 
 use idle_head_core::behaviour::{Applied, BehaviourError, BehaviourParams};
 use idle_head_core::command::{Action, Hold, LookRequest};
 use idle_head_core::{Angle, Axis, Millis};
 
-use super::script::Event;
+use super::{Trace, script::Event};
+use crate::plot::{self, GREY, RED};
+use plotters::style::RGBColor;
 
 /// What kind of motion a mark stands for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -210,4 +212,61 @@ pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
     let mut keep = keep.into_iter();
     marks.retain(|_| keep.next().unwrap_or(true));
     marks.sort_by_key(|m| m.t_ms);
+}
+
+/// Draws `trace` to the PNG `path`: the three axes over time (in minutes
+/// past five of them), each command marked where it was applied and its
+/// motion shaded on the axes it moves (a look's return in blue, a refused
+/// command in red).
+#[allow(clippy::cast_precision_loss)] // frame times, far below 2^52
+pub fn draw(trace: &Trace, seed: Option<u32>, path: &std::path::Path) -> anyhow::Result<()> {
+    let end_ms = trace.rows.last().map_or(0, |r| r.t_ms);
+    let (unit, ms_per_unit) = if end_ms > 300_000 {
+        ("min", 60_000.0)
+    } else {
+        ("s", 1000.0)
+    };
+    let at = |ms: u64| ms as f64 / ms_per_unit;
+    let back = |m: &Mark| m.kind == Kind::Return;
+    let marks: Vec<plot::Mark> = (trace.marks.iter())
+        .map(|m| plot::Mark {
+            from: at(m.t_ms),
+            to: at(m.t_ms + m.span_ms),
+            axes: m.axes.clone(),
+            label: m.label.clone(),
+            line: if m.refused() {
+                RED
+            } else if back(m) {
+                RGBColor(70, 110, 160)
+            } else {
+                GREY
+            },
+            shade: if back(m) {
+                RGBColor(214, 230, 245)
+            } else {
+                RGBColor(255, 228, 196)
+            },
+        })
+        .collect();
+    let rows: Vec<(f64, [f64; 3])> = (trace.rows.iter())
+        .map(|r| (at(r.t_ms), r.angles.map(|a| f64::from(a) / 1000.0)))
+        .collect();
+    let loops = seed.map_or_else(
+        || "Table 2 loops".to_owned(),
+        |s| format!("loops of seed {s}"),
+    );
+    let title = format!(
+        "Commanded angles, {} frames ({loops}; after fade, limits and clamps)",
+        rows.len()
+    );
+    let note = "shaded: a command's motion on the axes it moves (blue: a look's return to the \
+                centre); dashed: when it was applied (red: refused)";
+    plot::motion(
+        path,
+        title,
+        vec![note.to_owned()],
+        &format!("time ({unit})"),
+        &rows,
+        &marks,
+    )
 }
