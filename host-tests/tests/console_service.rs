@@ -11,63 +11,12 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use host_tests::console::head::{SimFrames, service, shared};
 use host_tests::console::{LINE, REPLY, count_line_ends, random_line, random_stream, rng};
-use idle_head_core::behaviour::{Applied, CommandQueue};
-use idle_head_core::console::{
-    ConsoleLink, ConsoleService, ErrorCode, Response, Session, outcome_reply, parse, respond,
-};
-use idle_head_core::settings::{RamStorage, SettingsStorage, StorageError};
+use idle_head_core::behaviour::Applied;
+use idle_head_core::console::{ErrorCode, Response, Session, outcome_reply, parse, respond};
+use idle_head_core::settings::{SettingsStorage, StorageError};
 use proptest::prelude::RngExt as _;
 
-/// The console service of a simulated head, talked to line by line.
-struct Console {
-    queue: &'static CommandQueue,
-    link: &'static ConsoleLink,
-    frames: SimFrames,
-    service: ConsoleService<'static, RamStorage>,
-}
-
-impl Console {
-    /// On the built-in settings.
-    fn new() -> Self {
-        let (queue, link) = shared();
-        Self {
-            queue,
-            link,
-            frames: SimFrames::new(),
-            service: service(queue, link),
-        }
-    }
-
-    /// Feeds `text` (lines) to the service, a frame after each line (and
-    /// the frames a queued action's reply waits for); the replies.
-    fn say(&mut self, text: &str) -> Vec<String> {
-        let mut session = Session::<LINE, REPLY>::new();
-        let mut replies = Vec::new();
-        for line in text.lines() {
-            session.feed(line.as_bytes(), &mut self.service, |_| {
-                panic!("reply before the line end")
-            });
-            let reply = match session.push(b'\n', &mut self.service) {
-                Some(reply) => reply.to_vec(),
-                None => self
-                    .frames
-                    .finish(&mut session, self.queue, self.link, 0)
-                    .expect("a reply that waits")
-                    .to_vec(),
-            };
-            replies.push(String::from_utf8(reply).unwrap().trim_end().to_owned());
-            self.play(1);
-        }
-        replies
-    }
-
-    /// Plays `n` frames.
-    fn play(&mut self, n: usize) {
-        for _ in 0..n {
-            self.frames.frame(self.queue, self.link);
-        }
-    }
-}
+use host_tests::console::talk::SimConsole as Console;
 
 #[test]
 fn every_command_does_what_it_says() {
@@ -527,6 +476,7 @@ fn the_widest_status_fits_a_reply() {
         faults: [u32::MAX; 3],
         disabled: [true; 3],
         track: None,
+        idle: None,
     });
     let status = c.say("status").remove(0);
     assert!(!status.contains('…'), "{status}");

@@ -12,10 +12,10 @@
 //! tilt  [amp_mdeg] [ms] [intensity=PCT]                 cycles= if it repeats)
 //! look <pitch_mdeg> <yaw_mdeg> [ms] [hold=MS|hold=stay]
 //! center [ms]
-//! idle on | idle off | idle amp <percent>
-//! look duck <percent>
+//! idle | idle on | idle off | idle amp <percent>
+//! look duck [<percent>]
 //! rest | wake | rest after <seconds>|never | rest pose <pitch> <roll> <yaw>
-//! rest relax on|off
+//! rest relax on|off | rest after | rest pose | rest relax  (the last three: show)
 //! input <2..5> [off | button <motion command> | presence [<yaw_mdeg>]]
 //! seed [<n> | random | board | paper]
 //! radar [on | off]
@@ -82,7 +82,9 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
     let Some(first) = words.next() else {
         return Err(words.error_here(ParseErrorKind::Empty));
     };
-    let command = if let Some(action) = motion(first, &mut words)? {
+    let command = if first.lower() == Word::Is(Kw::Idle) && words.peek().is_none() {
+        Command::IdleQuery
+    } else if let Some(action) = motion(first, &mut words)? {
         Command::Act(action)
     } else {
         match first.lower() {
