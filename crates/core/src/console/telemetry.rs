@@ -110,11 +110,11 @@ mod tests {
     use crate::track::{Person, Sighting, TrackView};
     use crate::units::{Angle, Microseconds, Millimetres};
 
-    fn person(x: i32, y: i32) -> Option<Person> {
-        Some(Person {
+    fn person(x: i32, y: i32) -> Person {
+        Person {
             x: Millimetres(x),
             y: Millimetres(y),
-        })
+        }
     }
 
     #[test]
@@ -145,7 +145,7 @@ mod tests {
         let radar = HeadStatus {
             track: Some(TrackView {
                 seen: Sighting {
-                    people: [person(-812, 1950), None, person(1200, 3400)],
+                    people: [Some(person(-812, 1950)), None, Some(person(1200, 3400))],
                 },
                 who: Some(1),
                 at: Some(Angle::from_millidegrees(-14_036)),
@@ -170,7 +170,7 @@ mod tests {
         // exact but for the time, whose 20 digits are a u64's (the ms of
         // u64::MAX µs have 17), and `targets`, whose 3 are a u8's (a
         // sighting holds at most 3 people: 1 digit).
-        let far = person(i32::MIN, i32::MIN);
+        let far = Some(person(i32::MIN, i32::MIN));
         let worst = HeadStatus {
             frame: u64::MAX,
             time: crate::Timestamp(u64::MAX),
