@@ -11,7 +11,9 @@
 mod host;
 mod marks;
 mod plot;
+mod report;
 mod script;
+mod watch;
 
 use std::{fs, path::PathBuf};
 
@@ -33,8 +35,7 @@ use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::pwm_clock::PICO_SYS_HZ;
 use marks::Mark;
 pub use script::{Event, Kind};
-
-use crate::steps::Steps;
+pub use watch::Watch;
 
 /// A script's events (see `script.rs`), checked with `params`.
 pub fn parse_script(text: &str, params: &BehaviourParams) -> Result<Vec<Event>> {
@@ -61,6 +62,14 @@ pub struct Args {
     /// The CSV to write [default: trace/trace.csv in the target directory].
     #[arg(long, value_name = "csv")]
     pub out: Option<PathBuf>,
+    /// Also write the telemetry lines `watch` would stream meanwhile (the
+    /// core's own, with the radar's people when a script turns it on), one
+    /// a line, to this file.
+    #[arg(long, value_name = "file")]
+    pub telemetry: Option<PathBuf>,
+    /// The telemetry's lines a second (1 to 50; the panel asks for 20).
+    #[arg(long, value_name = "hz", default_value_t = 20, value_parser = clap::value_parser!(u8).range(1..=50))]
+    pub watch: u8,
     /// Also draw the three axes over time, the commands marked, to this PNG
     /// [without a file: trace/trace.png in the target directory].
     #[arg(long, value_name = "file")]
@@ -122,6 +131,11 @@ pub struct Trace {
     /// The script's commands as applied, and the looks' returns, in time
     /// order.
     pub marks: Vec<Mark>,
+    /// The telemetry lines, when asked for ([`simulate_watched`]).
+    pub watch: Option<Watch>,
+    /// The replies to the lines asked of the console after the last frame
+    /// ([`simulate_watched`]).
+    pub answers: Vec<String>,
 }
 
 /// A PWM channel that keeps the last duty, counted as the Pico's slice
@@ -221,6 +235,21 @@ pub fn simulate(
     rate: ServoRate,
     events: &[Event],
 ) -> Result<Trace> {
+    simulate_watched(micros, seed, rate, events, None, &[])
+}
+
+/// As [`simulate`], with the telemetry lines of a `watch` (if `watch`
+/// gives its lines a second), and the console's replies to `ask` after the
+/// last frame.
+pub fn simulate_watched(
+    micros: u64,
+    seed: Option<u32>,
+    rate: ServoRate,
+    events: &[Event],
+    watch: Option<u8>,
+    ask: &[&str],
+) -> Result<Trace> {
+    let mut watch = watch.map(Watch::new);
     let (driver_params, params) = at_rate(rate)?;
     let period = driver_params.config().frame_period;
     let playback =
@@ -302,27 +331,51 @@ pub fn simulate(
                 .map_err(|e| anyhow!("{} ms: servo rate refused: {e}", t_us / 1000))?;
         }
         let report = played.report;
-        let mode = HeadMode::of(driver.is_stopped(), driver.is_stopping(), head.rest_state());
-        link.publish(HeadStatus::of(
+        publish(
+            &head,
+            &driver,
             &report,
-            driver.stats(),
-            mode,
-            Timestamp(t_us),
-        ));
+            (&link, &show),
+            t_us,
+            watch.as_mut(),
+        );
         let period_us = driver.params().config().frame_period.0;
         rows.push(row(frame, t_us, &report, &mut driver));
         frame += 1;
         t_us += u64::from(period_us);
     }
     marks::settle(&mut marks, params.config().blend.0, t_us / 1000);
-    for event in &events[next..] {
-        println!(
-            "line {}: at {} s, after the trace's end: not run",
-            event.line,
-            script::show_seconds(event.at_us)
-        );
+    events[next..].iter().for_each(script::not_run);
+    let answers = ask.iter().map(|line| console.line(line).0).collect();
+    Ok(Trace {
+        rows,
+        marks,
+        watch,
+        answers,
+    })
+}
+
+/// Publishes the status after the frame at `t_us` that wrote `report` to
+/// the console's link, as the frame task does (the tracker's view while
+/// the radar is on), and to `watch`, if one streams.
+fn publish(
+    head: &Head<Idle>,
+    driver: &FrameDriver<Channel>,
+    report: &FrameReport,
+    (link, show): (&ConsoleLink, &ShowLink),
+    t_us: u64,
+    watch: Option<&mut Watch>,
+) {
+    let mode = HeadMode::of(driver.is_stopped(), driver.is_stopping(), head.rest_state());
+    let mut status = HeadStatus::of(report, driver.stats(), mode, Timestamp(t_us));
+    status.idle = Some(head.idle_view());
+    if show.track.settings().radar {
+        status.track = Some(head.track_view());
     }
-    Ok(Trace { rows, marks })
+    link.publish(status);
+    if let Some(watch) = watch {
+        watch.frame(t_us, &status);
+    }
 }
 
 /// The radar's frame period, µs (the LD2450 reports ten times a second).
@@ -332,9 +385,12 @@ const RADAR_US: u64 = 100_000;
 /// through the receiver's link.
 fn send_radar(show: &ShowLink, people: Sighting, sent: &mut u64, t_us: u64) {
     while *sent * RADAR_US <= t_us {
-        show.track
-            .publish(Some(people), idle_head_core::track::Counters::default());
         *sent += 1;
+        let counters = idle_head_core::track::Counters {
+            good: u32::try_from(*sent).unwrap_or(u32::MAX),
+            ..idle_head_core::track::Counters::default()
+        };
+        show.track.publish(Some(people), counters);
     }
 }
 
@@ -501,17 +557,28 @@ pub fn command(args: &Args) -> Result<bool> {
         }
         None => Vec::new(),
     };
-    let trace = simulate(args.micros, args.seed, rate, &events)?;
+    let watch = args.telemetry.as_ref().map(|_| args.watch);
+    let trace = simulate_watched(args.micros, args.seed, rate, &events, watch, &[])?;
     let out = match &args.out {
         Some(out) => out.clone(),
         None => default_dir()?.join("trace.csv"),
     };
-    write_csv(&trace, &out)?;
+    report::write_csv(&trace, &out)?;
     for mark in &trace.marks {
         println!("{:>9} ms  {}", mark.t_ms, mark.reply);
     }
-    summary(&trace);
+    report::summary(&trace);
     println!("wrote {} ({} frames)", out.display(), trace.rows.len());
+    if let (Some(path), Some(watch)) = (&args.telemetry, &trace.watch) {
+        fs::write(path, watch.lines.join("\n") + "\n")
+            .with_context(|| format!("writing {}", path.display()))?;
+        println!(
+            "wrote {} ({} telemetry lines, {} a second)",
+            path.display(),
+            watch.lines.len(),
+            args.watch
+        );
+    }
     if let Some(png) = &args.png {
         let png = match png {
             Some(png) => png.clone(),
@@ -521,43 +588,6 @@ pub fn command(args: &Args) -> Result<bool> {
         println!("wrote {}", png.display());
     }
     Ok(true)
-}
-
-fn write_csv(trace: &Trace, path: &std::path::Path) -> Result<()> {
-    use std::fmt::Write as _;
-    let mut csv =
-        String::from("frame,t_ms,pitch_mdeg,roll_mdeg,yaw_mdeg,pitch_ns,roll_ns,yaw_ns\n");
-    for row in &trace.rows {
-        let [p, r, y] = row.angles;
-        let [pn, rn, yn] = row.pulses;
-        let t_ms = match row.t_us % 1000 {
-            0 => format!("{}", row.t_us / 1000),
-            us => format!("{}.{us:03}", row.t_us / 1000),
-        };
-        let _ = writeln!(csv, "{},{t_ms},{p},{r},{y},{pn},{rn},{yn}", row.frame);
-    }
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    fs::write(path, csv).with_context(|| format!("writing {}", path.display()))
-}
-
-/// Range, largest step and largest change of step per axis.
-fn summary(trace: &Trace) {
-    for (i, axis) in Axis::ALL.iter().enumerate() {
-        let values: Vec<i64> = trace.rows.iter().map(|r| i64::from(r.angles[i])).collect();
-        let (lo, hi) = values
-            .iter()
-            .fold((i64::MAX, i64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-        let angles: Vec<f64> = trace.rows.iter().map(|r| f64::from(r.angles[i])).collect();
-        let Steps { step, turn } = Steps::of(&angles);
-        let pulses = trace.rows.iter().map(|r| r.pulses[i]);
-        let (plo, phi) = pulses.fold((u64::MAX, 0), |(lo, hi), p| (lo.min(p), hi.max(p)));
-        println!(
-            "{:<5} angle {lo}..{hi} mdeg, largest step {step:.0} mdeg/frame, largest change of step {turn:.0} mdeg/frame² (frames as they came), pulses {plo}..{phi} ns",
-            axis.name()
-        );
-    }
 }
 
 #[cfg(test)]
