@@ -15,7 +15,9 @@ export function crc8(bytes) {
 
 /**
  * A telemetry line (`~ t=… p=… r=… y=… us=a,b,c lost=n *hh`) as numbers,
- * or null if it is damaged.
+ * or null if it is damaged. With the radar on it goes on with `targets=n
+ * at=<yaw mdeg>|- xy=x,y;x,y|- who=<index>|-`: then `radar` is
+ * {targets, at (degrees or null), people [{x, y} mm], who (index or null)}.
  */
 export function parseTelemetry(line) {
   const star = line.lastIndexOf(' *');
@@ -37,7 +39,25 @@ export function parseTelemetry(line) {
     us,
     lost: Number(fields.lost),
   };
-  return [t.t, t.pitch, t.roll, t.yaw, ...us].every(Number.isFinite) ? t : null;
+  if (!([t.t, t.pitch, t.roll, t.yaw, ...us].every(Number.isFinite))) return null;
+  if (fields.targets !== undefined) {
+    const people = !fields.xy || fields.xy === '-' ? [] : fields.xy.split(';').map((pair) => {
+      const [x, y] = pair.split(',').map(Number);
+      return { x, y };
+    });
+    const radar = {
+      targets: Number(fields.targets),
+      at: fields.at === undefined || fields.at === '-' ? null : Number(fields.at) / 1000,
+      people,
+      who: fields.who === undefined || fields.who === '-' ? null : Number(fields.who),
+    };
+    const numbers = [radar.targets, ...people.flatMap((p) => [p.x, p.y])];
+    if (radar.at !== null) numbers.push(radar.at);
+    if (radar.who !== null) numbers.push(radar.who);
+    if (!numbers.every(Number.isFinite)) return null;
+    t.radar = radar;
+  }
+  return t;
 }
 
 /** Web Serial: the board's USB serial port, chosen by the user. */

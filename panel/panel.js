@@ -1,8 +1,8 @@
 // The panel: connects to a head (the bridge of `cargo xtask panel` when
 // the page is served with one, else Web Serial), shows what the head is
 // told (drawing, readouts, plot, status), and offers its actions,
-// calibration and settings (servo rate, rest, inputs and DMX in modules of
-// their own).
+// calibration and settings (servo rate, rest, idle, inputs, DMX and the
+// radar in modules of their own), every one read back from the head.
 // Every line sent and received goes to the log.
 
 import { BridgeTransport, Console, NoReply, SerialTransport, commandWords, fields, gestureWords, refusal } from './link.js';
@@ -11,6 +11,8 @@ import * as rest from './rest.js';
 import * as inputs from './inputs.js';
 import * as dmx from './dmx.js';
 import * as rate from './rate.js';
+import * as idle from './idle.js';
+import * as radar from './radar.js';
 
 const $ = (id) => document.getElementById(id);
 const AXES = ['pitch', 'roll', 'yaw'];
@@ -25,6 +27,8 @@ let pollTimer = null; // status polled for the readouts (no telemetry)
 let limitRun = null; // a "go to limit" in progress
 let hasInputs = false; // the firmware has trigger inputs
 let hasDmx = false; // the firmware answers `dmx`
+let hasRest = false; // the firmware has rest settings
+let hasRadar = false; // the firmware has a radar
 
 // ---- log ----------------------------------------------------------------
 
@@ -75,7 +79,7 @@ async function connect(makeTransport) {
     return;
   }
   const console = new Console(transport, {
-    onTelemetry: showTelemetry,
+    onTelemetry: telemetry,
     onLine: (direction, text) => log(direction, text),
   });
   link = { transport, console };
@@ -90,20 +94,35 @@ async function connect(makeTransport) {
   }
 }
 
-/** What the page asks first: the commands, the status, the servos, telemetry. */
+/** A telemetry line: the drawing, readouts and plot, and the radar's map. */
+function telemetry(t) {
+  showTelemetry(t);
+  if (hasRadar) radar.showTelemetry(t);
+}
+
+/** Every setting, as the head answers it: on connect, after Load and Defaults. */
+async function readSettings() {
+  for (const axis of AXES) await readServo(axis);
+  showServo();
+  await rate.read();
+  if (hasRest) await rest.read();
+  await idle.read();
+  if (hasInputs) await inputs.read();
+  if (hasDmx) hasDmx = await dmx.read();
+  if (hasRadar) await radar.read();
+}
+
+/** What the page asks first: the commands, the status, every setting, telemetry. */
 async function start() {
   const help = await ask('help');
   makeGestureButtons(gestureWords(help));
   const words = commandWords(help);
-  rest.offered(words);
-  rest.forget();
-  await refreshStatus();
-  for (const axis of AXES) await readServo(axis);
-  await rate.read();
+  hasRest = rest.offered(words);
   hasInputs = inputs.offered(words);
-  if (hasInputs) await inputs.read();
-  hasDmx = dmx.offered(words) && (await dmx.read());
-  showServo();
+  hasDmx = dmx.offered(words);
+  hasRadar = radar.offered(words);
+  await refreshStatus();
+  await readSettings();
   const watch = await ask(`watch ${WATCH_HZ}`);
   if (watch.startsWith('err')) {
     banner(
@@ -116,7 +135,13 @@ async function start() {
   setState('connected', 'on');
   setControls(true);
   statusTimer = setInterval(() => {
-    if (!limitRun) refreshStatus().then(() => hasDmx && dmx.refresh()).catch(fault);
+    if (!limitRun) {
+      refreshStatus()
+        .then(() => hasDmx && dmx.refresh())
+        .then(() => hasRadar && radar.refresh())
+        .then(() => idle.readIdle())
+        .catch(fault);
+    }
   }, 2000);
 }
 
@@ -507,6 +532,8 @@ async function main() {
   inputs.setUp(page);
   dmx.setUp(page);
   rate.setUp(page);
+  idle.setUp(page);
+  radar.setUp(page);
   makePlot();
   setUpLookPad();
   setControls(false);
@@ -518,35 +545,15 @@ async function main() {
     showLookTarget();
     await ask('center');
   });
-  on('idle-on', 'change', () => ask($('idle-on').checked ? 'idle on' : 'idle off'));
-  $('idle-amp').addEventListener('input', () => {
-    $('idle-amp-value').textContent = $('idle-amp').value;
-  });
-  on('idle-amp', 'change', () => ask(`idle amp ${$('idle-amp').value}`));
-  on('seed-set', 'click', async () => {
-    await ask(`seed ${Math.round(Number($('seed').value))}`);
-    await refreshStatus();
-  });
-  on('seed-random', 'click', async () => {
-    const reply = await ask('seed random');
-    const f = fields(reply);
-    if (f.seed) $('seed').value = f.seed;
-    await refreshStatus();
-  });
   on('save', 'click', async () => {
     await ask('save');
     await refreshStatus();
   });
   for (const id of ['load', 'defaults']) {
     on(id, 'click', async () => {
-      const reply = await ask(id);
-      for (const axis of AXES) await readServo(axis);
-      showServo();
-      await rate.read();
-      if (reply.startsWith('ok')) rest.forget();
+      await ask(id);
       await refreshStatus();
-      if (hasInputs) await inputs.read();
-      if (hasDmx) await dmx.read();
+      await readSettings();
     });
   }
   for (const radio of document.querySelectorAll('input[name=axis]')) radio.addEventListener('change', () => showServo());

@@ -1,53 +1,72 @@
 // Rest and wake: the head's mode as `status` reports it, Rest and Wake by
 // hand, and the rest settings (`rest after`, `rest pose`, `rest relax`;
-// docs/user/protocol.md).
+// docs/user/protocol.md), read back from the head: `rest after` alone
+// answers all three (`ok rest after=120 pose=-8000,0,0 relax=off`, then
+// ` clamped=…` where the head rests if the pose lies past the limits).
 //
-// The firmware answers no query for the rest settings, so the page shows
-// what it knows: the built-in values while `status` says the head runs on
-// them (`settings=defaults`), and each value set here since; a value it
-// does not know is blank (a checkbox half-ticked).
+// A firmware that cannot be asked (an older one answers `err`) leaves
+// what the page does not know blank (a checkbox half-ticked), each value
+// shown once set here.
 
 import { fields, refusal } from './link.js';
 
 const $ = (id) => document.getElementById(id);
 
-/** The built-in rest settings (`rest after 120`, `rest pose 8000 0 0`, `rest relax off`). */
-const BUILT_IN = { seconds: 120, never: false, pose: [8, 0, 0], relax: false };
 const POSE = ['pitch', 'roll', 'yaw'];
 
 let page = null; // {ask, refreshStatus}
 /** What the page knows of the rest settings: null where it does not. */
 const UNKNOWN = { seconds: null, never: null, pose: null, relax: null };
 let known = { ...UNKNOWN };
+/** Whether the head answers `rest after` alone. */
+let answers = true;
+/** The control whose change is being answered (it snaps back if refused). */
+let answering = null;
+
+/**
+ * Shows `write(control)` in the control `id`, unless it is being typed in
+ * (it has the focus and the answer is to another one's change).
+ */
+function put(id, write) {
+  const control = $(id);
+  if (control === document.activeElement && id !== answering) return;
+  write(control);
+}
 
 /** Degrees as the console's whole millidegrees. */
 const mdeg = (degrees) => Math.round(degrees * 1000);
+const degrees = (text) => text.split(',').map((v) => Number(v) / 1000);
 
-// Each part is drawn from `known` when it is learnt or a change is
-// refused (it snaps back); a change taken is already on show, and a field
-// is never redrawn under the user's fingers by an answer to another one.
 function showAfter() {
-  $('rest-after').value = known.seconds === null ? '' : String(known.seconds);
-  $('rest-never').checked = known.never === true;
-  $('rest-never').indeterminate = known.never === null;
+  put('rest-after', (c) => {
+    c.value = known.seconds === null ? '' : String(known.seconds);
+  });
+  put('rest-never', (c) => {
+    c.checked = known.never === true;
+    c.indeterminate = known.never === null;
+  });
 }
 
 function showPose() {
   POSE.forEach((axis, i) => {
-    $(`rest-${axis}`).value = known.pose ? String(known.pose[i]) : '';
+    put(`rest-${axis}`, (c) => {
+      c.value = known.pose ? String(known.pose[i]) : '';
+    });
   });
 }
 
 function showRelax() {
-  $('rest-relax').checked = known.relax === true;
-  $('rest-relax').indeterminate = known.relax === null;
+  put('rest-relax', (c) => {
+    c.checked = known.relax === true;
+    c.indeterminate = known.relax === null;
+  });
 }
 
 function showAll() {
   showAfter();
   showPose();
   showRelax();
-  $('rest-note').hidden = !Object.values(known).includes(null);
+  $('rest-note').hidden = answers || !Object.values(known).includes(null);
 }
 
 function say(text, warn = false) {
@@ -55,17 +74,62 @@ function say(text, warn = false) {
   $('why-rest').classList.toggle('warn', warn);
 }
 
-/** Sends one rest setting: `taken(reply)` on `ok`; a refused one snaps back (`redraw`) with the reason. */
+/** The pose clamped to the limits, as a note (or none). */
+function sayClamped(clamped) {
+  if (clamped) say(`past the servos' limits: the head rests at pitch ${clamped[0]}°, roll ${clamped[1]}°, yaw ${clamped[2]}°`, true);
+}
+
+/**
+ * Reads the rest settings from the head (on connect, after a change, Load
+ * or Defaults); whether it answered. `quiet` keeps the note under the
+ * group (a refusal's reason).
+ */
+export async function read(quiet = false) {
+  const reply = await page.ask('rest after');
+  answers = reply.startsWith('ok rest ');
+  if (!answers) {
+    known = { ...UNKNOWN };
+    showAll();
+    return false;
+  }
+  const f = fields(reply);
+  const never = f.after === 'never';
+  known = {
+    seconds: never ? null : Number(f.after),
+    never,
+    pose: degrees(f.pose ?? '0,0,0'),
+    relax: f.relax === 'on',
+  };
+  showAll();
+  if (!quiet) say('');
+  sayClamped(f.clamped ? degrees(f.clamped) : null);
+  return true;
+}
+
+/**
+ * Sends one rest setting, then reads them back; a refused one snaps back
+ * with the reason. A head that cannot be asked: `taken(reply)` on `ok`,
+ * `redraw` on a refusal.
+ */
 async function set(line, taken, redraw) {
   say('');
+  const source = document.activeElement?.id ?? null;
   const reply = await page.ask(line);
-  if (reply.startsWith('ok')) {
-    taken(reply);
-  } else {
-    say(refusal(reply));
-    redraw();
+  const refused = !reply.startsWith('ok');
+  if (refused) say(refusal(reply));
+  answering = source;
+  try {
+    if (answers) {
+      await read(refused);
+    } else if (refused) {
+      redraw();
+    } else {
+      taken(reply);
+      showAll();
+    }
+  } finally {
+    answering = null;
   }
-  $('rest-note').hidden = !Object.values(known).includes(null);
   await page.refreshStatus();
 }
 
@@ -76,9 +140,6 @@ function setSeconds(seconds) {
     () => {
       known.seconds = seconds;
       known.never = false;
-      if ($('rest-after').value === '') $('rest-after').value = String(seconds);
-      $('rest-never').checked = false;
-      $('rest-never').indeterminate = false;
     },
     showAfter,
   );
@@ -95,9 +156,9 @@ function setAfter() {
 
 function setNever() {
   if (!$('rest-never').checked) {
-    // Back to a time: the one in the field, else the built-in one.
+    // Back to a time: the one in the field, else the built-in one (120 s).
     const value = $('rest-after').value;
-    return setSeconds(value === '' ? BUILT_IN.seconds : Math.round(Number(value)));
+    return setSeconds(value === '' ? 120 : Math.round(Number(value)));
   }
   return set(
     'rest after never',
@@ -115,14 +176,10 @@ function setPose() {
     `rest pose ${pose.map(mdeg).join(' ')}`,
     (reply) => {
       known.pose = pose;
-      // `ok clamped pitch=… roll=… yaw=…`: the pose past the limits, clamped to them.
+      // `ok clamped pitch=… roll=… yaw=…`: the pose past the limits.
       if (reply.startsWith('ok clamped')) {
         const f = fields(reply);
-        known.pose = POSE.map((axis) => Number(f[axis]) / 1000);
-        showPose();
-        say(`clamped to the servos' limits: pitch ${known.pose[0]}°, roll ${known.pose[1]}°, yaw ${known.pose[2]}°`, true);
-      } else if (pose.some((v, i) => $(`rest-${POSE[i]}`).value === '')) {
-        showPose(); // the blanks, sent as 0°
+        sayClamped(POSE.map((axis) => Number(f[axis]) / 1000));
       }
     },
     showPose,
@@ -148,20 +205,9 @@ async function act(word) {
   await page.refreshStatus();
 }
 
-/** Connected (or after Load): nothing known until `status` says more. */
-export function forget() {
-  known = { ...UNKNOWN };
-  say('');
-  showAll();
-}
-
-/** A `status` reply's fields: the mode, and the built-in settings if it runs on them. */
+/** A `status` reply's fields: the mode. */
 export function showStatus(f) {
   $('mode').textContent = f.mode ?? '–';
-  if (f.settings === 'defaults' && JSON.stringify(known) !== JSON.stringify(BUILT_IN)) {
-    known = { ...BUILT_IN, pose: [...BUILT_IN.pose] };
-    showAll();
-  }
 }
 
 /** Whether the firmware has rest and wake (`help` lists them). */

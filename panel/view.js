@@ -15,7 +15,7 @@ export function makePlot() {
   plot = new uPlot(
     {
       width: el.clientWidth || 370,
-      height: 140,
+      height: 120,
       legend: { show: false },
       scales: { x: { time: false } },
       axes: [{ label: 's', size: 30 }, { label: '°', size: 40 }],

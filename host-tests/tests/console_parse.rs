@@ -114,6 +114,34 @@ fn look_center_idle_seed() {
     assert_eq!(ok("seed random"), Command::Seed(SeedChoice::Random));
 }
 
+/// The settings that have no word of their own to show them: `rest
+/// after|pose|relax` alone, `look duck` alone and `idle` alone ask; with a
+/// value they set (`rest` and `look` stay motions).
+#[test]
+fn settings_shown_by_their_words_alone() {
+    use idle_head_core::command::{RestAfter, RestSetting};
+    for line in ["rest after", "REST pose", "rest\trelax "] {
+        assert_eq!(ok(line), Command::Rest(None), "`{line}`");
+    }
+    assert_eq!(ok("look duck"), Command::LookDuck(None));
+    assert_eq!(ok("idle"), Command::IdleQuery);
+    assert_eq!(ok("  Idle "), Command::IdleQuery);
+    assert_eq!(
+        ok("rest after never"),
+        Command::Rest(Some(RestSetting::After(RestAfter::Never)))
+    );
+    assert_eq!(
+        ok("rest relax on"),
+        Command::Rest(Some(RestSetting::Relax(true)))
+    );
+    assert_eq!(
+        ok("look duck 70"),
+        Command::LookDuck(Some(Percent::new(70).unwrap()))
+    );
+    assert_eq!(ok("rest"), Command::Act(Action::Rest));
+    assert_eq!(ok("idle off"), Command::Act(Action::Idle(false)));
+}
+
 #[test]
 fn servo_fields() {
     let servo = |axis, setting| Command::Servo {
@@ -192,7 +220,15 @@ fn errors_name_the_word_and_the_rule() {
             "look 1 2 hold=soon",
             "syntax `soon`: hold in ms must be a whole number",
         ),
-        ("idle", "syntax missing `on`, `off` or `amp`"),
+        ("input 2 button idle", "syntax missing `on`, `off` or `amp`"),
+        ("rest pose 1000", "syntax missing roll in mdeg"),
+        ("rest after 0", "range `0`: seconds must be in 1..=86400"),
+        (
+            "look duck 101",
+            "range `101`: percentage must be in 0..=100",
+        ),
+        ("look duck 50 now", "syntax `now`: unexpected"),
+        ("idle now", "syntax `now`: expected `on`, `off` or `amp`"),
         (
             "idle maybe",
             "syntax `maybe`: expected `on`, `off` or `amp`",

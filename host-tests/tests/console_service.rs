@@ -18,56 +18,7 @@ use idle_head_core::console::{
 use idle_head_core::settings::{FlashFailed, RamStorage, SettingsStorage, StorageError};
 use proptest::prelude::RngExt as _;
 
-/// The console service of a simulated head, talked to line by line.
-struct Console {
-    queue: &'static CommandQueue,
-    link: &'static ConsoleLink,
-    frames: SimFrames,
-    service: ConsoleService<'static, RamStorage>,
-}
-
-impl Console {
-    /// On the built-in settings.
-    fn new() -> Self {
-        let (queue, link) = shared();
-        Self {
-            queue,
-            link,
-            frames: SimFrames::new(),
-            service: service(queue, link),
-        }
-    }
-
-    /// Feeds `text` (lines) to the service, a frame after each line (and
-    /// the frames a queued action's reply waits for); the replies.
-    fn say(&mut self, text: &str) -> Vec<String> {
-        let mut session = Session::<LINE, REPLY>::new();
-        let mut replies = Vec::new();
-        for line in text.lines() {
-            session.feed(line.as_bytes(), &mut self.service, |_| {
-                panic!("reply before the line end")
-            });
-            let reply = match session.push(b'\n', &mut self.service) {
-                Some(reply) => reply.to_vec(),
-                None => self
-                    .frames
-                    .finish(&mut session, self.queue, self.link, 0)
-                    .expect("a reply that waits")
-                    .to_vec(),
-            };
-            replies.push(String::from_utf8(reply).unwrap().trim_end().to_owned());
-            self.play(1);
-        }
-        replies
-    }
-
-    /// Plays `n` frames.
-    fn play(&mut self, n: usize) {
-        for _ in 0..n {
-            self.frames.frame(self.queue, self.link);
-        }
-    }
-}
+use host_tests::console::talk::SimConsole as Console;
 
 #[test]
 fn every_command_does_what_it_says() {
@@ -519,6 +470,7 @@ fn the_widest_status_fits_a_reply() {
         faults: [u32::MAX; 3],
         disabled: [true; 3],
         track: None,
+        idle: None,
     });
     let status = c.say("status").remove(0);
     assert!(!status.contains('…'), "{status}");

@@ -90,6 +90,7 @@ fn the_telemetry_figures_in_the_protocol_document_hold() {
         faults: [0; 3],
         disabled: [false; 3],
         track: None,
+        idle: None,
     };
     let mut out = [0; TELEMETRY_LINE];
     let line = telemetry_line(&status, 0, &mut out);
@@ -116,6 +117,39 @@ fn the_telemetry_figures_in_the_protocol_document_hold() {
             percent(TELEMETRY_LINE)
         ),
     ];
+    // With the radar on and two people: the second example line.
+    let person = |x, y| {
+        Some(idle_head_core::track::Person {
+            x: idle_head_core::Millimetres(x),
+            y: idle_head_core::Millimetres(y),
+        })
+    };
+    let people = idle_head_core::track::Sighting {
+        people: [person(500, 2000), person(-1200, 3400), None],
+    };
+    let radar = HeadStatus {
+        track: Some(idle_head_core::track::TrackView {
+            seen: people,
+            who: Some(0),
+            at: Some(Angle::from_millidegrees(-14_036)),
+        }),
+        ..status
+    };
+    let mut out = [0; TELEMETRY_LINE];
+    let line = telemetry_line(&radar, 0, &mut out);
+    let text = std::str::from_utf8(line).unwrap();
+    assert!(
+        doc.contains(text.trim_end()),
+        "the document's radar example line: {text}"
+    );
+    let figures = figures.into_iter().chain([
+        format!("two people (the second line) it takes {} bytes", line.len()),
+        format!("{} %\nat 50 lines a second", percent(line.len())),
+        format!(
+            "At 20\nlines a second, as the panel asks for them, the longest takes {} %",
+            TELEMETRY_LINE * 20 * 10 * 100 / 115_200
+        ),
+    ]);
     for figure in figures {
         assert!(
             doc.contains(&figure),

@@ -270,3 +270,56 @@ fn a_console_look_takes_the_gaze_until_it_returns() {
     let back = yaw_after(&mut rig, 100, &on, &[(-1000, 2000)]);
     assert!((back - 26_565).abs() < 300 || back > 10_000, "{back}");
 }
+
+/// What `watch` reports of the tracker: the people of the latest
+/// sighting in slot order (an empty slot left out), whom the head attends
+/// to among them, and the yaw it aims at; the line the console writes.
+#[test]
+fn the_watch_view_lists_the_people_and_whom_the_head_attends_to() {
+    use idle_head_core::console::{HeadStatus, TELEMETRY_LINE, telemetry_line};
+    use idle_head_core::track::Sighting;
+    let mut rig = still_rig();
+    let on = radar_on();
+    // Slot 0 far away on the radar's left, slot 1 empty, slot 2 near on
+    // its right: the nearest is the second person listed.
+    let far = sighting(&[(-1000, 3000)]).people[0];
+    let near = sighting(&[(800, 1200)]).people[0];
+    let both = Sighting {
+        people: [far, None, near],
+    };
+    rig.run_tracked(60, &on, |_| both);
+    let view = rig.head.track_view();
+    assert_eq!(view.seen, both);
+    assert_eq!(view.targets(), 2);
+    assert_eq!(view.who, Some(1), "the nearer person, listed second");
+    // Aimed at the near person's bearing: −atan2(800, 1200) = −33.69°.
+    let at = view.at.expect("aiming").millidegrees();
+    assert!((at + 33_690).abs() < 2_500, "{at}");
+    let status = HeadStatus {
+        track: Some(view),
+        ..HeadStatus::default()
+    };
+    let mut out = [0; TELEMETRY_LINE];
+    let line = String::from_utf8(telemetry_line(&status, 0, &mut out).to_vec()).unwrap();
+    assert!(
+        line.contains(" targets=2 at=") && line.contains(" xy=-1000,3000;800,1200 who=1 *"),
+        "{line}"
+    );
+
+    // The attended person missing from a frame (not yet gone): listed no
+    // more, and `who` names nobody while the head holds its aim.
+    let only_far = Sighting {
+        people: [far, None, None],
+    };
+    rig.run_tracked(3, &on, |_| only_far);
+    let view = rig.head.track_view();
+    assert_eq!((view.targets(), view.who), (1, None));
+    assert!(view.at.is_some(), "the aim holds");
+
+    // Radar as presence only (`track off`): the people are still listed,
+    // attended by nobody.
+    let off = TrackSettings { gaze: false, ..on };
+    rig.run_tracked(3, &off, |_| both);
+    let view = rig.head.track_view();
+    assert_eq!((view.seen, view.who, view.at), (both, None, None));
+}

@@ -14,65 +14,17 @@
 //   emulator's GP2 can be pressed (`pin 2 0` to the harness).
 // - bridge: the page served by `cargo xtask panel` with a bridge (QEMU, a
 //   serial port) connects over its bridge on load.
+// - replay: the page on a fake serial port that replays the telemetry of
+//   a host trace with the radar's people (replay.mjs).
 //
 // Each prints what it checked; any failed check, page error or timeout
-// fails the run (exit 1). Screenshots at 1280×800 go to `shots`.
+// fails the run (exit 1). Screenshots at 1280×800 go to `shots`. What the
+// sessions share is in common.mjs; the settings' read-back in settings.mjs.
 
 import { spawn } from 'node:child_process';
-import { mkdirSync } from 'node:fs';
-import { join } from 'node:path';
-import { chromium } from 'playwright-core';
-
-const cfg = JSON.parse(process.argv[2] ?? '{}');
-const CHROMIUM = cfg.chromium ?? '/usr/bin/chromium';
-const ARGS = [
-  '--headless',
-  '--no-sandbox',
-  '--disable-gpu',
-  '--disable-quic',
-  '--no-first-run',
-  '--disable-background-networking',
-  '--disable-component-update',
-  '--disable-sync',
-];
-const started = Date.now();
-const say = (text) => console.log(`[${((Date.now() - started) / 1000).toFixed(1)} s] ${text}`);
-const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
-
-function check(ok, what) {
-  if (!ok) throw new Error(`check failed: ${what}`);
-  say(`ok: ${what}`);
-}
-
-/** Waits until `probe()` is truthy (polling), or fails after `ms`. */
-/**
- * Waits for `probe` to give a value. The limits are for a head that is
- * there; on a loaded machine the emulators fall behind real time, so each
- * limit stretches by SLACK (a head that never answers still fails, only
- * later). The Nod check's 2 s is the requirement itself and does not.
- */
-const SLACK = Number(process.env.PANEL_TEST_SLACK ?? 3);
-
-async function until(probe, ms, what) {
-  const end = Date.now() + ms * SLACK;
-  for (;;) {
-    const value = await probe();
-    if (value) return value;
-    if (Date.now() > end) throw new Error(`timed out after ${ms * SLACK} ms: ${what}`);
-    await sleep(50);
-  }
-}
-
-async function readout(page, axis) {
-  return Number(await page.locator(`#${axis}`).textContent());
-}
-
-async function shot(page, name) {
-  mkdirSync(cfg.shots, { recursive: true });
-  const path = join(cfg.shots, `panel-${name}.png`);
-  await page.screenshot({ path });
-  say(`screenshot ${path}`);
-}
+import { browser, cfg, check, fakeSerial, readout, say, sayLog, shot, sleep, until, watchErrors } from './common.mjs';
+import { replaySession } from './replay.mjs';
+import { CHANGED, changeSettings, loadReadsBack, readsBack } from './settings.mjs';
 
 /** The pitch readout swings by more than 2° within 2 s of a click on Nod. */
 async function nodSwings(page) {
@@ -162,11 +114,11 @@ async function session(page, { yawPulse }) {
 /** Rest to a pose set in the Rest group, then Wake. `pitchPulse()` is
  * the pitch servo's pulse in µs as the session sees it. */
 async function restAndWake(page, { pitchPulse }) {
-  // The head runs on its built-in settings or has saved them since the
-  // page connected: the rest settings it cannot be asked for are the built-in ones.
+  // The head runs on its built-in rest settings, read back on connect.
   const pose0 = await Promise.all(['pitch', 'roll', 'yaw'].map((a) => page.getByLabel(`rest pose ${a} in degrees`).inputValue()));
   const after0 = await page.getByLabel('rest after, seconds with no one there').inputValue();
-  check(pose0.join(' ') === '8 0 0' && after0 === '120', `rest settings on connect: the built-in pose ${pose0.join('°, ')}°, rest after ${after0} s`);
+  check(pose0.join(' ') === '8 0 0' && after0 === '120' && (await page.locator('#rest-note').isHidden()),
+    `rest settings read back on connect: the built-in pose ${pose0.join('°, ')}°, rest after ${after0} s`);
   const after = page.getByLabel('rest after, seconds with no one there');
   await after.fill('0');
   await after.press('Enter');
@@ -278,109 +230,7 @@ async function servoRate(page, { pulses }) {
   check((await field.inputValue()) === '333' && why.includes('50..=333'), `servo rate 400 refused, snapped back to 333: "${why}"`);
 }
 
-/** The panel's log, its last lines, when a check failed: what was sent and answered. */
-async function sayLog(page) {
-  const lines = await page?.locator('#log li').allTextContents().catch(() => []);
-  if (lines?.length) say(`the panel's log, last lines:\n  ${lines.slice(-12).join('\n  ')}`);
-}
-
-/** Load: the inputs and DMX read again as saved (before they were
- * changed), the rest settings blank (the head cannot be asked for them). */
-async function loadReadsBack(page) {
-  await page.getByRole('button', { name: 'Load' }).click();
-  await until(async () => (await page.getByLabel('GP2 role').inputValue()) === 'off', 5000, 'GP2 read again as saved: off');
-  await until(async () => (await page.getByLabel('DMX start address').inputValue()) === '1', 5000, 'the DMX address read again as saved: 1');
-  await until(async () => (await page.getByLabel('servo rate in Hz').inputValue()) === '50', 5000, 'the servo rate read again as saved: 50');
-  const pitch = await page.getByLabel('rest pose pitch in degrees').inputValue();
-  check(pitch === '' && (await page.locator('#rest-note').isVisible()) && (await page.locator('#unsaved').isHidden()),
-    'Load: GP2, the DMX address and the servo rate read again as saved (off, 1, 50 Hz); the rest pose blank, with the note');
-}
-
-async function browser() {
-  return chromium.launch({ executablePath: CHROMIUM, args: ARGS, headless: true });
-}
-
-/** Collects the page's errors in `errors`, and says each as it comes (a
- * check that times out after one has its cause in the output). */
-function watchErrors(page, errors) {
-  const note = (text) => {
-    errors.push(text);
-    say(text);
-  };
-  page.on('pageerror', (error) => note(`page error: ${error.message}`));
-  page.on('console', (message) => {
-    if (message.type() === 'error') note(`console error: ${message.text()}`);
-  });
-}
-
 // ---- the Web Serial session ------------------------------------------
-
-/** The page's fake `navigator.serial`: ports whose bytes go to and come
- * from Node (`__serialWrite`, `__serialData`), which can be unplugged. */
-function fakeSerial() {
-  class FakePort extends EventTarget {
-    constructor(id) {
-      super();
-      this.id = id;
-      this.readable = null;
-      this.writable = null;
-    }
-    getInfo() {
-      return { usbVendorId: 0x16c0, usbProductId: 0x27dd };
-    }
-    async open() {
-      if (window.__fake.unplugged.has(this.id)) throw new Error('the device has been lost');
-      this.readable = new ReadableStream({
-        start: (controller) => {
-          this.controller = controller;
-        },
-      });
-      this.writable = new WritableStream({
-        write: (chunk) => window.__serialWrite(this.id, Array.from(chunk)),
-      });
-    }
-    async close() {
-      this.readable = this.writable = null;
-    }
-  }
-  const listeners = new EventTarget();
-  window.__fake = { ports: [], unplugged: new Set() };
-  window.__serialData = (id, bytes) => {
-    const port = window.__fake.ports.find((p) => p.id === id);
-    try {
-      port?.controller?.enqueue(new Uint8Array(bytes));
-    } catch {
-      // closed
-    }
-  };
-  window.__unplug = (id) => {
-    const port = window.__fake.ports.find((p) => p.id === id);
-    window.__fake.unplugged.add(id);
-    try {
-      port.controller.error(new DOMException('The device has been lost.', 'NetworkError'));
-    } catch {
-      // closed
-    }
-    const event = new Event('disconnect');
-    Object.defineProperty(event, 'target', { value: port });
-    listeners.dispatchEvent(event);
-  };
-  let next = 0;
-  Object.defineProperty(navigator, 'serial', {
-    value: {
-      async requestPort() {
-        const port = new FakePort(next++);
-        window.__fake.ports.push(port);
-        return port;
-      },
-      async getPorts() {
-        return window.__fake.ports.filter((p) => !window.__fake.unplugged.has(p.id));
-      },
-      addEventListener: (type, fn) => listeners.addEventListener(type, fn),
-      removeEventListener: (type, fn) => listeners.removeEventListener(type, fn),
-    },
-  });
-}
 
 async function serialSession() {
   const harness = spawn('node', ['harness.mjs', cfg.harness.arg], { cwd: cfg.harness.cwd, stdio: ['pipe', 'pipe', 'inherit'] });
@@ -445,6 +295,12 @@ async function serialSession() {
     // GP2 is pulled up (a button to ground): pressed is low.
     await inputsAndDmx(page, { press: async (down) => harness.stdin.write(`pin 2 ${down ? 0 : 1}\n`) });
     await shot(page, 'inputs');
+    await changeSettings(page);
+    const nobody = await until(async () => {
+      const text = await page.getByLabel('people the radar sees', { exact: true }).textContent();
+      return text === 'Nobody in view.' ? text : null;
+    }, 3000, "the map: the emulated Pico's radar sees nobody");
+    check(true, `radar on, the emulated Pico's telemetry carries its people: "${nobody}"`);
 
     // Unplugged mid-session.
     await page.evaluate((id) => window.__unplug(id), port);
@@ -456,13 +312,8 @@ async function serialSession() {
     mode = 'old';
     await page.getByRole('button', { name: 'Reconnect' }).click();
     await until(async () => (await page.locator('#banner-text').textContent()).includes('watch'), 10000, 'the page says the firmware has no telemetry');
-    // Read on connect: the inputs and DMX as set before; the rest settings,
-    // changed and not saved, cannot be asked for.
-    const role = await page.getByLabel('GP2 role').inputValue();
-    const dmxAddress = await page.getByLabel('DMX start address').inputValue();
-    const restPitch = await page.getByLabel('rest pose pitch in degrees').inputValue();
-    check(role === 'button' && dmxAddress === '17' && restPitch === '' && (await page.locator('#rest-note').isVisible()),
-      `reconnected: GP2 read as a ${role}, DMX address ${dmxAddress}; the rest pose blank, as the head cannot be asked for it`);
+    // Read on connect: every setting as set before (changed, not saved).
+    await readsBack(page, CHANGED, 'reconnected: every setting read back from the emulated Pico');
     const p0 = await readout(page, 'pitch');
     await page.getByLabel('idle motion').check();
     await page.getByRole('button', { name: 'Nod' }).click();
@@ -527,6 +378,16 @@ async function bridgeSession() {
       await inputsAndDmx(page);
       const pulses = async () => (/pulses (\d+), (\d+), (\d+)/.exec(await page.locator('#pulses').textContent()) ?? []).slice(1).map(Number);
       await servoRate(page, { pulses });
+      await changeSettings(page);
+      const nobody = await until(async () => {
+        const text = await page.getByLabel('people the radar sees', { exact: true }).textContent();
+        return text === 'Nobody in view.' ? text : null;
+      }, 3000, "the map: QEMU's radar, with nothing wired, sees nobody");
+      check(true, `radar on, QEMU's telemetry carries its people: "${nobody}"`);
+      // Reconnected (the page loaded again): every setting read back.
+      await page.reload();
+      await until(async () => (await page.locator('#state').textContent()).startsWith('connected'), 20000, 'connected again on load');
+      await readsBack(page, { ...CHANGED, rate: '333' }, 'reloaded: every setting read back from QEMU');
       await loadReadsBack(page);
     }
     check(errors.length === 0, `no page errors${errors.length ? `: ${errors.join('; ')}` : ''}`);
@@ -562,6 +423,7 @@ async function gazeControls(page) {
 
 try {
   if (cfg.session === 'serial') await serialSession();
+  else if (cfg.session === 'replay') await replaySession();
   else await bridgeSession();
   say(`passed: ${cfg.label ?? cfg.session}`);
 } catch (error) {

@@ -11,6 +11,7 @@
 mod host;
 mod marks;
 mod script;
+mod watch;
 
 use std::{fs, path::PathBuf};
 
@@ -33,6 +34,7 @@ use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::pwm_clock::PICO_SYS_HZ;
 use marks::Mark;
 pub use script::{Event, Kind};
+pub use watch::Watch;
 
 use crate::{project, steps::Steps};
 
@@ -62,6 +64,14 @@ pub struct Args {
     /// The CSV to write [default: trace/trace.csv in the target directory].
     #[arg(long, value_name = "csv")]
     pub out: Option<PathBuf>,
+    /// Also write the telemetry lines `watch` would stream meanwhile (the
+    /// core's own, with the radar's people when a script turns it on), one
+    /// a line, to this file.
+    #[arg(long, value_name = "file")]
+    pub telemetry: Option<PathBuf>,
+    /// The telemetry's lines a second (1 to 50; the panel asks for 20).
+    #[arg(long, value_name = "hz", default_value_t = 20, value_parser = clap::value_parser!(u8).range(1..=50))]
+    pub watch: u8,
     /// Also draw the three axes over time, the commands marked, to this PNG
     /// [without a file: trace/trace.png in the target directory].
     #[arg(long, value_name = "file")]
@@ -101,6 +111,11 @@ pub struct Trace {
     /// The script's commands as applied, and the looks' returns, in time
     /// order.
     pub marks: Vec<Mark>,
+    /// The telemetry lines, when asked for ([`simulate_watched`]).
+    pub watch: Option<Watch>,
+    /// The replies to the lines asked of the console after the last frame
+    /// ([`simulate_watched`]).
+    pub answers: Vec<String>,
 }
 
 /// A PWM channel that keeps the last duty, counted as the Pico's slice
@@ -200,6 +215,21 @@ pub fn simulate(
     rate: ServoRate,
     events: &[Event],
 ) -> Result<Trace> {
+    simulate_watched(micros, seed, rate, events, None, &[])
+}
+
+/// As [`simulate`], with the telemetry lines of a `watch` (if `watch`
+/// gives its lines a second), and the console's replies to `ask` after the
+/// last frame.
+pub fn simulate_watched(
+    micros: u64,
+    seed: Option<u32>,
+    rate: ServoRate,
+    events: &[Event],
+    watch: Option<u8>,
+    ask: &[&str],
+) -> Result<Trace> {
+    let mut watch = watch.map(Watch::new);
     let (driver_params, params) = at_rate(rate)?;
     let period = driver_params.config().frame_period;
     let playback =
@@ -281,27 +311,51 @@ pub fn simulate(
                 .map_err(|e| anyhow!("{} ms: servo rate refused: {e}", t_us / 1000))?;
         }
         let report = played.report;
-        let mode = HeadMode::of(driver.is_stopped(), driver.is_stopping(), head.rest_state());
-        link.publish(HeadStatus::of(
+        publish(
+            &head,
+            &driver,
             &report,
-            driver.stats(),
-            mode,
-            Timestamp(t_us),
-        ));
+            (&link, &show),
+            t_us,
+            watch.as_mut(),
+        );
         let period_us = driver.params().config().frame_period.0;
         rows.push(row(frame, t_us, &report, &mut driver));
         frame += 1;
         t_us += u64::from(period_us);
     }
     marks::settle(&mut marks, params.config().blend.0, t_us / 1000);
-    for event in &events[next..] {
-        println!(
-            "line {}: at {} s, after the trace's end: not run",
-            event.line,
-            script::show_seconds(event.at_us)
-        );
+    events[next..].iter().for_each(script::not_run);
+    let answers = ask.iter().map(|line| console.line(line).0).collect();
+    Ok(Trace {
+        rows,
+        marks,
+        watch,
+        answers,
+    })
+}
+
+/// Publishes the status after the frame at `t_us` that wrote `report` to
+/// the console's link, as the frame task does (the tracker's view while
+/// the radar is on), and to `watch`, if one streams.
+fn publish(
+    head: &Head<Idle>,
+    driver: &FrameDriver<Channel>,
+    report: &FrameReport,
+    (link, show): (&ConsoleLink, &ShowLink),
+    t_us: u64,
+    watch: Option<&mut Watch>,
+) {
+    let mode = HeadMode::of(driver.is_stopped(), driver.is_stopping(), head.rest_state());
+    let mut status = HeadStatus::of(report, driver.stats(), mode, Timestamp(t_us));
+    status.idle = Some(head.idle_view());
+    if show.track.settings().radar {
+        status.track = Some(head.track_view());
     }
-    Ok(Trace { rows, marks })
+    link.publish(status);
+    if let Some(watch) = watch {
+        watch.frame(t_us, &status);
+    }
 }
 
 /// The radar's frame period, µs (the LD2450 reports ten times a second).
@@ -311,9 +365,12 @@ const RADAR_US: u64 = 100_000;
 /// through the receiver's link.
 fn send_radar(show: &ShowLink, people: Sighting, sent: &mut u64, t_us: u64) {
     while *sent * RADAR_US <= t_us {
-        show.track
-            .publish(Some(people), idle_head_core::track::Counters::default());
         *sent += 1;
+        let counters = idle_head_core::track::Counters {
+            good: u32::try_from(*sent).unwrap_or(u32::MAX),
+            ..idle_head_core::track::Counters::default()
+        };
+        show.track.publish(Some(people), counters);
     }
 }
 
@@ -481,7 +538,8 @@ pub fn command(args: &Args) -> Result<bool> {
         }
         None => Vec::new(),
     };
-    let trace = simulate(args.micros, args.seed, rate, &events)?;
+    let watch = args.telemetry.as_ref().map(|_| args.watch);
+    let trace = simulate_watched(args.micros, args.seed, rate, &events, watch, &[])?;
     let dir = || -> Result<PathBuf> {
         Ok(project::metadata(&project::root())?
             .target_dir
@@ -522,6 +580,15 @@ pub fn command(args: &Args) -> Result<bool> {
         );
     }
     println!("wrote {} ({} frames)", out.display(), trace.rows.len());
+    if let (Some(path), Some(watch)) = (&args.telemetry, &trace.watch) {
+        project::write(path, watch.lines.join("\n") + "\n")?;
+        println!(
+            "wrote {} ({} telemetry lines, {} a second)",
+            path.display(),
+            watch.lines.len(),
+            args.watch
+        );
+    }
     if let Some(png) = &args.png {
         let png = png
             .clone()

@@ -23,7 +23,10 @@
 //! frame, servo calibrations from the console's link, each command's
 //! outcome told to the console port that asked for it
 //! (`ConsoleLink::answer`, as [`FrameLoop::drain`] does), the status
-//! published for it after every frame ([`FrameLoop::publish`]), the
+//! published for it after every frame ([`FrameLoop::publish`]: the
+//! pose, the idle and the tracker's view), the telemetry line `watch`
+//! writes of it (`idle_head_core::console::telemetry_line`, any people
+//! at any positions), the
 //! console's parser (`idle_head_core::console::parse`) on any line, the
 //! trigger inputs' state machine (`idle_head_core::input::Inputs`) on any
 //! levels; the show layer ([`FrameLoop::show`]: any DMX cue, DMX on or off,
@@ -63,7 +66,7 @@ use idle_head_core::bottango::{self, Curve, Op, line::CurveArgs};
 use idle_head_core::command::{
     Action, GestureKind, GestureRequest, Hold, InputRole, LookRequest, Percent, RestAfter,
 };
-use idle_head_core::console::{ConsoleLink, parse};
+use idle_head_core::console::{ConsoleLink, TELEMETRY_LINE, parse, telemetry_line};
 use idle_head_core::dmx::{DmxAddress, DmxSettings};
 use idle_head_core::driver::{
     DegreesPerSecond, DegreesPerSecondSquared, DriverParams, FrameDriver, MotionLimits,
@@ -72,7 +75,7 @@ use idle_head_core::idle::{IdlePlayer, IdleTiming};
 use idle_head_core::input::{InputSettings, Inputs, Micros};
 use idle_head_core::servo::{Direction, NanosPerDegree, ServoCalibration, ServoRate, SetPeriod};
 use idle_head_core::track::ld2450::Decoder;
-use idle_head_core::track::{Person, Prefer, Sighting, SightingSource, TrackSettings};
+use idle_head_core::track::{Person, Prefer, Sighting, SightingSource, TrackSettings, TrackView};
 use idle_head_core::units::{Angle, AngleRange, Microseconds, Millis};
 use idle_head_core::{Axis, Playback};
 use idle_head_firmware::config::{
@@ -428,6 +431,26 @@ fn main() -> ! {
                 LINK.set_rate(rate);
                 let tick = frames.next(black_box(0));
                 frames.take_rate(&mut driver, tick);
+            }
+            14 => {
+                // A telemetry line (`watch`) of the status the last frame
+                // published, with any tracker view and any count of lines
+                // lost, into a buffer of the line's bound.
+                let mut status = LINK.status();
+                let mut seen = Sighting::NOBODY;
+                for slot in &mut seen.people {
+                    *slot = black_box(Some(Person {
+                        x: Millimetres(black_box(0)),
+                        y: Millimetres(black_box(0)),
+                    }));
+                }
+                status.track = black_box(Some(TrackView {
+                    seen,
+                    who: black_box(Some(0)),
+                    at: black_box(Some(Angle::from_millidegrees(black_box(0)))),
+                }));
+                let mut out = [0_u8; TELEMETRY_LINE];
+                black_box(telemetry_line(&status, black_box(0), &mut out));
             }
             _ => {}
         }

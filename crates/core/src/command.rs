@@ -232,10 +232,14 @@ pub enum Command {
         /// The new role, if any.
         role: Option<InputRole>,
     },
-    /// Change the rest settings.
-    Rest(RestSetting),
-    /// How much a held look ducks the idle on its axes.
-    LookDuck(Percent),
+    /// Show the rest settings (`None`: `rest after`, `rest pose` or
+    /// `rest relax` alone), or change one.
+    Rest(Option<RestSetting>),
+    /// Show (`None`) or set how much a held look ducks the idle on its
+    /// axes.
+    LookDuck(Option<Percent>),
+    /// Show the idle motion: on or off, and its amplitude (`idle` alone).
+    IdleQuery,
     /// Show the seed in use.
     SeedQuery,
     /// Show the radar's state and counters (`None`), or switch it on or off.

@@ -314,6 +314,7 @@ impl<'a, I: IdleSource> FrameLoop<'a, I> {
                 self.head.rest_state(),
             );
             let mut status = HeadStatus::of(report, driver.stats(), mode, self.at);
+            status.idle = Some(self.head.idle_view());
             if self.show.is_some_and(|show| show.track.settings().radar) {
                 status.track = Some(self.head.track_view());
             }

@@ -240,7 +240,9 @@ impl SimFrames {
             self.driver.is_stopping(),
             self.head.rest_state(),
         );
-        link.publish(HeadStatus::of(&report, self.driver.stats(), mode, at));
+        let mut status = HeadStatus::of(&report, self.driver.stats(), mode, at);
+        status.idle = Some(self.head.idle_view());
+        link.publish(status);
         self.frame += 1;
         self.frames += 1;
         self.at += u64::from(self.driver.params().config().frame_period.0);

@@ -7,6 +7,7 @@
 pub mod head;
 mod model;
 mod mutate;
+pub mod talk;
 mod text;
 
 use idle_head_core::command::Command;

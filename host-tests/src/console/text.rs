@@ -185,15 +185,21 @@ pub fn random_command(rng: &mut TestRng) -> Command {
                 },
             }),
         },
-        13 => match rng.random_range(0..4) {
-            0 => Command::Rest(RestSetting::After(if rng.random_bool(0.2) {
+        13 => match rng.random_range(0..7) {
+            0 => Command::Rest(Some(RestSetting::After(if rng.random_bool(0.2) {
                 RestAfter::Never
             } else {
                 RestAfter::Seconds(rng.random_range(1..=86_400))
-            })),
-            1 => Command::Rest(RestSetting::Pose([angle(rng), angle(rng), angle(rng)])),
-            2 => Command::Rest(RestSetting::Relax(rng.random_bool(0.5))),
-            _ => Command::LookDuck(percent(rng)),
+            }))),
+            1 => Command::Rest(Some(RestSetting::Pose([
+                angle(rng),
+                angle(rng),
+                angle(rng),
+            ]))),
+            2 => Command::Rest(Some(RestSetting::Relax(rng.random_bool(0.5)))),
+            3 => Command::Rest(None),
+            4 => Command::IdleQuery,
+            _ => Command::LookDuck(maybe(rng, percent)),
         },
         10 => match rng.random_range(0..10) {
             0 => Command::Seed(SeedChoice::Random),
@@ -366,6 +372,16 @@ fn write_command(s: &mut Style<'_>, command: &Command) {
         }
         Command::Rest(setting) => {
             s.word("rest");
+            let Some(setting) = setting else {
+                // Any of the three fields alone shows them all.
+                let field = match s.rng.as_mut().map_or(0, |r| r.random_range(0..3)) {
+                    0 => "after",
+                    1 => "pose",
+                    _ => "relax",
+                };
+                s.word(field);
+                return;
+            };
             match setting {
                 RestSetting::After(RestAfter::Never) => {
                     s.word("after");
@@ -390,8 +406,11 @@ fn write_command(s: &mut Style<'_>, command: &Command) {
         Command::LookDuck(p) => {
             s.word("look");
             s.word("duck");
-            s.number(i64::from(p.get()));
+            if let Some(p) = p {
+                s.number(i64::from(p.get()));
+            }
         }
+        Command::IdleQuery => s.word("idle"),
         Command::Seed(SeedChoice::Random) => {
             s.word("seed");
             s.word("random");

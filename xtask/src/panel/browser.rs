@@ -1,8 +1,9 @@
 //! The panel's browser tests, a stage of `cargo xtask test`: Debian's
 //! Chromium, headless, driven by playwright-core (`panel/tests/browser.mjs`)
-//! over Web Serial (the emulated Pico), the bridge of `panel --qemu`, and a
+//! over Web Serial (the emulated Pico), the bridge of `panel --qemu`, a
 //! real serial port (QEMU's UART0 on a pty, through `console --port` and
-//! `panel --port`). Screenshots go to `target/panel/`.
+//! `panel --port`), and the radar's map on the telemetry of a host trace
+//! replayed by a fake serial port. Screenshots go to `target/panel/`.
 
 use std::{
     io::{BufRead, BufReader, Write},
@@ -17,11 +18,10 @@ use anyhow::{Context, Result, bail};
 use super::{Bridge, ensure_dependencies, server::Server};
 use crate::console::{Pace, qemu::qemu_command};
 use crate::project::{Metadata, PICO, QEMU};
-use crate::{setup, sim};
+use crate::{setup, sim, trace};
 
 /// The stage's name.
-pub const STAGE: &str =
-    "panel in a real browser: Web Serial (emulated Pico), bridge (QEMU), serial port (pty)";
+pub const STAGE: &str = "panel in a real browser: Web Serial (emulated Pico), bridge (QEMU), serial port (pty), radar map (replay)";
 
 /// Debian's Chromium.
 const CHROMIUM: &str = "/usr/bin/chromium";
@@ -77,6 +77,9 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
 
     // 3. A real serial port: QEMU's UART0 as a pseudo-terminal.
     report.push(serial_port(root, &chromium, &QEMU.elf(metadata), &shots)?);
+
+    // 4. The radar's map: the telemetry of a scripted walk, replayed.
+    report.push(replay(root, &chromium, &shots)?);
     Ok(format!(
         "{}; {:.0} s",
         report.join("; "),
@@ -112,6 +115,72 @@ fn browser(root: &Path, chromium: &Path, config: &serde_json::Value) -> Result<S
             || format!("{} passed", config["label"]),
             |l| format!("{}: {l}", config["label"]),
         ))
+}
+
+/// The lines the page sends as it connects and every 2 s after: their
+/// replies are the console's, at the end of the replayed run.
+const PAGE_ASKS: [&str; 18] = [
+    "help",
+    "status",
+    "servo pitch",
+    "servo roll",
+    "servo yaw",
+    "servo rate",
+    "rest after",
+    "idle",
+    "look duck",
+    "seed",
+    "input 2",
+    "input 3",
+    "input 4",
+    "input 5",
+    "dmx",
+    "radar",
+    "track",
+    "watch 20",
+];
+
+/// The radar's map: the host trace of `panel/tests/radar-replay.txt` (the
+/// core's frame engine, tracker and console service, as on a board), its
+/// telemetry lines (`watch 20`, the core's own) replayed to the page by a
+/// fake serial port in real time, which answers the page's lines with the
+/// console's replies at the end of the run.
+fn replay(root: &Path, chromium: &Path, shots: &Path) -> Result<String> {
+    let path = root.join("panel/tests/radar-replay.txt");
+    let script =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let (_, params) = trace::built_in()?;
+    let events = trace::parse_script(&script, &params)?;
+    let end = events.last().map_or(0, |e| e.at_us) + 1_500_000;
+    let run = trace::simulate_watched(
+        end,
+        None,
+        idle_head_core::servo::ServoRate::DEFAULT,
+        &events,
+        Some(20),
+        &PAGE_ASKS,
+    )?;
+    let lines = run.watch.map(|w| w.lines).unwrap_or_default();
+    let answers: serde_json::Map<String, serde_json::Value> = PAGE_ASKS
+        .iter()
+        .zip(run.answers)
+        .map(|(ask, reply)| ((*ask).to_owned(), reply.into()))
+        .collect();
+    let (stop, _) = mpsc::channel();
+    let plain = Server::start(root, "127.0.0.1:0".parse()?, None, stop)?;
+    let session = browser(
+        root,
+        chromium,
+        &serde_json::json!({
+            "session": "replay",
+            "url": format!("http://{}/", plain.address),
+            "shots": shots,
+            "label": "radar-replay",
+            "replay": { "lines": lines, "answers": answers },
+        }),
+    );
+    drop(plain);
+    session
 }
 
 /// QEMU with UART0 on a pseudo-terminal: `cargo xtask console --port` with

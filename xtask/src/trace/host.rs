@@ -62,7 +62,7 @@ impl<'a> Console<'a> {
     /// action says what it started (the trace marks it).
     pub fn line(&mut self, line: &str) -> (String, bool) {
         let before = self.queue.len();
-        let mut out = [0; 160];
+        let mut out = [0; idle_head_core::console::PORT_REPLY];
         let later = match respond(Ok(line.as_bytes()), &mut self.service, &mut out) {
             Response::Now(reply) => return (text(reply), self.queue.len() > before),
             Response::Later(later) => later,

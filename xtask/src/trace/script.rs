@@ -87,6 +87,15 @@ pub fn show_seconds(us: u64) -> String {
     text
 }
 
+/// Says that `event` came after the trace's end.
+pub fn not_run(event: &Event) {
+    println!(
+        "line {}: at {} s, after the trace's end: not run",
+        event.line,
+        show_seconds(event.at_us)
+    );
+}
+
 /// Parses a script: its events, in time order. A script is a program, read
 /// top to bottom: a line timed before the line above it is an error (lines
 /// at the same time run in line order). Every bad line is reported, each

@@ -1,6 +1,8 @@
 use super::*;
 use idle_head_core::behaviour::LimitMode;
 
+use crate::steps::Steps;
+
 fn run(script: &str, seconds: u64) -> Trace {
     let (_, params) = built_in().unwrap();
     let events = script::parse(script, &params).unwrap();
@@ -179,4 +181,54 @@ fn a_button_runs_its_action_within_a_frame_of_its_edge() {
     let idle = run("", 5);
     let first = (150..250).find(|&k| trace.rows[k].angles[0] != idle.rows[k].angles[0]);
     assert_eq!(first, Some(150));
+}
+
+/// `--telemetry`: a line per tick of `watch` (the first frame at or after
+/// each), the core's own; with the radar on, its people and whom the head
+/// attends to.
+#[test]
+fn the_telemetry_of_a_trace_carries_the_radars_people() {
+    let script = "0 idle off\n1 radar on\n1.2 radar 400,2000 -900,3000\n";
+    let (_, params) = built_in().unwrap();
+    let events = script::parse(script, &params).unwrap();
+    let trace = simulate_watched(
+        3_000_000,
+        None,
+        ServoRate::DEFAULT,
+        &events,
+        Some(20),
+        &["radar", "track"],
+    )
+    .unwrap();
+    let lines = trace.watch.unwrap().lines;
+    // 3 s at 20 a second: ticks at 0, 50, …, 2950 ms, each taken by the
+    // first 20 ms frame at or after it.
+    assert_eq!(lines.len(), 60);
+    let times: Vec<u64> = lines
+        .iter()
+        .map(|l| l.split_whitespace().nth(1).unwrap()[2..].parse().unwrap())
+        .collect();
+    assert_eq!(&times[..4], [0, 60, 100, 160]);
+    for line in &lines {
+        let (body, crc) = line.rsplit_once(" *").unwrap();
+        let sum = idle_head_core::console::checksum(body.as_bytes());
+        assert_eq!(crc, format!("{sum:02x}"), "{line}");
+    }
+    assert!(!lines[19].contains("targets="), "{}", lines[19]);
+    assert!(
+        lines[21].contains(" targets=0 at=- xy=- who=- *"),
+        "{}",
+        lines[21]
+    );
+    let last = lines.last().unwrap();
+    assert!(
+        last.contains(" targets=2 at=") && last.contains(" xy=400,2000;-900,3000 who=0 *"),
+        "{last}"
+    );
+    // The radar sends from power-up, ten frames a second: 0 to 2.9 s.
+    assert_eq!(trace.answers[0], "ok radar=on frames=30 bad=0 targets=2");
+    assert_eq!(
+        trace.answers[1],
+        "ok track=on height=300 mount=0 prefer=nearest"
+    );
 }

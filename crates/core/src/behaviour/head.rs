@@ -319,12 +319,23 @@ impl<I: IdleSource> Head<I> {
         self.tracker.aiming()
     }
 
-    /// The tracker for `watch`: people in the latest sighting, and the yaw
-    /// the head aims at.
+    /// The tracker for `watch`: the latest sighting, whom the head attends
+    /// to in it, and the yaw the head aims at.
     pub const fn track_view(&self) -> crate::track::TrackView {
+        let (seen, who) = self.tracker.seen();
         crate::track::TrackView {
-            targets: self.tracker.targets(),
+            seen: *seen,
+            who,
             at: self.tracker.aiming(),
+        }
+    }
+
+    /// The idle motion as the mixer has it, for `idle`: on or off, and the
+    /// amplitude last set (by the console, an input or DMX).
+    pub const fn idle_view(&self) -> crate::console::IdleView {
+        crate::console::IdleView {
+            on: self.mixer.idle_on(),
+            amp: self.mixer.idle_amp(),
         }
     }
 

@@ -523,6 +523,12 @@ impl Mixer {
         self.modes
     }
 
+    /// Whether the idle is on (`idle on|off`).
+    #[must_use]
+    pub const fn idle_on(&self) -> bool {
+        self.idle_on
+    }
+
     /// The idle amplitude as last set (`idle amp`), whether the idle is on
     /// or off.
     #[must_use]

@@ -119,6 +119,13 @@ impl BehaviourParams {
         rest_offsets(&self.config, &self.pose, &self.room).0
     }
 
+    /// Whether the rest pose lies past the servos' limits (the head rests
+    /// clamped to them, at [`rest_pose`](Self::rest_pose)).
+    #[must_use]
+    pub const fn rest_clamped(&self) -> bool {
+        rest_offsets(&self.config, &self.pose, &self.room).1
+    }
+
     /// The rest pose, `[pitch, roll, yaw]` axis angles, as the head rests:
     /// within the servos' limits.
     #[must_use]

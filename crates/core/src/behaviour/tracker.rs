@@ -53,8 +53,11 @@ pub(crate) struct Tracker {
     last: u64,
     /// The aim's yaw, for `watch`.
     at: Option<Angle>,
-    /// People in the latest sighting, for `watch`.
-    targets: u8,
+    /// The latest sighting, for `watch`.
+    seen: Sighting,
+    /// Whom attention attends to, as an index among `seen`'s people, if
+    /// they are in it, for `watch`.
+    who: Option<u8>,
 }
 
 impl Tracker {
@@ -66,7 +69,8 @@ impl Tracker {
             attended: None,
             last: 0,
             at: None,
-            targets: 0,
+            seen: Sighting::NOBODY,
+            who: None,
         }
     }
 
@@ -75,9 +79,23 @@ impl Tracker {
         self.at
     }
 
-    /// People in the latest sighting.
-    pub(crate) const fn targets(&self) -> u8 {
-        self.targets
+    /// The latest sighting, and whom attention attends to among its
+    /// people (see [`TrackView::who`](crate::track::TrackView::who)).
+    pub(crate) const fn seen(&self) -> (&Sighting, Option<u8>) {
+        (&self.seen, self.who)
+    }
+
+    /// Whom attention attends to among the latest sighting's people: the
+    /// attended person's track, if that sighting updated it, is where one
+    /// of them was.
+    fn attended_in_sighting(&self) -> Option<u8> {
+        let i = self.attention.attended()?;
+        if !self.attention.fresh(i, self.last) {
+            return None;
+        }
+        let at = self.attention.person(i)?;
+        let k = self.seen.people.iter().flatten().position(|p| *p == at)?;
+        Some(k as u8)
     }
 
     /// Between frames, at `now` µs: the sighting that came (if any) with
@@ -89,19 +107,23 @@ impl Tracker {
         settings: &TrackSettings,
         sighting: Option<&Sighting>,
     ) -> Option<TrackEvent> {
+        if let Some(s) = sighting {
+            self.seen = *s;
+        }
         if !settings.gazes() {
+            self.who = None;
             return self.release(mixer);
         }
         let dt_ms = (now.saturating_sub(self.last) / 1000).min(u64::from(u32::MAX)) as u32;
         match sighting {
             Some(s) => {
-                self.targets = s.count();
                 self.attention.sight(now, s, settings.prefer);
                 self.last = now;
             }
             None if now >= self.attention.deadline() => self.attention.tick(now, settings.prefer),
             None => return None,
         }
+        self.who = self.attended_in_sighting();
         let angles = |i: usize| {
             let person = self.attention.person(i)?;
             Some([pitch(&person, settings), bearing(&person, settings)])

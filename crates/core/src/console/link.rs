@@ -79,6 +79,19 @@ pub struct HeadStatus {
     pub disabled: [bool; 3],
     /// The tracker, while the radar is on (`None`: off).
     pub track: Option<TrackView>,
+    /// The idle motion as the mixer has it (`None`: not published).
+    pub idle: Option<IdleView>,
+}
+
+/// The idle motion as the last frame left it, for `idle`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct IdleView {
+    /// Whether it is on (`idle on|off`).
+    pub on: bool,
+    /// The amplitude last set (`idle amp`, an input's or DMX's), on or
+    /// off.
+    pub amp: crate::units::Percent,
 }
 
 impl HeadMode {
@@ -114,6 +127,7 @@ impl HeadStatus {
             faults: stats.faults,
             disabled: stats.disabled,
             track: None,
+            idle: None,
         }
     }
 
@@ -178,6 +192,7 @@ impl ConsoleLink {
                 faults: [0; 3],
                 disabled: [false; 3],
                 track: None,
+                idle: None,
             }),
             servos: SharedCell::new([None; 3]),
             seeds: Signal::new(),

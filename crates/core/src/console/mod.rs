@@ -33,7 +33,7 @@ mod shared;
 mod telemetry;
 
 pub use framer::{Framer, LineError};
-pub use link::{ConsoleLink, HeadMode, HeadStatus, OUTCOMES, Outcome, PORTS};
+pub use link::{ConsoleLink, HeadMode, HeadStatus, IdleView, OUTCOMES, Outcome, PORTS};
 pub use outbox::{HELD, Outbox, WAITING};
 pub use outcome::{outcome_reply, unanswered};
 pub use parse::{ActionLine, KEYWORDS, ParseError, ParseErrorKind, Span, parse};

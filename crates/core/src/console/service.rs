@@ -194,7 +194,17 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
             ticket: self.ticket,
         };
         match self.queue.try_submit_from(action, asker) {
-            Ok(()) => reply.defer(asker.ticket),
+            Ok(()) => {
+                // The console's idle amplitude is a setting, kept with
+                // `save` (an input's or DMX's is not).
+                if let Action::IdleAmp(amp) = action
+                    && amp != self.settings.behaviour.idle.amplitude
+                {
+                    self.settings.behaviour.idle.amplitude = amp;
+                    self.source = SettingsSource::Changed;
+                }
+                reply.defer(asker.ticket);
+            }
             Err(full) => {
                 text(reply.err(ErrorCode::Busy)).with(&full);
             }
@@ -441,8 +451,11 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
                 input,
                 role: Some(role),
             } => self.set_input(input, role, reply),
-            Command::Rest(setting) => self.set_rest(setting, reply),
-            Command::LookDuck(duck) => self.set_look_duck(duck),
+            Command::Rest(None) => self.show_rest(reply),
+            Command::Rest(Some(setting)) => self.set_rest(setting, reply),
+            Command::LookDuck(None) => self.show_look_duck(reply),
+            Command::LookDuck(Some(duck)) => self.set_look_duck(duck),
+            Command::IdleQuery => self.show_idle(reply),
             Command::SeedQuery => self.show_seed(text(reply.ok())),
             Command::Radar(on) => self.radar(on, reply),
             Command::Track(setting) => self.track(setting, reply),

@@ -12,17 +12,32 @@
 //! `p`, `r`, `y` the commanded angles in mdeg; `us` the pulses written;
 //! `lost` the lines this port dropped so far because the host read too
 //! slowly (each tick whose line could not go out in time).
+//!
+//! With the radar on, then `targets` (the people in the radar's latest
+//! frame), `at` (the yaw the head aims at while it follows someone, `-`
+//! otherwise), `xy` (each person's `x,y` in mm in the radar's frame,
+//! `;` between them, in the radar's slot order; `-` for nobody) and `who`
+//! (whom the head attends to, an index into `xy` from 0; `-` for nobody,
+//! or someone not in this frame):
+//!
+//! ```text
+//! ~ t=123440 p=-1505 r=-119 y=-236 us=1483,1499,1497 lost=0 targets=2 at=-14036 xy=-812,1950;1200,3400 who=0 *3a
+//! ```
 
 use crate::text::{Out, Text};
 
 use super::link::HeadStatus;
 use super::session::{PORT_REPLY, checksum};
+use crate::track::PEOPLE;
 
 /// The longest telemetry line, CR LF included:
 /// `~ t=` (4) + 20 digits, ` p=`/` r=`/` y=` 3 × (3 + 11), ` us=` (4) +
 /// 3 × 10 + 2 commas, ` lost=` (6) + 10, ` *hh` (4), CR LF (2).
-/// With the radar on, ` targets=` (9) + 3 digits and ` at=` (4) + 11.
-pub const TELEMETRY_LINE: usize = 4 + 20 + 3 * 14 + 4 + 32 + 6 + 10 + 4 + 2 + 12 + 15;
+/// With the radar on, ` targets=` (9) + 3 digits, ` at=` (4) + 11,
+/// ` xy=` (4) + [`PEOPLE`] × (11 + comma + 11) + a semicolon between two,
+/// and ` who=` (5) + 3 digits: 234 bytes in all.
+pub const TELEMETRY_LINE: usize =
+    4 + 20 + 3 * 14 + 4 + 32 + 6 + 10 + 4 + 2 + 12 + 15 + 4 + PEOPLE * 24 - 1 + 8;
 
 // A port's telemetry line is written into its session's reply buffer.
 const _: () = assert!(TELEMETRY_LINE <= PORT_REPLY);
@@ -43,10 +58,30 @@ pub fn telemetry_line<'b>(status: &HeadStatus, lost: u32, out: &'b mut [u8]) -> 
     if let Some(track) = status.track {
         line.text()
             .str(" targets=")
-            .u64(track.targets.into())
+            .u64(track.targets().into())
             .str(" at=");
         match track.at {
             Some(yaw) => line.text().i64(yaw.millidegrees().into()),
+            None => line.text().str("-"),
+        };
+        line.text().str(" xy=");
+        let mut first = true;
+        for person in track.seen.people.iter().flatten() {
+            if !first {
+                line.text().str(";");
+            }
+            first = false;
+            line.text()
+                .i64(person.x.0.into())
+                .str(",")
+                .i64(person.y.0.into());
+        }
+        if first {
+            line.text().str("-");
+        }
+        line.text().str(" who=");
+        match track.who {
+            Some(k) => line.text().u64(k.into()),
             None => line.text().str("-"),
         };
     }
@@ -81,7 +116,15 @@ pub(crate) fn write_pose(out: &mut dyn Text, status: &HeadStatus, angles: Angles
 mod tests {
     use super::*;
     use crate::console::HeadMode;
-    use crate::units::{Angle, Microseconds};
+    use crate::track::{Person, Sighting, TrackView};
+    use crate::units::{Angle, Microseconds, Millimetres};
+
+    fn person(x: i32, y: i32) -> Person {
+        Person {
+            x: Millimetres(x),
+            y: Millimetres(y),
+        }
+    }
 
     #[test]
     fn a_line_reads_back_and_the_longest_fits() {
@@ -95,6 +138,7 @@ mod tests {
             faults: [0; 3],
             disabled: [false; 3],
             track: None,
+            idle: None,
         };
         let line = telemetry_line(&status, 3, &mut out).to_vec();
         let text = std::str::from_utf8(&line).unwrap();
@@ -104,30 +148,59 @@ mod tests {
             "~ t=1000 p=-1505 r=-119 y=236 us=1483,1499,1497 lost=3"
         );
         assert_eq!(tail, format!("{:02x}\r\n", checksum(body.as_bytes())));
-        let worst = HeadStatus {
-            frame: u64::MAX,
-            time: crate::Timestamp(u64::MAX),
-            angles: [Angle::from_millidegrees(i32::MIN + 1); 3],
-            pulses: [Microseconds(u32::MAX); 3],
-            ..status
-        };
+
+        // The radar's people in slot order, the empty slot left out; `who`
+        // counts among those listed.
         let radar = HeadStatus {
-            track: Some(crate::track::TrackView {
-                targets: 2,
+            track: Some(TrackView {
+                seen: Sighting {
+                    people: [Some(person(-812, 1950)), None, Some(person(1200, 3400))],
+                },
+                who: Some(1),
                 at: Some(Angle::from_millidegrees(-14_036)),
             }),
             ..status
         };
         let line = telemetry_line(&radar, 3, &mut out).to_vec();
-        assert!(String::from_utf8_lossy(&line).contains(" lost=3 targets=2 at=-14036 *"));
+        assert!(
+            String::from_utf8_lossy(&line)
+                .contains(" lost=3 targets=2 at=-14036 xy=-812,1950;1200,3400 who=1 *"),
+            "{}",
+            String::from_utf8_lossy(&line)
+        );
+        let nobody = HeadStatus {
+            track: Some(TrackView::default()),
+            ..status
+        };
+        let line = telemetry_line(&nobody, 0, &mut out).to_vec();
+        assert!(String::from_utf8_lossy(&line).contains(" lost=0 targets=0 at=- xy=- who=- *"));
+
+        // Every field at its longest: the line end whole, and the bound
+        // exact but for the time, whose 20 digits are a u64's (the ms of
+        // u64::MAX µs have 17), and `targets`, whose 3 are a u8's (a
+        // sighting holds at most 3 people: 1 digit).
+        let far = Some(person(i32::MIN, i32::MIN));
         let worst = HeadStatus {
-            track: Some(crate::track::TrackView {
-                targets: u8::MAX,
-                at: Some(Angle::from_millidegrees(i32::MIN + 1)),
+            frame: u64::MAX,
+            time: crate::Timestamp(u64::MAX),
+            angles: [Angle::from_millidegrees(i32::MIN); 3],
+            pulses: [Microseconds(u32::MAX); 3],
+            track: Some(TrackView {
+                seen: Sighting {
+                    people: [far; crate::track::PEOPLE],
+                },
+                who: Some(u8::MAX),
+                at: Some(Angle::from_millidegrees(i32::MIN)),
             }),
-            ..worst
+            ..status
         };
         let line = telemetry_line(&worst, u32::MAX, &mut out);
         assert!(line.ends_with(b"\r\n"), "{}", String::from_utf8_lossy(line));
+        assert_eq!(
+            line.len(),
+            TELEMETRY_LINE - 3 - 2,
+            "{}",
+            String::from_utf8_lossy(line)
+        );
     }
 }

@@ -35,10 +35,22 @@ use crate::units::{Angle, Millimetres};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct TrackView {
-    /// People in the latest sighting.
-    pub targets: u8,
+    /// The latest sighting the frame task took.
+    pub seen: Sighting,
+    /// Whom the head attends to, if they are in `seen`: the index among
+    /// its people, counted in slot order over the slots that hold someone
+    /// (as `watch` lists them).
+    pub who: Option<u8>,
     /// The yaw the head aims at (an axis angle), if it follows someone.
     pub at: Option<Angle>,
+}
+
+impl TrackView {
+    /// People in the latest sighting.
+    #[must_use]
+    pub fn targets(&self) -> u8 {
+        self.seen.count()
+    }
 }
 
 /// People a sighting holds at most (the LD2450 tracks three).

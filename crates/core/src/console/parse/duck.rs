@@ -1,4 +1,5 @@
-//! `look duck <percent>`: how much a held look ducks the idle on its axes.
+//! `look duck [<percent>]`: how much a held look ducks the idle on its
+//! axes (alone: the duck in effect).
 
 use crate::command::Command;
 
@@ -13,8 +14,12 @@ pub(super) fn follows(words: &mut Words<'_>) -> bool {
         .is_some_and(|word| word.lower() == Word::Is(Kw::Duck))
 }
 
-/// `look duck <percent>` (after the word `look`).
+/// `look duck [<percent>]` (after the word `look`; alone: the duck in
+/// effect).
 pub(super) fn look_duck(words: &mut Words<'_>) -> Result<Command, ParseError> {
     words.next();
-    Ok(Command::LookDuck(to_percent(words.number(&PERCENT)?)))
+    if words.peek().is_none() {
+        return Ok(Command::LookDuck(None));
+    }
+    Ok(Command::LookDuck(Some(to_percent(words.number(&PERCENT)?))))
 }

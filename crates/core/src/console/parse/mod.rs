@@ -59,7 +59,9 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
     let Some(first) = words.next() else {
         return Err(words.error_here(ParseErrorKind::Empty));
     };
-    let command = if let Some(action) = motion(first, &mut words)? {
+    let command = if first.lower() == Word::Is(Kw::Idle) && words.peek().is_none() {
+        Command::IdleQuery
+    } else if let Some(action) = motion(first, &mut words)? {
         Command::Act(action)
     } else {
         match first.lower() {

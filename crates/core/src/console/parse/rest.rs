@@ -1,5 +1,7 @@
 //! `rest after <seconds>|never`, `rest pose <pitch> <roll> <yaw>`,
-//! `rest relax on|off` (`rest` alone is a motion: the head rests).
+//! `rest relax on|off`; any of `rest after`, `rest pose` and `rest relax`
+//! alone shows the rest settings (`rest` alone is a motion: the head
+//! rests).
 
 use crate::command::{Command, MAX_REST_AFTER, RestAfter, RestSetting};
 use crate::units::Angle;
@@ -17,18 +19,18 @@ pub(super) fn rest(words: &mut Words<'_>) -> Result<Command, ParseError> {
     let Some(word) = words.next() else {
         return Err(words.error_here(ParseErrorKind::Missing(EXPECTED)));
     };
-    let setting = match word.lower() {
-        Word::Is(Kw::After) => {
-            const WHEN: &str = "seconds or `never`";
-            match words.peek() {
-                Some(w) if w.lower() == Word::Is(Kw::Never) => {
-                    words.next();
-                    RestSetting::After(RestAfter::Never)
-                }
-                Some(_) => RestSetting::After(RestAfter::Seconds(words.number(&SECONDS)? as u32)),
-                None => return Err(words.error_here(ParseErrorKind::Missing(WHEN))),
+    let field = word.lower();
+    if matches!(field, Word::Is(Kw::After | Kw::Pose | Kw::Relax)) && words.peek().is_none() {
+        return Ok(Command::Rest(None));
+    }
+    let setting = match field {
+        Word::Is(Kw::After) => match words.peek() {
+            Some(w) if w.lower() == Word::Is(Kw::Never) => {
+                words.next();
+                RestSetting::After(RestAfter::Never)
             }
-        }
+            _ => RestSetting::After(RestAfter::Seconds(words.number(&SECONDS)? as u32)),
+        },
         Word::Is(Kw::Pose) => {
             let mut angle =
                 |field| -> Result<Angle, ParseError> { Ok(to_angle(words.number(field)?)) };
@@ -47,5 +49,5 @@ pub(super) fn rest(words: &mut Words<'_>) -> Result<Command, ParseError> {
         }
         _ => return Err(word.error(ParseErrorKind::UnknownWord { expected: EXPECTED })),
     };
-    Ok(Command::Rest(setting))
+    Ok(Command::Rest(Some(setting)))
 }

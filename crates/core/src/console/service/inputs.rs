@@ -1,15 +1,16 @@
-//! The service's trigger inputs, rest and look settings: `input <n> …`,
-//! `rest after|pose|relax …`, `look duck …`, and the inputs in `status`.
+//! The service's trigger inputs, rest, look and idle settings: `input <n> …`,
+//! `rest after|pose|relax …`, `look duck …`, `idle` alone, and the inputs
+//! in `status`.
 //!
 //! Each change is checked, put in the settings (kept with `save`) and sent
 //! where it takes effect: the roles and the rest timer to the input task,
 //! the rest pose, relax and the look's duck to the frame task (both through
 //! the [`ConsoleLink`](super::ConsoleLink)), between two of its frames.
 
-use crate::command::{InputRole, RestSetting};
+use crate::command::{InputRole, RestAfter, RestSetting};
 use crate::input::{FIRST_INPUT, INPUTS};
 use crate::settings::{SettingsSource, SettingsStorage};
-use crate::text::Arg::Int;
+use crate::text::Arg::{Int, Str, Uint};
 use crate::text::Text;
 use crate::units::{Angle, Percent};
 
@@ -104,6 +105,64 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
             }
         }
         self.source = SettingsSource::Changed;
+    }
+
+    /// `rest after`, `rest pose` or `rest relax` alone: `ok rest
+    /// after=<s>|never pose=<p>,<r>,<y> relax=on|off`, the pose as set,
+    /// then ` clamped=<p>,<r>,<y>` where the head rests if that lies past
+    /// the servos' limits.
+    #[inline(never)]
+    pub(super) fn show_rest(&self, reply: &mut Reply<'_>) {
+        let out = text(reply.ok());
+        out.str("rest after=");
+        match self.settings.inputs.rest_after {
+            RestAfter::Never => out.str("never"),
+            RestAfter::Seconds(s) => out.u64(s.into()),
+        };
+        let rest = &self.settings.behaviour.rest;
+        let [p, r, y] = rest.pose.map(Angle::millidegrees);
+        out.fill(
+            " pose={},{},{} relax={}",
+            &[
+                Int(p.into()),
+                Int(r.into()),
+                Int(y.into()),
+                Str(if rest.relax { "on" } else { "off" }),
+            ],
+        );
+        if self.behaviour.rest_clamped() {
+            let [p, r, y] = self.behaviour.rest_pose().map(Angle::millidegrees);
+            out.fill(
+                " clamped={},{},{}",
+                &[Int(p.into()), Int(r.into()), Int(y.into())],
+            );
+        }
+    }
+
+    /// `look duck` alone: `ok look duck=<percent>`.
+    #[inline(never)]
+    pub(super) fn show_look_duck(&self, reply: &mut Reply<'_>) {
+        text(reply.ok())
+            .str("look duck=")
+            .u64(self.settings.behaviour.gaze.duck.get().into());
+    }
+
+    /// `idle` alone: `ok idle=on|off amp=<percent>`, as the last frame
+    /// left the mixer (before the first frame: the settings' amplitude,
+    /// and on, as the head starts).
+    #[inline(never)]
+    pub(super) fn show_idle(&self, reply: &mut Reply<'_>) {
+        let idle = self.link.status().idle.unwrap_or(crate::console::IdleView {
+            on: true,
+            amp: self.settings.behaviour.idle.amplitude,
+        });
+        text(reply.ok()).fill(
+            "idle={} amp={}",
+            &[
+                Str(if idle.on { "on" } else { "off" }),
+                Uint(idle.amp.get().into()),
+            ],
+        );
     }
 
     /// `look duck <percent>`.
