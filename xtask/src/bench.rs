@@ -20,6 +20,7 @@ mod frame;
 pub mod latency;
 mod paths;
 mod telemetry;
+pub mod tracking;
 
 pub use frame::FrameRow;
 use frame::frames_over_budget;
@@ -277,6 +278,12 @@ pub fn command(options: Options) -> Result<bool> {
             false
         }
     };
+    // How the head follows people, in the host trace.
+    println!();
+    if let Err(error) = tracking::stage() {
+        println!("tracking FAILED: {error:#}");
+        passed = false;
+    }
     // The latency rows: the shipped image in the RP2040 emulator
     // (`bench/latency.rs`).
     println!();

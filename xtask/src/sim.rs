@@ -17,6 +17,7 @@ mod noise;
 mod planted;
 pub mod pulses;
 mod pulses_csv;
+mod radar;
 mod run;
 mod script;
 mod show;
@@ -53,6 +54,7 @@ pub fn play_script(
 pub use exchange::BYTE_TIME;
 pub use node::UartScript;
 pub use noise::{NOISE_STAGE, test_noise};
+pub use radar::{RADAR_DMX_STAGE, RADAR_STAGE, test_radar, test_radar_dmx};
 pub use run::{Boot, Report, logged_peak_stack};
 pub use show::{SHOW_STAGE, test_show};
 
@@ -169,6 +171,13 @@ pub struct Args {
     /// host trace of it. Without `--seconds`, to 5 s after its last line.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood"])]
     pub script: Option<PathBuf>,
+    /// Play a file of radar lines (`<s> radar <x_mm>,<y_mm> ...`, up to
+    /// three people, or `<s> radar none`) into GP13 as an HLK-LD2450's
+    /// frames, ten a second, with `radar on` sent first; every pulse
+    /// checked against the host trace of it. Without `--seconds`, to 5 s
+    /// after its last line.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood", "script", "dmx", "show"])]
+    pub radar: Option<PathBuf>,
     /// With `--script`: the servos' rate, Hz (50 to 333), from the first
     /// frame: the image boots on settings of that rate (planted in its
     /// settings sectors), and the host trace runs at it.
@@ -228,11 +237,15 @@ pub fn command(args: &Args) -> Result<bool> {
         return script::command(
             &root,
             &metadata,
-            path,
+            script::read(path)?,
             (args.virtual_time, args.timeout),
             rate,
             args.pulses.as_ref(),
         );
+    }
+    if let Some(path) = &args.radar {
+        let time = (args.virtual_time, args.timeout);
+        return radar::command(&root, &metadata, path, time, args.pulses.as_ref());
     }
     let runs: [(bool, &str, Stage); 5] = [
         (args.inputs, "inputs", inputs::test_inputs),

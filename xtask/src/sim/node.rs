@@ -99,6 +99,10 @@ pub struct Config {
     pub script: Option<PinScript>,
     /// A stream of console lines made as they go out (`sim/stream.mjs`).
     pub stream: Option<LineStream>,
+    /// An HLK-LD2450 radar on GP13 (`sim/radar.mjs`; see `radar.rs`).
+    pub radar: Option<Value>,
+    /// The flash's unique id (none: the flash answers all ones).
+    pub uid: Option<u64>,
 }
 
 /// A stream of console lines on UART0 or USB (`sim/stream.mjs`): `count`
@@ -209,6 +213,8 @@ impl Config {
                 })).collect()))
             },
             "dmx": self.dmx,
+            "radar": self.radar,
+            "uid": self.uid.map(|id| format!("{id:016x}")),
             "rom": self.rom.map(|rom| json!({
                 "erase_ns": nanos(rom.erase),
                 "program_ns": nanos(rom.program),

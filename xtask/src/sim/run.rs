@@ -66,6 +66,8 @@ pub struct Boot {
     pub dmx_frames: Vec<u64>,
     /// The input pins the script drove: when, which GPIO, high or low.
     pub drives: Vec<(f64, u8, bool)>,
+    /// The radar frames sent to the end of the run.
+    pub radar_frames: u64,
 }
 
 impl Boot {
@@ -409,6 +411,7 @@ fn into_boot(boot: &mut Boot, event: &Event) {
             boot.dmx_changes.push(*ns);
             boot.dmx_frames.push(*frame);
         }
+        Event::Radar { frames, .. } => boot.radar_frames = *frames,
         Event::Flash {
             op,
             addr,

@@ -1,7 +1,8 @@
 //! `cargo xtask sim --script FILE`: a trace script played into the shipped
 //! image (pin lines drive GP2 to GP5, console lines go to UART0 2 ms before
 //! their time, times from the first frame), every pulse checked against
-//! the host trace of the same script; at another
+//! the host trace of the same script; radar lines go to GP13 as the
+//! LD2450's frames (`radar.rs`); at another
 //! servo rate (`--rate`) the image boots on settings of that rate planted
 //! in its settings sectors, and the trace and the check run at it.
 
@@ -10,6 +11,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result, anyhow, bail};
 
+use idle_head_core::seed::BoardId;
 use idle_head_core::servo::ServoRate;
 use idle_head_core::settings::Settings;
 
@@ -21,8 +23,8 @@ use crate::elf;
 use crate::project::{Metadata, PICO};
 use crate::trace::{self, Event, Kind};
 
-/// How much before its time a console line is in.
-const EARLY: Duration = Duration::from_millis(2);
+/// How much before its time a console line (or a radar frame) is in.
+pub const EARLY: Duration = Duration::from_millis(2);
 
 /// The first frame a console line is taken at: the board's console reads
 /// its UART once the boot's work (the first loop sets) is done, some 40 ms
@@ -47,6 +49,15 @@ pub fn parse(text: &str) -> Result<Vec<Event>> {
 pub fn default_time(events: &[Event]) -> Duration {
     let last = events.last().map_or(0, |e| e.at_us);
     Duration::from_micros(last) + Duration::from_secs(5)
+}
+
+/// The board a script plays on: the servos' rate from the first frame (the
+/// image boots on settings of that rate) and the flash's unique id (none:
+/// the flash answers all ones, and the idle plays the paper's seeds).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Board {
+    pub rate: ServoRate,
+    pub uid: Option<u64>,
 }
 
 /// What a script run's pulses are checked against.
@@ -80,12 +91,12 @@ pub fn play(
         time,
         wall,
         against,
-        ServoRate::DEFAULT,
+        Board::default(),
     )
 }
 
-/// [`play`] with the servos at `rate` from the first frame (the image
-/// boots on settings of that rate).
+/// [`play`] on `board`: the servos at its rate from the first frame (the
+/// image boots on settings of that rate), its flash's unique id.
 pub fn play_at(
     root: &Path,
     metadata: &Metadata,
@@ -93,8 +104,9 @@ pub fn play_at(
     time: Duration,
     wall: Duration,
     against: Against,
-    rate: ServoRate,
+    board: Board,
 ) -> Result<Report> {
+    let rate = board.rate;
     if let Some(e) = events.iter().find(|e| changes_rate(&e.text)) {
         bail!(
             "{:.3} s `{}`: the emulator's pulse check runs at one servo rate; \
@@ -128,13 +140,11 @@ pub fn play_at(
                     .lines
                     .push((frame, format!("{}\r\n", event.text).into_bytes()));
             }
-            Kind::Radar(_) => anyhow::bail!(
-                "line {}: radar lines play in the host trace (`cargo xtask trace`); \
-                 the emulator has no radar on GP13 yet",
-                event.line
-            ),
+            // The radar's frames, below.
+            Kind::Radar(_) => {}
         }
     }
+    let radar = super::radar::line(&events, rate, time);
     let planted = if rate == ServoRate::DEFAULT {
         None
     } else {
@@ -154,6 +164,8 @@ pub fn play_at(
         config.inputs = harness::input_pins();
         config.script = Some(script);
         config.flash_fill = planted;
+        config.radar = radar;
+        config.uid = board.uid;
         // A head relaxed at rest is silent for as long as it rests (no
         // pulse, no log line but once a loop): the wall limit alone tells a
         // stuck run.
@@ -163,9 +175,12 @@ pub fn play_at(
         Against::Host => {
             // The host's frames outlast the emulator's (which began a
             // little after power-on).
+            let seeds = board
+                .uid
+                .map(|id| Settings::DEFAULT.idle_seeds(BoardId(id)));
             let host = trace::simulate(
                 u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX),
-                None,
+                seeds,
                 rate,
                 &events,
             )?;
@@ -206,19 +221,20 @@ fn written(report: &Report) -> Vec<[u16; 3]> {
         .collect()
 }
 
-/// `cargo xtask sim --script FILE [--rate HZ] [--pulses CSV]`.
+/// `cargo xtask sim --script FILE [--rate HZ] [--pulses CSV]` (and
+/// `--radar FILE`: its `events`).
 pub fn command(
     root: &Path,
     metadata: &Metadata,
-    path: &Path,
+    events: Vec<Event>,
     (time, wall): (Option<Duration>, Duration),
     rate: ServoRate,
     pulses: Option<&PathBuf>,
 ) -> Result<bool> {
     PICO.build(root)?;
-    let events = read(path)?;
     let time = time.unwrap_or_else(|| default_time(&events));
-    let report = play_at(root, metadata, events, time, wall, Against::Host, rate)?;
+    let board = Board { rate, uid: None };
+    let report = play_at(root, metadata, events, time, wall, Against::Host, board)?;
     print!("{}", report.log_text(false));
     if let Some(boot) = report.boots.first() {
         println!("UART0 replies:");

@@ -70,6 +70,7 @@ pub fn test_rate(root: &Path, metadata: &Metadata) -> Result<()> {
     let events = super::script::parse(RATE_SCRIPT)?;
     let rate = idle_head_core::servo::ServoRate::MAX;
     let time = Duration::from_secs(7);
+    let board = super::script::Board { rate, uid: None };
     let report = super::script::play_at(
         root,
         metadata,
@@ -77,7 +78,7 @@ pub fn test_rate(root: &Path, metadata: &Metadata) -> Result<()> {
         time,
         WALL,
         super::script::Against::Host,
-        rate,
+        board,
     )?;
     print!("{}", report.table());
     println!("{}", report.verdict());

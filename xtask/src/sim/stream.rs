@@ -216,7 +216,10 @@ pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     // frame was late.)
     let (text, problems) = report.boots.first().map_or_else(
         || (String::new(), vec!["no boot".to_owned()]),
-        |boot| check_dmx(boot, changes.len()),
+        |boot| {
+            let reply = boot.uart_replies().into_iter().next().unwrap_or_default();
+            check_dmx(boot, &reply, changes.len())
+        },
     );
     print!("{text}");
     if problems.is_empty() {
@@ -231,10 +234,10 @@ fn wall(length: Duration) -> Duration {
     (START + length) * 3 + Duration::from_secs(120)
 }
 
-/// The `dmx` counters against the frames sent: every one good.
-fn check_dmx(boot: &Boot, changes: usize) -> (String, Vec<String>) {
+/// The `dmx` counters of its `reply` against the frames sent in `boot`:
+/// every one good.
+pub(super) fn check_dmx(boot: &Boot, reply: &str, changes: usize) -> (String, Vec<String>) {
     let mut problems = Vec::new();
-    let reply = boot.uart_replies().into_iter().next().unwrap_or_default();
     let counter = |name: &str| -> Option<u64> {
         reply
             .split(' ')
