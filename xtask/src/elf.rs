@@ -9,7 +9,7 @@ use crate::{board::Board, figures};
 use object::read::elf::{ElfFile32, ProgramHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, SectionKind, elf};
 
-/// RAM budget of the Pico image: static RAM (`.data + .bss + .uninit`) plus
+/// RAM budget of the Pico image: static RAM (`.radar_ring + .data + .bss + .uninit`) plus
 /// the peak stack measured in the RP2040 emulator (the boot precompute's
 /// stack frame is most of it).
 pub const RAM_BUDGET: u64 = 48 * 1024;
@@ -148,9 +148,11 @@ impl Image {
             .sum()
     }
 
-    /// Bytes of RAM taken before `main` runs: `.data + .bss + .uninit`.
+    /// Bytes of RAM taken before `main` runs: `.data + .bss + .uninit`,
+    /// and the radar's DMA ring (`.radar_ring`, placed by the board's
+    /// `memory.x`).
     pub fn static_ram(&self) -> u64 {
-        self.size_of(&[".data", ".bss", ".uninit"])
+        self.size_of(&[".radar_ring", ".data", ".bss", ".uninit"])
     }
 
     /// Bytes written to flash: every allocated section with contents
@@ -360,7 +362,7 @@ pub fn record_image(path: &Path, image: &Image, flash_budget: Option<u64>) {
         .collect();
     let intro = format!(
         "Flash is every section stored in flash (`.data`'s initial values included); \
-         static RAM is `.data + .bss + .uninit`. Sections of `{name}`: {}.",
+         static RAM is `.radar_ring + .data + .bss + .uninit`. Sections of `{name}`: {}.",
         sections.join(", ")
     );
     let size = format!("{} ({})", figures::bytes(flash), figures::kib(flash));

@@ -79,7 +79,7 @@ pub fn check(path: &Path) -> Result<()> {
     println!("{}", path.display());
     print!("{}", image.table());
     println!(
-        "  flash {} B, static RAM {} B (.data + .bss + .uninit)",
+        "  flash {} B, static RAM {} B (.radar_ring + .data + .bss + .uninit)",
         image.flash(),
         image.static_ram()
     );

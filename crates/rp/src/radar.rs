@@ -13,8 +13,11 @@
 //! into a ring in RAM ([`RING`] characters) as it arrives, as UART0's
 //! console does: it needs neither the CPU nor the flash, so nothing is
 //! lost while the port tasks are busy or while a flash erase holds the
-//! interrupts off (45 ms typically, 400 ms at worst; the ring holds 0.85 s
-//! of the radar's frames, 10 ms of back-to-back bytes). A timer alarm of
+//! interrupts off. The longest the alarm below can be kept waiting is a
+//! `save`: it runs on the port executor, at the alarm's own priority, and
+//! may erase all four settings sectors, 45 ms each typically and 400 ms
+//! at worst with the interrupts off, 1.6 s in all; the ring holds 1.7 s of
+//! the radar's frames (20 ms of back-to-back bytes). A timer alarm of
 //! its own, at the ports' priority, looks at the ring every [`POLL`] and
 //! hands what came to the firmware layer's decoder
 //! ([`idle_head_firmware::radar::receive`]); a damaged character, a ring
@@ -53,9 +56,9 @@ use crate::{PORT_PRIORITY, SYS_HZ};
 pub const BAUD: u32 = 256_000;
 /// PIO cycles a bit (the program's timing).
 const CYCLES_PER_BIT: u32 = 8;
-/// Characters the ring holds: 256 · 39 µs of back-to-back bytes, or eight
-/// of the radar's 30-byte frames (0.85 s at its ten a second).
-pub const RING: usize = 256;
+/// Characters the ring holds: 512 · 39 µs of back-to-back bytes, or 17
+/// of the radar's 30-byte frames (1.7 s at its ten a second).
+pub const RING: usize = 512;
 /// How often the alarm looks at the ring: what a byte waits at most
 /// before the decoder sees it.
 pub const POLL: Duration = Duration::from_millis(1);
@@ -68,22 +71,23 @@ const SM: usize = 0;
 /// A character's flag for a low stop bit (the program's bit 8).
 const DAMAGED: u16 = 0x100;
 
-/// The ring's size as the DMA counts it: 2^9 bytes of 16-bit words.
-const RING_BITS: u8 = 9;
+/// The ring's size as the DMA counts it: 2^10 bytes of 16-bit words.
+const RING_BITS: u8 = 10;
 const _: () = assert!(1 << RING_BITS == RING * 2);
 
 /// The words the DMA writes, aligned to their size (the DMA's ring wraps
 /// its write address on that boundary). Never read before the DMA wrote
-/// it, so it needs no zeroing at reset: in `.uninit`, after `.bss`, where
-/// its alignment costs less padding than among the zeroed statics.
-#[repr(C, align(512))]
+/// it, so it needs no zeroing at reset: in a section of its own,
+/// `.radar_ring`, which the board's `memory.x` places first in RAM, where
+/// its alignment costs no padding.
+#[repr(C, align(1024))]
 struct Ring(UnsafeCell<MaybeUninit<[u16; RING]>>);
 
 // Note(unsafe): only the DMA writes the ring, and only the alarm's handler
 // reads it, with volatile reads of whole words the DMA has written.
 unsafe impl Sync for Ring {}
 
-#[unsafe(link_section = ".uninit.radar")]
+#[unsafe(link_section = ".radar_ring")]
 static RX_RING: Ring = Ring(UnsafeCell::new(MaybeUninit::uninit()));
 
 /// The receive DMA channel, for the alarm.

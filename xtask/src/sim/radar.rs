@@ -11,7 +11,9 @@
 //!   trace computes them, and `seed` answers each its `board:<n>`;
 //! - DMX512 at the full universe rate on GP9 and the radar on GP13 at
 //!   once: every DMX frame counted good, every radar frame counted, none
-//!   bad, no servo frame late.
+//!   bad, no servo frame late; and a `save` that erases flash sectors
+//!   (400 ms each with the interrupts off, the flash's worst case) while
+//!   the radar sends: every radar frame counted, none bad.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -37,7 +39,8 @@ pub const RADAR_STAGE: &str = "Pico image in the RP2040 emulator: a radar walk o
      give two idle motions";
 /// See [`RADAR_STAGE`].
 pub const RADAR_DMX_STAGE: &str = "Pico image in the RP2040 emulator: DMX512 on GP9 and the \
-     radar on GP13 at once: every frame of both counted, none lost";
+     radar on GP13 at once: every frame of both counted, none lost; a flash erase loses no radar \
+     frame";
 
 /// The LD2450's line rate.
 const BAUD: u32 = 256_000;
@@ -261,24 +264,79 @@ pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     let (summary, mut problems) = stream::check_dmx(boot, &dmx_reply, changes.len());
     print!("{summary}");
     let radar_reply = reply("ok radar=").unwrap_or_default();
-    let counter = |name: &str| -> Option<u64> {
-        radar_reply
-            .split(' ')
-            .find_map(|f| f.strip_prefix(name)?.strip_prefix('=')?.parse().ok())
-    };
     println!("radar: {} frames sent; `{radar_reply}`", boot.radar_frames);
-    if counter("frames") != Some(boot.radar_frames) || counter("bad") != Some(0) {
-        problems.push(format!(
-            "radar: `{radar_reply}` for {} frames sent",
-            boot.radar_frames
-        ));
-    }
+    problems.extend(counted(boot, &radar_reply));
     problems.extend(report.problems.iter().cloned());
+    problems.extend(erase(root, &elf)?);
     if problems.is_empty() {
         Ok(())
     } else {
         bail!("{}", problems.join("; "))
     }
+}
+
+/// The problem, if the radar's `reply` did not count every frame `boot`
+/// sent, or counted one bad.
+fn counted(boot: &Boot, reply: &str) -> Option<String> {
+    let counter = |name: &str| -> Option<u64> {
+        reply
+            .split(' ')
+            .find_map(|f| f.strip_prefix(name)?.strip_prefix('=')?.parse().ok())
+    };
+    (counter("frames") != Some(boot.radar_frames) || counter("bad") != Some(0))
+        .then(|| format!("radar: `{reply}` for {} frames sent", boot.radar_frames))
+}
+
+/// A `save` at 2 s over settings sectors full of noise (each erase 400 ms
+/// with the interrupts off) while a person stands in front of the radar
+/// from 1 s to 5 s; `radar` asked at 5.2 s. The problems.
+fn erase(root: &Path, elf: &Path) -> Result<Vec<String>> {
+    let region = crate::elf::Image::read(elf)?
+        .settings
+        .context("the image has no settings region")?;
+    let sectors = super::store::noise(usize::try_from(region.end - region.start)?);
+    let events = script::parse("0 radar on\n1 radar -400,1800\n")?;
+    let query = Duration::from_millis(5200);
+    let radar = line(&events, ServoRate::DEFAULT, Duration::from_secs(5));
+    let pins = PinScript {
+        anchor: harness::SERVOS[0].2,
+        early: EARLY,
+        lines: vec![
+            (Duration::from_millis(100), b"radar on\r\n".to_vec()),
+            (Duration::from_secs(2), b"save\r\n".to_vec()),
+            (query, b"radar\r\n".to_vec()),
+        ],
+        ..PinScript::default()
+    };
+    let report = run::run_with(root, elf, query + Duration::from_secs(1), WALL, |config| {
+        config.script = Some(pins);
+        config.radar = radar;
+        config.rom = Some(super::store::WORST);
+        config.flash_fill = Some((region.start, sectors));
+    })?;
+    let boot = report.boots.first().context("no boot")?;
+    let erased: f64 = boot
+        .flash
+        .iter()
+        .filter(|op| op.erase)
+        .map(|op| op.busy_ns)
+        .sum();
+    let reply = boot
+        .uart_replies()
+        .into_iter()
+        .find(|r| r.starts_with("ok radar="))
+        .unwrap_or_default();
+    println!(
+        "save: {:.0} ms of sector erases with the interrupts off; radar: {} frames sent; `{reply}`",
+        erased / 1e6,
+        boot.radar_frames
+    );
+    let mut problems: Vec<String> = report.problems.clone();
+    if erased < 400e6 {
+        problems.push(format!("save: only {:.0} ms of erases", erased / 1e6));
+    }
+    problems.extend(counted(boot, &reply).map(|p| format!("during a save: {p}")));
+    Ok(problems)
 }
 
 #[cfg(test)]

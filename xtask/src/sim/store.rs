@@ -342,7 +342,7 @@ fn first_pulses(boot: &Boot) -> [Option<u32>; 3] {
 }
 
 /// `len` bytes of noise (xorshift32): a store no firmware wrote.
-fn noise(len: usize) -> Vec<u8> {
+pub(super) fn noise(len: usize) -> Vec<u8> {
     let mut x: u32 = 0x2545_f491;
     (0..len)
         .map(|_| {
