@@ -79,3 +79,53 @@ export function roscRandomBit(chip) {
     return state & 1;
   };
 }
+
+// The flash's unique id (command 4Bh) through the SSI. On the chip,
+// embassy-rp's `blocking_unique_id` (from RAM, the boot ROM's
+// `connect_internal_flash` and `flash_exit_xip` before it) puts the SSI in
+// standard SPI, EEPROM-read mode (CTRLR0: SPI_FRF 0, TMOD 3), writes the
+// command into DR and reads CTRLR1 + 1 frames back: four dummy bytes, then
+// the flash's eight id bytes. rp2040js's SSI answers every DR read with 0
+// (it only fakes the status register's reply for boot2), so every board
+// would read the id 0. Here, in that mode, the bytes after 4Bh are the
+// flash's: the dummy bytes and then `uid` (16 hex digits, the order the
+// flash sends them), or all ones without one (a flash without the command
+// leaves its output high: no id, as `BoardId` takes it). Any other command
+// in that mode, and every other mode (boot2's), is rp2040js's own.
+const SSI_BASE = 0x18000;
+const SSI_CTRLR0 = 0x00;
+const SSI_CTRLR1 = 0x04;
+const SSI_SSIENR = 0x08;
+const SSI_SR = 0x28;
+const SSI_DR0 = 0x60;
+const SR_TFNF_TFE = 0x6;
+const SR_RFNE = 0x8;
+const CMD_UNIQUE_ID = 0x4b;
+const UNIQUE_ID_DUMMY = 4;
+export function flashUniqueId(chip, uid) {
+  const ssi = chip.peripherals[SSI_BASE];
+  const id = uid ? [...Buffer.from(uid, 'hex')] : new Array(8).fill(0xff);
+  const rx = []; // the frames received, not yet read
+  let command = null; // the command of the transfer under way
+  const eepromRead = () => ((ssi.crtlr0 >> 8) & 3) === 3 && ((ssi.crtlr0 >> 21) & 3) === 0;
+  const read = ssi.readUint32.bind(ssi);
+  ssi.readUint32 = (offset) => {
+    if (command === CMD_UNIQUE_ID && offset === SSI_SR) return SR_TFNF_TFE | (rx.length ? SR_RFNE : 0);
+    if (command === CMD_UNIQUE_ID && offset === SSI_DR0) return rx.shift() ?? 0xff;
+    return read(offset);
+  };
+  const write = ssi.writeUint32.bind(ssi);
+  ssi.writeUint32 = (offset, value) => {
+    if (offset === SSI_SSIENR) {
+      command = null;
+      rx.length = 0;
+    }
+    if (offset === SSI_DR0 && ssi.ssienr & 1 && eepromRead() && command === null && (value & 0xff) === CMD_UNIQUE_ID) {
+      command = CMD_UNIQUE_ID;
+      const frames = read(SSI_CTRLR1) + 1;
+      for (let i = 0; i < frames; i++) rx.push(i < UNIQUE_ID_DUMMY ? 0xff : (id[i - UNIQUE_ID_DUMMY] ?? 0xff));
+      return;
+    }
+    write(offset, value);
+  };
+}

@@ -2,8 +2,9 @@
 // as JSON lines on stdout, one event per line. It only reports raw facts;
 // `cargo xtask sim` decodes and checks them. Here: the power-up, the boots
 // and the watchdog's resets, the RTT log, the run loops; beside it, the
-// emulator's gaps (chip.mjs, uart.mjs), the USB host (usb.mjs), DMX512
-// (dmx.mjs), what the outside scripts (script.mjs), the boot ROM (rom.mjs).
+// emulator's gaps (chip.mjs, uart.mjs, pio.mjs), the USB host (usb.mjs),
+// DMX512 (dmx.mjs), the radar (radar.mjs), what the outside scripts
+// (script.mjs), the boot ROM (rom.mjs).
 //
 //   node harness.mjs '<config as JSON>'    (or @<file> holding it)
 //
@@ -28,8 +29,12 @@
 //               host enumerates the device, and from at_ns on sends the bytes; boot 0 only;
 //               or a list of them, each sent at its time,
 //   dmx:        optional, DMX512 frames on UART1's RX line (GP9): see dmx.mjs,
-//   rom:        optional, {erase_ns, program_ns}: a boot ROM with the flash functions
-//               (rom.mjs), a sector erase and a page program taking that much virtual time,
+//   rom:        optional, {erase_ns, program_ns}: how long a sector erase and a page program
+//               of the boot ROM's flash functions (rom.mjs, always there: the boot reads the
+//               flash's unique id through them) take; the W25Q16JV's worst case without,
+//   uid:        optional, the flash's unique id, 16 hex digits (chip.mjs; without: none, all ones),
+//   radar:      optional, an HLK-LD2450 on GP13 (radar.mjs), its frames from the script's time 0;
+//               without, GP13 sits at its pad's pull (nothing wired),
 //   flash_fill: optional, {addr, hex}: bytes written over the image's flash before power-on,
 //   power_cycles_ns: optional, virtual times at which the power goes off and on again:
 //               the next boot starts from the flash as the last one left it, nothing else kept,
@@ -71,6 +76,7 @@
 //   {"ev":"usb","ns":..,"hex":".."}                 bytes the device sent on its CDC-ACM IN endpoint
 //   {"ev":"usb_in","ns":..,"n":..}                  the host sent a scripted chunk of n bytes
 //   {"ev":"dmx","ns":..,"frame":..,"changed":true}  a DMX frame with a change ended (dmx.mjs)
+//   {"ev":"radar","ns":..,"frames":..}              the radar frames sent in the run, at its end
 //   {"ev":"unmodelled","peripheral":"ROSC_BASE","op":"write","offset":4,"count":1}
 //                                                   accesses to a register rp2040js does not
 //                                                   model, counted over the run (at its end)
@@ -80,7 +86,9 @@
 
 import { readFileSync } from 'node:fs';
 import { RP2040 } from 'rp2040js';
-import { roscRandomBit, sevAsOnTheChip, unmodelledCounter, xipControlAsOnTheChip } from './chip.mjs';
+import { flashUniqueId, roscRandomBit, sevAsOnTheChip, unmodelledCounter, xipControlAsOnTheChip } from './chip.mjs';
+import { pioInStep } from './pio.mjs';
+import { RADAR_PIN, radarLine } from './radar.mjs';
 import { romImage, serveRom } from './rom.mjs';
 import { scripted } from './script.mjs';
 import { uartAsOnTheChip } from './uart.mjs';
@@ -135,6 +143,19 @@ const stream = lineStream(cfg);
 const usb = usbLink(cfg, { emit, now, active }, stream);
 const outside = scripted(cfg, { emit, now, active, chip: () => mcu, boot: () => boot, bootNs: () => bootNs }, stream);
 const dmx = cfg.dmx ? dmxLine(cfg.dmx, emit) : null;
+// The PIO state machines in step with the CPU (pio.mjs), and what drives
+// GP13: the radar's TX (radar.mjs), or nothing wired, the pad's pull.
+const pio = pioInStep();
+const radar = cfg.radar ? radarLine(cfg.radar) : null;
+pio.drive(
+  RADAR_PIN,
+  radar?.line ?? {
+    level: () => mcu.gpio[RADAR_PIN].pullupEnabled,
+    next: (t, high) => (mcu.gpio[RADAR_PIN].pullupEnabled === high ? t : Infinity),
+  },
+);
+// The boot ROM's flash functions take the W25Q16JV's worst case unless told.
+const romTiming = cfg.rom ?? { erase_ns: 400e6, program_ns: 3e6 };
 
 // The flash at power-on: the image, and `flash_fill` over it.
 function firstFlash() {
@@ -156,7 +177,7 @@ function firstFlash() {
 // registers survive a watchdog reset, and SRAM keeps its contents.
 function powerUp(kept) {
   const chip = new RP2040();
-  if (cfg.rom) chip.loadBootrom(romImage()); // (this erases the flash: load it after)
+  chip.loadBootrom(romImage()); // (this erases the flash: load it after)
   chip.logger = {
     debug() {},
     info: sevAsOnTheChip(chip),
@@ -169,7 +190,7 @@ function powerUp(kept) {
       lastActivity = now();
     };
     const complain = (msg) => emit({ ev: 'emu', level: 'error', msg });
-    if (cfg.rom && serveRom(chip, code, cfg.rom, flashOp, complain, stall)) return;
+    if (serveRom(chip, code, romTiming, flashOp, complain, stall)) return;
     emit({ ev: 'emu', level: 'error', msg: `breakpoint ${code} at ${hex(chip.core.PC)}` });
     stop = 'break';
   };
@@ -196,6 +217,7 @@ function powerUp(kept) {
   if (dmx) dmx.attach(chip.uart[1], () => now());
   xipControlAsOnTheChip(chip);
   roscRandomBit(chip);
+  flashUniqueId(chip, cfg.uid);
   if ((cfg.usb || cfg.live || stream?.port === 'usb') && boot === 0) usb.attach(chip);
   chip.uart[0].onByte = (byte) => {
     if (uartTx.bytes.length === 0) uartTx.ns = now();
@@ -211,7 +233,10 @@ function powerUp(kept) {
       if (offset === 0x0c) emit({ ev: 'cc', slice, value: value >>> 0, ns: now() });
       if (offset === 0x00 && (channel.csr & 1) !== on) {
         emit({ ev: 'en', slice, on: !on, ns: now() });
-        if (!on && boot === 0 && slice === outside.anchorSlice) outside.anchor(now());
+        if (!on && boot === 0 && slice === outside.anchorSlice) {
+          outside.anchor(now());
+          radar?.anchor(now());
+        }
         // On the chip a channel's output is high while the counter is below
         // the compare value, also right after the enable; rp2040js only
         // raises it at the first wrap. Set it here as the chip does (the
@@ -232,6 +257,7 @@ function feedOutside() {
   mcu.uart[0].sendDue();
   if (usb.send) usb.feed();
   if (dmx) dmx.feed();
+  pio.feed();
   if (outside.pinsQueued()) outside.feedPins();
 }
 
@@ -310,6 +336,7 @@ function startBoot(kept) {
   boot += 1;
   outside.startBoot(boot);
   mcu = powerUp(kept);
+  pio.attach(mcu, now);
   watchdogFired = null;
   emit({ ev: 'boot', n: boot, ns: bootNs });
   for (const pin of cfg.pins) edge(pin, false, true); // a reset releases the pins: low
@@ -374,10 +401,11 @@ function run() {
           continue;
         }
         if (sending !== Infinity && (wait <= 0 || sending < wait)) wait = sending;
-        const more = Math.min(dmx ? dmx.due() : Infinity, usb.due()) - now(); // DMX, USB
+        const more = Math.min(dmx ? dmx.due() : Infinity, usb.due(), pio.due()) - now(); // DMX, USB, PIO
         if (more <= 0) {
           if (dmx) dmx.feed();
           if (usb.send) usb.feed();
+          pio.feed();
           continue;
         }
         if (more !== Infinity && (wait <= 0 || more < wait)) wait = more;
@@ -413,6 +441,7 @@ function run() {
       mcu.uart[0].sendDue();
       if ((i & 255) === 0 && usb.send) usb.feed();
       if (dmx) dmx.feed();
+      if ((i & 63) === 0) pio.feed();
       if ((i & 255) === 0 && now() >= outside.powerCycleDue()) break;
     }
     if (cfg.rtt) drainRtt();
@@ -438,6 +467,7 @@ function run() {
   }
   endBoot();
   unmodelled.report(emit);
+  if (radar) emit({ ev: 'radar', ns: now(), frames: radar.count(now()) });
   emit({ ev: 'end', why: stop, ns: now(), instructions, wall_ms: Date.now() - started });
   flush();
 }
@@ -494,6 +524,7 @@ async function runLive() {
       step();
       if ((instructions & 63) === 0 && cfg.rtt) drainRtt();
       if ((instructions & 15) === 0) mcu.uart[0].sendDue();
+      if ((instructions & 63) === 0) pio.feed();
     }
     if (cfg.rtt) drainRtt();
     flushRtt();

@@ -2,7 +2,10 @@
 // embassy-rp's flash driver looks up, done by the harness on the emulator's
 // flash array. rp2040js runs without a boot ROM (none is shipped with it,
 // and none is committed here); without one, `rom_table_lookup` is a call to
-// address 0 and every flash erase or write fails.
+// address 0 and every flash erase or write fails. The harness loads it in
+// every run: the boot reads the flash's unique id after the ROM's
+// `connect_internal_flash` and `flash_exit_xip` (the id itself comes over
+// the SSI, which chip.mjs answers).
 //
 // The layout is the documented one (RP2040 datasheet, 2.8.2 "Bootrom
 // Contents"): the magic `Mu\x01` and the ROM version at 0x10..0x13, then

@@ -23,6 +23,7 @@ mod paths;
 
 pub use latency::stage as latency_stage;
 mod telemetry;
+pub mod tracking;
 
 use crate::figures::{self, thousands};
 use crate::log::{LogLine, Run, field, number};
@@ -368,13 +369,19 @@ pub fn command(options: Options) -> Result<bool> {
     let (root, metadata) = project::prepare()?;
     setup::ensure_qemu()?;
     let qemu = run_and_check(&root, &metadata, options, None);
+    // How the head follows people, in the host trace.
+    let tracking = tracking::stage();
     let latency = latency::stage(&root, &metadata);
-    for (what, result) in [("bench", &qemu), ("latency", &latency)] {
+    for (what, result) in [
+        ("bench", &qemu),
+        ("tracking", &tracking),
+        ("latency", &latency),
+    ] {
         if let Err(error) = result {
             println!("{what} FAILED: {error:#}");
         }
     }
-    Ok(qemu.is_ok() && latency.is_ok())
+    Ok(qemu.is_ok() && tracking.is_ok() && latency.is_ok())
 }
 
 /// The benchmark's rows, for the measured figures.

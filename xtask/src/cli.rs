@@ -54,7 +54,8 @@ pub enum Command {
         only: Option<String>,
     },
     /// Run the benchmark in QEMU (boot precompute and frame update against
-    /// their budgets), then the latency rows in the RP2040 emulator.
+    /// their budgets), the tracking figures in the host trace, then the
+    /// latency rows in the RP2040 emulator.
     Bench {
         #[command(flatten)]
         timeout: Timeout,

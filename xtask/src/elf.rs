@@ -9,7 +9,7 @@ use crate::{board::Board, figures, project};
 use object::read::elf::{ElfFile32, ProgramHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, SectionKind, elf};
 
-/// RAM budget of the Pico image: static RAM (`.data + .bss + .uninit`) plus
+/// RAM budget of the Pico image: static RAM (`.radar_ring + .data + .bss + .uninit`) plus
 /// the peak stack measured in the RP2040 emulator (the boot precompute's
 /// stack frame is most of it).
 pub const RAM_BUDGET: u64 = 48 * 1024;
@@ -139,9 +139,12 @@ impl Image {
         self.sections.iter().find(|section| section.name == name)
     }
 
-    /// Bytes of RAM taken before `main` runs: `.data + .bss + .uninit`.
+    /// Bytes of RAM taken before `main` runs: `.data + .bss + .uninit`,
+    /// and the radar's DMA ring (`.radar_ring`, placed by the board's
+    /// `memory.x`).
     pub fn static_ram(&self) -> u64 {
-        let ram = |s: &&Section| [".data", ".bss", ".uninit"].contains(&s.name.as_str());
+        let ram =
+            |s: &&Section| [".radar_ring", ".data", ".bss", ".uninit"].contains(&s.name.as_str());
         self.sections.iter().filter(ram).map(|s| s.size).sum()
     }
 
@@ -342,7 +345,7 @@ fn record_image(path: &Path, image: &Image) {
     }
     let intro = format!(
         "Flash is every section stored in flash (`.data`'s initial values included); \
-         static RAM is `.data + .bss + .uninit`. Sections of `{name}`: {sections}."
+         static RAM is `.radar_ring + .data + .bss + .uninit`. Sections of `{name}`: {sections}."
     );
     let row = vec![
         name.to_string(),

@@ -32,9 +32,10 @@ pub struct Table {
 
 /// The page's sections: the title, the keys of the tables under it (a key
 /// is a prefix: `image ` takes every image's), and how to measure them.
-const SECTIONS: [(&str, &[&str], &str); 5] = [
+const SECTIONS: [(&str, &[&str], &str); 6] = [
     ("Memory", &["image ", "ram"], TEST),
     ("Frame cost", &["frames", "latency"], TEST),
+    ("Tracking", &["tracking"], TEST),
     ("Boot precompute", &["precompute"], TEST),
     ("Idle loop sets", &["qemu"], TEST),
     (
@@ -162,8 +163,9 @@ fn render(figures: &BTreeMap<String, Table>) -> (String, Vec<&'static str>) {
          do not edit. -->\n\n\
          These figures are written by the project's tools as they measure, never by \
          hand. `cargo xtask test` records the images' sizes, their RAM with the peak \
-         stack, the QEMU run and the benchmark; `cargo xtask bench` the benchmark and \
-         the latency rows; `cargo xtask metrics` the loop quality; `cargo xtask book` \
+         stack, the QEMU run, the benchmark and the tracking figures; `cargo xtask \
+         bench` the benchmark, the tracking figures and the latency rows; `cargo xtask \
+         metrics` the loop quality; `cargo xtask book` \
          writes this page from what they recorded (`target/figures.json`). Each table \
          says which command recorded it, and on which commit.\n",
     );

@@ -14,6 +14,7 @@ pub mod node;
 mod planted;
 pub mod pulses;
 mod pulses_csv;
+mod radar;
 mod run;
 mod script;
 mod show;
@@ -53,12 +54,17 @@ pub fn play_script(
     time: Duration,
     wall: Duration,
 ) -> Result<Report> {
-    let (against, rate) = (
-        script::Against::Written,
-        idle_head_core::servo::ServoRate::DEFAULT,
-    );
-    script::play(root, metadata, events, (time, wall), against, rate)
+    let against = script::Against::Written;
+    script::play(
+        root,
+        metadata,
+        events,
+        (time, wall),
+        against,
+        script::Board::default(),
+    )
 }
+pub use radar::{RADAR_DMX_STAGE, RADAR_STAGE, test_radar, test_radar_dmx};
 
 /// The harness's DMX line for a DMX script's text (see `xtask/src/sim/dmx.rs`).
 pub fn dmx_line(script: &str) -> Result<serde_json::Value> {
@@ -159,6 +165,13 @@ pub struct Args {
     /// host trace of it. Without `--seconds`, to 5 s after its last line.
     #[arg(long, value_name = "FILE", group = "run")]
     pub script: Option<PathBuf>,
+    /// Play a file of radar lines (`<s> radar <x_mm>,<y_mm> ...`, up to
+    /// three people, or `<s> radar none`) into GP13 as an HLK-LD2450's
+    /// frames, ten a second, with `radar on` sent first; every pulse
+    /// checked against the host trace of it. Without `--seconds`, to 5 s
+    /// after its last line.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood", "script", "dmx", "show"])]
+    pub radar: Option<PathBuf>,
     /// With `--script`: the servos' rate, Hz (50 to 333), from the first
     /// frame: the image boots on settings of that rate (planted in its
     /// settings sectors), and the host trace runs at it.
@@ -191,10 +204,18 @@ pub fn command(args: &Args) -> Result<bool> {
     let (root, md) = (root.as_path(), &metadata);
     PICO.build(root)?;
     if let Some(path) = &args.script {
-        return script::command(root, md, path, args);
+        let rate = idle_head_core::servo::ServoRate::new(args.rate)
+            .ok_or_else(|| anyhow::anyhow!("{} Hz: not a servo rate", args.rate))?;
+        let events = script::read(path)?;
+        let time = (args.virtual_time, args.timeout);
+        return script::command(root, md, events, time, rate, args.pulses.as_ref());
     }
     if args.dmx.is_some() || args.pulses.is_some() && !args.show {
         return show::command(root, md, args);
+    }
+    if let Some(path) = &args.radar {
+        let time = (args.virtual_time, args.timeout);
+        return radar::command(root, md, path, time, args.pulses.as_ref());
     }
     let time = args.virtual_time;
     let result = if let Some(port) = &args.stream {

@@ -158,6 +158,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
 
     // 5. The boot-time benchmark in QEMU and the default set's instruction
     // budget; its telemetry check compares against the QEMU run above.
+    stages.run(bench::tracking::STAGE, bench::tracking::stage);
     stages.run(bench::LATENCY_STAGE, || {
         bench::latency_stage(&root, &metadata)
     });
@@ -263,6 +264,8 @@ fn sim_stages(
     stages.run(sim::DMX_STREAM_STAGE, || sim::test_dmx(root, metadata));
     stages.run(sim::FAILURES_STAGE, || sim::test_failures(root, metadata));
     stages.run(sim::SHOW_STAGE, || sim::test_show(root, metadata));
+    stages.run(sim::RADAR_STAGE, || sim::test_radar(root, metadata));
+    stages.run(sim::RADAR_DMX_STAGE, || sim::test_radar_dmx(root, metadata));
     stages.run(MEMORY, || {
         let peak = |elf: &Path, stack: Option<u64>| -> Result<Option<elf::Peak>> {
             let Some(stack) = stack else { return Ok(None) };

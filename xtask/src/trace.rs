@@ -10,20 +10,19 @@
 
 mod host;
 mod marks;
+pub mod radar;
 mod script;
 mod watch;
 
 use std::{fs, path::PathBuf};
 
 use anyhow::{Context, Result, anyhow};
-use idle_head_core::Millimetres;
 use idle_head_core::behaviour::{BehaviourConfig, CommandQueue, Head, LOOP_DURATION, ShowLink};
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver, FrameReport};
 use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
 use idle_head_core::pwm_clock::SliceClock;
 use idle_head_core::servo::{ServoRate, SetPeriod};
-use idle_head_core::track::{Person, Sighting};
 use idle_head_core::{Axis, Microseconds, Playback, Timestamp};
 use idle_head_firmware::config::IDLE_MODE;
 use std::fmt::Write as _;
@@ -156,14 +155,21 @@ impl SetPeriod for Channel {
     }
 }
 
-/// The idle loops' configuration for `seed` (or Table 2's).
-fn config(seed: Option<u32>) -> HeadConfig {
+/// `--seed n`: pitch n, roll and yaw the next two values of the paper's
+/// LCG.
+fn lcg_seeds(seed: u32) -> [u32; 3] {
+    let mut lcg = Lcg::new(seed);
+    [seed, lcg.next_value(), lcg.next_value()]
+}
+
+/// The idle loops' configuration for `seeds` `[pitch, roll, yaw]` (or
+/// Table 2's).
+fn config(seeds: Option<[u32; 3]>) -> HeadConfig {
     let mut config = DEFAULT_HEAD;
-    if let Some(seed) = seed {
-        let mut lcg = Lcg::new(seed);
-        config.pitch.seed = seed;
-        config.roll.seed = lcg.next_value();
-        config.yaw.seed = lcg.next_value();
+    if let Some([pitch, roll, yaw]) = seeds {
+        config.pitch.seed = pitch;
+        config.roll.seed = roll;
+        config.yaw.seed = yaw;
     }
     config
 }
@@ -173,7 +179,7 @@ fn config(seed: Option<u32>) -> HeadConfig {
 /// its join is due.
 type Idle = IdlePlayer<Box<LoopSet<DEFAULT_N>>, GenerateOnTake<Box<LoopSet<DEFAULT_N>>, DEFAULT_N>>;
 
-fn idle(config: HeadConfig, playback: Playback, seed: Option<u32>) -> Result<Idle> {
+fn idle(config: HeadConfig, playback: Playback, seed: Option<[u32; 3]>) -> Result<Idle> {
     let timing = IdleTiming::new(playback).map_err(|e| anyhow!("{}", e.message()))?;
     let mut stream = LoopStream::new(config, &timing);
     let mut first = Box::new(LoopSet::new());
@@ -208,10 +214,12 @@ pub fn at_rate(rate: ServoRate) -> Result<(DriverParams, BehaviourParams)> {
 
 /// Runs `micros` of frames at `rate` with `events` (sorted by time):
 /// motion lines through the queue, other console lines through the
-/// console's service, pin lines into the input task ([`host`]).
+/// console's service, pin lines into the input task ([`host`]), radar
+/// lines as the radar's frames ([`radar`]); the idle from `seed` (`[pitch,
+/// roll, yaw]`, else Table 2's).
 pub fn simulate(
     micros: u64,
-    seed: Option<u32>,
+    seed: Option<[u32; 3]>,
     rate: ServoRate,
     events: &[Event],
 ) -> Result<Trace> {
@@ -223,7 +231,7 @@ pub fn simulate(
 /// last frame.
 pub fn simulate_watched(
     micros: u64,
-    seed: Option<u32>,
+    seed: Option<[u32; 3]>,
     rate: ServoRate,
     events: &[Event],
     watch: Option<u8>,
@@ -248,8 +256,7 @@ pub fn simulate_watched(
     let mut console = host::Console::new(&queue, &link, &show, rate)?;
     let mut task = host::Task::new(&link);
     // What the radar sees (a script's radar lines), sent at its 10 Hz.
-    let mut people = Sighting::NOBODY;
-    let mut radar_frames = 0_u64;
+    let mut radar = radar::Radar::of(events);
 
     let mut rows = Vec::with_capacity(usize::try_from(micros / u64::from(period.0)).unwrap_or(0));
     let mut marks = Vec::new();
@@ -261,8 +268,7 @@ pub fn simulate_watched(
         let rest = head.rest_state();
         // The script's lines due, and the input task's wakes between them.
         while let Some(event) = events.get(next).filter(|e| e.at_us <= t_us) {
-            if let Kind::Radar(seen) = event.kind {
-                people = sighting(&seen);
+            if let Kind::Radar(_) = event.kind {
                 next += 1;
                 continue;
             }
@@ -277,7 +283,7 @@ pub fn simulate_watched(
             }
             next += 1;
         }
-        send_radar(&show, people, &mut radar_frames, t_us);
+        radar.send(&show, t_us);
         task.radar(show.track.presence());
         wake_until(&mut task, t_us, rest, &link, &queue, &mut origins);
         // What the console sent through the link, then the queue.
@@ -356,34 +362,6 @@ fn publish(
     if let Some(watch) = watch {
         watch.frame(t_us, &status);
     }
-}
-
-/// The radar's frame period, µs (the LD2450 reports ten times a second).
-const RADAR_US: u64 = 100_000;
-
-/// The radar's frames due by `t_us` (`sent` so far), seeing `people`,
-/// through the receiver's link.
-fn send_radar(show: &ShowLink, people: Sighting, sent: &mut u64, t_us: u64) {
-    while *sent * RADAR_US <= t_us {
-        *sent += 1;
-        let counters = idle_head_core::track::Counters {
-            good: u32::try_from(*sent).unwrap_or(u32::MAX),
-            ..idle_head_core::track::Counters::default()
-        };
-        show.track.publish(Some(people), counters);
-    }
-}
-
-/// A sighting of a radar line's people.
-fn sighting(seen: &[Option<(i32, i32)>; 3]) -> Sighting {
-    let mut s = Sighting::NOBODY;
-    for (slot, p) in s.people.iter_mut().zip(seen) {
-        *slot = p.map(|(x, y)| Person {
-            x: Millimetres(x),
-            y: Millimetres(y),
-        });
-    }
-    s
 }
 
 /// Where a script's lines go.
@@ -539,7 +517,14 @@ pub fn command(args: &Args) -> Result<bool> {
         None => Vec::new(),
     };
     let watch = args.telemetry.as_ref().map(|_| args.watch);
-    let trace = simulate_watched(args.micros, args.seed, rate, &events, watch, &[])?;
+    let trace = simulate_watched(
+        args.micros,
+        args.seed.map(lcg_seeds),
+        rate,
+        &events,
+        watch,
+        &[],
+    )?;
     let dir = || -> Result<PathBuf> {
         Ok(project::metadata(&project::root())?
             .target_dir

@@ -1,7 +1,10 @@
 //! The settings store in the board's flash: the last four 4 KiB erase
 //! sectors (`SETTINGS` in the board's memory.x, which keeps code out of
 //! them), on embassy-rp's flash driver in blocking mode, made async by
-//! [`BlockingAsync`] (see `idle_head_firmware::storage`).
+//! [`BlockingAsync`] (see `idle_head_firmware::storage`). Before the store
+//! opens, at boot when nothing else runs, the board's unique id is read:
+//! the flash chip's on the Pico (the RP2040 has none of its own), the
+//! chip id in OTP on the Pico 2.
 
 use core::ops::Range;
 
@@ -11,6 +14,7 @@ use embassy_rp::flash::{Blocking, ERASE_SIZE, Flash};
 use embassy_rp::peripherals::FLASH;
 use embassy_time::Duration;
 use idle_head_core::driver::DriverConfig;
+use idle_head_core::seed::BoardId;
 use idle_head_firmware::boot::Loaded;
 use idle_head_firmware::storage::{self, FlashBusy, FlashStorage};
 use static_cell::StaticCell;
@@ -47,10 +51,10 @@ pub type Storage = &'static mut Store;
 /// Where the store stays.
 static STORE: StaticCell<Store> = StaticCell::new();
 
-/// Opens the store and reads the settings the board boots with, checked
-/// against `base` (see `idle_head_firmware::storage::open`); `feed` feeds
-/// the watchdog before each flash operation, while `busy` is set. `None` if
-/// called twice.
+/// Reads the board's unique id, then opens the store and reads the
+/// settings the board boots with, checked against `base` (see
+/// `idle_head_firmware::storage::open`); `feed` feeds the watchdog before
+/// each flash operation, while `busy` is set. `None` if called twice.
 #[must_use]
 #[inline(never)]
 pub fn open(
@@ -58,9 +62,11 @@ pub fn open(
     base: &DriverConfig,
     feed: fn(Duration),
     busy: &'static FlashBusy,
-) -> Option<Loaded<Storage>> {
-    let flash = BlockingAsync::new(Flash::new_blocking(flash));
-    storage::open(
+) -> Option<(Loaded<Storage>, BoardId)> {
+    let mut flash = Flash::new_blocking(flash);
+    let id = unique_id(&mut flash);
+    let flash = BlockingAsync::new(flash);
+    let loaded = storage::open(
         &STORE,
         flash,
         SETTINGS_RANGE,
@@ -68,5 +74,26 @@ pub fn open(
         base,
         feed,
         busy,
-    )
+    )?;
+    Some((loaded, id))
+}
+
+/// The flash chip's 64-bit unique id (command 4Bh, the W25Q16JV's; the
+/// boot ROM's flash functions around it, interrupts off for the few µs it
+/// takes), in the order the chip sends it; [`BoardId::NONE`] if it cannot
+/// be read. A flash without the command answers all ones: no id either.
+#[cfg(feature = "rp2040")]
+fn unique_id(flash: &mut Flash<'static, FLASH, Blocking, FLASH_SIZE>) -> BoardId {
+    let mut id = [0; 8];
+    match flash.blocking_unique_id(&mut id) {
+        Ok(()) => BoardId(u64::from_be_bytes(id)),
+        Err(_) => BoardId::NONE,
+    }
+}
+
+/// The RP2350's 64-bit chip id, from OTP rows 0 to 3; [`BoardId::NONE`] if
+/// it cannot be read.
+#[cfg(feature = "rp235xa")]
+fn unique_id(_: &mut Flash<'static, FLASH, Blocking, FLASH_SIZE>) -> BoardId {
+    embassy_rp::otp::get_chipid().map_or(BoardId::NONE, BoardId)
 }

@@ -10,7 +10,7 @@
 //! |---|---|---|
 //! | `P0` | the timer's alarm, the DMX512 receiver ([`dmx`]) | interrupts, microseconds each |
 //! | `P1` | the frame task | an interrupt executor on `SWI_IRQ_1` |
-//! | `P2` | the console on the UART and USB, the USB device, the trigger inputs ([`input`]), and their interrupts | an interrupt executor on `SWI_IRQ_0` ([`PORT_PRIORITY`]) |
+//! | `P2` | the console on the UART and USB, the USB device, the trigger inputs ([`input`]), and their interrupts; the radar's receiver ([`radar`]) | an interrupt executor on `SWI_IRQ_0` ([`PORT_PRIORITY`]); the radar's timer alarm |
 //! | thread mode | the loop generator, the status report ([`report`](idle_head_firmware::report)) | what is left |
 //!
 //! Nothing a person or a show waits for sits behind the loop generator
@@ -32,6 +32,7 @@ pub mod input;
 mod panic;
 pub mod pico;
 pub mod pwm;
+pub mod radar;
 pub mod uart;
 pub mod usb;
 pub mod waits;
@@ -50,6 +51,7 @@ use embassy_time::Duration;
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::console::SharedService;
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
+use idle_head_core::seed::BoardId;
 use idle_head_firmware::boot::{self, Clock, FLASH_BUSY, Generator, LINKS, Loaded};
 use idle_head_firmware::hooks::{BoardHooks, Watchdog};
 use static_cell::StaticCell;
@@ -57,6 +59,7 @@ use static_cell::StaticCell;
 use crate::dmx::DmxUart;
 use crate::input::GpioInputs;
 use crate::pwm::ServoPwm;
+use crate::radar::RadarRx;
 use crate::uart::UartPort;
 use crate::usb::UsbPort;
 use idle_head_firmware::console::{Gone, Port, Received};
@@ -103,6 +106,11 @@ pub struct Board {
     pub dmx: DmxUart,
     /// Where the DMX input is, for the log.
     pub dmx_pins: &'static str,
+    /// The radar's receiver ([`radar::receiver`]; `None` if it could not
+    /// be set up).
+    pub radar: Option<RadarRx>,
+    /// Where the radar is, for the log.
+    pub radar_pins: &'static str,
     /// The USB driver, for the console's USB serial port.
     pub usb: embassy_rp::usb::Driver<'static, USB>,
     /// The flash, for the settings store.
@@ -154,6 +162,8 @@ pub fn start(spawner: Spawner, board: Board) {
         uart_pins,
         dmx,
         dmx_pins,
+        radar,
+        radar_pins,
         usb,
         flash,
         watchdog,
@@ -171,16 +181,19 @@ pub fn start(spawner: Spawner, board: Board) {
         None => defmt::info!("boot: power-on or reset pin"),
     }
     log_clocks(name, servo_pins);
-    // Before the first frame: nothing else runs yet while the store is read.
-    let Some(loaded) = flash::open(flash, &CONFIG, feed_watchdog, &FLASH_BUSY) else {
+    // Before the first frame: nothing else runs yet while the unique id and
+    // the store are read.
+    let Some((loaded, id)) = flash::open(flash, &CONFIG, feed_watchdog, &FLASH_BUSY) else {
         defmt::error!("boot: called twice");
         return;
     };
-    let Some(head) = boot_head(spawner, loaded) else {
+    log_id(id);
+    let Some(head) = boot_head(spawner, loaded, id) else {
         return;
     };
     spawn_frames(servos, &head, BoardWatchdog);
     spawn_dmx(dmx, dmx_pins);
+    spawn_radar(radar, radar_pins);
     interrupt::SWI_IRQ_0.set_priority(PORT_PRIORITY);
     interrupt::IO_IRQ_BANK0.set_priority(PORT_PRIORITY);
     interrupt::USBCTRL_IRQ.set_priority(PORT_PRIORITY);
@@ -242,11 +255,11 @@ struct Head {
     service: &'static Service,
 }
 
-/// Runs the boot sequence on the settings `loaded`, spawns the loop
-/// generator and puts the console service in its static.
+/// Runs the boot sequence on the settings `loaded` on the board `id`,
+/// spawns the loop generator and puts the console service in its static.
 #[inline(never)]
-fn boot_head(spawner: Spawner, loaded: Loaded<flash::Storage>) -> Option<Head> {
-    let Ok(booted) = boot::boot(&CONFIG, loaded, oscillator_jitter()) else {
+fn boot_head(spawner: Spawner, loaded: Loaded<flash::Storage>, id: BoardId) -> Option<Head> {
+    let Ok(booted) = boot::boot_on(&CONFIG, loaded, oscillator_jitter(), id) else {
         defmt::error!("boot: called twice");
         return None;
     };
@@ -286,6 +299,36 @@ fn spawn_dmx(dmx: DmxUart, pins: &'static str) {
         if settings.on { "on" } else { "off" },
         settings.address.get()
     );
+}
+
+/// Starts the radar's receiver, if set up.
+#[inline(never)]
+fn spawn_radar(radar: Option<RadarRx>, pins: &'static str) {
+    let Some(rx) = radar else {
+        defmt::error!("radar: its receiver could not be set up ({=str})", pins);
+        return;
+    };
+    radar::listen(rx);
+    defmt::info!(
+        "radar: {=str}, {=u32} baud 8N1, {=str}",
+        pins,
+        radar::BAUD,
+        if LINKS.show.track.settings().radar {
+            "on"
+        } else {
+            "off"
+        }
+    );
+}
+
+/// Logs the board's unique id, whose seeds the idle plays by default
+/// (`seed board`).
+fn log_id(id: BoardId) {
+    if let Some(seed) = id.seed() {
+        defmt::info!("board id {=u64:016x}: seed board:{=u32}", id.0, seed);
+    } else {
+        defmt::info!("board id: none read (seed board plays the paper's seeds)");
+    }
 }
 
 /// Spawns the console on the UART and on the USB serial port.

@@ -14,21 +14,16 @@
 //! | input 4     | GP4  | 6         | GPIO, trigger input|
 //! | input 5     | GP5  | 7         | GPIO, trigger input|
 //! | DMX512 in   | GP9  | 12        | UART1 RX, 250 kbaud 8N2 |
+//! | radar TX in | GP13 | 17        | PIO0 SM0, 256000 8N1, by DMA channel 1 |
+//! | (radar RX)  | GP12 | 16        | not used: only for configuring the module |
 //!
-//! (GPIO n drives PWM slice ⌊n/2⌋ mod 8, channel A for even n.) One slice
-//! per servo, so each output starts on its own first valid pulse
-//! ([`crate::pwm`]). Servo signal wires to these pins, servo ground to a
-//! board GND (e.g. pin 23) and to the servo supply's ground; power the
-//! servos from their own 5 to 6 V supply, not from the board.
-//!
-//! The trigger inputs take a button to ground or a presence sensor's
-//! output (3.3 V logic, never 5 V) each, with a board GND (pin 3 or 8)
-//! beside them ([`crate::input`]; the user guide's chapter on inputs).
-//!
-//! A board with another pinout builds its [`Board`] the same way with its
-//! own pins.
+//! One PWM slice per servo (GPIO n drives slice ⌊n/2⌋ mod 8), so each
+//! output starts on its own first valid pulse ([`crate::pwm`]). The wiring
+//! (grounds, power, 3.3 V inputs) is the user guide's. A board with another
+//! pinout builds its [`Board`] the same way with its own pins.
 
-use embassy_rp::peripherals::USB;
+use embassy_rp::peripherals::{PIO0, USB};
+use embassy_rp::pio::{self, Pio};
 use embassy_rp::{Peripherals, bind_interrupts, usb};
 
 use crate::input::GpioInputs;
@@ -37,12 +32,20 @@ use crate::{Board, SERVO_CLOCK};
 
 bind_interrupts!(struct Irqs {
     USBCTRL_IRQ => usb::InterruptHandler<USB>;
+    PIO0_IRQ_0 => pio::InterruptHandler<PIO0>;
 });
 
 /// The [`Board`] of a Raspberry Pi Pico or Pico 2 named `name`, from the
 /// chip's peripherals. The servo outputs stay low until the first frame.
 #[must_use]
 pub fn board(p: Peripherals, name: &'static str) -> Board {
+    let Pio {
+        mut common, sm0, ..
+    } = Pio::new(p.PIO0, Irqs);
+    let radar = crate::radar::receiver(&mut common, sm0, p.PIN_13, p.DMA_CH1);
+    // PIO0's instruction memory keeps the program for as long as the
+    // board runs.
+    core::mem::forget(common);
     Board {
         name,
         servos: [
@@ -55,6 +58,8 @@ pub fn board(p: Peripherals, name: &'static str) -> Board {
         uart_pins: "UART0 GP0 TX, GP1 RX",
         dmx: crate::dmx::receiver(p.UART1, p.PIN_9),
         dmx_pins: "UART1 RX GP9",
+        radar,
+        radar_pins: "LD2450 TX to GP13 (PIO0 SM0, DMA channel 1)",
         usb: usb::Driver::new(p.USB, Irqs),
         flash: p.FLASH,
         watchdog: p.WATCHDOG,

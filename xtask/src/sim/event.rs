@@ -71,7 +71,10 @@ pub enum Event {
     UsbIn { ns: f64, n: usize },
     /// A DMX frame carrying a change ended (its last byte went out).
     Dmx { ns: f64, frame: u64, changed: bool },
-    /// Accesses to a register rp2040js does not model, counted over the run.
+    /// The radar frames sent in the run, at its end.
+    Radar { ns: f64, frames: u64 },
+    /// Accesses to a register rp2040js does not model, counted over the
+    /// run.
     Unmodelled {
         peripheral: String,
         op: Op,

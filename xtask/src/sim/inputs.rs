@@ -9,7 +9,6 @@ use std::time::Duration;
 use anyhow::{Context, Result};
 use idle_head_core::Axis;
 use idle_head_core::behaviour::{BehaviourConfig, LimitMode};
-use idle_head_core::servo::ServoRate;
 
 use super::pulses::{Pulse, angle};
 use super::{run, script};
@@ -36,7 +35,14 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     let events = script::parse(SCRIPT)?;
     let time = (Duration::from_millis(12_500), super::WALL);
     let against = script::Against::Host;
-    let report = script::play(root, metadata, events, time, against, ServoRate::DEFAULT)?;
+    let report = script::play(
+        root,
+        metadata,
+        events,
+        time,
+        against,
+        script::Board::default(),
+    )?;
     print!("{}", report.table());
     let boot = report.first()?;
     let timing = run::timing();

@@ -104,6 +104,11 @@ pub struct Config {
     pub script: Option<PinScript>,
     /// A stream of console lines made as they go out (`sim/stream.mjs`).
     pub stream: Option<LineStream>,
+    /// An HLK-LD2450 radar on GP13 (`sim/radar.mjs`; see `radar.rs`).
+    pub radar: Option<Value>,
+    /// The flash's unique id (none: the flash answers all ones).
+    #[serde(serialize_with = "uid")]
+    pub uid: Option<u64>,
 }
 
 /// Bytes sent at a time.
@@ -312,4 +317,13 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
         );
     }
     Ok(events)
+}
+
+/// A unique id as the harness reads it: 16 hex digits.
+#[allow(clippy::ref_option)]
+fn uid<S: serde::Serializer>(id: &Option<u64>, s: S) -> Result<S::Ok, S::Error> {
+    match id {
+        Some(id) => s.serialize_some(&format!("{id:016x}")),
+        None => s.serialize_none(),
+    }
 }

@@ -59,6 +59,8 @@ pub struct Boot {
     pub dmx_frames: Vec<u64>,
     /// The input pins the script drove: when, which GPIO, high or low.
     pub drives: Vec<(f64, u8, bool)>,
+    /// The radar frames sent to the end of the run.
+    pub radar_frames: u64,
 }
 
 impl Boot {
@@ -312,6 +314,7 @@ fn into_boot(boot: &mut Boot, event: &Event) {
             boot.dmx_changes.push(ns);
             boot.dmx_frames.push(frame);
         }
+        Event::Radar { frames, .. } => boot.radar_frames = frames,
         Event::Flash {
             op, len, busy_ns, ..
         } => boot.flash.push((op == Op::Erase, len, busy_ns)),

@@ -1,15 +1,17 @@
 //! `cargo xtask sim --script FILE`: a trace script played into the shipped
 //! image (pin lines drive GP2 to GP5, console lines go to UART0 2 ms before
 //! their time, times from the first frame), every pulse checked against
-//! the host trace of the same script; at another servo rate (`--rate`) the
-//! image boots on settings of that rate planted in its settings sectors,
-//! and the trace and the check run at it.
+//! the host trace of the same script; radar lines go to GP13 as the
+//! LD2450's frames (`radar.rs`); at another
+//! servo rate (`--rate`) the image boots on settings of that rate planted
+//! in its settings sectors, and the trace and the check run at it.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
 
+use idle_head_core::seed::BoardId;
 use idle_head_core::servo::ServoRate;
 use idle_head_core::settings::Settings;
 
@@ -21,11 +23,21 @@ use crate::elf;
 use crate::project::{Metadata, PICO};
 use crate::trace::{self, Event, Kind};
 
+/// How much before its time a console line (or a radar frame) is in.
+pub const EARLY: Duration = Duration::from_millis(2);
+
 /// The first frame a console line is taken at: the board's console reads
 /// its UART once the boot's work (the first loop sets) is done, some 40 ms
 /// after the first frame; a line timed earlier is taken here, in the
 /// emulator and in the host trace it is checked against alike.
 pub const CONSOLE_UP: Duration = Duration::from_millis(100);
+
+/// The events of the script at `path`.
+pub fn read(path: &Path) -> Result<Vec<Event>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading the script {}", path.display()))?;
+    parse(&text).with_context(|| format!("{}", path.display()))
+}
 
 /// The events of a script's `text`.
 pub fn parse(text: &str) -> Result<Vec<Event>> {
@@ -37,6 +49,15 @@ pub fn parse(text: &str) -> Result<Vec<Event>> {
 pub fn default_time(events: &[Event]) -> Duration {
     let last = events.last().map_or(0, |e| e.at_us);
     Duration::from_micros(last) + Duration::from_secs(5)
+}
+
+/// The board a script plays on: the servos' rate from the first frame (the
+/// image boots on settings of that rate) and the flash's unique id (none:
+/// the flash answers all ones, and the idle plays the paper's seeds).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Board {
+    pub rate: ServoRate,
+    pub uid: Option<u64>,
 }
 
 /// What a script run's pulses are checked against.
@@ -62,8 +83,9 @@ pub fn play(
     mut events: Vec<Event>,
     (time, wall): (Duration, Duration),
     against: Against,
-    rate: ServoRate,
+    board: Board,
 ) -> Result<Report> {
+    let rate = board.rate;
     if let Some(e) = events.iter().find(|e| changes_rate(&e.text)) {
         bail!(
             "{:.3} s `{}`: the emulator's pulse check runs at one servo rate; give it with \
@@ -81,10 +103,9 @@ pub fn play(
     }
     // (Lines keep their order: a pin line before 0.1 s stays first.)
     events.sort_by_key(|e| e.at_us);
-    let early = Duration::from_millis(2);
     let mut script = PinScript {
         anchor_slice: SERVOS[0].2,
-        early,
+        early: EARLY,
         ..PinScript::default()
     };
     for event in &events {
@@ -102,13 +123,11 @@ pub fn play(
                     .lines
                     .push(Chunk::new(format!("{}\r\n", event.text), frame));
             }
-            Kind::Radar(_) => bail!(
-                "line {}: radar lines play in the host trace (`cargo xtask trace`); the emulator \
-                 has no radar on GP13 yet",
-                event.line
-            ),
+            // The radar's frames, below.
+            Kind::Radar(_) => {}
         }
     }
+    let radar = super::radar::line(&events, rate, time);
     let planted = if rate == ServoRate::DEFAULT {
         None
     } else {
@@ -131,6 +150,8 @@ pub fn play(
         config.inputs = input_pins();
         config.script = Some(script);
         config.flash_fill = planted;
+        config.radar = radar;
+        config.uid = board.uid;
         // A head relaxed at rest is silent for as long as it rests (no
         // pulse, no log line but once a loop): the wall limit alone tells a
         // stuck run.
@@ -140,8 +161,15 @@ pub fn play(
         Against::Host => {
             // The host's frames outlast the emulator's (which began a
             // little after power-on).
-            let micros = u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX);
-            let host = trace::simulate(micros, None, rate, &events)?;
+            let seeds = board
+                .uid
+                .map(|id| Settings::DEFAULT.idle_seeds(BoardId(id)));
+            let host = trace::simulate(
+                u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX),
+                seeds,
+                rate,
+                &events,
+            )?;
             host.rows.iter().map(|row| row.duties).collect()
         }
         Against::Written => written(&report),
@@ -179,22 +207,19 @@ fn written(report: &Report) -> Vec<[u16; 3]> {
     (0..n).map(duty).collect()
 }
 
-/// `cargo xtask sim --script FILE [--rate HZ] [--pulses CSV]`.
-pub fn command(root: &Path, metadata: &Metadata, path: &Path, args: &super::Args) -> Result<bool> {
-    let rate =
-        ServoRate::new(args.rate).with_context(|| format!("{} Hz: not a servo rate", args.rate))?;
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("reading the script {}", path.display()))?;
-    let events = parse(&text).with_context(|| format!("{}", path.display()))?;
-    let time = args.virtual_time.unwrap_or_else(|| default_time(&events));
-    let report = play(
-        root,
-        metadata,
-        events,
-        (time, args.timeout),
-        Against::Host,
-        rate,
-    )?;
+/// `cargo xtask sim --script FILE [--rate HZ] [--pulses CSV]` (and
+/// `--radar FILE`: its `events`).
+pub fn command(
+    root: &Path,
+    metadata: &Metadata,
+    events: Vec<Event>,
+    (time, wall): (Option<Duration>, Duration),
+    rate: ServoRate,
+    pulses: Option<&PathBuf>,
+) -> Result<bool> {
+    let time = time.unwrap_or_else(|| default_time(&events));
+    let board = Board { rate, uid: None };
+    let report = play(root, metadata, events, (time, wall), Against::Host, board)?;
     print!("{}", report.log_text(false));
     let boot = report.first()?;
     println!("UART0 replies:");
@@ -206,7 +231,7 @@ pub fn command(root: &Path, metadata: &Metadata, path: &Path, args: &super::Args
         .verdict()
         .replace("the host's duty", "the host trace's duty");
     println!("{verdict}\n{}", report.summary());
-    if let Some(path) = &args.pulses {
+    if let Some(path) = pulses {
         let rows = pulses_csv::write(path, &boot.trains, &run::timing_at(rate))?;
         println!("wrote {} ({rows} frames)", path.display());
     }

@@ -70,7 +70,17 @@ const RATE_SCRIPT: &str = "\
 pub fn test_rate(root: &Path, metadata: &Metadata) -> Result<()> {
     let events = script::parse(RATE_SCRIPT)?;
     let time = (Duration::from_secs(7), WALL);
-    let report = script::play(root, metadata, events, time, Against::Host, ServoRate::MAX)?;
+    let report = script::play(
+        root,
+        metadata,
+        events,
+        time,
+        Against::Host,
+        script::Board {
+            rate: ServoRate::MAX,
+            uid: None,
+        },
+    )?;
     print!("{}", report.table());
     let frames = report.boots.first().map_or(0, |boot| boot.servos[0].frames);
     let few = format!("{frames} frames checked, not the 2,300 of 7 s at 333 Hz");

@@ -286,7 +286,7 @@ fn steps_around_the_save(boot: &Boot) -> (String, Vec<String>) {
 }
 
 /// `len` bytes of noise (xorshift32): a store no firmware wrote.
-fn noise(len: usize) -> Vec<u8> {
+pub(super) fn noise(len: usize) -> Vec<u8> {
     let mut x: u32 = 0x2545_f491;
     let mut next = || {
         x ^= x << 13;

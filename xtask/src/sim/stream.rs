@@ -9,6 +9,7 @@ use std::{fmt::Write as _, path::Path, time::Duration};
 use anyhow::Result;
 use idle_head_core::console::checksum;
 
+use super::Boot;
 use super::{
     dmx,
     node::{LineStream, StreamLine, UartScript},
@@ -257,7 +258,16 @@ pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     // engages the show layer, mix 0 or not. No frame may be late.)
     let boot = report.first()?;
     let reply = boot.uart_replies().into_iter().next().unwrap_or_default();
-    let counter = |name| field(&reply, name).and_then(|v| v.parse::<u64>().ok());
+    let (text, problems) = check_dmx(boot, &reply, changes.len());
+    print!("{text}");
+    crate::project::verdict(&problems)
+}
+
+/// The `dmx` counters of its `reply` against the frames sent in `boot`
+/// (`changes` of them changed the slots): every one good, no frame late;
+/// a summary and the problems.
+pub(super) fn check_dmx(boot: &Boot, reply: &str, changes: usize) -> (String, Vec<String>) {
+    let counter = |name| field(reply, name).and_then(|v| v.parse::<u64>().ok());
     let mut problems: Vec<String> = ["short", "long", "start_code", "garbled"]
         .into_iter()
         .filter(|name| counter(name) != Some(0))
@@ -268,10 +278,9 @@ pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     let good = counter("good").unwrap_or(0);
     let sent = boot.dmx_frames.last().map_or(0, |&frame| frame + 1);
     let seen = boot.dmx_changes.len();
-    if seen != changes.len() || good < sent {
-        let all = changes.len();
+    if seen != changes || good < sent {
         problems.push(format!(
-            "{good} good frames, {sent} sent by the last change ({seen} of {all} changes seen)"
+            "{good} good frames, {sent} sent by the last change ({seen} of {changes} changes seen)"
         ));
     }
     let late: Vec<&str> = (boot.log.iter().map(|(_, line)| line.message.as_str()))
@@ -280,10 +289,12 @@ pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     if let Some(first) = late.first() {
         problems.push(format!("{} frames late: `{first}`", late.len()));
     }
-    let sets = sets(&report);
-    println!(
+    let sets = (boot.log.iter())
+        .filter(|(_, line)| line.message.starts_with("loop set "))
+        .count();
+    let summary = format!(
         "DMX: {sent} frames of 512 slots sent by the last change, {good} counted good; {sets} loop \
-         sets generated meanwhile; `{reply}`"
+         sets generated meanwhile; `{reply}`\n"
     );
-    crate::project::verdict(&problems)
+    (summary, problems)
 }

@@ -1,0 +1,389 @@
+//! The radar in the emulator: a script's radar lines as an HLK-LD2450's
+//! frames on GP13 (`sim/radar.mjs` encodes them; `sim/pio.mjs` runs the
+//! firmware's PIO UART in step with the CPU), and the stages that check
+//! the shipped image with it:
+//!
+//! - a walk (2 m away, left to right at 1 m/s, `radar on` and `track on`
+//!   over UART0) is followed: the yaw within 5° RMS of the walker's bearing
+//!   after the first second, every pulse the host trace's duty;
+//! - two boards whose flashes have different unique ids play different
+//!   idle motion from the same image, each its own id's seeds as the host
+//!   trace computes them, and `seed` answers each its `board:<n>`;
+//! - DMX512 at the full universe rate on GP9 and the radar on GP13 at
+//!   once: every DMX frame counted good, every radar frame counted, none
+//!   bad, no servo frame late; and a `save` that erases flash sectors
+//!   (400 ms each with the interrupts off, the flash's worst case) while
+//!   the radar sends: every radar frame counted, none bad.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use anyhow::{Context, Result, anyhow, bail};
+use idle_head_core::seed::BoardId;
+use idle_head_core::servo::ServoRate;
+use serde_json::{Value, json};
+
+use super::image::SERVOS;
+use super::node::Chunk;
+use super::node::{PinScript, nanos};
+use super::pulses::angle;
+use super::run::{self, Boot};
+use super::script::{self, Against, Board, EARLY};
+use super::{WALL, dmx, stages::shipped_image, stream};
+use crate::bench::tracking::{self, Walk};
+use crate::project::Metadata;
+use crate::trace::{Event, Kind, radar::PERIOD_US};
+
+/// Stage names.
+pub const RADAR_STAGE: &str = "Pico image in the RP2040 emulator: a radar walk on GP13 is \
+     followed within 5° of the bearing, every pulse the host trace's; two boards' unique ids \
+     give two idle motions";
+/// See [`RADAR_STAGE`].
+pub const RADAR_DMX_STAGE: &str = "Pico image in the RP2040 emulator: DMX512 on GP9 and the \
+     radar on GP13 at once: every frame of both counted, none lost; a flash erase loses no radar \
+     frame";
+
+/// The LD2450's line rate.
+const BAUD: u32 = 256_000;
+/// Two boards' flash unique ids (as a W25Q16JV reports them).
+const BOARDS: [u64; 2] = [0xe661_4103_e745_2d2f, 0xe661_4103_e72b_8a21];
+
+/// The harness's `radar` for the radar lines of `events` (none: no radar
+/// wired), its frames from the script's time 0 to `time`, each in
+/// [`EARLY`] before the first servo frame at `rate` at or after its time.
+pub fn line(events: &[Event], rate: ServoRate, time: Duration) -> Option<Value> {
+    let lines: Vec<Value> = events
+        .iter()
+        .filter_map(|e| match e.kind {
+            Kind::Radar(people) => Some(json!({
+                "at_ns": e.at_us * 1000,
+                "people": people.map(|p| p.map(|(x, y)| [x, y])),
+            })),
+            _ => None,
+        })
+        .collect();
+    (!lines.is_empty()).then(|| {
+        json!({
+            "baud": BAUD,
+            "period_ns": PERIOD_US * 1000,
+            "frame_ns": u64::from(rate.period().0) * 1000,
+            "early_ns": nanos(EARLY),
+            "end_ns": nanos(time),
+            "lines": lines,
+        })
+    })
+}
+
+/// `--radar FILE`: its radar lines, after `radar on` at 0.
+pub fn read(path: &Path) -> Result<Vec<Event>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading the radar lines {}", path.display()))?;
+    let events = script::parse(&format!("0 radar on\n{text}"))
+        .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    if let Some(e) = events
+        .iter()
+        .skip(1)
+        .find(|e| !matches!(e.kind, Kind::Radar(_)))
+    {
+        bail!(
+            "{} line {}: `{}` is not a radar line (`<s> radar <x_mm>,<y_mm> ...` or \
+             `<s> radar none`; --script plays other lines)",
+            path.display(),
+            e.line - 1,
+            e.text
+        );
+    }
+    Ok(events)
+}
+
+/// `cargo xtask sim --radar FILE`.
+pub fn command(
+    root: &Path,
+    metadata: &Metadata,
+    path: &Path,
+    time: (Option<Duration>, Duration),
+    pulses: Option<&PathBuf>,
+) -> Result<bool> {
+    script::command(
+        root,
+        metadata,
+        read(path)?,
+        time,
+        ServoRate::DEFAULT,
+        pulses,
+    )
+}
+
+/// The yaw of each frame of `boot`, m°, from its pulses.
+fn yaw(boot: &Boot) -> Vec<f64> {
+    let timing = run::timing();
+    let mut yaw = Vec::new();
+    for pulse in &boot.servos[2].pulses {
+        yaw.resize(pulse.frame, f64::NAN);
+        yaw.push(angle(2, f64::from(pulse.counts) * timing.count_ns));
+    }
+    yaw
+}
+
+/// [`RADAR_STAGE`].
+pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
+    let mut problems = Vec::new();
+    // The walk.
+    let events = script::parse(&tracking::walk_script())?;
+    let time = Duration::from_micros(tracking::WALK_RUN_US);
+    let report = script::play(
+        root,
+        metadata,
+        events,
+        (time, WALL),
+        Against::Host,
+        Board::default(),
+    )?;
+    println!("{}", report.verdict());
+    problems.extend(report.problems.iter().map(|p| format!("walk: {p}")));
+    let boot = report.boots.first().context("no boot")?;
+    let walk = Walk::of(&yaw(boot), u64::from(ServoRate::DEFAULT.period().0))?;
+    println!(
+        "walk: {} radar frames sent; the yaw {} ms behind the bearing, {:.2}° RMS and at most \
+         {:.2}° from it after the first second",
+        boot.radar_frames,
+        walk.lag_ms,
+        walk.rms / 1000.0,
+        walk.largest / 1000.0
+    );
+    if walk.rms.is_nan() || walk.rms > 5000.0 {
+        problems.push(format!(
+            "walk: RMS error {:.2}°, not within 5°",
+            walk.rms / 1000.0
+        ));
+    }
+    if !says(boot, "track: turned to yaw") {
+        problems.push("walk: the frame task never logged `track: turned to yaw`".to_owned());
+    }
+    // Two boards.
+    let mut yaws = Vec::new();
+    for uid in BOARDS {
+        let (found, yaw) = board(root, metadata, uid)?;
+        problems.extend(found);
+        yaws.push(yaw);
+    }
+    let n = yaws[0].len().min(yaws[1].len());
+    let differ = (0..n)
+        .filter(|&k| (yaws[0][k] - yaws[1][k]).abs() > 30.0)
+        .count();
+    println!("two boards: yaw differs by more than a count in {differ} of {n} frames");
+    if differ < n / 2 {
+        problems.push(format!(
+            "two boards: the yaw differs in only {differ} of {n} frames"
+        ));
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        bail!("{}", problems.join("; "))
+    }
+}
+
+/// One board of flash unique id `uid`: its run, checked against the host
+/// trace of its seeds, and `seed`'s reply; the problems and its yaw.
+fn board(root: &Path, metadata: &Metadata, uid: u64) -> Result<(Vec<String>, Vec<f64>)> {
+    let events = script::parse("3 seed\n")?;
+    let board = Board {
+        uid: Some(uid),
+        ..Board::default()
+    };
+    let time = Duration::from_secs(4);
+    let report = script::play(root, metadata, events, (time, WALL), Against::Host, board)?;
+    let boot = report.boots.first().context("no boot")?;
+    let seed = BoardId(uid).seed().context("an id that is no id")?;
+    let mut problems: Vec<String> = report
+        .problems
+        .iter()
+        .map(|p| format!("board {uid:016x}: {p}"))
+        .collect();
+    let replies = boot.uart_replies();
+    let want = format!("ok seed=board:{seed}");
+    println!(
+        "board {uid:016x}: {}, `seed` answers `{}`",
+        report.verdict(),
+        replies.join(" | ")
+    );
+    if replies != [want.clone()] {
+        problems.push(format!(
+            "board {uid:016x}: `seed` answered {replies:?}, not `{want}`"
+        ));
+    }
+    if !says(boot, &format!("board id {uid:016x}: seed board:{seed}")) {
+        problems.push(format!("board {uid:016x}: the boot did not log its id"));
+    }
+    Ok((problems, yaw(boot)))
+}
+
+/// Whether `boot`'s log has a line containing `text`.
+fn says(boot: &Boot, text: &str) -> bool {
+    boot.log.iter().any(|(_, line)| line.message.contains(text))
+}
+
+/// [`RADAR_DMX_STAGE`]: DMX512 at the full universe rate (a change of a
+/// slot past the head's every 0.23 s) and the radar (a person walking up
+/// and standing) from 1 s to 9 s; `dmx` and `radar` asked at 9.2 s.
+pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
+    let elf = shipped_image(root, metadata)?;
+    let (from, to) = (1.0, 9.0);
+    let mut text = String::new();
+    let mut k = 0;
+    while from + f64::from(k) * 0.23 < to {
+        let _ = writeln!(text, "{:.3} 11={}", from + f64::from(k) * 0.23, k % 2 * 100);
+        k += 1;
+    }
+    let changes = dmx::parse(&text)?;
+    let mut script = String::from("0 radar on\n");
+    for i in 0..30 {
+        let _ = writeln!(
+            script,
+            "{:.1} radar 300,{}",
+            1.0 + f64::from(i) * 0.1,
+            3000 - 50 * i
+        );
+    }
+    let events = script::parse(&script)?;
+    let query = Duration::from_millis(9200);
+    let radar = line(&events, ServoRate::DEFAULT, Duration::from_secs_f64(to));
+    let pins = PinScript {
+        anchor_slice: SERVOS[0].2,
+        early: EARLY,
+        lines: vec![
+            Chunk::new(b"radar on\r\n".to_vec(), Duration::from_millis(100)),
+            Chunk::new(b"dmx\r\nradar\r\n".to_vec(), query),
+        ],
+        ..PinScript::default()
+    };
+    let report = run::run_with(root, &elf, query + Duration::from_secs(1), WALL, |config| {
+        config.dmx = Some(dmx::line(&changes));
+        config.script = Some(pins);
+        config.radar = radar;
+    })?;
+    // (The pulses are not the idle's: the radar turns the head. What is
+    // checked is that no frame was late: the log says so.)
+    let boot = report.boots.first().context("no boot")?;
+    let replies = boot.uart_replies();
+    let reply = |start: &str| replies.iter().find(|r| r.starts_with(start)).cloned();
+    let dmx_reply = reply("ok dmx=").unwrap_or_default();
+    let (summary, mut problems) = stream::check_dmx(boot, &dmx_reply, changes.len());
+    print!("{summary}");
+    let radar_reply = reply("ok radar=").unwrap_or_default();
+    println!("radar: {} frames sent; `{radar_reply}`", boot.radar_frames);
+    problems.extend(counted(boot, &radar_reply));
+    problems.extend(report.problems.iter().cloned());
+    problems.extend(erase(root, &elf)?);
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        bail!("{}", problems.join("; "))
+    }
+}
+
+/// The problem, if the radar's `reply` did not count every frame `boot`
+/// sent, or counted one bad.
+fn counted(boot: &Boot, reply: &str) -> Option<String> {
+    let counter = |name: &str| -> Option<u64> {
+        reply
+            .split(' ')
+            .find_map(|f| f.strip_prefix(name)?.strip_prefix('=')?.parse().ok())
+    };
+    (counter("frames") != Some(boot.radar_frames) || counter("bad") != Some(0))
+        .then(|| format!("radar: `{reply}` for {} frames sent", boot.radar_frames))
+}
+
+/// A `save` at 2 s over settings sectors full of noise (each erase 400 ms
+/// with the interrupts off) while a person stands in front of the radar
+/// from 1 s to 5 s; `radar` asked at 5.2 s. The problems.
+fn erase(root: &Path, elf: &Path) -> Result<Vec<String>> {
+    let region = crate::elf::Image::read(elf)?
+        .settings
+        .context("the image has no settings region")?;
+    let sectors = super::store::noise(usize::try_from(region.end - region.start)?);
+    let events = script::parse("0 radar on\n1 radar -400,1800\n")?;
+    let query = Duration::from_millis(5200);
+    let radar = line(&events, ServoRate::DEFAULT, Duration::from_secs(5));
+    let pins = PinScript {
+        anchor_slice: SERVOS[0].2,
+        early: EARLY,
+        lines: vec![
+            Chunk::new(b"radar on\r\n".to_vec(), Duration::from_millis(100)),
+            Chunk::new(b"save\r\n".to_vec(), Duration::from_secs(2)),
+            Chunk::new(b"radar\r\n".to_vec(), query),
+        ],
+        ..PinScript::default()
+    };
+    let report = run::run_with(root, elf, query + Duration::from_secs(1), WALL, |config| {
+        config.script = Some(pins);
+        config.radar = radar;
+        config.rom = Some(super::store::WORST);
+        config.flash_fill = Some(super::node::Fill {
+            addr: region.start,
+            hex: sectors,
+        });
+    })?;
+    let boot = report.boots.first().context("no boot")?;
+    let erased: f64 = boot.flash.iter().filter(|op| op.0).map(|op| op.2).sum();
+    let reply = boot
+        .uart_replies()
+        .into_iter()
+        .find(|r| r.starts_with("ok radar="))
+        .unwrap_or_default();
+    println!(
+        "save: {:.0} ms of sector erases with the interrupts off; radar: {} frames sent; `{reply}`",
+        erased / 1e6,
+        boot.radar_frames
+    );
+    let mut problems: Vec<String> = report.problems.clone();
+    if erased < 400e6 {
+        problems.push(format!("save: only {:.0} ms of erases", erased / 1e6));
+    }
+    problems.extend(counted(boot, &reply).map(|p| format!("during a save: {p}")));
+    Ok(problems)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn radar_lines_become_the_harness_radar_and_others_do_not() {
+        let events = script::parse("0 radar on\n1 nod\n").unwrap();
+        assert_eq!(
+            line(&events, ServoRate::DEFAULT, Duration::from_secs(2)),
+            None
+        );
+        let events =
+            script::parse("0 radar on\n1.5 radar -782,1713 100,2000\n2 radar none\n").unwrap();
+        let radar = line(&events, ServoRate::MAX, Duration::from_secs(3)).unwrap();
+        assert_eq!(radar["frame_ns"], 3_003_000);
+        assert_eq!(radar["lines"][0]["at_ns"], 1_500_000_000_u64);
+        assert_eq!(
+            radar["lines"][0]["people"],
+            json!([[-782, 1713], [100, 2000], null])
+        );
+        assert_eq!(radar["lines"][1]["people"], json!([null, null, null]));
+    }
+
+    #[test]
+    fn a_radar_file_holds_radar_lines_only() {
+        let dir = std::env::temp_dir().join(format!("radar-lines-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (good, bad) = (dir.join("good.txt"), dir.join("bad.txt"));
+        std::fs::write(&good, "1 radar 0,1500\n2 radar none\n").unwrap();
+        std::fs::write(&bad, "1 radar 0,1500\n2 nod\n").unwrap();
+        let events = read(&good).unwrap();
+        assert_eq!(events[0].text, "radar on");
+        assert_eq!(events.len(), 3);
+        let error = format!("{:#}", read(&bad).unwrap_err());
+        assert!(
+            error.contains("line 2: `nod` is not a radar line"),
+            "{error}"
+        );
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}
