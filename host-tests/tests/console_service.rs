@@ -11,11 +11,9 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use host_tests::console::head::{SimFrames, service, shared};
 use host_tests::console::{LINE, REPLY, count_line_ends, random_line, random_stream, rng};
-use idle_head_core::behaviour::{Applied, CommandQueue};
-use idle_head_core::console::{
-    ConsoleLink, ConsoleService, ErrorCode, Response, Session, outcome_reply, parse, respond,
-};
-use idle_head_core::settings::{FlashFailed, RamStorage, SettingsStorage, StorageError};
+use idle_head_core::behaviour::Applied;
+use idle_head_core::console::{ErrorCode, Response, Session, outcome_reply, parse, respond};
+use idle_head_core::settings::{FlashFailed, SettingsStorage, StorageError};
 use proptest::prelude::RngExt as _;
 
 use host_tests::console::talk::SimConsole as Console;
