@@ -18,8 +18,9 @@
 //!   the event of equal width (an event whose axis still moves is skipped
 //!   and counted);
 //! - the response: the rising edge of the first pulse after the event whose
-//!   width differs from the baseline by more than one count (0.3125 µs,
-//!   0.028°): the first pulse that reflects the input.
+//!   width differs from the baseline by more than one and a half counts
+//!   of the PWM at the row's rate (0.47 µs at 50 Hz, 0.12 µs at 200 Hz):
+//!   the first pulse that reflects the input.
 //!
 //! The latency is the response's time minus the event's; the row gives the
 //! median, the 99th percentile and the largest, in ms:
@@ -57,6 +58,7 @@
 use std::{fmt::Write as _, path::Path, time::Duration};
 
 use anyhow::{Context, Result, bail};
+use idle_head_core::servo::ServoRate;
 
 use crate::project::Metadata;
 use crate::sim::pulses::{self, Measured};
@@ -254,19 +256,22 @@ pub fn response(pulses: &[Measured], at: f64, count_ns: f64) -> Response {
 
 /// The row of `events` (ns) on yaw's pulses in `boot`, at 50 Hz.
 pub fn row(name: &'static str, events: &[f64], boot: &Boot) -> Result<Row> {
-    row_at(name, events, boot, (20e6, GOAL_MS))
+    row_at(name, events, boot, ServoRate::DEFAULT, GOAL_MS)
 }
 
-/// The row of `events` (ns) on yaw's pulses in `boot`, with frames
-/// `frame_ns` apart and the goal `goal_ms` for p99.
+/// The row of `events` (ns) on yaw's pulses in `boot`, the servos at
+/// `rate` (its frames, and its PWM count for the response), with the goal
+/// `goal_ms` for p99.
 pub fn row_at(
     name: &'static str,
     events: &[f64],
     boot: &Boot,
-    (frame_ns, goal_ms): (f64, f64),
+    rate: ServoRate,
+    goal_ms: f64,
 ) -> Result<Row> {
     let pulses = &pulses::measure(&boot.trains[2]);
-    let count_ns = crate::sim::count_ns();
+    let count_ns = crate::sim::count_ns_at(rate);
+    let frame_ns = f64::from(rate.period().0) * 1e3;
     let mut ms = Vec::new();
     let mut worst: Vec<(f64, f64)> = Vec::new();
     let mut skipped = 0;
