@@ -402,7 +402,7 @@ impl ServoCalibration {
 
     /// The unclamped pulse for `angle`, in picoseconds, exactly:
     /// `neutral · 10⁶ ± angle · per_degree` (m° · ns/° = ps), saturating
-    /// at the ends of `i64` (|angle · per_degree| < 2⁶³ already).
+    /// at the ends of `i64` (`|angle · per_degree|` < 2⁶³ already).
     #[must_use]
     pub const fn raw_pulse_ps(&self, angle: Angle) -> i64 {
         let ps = angle.millidegrees() as i64 * self.per_degree.0 as i64;

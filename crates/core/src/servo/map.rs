@@ -192,7 +192,7 @@ impl ServoMap {
             let sum = range.checked_mul(k).and_then(|x| x.checked_add(c));
             if sum.is_some_and(|x| x < 1 << 32) {
                 // Error of the fraction < (1 + range)/2ˢ < 1 count.
-                if 1 + range < scale && base <= u64::from(u16::MAX) {
+                if 1 + range < scale && u16::try_from(base).is_ok() {
                     self.duty_k = k as u32;
                     self.duty_c = c as u32;
                     self.duty_base = base as u32;
