@@ -305,3 +305,39 @@ fn a_change_of_rate_goes_on_with_the_motion_as_it_was() {
         .collect();
     assert_eq!(periods, [3003, 5000, 3003, 20_000]);
 }
+
+/// `servo rate` checks the settings in effect at the new rate with
+/// `Settings::validate_rate`, which skips the gestures' plans: it must
+/// answer as the full `validate` does, at every rate, for settings the
+/// rate leaves valid and for settings it makes invalid (a frequency cap
+/// only the faster rates allow, gesture limits beyond the idle's).
+#[test]
+fn a_change_of_rate_is_checked_as_the_full_settings() {
+    use idle_head_core::driver::DriverConfig;
+    use idle_head_core::settings::Settings;
+    use idle_head_core::units::{DegreesPerSecond, MilliHertz};
+    let base = DriverConfig::DEFAULT;
+    let mut fast_cap = Settings::DEFAULT;
+    // 8 frames a cycle: 6250 mHz at 50 Hz, 41 625 at 333 Hz.
+    fast_cap.behaviour.max_frequency = MilliHertz(10_000);
+    let mut brisk = Settings::DEFAULT;
+    brisk.behaviour.gesture_limits[2].max_speed = DegreesPerSecond(1999);
+    let mut refused = Settings::DEFAULT;
+    refused.behaviour.gesture_limits[0].max_speed = DegreesPerSecond(1);
+    let (mut valid, mut invalid) = (0, 0);
+    for settings in [Settings::DEFAULT, fast_cap, brisk, refused] {
+        for hz in ServoRate::MIN.hz()..=ServoRate::MAX.hz() {
+            let mut next = settings;
+            next.rate = rate(hz);
+            let full = next.validate(&base);
+            assert_eq!(next.validate_rate(&base), full, "{hz} Hz");
+            if full.is_ok() {
+                valid += 1
+            } else {
+                invalid += 1
+            }
+        }
+    }
+    // Both answers were seen.
+    assert!(valid > 0 && invalid > 0, "{valid} valid, {invalid} invalid");
+}

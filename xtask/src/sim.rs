@@ -71,12 +71,12 @@ pub fn dmx_line(script: &str) -> Result<serde_json::Value> {
     Ok(dmx::line(&dmx::parse(script)?))
 }
 
-/// One PWM count of the servo slices at 50 Hz, ns.
-pub fn count_ns() -> f64 {
-    run::timing().count_ns
+/// One PWM count of the servo slices at `rate`, ns.
+pub fn count_ns_at(rate: idle_head_core::servo::ServoRate) -> f64 {
+    run::timing_at(rate).count_ns
 }
 
-/// The frame period at 50 Hz, ns.
+/// The frame period, ns.
 pub fn frame_ns() -> f64 {
     run::timing().frame_ns
 }

@@ -16,6 +16,7 @@ use idle_head_core::behaviour::{
 };
 use idle_head_core::command::{Action, GestureKind, GestureRequest, Hold, LookRequest};
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
+use idle_head_core::servo::{PwmTiming, ServoMap};
 use idle_head_core::units::{Angle, Millis, Timestamp};
 
 type Idle = host_tests::rig::Idle;
@@ -311,8 +312,11 @@ fn exact_duties_of_a_look_through_the_mock() {
     for k in 1..frames {
         let offsets = mixer.frame(frame(k), [Angle::ZERO; 3]);
         for (i, list) in expected.iter_mut().enumerate() {
-            let pulse = driver.config().servos[i].pulse(offsets[i]);
-            list.push(u16::try_from(pulse.0).unwrap());
+            // The servo map (checked against the exact pulse in
+            // `servo_map.rs`) on a channel of 1 count per µs.
+            let cal = &driver.config().servos[i];
+            let map = ServoMap::new(cal, PwmTiming::SERVO_50HZ, 20_000);
+            list.push(map.duty(cal, offsets[i]).0);
         }
     }
     // The yaw pulses rise smoothly to 1500 + 18 · 11.111 = 1700 µs.

@@ -7,13 +7,15 @@
 //! host's hand-over of a line's last byte, a button's edge); its baseline
 //! the axis at rest before it (the last two pulses of equal width, else
 //! the event is skipped); its response the rise of the first pulse after
-//! it whose width differs from the baseline by more than a count. A row
+//! it whose width differs from the baseline by more than one and a half PWM counts at the
+//! row's rate (0.47 µs at 50 Hz, 0.12 µs at 200 Hz). A row
 //! gives the latencies' median, 99th percentile and largest, in ms, against
 //! its goal for p99, and the longest a port task waited for the CPU.
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
 use anyhow::{Result, anyhow, bail};
+use idle_head_core::servo::ServoRate;
 
 use crate::project::Metadata;
 use crate::sim::pulses::{self, Measured};
@@ -247,19 +249,22 @@ pub fn response(pulses: &[Measured], at: f64, count_ns: f64) -> Response {
 
 /// The row of `events` (ns) on yaw's pulses in `boot`, at 50 Hz.
 pub fn row(name: &'static str, events: &[f64], boot: &Boot) -> Result<Row> {
-    row_at(name, events, boot, (20e6, GOAL_MS))
+    row_at(name, events, boot, ServoRate::DEFAULT, GOAL_MS)
 }
 
-/// The row of `events` (ns) on yaw's pulses in `boot`, with frames
-/// `frame_ns` apart and the goal `goal_ms` for p99.
+/// The row of `events` (ns) on yaw's pulses in `boot`, the servos at
+/// `rate` (its frames, and its PWM count for the response), with the goal
+/// `goal_ms` for p99.
 pub fn row_at(
     name: &'static str,
     events: &[f64],
     boot: &Boot,
-    (frame_ns, goal_ms): (f64, f64),
+    rate: ServoRate,
+    goal_ms: f64,
 ) -> Result<Row> {
     let pulses = &pulses::measure(&boot.trains[2]);
-    let count_ns = crate::sim::count_ns();
+    let count_ns = crate::sim::count_ns_at(rate);
+    let frame_ns = f64::from(rate.period().0) * 1e3;
     let (mut ms, mut worst, mut skipped, mut phases) = (Vec::new(), Vec::new(), 0, [0; 5]);
     let first = pulses.first().map_or(0.0, |p| p.rise);
     for &at in events {

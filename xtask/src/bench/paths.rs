@@ -14,6 +14,7 @@ use std::{path::Path, time::Duration};
 
 use anyhow::{Context, Result, bail};
 use idle_head_core::bottango::hash;
+use idle_head_core::servo::ServoRate;
 
 use super::latency::{self, LOOK_GAP, Row, SCHEDULED, schedule};
 use crate::project::Metadata;
@@ -110,11 +111,13 @@ pub fn uart_look_200_hz(root: &Path, metadata: &Metadata, wall: Duration) -> Res
         let start = String::from_utf8_lossy(&boot.uart[..boot.uart.len().min(80)]);
         bail!("uart look at 200 Hz: the rate was not taken: {start:?}");
     }
+    let rate = ServoRate::new(200).context("200 Hz is a servo rate")?;
     latency::row_at(
         "uart look at 200 Hz",
         &events,
         &boot,
-        (5e6, latency::GOAL_200_HZ_MS),
+        rate,
+        latency::GOAL_200_HZ_MS,
     )
 }
 

@@ -115,6 +115,30 @@ impl BehaviourConfig {
     /// );
     /// ```
     pub const fn build(&self, driver: &DriverParams) -> Result<BehaviourParams, BehaviourError> {
+        match self.build_at_rate(driver) {
+            Ok(params) => match self.check_gestures(&params) {
+                Ok(()) => Ok(params),
+                Err(e) => Err(e),
+            },
+            Err(e) => Err(e),
+        }
+    }
+
+    /// [`build`](Self::build) without planning each gesture's defaults:
+    /// for a configuration that `build` accepted with a driver that
+    /// differs from `driver` only in its frame period (`servo rate`). The
+    /// plans read the configuration, the servos' room and the limits in
+    /// °/s and °/s², never the frame period, so they hold at every rate;
+    /// the frame period enters only the frequency cap and the per-frame
+    /// rates, checked and worked out here. (The gesture plans are most of
+    /// `build`'s work: 64-bit divisions, a port task's CPU on a Cortex-M0+.)
+    ///
+    /// # Errors
+    /// The first problem found, as a [`BehaviourError`].
+    pub const fn build_at_rate(
+        &self,
+        driver: &DriverParams,
+    ) -> Result<BehaviourParams, BehaviourError> {
         let cfg = driver.config();
         let frame_us = cfg.frame_period.0;
         // Frame rate in mHz: at least 8 frames per cycle at the cap.
@@ -187,8 +211,12 @@ impl BehaviourConfig {
             look_duck: q16(self.gaze.duck),
             pose: cfg.neutral_pose,
         };
+        Ok(params)
+    }
 
-        // Each gesture's defaults, at both ends of the intensity range.
+    /// Each gesture's defaults, at both ends of the intensity range,
+    /// planned with `params`.
+    const fn check_gestures(&self, params: &BehaviourParams) -> Result<(), BehaviourError> {
         let mut k = 0;
         while k < GestureKind::COUNT {
             let row = GestureKind::ALL[k].row();
@@ -200,16 +228,16 @@ impl BehaviourConfig {
             check_defaults!(row.fields, d, MAX_CYCLES, self.max_frequency);
             let mut request = GestureRequest::new(row.kind);
             request.intensity = Some(Percent::FULL);
-            if let Err(e) = gesture::plan(&params, &request) {
+            if let Err(e) = gesture::plan(params, &request) {
                 return Err(e);
             }
             request.intensity = Some(Percent::ZERO);
-            if let Err(e) = gesture::plan(&params, &request) {
+            if let Err(e) = gesture::plan(params, &request) {
                 return Err(e);
             }
             k += 1;
         }
-        Ok(params)
+        Ok(())
     }
 }
 

@@ -329,12 +329,13 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         );
     }
 
-    /// `servo rate <hz>`: checked as the settings at that rate, then sent
-    /// to the frame task, which takes it at a frame boundary.
+    /// `servo rate <hz>`: checked as the settings at that rate (those in
+    /// effect are valid: only what the rate changes), then sent to the
+    /// frame task, which takes it at a frame boundary.
     fn set_rate(&mut self, rate: ServoRate, reply: &mut Reply<'_>) {
         let mut next = self.settings;
         next.rate = rate;
-        match next.validate(&self.base) {
+        match next.validate_rate(&self.base) {
             Ok(valid) if Self::inputs_refused(&next, &valid.behaviour, reply) => {}
             Ok(valid) => {
                 self.link.set_rate(rate);

@@ -4,6 +4,10 @@
 use crate::axis::Axis;
 use crate::units::{Angle, AngleRange, Microseconds};
 
+/// Picoseconds per microsecond: an angle in m° times a scale in ns/° is a
+/// pulse in ps.
+const PS_PER_US: i64 = 1_000_000;
+
 /// Pulse change per degree, in **nanoseconds per degree** (1 LSB = 1 ns/°).
 ///
 /// Nanoseconds keep the usual hobby servo scale exact enough: 1000 µs per 90°
@@ -384,7 +388,6 @@ impl ServoCalibration {
     #[must_use]
     pub const fn raw_pulse_us(&self, angle: Angle) -> i64 {
         // millidegrees · ns/degree = picoseconds; 10^6 ps = 1 µs.
-        const PS_PER_US: i64 = 1_000_000;
         let ps = angle.millidegrees() as i64 * self.per_degree.0 as i64;
         let us = if ps >= 0 {
             (ps + PS_PER_US / 2) / PS_PER_US
@@ -394,6 +397,48 @@ impl ServoCalibration {
         match self.direction {
             Direction::Normal => self.neutral.0 as i64 + us,
             Direction::Reversed => self.neutral.0 as i64 - us,
+        }
+    }
+
+    /// The unclamped pulse for `angle`, in picoseconds, exactly:
+    /// `neutral · 10⁶ ± angle · per_degree` (m° · ns/° = ps), saturating
+    /// at the ends of `i64` (`|angle · per_degree|` < 2⁶³ already).
+    #[must_use]
+    pub const fn raw_pulse_ps(&self, angle: Angle) -> i64 {
+        let ps = angle.millidegrees() as i64 * self.per_degree.0 as i64;
+        let neutral = self.neutral.0 as i64 * PS_PER_US;
+        match self.direction {
+            Direction::Normal => neutral.saturating_add(ps),
+            Direction::Reversed => neutral.saturating_sub(ps),
+        }
+    }
+
+    /// The pulse for `angle` in picoseconds, clamped to `[min_pulse,
+    /// max_pulse]`: what the PWM is asked to write, before its counts
+    /// round it ([`PwmTiming::duty_ps`]). [`pulse`](Self::pulse) is this
+    /// in whole µs.
+    ///
+    /// ```
+    /// use idle_head_core::servo::ServoCalibration;
+    /// use idle_head_core::{Angle, Axis};
+    /// let cal = ServoCalibration::hobby(Axis::Yaw);
+    /// // 16 m° · 11 111 ns/° = 177 776 ps above the 1500 µs neutral.
+    /// assert_eq!(cal.pulse_ps(Angle::from_millidegrees(16)), 1_500_177_776);
+    /// assert_eq!(cal.pulse_ps(Angle::from_degrees(90)), 2_000_000_000);
+    /// ```
+    #[must_use]
+    pub const fn pulse_ps(&self, angle: Angle) -> u64 {
+        let raw = self.raw_pulse_ps(angle);
+        let (min, max) = (
+            self.min_pulse.0 as i64 * PS_PER_US,
+            self.max_pulse.0 as i64 * PS_PER_US,
+        );
+        if raw <= min {
+            min as u64
+        } else if raw >= max {
+            max as u64
+        } else {
+            raw as u64
         }
     }
 
@@ -449,6 +494,39 @@ impl PwmTiming {
         let num = pulse.0 as u64 * max_duty as u64 + self.period.0 as u64 / 2;
         let Some(ticks) = num.checked_div(self.period.0 as u64) else {
             return Duty(max_duty);
+        };
+        if ticks >= max_duty as u64 {
+            Duty(max_duty)
+        } else {
+            Duty(ticks as u16)
+        }
+    }
+
+    /// Duty ticks for a pulse of `ps` picoseconds, as [`duty`](Self::duty)
+    /// counts a pulse in µs: `⌊(ps · max_duty + ⌊T/2⌋) / T⌋` with the period
+    /// `T` in ps, saturated at `max_duty` (also for a zero period). For a
+    /// whole-µs pulse it is [`duty`](Self::duty) of it; between whole µs it
+    /// keeps the resolution of the PWM's counts (at 200 Hz on the Pico, 80
+    /// ns: 62 500 counts per 5000 µs).
+    ///
+    /// ```
+    /// use idle_head_core::servo::{Duty, PwmTiming};
+    /// use idle_head_core::Microseconds;
+    /// let t = PwmTiming { period: Microseconds(5000) };
+    /// assert_eq!(t.duty_ps(1_500_000_000, 62_499), t.duty(Microseconds(1500), 62_499));
+    /// // 0.18 µs more: two counts of 80 ns more, where the µs would round it away.
+    /// assert_eq!(t.duty_ps(1_500_177_776, 62_499).0, t.duty(Microseconds(1500), 62_499).0 + 2);
+    /// ```
+    #[must_use]
+    pub const fn duty_ps(&self, ps: u64, max_duty: u16) -> Duty {
+        let period = self.period.0 as u64 * PS_PER_US as u64;
+        if period == 0 {
+            return Duty(max_duty);
+        }
+        // ps · max_duty fits u64 for any pulse up to 2.8 s; wider in u128.
+        let ticks = match ps.checked_mul(max_duty as u64) {
+            Some(p) if p <= u64::MAX - period / 2 => (p + period / 2) / period,
+            _ => ((ps as u128 * max_duty as u128 + (period / 2) as u128) / period as u128) as u64,
         };
         if ticks >= max_duty as u64 {
             Duty(max_duty)

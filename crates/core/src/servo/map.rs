@@ -1,9 +1,12 @@
 //! The frame path's angle → pulse → duty conversion: one servo's calibration
 //! and its channel's duty scale, worked out once into 32-bit integer steps.
 //!
-//! The pulse is exactly [`ServoCalibration::pulse`]'s and the duty within
-//! one count of [`PwmTiming::duty`]'s, in `i32` without a division for any
-//! usual calibration (in 64 bits beyond).
+//! The pulse that replies and logs show is exactly
+//! [`ServoCalibration::pulse`]'s (whole µs); the duty is counted from the
+//! exact pulse (ps), within one count of [`PwmTiming::duty_ps`] of
+//! [`ServoCalibration::pulse_ps`], so a servo moves by the PWM's count,
+//! not by 1 µs; in `i32` without a division for any usual calibration (in
+//! 64 bits beyond).
 //!
 //! Why it is built so: the book's notes on the code
 //! (`docs/design/code.md`, “Angle to pulse to duty”).
@@ -30,7 +33,7 @@ const NARROW_PS: i64 = (1 << 31) - (1 << 20);
 /// let map = ServoMap::new(&cal, PwmTiming::SERVO_50HZ, 63_999);
 /// let nine = Angle::from_degrees(9);
 /// assert_eq!(map.pulse(&cal, nine), cal.pulse(nine)); // 1600 µs
-/// assert_eq!(map.duty(&cal, nine), PwmTiming::SERVO_50HZ.duty(Microseconds(1600), 63_999));
+/// assert_eq!(map.duty(&cal, nine), PwmTiming::SERVO_50HZ.duty_ps(cal.pulse_ps(nine), 63_999));
 /// assert_eq!(map.duty(&cal, Angle::from_degrees(90)), Duty(6400)); // 2000 µs: clamped
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,16 +47,22 @@ pub struct ServoMap {
     ps_per_mdeg: i32,
     /// `k` of the module docs (0: the 64-bit duty form).
     duty_k: u32,
-    /// `c` of the module docs; the PWM period `T` (µs) in the 64-bit form.
+    /// `c` of the module docs.
     duty_c: u32,
-    /// `⌊(min_pulse·M + ⌊T/2⌋)/T⌋`: the duty of `min_pulse`.
-    duty_base: u16,
+    /// `b` of the module docs.
+    duty_base: u32,
+    /// The PWM period `T` (µs), for the 64-bit form.
+    period: u32,
+    /// Duty of `min_pulse`: the smallest written.
+    duty_min: u16,
     /// Duty of `max_pulse`: the largest written.
     duty_max: u16,
     /// Counts per period `M`.
     max_duty: u16,
     /// `s` of the duty form.
     shift: u8,
+    /// Whether `u` counts down from `hi` (a reversed servo).
+    from_hi: bool,
     /// Whether the pulse takes the 32-bit form.
     narrow_pulse: bool,
 }
@@ -69,15 +78,20 @@ impl ServoMap {
             hi: i32::MAX,
             ps_per_mdeg: 0,
             duty_k: 0,
-            duty_c: pwm.period.0,
-            duty_base: pwm.duty(cal.min_pulse, max_duty).0,
+            duty_c: 0,
+            duty_base: 0,
+            period: pwm.period.0,
+            duty_min: pwm.duty(cal.min_pulse, max_duty).0,
             duty_max: pwm.duty(cal.max_pulse, max_duty).0,
             max_duty,
             shift: 0,
+            from_hi: false,
             narrow_pulse: false,
         };
         map.narrow_pulse_form(cal);
-        map.narrow_duty_form(cal, pwm.period.0);
+        if map.narrow_pulse {
+            map.narrow_duty_form(cal);
+        }
         map
     }
 
@@ -112,33 +126,62 @@ impl ServoMap {
         }
     }
 
-    /// `k`, `c` and `s` of the 32-bit duty form, if the pulse range fits it.
-    fn narrow_duty_form(&mut self, cal: &ServoCalibration, period: u32) {
-        let (min, max) = (u64::from(cal.min_pulse.0), u64::from(cal.max_pulse.0));
-        let (counts, period) = (u64::from(self.max_duty), u64::from(period));
-        let base = (min * counts + period / 2).checked_rem(period);
-        let (Some(rem), Some(span)) = (base, max.checked_sub(min)) else {
+    /// `b`, `k`, `c` and `s` of the 32-bit duty form, if the domain fits it
+    /// (after [`narrow_pulse_form`](Self::narrow_pulse_form): `|a·s|` of
+    /// the domain below 2³¹). Two or three 64-bit divisions, no search.
+    fn narrow_duty_form(&mut self, cal: &ServoCalibration) {
+        self.from_hi = self.ps_per_mdeg < 0;
+        let end = if self.from_hi { self.hi } else { self.lo };
+        let range = u64::from(self.hi.abs_diff(self.lo));
+        let per_mdeg = u64::from(self.ps_per_mdeg.unsigned_abs());
+        let counts = u64::from(self.max_duty);
+        let period = u64::from(self.period) * PS_PER_US as u64;
+        let start =
+            i64::from(cal.neutral.0) * PS_PER_US + i64::from(end) * i64::from(self.ps_per_mdeg);
+        // The smaller end's pulse lies 1 µs below `min_pulse`, above 0 ps
+        // for a sane calibration; any product that overflows: the 64-bit form.
+        let x = u64::try_from(start)
+            .ok()
+            .and_then(|start| start.checked_mul(counts))
+            .and_then(|x| x.checked_add(period / 2));
+        let (Some(x), Some(num)) = (x, per_mdeg.checked_mul(counts)) else {
             return;
         };
-        // The largest s whose sum stays below 2³² (k, c and the sum grow
-        // with 2ˢ): M·2ˢ < 2⁴⁷, r·2ˢ < 2⁶³.
-        for shift in (0..32).rev() {
-            let k = (counts << shift).div_ceil(period);
-            let c = (rem << shift).div_ceil(period);
-            let sum = span.checked_mul(k).and_then(|x| x.checked_add(c));
+        let (Some(base), Some(rem)) = (x.checked_div(period), x.checked_rem(period)) else {
+            return;
+        };
+        // Counts over the domain, plus 1 for `c`: the largest s keeps about
+        // q·2ˢ below 2³²; one step down if the ceilings push the sum over.
+        let q = range.saturating_mul(num) / period + 1;
+        let mut shift = 32u32.saturating_sub(64 - q.leading_zeros());
+        loop {
+            let scale = 1u64 << shift;
+            let k = num.checked_mul(scale).map(|x| x.div_ceil(period));
+            let c = rem.checked_mul(scale).map(|x| x.div_ceil(period));
+            let (Some(k), Some(c)) = (k, c) else {
+                return;
+            };
+            let sum = range.checked_mul(k).and_then(|x| x.checked_add(c));
             if sum.is_some_and(|x| x < 1 << 32) {
-                // Error of the fraction < (1 + span)/2ˢ ≤ ¼ count.
-                if 4 * (1 + span) <= 1 << shift {
+                // Error of the fraction < (1 + range)/2ˢ < 1 count.
+                if 1 + range < scale && u16::try_from(base).is_ok() {
                     self.duty_k = k as u32;
                     self.duty_c = c as u32;
+                    self.duty_base = base as u32;
                     self.shift = shift as u8;
                 }
                 return;
             }
+            if shift == 0 {
+                return;
+            }
+            shift -= 1;
         }
     }
 
-    /// The pulse for `angle`: [`ServoCalibration::pulse`], exactly.
+    /// The pulse for `angle` in whole µs: [`ServoCalibration::pulse`],
+    /// exactly (what replies and logs show; the duty keeps the finer
+    /// pulse).
     #[must_use]
     #[inline]
     pub fn pulse(&self, cal: &ServoCalibration, angle: Angle) -> Microseconds {
@@ -153,45 +196,51 @@ impl ServoMap {
         Microseconds(raw.max(min).min(max) as u32)
     }
 
-    /// The duty of a pulse in `[min_pulse, max_pulse]`: [`PwmTiming::duty`]
-    /// within one count (see the [module docs](self)); a pulse outside that
-    /// range gets the duty of the nearer end.
+    /// The duty of a whole-µs pulse: [`PwmTiming::duty`] of it clamped to
+    /// `[min_pulse, max_pulse]`.
     #[must_use]
-    #[inline]
     pub fn pulse_duty(&self, cal: &ServoCalibration, pulse: Microseconds) -> Duty {
         let clamped = pulse.0.max(cal.min_pulse.0).min(cal.max_pulse.0);
-        self.clamped_pulse_duty(cal, Microseconds(clamped))
+        let timing = PwmTiming {
+            period: Microseconds(self.period),
+        };
+        timing.duty(Microseconds(clamped), self.max_duty)
     }
 
-    /// [`pulse_duty`](Self::pulse_duty) of a pulse already in `[min_pulse, max_pulse]`.
-    #[inline]
-    fn clamped_pulse_duty(&self, cal: &ServoCalibration, pulse: Microseconds) -> Duty {
-        if self.duty_k == 0 {
-            let timing = PwmTiming {
-                period: Microseconds(self.duty_c),
-            };
-            let duty = timing.duty(pulse, self.max_duty).0;
-            return Duty(duty.max(self.duty_base).min(self.duty_max));
-        }
-        // δ ≤ span, so c + δ·k < 2³² (checked in `new`).
-        let delta = pulse.0.wrapping_sub(cal.min_pulse.0);
-        let fraction = self.duty_c.wrapping_add(delta.wrapping_mul(self.duty_k)) >> self.shift;
-        let duty = u32::from(self.duty_base) + fraction;
-        Duty(duty.min(u32::from(self.duty_max)) as u16)
-    }
-
-    /// The pulse and the duty for `angle`: what the frame driver writes.
+    /// The pulse and the duty for `angle`: what the frame driver writes
+    /// (the duty) and reports (both).
     #[must_use]
     #[inline]
     pub fn pulse_and_duty(&self, cal: &ServoCalibration, angle: Angle) -> (Microseconds, Duty) {
-        let pulse = self.pulse(cal, angle);
-        (pulse, self.clamped_pulse_duty(cal, pulse))
+        (self.pulse(cal, angle), self.duty(cal, angle))
     }
 
-    /// The duty for `angle`.
+    /// The duty for `angle`: [`PwmTiming::duty_ps`] of
+    /// [`ServoCalibration::pulse_ps`] within one count (see the
+    /// [module docs](self)).
     #[must_use]
+    #[inline]
     pub fn duty(&self, cal: &ServoCalibration, angle: Angle) -> Duty {
-        self.pulse_duty(cal, self.pulse(cal, angle))
+        if self.duty_k == 0 {
+            let timing = PwmTiming {
+                period: Microseconds(self.period),
+            };
+            let duty = timing.duty_ps(cal.pulse_ps(angle), self.max_duty).0;
+            return Duty(duty.max(self.duty_min).min(self.duty_max));
+        }
+        let a = angle.millidegrees().max(self.lo).min(self.hi);
+        // u ≤ hi − lo, so c + u·k < 2³² (checked in `new`).
+        let u = if self.from_hi {
+            self.hi.wrapping_sub(a)
+        } else {
+            a.wrapping_sub(self.lo)
+        } as u32;
+        let fraction = self.duty_c.wrapping_add(u.wrapping_mul(self.duty_k)) >> self.shift;
+        let duty = self.duty_base.saturating_add(fraction);
+        Duty(
+            duty.max(u32::from(self.duty_min))
+                .min(u32::from(self.duty_max)) as u16,
+        )
     }
 
     /// Counts per PWM period.
@@ -271,4 +320,32 @@ fn div_1e6(u: u32) -> u32 {
         q += 1;
     }
     q
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::axis::Axis;
+
+    /// The hobby servo takes the 32-bit duty form at the Pico's 50, 200 and
+    /// 333 Hz, with the documented bound on its excess (in counts).
+    #[test]
+    fn the_hobby_servo_takes_the_32_bit_form_at_every_pico_rate() {
+        for (period, max_duty, bound) in [
+            (20_000, 63_999, 0.2),
+            (5000, 62_499, 0.35),
+            (3003, 60_059, 0.7),
+        ] {
+            for direction in [Direction::Normal, Direction::Reversed] {
+                let cal = ServoCalibration::hobby(Axis::Yaw).with_direction(direction);
+                let pwm = PwmTiming {
+                    period: Microseconds(period),
+                };
+                let map = ServoMap::new(&cal, pwm, max_duty);
+                assert_ne!(map.duty_k, 0, "{period} µs");
+                let excess = f64::from(map.hi - map.lo + 1) / f64::from(1u32 << map.shift);
+                assert!(excess < bound, "{period} µs: {excess} (s = {})", map.shift);
+            }
+        }
+    }
 }

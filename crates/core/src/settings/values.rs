@@ -71,7 +71,7 @@ impl core::error::Error for SettingsError {}
 
 /// Settings checked against a board's driver configuration: the
 /// parameters the frame path uses.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Validated {
     /// The driver's parameters with these servos.
     pub driver: DriverParams,
@@ -131,6 +131,27 @@ impl Settings {
             Err(e) => return Err(SettingsError::Driver(e)),
         };
         match self.behaviour.build(&driver) {
+            Ok(behaviour) => Ok(Validated { driver, behaviour }),
+            Err(e) => Err(SettingsError::Behaviour(e)),
+        }
+    }
+
+    /// [`validate`](Self::validate) of settings that differ from valid
+    /// ones only in their [`rate`](Self::rate) (`servo rate`): the driver
+    /// checked in full at the new rate, the behaviour as
+    /// [`BehaviourConfig::build_at_rate`](crate::behaviour::BehaviourConfig::build_at_rate)
+    /// checks it (the gestures' defaults, which no frame period changes,
+    /// are not planned again). The same result as `validate` for such
+    /// settings, at a tenth of its work.
+    ///
+    /// # Errors
+    /// As [`validate`](Self::validate).
+    pub const fn validate_rate(&self, base: &DriverConfig) -> Result<Validated, SettingsError> {
+        let driver = match self.driver_config(base).build() {
+            Ok(driver) => driver,
+            Err(e) => return Err(SettingsError::Driver(e)),
+        };
+        match self.behaviour.build_at_rate(&driver) {
             Ok(behaviour) => Ok(Validated { driver, behaviour }),
             Err(e) => Err(SettingsError::Behaviour(e)),
         }

@@ -23,7 +23,7 @@ use crate::servo::{ServoMap, SetPeriod};
 use crate::units::Microseconds;
 
 use super::super::config::slew_params;
-use super::super::error::RateError;
+use super::super::error::{ConfigError, RateError};
 use super::FrameDriver;
 
 impl<P: SetDutyCycle> FrameDriver<P> {
@@ -87,9 +87,12 @@ impl<P: SetDutyCycle> FrameDriver<P> {
         if period == old {
             return Ok(());
         }
-        let mut next = self.params.config;
-        next.frame_period = period;
-        next.build().map_err(RateError::Config)?;
+        // Of `DriverConfig::build`'s checks, only these two read the frame
+        // period (the servos were checked at the new PWM period): the rest
+        // held at `set_pwm_period` and at every frame since.
+        if period.0 == 0 {
+            return Err(RateError::Config(ConfigError::ZeroFramePeriod));
+        }
         let config = &self.params.config;
         let mut limits = [None; 3];
         for (i, (slot, axis)) in limits.iter_mut().zip(Axis::ALL).enumerate() {
