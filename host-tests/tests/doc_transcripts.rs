@@ -324,4 +324,17 @@ fn a_wrong_reply_is_named_with_its_file_and_line() {
     let (failures, _) = replay("page.md", doc, None);
     assert!(failures[0].starts_with("page.md: setup `servo rate 20`"));
     assert_eq!(values_as_any("ok a=12 b=on 40 ms"), "ok a=… b=… # ms");
+    // The state a setup line makes is there for the block.
+    let doc = "<!-- transcript: after \"servo rate 200\" -->\n```text\n> servo rate\n\
+               < ok servo rate=200 period_us=5000\n```\n";
+    assert_eq!(replay("page.md", doc, None), (vec![], 1));
+    // A block another test replays must be named by it.
+    let doc =
+        "<!-- transcript: replayed by host-tests/tests/seeds.rs -->\n```text\n> x\n< y\n```\n";
+    let (failures, played) = replay("docs/user/page.md", doc, None);
+    assert_eq!(played, 0);
+    assert!(
+        failures[0].contains("does not replay docs/user/page.md"),
+        "{failures:?}"
+    );
 }
