@@ -181,14 +181,14 @@ impl Head {
         let mut got = String::new();
         for &byte in format!("{line}\r\n").as_bytes() {
             if let Some(r) = self.session.push(byte, &mut self.handler) {
-                got.push_str(&String::from_utf8(r.to_vec()).unwrap());
+                got.push_str(std::str::from_utf8(r).unwrap());
             }
             // A queued action's reply: once the frame task took it.
             if let Some(r) = self
                 .frames
                 .finish(&mut self.session, self.queue, self.link, 0)
             {
-                got.push_str(&String::from_utf8(r.to_vec()).unwrap());
+                got.push_str(std::str::from_utf8(r).unwrap());
             }
         }
         self.frames.frame(self.queue, self.link);
