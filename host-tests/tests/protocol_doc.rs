@@ -1,57 +1,6 @@
-//! The exchanges in `docs/user/protocol.md` are what the console does: every
-//! `> line` of an example, sent to the firmware's console service on a
-//! simulated head (built-in settings, one frame played after each line,
-//! and the frames a queued action's reply waits for; the examples in the
-//! order of the document), gets the `< reply` written under it, byte for
-//! byte. `BLESS=1 cargo test --test protocol_doc` writes the replies the
-//! service gave into the document instead (review the diff).
-
-use host_tests::console::head::{SimFrames, service, shared};
-use idle_head_core::console::PortSession;
-
-#[test]
-fn the_examples_in_the_protocol_document_hold() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/user/protocol.md");
-    let doc = std::fs::read_to_string(path).expect("docs/user/protocol.md");
-    let (queue, link) = shared();
-    let mut frames = SimFrames::new();
-    let mut handler = service(queue, link);
-    let mut session = PortSession::new();
-    let bless = std::env::var_os("BLESS").is_some();
-    let mut blessed: Vec<String> = doc.lines().map(str::to_owned).collect();
-    let mut exchanges = 0;
-    let mut lines = doc.lines().enumerate().peekable();
-    while let Some((_, line)) = lines.next() {
-        let Some(sent) = line.strip_prefix("> ") else {
-            continue;
-        };
-        let (at, want) = lines
-            .next()
-            .and_then(|(at, l)| Some((at, l.strip_prefix("< ")?)))
-            .unwrap_or_else(|| panic!("`> {sent}` has no `< ` reply under it"));
-        let mut got = Vec::new();
-        for &byte in format!("{sent}\r\n").as_bytes() {
-            if let Some(r) = session.push(byte, &mut handler) {
-                got.push(String::from_utf8(r.to_vec()).unwrap());
-            }
-            // A queued action's reply: once the frame task took it.
-            if let Some(r) = frames.finish(&mut session, queue, link, 0) {
-                got.push(String::from_utf8(r.to_vec()).unwrap());
-            }
-        }
-        frames.frame(queue, link);
-        if bless && got.len() == 1 {
-            blessed[at] = format!("< {}", got[0].trim_end());
-        } else {
-            assert_eq!(got, [format!("{want}\r\n")], "`> {sent}`");
-        }
-        exchanges += 1;
-    }
-    if bless {
-        std::fs::write(path, blessed.join("\n") + "\n").expect("docs/user/protocol.md");
-    }
-    assert!(exchanges >= 20, "{exchanges} exchanges found");
-}
+//! What `docs/user/protocol.md` and `docs/user/show.md` say beside their
+//! example exchanges (those are replayed by `doc_transcripts.rs`): a row
+//! for every gesture, the telemetry line and its bandwidth, the DMX bands.
 
 /// Every gesture of the table has its row in the document's table of
 /// commands, with `cycles=` where the gesture may have more than one.

@@ -1,10 +1,10 @@
-//! `cargo xtask book`: the measured figures page, the book built with
-//! mdBook into `target/book`, and every link in it checked.
+//! `cargo xtask book`: the book built with mdBook into `target/book`, and
+//! every link in it checked.
 //!
 //! The links are checked by linkinator (npm, pinned in `xtask/book/`; it
 //! installs in seconds where a Rust link checker compiles for minutes): in
 //! the built book every page, picture and `#anchor` (against the ids mdBook
-//! gave its headings, the generated figures page included), and in the
+//! gave its headings, the measured figures page included), and in the
 //! README every file of the repository and `#anchor` (against the heading
 //! ids GitHub gives the Markdown). Links to other sites are not followed.
 
@@ -13,36 +13,19 @@ use std::path::Path;
 use anyhow::Result;
 use xshell::cmd;
 
-use crate::{figures, log::Run, project, setup, sim::node};
+use crate::{project, setup, sim::node};
 
 /// The stage's name in `cargo xtask test`.
 pub const STAGE: &str = "book: built with mdBook into target/book, every link and anchor resolves";
 
 /// Where the book is built, as `docs/book.toml`'s `build-dir` also says.
 const OUT: &str = "target/book";
-/// The generated page of measured figures (ignored by git).
-const FIGURES_PAGE: &str = "docs/design/figures.md";
 /// Links not followed: to any other site than linkinator's own server.
 const EXTERNAL: &str = "^https?://(?!localhost)";
 
-/// Records the QEMU smoke run's figures if `smoke` is given (`cargo xtask
-/// test` passes its run), writes the figures page, builds the book and
-/// checks its links and the README's; fails on a build error or a broken
-/// link.
-pub fn stage(root: &Path, smoke: Option<&Run>) -> Result<()> {
-    if let Some(run) = smoke {
-        crate::qemu::record_figures(&run.log);
-    }
-    let recorded = figures::write_page(&figures::path(), &root.join(FIGURES_PAGE))?;
-    println!(
-        "{FIGURES_PAGE}: written from {} ({})",
-        project::relative(&figures::path()).display(),
-        if recorded.is_empty() {
-            "nothing recorded yet: the page says how to measure".to_owned()
-        } else {
-            recorded.join(", ")
-        }
-    );
+/// Builds the book and checks its links and the README's; fails on a
+/// build error or a broken link.
+pub fn stage(root: &Path) -> Result<()> {
     let mdbook = setup::ensure_mdbook(&root.join("target").join("tools"))?;
     let tools = root.join("xtask/book");
     node::npm_ci(&tools, &["linkinator"], &[])?;
@@ -70,7 +53,7 @@ pub fn stage(root: &Path, smoke: Option<&Run>) -> Result<()> {
 /// `cargo xtask book`. `Ok(false)` when the build or the link check failed.
 pub fn command() -> Result<bool> {
     let (root, _) = project::prepare()?;
-    match stage(&root, None) {
+    match stage(&root) {
         Ok(()) => Ok(true),
         Err(error) => {
             println!("book FAILED: {error:#}");

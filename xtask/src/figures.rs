@@ -1,30 +1,29 @@
 //! Measured figures: the commands that measure (`elf`, `qemu`, `bench`,
-//! `metrics`) record each of their tables here as they go, kept in
-//! `target/figures.json`; `cargo xtask book` writes the book's page from
-//! them ([`write_page`]). No figure in the docs is typed by hand.
+//! `metrics`) write each of their tables into the book's page of measured
+//! figures, `docs/design/figures.md`, as they go ([`record`]). The page is
+//! committed, so that links to it work on the repository's web view too;
+//! `cargo xtask test` fails when what it measured changed the page
+//! ([`stale`]). No figure in the docs is typed by hand.
 
 // Sizes and counts are far below 2^52: the float conversions are exact.
 #![allow(clippy::cast_precision_loss)]
 
-use std::{
-    collections::BTreeMap,
-    fmt::Write as _,
-    path::{Path, PathBuf},
-    process::Command,
-};
+use std::{collections::BTreeMap, fmt::Write as _, path::Path};
 
-use anyhow::{Context, Result};
-use serde::{Deserialize, Serialize};
+use anyhow::{Context, Result, bail};
 
 use crate::project;
 
-/// One table of the page, as the command that measured it recorded it: the
-/// command line and the working tree's commit, what the table shows
-/// (Markdown, said before it), its header and rows.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+/// The stage's name in `cargo xtask test`.
+pub const STAGE: &str = "figures page: docs/design/figures.md has what this run measured";
+
+/// The page, from the repository's root.
+pub const PAGE: &str = "docs/design/figures.md";
+
+/// One table of the page, as the command that measured it recorded it:
+/// what the table shows (Markdown, said before it), its header and rows.
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct Table {
-    pub command: String,
-    pub commit: Option<String>,
     pub intro: String,
     pub header: Vec<String>,
     pub rows: Vec<Vec<String>>,
@@ -41,15 +40,14 @@ const SECTIONS: [(&str, &[&str], &str); 6] = [
     (
         "Loop quality",
         &["metrics "],
-        "run `cargo xtask metrics`, then `cargo xtask book`",
+        "`cargo xtask metrics` measures these",
     ),
 ];
-const TEST: &str = "`cargo xtask test` measures these (and builds this page again)";
+const TEST: &str = "`cargo xtask test` measures these";
 
-/// Where the figures are kept: `target/figures.json`, beside the book.
-pub fn path() -> PathBuf {
-    project::root().join("target").join("figures.json")
-}
+/// The line above each table that names it, so that a command can replace
+/// its own tables and keep the others.
+const MARK: (&str, &str) = ("<!-- figures: ", " -->");
 
 /// `1234567` as `1,234,567`.
 pub fn thousands(value: u64) -> String {
@@ -86,120 +84,135 @@ pub fn of_ceiling(part: u64, ceiling: Option<u64>) -> String {
     ceiling.map_or_else(|| "no ceiling".to_owned(), of)
 }
 
-/// Prints the table `key` and records it (replacing the one recorded
-/// before) as the running command's, on the working tree's commit. A table
-/// that cannot be recorded does not fail the check that measured it: it is
-/// reported, and the page shows the last one recorded.
+/// Prints the table `key` and writes it into the page (replacing the one
+/// there before; the others are kept). A table that cannot be written does
+/// not fail the check that measured it: it is reported.
 pub fn record(key: &str, intro: String, header: &[&str], rows: Vec<Vec<String>>) {
     println!("{key}:\n  | {} |", header.join(" | "));
     for row in &rows {
         println!("  | {} |", row.join(" | "));
     }
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let git = Command::new("git")
-        .args(["describe", "--always", "--dirty"])
-        .current_dir(project::root())
-        .output();
-    let commit = git.ok().filter(|out| out.status.success());
-    let commit = commit.map(|out| String::from_utf8_lossy(&out.stdout).trim().to_owned());
     let table = Table {
-        command: format!("cargo xtask {}", args.join(" ")).trim().to_owned(),
-        commit: commit.filter(|text| !text.is_empty()),
         intro,
         header: header.iter().map(|h| (*h).to_owned()).collect(),
         rows,
     };
-    let path = path();
-    match update_at(&path, key, table) {
-        Ok(()) => println!(
-            "  ({key} recorded in {})",
-            project::relative(&path).display()
-        ),
-        Err(error) => println!("warning: {key} not recorded: {error:#}"),
+    let path = project::root().join(PAGE);
+    match update(&path, key, &table) {
+        Ok(false) => println!("  ({key}: as {PAGE} has it)"),
+        Ok(true) => println!("  ({key}: written into {PAGE}, which changed: commit it)"),
+        Err(error) => println!("warning: {key} not written into {PAGE}: {error:#}"),
     }
 }
 
-/// The tables at `path`; none if there is no file.
-fn load(path: &Path) -> Result<BTreeMap<String, Table>> {
+/// Writes `table` as `key`'s into the page at `path`; whether the page
+/// changed.
+fn update(path: &Path, key: &str, table: &Table) -> Result<bool> {
+    let old = read(path)?;
+    let mut tables = parse(&old);
+    tables.insert(key.to_owned(), render_table(table));
+    let new = render(&tables);
+    if new == old {
+        return Ok(false);
+    }
+    let partial = path.with_extension("md.partial");
+    project::write(&partial, &new)?;
+    std::fs::rename(&partial, path).with_context(|| format!("writing {}", path.display()))?;
+    Ok(true)
+}
+
+/// The page's text; empty if there is none.
+pub fn read(path: &Path) -> Result<String> {
     match std::fs::read_to_string(path) {
-        Ok(text) => serde_json::from_str(&text)
-            .with_context(|| format!("{} holds no figures this xtask can read", path.display())),
-        Err(error) if error.kind() == std::io::ErrorKind::NotFound => Ok(BTreeMap::new()),
+        Ok(text) => Ok(text),
+        Err(error) if error.kind() == std::io::ErrorKind::NotFound => Ok(String::new()),
         Err(error) => Err(error).with_context(|| format!("reading {}", path.display())),
     }
 }
 
-/// Replaces the table `key` at `path` (through a temporary file, so that a
-/// reader never sees half a file); a file this xtask cannot read (another
-/// version's) is started afresh.
-fn update_at(path: &Path, key: &str, table: Table) -> Result<()> {
-    let mut figures = load(path).unwrap_or_else(|error| {
-        println!("figures: {error:#}; starting afresh");
-        BTreeMap::new()
-    });
-    figures.insert(key.to_owned(), table);
-    let partial = path.with_extension("json.partial");
-    project::write(&partial, serde_json::to_string_pretty(&figures)?)?;
-    std::fs::rename(&partial, path).with_context(|| format!("writing {}", path.display()))
+/// Fails, naming the tables, if the page at `path` is no longer `before`:
+/// what this run measured differs from what was committed. The page is
+/// written already; committing it is what is left.
+pub fn stale(path: &Path, before: &str) -> Result<()> {
+    let after = read(path)?;
+    if after == before {
+        println!("{PAGE}: every table this run measured is as the page has it");
+        return Ok(());
+    }
+    let (old, new) = (parse(before), parse(&after));
+    let changed: Vec<&str> = (new.iter())
+        .filter(|(key, text)| old.get(*key) != Some(*text))
+        .map(|(key, _)| key.as_str())
+        .collect();
+    bail!(
+        "{PAGE} was stale ({}): it is written with this run's figures now; review the \
+         diff and commit it",
+        changed.join(", ")
+    )
 }
 
-/// Writes the page to `page` from the figures at `figures_path`; returns
-/// the sections that had figures. Every heading is there whether or not
-/// its figures are, so that the links to it resolve.
-pub fn write_page(figures_path: &Path, page: &Path) -> Result<Vec<&'static str>> {
-    let figures = load(figures_path).unwrap_or_else(|error| {
-        println!("figures: {error:#}; the page says how to measure");
-        BTreeMap::new()
-    });
-    let (text, recorded) = render(&figures);
-    std::fs::write(page, text).with_context(|| format!("writing {}", page.display()))?;
-    Ok(recorded)
-}
-
-fn render(figures: &BTreeMap<String, Table>) -> (String, Vec<&'static str>) {
-    let mut out = String::from(
-        "# Measured figures\n\n\
-         <!-- Written by `cargo xtask book` from target/figures.json: not in git, \
-         do not edit. -->\n\n\
-         These figures are written by the project's tools as they measure, never by \
-         hand. `cargo xtask test` records the images' sizes, their RAM with the peak \
-         stack, the QEMU run, the benchmark and the tracking figures; `cargo xtask \
-         bench` the benchmark, the tracking figures and the latency rows; `cargo xtask \
-         metrics` the loop quality; `cargo xtask book` \
-         writes this page from what they recorded (`target/figures.json`). Each table \
-         says which command recorded it, and on which commit.\n",
-    );
-    let mut recorded = Vec::new();
-    for (title, keys, how) in SECTIONS {
-        let _ = write!(out, "\n## {title}\n");
-        let tables: Vec<&Table> = (keys.iter())
-            .flat_map(|key| figures.iter().filter(move |(k, _)| k.starts_with(key)))
-            .map(|(_, table)| table)
-            .collect();
-        if tables.is_empty() {
-            let _ = write!(out, "\nNot measured yet: {how}.\n");
-            continue;
+/// The tables of a page, each as its text, by key.
+fn parse(page: &str) -> BTreeMap<String, String> {
+    let mut tables = BTreeMap::new();
+    let mut current: Option<(String, String)> = None;
+    for line in page.lines() {
+        let mark = line
+            .strip_prefix(MARK.0)
+            .and_then(|rest| rest.strip_suffix(MARK.1));
+        if mark.is_some() || line.starts_with("## ") {
+            tables.extend(current.take().map(|(k, t)| (k, t.trim().to_owned())));
         }
-        recorded.push(title);
-        for table in tables {
-            let on = table
-                .commit
-                .as_ref()
-                .map_or_else(String::new, |c| format!(" on `{c}`"));
-            let _ = write!(
-                out,
-                "\n{} Recorded by `{}`{on}.\n\n",
-                table.intro, table.command
-            );
-            let line = |cells: &[String]| format!("| {} |\n", cells.join(" | "));
-            out.push_str(&line(&table.header));
-            out.push_str(&line(&vec!["---".to_owned(); table.header.len()]));
-            for row in &table.rows {
-                out.push_str(&line(row));
-            }
+        if let Some(key) = mark {
+            current = Some((key.to_owned(), String::new()));
+        } else if let Some((_, text)) = &mut current {
+            text.push_str(line);
+            text.push('\n');
         }
     }
-    (out, recorded)
+    tables.extend(current.map(|(k, t)| (k, t.trim().to_owned())));
+    tables
+}
+
+fn render_table(table: &Table) -> String {
+    let line = |cells: &[String]| format!("| {} |\n", cells.join(" | "));
+    let mut out = format!("{}\n\n", table.intro);
+    out.push_str(&line(&table.header));
+    out.push_str(&line(&vec!["---".to_owned(); table.header.len()]));
+    for row in &table.rows {
+        out.push_str(&line(row));
+    }
+    out.trim().to_owned()
+}
+
+/// The page: every heading whether or not its figures are there, so that
+/// the links to it resolve.
+fn render(tables: &BTreeMap<String, String>) -> String {
+    let mut out = String::from(
+        "# Measured figures\n\n\
+         <!-- Written by the commands that measure (`cargo xtask test`, `bench`, \
+         `metrics`): do not edit. -->\n\n\
+         These figures are written by the project's tools as they measure, never by \
+         hand. `cargo xtask test` measures the images' sizes, their RAM with the peak \
+         stack, the QEMU run, the benchmark, the latency rows and the tracking figures, \
+         writes them here and fails when this page said otherwise (commit the page it \
+         wrote); `cargo xtask bench` measures the benchmark, the tracking figures and \
+         the latency rows, `cargo xtask metrics` the loop quality.\n",
+    );
+    for (title, keys, how) in SECTIONS {
+        let _ = write!(out, "\n## {title}\n");
+        let mut any = false;
+        for (key, text) in keys
+            .iter()
+            .flat_map(|prefix| tables.iter().filter(move |(k, _)| k.starts_with(prefix)))
+        {
+            any = true;
+            let _ = write!(out, "\n{}{key}{}\n\n{text}\n", MARK.0, MARK.1);
+        }
+        if !any {
+            let _ = write!(out, "\nNot measured yet: {how}.\n");
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -213,29 +226,32 @@ mod tests {
             ["0", "999", "1,000", "133,967,040"]
         );
         let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("figures.json");
+        let path = dir.path().join("figures.md");
         let table = |value: &str| Table {
-            command: "cargo xtask test".into(),
             intro: "Sizes.".into(),
             header: vec!["image".into(), "flash".into()],
             rows: vec![vec!["pico".into(), value.into()]],
-            ..Table::default()
         };
-        update_at(&path, "image pico", table("100 B")).unwrap();
-        update_at(&path, "qemu", table("7")).unwrap();
-        update_at(&path, "image pico", table("200 B")).unwrap();
-        let figures = load(&path).unwrap();
-        assert_eq!(figures.len(), 2);
-        let (page, recorded) = render(&figures);
-        assert_eq!(recorded, ["Memory", "Idle loop sets"]);
-        assert!(page.contains("## Memory\n\nSizes. Recorded by `cargo xtask test`.\n\n"));
-        assert!(page.contains("| image | flash |\n| --- | --- |\n| pico | 200 B |\n"));
+        assert!(update(&path, "image pico", &table("100 B")).unwrap());
+        assert!(update(&path, "qemu", &table("7")).unwrap());
+        let before = read(&path).unwrap();
+        // The same figures again: the page stays as it is.
+        assert!(!update(&path, "image pico", &table("100 B")).unwrap());
+        stale(&path, &before).unwrap();
+        assert!(update(&path, "image pico", &table("200 B")).unwrap());
+        let page = read(&path).unwrap();
+        assert_eq!(parse(&page).len(), 2);
+        assert!(page.contains(
+            "## Memory\n\n<!-- figures: image pico -->\n\nSizes.\n\n\
+             | image | flash |\n| --- | --- |\n| pico | 200 B |\n"
+        ));
         assert!(!page.contains("100 B"));
-        assert!(page.contains("## Loop quality\n\nNot measured yet: run `cargo xtask metrics`"));
-        // A file of another shape is started afresh, not kept half-read.
-        std::fs::write(&path, "{\"images\": 3}").unwrap();
-        assert!(load(&path).is_err());
-        update_at(&path, "qemu", table("8")).unwrap();
-        assert_eq!(load(&path).unwrap().len(), 1);
+        assert!(page.contains("## Idle loop sets\n\n<!-- figures: qemu -->\n\nSizes."));
+        assert!(page.contains("## Loop quality\n\nNot measured yet: `cargo xtask metrics`"));
+        // A run that measured other figures than the page had fails, naming them.
+        let error = stale(&path, &before).unwrap_err().to_string();
+        assert!(error.contains("was stale (image pico)"), "{error}");
+        // Rendering what was parsed gives the page back.
+        assert_eq!(render(&parse(&page)), page);
     }
 }

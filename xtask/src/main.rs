@@ -9,6 +9,8 @@ mod board;
 mod book;
 mod cli;
 #[cfg(test)]
+mod cli_doc;
+#[cfg(test)]
 mod comments;
 mod console;
 mod elf;

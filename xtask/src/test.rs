@@ -9,7 +9,7 @@ use xshell::cmd;
 
 use crate::{
     args::Options,
-    bench, book, console, elf,
+    bench, book, console, elf, figures,
     log::Run,
     panel, pico2,
     project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
@@ -88,6 +88,8 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     let core = project::shell("crates/core")?;
     let firmware = project::shell("crates/firmware")?;
     let xtask = project::shell("xtask")?;
+    let figures_page = root.join(figures::PAGE);
+    let figures_before = figures::read(&figures_page)?;
     let mut stages = Stages {
         results: Vec::new(),
         only,
@@ -174,7 +176,10 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     });
 
     // 6. The book, with the figures measured above, and its links.
-    stages.run(book::STAGE, || book::stage(&root, qemu_run.as_ref()));
+    stages.run(book::STAGE, || book::stage(&root));
+    stages.run(figures::STAGE, || {
+        figures::stale(&figures_page, &figures_before)
+    });
 
     Ok(stages.finish(start))
 }
@@ -349,6 +354,7 @@ fn qemu_stages(
         }
         let verdict = qemu::check_summary(&run.log)?;
         println!("{verdict}");
+        qemu::record_figures(&run.log);
         Ok(())
     });
     Some(run)

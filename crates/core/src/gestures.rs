@@ -102,6 +102,7 @@ pub const MAX_CYCLES: u8 = 32;
 // reused, so a new gesture takes a new block (the next free one is named
 // in `settings/fields.rs`).
 gestures! {
+    // ANCHOR: nod
     /// Nodding "yes" on the pitch axis.
     Nod {
         name: "nod",
@@ -117,6 +118,7 @@ gestures! {
         },
         settings: 22,
     },
+    // ANCHOR_END: nod
     /// Shaking "no" on the yaw axis.
     Shake {
         name: "shake",

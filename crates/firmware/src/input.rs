@@ -43,6 +43,7 @@ pub const RETRY: Duration = Duration::from_millis(5);
 // The executors here are single-threaded: no `Send` bound is wanted on the
 // futures, which is what the lint warns about.
 #[allow(async_fn_in_trait)]
+// ANCHOR: source
 pub trait InputSource {
     /// Sets input `i` (from 0) up with `pull`, the one its role needs.
     fn set_pull(&mut self, i: usize, pull: Pull);
@@ -56,6 +57,7 @@ pub trait InputSource {
     /// (wait for the other level, not for an edge).
     async fn changed(&mut self, seen: u8, watched: u8);
 }
+// ANCHOR_END: source
 
 /// Sets every input's pull for its role in `settings`.
 fn pulls(source: &mut impl InputSource, settings: &InputSettings) {

@@ -494,10 +494,12 @@ async fn generator(generator: Generator) {
 }
 
 /// The trigger inputs, for as long as the board runs.
+// ANCHOR: task
 #[embassy_executor::task]
 async fn input_task(mut inputs: GpioInputs) {
     idle_head_firmware::input::run(&mut inputs, &LINKS).await;
 }
+// ANCHOR_END: task
 
 /// The USB device: enumeration, control requests, bus resets.
 #[embassy_executor::task]
