@@ -1,7 +1,7 @@
 // Rest and wake: the head's mode as `status` reports it, Rest and Wake by
 // hand, and the rest settings (`rest after`, `rest pose`, `rest relax`;
 // docs/user/protocol.md), read back from the head: `rest after` alone
-// answers all three (`ok rest after=120 pose=-8000,0,0 relax=off`, then
+// answers all three (`ok rest after=120 pose=8000,0,0 relax=off`, then
 // ` clamped=…` where the head rests if the pose lies past the limits).
 //
 // A firmware that cannot be asked (an older one answers `err`) leaves

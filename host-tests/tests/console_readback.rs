@@ -26,7 +26,7 @@ const BUILT_IN: &[(&str, &str)] = &[
         "ok yaw neutral=1500 per-degree=11111 direction=normal min=1000 max=2000 limits=-23000,32000",
     ),
     ("servo rate", "ok servo rate=50 period_us=20000"),
-    ("rest after", "ok rest after=120 pose=-8000,0,0 relax=off"),
+    ("rest after", "ok rest after=120 pose=8000,0,0 relax=off"),
     ("look duck", "ok look duck=80"),
     ("idle", "ok idle=on amp=100"),
     ("seed", "ok seed=board:none"),
@@ -55,7 +55,7 @@ const CHANGED: &[(&str, &str, &str)] = &[
     (
         "rest after 300",
         "rest pose",
-        "ok rest after=300 pose=-8000,0,0 relax=off",
+        "ok rest after=300 pose=8000,0,0 relax=off",
     ),
     (
         "rest pose -10000 2000 5000",

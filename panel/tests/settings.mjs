@@ -126,7 +126,7 @@ export async function loadReadsBack(page) {
   await page.getByRole('button', { name: 'Load' }).click();
   const saved = {
     after: '120',
-    pose: '-8 0 0',
+    pose: '8 0 0',
     relax: false,
     duck: '80',
     idle: '100',
