@@ -276,7 +276,9 @@ async function gesture(word) {
   await ask(line);
 }
 
-// The look pad: x is yaw (±45°), y is pitch (±30°, up is positive).
+// The look pad, the head as the audience faces it: x is yaw (±45°, right
+// is positive: the head turns to its own left), y is pitch (±30°, down is
+// positive: nose down).
 const PAD = { yaw: 45, pitch: 30 };
 let lookAt = { pitch: 0, yaw: 0 };
 let lookBusy = false;
@@ -285,7 +287,7 @@ let lookNext = null;
 function showLookTarget() {
   const target = $('look-target');
   target.setAttribute('cx', String((lookAt.yaw / PAD.yaw) * 50));
-  target.setAttribute('cy', String((-lookAt.pitch / PAD.pitch) * 35));
+  target.setAttribute('cy', String((lookAt.pitch / PAD.pitch) * 35));
   $('lookpad').setAttribute('aria-valuetext', `yaw ${lookAt.yaw}°, pitch ${lookAt.pitch}°`);
 }
 
@@ -315,7 +317,7 @@ function padPoint(event) {
   const x = ((event.clientX - box.left) / box.width) * 2 - 1;
   const y = ((event.clientY - box.top) / box.height) * 2 - 1;
   const clamp = (v) => Math.max(-1, Math.min(1, v));
-  return { yaw: Math.round(clamp(x) * PAD.yaw), pitch: Math.round(-clamp(y) * PAD.pitch) };
+  return { yaw: Math.round(clamp(x) * PAD.yaw), pitch: Math.round(clamp(y) * PAD.pitch) };
 }
 
 function setUpLookPad() {
@@ -336,7 +338,7 @@ function setUpLookPad() {
   pad.addEventListener('keydown', (event) => {
     if (!link) return;
     const step = event.shiftKey ? 10 : 2;
-    const moves = { ArrowLeft: [0, -step], ArrowRight: [0, step], ArrowUp: [step, 0], ArrowDown: [-step, 0] };
+    const moves = { ArrowLeft: [0, -step], ArrowRight: [0, step], ArrowUp: [-step, 0], ArrowDown: [step, 0] };
     if (moves[event.key]) {
       const [dp, dy] = moves[event.key];
       lookAt = {

@@ -57,6 +57,7 @@ export function showPose(pitch, roll, yaw) {
   $('front-head').setAttribute('transform', `rotate(${-roll})`);
   const shift = 28 * Math.sin((yaw * Math.PI) / 180);
   $('front-face').setAttribute('transform', `translate(${shift} 0)`);
-  // Side: pitch nods the head (positive: up).
-  $('side-head').setAttribute('transform', `rotate(${-pitch})`);
+  // Side, from the head's right (its face to the right): pitch nods the
+  // head, positive nose down (clockwise on the page).
+  $('side-head').setAttribute('transform', `rotate(${pitch})`);
 }

@@ -22,6 +22,7 @@
 // sessions share is in common.mjs; the settings' read-back in settings.mjs.
 
 import { spawn } from 'node:child_process';
+import { fileURLToPath } from 'node:url';
 import { browser, cfg, check, fakeSerial, readout, say, sayLog, shot, sleep, until, watchErrors } from './common.mjs';
 import { replaySession } from './replay.mjs';
 import { CHANGED, changeSettings, loadReadsBack, readsBack } from './settings.mjs';
@@ -41,6 +42,32 @@ async function nodSwings(page) {
   }
   check(swing > 2, `Nod: the pitch readout swung by ${swing.toFixed(1)}° within ${Date.now() - clicked} ms (more than 2° within 2 s)`);
   return swing;
+}
+
+/** The README's picture of the panel (docs/images/panel.png), taken on
+ * the shipped image in the emulator once connected, the idle moving the
+ * readouts and a nod under way: a head at work, not a refusal. */
+async function frontPage(page) {
+  await until(async () => (await page.locator('#state').textContent()).startsWith('connected'), 20000, 'connected');
+  const pose = async () => Promise.all(['pitch', 'roll', 'yaw'].map((a) => readout(page, a)));
+  const start = await until(async () => {
+    const now = await pose();
+    return now.every(Number.isFinite) ? now : null;
+  }, 10000, 'the readouts show the pose');
+  await until(async () => {
+    const now = await pose();
+    return now.some((v, i) => Math.abs(v - start[i]) > 0.5) || null;
+  }, 6000, 'the idle moves the readouts');
+  await sleep(2000);
+  await until(async () => !(await page.getByRole('button', { name: 'Nod' }).isDisabled()), 10000, 'the Nod button');
+  await page.getByRole('button', { name: 'Nod' }).click();
+  await until(async () => (await page.locator('#log li').allTextContents()).some((l) => l.startsWith('ok nod')), 4000, 'the nod answered');
+  await sleep(300);
+  const moved = (await pose()).map((v, i) => Math.abs(v - start[i]));
+  check(Math.max(...moved) > 0.5, `the front page's picture: connected, the readouts moved by ${moved.map((v) => v.toFixed(1)).join('°, ')}°, a nod under way`);
+  const path = fileURLToPath(new URL('../../docs/images/panel.png', import.meta.url));
+  await page.screenshot({ path });
+  say(`screenshot ${path}`);
 }
 
 /** What every session checks once connected: status, a calibration
@@ -287,6 +314,7 @@ async function serialSession() {
     await page.goto(cfg.url);
     check((await page.locator('#state').textContent()) === 'not connected', 'served without a bridge: the page waits for Connect');
     await page.getByRole('button', { name: 'Connect' }).click();
+    await frontPage(page);
     await session(page, { yawPulse });
     const pitch = pitchDuties.filter((d) => d.at > Date.now() - 4000).map((d) => d.us);
     const span = Math.max(...pitch) - Math.min(...pitch);
@@ -408,8 +436,18 @@ async function gazeControls(page) {
   const yaw = await until(async () => {
     const value = await readout(page, 'yaw');
     return value > 8 ? value : null;
-  }, 4000, 'the head looks 10° to the right');
+  }, 4000, 'the head looks 10° to its left (the audience\'s right, right on the pad)');
   check(true, `look pad from the keyboard (5 × ArrowRight, Enter): yaw readout ${yaw}°`);
+  // Down on the pad is nose down, +pitch, drawn turning clockwise from the
+  // head's right side (docs/user/conventions.md).
+  for (let i = 0; i < 5; i++) await page.keyboard.press('ArrowDown');
+  await page.keyboard.press('Enter');
+  const pitch = await until(async () => {
+    const value = await readout(page, 'pitch');
+    return value > 8 ? value : null;
+  }, 4000, 'the head looks 10° down (down on the pad)');
+  const turn = Number(/rotate\((-?[\d.]+)\)/.exec(await page.locator('#side-head').getAttribute('transform'))?.[1]);
+  check(turn > 8, `look pad (5 × ArrowDown, Enter): pitch readout ${pitch}°, the side view turned clockwise by ${turn}° (nose down)`);
   await page.getByRole('radio', { name: 'yaw' }).check();
   const limit = Number(await page.getByLabel('upper limit (°)').inputValue());
   await page.getByRole('button', { name: 'Go to upper limit' }).click();
