@@ -232,7 +232,8 @@ fn loaded_settings<E: Loggable>(
                 e
             ),
         },
-        Err(StorageError::Empty) => {
+        // (A store never reports itself absent: only a board's `None` does.)
+        Err(StorageError::Empty | StorageError::Absent) => {
             log::info!("settings: defaults (empty store at {=u32:#010x})", at);
         }
         Err(StorageError::Older { found } | StorageError::Newer { found }) => log::warn!(
