@@ -35,6 +35,7 @@ use crate::log;
 /// How long the task waits before it tries a full queue again.
 pub const RETRY: Duration = Duration::from_millis(5);
 
+// ANCHOR: source
 /// Where the trigger inputs' levels come from: GPIO pins (`idle-head-rp`'s
 /// `GpioInputs`), or anything else that has a level and can wait for it
 /// to change (a bus message, a sensor on another link): as many inputs as
@@ -64,6 +65,7 @@ pub trait InputSource {
     /// (wait for the other level, not for an edge).
     async fn changed(&mut self, seen: u8, watched: u8);
 }
+// ANCHOR_END: source
 
 /// Sets every input's pull for its role in `settings`.
 fn pulls(source: &mut impl InputSource, settings: &InputSettings) {
