@@ -2,16 +2,7 @@
 //! watchdog, which every board has, and the parts it may have, each added
 //! with a method of its own. [`start`](crate::start) runs the tasks of the
 //! parts there are; the console answers for the others with
-//! `err unavailable`.
-//!
-//! | part | method | without it |
-//! |---|---|---|
-//! | console on a UART | [`Board::with_uart`] | no console there |
-//! | console on USB (CDC-ACM) | [`Board::with_usb`] | no console there |
-//! | settings store in flash, unique id | [`Board::with_flash`] | the built-in settings; `save`, `load`: `err unavailable`; `seed board` plays the paper's seeds |
-//! | DMX512 receiver | [`Board::with_dmx`] | `dmx`: `err unavailable`, no `dmx=` in `status` |
-//! | trigger inputs | [`Board::with_inputs`] | `input <n>`: `err unavailable`, no `inputs=` in `status` |
-//! | LD2450 radar | [`Board::with_radar`] | `radar`: `err unavailable` |
+//! `err unavailable` (the table of parts is [`Board`]'s).
 
 use embassy_rp::Peri;
 use embassy_rp::peripherals::{FLASH, USB, WATCHDOG};
@@ -31,8 +22,17 @@ pub(crate) struct Wired<T> {
     pub(crate) pins: &'static str,
 }
 
-/// A board: its servos and watchdog, and the optional parts it has (see
-/// the [module docs](self)). The Pico's is [`pico::board`](crate::pico::board);
+/// A board: its servos and watchdog, and the optional parts it has:
+///
+/// | part | method | without it |
+/// |---|---|---|
+/// | console on a UART | [`Board::with_uart`] | no console there |
+/// | console on USB (CDC-ACM) | [`Board::with_usb`] | no console there |
+/// | settings store in flash, unique id | [`Board::with_flash`] | the built-in settings; `save`, `load`: `err unavailable`; `seed board` plays the paper's seeds |
+/// | DMX512 receiver | [`Board::with_dmx`] | `dmx`: `err unavailable`, no `dmx=` in `status` |
+/// | trigger inputs | [`Board::with_inputs`] | `input <n>`: `err unavailable`, no `inputs=` in `status` |
+/// | LD2450 radar | [`Board::with_radar`] | `radar`: `err unavailable` |
+/// The Pico's is [`pico::board`](crate::pico::board);
 /// `examples/minimal.rs` at the repository's top builds one with servos and
 /// USB only.
 pub struct Board {

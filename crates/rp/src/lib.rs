@@ -4,7 +4,7 @@
 //!
 //! A board makes the [`Board`] (the three servo outputs and the watchdog,
 //! and whichever of the console's UART and USB port, the flash, the DMX
-//! receiver, the trigger inputs and the radar it has: [`board`]) and calls
+//! receiver, the trigger inputs and the radar it has: see [`Board`]) and calls
 //! [`start`], which runs the firmware layer's boot sequence and spawns, by
 //! priority, the tasks of the parts there are:
 //!
