@@ -106,7 +106,7 @@ const CONFIG: DriverConfig = DriverConfig::DEFAULT;
 
 /// The console service, shared by the ports (the port executor only).
 /// (`None`: a board without a settings store.)
-type Service = SharedService<Option<flash::Storage>>;
+type Service = SharedService<flash::Storage>;
 static SERVICE: StaticCell<Service> = StaticCell::new();
 
 /// The frame task's executor, above thread mode.
@@ -200,25 +200,20 @@ pub fn start(spawner: Spawner, board: Board) {
 #[inline(never)]
 fn open_store(
     flash: Option<embassy_rp::Peri<'static, embassy_rp::peripherals::FLASH>>,
-) -> Option<(Loaded<Option<flash::Storage>>, BoardId)> {
-    let Some(flash) = flash else {
-        defmt::info!("settings: built-in (this board has no settings store)");
-        return Some((Loaded::defaults(None), BoardId::NONE));
-    };
-    let (loaded, id) = flash::open(flash, &CONFIG, feed_watchdog, &FLASH_BUSY)?;
-    let Loaded {
-        storage,
-        settings,
-        source,
-        valid,
-    } = loaded;
-    let loaded = Loaded {
-        storage: Some(storage),
-        settings,
-        source,
-        valid,
-    };
-    Some((loaded, id))
+) -> Option<(Loaded<flash::Storage>, BoardId)> {
+    match flash {
+        Some(flash) => flash::open(flash, &CONFIG, feed_watchdog, &FLASH_BUSY),
+        None => no_store(),
+    }
+}
+
+/// The built-in settings on a board without a settings store (out of
+/// line: the settings it holds are not on the stack under the store's
+/// reading).
+#[inline(never)]
+fn no_store() -> Option<(Loaded<flash::Storage>, BoardId)> {
+    defmt::info!("settings: built-in (this board has no settings store)");
+    Some((Loaded::defaults(None), BoardId::NONE))
 }
 
 /// What the port executor's tasks start from.
@@ -272,7 +267,7 @@ struct Head {
 #[inline(never)]
 fn boot_head(
     spawner: Spawner,
-    loaded: Loaded<Option<flash::Storage>>,
+    loaded: Loaded<flash::Storage>,
     id: BoardId,
     parts: BoardParts,
 ) -> Option<Head> {
