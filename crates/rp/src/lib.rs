@@ -203,7 +203,7 @@ fn open_store(
 ) -> Option<(Loaded<flash::Storage>, BoardId)> {
     match flash {
         Some(flash) => flash::open(flash, &CONFIG, feed_watchdog, &FLASH_BUSY),
-        None => no_store(),
+        None => Some(no_store()),
     }
 }
 
@@ -211,9 +211,9 @@ fn open_store(
 /// line: the settings it holds are not on the stack under the store's
 /// reading).
 #[inline(never)]
-fn no_store() -> Option<(Loaded<flash::Storage>, BoardId)> {
+fn no_store() -> (Loaded<flash::Storage>, BoardId) {
     defmt::info!("settings: built-in (this board has no settings store)");
-    Some((Loaded::defaults(None), BoardId::NONE))
+    (Loaded::defaults(None), BoardId::NONE)
 }
 
 /// What the port executor's tasks start from.
