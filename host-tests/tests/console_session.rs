@@ -257,7 +257,15 @@ fn error_codes_are_one_word_each() {
     assert_eq!(
         words,
         [
-            "syntax", "range", "line", "busy", "invalid", "limit", "storage", "state"
+            "syntax",
+            "range",
+            "line",
+            "busy",
+            "invalid",
+            "limit",
+            "storage",
+            "state",
+            "unavailable"
         ]
     );
     for (i, w) in words.iter().enumerate() {

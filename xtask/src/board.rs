@@ -3,7 +3,25 @@
 
 use std::ops::Range;
 
+use idle_head_core::console::BoardParts;
+use idle_head_core::input::InputIds;
+
 use crate::project::{Image, PICO};
+
+/// The Pico's trigger inputs, as `crates/rp/src/pico.rs` wires them: GP2
+/// to GP5, `input 2` to `input 5`.
+pub const PICO_INPUTS: [u8; 4] = [2, 3, 4, 5];
+
+/// What the Pico image's console answers for (`crates/rp/src/pico.rs`):
+/// its inputs, the DMX receiver and the radar; the host's models of its
+/// console take them.
+pub fn pico_parts() -> BoardParts {
+    BoardParts {
+        inputs: InputIds::new(&PICO_INPUTS).unwrap_or(InputIds::NONE),
+        dmx: true,
+        radar: true,
+    }
+}
 
 /// The Pico 2's compilation target: the RP2350's Cortex-M33 (ARMv8-M
 /// Mainline, with its single-precision FPU).

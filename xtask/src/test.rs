@@ -143,6 +143,19 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
             )
         },
     );
+    // A board with servos and USB only, on the same `start` as the Pico's.
+    stages.run(
+        "minimal board example, servos and USB only (examples/minimal.rs): clippy, build",
+        || {
+            let clippy = "clippy --release --example minimal -- -D warnings";
+            let build = "build --release --example minimal";
+            for args in [clippy, build] {
+                let args = args.split_whitespace();
+                project::run(&sh, FIRMWARE_ENV, cmd!(sh, "cargo {args...}"))?;
+            }
+            Ok(())
+        },
+    );
     // The frame path cannot panic: this image links the frame update against
     // a panic handler that does not exist, so the link fails if any panic
     // path survives optimisation (boards/qemu/src/panic_proof.rs).

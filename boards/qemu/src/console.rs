@@ -23,12 +23,35 @@ use core::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use core::task::{Context, Poll};
 
 use embassy_time::Duration;
-use idle_head_core::console::{ConsoleService, DualSession};
+use idle_head_core::console::{BoardParts, ConsoleService, DualSession};
+use idle_head_core::input::InputIds;
+use idle_head_core::seed::BoardId;
 use idle_head_core::settings::RamStorage;
-use idle_head_firmware::boot::LINKS;
+use idle_head_firmware::boot::{self, BootError, Booted, LINKS, Loaded};
 use idle_head_firmware::console::{Gone, Place, Port, Received, serve};
 
 use crate::uart::{RX_READY, UART0, UART1};
+
+/// What the console answers for: the Pico's inputs (`input 2` to
+/// `input 5`), DMX and the radar, so that a host tool (the panel,
+/// `cargo xtask console --qemu`) meets the Pico's console. Nothing is
+/// wired to them here: the inputs never change, DMX is `lost`, the radar
+/// sees nobody.
+pub const PARTS: BoardParts = BoardParts {
+    inputs: match InputIds::new(&[2, 3, 4, 5]) {
+        Ok(ids) => ids,
+        Err(_) => InputIds::NONE,
+    },
+    dmx: true,
+    radar: true,
+};
+
+/// The boot sequence on the built-in settings, saved to RAM, with the
+/// console answering for [`PARTS`].
+pub fn boot() -> Result<Booted<RamStorage>, BootError> {
+    let loaded = Loaded::defaults(RamStorage::new());
+    boot::boot_on(&crate::CONFIG, loaded, 0, BoardId::NONE, PARTS)
+}
 
 /// What kind of run this is; see the [module docs](self).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]

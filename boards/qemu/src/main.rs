@@ -60,9 +60,8 @@ use defmt_semihosting as _;
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head_core::motion::DEFAULT_N;
-use idle_head_core::settings::RamStorage;
 use idle_head_core::{Microseconds, Millis};
-use idle_head_firmware::boot::{self, Generator, LINKS, Loaded};
+use idle_head_firmware::boot::{Generator, LINKS};
 use idle_head_firmware::config::{DEFAULT_PARAMS, LOOP_DURATION};
 use idle_head_firmware::tasks;
 
@@ -114,7 +113,7 @@ fn main() -> ! {
         CONFIG.servos[0].max_pulse.0
     );
 
-    let Ok(booted) = boot::boot(&CONFIG, Loaded::defaults(RamStorage::new()), 0) else {
+    let Ok(booted) = console::boot() else {
         exit::exit(false)
     };
     let mode = console::Mode::from_host();

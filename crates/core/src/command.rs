@@ -226,8 +226,9 @@ pub enum Command {
     Dmx(Option<DmxSetting>),
     /// Show (`None`) or change a trigger input's role.
     Input {
-        /// The input's number, as the console names it (2 to 5: GP2 to
-        /// GP5 on the Pico; see [`crate::input::FIRST_INPUT`]).
+        /// The input's number, as the console names it: one of the
+        /// board's [`InputIds`](crate::input::InputIds) (GP2 to GP5 on
+        /// the Pico), which the service checks, not the parser.
         input: u8,
         /// The new role, if any.
         role: Option<InputRole>,

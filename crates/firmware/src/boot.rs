@@ -22,7 +22,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_time::Instant;
 use idle_head_core::Axis;
 use idle_head_core::behaviour::{BehaviourParams, CommandQueue, ShowLink};
-use idle_head_core::console::{ConsoleLink, ConsoleService};
+use idle_head_core::console::{BoardParts, ConsoleLink, ConsoleService};
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::driver::DriverParams;
 use idle_head_core::motion::{DEFAULT_HEAD, HeadConfig};
@@ -196,8 +196,8 @@ pub enum BootError {
 
 /// The boot sequence (see the [module docs](self)) on the board's driver
 /// configuration `base`, with the settings `loaded`; `entropy` is mixed into
-/// the console's `seed random`. A board without a unique id: see
-/// [`boot_on`].
+/// the console's `seed random`. A board with no unique id and none of the
+/// optional parts (inputs, DMX, radar): see [`boot_on`] for the others.
 ///
 /// # Errors
 /// [`BootError::AlreadyBooted`] if called a second time.
@@ -206,12 +206,14 @@ pub fn boot<S: SettingsStorage>(
     loaded: Loaded<S>,
     entropy: u32,
 ) -> Result<Booted<S>, BootError> {
-    boot_on(base, loaded, entropy, BoardId::NONE)
+    boot_on(base, loaded, entropy, BoardId::NONE, BoardParts::NONE)
 }
 
 /// [`boot`] on a board whose unique id is `id` (the RP2040's flash unique
 /// id, the RP2350's chip id; [`BoardId::NONE`] if it cannot read one): the
-/// idle's seeds of `seed board`, the default, come from it.
+/// idle's seeds of `seed board`, the default, come from it. The console
+/// answers for the board's `parts` (its inputs' numbers, DMX, radar) and
+/// refuses the commands of those it lacks.
 ///
 /// # Errors
 /// [`BootError::AlreadyBooted`] if called a second time.
@@ -221,6 +223,7 @@ pub fn boot_on<S: SettingsStorage>(
     loaded: Loaded<S>,
     entropy: u32,
     id: BoardId,
+    parts: BoardParts,
 ) -> Result<Booted<S>, BootError> {
     log_servos(&loaded);
     let [first, spare] = SETS.try_take().ok_or(BootError::AlreadyBooted)?;
@@ -248,7 +251,10 @@ pub fn boot_on<S: SettingsStorage>(
         &valid,
     );
     service.add_entropy(entropy);
-    let service = service.with_show(&links.show).with_board(id);
+    let service = service
+        .with_show(&links.show)
+        .with_board(id)
+        .with_parts(parts);
     Ok(Booted {
         generator: Generator {
             head,

@@ -27,7 +27,7 @@
 use embassy_futures::select::{Either3, select3};
 use embassy_time::{Duration, Instant, Timer};
 use idle_head_core::console::HeadMode;
-use idle_head_core::input::{FIRST_INPUT, INPUTS, InputSettings, Inputs, Micros, Pull};
+use idle_head_core::input::{InputIds, InputSettings, Inputs, Micros, Pull};
 
 use crate::boot::Links;
 use crate::log;
@@ -35,8 +35,12 @@ use crate::log;
 /// How long the task waits before it tries a full queue again.
 pub const RETRY: Duration = Duration::from_millis(5);
 
-/// What a board implements for its trigger inputs: [`INPUTS`] of them,
-/// the first as `input 2` (GP2 on the Pico).
+// ANCHOR: source
+/// Where the trigger inputs' levels come from: GPIO pins (`idle-head-rp`'s
+/// `GpioInputs`), or anything else that has a level and can wait for it
+/// to change (a bus message, a sensor on another link): as many inputs as
+/// its [`ids`](Self::ids), up to [`SLOTS`](idle_head_core::input::SLOTS),
+/// input `i` in slot `i` (bit `i` of the levels, role `i` of the settings).
 ///
 /// A source reads levels and waits for them to change; it interprets
 /// nothing (no debouncing, no roles). It must not block.
@@ -45,7 +49,12 @@ pub const RETRY: Duration = Duration::from_millis(5);
 #[allow(async_fn_in_trait)]
 // ANCHOR: source
 pub trait InputSource {
-    /// Sets input `i` (from 0) up with `pull`, the one its role needs.
+    /// Its inputs' numbers, as the console names them (the Pico's: its
+    /// GPIO numbers, 2 to 5).
+    fn ids(&self) -> InputIds;
+
+    /// Sets input `i` (from 0) up with `pull`, the one its role needs (a
+    /// source without pull resistors ignores it).
     fn set_pull(&mut self, i: usize, pull: Pull);
 
     /// The levels now: bit `i` set while input `i` is high.
@@ -113,7 +122,7 @@ fn start(source: &mut impl InputSource, links: &Links, now: Instant) -> Inputs {
     let _ = link.take_inputs_changed();
     let settings = link.input_settings();
     pulls(source, &settings);
-    log_roles(&settings);
+    log_roles(source.ids(), &settings);
     Inputs::new(&settings, micros(now))
 }
 
@@ -150,7 +159,7 @@ fn step(
     if wake.changed || link.take_inputs_changed() {
         inputs.configure(&settings, now);
         pulls(source, &settings);
-        log_roles(&settings);
+        log_roles(source.ids(), &settings);
     }
     let levels = source.levels();
     let resting = link.status().mode == HeadMode::Resting;
@@ -169,7 +178,10 @@ fn step(
     link.publish_inputs(status);
     if status.active != shown.active {
         shown.active = status.active;
-        log::info!("inputs: active {=u8:#06b} (bit 0: input 2)", shown.active);
+        log::info!(
+            "inputs: active {=u8:#06b} (bit 0: the first input)",
+            shown.active
+        );
     }
     if inputs.lost() != shown.lost {
         shown.lost = inputs.lost();
@@ -188,9 +200,9 @@ fn step(
     (levels, settings.watched(), deadline)
 }
 
-/// Logs each input's role.
-fn log_roles(settings: &InputSettings) {
-    for (n, role) in (FIRST_INPUT..).zip(settings.roles.iter()).take(INPUTS) {
+/// Logs the role of each of the inputs numbered `ids`.
+fn log_roles(ids: InputIds, settings: &InputSettings) {
+    for (&n, role) in ids.as_slice().iter().zip(settings.roles.iter()) {
         log::info!("input {=u8}: {=str}", n, role.word());
     }
 }

@@ -133,8 +133,11 @@ impl<F: NorFlash> SettingsStorage for FlashStorage<F> {
 /// no frames yet), checked against `base`; the built-in settings if there
 /// are none or they are not usable. The log says which. `feed` feeds the
 /// board's watchdog before each later flash operation, and `busy` tells
-/// the frames that it runs. `None` if `cell` was taken.
-pub fn open<F>(
+/// the frames that it runs. The console's storage is `S` made from the
+/// store (the store itself, or `Some(store)` for a board's optional one,
+/// made here so that the settings are not copied again on the way).
+/// `None` if `cell` was taken.
+pub fn open<F, S>(
     cell: &'static StaticCell<FlashStorage<F>>,
     flash: F,
     range: Range<u32>,
@@ -142,10 +145,11 @@ pub fn open<F>(
     base: &DriverConfig,
     feed: fn(Duration),
     busy: &'static FlashBusy,
-) -> Option<Loaded<&'static mut FlashStorage<F>>>
+) -> Option<Loaded<S>>
 where
     F: NorFlash,
     F::Error: Loggable,
+    S: From<&'static mut FlashStorage<F>>,
 {
     let store = Store::new(SectorWise(flash), range).ok();
     if store.is_none() {
@@ -159,6 +163,7 @@ where
         }
         loaded.and_then(|loaded| loaded_settings(loaded, base, address))
     });
+    let storage = S::from(storage);
     Some(match loaded {
         Some((settings, valid)) => Loaded {
             storage,
@@ -232,7 +237,8 @@ fn loaded_settings<E: Loggable>(
                 e
             ),
         },
-        Err(StorageError::Empty) => {
+        // (A store never reports itself absent: only a board's `None` does.)
+        Err(StorageError::Empty | StorageError::Absent) => {
             log::info!("settings: defaults (empty store at {=u32:#010x})", at);
         }
         Err(StorageError::Older { found } | StorageError::Newer { found }) => log::warn!(

@@ -45,8 +45,9 @@ pub type BoardFlash = BlockingAsync<Flash<'static, FLASH, Blocking, FLASH_SIZE>>
 /// The store on the board's flash, in a static of its own.
 pub type Store = FlashStorage<BoardFlash>;
 
-/// The console's `save` and `load` on the board's flash.
-pub type Storage = &'static mut Store;
+/// The console's `save` and `load` on the board's flash (`None` on a board
+/// without a settings store: `err unavailable`).
+pub type Storage = Option<&'static mut Store>;
 
 /// Where the store stays.
 static STORE: StaticCell<Store> = StaticCell::new();

@@ -1,4 +1,5 @@
-//! The trigger inputs on GPIO pins: an [`InputSource`] over four pins.
+//! The trigger inputs on GPIO pins: an [`InputSource`] over as many pins as
+//! the board gives (up to [`SLOTS`]), each named by its GPIO number.
 //!
 //! Each pin is an input with the pull its role needs (set by the input
 //! task): the internal pull-up for a button to ground (active low), the
@@ -17,49 +18,64 @@
 
 use core::future::pending;
 
-use embassy_futures::select::select4;
+use embassy_futures::select::select_array;
 use embassy_rp::Peri;
-use embassy_rp::gpio::{AnyPin, Flex, Pull as RpPull};
-use idle_head_core::input::{INPUTS, Pull};
+use embassy_rp::gpio::{AnyPin, Flex, Pin, Pull as RpPull};
+use idle_head_core::input::{InputIds, Pull, SLOTS};
 use idle_head_firmware::input::InputSource;
 
-/// Four GPIO pins as the trigger inputs, the first as `input 2`.
+/// GPIO pins as the trigger inputs, in the order the board gives them:
+/// each is `input <n>` for its GPIO number `n`.
 pub struct GpioInputs {
-    pins: [Flex<'static>; INPUTS],
+    pins: [Option<Flex<'static>>; SLOTS],
+    ids: InputIds,
 }
 
 impl GpioInputs {
     /// The inputs on `pins` (GP2 to GP5 on the Pico), each an input pulled
-    /// down until the input task gives it its role's pull.
+    /// down until the input task gives it its role's pull. At most
+    /// [`SLOTS`] pins (checked when it compiles).
     #[must_use]
-    pub fn new(pins: [Peri<'static, AnyPin>; INPUTS]) -> Self {
-        Self {
-            pins: pins.map(|pin| {
-                let mut flex = Flex::new(pin);
-                flex.set_as_input();
-                flex.set_pull(RpPull::Down);
-                flex
-            }),
+    pub fn new<const N: usize>(pins: [Peri<'static, AnyPin>; N]) -> Self {
+        const { assert!(N <= SLOTS, "more trigger inputs than the settings keep") };
+        let mut numbers = [0; SLOTS];
+        let mut flexes = [const { None }; SLOTS];
+        for ((pin, number), slot) in pins.into_iter().zip(&mut numbers).zip(&mut flexes) {
+            *number = pin.pin();
+            let mut flex = Flex::new(pin);
+            flex.set_as_input();
+            flex.set_pull(RpPull::Down);
+            *slot = Some(flex);
         }
+        // (Distinct: each pin is owned once.)
+        let ids = InputIds::new(numbers.get(..N).unwrap_or_default()).unwrap_or(InputIds::NONE);
+        Self { pins: flexes, ids }
     }
 }
 
 /// Waits until `pin` is at the level it was not at in `seen` (bit `i`), if
-/// watched; for ever if not.
-async fn other_level(pin: &mut Flex<'static>, i: usize, seen: u8, watched: u8) {
+/// there and watched; for ever if not.
+async fn other_level(pin: Option<&mut Flex<'static>>, i: usize, seen: u8, watched: u8) {
     let bit = 1 << i;
-    if watched & bit == 0 {
-        pending::<()>().await;
-    } else if seen & bit != 0 {
-        pin.wait_for_low().await;
-    } else {
-        pin.wait_for_high().await;
+    match pin {
+        Some(pin) if watched & bit != 0 => {
+            if seen & bit != 0 {
+                pin.wait_for_low().await;
+            } else {
+                pin.wait_for_high().await;
+            }
+        }
+        _ => pending::<()>().await,
     }
 }
 
 impl InputSource for GpioInputs {
+    fn ids(&self) -> InputIds {
+        self.ids
+    }
+
     fn set_pull(&mut self, i: usize, pull: Pull) {
-        if let Some(pin) = self.pins.get_mut(i) {
+        if let Some(Some(pin)) = self.pins.get_mut(i) {
             pin.set_pull(match pull {
                 Pull::Up => RpPull::Up,
                 Pull::Down => RpPull::Down,
@@ -71,18 +87,15 @@ impl InputSource for GpioInputs {
         self.pins
             .iter()
             .enumerate()
-            .filter(|(_, pin)| pin.is_high())
+            .filter(|(_, pin)| pin.as_ref().is_some_and(Flex::is_high))
             .fold(0, |bits, (i, _)| bits | (1 << i))
     }
 
     async fn changed(&mut self, seen: u8, watched: u8) {
-        let [a, b, c, d] = &mut self.pins;
-        select4(
-            other_level(a, 0, seen, watched),
-            other_level(b, 1, seen, watched),
-            other_level(c, 2, seen, watched),
-            other_level(d, 3, seen, watched),
-        )
+        let mut pins = self.pins.iter_mut();
+        select_array(core::array::from_fn::<_, SLOTS, _>(|i| {
+            other_level(pins.next().and_then(Option::as_mut), i, seen, watched)
+        }))
         .await;
     }
 }

@@ -2,9 +2,11 @@
 //! Pico and Pico 2 boards share, so that a board file only says which pins
 //! and peripherals go where.
 //!
-//! A board makes the [`Board`] (the three servo outputs, the console's
-//! UART and USB driver, the flash, the watchdog) and calls [`start`], which
-//! runs the firmware layer's boot sequence and spawns, by priority:
+//! A board makes the [`Board`] (the three servo outputs and the watchdog,
+//! and whichever of the console's UART and USB port, the flash, the DMX
+//! receiver, the trigger inputs and the radar it has: see [`Board`]) and calls
+//! [`start`], which runs the firmware layer's boot sequence and spawns, by
+//! priority, the tasks of the parts there are:
 //!
 //! | priority | what | runs |
 //! |---|---|---|
@@ -26,6 +28,7 @@ compile_error!("choose one chip: the `rp2040` or the `rp235xa` feature");
 #[cfg(not(any(feature = "rp2040", feature = "rp235xa")))]
 compile_error!("choose a chip: the `rp2040` or the `rp235xa` feature");
 
+mod board;
 pub mod dmx;
 pub mod flash;
 pub mod input;
@@ -40,22 +43,23 @@ pub mod waits;
 use core::cell::RefCell;
 
 use embassy_executor::{InterruptExecutor, Spawner};
-use embassy_rp::Peri;
 use embassy_rp::interrupt::{self, InterruptExt, Priority};
-use embassy_rp::peripherals::{FLASH, USB, WATCHDOG};
+use embassy_rp::peripherals::USB;
 use embassy_rp::watchdog::{ResetReason, Watchdog as RpWatchdog};
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_time::Duration;
 
 use idle_head_core::behaviour::BehaviourParams;
-use idle_head_core::console::SharedService;
+use idle_head_core::console::{BoardParts, SharedService};
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head_core::seed::BoardId;
 use idle_head_firmware::boot::{self, Clock, FLASH_BUSY, Generator, LINKS, Loaded};
 use idle_head_firmware::hooks::{BoardHooks, Watchdog};
 use static_cell::StaticCell;
 
+pub use crate::board::Board;
+use crate::board::Wired;
 use crate::dmx::DmxUart;
 use crate::input::GpioInputs;
 use crate::pwm::ServoPwm;
@@ -81,6 +85,17 @@ pub use idle_head_core::pwm_clock::PICO2_SERVO_CLOCK as SERVO_CLOCK;
 #[cfg(feature = "rp235xa")]
 pub use idle_head_core::pwm_clock::PICO2_SYS_HZ as SYS_HZ;
 
+embassy_rp::bind_interrupts!(
+    /// The interrupts of the drivers a board makes for its parts, bound
+    /// once here for every board: the USB driver
+    /// (`embassy_rp::usb::Driver::new(p.USB, Irqs)`) and PIO0, which the
+    /// radar's receiver runs on (`Pio::new(p.PIO0, Irqs)`).
+    pub struct Irqs {
+        USBCTRL_IRQ => embassy_rp::usb::InterruptHandler<USB>;
+        PIO0_IRQ_0 => embassy_rp::pio::InterruptHandler<embassy_rp::peripherals::PIO0>;
+    }
+);
+
 /// The port tasks' executor and their interrupts: below the frame task's
 /// (`P1`), above thread mode.
 pub const PORT_PRIORITY: Priority = Priority::P2;
@@ -89,41 +104,8 @@ pub const PORT_PRIORITY: Priority = Priority::P2;
 /// the anatomical limits, a 2 s fade (see `DriverConfig::DEFAULT`).
 const CONFIG: DriverConfig = DriverConfig::DEFAULT;
 
-/// What a board hands over: its peripherals, set up for their part.
-pub struct Board {
-    /// The board's name, for the log.
-    pub name: &'static str,
-    /// The servo outputs `[pitch, roll, yaw]`, each on a PWM slice of its
-    /// own, clocked by [`SERVO_CLOCK`] ([`ServoPwm::new`]).
-    pub servos: [ServoPwm; 3],
-    /// Where the servos are, for the log (`"pitch GP16 (PWM0 A), …"`).
-    pub servo_pins: &'static str,
-    /// The console's UART ([`uart::console`]).
-    pub uart: UartPort,
-    /// Where the UART is, for the log.
-    pub uart_pins: &'static str,
-    /// The DMX512 receiver's UART ([`dmx::receiver`]).
-    pub dmx: DmxUart,
-    /// Where the DMX input is, for the log.
-    pub dmx_pins: &'static str,
-    /// The radar's receiver ([`radar::receiver`]; `None` if it could not
-    /// be set up).
-    pub radar: Option<RadarRx>,
-    /// Where the radar is, for the log.
-    pub radar_pins: &'static str,
-    /// The USB driver, for the console's USB serial port.
-    pub usb: embassy_rp::usb::Driver<'static, USB>,
-    /// The flash, for the settings store.
-    pub flash: Peri<'static, FLASH>,
-    /// The watchdog.
-    pub watchdog: Peri<'static, WATCHDOG>,
-    /// The trigger inputs ([`input::GpioInputs`]).
-    pub inputs: GpioInputs,
-    /// Where the inputs are, for the log.
-    pub input_pins: &'static str,
-}
-
 /// The console service, shared by the ports (the port executor only).
+/// (`None`: a board without a settings store.)
 type Service = SharedService<flash::Storage>;
 static SERVICE: StaticCell<Service> = StaticCell::new();
 
@@ -154,21 +136,18 @@ unsafe fn SWI_IRQ_0() {
 /// console service on its way to its static, the USB builder) is gone
 /// before the next: the boot's stack is the deepest step's, not their sum.
 pub fn start(spawner: Spawner, board: Board) {
+    let parts = board.parts();
     let Board {
         name,
         servos,
         servo_pins,
+        watchdog,
         uart,
-        uart_pins,
-        dmx,
-        dmx_pins,
-        radar,
-        radar_pins,
         usb,
         flash,
-        watchdog,
+        dmx,
         inputs,
-        input_pins,
+        radar,
     } = board;
     let watchdog = RpWatchdog::new(watchdog);
     let reason = watchdog.reset_reason();
@@ -183,26 +162,28 @@ pub fn start(spawner: Spawner, board: Board) {
     log_clocks(name, servo_pins);
     // Before the first frame: nothing else runs yet while the unique id and
     // the store are read.
-    let Some((loaded, id)) = flash::open(flash, &CONFIG, feed_watchdog, &FLASH_BUSY) else {
+    let Some((loaded, id)) = open_store(flash) else {
         defmt::error!("boot: called twice");
         return;
     };
     log_id(id);
-    let Some(head) = boot_head(spawner, loaded, id) else {
+    let Some(head) = boot_head(spawner, loaded, id, parts) else {
         return;
     };
     spawn_frames(servos, &head, BoardWatchdog);
-    spawn_dmx(dmx, dmx_pins);
-    spawn_radar(radar, radar_pins);
+    if let Some(dmx) = dmx {
+        spawn_dmx(dmx);
+    }
+    if let Some(radar) = radar {
+        spawn_radar(radar);
+    }
     interrupt::SWI_IRQ_0.set_priority(PORT_PRIORITY);
     interrupt::IO_IRQ_BANK0.set_priority(PORT_PRIORITY);
     interrupt::USBCTRL_IRQ.set_priority(PORT_PRIORITY);
     let executor = PORT_EXECUTOR.start(interrupt::SWI_IRQ_0);
     let parts = Ports {
         inputs,
-        input_pins,
         uart,
-        uart_pins,
         usb,
         service: head.service,
     };
@@ -214,13 +195,32 @@ pub fn start(spawner: Spawner, board: Board) {
     spawn(spawner, report_task(), "report");
 }
 
+/// The settings store on `flash` and the board's id, or the built-in
+/// settings and no id on a board without one. `None` if called twice.
+#[inline(never)]
+fn open_store(
+    flash: Option<embassy_rp::Peri<'static, embassy_rp::peripherals::FLASH>>,
+) -> Option<(Loaded<flash::Storage>, BoardId)> {
+    match flash {
+        Some(flash) => flash::open(flash, &CONFIG, feed_watchdog, &FLASH_BUSY),
+        None => Some(no_store()),
+    }
+}
+
+/// The built-in settings on a board without a settings store (out of
+/// line: the settings it holds are not on the stack under the store's
+/// reading).
+#[inline(never)]
+fn no_store() -> (Loaded<flash::Storage>, BoardId) {
+    defmt::info!("settings: built-in (this board has no settings store)");
+    (Loaded::defaults(None), BoardId::NONE)
+}
+
 /// What the port executor's tasks start from.
 struct Ports {
-    inputs: GpioInputs,
-    input_pins: &'static str,
-    uart: UartPort,
-    uart_pins: &'static str,
-    usb: embassy_rp::usb::Driver<'static, USB>,
+    inputs: Option<Wired<GpioInputs>>,
+    uart: Option<Wired<UartPort>>,
+    usb: Option<embassy_rp::usb::Driver<'static, USB>>,
     service: &'static Service,
 }
 
@@ -237,15 +237,21 @@ async fn ports_task(parts: Ports) {
     // Note(unsafe): polled by the port executor, as the one way to spawn
     // tasks that are not `Send` in an interrupt executor.
     let spawner = unsafe { Spawner::for_current_executor() }.await;
-    spawn(spawner, input_task(parts.inputs), "input");
-    defmt::info!("inputs: {=str}", parts.input_pins);
-    spawn_console(
-        spawner,
-        parts.uart,
-        parts.uart_pins,
-        parts.usb,
-        parts.service,
-    );
+    if let Some(inputs) = parts.inputs {
+        spawn(spawner, input_task(inputs.part), "input");
+        defmt::info!("inputs: {=str}", inputs.pins);
+    }
+    if let Some(uart) = parts.uart {
+        spawn(
+            spawner,
+            console(ConsolePort::Uart(uart.part), parts.service),
+            "uart console",
+        );
+        defmt::info!("console: UART {=str}, 115200 8N1", uart.pins);
+    }
+    if let Some(usb) = parts.usb {
+        spawn_usb(spawner, usb, parts.service);
+    }
 }
 
 /// What the boot leaves for the frame task and the console.
@@ -255,11 +261,17 @@ struct Head {
     service: &'static Service,
 }
 
-/// Runs the boot sequence on the settings `loaded` on the board `id`,
-/// spawns the loop generator and puts the console service in its static.
+/// Runs the boot sequence on the settings `loaded` on the board `id` with
+/// `parts`, spawns the loop generator and puts the console service in its
+/// static.
 #[inline(never)]
-fn boot_head(spawner: Spawner, loaded: Loaded<flash::Storage>, id: BoardId) -> Option<Head> {
-    let Ok(booted) = boot::boot_on(&CONFIG, loaded, oscillator_jitter(), id) else {
+fn boot_head(
+    spawner: Spawner,
+    loaded: Loaded<flash::Storage>,
+    id: BoardId,
+    parts: BoardParts,
+) -> Option<Head> {
+    let Ok(booted) = boot::boot_on(&CONFIG, loaded, oscillator_jitter(), id, parts) else {
         defmt::error!("boot: called twice");
         return None;
     };
@@ -287,9 +299,9 @@ fn spawn_frames(servos: [ServoPwm; 3], head: &Head, watchdog: BoardWatchdog) {
     }
 }
 
-/// Starts the DMX receiver on `dmx`.
+/// Starts the DMX receiver.
 #[inline(never)]
-fn spawn_dmx(dmx: DmxUart, pins: &'static str) {
+fn spawn_dmx(Wired { part: dmx, pins }: Wired<DmxUart>) {
     dmx::listen(dmx);
     let settings = LINKS.show.dmx.settings();
     defmt::info!(
@@ -303,7 +315,7 @@ fn spawn_dmx(dmx: DmxUart, pins: &'static str) {
 
 /// Starts the radar's receiver, if set up.
 #[inline(never)]
-fn spawn_radar(radar: Option<RadarRx>, pins: &'static str) {
+fn spawn_radar(Wired { part: radar, pins }: Wired<Option<RadarRx>>) {
     let Some(rx) = radar else {
         defmt::error!("radar: its receiver could not be set up ({=str})", pins);
         return;
@@ -331,21 +343,13 @@ fn log_id(id: BoardId) {
     }
 }
 
-/// Spawns the console on the UART and on the USB serial port.
+/// Spawns the USB device and the console on its serial port.
 #[inline(never)]
-fn spawn_console(
+fn spawn_usb(
     spawner: Spawner,
-    uart: UartPort,
-    uart_pins: &'static str,
     usb: embassy_rp::usb::Driver<'static, USB>,
     service: &'static Service,
 ) {
-    spawn(
-        spawner,
-        console(ConsolePort::Uart(uart), service),
-        "uart console",
-    );
-    defmt::info!("console: UART {=str}, 115200 8N1", uart_pins);
     let (device, serial) = usb::build(usb);
     spawn(spawner, usb_device(device), "usb device");
     spawn(

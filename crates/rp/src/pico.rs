@@ -20,20 +20,16 @@
 //! One PWM slice per servo (GPIO n drives slice ⌊n/2⌋ mod 8), so each
 //! output starts on its own first valid pulse ([`crate::pwm`]). The wiring
 //! (grounds, power, 3.3 V inputs) is the user guide's. A board with another
-//! pinout builds its [`Board`] the same way with its own pins.
+//! pinout, or fewer parts, builds its [`Board`] the same way with its own
+//! pins, adding only the parts it has (`examples/minimal.rs`: servos and
+//! USB only).
 
-use embassy_rp::peripherals::{PIO0, USB};
-use embassy_rp::pio::{self, Pio};
-use embassy_rp::{Peripherals, bind_interrupts, usb};
+use embassy_rp::pio::Pio;
+use embassy_rp::{Peripherals, usb};
 
 use crate::input::GpioInputs;
 use crate::pwm::ServoPwm;
-use crate::{Board, SERVO_CLOCK};
-
-bind_interrupts!(struct Irqs {
-    USBCTRL_IRQ => usb::InterruptHandler<USB>;
-    PIO0_IRQ_0 => pio::InterruptHandler<PIO0>;
-});
+use crate::{Board, Irqs, SERVO_CLOCK};
 
 /// The [`Board`] of a Raspberry Pi Pico or Pico 2 named `name`, from the
 /// chip's peripherals. The servo outputs stay low until the first frame.
@@ -46,29 +42,30 @@ pub fn board(p: Peripherals, name: &'static str) -> Board {
     // PIO0's instruction memory keeps the program for as long as the
     // board runs.
     core::mem::forget(common);
-    Board {
+    let servos = [
+        ServoPwm::new(p.PWM_SLICE0, p.PIN_16, &SERVO_CLOCK),
+        ServoPwm::new(p.PWM_SLICE1, p.PIN_18, &SERVO_CLOCK),
+        ServoPwm::new(p.PWM_SLICE2, p.PIN_20, &SERVO_CLOCK),
+    ];
+    let inputs = GpioInputs::new([
+        p.PIN_2.into(),
+        p.PIN_3.into(),
+        p.PIN_4.into(),
+        p.PIN_5.into(),
+    ]);
+    Board::new(
         name,
-        servos: [
-            ServoPwm::new(p.PWM_SLICE0, p.PIN_16, &SERVO_CLOCK),
-            ServoPwm::new(p.PWM_SLICE1, p.PIN_18, &SERVO_CLOCK),
-            ServoPwm::new(p.PWM_SLICE2, p.PIN_20, &SERVO_CLOCK),
-        ],
-        servo_pins: "pitch GP16 (PWM0 A), roll GP18 (PWM1 A), yaw GP20 (PWM2 A)",
-        uart: crate::uart::console(p.UART0, p.PIN_0, p.PIN_1, p.DMA_CH0),
-        uart_pins: "UART0 GP0 TX, GP1 RX",
-        dmx: crate::dmx::receiver(p.UART1, p.PIN_9),
-        dmx_pins: "UART1 RX GP9",
-        radar,
-        radar_pins: "LD2450 TX to GP13 (PIO0 SM0, DMA channel 1)",
-        usb: usb::Driver::new(p.USB, Irqs),
-        flash: p.FLASH,
-        watchdog: p.WATCHDOG,
-        inputs: GpioInputs::new([
-            p.PIN_2.into(),
-            p.PIN_3.into(),
-            p.PIN_4.into(),
-            p.PIN_5.into(),
-        ]),
-        input_pins: "input 2 GP2, input 3 GP3, input 4 GP4, input 5 GP5",
-    }
+        servos,
+        "pitch GP16 (PWM0 A), roll GP18 (PWM1 A), yaw GP20 (PWM2 A)",
+        p.WATCHDOG,
+    )
+    .with_uart(
+        crate::uart::console(p.UART0, p.PIN_0, p.PIN_1, p.DMA_CH0),
+        "UART0 GP0 TX, GP1 RX",
+    )
+    .with_usb(usb::Driver::new(p.USB, Irqs))
+    .with_flash(p.FLASH)
+    .with_dmx(crate::dmx::receiver(p.UART1, p.PIN_9), "UART1 RX GP9")
+    .with_inputs(inputs, "input 2 GP2, input 3 GP3, input 4 GP4, input 5 GP5")
+    .with_radar(radar, "LD2450 TX to GP13 (PIO0 SM0, DMA channel 1)")
 }

@@ -12,10 +12,11 @@ use idle_head_core::behaviour::{
     Applied, BehaviourConfig, BehaviourError, CommandQueue, Head, RestState, ShowLink,
 };
 use idle_head_core::console::{
-    ConsoleLink, ConsoleService, HeadMode, HeadStatus, Outcome, Session, outcome_reply, unanswered,
+    BoardParts, ConsoleLink, ConsoleService, HeadMode, HeadStatus, Outcome, Session, outcome_reply,
+    unanswered,
 };
 use idle_head_core::driver::{DriverConfig, FrameDriver};
-use idle_head_core::input::{InputSettings, Inputs, Micros};
+use idle_head_core::input::{InputIds, InputSettings, Inputs, Micros};
 use idle_head_core::servo::SetPeriod;
 use idle_head_core::settings::RamStorage;
 use idle_head_core::{Axis, Timestamp};
@@ -313,8 +314,19 @@ pub fn shared() -> (&'static CommandQueue, &'static ConsoleLink) {
     )
 }
 
-/// A console service for a simulated head on the built-in settings, with
-/// a RAM store.
+/// The parts of the Pico (`crates/rp/src/pico.rs`): trigger inputs on
+/// GP2 to GP5, a DMX receiver, a radar.
+#[must_use]
+pub fn pico_parts() -> BoardParts {
+    BoardParts {
+        inputs: InputIds::new(&[2, 3, 4, 5]).expect("four distinct inputs"),
+        dmx: true,
+        radar: true,
+    }
+}
+
+/// A console service for a simulated Pico ([`pico_parts`]) on the
+/// built-in settings, with a RAM store.
 #[must_use]
 pub fn service(
     queue: &'static CommandQueue,
@@ -322,4 +334,5 @@ pub fn service(
 ) -> ConsoleService<'static, RamStorage> {
     ConsoleService::with_defaults(queue, link, RamStorage::new())
         .with_show(Box::leak(Box::new(ShowLink::new())))
+        .with_parts(pico_parts())
 }

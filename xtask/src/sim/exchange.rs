@@ -130,7 +130,8 @@ fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
     });
     let service = ConsoleService::with_defaults(queue, link, RamStorage::new())
         // As on the board: DMX on, no frames in this run (`dmx=lost`).
-        .with_show(Box::leak(Box::new(ShowLink::new())));
+        .with_show(Box::leak(Box::new(ShowLink::new())))
+        .with_parts(crate::board::pico_parts());
     let service: &'static SharedService<RamStorage> =
         Box::leak(Box::new(Mutex::new(RefCell::new(service))));
     // What the frame task answers a queued action: the mixer's answer on

@@ -6,7 +6,6 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use idle_head_core::input::{FIRST_INPUT, INPUTS};
 use object::read::elf::ElfFile32;
 use object::{Endianness, Object, ObjectSymbol, elf};
 
@@ -24,7 +23,7 @@ pub const SERVOS: [(&str, u8, u8); 3] = [("pitch", 16, 0), ("roll", 18, 1), ("ya
 
 /// The trigger inputs' GPIOs, as wired on the Pico: GP2 to GP5.
 pub fn input_pins() -> Vec<u8> {
-    (FIRST_INPUT..).take(INPUTS).collect()
+    crate::board::PICO_INPUTS.to_vec()
 }
 
 /// The parts of a Pico ELF the emulator run uses.

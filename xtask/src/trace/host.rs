@@ -6,7 +6,7 @@
 use idle_head_core::behaviour::{CommandQueue, RestState, ShowLink};
 use idle_head_core::console::{ActionLine, ConsoleLink, ConsoleService, Response, respond};
 use idle_head_core::driver::DriverConfig;
-use idle_head_core::input::{INPUTS, InputSettings, Inputs, Micros, Pull};
+use idle_head_core::input::{InputSettings, Inputs, Micros, Pull, SLOTS};
 use idle_head_core::servo::ServoRate;
 use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
 
@@ -51,7 +51,8 @@ impl<'a> Console<'a> {
             source,
         )
         .map_err(|e| anyhow::anyhow!("the built-in settings: {e}"))?
-        .with_show(show);
+        .with_show(show)
+        .with_parts(crate::board::pico_parts());
         Ok(Self { service, queue })
     }
 
@@ -81,7 +82,7 @@ fn text(reply: &[u8]) -> String {
 pub struct Task {
     inputs: Inputs,
     /// The levels a pin line set (`None`: the input's idle level).
-    driven: [Option<bool>; INPUTS],
+    driven: [Option<bool>; SLOTS],
     /// When the task wakes next at the latest, µs.
     deadline: Option<u64>,
     /// The radar's presence as the link says (`None`: off).
@@ -93,7 +94,7 @@ impl Task {
     pub fn new(link: &ConsoleLink) -> Self {
         Self {
             inputs: Inputs::new(&link.input_settings(), Micros(0)),
-            driven: [None; INPUTS],
+            driven: [None; SLOTS],
             deadline: Some(0),
             radar: None,
         }
@@ -101,8 +102,8 @@ impl Task {
 
     /// The level input `input` (2 to 5) is driven to from now on.
     pub fn drive(&mut self, input: u8, high: bool) {
-        let i = usize::from(input - idle_head_core::input::FIRST_INPUT);
-        if let Some(level) = self.driven.get_mut(i) {
+        let slot = crate::board::pico_parts().inputs.slot(input);
+        if let Some(level) = slot.and_then(|i| self.driven.get_mut(i)) {
             *level = Some(high);
         }
     }
@@ -119,7 +120,7 @@ impl Task {
 
     /// The levels the task reads under `settings`.
     fn levels(&self, settings: &InputSettings) -> u8 {
-        (0..INPUTS).fold(0, |bits, i| {
+        (0..SLOTS).fold(0, |bits, i| {
             let idle = settings.roles[i].pull() == Pull::Up;
             if self.driven[i].unwrap_or(idle) {
                 bits | (1 << i)

@@ -15,7 +15,6 @@ use anyhow::{Result, bail};
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::command::{Action, Command};
 use idle_head_core::console;
-use idle_head_core::input::{FIRST_INPUT, INPUTS};
 
 /// One scripted line.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -175,7 +174,7 @@ fn pin(text: &str) -> Result<Kind, String> {
     let input: u8 = input
         .parse()
         .ok()
-        .filter(|&n| n >= FIRST_INPUT && usize::from(n - FIRST_INPUT) < INPUTS)
+        .filter(|n| crate::board::PICO_INPUTS.contains(n))
         .ok_or_else(usage)?;
     let high = match level.trim() {
         "high" => true,

@@ -25,6 +25,7 @@ mod link;
 mod outbox;
 mod outcome;
 mod parse;
+mod parts;
 mod port;
 mod reply;
 mod service;
@@ -37,6 +38,7 @@ pub use link::{ConsoleLink, HeadMode, HeadStatus, IdleView, OUTCOMES, Outcome, P
 pub use outbox::{HELD, Outbox, WAITING};
 pub use outcome::{outcome_reply, unanswered};
 pub use parse::{ActionLine, KEYWORDS, ParseError, ParseErrorKind, Span, parse};
+pub use parts::BoardParts;
 pub use port::DualSession;
 pub use reply::{ErrorCode, Reply};
 pub use service::{ConsoleService, HELP, VERSION};

@@ -39,11 +39,14 @@ pub enum ErrorCode {
     /// `state`: the command makes no sense now (e.g. a gesture while the
     /// head is stopped).
     State,
+    /// `unavailable`: the board lacks the part the command needs (no
+    /// settings store, DMX receiver, radar, or no such input).
+    Unavailable,
 }
 
 impl ErrorCode {
     /// Every code, in the order of the documentation.
-    pub const ALL: [Self; 8] = [
+    pub const ALL: [Self; 9] = [
         Self::Syntax,
         Self::Range,
         Self::Line,
@@ -52,6 +55,7 @@ impl ErrorCode {
         Self::Limit,
         Self::Storage,
         Self::State,
+        Self::Unavailable,
     ];
 
     /// The word on the wire.
@@ -66,6 +70,7 @@ impl ErrorCode {
             Self::Limit => "limit",
             Self::Storage => "storage",
             Self::State => "state",
+            Self::Unavailable => "unavailable",
         }
     }
 

@@ -97,6 +97,9 @@ pub struct ConsoleService<'a, S, const N: usize = { crate::behaviour::queue::CAP
     show: Option<&'a ShowLink>,
     /// The board's unique id (`seed board`).
     board: crate::seed::BoardId,
+    /// What the board has (inputs, DMX, radar): none until
+    /// [`with_parts`](Self::with_parts).
+    parts: super::BoardParts,
 }
 
 impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
@@ -143,7 +146,23 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
             ticket: 0,
             show: None,
             board: crate::seed::BoardId::NONE,
+            parts: super::BoardParts::NONE,
         }
+    }
+
+    /// The service on a board that has `parts`: its inputs' numbers, and
+    /// whether it has a DMX receiver and a radar (the commands for a part
+    /// it lacks answer `err unavailable`).
+    #[must_use]
+    pub const fn with_parts(mut self, parts: super::BoardParts) -> Self {
+        self.parts = parts;
+        self
+    }
+
+    /// What the board has, as [`with_parts`](Self::with_parts) set it.
+    #[must_use]
+    pub const fn parts(&self) -> super::BoardParts {
+        self.parts
     }
 
     /// A service on the built-in settings and driver configuration
@@ -291,7 +310,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
             }
         }
         match next.validate(&self.base) {
-            Ok(valid) if Self::inputs_refused(&next, &valid.behaviour, reply) => {}
+            Ok(valid) if self.inputs_refused(&next, &valid.behaviour, reply) => {}
             Ok(valid) => {
                 self.link.set_servo(axis, cal);
                 self.settings = next;
@@ -336,7 +355,7 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
         let mut next = self.settings;
         next.rate = rate;
         match next.validate_rate(&self.base) {
-            Ok(valid) if Self::inputs_refused(&next, &valid.behaviour, reply) => {}
+            Ok(valid) if self.inputs_refused(&next, &valid.behaviour, reply) => {}
             Ok(valid) => {
                 self.link.set_rate(rate);
                 self.settings = next;
@@ -493,10 +512,11 @@ fn change(cal: &mut ServoCalibration, setting: ServoSetting) {
 }
 
 fn storage_error(e: StorageError, what: &str, reply: &mut Reply<'_>) {
-    text(reply.err(ErrorCode::Storage))
-        .str(what)
-        .str(": ")
-        .with(&e);
+    let code = match e {
+        StorageError::Absent => ErrorCode::Unavailable,
+        _ => ErrorCode::Storage,
+    };
+    text(reply.err(code)).str(what).str(": ").with(&e);
 }
 
 /// A reply as the [`Text`] its words are written into.

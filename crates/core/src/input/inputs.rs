@@ -22,7 +22,7 @@
 
 use crate::command::Action;
 
-use super::{BUTTON_HOLD_OFF, Debouncer, GLANCE_HOLD_OFF, INPUTS, InputRole, InputSettings};
+use super::{BUTTON_HOLD_OFF, Debouncer, GLANCE_HOLD_OFF, InputRole, InputSettings, SLOTS};
 
 /// A moment, in µs since the board started.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -45,7 +45,7 @@ impl Micros {
 
 /// Actions the outbox holds at most: an edge of every input and a rest,
 /// should they come at once while the queue is full.
-pub const OUTBOX: usize = INPUTS + 1;
+pub const OUTBOX: usize = SLOTS + 1;
 
 /// The inputs as `status` and `input <n>` show them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -101,10 +101,10 @@ const fn kind_of(role: &InputRole) -> u8 {
 pub struct Inputs {
     /// Each input's kind of role as of the last settings (see `kind`): a
     /// change of kind starts the input afresh.
-    kinds: [u8; INPUTS],
-    debouncers: [Debouncer; INPUTS],
+    kinds: [u8; SLOTS],
+    debouncers: [Debouncer; SLOTS],
     /// When each button last ran its action (bit `i` of `pressed`: ever).
-    presses: [Micros; INPUTS],
+    presses: [Micros; SLOTS],
     pressed: u8,
     /// When the last glance was ([`NEVER`] before the first).
     last_glance: Micros,
@@ -150,9 +150,9 @@ impl Inputs {
     #[must_use]
     pub fn new(settings: &InputSettings, now: Micros) -> Self {
         let mut inputs = Self {
-            kinds: [u8::MAX; INPUTS],
-            debouncers: [Debouncer::new(); INPUTS],
-            presses: [Micros(0); INPUTS],
+            kinds: [u8::MAX; SLOTS],
+            debouncers: [Debouncer::new(); SLOTS],
+            presses: [Micros(0); SLOTS],
             pressed: 0,
             last_glance: NEVER,
             empty_since: now,

@@ -1,7 +1,8 @@
 //! Trigger inputs: what a button or a presence sensor means for the head.
 //!
-//! A board reads its inputs' levels (the firmware layer's `InputSource`);
-//! what a level means lives here: [`InputRole`] (off, a button with an
+//! A board reads its inputs' levels (the firmware layer's `InputSource`)
+//! and names them ([`InputIds`]: how many, and each one's number); what a
+//! level means lives here: [`InputRole`] (off, a button with an
 //! action, a presence sensor), [`Debouncer`] (a button's press at once, a
 //! presence level once it has held, [`Debounce`]) and [`Inputs`], which
 //! turns edges into the same [`Action`](crate::command::Action)s the console
@@ -13,23 +14,24 @@
 //! (`docs/design/code.md`, “Trigger inputs”).
 
 mod debounce;
+mod ids;
 mod inputs;
 mod role;
 mod settings;
 
 pub use debounce::{Debounce, Debouncer};
+pub use ids::{IdsError, InputIds};
 pub use inputs::{InputStatus, Inputs, Micros, OUTBOX, RADAR_HOLD_MS, RADAR_POLL_MS};
 pub use role::{InputRole, Pull};
 pub use settings::{InputSettings, MAX_REST_AFTER, RestAfter};
 
 use crate::units::Millis;
 
-/// How many trigger inputs a head has (GP2 to GP5 on the Pico).
-pub const INPUTS: usize = 4;
-
-/// The first input's number in the console's words (`input 2`): the Pico's
-/// GPIO numbers.
-pub const FIRST_INPUT: u8 = 2;
+/// How many inputs the settings keep a role for: the most a board can
+/// have. The board says how many it has and their numbers ([`InputIds`]);
+/// its input in slot `i` takes role `i` (the settings record keeps all
+/// four, so a record saved on one board loads on another).
+pub const SLOTS: usize = 4;
 
 /// A button's level must hold this long to count.
 pub const BUTTON_DEBOUNCE: Millis = Millis(5);

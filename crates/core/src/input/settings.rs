@@ -2,7 +2,7 @@
 
 pub use crate::command::{MAX_REST_AFTER, RestAfter};
 
-use super::{INPUTS, InputRole};
+use super::{InputRole, SLOTS};
 
 impl RestAfter {
     /// `seconds`, if in `1..=MAX_REST_AFTER`.
@@ -29,8 +29,9 @@ impl RestAfter {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct InputSettings {
-    /// The roles of the inputs, the first (`input 2`, GP2) first.
-    pub roles: [InputRole; INPUTS],
+    /// The inputs' roles by slot (see [`InputIds`](super::InputIds)): a
+    /// board with fewer inputs keeps the other roles, unused.
+    pub roles: [InputRole; SLOTS],
     /// When the head rests (with at least one presence input).
     pub rest_after: RestAfter,
 }
@@ -39,7 +40,7 @@ impl InputSettings {
     /// Every input off (the head behaves as without inputs), rest after
     /// 2 minutes without presence once a presence input is configured.
     pub const DEFAULT: Self = Self {
-        roles: [InputRole::Off; INPUTS],
+        roles: [InputRole::Off; SLOTS],
         rest_after: RestAfter::Seconds(120),
     };
 

@@ -8,13 +8,13 @@ use crate::units::Angle;
 
 const NOD: Action = Action::Gesture(GestureRequest::new(GestureKind::Nod));
 
-fn settings(roles: [InputRole; INPUTS], rest_after: RestAfter) -> InputSettings {
+fn settings(roles: [InputRole; SLOTS], rest_after: RestAfter) -> InputSettings {
     InputSettings { roles, rest_after }
 }
 
 /// The settings with `role` on the first input (GP2), the others off.
 fn first(role: InputRole, rest_after: RestAfter) -> InputSettings {
-    let mut roles = [InputRole::Off; INPUTS];
+    let mut roles = [InputRole::Off; SLOTS];
     roles[0] = role;
     settings(roles, rest_after)
 }
@@ -202,7 +202,7 @@ fn a_presence_input_stuck_high_keeps_the_head_awake() {
     );
     assert_eq!(run.inputs.deadline(&s), None);
     // And a sensor already high when configured: present, but no edge.
-    let mut run = Run::new(&settings([InputRole::Off; INPUTS], RestAfter::Seconds(5)));
+    let mut run = Run::new(&settings([InputRole::Off; SLOTS], RestAfter::Seconds(5)));
     run.levels = 1;
     run.settings = s;
     run.inputs.configure(&s, Micros(0));
@@ -267,7 +267,7 @@ fn without_a_presence_input_the_head_never_rests() {
 
 #[test]
 fn a_full_outbox_counts_what_it_lost() {
-    let s = settings([InputRole::Button(NOD); INPUTS], RestAfter::Never);
+    let s = settings([InputRole::Button(NOD); SLOTS], RestAfter::Never);
     let mut inputs = Inputs::new(&s, Micros(0));
     inputs.update(&s, Micros(0), 0b1111, false);
     let mut t = 0;

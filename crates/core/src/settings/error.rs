@@ -46,6 +46,8 @@ pub enum StorageError<E = FlashFailed, I = SettingsError> {
     Invalid(I),
     /// The flash driver failed.
     Flash(E),
+    /// The board has no settings store.
+    Absent,
 }
 
 impl<E, I> StorageError<E, I> {
@@ -60,6 +62,7 @@ impl<E, I> StorageError<E, I> {
             Self::TooLong { needs } => StorageError::TooLong { needs },
             Self::Invalid(why) => StorageError::Invalid(why),
             Self::Flash(_) => StorageError::Flash(FlashFailed),
+            Self::Absent => StorageError::Absent,
         }
     }
 }
@@ -78,6 +81,7 @@ impl<E, I: Describe> Describe for StorageError<E, I> {
             Self::Invalid(e) => out.str("stored settings fail validation: ").with(e),
             Self::TooLong { .. } => out.str("settings do not fit the store"),
             Self::Flash(_) => out.str("the flash failed"),
+            Self::Absent => out.str("this board has no settings store"),
         };
     }
 }

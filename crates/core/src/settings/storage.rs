@@ -52,6 +52,18 @@ impl<T: SettingsStorage + ?Sized> SettingsStorage for &mut T {
     }
 }
 
+/// A board's store, if it has one: `None` refuses every `save` and `load`
+/// with [`StorageError::Absent`] (the console's `err unavailable`).
+impl<T: SettingsStorage> SettingsStorage for Option<T> {
+    fn save(&mut self, settings: &Settings) -> Result<(), StorageError> {
+        self.as_mut().ok_or(StorageError::Absent)?.save(settings)
+    }
+
+    fn load(&mut self) -> Result<Settings, StorageError> {
+        self.as_mut().ok_or(StorageError::Absent)?.load()
+    }
+}
+
 /// One record kept in RAM as the flash store keeps it (version, then the
 /// record's bytes), `N` bytes at most (by default as many as the flash
 /// store's buffer holds): lost at reset.

@@ -17,7 +17,7 @@ use crate::behaviour::{BehaviourConfig, BehaviourError, BehaviourParams};
 use crate::command::InputRole;
 use crate::dmx::DmxSettings;
 use crate::driver::{ConfigError, DriverConfig, DriverParams};
-use crate::input::{FIRST_INPUT, InputSettings};
+use crate::input::InputSettings;
 use crate::motion::DEFAULT_HEAD;
 use crate::seed::Seeding;
 use crate::servo::{ServoCalibration, ServoRate};
@@ -158,15 +158,19 @@ impl Settings {
     }
 
     /// Checks each button's action with `behaviour` as the console checks
-    /// a motion command: the first that the head would refuse, with its
-    /// input's number. (Not part of [`validate`](Self::validate): a record
+    /// a motion command, on the board's first `used` slots (its inputs):
+    /// the first that the head would refuse, with its input's slot. (Not part of [`validate`](Self::validate): a record
     /// loads whatever its buttons say, and a press the head refuses is
     /// logged, not played.)
     ///
     /// # Errors
-    /// The input's number (as the console names it) and why.
-    pub fn check_inputs(&self, behaviour: &BehaviourParams) -> Result<(), (u8, BehaviourError)> {
-        for (n, role) in (FIRST_INPUT..).zip(&self.inputs.roles) {
+    /// The input's slot (see [`InputIds`](crate::input::InputIds)) and why.
+    pub fn check_inputs(
+        &self,
+        behaviour: &BehaviourParams,
+        used: usize,
+    ) -> Result<(), (usize, BehaviourError)> {
+        for (n, role) in self.inputs.roles.iter().enumerate().take(used) {
             if let InputRole::Button(action) = role {
                 behaviour.check(action).map_err(|e| (n, e))?;
             }

@@ -5,7 +5,8 @@ use embassy_time::Instant;
 use idle_head_core::Angle;
 use idle_head_core::command::{Action, GestureKind, GestureRequest, InputRole};
 use idle_head_core::input::{
-    BUTTON_DEBOUNCE, BUTTON_HOLD_OFF, INPUTS, InputSettings, PRESENCE_DEBOUNCE, Pull, RestAfter,
+    BUTTON_DEBOUNCE, BUTTON_HOLD_OFF, InputIds, InputSettings, PRESENCE_DEBOUNCE, Pull, RestAfter,
+    SLOTS,
 };
 
 use super::{InputSource, RETRY, Shown, Wake, start, step};
@@ -16,10 +17,14 @@ const NOD: Action = Action::Gesture(GestureRequest::new(GestureKind::Nod));
 /// Levels set by the test; the pulls the task set up.
 struct Source {
     levels: u8,
-    pulls: [Option<Pull>; INPUTS],
+    pulls: [Option<Pull>; SLOTS],
 }
 
 impl InputSource for Source {
+    fn ids(&self) -> InputIds {
+        InputIds::new(&[2, 3, 4, 5]).unwrap()
+    }
+
     fn set_pull(&mut self, i: usize, pull: Pull) {
         self.pulls[i] = Some(pull);
     }
@@ -55,7 +60,7 @@ impl Task {
         links.console.set_inputs(settings);
         let mut source = Source {
             levels,
-            pulls: [None; INPUTS],
+            pulls: [None; SLOTS],
         };
         let inputs = start(&mut source, &links, ms(0));
         let mut task = Self {
@@ -99,7 +104,7 @@ impl Task {
 
 /// A button on the first input (GP2) that nods, the others off.
 fn button() -> InputSettings {
-    let mut roles = [InputRole::Off; INPUTS];
+    let mut roles = [InputRole::Off; SLOTS];
     roles[0] = InputRole::Button(NOD);
     InputSettings {
         roles,
@@ -109,7 +114,7 @@ fn button() -> InputSettings {
 
 /// A presence sensor on the second input (GP3) toward `deg`.
 fn presence(deg: i32) -> InputSettings {
-    let mut roles = [InputRole::Off; INPUTS];
+    let mut roles = [InputRole::Off; SLOTS];
     roles[1] = InputRole::Presence {
         toward: Some(Angle::from_degrees(deg)),
     };
@@ -232,4 +237,82 @@ fn new_settings_from_the_console_take_effect_at_the_next_wake() {
     assert_eq!(task.last.1, 0b0001);
     task.set(1000, PRESSED);
     assert_eq!(task.taken(), [NOD]);
+}
+
+/// Another source than pins: presence announced by messages on a bus
+/// (`[input, level]`, from a sensor on another board), one input numbered
+/// 40. No pulls: it ignores them.
+struct BusPresence {
+    present: bool,
+}
+
+impl BusPresence {
+    const ID: u8 = 40;
+
+    /// A message from the bus: `[input, 0|1]`; others are not for it.
+    fn receive(&mut self, message: &[u8]) {
+        if let [Self::ID, level @ (0 | 1)] = message {
+            self.present = *level == 1;
+        }
+    }
+}
+
+impl InputSource for BusPresence {
+    fn ids(&self) -> InputIds {
+        InputIds::new(&[Self::ID]).unwrap()
+    }
+
+    fn set_pull(&mut self, _: usize, _: Pull) {}
+
+    fn levels(&mut self) -> u8 {
+        u8::from(self.present)
+    }
+
+    async fn changed(&mut self, seen: u8, watched: u8) {
+        if (self.levels() ^ seen) & watched == 0 {
+            // The next message wakes the task on a board; here the test does.
+            core::future::pending::<()>().await;
+        }
+    }
+}
+
+#[test]
+fn presence_from_bus_messages_wakes_and_rests_the_head_as_a_pin_would() {
+    let links = Box::new(Links::new());
+    let mut roles = [InputRole::Off; SLOTS];
+    roles[0] = InputRole::Presence { toward: None };
+    links.console.set_inputs(InputSettings {
+        roles,
+        rest_after: RestAfter::Seconds(1),
+    });
+    let mut bus = BusPresence { present: false };
+    let mut inputs = start(&mut bus, &links, ms(0));
+    let mut shown = Shown::default();
+    let mut wake = |bus: &mut BusPresence, at: u64| {
+        let wake = Wake {
+            changed: false,
+            now: ms(at),
+        };
+        step(bus, &mut inputs, &mut shown, wake, &links)
+    };
+    let taken = |links: &Links| std::iter::from_fn(|| links.commands.take()).collect::<Vec<_>>();
+    let (levels, watched, _) = wake(&mut bus, 0);
+    assert_eq!((levels, watched), (0, 0b1));
+    // A message that is not for it changes nothing; the one that is ends
+    // the wait at once.
+    bus.receive(&[41, 1]);
+    assert_eq!(bus.levels(), 0);
+    bus.receive(&[BusPresence::ID, 1]);
+    embassy_futures::block_on(bus.changed(levels, watched));
+    wake(&mut bus, 100);
+    wake(&mut bus, 100 + u64::from(PRESENCE_DEBOUNCE.0));
+    assert!(links.console.inputs().is_active(0));
+    // Nobody any more: the head rests a second later.
+    bus.receive(&[BusPresence::ID, 0]);
+    wake(&mut bus, 500);
+    let (_, _, deadline) = wake(&mut bus, 500 + u64::from(PRESENCE_DEBOUNCE.0));
+    assert!(!links.console.inputs().is_active(0));
+    let rest = deadline.expect("the rest timer runs");
+    wake(&mut bus, rest.as_millis());
+    assert_eq!(taken(&links), [Action::Rest]);
 }

@@ -5,18 +5,14 @@
 //! motion holds no other command: a line never nests).
 
 use crate::command::{Command, InputRole};
-use crate::input::{FIRST_INPUT, INPUTS};
 
 use super::error::{ParseError, ParseErrorKind};
 use super::words::{Field, Kw, Word, Words};
 use super::{YAW, to_angle};
 
-/// The inputs' numbers, as the console names them (GP2 to GP5).
-const INPUT: Field = Field::new(
-    "input (2 to 5)",
-    FIRST_INPUT as i64,
-    FIRST_INPUT as i64 + INPUTS as i64 - 1,
-);
+/// An input's number, as the console names it: which numbers a board has
+/// is the board's (`InputIds`), and the service refuses the others.
+const INPUT: Field = Field::new("input", 0, u8::MAX as i64);
 /// Where a presence sensor looks: a yaw, as `look` takes it.
 const DIRECTION: Field = YAW;
 

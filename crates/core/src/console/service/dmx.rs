@@ -32,9 +32,10 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
     }
 
     /// The DMX signal as `status` and `dmx` report it: `off` as soon as
-    /// it is switched off, else as the frame task last judged it.
+    /// it is switched off, else as the frame task last judged it; `None`
+    /// on a board without a receiver.
     fn signal(&self) -> Option<Signal> {
-        let show = self.show?;
+        let show = self.show.filter(|_| self.parts.dmx)?;
         Some(match (self.settings.dmx.on, show.dmx.signal()) {
             (false, _) => Signal::Off,
             (true, Signal::Ok) => Signal::Ok,
@@ -44,8 +45,8 @@ impl<'a, S: SettingsStorage, const N: usize> ConsoleService<'a, S, N> {
 
     pub(super) fn dmx(&mut self, setting: Option<DmxSetting>, reply: &mut Reply<'_>) {
         let Some(setting) = setting else {
-            let Some(show) = self.show else {
-                text(reply.err(ErrorCode::State)).str("this board has no DMX receiver");
+            let Some(show) = self.show.filter(|_| self.parts.dmx) else {
+                text(reply.err(ErrorCode::Unavailable)).str("this board has no DMX receiver");
                 return;
             };
             let c = show.dmx.counters();

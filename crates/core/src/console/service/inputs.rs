@@ -8,7 +8,6 @@
 //! the [`ConsoleLink`](super::ConsoleLink)), between two of its frames.
 
 use crate::command::{InputRole, RestAfter, RestSetting};
-use crate::input::{FIRST_INPUT, INPUTS};
 use crate::settings::{SettingsSource, SettingsStorage};
 use crate::text::Arg::{Int, Str, Uint};
 use crate::text::Text;
@@ -18,11 +17,33 @@ use super::{ConsoleService, ErrorCode, Reply, behaviour_code, text};
 use crate::console::ActionLine;
 
 impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
+    /// The slot of the board's input numbered `input`; else the reply
+    /// says which inputs the board has (`err range`), or that it has none
+    /// (`err unavailable`).
+    fn input_slot(&self, input: u8, reply: &mut Reply<'_>) -> Option<usize> {
+        let ids = self.parts.inputs;
+        let slot = ids.slot(input);
+        if slot.is_none() {
+            if ids.is_empty() {
+                text(reply.err(ErrorCode::Unavailable)).str("this board has no trigger inputs");
+            } else {
+                text(reply.err(ErrorCode::Range))
+                    .str("this board has no input ")
+                    .u64(input.into())
+                    .str(": its inputs are ")
+                    .with(&ids);
+            }
+        }
+        slot
+    }
+
     /// `input <n>`: `ok input <n> off`, or its level, then its role as
     /// `input <n> <role>` takes it (`button nod 6000`, `presence -20000`).
     #[inline(never)]
     pub(super) fn show_input(&self, input: u8, reply: &mut Reply<'_>) {
-        let i = usize::from(input - FIRST_INPUT);
+        let Some(i) = self.input_slot(input, reply) else {
+            return;
+        };
         let Some(role) = self.settings.inputs.roles.get(i) else {
             return;
         };
@@ -54,10 +75,9 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
     /// where it goes).
     #[inline(never)]
     pub(super) fn set_input(&mut self, input: u8, role: InputRole, reply: &mut Reply<'_>) {
-        let i = usize::from(input - FIRST_INPUT);
-        if i >= INPUTS {
+        let Some(i) = self.input_slot(input, reply) else {
             return;
-        }
+        };
         match role {
             InputRole::Button(action) => {
                 if let Err(e) = self.behaviour.check(&action) {
@@ -184,13 +204,18 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
     }
 
     /// The inputs for `status`: `-` for an input that is off, else `b`
-    /// (button) or `p` (presence) and `1` if active, `0` if not, from GP2
-    /// on (`inputs=b0,p1,-,-`).
+    /// (button) or `p` (presence) and `1` if active, `0` if not, in the
+    /// order of the board's inputs (the Pico's: GP2 to GP5,
+    /// `inputs=b0,p1,-,-`); nothing on a board without inputs.
     #[inline(never)]
     pub(super) fn status_inputs(&self, out: &mut dyn Text) {
+        let used = self.parts.inputs.len();
+        if used == 0 {
+            return;
+        }
         let status = self.link.inputs();
         out.str(" inputs=");
-        for (i, role) in self.settings.inputs.roles.iter().enumerate() {
+        for (i, role) in self.settings.inputs.roles.iter().enumerate().take(used) {
             if i > 0 {
                 out.str(",");
             }
@@ -219,16 +244,18 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
     /// Why the settings `next` would refuse a button's action with their
     /// behaviour, if one would: `err limit`.
     pub(super) fn inputs_refused(
+        &self,
         next: &crate::settings::Settings,
         behaviour: &crate::behaviour::BehaviourParams,
         reply: &mut Reply<'_>,
     ) -> bool {
-        match next.check_inputs(behaviour) {
+        let ids = self.parts.inputs;
+        match next.check_inputs(behaviour, ids.len()) {
             Ok(()) => false,
-            Err((input, e)) => {
+            Err((slot, e)) => {
                 text(reply.err(ErrorCode::Limit))
                     .str("input ")
-                    .u64(input.into())
+                    .u64(ids.id(slot).unwrap_or_default().into())
                     .str(" would go past the new limits: ")
                     .with(&e);
                 true

@@ -4,7 +4,7 @@
 
 use super::{ConsoleService, text};
 use crate::command::{SeedChoice, TrackSetting};
-use crate::console::reply::Reply;
+use crate::console::reply::{ErrorCode, Reply};
 use crate::seed::{BoardId, Seeding, Shown};
 use crate::settings::{Settings, SettingsSource, SettingsStorage};
 use crate::text::Arg::{Int, Str, Uint};
@@ -25,11 +25,17 @@ impl<S: SettingsStorage, const N: usize> ConsoleService<'_, S, N> {
         self.board
     }
 
-    /// `radar`: the receiver's counters; `radar on|off`.
+    /// `radar`: the receiver's counters (`err unavailable` on a board
+    /// without a radar); `radar on|off`, a setting kept and saved on any
+    /// board, as `dmx on|off` is.
     pub(super) fn radar(&mut self, on: Option<bool>, reply: &mut Reply<'_>) {
         if let Some(on) = on {
             self.settings.track.radar = on;
             self.push_track();
+            return;
+        }
+        if !self.parts.radar {
+            text(reply.err(ErrorCode::Unavailable)).str("this board has no radar");
             return;
         }
         let received = self.show.map(|s| s.track.received()).unwrap_or_default();
