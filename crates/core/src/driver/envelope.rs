@@ -184,8 +184,11 @@ impl Envelope {
                 self.stepped = true;
                 self.level -= self.frame as i32;
                 // (x, rem) − (step, step_rem), borrowing `fade` from x; the
-                // result is level·2¹⁶ ≥ 0 divided by fade.
-                if self.rem < self.step_rem {
+                // result is level·2¹⁶ ≥ 0 divided by fade. A frame longer
+                // than the fade (its step clamped) divides instead.
+                if self.step >= UNITY {
+                    self.set_level(self.level as i64);
+                } else if self.rem < self.step_rem {
                     self.rem += self.fade - self.step_rem;
                     self.x -= self.step as i32 + 1;
                 } else {
@@ -201,8 +204,11 @@ impl Envelope {
                 self.stepped = true;
                 self.level += self.frame as i32;
                 // (x, rem) + (step, step_rem), carrying when rem reaches
-                // fade (both below it: no overflow as written).
-                if self.rem >= self.fade - self.step_rem {
+                // fade (both below it: no overflow as written); a frame
+                // longer than the fade (its step clamped) divides instead.
+                if self.step >= UNITY {
+                    self.set_level(self.level as i64);
+                } else if self.rem >= self.fade - self.step_rem {
                     self.rem -= self.fade - self.step_rem;
                     self.x += self.step as i32 + 1;
                 } else {
@@ -242,4 +248,31 @@ const fn smoothstep(x: u32) -> u32 {
     let (qh, ql) = (q >> 16, q & 0xFFFF);
     let (ch, cl) = (c >> 16, c & 0xFFFF);
     (qh * c + ql * ch + ((ql * cl) >> 16)) >> 16
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Envelope, UNITY};
+
+    /// A fade shorter than a frame (2 ms at 333 Hz): the gain still rises
+    /// from 0 to 1 and falls back, never outside them.
+    #[test]
+    fn a_fade_shorter_than_a_frame_stays_within_its_gains() {
+        let mut envelope = Envelope::new(2_000, 3_000);
+        envelope.start();
+        let mut last = 0;
+        for _ in 0..10 {
+            let gain = envelope.next_gain();
+            assert!(gain <= UNITY && gain >= last, "{gain} after {last}");
+            last = gain;
+        }
+        assert_eq!(last, UNITY);
+        envelope.set_stopping(true);
+        for _ in 0..10 {
+            let gain = envelope.next_gain();
+            assert!(gain <= last, "{gain} after {last}");
+            last = gain;
+        }
+        assert_eq!(last, 0);
+    }
 }
