@@ -45,7 +45,7 @@ pub const BUDGET: u64 = 150_000;
 
 /// The name of the benchmark's stage in `cargo xtask test`.
 pub const STAGE: &str = "QEMU bench: default set within its 150,000-instruction budget, \
-                         frame update at 50 and 333 Hz: median within 1,200 idle and 2,000 \
+                         frame update at 50 and 333 Hz: median within 1,200 idle (1,300 at 333 Hz) and 2,000 \
                          with a gesture and a look, max within 4,000";
 
 /// The latency stage's name in `cargo xtask test`.
@@ -184,6 +184,12 @@ impl Verdict {
 pub const CEILINGS: [(Option<&str>, [u64; 2]); 2] =
     [(None, [1200, 4000]), (Some("gesture+look"), [2000, 4000])];
 pub const RATES: [u64; 2] = [50, 333];
+/// The idle frame's median ceiling at 333 Hz: 1,300, over the 1,200 of the
+/// other rates. The duty is counted from the exact angle (so that a look's
+/// first 5 ms frame at 200 Hz, 16 mdeg, reaches the pulse), besides the
+/// whole-µs pulse the reports show: about 45 instructions a servo more.
+/// At 333 Hz, 1,300 instructions are 0.35 % of a frame's 375,375 cycles.
+pub const IDLE_MEDIAN_AT_333_HZ: u64 = 1300;
 
 /// A `frame bench ...` line: instructions per frame update over a loop, at
 /// the servo rate `rate` (Hz; 50 in a log without `rate=`), with
@@ -250,7 +256,10 @@ impl FrameRow {
         let own = CEILINGS
             .iter()
             .find(|(scenario, _)| *scenario == self.scenario.as_deref());
-        own.map(|(_, ceiling)| *ceiling)
+        own.map(|(scenario, [median, max])| match (self.rate, scenario) {
+            (333, None) => [IDLE_MEDIAN_AT_333_HZ, *max],
+            _ => [*median, *max],
+        })
     }
 
     /// The median and the max within this row's ceiling (a row without
