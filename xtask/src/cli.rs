@@ -52,6 +52,10 @@ pub enum Command {
         /// are listed as skipped), e.g. `--only emulator`.
         #[arg(long, value_name = "TEXT")]
         only: Option<String>,
+        /// One emulator stage, exactly this name, on images already built:
+        /// how the full run starts its emulator stages side by side.
+        #[arg(long, hide = true, conflicts_with = "only")]
+        stage: Option<String>,
     },
     /// Run the benchmark in QEMU (boot precompute and frame update against
     /// their budgets), the tracking figures in the host trace, then the
@@ -140,6 +144,7 @@ mod tests {
             timeout,
             no_budget: false,
             only: None,
+            stage: None,
         }) = test
         else {
             panic!("{test:?}");
