@@ -138,18 +138,7 @@ mod tests {
     fn the_definition_is_consistent_and_a_bad_option_is_named() {
         Cli::command().debug_assert();
         assert!(parse(&[]).unwrap().is_none());
-        let test = parse(&["test"]).unwrap();
-        let Some(Command::Test {
-            bless: false,
-            timeout,
-            no_budget: false,
-            only: None,
-            stage: None,
-        }) = test
-        else {
-            panic!("{test:?}");
-        };
-        assert_eq!(timeout.timeout, 120);
+        assert!(matches!(parse(&["test"]), Ok(Some(Command::Test { .. }))));
         // Each command takes only the options that mean something to it.
         for (args, named) in [
             (&["qemu", "--timeout", "0"][..], "--timeout"),
