@@ -257,7 +257,8 @@ type Emulated = (&'static str, fn(&Path, &Metadata) -> Result<()>);
 /// runs on one core (the latency stage on as many as there are): the full
 /// run builds their images first, then runs them side by side as
 /// `cargo xtask test --stage NAME`, longest first, each one's output held
-/// back and printed in this order.
+/// back and printed in this order. Only the latency stage among them records
+/// figures (`target/figures.json` is never written by two at once).
 const EMULATED: [Emulated; 16] = [
     (sim::PULSES_STAGE, |root, metadata| {
         let report = sim::test_pulses(root, metadata)?;
