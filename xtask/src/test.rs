@@ -373,17 +373,20 @@ fn sim_stages(
             None
         }
     };
-    // Longest first: the two streams, the latency rows.
+    // Longest first: the two 10-minute streams, the DMX stream, the latency rows.
     let mut queue: Vec<usize> = chosen
         .iter()
         .copied()
         .filter(|&i| blocker(i).is_none())
         .collect();
-    let long = |i: &usize| {
-        let name = EMULATED[*i].0;
-        !(name.contains("stream") || name == bench::LATENCY_STAGE)
-    };
-    queue.sort_by_key(long);
+    let long = [
+        sim::UART_STREAM_STAGE,
+        sim::USB_STREAM_STAGE,
+        sim::DMX_STREAM_STAGE,
+        bench::LATENCY_STAGE,
+    ];
+    let rank = |i: &usize| long.iter().position(|name| *name == EMULATED[*i].0);
+    queue.sort_by_key(|i| rank(i).unwrap_or(long.len()));
     let queue = std::sync::Mutex::new(queue.into_iter());
     let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
     let (sender, results) = std::sync::mpsc::channel();
