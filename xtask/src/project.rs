@@ -144,6 +144,13 @@ pub fn prebuilt() -> bool {
     std::env::var_os(PREBUILT).is_some()
 }
 
+/// How many runs share the cores ([`PREBUILT`]'s value, else 1): each
+/// emulator run's wall-time limit is that many times its own.
+pub fn side_by_side() -> u32 {
+    let value = std::env::var(PREBUILT).ok().and_then(|v| v.parse().ok());
+    value.unwrap_or(1).max(1)
+}
+
 /// A firmware image: one `[[bin]]` of a package of the repository, built
 /// with `cargo build --release` in its folder into the one target directory.
 #[derive(Debug, Clone, Copy)]

@@ -309,15 +309,16 @@ pub fn stage(name: &str) -> Result<bool> {
 /// as they came), its error, its seconds.
 type Outcome = (Vec<u8>, Option<String>, f64);
 
-/// Runs `xtask test --stage name` with [`project::PREBUILT`] set.
-fn run_apart(name: &str) -> Outcome {
+/// Runs `xtask test --stage name` with [`project::PREBUILT`] set to the
+/// number of runs at once, `cores`.
+fn run_apart(name: &str, cores: usize) -> Outcome {
     let start = Instant::now();
     let run = || -> Result<(Vec<u8>, std::process::ExitStatus)> {
         let (mut reader, writer) = std::io::pipe()?;
         let mut command = std::process::Command::new(std::env::current_exe()?);
         command
             .args(["test", "--stage", name])
-            .env(project::PREBUILT, "1");
+            .env(project::PREBUILT, cores.to_string());
         command.stdin(std::process::Stdio::null());
         let mut child = command.stdout(writer.try_clone()?).stderr(writer).spawn()?;
         drop(command);
@@ -396,7 +397,7 @@ fn sim_stages(
             let queue = &queue;
             scope.spawn(move || {
                 while let Some(i) = queue.lock().ok().and_then(|mut q| q.next()) {
-                    let _ = sender.send((i, run_apart(EMULATED[i].0)));
+                    let _ = sender.send((i, run_apart(EMULATED[i].0, cores)));
                 }
             });
         }
