@@ -57,7 +57,11 @@ fn main() -> ExitCode {
             timeout,
             no_budget,
             only,
+            stage: None,
         }) => test::command(options(bless, timeout, no_budget), only.as_deref()),
+        Some(Command::Test {
+            stage: Some(stage), ..
+        }) => test::stage(&stage),
         Some(Command::Bench { timeout, no_budget }) => {
             bench::command(options(false, timeout, no_budget))
         }

@@ -34,7 +34,7 @@ pub use script::{default_time as script_time, parse as parse_script};
 pub use show::{SHOW_STAGE, test_show};
 pub use stages::{
     CONSOLE_STAGE, CONSOLE_TIME, DRILL_STAGE, FAILURES_STAGE, PULSES_STAGE, RATE_STAGE, WALL,
-    test_console, test_drill, test_failures, test_pulses, test_rate,
+    build_drill, test_console, test_drill, test_failures, test_pulses, test_rate,
 };
 pub use store::{STORE_STAGE, test_store};
 pub use stream::{

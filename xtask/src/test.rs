@@ -30,21 +30,41 @@ impl Stages<'_> {
     /// Runs one stage; `Ok(())` passes, an error fails it. A stage `--only`
     /// leaves out does not run, and counts as passed for what follows.
     fn run(&mut self, name: &str, stage: impl FnOnce() -> Result<()>) -> bool {
-        if self.only.is_some_and(|only| !name.contains(only)) {
+        self.run_if(false, name, stage)
+    }
+
+    /// [`Stages::run`], also when `--only` leaves it out if `needed`.
+    fn run_if(&mut self, needed: bool, name: &str, stage: impl FnOnce() -> Result<()>) -> bool {
+        if !needed && !self.chosen(name) {
             self.left_out += 1;
             return true;
         }
         println!("\n==> {name}");
         let start = Instant::now();
         let failed = stage().err().map(|error| format!("{error:#}"));
-        let seconds = start.elapsed().as_secs_f64();
+        self.score(name, failed, start.elapsed().as_secs_f64())
+    }
+
+    /// Whether `--only` lets the stage `name` run.
+    fn chosen(&self, name: &str) -> bool {
+        self.only.is_none_or(|only| name.contains(only))
+    }
+
+    /// Prints the output of a stage run apart, and scores it.
+    fn record(&mut self, name: &str, (output, failed, seconds): Outcome) {
+        println!("\n==> {name}");
+        let _ = std::io::Write::write_all(&mut std::io::stdout(), &output);
+        self.score(name, failed, seconds);
+    }
+
+    fn score(&mut self, name: &str, failed: Option<String>, seconds: f64) -> bool {
         match &failed {
             None => println!("--- ok: {name} ({seconds:.1} s)"),
             Some(error) => println!("--- FAILED: {name}: {error}"),
         }
-        self.results
-            .push((name.to_owned(), failed.clone(), seconds));
-        failed.is_none()
+        let passed = failed.is_none();
+        self.results.push((name.to_owned(), failed, seconds));
+        passed
     }
 
     /// Records a stage that could not run because an earlier one failed.
@@ -117,7 +137,11 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     clippy_stages(&mut stages);
 
     // 3. The Pico image: placement of the boot stage, memory budgets, no allocator.
-    let pico_built = stages.run("Pico build (cargo build --release)", || PICO.build(&root));
+    // (Also for any emulator stage: they run on the image built here.)
+    let emulated = EMULATED.iter().any(|(name, _)| stages.chosen(name));
+    let pico_built = stages.run_if(emulated, "Pico build (cargo build --release)", || {
+        PICO.build(&root)
+    });
     if pico_built {
         stages.run(
             "Pico image: .boot2 placement, memory budgets, no allocator",
@@ -174,9 +198,6 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     // 5. The boot-time benchmark in QEMU and the default set's instruction
     // budget; its telemetry check compares against the QEMU run above.
     stages.run(bench::tracking::STAGE, bench::tracking::stage);
-    stages.run(bench::LATENCY_STAGE, || {
-        bench::latency_stage(&root, &metadata)
-    });
     stages.run(bench::STAGE, || {
         setup::ensure_qemu()?;
         bench::run_and_check(&root, &metadata, options, qemu_run.as_ref())
@@ -247,6 +268,95 @@ fn clippy_stages(stages: &mut Stages<'_>) {
     }
 }
 
+/// An emulator stage: its name, and what it runs on images built already.
+type Emulated = (&'static str, fn(&Path, &Metadata) -> Result<()>);
+
+/// The stages in the RP2040 emulator, in the order of the score card. Each
+/// runs on one core (the latency stage on as many as there are): the full
+/// run builds their images first, then runs them side by side as
+/// `cargo xtask test --stage NAME`, longest first, each one's output held
+/// back and printed in this order. Only the latency stage among them records
+/// figures (`target/figures.json` is never written by two at once).
+const EMULATED: [Emulated; 16] = [
+    (sim::PULSES_STAGE, |root, metadata| {
+        let report = sim::test_pulses(root, metadata)?;
+        let stack = report.peak_stack().map(|s| s.to_string());
+        project::write(&peak_file(metadata), stack.unwrap_or_default())
+    }),
+    (sim::RATE_STAGE, sim::test_rate),
+    (sim::DRILL_STAGE, sim::test_drill),
+    (sim::INPUTS_STAGE, sim::test_inputs),
+    (sim::CONSOLE_STAGE, |root, metadata| {
+        sim::test_console(root, metadata, sim::CONSOLE_TIME, sim::WALL)
+    }),
+    (sim::STORE_STAGE, sim::test_store),
+    (sim::NOISE_STAGE, sim::test_noise),
+    (sim::FLOOD_STAGE, sim::test_flood),
+    (sim::UART_STREAM_STAGE, |root, metadata| {
+        sim::test_stream(root, metadata, "uart", sim::STREAM_LENGTH)
+    }),
+    (sim::USB_STREAM_STAGE, |root, metadata| {
+        sim::test_stream(root, metadata, "usb", sim::STREAM_LENGTH)
+    }),
+    (sim::DMX_STREAM_STAGE, sim::test_dmx),
+    (sim::FAILURES_STAGE, sim::test_failures),
+    (sim::SHOW_STAGE, sim::test_show),
+    (sim::RADAR_STAGE, sim::test_radar),
+    (sim::RADAR_DMX_STAGE, sim::test_radar_dmx),
+    (bench::LATENCY_STAGE, bench::latency_stage),
+];
+
+/// Where the pulses stage leaves the peak stack it measured, for the RAM
+/// stage.
+fn peak_file(metadata: &Metadata) -> std::path::PathBuf {
+    metadata.target_dir.join("sim-pulses-peak-stack")
+}
+
+/// `cargo xtask test --stage NAME`: one of [`EMULATED`], on images built
+/// already.
+pub fn stage(name: &str) -> Result<bool> {
+    let Some((_, run)) = EMULATED.iter().find(|(stage, _)| *stage == name) else {
+        bail!("no emulator stage is called `{name}`");
+    };
+    let root = project::root();
+    run(&root, &project::metadata(&root)?)?;
+    Ok(true)
+}
+
+/// A stage's run in a process of its own: its output (stdout and stderr
+/// as they came), its error, its seconds.
+type Outcome = (Vec<u8>, Option<String>, f64);
+
+/// Runs `xtask test --stage name` with [`project::PREBUILT`] set to the
+/// number of runs at once, `cores`.
+fn run_apart(name: &str, cores: usize) -> Outcome {
+    let start = Instant::now();
+    let run = || -> Result<(Vec<u8>, std::process::ExitStatus)> {
+        let (mut reader, writer) = std::io::pipe()?;
+        let mut command = std::process::Command::new(std::env::current_exe()?);
+        command
+            .args(["test", "--stage", name])
+            .env(project::PREBUILT, cores.to_string());
+        command.stdin(std::process::Stdio::null());
+        let mut child = command.stdout(writer.try_clone()?).stderr(writer).spawn()?;
+        drop(command);
+        let mut output = Vec::new();
+        std::io::Read::read_to_end(&mut reader, &mut output)?;
+        Ok((output, child.wait()?))
+    };
+    let (output, failed) = match run() {
+        Ok((output, status)) if status.success() => (output, None),
+        Ok((output, status)) => {
+            let text = String::from_utf8_lossy(&output);
+            let error = text.lines().rev().find_map(|l| l.strip_prefix("error: "));
+            let error = error.map_or_else(|| status.to_string(), str::to_owned);
+            (output, Some(error))
+        }
+        Err(error) => (Vec::new(), Some(format!("starting it: {error:#}"))),
+    };
+    (output, failed, start.elapsed().as_secs_f64())
+}
+
 fn sim_stages(
     stages: &mut Stages<'_>,
     root: &Path,
@@ -255,45 +365,91 @@ fn sim_stages(
     qemu_run: Option<&Run>,
 ) {
     const MEMORY: &str = "RAM: static + peak stack of the Pico image within its budget";
-    let mut report = None;
-    if pico_built {
-        stages.run(sim::PULSES_STAGE, || {
-            report = Some(sim::test_pulses(root, metadata)?);
-            Ok(())
-        });
-    } else {
-        stages.blocked(sim::PULSES_STAGE, "the Pico build");
-    }
-    stages.run(sim::RATE_STAGE, || sim::test_rate(root, metadata));
-    stages.run(sim::DRILL_STAGE, || sim::test_drill(root, metadata));
-    stages.run(sim::INPUTS_STAGE, || sim::test_inputs(root, metadata));
-    stages.run(sim::CONSOLE_STAGE, || {
-        sim::test_console(root, metadata, sim::CONSOLE_TIME, sim::WALL)
+    const DRILL_BUILD: &str =
+        "watchdog drill image (cargo build --release --features watchdog-drill)";
+    let drill = stages.chosen(sim::DRILL_STAGE);
+    let drill_built = stages.run_if(drill, DRILL_BUILD, || sim::build_drill(metadata).map(drop));
+    let _ = std::fs::remove_file(peak_file(metadata));
+    let chosen: Vec<usize> = (0..EMULATED.len())
+        .filter(|&i| stages.chosen(EMULATED[i].0))
+        .collect();
+    let node = chosen.is_empty() || {
+        let ensured = sim::node::ensure(root);
+        if let Err(error) = &ensured {
+            println!("the emulator cannot run: {error:#}");
+        }
+        ensured.is_ok()
+    };
+    let blocker = |i: usize| {
+        let name = EMULATED[i].0;
+        if !pico_built {
+            Some("the Pico build")
+        } else if !node {
+            Some("the emulator's setup")
+        } else if name == sim::DRILL_STAGE && !drill_built {
+            Some("the drill image's build")
+        } else {
+            None
+        }
+    };
+    // Longest first: the two 10-minute streams, the DMX stream, the latency rows.
+    let mut queue: Vec<usize> = chosen
+        .iter()
+        .copied()
+        .filter(|&i| blocker(i).is_none())
+        .collect();
+    let long = [
+        sim::UART_STREAM_STAGE,
+        sim::USB_STREAM_STAGE,
+        sim::DMX_STREAM_STAGE,
+        bench::LATENCY_STAGE,
+    ];
+    let rank = |i: &usize| long.iter().position(|name| *name == EMULATED[*i].0);
+    queue.sort_by_key(|i| rank(i).unwrap_or(long.len()));
+    let queue = std::sync::Mutex::new(queue.into_iter());
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+    let (sender, results) = std::sync::mpsc::channel();
+    std::thread::scope(|scope| {
+        for _ in 0..cores {
+            let sender = sender.clone();
+            let queue = &queue;
+            scope.spawn(move || {
+                while let Some(i) = queue.lock().ok().and_then(|mut q| q.next()) {
+                    let _ = sender.send((i, run_apart(EMULATED[i].0, cores)));
+                }
+            });
+        }
+        drop(sender);
+        let mut done: Vec<Option<Outcome>> = vec![None; EMULATED.len()];
+        let mut next = 0;
+        let mut record = |done: &mut Vec<Option<Outcome>>, next: &mut usize| {
+            while let Some(&i) = chosen.get(*next) {
+                if let Some(by) = blocker(i) {
+                    stages.blocked(EMULATED[i].0, by);
+                } else if let Some(outcome) = done[i].take() {
+                    stages.record(EMULATED[i].0, outcome);
+                } else {
+                    return;
+                }
+                *next += 1;
+            }
+        };
+        record(&mut done, &mut next);
+        for (i, outcome) in results {
+            done[i] = Some(outcome);
+            record(&mut done, &mut next);
+        }
     });
-    stages.run(sim::STORE_STAGE, || sim::test_store(root, metadata));
-    stages.run(sim::NOISE_STAGE, || sim::test_noise(root, metadata));
-    stages.run(sim::FLOOD_STAGE, || sim::test_flood(root, metadata));
-    stages.run(sim::UART_STREAM_STAGE, || {
-        sim::test_stream(root, metadata, "uart", sim::STREAM_LENGTH)
-    });
-    stages.run(sim::USB_STREAM_STAGE, || {
-        sim::test_stream(root, metadata, "usb", sim::STREAM_LENGTH)
-    });
-    stages.run(sim::DMX_STREAM_STAGE, || sim::test_dmx(root, metadata));
-    stages.run(sim::FAILURES_STAGE, || sim::test_failures(root, metadata));
-    stages.run(sim::SHOW_STAGE, || sim::test_show(root, metadata));
-    stages.run(sim::RADAR_STAGE, || sim::test_radar(root, metadata));
-    stages.run(sim::RADAR_DMX_STAGE, || sim::test_radar_dmx(root, metadata));
+    stages.left_out += EMULATED.len() - chosen.len();
     stages.run(MEMORY, || {
         let peak = |elf: &Path, stack: Option<u64>| -> Result<Option<elf::Peak>> {
             let Some(stack) = stack else { return Ok(None) };
             let static_ram = elf::Image::read(elf)?.static_ram();
             Ok(Some(elf::Peak { static_ram, stack }))
         };
-        let pico = peak(
-            &PICO.elf(metadata),
-            report.as_ref().and_then(sim::Report::peak_stack),
-        )?;
+        let stack = std::fs::read_to_string(peak_file(metadata)).ok();
+        let stack = stack.and_then(|s| s.trim().parse().ok());
+        let pico = peak(&PICO.elf(metadata), stack)?;
         let qemu_peak = qemu_run.and_then(|run| sim::logged_peak_stack(&run.log));
         let qemu = peak(&QEMU.elf(metadata), qemu_peak)?;
         elf::check_ram(pico, qemu)

@@ -177,9 +177,10 @@ fn config(seeds: Option<[u32; 3]>) -> HeadConfig {
 /// The firmware's idle source for `config`: its stream of loop sets
 /// (never-repeating unless built with `fixed-loop`), each generated when
 /// its join is due.
-type Idle = IdlePlayer<Box<LoopSet<DEFAULT_N>>, GenerateOnTake<Box<LoopSet<DEFAULT_N>>, DEFAULT_N>>;
+pub type Idle =
+    IdlePlayer<Box<LoopSet<DEFAULT_N>>, GenerateOnTake<Box<LoopSet<DEFAULT_N>>, DEFAULT_N>>;
 
-fn idle(config: HeadConfig, playback: Playback, seed: Option<[u32; 3]>) -> Result<Idle> {
+pub fn idle(config: HeadConfig, playback: Playback, seed: Option<[u32; 3]>) -> Result<Idle> {
     let timing = IdleTiming::new(playback).map_err(|e| anyhow!("{}", e.message()))?;
     let mut stream = LoopStream::new(config, &timing);
     let mut first = Box::new(LoopSet::new());

@@ -3,9 +3,8 @@
 use anyhow::{Result, anyhow, bail};
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use idle_head_core::driver::{DriverConfig, FrameDriver};
-use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N};
-use idle_head_firmware::config::{IDLE_MODE, LOOP_DURATION};
+use idle_head_firmware::config::LOOP_DURATION;
 use idle_head_firmware::frame::FrameLoop;
 
 use idle_head_core::Playback;
@@ -27,24 +26,10 @@ pub fn pico_duties(frames: usize) -> Result<Vec<[u16; 3]>> {
     let params = config.build().map_err(|e| anyhow!("{}", e.message()))?;
     let playback = Playback::new(LOOP_DURATION, config.frame_period, DEFAULT_N)
         .map_err(|e| anyhow!("playback: {e:?}"))?;
-    let timing = IdleTiming::new(playback).map_err(|e| anyhow!("{}", e.message()))?;
-    let mut stream = LoopStream::new(DEFAULT_HEAD, &timing);
-    let mut first = Box::new(LoopSet::<DEFAULT_N>::new());
-    stream
-        .next_into(&mut first)
-        .map_err(|e| anyhow!("generating the default loops: {}", e.error.message()))?;
-    let supply = GenerateOnTake::new(stream, Box::new(LoopSet::new()));
-    let idle = IdlePlayer::new(first, supply, timing, IDLE_MODE);
+    let idle = crate::trace::idle(DEFAULT_HEAD, playback, None)?;
     let mut frame_loop = FrameLoop::new(idle, config.frame_period, TICK_HZ, 0)
         .map_err(|e| anyhow!("frame loop: {e:?}"))?;
-    let mut driver = FrameDriver::new(
-        [
-            Recorder::default(),
-            Recorder::default(),
-            Recorder::default(),
-        ],
-        params,
-    );
+    let mut driver = FrameDriver::new([(); 3].map(|()| Recorder::default()), params);
     for _ in 0..frames {
         let tick = frame_loop.next(frame_loop.deadline());
         frame_loop.write(&mut driver, tick);

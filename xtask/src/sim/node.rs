@@ -274,6 +274,10 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     // The configuration goes in a file: a run of a thousand scripted
     // chunks is more than a command line may carry.
     static RUNS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let config = &Config {
+        wall: config.wall * project::side_by_side(),
+        ..config.clone()
+    };
     let n = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let file = std::env::temp_dir().join(format!("idle-head-sim-{}-{n}.json", std::process::id()));
     std::fs::write(&file, config.json().to_string())

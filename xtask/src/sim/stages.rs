@@ -114,12 +114,10 @@ pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
     Ok(report)
 }
 
-/// Builds the drill image (`--features watchdog-drill`, in a target
-/// directory of its own so that the shipped ELF is never overwritten), runs
-/// two of its boots (each 3 s of frames and the timeout) and checks the
+/// Builds the drill image ([`build_drill`]), runs two of its boots (each 3 s of frames and the timeout) and checks the
 /// reset and the soft start after it.
 pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf = build_variant(root, metadata, "watchdog-drill")?;
+    let elf = build_drill(metadata)?;
     let mut report = run::run_with(root, &elf, Duration::from_millis(6_500), WALL, |_| {})?;
     run::check(&mut report)?;
     print!("{}{}", report.log_text(false), report.table());
@@ -188,18 +186,26 @@ pub fn shipped_image(root: &Path, metadata: &Metadata) -> Result<PathBuf> {
     Ok(PICO.elf(metadata))
 }
 
-/// Builds the Pico image with `feature` in a target directory of its own
-/// (`target/<feature>`), so that the shipped ELF is never overwritten;
-/// returns its ELF.
-pub fn build_variant(root: &Path, metadata: &Metadata, feature: &str) -> Result<PathBuf> {
-    let target = metadata.target_dir.join(feature);
-    let sh = xshell::Shell::new()?;
-    sh.change_dir(root);
-    let build = cmd!(
-        sh,
-        "cargo build --release --features {feature} --target-dir {target}"
-    );
-    project::run(&sh, project::FIRMWARE_ENV, build)?;
+/// Builds the drill image (`--features watchdog-drill`) and returns its ELF,
+/// `target/watchdog-drill/…/pico`: the shipped ELF is never overwritten.
+/// Its intermediate files stay in the one target directory
+/// (`build.build-dir`), so it shares every dependency with the shipped
+/// image and only the three crates the feature changes compile again.
+pub fn build_drill(metadata: &Metadata) -> Result<PathBuf> {
+    let build_dir = metadata.target_dir.to_string_lossy();
+    let target = metadata.target_dir.join("watchdog-drill");
+    if !project::prebuilt() {
+        let sh = project::shell(".")?;
+        let build = cmd!(
+            sh,
+            "cargo build --release --features watchdog-drill --target-dir {target}"
+        );
+        let env = [
+            project::FIRMWARE_ENV[0],
+            ("CARGO_BUILD_BUILD_DIR", &build_dir),
+        ];
+        project::run(&sh, &env, build)?;
+    }
     Ok(target.join(TARGET).join("release").join(PICO.bin))
 }
 
