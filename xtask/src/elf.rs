@@ -9,10 +9,14 @@ use crate::{board::Board, figures, project};
 use object::read::elf::{ElfFile32, ProgramHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, SectionKind, elf};
 
-/// RAM budget of the Pico image: static RAM (`.radar_ring + .data + .bss + .uninit`) plus
-/// the peak stack measured in the RP2040 emulator (the boot precompute's
-/// stack frame is most of it).
-pub const RAM_BUDGET: u64 = 48 * 1024;
+/// RAM budget of the Pico image: static RAM (`.radar_ring + .data + .bss +
+/// .uninit`) plus the peak stack measured in the RP2040 emulator: 50 KiB,
+/// over the 48 KiB first set. The radar's receiver (its DMA ring and
+/// state), the board's optional parts and the settings read back took the
+/// static RAM to 38,964 B; the deepest stack, 10,584 B, comes in the
+/// settings store's run (a saved record read, decoded and validated, under
+/// the port and frame executors). Of the RP2040's 264 KiB.
+pub const RAM_BUDGET: u64 = 50 * 1024;
 /// Flash budget of the Pico image: everything stored in flash
 /// (`.boot2 + .vector_table + .text + .rodata` and `.data`'s initial values).
 pub const FLASH_BUDGET: u64 = 192 * 1024;

@@ -177,6 +177,7 @@ where
 
 /// Polls `future` once: every flash operation of the boards' drivers is blocking
 /// underneath, so the store's futures complete on their first poll.
+#[inline(always)]
 fn at_once<F: Future>(future: F) -> Option<F::Output> {
     match pin!(future).poll(&mut Context::from_waker(Waker::noop())) {
         Poll::Ready(output) => Some(output),

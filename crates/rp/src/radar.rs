@@ -8,9 +8,9 @@
 //! a ring lapped or a stalled state machine is reported as lost bytes
 //! ([`idle_head_firmware::radar::Radar::receive_error`]).
 //!
-//! Invariant: the ring outlasts the longest time the alarm can be kept
-//! waiting (a `save` erasing every settings sector with the interrupts
-//! off). The program, the ring's sizing and the idle line are in the
+//! Invariant: the ring outlasts a typical `save` (every settings sector
+//! erased with the interrupts off, the alarm kept waiting); frames lost
+//! to a longer one are counted. The program, the ring's sizing and the idle line are in the
 //! book's notes on the code (`docs/design/code.md`, "The radar's
 //! receiver").
 
@@ -40,9 +40,9 @@ use crate::{PORT_PRIORITY, SYS_HZ};
 pub const BAUD: u32 = 256_000;
 /// PIO cycles a bit (the program's timing).
 const CYCLES_PER_BIT: u32 = 8;
-/// Characters the ring holds: 512 · 39 µs of back-to-back bytes, or 17
-/// of the radar's 30-byte frames (1.7 s at its ten a second).
-pub const RING: usize = 512;
+/// Characters the ring holds: 256 · 39 µs of back-to-back bytes, or eight
+/// of the radar's 30-byte frames (0.85 s at its ten a second).
+pub const RING: usize = 256;
 /// How often the alarm looks at the ring: what a byte waits at most
 /// before the decoder sees it.
 pub const POLL: Duration = Duration::from_millis(1);
@@ -56,7 +56,7 @@ const SM: usize = 0;
 const DAMAGED: u16 = 0x100;
 
 /// The ring's size as the DMA counts it: 2^10 bytes of 16-bit words.
-const RING_BITS: u8 = 10;
+const RING_BITS: u8 = 9;
 const _: () = assert!(1 << RING_BITS == RING * 2);
 
 /// The words the DMA writes, aligned to their size (the DMA's ring wraps
@@ -64,7 +64,7 @@ const _: () = assert!(1 << RING_BITS == RING * 2);
 /// it, so it needs no zeroing at reset: in a section of its own,
 /// `.radar_ring`, which the board's `memory.x` places first in RAM, where
 /// its alignment costs no padding.
-#[repr(C, align(1024))]
+#[repr(C, align(512))]
 struct Ring(UnsafeCell<MaybeUninit<[u16; RING]>>);
 
 // Note(unsafe): only the DMA writes the ring, and only the alarm's handler
