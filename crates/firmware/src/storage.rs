@@ -176,7 +176,10 @@ where
 }
 
 /// Polls `future` once: every flash operation of the boards' drivers is blocking
-/// underneath, so the store's futures complete on their first poll.
+/// underneath, so the store's futures complete on their first poll. Always
+/// inline: the future is built in its caller's frame and polled there, not
+/// copied into a frame of its own (half a kilobyte of the boot's stack).
+#[allow(clippy::inline_always)]
 #[inline(always)]
 fn at_once<F: Future>(future: F) -> Option<F::Output> {
     match pin!(future).poll(&mut Context::from_waker(Waker::noop())) {
