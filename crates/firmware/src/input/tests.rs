@@ -316,3 +316,58 @@ fn presence_from_bus_messages_wakes_and_rests_the_head_as_a_pin_would() {
     wake(&mut bus, rest.as_millis());
     assert_eq!(taken(&links), [Action::Rest]);
 }
+
+/// A resting head, as the frame task reports it.
+fn resting(task: &Task) {
+    task.links
+        .console
+        .publish(idle_head_core::console::HeadStatus {
+            mode: idle_head_core::console::HeadMode::Resting,
+            ..idle_head_core::console::HeadStatus::default()
+        });
+}
+
+/// A radar frame with somebody in it, through the receiver's link.
+fn somebody(task: &Task) {
+    use idle_head_core::Millimetres;
+    use idle_head_core::track::{Counters, Person, Sighting};
+    let mut seen = Sighting::NOBODY;
+    seen.people[0] = Some(Person {
+        x: Millimetres(0),
+        y: Millimetres(1500),
+    });
+    task.links
+        .show
+        .track
+        .publish(Some(seen), Counters::default());
+}
+
+#[test]
+fn the_radar_wakes_a_resting_head_and_only_while_it_is_on() {
+    // Off: a sighting is nobody, for the inputs.
+    let mut task = Task::new(InputSettings::DEFAULT, 0);
+    resting(&task);
+    task.wake(100, false);
+    somebody(&task);
+    task.wake(200, false);
+    assert!(
+        task.taken()
+            .iter()
+            .all(|a| !matches!(a, Action::Wake { .. }))
+    );
+    // On: the first sighting with somebody wakes the head.
+    let mut task = Task::new(InputSettings::DEFAULT, 0);
+    let mut settings = task.links.show.track.settings();
+    settings.radar = true;
+    task.links.show.track.set(settings);
+    resting(&task);
+    task.wake(100, false);
+    somebody(&task);
+    task.wake(200, false);
+    assert!(
+        task.taken()
+            .iter()
+            .any(|a| matches!(a, Action::Wake { .. })),
+        "a radar sighting wakes the head"
+    );
+}
