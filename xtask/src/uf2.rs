@@ -129,7 +129,7 @@ pub fn command(args: &Args) -> Result<bool> {
     let elf = if let Some(elf) = &args.elf {
         elf.clone()
     } else {
-        let (root, metadata) = project::prepare()?;
+        let (root, metadata) = crate::setup::prepare()?;
         args.board.image().build(&root)?;
         args.board.image().elf(&metadata)
     };
