@@ -29,7 +29,7 @@ use crate::figures::{self, thousands};
 use crate::log::{LogLine, Run, field, number};
 use crate::{
     args::Options,
-    project::{self, Image, Metadata, QEMU},
+    project::{Image, Metadata, QEMU},
     qemu::{self, Echo},
     setup,
 };
@@ -375,7 +375,7 @@ pub fn run_and_check(
 /// `cargo xtask bench`: the rows in QEMU, then the latency rows in the
 /// RP2040 emulator. `Ok(false)` when either failed.
 pub fn command(options: Options) -> Result<bool> {
-    let (root, metadata) = project::prepare()?;
+    let (root, metadata) = setup::prepare()?;
     setup::ensure_qemu()?;
     let qemu = run_and_check(&root, &metadata, options, None);
     // How the head follows people, in the host trace.

@@ -52,7 +52,7 @@ pub fn stage(root: &Path) -> Result<()> {
 
 /// `cargo xtask book`. `Ok(false)` when the build or the link check failed.
 pub fn command() -> Result<bool> {
-    let (root, _) = project::prepare()?;
+    let (root, _) = setup::prepare()?;
     match stage(&root) {
         Ok(()) => Ok(true),
         Err(error) => {

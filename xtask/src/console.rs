@@ -48,7 +48,7 @@ pub fn command(args: &Args) -> Result<bool> {
     };
     let wait = Duration::from_secs(args.wait);
     let (talk, port, ran) = if args.qemu {
-        let (root, metadata) = project::prepare()?;
+        let (root, metadata) = setup::prepare()?;
         setup::ensure_qemu()?;
         project::QEMU.build(&root)?;
         eprintln!("console: QEMU running; type commands, end with Ctrl-D");

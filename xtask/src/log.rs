@@ -3,12 +3,13 @@
 
 use std::{
     path::{Path, PathBuf},
-    process::ExitStatus,
     time::Duration,
 };
 
 use anyhow::{Context, Result};
 use defmt_decoder::{DecodeError, Frame, Locations, StreamDecoder, Table};
+
+use crate::project::Exit;
 
 /// An ELF's defmt table, and its source locations (which need debug
 /// info: without them the log still decodes).
@@ -130,15 +131,6 @@ impl LogLine {
             println!("      └─ {location}");
         }
     }
-}
-
-/// How QEMU ended.
-#[derive(Debug, Clone, Copy)]
-pub enum Exit {
-    /// QEMU exited (semihosting exit code, 0 = success).
-    Status(ExitStatus),
-    /// Killed after the timeout.
-    TimedOut(Duration),
 }
 
 /// The outcome of one QEMU run.

@@ -51,7 +51,7 @@ pub struct Args {
 pub fn command(args: &Args) -> Result<bool> {
     let root = project::root();
     if args.test {
-        let (root, metadata) = project::prepare()?;
+        let (root, metadata) = setup::prepare()?;
         println!("{}", browser::stage(&root, &metadata)?);
         return Ok(true);
     }
@@ -62,11 +62,11 @@ pub fn command(args: &Args) -> Result<bool> {
         return Ok(true);
     }
     let bridge = if args.sim {
-        let (root, metadata) = project::prepare()?;
+        let (root, metadata) = setup::prepare()?;
         project::PICO.build(&root)?;
         Some(Bridge::sim(&root, &project::PICO.elf(&metadata))?)
     } else if args.qemu {
-        let (root, metadata) = project::prepare()?;
+        let (root, metadata) = setup::prepare()?;
         setup::ensure_qemu()?;
         project::QEMU.build(&root)?;
         Some(Bridge::qemu(&project::QEMU.elf(&metadata))?)

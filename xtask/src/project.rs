@@ -4,7 +4,7 @@
 
 use std::{
     path::{Path, PathBuf},
-    process::{Child, ChildStderr, ChildStdout},
+    process::{Child, ChildStderr, ChildStdout, ExitStatus},
     thread,
     time::Duration,
 };
@@ -13,8 +13,6 @@ use anyhow::{Context, Result, anyhow, bail};
 use cargo_metadata::MetadataCommand;
 use wait_timeout::ChildExt;
 use xshell::{Cmd, Shell, cmd};
-
-use crate::log::Exit;
 
 /// The firmware's compilation target (ARMv6-M: RP2040's Cortex-M0+, QEMU's Cortex-M0).
 pub const TARGET: &str = "thumbv6m-none-eabi";
@@ -38,15 +36,6 @@ pub fn relative(path: &Path) -> PathBuf {
     path.strip_prefix(root()).unwrap_or(path).to_path_buf()
 }
 
-/// What a command that builds starts from: the toolchain made complete
-/// (`setup::ensure_toolchain`), the repository root and cargo's metadata.
-pub fn prepare() -> Result<(PathBuf, Metadata)> {
-    let root = root();
-    crate::setup::ensure_toolchain(&root)?;
-    let metadata = metadata(&root)?;
-    Ok((root, metadata))
-}
-
 /// A shell whose commands run in `dir`, relative to the repository root.
 pub fn shell(dir: &str) -> Result<Shell> {
     let sh = Shell::new()?;
@@ -67,6 +56,15 @@ pub fn run(sh: &Shell, env: &[(&str, &str)], cmd: Cmd<'_>) -> Result<()> {
     eprintln!("$ {line}");
     let cmd = cmd.envs(env.iter().copied()).quiet();
     cmd.run().map_err(|error| anyhow!("{error}"))
+}
+
+/// How a child process ended ([`finish`]).
+#[derive(Debug, Clone, Copy)]
+pub enum Exit {
+    /// QEMU exited (semihosting exit code, 0 = success).
+    Status(ExitStatus),
+    /// Killed after the timeout.
+    TimedOut(Duration),
 }
 
 /// What a child left behind ([`finish`]).

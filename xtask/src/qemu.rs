@@ -22,7 +22,7 @@ use crate::{
 
 /// `cargo xtask qemu`: build, run, show. `Ok(false)` when the run failed.
 pub fn command(options: Options) -> Result<bool> {
-    let (root, metadata) = project::prepare()?;
+    let (root, metadata) = setup::prepare()?;
     setup::ensure_qemu()?;
     QEMU.build(&root)?;
     let run = run(&QEMU.elf(&metadata), options.timeout, Echo::All)?;

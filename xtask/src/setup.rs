@@ -13,6 +13,15 @@ use crate::{board::PICO2_TARGET, project};
 /// QEMU's system emulator for Arm.
 pub const QEMU_BINARY: &str = "qemu-system-arm";
 
+/// What a command that builds starts from: the toolchain made complete
+/// ([`ensure_toolchain`]), the repository root and cargo's metadata.
+pub fn prepare() -> Result<(PathBuf, project::Metadata)> {
+    let root = project::root();
+    ensure_toolchain(&root)?;
+    let metadata = project::metadata(&root)?;
+    Ok((root, metadata))
+}
+
 /// Adds the firmware targets, rustfmt and clippy to the toolchain the
 /// repository uses (the one named by `rust-toolchain.toml`, so rustup runs in
 /// the repository root). Without rustup, a toolchain installed some other

@@ -200,7 +200,7 @@ fn seconds(value: &str, max: f64) -> Result<Duration, String> {
 
 /// `cargo xtask sim`. `Ok(false)` when a check failed.
 pub fn command(args: &Args) -> Result<bool> {
-    let (root, metadata) = project::prepare()?;
+    let (root, metadata) = crate::setup::prepare()?;
     let (root, md) = (root.as_path(), &metadata);
     PICO.build(root)?;
     if let Some(path) = &args.script {

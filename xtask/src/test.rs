@@ -102,7 +102,7 @@ impl Stages<'_> {
 /// `Ok(false)` when a stage failed.
 pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     let start = Instant::now();
-    let (root, metadata) = project::prepare()?;
+    let (root, metadata) = setup::prepare()?;
     let sh = project::shell(".")?;
     let host_tests = project::shell("host-tests")?;
     let core = project::shell("crates/core")?;

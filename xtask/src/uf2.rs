@@ -5,12 +5,14 @@
 //! Every emulator run of the Pico image boots from the UF2 written here
 //! (`sim/harness.mjs` lays its blocks into flash): that is its test.
 
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use elf2flash_core::boards::{BoardInfo, RP2040, RP2350};
+use object::{Object, ObjectSection};
 
-use crate::{board::Board, elf, pico2, project};
+use crate::{board::Board, elf, project};
 
 /// `cargo xtask uf2`.
 #[derive(Debug, clap::Args)]
@@ -23,6 +25,9 @@ pub struct Args {
     #[arg(value_name = "ELF")]
     pub elf: Option<PathBuf>,
 }
+
+/// A block's first and last words (`PICOBIN_BLOCK_MARKER_START`, `_END`).
+const MARKERS: (u32, u32) = (0xffff_ded3, 0xab12_3579);
 
 /// Size of a UF2 block; each carries one 256-byte flash page.
 const BLOCK: usize = 512;
@@ -55,8 +60,40 @@ pub fn check_boot(data: &[u8], board: Board) -> Result<()> {
         Board::Pico => elf::Image::parse(data)
             .context("parsing the ELF")?
             .check_boot2(),
-        Board::Pico2 => pico2::start_block(data).map(|_| ()),
+        Board::Pico2 => start_block(data).map(|_| ()),
     }
+}
+
+/// The addresses of the `.start_block` section of the ELF `data`, checked:
+/// inside the first 4 KiB of flash, where the boot ROM searches, opening
+/// and closing with the block markers.
+pub fn start_block(data: &[u8]) -> Result<Range<u64>> {
+    let file = object::File::parse(data).context("parsing the ELF")?;
+    let section = file.section_by_name(".start_block").context(
+        "no `.start_block` section: the RP2350 boot ROM would not find the image (does memory.x \
+         place `.start_block`, and does embassy-rp link its IMAGE_DEF?)",
+    )?;
+    let range = section.address()..section.address() + section.size();
+    let search = elf::XIP.start..elf::XIP.start + 0x1000;
+    if range.start < search.start || range.end > search.end {
+        bail!(
+            "`.start_block` is at {range:#010x?}, outside the first 4 KiB of flash where the boot \
+             ROM searches"
+        );
+    }
+    let bytes = section.data().context("reading `.start_block`")?;
+    let word = |at: usize| Some(u32::from_le_bytes(bytes.get(at..at + 4)?.try_into().ok()?));
+    let last = bytes.len().checked_sub(4).and_then(word);
+    if word(0) != Some(MARKERS.0) || last != Some(MARKERS.1) {
+        bail!(
+            "`.start_block` ({} B) does not open with {:#010x} and close with {:#010x}: not a \
+             block the boot ROM reads",
+            bytes.len(),
+            MARKERS.0,
+            MARKERS.1
+        );
+    }
+    Ok(range)
 }
 
 /// Makes the UF2 of the ELF at `elf` and writes it beside it (`…/pico` →
@@ -92,7 +129,7 @@ pub fn command(args: &Args) -> Result<bool> {
     let elf = if let Some(elf) = &args.elf {
         elf.clone()
     } else {
-        let (root, metadata) = project::prepare()?;
+        let (root, metadata) = crate::setup::prepare()?;
         args.board.image().build(&root)?;
         args.board.image().elf(&metadata)
     };

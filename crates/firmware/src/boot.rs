@@ -25,9 +25,9 @@ use idle_head_core::behaviour::{BehaviourParams, CommandQueue, ShowLink};
 use idle_head_core::console::{BoardParts, ConsoleLink, ConsoleService};
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::driver::DriverParams;
-use idle_head_core::motion::{DEFAULT_HEAD, HeadConfig};
+use idle_head_core::motion::HeadConfig;
 use idle_head_core::seed::BoardId;
-use idle_head_core::settings::{Settings, SettingsSource, SettingsStorage, Validated};
+use idle_head_core::settings::SettingsStorage;
 use portable_atomic::AtomicU32;
 use static_cell::ConstStaticCell;
 
@@ -37,6 +37,7 @@ use crate::exchange::{Exchange, FirstSet};
 use crate::log;
 use crate::radar::Radar;
 use crate::storage::FlashBusy;
+pub use crate::storage::Loaded;
 
 /// What the firmware's tasks share: one of these lives in [`LINKS`], and
 /// each task is handed the part it needs (a host test makes its own).
@@ -97,42 +98,6 @@ pub static FLASH_BUSY: FlashBusy = FlashBusy::new();
 /// The two loop set buffers, 2 · 5.4 KB: one plays while the generator
 /// fills the other. All zero (the neutral pose) until generated.
 static SETS: ConstStaticCell<[Set; 2]> = ConstStaticCell::new([Set::new(), Set::new()]);
-
-/// The settings a board boots with, and the storage the console saves to.
-pub struct Loaded<S> {
-    /// The console's storage.
-    pub storage: S,
-    /// The settings in effect.
-    pub settings: Settings,
-    /// Where they came from.
-    pub source: SettingsSource,
-    /// Their parameters for the driver and the behaviour.
-    pub valid: Validated,
-}
-
-impl<S> Loaded<S> {
-    /// The built-in settings, with `storage` for the console's `save`.
-    pub const fn defaults(storage: S) -> Self {
-        Self {
-            storage,
-            settings: Settings::DEFAULT,
-            source: SettingsSource::Defaults,
-            valid: Validated::DEFAULT,
-        }
-    }
-
-    /// The idle motion's configuration with these settings' seeds on a
-    /// board of `id` (see `idle_head_core::seed`).
-    #[must_use]
-    pub const fn head(&self, id: BoardId) -> HeadConfig {
-        let seeds = self.settings.idle_seeds(id);
-        let mut head = DEFAULT_HEAD;
-        head.pitch.seed = seeds[0];
-        head.roll.seed = seeds[1];
-        head.yaw.seed = seeds[2];
-        head
-    }
-}
 
 /// How a board times the boot precompute, and in what unit it logs it.
 pub trait Stopwatch {

@@ -22,6 +22,8 @@ use core::task::{Context, Poll, Waker};
 use embassy_time::Duration;
 use embedded_storage_async::nor_flash::NorFlash;
 use idle_head_core::driver::DriverConfig;
+use idle_head_core::motion::{DEFAULT_HEAD, HeadConfig};
+use idle_head_core::seed::BoardId;
 use idle_head_core::settings::{
     FlashFailed, Loaded as Stored, Record, SETTINGS_BUFFER, SectorWise, Settings, SettingsError,
     SettingsSource, SettingsStorage, SettingsStore, StorageError, Validated,
@@ -29,12 +31,47 @@ use idle_head_core::settings::{
 
 use static_cell::StaticCell;
 
-use crate::boot::Loaded;
 use crate::log::{self, Loggable};
 
 /// The watchdog timeout the frames feed while a flash operation is under
 /// way: a 400 ms sector erase, with a wide margin.
 pub const FLASH_WATCHDOG_MS: u64 = 1000;
+
+/// The settings a board boots with, and the storage the console saves to.
+pub struct Loaded<S> {
+    /// The console's storage.
+    pub storage: S,
+    /// The settings in effect.
+    pub settings: Settings,
+    /// Where they came from.
+    pub source: SettingsSource,
+    /// Their parameters for the driver and the behaviour.
+    pub valid: Validated,
+}
+
+impl<S> Loaded<S> {
+    /// The built-in settings, with `storage` for the console's `save`.
+    pub const fn defaults(storage: S) -> Self {
+        Self {
+            storage,
+            settings: Settings::DEFAULT,
+            source: SettingsSource::Defaults,
+            valid: Validated::DEFAULT,
+        }
+    }
+
+    /// The idle motion's configuration with these settings' seeds on a
+    /// board of `id` (see `idle_head_core::seed`).
+    #[must_use]
+    pub const fn head(&self, id: BoardId) -> HeadConfig {
+        let seeds = self.settings.idle_seeds(id);
+        let mut head = DEFAULT_HEAD;
+        head.pitch.seed = seeds[0];
+        head.roll.seed = seeds[1];
+        head.yaw.seed = seeds[2];
+        head
+    }
+}
 
 /// Whether `save` or `load` uses the flash: while it does, the frames
 /// feed the watchdog with [`FLASH_WATCHDOG_MS`] (see the [module

@@ -5,6 +5,7 @@
 //! each is), `<out>/<stem>.png` the stages as panels in the style of the
 //! paper's Figures 6 and 7.
 
+mod figure;
 mod stages;
 
 use std::path::PathBuf;
@@ -17,7 +18,7 @@ use idle_head_core::{
 
 use crate::{args::LoopShape, project};
 use stages::LoopSpec;
-pub use stages::{Stages, closure_name, deg};
+pub use stages::{Stages, closure_name};
 
 /// Options of `cargo xtask preview` (its help text is in `cli.rs`).
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
@@ -143,7 +144,7 @@ pub fn command(args: &Args) -> Result<bool> {
             out.join(format!("{stem}.png")),
         );
         std::fs::write(&csv, stages.csv()).with_context(|| format!("writing {}", csv.display()))?;
-        crate::plot::stages(&stages, &png)?;
+        figure::draw(&stages, &png)?;
         println!("{}", stages.title());
         for line in &stages.metric_lines() {
             println!("  {line}");

@@ -14,8 +14,6 @@ use crate::{board::Board, elf::XIP, uf2};
 
 /// Where boot2 leaves the vector table: right behind its own 256 bytes.
 pub const VECTOR_TABLE: u64 = XIP.start + 0x100;
-/// What cortex-m-rt's `paint-stack` fills the stack with before `main`.
-pub const STACK_PAINT: u32 = 0xcccc_cccc;
 
 /// The servos as wired on the Pico (`crates/rp/src/pico.rs`): name, GPIO,
 /// PWM slice (channel A).

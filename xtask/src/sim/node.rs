@@ -14,7 +14,7 @@ use serde_json::Value;
 use xshell::{Shell, cmd};
 
 use super::event::Event;
-use crate::{log::Exit, project, setup};
+use crate::{project, project::Exit, setup};
 
 /// The folder with the harness and its `package.json`.
 pub fn folder(root: &Path) -> PathBuf {
@@ -218,6 +218,10 @@ impl UartScript {
     }
 }
 
+/// What cortex-m-rt's `paint-stack` fills the stack with before `main`
+/// (the harness reads the stack's depth from what is left of it).
+pub const STACK_PAINT: u32 = 0xcccc_cccc;
+
 /// One byte at 115200 baud, 8N1: 10 bits.
 pub const BYTE_TIME: Duration = Duration::from_nanos(1_000_000_000 * 10 / 115_200);
 
@@ -225,7 +229,7 @@ impl Config {
     /// The harness's configuration, as JSON.
     pub fn json(&self) -> Value {
         let mut json = serde_json::to_value(self).unwrap_or_default();
-        json["paint"] = super::image::STACK_PAINT.into();
+        json["paint"] = STACK_PAINT.into();
         for key in ["script", "stream"] {
             if json[key].is_object() {
                 json[key]["byte_ns"] = nanos(BYTE_TIME).into();

@@ -22,18 +22,17 @@ use std::time::Duration;
 use anyhow::{Context, Result, anyhow, bail};
 use idle_head_core::seed::BoardId;
 use idle_head_core::servo::ServoRate;
-use serde_json::{Value, json};
 
 use super::image::SERVOS;
 use super::node::Chunk;
-use super::node::{PinScript, nanos};
+use super::node::PinScript;
 use super::pulses::angle;
 use super::run::{self, Boot};
-use super::script::{self, Against, Board, EARLY};
+use super::script::{self, Against, Board, EARLY, line};
 use super::{WALL, dmx, stages::shipped_image, stream};
 use crate::bench::tracking::{self, Walk};
 use crate::project::Metadata;
-use crate::trace::{Event, Kind, radar::PERIOD_US};
+use crate::trace::{Event, Kind};
 
 /// Stage names.
 pub const RADAR_STAGE: &str = "Pico image in the RP2040 emulator: a radar walk on GP13 is \
@@ -44,36 +43,8 @@ pub const RADAR_DMX_STAGE: &str = "Pico image in the RP2040 emulator: DMX512 on 
      radar on GP13 at once: every frame of both counted, none lost; a flash erase loses no radar \
      frame";
 
-/// The LD2450's line rate.
-const BAUD: u32 = 256_000;
 /// Two boards' flash unique ids (as a W25Q16JV reports them).
 const BOARDS: [u64; 2] = [0xe661_4103_e745_2d2f, 0xe661_4103_e72b_8a21];
-
-/// The harness's `radar` for the radar lines of `events` (none: no radar
-/// wired), its frames from the script's time 0 to `time`, each in
-/// [`EARLY`] before the first servo frame at `rate` at or after its time.
-pub fn line(events: &[Event], rate: ServoRate, time: Duration) -> Option<Value> {
-    let lines: Vec<Value> = events
-        .iter()
-        .filter_map(|e| match e.kind {
-            Kind::Radar(people) => Some(json!({
-                "at_ns": e.at_us * 1000,
-                "people": people.map(|p| p.map(|(x, y)| [x, y])),
-            })),
-            _ => None,
-        })
-        .collect();
-    (!lines.is_empty()).then(|| {
-        json!({
-            "baud": BAUD,
-            "period_ns": PERIOD_US * 1000,
-            "frame_ns": u64::from(rate.period().0) * 1000,
-            "early_ns": nanos(EARLY),
-            "end_ns": nanos(time),
-            "lines": lines,
-        })
-    })
-}
 
 /// `--radar FILE`: its radar lines, after `radar on` at 0.
 pub fn read(path: &Path) -> Result<Vec<Event>> {
@@ -355,6 +326,7 @@ fn erase(root: &Path, elf: &Path) -> Result<Vec<String>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::json;
 
     #[test]
     fn radar_lines_become_the_harness_radar_and_others_do_not() {

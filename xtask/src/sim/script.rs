@@ -10,21 +10,25 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
+use serde_json::{Value, json};
 
 use idle_head_core::seed::BoardId;
 use idle_head_core::servo::ServoRate;
 use idle_head_core::settings::Settings;
 
 use super::image::{SERVOS, input_pins};
-use super::node::{Chunk, Fill, PinLevel, PinScript};
+use super::node::{Chunk, Fill, PinLevel, PinScript, nanos};
 use super::run::{self, Report};
 use super::{planted, pulses_csv};
 use crate::elf;
 use crate::project::{Metadata, PICO};
-use crate::trace::{self, Event, Kind};
+use crate::trace::{self, Event, Kind, radar::PERIOD_US};
 
 /// How much before its time a console line (or a radar frame) is in.
 pub const EARLY: Duration = Duration::from_millis(2);
+
+/// The radar's (an LD2450's) line rate.
+const BAUD: u32 = 256_000;
 
 /// The first frame a console line is taken at: the board's console reads
 /// its UART once the boot's work (the first loop sets) is done, some 40 ms
@@ -127,7 +131,7 @@ pub fn play(
             Kind::Radar(_) => {}
         }
     }
-    let radar = super::radar::line(&events, rate, time);
+    let radar = line(&events, rate, time);
     let planted = if rate == ServoRate::DEFAULT {
         None
     } else {
@@ -236,6 +240,32 @@ pub fn command(
         println!("wrote {} ({rows} frames)", path.display());
     }
     Ok(report.problems.is_empty())
+}
+
+/// The harness's `radar` for the radar lines of `events` (none: no radar
+/// wired), its frames from the script's time 0 to `time`, each in
+/// [`EARLY`] before the first servo frame at `rate` at or after its time.
+pub fn line(events: &[Event], rate: ServoRate, time: Duration) -> Option<Value> {
+    let lines: Vec<Value> = events
+        .iter()
+        .filter_map(|e| match e.kind {
+            Kind::Radar(people) => Some(json!({
+                "at_ns": e.at_us * 1000,
+                "people": people.map(|p| p.map(|(x, y)| [x, y])),
+            })),
+            _ => None,
+        })
+        .collect();
+    (!lines.is_empty()).then(|| {
+        json!({
+            "baud": BAUD,
+            "period_ns": PERIOD_US * 1000,
+            "frame_ns": u64::from(rate.period().0) * 1000,
+            "early_ns": nanos(EARLY),
+            "end_ns": nanos(time),
+            "lines": lines,
+        })
+    })
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! [`LimitMode`]s an axis is driven with.
 
 use crate::axis::Axis;
-use crate::driver::{MotionLimits, SlewRates};
+use crate::driver::{MotionLimits, SlewRates, slew_rates};
 use crate::units::{Angle, AngleRange, Microseconds, Millis, Percent};
 
 use super::config::{BehaviourConfig, LiveConfig};
@@ -93,8 +93,7 @@ impl BehaviourParams {
             return;
         }
         self.frame_us = period.0;
-        self.rates =
-            super::validate::mode_rates(&self.idle_limits, &self.config.gesture_limits, period);
+        self.rates = mode_rates(&self.idle_limits, &self.config.gesture_limits, period);
     }
 
     /// The driver's neutral pose, `[pitch, roll, yaw]`: the gaze's centre.
@@ -245,4 +244,30 @@ pub(super) const fn rest_offsets(
         i += 1;
     }
     (offsets, clamped)
+}
+
+/// The per-frame rates of both modes' limits, `[idle, gesture]` per axis,
+/// at the frame period `period` (`None` where the driver refuses them).
+pub(super) const fn mode_rates(
+    idle: &[MotionLimits; 3],
+    gesture: &[MotionLimits; 3],
+    period: Microseconds,
+) -> [[Option<SlewRates>; 2]; 3] {
+    let mut rates = [[None; 2]; 3];
+    let mut i = 0;
+    while i < 3 {
+        let axis = Axis::ALL[i];
+        rates[i] = [
+            match slew_rates(axis, idle[i], period) {
+                Ok(r) => Some(r),
+                Err(_) => None,
+            },
+            match slew_rates(axis, gesture[i], period) {
+                Ok(r) => Some(r),
+                Err(_) => None,
+            },
+        ];
+        i += 1;
+    }
+    rates
 }

@@ -11,15 +11,15 @@ use const_format::concatcp;
 
 use crate::axis::Axis;
 use crate::command::{GestureRequest, Hold};
-use crate::driver::{DriverParams, MotionLimits, SlewRates, slew_rates};
+use crate::driver::DriverParams;
 use crate::gestures::{GestureKind, MAX_CYCLES};
-use crate::units::{Angle, AngleRange, Microseconds, Percent};
+use crate::units::{Angle, AngleRange, Percent};
 
 use super::config::{BehaviourConfig, MAX_HOLD};
 use super::error::BehaviourError;
 use super::fixed::{MAX_SPAN, Span};
 use super::gesture;
-use super::params::{BehaviourParams, q16, room_around};
+use super::params::{BehaviourParams, mode_rates, q16, room_around};
 
 const fn min(a: i64, b: i64) -> i64 {
     if a < b { a } else { b }
@@ -247,29 +247,3 @@ const _: () = match crate::driver::DriverConfig::DEFAULT.build() {
     Ok(driver) => BehaviourConfig::DEFAULT.assert_valid(&driver),
     Err(e) => panic!("{}", e.message()),
 };
-
-/// The per-frame rates of both modes' limits, `[idle, gesture]` per axis,
-/// at the frame period `period` (`None` where the driver refuses them).
-pub(super) const fn mode_rates(
-    idle: &[MotionLimits; 3],
-    gesture: &[MotionLimits; 3],
-    period: Microseconds,
-) -> [[Option<SlewRates>; 2]; 3] {
-    let mut rates = [[None; 2]; 3];
-    let mut i = 0;
-    while i < 3 {
-        let axis = Axis::ALL[i];
-        rates[i] = [
-            match slew_rates(axis, idle[i], period) {
-                Ok(r) => Some(r),
-                Err(_) => None,
-            },
-            match slew_rates(axis, gesture[i], period) {
-                Ok(r) => Some(r),
-                Err(_) => None,
-            },
-        ];
-        i += 1;
-    }
-    rates
-}
