@@ -23,25 +23,11 @@
 //! then exits 0, or 1 if any invariant failed (each failure is logged as an
 //! error first). The checksum is compared with the host's by `cargo xtask`.
 //!
-//! # Time compression
-//!
-//! Idle time is not free under `-icount shift=0`: QEMU either lets the
-//! virtual clock follow the wall clock while the core sleeps (the default,
-//! `sleep=on`) or jumps it (`sleep=off`). To keep the run short either way
-//! the smoke build plays its frames [`SPEEDUP`] = 20 times faster: one every
-//! 1 ms instead of 20 ms, a 1.5 s loop instead of 30 s. Everything else is
-//! the Pico's configuration as it is, driver and behaviour alike, whose
-//! per-frame quantities (loop position, fade gain, step and acceleration
-//! limits of the idle and gesture modes, gesture and gaze timing, fault
-//! counts) all derive from the Pico's 20 ms frame period: frame `k` here
-//! writes the same pulses as frame `k` on the board, and only the wall clock
-//! between frames is shorter. The virtual PWM keeps the 50 Hz servo period. The whole run is
-//! about 1.9 s of virtual time.
-//!
-//! # Priorities
-//!
-//! As on the Pico, the frame task runs above the loop generator and the
-//! console (see `executor.rs`).
+//! The frames come [`SPEEDUP`] = 20 times faster than on the board (idle
+//! time is not free under `-icount`): one every 1 ms, with the Pico's
+//! configuration as it is, so frame `k` writes the pulses frame `k` writes
+//! on the board. As on the Pico, the frame task runs above the loop
+//! generator and the console (`executor.rs`).
 #![no_std]
 #![no_main]
 
