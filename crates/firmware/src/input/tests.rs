@@ -371,3 +371,26 @@ fn the_radar_wakes_a_resting_head_and_only_while_it_is_on() {
         "a radar sighting wakes the head"
     );
 }
+
+#[test]
+fn a_button_bound_to_a_look_by_the_console_runs_that_look_at_its_press() {
+    use idle_head_core::command::Command;
+    let line = b"input 2 button look 0 3000 60 hold=stay";
+    let Ok(Command::Input {
+        input: 2,
+        role: Some(role @ InputRole::Button(look @ Action::Look(_))),
+    }) = idle_head_core::console::parse(line)
+    else {
+        panic!("`input 2 button look 0 3000 60 hold=stay` is a button running a look")
+    };
+    let mut roles = [InputRole::Off; SLOTS];
+    roles[0] = role;
+    let settings = InputSettings {
+        roles,
+        rest_after: RestAfter::Seconds(120),
+    };
+    let mut task = Task::new(settings, RELEASED);
+    assert!(task.taken().is_empty());
+    task.set(1000, PRESSED);
+    assert_eq!(task.taken(), [look], "the press runs the look at once");
+}
