@@ -94,7 +94,7 @@ fn a_scripted_nod_moves_pitch_only_and_answers() {
     assert_eq!(nodding.marks.len(), 1);
     assert_eq!(
         nodding.marks[0].reply,
-        "ok nod 6000 mdeg 2 cycles 800 ms intensity 50"
+        "ok nod amp_mdeg=6000 ms=800 cycles=2 intensity=50"
     );
     let frame = |t: &Trace, k: usize| t.rows[k].angles;
     for k in 0..300 {
@@ -166,7 +166,7 @@ fn a_presence_script_rests_relaxes_wakes_and_glances() {
         .unwrap();
     assert_eq!(
         (wake.t_ms, wake.reply.as_str()),
-        (12_060, "ok wake 1000 ms")
+        (12_060, "ok wake ms=1000")
     );
 }
 
@@ -177,7 +177,11 @@ fn a_button_runs_its_action_within_a_frame_of_its_edge() {
     // Pressed at 3 s (the press counts at its edge), taken by the frame
     // due then, which is already a step into the nod.
     assert_eq!(nod.t_ms, 3000);
-    assert!(nod.reply.starts_with("ok nod 6000 mdeg"), "{}", nod.reply);
+    assert!(
+        nod.reply.starts_with("ok nod amp_mdeg=6000 "),
+        "{}",
+        nod.reply
+    );
     let idle = run("", 5);
     let first = (150..250).find(|&k| trace.rows[k].angles[0] != idle.rows[k].angles[0]);
     assert_eq!(first, Some(150));
