@@ -4,8 +4,8 @@
 //! direct-form f32 smoothing) and `frame bench [rate=…] [scenario=…]
 //! frames=… min=… median=… max=… max_at=… mean=…` (one frame update over a
 //! whole loop, idle and with a gesture and a look, at 50 and 333 Hz); this
-//! module prints them and holds the default row to its [`BUDGET`] and each
-//! frame row to its ceiling. Then the latency rows (`latency.rs`).
+//! module holds the default row to its [`BUDGET`] and each frame row to its
+//! ceiling. Then the tracking figures and the latency rows.
 
 // Instruction counts are far below 2^52 and positive: the float conversions are exact.
 #![allow(
@@ -20,10 +20,10 @@ use anyhow::{Context, Result, bail};
 
 pub mod latency;
 mod paths;
-
-pub use latency::stage as latency_stage;
 mod telemetry;
 pub mod tracking;
+
+pub use latency::stage as latency_stage;
 
 use crate::figures::{self, thousands};
 use crate::log::{LogLine, Run, field, number};
@@ -37,10 +37,9 @@ use crate::{
 /// The benchmark image: bin `bench` of the QEMU package (`boards/qemu/src/bench.rs`).
 pub const BENCH: Image = Image::qemu("bench");
 
-/// The budget for the default set (three axes, N = 900, W = 59) at boot:
-/// 150,000 instructions, about 1.2 ms on a 125 MHz RP2040. The count is a
-/// property of the compiler as much as of the code, which is why
-/// rust-toolchain.toml pins the toolchain.
+/// The default set's budget (three axes, N = 900, W = 59) at boot, about
+/// 1.2 ms on a 125 MHz RP2040. The count depends on the compiler as much as
+/// on the code: rust-toolchain.toml pins the toolchain.
 pub const BUDGET: u64 = 150_000;
 
 /// The name of the benchmark's stage in `cargo xtask test`.
@@ -53,22 +52,30 @@ pub const LATENCY_STAGE: &str = "latency in the RP2040 emulator: at 50 Hz a look
      UART0, an input edge, DMX and a Bottango curve each on the servos within 25 ms at p99, at \
      200 Hz a look over UART0 within 8 ms; no port task waits more than 1 ms for the CPU";
 
-/// RP2040 system clock (Hz) the time column assumes: 125 MHz, the Pico's default.
+/// The Pico's default system clock, Hz, which the time columns assume.
 const RP2040_HZ: f64 = 125e6;
 
 /// The rows the image must report: the default, across W (N = 900), across N (W = 59).
 const LABELS: [&str; 7] = ["default", "w15", "w59", "w239", "n450", "n900", "n1800"];
 
 /// Largest max/min engine count over the W rows still called flat: the
-/// engine's smoother is O(N) whatever W is, only the O(W) kernel table and
-/// wrap correction grow with W (the direct form grows 16× from W = 15 to 239).
+/// engine's smoother is O(N) whatever W is (the direct form grows 16× from
+/// W = 15 to 239).
 const FLAT_LIMIT: f64 = 1.5;
 
 /// How far the marginal cost per sample may change between N = 450..900 and
-/// N = 900..1800 (as a ratio) and still be called linear. The plain ratio
-/// n1800/n450 is 4 only without a fixed cost (kernel table, wrap correction,
-/// call overhead), which pulls it below 4; the marginal cost ignores that.
+/// 900..1800 (as a ratio) and still be called linear; the plain ratio
+/// n1800/n450 is pulled below 4 by the fixed cost.
 const MARGINAL_TOLERANCE: f64 = 0.1;
+
+/// The numbers `keys` of the log line `message`.
+fn numbers<const N: usize>(message: &str, keys: [&str; N]) -> Result<[u64; N]> {
+    let mut out = [0; N];
+    for (value, key) in out.iter_mut().zip(keys) {
+        *value = number(message, key)?;
+    }
+    Ok(out)
+}
 
 /// One `bench row=...` line: instructions of the engine (three axes, the
 /// whole pipeline) and of the direct-form f32 smoothing (three axes).
@@ -86,32 +93,28 @@ pub fn rows(log: &[LogLine]) -> Result<Vec<Row>> {
     let rows = log.iter().filter(|l| l.message.starts_with("bench "));
     let row = |m: &str| -> Result<Row> {
         let label = field(m, "row").with_context(|| format!("`{m}` has no `row=`"))?;
-        let [n, w, engine, direct] = ["n", "w", "engine", "direct"].map(|key| number(m, key));
+        let [n, w, engine, direct] = numbers(m, ["n", "w", "engine", "direct"])?;
         let label = label.to_owned();
         Ok(Row {
             label,
-            n: n?,
-            w: w?,
-            engine: engine?,
-            direct: direct?,
+            n,
+            w,
+            engine,
+            direct,
         })
     };
     rows.map(|line| row(&line.message)).collect()
 }
 
-/// What the rows say: the budget, flatness in W and linearity in N.
+/// What the rows say: the `default` row's engine count; max/min over the W
+/// rows; n1800/n450 (4 if proportional to N); the marginal cost per unit of
+/// N from 450 to 900 and from 900 to 1800; the fixed cost this implies.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Verdict {
-    /// Engine instructions of the `default` row.
     pub default: u64,
-    /// max/min of the engine counts over the W rows.
     pub flatness: f64,
-    /// engine(n1800) / engine(n450): 4 if the cost is proportional to N.
     pub linearity: f64,
-    /// Marginal engine instructions per unit of N (three axes) from N = 450
-    /// to 900 and from 900 to 1800.
     pub marginal: [f64; 2],
-    /// The fixed cost this implies: engine(n450) − 450 × the first marginal cost.
     pub fixed: f64,
 }
 
@@ -142,8 +145,7 @@ impl Verdict {
         self.flatness <= FLAT_LIMIT
     }
 
-    /// The engine count grows linearly with N: the same marginal cost per
-    /// sample over both steps of N.
+    /// The same marginal cost per sample over both steps of N.
     pub fn linear(&self) -> bool {
         let [a, b] = self.marginal;
         a > 0.0 && b > 0.0 && (b / a - 1.0).abs() <= MARGINAL_TOLERANCE
@@ -174,26 +176,22 @@ impl Verdict {
     }
 }
 
-/// The frame rows the image must report at every one of [`RATES`] (Hz):
-/// by scenario, and their ceilings on the median and the max. Idle:
-/// playback, fade, limits, mapping and PWM writes of three servos, 1,200 at
-/// the median (about 10 µs on a 125 MHz RP2040). With a gesture and a look
-/// playing, the mixer's gesture shape and the gaze's minimum-jerk moves are
-/// evaluated afresh every frame: 2,000 at the median. The costliest frame
-/// of either stays within 4,000.
+/// The frame rows the image must report at every one of [`RATES`] (Hz), by
+/// scenario, with their ceilings on the median and the max. Idle (playback,
+/// fade, limits, mapping, three PWM writes): 1,200 at the median, about
+/// 10 µs on a 125 MHz RP2040. With a gesture and a look, whose shapes are
+/// evaluated afresh every frame: 2,000. The costliest frame: 4,000.
 pub const CEILINGS: [(Option<&str>, [u64; 2]); 2] =
     [(None, [1200, 4000]), (Some("gesture+look"), [2000, 4000])];
 pub const RATES: [u64; 2] = [50, 333];
-/// The idle frame's median ceiling at 333 Hz: 1,300, over the 1,200 of the
-/// other rates. The duty is counted from the exact angle (so that a look's
-/// first 5 ms frame at 200 Hz, 16 mdeg, reaches the pulse), besides the
-/// whole-µs pulse the reports show: about 45 instructions a servo more.
-/// At 333 Hz, 1,300 instructions are 0.35 % of a frame's 375,375 cycles.
+/// The idle median's ceiling at 333 Hz: the duty is counted from the exact
+/// angle (so that a look's first 5 ms frame at 200 Hz, 16 mdeg, reaches the
+/// pulse), about 45 instructions a servo more; 0.35 % of a 333 Hz frame.
 pub const IDLE_MEDIAN_AT_333_HZ: u64 = 1300;
 
-/// A `frame bench ...` line: instructions per frame update over a loop, at
-/// the servo rate `rate` (Hz; 50 in a log without `rate=`), with
-/// `scenario` playing besides the idle loops (if any).
+/// A `frame bench ...` line: instructions per frame update over a loop at
+/// the servo rate `rate` (Hz; 50 in a log without `rate=`), with `scenario`
+/// playing over the idle (if any); `max_at` is the frame that took `max`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FrameRow {
     pub rate: u64,
@@ -202,7 +200,6 @@ pub struct FrameRow {
     pub min: u64,
     pub median: u64,
     pub max: u64,
-    /// The frame that took `max`.
     pub max_at: u64,
     pub mean: u64,
 }
@@ -215,38 +212,31 @@ impl FrameRow {
             .iter()
             .filter_map(|l| l.message.strip_prefix("frame bench "));
         let row = |m: &str| -> Result<Self> {
-            let [frames, min, median, max, max_at, mean] =
-                ["frames", "min", "median", "max", "max_at", "mean"].map(|key| number(m, key));
+            let keys = ["frames", "min", "median", "max", "max_at", "mean"];
+            let [frames, min, median, max, max_at, mean] = numbers(m, keys)?;
+            let rate = field(m, "rate").map_or(Ok(50), |_| number(m, "rate"))?;
+            let scenario = field(m, "scenario").map(str::to_owned);
             Ok(Self {
-                rate: if field(m, "rate").is_some() {
-                    number(m, "rate")?
-                } else {
-                    50
-                },
-                scenario: field(m, "scenario").map(str::to_owned),
-                frames: frames?,
-                min: min?,
-                median: median?,
-                max: max?,
-                max_at: max_at?,
-                mean: mean?,
+                rate,
+                scenario,
+                frames,
+                min,
+                median,
+                max,
+                max_at,
+                mean,
             })
         };
         let rows: Vec<Self> = lines.map(row).collect::<Result<_>>()?;
         for (rate, (scenario, _)) in RATES.into_iter().flat_map(|r| CEILINGS.map(|c| (r, c))) {
-            if !rows
-                .iter()
-                .any(|row| row.rate == rate && row.scenario.as_deref() == scenario)
-            {
+            if !(rows.iter()).any(|row| row.rate == rate && row.scenario.as_deref() == scenario) {
                 let scenario = scenario.map_or(String::new(), |s| format!(" scenario={s}"));
                 bail!("the benchmark reported no `frame bench rate={rate}{scenario}` line");
             }
         }
         if let Some(row) = rows.iter().find(|row| row.ceiling().is_none()) {
-            bail!(
-                "the benchmark reported a frame row without a ceiling: `{}`",
-                row.label()
-            );
+            let label = row.label();
+            bail!("the benchmark reported a frame row without a ceiling: `{label}`");
         }
         Ok(rows)
     }
@@ -269,13 +259,10 @@ impl FrameRow {
             .is_some_and(|[median, max]| self.median <= median && self.max <= max)
     }
 
-    /// The row's label: `frame`, or `frame (gesture + look)`; at another
-    /// rate than 50 Hz, with it: `frame at 333 Hz`.
+    /// `frame`, or `frame (gesture + look)`; at another rate than 50 Hz,
+    /// with it: `frame at 333 Hz`.
     pub fn label(&self) -> String {
-        let scenario = self
-            .scenario
-            .as_ref()
-            .map(|s| format!(" ({})", s.replace('+', " + ")));
+        let scenario = (self.scenario.as_ref()).map(|s| format!(" ({})", s.replace('+', " + ")));
         let rate = (self.rate != 50).then(|| format!(" at {} Hz", self.rate));
         format!(
             "frame{}{}",
@@ -285,10 +272,8 @@ impl FrameRow {
     }
 
     /// The share of the CPU the frame update takes at the row's rate, %:
-    /// the mean frame's instructions at one 125 MHz cycle each (a lower
-    /// bound: some take two or more; QEMU counts one instruction a ns) over
-    /// the frame period (the servo rate's rounding to whole µs: 3003 at
-    /// 333 Hz).
+    /// the mean frame at one 125 MHz cycle an instruction (a lower bound)
+    /// over the frame period (rounded to whole µs: 3003 at 333 Hz).
     pub fn load_percent(&self) -> f64 {
         let period_us = (1_000_000 + self.rate / 2) / self.rate.max(1);
         self.mean as f64 / RP2040_HZ * 1e6 / period_us as f64 * 100.0
@@ -317,8 +302,7 @@ pub fn frames_over_budget(frames: &[FrameRow]) -> Option<String> {
 
 /// Fails if the run or the log is broken, or (unless `no_budget`) if the
 /// default row or a frame row is over its budget. `smoke`: the QEMU smoke
-/// image's plain run, if the caller made it (the telemetry check compares
-/// against it; without, it runs the image itself).
+/// image's plain run, if the caller made it (for the telemetry check).
 pub fn run_and_check(
     root: &Path,
     metadata: &Metadata,

@@ -1,22 +1,23 @@
 //! The latency rows of `cargo xtask bench`: how long an input takes to
 //! reach the servo pins, measured in the RP2040 emulator on the shipped
 //! image (docs/dev/emulators.md, "Latency"). One run per path, at least
-//! [`EVENTS`] events at seeded random times (so their phases against the
-//! frame spread evenly). An event's time is when the input has fully
+//! [`EVENTS`] events at seeded random times (so that their phases against
+//! the frame spread evenly). An event's time is when the input has fully
 //! arrived (the end of the DMX frame that carries the change, the USB
 //! host's hand-over of a line's last byte, a button's edge); its baseline
-//! the axis at rest before it (the last two pulses of equal width, else
-//! the event is skipped); its response the rise of the first pulse after
-//! it whose width differs from the baseline by more than one and a half PWM counts at the
-//! row's rate (0.47 µs at 50 Hz, 0.12 µs at 200 Hz). A row
-//! gives the latencies' median, 99th percentile and largest, in ms, against
-//! its goal for p99, and the longest a port task waited for the CPU.
+//! the axis at rest before it (the last two pulses of equal width, else the
+//! event is skipped); its response the rise of the first pulse after it
+//! whose width differs from the baseline by more than one and a half PWM
+//! counts at the row's rate. A row gives the latencies' median, 99th
+//! percentile and largest, in ms, against its goal for p99, and the longest
+//! a port task waited for the CPU.
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
 use anyhow::{Result, anyhow, bail};
 use idle_head_core::servo::ServoRate;
 
+use crate::metrics::percentile;
 use crate::project::Metadata;
 use crate::sim::pulses::{self, Measured};
 use crate::sim::{Boot, dmx_line, parse_script, play_script, run_shipped, script_time};
@@ -39,17 +40,17 @@ pub const LOOK_GAP: (Duration, Duration) = (Duration::from_millis(110), Duration
 /// are over before the next; a press is held 30 ms.
 const PRESS_GAP: (Duration, Duration) = (Duration::from_millis(150), Duration::from_millis(170));
 const HELD: Duration = Duration::from_millis(30);
-/// The input edge's run plays a script, and computes its host trace: more
+/// The input edge's run plays a script and computes its host trace: more
 /// wall time than the others, at least.
 const SCRIPT_WALL: Duration = Duration::from_secs(600);
 /// The longest a port task may wait for the CPU, µs.
 pub const PORT_WAIT_US: u32 = 1000;
 
 /// One latency row: its name (`dmx`, `usb look`, …), the latencies (ms,
-/// sorted), the events skipped (the axis still moved), the events' phases
-/// against the frame (per fifth of it), the three slowest (when, s, and
-/// their latency), the longest a port task waited for the CPU in the run
-/// (µs, as the image logged it), and the goal for p99 (ms).
+/// sorted), the events skipped (the axis still moved), the events per fifth
+/// of the frame, the three slowest (when, s, and their latency), the
+/// longest a port task waited for the CPU (µs, as the image logged it), and
+/// the goal for p99 (ms).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Row {
     pub name: &'static str,
@@ -62,49 +63,31 @@ pub struct Row {
 }
 
 impl Row {
-    /// The `p`-th percentile (nearest rank), ms.
-    pub fn percentile(&self, p: f64) -> f64 {
-        #[allow(
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss,
-            clippy::cast_precision_loss
-        )]
-        let rank = (p / 100.0 * self.ms.len() as f64).ceil() as usize;
-        self.ms
-            .get(rank.clamp(1, self.ms.len().max(1)) - 1)
-            .copied()
-            .unwrap_or(f64::NAN)
-    }
-
     /// p50, p99 and the largest, ms.
     fn spread(&self) -> [f64; 3] {
-        [
-            self.percentile(50.0),
-            self.percentile(99.0),
-            self.ms.last().copied().unwrap_or(f64::NAN),
-        ]
+        [0.5, 0.99, 1.0].map(|q| percentile(&self.ms, q))
     }
 
     /// The row for the measured figures: label, events, p50, p99, max, goal,
     /// the port tasks' longest wait.
     pub fn figure(&self) -> Vec<String> {
         let [p50, p99, max] = self.spread().map(|ms| format!("{ms:.1}"));
-        let missed = if self.percentile(99.0) <= self.goal_ms {
+        let missed = if self.spread()[1] <= self.goal_ms {
             ""
         } else {
             " (missed)"
         };
-        let waited = self
-            .waited_us
-            .map_or_else(|| "not logged".to_owned(), |us| format!("{us} µs"));
+        let waited =
+            (self.waited_us).map_or_else(|| "not logged".to_owned(), |us| format!("{us} µs"));
         let events = figures::thousands(self.ms.len() as u64);
+        let goal = format!("{:.0}{missed}", self.goal_ms);
         vec![
             format!("latency {}", self.name),
             events,
             p50,
             p99,
             max,
-            format!("{:.0}{missed}", self.goal_ms),
+            goal,
             waited,
         ]
     }
@@ -116,9 +99,7 @@ impl Row {
         let mut text = format!(
             "latency {name} p50={p50:.1} p99={p99:.1} max={max:.1} events={events} skipped={skipped}\n"
         );
-        let slowest: Vec<String> = self
-            .worst
-            .iter()
+        let slowest: Vec<String> = (self.worst.iter())
             .map(|(at, ms)| format!("{ms:.1} ms at {at:.3} s"))
             .collect();
         let met = if p99 <= self.goal_ms { "met" } else { "missed" };
@@ -130,11 +111,8 @@ impl Row {
             slowest.join(", ")
         );
         if p99 > self.goal_ms {
-            let _ = writeln!(
-                text,
-                "  (where the time goes: the wait for the next frame (0 to a frame), the PWM's latch \
-                 to the next period (a tenth of one), and the transport before the frame)"
-            );
+            text += "  (where the time goes: the wait for the next frame (0 to a frame), the PWM's \
+                     latch to the next period (a tenth of one), and the transport before the frame)\n";
         }
         if let Some(us) = self.waited_us {
             let _ = writeln!(text, "  (port tasks waited at most {us} µs for the CPU)");
@@ -142,18 +120,20 @@ impl Row {
         text
     }
 
-    /// Whether the row meets its goals: p99 within its goal, the port
-    /// tasks' wait within [`PORT_WAIT_US`]; the misses if not.
+    /// The misses of the row's goals (p99 within its goal, the port tasks'
+    /// wait within [`PORT_WAIT_US`]), if any.
     pub fn misses(&self) -> Option<String> {
-        let p99 = self.percentile(99.0);
+        let p99 = self.spread()[1];
         let mut misses = Vec::new();
         if p99.is_nan() || p99 > self.goal_ms {
             misses.push(format!("p99 {p99:.1} ms over {} ms", self.goal_ms));
         }
         match self.waited_us {
-            Some(us) if us > PORT_WAIT_US => misses.push(format!(
-                "a port task waited {us} µs, over {PORT_WAIT_US} µs"
-            )),
+            Some(us) if us > PORT_WAIT_US => {
+                misses.push(format!(
+                    "a port task waited {us} µs, over {PORT_WAIT_US} µs"
+                ));
+            }
             None => misses.push("the port tasks' wait was not logged".to_owned()),
             Some(_) => {}
         }
@@ -416,7 +396,7 @@ mod tests {
             waited_us: Some(300),
             goal_ms: GOAL_MS,
         };
-        assert_eq!((row.percentile(50.0), row.percentile(99.0)), (100.0, 198.0));
+        assert_eq!(row.spread()[..2], [100.0, 198.0]);
         assert!(
             row.lines()
                 .starts_with("latency x p50=100.0 p99=198.0 max=200.0 events=200")

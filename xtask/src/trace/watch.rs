@@ -5,14 +5,12 @@
 
 use idle_head_core::console::{HeadStatus, TELEMETRY_LINE, telemetry_line};
 
-/// A stream of telemetry lines at `hz` a second.
+/// A stream of telemetry lines: its tick's period and next tick (µs), the
+/// lines so far (without their line ends).
 #[derive(Debug, Clone)]
 pub struct Watch {
-    /// The tick's period, µs.
     period_us: u64,
-    /// The next tick, µs.
     next_us: u64,
-    /// The lines so far, without their line ends.
     pub lines: Vec<String>,
 }
 
@@ -36,7 +34,7 @@ impl Watch {
         }
         let mut out = [0; TELEMETRY_LINE];
         let line = telemetry_line(status, 0, &mut out);
-        self.lines
-            .push(String::from_utf8_lossy(line).trim_end().to_owned());
+        let line = String::from_utf8_lossy(line).trim_end().to_owned();
+        self.lines.push(line);
     }
 }
