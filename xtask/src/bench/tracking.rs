@@ -42,9 +42,14 @@ const NOISE_MM: i32 = 40;
 const NOISE_SEEDS: u32 = 4;
 
 /// The walker's x at `t_us` (from the first frame), mm.
-fn walker_x(t_us: u64) -> f64 {
-    let walked = t_us.clamp(WALK_FROM_US, WALK_FROM_US + WALK_US) - WALK_FROM_US;
-    -2000.0 + walked as f64 / 1000.0
+fn walker_x(t_us: f64) -> f64 {
+    let (from, to) = (WALK_FROM_US as f64, (WALK_FROM_US + WALK_US) as f64);
+    -2000.0 + (t_us.clamp(from, to) - from) / 1000.0
+}
+
+/// The walker's bearing at `t_us`, m°.
+fn bearing(t_us: f64) -> f64 {
+    -walker_x(t_us).atan2(f64::from(DISTANCE_MM)).to_degrees() * 1000.0
 }
 
 /// The walk as a trace script: the radar and the gaze on by console
@@ -52,7 +57,7 @@ fn walker_x(t_us: u64) -> f64 {
 pub fn walk_script() -> String {
     let mut text = String::from("0 radar on\n0 track on\n");
     for t in (WALK_FROM_US..=WALK_FROM_US + WALK_US).step_by(PERIOD_US as usize) {
-        let x = walker_x(t).round();
+        let x = walker_x(t as f64).round();
         let _ = writeln!(text, "{} radar {x},{DISTANCE_MM}", seconds(t));
     }
     let _ = writeln!(
@@ -92,10 +97,6 @@ impl Walk {
             f64::from(room.min.millidegrees()),
             f64::from(room.max.millidegrees()),
         );
-        let bearing = |t_us: f64| -> f64 {
-            let x = walker_x(t_us.max(0.0) as u64);
-            -x.atan2(f64::from(DISTANCE_MM)).to_degrees() * 1000.0
-        };
         let from = usize::try_from((WALK_FROM_US + 1_000_000) / period_us)?;
         let to = usize::try_from((WALK_FROM_US + WALK_US) / period_us)?.min(yaw.len());
         if from >= to {
@@ -228,22 +229,12 @@ pub fn stage() -> Result<()> {
             deg(f64::from(pp))
         ));
     }
-    if misses.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", misses.join("; "))
-    }
+    crate::project::verdict(&misses)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The walker's bearing at `t_us`, m°, within `room`.
-    fn bearing(t_us: f64, (lo, hi): (f64, f64)) -> f64 {
-        let x = -2000.0 + (t_us - 3e6).clamp(0.0, 4e6) / 1000.0;
-        (-(x / 2000.0).atan().to_degrees() * 1000.0).clamp(lo, hi)
-    }
 
     #[test]
     fn a_yaw_that_follows_100_ms_late_has_a_lag_of_100_ms() {
@@ -254,13 +245,13 @@ mod tests {
             f64::from(room.max.millidegrees()),
         );
         let exact: Vec<f64> = (0..400)
-            .map(|k| bearing(f64::from(k) * 20e3, room))
+            .map(|k| bearing(f64::from(k) * 20e3).clamp(room.0, room.1))
             .collect();
         let walk = Walk::of(&exact, 20_000).unwrap();
         assert_eq!(walk.lag_ms, 0);
         assert!(walk.rms < 1.0 && walk.largest < 1.0, "{walk:?}");
         let late: Vec<f64> = (0..400)
-            .map(|k| bearing(f64::from(k) * 20e3 - 100e3, room))
+            .map(|k| bearing(f64::from(k) * 20e3 - 100e3).clamp(room.0, room.1))
             .collect();
         let walk = Walk::of(&late, 20_000).unwrap();
         assert_eq!(walk.lag_ms, 100);

@@ -24,12 +24,12 @@ use idle_head_core::{
     },
 };
 
-/// One loop to preview.
+/// One loop to preview: its axis, length, and configuration (seed, window,
+/// step, range and closure).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LoopSpec {
     pub axis: Axis,
     pub n: usize,
-    /// Seed, window, step, range and closure.
     pub cfg: AxisConfig,
 }
 
@@ -38,19 +38,23 @@ pub fn deg(angle: Angle) -> f64 {
     f64::from(angle.millidegrees()) / f64::from(Angle::SCALE)
 }
 
+pub fn closure_name(closure: Closure) -> &'static str {
+    match closure {
+        Closure::Paper => "paper",
+        Closure::Seamless => "seamless",
+    }
+}
+
 /// The paper closure's open walk in degrees: u(0) = 0, u(n) = u(n−1) ± δ with
 /// the sign of r(n).
 pub fn paper_walk(seed: u32, n: usize, delta: f64) -> Vec<f64> {
     let mut lcg = Lcg::new(seed);
-    let mut u = 0.0;
-    (0..n)
-        .map(|i| {
-            if i > 0 {
-                u += f64::from(step_of(lcg.next_value())) * delta;
-            }
-            u
-        })
-        .collect()
+    let steps = (1..n).map(|_| f64::from(step_of(lcg.next_value())) * delta);
+    let walk = steps.scan(0.0, |u, step| {
+        *u += step;
+        Some(*u)
+    });
+    std::iter::once(0.0).chain(walk).take(n).collect()
 }
 
 /// The seamless closure's periodic walk in degrees: e(k) = ±1 from r(k+1),
@@ -61,14 +65,11 @@ pub fn seamless_walk(seed: u32, n: usize, delta: f64) -> Vec<f64> {
         .map(|_| f64::from(step_of(lcg.next_value())))
         .collect();
     let drift = steps.iter().sum::<f64>() / n as f64;
-    let mut u = 0.0;
-    steps
-        .iter()
-        .map(|e| {
-            u += (e - drift) * delta;
-            u
-        })
-        .collect()
+    let walk = steps.iter().scan(0.0, |u, e| {
+        *u += (e - drift) * delta;
+        Some(*u)
+    });
+    walk.collect()
 }
 
 /// The paper's normalisation into [a1, a2]: a1 + (s − min)(a2 − a1)/(max − min).
@@ -76,24 +77,21 @@ pub fn normalize(values: &[f64], a1: f64, a2: f64) -> Vec<f64> {
     let min = values.iter().copied().fold(f64::INFINITY, f64::min);
     let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let span = max - min;
-    values
-        .iter()
-        .map(|&s| {
-            if span > 0.0 {
-                a1 + (s - min) * (a2 - a1) / span
-            } else {
-                a1
-            }
-        })
-        .collect()
+    let scale = |s: f64| {
+        if span > 0.0 {
+            a1 + (s - min) * (a2 - a1) / span
+        } else {
+            a1
+        }
+    };
+    values.iter().map(|&s| scale(s)).collect()
 }
 
 /// The length-N Hann taper of the paper closure: ½ − ½·cos(2πn/(N−1)).
 pub fn taper(n: usize) -> Vec<f64> {
     let span = (n.max(2) - 1) as f64;
-    (0..n)
-        .map(|i| 0.5 - 0.5 * (std::f64::consts::TAU * i as f64 / span).cos())
-        .collect()
+    let weight = |i: usize| 0.5 - 0.5 * (std::f64::consts::TAU * i as f64 / span).cos();
+    (0..n).map(weight).collect()
 }
 
 fn mean(values: &[f64]) -> f64 {
@@ -111,21 +109,18 @@ impl Trace for Recorder {
     }
 }
 
-/// All stages of one loop.
+/// All stages of one loop, in degrees, in generation order but the stored
+/// loop (playback order); the paper closure's Hann taper and tapered loop;
+/// the stored loop's metrics.
 #[derive(Debug, Clone)]
 pub struct Stages {
     pub spec: LoopSpec,
     pub info: LoopInfo,
     pub walk: Vec<f64>,
-    /// Smoothed walk, degrees, generation order.
     pub smoothed: Vec<f64>,
-    /// Normalised into [α1, α2], degrees, generation order.
     pub normalized: Vec<f64>,
-    /// Paper closure only: the Hann taper and the tapered loop (degrees).
     pub tapered: Option<(Vec<f64>, Vec<f64>)>,
-    /// The stored loop, degrees, playback order.
     pub final_loop: Vec<f64>,
-    /// Metrics of the stored loop.
     pub metrics: LoopMetrics,
 }
 
@@ -144,11 +139,9 @@ impl Stages {
             Closure::Paper => paper_walk(cfg.seed, n, delta),
             Closure::Seamless => seamless_walk(cfg.seed, n, delta),
         };
-        let mut smoothed: Vec<f64> = recorder.0.iter().map(|s| s * delta).collect();
+        let smoothed: Vec<f64> = recorder.0.iter().map(|s| s * delta).collect();
         let shift = mean(&walk) - mean(&smoothed);
-        for s in &mut smoothed {
-            *s += shift;
-        }
+        let smoothed: Vec<f64> = smoothed.iter().map(|s| s + shift).collect();
         let (a1, a2) = (deg(cfg.range.min), deg(cfg.range.max));
         let normalized = normalize(&smoothed, a1, a2);
         let final_loop: Vec<f64> = stored.iter().map(|s| f64::from(s.0) / 1000.0).collect();
@@ -236,13 +229,6 @@ impl Stages {
                 ),
             },
         ]
-    }
-}
-
-pub fn closure_name(closure: Closure) -> &'static str {
-    match closure {
-        Closure::Paper => "paper",
-        Closure::Seamless => "seamless",
     }
 }
 
