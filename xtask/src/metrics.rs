@@ -109,23 +109,42 @@ fn measure(range: std::ops::Range<u32>, args: Args, closure: Closure) -> Result<
     Ok(results)
 }
 
+/// `job` of 0 to `count` − 1, `cores` at a time, in order; a job that
+/// panicked is an error.
+pub fn parallel<T: Send>(
+    count: usize,
+    cores: usize,
+    job: impl Fn(usize) -> Result<T> + Sync,
+) -> Vec<Result<T>> {
+    let mut results = Vec::new();
+    for batch in (0..count).collect::<Vec<_>>().chunks(cores.max(1)) {
+        thread::scope(|scope| {
+            let job = &job;
+            let runs: Vec<_> = batch.iter().map(|&i| scope.spawn(move || job(i))).collect();
+            let panicked = || Err(anyhow!("a worker thread panicked"));
+            results.extend(
+                runs.into_iter()
+                    .map(|run| run.join().unwrap_or_else(|_| panicked())),
+            );
+        });
+    }
+    results
+}
+
 /// Measures every seed for `closure` on all available cores.
 pub fn run(args: Args, closure: Closure) -> Result<Results> {
     let threads = thread::available_parallelism().map_or(1, usize::from) as u32;
     let chunk = args.seeds.div_ceil(threads);
-    let parts: Vec<Result<Results>> = thread::scope(|scope| {
-        let ranges =
-            (0..threads).map(|t| (t * chunk).min(args.seeds)..((t + 1) * chunk).min(args.seeds));
-        let handles: Vec<_> = ranges
-            .map(|r| scope.spawn(move || measure(r, args, closure)))
-            .collect();
-        let panicked = || Err(anyhow!("a worker thread panicked"));
-        (handles.into_iter())
-            .map(|h| h.join().unwrap_or_else(|_| panicked()))
-            .collect()
-    });
+    let part = |t: usize| {
+        let t = t as u32;
+        measure(
+            (t * chunk).min(args.seeds)..((t + 1) * chunk).min(args.seeds),
+            args,
+            closure,
+        )
+    };
     let mut all = Results::default();
-    for part in parts {
+    for part in parallel(threads as usize, threads as usize, part) {
         let part = part?;
         all.loops.extend(part.loops);
         all.rejected.extend(part.rejected);

@@ -14,16 +14,17 @@
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, bail};
 use idle_head_core::servo::ServoRate;
 
-use crate::metrics::percentile;
+use crate::metrics::{parallel, percentile};
 use crate::project::Metadata;
 use crate::sim::pulses::{self, Measured};
 use crate::sim::{Boot, dmx_line, parse_script, play_script, run_shipped, script_time};
 use crate::{figures, project};
 
 pub use super::paths::PATHS;
+use super::paths::count;
 
 /// Events per row, at least; more are scheduled, for the ones skipped.
 pub const EVENTS: usize = 1000;
@@ -148,19 +149,9 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<()> {
     // One at a time when `cargo xtask test` runs it beside other stages.
     let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
     let cores = if crate::project::prebuilt() { 1 } else { cores };
-    let mut results = Vec::new();
-    for batch in PATHS.chunks(cores) {
-        std::thread::scope(|scope| {
-            let runs: Vec<_> = (batch.iter())
-                .map(|path| scope.spawn(|| path(root, metadata, crate::sim::WALL)))
-                .collect();
-            let panicked = || Err(anyhow!("a latency run panicked"));
-            results.extend(
-                runs.into_iter()
-                    .map(|run| run.join().unwrap_or_else(|_| panicked())),
-            );
-        });
-    }
+    let results = parallel(PATHS.len(), cores, |i| {
+        PATHS[i](root, metadata, crate::sim::WALL)
+    });
     let (mut rows, mut misses) = (Vec::new(), Vec::new());
     for result in results {
         match result {
@@ -304,13 +295,7 @@ pub fn dmx(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
     let boot = report.first()?;
     // The first change is the set-up's.
     let events: Vec<f64> = boot.dmx_changes.iter().skip(1).copied().collect();
-    if events.len() != times.len() {
-        bail!(
-            "{} DMX frames carried a change, not {}",
-            events.len(),
-            times.len()
-        );
-    }
+    count(events.len(), times.len(), "DMX frames carried a change")?;
     row("dmx", &events, boot)
 }
 
@@ -333,9 +318,7 @@ pub fn input_edge(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Ro
     }
     let boot = report.first()?;
     let edges: Vec<f64> = boot.drives.iter().filter(|d| !d.2).map(|d| d.0).collect();
-    if edges.len() != times.len() {
-        bail!("{} presses went out, not {}", edges.len(), times.len());
-    }
+    count(edges.len(), times.len(), "presses went out")?;
     row("input edge", &edges, boot)
 }
 
