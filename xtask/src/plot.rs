@@ -1,9 +1,9 @@
-//! Every PNG of the project commands: a figure of stacked panels (curves,
-//! shaded spans, labelled markers), drawn by plotters with a built-in font
-//! (`DejaVu Sans`) so that a plot looks the same on every machine; the
-//! three axes over time (`trace`, `qemu`) and a loop's stages (`preview`).
-//! A curve with more points than its panel has pixel columns is drawn as
-//! each column's range and mean.
+//! Every PNG of the project commands (`trace` and `qemu`: the three axes
+//! over time; `preview`: a loop's stages): a figure of stacked panels
+//! (curves, shaded spans, labelled markers), drawn by plotters with a
+//! built-in font so that a plot looks the same on every machine. A curve
+//! with more points than its panel has pixel columns is drawn as each
+//! column's range and mean.
 
 // Sample counts and pixel positions are far below f64's exact range.
 #![allow(
@@ -32,18 +32,17 @@ pub const PURPLE: RGBColor = RGBColor(148, 103, 189);
 pub const GREY: RGBColor = RGBColor(110, 110, 110);
 pub const LIGHT: RGBColor = RGBColor(190, 190, 190);
 
-/// A figure: a title, lines of text under it, and panels one above the other.
+/// A figure: a title, lines of text under it, and panels one above the
+/// other, each `panel_height` pixels high.
 pub struct Figure {
     pub title: String,
     pub notes: Vec<String>,
     pub panels: Vec<Panel>,
-    /// Height of each panel, pixels.
     pub panel_height: u32,
 }
 
 /// One panel: its curves over a shared x axis, shaded x ranges behind them
 /// and dashed vertical markers with a label at the top.
-#[derive(Default)]
 pub struct Panel {
     pub title: String,
     pub x_desc: String,
@@ -65,7 +64,8 @@ pub struct Curve {
 impl Curve {
     /// A solid curve through `points`.
     pub fn new(label: impl Into<String>, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
-        let (label, dashed) = (label.into(), false);
+        let label = label.into();
+        let dashed = false;
         Self {
             label,
             color,
@@ -76,11 +76,8 @@ impl Curve {
 
     /// A solid curve of `values`, one per index.
     pub fn indexed(label: impl Into<String>, color: RGBColor, values: &[f64]) -> Self {
-        Self::new(
-            label,
-            color,
-            (0..).map(f64::from).zip(values.iter().copied()).collect(),
-        )
+        let points = (0..).map(f64::from).zip(values.iter().copied());
+        Self::new(label, color, points.collect())
     }
 }
 
@@ -105,10 +102,11 @@ pub fn motion(
     rows: &[(f64, [f64; 3])],
     marks: &[Mark],
 ) -> Result<()> {
-    let panel = |axis: Axis, color| {
+    let panel = |(axis, color): (Axis, RGBColor)| {
         let i = axis.index();
         let points = rows.iter().map(|r| (r.0, r.1[i])).collect();
         let on = |m: &&Mark| m.axes.contains(&axis);
+        let marked = |m: &&Mark| m.axes.is_empty() || m.axes.contains(&axis);
         Panel {
             title: format!("{} (°)", axis.name()),
             x_desc: x_desc.to_owned(),
@@ -119,23 +117,24 @@ pub fn motion(
                 .filter(on)
                 .map(|m| (m.from, m.to, m.shade))
                 .collect(),
-            markers: (marks.iter())
-                .filter(|m| m.axes.is_empty() || m.axes.contains(&axis))
+            markers: (marks.iter().filter(marked))
                 .map(|m| (m.from, m.label.clone(), m.line))
                 .collect(),
         }
     };
-    let panels = vec![
-        panel(Axis::Pitch, BLUE),
-        panel(Axis::Roll, ORANGE),
-        panel(Axis::Yaw, GREEN),
+    let colors = [
+        (Axis::Pitch, BLUE),
+        (Axis::Roll, ORANGE),
+        (Axis::Yaw, GREEN),
     ];
+    let panels = colors.map(panel).into();
+    let panel_height = 250;
     draw(
         &Figure {
             title,
             notes,
             panels,
-            panel_height: 250,
+            panel_height,
         },
         path,
     )

@@ -14,7 +14,7 @@ pub mod radar;
 mod script;
 mod watch;
 
-use std::{fs, path::PathBuf};
+use std::{fmt::Write as _, fs, path::PathBuf};
 
 use anyhow::{Context, Result, anyhow};
 use idle_head_core::behaviour::{
@@ -248,15 +248,15 @@ pub fn simulate_watched(
         if let Some(period) = retime {
             driver.set_pwm_period(period).map_err(refused(t_us))?;
         }
-        let (t_ms, mut taken) = (t_us / 1000, std::mem::take(&mut beside.origins).into_iter());
+        let (ms, mut taken) = (t_us / 1000, std::mem::take(&mut beside.origins).into_iter());
         let mixer = *head.mixer().params();
         head.drain(&mut driver, &queue, |_, outcome| {
-            let (text, line) = match taken.next() {
+            let (text, number) = match taken.next() {
                 Some(Origin::Line(i)) => (events[i].text.clone(), events[i].line),
                 Some(Origin::Other(text)) => (text, 0),
                 None => return,
             };
-            marks.extend(marks::marks(&text, line, t_ms, outcome, &mixer));
+            marks.extend(marks::marks(&text, number, ms, outcome, &mixer));
         });
         beside.origins.extend(taken);
         let sighting = show.track.take();
@@ -326,7 +326,7 @@ pub fn command(args: &Args) -> Result<bool> {
     for (frame, row) in trace.rows.iter().enumerate() {
         let ([p, r, y], [pn, rn, yn]) = (row.angles, row.pulses);
         let t = ms(row.t_us);
-        csv += &format!("{frame},{t},{p},{r},{y},{pn},{rn},{yn}\n");
+        let _ = writeln!(csv, "{frame},{t},{p},{r},{y},{pn},{rn},{yn}");
     }
     project::write(&out, csv)?;
     for mark in &trace.marks {
