@@ -1,9 +1,7 @@
 //! The frame work with telemetry streaming: `watch 50` on the QEMU image's
 //! UART0 through the smoke schedule must leave the frame work the smoke run
-//! logs (average and worst) within one `SysTick` count (80 instructions:
-//! 12.5 MHz after reset under `-icount shift=0`, `boards/qemu/src/systick.rs`)
-//! of the run without it, and miss no frame: telemetry is written by the
-//! console task, never on the frame path.
+//! logs (average and worst) within one `SysTick` count of the run without
+//! it: telemetry is written by the console task, never on the frame path.
 
 use std::{
     io::Read,
@@ -18,16 +16,16 @@ use crate::console::{Pace, qemu_session};
 use crate::log::{LogLine, Run};
 use crate::qemu::{self, Echo};
 
-/// Instructions per `SysTick` count in the smoke run.
+/// Instructions per `SysTick` count in the smoke run (12.5 MHz after reset
+/// under `-icount shift=0`, `boards/qemu/src/systick.rs`).
 const INSNS_PER_COUNT: u64 = 80;
 
 /// Telemetry lines to see before the host hangs up: the schedule's
 /// fade-out starts at frame 1800, a line every 20 frames.
 const LINES: usize = 80;
 
-/// The console's input: `watch 50`, then nothing until [`LINES`]
-/// telemetry lines came (or the deadline passed), then the end (the host
-/// hangs up, and the schedule fades out).
+/// The console's input: `watch 50`, then nothing until [`LINES`] telemetry
+/// lines came (or the deadline passed), then the end (the host hangs up).
 struct Streaming<'a> {
     sent: bool,
     seen: &'a AtomicUsize,
@@ -54,10 +52,8 @@ fn frame_work(log: &[LogLine]) -> Result<(u64, u64)> {
         .iter()
         .find_map(|l| l.message.strip_prefix("frame work: "));
     let line = line.context("the run logged no frame work")?;
-    let mut numbers = line
-        .split(|c: char| !c.is_ascii_digit())
-        .filter(|w| !w.is_empty())
-        .map(str::parse);
+    let words = line.split(|c: char| !c.is_ascii_digit());
+    let mut numbers = words.filter(|w| !w.is_empty()).map(str::parse);
     match (numbers.next(), numbers.next()) {
         (Some(Ok(average)), Some(Ok(most))) => Ok((average, most)),
         _ => bail!("unreadable frame work line: {line}"),
@@ -65,9 +61,8 @@ fn frame_work(log: &[LogLine]) -> Result<(u64, u64)> {
 }
 
 /// Runs the QEMU smoke image `elf` with `watch 50` streaming, against its
-/// plain run: `plain` if the caller made it (`cargo xtask test`'s QEMU
-/// stage), else run here; the bench's line about it, or why the frames
-/// were not untouched.
+/// plain run (`plain`, else run here): the bench's line about it, or why
+/// the frames were not untouched.
 pub fn check(elf: &Path, timeout: Duration, plain: Option<&Run>) -> Result<String> {
     let without = match plain {
         Some(run) => frame_work(&run.log)?,

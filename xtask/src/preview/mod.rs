@@ -1,16 +1,14 @@
-//! `cargo xtask preview`: the stages of a loop as CSV and PNG, for people.
-//! The core library's engine runs on the host (`generate_into` with a
-//! `Trace` observer); `<out>/<stem>.csv` has the columns
-//! `n,walk,smoothed,normalized,final` in degrees (`stages.rs` says what
-//! each is), `<out>/<stem>.png` the stages as panels in the style of the
-//! paper's Figures 6 and 7.
+//! `cargo xtask preview`: the stages of a loop, from the core's engine on
+//! the host, as `<out>/<stem>.csv` (`n,walk,smoothed,normalized,final` in
+//! degrees, `stages.rs`) and `<out>/<stem>.png` (panels in the style of the
+//! paper's Figures 6 and 7).
 
 mod figure;
 mod stages;
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use idle_head_core::{
     Angle, AngleRange, Axis,
     motion::{AxisError, Closure, DEFAULT_HEAD},
@@ -109,15 +107,17 @@ impl Args {
                 Some(stem) => format!("{stem}-{}", axis.name()),
                 None => axis.name().to_owned(),
             };
-            let spec = |axis| LoopSpec {
-                axis,
-                n,
-                cfg: *DEFAULT_HEAD.axis(axis),
+            let spec = |axis: Axis| {
+                (
+                    LoopSpec {
+                        axis,
+                        n,
+                        cfg: *DEFAULT_HEAD.axis(axis),
+                    },
+                    stem(axis),
+                )
             };
-            Axis::ALL
-                .into_iter()
-                .map(|axis| (spec(axis), stem(axis)))
-                .collect()
+            Axis::ALL.map(spec).into()
         };
         for (LoopSpec { axis, n, cfg }, _) in &specs {
             cfg.validate(*axis, *n)
@@ -130,20 +130,13 @@ impl Args {
 /// `cargo xtask preview`.
 pub fn command(args: &Args) -> Result<bool> {
     let loops = args.loops()?;
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| project::root().join("preview"));
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let out = (args.out.clone()).unwrap_or_else(|| project::root().join("preview"));
     // Paths as the user would name them: relative to the current folder.
     let here = std::env::current_dir().unwrap_or_default();
     for (spec, stem) in loops {
         let stages = Stages::compute(spec)?;
-        let (csv, png) = (
-            out.join(format!("{stem}.csv")),
-            out.join(format!("{stem}.png")),
-        );
-        std::fs::write(&csv, stages.csv()).with_context(|| format!("writing {}", csv.display()))?;
+        let [csv, png] = ["csv", "png"].map(|ext| out.join(format!("{stem}.{ext}")));
+        project::write(&csv, stages.csv())?;
         figure::draw(&stages, &png)?;
         println!("{}", stages.title());
         for line in &stages.metric_lines() {

@@ -21,8 +21,7 @@ fn idle_only_is_the_plain_frame_loop() {
     let playback = Playback::new(LOOP_DURATION, driver.config().frame_period, DEFAULT_N).unwrap();
     let mut source = idle(config(None), playback, None).unwrap();
     let period = driver.config().frame_period;
-    let channel = || Channel::at(period).unwrap();
-    let mut plain = FrameDriver::new([channel(), channel(), channel()], driver);
+    let mut plain = FrameDriver::new([Channel::at(period).unwrap(); 3], driver);
     for row in &trace.rows {
         let report = plain.write_frame(source.offsets(Timestamp(row.t_us)));
         assert_eq!(row.angles, report.servos.map(|s| s.angle.millidegrees()));
@@ -33,11 +32,8 @@ fn idle_only_is_the_plain_frame_loop() {
 fn a_looks_return_is_marked_where_the_head_goes_back() {
     // The idle motion off (it fades out in 1 s): only the gaze moves.
     let trace = run("0 idle off\n2 look 10000 0 500 hold=1000\n", 6);
-    let back: Vec<&Mark> = trace
-        .marks
-        .iter()
-        .filter(|m| m.kind == marks::Kind::Return)
-        .collect();
+    let returns = |m: &&Mark| m.kind == marks::Kind::Return;
+    let back: Vec<&Mark> = trace.marks.iter().filter(returns).collect();
     assert_eq!(back.len(), 1, "{:?}", trace.marks);
     let back = back[0];
     // 500 ms there, the 1 s hold, then back: the mark is at the frame that
@@ -64,12 +60,9 @@ fn a_looks_return_is_marked_where_the_head_goes_back() {
 #[test]
 fn a_return_is_cut_or_left_out_by_the_next_gaze_move() {
     let returns = |script: &str| -> Vec<(u64, u64)> {
-        run(script, 8)
-            .marks
-            .iter()
-            .filter(|m| m.kind == marks::Kind::Return)
-            .map(|m| (m.t_ms, m.span_ms))
-            .collect()
+        let marks = run(script, 8).marks.into_iter();
+        let back = marks.filter(|m| m.kind == marks::Kind::Return);
+        back.map(|m| (m.t_ms, m.span_ms)).collect()
     };
     let look = "2 look 10000 0 500 hold=1000\n";
     let whole = returns(look);
