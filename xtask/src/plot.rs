@@ -52,8 +52,8 @@ pub struct Panel {
     pub markers: Vec<(f64, String, RGBColor)>,
 }
 
-/// One curve; a dashed one is a reference line. A curve without a label
-/// has no entry in the legend.
+/// One curve (a dashed one is a reference line; one without a label has no
+/// entry in the legend).
 pub struct Curve {
     pub label: String,
     pub color: RGBColor,
@@ -81,8 +81,8 @@ impl Curve {
     }
 }
 
-/// A command on the motion plot: where it starts and ends (x), the axes it
-/// shades (none: only its marker, on every panel), its label and colours.
+/// A command on the motion plot: from and to (x), the axes it shades (none:
+/// only its marker, on every panel), its label and colours.
 pub struct Mark {
     pub from: f64,
     pub to: f64,
@@ -187,15 +187,10 @@ fn paint(root: &Area<'_>, figure: &Figure, header: u32) -> Drawn {
 
 fn draw_panel(area: &Area<'_>, panel: &Panel) -> Drawn {
     let points = panel.curves.iter().flat_map(|c| c.points.iter());
-    let (x0, x1, lo, hi) = points.fold(
-        (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        ),
-        |(x0, x1, lo, hi), &(x, y)| (x0.min(x), x1.max(x), lo.min(y), hi.max(y)),
-    );
+    let (inf, neg) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (x0, x1, lo, hi) = points.fold((inf, neg, inf, neg), |(x0, x1, lo, hi), &(x, y)| {
+        (x0.min(x), x1.max(x), lo.min(y), hi.max(y))
+    });
     let (x0, x1) = if x1 > x0 { (x0, x1) } else { (0.0, 1.0) };
     let (lo, hi) = if hi >= lo { (lo, hi) } else { (-1.0, 1.0) };
     // Room above the curves for two rows of labels.

@@ -12,7 +12,6 @@ mod host;
 mod marks;
 pub mod radar;
 mod script;
-mod watch;
 
 use std::{fmt::Write as _, fs, path::PathBuf};
 
@@ -30,9 +29,9 @@ use idle_head_core::{Axis, Microseconds, Playback, Timestamp};
 use idle_head_firmware::config::IDLE_MODE;
 
 use host::Origin;
+pub use host::Watch;
 use marks::Mark;
 pub use script::{Event, Kind, parse as parse_script};
-pub use watch::Watch;
 
 use crate::{project, steps::Steps};
 

@@ -354,11 +354,7 @@ mod tests {
             width: width_us * 1e3,
         };
         let widths = [1500.0, 1500.0, 1500.0, 1500.3125, 1502.0, 1503.0];
-        let pulses: Vec<Measured> = widths
-            .iter()
-            .enumerate()
-            .map(|(k, &w)| pulse(k, w))
-            .collect();
+        let pulses: Vec<Measured> = (0..6).map(|k| pulse(k, widths[k])).collect();
         // An event at 55 ms: a count of change is noise, 1502 µs moves.
         assert_eq!(response(&pulses, 55e6, count), Response::After(35.0));
         // The axis still moved before 95 ms; nothing before 5 ms: no baseline.
@@ -380,10 +376,8 @@ mod tests {
             goal_ms: GOAL_MS,
         };
         assert_eq!(row.spread()[..2], [100.0, 198.0]);
-        assert!(
-            row.lines()
-                .starts_with("latency x p50=100.0 p99=198.0 max=200.0 events=200")
-        );
+        let lines = row.lines();
+        assert!(lines.starts_with("latency x p50=100.0 p99=198.0 max=200.0 events=200"));
         assert!(row.lines().contains("where the time goes"));
         assert_eq!(row.misses().unwrap(), "latency x: p99 198.0 ms over 25 ms");
         let fast = Row {
@@ -397,30 +391,24 @@ mod tests {
             ..fast.clone()
         };
         assert!(waited.misses().unwrap().contains("waited 1001 µs"));
-        assert!(
-            Row {
-                waited_us: None,
-                ..fast.clone()
-            }
-            .misses()
-            .unwrap()
-            .contains("not logged")
-        );
+        let unlogged = Row {
+            waited_us: None,
+            ..fast.clone()
+        };
+        assert!(unlogged.misses().unwrap().contains("not logged"));
         let at_200_hz = Row {
             ms: vec![8.5; 100],
             goal_ms: GOAL_200_HZ_MS,
             ..fast
         };
-        assert_eq!(
-            at_200_hz.misses().unwrap(),
-            "latency x: p99 8.5 ms over 8 ms"
-        );
+        let misses = at_200_hz.misses().unwrap();
+        assert_eq!(misses, "latency x: p99 8.5 ms over 8 ms");
         let times = schedule(Duration::from_secs(1), 100, DMX_GAP, 7);
         assert_eq!(times, schedule(Duration::from_secs(1), 100, DMX_GAP, 7));
+        let gaps = times.windows(2).map(|w| w[1].saturating_sub(w[0]));
         assert!(
-            times
-                .windows(2)
-                .all(|w| (DMX_GAP.0..DMX_GAP.1).contains(&w[1].saturating_sub(w[0])))
+            gaps.into_iter()
+                .all(|gap| (DMX_GAP.0..DMX_GAP.1).contains(&gap))
         );
     }
 
@@ -431,17 +419,10 @@ mod tests {
         assert_eq!(events.len(), 3 + 2 * SCHEDULED);
         let presses: Vec<u64> = events[3..].iter().step_by(2).map(|e| e.at_us).collect();
         let releases = events[4..].iter().step_by(2).map(|e| e.at_us);
-        assert!(
-            presses
-                .iter()
-                .zip(releases)
-                .all(|(press, release)| release - press == 30_000)
-        );
-        assert!(
-            presses
-                .windows(2)
-                .all(|w| (150_000..170_000).contains(&(w[1] - w[0])))
-        );
+        let mut held = presses.iter().zip(releases);
+        assert!(held.all(|(press, release)| release - press == 30_000));
+        let mut gaps = presses.windows(2).map(|w| w[1] - w[0]);
+        assert!(gaps.all(|gap| (150_000..170_000).contains(&gap)));
         // Spread over the frame: every fifth of it is hit.
         for fifth in 0..5 {
             assert!(presses.iter().any(|at| at % 20_000 / 4000 == fifth));

@@ -1,11 +1,13 @@
 //! What runs beside the frame task on a board, on the host: the console's
 //! service and the input task, the firmware's core code on the trace's queue
-//! and link. The input task wakes as on the board: at a pin's change, at its
+//! and link, and the telemetry lines a port would stream (`watch <hz>`).
+//! The input task wakes as on the board: at a pin's change, at its
 //! deadlines, and when the console changes its settings.
 
 use idle_head_core::behaviour::{CommandQueue, RestState, ShowLink};
 use idle_head_core::console::{
-    ActionLine, ConsoleLink, ConsoleService, PORT_REPLY, Response, respond,
+    ActionLine, ConsoleLink, ConsoleService, HeadStatus, PORT_REPLY, Response, TELEMETRY_LINE,
+    respond, telemetry_line,
 };
 use idle_head_core::driver::DriverConfig;
 use idle_head_core::input::{Inputs, Micros, Pull, SLOTS};
@@ -161,5 +163,40 @@ impl<'a> Beside<'a> {
         } else {
             self.inputs.deadline(&settings).map(|at| at.0)
         };
+    }
+}
+
+/// A stream of telemetry lines: its tick's period and next tick (µs), the
+/// lines so far (without their line ends): the core's own line of the
+/// status the first frame at or after each tick published.
+#[derive(Debug, Clone)]
+pub struct Watch {
+    period_us: u64,
+    next_us: u64,
+    pub lines: Vec<String>,
+}
+
+impl Watch {
+    /// A stream of `hz` lines a second from the first frame on.
+    pub fn new(hz: u8) -> Self {
+        Self {
+            period_us: 1_000_000 / u64::from(hz.max(1)),
+            next_us: 0,
+            lines: Vec::new(),
+        }
+    }
+
+    /// The frame at `t_us` published `status`: its line, if a tick is due.
+    pub fn frame(&mut self, t_us: u64, status: &HeadStatus) {
+        if t_us < self.next_us {
+            return;
+        }
+        while self.next_us <= t_us {
+            self.next_us += self.period_us;
+        }
+        let mut out = [0; TELEMETRY_LINE];
+        let line = telemetry_line(status, 0, &mut out);
+        let line = String::from_utf8_lossy(line).trim_end().to_owned();
+        self.lines.push(line);
     }
 }

@@ -85,10 +85,8 @@ fn a_scripted_nod_moves_pitch_only_and_answers() {
     let idle = run("", 6);
     let nodding = run("3 nod 6000 800\n", 6);
     assert_eq!(nodding.marks.len(), 1);
-    assert_eq!(
-        nodding.marks[0].reply,
-        "ok nod amp_mdeg=6000 ms=800 cycles=2 intensity=50"
-    );
+    let reply = &nodding.marks[0].reply;
+    assert_eq!(reply, "ok nod amp_mdeg=6000 ms=800 cycles=2 intensity=50");
     let frame = |t: &Trace, k: usize| t.rows[k].angles;
     for k in 0..300 {
         let (a, b) = (frame(&idle, k), frame(&nodding, k));
@@ -134,10 +132,8 @@ fn a_presence_script_rests_relaxes_wakes_and_glances() {
     // (Exactly: the angles are the limiter's own, no measurement's.)
     let (_, params) = built_in().unwrap();
     for axis in Axis::ALL {
-        let wake: Vec<f64> = (12_040..=13_060)
-            .step_by(20)
-            .map(|ms| f64::from(at(ms).angles[axis.index()]))
-            .collect();
+        let angle = |ms: u64| f64::from(at(ms).angles[axis.index()]);
+        let wake: Vec<f64> = (12_040..=13_060).step_by(20).map(angle).collect();
         let steps = Steps::of(&wake);
         let allowed = Steps::allowed(&params, axis, LimitMode::Idle);
         assert!(steps.within(allowed), "{axis:?}: {steps:?}");
@@ -152,11 +148,8 @@ fn a_presence_script_rests_relaxes_wakes_and_glances() {
         .collect();
     assert!(held.len() >= 100, "{} frames near -20°", held.len());
     assert!(!near(19_000));
-    let wake = trace
-        .marks
-        .iter()
-        .find(|m| m.reply.starts_with("ok wake"))
-        .unwrap();
+    let wake = trace.marks.iter().find(|m| m.reply.starts_with("ok wake"));
+    let wake = wake.unwrap();
     assert_eq!(
         (wake.t_ms, wake.reply.as_str()),
         (12_060, "ok wake ms=1000")
@@ -188,23 +181,22 @@ fn the_telemetry_of_a_trace_carries_the_radars_people() {
     let script = "0 idle off\n1 radar on\n1.2 radar 400,2000 -900,3000\n";
     let (_, params) = built_in().unwrap();
     let events = script::parse(script, &params).unwrap();
+    let asks = ["radar", "track"];
     let trace = simulate_watched(
         3_000_000,
         None,
         ServoRate::DEFAULT,
         &events,
         Some(20),
-        &["radar", "track"],
-    )
-    .unwrap();
+        &asks,
+    );
+    let trace = trace.unwrap();
     let lines = trace.watch.unwrap().lines;
     // 3 s at 20 a second: ticks at 0, 50, …, 2950 ms, each taken by the
     // first 20 ms frame at or after it.
     assert_eq!(lines.len(), 60);
-    let times: Vec<u64> = lines
-        .iter()
-        .map(|l| l.split_whitespace().nth(1).unwrap()[2..].parse().unwrap())
-        .collect();
+    let time = |l: &String| l.split_whitespace().nth(1).unwrap()[2..].parse().unwrap();
+    let times: Vec<u64> = lines.iter().map(time).collect();
     assert_eq!(&times[..4], [0, 60, 100, 160]);
     for line in &lines {
         let (body, crc) = line.rsplit_once(" *").unwrap();
@@ -212,11 +204,8 @@ fn the_telemetry_of_a_trace_carries_the_radars_people() {
         assert_eq!(crc, format!("{sum:02x}"), "{line}");
     }
     assert!(!lines[19].contains("targets="), "{}", lines[19]);
-    assert!(
-        lines[21].contains(" targets=0 at=- xy=- who=- *"),
-        "{}",
-        lines[21]
-    );
+    let nobody = &lines[21];
+    assert!(nobody.contains(" targets=0 at=- xy=- who=- *"), "{nobody}");
     let last = lines.last().unwrap();
     assert!(
         last.contains(" targets=2 at=") && last.contains(" xy=400,2000;-900,3000 who=0 *"),
@@ -224,8 +213,6 @@ fn the_telemetry_of_a_trace_carries_the_radars_people() {
     );
     // The radar sends from power-up, ten frames a second: 0 to 2.9 s.
     assert_eq!(trace.answers[0], "ok radar=on frames=30 bad=0 targets=2");
-    assert_eq!(
-        trace.answers[1],
-        "ok track=on height=300 mount=0 prefer=nearest"
-    );
+    let track = &trace.answers[1];
+    assert_eq!(track, "ok track=on height=300 mount=0 prefer=nearest");
 }
