@@ -129,9 +129,8 @@ fn return_duration(params: &BehaviourParams, pitch: Angle, yaw: Angle) -> Option
 /// up in time order.
 pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
     let applied = |m: &Mark| !m.refused();
-    let gestures: Vec<usize> = (0..marks.len())
-        .filter(|&i| marks[i].kind == Kind::Gesture && applied(&marks[i]))
-        .collect();
+    let gesture = |i: &usize| marks[*i].kind == Kind::Gesture && applied(&marks[*i]);
+    let gestures: Vec<usize> = (0..marks.len()).filter(gesture).collect();
     for pair in gestures.windows(2) {
         let next = marks[pair[1]].t_ms;
         let mark = &mut marks[pair[0]];
@@ -149,8 +148,8 @@ pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
         }
         let next_move = marks[i + 1..]
             .iter()
-            .find(|m| m.kind == Kind::Gaze && applied(m))
-            .map(|m| m.t_ms);
+            .find(|m| m.kind == Kind::Gaze && applied(m));
+        let next_move = next_move.map(|m| m.t_ms);
         let mark = &mut marks[i];
         match next_move {
             Some(t) if t <= mark.t_ms => keep[i] = false,
@@ -168,8 +167,7 @@ pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
 
 /// Draws `trace` to the PNG `path`: the three axes over time (in minutes
 /// past five of them), each command marked where it was applied and its
-/// motion shaded on the axes it moves (a look's return in blue, a refused
-/// command in red).
+/// motion shaded on the axes it moves.
 #[allow(clippy::cast_precision_loss)] // frame times, far below 2^52
 pub fn draw(trace: &Trace, seed: Option<u32>, path: &std::path::Path) -> anyhow::Result<()> {
     let end_ms = trace.rows.last().map_or(0, |r| r.t_us / 1000);
@@ -179,25 +177,28 @@ pub fn draw(trace: &Trace, seed: Option<u32>, path: &std::path::Path) -> anyhow:
         ("s", 1000.0)
     };
     let at = |ms: u64| ms as f64 / ms_per_unit;
-    let back = |m: &Mark| m.kind == Kind::Return;
+    // A look's return in blue, a refused command's line in red.
+    let (blue, light_blue, orange) = (
+        RGBColor(70, 110, 160),
+        RGBColor(214, 230, 245),
+        RGBColor(255, 228, 196),
+    );
     let marks: Vec<plot::Mark> = (trace.marks.iter())
-        .map(|m| plot::Mark {
-            from: at(m.t_ms),
-            to: at(m.t_ms + m.span_ms),
-            axes: m.axes.clone(),
-            label: m.label.clone(),
-            line: if m.refused() {
-                RED
-            } else if back(m) {
-                RGBColor(70, 110, 160)
-            } else {
-                GREY
-            },
-            shade: if back(m) {
-                RGBColor(214, 230, 245)
-            } else {
-                RGBColor(255, 228, 196)
-            },
+        .map(|m| {
+            let back = m.kind == Kind::Return;
+            let line = match (m.refused(), back) {
+                (true, _) => RED,
+                (false, true) => blue,
+                (false, false) => GREY,
+            };
+            plot::Mark {
+                from: at(m.t_ms),
+                to: at(m.t_ms + m.span_ms),
+                axes: m.axes.clone(),
+                label: m.label.clone(),
+                line,
+                shade: if back { light_blue } else { orange },
+            }
         })
         .collect();
     let rows: Vec<(f64, [f64; 3])> = (trace.rows.iter())
@@ -207,18 +208,11 @@ pub fn draw(trace: &Trace, seed: Option<u32>, path: &std::path::Path) -> anyhow:
         || "Table 2 loops".to_owned(),
         |s| format!("loops of seed {s}"),
     );
-    let title = format!(
-        "Commanded angles, {} frames ({loops}; after fade, limits and clamps)",
-        rows.len()
-    );
+    let frames = rows.len();
+    let title =
+        format!("Commanded angles, {frames} frames ({loops}; after fade, limits and clamps)");
     let note = "shaded: a command's motion on the axes it moves (blue: a look's return to the \
                 centre); dashed: when it was applied (red: refused)";
-    plot::motion(
-        path,
-        title,
-        vec![note.to_owned()],
-        &format!("time ({unit})"),
-        &rows,
-        &marks,
-    )
+    let x = format!("time ({unit})");
+    plot::motion(path, title, vec![note.to_owned()], &x, &rows, &marks)
 }
