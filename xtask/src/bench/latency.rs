@@ -1,16 +1,10 @@
 //! The latency rows of `cargo xtask bench`: how long an input takes to
 //! reach the servo pins, measured in the RP2040 emulator on the shipped
 //! image (docs/dev/emulators.md, "Latency"). One run per path, at least
-//! [`EVENTS`] events at seeded random times (so that their phases against
-//! the frame spread evenly). An event's time is when the input has fully
-//! arrived (the end of the DMX frame that carries the change, the USB
-//! host's hand-over of a line's last byte, a button's edge); its baseline
-//! the axis at rest before it (the last two pulses of equal width, else the
-//! event is skipped); its response the rise of the first pulse after it
-//! whose width differs from the baseline by more than one and a half PWM
-//! counts at the row's rate. A row gives the latencies' median, 99th
-//! percentile and largest, in ms, against its goal for p99, and the longest
-//! a port task waited for the CPU.
+//! [`EVENTS`] events at seeded random times, so that their phases against
+//! the frame spread evenly, each timed by [`response`]. A row gives the
+//! latencies' median, 99th percentile and largest, in ms, against its goal
+//! for p99, and the longest a port task waited for the CPU.
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
@@ -206,8 +200,12 @@ pub enum Response {
     After(f64),
 }
 
-/// The response to an event at `at` (ns) on an axis whose pulses are
-/// `pulses`.
+/// The response to an event at `at` (ns: when the input has fully arrived,
+/// the end of the DMX frame that carries the change, the USB host's
+/// hand-over of a line's last byte, a button's edge) on an axis whose
+/// pulses are `pulses`: the rise of the first pulse whose width differs
+/// from the baseline, the axis at rest before the event (the last two
+/// pulses of equal width), by more than one and a half PWM counts.
 pub fn response(pulses: &[Measured], at: f64, count_ns: f64) -> Response {
     let before = pulses.partition_point(|p| p.rise < at);
     let baseline = before.checked_sub(2).map(|i| (&pulses[i], &pulses[i + 1]));

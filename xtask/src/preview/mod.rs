@@ -1,9 +1,8 @@
 //! `cargo xtask preview`: the stages of a loop, from the core's engine on
 //! the host, as `<out>/<stem>.csv` (`n,walk,smoothed,normalized,final` in
 //! degrees, `stages.rs`) and `<out>/<stem>.png` (panels in the style of the
-//! paper's Figures 6 and 7).
+//! paper's Figures 6 and 7, drawn by [`crate::plot`]).
 
-mod figure;
 mod stages;
 
 use std::path::PathBuf;
@@ -137,7 +136,7 @@ pub fn command(args: &Args) -> Result<bool> {
         let stages = Stages::compute(spec)?;
         let [csv, png] = ["csv", "png"].map(|ext| out.join(format!("{stem}.{ext}")));
         project::write(&csv, stages.csv())?;
-        figure::draw(&stages, &png)?;
+        stages::draw(&stages, &png)?;
         println!("{}", stages.title());
         for line in &stages.metric_lines() {
             println!("  {line}");

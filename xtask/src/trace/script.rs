@@ -174,14 +174,10 @@ mod tests {
     use super::*;
     use std::fmt::Write as _;
 
-    use idle_head_core::behaviour::BehaviourConfig;
     use idle_head_core::command::GestureKind;
-    use idle_head_core::driver::DriverConfig;
 
     fn params() -> BehaviourParams {
-        BehaviourConfig::DEFAULT
-            .build(&DriverConfig::DEFAULT.build().unwrap())
-            .unwrap()
+        crate::trace::built_in().unwrap().1
     }
 
     #[test]
