@@ -213,6 +213,6 @@ fn the_telemetry_of_a_trace_carries_the_radars_people() {
     );
     // The radar sends from power-up, ten frames a second: 0 to 2.9 s.
     assert_eq!(trace.answers[0], "ok radar=on frames=30 bad=0 targets=2");
-    let track = &trace.answers[1];
-    assert_eq!(track, "ok track=on height=300 mount=0 prefer=nearest");
+    let tracking = &trace.answers[1];
+    assert_eq!(tracking, "ok track=on height=300 mount=0 prefer=nearest");
 }
