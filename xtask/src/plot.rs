@@ -296,9 +296,8 @@ mod tests {
     #[test]
     fn a_long_curve_is_drawn_as_each_columns_range_and_mean_and_a_figure_is_drawn() {
         // A saw tooth of 10 points, 0 to 9, over 180,000 points.
-        let points: Vec<(f64, f64)> = (0..180_000)
-            .map(|i| (f64::from(i), f64::from(i % 10)))
-            .collect();
+        let saw = |i| (f64::from(i), f64::from(i % 10));
+        let points: Vec<(f64, f64)> = (0..180_000).map(saw).collect();
         let bands = bands(&points, 1300);
         assert!(bands.len() <= 1300 && bands.len() > 1200, "{}", bands.len());
         for &(_, min, max, mean) in &bands {
@@ -317,15 +316,8 @@ mod tests {
             shade: LIGHT,
         };
         let rows = [(0.0, [0.0; 3]), (1.0, [1.0, 2.0, 3.0]), (3.0, [0.0; 3])];
-        motion(
-            &path,
-            "a figure".into(),
-            vec!["a note".into()],
-            "s",
-            &rows,
-            &[mark],
-        )
-        .unwrap();
+        let notes = vec!["a note".into()];
+        motion(&path, "a figure".into(), notes, "s", &rows, &[mark]).unwrap();
         assert!(std::fs::read(&path).unwrap().starts_with(b"\x89PNG"));
     }
 }

@@ -171,34 +171,24 @@ mod tests {
         let three = loops("--name head").unwrap();
         let names: Vec<&str> = three.iter().map(|(_, name)| name.as_str()).collect();
         assert_eq!(names, ["head-pitch", "head-roll", "head-yaw"]);
-        assert_eq!(
-            (three[0].0.cfg, three[2].0.n),
-            (DEFAULT_HEAD.pitch, DEFAULT_N)
-        );
+        let first = (three[0].0.cfg, three[2].0.n);
+        assert_eq!(first, (DEFAULT_HEAD.pitch, DEFAULT_N));
         let one = loops("--seed 127 --n=450 --w 31 --range -4.5 12 --closure Paper --axis pitch");
         let one = one.unwrap();
         let [(spec, name)] = &one[..] else {
             panic!("{one:?}")
         };
-        assert_eq!(
-            (name.as_str(), spec.axis, spec.n),
-            ("loop", Axis::Pitch, 450)
-        );
+        assert_eq!((name.as_str(), spec.axis), ("loop", Axis::Pitch));
+        assert_eq!(spec.n, 450);
         let range = AngleRange {
             min: Angle::from_millidegrees(-4500),
             max: Angle::from_degrees(12),
         };
         let cfg = &spec.cfg;
-        assert_eq!(
-            (cfg.seed, cfg.window, cfg.range, cfg.closure),
-            (127, 31, range, Closure::Paper)
-        );
-        for bad in [
-            "--closure smooth",
-            "--axis sideways",
-            "--range 1 1e30",
-            "--name a/b",
-        ] {
+        assert_eq!((cfg.seed, cfg.window), (127, 31));
+        assert_eq!((cfg.range, cfg.closure), (range, Closure::Paper));
+        let bad = "--closure smooth|--axis sideways|--range 1 1e30|--name a/b";
+        for bad in bad.split('|') {
             assert!(loops(bad).is_err(), "{bad}");
         }
         // A range the firmware cannot play: the error is the core's.
@@ -207,9 +197,7 @@ mod tests {
             axis: Axis::Yaw,
             error: cfg.validate(Axis::Yaw, DEFAULT_N).unwrap_err(),
         };
-        assert_eq!(
-            format!("{:#}", loops("--range -50 50").unwrap_err()),
-            core.to_string()
-        );
+        let error = loops("--range -50 50").unwrap_err();
+        assert_eq!(format!("{error:#}"), core.to_string());
     }
 }
