@@ -290,11 +290,11 @@ pub fn frames_over_budget(frames: &[FrameRow]) -> Option<String> {
                 || "no ceiling".to_owned(),
                 |[median, max]| format!("ceiling {} and {}", thousands(median), thousands(max)),
             );
+            let (label, median) = (frame.label(), thousands(frame.median));
+            let max = thousands(frame.max);
             format!(
-                "row `{}` takes {} instructions at the median and {} at most ({ceiling})",
-                frame.label(),
-                thousands(frame.median),
-                thousands(frame.max)
+                "row `{label}` takes {median} instructions at the median and {max} at most \
+                 ({ceiling})"
             )
         })
         .collect();

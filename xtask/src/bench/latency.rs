@@ -106,8 +106,9 @@ impl Row {
             slowest.join(", ")
         );
         if p99 > self.goal_ms {
-            text += "  (where the time goes: the wait for the next frame (0 to a frame), the PWM's \
-                     latch to the next period (a tenth of one), and the transport before the frame)\n";
+            text += "  (where the time goes: the wait for the next frame (0 to a frame), the \
+                     PWM's latch to the next period (a tenth of one), and the transport before \
+                     the frame)\n";
         }
         if let Some(us) = self.waited_us {
             let _ = writeln!(text, "  (port tasks waited at most {us} µs for the CPU)");
@@ -309,10 +310,8 @@ pub fn input_edge(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Ro
     let time = script_time(&events);
     let report = play_script(root, metadata, events, time, wall.max(SCRIPT_WALL))?;
     if !report.problems.is_empty() {
-        bail!(
-            "the input edge's run failed its checks:\n  {}",
-            report.problems.join("\n  ")
-        );
+        let problems = report.problems.join("\n  ");
+        bail!("the input edge's run failed its checks:\n  {problems}");
     }
     let boot = report.first()?;
     let edges: Vec<f64> = boot.drives.iter().filter(|d| !d.2).map(|d| d.0).collect();
@@ -329,13 +328,8 @@ fn press_script(times: &[Duration]) -> String {
     );
     let show = |at: Duration| format!("{}.{:06}", at.as_secs(), at.subsec_micros());
     for (k, &at) in times.iter().enumerate() {
-        let pin = 2 + k % 2;
-        let _ = writeln!(
-            text,
-            "{} pin {pin} low\n{} pin {pin} high",
-            show(at),
-            show(at + HELD)
-        );
+        let (pin, press, release) = (2 + k % 2, show(at), show(at + HELD));
+        let _ = writeln!(text, "{press} pin {pin} low\n{release} pin {pin} high");
     }
     text
 }

@@ -204,10 +204,8 @@ pub fn draw(trace: &Trace, seed: Option<u32>, path: &std::path::Path) -> anyhow:
     let rows: Vec<(f64, [f64; 3])> = (trace.rows.iter())
         .map(|r| (at(r.t_us / 1000), r.angles.map(|a| f64::from(a) / 1000.0)))
         .collect();
-    let loops = seed.map_or_else(
-        || "Table 2 loops".to_owned(),
-        |s| format!("loops of seed {s}"),
-    );
+    let loops = seed.map(|s| format!("loops of seed {s}"));
+    let loops = loops.unwrap_or_else(|| "Table 2 loops".to_owned());
     let frames = rows.len();
     let title =
         format!("Commanded angles, {frames} frames ({loops}; after fade, limits and clamps)");
