@@ -276,12 +276,8 @@ mod tests {
             assert_eq!(result.loops.len() + result.rejected.len(), 9);
             if closure == Closure::Seamless {
                 // The seamless loop starts at the neutral pose and stays in range.
-                assert!(
-                    result
-                        .loops
-                        .iter()
-                        .all(|m| m[5] == 0.0 && m[3] >= 0.0 && m[4] >= 0.0)
-                );
+                let mut loops = result.loops.iter();
+                assert!(loops.all(|m| m[5] == 0.0 && m[3] >= 0.0 && m[4] >= 0.0));
             }
         }
     }

@@ -202,15 +202,10 @@ impl Stages {
         let m = &self.metrics;
         let LoopSpec { cfg, .. } = self.spec;
         let inside = cfg.range.contains(m.min) && cfg.range.contains(m.max);
+        let (d1, d2, lively) = (m.velocity_ratio, m.acceleration_ratio, m.liveliness);
         vec![
-            format!(
-                "continuity: max|d1|/P95|d1| = {:.2}, max|d2|/P95|d2| = {:.2}",
-                m.velocity_ratio, m.acceleration_ratio
-            ),
-            format!(
-                "liveliness (min over 10 segments of mean|d1| / mean|d1|) = {:.2}",
-                m.liveliness
-            ),
+            format!("continuity: max|d1|/P95|d1| = {d1:.2}, max|d2|/P95|d2| = {d2:.2}"),
+            format!("liveliness (min over 10 segments of mean|d1| / mean|d1|) = {lively:.2}"),
             format!(
                 "range: min = {:.3}°, max = {:.3}° ({} [{}°, {}°]); start x(0) = {:.3}°",
                 deg(m.min),
@@ -363,16 +358,10 @@ mod tests {
     fn stages_of_a_default_axis() {
         for closure in [Closure::Paper, Closure::Seamless] {
             let cfg = DEFAULT_HEAD.pitch.with_closure(closure);
-            let stages = Stages::compute(LoopSpec {
-                axis: Axis::Pitch,
-                n: DEFAULT_N,
-                cfg,
-            })
-            .unwrap();
-            let norm = &stages.normalized;
-            let (lo, hi) = norm
-                .iter()
-                .fold((f64::MAX, f64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+            let (axis, n) = (Axis::Pitch, DEFAULT_N);
+            let stages = Stages::compute(LoopSpec { axis, n, cfg }).unwrap();
+            let norm = stages.normalized.iter();
+            let (lo, hi) = norm.fold((f64::MAX, f64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
             assert!((lo + 4.0).abs() < 1e-9 && (hi - 12.0).abs() < 1e-9);
             assert_eq!(stages.tapered.is_some(), closure == Closure::Paper);
             let csv = stages.csv();
