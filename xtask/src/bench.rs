@@ -4,8 +4,9 @@
 //! direct-form f32 smoothing) and `frame bench [rate=…] [scenario=…]
 //! frames=… min=… median=… max=… max_at=… mean=…` (one frame update over a
 //! whole loop, idle and with a gesture and a look, at 50 and 333 Hz); this
-//! module prints them and holds the default row to its [`BUDGET`] and each
-//! frame row to its ceiling. Then the latency rows (`latency.rs`).
+//! module holds the default row to its [`BUDGET`] and each frame row to its
+//! ceiling, and the frame work to its own with telemetry streaming. Then the
+//! tracking figures and the latency rows.
 
 // Instruction counts are far below 2^52 and positive: the float conversions are exact.
 #![allow(
@@ -14,17 +15,20 @@
     clippy::cast_sign_loss
 )]
 
+use std::io::Read;
 use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 
 pub mod latency;
 mod paths;
-
-pub use latency::stage as latency_stage;
-mod telemetry;
 pub mod tracking;
 
+pub use latency::stage as latency_stage;
+
+use crate::console::{Pace, qemu_session};
 use crate::figures::{self, thousands};
 use crate::log::{LogLine, Run, field, number};
 use crate::{
@@ -37,10 +41,9 @@ use crate::{
 /// The benchmark image: bin `bench` of the QEMU package (`boards/qemu/src/bench.rs`).
 pub const BENCH: Image = Image::qemu("bench");
 
-/// The budget for the default set (three axes, N = 900, W = 59) at boot:
-/// 150,000 instructions, about 1.2 ms on a 125 MHz RP2040. The count is a
-/// property of the compiler as much as of the code, which is why
-/// rust-toolchain.toml pins the toolchain.
+/// The default set's budget (three axes, N = 900, W = 59) at boot, about
+/// 1.2 ms on a 125 MHz RP2040. The count depends on the compiler as much as
+/// on the code: rust-toolchain.toml pins the toolchain.
 pub const BUDGET: u64 = 150_000;
 
 /// The name of the benchmark's stage in `cargo xtask test`.
@@ -53,22 +56,27 @@ pub const LATENCY_STAGE: &str = "latency in the RP2040 emulator: at 50 Hz a look
      UART0, an input edge, DMX and a Bottango curve each on the servos within 25 ms at p99, at \
      200 Hz a look over UART0 within 8 ms; no port task waits more than 1 ms for the CPU";
 
-/// RP2040 system clock (Hz) the time column assumes: 125 MHz, the Pico's default.
+/// The Pico's default system clock, Hz, which the time columns assume.
 const RP2040_HZ: f64 = 125e6;
 
-/// The rows the image must report: the default, across W (N = 900), across N (W = 59).
-const LABELS: [&str; 7] = ["default", "w15", "w59", "w239", "n450", "n900", "n1800"];
-
 /// Largest max/min engine count over the W rows still called flat: the
-/// engine's smoother is O(N) whatever W is, only the O(W) kernel table and
-/// wrap correction grow with W (the direct form grows 16× from W = 15 to 239).
+/// engine's smoother is O(N) whatever W is (the direct form grows 16× from
+/// W = 15 to 239).
 const FLAT_LIMIT: f64 = 1.5;
 
 /// How far the marginal cost per sample may change between N = 450..900 and
-/// N = 900..1800 (as a ratio) and still be called linear. The plain ratio
-/// n1800/n450 is 4 only without a fixed cost (kernel table, wrap correction,
-/// call overhead), which pulls it below 4; the marginal cost ignores that.
+/// 900..1800 (as a ratio) and still be called linear; the plain ratio
+/// n1800/n450 is pulled below 4 by the fixed cost.
 const MARGINAL_TOLERANCE: f64 = 0.1;
+
+/// The numbers `keys` of the log line `message`.
+fn numbers<const N: usize>(message: &str, keys: [&str; N]) -> Result<[u64; N]> {
+    let mut out = [0; N];
+    for (value, key) in out.iter_mut().zip(keys) {
+        *value = number(message, key)?;
+    }
+    Ok(out)
+}
 
 /// One `bench row=...` line: instructions of the engine (three axes, the
 /// whole pipeline) and of the direct-form f32 smoothing (three axes).
@@ -86,32 +94,28 @@ pub fn rows(log: &[LogLine]) -> Result<Vec<Row>> {
     let rows = log.iter().filter(|l| l.message.starts_with("bench "));
     let row = |m: &str| -> Result<Row> {
         let label = field(m, "row").with_context(|| format!("`{m}` has no `row=`"))?;
-        let [n, w, engine, direct] = ["n", "w", "engine", "direct"].map(|key| number(m, key));
+        let [n, w, engine, direct] = numbers(m, ["n", "w", "engine", "direct"])?;
         let label = label.to_owned();
         Ok(Row {
             label,
-            n: n?,
-            w: w?,
-            engine: engine?,
-            direct: direct?,
+            n,
+            w,
+            engine,
+            direct,
         })
     };
     rows.map(|line| row(&line.message)).collect()
 }
 
-/// What the rows say: the budget, flatness in W and linearity in N.
+/// What the rows say: the `default` row's engine count; max/min over the W
+/// rows; n1800/n450 (4 if proportional to N); the marginal cost per unit of
+/// N from 450 to 900 and from 900 to 1800; the fixed cost this implies.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Verdict {
-    /// Engine instructions of the `default` row.
     pub default: u64,
-    /// max/min of the engine counts over the W rows.
     pub flatness: f64,
-    /// engine(n1800) / engine(n450): 4 if the cost is proportional to N.
     pub linearity: f64,
-    /// Marginal engine instructions per unit of N (three axes) from N = 450
-    /// to 900 and from 900 to 1800.
     pub marginal: [f64; 2],
-    /// The fixed cost this implies: engine(n450) − 450 × the first marginal cost.
     pub fixed: f64,
 }
 
@@ -142,8 +146,7 @@ impl Verdict {
         self.flatness <= FLAT_LIMIT
     }
 
-    /// The engine count grows linearly with N: the same marginal cost per
-    /// sample over both steps of N.
+    /// The same marginal cost per sample over both steps of N.
     pub fn linear(&self) -> bool {
         let [a, b] = self.marginal;
         a > 0.0 && b > 0.0 && (b / a - 1.0).abs() <= MARGINAL_TOLERANCE
@@ -174,26 +177,22 @@ impl Verdict {
     }
 }
 
-/// The frame rows the image must report at every one of [`RATES`] (Hz):
-/// by scenario, and their ceilings on the median and the max. Idle:
-/// playback, fade, limits, mapping and PWM writes of three servos, 1,200 at
-/// the median (about 10 µs on a 125 MHz RP2040). With a gesture and a look
-/// playing, the mixer's gesture shape and the gaze's minimum-jerk moves are
-/// evaluated afresh every frame: 2,000 at the median. The costliest frame
-/// of either stays within 4,000.
+/// The frame rows the image must report at every one of [`RATES`] (Hz), by
+/// scenario, with their ceilings on the median and the max. Idle (playback,
+/// fade, limits, mapping, three PWM writes): 1,200 at the median, about
+/// 10 µs on a 125 MHz RP2040. With a gesture and a look, whose shapes are
+/// evaluated afresh every frame: 2,000. The costliest frame: 4,000.
 pub const CEILINGS: [(Option<&str>, [u64; 2]); 2] =
     [(None, [1200, 4000]), (Some("gesture+look"), [2000, 4000])];
 pub const RATES: [u64; 2] = [50, 333];
-/// The idle frame's median ceiling at 333 Hz: 1,300, over the 1,200 of the
-/// other rates. The duty is counted from the exact angle (so that a look's
-/// first 5 ms frame at 200 Hz, 16 mdeg, reaches the pulse), besides the
-/// whole-µs pulse the reports show: about 45 instructions a servo more.
-/// At 333 Hz, 1,300 instructions are 0.35 % of a frame's 375,375 cycles.
+/// The idle median's ceiling at 333 Hz: the duty is counted from the exact
+/// angle (so that a look's first 5 ms frame at 200 Hz, 16 mdeg, reaches the
+/// pulse), about 45 instructions a servo more; 0.35 % of a 333 Hz frame.
 pub const IDLE_MEDIAN_AT_333_HZ: u64 = 1300;
 
-/// A `frame bench ...` line: instructions per frame update over a loop, at
-/// the servo rate `rate` (Hz; 50 in a log without `rate=`), with
-/// `scenario` playing besides the idle loops (if any).
+/// A `frame bench ...` line: instructions per frame update over a loop at
+/// the servo rate `rate` (Hz; 50 in a log without `rate=`), with `scenario`
+/// playing over the idle (if any); `max_at` is the frame that took `max`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FrameRow {
     pub rate: u64,
@@ -202,7 +201,6 @@ pub struct FrameRow {
     pub min: u64,
     pub median: u64,
     pub max: u64,
-    /// The frame that took `max`.
     pub max_at: u64,
     pub mean: u64,
 }
@@ -215,38 +213,31 @@ impl FrameRow {
             .iter()
             .filter_map(|l| l.message.strip_prefix("frame bench "));
         let row = |m: &str| -> Result<Self> {
-            let [frames, min, median, max, max_at, mean] =
-                ["frames", "min", "median", "max", "max_at", "mean"].map(|key| number(m, key));
+            let keys = ["frames", "min", "median", "max", "max_at", "mean"];
+            let [frames, min, median, max, max_at, mean] = numbers(m, keys)?;
+            let rate = field(m, "rate").map_or(Ok(50), |_| number(m, "rate"))?;
+            let scenario = field(m, "scenario").map(str::to_owned);
             Ok(Self {
-                rate: if field(m, "rate").is_some() {
-                    number(m, "rate")?
-                } else {
-                    50
-                },
-                scenario: field(m, "scenario").map(str::to_owned),
-                frames: frames?,
-                min: min?,
-                median: median?,
-                max: max?,
-                max_at: max_at?,
-                mean: mean?,
+                rate,
+                scenario,
+                frames,
+                min,
+                median,
+                max,
+                max_at,
+                mean,
             })
         };
         let rows: Vec<Self> = lines.map(row).collect::<Result<_>>()?;
         for (rate, (scenario, _)) in RATES.into_iter().flat_map(|r| CEILINGS.map(|c| (r, c))) {
-            if !rows
-                .iter()
-                .any(|row| row.rate == rate && row.scenario.as_deref() == scenario)
-            {
+            if !(rows.iter()).any(|row| row.rate == rate && row.scenario.as_deref() == scenario) {
                 let scenario = scenario.map_or(String::new(), |s| format!(" scenario={s}"));
                 bail!("the benchmark reported no `frame bench rate={rate}{scenario}` line");
             }
         }
         if let Some(row) = rows.iter().find(|row| row.ceiling().is_none()) {
-            bail!(
-                "the benchmark reported a frame row without a ceiling: `{}`",
-                row.label()
-            );
+            let label = row.label();
+            bail!("the benchmark reported a frame row without a ceiling: `{label}`");
         }
         Ok(rows)
     }
@@ -269,13 +260,10 @@ impl FrameRow {
             .is_some_and(|[median, max]| self.median <= median && self.max <= max)
     }
 
-    /// The row's label: `frame`, or `frame (gesture + look)`; at another
-    /// rate than 50 Hz, with it: `frame at 333 Hz`.
+    /// `frame`, or `frame (gesture + look)`; at another rate than 50 Hz,
+    /// with it: `frame at 333 Hz`.
     pub fn label(&self) -> String {
-        let scenario = self
-            .scenario
-            .as_ref()
-            .map(|s| format!(" ({})", s.replace('+', " + ")));
+        let scenario = (self.scenario.as_ref()).map(|s| format!(" ({})", s.replace('+', " + ")));
         let rate = (self.rate != 50).then(|| format!(" at {} Hz", self.rate));
         format!(
             "frame{}{}",
@@ -285,10 +273,8 @@ impl FrameRow {
     }
 
     /// The share of the CPU the frame update takes at the row's rate, %:
-    /// the mean frame's instructions at one 125 MHz cycle each (a lower
-    /// bound: some take two or more; QEMU counts one instruction a ns) over
-    /// the frame period (the servo rate's rounding to whole µs: 3003 at
-    /// 333 Hz).
+    /// the mean frame at one 125 MHz cycle an instruction (a lower bound)
+    /// over the frame period (rounded to whole µs: 3003 at 333 Hz).
     pub fn load_percent(&self) -> f64 {
         let period_us = (1_000_000 + self.rate / 2) / self.rate.max(1);
         self.mean as f64 / RP2040_HZ * 1e6 / period_us as f64 * 100.0
@@ -304,11 +290,11 @@ pub fn frames_over_budget(frames: &[FrameRow]) -> Option<String> {
                 || "no ceiling".to_owned(),
                 |[median, max]| format!("ceiling {} and {}", thousands(median), thousands(max)),
             );
+            let (label, median) = (frame.label(), thousands(frame.median));
+            let max = thousands(frame.max);
             format!(
-                "row `{}` takes {} instructions at the median and {} at most ({ceiling})",
-                frame.label(),
-                thousands(frame.median),
-                thousands(frame.max)
+                "row `{label}` takes {median} instructions at the median and {max} at most \
+                 ({ceiling})"
             )
         })
         .collect();
@@ -317,8 +303,7 @@ pub fn frames_over_budget(frames: &[FrameRow]) -> Option<String> {
 
 /// Fails if the run or the log is broken, or (unless `no_budget`) if the
 /// default row or a frame row is over its budget. `smoke`: the QEMU smoke
-/// image's plain run, if the caller made it (the telemetry check compares
-/// against it; without, it runs the image itself).
+/// image's plain run, if the caller made it (for the telemetry check).
 pub fn run_and_check(
     root: &Path,
     metadata: &Metadata,
@@ -331,45 +316,31 @@ pub fn run_and_check(
     if !run.succeeded() {
         bail!("{}", run.describe());
     }
+    // The verdict needs every row: the default, across W and across N.
     let rows = rows(&run.log)?;
-    let missing: Vec<&str> = LABELS
-        .into_iter()
-        .filter(|l| !rows.iter().any(|row| row.label == *l))
-        .collect();
-    if !missing.is_empty() {
-        bail!("the benchmark reported no row for {}", missing.join(", "));
-    }
     let verdict = Verdict::of(&rows)?;
     print!("{}", verdict.lines());
     let frames = FrameRow::all(&run.log)?;
     record_figures(&rows, &frames);
     QEMU.build(root)?;
-    println!(
-        "\n{}",
-        telemetry::check(&QEMU.elf(metadata), options.timeout, smoke)?
-    );
+    let telemetry = telemetry_check(&QEMU.elf(metadata), options.timeout, smoke)?;
+    println!("\n{telemetry}");
     let mut over = frames_over_budget(&frames).into_iter().collect::<Vec<_>>();
     if verdict.default > BUDGET {
+        let (default, budget) = (thousands(verdict.default), thousands(BUDGET));
         over.push(format!(
-            "the default set takes {} instructions, over its budget of {}",
-            thousands(verdict.default),
-            thousands(BUDGET)
+            "the default set takes {default} instructions, over its budget of {budget}"
         ));
     }
-    match (over.is_empty(), options.no_budget) {
-        (true, _) => Ok(()),
-        (false, true) => {
-            println!(
-                "(--no-budget: the ceilings are reported, not enforced: {})",
-                over.join("; ")
-            );
-            Ok(())
-        }
-        (false, false) => bail!(
-            "{} (pass --no-budget to report without failing)",
-            over.join("; ")
-        ),
+    let over = over.join("; ");
+    if over.is_empty() {
+        return Ok(());
     }
+    if !options.no_budget {
+        bail!("{over} (pass --no-budget to report without failing)");
+    }
+    println!("(--no-budget: the ceilings are reported, not enforced: {over})");
+    Ok(())
 }
 
 /// `cargo xtask bench`: the rows in QEMU, then the latency rows in the
@@ -381,14 +352,16 @@ pub fn command(options: Options) -> Result<bool> {
     // How the head follows people, in the host trace.
     let tracking = tracking::stage();
     let latency = latency::stage(&root, &metadata);
-    for (what, result) in [
+    let results = [
         ("bench", &qemu),
         ("tracking", &tracking),
         ("latency", &latency),
-    ] {
-        if let Err(error) = result {
-            println!("{what} FAILED: {error:#}");
-        }
+    ];
+    for (what, error) in results
+        .iter()
+        .filter_map(|(w, r)| Some((w, r.as_ref().err()?)))
+    {
+        println!("{what} FAILED: {error:#}");
     }
     Ok(qemu.is_ok() && tracking.is_ok() && latency.is_ok())
 }
@@ -402,18 +375,8 @@ fn record_figures(rows: &[Row], frames: &[FrameRow]) {
                  (a 20 ms frame: 2,500,000 cycles of a 125 MHz RP2040) and 333 Hz (3003 µs: \
                  375,375 cycles). The CPU load is the mean frame at one cycle an instruction \
                  over the frame period: a lower bound.";
-    let header = [
-        "row",
-        "rate",
-        "frames",
-        "min",
-        "median",
-        "max",
-        "mean",
-        "ceiling (median / max)",
-        "median at 125 MHz",
-        "CPU load",
-    ];
+    let header = "row|rate|frames|min|median|max|mean|ceiling (median / max)|median at 125 MHz|\
+                  CPU load";
     // Each with its ceiling: `FrameRow::all` refused a row without one.
     let cells = frames.iter().filter_map(|row| {
         let [median, max] = row.ceiling()?;
@@ -424,6 +387,7 @@ fn record_figures(rows: &[Row], frames: &[FrameRow]) {
         cells.push(format!("≥ {:.3} %", row.load_percent()));
         Some(cells)
     });
+    let header: Vec<&str> = header.split('|').collect();
     figures::record("frames", intro.to_owned(), &header, cells.collect());
     let intro = format!(
         "Instructions of the three axes' loops, computed at boot, for the default set and \
@@ -432,15 +396,8 @@ fn record_figures(rows: &[Row], frames: &[FrameRow]) {
          set's ceiling is {} instructions.",
         thousands(BUDGET)
     );
-    let header = [
-        "row",
-        "N",
-        "W",
-        "engine",
-        "direct f32 smoothing",
-        "ratio",
-        "engine at 125 MHz",
-    ];
+    let header = "row|N|W|engine|direct f32 smoothing|ratio|engine at 125 MHz";
+    let header: Vec<&str> = header.split('|').collect();
     let cells = rows.iter().map(|row| {
         vec![
             row.label.clone(),
@@ -453,6 +410,97 @@ fn record_figures(rows: &[Row], frames: &[FrameRow]) {
         ]
     });
     figures::record("precompute", intro, &header, cells.collect());
+}
+
+/// Instructions per `SysTick` count in the smoke run (12.5 MHz after reset
+/// under `-icount shift=0`, `boards/qemu/src/systick.rs`).
+const INSNS_PER_COUNT: u64 = 80;
+
+/// Telemetry lines to see before the host hangs up: the schedule's
+/// fade-out starts at frame 1800, a line every 20 frames.
+const LINES: usize = 80;
+
+/// The console's input: `watch 50`, then nothing until [`LINES`] telemetry
+/// lines came (or the deadline passed), then the end (the host hangs up).
+struct Streaming<'a> {
+    sent: bool,
+    seen: &'a AtomicUsize,
+    deadline: Instant,
+}
+
+impl Read for Streaming<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if !std::mem::replace(&mut self.sent, true) {
+            let line = b"watch 50\n";
+            buf[..line.len()].copy_from_slice(line);
+            return Ok(line.len());
+        }
+        while self.seen.load(Ordering::Acquire) < LINES && Instant::now() < self.deadline {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        Ok(0)
+    }
+}
+
+/// What a run logged of its frame work: `(average, at most)`.
+fn frame_work(log: &[LogLine]) -> Result<(u64, u64)> {
+    let line = log
+        .iter()
+        .find_map(|l| l.message.strip_prefix("frame work: "));
+    let line = line.context("the run logged no frame work")?;
+    let words = line.split(|c: char| !c.is_ascii_digit());
+    let mut numbers = words.filter(|w| !w.is_empty()).map(str::parse);
+    match (numbers.next(), numbers.next()) {
+        (Some(Ok(average)), Some(Ok(most))) => Ok((average, most)),
+        _ => bail!("unreadable frame work line: {line}"),
+    }
+}
+
+/// The frame work with telemetry streaming: runs the QEMU smoke image `elf`
+/// with `watch 50` on UART0 through the smoke schedule, against its plain
+/// run (`plain`, else run here). The frame work it logs (average and worst)
+/// must stay within one `SysTick` count: telemetry is written by the
+/// console task, never on the frame path. The bench's line about it.
+fn telemetry_check(elf: &Path, timeout: Duration, plain: Option<&Run>) -> Result<String> {
+    let without = match plain {
+        Some(run) => frame_work(&run.log)?,
+        None => frame_work(&qemu::run(elf, timeout, Echo::Problems)?.log)?,
+    };
+    let seen = AtomicUsize::new(0);
+    let input = Streaming {
+        sent: false,
+        seen: &seen,
+        deadline: Instant::now() + timeout,
+    };
+    let mut count = |line: &[u8]| {
+        if line.starts_with(b"~ ") {
+            seen.fetch_add(1, Ordering::AcqRel);
+        }
+    };
+    let wait = Duration::from_secs(5);
+    let session = qemu_session(elf, input, &mut count, Pace::Fast, Echo::Problems, wait)?;
+    let lines = seen.load(Ordering::Acquire);
+    let with = frame_work(&session.run.log)?;
+    let verdict = qemu::check_summary(&session.run.log)?;
+    if lines < LINES {
+        bail!("telemetry: only {lines} lines streamed during the run");
+    }
+    let line = format!(
+        "telemetry: the smoke schedule with `watch 50` streaming on UART0 ({lines} lines): \
+         frame work {} instructions on average, at most {} (without: {}, {}); {verdict}",
+        with.0, with.1, without.0, without.1
+    );
+    let count = INSNS_PER_COUNT;
+    if with.0.abs_diff(without.0) > count || with.1.abs_diff(without.1) > count {
+        bail!(
+            "{line}: telemetry changed the frame work by more than one count ({count} instructions)"
+        );
+    }
+    Ok(format!(
+        "{line}\ntelemetry adds nothing to the frame path (within one count of {count} \
+         instructions): it is written by the console task, and the frame rows above hold with \
+         `watch 50` running"
+    ))
 }
 
 #[cfg(test)]

@@ -1,9 +1,7 @@
 //! `cargo xtask metrics`: the distributions of the loop metrics over many
-//! seeds, both closures. Seed i is `i · 2654435761 + 12345` mod 2³² (spread
-//! over the `u32` range) on axis i mod 3 with its default row; each loop is
-//! generated as the firmware does and measured by [`LoopMetrics`]. Range
-//! columns are relative to the loop's own [α1, α2]; percentiles are
-//! nearest-rank.
+//! seeds, both closures, each loop generated as the firmware does and
+//! measured by [`LoopMetrics`]. Range columns are relative to the loop's own
+//! [α1, α2]; percentiles are nearest-rank.
 
 // Counts and angles are small: float conversions are exact or harmless.
 #![allow(
@@ -16,13 +14,14 @@ use std::{thread, time::Instant};
 
 use anyhow::{Context, Result, anyhow};
 use idle_head_core::{
-    Angle, Axis,
+    Axis,
     metrics::LoopMetrics,
     motion::{AxisConfig, AxisError, Closure, DEFAULT_HEAD, HannKernel, Mdeg16, generate_into},
 };
 
 use crate::args::LoopShape;
 use crate::figures;
+use crate::preview::{closure_name, deg};
 
 /// The continuity ratio a loop must not exceed (max over P95, both d1 and d2).
 pub const CONTINUITY_LIMIT: f64 = 3.0;
@@ -39,7 +38,7 @@ pub struct Args {
 }
 
 /// The configuration of seed number `i`: axis i mod 3 with its default
-/// row, seed `i · 2654435761 + 12345` mod 2³².
+/// row, seed `i · 2654435761 + 12345` mod 2³² (spread over the `u32` range).
 pub fn config(i: u32, args: Args, closure: Closure) -> (Axis, AxisConfig) {
     let axis = Axis::ALL[(i % 3) as usize];
     let seed = i.wrapping_mul(2_654_435_761).wrapping_add(12_345);
@@ -64,19 +63,14 @@ const ROWS: [(&str, Measure); 6] = [
     ("start x(0) (°)", |m, _| deg(m.start)),
 ];
 
-fn deg(a: Angle) -> f64 {
-    f64::from(a.millidegrees()) / f64::from(Angle::SCALE)
-}
-
 /// Nearest-rank percentile `q` (0..=1) of sorted values.
 pub fn percentile(sorted: &[f64], q: f64) -> f64 {
     let rank = ((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len().max(1));
     sorted.get(rank - 1).copied().unwrap_or(f64::NAN)
 }
 
-/// Everything measured for one closure: per measured seed, the [`ROWS`]'
-/// values; the seeds the engine rejected (for example a flat walk), with
-/// the reason.
+/// Per measured seed, the [`ROWS`]' values; the seeds the engine rejected
+/// (for example a flat walk), with the reason.
 #[derive(Debug, Default)]
 pub struct Results {
     pub loops: Vec<[f64; 6]>,
@@ -115,24 +109,42 @@ fn measure(range: std::ops::Range<u32>, args: Args, closure: Closure) -> Result<
     Ok(results)
 }
 
+/// `job` of 0 to `count` − 1, `cores` at a time, in order; a job that
+/// panicked is an error.
+pub fn parallel<T: Send>(
+    count: usize,
+    cores: usize,
+    job: impl Fn(usize) -> Result<T> + Sync,
+) -> Vec<Result<T>> {
+    let mut results = Vec::new();
+    for batch in (0..count).collect::<Vec<_>>().chunks(cores.max(1)) {
+        thread::scope(|scope| {
+            let job = &job;
+            let runs: Vec<_> = batch.iter().map(|&i| scope.spawn(move || job(i))).collect();
+            let panicked = || Err(anyhow!("a worker thread panicked"));
+            results.extend(
+                runs.into_iter()
+                    .map(|run| run.join().unwrap_or_else(|_| panicked())),
+            );
+        });
+    }
+    results
+}
+
 /// Measures every seed for `closure` on all available cores.
 pub fn run(args: Args, closure: Closure) -> Result<Results> {
     let threads = thread::available_parallelism().map_or(1, usize::from) as u32;
     let chunk = args.seeds.div_ceil(threads);
-    let parts: Vec<Result<Results>> = thread::scope(|scope| {
-        let ranges =
-            (0..threads).map(|t| (t * chunk).min(args.seeds)..((t + 1) * chunk).min(args.seeds));
-        let handles: Vec<_> = ranges
-            .map(|r| scope.spawn(move || measure(r, args, closure)))
-            .collect();
-        let panicked = || Err(anyhow!("a worker thread panicked"));
-        handles
-            .into_iter()
-            .map(|h| h.join().unwrap_or_else(|_| panicked()))
-            .collect()
-    });
+    let part = |t: usize| {
+        let t = t as u32;
+        measure(
+            (t * chunk).min(args.seeds)..((t + 1) * chunk).min(args.seeds),
+            args,
+            closure,
+        )
+    };
     let mut all = Results::default();
-    for part in parts {
+    for part in parallel(threads as usize, threads as usize, part) {
         let part = part?;
         all.loops.extend(part.loops);
         all.rejected.extend(part.rejected);
@@ -171,7 +183,7 @@ pub fn command(args: &Args) -> Result<bool> {
     let start = Instant::now();
     for closure in [Closure::Seamless, Closure::Paper] {
         let result = run(args, closure)?;
-        let name = crate::preview::closure_name(closure);
+        let name = closure_name(closure);
         println!(
             "{name:<9} continuity > {CONTINUITY_LIMIT}: {} of {} seeds (velocity {}, acceleration \
              {}); outside [α1, α2]: {}; start ≠ 0: {}; rejected: {}",
@@ -200,11 +212,10 @@ pub fn command(args: &Args) -> Result<bool> {
     Ok(true)
 }
 
-/// A closure's distributions (min, median, p99, max), for the measured
-/// figures.
+/// A closure's distributions (min, median, p99, max), for the figures.
 fn record_figures(closure: Closure, result: &Results, args: Args) {
     let seeds = figures::thousands(u64::from(args.seeds));
-    let name = crate::preview::closure_name(closure);
+    let name = closure_name(closure);
     // The page shows the paper closure's table first: it says what the columns are.
     let columns = if closure == Closure::Paper {
         format!(
@@ -265,12 +276,8 @@ mod tests {
             assert_eq!(result.loops.len() + result.rejected.len(), 9);
             if closure == Closure::Seamless {
                 // The seamless loop starts at the neutral pose and stays in range.
-                assert!(
-                    result
-                        .loops
-                        .iter()
-                        .all(|m| m[5] == 0.0 && m[3] >= 0.0 && m[4] >= 0.0)
-                );
+                let mut loops = result.loops.iter();
+                assert!(loops.all(|m| m[5] == 0.0 && m[3] >= 0.0 && m[4] >= 0.0));
             }
         }
     }

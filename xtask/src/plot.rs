@@ -1,9 +1,9 @@
-//! Every PNG of the project commands: a figure of stacked panels (curves,
-//! shaded spans, labelled markers), drawn by plotters with a built-in font
-//! (`DejaVu Sans`) so that a plot looks the same on every machine; the
-//! three axes over time (`trace`, `qemu`) and a loop's stages (`preview`).
-//! A curve with more points than its panel has pixel columns is drawn as
-//! each column's range and mean.
+//! Every PNG of the project commands (`trace` and `qemu`: the three axes
+//! over time; `preview`: a loop's stages): a figure of stacked panels
+//! (curves, shaded spans, labelled markers), drawn by plotters with a
+//! built-in font so that a plot looks the same on every machine. A curve
+//! with more points than its panel has pixel columns is drawn as each
+//! column's range and mean.
 
 // Sample counts and pixel positions are far below f64's exact range.
 #![allow(
@@ -32,18 +32,17 @@ pub const PURPLE: RGBColor = RGBColor(148, 103, 189);
 pub const GREY: RGBColor = RGBColor(110, 110, 110);
 pub const LIGHT: RGBColor = RGBColor(190, 190, 190);
 
-/// A figure: a title, lines of text under it, and panels one above the other.
+/// A figure: a title, lines of text under it, and panels one above the
+/// other, each `panel_height` pixels high.
 pub struct Figure {
     pub title: String,
     pub notes: Vec<String>,
     pub panels: Vec<Panel>,
-    /// Height of each panel, pixels.
     pub panel_height: u32,
 }
 
 /// One panel: its curves over a shared x axis, shaded x ranges behind them
 /// and dashed vertical markers with a label at the top.
-#[derive(Default)]
 pub struct Panel {
     pub title: String,
     pub x_desc: String,
@@ -53,8 +52,8 @@ pub struct Panel {
     pub markers: Vec<(f64, String, RGBColor)>,
 }
 
-/// One curve; a dashed one is a reference line. A curve without a label
-/// has no entry in the legend.
+/// One curve (a dashed one is a reference line; one without a label has no
+/// entry in the legend).
 pub struct Curve {
     pub label: String,
     pub color: RGBColor,
@@ -65,7 +64,8 @@ pub struct Curve {
 impl Curve {
     /// A solid curve through `points`.
     pub fn new(label: impl Into<String>, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
-        let (label, dashed) = (label.into(), false);
+        let label = label.into();
+        let dashed = false;
         Self {
             label,
             color,
@@ -76,16 +76,13 @@ impl Curve {
 
     /// A solid curve of `values`, one per index.
     pub fn indexed(label: impl Into<String>, color: RGBColor, values: &[f64]) -> Self {
-        Self::new(
-            label,
-            color,
-            (0..).map(f64::from).zip(values.iter().copied()).collect(),
-        )
+        let points = (0..).map(f64::from).zip(values.iter().copied());
+        Self::new(label, color, points.collect())
     }
 }
 
-/// A command on the motion plot: where it starts and ends (x), the axes it
-/// shades (none: only its marker, on every panel), its label and colours.
+/// A command on the motion plot: from and to (x), the axes it shades (none:
+/// only its marker, on every panel), its label and colours.
 pub struct Mark {
     pub from: f64,
     pub to: f64,
@@ -105,10 +102,11 @@ pub fn motion(
     rows: &[(f64, [f64; 3])],
     marks: &[Mark],
 ) -> Result<()> {
-    let panel = |axis: Axis, color| {
+    let panel = |(axis, color): (Axis, RGBColor)| {
         let i = axis.index();
         let points = rows.iter().map(|r| (r.0, r.1[i])).collect();
         let on = |m: &&Mark| m.axes.contains(&axis);
+        let marked = |m: &&Mark| m.axes.is_empty() || m.axes.contains(&axis);
         Panel {
             title: format!("{} (°)", axis.name()),
             x_desc: x_desc.to_owned(),
@@ -119,23 +117,24 @@ pub fn motion(
                 .filter(on)
                 .map(|m| (m.from, m.to, m.shade))
                 .collect(),
-            markers: (marks.iter())
-                .filter(|m| m.axes.is_empty() || m.axes.contains(&axis))
+            markers: (marks.iter().filter(marked))
                 .map(|m| (m.from, m.label.clone(), m.line))
                 .collect(),
         }
     };
-    let panels = vec![
-        panel(Axis::Pitch, BLUE),
-        panel(Axis::Roll, ORANGE),
-        panel(Axis::Yaw, GREEN),
+    let colors = [
+        (Axis::Pitch, BLUE),
+        (Axis::Roll, ORANGE),
+        (Axis::Yaw, GREEN),
     ];
+    let panels = colors.map(panel).into();
+    let panel_height = 250;
     draw(
         &Figure {
             title,
             notes,
             panels,
-            panel_height: 250,
+            panel_height,
         },
         path,
     )
@@ -188,15 +187,10 @@ fn paint(root: &Area<'_>, figure: &Figure, header: u32) -> Drawn {
 
 fn draw_panel(area: &Area<'_>, panel: &Panel) -> Drawn {
     let points = panel.curves.iter().flat_map(|c| c.points.iter());
-    let (x0, x1, lo, hi) = points.fold(
-        (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        ),
-        |(x0, x1, lo, hi), &(x, y)| (x0.min(x), x1.max(x), lo.min(y), hi.max(y)),
-    );
+    let (inf, neg) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (x0, x1, lo, hi) = points.fold((inf, neg, inf, neg), |(x0, x1, lo, hi), &(x, y)| {
+        (x0.min(x), x1.max(x), lo.min(y), hi.max(y))
+    });
     let (x0, x1) = if x1 > x0 { (x0, x1) } else { (0.0, 1.0) };
     let (lo, hi) = if hi >= lo { (lo, hi) } else { (-1.0, 1.0) };
     // Room above the curves for two rows of labels.
@@ -302,9 +296,8 @@ mod tests {
     #[test]
     fn a_long_curve_is_drawn_as_each_columns_range_and_mean_and_a_figure_is_drawn() {
         // A saw tooth of 10 points, 0 to 9, over 180,000 points.
-        let points: Vec<(f64, f64)> = (0..180_000)
-            .map(|i| (f64::from(i), f64::from(i % 10)))
-            .collect();
+        let saw = |i| (f64::from(i), f64::from(i % 10));
+        let points: Vec<(f64, f64)> = (0..180_000).map(saw).collect();
         let bands = bands(&points, 1300);
         assert!(bands.len() <= 1300 && bands.len() > 1200, "{}", bands.len());
         for &(_, min, max, mean) in &bands {
@@ -323,15 +316,8 @@ mod tests {
             shade: LIGHT,
         };
         let rows = [(0.0, [0.0; 3]), (1.0, [1.0, 2.0, 3.0]), (3.0, [0.0; 3])];
-        motion(
-            &path,
-            "a figure".into(),
-            vec!["a note".into()],
-            "s",
-            &rows,
-            &[mark],
-        )
-        .unwrap();
+        let notes = vec!["a note".into()];
+        motion(&path, "a figure".into(), notes, "s", &rows, &[mark]).unwrap();
         assert!(std::fs::read(&path).unwrap().starts_with(b"\x89PNG"));
     }
 }

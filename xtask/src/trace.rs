@@ -12,35 +12,28 @@ mod host;
 mod marks;
 pub mod radar;
 mod script;
-mod watch;
 
-use std::{fs, path::PathBuf};
+use std::{fmt::Write as _, fs, path::PathBuf};
 
 use anyhow::{Context, Result, anyhow};
-use idle_head_core::behaviour::{BehaviourConfig, CommandQueue, Head, LOOP_DURATION, ShowLink};
-use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver, FrameReport};
+use idle_head_core::behaviour::{
+    BehaviourConfig, BehaviourParams, CommandQueue, Head, LOOP_DURATION, ShowLink,
+};
+use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
+use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
-use idle_head_core::pwm_clock::SliceClock;
+use idle_head_core::pwm_clock::{PICO_SYS_HZ, SliceClock};
 use idle_head_core::servo::{ServoRate, SetPeriod};
 use idle_head_core::{Axis, Microseconds, Playback, Timestamp};
 use idle_head_firmware::config::IDLE_MODE;
-use std::fmt::Write as _;
 
 use host::Origin;
-use idle_head_core::behaviour::BehaviourParams;
-use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
-use idle_head_core::pwm_clock::PICO_SYS_HZ;
+pub use host::Watch;
 use marks::Mark;
-pub use script::{Event, Kind};
-pub use watch::Watch;
+pub use script::{Event, Kind, parse as parse_script};
 
 use crate::{project, steps::Steps};
-
-/// A script's events (see `script.rs`), checked with `params`.
-pub fn parse_script(text: &str, params: &BehaviourParams) -> Result<Vec<Event>> {
-    script::parse(text, params)
-}
 
 /// Options of `cargo xtask trace`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
@@ -87,38 +80,30 @@ fn positive_seconds(text: &str) -> Result<u64, String> {
     }
 }
 
-/// One frame of the trace.
+/// One frame of the trace (the frame's number is its index).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Row {
-    pub frame: u64,
-    /// Time of the frame in ms (rounded down).
-    pub t_ms: u64,
-    /// Time of the frame in µs.
     pub t_us: u64,
-    /// Commanded angles, m°.
+    /// Commanded angles, m°; pulse widths, ns; the duties written, counts of
+    /// the Pico's PWM (0: no pulse).
     pub angles: [i32; 3],
     pub pulses: [u64; 3],
-    /// The duties written, counts of the Pico's PWM (0: no pulse).
     pub duties: [u16; 3],
-    /// The frame period after this frame, µs.
-    pub period_us: u32,
 }
 
-/// The simulated run.
+/// The simulated run: its frames; the commands as applied and the looks'
+/// returns, in time order; the telemetry lines, if asked for; the replies
+/// to the lines asked of the console after the last frame.
 pub struct Trace {
     pub rows: Vec<Row>,
-    /// The script's commands as applied, and the looks' returns, in time
-    /// order.
     pub marks: Vec<Mark>,
-    /// The telemetry lines, when asked for ([`simulate_watched`]).
     pub watch: Option<Watch>,
-    /// The replies to the lines asked of the console after the last frame
-    /// ([`simulate_watched`]).
     pub answers: Vec<String>,
 }
 
 /// A PWM channel that keeps the last duty, counted as the Pico's slice
 /// counts its period.
+#[derive(Clone, Copy)]
 struct Channel {
     duty: u16,
     clock: SliceClock,
@@ -155,28 +140,18 @@ impl SetPeriod for Channel {
     }
 }
 
-/// `--seed n`: pitch n, roll and yaw the next two values of the paper's
-/// LCG.
-fn lcg_seeds(seed: u32) -> [u32; 3] {
-    let mut lcg = Lcg::new(seed);
-    [seed, lcg.next_value(), lcg.next_value()]
-}
-
 /// The idle loops' configuration for `seeds` `[pitch, roll, yaw]` (or
 /// Table 2's).
 fn config(seeds: Option<[u32; 3]>) -> HeadConfig {
     let mut config = DEFAULT_HEAD;
     if let Some([pitch, roll, yaw]) = seeds {
-        config.pitch.seed = pitch;
-        config.roll.seed = roll;
-        config.yaw.seed = yaw;
+        (config.pitch.seed, config.roll.seed, config.yaw.seed) = (pitch, roll, yaw);
     }
     config
 }
 
-/// The firmware's idle source for `config`: its stream of loop sets
-/// (never-repeating unless built with `fixed-loop`), each generated when
-/// its join is due.
+/// The firmware's idle source: its stream of loop sets (never-repeating
+/// unless built with `fixed-loop`), each generated when its join is due.
 pub type Idle =
     IdlePlayer<Box<LoopSet<DEFAULT_N>>, GenerateOnTake<Box<LoopSet<DEFAULT_N>>, DEFAULT_N>>;
 
@@ -198,26 +173,17 @@ pub fn built_in() -> Result<(DriverParams, BehaviourParams)> {
 }
 
 /// The built-in driver's parameters at `rate`, and the behaviour's built
-/// on them.
-///
-/// # Errors
-/// If a configuration is refused at that rate.
+/// on them; fails if a configuration is refused at that rate.
 pub fn at_rate(rate: ServoRate) -> Result<(DriverParams, BehaviourParams)> {
     let mut config = DriverConfig::DEFAULT;
-    config.frame_period = rate.period();
-    config.pwm.period = rate.period();
+    (config.frame_period, config.pwm.period) = (rate.period(), rate.period());
     let driver = config.build().map_err(|e| anyhow!("{}", e.message()))?;
-    let params = BehaviourConfig::DEFAULT
-        .build(&driver)
-        .map_err(|e| anyhow!("{e}"))?;
+    let params = (BehaviourConfig::DEFAULT.build(&driver)).map_err(|e| anyhow!("{e}"))?;
     Ok((driver, params))
 }
 
-/// Runs `micros` of frames at `rate` with `events` (sorted by time):
-/// motion lines through the queue, other console lines through the
-/// console's service, pin lines into the input task ([`host`]), radar
-/// lines as the radar's frames ([`radar`]); the idle from `seed` (`[pitch,
-/// roll, yaw]`, else Table 2's).
+/// Runs `micros` of frames at `rate` with `events` (sorted by time); the
+/// idle from `seed` (`[pitch, roll, yaw]`, else Table 2's).
 pub fn simulate(
     micros: u64,
     seed: Option<[u32; 3]>,
@@ -243,265 +209,91 @@ pub fn simulate_watched(
     let period = driver_params.config().frame_period;
     let playback =
         Playback::new(LOOP_DURATION, period, DEFAULT_N).map_err(|e| anyhow!("playback: {e:?}"))?;
-    let idle = idle(config(seed), playback, seed)?;
-    let mut head = Head::new(idle, params);
-    let channels = [
-        Channel::at(period)?,
-        Channel::at(period)?,
-        Channel::at(period)?,
-    ];
-    let mut driver = FrameDriver::new(channels, driver_params);
-    let queue: CommandQueue = CommandQueue::new();
-    let link = ConsoleLink::new();
-    let show = ShowLink::new();
-    let mut console = host::Console::new(&queue, &link, &show, rate)?;
-    let mut task = host::Task::new(&link);
-    // What the radar sees (a script's radar lines), sent at its 10 Hz.
+    let mut head = Head::new(idle(config(seed), playback, seed)?, params);
+    let mut driver = FrameDriver::new([Channel::at(period)?; 3], driver_params);
+    let (queue, link, show) = (CommandQueue::new(), ConsoleLink::new(), ShowLink::new());
+    let mut beside = host::Beside::new(&queue, &link, &show, rate)?;
     let mut radar = radar::Radar::of(events);
+    let refused = |t_us: u64| move |e| anyhow!("{} ms: servo rate refused: {e}", t_us / 1000);
 
     let mut rows = Vec::with_capacity(usize::try_from(micros / u64::from(period.0)).unwrap_or(0));
-    let mut marks = Vec::new();
-    let mut next = 0;
-    // Where each queued action came from, oldest first.
-    let mut origins: Vec<Origin> = Vec::new();
-    let (mut frame, mut t_us) = (0, 0);
+    let (mut marks, mut next, mut t_us) = (Vec::new(), 0, 0);
     while t_us < micros {
         let rest = head.rest_state();
         // The script's lines due, and the input task's wakes between them.
         while let Some(event) = events.get(next).filter(|e| e.at_us <= t_us) {
-            if let Kind::Radar(_) = event.kind {
-                next += 1;
-                continue;
-            }
-            wake_until(&mut task, event.at_us, rest, &link, &queue, &mut origins);
-            let lines = Lines {
-                queue: &queue,
-                link: &link,
-                origins: &mut origins,
-            };
-            if !lines.take(event, next, rest, &mut console, &mut task) {
+            beside.wake_until(event.at_us, rest);
+            if !beside.take(event, next, rest) {
                 break;
             }
             next += 1;
         }
         radar.send(&show, t_us);
-        task.radar(show.track.presence());
-        wake_until(&mut task, t_us, rest, &link, &queue, &mut origins);
-        // What the console sent through the link, then the queue.
-        from_link(&link, &mut head, &mut driver, t_us);
-        // A new rate: the outputs from this frame on, the frames after it.
+        beside.radar = show.track.presence();
+        beside.wake_until(t_us, rest);
+        // What the console sent through the link: live settings,
+        // calibrations, a new rate (the outputs from this frame on, the
+        // frames after it); then the queue.
+        if let Some(live) = link.take_live() {
+            head.set_live(&mut driver, &live);
+        }
+        for (axis, cal) in Axis::ALL.iter().zip(link.take_servos()) {
+            if let Some(Err(e)) = cal.map(|cal| head.set_servo(&mut driver, *axis, cal)) {
+                let (ms, name) = (t_us / 1000, axis.name());
+                println!("{ms} ms: {name} servo calibration refused: {e}");
+            }
+        }
         let retime = link.take_rate().map(ServoRate::period);
         if let Some(period) = retime {
-            driver
-                .set_pwm_period(period)
-                .map_err(|e| anyhow!("{} ms: servo rate refused: {e}", t_us / 1000))?;
+            driver.set_pwm_period(period).map_err(refused(t_us))?;
         }
-        drain(
-            &mut head,
-            &mut driver,
-            &queue,
-            &mut origins,
-            events,
-            t_us,
-            &mut marks,
-        );
+        let (ms, mut taken) = (t_us / 1000, std::mem::take(&mut beside.origins).into_iter());
+        let mixer = *head.mixer().params();
+        head.drain(&mut driver, &queue, |_, outcome| {
+            let (text, number) = match taken.next() {
+                Some(Origin::Line(i)) => (events[i].text.clone(), events[i].line),
+                Some(Origin::Other(text)) => (text, 0),
+                None => return,
+            };
+            marks.extend(marks::marks(&text, number, ms, outcome, &mixer));
+        });
+        beside.origins.extend(taken);
         let sighting = show.track.take();
-        head.track(
-            &mut driver,
-            Timestamp(t_us),
-            &show.track.settings(),
-            sighting.as_ref(),
-        );
-        let played = head.frame(&mut driver, Timestamp(t_us));
+        let settings = show.track.settings();
+        head.track(&mut driver, Timestamp(t_us), &settings, sighting.as_ref());
+        let report = head.frame(&mut driver, Timestamp(t_us)).report;
         if let Some(period) = retime {
-            head.set_frame_period(&mut driver, period)
-                .map_err(|e| anyhow!("{} ms: servo rate refused: {e}", t_us / 1000))?;
+            (head.set_frame_period(&mut driver, period)).map_err(refused(t_us))?;
         }
-        let report = played.report;
-        publish(
-            &head,
-            &driver,
-            &report,
-            (&link, &show),
+        // The status to the console's link, as the frame task publishes it
+        // (the tracker's view while the radar is on), and to `watch`.
+        let mode = HeadMode::of(driver.is_stopped(), driver.is_stopping(), head.rest_state());
+        let mut status = HeadStatus::of(&report, driver.stats(), mode, Timestamp(t_us));
+        status.idle = Some(head.idle_view());
+        status.track = settings.radar.then(|| head.track_view());
+        link.publish(status);
+        if let Some(watch) = watch.as_mut() {
+            watch.frame(t_us, &status);
+        }
+        let count_ps = driver.channels_mut()[0].clock.count_ps(PICO_SYS_HZ);
+        let servos = report.servos;
+        rows.push(Row {
             t_us,
-            watch.as_mut(),
-        );
-        let period_us = driver.params().config().frame_period.0;
-        rows.push(row(frame, t_us, &report, &mut driver));
-        frame += 1;
-        t_us += u64::from(period_us);
+            angles: servos.map(|s| s.angle.millidegrees()),
+            pulses: servos.map(|s| (u64::from(s.duty.0) * count_ps + 500) / 1000),
+            duties: servos.map(|s| s.duty.0),
+        });
+        t_us += u64::from(driver.params().config().frame_period.0);
     }
     marks::settle(&mut marks, params.config().blend.0, t_us / 1000);
     events[next..].iter().for_each(script::not_run);
-    let answers = ask.iter().map(|line| console.line(line).0).collect();
+    let answers = ask.iter().map(|line| beside.line(line).0).collect();
     Ok(Trace {
         rows,
         marks,
         watch,
         answers,
     })
-}
-
-/// Publishes the status after the frame at `t_us` that wrote `report` to
-/// the console's link, as the frame task does (the tracker's view while
-/// the radar is on), and to `watch`, if one streams.
-fn publish(
-    head: &Head<Idle>,
-    driver: &FrameDriver<Channel>,
-    report: &FrameReport,
-    (link, show): (&ConsoleLink, &ShowLink),
-    t_us: u64,
-    watch: Option<&mut Watch>,
-) {
-    let mode = HeadMode::of(driver.is_stopped(), driver.is_stopping(), head.rest_state());
-    let mut status = HeadStatus::of(report, driver.stats(), mode, Timestamp(t_us));
-    status.idle = Some(head.idle_view());
-    if show.track.settings().radar {
-        status.track = Some(head.track_view());
-    }
-    link.publish(status);
-    if let Some(watch) = watch {
-        watch.frame(t_us, &status);
-    }
-}
-
-/// Where a script's lines go.
-struct Lines<'a> {
-    queue: &'a CommandQueue,
-    link: &'a ConsoleLink,
-    origins: &'a mut Vec<Origin>,
-}
-
-impl Lines<'_> {
-    /// Takes `event` (the script's `index`-th) with the head in `rest`;
-    /// `false` if it has to wait for the next frame (the queue is full).
-    fn take(
-        self,
-        event: &Event,
-        index: usize,
-        rest: idle_head_core::behaviour::RestState,
-        console: &mut host::Console<'_>,
-        task: &mut host::Task,
-    ) -> bool {
-        match event.kind {
-            Kind::Act(action) => {
-                if self.queue.try_submit(action).is_err() {
-                    // A console would be told `err busy`; the script waits.
-                    println!(
-                        "line {}: command queue full at {} ms, `{}` waits a frame",
-                        event.line,
-                        event.at_us / 1000,
-                        event.text
-                    );
-                    return false;
-                }
-                self.origins.push(Origin::Line(index));
-            }
-            Kind::Console => {
-                let (reply, queued) = console.line(&event.text);
-                println!("{:>9} ms  {}: {reply}", event.at_us / 1000, event.text);
-                if queued {
-                    self.origins.push(Origin::Other(event.text.clone()));
-                }
-                // The input task takes new settings at once.
-                task.wake(event.at_us, rest, self.link, self.queue, self.origins);
-            }
-            Kind::Pin { input, high } => {
-                task.drive(input, high);
-                task.wake(event.at_us, rest, self.link, self.queue, self.origins);
-            }
-            // Taken by the frame loop.
-            Kind::Radar(_) => {}
-        }
-        true
-    }
-}
-
-/// The row of frame `frame` at `t_us` that wrote `report`.
-fn row(frame: u64, t_us: u64, report: &FrameReport, driver: &mut FrameDriver<Channel>) -> Row {
-    let servos = report.servos;
-    let count_ps = driver.channels_mut()[0].clock.count_ps(PICO_SYS_HZ);
-    Row {
-        frame,
-        t_ms: t_us / 1000,
-        t_us,
-        angles: servos.map(|s| s.angle.millidegrees()),
-        pulses: servos.map(|s| (u64::from(s.duty.0) * count_ps + 500) / 1000),
-        duties: servos.map(|s| s.duty.0),
-        period_us: driver.params().config().frame_period.0,
-    }
-}
-
-/// The queue's actions taken before the frame at `t_us`, each marked with
-/// the line (or other source) it came from.
-fn drain(
-    head: &mut Head<Idle>,
-    driver: &mut FrameDriver<Channel>,
-    queue: &CommandQueue,
-    origins: &mut Vec<Origin>,
-    events: &[Event],
-    t_us: u64,
-    marks: &mut Vec<Mark>,
-) {
-    let params = *head.mixer().params();
-    let mut taken = origins.drain(..).collect::<std::collections::VecDeque<_>>();
-    head.drain(driver, queue, |action, outcome| {
-        let Some(origin) = taken.pop_front() else {
-            return;
-        };
-        let event = match origin {
-            Origin::Line(i) => events[i].clone(),
-            Origin::Other(text) => Event {
-                line: 0,
-                at_us: t_us,
-                text,
-                kind: Kind::Act(*action),
-            },
-        };
-        marks.extend(marks::marks(&event, t_us / 1000, outcome, &params));
-    });
-    origins.extend(taken);
-}
-
-/// Between frames: the live settings and calibrations the console sent
-/// (the rate is the frame's, [`simulate`]).
-fn from_link<I: idle_head_core::behaviour::IdleSource>(
-    link: &ConsoleLink,
-    head: &mut Head<I>,
-    driver: &mut FrameDriver<Channel>,
-    t_us: u64,
-) {
-    if let Some(live) = link.take_live() {
-        head.set_live(driver, &live);
-    }
-    for (axis, cal) in Axis::ALL.iter().zip(link.take_servos()) {
-        if let Some(cal) = cal
-            && let Err(e) = head.set_servo(driver, *axis, cal)
-        {
-            println!(
-                "{} ms: {} servo calibration refused: {e}",
-                t_us / 1000,
-                axis.name()
-            );
-        }
-    }
-}
-
-/// The input task's wakes at its deadlines up to `until` µs.
-fn wake_until(
-    task: &mut host::Task,
-    until: u64,
-    rest: idle_head_core::behaviour::RestState,
-    link: &ConsoleLink,
-    queue: &CommandQueue,
-    origins: &mut Vec<Origin>,
-) {
-    while let Some(at) = task.deadline().filter(|&at| at <= until) {
-        task.wake(at, rest, link, queue, origins);
-        if task.deadline() == Some(at) {
-            break;
-        }
-    }
 }
 
 /// `cargo xtask trace`: the CSV, and the PNG if asked for, to trace/ in the
@@ -517,34 +309,23 @@ pub fn command(args: &Args) -> Result<bool> {
         }
         None => Vec::new(),
     };
+    // `--seed n`: pitch n, roll and yaw the next two values of the paper's LCG.
+    let seeds = args.seed.map(|seed| {
+        let mut lcg = Lcg::new(seed);
+        [seed, lcg.next_value(), lcg.next_value()]
+    });
     let watch = args.telemetry.as_ref().map(|_| args.watch);
-    let trace = simulate_watched(
-        args.micros,
-        args.seed.map(lcg_seeds),
-        rate,
-        &events,
-        watch,
-        &[],
-    )?;
-    let dir = || -> Result<PathBuf> {
-        Ok(project::metadata(&project::root())?
-            .target_dir
-            .join("trace"))
+    let trace = simulate_watched(args.micros, seeds, rate, &events, watch, &[])?;
+    let default = |name: &str| -> Result<PathBuf> {
+        let target = project::metadata(&project::root())?.target_dir;
+        Ok(target.join("trace").join(name))
     };
-    let out = args
-        .out
-        .clone()
-        .map_or_else(|| Ok(dir()?.join("trace.csv")), Ok::<_, anyhow::Error>)?;
-    let mut csv =
-        String::from("frame,t_ms,pitch_mdeg,roll_mdeg,yaw_mdeg,pitch_ns,roll_ns,yaw_ns\n");
-    for row in &trace.rows {
+    let out = args.out.clone().map_or_else(|| default("trace.csv"), Ok)?;
+    let mut csv = "frame,t_ms,pitch_mdeg,roll_mdeg,yaw_mdeg,pitch_ns,roll_ns,yaw_ns\n".to_owned();
+    for (frame, row) in trace.rows.iter().enumerate() {
         let ([p, r, y], [pn, rn, yn]) = (row.angles, row.pulses);
-        let _ = writeln!(
-            csv,
-            "{},{},{p},{r},{y},{pn},{rn},{yn}",
-            row.frame,
-            ms(row.t_us)
-        );
+        let t = ms(row.t_us);
+        let _ = writeln!(csv, "{frame},{t},{p},{r},{y},{pn},{rn},{yn}");
     }
     project::write(&out, csv)?;
     for mark in &trace.marks {
@@ -553,12 +334,12 @@ pub fn command(args: &Args) -> Result<bool> {
     // Range, largest step and largest change of step per axis.
     for axis in Axis::ALL {
         let i = axis.index();
+        let angles: Vec<f64> = trace.rows.iter().map(|r| f64::from(r.angles[i])).collect();
         let (lo, hi) = (trace.rows.iter().map(|r| r.angles[i]))
             .fold((i32::MAX, i32::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)));
-        let angles: Vec<f64> = trace.rows.iter().map(|r| f64::from(r.angles[i])).collect();
         let Steps { step, turn } = Steps::of(&angles);
-        let pulses = trace.rows.iter().map(|r| r.pulses[i]);
-        let (plo, phi) = pulses.fold((u64::MAX, 0), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        let (plo, phi) = (trace.rows.iter().map(|r| r.pulses[i]))
+            .fold((u64::MAX, 0), |(lo, hi), p| (lo.min(p), hi.max(p)));
         println!(
             "{:<5} angle {lo}..{hi} mdeg, largest step {step:.0} mdeg/frame, largest change of step \
              {turn:.0} mdeg/frame² (frames as they came), pulses {plo}..{phi} ns",
@@ -568,17 +349,14 @@ pub fn command(args: &Args) -> Result<bool> {
     println!("wrote {} ({} frames)", out.display(), trace.rows.len());
     if let (Some(path), Some(watch)) = (&args.telemetry, &trace.watch) {
         project::write(path, watch.lines.join("\n") + "\n")?;
+        let (lines, hz) = (watch.lines.len(), args.watch);
         println!(
-            "wrote {} ({} telemetry lines, {} a second)",
-            path.display(),
-            watch.lines.len(),
-            args.watch
+            "wrote {} ({lines} telemetry lines, {hz} a second)",
+            path.display()
         );
     }
     if let Some(png) = &args.png {
-        let png = png
-            .clone()
-            .map_or_else(|| Ok(dir()?.join("trace.png")), Ok::<_, anyhow::Error>)?;
+        let png = png.clone().map_or_else(|| default("trace.png"), Ok)?;
         marks::draw(&trace, args.seed, &png)?;
         println!("wrote {}", png.display());
     }

@@ -1,28 +1,24 @@
 //! The latency rows of `cargo xtask bench`: how long an input takes to
 //! reach the servo pins, measured in the RP2040 emulator on the shipped
 //! image (docs/dev/emulators.md, "Latency"). One run per path, at least
-//! [`EVENTS`] events at seeded random times (so their phases against the
-//! frame spread evenly). An event's time is when the input has fully
-//! arrived (the end of the DMX frame that carries the change, the USB
-//! host's hand-over of a line's last byte, a button's edge); its baseline
-//! the axis at rest before it (the last two pulses of equal width, else
-//! the event is skipped); its response the rise of the first pulse after
-//! it whose width differs from the baseline by more than one and a half PWM counts at the
-//! row's rate (0.47 µs at 50 Hz, 0.12 µs at 200 Hz). A row
-//! gives the latencies' median, 99th percentile and largest, in ms, against
-//! its goal for p99, and the longest a port task waited for the CPU.
+//! [`EVENTS`] events at seeded random times, so that their phases against
+//! the frame spread evenly, each timed by [`response`]. A row gives the
+//! latencies' median, 99th percentile and largest, in ms, against its goal
+//! for p99, and the longest a port task waited for the CPU.
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, bail};
 use idle_head_core::servo::ServoRate;
 
+use crate::metrics::{parallel, percentile};
 use crate::project::Metadata;
 use crate::sim::pulses::{self, Measured};
 use crate::sim::{Boot, dmx_line, parse_script, play_script, run_shipped, script_time};
 use crate::{figures, project};
 
 pub use super::paths::PATHS;
+use super::paths::count;
 
 /// Events per row, at least; more are scheduled, for the ones skipped.
 pub const EVENTS: usize = 1000;
@@ -39,17 +35,17 @@ pub const LOOK_GAP: (Duration, Duration) = (Duration::from_millis(110), Duration
 /// are over before the next; a press is held 30 ms.
 const PRESS_GAP: (Duration, Duration) = (Duration::from_millis(150), Duration::from_millis(170));
 const HELD: Duration = Duration::from_millis(30);
-/// The input edge's run plays a script, and computes its host trace: more
+/// The input edge's run plays a script and computes its host trace: more
 /// wall time than the others, at least.
 const SCRIPT_WALL: Duration = Duration::from_secs(600);
 /// The longest a port task may wait for the CPU, µs.
 pub const PORT_WAIT_US: u32 = 1000;
 
 /// One latency row: its name (`dmx`, `usb look`, …), the latencies (ms,
-/// sorted), the events skipped (the axis still moved), the events' phases
-/// against the frame (per fifth of it), the three slowest (when, s, and
-/// their latency), the longest a port task waited for the CPU in the run
-/// (µs, as the image logged it), and the goal for p99 (ms).
+/// sorted), the events skipped (the axis still moved), the events per fifth
+/// of the frame, the three slowest (when, s, and their latency), the
+/// longest a port task waited for the CPU (µs, as the image logged it), and
+/// the goal for p99 (ms).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Row {
     pub name: &'static str,
@@ -62,49 +58,31 @@ pub struct Row {
 }
 
 impl Row {
-    /// The `p`-th percentile (nearest rank), ms.
-    pub fn percentile(&self, p: f64) -> f64 {
-        #[allow(
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss,
-            clippy::cast_precision_loss
-        )]
-        let rank = (p / 100.0 * self.ms.len() as f64).ceil() as usize;
-        self.ms
-            .get(rank.clamp(1, self.ms.len().max(1)) - 1)
-            .copied()
-            .unwrap_or(f64::NAN)
-    }
-
     /// p50, p99 and the largest, ms.
     fn spread(&self) -> [f64; 3] {
-        [
-            self.percentile(50.0),
-            self.percentile(99.0),
-            self.ms.last().copied().unwrap_or(f64::NAN),
-        ]
+        [0.5, 0.99, 1.0].map(|q| percentile(&self.ms, q))
     }
 
     /// The row for the measured figures: label, events, p50, p99, max, goal,
     /// the port tasks' longest wait.
     pub fn figure(&self) -> Vec<String> {
         let [p50, p99, max] = self.spread().map(|ms| format!("{ms:.1}"));
-        let missed = if self.percentile(99.0) <= self.goal_ms {
+        let missed = if self.spread()[1] <= self.goal_ms {
             ""
         } else {
             " (missed)"
         };
-        let waited = self
-            .waited_us
-            .map_or_else(|| "not logged".to_owned(), |us| format!("{us} µs"));
+        let waited =
+            (self.waited_us).map_or_else(|| "not logged".to_owned(), |us| format!("{us} µs"));
         let events = figures::thousands(self.ms.len() as u64);
+        let goal = format!("{:.0}{missed}", self.goal_ms);
         vec![
             format!("latency {}", self.name),
             events,
             p50,
             p99,
             max,
-            format!("{:.0}{missed}", self.goal_ms),
+            goal,
             waited,
         ]
     }
@@ -116,9 +94,7 @@ impl Row {
         let mut text = format!(
             "latency {name} p50={p50:.1} p99={p99:.1} max={max:.1} events={events} skipped={skipped}\n"
         );
-        let slowest: Vec<String> = self
-            .worst
-            .iter()
+        let slowest: Vec<String> = (self.worst.iter())
             .map(|(at, ms)| format!("{ms:.1} ms at {at:.3} s"))
             .collect();
         let met = if p99 <= self.goal_ms { "met" } else { "missed" };
@@ -130,11 +106,9 @@ impl Row {
             slowest.join(", ")
         );
         if p99 > self.goal_ms {
-            let _ = writeln!(
-                text,
-                "  (where the time goes: the wait for the next frame (0 to a frame), the PWM's latch \
-                 to the next period (a tenth of one), and the transport before the frame)"
-            );
+            text += "  (where the time goes: the wait for the next frame (0 to a frame), the \
+                     PWM's latch to the next period (a tenth of one), and the transport before \
+                     the frame)\n";
         }
         if let Some(us) = self.waited_us {
             let _ = writeln!(text, "  (port tasks waited at most {us} µs for the CPU)");
@@ -142,18 +116,20 @@ impl Row {
         text
     }
 
-    /// Whether the row meets its goals: p99 within its goal, the port
-    /// tasks' wait within [`PORT_WAIT_US`]; the misses if not.
+    /// The misses of the row's goals (p99 within its goal, the port tasks'
+    /// wait within [`PORT_WAIT_US`]), if any.
     pub fn misses(&self) -> Option<String> {
-        let p99 = self.percentile(99.0);
+        let p99 = self.spread()[1];
         let mut misses = Vec::new();
         if p99.is_nan() || p99 > self.goal_ms {
             misses.push(format!("p99 {p99:.1} ms over {} ms", self.goal_ms));
         }
         match self.waited_us {
-            Some(us) if us > PORT_WAIT_US => misses.push(format!(
-                "a port task waited {us} µs, over {PORT_WAIT_US} µs"
-            )),
+            Some(us) if us > PORT_WAIT_US => {
+                misses.push(format!(
+                    "a port task waited {us} µs, over {PORT_WAIT_US} µs"
+                ));
+            }
             None => misses.push("the port tasks' wait was not logged".to_owned()),
             Some(_) => {}
         }
@@ -168,19 +144,9 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<()> {
     // One at a time when `cargo xtask test` runs it beside other stages.
     let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
     let cores = if crate::project::prebuilt() { 1 } else { cores };
-    let mut results = Vec::new();
-    for batch in PATHS.chunks(cores) {
-        std::thread::scope(|scope| {
-            let runs: Vec<_> = (batch.iter())
-                .map(|path| scope.spawn(|| path(root, metadata, crate::sim::WALL)))
-                .collect();
-            let panicked = || Err(anyhow!("a latency run panicked"));
-            results.extend(
-                runs.into_iter()
-                    .map(|run| run.join().unwrap_or_else(|_| panicked())),
-            );
-        });
-    }
+    let results = parallel(PATHS.len(), cores, |i| {
+        PATHS[i](root, metadata, crate::sim::WALL)
+    });
     let (mut rows, mut misses) = (Vec::new(), Vec::new());
     for result in results {
         match result {
@@ -235,8 +201,12 @@ pub enum Response {
     After(f64),
 }
 
-/// The response to an event at `at` (ns) on an axis whose pulses are
-/// `pulses`.
+/// The response to an event at `at` (ns: when the input has fully arrived,
+/// the end of the DMX frame that carries the change, the USB host's
+/// hand-over of a line's last byte, a button's edge) on an axis whose
+/// pulses are `pulses`: the rise of the first pulse whose width differs
+/// from the baseline, the axis at rest before the event (the last two
+/// pulses of equal width), by more than one and a half PWM counts.
 pub fn response(pulses: &[Measured], at: f64, count_ns: f64) -> Response {
     let before = pulses.partition_point(|p| p.rise < at);
     let baseline = before.checked_sub(2).map(|i| (&pulses[i], &pulses[i + 1]));
@@ -324,13 +294,7 @@ pub fn dmx(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
     let boot = report.first()?;
     // The first change is the set-up's.
     let events: Vec<f64> = boot.dmx_changes.iter().skip(1).copied().collect();
-    if events.len() != times.len() {
-        bail!(
-            "{} DMX frames carried a change, not {}",
-            events.len(),
-            times.len()
-        );
-    }
+    count(events.len(), times.len(), "DMX frames carried a change")?;
     row("dmx", &events, boot)
 }
 
@@ -346,16 +310,12 @@ pub fn input_edge(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Ro
     let time = script_time(&events);
     let report = play_script(root, metadata, events, time, wall.max(SCRIPT_WALL))?;
     if !report.problems.is_empty() {
-        bail!(
-            "the input edge's run failed its checks:\n  {}",
-            report.problems.join("\n  ")
-        );
+        let problems = report.problems.join("\n  ");
+        bail!("the input edge's run failed its checks:\n  {problems}");
     }
     let boot = report.first()?;
     let edges: Vec<f64> = boot.drives.iter().filter(|d| !d.2).map(|d| d.0).collect();
-    if edges.len() != times.len() {
-        bail!("{} presses went out, not {}", edges.len(), times.len());
-    }
+    count(edges.len(), times.len(), "presses went out")?;
     row("input edge", &edges, boot)
 }
 
@@ -368,13 +328,8 @@ fn press_script(times: &[Duration]) -> String {
     );
     let show = |at: Duration| format!("{}.{:06}", at.as_secs(), at.subsec_micros());
     for (k, &at) in times.iter().enumerate() {
-        let pin = 2 + k % 2;
-        let _ = writeln!(
-            text,
-            "{} pin {pin} low\n{} pin {pin} high",
-            show(at),
-            show(at + HELD)
-        );
+        let (pin, press, release) = (2 + k % 2, show(at), show(at + HELD));
+        let _ = writeln!(text, "{press} pin {pin} low\n{release} pin {pin} high");
     }
     text
 }
@@ -391,11 +346,7 @@ mod tests {
             width: width_us * 1e3,
         };
         let widths = [1500.0, 1500.0, 1500.0, 1500.3125, 1502.0, 1503.0];
-        let pulses: Vec<Measured> = widths
-            .iter()
-            .enumerate()
-            .map(|(k, &w)| pulse(k, w))
-            .collect();
+        let pulses: Vec<Measured> = (0..6).map(|k| pulse(k, widths[k])).collect();
         // An event at 55 ms: a count of change is noise, 1502 µs moves.
         assert_eq!(response(&pulses, 55e6, count), Response::After(35.0));
         // The axis still moved before 95 ms; nothing before 5 ms: no baseline.
@@ -416,11 +367,9 @@ mod tests {
             waited_us: Some(300),
             goal_ms: GOAL_MS,
         };
-        assert_eq!((row.percentile(50.0), row.percentile(99.0)), (100.0, 198.0));
-        assert!(
-            row.lines()
-                .starts_with("latency x p50=100.0 p99=198.0 max=200.0 events=200")
-        );
+        assert_eq!(row.spread()[..2], [100.0, 198.0]);
+        let lines = row.lines();
+        assert!(lines.starts_with("latency x p50=100.0 p99=198.0 max=200.0 events=200"));
         assert!(row.lines().contains("where the time goes"));
         assert_eq!(row.misses().unwrap(), "latency x: p99 198.0 ms over 25 ms");
         let fast = Row {
@@ -434,30 +383,24 @@ mod tests {
             ..fast.clone()
         };
         assert!(waited.misses().unwrap().contains("waited 1001 µs"));
-        assert!(
-            Row {
-                waited_us: None,
-                ..fast.clone()
-            }
-            .misses()
-            .unwrap()
-            .contains("not logged")
-        );
+        let unlogged = Row {
+            waited_us: None,
+            ..fast.clone()
+        };
+        assert!(unlogged.misses().unwrap().contains("not logged"));
         let at_200_hz = Row {
             ms: vec![8.5; 100],
             goal_ms: GOAL_200_HZ_MS,
             ..fast
         };
-        assert_eq!(
-            at_200_hz.misses().unwrap(),
-            "latency x: p99 8.5 ms over 8 ms"
-        );
+        let misses = at_200_hz.misses().unwrap();
+        assert_eq!(misses, "latency x: p99 8.5 ms over 8 ms");
         let times = schedule(Duration::from_secs(1), 100, DMX_GAP, 7);
         assert_eq!(times, schedule(Duration::from_secs(1), 100, DMX_GAP, 7));
+        let gaps = times.windows(2).map(|w| w[1].saturating_sub(w[0]));
         assert!(
-            times
-                .windows(2)
-                .all(|w| (DMX_GAP.0..DMX_GAP.1).contains(&w[1].saturating_sub(w[0])))
+            gaps.into_iter()
+                .all(|gap| (DMX_GAP.0..DMX_GAP.1).contains(&gap))
         );
     }
 
@@ -468,17 +411,10 @@ mod tests {
         assert_eq!(events.len(), 3 + 2 * SCHEDULED);
         let presses: Vec<u64> = events[3..].iter().step_by(2).map(|e| e.at_us).collect();
         let releases = events[4..].iter().step_by(2).map(|e| e.at_us);
-        assert!(
-            presses
-                .iter()
-                .zip(releases)
-                .all(|(press, release)| release - press == 30_000)
-        );
-        assert!(
-            presses
-                .windows(2)
-                .all(|w| (150_000..170_000).contains(&(w[1] - w[0])))
-        );
+        let mut held = presses.iter().zip(releases);
+        assert!(held.all(|(press, release)| release - press == 30_000));
+        let mut gaps = presses.windows(2).map(|w| w[1] - w[0]);
+        assert!(gaps.all(|gap| (150_000..170_000).contains(&gap)));
         // Spread over the frame: every fifth of it is hit.
         for fifth in 0..5 {
             assert!(presses.iter().any(|at| at % 20_000 / 4000 == fifth));

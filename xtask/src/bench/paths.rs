@@ -50,12 +50,19 @@ fn all_ok(replies: &[u8], what: &str) -> Result<()> {
     }
 }
 
+/// Fails unless `got` is `want`: `<got> <what>, not <want>`.
+pub fn count(got: usize, want: usize, what: &str) -> Result<()> {
+    if got != want {
+        bail!("{got} {what}, not {want}");
+    }
+    Ok(())
+}
+
 /// The first boot of the shipped image run until 0.5 s after `last`, its
 /// USB port sent `chunks`, every reply `ok`.
 fn usb_run(
-    root: &Path,
-    metadata: &Metadata,
-    (wall, last): (Duration, Duration),
+    (root, metadata, wall): (&Path, &Metadata, Duration),
+    last: Duration,
     chunks: Vec<Chunk>,
     what: &str,
 ) -> Result<Boot> {
@@ -70,64 +77,43 @@ fn usb_run(
 pub fn usb_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
     let times = schedule(Duration::from_secs(4), SCHEDULED, LOOK_GAP, 0x1007_c0de);
     let mut chunks = vec![Chunk::new(b"idle off\n", Duration::from_millis(2500))];
-    chunks.extend(
-        times
-            .iter()
-            .enumerate()
-            .map(|(k, at)| Chunk::new(look_line(k), *at)),
-    );
+    let looks = times.iter().enumerate();
+    chunks.extend(looks.map(|(k, at)| Chunk::new(look_line(k), *at)));
     let last = times.last().copied().unwrap_or_default();
-    let boot = usb_run(root, metadata, (wall, last), chunks, "usb look")?;
+    let boot = usb_run((root, metadata, wall), last, chunks, "usb look")?;
     let events: Vec<f64> = boot.usb_in.iter().skip(1).copied().collect();
-    if events.len() != times.len() {
-        bail!("{} USB lines went out, not {}", events.len(), times.len());
-    }
+    count(events.len(), times.len(), "USB lines went out")?;
     latency::row("usb look", &events, &boot)
 }
 
 /// `latency uart look`: `look` lines over UART0 at 115200 baud, each in by
 /// its time.
 pub fn uart_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
-    let (events, boot) = uart_looks(root, metadata, wall, b"idle off\n", 0x0a47_100c)?;
+    let (events, boot) = uart_looks((root, metadata, wall), b"idle off\n", 0x0a47_100c)?;
     latency::row("uart look", &events, &boot)
 }
 
 /// `latency uart look at 200 Hz`: the same after `servo rate 200`, against
 /// its own goal (a 5 ms frame and the transport).
 pub fn uart_look_200_hz(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
-    let (events, boot) = uart_looks(
-        root,
-        metadata,
-        wall,
-        b"idle off\nservo rate 200\n",
-        0x200_100c,
-    )?;
+    let setup = b"idle off\nservo rate 200\n";
+    let (events, boot) = uart_looks((root, metadata, wall), setup, 0x200_100c)?;
     let answered = String::from_utf8_lossy(&boot.uart);
-    if !answered
-        .lines()
-        .take(2)
-        .any(|line| line.trim_end() == "ok servo rate=200 period_us=5000")
-    {
+    let taken = |line: &str| line.trim_end() == "ok servo rate=200 period_us=5000";
+    if !answered.lines().take(2).any(taken) {
         let start = String::from_utf8_lossy(&boot.uart[..boot.uart.len().min(80)]);
         bail!("uart look at 200 Hz: the rate was not taken: {start:?}");
     }
     let rate = ServoRate::new(200).context("200 Hz is a servo rate")?;
-    latency::row_at(
-        "uart look at 200 Hz",
-        &events,
-        &boot,
-        rate,
-        latency::GOAL_200_HZ_MS,
-    )
+    let goal = latency::GOAL_200_HZ_MS;
+    latency::row_at("uart look at 200 Hz", &events, &boot, rate, goal)
 }
 
 /// A run of `look` lines over UART0 at times seeded by `seed` after `setup`
 /// (one or more lines, at 2.5 s): each line's arrival, and the boot, every
 /// line answered `ok`.
 fn uart_looks(
-    root: &Path,
-    metadata: &Metadata,
-    wall: Duration,
+    (root, metadata, wall): (&Path, &Metadata, Duration),
     setup: &[u8],
     seed: u32,
 ) -> Result<(Vec<f64>, Boot)> {
@@ -142,13 +128,11 @@ fn uart_looks(
     let report = run_shipped(root, metadata, end, wall, |config| config.uart = scripts)?;
     let boot = report.boots.into_iter().next().context("no boot")?;
     // One script for the setup, one for each look.
-    if boot.uart_lines.len() != times.len() + 1 {
-        bail!(
-            "{} UART scripts went out, not {}",
-            boot.uart_lines.len(),
-            times.len() + 1
-        );
-    }
+    count(
+        boot.uart_lines.len(),
+        times.len() + 1,
+        "UART scripts went out",
+    )?;
     all_ok(&boot.uart, "uart look")?;
     Ok((boot.uart_lines.iter().skip(1).copied().collect(), boot))
 }
@@ -163,10 +147,8 @@ const STEP: i32 = 256;
 
 /// Bottango lines with their hashes.
 fn bottango_lines(bodies: &[&str]) -> Vec<u8> {
-    let lines = bodies
-        .iter()
-        .map(|body| format!("{body},h{}\n", hash(body.as_bytes())));
-    lines.collect::<String>().into_bytes()
+    let line = |body: &&str| format!("{body},h{}\n", hash(body.as_bytes()));
+    bodies.iter().map(line).collect::<String>().into_bytes()
 }
 
 /// `latency bottango`: a Bottango session over USB steps yaw by 1.25° and
@@ -191,12 +173,10 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
         0xb077_a160,
     );
     let ms_after = |at: Duration| ((at.as_secs_f64() * 1e9 - t0) / 1e6).round() as u64 - clock_ms;
+    let setup = bottango_lines(&["hRQ,144", "rMTR,yaw,-20000,20000,3000,4096"]);
     let mut chunks = vec![
         Chunk::new(b"idle off\n", Duration::from_secs(2)),
-        Chunk::new(
-            bottango_lines(&["hRQ,144", "rMTR,yaw,-20000,20000,3000,4096"]),
-            Duration::from_millis(2300),
-        ),
+        Chunk::new(setup, Duration::from_millis(2300)),
         Chunk::new(bottango_lines(&["tSYN,0"]), sync),
     ];
     let mut events = Vec::new();
@@ -213,13 +193,11 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
             start + 40,
             next - start - 40
         );
-        chunks.push(Chunk::new(
-            bottango_lines(&[&step, &hold]),
-            pair[0].saturating_sub(AHEAD),
-        ));
+        let lines = bottango_lines(&[&step, &hold]);
+        chunks.push(Chunk::new(lines, pair[0].saturating_sub(AHEAD)));
         events.push(t0 + (clock_ms + start) as f64 * 1e6);
     }
     let last = times.last().copied().unwrap_or_default();
-    let boot = usb_run(root, metadata, (wall, last), chunks, "bottango")?;
+    let boot = usb_run((root, metadata, wall), last, chunks, "bottango")?;
     latency::row("bottango", &events, &boot)
 }

@@ -11,10 +11,7 @@ const LOG: [&str; 7] = [
 ];
 
 fn log(lines: &[&str]) -> Vec<LogLine> {
-    lines
-        .iter()
-        .map(|message| LogLine::new("INFO", *message))
-        .collect()
+    lines.iter().map(|m| LogLine::new("INFO", *m)).collect()
 }
 
 #[test]
@@ -44,13 +41,11 @@ fn bench_rows_and_their_verdict() {
     assert!((verdict.marginal[0] - 574.044_444).abs() < 1e-5);
     assert!((verdict.marginal[1] - 581.155_555).abs() < 1e-5);
     assert!(verdict.linear() && verdict.lines().contains("OVER"));
-    assert!(
-        !Verdict {
-            marginal: [100.0, 200.0],
-            ..verdict
-        }
-        .linear()
-    );
+    let uneven = Verdict {
+        marginal: [100.0, 200.0],
+        ..verdict
+    };
+    assert!(!uneven.linear());
     let without: Vec<Row> = rows.into_iter().filter(|row| row.label != "n450").collect();
     assert!(Verdict::of(&without).is_err());
 }
@@ -81,13 +76,11 @@ fn frame_rows_are_held_to_their_own_ceilings_and_named() {
     assert_eq!(rows[2].label(), "frame at 333 Hz");
     // 1,830 is over the idle row's 1,200 but within this row's 2,000.
     assert!(rows[0].within_budget() && rows[1].within_budget() && rows[2].within_budget());
-    assert!(
-        !FrameRow {
-            max: 4001,
-            ..rows[0].clone()
-        }
-        .within_budget()
-    );
+    let slow = FrameRow {
+        max: 4001,
+        ..rows[0].clone()
+    };
+    assert!(!slow.within_budget());
     assert_eq!(
         frames_over_budget(&rows).unwrap(),
         "frame update over its ceiling: row `frame (gesture + look) at 333 Hz` takes 2,001 \

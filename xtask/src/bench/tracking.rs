@@ -42,9 +42,14 @@ const NOISE_MM: i32 = 40;
 const NOISE_SEEDS: u32 = 4;
 
 /// The walker's x at `t_us` (from the first frame), mm.
-fn walker_x(t_us: u64) -> f64 {
-    let walked = t_us.clamp(WALK_FROM_US, WALK_FROM_US + WALK_US) - WALK_FROM_US;
-    -2000.0 + walked as f64 / 1000.0
+fn walker_x(t_us: f64) -> f64 {
+    let (from, to) = (WALK_FROM_US as f64, (WALK_FROM_US + WALK_US) as f64);
+    -2000.0 + (t_us.clamp(from, to) - from) / 1000.0
+}
+
+/// The walker's bearing at `t_us`, m°.
+fn bearing(t_us: f64) -> f64 {
+    -walker_x(t_us).atan2(f64::from(DISTANCE_MM)).to_degrees() * 1000.0
 }
 
 /// The walk as a trace script: the radar and the gaze on by console
@@ -52,7 +57,7 @@ fn walker_x(t_us: u64) -> f64 {
 pub fn walk_script() -> String {
     let mut text = String::from("0 radar on\n0 track on\n");
     for t in (WALK_FROM_US..=WALK_FROM_US + WALK_US).step_by(PERIOD_US as usize) {
-        let x = walker_x(t).round();
+        let x = walker_x(t as f64).round();
         let _ = writeln!(text, "{} radar {x},{DISTANCE_MM}", seconds(t));
     }
     let _ = writeln!(
@@ -88,14 +93,7 @@ impl Walk {
     pub fn of(yaw: &[f64], period_us: u64) -> Result<Self> {
         let (_, params) = trace::built_in()?;
         let room = params.room(Axis::Yaw);
-        let (lo, hi) = (
-            f64::from(room.min.millidegrees()),
-            f64::from(room.max.millidegrees()),
-        );
-        let bearing = |t_us: f64| -> f64 {
-            let x = walker_x(t_us.max(0.0) as u64);
-            -x.atan2(f64::from(DISTANCE_MM)).to_degrees() * 1000.0
-        };
+        let [lo, hi] = [room.min, room.max].map(|a| f64::from(a.millidegrees()));
         let from = usize::try_from((WALK_FROM_US + 1_000_000) / period_us)?;
         let to = usize::try_from((WALK_FROM_US + WALK_US) / period_us)?.min(yaw.len());
         if from >= to {
@@ -131,11 +129,11 @@ fn yaw_of(script: &str, micros: u64) -> Result<Vec<f64>> {
     let (_, params) = trace::built_in()?;
     let events = trace::parse_script(script, &params)?;
     let run = trace::simulate(micros, None, ServoRate::DEFAULT, &events)?;
-    Ok(run
+    let yaw = run
         .rows
         .iter()
-        .map(|row| f64::from(row.angles[Axis::Yaw.index()]))
-        .collect())
+        .map(|row| f64::from(row.angles[Axis::Yaw.index()]));
+    Ok(yaw.collect())
 }
 
 /// A person standing at [`STANDING`], seen by the radar with ±`noise` mm
@@ -164,9 +162,8 @@ fn noise_pp(amplitude: i32) -> Result<i32> {
     let mut worst = 0;
     for seed in 1..=NOISE_SEEDS {
         let noisy = yaw_of(&standing_script(amplitude, seed), micros)?;
-        let d: Vec<i32> = (from..clean.len().min(noisy.len()))
-            .map(|k| (noisy[k] - clean[k]) as i32)
-            .collect();
+        let frames = from..clean.len().min(noisy.len());
+        let d: Vec<i32> = frames.map(|k| (noisy[k] - clean[k]) as i32).collect();
         let pp = d.iter().max().unwrap_or(&0) - d.iter().min().unwrap_or(&0);
         worst = worst.max(pp);
     }
@@ -209,12 +206,8 @@ pub fn stage() -> Result<()> {
                  the firmware's core frame by frame at 50 Hz, the radar's frames ten a second, \
                  the idle playing under the gaze; [attention and \
                  tracking](attention.md)). The bearing is held to the yaw's limits.";
-    figures::record(
-        "tracking",
-        intro.to_owned(),
-        &["figure", "measured", "acceptance"],
-        rows,
-    );
+    let header = ["figure", "measured", "acceptance"];
+    figures::record("tracking", intro.to_owned(), &header, rows);
     let mut misses = Vec::new();
     if walk.lag_ms > MAX_LAG_MS {
         misses.push(format!("the yaw lags the walker by {} ms", walk.lag_ms));
@@ -223,44 +216,29 @@ pub fn stage() -> Result<()> {
         misses.push(format!("the walk's RMS error is {}", deg(walk.rms)));
     }
     if pp >= MAX_NOISE_PP {
-        misses.push(format!(
-            "radar noise moves the yaw {} peak-to-peak",
-            deg(f64::from(pp))
-        ));
+        let pp = deg(f64::from(pp));
+        misses.push(format!("radar noise moves the yaw {pp} peak-to-peak"));
     }
-    if misses.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", misses.join("; "))
-    }
+    crate::project::verdict(&misses)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// The walker's bearing at `t_us`, m°, within `room`.
-    fn bearing(t_us: f64, (lo, hi): (f64, f64)) -> f64 {
-        let x = -2000.0 + (t_us - 3e6).clamp(0.0, 4e6) / 1000.0;
-        (-(x / 2000.0).atan().to_degrees() * 1000.0).clamp(lo, hi)
-    }
-
     #[test]
     fn a_yaw_that_follows_100_ms_late_has_a_lag_of_100_ms() {
         let (_, params) = trace::built_in().unwrap();
         let room = params.room(Axis::Yaw);
-        let room = (
-            f64::from(room.min.millidegrees()),
-            f64::from(room.max.millidegrees()),
-        );
+        let [lo, hi] = [room.min, room.max].map(|a| f64::from(a.millidegrees()));
         let exact: Vec<f64> = (0..400)
-            .map(|k| bearing(f64::from(k) * 20e3, room))
+            .map(|k| bearing(f64::from(k) * 20e3).clamp(lo, hi))
             .collect();
         let walk = Walk::of(&exact, 20_000).unwrap();
         assert_eq!(walk.lag_ms, 0);
         assert!(walk.rms < 1.0 && walk.largest < 1.0, "{walk:?}");
         let late: Vec<f64> = (0..400)
-            .map(|k| bearing(f64::from(k) * 20e3 - 100e3, room))
+            .map(|k| bearing(f64::from(k) * 20e3 - 100e3).clamp(lo, hi))
             .collect();
         let walk = Walk::of(&late, 20_000).unwrap();
         assert_eq!(walk.lag_ms, 100);

@@ -1,16 +1,13 @@
-//! `cargo xtask preview`: the stages of a loop as CSV and PNG, for people.
-//! The core library's engine runs on the host (`generate_into` with a
-//! `Trace` observer); `<out>/<stem>.csv` has the columns
-//! `n,walk,smoothed,normalized,final` in degrees (`stages.rs` says what
-//! each is), `<out>/<stem>.png` the stages as panels in the style of the
-//! paper's Figures 6 and 7.
+//! `cargo xtask preview`: the stages of a loop, from the core's engine on
+//! the host, as `<out>/<stem>.csv` (`n,walk,smoothed,normalized,final` in
+//! degrees, `stages.rs`) and `<out>/<stem>.png` (panels in the style of the
+//! paper's Figures 6 and 7, drawn by [`crate::plot`]).
 
-mod figure;
 mod stages;
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use idle_head_core::{
     Angle, AngleRange, Axis,
     motion::{AxisError, Closure, DEFAULT_HEAD},
@@ -18,7 +15,7 @@ use idle_head_core::{
 
 use crate::{args::LoopShape, project};
 use stages::LoopSpec;
-pub use stages::{Stages, closure_name};
+pub use stages::{Stages, closure_name, deg};
 
 /// Options of `cargo xtask preview` (its help text is in `cli.rs`).
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
@@ -109,15 +106,17 @@ impl Args {
                 Some(stem) => format!("{stem}-{}", axis.name()),
                 None => axis.name().to_owned(),
             };
-            let spec = |axis| LoopSpec {
-                axis,
-                n,
-                cfg: *DEFAULT_HEAD.axis(axis),
+            let spec = |axis: Axis| {
+                (
+                    LoopSpec {
+                        axis,
+                        n,
+                        cfg: *DEFAULT_HEAD.axis(axis),
+                    },
+                    stem(axis),
+                )
             };
-            Axis::ALL
-                .into_iter()
-                .map(|axis| (spec(axis), stem(axis)))
-                .collect()
+            Axis::ALL.map(spec).into()
         };
         for (LoopSpec { axis, n, cfg }, _) in &specs {
             cfg.validate(*axis, *n)
@@ -130,21 +129,14 @@ impl Args {
 /// `cargo xtask preview`.
 pub fn command(args: &Args) -> Result<bool> {
     let loops = args.loops()?;
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| project::root().join("preview"));
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let out = (args.out.clone()).unwrap_or_else(|| project::root().join("preview"));
     // Paths as the user would name them: relative to the current folder.
     let here = std::env::current_dir().unwrap_or_default();
     for (spec, stem) in loops {
         let stages = Stages::compute(spec)?;
-        let (csv, png) = (
-            out.join(format!("{stem}.csv")),
-            out.join(format!("{stem}.png")),
-        );
-        std::fs::write(&csv, stages.csv()).with_context(|| format!("writing {}", csv.display()))?;
-        figure::draw(&stages, &png)?;
+        let [csv, png] = ["csv", "png"].map(|ext| out.join(format!("{stem}.{ext}")));
+        project::write(&csv, stages.csv())?;
+        stages::draw(&stages, &png)?;
         println!("{}", stages.title());
         for line in &stages.metric_lines() {
             println!("  {line}");
@@ -179,34 +171,24 @@ mod tests {
         let three = loops("--name head").unwrap();
         let names: Vec<&str> = three.iter().map(|(_, name)| name.as_str()).collect();
         assert_eq!(names, ["head-pitch", "head-roll", "head-yaw"]);
-        assert_eq!(
-            (three[0].0.cfg, three[2].0.n),
-            (DEFAULT_HEAD.pitch, DEFAULT_N)
-        );
+        let first = (three[0].0.cfg, three[2].0.n);
+        assert_eq!(first, (DEFAULT_HEAD.pitch, DEFAULT_N));
         let one = loops("--seed 127 --n=450 --w 31 --range -4.5 12 --closure Paper --axis pitch");
         let one = one.unwrap();
         let [(spec, name)] = &one[..] else {
             panic!("{one:?}")
         };
-        assert_eq!(
-            (name.as_str(), spec.axis, spec.n),
-            ("loop", Axis::Pitch, 450)
-        );
+        assert_eq!((name.as_str(), spec.axis), ("loop", Axis::Pitch));
+        assert_eq!(spec.n, 450);
         let range = AngleRange {
             min: Angle::from_millidegrees(-4500),
             max: Angle::from_degrees(12),
         };
         let cfg = &spec.cfg;
-        assert_eq!(
-            (cfg.seed, cfg.window, cfg.range, cfg.closure),
-            (127, 31, range, Closure::Paper)
-        );
-        for bad in [
-            "--closure smooth",
-            "--axis sideways",
-            "--range 1 1e30",
-            "--name a/b",
-        ] {
+        assert_eq!((cfg.seed, cfg.window), (127, 31));
+        assert_eq!((cfg.range, cfg.closure), (range, Closure::Paper));
+        let bad = "--closure smooth|--axis sideways|--range 1 1e30|--name a/b";
+        for bad in bad.split('|') {
             assert!(loops(bad).is_err(), "{bad}");
         }
         // A range the firmware cannot play: the error is the core's.
@@ -215,9 +197,7 @@ mod tests {
             axis: Axis::Yaw,
             error: cfg.validate(Axis::Yaw, DEFAULT_N).unwrap_err(),
         };
-        assert_eq!(
-            format!("{:#}", loops("--range -50 50").unwrap_err()),
-            core.to_string()
-        );
+        let error = loops("--range -50 50").unwrap_err();
+        assert_eq!(format!("{error:#}"), core.to_string());
     }
 }

@@ -5,16 +5,19 @@
 //! engine defines it only up to a constant); `normalized`, the paper's
 //! min-max normalisation into [α1, α2]; `final`, the stored loop in
 //! playback order, from the split point p: `final(i)` is the closure's last
-//! stage at (i + p) mod N. (The split point is held to a reference
-//! implementation by `host-tests`.)
+//! stage at (i + p) mod N (held to a reference implementation by
+//! `host-tests`); and their figure.
 
 // Sample indices (< 2^13) and angles are small: float conversions are exact
 // or far below the printed resolution.
 #![allow(clippy::cast_precision_loss)]
 
-use std::fmt::Write as _;
+use std::{fmt::Write as _, path::Path};
 
 use anyhow::{Context, Result};
+use plotters::style::RGBColor;
+
+use crate::plot::{self, BLUE, Curve, Figure, GREEN, GREY, LIGHT, ORANGE, PURPLE, Panel, RED};
 use idle_head_core::{
     Angle, Axis,
     metrics::LoopMetrics,
@@ -24,12 +27,12 @@ use idle_head_core::{
     },
 };
 
-/// One loop to preview.
+/// One loop to preview: its axis, length, and configuration (seed, window,
+/// step, range and closure).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LoopSpec {
     pub axis: Axis,
     pub n: usize,
-    /// Seed, window, step, range and closure.
     pub cfg: AxisConfig,
 }
 
@@ -38,19 +41,23 @@ pub fn deg(angle: Angle) -> f64 {
     f64::from(angle.millidegrees()) / f64::from(Angle::SCALE)
 }
 
+pub fn closure_name(closure: Closure) -> &'static str {
+    match closure {
+        Closure::Paper => "paper",
+        Closure::Seamless => "seamless",
+    }
+}
+
 /// The paper closure's open walk in degrees: u(0) = 0, u(n) = u(n−1) ± δ with
 /// the sign of r(n).
 pub fn paper_walk(seed: u32, n: usize, delta: f64) -> Vec<f64> {
     let mut lcg = Lcg::new(seed);
-    let mut u = 0.0;
-    (0..n)
-        .map(|i| {
-            if i > 0 {
-                u += f64::from(step_of(lcg.next_value())) * delta;
-            }
-            u
-        })
-        .collect()
+    let steps = (1..n).map(|_| f64::from(step_of(lcg.next_value())) * delta);
+    let walk = steps.scan(0.0, |u, step| {
+        *u += step;
+        Some(*u)
+    });
+    std::iter::once(0.0).chain(walk).take(n).collect()
 }
 
 /// The seamless closure's periodic walk in degrees: e(k) = ±1 from r(k+1),
@@ -61,14 +68,11 @@ pub fn seamless_walk(seed: u32, n: usize, delta: f64) -> Vec<f64> {
         .map(|_| f64::from(step_of(lcg.next_value())))
         .collect();
     let drift = steps.iter().sum::<f64>() / n as f64;
-    let mut u = 0.0;
-    steps
-        .iter()
-        .map(|e| {
-            u += (e - drift) * delta;
-            u
-        })
-        .collect()
+    let walk = steps.iter().scan(0.0, |u, e| {
+        *u += (e - drift) * delta;
+        Some(*u)
+    });
+    walk.collect()
 }
 
 /// The paper's normalisation into [a1, a2]: a1 + (s − min)(a2 − a1)/(max − min).
@@ -76,24 +80,21 @@ pub fn normalize(values: &[f64], a1: f64, a2: f64) -> Vec<f64> {
     let min = values.iter().copied().fold(f64::INFINITY, f64::min);
     let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let span = max - min;
-    values
-        .iter()
-        .map(|&s| {
-            if span > 0.0 {
-                a1 + (s - min) * (a2 - a1) / span
-            } else {
-                a1
-            }
-        })
-        .collect()
+    let scale = |s: f64| {
+        if span > 0.0 {
+            a1 + (s - min) * (a2 - a1) / span
+        } else {
+            a1
+        }
+    };
+    values.iter().map(|&s| scale(s)).collect()
 }
 
 /// The length-N Hann taper of the paper closure: ½ − ½·cos(2πn/(N−1)).
 pub fn taper(n: usize) -> Vec<f64> {
     let span = (n.max(2) - 1) as f64;
-    (0..n)
-        .map(|i| 0.5 - 0.5 * (std::f64::consts::TAU * i as f64 / span).cos())
-        .collect()
+    let weight = |i: usize| 0.5 - 0.5 * (std::f64::consts::TAU * i as f64 / span).cos();
+    (0..n).map(weight).collect()
 }
 
 fn mean(values: &[f64]) -> f64 {
@@ -111,21 +112,18 @@ impl Trace for Recorder {
     }
 }
 
-/// All stages of one loop.
+/// All stages of one loop, in degrees, in generation order but the stored
+/// loop (playback order); the paper closure's Hann taper and tapered loop;
+/// the stored loop's metrics.
 #[derive(Debug, Clone)]
 pub struct Stages {
     pub spec: LoopSpec,
     pub info: LoopInfo,
     pub walk: Vec<f64>,
-    /// Smoothed walk, degrees, generation order.
     pub smoothed: Vec<f64>,
-    /// Normalised into [α1, α2], degrees, generation order.
     pub normalized: Vec<f64>,
-    /// Paper closure only: the Hann taper and the tapered loop (degrees).
     pub tapered: Option<(Vec<f64>, Vec<f64>)>,
-    /// The stored loop, degrees, playback order.
     pub final_loop: Vec<f64>,
-    /// Metrics of the stored loop.
     pub metrics: LoopMetrics,
 }
 
@@ -144,11 +142,9 @@ impl Stages {
             Closure::Paper => paper_walk(cfg.seed, n, delta),
             Closure::Seamless => seamless_walk(cfg.seed, n, delta),
         };
-        let mut smoothed: Vec<f64> = recorder.0.iter().map(|s| s * delta).collect();
+        let smoothed: Vec<f64> = recorder.0.iter().map(|s| s * delta).collect();
         let shift = mean(&walk) - mean(&smoothed);
-        for s in &mut smoothed {
-            *s += shift;
-        }
+        let smoothed: Vec<f64> = smoothed.iter().map(|s| s + shift).collect();
         let (a1, a2) = (deg(cfg.range.min), deg(cfg.range.max));
         let normalized = normalize(&smoothed, a1, a2);
         let final_loop: Vec<f64> = stored.iter().map(|s| f64::from(s.0) / 1000.0).collect();
@@ -206,15 +202,10 @@ impl Stages {
         let m = &self.metrics;
         let LoopSpec { cfg, .. } = self.spec;
         let inside = cfg.range.contains(m.min) && cfg.range.contains(m.max);
+        let (d1, d2, lively) = (m.velocity_ratio, m.acceleration_ratio, m.liveliness);
         vec![
-            format!(
-                "continuity: max|d1|/P95|d1| = {:.2}, max|d2|/P95|d2| = {:.2}",
-                m.velocity_ratio, m.acceleration_ratio
-            ),
-            format!(
-                "liveliness (min over 10 segments of mean|d1| / mean|d1|) = {:.2}",
-                m.liveliness
-            ),
+            format!("continuity: max|d1|/P95|d1| = {d1:.2}, max|d2|/P95|d2| = {d2:.2}"),
+            format!("liveliness (min over 10 segments of mean|d1| / mean|d1|) = {lively:.2}"),
             format!(
                 "range: min = {:.3}°, max = {:.3}° ({} [{}°, {}°]); start x(0) = {:.3}°",
                 deg(m.min),
@@ -239,11 +230,96 @@ impl Stages {
     }
 }
 
-pub fn closure_name(closure: Closure) -> &'static str {
-    match closure {
-        Closure::Paper => "paper",
-        Closure::Seamless => "seamless",
+/// Draws a loop's stages (`cargo xtask preview`) to `path`: stacked panels
+/// in the style of the paper's Figures 6 and 7, the split point marked, the
+/// loop's metrics under the title.
+pub fn draw(stages: &Stages, path: &Path) -> Result<()> {
+    let (n, cfg, p) = (stages.spec.n, stages.spec.cfg, stages.info.split);
+    let (a1, a2) = (deg(cfg.range.min), deg(cfg.range.max));
+    let (walk, window) = match cfg.closure {
+        Closure::Paper => ("random walk u(n) = u(n−1) ± δ", "causal"),
+        Closure::Seamless => ("periodic random walk (mean step removed)", "circular"),
+    };
+    let split = (f64::from(p), format!("split p = {p}"), RED);
+    // A panel of `curves` (label, colour, values); in the range's ends
+    // (dashed) if `marker` says where to mark it.
+    let panel = |title: String, curves: &[(&str, RGBColor, &[f64])], marker: Option<_>| {
+        let mut curves: Vec<Curve> = (curves.iter())
+            .map(|&(label, color, values)| Curve::indexed(label, color, values))
+            .collect();
+        let range = format!("[α1, α2] = [{a1}°, {a2}°]");
+        for (label, y) in marker
+            .iter()
+            .flat_map(|_| [(range.clone(), a1), (String::new(), a2)])
+        {
+            let points = vec![(0.0, y), ((n.max(2) - 1) as f64, y)];
+            curves.push(Curve {
+                dashed: true,
+                ..Curve::new(label, GREY, points)
+            });
+        }
+        let x_desc = "sample index n (generation order)".to_owned();
+        let y_desc = "angle (°)".to_owned();
+        let markers = marker.into_iter().collect();
+        Panel {
+            title,
+            x_desc,
+            y_desc,
+            curves,
+            markers,
+            spans: Vec::new(),
+        }
+    };
+    let mut panels = vec![
+        panel(format!("1. {walk}"), &[("walk", GREY, &stages.walk)], None),
+        panel(
+            format!(
+                "2. smoothed with a {}-tap Hann window ({window})",
+                cfg.window
+            ),
+            &[
+                ("walk", LIGHT, &stages.walk),
+                ("smoothed", BLUE, &stages.smoothed),
+            ],
+            None,
+        ),
+        panel(
+            "3. normalised into [α1, α2]".to_owned(),
+            &[("normalised", ORANGE, &stages.normalized)],
+            Some(split.clone()),
+        ),
+    ];
+    if let Some((taper, tapered)) = &stages.tapered {
+        let title = "4. Hann taper ½ − ½·cos(2πn/(N−1))".to_owned();
+        let mut weights = panel(title, &[("taper", PURPLE, taper)], None);
+        "weight".clone_into(&mut weights.y_desc);
+        panels.push(weights);
+        let title = "5. normalised × taper: both ends at zero".to_owned();
+        panels.push(panel(title, &[("tapered", GREEN, tapered)], Some(split)));
     }
+    let title = format!(
+        "{}. final loop, stored (0.001° steps), in playback order: halves exchanged at p",
+        panels.len() + 1
+    );
+    let start = (0.0, format!("start = sample p = {p}"), RED);
+    let mut stored = panel(title, &[("final", RED, &stages.final_loop)], Some(start));
+    "playback index i (final(i) = stage(i + p mod N))".clone_into(&mut stored.x_desc);
+    let seam = (n - usize::from(p) % n) % n;
+    if seam != 0 {
+        let label = format!("seam: samples N−1 | 0 (index {seam})");
+        stored.markers.push((seam as f64, label, GREY));
+    }
+    panels.push(stored);
+    let note = "Idle-loop generation after Kocoń, section 3 (stages as in Figures 6 and 7)";
+    let mut notes = vec![note.to_owned()];
+    notes.extend(stages.metric_lines());
+    let figure = Figure {
+        title: stages.title(),
+        notes,
+        panels,
+        panel_height: 240,
+    };
+    plot::draw(&figure, path)
 }
 
 #[cfg(test)]
@@ -282,16 +358,10 @@ mod tests {
     fn stages_of_a_default_axis() {
         for closure in [Closure::Paper, Closure::Seamless] {
             let cfg = DEFAULT_HEAD.pitch.with_closure(closure);
-            let stages = Stages::compute(LoopSpec {
-                axis: Axis::Pitch,
-                n: DEFAULT_N,
-                cfg,
-            })
-            .unwrap();
-            let norm = &stages.normalized;
-            let (lo, hi) = norm
-                .iter()
-                .fold((f64::MAX, f64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+            let (axis, n) = (Axis::Pitch, DEFAULT_N);
+            let stages = Stages::compute(LoopSpec { axis, n, cfg }).unwrap();
+            let norm = stages.normalized.iter();
+            let (lo, hi) = norm.fold((f64::MAX, f64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
             assert!((lo + 4.0).abs() < 1e-9 && (hi - 12.0).abs() < 1e-9);
             assert_eq!(stages.tapered.is_some(), closure == Closure::Paper);
             let csv = stages.csv();

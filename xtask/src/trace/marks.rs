@@ -4,39 +4,36 @@
 
 use idle_head_core::behaviour::{Applied, BehaviourError, BehaviourParams};
 use idle_head_core::command::{Action, Hold, LookRequest};
+use idle_head_core::console::{PORT_REPLY, Reply, outcome_reply};
 use idle_head_core::{Angle, Axis, Millis};
 
-use super::{Trace, script::Event};
+use super::Trace;
 use crate::plot::{self, GREY, RED};
 use plotters::style::RGBColor;
 
-/// What kind of motion a mark stands for.
+/// What kind of motion a mark stands for: a gesture, a move of the gaze
+/// (`look`, `center`), a look's return to the centre, a rest or a wake,
+/// anything else (idle, stop, a refused command).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
-    /// A gesture (any of the core's gesture table).
     Gesture,
-    /// A move of the gaze: `look` or `center`.
     Gaze,
-    /// A look's return to the centre after its hold.
     Return,
-    /// A rest or a wake: the blend to the rest pose and back.
     Rest,
-    /// Anything else (idle, stop, a refused command).
     Other,
 }
 
-/// A command as applied, or a look's return.
+/// A command as applied, or a look's return: when (ms), how long its motion
+/// lasts (ms, 0: a switch), on which axes, a short label (`nod`, `look
+/// (clamped)`, `return`, ...) and the console's reply (for a return: what
+/// it is).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mark {
-    /// When it was applied (or the return starts), in ms.
     pub t_ms: u64,
-    /// How long its motion lasts, in ms (0: a switch).
     pub span_ms: u64,
     pub axes: Vec<Axis>,
     pub kind: Kind,
-    /// A short label (`nod`, `look clamped`, `return`, ...).
     pub label: String,
-    /// The reply a console would give (for a return: what it is).
     pub reply: String,
 }
 
@@ -47,84 +44,38 @@ impl Mark {
     }
 }
 
-/// The marks of `event`, applied at `t_ms` with `outcome`: its own, and
-/// for a look that returns, the return.
+/// The marks of the command `text` (script line `line`, 0 for another
+/// source), applied at `t_ms` with `outcome`: its own, and for a look that
+/// returns, the return.
 pub fn marks(
-    event: &Event,
+    text: &str,
+    line: usize,
     t_ms: u64,
     outcome: &Result<Applied, BehaviourError>,
     params: &BehaviourParams,
 ) -> Vec<Mark> {
-    let word = event
-        .text
-        .split_whitespace()
-        .next()
-        .unwrap_or("")
-        .to_owned();
-    let (axes, span_ms, kind, label, reply) = match outcome {
-        Err(e) => (
-            vec![],
-            0,
-            Kind::Other,
-            format!("{word} (refused)"),
-            format!("err {} {e}", e.code()),
-        ),
-        Ok(Applied::Gesture(plan)) => (
-            vec![plan.kind.axis()],
-            u64::from(plan.duration.0),
-            Kind::Gesture,
-            word,
-            format!(
-                "ok {} {} mdeg {} cycles {} ms intensity {}",
-                plan.kind.name(),
-                plan.amplitude.millidegrees(),
-                plan.cycles,
-                plan.duration.0,
-                plan.intensity.get()
-            ),
-        ),
-        Ok(Applied::Look(look)) => (
-            vec![Axis::Pitch, Axis::Yaw],
-            u64::from(look.duration.0),
-            Kind::Gaze,
-            if look.clamped {
-                "look (clamped)".to_owned()
-            } else {
-                word
-            },
-            format!(
-                "ok look{} {} {} {} ms",
-                if look.clamped { " clamped" } else { "" },
-                look.pitch.millidegrees(),
-                look.yaw.millidegrees(),
-                look.duration.0
-            ),
-        ),
-        Ok(Applied::Center(ms)) => (
-            vec![Axis::Pitch, Axis::Yaw],
-            u64::from(ms.0),
-            Kind::Gaze,
-            word,
-            format!("ok center {} ms", ms.0),
-        ),
-        Ok(Applied::Idle(p)) => (
-            vec![],
-            0,
-            Kind::Other,
-            event.text.clone(),
-            format!("ok idle {} %", p.get()),
-        ),
-        Ok(Applied::Stop) => (vec![], 0, Kind::Other, word, "ok stop".to_owned()),
-        Ok(Applied::Rest(ms) | Applied::Wake(ms)) => {
-            let what = if matches!(outcome, Ok(Applied::Rest(_))) {
-                "rest"
-            } else {
-                "wake"
-            };
-            let reply = format!("ok {what} {} ms", ms.0);
-            (Axis::ALL.to_vec(), u64::from(ms.0), Kind::Rest, word, reply)
-        }
+    let word = text.split_whitespace().next().unwrap_or("");
+    let gaze = vec![Axis::Pitch, Axis::Yaw];
+    let (axes, span, kind) = match outcome {
+        Ok(Applied::Gesture(plan)) => (vec![plan.kind.axis()], plan.duration, Kind::Gesture),
+        Ok(Applied::Look(look)) => (gaze.clone(), look.duration, Kind::Gaze),
+        Ok(Applied::Center(ms)) => (gaze.clone(), *ms, Kind::Gaze),
+        Ok(Applied::Rest(ms) | Applied::Wake(ms)) => (Axis::ALL.to_vec(), *ms, Kind::Rest),
+        _ => (vec![], Millis(0), Kind::Other),
     };
+    let label = match outcome {
+        Err(_) => format!("{word} (refused)"),
+        Ok(Applied::Look(look)) if look.clamped => "look (clamped)".to_owned(),
+        Ok(Applied::Idle(_)) => text.to_owned(),
+        _ => word.to_owned(),
+    };
+    let mut out = [0; PORT_REPLY];
+    let mut reply = Reply::new(&mut out);
+    outcome_reply(&mut reply, outcome);
+    let reply = String::from_utf8_lossy(reply.finish())
+        .trim_end()
+        .to_owned();
+    let span_ms = u64::from(span.0);
     let mut marks = vec![Mark {
         t_ms,
         span_ms,
@@ -137,18 +88,19 @@ pub fn marks(
         && let Hold::Return(hold) = look.hold
         && let Some(back) = return_duration(params, look.pitch, look.yaw)
     {
-        // As the gaze plans it: the move, then the hold, then the move
-        // back at the rule's duration.
+        // As the gaze plans it: the move, the hold, the move back at the
+        // rule's duration.
+        let reply = format!(
+            "(the look at line {line} returns to the centre after its {} ms hold, in {} ms)",
+            hold.0, back.0
+        );
         marks.push(Mark {
-            t_ms: t_ms + u64::from(look.duration.0) + u64::from(hold.0),
+            t_ms: t_ms + span_ms + u64::from(hold.0),
             span_ms: u64::from(back.0),
-            axes: vec![Axis::Pitch, Axis::Yaw],
+            axes: gaze,
             kind: Kind::Return,
             label: "return".to_owned(),
-            reply: format!(
-                "(the look at line {} returns to the centre after its {} ms hold, in {} ms)",
-                event.line, hold.0, back.0
-            ),
+            reply,
         });
     }
     marks
@@ -177,9 +129,8 @@ fn return_duration(params: &BehaviourParams, pitch: Angle, yaw: Angle) -> Option
 /// up in time order.
 pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
     let applied = |m: &Mark| !m.refused();
-    let gestures: Vec<usize> = (0..marks.len())
-        .filter(|&i| marks[i].kind == Kind::Gesture && applied(&marks[i]))
-        .collect();
+    let gesture = |i: &usize| marks[*i].kind == Kind::Gesture && applied(&marks[*i]);
+    let gestures: Vec<usize> = (0..marks.len()).filter(gesture).collect();
     for pair in gestures.windows(2) {
         let next = marks[pair[1]].t_ms;
         let mark = &mut marks[pair[0]];
@@ -197,8 +148,8 @@ pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
         }
         let next_move = marks[i + 1..]
             .iter()
-            .find(|m| m.kind == Kind::Gaze && applied(m))
-            .map(|m| m.t_ms);
+            .find(|m| m.kind == Kind::Gaze && applied(m));
+        let next_move = next_move.map(|m| m.t_ms);
         let mark = &mut marks[i];
         match next_move {
             Some(t) if t <= mark.t_ms => keep[i] = false,
@@ -216,57 +167,50 @@ pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
 
 /// Draws `trace` to the PNG `path`: the three axes over time (in minutes
 /// past five of them), each command marked where it was applied and its
-/// motion shaded on the axes it moves (a look's return in blue, a refused
-/// command in red).
+/// motion shaded on the axes it moves.
 #[allow(clippy::cast_precision_loss)] // frame times, far below 2^52
 pub fn draw(trace: &Trace, seed: Option<u32>, path: &std::path::Path) -> anyhow::Result<()> {
-    let end_ms = trace.rows.last().map_or(0, |r| r.t_ms);
+    let end_ms = trace.rows.last().map_or(0, |r| r.t_us / 1000);
     let (unit, ms_per_unit) = if end_ms > 300_000 {
         ("min", 60_000.0)
     } else {
         ("s", 1000.0)
     };
     let at = |ms: u64| ms as f64 / ms_per_unit;
-    let back = |m: &Mark| m.kind == Kind::Return;
+    // A look's return in blue, a refused command's line in red.
+    let (blue, light_blue, orange) = (
+        RGBColor(70, 110, 160),
+        RGBColor(214, 230, 245),
+        RGBColor(255, 228, 196),
+    );
     let marks: Vec<plot::Mark> = (trace.marks.iter())
-        .map(|m| plot::Mark {
-            from: at(m.t_ms),
-            to: at(m.t_ms + m.span_ms),
-            axes: m.axes.clone(),
-            label: m.label.clone(),
-            line: if m.refused() {
-                RED
-            } else if back(m) {
-                RGBColor(70, 110, 160)
-            } else {
-                GREY
-            },
-            shade: if back(m) {
-                RGBColor(214, 230, 245)
-            } else {
-                RGBColor(255, 228, 196)
-            },
+        .map(|m| {
+            let back = m.kind == Kind::Return;
+            let line = match (m.refused(), back) {
+                (true, _) => RED,
+                (false, true) => blue,
+                (false, false) => GREY,
+            };
+            plot::Mark {
+                from: at(m.t_ms),
+                to: at(m.t_ms + m.span_ms),
+                axes: m.axes.clone(),
+                label: m.label.clone(),
+                line,
+                shade: if back { light_blue } else { orange },
+            }
         })
         .collect();
     let rows: Vec<(f64, [f64; 3])> = (trace.rows.iter())
-        .map(|r| (at(r.t_ms), r.angles.map(|a| f64::from(a) / 1000.0)))
+        .map(|r| (at(r.t_us / 1000), r.angles.map(|a| f64::from(a) / 1000.0)))
         .collect();
-    let loops = seed.map_or_else(
-        || "Table 2 loops".to_owned(),
-        |s| format!("loops of seed {s}"),
-    );
-    let title = format!(
-        "Commanded angles, {} frames ({loops}; after fade, limits and clamps)",
-        rows.len()
-    );
+    let loops = seed.map(|s| format!("loops of seed {s}"));
+    let loops = loops.unwrap_or_else(|| "Table 2 loops".to_owned());
+    let frames = rows.len();
+    let title =
+        format!("Commanded angles, {frames} frames ({loops}; after fade, limits and clamps)");
     let note = "shaded: a command's motion on the axes it moves (blue: a look's return to the \
                 centre); dashed: when it was applied (red: refused)";
-    plot::motion(
-        path,
-        title,
-        vec![note.to_owned()],
-        &format!("time ({unit})"),
-        &rows,
-        &marks,
-    )
+    let x = format!("time ({unit})");
+    plot::motion(path, title, vec![note.to_owned()], &x, &rows, &marks)
 }

@@ -1,12 +1,10 @@
-//! The radar in the trace: a script's `<s> radar <x>,<y> ...` lines as the
-//! LD2450's frames, ten a second, handed to the frame task as the board's
-//! receiver hands them over (`sim/radar.mjs` sends the emulator's on the
-//! same schedule, so that both take each sighting at the same frame).
-//!
-//! The radar sends from the script's first radar line on: frame `k` is due
-//! at `k` · 100 ms from the first frame and sees the people of the last
-//! radar line at or before then; the first frame at or after that takes
-//! it. A script without radar lines has no radar: nothing is sent.
+//! The radar in the trace: a script's radar lines as the LD2450's frames,
+//! ten a second from the first radar line on, handed to the frame task as
+//! the board's receiver hands them over (`sim/radar.mjs` sends the
+//! emulator's on the same schedule, so that both take each sighting at the
+//! same frame). Frame `k` is due at `k` · 100 ms and sees the people of the
+//! last radar line at or before then; the first frame at or after that takes
+//! it. A script without radar lines has no radar.
 
 use idle_head_core::Millimetres;
 use idle_head_core::behaviour::ShowLink;
@@ -17,24 +15,21 @@ use super::{Event, Kind};
 /// The radar's frame period, µs (the LD2450 reports ten times a second).
 pub const PERIOD_US: u64 = 100_000;
 
-/// A script's radar lines, and the frames sent so far.
+/// A script's radar lines (when each sees whom, in time order), and the
+/// next frame to send.
 pub struct Radar {
-    /// When each line sees whom, in time order.
     lines: Vec<(u64, Sighting)>,
-    /// The next frame to send.
     next: u64,
 }
 
 impl Radar {
     /// The radar lines of `events` (in time order).
     pub fn of(events: &[Event]) -> Self {
-        let lines: Vec<(u64, Sighting)> = events
-            .iter()
-            .filter_map(|e| match e.kind {
-                Kind::Radar(seen) => Some((e.at_us, sighting(&seen))),
-                _ => None,
-            })
-            .collect();
+        let radar = |e: &Event| match e.kind {
+            Kind::Radar(seen) => Some((e.at_us, sighting(&seen))),
+            _ => None,
+        };
+        let lines: Vec<(u64, Sighting)> = events.iter().filter_map(radar).collect();
         let next = lines.first().map_or(u64::MAX, |l| l.0.div_ceil(PERIOD_US));
         Self { lines, next }
     }
@@ -44,12 +39,8 @@ impl Radar {
     pub fn send(&mut self, show: &ShowLink, t_us: u64) {
         while self.next.saturating_mul(PERIOD_US) <= t_us {
             let due = self.next * PERIOD_US;
-            let seen = self
-                .lines
-                .iter()
-                .take_while(|l| l.0 <= due)
-                .last()
-                .map_or(Sighting::NOBODY, |l| l.1);
+            let seen = self.lines.iter().take_while(|l| l.0 <= due).last();
+            let seen = seen.map_or(Sighting::NOBODY, |l| l.1);
             self.next += 1;
             let counters = Counters {
                 good: u32::try_from(self.next).unwrap_or(u32::MAX),

@@ -1,62 +1,37 @@
 //! Trace scripts: `<seconds> <command>` per line, the command in the
-//! console's words (parsed by the core's `console::parse`), or a trigger
-//! input's level: `<seconds> pin <n> high|low` (`n` 2 to 5, as `input <n>`).
-//!
-//! A motion command is queued for the frame task as the console would
-//! queue it; any other console line (`input 2 presence -20000`, `rest after
-//! 5`, `servo …`) goes through the console's service, whose reply the trace
-//! prints; a pin line changes the level the input task sees. Pins start at
-//! their idle level (a button's pull-up keeps it high, a presence sensor's
-//! pull-down low) until a line changes them.
-
-use std::fmt::Write as _;
+//! console's words (parsed by the core's `console::parse`): a motion command
+//! is queued for the frame task as the console would queue it; any other
+//! console line (`input 2 presence -20000`, `rest after 5`, `servo …`) goes
+//! through the console's service. `<seconds> pin <n> high|low` (`n` 2 to 5,
+//! as `input <n>`) sets a trigger input's level (each starts at its idle
+//! level: a button's pull-up keeps it high, a presence sensor's pull-down
+//! low); `<seconds> radar none|<x>,<y> …` says what the radar sees.
 
 use anyhow::{Result, bail};
 use idle_head_core::behaviour::BehaviourParams;
 use idle_head_core::command::{Action, Command};
 use idle_head_core::console;
 
-/// One scripted line.
+/// One scripted line: its number in the script (from 1), when (µs from the
+/// first frame), the command as written, and what it is.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Event {
-    /// Its line in the script (from 1; 0 for what an input did).
     pub line: usize,
-    /// When, in µs from the first frame.
     pub at_us: u64,
-    /// The command as written.
     pub text: String,
-    /// What it is.
     pub kind: Kind,
 }
 
-/// What a scripted line is.
+/// What a scripted line is: a motion command for the frame task's queue,
+/// another console line for the console's service, a trigger input's level
+/// (`input` 2 to 5), or up to three people at `(x, y)` mm the radar sees
+/// from then on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
-    /// A motion command, for the frame task's queue.
     Act(Action),
-    /// Any other console line, for the console's service.
     Console,
-    /// A trigger input's level: `input` 2 to 5, high or low.
-    Pin {
-        /// The input's number.
-        input: u8,
-        /// Its level.
-        high: bool,
-    },
-    /// What the radar sees from now on: up to three people at `(x, y)` mm
-    /// in its frame, held until the next radar line.
+    Pin { input: u8, high: bool },
     Radar([Option<(i32, i32)>; 3]),
-}
-
-#[cfg(test)]
-impl Event {
-    /// The action, if the line is a motion command.
-    pub fn action(&self) -> Option<Action> {
-        match self.kind {
-            Kind::Act(action) => Some(action),
-            Kind::Console | Kind::Pin { .. } | Kind::Radar(_) => None,
-        }
-    }
 }
 
 /// `text` as seconds (`2`, `2.5`, `0.125`; at most µs), in µs.
@@ -66,10 +41,7 @@ pub fn seconds(text: &str) -> Result<u64> {
     if !digits(whole) || !digits(fraction) || fraction.len() > 6 {
         bail!("`{text}`: expected seconds such as 2 or 2.5 (at most 6 decimals)");
     }
-    let whole: u64 = whole
-        .parse()
-        .ok()
-        .filter(|&s| s <= 1_000_000)
+    let whole: u64 = (whole.parse().ok().filter(|&s| s <= 1_000_000))
         .ok_or_else(|| anyhow::anyhow!("`{text}`: at most 1000000 seconds"))?;
     let micros: u64 = format!("{fraction:0<6}").parse().unwrap_or(0);
     Ok(whole * 1_000_000 + micros)
@@ -77,22 +49,17 @@ pub fn seconds(text: &str) -> Result<u64> {
 
 /// `us` as decimal seconds without trailing zeros.
 pub fn show_seconds(us: u64) -> String {
-    let mut text = format!("{}", us / 1_000_000);
-    let fraction = us % 1_000_000;
-    if fraction != 0 {
-        let digits = format!("{fraction:06}");
-        let _ = write!(text, ".{}", digits.trim_end_matches('0'));
+    let fraction = format!("{:06}", us % 1_000_000);
+    match fraction.trim_end_matches('0') {
+        "" => format!("{}", us / 1_000_000),
+        digits => format!("{}.{digits}", us / 1_000_000),
     }
-    text
 }
 
 /// Says that `event` came after the trace's end.
 pub fn not_run(event: &Event) {
-    println!(
-        "line {}: at {} s, after the trace's end: not run",
-        event.line,
-        show_seconds(event.at_us)
-    );
+    let (line, at) = (event.line, show_seconds(event.at_us));
+    println!("line {line}: at {at} s, after the trace's end: not run");
 }
 
 /// Parses a script: its events, in time order. A script is a program, read
@@ -142,10 +109,8 @@ fn event(line: usize, text: &str, params: &BehaviourParams) -> Result<Event, Str
         .filter(|rest| rest.starts_with(char::is_whitespace))
         .map(str::trim)
         .filter(|rest| *rest == "none" || rest.contains(','));
-    let kind = if let Some(pin) = command
-        .strip_prefix("pin")
-        .filter(|rest| rest.starts_with(char::is_whitespace))
-    {
+    let pin = (command.strip_prefix("pin")).filter(|rest| rest.starts_with(char::is_whitespace));
+    let kind = if let Some(pin) = pin {
         self::pin(pin.trim())?
     } else if let Some(people) = radar {
         self::radar(people)?
@@ -207,14 +172,12 @@ fn radar(text: &str) -> Result<Kind, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use idle_head_core::behaviour::BehaviourConfig;
-    use idle_head_core::command::GestureKind;
-    use idle_head_core::driver::DriverConfig;
+    use std::fmt::Write as _;
+
+    use idle_head_core::command::{GestureKind, GestureRequest};
 
     fn params() -> BehaviourParams {
-        BehaviourConfig::DEFAULT
-            .build(&DriverConfig::DEFAULT.build().unwrap())
-            .unwrap()
+        crate::trace::built_in().unwrap().1
     }
 
     #[test]
@@ -243,22 +206,13 @@ mod tests {
 8 stop
 ";
         let events = parse(script, &params()).unwrap();
-        let lines: Vec<(usize, u64)> = events.iter().map(|e| (e.line, e.at_us)).collect();
-        assert_eq!(
-            lines,
-            [
-                (2, 1_000_000),
-                (4, 2_500_000),
-                (5, 4_000_000),
-                (6, 4_000_000),
-                (7, 6_000_000),
-                (8, 7_000_000),
-                (9, 8_000_000),
-            ]
-        );
-        assert!(
-            matches!(events[1].action(), Some(Action::Gesture(g)) if g.kind == GestureKind::Nod)
-        );
+        let lines: Vec<usize> = events.iter().map(|e| e.line).collect();
+        let times: Vec<u64> = events.iter().map(|e| e.at_us).collect();
+        assert_eq!(lines, [2, 4, 5, 6, 7, 8, 9]);
+        let s = 1_000_000;
+        assert_eq!(times, [s, 5 * s / 2, 4 * s, 4 * s, 6 * s, 7 * s, 8 * s]);
+        let nod = |g: &GestureRequest| g.kind == GestureKind::Nod;
+        assert!(matches!(events[1].kind, Kind::Act(Action::Gesture(g)) if nod(&g)));
     }
 
     #[test]
@@ -287,8 +241,8 @@ line 4: at 2.9 s, before line 3 (at 3 s): lines must be in time order"
         let events = parse(&script, &params()).unwrap();
         let kinds: Vec<GestureKind> = events
             .iter()
-            .map(|e| match e.action() {
-                Some(Action::Gesture(g)) => g.kind,
+            .map(|e| match e.kind {
+                Kind::Act(Action::Gesture(g)) => g.kind,
                 other => panic!("{other:?}"),
             })
             .collect();
@@ -333,22 +287,9 @@ line 8: `pin 2 up`: expected `pin <2..5> high|low`"
 ";
         let events = parse(script, &params()).unwrap();
         let kinds: Vec<Kind> = events.iter().map(|e| e.kind).collect();
-        assert_eq!(
-            kinds,
-            [
-                Kind::Console,
-                Kind::Console,
-                Kind::Pin {
-                    input: 2,
-                    high: true
-                },
-                Kind::Console,
-                Kind::Pin {
-                    input: 2,
-                    high: false
-                },
-            ]
-        );
+        let pin = |high| Kind::Pin { input: 2, high };
+        let console = Kind::Console;
+        assert_eq!(kinds, [console, console, pin(true), console, pin(false)]);
         assert_eq!(events[2].at_us, 1_500_000);
     }
 }

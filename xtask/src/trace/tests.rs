@@ -21,8 +21,7 @@ fn idle_only_is_the_plain_frame_loop() {
     let playback = Playback::new(LOOP_DURATION, driver.config().frame_period, DEFAULT_N).unwrap();
     let mut source = idle(config(None), playback, None).unwrap();
     let period = driver.config().frame_period;
-    let channel = || Channel::at(period).unwrap();
-    let mut plain = FrameDriver::new([channel(), channel(), channel()], driver);
+    let mut plain = FrameDriver::new([Channel::at(period).unwrap(); 3], driver);
     for row in &trace.rows {
         let report = plain.write_frame(source.offsets(Timestamp(row.t_us)));
         assert_eq!(row.angles, report.servos.map(|s| s.angle.millidegrees()));
@@ -33,11 +32,8 @@ fn idle_only_is_the_plain_frame_loop() {
 fn a_looks_return_is_marked_where_the_head_goes_back() {
     // The idle motion off (it fades out in 1 s): only the gaze moves.
     let trace = run("0 idle off\n2 look 10000 0 500 hold=1000\n", 6);
-    let back: Vec<&Mark> = trace
-        .marks
-        .iter()
-        .filter(|m| m.kind == marks::Kind::Return)
-        .collect();
+    let returns = |m: &&Mark| m.kind == marks::Kind::Return;
+    let back: Vec<&Mark> = trace.marks.iter().filter(returns).collect();
     assert_eq!(back.len(), 1, "{:?}", trace.marks);
     let back = back[0];
     // 500 ms there, the 1 s hold, then back: the mark is at the frame that
@@ -64,12 +60,9 @@ fn a_looks_return_is_marked_where_the_head_goes_back() {
 #[test]
 fn a_return_is_cut_or_left_out_by_the_next_gaze_move() {
     let returns = |script: &str| -> Vec<(u64, u64)> {
-        run(script, 8)
-            .marks
-            .iter()
-            .filter(|m| m.kind == marks::Kind::Return)
-            .map(|m| (m.t_ms, m.span_ms))
-            .collect()
+        let marks = run(script, 8).marks.into_iter();
+        let back = marks.filter(|m| m.kind == marks::Kind::Return);
+        back.map(|m| (m.t_ms, m.span_ms)).collect()
     };
     let look = "2 look 10000 0 500 hold=1000\n";
     let whole = returns(look);
@@ -92,10 +85,8 @@ fn a_scripted_nod_moves_pitch_only_and_answers() {
     let idle = run("", 6);
     let nodding = run("3 nod 6000 800\n", 6);
     assert_eq!(nodding.marks.len(), 1);
-    assert_eq!(
-        nodding.marks[0].reply,
-        "ok nod 6000 mdeg 2 cycles 800 ms intensity 50"
-    );
+    let reply = &nodding.marks[0].reply;
+    assert_eq!(reply, "ok nod amp_mdeg=6000 ms=800 cycles=2 intensity=50");
     let frame = |t: &Trace, k: usize| t.rows[k].angles;
     for k in 0..300 {
         let (a, b) = (frame(&idle, k), frame(&nodding, k));
@@ -141,10 +132,8 @@ fn a_presence_script_rests_relaxes_wakes_and_glances() {
     // (Exactly: the angles are the limiter's own, no measurement's.)
     let (_, params) = built_in().unwrap();
     for axis in Axis::ALL {
-        let wake: Vec<f64> = (12_040..=13_060)
-            .step_by(20)
-            .map(|ms| f64::from(at(ms).angles[axis.index()]))
-            .collect();
+        let angle = |ms: u64| f64::from(at(ms).angles[axis.index()]);
+        let wake: Vec<f64> = (12_040..=13_060).step_by(20).map(angle).collect();
         let steps = Steps::of(&wake);
         let allowed = Steps::allowed(&params, axis, LimitMode::Idle);
         assert!(steps.within(allowed), "{axis:?}: {steps:?}");
@@ -159,14 +148,11 @@ fn a_presence_script_rests_relaxes_wakes_and_glances() {
         .collect();
     assert!(held.len() >= 100, "{} frames near -20°", held.len());
     assert!(!near(19_000));
-    let wake = trace
-        .marks
-        .iter()
-        .find(|m| m.reply.starts_with("ok wake"))
-        .unwrap();
+    let wake = trace.marks.iter().find(|m| m.reply.starts_with("ok wake"));
+    let wake = wake.unwrap();
     assert_eq!(
         (wake.t_ms, wake.reply.as_str()),
-        (12_060, "ok wake 1000 ms")
+        (12_060, "ok wake ms=1000")
     );
 }
 
@@ -177,7 +163,11 @@ fn a_button_runs_its_action_within_a_frame_of_its_edge() {
     // Pressed at 3 s (the press counts at its edge), taken by the frame
     // due then, which is already a step into the nod.
     assert_eq!(nod.t_ms, 3000);
-    assert!(nod.reply.starts_with("ok nod 6000 mdeg"), "{}", nod.reply);
+    assert!(
+        nod.reply.starts_with("ok nod amp_mdeg=6000 "),
+        "{}",
+        nod.reply
+    );
     let idle = run("", 5);
     let first = (150..250).find(|&k| trace.rows[k].angles[0] != idle.rows[k].angles[0]);
     assert_eq!(first, Some(150));
@@ -191,23 +181,22 @@ fn the_telemetry_of_a_trace_carries_the_radars_people() {
     let script = "0 idle off\n1 radar on\n1.2 radar 400,2000 -900,3000\n";
     let (_, params) = built_in().unwrap();
     let events = script::parse(script, &params).unwrap();
+    let asks = ["radar", "track"];
     let trace = simulate_watched(
         3_000_000,
         None,
         ServoRate::DEFAULT,
         &events,
         Some(20),
-        &["radar", "track"],
-    )
-    .unwrap();
+        &asks,
+    );
+    let trace = trace.unwrap();
     let lines = trace.watch.unwrap().lines;
     // 3 s at 20 a second: ticks at 0, 50, …, 2950 ms, each taken by the
     // first 20 ms frame at or after it.
     assert_eq!(lines.len(), 60);
-    let times: Vec<u64> = lines
-        .iter()
-        .map(|l| l.split_whitespace().nth(1).unwrap()[2..].parse().unwrap())
-        .collect();
+    let time = |l: &String| l.split_whitespace().nth(1).unwrap()[2..].parse().unwrap();
+    let times: Vec<u64> = lines.iter().map(time).collect();
     assert_eq!(&times[..4], [0, 60, 100, 160]);
     for line in &lines {
         let (body, crc) = line.rsplit_once(" *").unwrap();
@@ -215,11 +204,8 @@ fn the_telemetry_of_a_trace_carries_the_radars_people() {
         assert_eq!(crc, format!("{sum:02x}"), "{line}");
     }
     assert!(!lines[19].contains("targets="), "{}", lines[19]);
-    assert!(
-        lines[21].contains(" targets=0 at=- xy=- who=- *"),
-        "{}",
-        lines[21]
-    );
+    let nobody = &lines[21];
+    assert!(nobody.contains(" targets=0 at=- xy=- who=- *"), "{nobody}");
     let last = lines.last().unwrap();
     assert!(
         last.contains(" targets=2 at=") && last.contains(" xy=400,2000;-900,3000 who=0 *"),
@@ -227,8 +213,6 @@ fn the_telemetry_of_a_trace_carries_the_radars_people() {
     );
     // The radar sends from power-up, ten frames a second: 0 to 2.9 s.
     assert_eq!(trace.answers[0], "ok radar=on frames=30 bad=0 targets=2");
-    assert_eq!(
-        trace.answers[1],
-        "ok track=on height=300 mount=0 prefer=nearest"
-    );
+    let tracking = &trace.answers[1];
+    assert_eq!(tracking, "ok track=on height=300 mount=0 prefer=nearest");
 }
