@@ -26,6 +26,7 @@ mod unmodelled;
 use std::{fmt::Write as _, path::Path, path::PathBuf, time::Duration};
 
 use anyhow::{Result, bail};
+use idle_head_core::servo::ServoRate;
 
 pub use inputs::{INPUTS_STAGE, test_inputs};
 pub use node::{BYTE_TIME, Chunk, UartScript, folder as node_folder};
@@ -54,15 +55,8 @@ pub fn play_script(
     time: Duration,
     wall: Duration,
 ) -> Result<Report> {
-    let against = script::Against::Written;
-    script::play(
-        root,
-        metadata,
-        events,
-        (time, wall),
-        against,
-        script::Board::default(),
-    )
+    let (against, board) = (script::Against::Written, script::Board::default());
+    script::play(root, metadata, events, (time, wall), against, board)
 }
 pub use radar::{RADAR_DMX_STAGE, RADAR_STAGE, test_radar, test_radar_dmx};
 
@@ -72,7 +66,7 @@ pub fn dmx_line(script: &str) -> Result<serde_json::Value> {
 }
 
 /// One PWM count of the servo slices at `rate`, ns.
-pub fn count_ns_at(rate: idle_head_core::servo::ServoRate) -> f64 {
+pub fn count_ns_at(rate: ServoRate) -> f64 {
     run::timing_at(rate).count_ns
 }
 
@@ -203,19 +197,18 @@ pub fn command(args: &Args) -> Result<bool> {
     let (root, metadata) = crate::setup::prepare()?;
     let (root, md) = (root.as_path(), &metadata);
     PICO.build(root)?;
+    let (time, pulses) = ((args.virtual_time, args.timeout), args.pulses.as_ref());
     if let Some(path) = &args.script {
-        let rate = idle_head_core::servo::ServoRate::new(args.rate)
+        let rate = ServoRate::new(args.rate)
             .ok_or_else(|| anyhow::anyhow!("{} Hz: not a servo rate", args.rate))?;
-        let events = script::read(path)?;
-        let time = (args.virtual_time, args.timeout);
-        return script::command(root, md, events, time, rate, args.pulses.as_ref());
+        return script::command(root, md, script::read(path)?, time, rate, pulses);
     }
     if args.dmx.is_some() || args.pulses.is_some() && !args.show {
         return show::command(root, md, args);
     }
     if let Some(path) = &args.radar {
-        let time = (args.virtual_time, args.timeout);
-        return radar::command(root, md, path, time, args.pulses.as_ref());
+        let events = radar::read(path)?;
+        return script::command(root, md, events, time, ServoRate::DEFAULT, pulses);
     }
     let time = args.virtual_time;
     let result = if let Some(port) = &args.stream {
@@ -245,8 +238,7 @@ pub fn command(args: &Args) -> Result<bool> {
             stage(root, md)
         } else {
             let time = time.unwrap_or(DEFAULT_TIME);
-            let mut report = run::run_with(root, &PICO.elf(md), time, args.timeout, |_| {})?;
-            run::check(&mut report)?;
+            let (_, report) = stages::checked_run(root, md, time, args.timeout, |_| {})?;
             report.print(args.verbose);
             return Ok(report.problems.is_empty());
         }

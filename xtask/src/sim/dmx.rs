@@ -3,7 +3,7 @@
 //! `<seconds> <slot>=<value> …` (slots relative to the head's address,
 //! 1-based; values hold until changed) or `<seconds> dmx stop`.
 
-use std::{path::Path, time::Duration};
+use std::{fmt::Write as _, path::Path, time::Duration};
 
 use anyhow::{Context, Result, bail};
 use serde_json::{Value, json};
@@ -98,6 +98,18 @@ pub fn parse(text: &str) -> Result<Vec<Change>> {
     }
     changes.sort_by_key(|c| c.at);
     Ok(changes)
+}
+
+/// A change of slot 11 (past the head's ten) to 0 and 100 in turn every
+/// 0.23 s from `from` to before `to`: the full universe rate, with frames
+/// the harness counts.
+pub fn alternating(from: Duration, to: Duration) -> Result<Vec<Change>> {
+    let (mut text, mut at, mut k) = (String::new(), from, 0);
+    while at < to {
+        let _ = writeln!(text, "{:.3} 11={}", at.as_secs_f64(), k % 2 * 100);
+        (at, k) = (at + Duration::from_millis(230), k + 1);
+    }
+    parse(&text)
 }
 
 /// The harness's `dmx` configuration for `changes`.

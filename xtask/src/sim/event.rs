@@ -5,6 +5,7 @@
 
 use anyhow::{Context, Result};
 use serde::{Deserialize, Deserializer};
+use std::time::Duration;
 
 /// One event of the harness. Times (`ns`) are virtual nanoseconds since
 /// power-on, across resets.
@@ -73,25 +74,75 @@ pub enum Event {
     Dmx { ns: f64, frame: u64, changed: bool },
     /// The radar frames sent in the run, at its end.
     Radar { ns: f64, frames: u64 },
-    /// Accesses to a register rp2040js does not model, counted over the
-    /// run.
-    Unmodelled {
-        peripheral: String,
-        op: Op,
-        offset: u32,
-        count: u64,
-    },
+    /// Accesses to a register rp2040js does not model, counted over the run.
+    Unmodelled(Unmodelled),
     /// A complaint of the emulator.
     Emu { level: Level, msg: String },
     /// The run is over.
-    End {
-        why: Why,
-        ns: f64,
-        instructions: u64,
-        wall_ms: u64,
-        #[serde(default)]
-        msg: Option<String>,
-    },
+    End(End),
+}
+
+/// Accesses to one register the emulator does not model.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Unmodelled {
+    /// The peripheral as rp2040js names it, the register's offset in it.
+    pub peripheral: String,
+    pub op: Op,
+    pub offset: u32,
+    pub count: u64,
+}
+
+/// How the harness ended: why, when, after how many instructions and how
+/// much wall time, and its error if it failed.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct End {
+    pub why: Why,
+    pub ns: f64,
+    pub instructions: u64,
+    pub wall_ms: u64,
+    #[serde(default, rename = "msg")]
+    pub error: Option<String>,
+}
+
+impl End {
+    /// How a run ended: its last `end` event.
+    pub fn of(events: &[Event]) -> Result<Self> {
+        let end = events.iter().rev().find_map(|e| match e {
+            Event::End(end) => Some(end.clone()),
+            _ => None,
+        });
+        end.context("the emulator harness ended without saying how")
+    }
+
+    /// Why the run did not reach its virtual time, if it did not.
+    pub fn problem(&self, silence: Duration) -> Option<String> {
+        let at = self.ns / 1e9;
+        let stuck = "the emulator made no progress";
+        Some(match self.why {
+            Why::Time => return None,
+            Why::Silent => format!(
+                "{stuck}: no log byte and no pin edge for {} s of virtual time (stopped at \
+                 {at:.3} s)",
+                silence.as_secs_f64()
+            ),
+            Why::Asleep => {
+                format!("{stuck}: the core sleeps with nothing left to wake it (at {at:.3} s)")
+            }
+            Why::Wall => format!(
+                "{stuck} in time: stopped after {:.1} s of wall time at {at:.3} s of virtual time \
+                 (raise with --timeout)",
+                Duration::from_millis(self.wall_ms).as_secs_f64()
+            ),
+            Why::Break => format!("the firmware hit a breakpoint at {at:.3} s"),
+            Why::Closed => format!("the live run's input closed at {at:.3} s"),
+            Why::Error => format!(
+                "the emulator stopped (error) at {at:.3} s: {}",
+                self.error.as_deref().unwrap_or("no reason given")
+            ),
+        })
+    }
 }
 
 /// What the boot ROM did to the flash (a sector erase, a page program), or

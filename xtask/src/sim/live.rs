@@ -61,7 +61,7 @@ pub fn events(stdout: ChildStdout, mut each: impl FnMut(Vec<u8>)) -> String {
     for line in BufReader::new(stdout).lines().map_while(Result::ok) {
         match Event::parse(&line) {
             Ok(Event::Usb { hex, .. }) => each(hex),
-            Ok(Event::End { why: end, .. }) => why = format!("the emulator stopped ({end:?})"),
+            Ok(Event::End(end)) => why = format!("the emulator stopped ({:?})", end.why),
             Ok(_) => {}
             Err(e) => why = format!("{e:#}"),
         }

@@ -318,7 +318,7 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
         );
     };
     let events = done.stdout?;
-    if !status.success() && !matches!(events.last(), Some(Event::End { .. })) {
+    if !status.success() && !matches!(events.last(), Some(Event::End(_))) {
         bail!(
             "the emulator harness failed ({status}):\n{}",
             done.stderr.trim_end()

@@ -16,7 +16,7 @@
 //!   the radar sends: every radar frame counted, none bad.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
 use anyhow::{Context, Result, anyhow, bail};
@@ -24,14 +24,14 @@ use idle_head_core::seed::BoardId;
 use idle_head_core::servo::ServoRate;
 
 use super::image::SERVOS;
-use super::node::Chunk;
-use super::node::PinScript;
+use super::node::{Chunk, Config, Fill, FlashTiming, PinScript};
 use super::pulses::angle;
-use super::run::{self, Boot};
+use super::run::{self, Boot, Report};
 use super::script::{self, Against, Board, EARLY, line};
 use super::{WALL, dmx, stages::shipped_image, stream};
 use crate::bench::tracking::{self, Walk};
-use crate::project::Metadata;
+use crate::log::field;
+use crate::project::{self, Metadata};
 use crate::trace::{Event, Kind};
 
 /// Stage names.
@@ -68,24 +68,6 @@ pub fn read(path: &Path) -> Result<Vec<Event>> {
     Ok(events)
 }
 
-/// `cargo xtask sim --radar FILE`.
-pub fn command(
-    root: &Path,
-    metadata: &Metadata,
-    path: &Path,
-    time: (Option<Duration>, Duration),
-    pulses: Option<&PathBuf>,
-) -> Result<bool> {
-    script::command(
-        root,
-        metadata,
-        read(path)?,
-        time,
-        ServoRate::DEFAULT,
-        pulses,
-    )
-}
-
 /// The yaw of each frame of `boot`, m°, from its pulses.
 fn yaw(boot: &Boot) -> Vec<f64> {
     let timing = run::timing();
@@ -113,7 +95,7 @@ pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
     )?;
     println!("{}", report.verdict());
     problems.extend(report.problems.iter().map(|p| format!("walk: {p}")));
-    let boot = report.boots.first().context("no boot")?;
+    let boot = report.first()?;
     let walk = Walk::of(&yaw(boot), u64::from(ServoRate::DEFAULT.period().0))?;
     println!(
         "walk: {} radar frames sent; the yaw {} ms behind the bearing, {:.2}° RMS and at most \
@@ -129,7 +111,7 @@ pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
             walk.rms / 1000.0
         ));
     }
-    if !says(boot, "track: turned to yaw") {
+    if !boot.says("track: turned to yaw") {
         problems.push("walk: the frame task never logged `track: turned to yaw`".to_owned());
     }
     // Two boards.
@@ -149,11 +131,7 @@ pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
             "two boards: the yaw differs in only {differ} of {n} frames"
         ));
     }
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", problems.join("; "))
-    }
+    project::verdict(&problems)
 }
 
 /// One board of flash unique id `uid`: its run, checked against the host
@@ -166,7 +144,7 @@ fn board(root: &Path, metadata: &Metadata, uid: u64) -> Result<(Vec<String>, Vec
     };
     let time = Duration::from_secs(4);
     let report = script::play(root, metadata, events, (time, WALL), Against::Host, board)?;
-    let boot = report.boots.first().context("no boot")?;
+    let boot = report.first()?;
     let seed = BoardId(uid).seed().context("an id that is no id")?;
     let mut problems: Vec<String> = report
         .problems
@@ -185,15 +163,10 @@ fn board(root: &Path, metadata: &Metadata, uid: u64) -> Result<(Vec<String>, Vec
             "board {uid:016x}: `seed` answered {replies:?}, not `{want}`"
         ));
     }
-    if !says(boot, &format!("board id {uid:016x}: seed board:{seed}")) {
+    if !boot.says(&format!("board id {uid:016x}: seed board:{seed}")) {
         problems.push(format!("board {uid:016x}: the boot did not log its id"));
     }
     Ok((problems, yaw(boot)))
-}
-
-/// Whether `boot`'s log has a line containing `text`.
-fn says(boot: &Boot, text: &str) -> bool {
-    boot.log.iter().any(|(_, line)| line.message.contains(text))
 }
 
 /// [`RADAR_DMX_STAGE`]: DMX512 at the full universe rate (a change of a
@@ -201,14 +174,8 @@ fn says(boot: &Boot, text: &str) -> bool {
 /// and standing) from 1 s to 9 s; `dmx` and `radar` asked at 9.2 s.
 pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     let elf = shipped_image(root, metadata)?;
-    let (from, to) = (1.0, 9.0);
-    let mut text = String::new();
-    let mut k = 0;
-    while from + f64::from(k) * 0.23 < to {
-        let _ = writeln!(text, "{:.3} 11={}", from + f64::from(k) * 0.23, k % 2 * 100);
-        k += 1;
-    }
-    let changes = dmx::parse(&text)?;
+    let to = Duration::from_secs(9);
+    let changes = dmx::alternating(Duration::from_secs(1), to)?;
     let mut script = String::from("0 radar on\n");
     for i in 0..30 {
         let _ = writeln!(
@@ -218,26 +185,15 @@ pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
             3000 - 50 * i
         );
     }
-    let events = script::parse(&script)?;
     let query = Duration::from_millis(9200);
-    let radar = line(&events, ServoRate::DEFAULT, Duration::from_secs_f64(to));
-    let pins = PinScript {
-        anchor_slice: SERVOS[0].2,
-        early: EARLY,
-        lines: vec![
-            Chunk::new(b"radar on\r\n".to_vec(), Duration::from_millis(100)),
-            Chunk::new(b"dmx\r\nradar\r\n".to_vec(), query),
-        ],
-        ..PinScript::default()
-    };
-    let report = run::run_with(root, &elf, query + Duration::from_secs(1), WALL, |config| {
+    let lines = vec![Chunk::new(b"dmx\r\nradar\r\n".to_vec(), query)];
+    let radar = (script.as_str(), to);
+    let report = with_radar(root, &elf, radar, lines, query, |config| {
         config.dmx = Some(dmx::line(&changes));
-        config.script = Some(pins);
-        config.radar = radar;
     })?;
     // (The pulses are not the idle's: the radar turns the head. What is
     // checked is that no frame was late: the log says so.)
-    let boot = report.boots.first().context("no boot")?;
+    let boot = report.first()?;
     let replies = boot.uart_replies();
     let reply = |start: &str| replies.iter().find(|r| r.starts_with(start)).cloned();
     let dmx_reply = reply("ok dmx=").unwrap_or_default();
@@ -248,27 +204,45 @@ pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     problems.extend(counted(boot, &radar_reply));
     problems.extend(report.problems.iter().cloned());
     problems.extend(erase(root, &elf)?);
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", problems.join("; "))
-    }
+    project::verdict(&problems)
+}
+
+/// Runs `elf` to a second after `query` with a radar on GP13 playing the
+/// radar lines of `script` to its end time, `radar on` over UART0 at
+/// 0.1 s and then `lines`; `setup` sets the rest.
+fn with_radar(
+    root: &Path,
+    elf: &Path,
+    (script, end): (&str, Duration),
+    lines: Vec<Chunk>,
+    query: Duration,
+    setup: impl FnOnce(&mut Config),
+) -> Result<Report> {
+    let radar = line(&script::parse(script)?, ServoRate::DEFAULT, end);
+    let on = Chunk::new(b"radar on\r\n".to_vec(), Duration::from_millis(100));
+    let pins = PinScript {
+        anchor_slice: SERVOS[0].2,
+        early: EARLY,
+        lines: [vec![on], lines].concat(),
+        ..PinScript::default()
+    };
+    run::run_with(root, elf, query + Duration::from_secs(1), WALL, |config| {
+        config.script = Some(pins);
+        config.radar = radar;
+        setup(config);
+    })
 }
 
 /// The problem, if the radar's `reply` did not count every frame `boot`
 /// sent, or counted one bad.
 fn counted(boot: &Boot, reply: &str) -> Option<String> {
-    let counter = |name: &str| -> Option<u64> {
-        reply
-            .split(' ')
-            .find_map(|f| f.strip_prefix(name)?.strip_prefix('=')?.parse().ok())
-    };
+    let counter = |name| field(reply, name).and_then(|v| v.parse::<u64>().ok());
     (counter("frames") != Some(boot.radar_frames) || counter("bad") != Some(0))
         .then(|| format!("radar: `{reply}` for {} frames sent", boot.radar_frames))
 }
 
 /// The flash's typical times (W25Q16JV): a sector erase, a page program.
-const TYPICAL: super::node::FlashTiming = super::node::FlashTiming {
+const TYPICAL: FlashTiming = FlashTiming {
     erase: Duration::from_millis(45),
     program: Duration::from_micros(400),
 };
@@ -281,29 +255,20 @@ fn erase(root: &Path, elf: &Path) -> Result<Vec<String>> {
         .settings
         .context("the image has no settings region")?;
     let sectors = super::store::noise(usize::try_from(region.end - region.start)?);
-    let events = script::parse("0 radar on\n1 radar -400,1800\n")?;
     let query = Duration::from_millis(5200);
-    let radar = line(&events, ServoRate::DEFAULT, Duration::from_secs(5));
-    let pins = PinScript {
-        anchor_slice: SERVOS[0].2,
-        early: EARLY,
-        lines: vec![
-            Chunk::new(b"radar on\r\n".to_vec(), Duration::from_millis(100)),
-            Chunk::new(b"save\r\n".to_vec(), Duration::from_secs(2)),
-            Chunk::new(b"radar\r\n".to_vec(), query),
-        ],
-        ..PinScript::default()
-    };
-    let report = run::run_with(root, elf, query + Duration::from_secs(1), WALL, |config| {
-        config.script = Some(pins);
-        config.radar = radar;
+    let lines = vec![
+        Chunk::new(b"save\r\n".to_vec(), Duration::from_secs(2)),
+        Chunk::new(b"radar\r\n".to_vec(), query),
+    ];
+    let radar = ("0 radar on\n1 radar -400,1800\n", Duration::from_secs(5));
+    let report = with_radar(root, elf, radar, lines, query, |config| {
         config.rom = Some(TYPICAL);
-        config.flash_fill = Some(super::node::Fill {
+        config.flash_fill = Some(Fill {
             addr: region.start,
             hex: sectors,
         });
     })?;
-    let boot = report.boots.first().context("no boot")?;
+    let boot = report.first()?;
     let erased: f64 = boot.flash.iter().filter(|op| op.0).map(|op| op.2).sum();
     let reply = boot
         .uart_replies()

@@ -9,12 +9,11 @@ use idle_head_core::pwm_clock::{PICO_SYS_HZ, SliceClock};
 use idle_head_core::servo::ServoRate;
 
 use super::{
-    event::{Event, Op, Why},
+    event::{End, Event, Op, Unmodelled},
     expect,
     image::{self, SERVOS},
     node,
     pulses::{self, Limits, ServoCheck, Timing, Train},
-    unmodelled::Unmodelled,
 };
 use crate::log::{Defmt, LogLine};
 
@@ -79,68 +78,6 @@ impl Boot {
     /// Whether a line of the log contains `text`.
     pub fn says(&self, text: &str) -> bool {
         self.log.iter().any(|(_, line)| line.message.contains(text))
-    }
-}
-
-/// How the harness ended: why ([`Why::Time`] when it ran the whole virtual
-/// time), when, after how many instructions and how much wall time, and
-/// its error if it failed.
-#[derive(Debug, Default)]
-pub struct End {
-    pub why: Why,
-    pub ns: f64,
-    pub instructions: u64,
-    pub wall_ms: u64,
-    pub error: Option<String>,
-}
-
-impl End {
-    /// How a run ended: its last `end` event.
-    pub fn of(events: &[Event]) -> Result<Self> {
-        match events.iter().rfind(|e| matches!(e, Event::End { .. })) {
-            Some(Event::End {
-                why,
-                ns,
-                instructions,
-                wall_ms,
-                msg,
-            }) => Ok(Self {
-                why: *why,
-                ns: *ns,
-                instructions: *instructions,
-                wall_ms: *wall_ms,
-                error: msg.clone(),
-            }),
-            _ => bail!("the emulator harness ended without saying how"),
-        }
-    }
-
-    /// Why the run did not reach its virtual time, if it did not.
-    pub fn problem(&self, silence: Duration) -> Option<String> {
-        let at = self.ns / 1e9;
-        let stuck = "the emulator made no progress";
-        Some(match self.why {
-            Why::Time => return None,
-            Why::Silent => format!(
-                "{stuck}: no log byte and no pin edge for {} s of virtual time (stopped at \
-                 {at:.3} s)",
-                silence.as_secs_f64()
-            ),
-            Why::Asleep => {
-                format!("{stuck}: the core sleeps with nothing left to wake it (at {at:.3} s)")
-            }
-            Why::Wall => format!(
-                "{stuck} in time: stopped after {:.1} s of wall time at {at:.3} s of virtual time \
-                 (raise with --timeout)",
-                Duration::from_millis(self.wall_ms).as_secs_f64()
-            ),
-            Why::Break => format!("the firmware hit a breakpoint at {at:.3} s"),
-            Why::Closed => format!("the live run's input closed at {at:.3} s"),
-            Why::Error => format!(
-                "the emulator stopped (error) at {at:.3} s: {}",
-                self.error.as_deref().unwrap_or("no reason given")
-            ),
-        })
     }
 }
 
@@ -231,25 +168,8 @@ pub fn sort(events: &[Event], defmt: &Defmt, stack_top: u64) -> Result<Report> {
                 Some((_, count)) => *count += 1,
                 None => report.emulator.push((msg.clone(), 1)),
             },
-            (
-                Event::Unmodelled {
-                    peripheral,
-                    op,
-                    offset,
-                    count,
-                },
-                _,
-            ) => {
-                let peripheral = peripheral.clone();
-                let (op, offset, count) = (*op, *offset, *count);
-                report.unmodelled.push(Unmodelled {
-                    peripheral,
-                    op,
-                    offset,
-                    count,
-                });
-            }
-            (Event::End { .. }, _) => {}
+            (Event::Unmodelled(access), _) => report.unmodelled.push(access.clone()),
+            (Event::End(_), _) => {}
             (_, None) => bail!("harness event before the first boot: {event:?}"),
             (Event::Rtt { ns, hex }, Some(boot)) => {
                 if let Some(decoder) = decoder.as_mut() {

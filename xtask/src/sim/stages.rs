@@ -12,10 +12,12 @@ use idle_head_core::servo::ServoRate;
 use xshell::cmd;
 
 use super::{
-    DEFAULT_TIME, exchange,
+    DEFAULT_TIME,
+    event::End,
+    exchange,
     image::{PicoImage, SERVOS, VECTOR_TABLE},
     node,
-    run::{self, End, Report},
+    run::{self, Report},
     script::{self, Against},
 };
 use crate::{
@@ -91,8 +93,7 @@ pub fn test_rate(root: &Path, metadata: &Metadata) -> Result<()> {
 /// every check passes over at least [`MIN_FRAMES`] frames and the loops'
 /// checksum is the host's. Returns the run for the memory stage.
 pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
-    let mut report = run::run_with(root, &PICO.elf(metadata), DEFAULT_TIME, WALL, |_| {})?;
-    run::check(&mut report)?;
+    let (_, report) = checked_run(root, metadata, DEFAULT_TIME, WALL, |_| {})?;
     print!("{}{}", report.log_text(false), report.table());
     let mut problems = Vec::new();
     if report.frames() < MIN_FRAMES {
@@ -112,6 +113,21 @@ pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
     }
     report.conclude(problems)?;
     Ok(report)
+}
+
+/// The shipped image (built) run for `time` (at most `wall`) with the
+/// harness set up by `setup`, every pulse checked against the host's idle.
+pub fn checked_run(
+    root: &Path,
+    metadata: &Metadata,
+    time: Duration,
+    wall: Duration,
+    setup: impl FnOnce(&mut node::Config),
+) -> Result<(PathBuf, Report)> {
+    let elf = shipped_image(root, metadata)?;
+    let mut report = run::run_with(root, &elf, time, wall, setup)?;
+    run::check(&mut report)?;
+    Ok((elf, report))
 }
 
 /// Builds the drill image ([`build_drill`]), runs two of its boots (each 3 s of frames and the timeout) and checks the
@@ -218,9 +234,7 @@ pub fn test_console(
     virtual_time: Duration,
     wall: Duration,
 ) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
-    let mut report = run::run_with(root, &elf, virtual_time, wall, exchange::configure)?;
-    run::check(&mut report)?;
+    let (elf, mut report) = checked_run(root, metadata, virtual_time, wall, exchange::configure)?;
     exchange::check(&mut report);
     print!("{}", report.log_text(false));
     print!(

@@ -4,7 +4,7 @@
 //! than the replies leave, a byte with a framing error, and DMX512 at the
 //! full universe rate for a minute (docs/dev/emulators.md, "Streams").
 
-use std::{fmt::Write as _, path::Path, time::Duration};
+use std::{path::Path, time::Duration};
 
 use anyhow::Result;
 use idle_head_core::console::checksum;
@@ -13,8 +13,8 @@ use super::Boot;
 use super::{
     dmx,
     node::{LineStream, StreamLine, UartScript},
-    run::{self, Report},
-    stages::{WALL, shipped_image},
+    run::Report,
+    stages::{WALL, checked_run},
 };
 use crate::{log::field, project::Metadata};
 
@@ -130,20 +130,19 @@ pub fn test_stream(
     port: &'static str,
     length: Duration,
 ) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
     let count = usize::try_from(length.as_micros() / EVERY.as_micros()).unwrap_or(usize::MAX);
     let time = START + length + Duration::from_secs(1);
-    let mut report = run::run_with(root, &elf, time, wall(length), |config| {
+    let (_, report) = checked_run(root, metadata, time, wall(length), |config| {
         let (start, every, lines) = (START, EVERY, CYCLE.to_vec());
-        config.stream = Some(LineStream {
+        let stream = LineStream {
             port,
             start,
             every,
             count,
             lines,
-        });
+        };
+        config.stream = Some(stream);
     })?;
-    run::check(&mut report)?;
     print!("{}", report.table());
     let (replies, problems) = replies(&report, port == "usb", count, |k| {
         match CYCLE[k % CYCLE.len()] {
@@ -170,13 +169,12 @@ const FLOOD_LINES: usize = 100;
 /// `status`: every line answered once, in order, no byte lost at UART0's
 /// FIFO (the board receives by DMA into a ring), every frame the host's.
 pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
     let machine = |n: usize| {
         let body = format!("#{n} status");
         format!("{body} *{:02x}\r\n", checksum(body.as_bytes())).into_bytes()
     };
     let time = Duration::from_millis(7_500);
-    let mut report = run::run_with(root, &elf, time, WALL, |config| {
+    let (_, report) = checked_run(root, metadata, time, WALL, |config| {
         config.uart = vec![
             UartScript::new(0, b"status\r\n".repeat(FLOOD_LINES), Duration::from_secs(3)),
             UartScript::new(
@@ -187,7 +185,6 @@ pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
             UartScript::new(0, b"status\r\n", Duration::from_secs(7)),
         ];
     })?;
-    run::check(&mut report)?;
     print!("{}", report.table());
     let lines = 2 * FLOOD_LINES + 1;
     let (replies, problems) = replies(&report, false, lines, |k| match k {
@@ -204,15 +201,14 @@ pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
 /// must be answered `err line bytes lost …`, the second `ok mode=…`, and
 /// every pulse stays the host's.
 pub fn test_noise(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
-    let mut report = run::run_with(root, &elf, Duration::from_millis(3_500), WALL, |config| {
+    let time = Duration::from_millis(3_500);
+    let (_, report) = checked_run(root, metadata, time, WALL, |config| {
         let noisy = UartScript::new(0, b"staXtus\r\nstatus\r\n", Duration::from_secs(3));
         config.uart = vec![UartScript {
             errors: vec![3],
             ..noisy
         }];
     })?;
-    run::check(&mut report)?;
     let want = [
         Want::Starts("err line bytes lost"),
         Want::Starts("ok mode="),
@@ -235,24 +231,15 @@ const DMX_LENGTH: Duration = Duration::from_secs(60);
 /// UART0 at the end) count every frame good, none short, long, of another
 /// start code or garbled, and no frame of the head's is late.
 pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
-    // A change every 0.23 s: the frames that carry one are counted by the
-    // harness; the last one at the end.
+    // The harness counts the frames that carry a change; the last one at the end.
     let end = START + DMX_LENGTH;
-    let mut text = String::new();
-    let (mut at, mut k) = (START, 0_u32);
-    while at < end {
-        let _ = writeln!(text, "{:.3} 11={}", at.as_secs_f64(), k % 2 * 100);
-        (at, k) = (at + Duration::from_millis(230), k + 1);
-    }
-    let changes = dmx::parse(&text)?;
+    let changes = dmx::alternating(START, end)?;
     let query = end + Duration::from_millis(50);
     let time = query + Duration::from_secs(1);
-    let mut report = run::run_with(root, &elf, time, wall(DMX_LENGTH), |config| {
+    let (_, report) = checked_run(root, metadata, time, wall(DMX_LENGTH), |config| {
         config.dmx = Some(dmx::line(&changes));
         config.uart = vec![UartScript::new(0, b"dmx\n", query)];
     })?;
-    run::check(&mut report)?;
     print!("{}", report.table());
     // (The pulses are not held to the idle's own: a console on the line
     // engages the show layer, mix 0 or not. No frame may be late.)

@@ -5,18 +5,7 @@
 
 use std::fmt::Write as _;
 
-use super::event::Op;
-
-/// Accesses to one register the emulator does not model.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Unmodelled {
-    /// The peripheral as rp2040js names it.
-    pub peripheral: String,
-    pub op: Op,
-    /// The register's offset in the peripheral.
-    pub offset: u32,
-    pub count: u64,
-}
+use super::event::{Op, Unmodelled};
 
 /// The known gaps, which embassy-rp's start-up touches: the peripheral, the
 /// writes covered (`None`: any access), why it does not matter. None
