@@ -25,7 +25,7 @@ mod unmodelled;
 
 use std::{fmt::Write as _, path::Path, path::PathBuf, time::Duration};
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use idle_head_core::servo::ServoRate;
 
 pub use inputs::{INPUTS_STAGE, test_inputs};
@@ -45,9 +45,8 @@ pub use stream::{
 
 use crate::project::{self, Metadata, PICO};
 
-/// Plays a script's `events` into the shipped image (built) for `time` from
-/// its first frame; every pulse checked against what the firmware wrote:
-/// on time, its own frame's, within the servos' limits (see `script.rs`).
+/// Plays `events` into the shipped image (built) for `time` from its first
+/// frame; every pulse checked against what the firmware wrote.
 pub fn play_script(
     root: &Path,
     metadata: &Metadata,
@@ -75,9 +74,7 @@ pub fn frame_ns() -> f64 {
     run::timing().frame_ns
 }
 
-/// Builds the shipped Pico image and runs it for `time` (at most `wall`),
-/// the harness configured by `setup`; the run sorted into boots, its
-/// pulses not checked against the host.
+/// Builds the shipped Pico image and runs it (see [`run::run_with`]).
 pub fn run_shipped(
     root: &Path,
     metadata: &Metadata,
@@ -89,8 +86,7 @@ pub fn run_shipped(
     run::run_with(root, &PICO.elf(metadata), time, wall, setup)
 }
 
-/// Options of `cargo xtask sim`: a plain run, or one of the runs the group
-/// `run` lets through (clap refuses two).
+/// Options of `cargo xtask sim`: a plain run or one of group `run`.
 #[allow(clippy::struct_excessive_bools)]
 #[derive(Debug, Clone, clap::Args)]
 #[command(group(clap::ArgGroup::new("run").multiple(false)))]
@@ -253,7 +249,7 @@ pub fn command(args: &Args) -> Result<bool> {
 type Stage = fn(&Path, &Metadata) -> Result<()>;
 
 impl Report {
-    /// Frames that went out as their own pulse, on every servo, all boots.
+    /// Frames that went out as their own pulse on every servo, all boots.
     pub fn frames(&self) -> usize {
         let fresh = |boot: &Boot| boot.servos.iter().map(|s| s.fresh).min().unwrap_or(0);
         self.boots.iter().map(fresh).sum()
@@ -266,14 +262,11 @@ impl Report {
 
     /// The first boot, which every run has.
     pub fn first(&self) -> Result<&Boot> {
-        match self.boots.first() {
-            Some(boot) => Ok(boot),
-            None => bail!("no boot"),
-        }
+        self.boots.first().context("no boot")
     }
 
-    /// The peak stack: the larger of what the firmware logged and what the
-    /// emulated RAM shows at the end of each boot.
+    /// The larger of the peak stack the firmware logged and the emulated
+    /// RAM's at the end of each boot.
     pub fn peak_stack(&self) -> Option<u64> {
         self.logged_stack()
             .max(self.boots.iter().filter_map(|b| b.stack_peak).max())
@@ -284,24 +277,22 @@ impl Report {
         self.boots.iter().filter_map(logged).max()
     }
 
-    /// Prints the log ([`Report::log_text`]), the table, the verdict and
-    /// the summary line.
+    /// Prints the log, the table, the verdict and the summary line.
     pub fn print(&self, verbose: bool) {
         print!("{}{}", self.log_text(verbose), self.table());
         println!("{}\n{}", self.verdict(), self.summary());
     }
 
-    /// Prints the verdict and the summary line; fails with the run's
-    /// problems and the scenario's `more`, if any.
+    /// Prints the verdict and summary; fails with the run's problems and
+    /// the scenario's `more`, if any.
     pub fn conclude(&self, more: impl IntoIterator<Item = String>) -> Result<()> {
         println!("{}\n{}", self.verdict(), self.summary());
         let problems: Vec<String> = self.problems.iter().cloned().chain(more).collect();
         project::verdict(&problems)
     }
 
-    /// The decoded log with virtual times, boots and resets marked, and
-    /// what the emulator said (`verbose`: each access to a register it does
-    /// not model, also the known ones).
+    /// The decoded log with virtual times, boots and resets marked, and what
+    /// the emulator said (`verbose`: also the known unmodelled registers).
     pub fn log_text(&self, verbose: bool) -> String {
         let mut text = String::new();
         for (b, boot) in self.boots.iter().enumerate() {
@@ -327,7 +318,7 @@ impl Report {
         text + &unmodelled::lines(&self.unmodelled, verbose)
     }
 
-    /// Per boot and servo: pulses, frames, widths, periods; then the frame
+    /// Per boot and servo: pulses, frames, widths, periods; the frame
     /// update's cycles, the stack and the run.
     pub fn table(&self) -> String {
         let us = |counts: u32| f64::from(counts) * run::timing_at(self.rate).count_ns / 1e3;
@@ -342,9 +333,8 @@ impl Report {
             for ((name, pin, _), check) in image::SERVOS.iter().zip(&boot.servos) {
                 let widths = || check.pulses.iter().map(|p| p.counts);
                 let first = check.pulses.first().map_or(0, |p| p.counts);
-                let period = check
-                    .periods
-                    .map_or("-".to_owned(), |(lo, hi)| format!("{lo:.0}..{hi:.0}"));
+                let period =
+                    (check.periods).map_or("-".to_owned(), |(lo, hi)| format!("{lo:.0}..{hi:.0}"));
                 let _ = writeln!(
                     text,
                     "  {name:<6} GP{pin:<3} {:>7} {:>7} {:>5} {:>9.1} {:>9.1} {:>9.1}  {period:<21} {:>10}",
@@ -359,17 +349,13 @@ impl Report {
             }
         }
         // Each boot's first call is the start frame (neutral pulses only).
-        let start = self
-            .boots
-            .first()
-            .and_then(|b| b.frame_cycles.first())
-            .copied()
-            .unwrap_or(0);
-        let mut cycles: Vec<u64> = self
+        let start = self.boots.first().and_then(|b| b.frame_cycles.first());
+        let start = start.copied().unwrap_or(0);
+        let cycles = self
             .boots
             .iter()
-            .flat_map(|b| b.frame_cycles.iter().skip(1).copied())
-            .collect();
+            .flat_map(|b| &b.frame_cycles[1.min(b.frame_cycles.len())..]);
+        let mut cycles: Vec<u64> = cycles.copied().collect();
         cycles.sort_unstable();
         let _ = match (cycles.first(), cycles.last()) {
             (Some(min), Some(max)) => writeln!(
@@ -420,20 +406,16 @@ impl Report {
         let (low, high) = periods.fold((f64::INFINITY, 0.0_f64), |(l, h), (a, b)| {
             (l.min(a), h.max(b))
         });
-        let period = if low.is_finite() {
-            format!("{low:.0}..{high:.0}")
-        } else {
-            "-".to_owned()
-        };
+        let finite = low.is_finite();
+        let period = finite.then(|| format!("{low:.0}..{high:.0}"));
+        let period = period.unwrap_or_else(|| "-".to_owned());
         let count_ns = run::timing_at(self.rate).count_ns;
         let first = |s: &pulses::ServoCheck| {
             let us = |p: &pulses::Pulse| format!("{:.0}", f64::from(p.counts) * count_ns / 1e3);
             s.pulses.first().map_or("-".to_owned(), us)
         };
-        let first: Vec<String> = self
-            .boots
-            .first()
-            .map_or_else(Vec::new, |b| b.servos.iter().map(first).collect());
+        let first = self.boots.first().map(|b| b.servos.each_ref().map(first));
+        let first = first.map_or_else(Vec::new, Vec::from);
         format!(
             "sim summary frames={} pulses={pulses} mismatches={mismatches} period_ns={period} first_us={} watchdog_resets={}",
             self.frames(),

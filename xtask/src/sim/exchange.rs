@@ -239,26 +239,17 @@ fn compare(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>
     (transcript, problems)
 }
 
-/// `bytes` with its line end dropped and other control bytes escaped.
+/// `bytes` with its line end dropped, the rest escaped.
 fn printable(bytes: &[u8]) -> String {
-    let text = bytes
-        .strip_suffix(b"\r\n")
-        .or_else(|| bytes.strip_suffix(b"\n"))
-        .or_else(|| bytes.strip_suffix(b"\r"))
-        .unwrap_or(bytes);
-    text.utf8_chunks()
-        .flat_map(|chunk| {
-            let valid = chunk.valid().chars().map(|c| {
-                if c.is_control() {
-                    format!("\\x{:02x}", u32::from(c))
-                } else {
-                    c.to_string()
-                }
-            });
-            let invalid = chunk.invalid().iter().map(|b| format!("\\x{b:02x}"));
-            valid.chain(invalid).collect::<Vec<_>>()
-        })
-        .collect()
+    let line_end = |b: &u8| matches!(b, b'\r' | b'\n');
+    let end = bytes.len()
+        - bytes
+            .iter()
+            .rev()
+            .take(2)
+            .take_while(|b| line_end(b))
+            .count();
+    bytes[..end].escape_ascii().to_string()
 }
 
 #[cfg(test)]

@@ -14,7 +14,7 @@ use anyhow::{Context as _, Result, bail};
 use embedded_storage_async::nor_flash::{
     ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash,
 };
-use idle_head_core::settings::{RawRecord, SETTINGS_BUFFER, Settings, SettingsStore};
+use idle_head_core::settings::{RawRecord, Record, SETTINGS_BUFFER, Settings, SettingsStore};
 
 /// The Pico's flash: erase sector and write unit.
 const SECTOR: usize = 4096;
@@ -40,28 +40,25 @@ pub fn version_1_sectors(root: &Path, len: usize) -> Result<Vec<u8>> {
 /// `len` bytes of settings sectors (whole sectors) holding one record of
 /// layout version `V` (its payload: `payload`), as the store writes it.
 pub fn store_of_version<const V: u16>(payload: &[u8], len: usize) -> Result<Vec<u8>> {
-    let flash = RamFlash(vec![0xff; len]);
-    let range = 0..u32::try_from(len)?;
     let record = RawRecord::<V, 240>::new(payload).context("a payload of at most 240 bytes")?;
-    let mut store: SettingsStore<RamFlash, _, 256> = SettingsStore::new(flash, range)
-        .map_err(|e| anyhow::anyhow!("the settings store refused the range: {e:?}"))?;
-    match ready(store.save(&record)).context("the store's save waited")? {
-        Ok(()) => Ok(store.into_flash().0),
-        Err(e) => bail!("planting a version {V} record: {e:?}"),
-    }
+    plant::<_, 256>(&record, len).with_context(|| format!("planting a version {V} record"))
 }
 
 /// `len` bytes of settings sectors holding `settings`, as a `save` leaves
 /// them (a board boots on them: at their servo rate, say).
 pub fn settings_sectors(settings: &Settings, len: usize) -> Result<Vec<u8>> {
+    plant::<_, SETTINGS_BUFFER>(settings, len).context("planting the settings")
+}
+
+/// `len` bytes of sectors the core's `SettingsStore` saved `record` to.
+fn plant<R: Record, const BUF: usize>(record: &R, len: usize) -> Result<Vec<u8>> {
     let flash = RamFlash(vec![0xff; len]);
-    let range = 0..u32::try_from(len)?;
-    let mut store: SettingsStore<RamFlash, Settings, SETTINGS_BUFFER> =
-        SettingsStore::new(flash, range)
+    let mut store: SettingsStore<RamFlash, R, BUF> =
+        SettingsStore::new(flash, 0..u32::try_from(len)?)
             .map_err(|e| anyhow::anyhow!("the settings store refused the range: {e:?}"))?;
-    match ready(store.save(settings)).context("the store's save waited")? {
+    match ready(store.save(record)).context("the store's save waited")? {
         Ok(()) => Ok(store.into_flash().0),
-        Err(e) => bail!("planting the settings: {e:?}"),
+        Err(e) => bail!("{e:?}"),
     }
 }
 

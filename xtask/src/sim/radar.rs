@@ -38,7 +38,6 @@ use crate::trace::{Event, Kind};
 pub const RADAR_STAGE: &str = "Pico image in the RP2040 emulator: a radar walk on GP13 is \
      followed within 5° of the bearing, every pulse the host trace's; two boards' unique ids \
      give two idle motions";
-/// See [`RADAR_STAGE`].
 pub const RADAR_DMX_STAGE: &str = "Pico image in the RP2040 emulator: DMX512 on GP9 and the \
      radar on GP13 at once: every frame of both counted, none lost; a flash erase loses no radar \
      frame";

@@ -155,7 +155,7 @@ pub fn play(
         config.script = Some(script);
         config.flash_fill = planted;
         config.radar = radar;
-        config.uid = board.uid;
+        config.uid = board.uid.map(|id| format!("{id:016x}"));
         // A head relaxed at rest is silent for as long as it rests (no
         // pulse, no log line but once a loop): the wall limit alone tells a
         // stuck run.

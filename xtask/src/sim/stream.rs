@@ -21,16 +21,12 @@ use crate::{log::field, project::Metadata};
 /// Stage names.
 pub const UART_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: a line every 2 ms on \
      UART0 for 10 minutes: every line answered once, in order, none lost, no frame late";
-/// See [`UART_STREAM_STAGE`].
 pub const USB_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: a line every 2 ms on \
      USB for 10 minutes: every line answered once, in order, none lost, no frame late";
-/// See [`UART_STREAM_STAGE`].
 pub const DMX_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: DMX512 at the full \
      universe rate for a minute across two loop generations: every frame decoded, none lost";
-/// See [`UART_STREAM_STAGE`].
 pub const FLOOD_STAGE: &str = "Pico image in the RP2040 emulator: a UART flood with no \
      flow control: every line answered once, in order, no byte lost, no frame late";
-/// See [`UART_STREAM_STAGE`].
 pub const NOISE_STAGE: &str = "Pico image in the RP2040 emulator: a byte with a framing \
      error on UART0: its line answered `err line bytes lost`, the next one `ok`";
 
