@@ -10,6 +10,7 @@ use std::{
     task::{Context, Poll, Waker},
 };
 
+use super::node::Fill;
 use anyhow::{Context as _, Result, bail};
 use embedded_storage_async::nor_flash::{
     ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash,
@@ -123,4 +124,27 @@ impl NorFlash for RamFlash {
         }
         Ok(())
     }
+}
+
+/// The settings sectors of the image `elf` filled with `sectors(len)`.
+pub fn fill(elf: &Path, sectors: impl FnOnce(usize) -> Result<Vec<u8>>) -> Result<Fill> {
+    let image = crate::elf::Image::read(elf)?;
+    let region = image.settings.context("the image has no settings region")?;
+    let hex = sectors(usize::try_from(region.end - region.start)?)?;
+    Ok(Fill {
+        addr: region.start,
+        hex,
+    })
+}
+
+/// `len` bytes of noise (xorshift32): a store no firmware wrote.
+pub fn noise(len: usize) -> Vec<u8> {
+    let mut x: u32 = 0x2545_f491;
+    let mut next = || {
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        x.to_le_bytes()[0]
+    };
+    (0..len).map(|_| next()).collect()
 }

@@ -24,11 +24,11 @@ use idle_head_core::seed::BoardId;
 use idle_head_core::servo::ServoRate;
 
 use super::image::SERVOS;
-use super::node::{Chunk, Config, Fill, FlashTiming, PinScript};
+use super::node::{Chunk, Config, FlashTiming, PinScript};
 use super::pulses::angle;
 use super::run::{self, Boot, Report};
 use super::script::{self, Against, Board, EARLY, line};
-use super::{WALL, dmx, stages::shipped_image, stream};
+use super::{WALL, dmx, planted, stages::shipped_image, stream};
 use crate::bench::tracking::{self, Walk};
 use crate::log::field;
 use crate::project::{self, Metadata};
@@ -246,14 +246,11 @@ const TYPICAL: FlashTiming = FlashTiming {
     program: Duration::from_micros(400),
 };
 
-/// A `save` at 2 s over settings sectors full of noise (each erase 45 ms
-/// with the interrupts off, the flash's typical time) while a person stands in front of the radar
-/// from 1 s to 5 s; `radar` asked at 5.2 s. The problems.
+/// A `save` at 2 s over noise in the settings sectors (each erase 45 ms
+/// with the interrupts off) while a person stands before the radar from
+/// 1 s to 5 s; `radar` asked at 5.2 s. The problems.
 fn erase(root: &Path, elf: &Path) -> Result<Vec<String>> {
-    let region = crate::elf::Image::read(elf)?
-        .settings
-        .context("the image has no settings region")?;
-    let sectors = super::store::noise(usize::try_from(region.end - region.start)?);
+    let sectors = planted::fill(elf, |len| Ok(planted::noise(len)))?;
     let query = Duration::from_millis(5200);
     let lines = vec![
         Chunk::new(b"save\r\n".to_vec(), Duration::from_secs(2)),
@@ -262,10 +259,7 @@ fn erase(root: &Path, elf: &Path) -> Result<Vec<String>> {
     let radar = ("0 radar on\n1 radar -400,1800\n", Duration::from_secs(5));
     let report = with_radar(root, elf, radar, lines, query, |config| {
         config.rom = Some(TYPICAL);
-        config.flash_fill = Some(Fill {
-            addr: region.start,
-            hex: sectors,
-        });
+        config.flash_fill = Some(sectors);
     })?;
     let boot = report.first()?;
     let erased: f64 = boot.flash.iter().filter(|op| op.0).map(|op| op.2).sum();

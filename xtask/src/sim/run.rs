@@ -252,7 +252,6 @@ pub fn check_at(report: &mut Report, expected: &[[u16; 3]], rate: ServoRate) {
     for (b, boot) in report.boots.iter_mut().enumerate() {
         for (i, train) in boot.trains.iter_mut().enumerate() {
             train.end = boot.end;
-            train.reset = boot.watchdog;
             let duties: Vec<u16> = expected.iter().map(|frame| frame[i]).collect();
             let verdict = pulses::check(train, &duties, &timing, limits[i]);
             let name = SERVOS[i].0;

@@ -17,10 +17,9 @@ use idle_head_core::servo::ServoRate;
 use idle_head_core::settings::Settings;
 
 use super::image::{SERVOS, input_pins};
-use super::node::{Chunk, Fill, PinLevel, PinScript, nanos};
+use super::node::{Chunk, PinLevel, PinScript, nanos};
 use super::run::{self, Report};
 use super::{planted, pulses_csv};
-use crate::elf;
 use crate::project::{Metadata, PICO};
 use crate::trace::{self, Event, Kind, radar::PERIOD_US};
 
@@ -132,22 +131,17 @@ pub fn play(
         }
     }
     let radar = line(&events, rate, time);
-    let planted = if rate == ServoRate::DEFAULT {
-        None
-    } else {
-        let image = elf::Image::read(&PICO.elf(metadata))?;
-        let region = image.settings.context("the image has no settings region")?;
-        let settings = Settings {
-            rate,
-            ..Settings::DEFAULT
-        };
-        let len = usize::try_from(region.end - region.start)?;
-        let hex = planted::settings_sectors(&settings, len)?;
-        Some(Fill {
-            addr: region.start,
-            hex,
-        })
+    let settings = Settings {
+        rate,
+        ..Settings::DEFAULT
     };
+    let planted = (rate != ServoRate::DEFAULT)
+        .then(|| {
+            planted::fill(&PICO.elf(metadata), |len| {
+                planted::settings_sectors(&settings, len)
+            })
+        })
+        .transpose()?;
     // The boot before the first frame: well under a tenth of a second.
     let boot = Duration::from_millis(100);
     let mut report = run::run_with(root, &PICO.elf(metadata), time + boot, wall, |config| {

@@ -9,7 +9,7 @@
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use super::{
     node::{Fill, FlashTiming, UartScript},
@@ -18,7 +18,7 @@ use super::{
     run::{self, Boot, Report},
     stages::{WALL, console_ram, shipped_image},
 };
-use crate::{elf, project, project::Metadata};
+use crate::{project, project::Metadata};
 
 /// Stage name.
 pub const STORE_STAGE: &str = "Pico image in the RP2040 emulator: `save` to flash with \
@@ -66,7 +66,7 @@ const UNKNOWN: &str =
 /// from power-on, µs.
 type Start = (
     &'static str,
-    Vec<u8>,
+    Fill,
     &'static [(&'static str, &'static str)],
     [u32; 3],
 );
@@ -74,26 +74,24 @@ type Start = (
 /// Runs the scenario from every start and checks it (see the module docs).
 pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
     let elf = shipped_image(root, metadata)?;
-    let region = elf::Image::read(&elf)?
-        .settings
-        .context("the image has no settings region")?;
-    let len = usize::try_from(region.end - region.start)?;
     let starts: [Start; 3] = [
         (
             "foreign data",
-            noise(len),
+            planted::fill(&elf, |len| Ok(planted::noise(len)))?,
             &[("INFO", "settings: defaults (empty store")],
             [1500; 3],
         ),
         (
             "a record this firmware cannot read",
-            planted::store_of_version::<0>(b"an unknown layout", len)?,
+            planted::fill(&elf, |len| {
+                planted::store_of_version::<0>(b"an unknown layout", len)
+            })?,
             &[("WARN", UNKNOWN)],
             [1500; 3],
         ),
         (
             "a record of layout version 1",
-            planted::version_1_sectors(root, len)?,
+            planted::fill(&elf, |len| planted::version_1_sectors(root, len))?,
             &[
                 ("INFO", "settings: loaded from flash (version 1)"),
                 ("INFO", "settings: migrated from version 1 to 2"),
@@ -106,10 +104,7 @@ pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
         println!("settings sectors holding {what}:");
         let report = run::run_with(root, &elf, Duration::from_millis(8_500), WALL, |config| {
             config.rom = Some(WORST);
-            config.flash_fill = Some(Fill {
-                addr: region.start,
-                hex: sectors,
-            });
+            config.flash_fill = Some(sectors);
             config.power_cycles = vec![POWER_CYCLE];
             config.uart = vec![
                 UartScript::new(0, SCRIPTS[0], SCRIPT_AT[0]),
@@ -283,18 +278,6 @@ fn steps_around_the_save(boot: &Boot) -> (String, Vec<String>) {
         }
     }
     (text, problems)
-}
-
-/// `len` bytes of noise (xorshift32): a store no firmware wrote.
-pub(super) fn noise(len: usize) -> Vec<u8> {
-    let mut x: u32 = 0x2545_f491;
-    let mut next = || {
-        x ^= x << 13;
-        x ^= x >> 17;
-        x ^= x << 5;
-        x.to_le_bytes()[0]
-    };
-    (0..len).map(|_| next()).collect()
 }
 
 #[cfg(test)]
