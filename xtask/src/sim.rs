@@ -3,6 +3,15 @@
 //! reports raw facts as JSON lines). This module decodes the log, rebuilds
 //! the pulse trains and checks them against the host's duties.
 
+/// Pushes `format!(...)` onto `problems` if `cond` holds.
+macro_rules! problem_if {
+    ($problems:expr, $cond:expr, $($format:tt)+) => {
+        if $cond {
+            $problems.push(format!($($format)+));
+        }
+    };
+}
+
 mod dmx;
 mod event;
 mod exchange;

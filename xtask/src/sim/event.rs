@@ -14,19 +14,14 @@ use std::time::Duration;
 pub enum Event {
     /// A boot starts (0: power-on).
     Boot { n: usize, ns: f64 },
-    /// Bytes from the RTT up-buffer (the defmt log), stamped with the first.
-    Rtt {
-        ns: f64,
-        #[serde(deserialize_with = "from_hex")]
-        hex: Vec<u8>,
-    },
+    /// Bytes of the defmt log, stamped with the first.
+    Rtt { ns: f64, hex: Hex },
     /// A watched pin changed level (`reset`: a reset released it).
     Edge {
         pin: u8,
         high: bool,
         ns: f64,
-        #[serde(default)]
-        reset: bool,
+        reset: Option<bool>,
     },
     /// The script drove an input pin.
     Drive { pin: u8, high: bool, ns: f64 },
@@ -51,35 +46,44 @@ pub enum Event {
     /// The lowest stack address written in a boot.
     Stack { n: usize, low: u64 },
     /// Bytes UART0 sent, stamped with the first.
-    Uart {
-        ns: f64,
-        #[serde(deserialize_with = "from_hex")]
-        hex: Vec<u8>,
-    },
-    /// The last byte of a UART script went onto UART0's RX line.
+    Uart { ns: f64, hex: Hex },
+    /// A UART script's last byte went onto UART0's RX line.
     UartRx { ns: f64, n: usize },
     /// A scripted byte found UART0's RX FIFO full.
     UartOverrun { ns: f64 },
-    /// The CDC-ACM host configured the device.
+    /// The USB host configured the device.
     UsbConnected { ns: f64 },
-    /// Bytes the device sent on its CDC-ACM IN endpoint.
-    Usb {
-        ns: f64,
-        #[serde(deserialize_with = "from_hex")]
-        hex: Vec<u8>,
-    },
-    /// The USB host sent a scripted chunk (a list of chunks only).
+    /// Bytes the device sent on its CDC-ACM port.
+    Usb { ns: f64, hex: Hex },
+    /// The USB host sent a scripted chunk.
     UsbIn { ns: f64, n: usize },
-    /// A DMX frame carrying a change ended (its last byte went out).
+    /// A DMX frame carrying a change ended.
     Dmx { ns: f64, frame: u64, changed: bool },
     /// The radar frames sent in the run, at its end.
     Radar { ns: f64, frames: u64 },
-    /// Accesses to a register rp2040js does not model, counted over the run.
+    /// Accesses to a register rp2040js does not model, over the run.
     Unmodelled(Unmodelled),
     /// A complaint of the emulator.
     Emu { level: Level, msg: String },
     /// The run is over.
     End(End),
+}
+
+/// Bytes, from lower-case hex digits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hex(pub Vec<u8>);
+
+impl<'de> Deserialize<'de> for Hex {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let text = String::deserialize(deserializer)?;
+        let byte = |i| {
+            text.get(i..i + 2)
+                .and_then(|pair| u8::from_str_radix(pair, 16).ok())
+        };
+        let bad = || serde::de::Error::custom(format!("bad hex: {text}"));
+        let bytes = (0..text.len()).step_by(2).map(|i| byte(i).ok_or_else(bad));
+        bytes.collect::<Result<_, _>>().map(Hex)
+    }
 }
 
 /// Accesses to one register the emulator does not model.
@@ -196,20 +200,6 @@ impl Event {
     }
 }
 
-/// Lower-case hex digits as bytes.
-fn from_hex<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<u8>, D::Error> {
-    let text = String::deserialize(deserializer)?;
-    let byte = |i| {
-        text.get(i..i + 2)
-            .and_then(|pair| u8::from_str_radix(pair, 16).ok())
-    };
-    let bad = || serde::de::Error::custom(format!("bad hex: {text}"));
-    (0..text.len())
-        .step_by(2)
-        .map(|i| byte(i).ok_or_else(bad))
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -221,7 +211,7 @@ mod tests {
             rtt,
             Event::Rtt {
                 ns: 12.5,
-                hex: vec![0, 0xff, 0x10]
+                hex: Hex(vec![0, 0xff, 0x10])
             }
         );
         let edge = Event::parse(r#"{"ev":"edge","pin":16,"high":false,"ns":3,"reset":true}"#);
@@ -229,7 +219,7 @@ mod tests {
             pin: 16,
             high: false,
             ns: 3.0,
-            reset: true,
+            reset: Some(true),
         };
         assert_eq!(edge.unwrap(), want);
         for line in [

@@ -60,7 +60,7 @@ pub fn events(stdout: ChildStdout, mut each: impl FnMut(Vec<u8>)) -> String {
     let mut why = "the emulator stopped".to_owned();
     for line in BufReader::new(stdout).lines().map_while(Result::ok) {
         match Event::parse(&line) {
-            Ok(Event::Usb { hex, .. }) => each(hex),
+            Ok(Event::Usb { hex, .. }) => each(hex.0),
             Ok(Event::End(end)) => why = format!("the emulator stopped ({:?})", end.why),
             Ok(_) => {}
             Err(e) => why = format!("{e:#}"),

@@ -165,7 +165,7 @@ pub fn sort(events: &[Event], defmt: &Defmt, stack_top: u64) -> Result<Report> {
             (_, None) => bail!("harness event before the first boot: {event:?}"),
             (Event::Rtt { ns, hex }, Some(boot)) => {
                 if let Some(decoder) = decoder.as_mut() {
-                    let lines = defmt.lines(decoder.as_mut(), hex);
+                    let lines = defmt.lines(decoder.as_mut(), &hex.0);
                     boot.log.extend(lines.into_iter().map(|line| (*ns, line)));
                 }
             }
@@ -191,7 +191,7 @@ fn into_boot(boot: &mut Boot, event: &Event) {
             pin,
             high,
             ns,
-            reset: false,
+            reset: None | Some(false),
         } => {
             if let Some(i) = by_pin(pin) {
                 boot.trains[i].edges.push((ns, high));
@@ -215,8 +215,8 @@ fn into_boot(boot: &mut Boot, event: &Event) {
         Event::Call { cycles, .. } => boot.frame_cycles.push(cycles),
         Event::Drive { pin, high, ns } => boot.drives.push((ns, pin, high)),
         Event::Watchdog { .. } => boot.watchdog = true,
-        Event::Uart { ref hex, .. } => boot.uart.extend(hex),
-        Event::Usb { ref hex, .. } => boot.usb.extend(hex),
+        Event::Uart { ref hex, .. } => boot.uart.extend(&hex.0),
+        Event::Usb { ref hex, .. } => boot.usb.extend(&hex.0),
         Event::UartOverrun { .. } => boot.uart_overruns += 1,
         Event::UartRx { ns, .. } => boot.uart_lines.push(ns),
         Event::UsbConnected { ns } => boot.usb_connected = Some(ns),
