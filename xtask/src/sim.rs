@@ -100,92 +100,76 @@ pub fn run_shipped(
 #[derive(Debug, Clone, clap::Args)]
 #[command(group(clap::ArgGroup::new("run").multiple(false)))]
 pub struct Args {
-    /// Virtual time to run, in seconds (default: 32.5, a 30 s loop, the
-    /// 2 s fade-in and half a second of boot; with `--console`, 6).
+    /// Virtual time to run, in seconds (default 32.5: a loop, the fade-in
+    /// and the boot; with `--console`, 6).
     #[arg(long = "seconds", value_name = "S", value_parser = |s: &str| seconds(s, 3600.0))]
     pub virtual_time: Option<Duration>,
     /// Wall-time limit in seconds.
     #[arg(long, value_name = "S", default_value = "120", value_parser = |s: &str| seconds(s, 86_400.0))]
     pub timeout: Duration,
-    /// The watchdog drill instead: build the test image (`--features
-    /// watchdog-drill`, in target/watchdog-drill), whose frames stop after
-    /// 3 s, and check that the watchdog resets it and the next boot starts
-    /// softly again.
+    /// The watchdog drill instead: the test image's frames stop after 3 s;
+    /// the watchdog must reset it and the next boot start softly.
     #[arg(long, group = "run")]
     pub drill: bool,
-    /// The trigger inputs' check instead: a presence script (a sensor on
-    /// GP2, a rest after 2 s with relax on, someone at 7 s); the rest, the
-    /// pulses stopping, the soft wake and the glance checked from the
-    /// pulses, every pulse against the host trace.
+    /// The trigger inputs' check instead: a presence sensor on GP2 rests,
+    /// relaxes, wakes softly and glances; every pulse the host trace's.
     #[arg(long, group = "run")]
     pub inputs: bool,
-    /// The console instead: a scripted exchange over UART0 and then over
-    /// USB CDC-ACM, every reply checked, and the image's RAM with the peak
-    /// stack of that run against the budget.
+    /// The console instead: a scripted exchange over UART0, then USB, every
+    /// reply checked; the image's RAM with the run's peak stack in budget.
     #[arg(long, group = "run")]
     pub console: bool,
-    /// The settings store instead: from three starts of the settings
-    /// sectors, `save` over UART0 with the flash's worst-case erase times,
-    /// a power cycle, and the next boot on the saved settings.
+    /// The settings store instead: `save` with worst-case erase times, a
+    /// power cycle, the next boot on the saved settings.
     #[arg(long, group = "run")]
     pub store: bool,
-    /// Line noise on UART0 instead: a byte received with a framing error;
-    /// its line must be answered `err line bytes lost …`, the next one `ok`.
+    /// Line noise on UART0 instead: a line with a framing error must be
+    /// answered `err line bytes lost …`, the next one `ok`.
     #[arg(long, group = "run")]
     pub noise: bool,
-    /// A UART flood instead: 200 `status` lines back to back at 115200
-    /// baud, more than the replies keep up with, then one more line: every
-    /// line answered once, in order, none lost.
+    /// A UART flood instead: 200 `status` lines back to back, faster than
+    /// the replies: every line answered once, in order.
     #[arg(long, group = "run")]
     pub flood: bool,
-    /// A stream instead: a line every 2 ms on UART0 (`uart`) or the USB
-    /// serial port (`usb`) for `--seconds` (default 600), every line
-    /// answered once, in order, none lost, no frame late.
+    /// A stream instead: a line every 2 ms on UART0 or USB for `--seconds`
+    /// (default 600): every line answered once, in order, no frame late.
     #[arg(long, value_name = "PORT", value_parser = ["uart", "usb"], group = "run")]
     pub stream: Option<String>,
     /// List every access to a register the emulator does not model, also
-    /// the known gaps that do not matter (summed up in one line without).
+    /// the known harmless ones (one line without).
     #[arg(long, short)]
     pub verbose: bool,
-    /// The show control run instead (the stage of `cargo xtask test`): DMX
-    /// frames into GP9 and a Bottango session over USB, each checked from
-    /// the pulses on the servo pins.
+    /// The show control stage instead: DMX into GP9 and a Bottango session
+    /// over USB, checked from the pulses.
     #[arg(long, group = "run")]
     pub show: bool,
-    /// Play DMX512 into GP9 (UART1 RX): FILE has lines `<s> <slot>=<value>
-    /// …` (slots relative to the head's address, 1-based; values hold until
-    /// changed) and `<s> dmx stop`; frames at about 44 Hz with proper
-    /// breaks. Runs until 3 s after the last line unless `--seconds`.
+    /// Play DMX512 into GP9: lines `<s> <slot>=<value> …` (slots from the
+    /// head's address, 1-based) and `<s> dmx stop`; runs to 3 s after the
+    /// last line unless `--seconds`.
     #[arg(long, value_name = "FILE", group = "run")]
     pub dmx: Option<PathBuf>,
-    /// Play a trace script into the shipped image instead (`cargo xtask
-    /// trace --script`'s: pin lines drive GP2 to GP5, console lines go to
-    /// UART0, times from the first frame) and check every pulse against the
-    /// host trace of it. Without `--seconds`, to 5 s after its last line.
+    /// Play a trace script (`cargo xtask trace --script`'s) into the image
+    /// and check every pulse against its host trace. Without `--seconds`,
+    /// to 5 s after its last line.
     #[arg(long, value_name = "FILE", group = "run")]
     pub script: Option<PathBuf>,
-    /// Play a file of radar lines (`<s> radar <x_mm>,<y_mm> ...`, up to
-    /// three people, or `<s> radar none`) into GP13 as an HLK-LD2450's
-    /// frames, ten a second, with `radar on` sent first; every pulse
-    /// checked against the host trace of it. Without `--seconds`, to 5 s
-    /// after its last line.
+    /// Play radar lines (`<s> radar <x_mm>,<y_mm> ...` or `<s> radar none`)
+    /// into GP13 as an HLK-LD2450, checked as `--script`.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood", "script", "dmx", "show"])]
     pub radar: Option<PathBuf>,
-    /// With `--script`: the servos' rate, Hz (50 to 333), from the first
-    /// frame: the image boots on settings of that rate (planted in its
-    /// settings sectors), and the host trace runs at it.
+    /// With `--script`: the servos' rate, Hz (50 to 333), planted in the
+    /// settings the image boots on; the host trace runs at it too.
     #[arg(long, value_name = "HZ", requires = "script", default_value_t = 50,
           value_parser = clap::value_parser!(u16).range(50..=333))]
     pub rate: u16,
-    /// With `--script`, `--dmx` or `--show` (or alone: the plain run, the
-    /// pulses not checked): write the pulses measured on GP16, GP18 and GP20
-    /// to this CSV, one row per frame: `t_ms,pitch_us,roll_us,yaw_us`.
+    /// With `--script`, `--dmx` or `--show` (alone: a plain run): the pulses
+    /// to this CSV, a row per frame: `t_ms,pitch_us,roll_us,yaw_us`.
     #[arg(long, value_name = "FILE.csv",
           conflicts_with_all = ["drill", "inputs", "console", "store", "noise", "flood", "stream"])]
     pub pulses: Option<PathBuf>,
 }
 
-/// One loop (30 s), the fade-in (2 s) and half a second for the boot.
+/// A loop (30 s), the fade-in (2 s) and half a second of boot.
 pub const DEFAULT_TIME: Duration = Duration::from_millis(32_500);
 
 /// Seconds above 0 and at most `max`.
