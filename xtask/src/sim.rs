@@ -1,7 +1,6 @@
-//! `cargo xtask sim`: the Pico image, as `cargo run --release` flashes it,
-//! in the RP2040 emulator rp2040js (Node.js, `sim/harness.mjs`, which
-//! reports raw facts as JSON lines). This module decodes the log, rebuilds
-//! the pulse trains and checks them against the host's duties.
+//! `cargo xtask sim`: the shipped Pico image in the RP2040 emulator
+//! rp2040js (`sim/harness.mjs` reports raw facts as JSON lines); here the
+//! log is decoded and the pulses checked against the host's duties.
 
 /// Pushes `format!(...)` onto `problems` if `cond` holds.
 macro_rules! problem_if {

@@ -100,9 +100,8 @@ pub fn parse(text: &str) -> Result<Vec<Change>> {
     Ok(changes)
 }
 
-/// A change of slot 11 (past the head's ten) to 0 and 100 in turn every
-/// 0.23 s from `from` to before `to`: the full universe rate, with frames
-/// the harness counts.
+/// Slot 11 (past the head's ten) set to 0 and 100 in turn every 0.23 s
+/// from `from` to before `to`.
 pub fn alternating(from: Duration, to: Duration) -> Result<Vec<Change>> {
     let (mut text, mut at, mut k) = (String::new(), from, 0);
     while at < to {

@@ -1,7 +1,6 @@
-//! The events `sim/harness.mjs` prints, one JSON object a line, tagged by
-//! `ev` (the harness's header lists them). An event this module does not
-//! know, or a field missing or of the wrong kind, is an error: the harness
-//! and its reader change together.
+//! The events `sim/harness.mjs` prints, a JSON object a line tagged by
+//! `ev`. An unknown event or field, or one missing, is an error: the
+//! harness and its reader change together.
 
 use anyhow::{Context, Result};
 use serde::{Deserialize, Deserializer};
@@ -149,9 +148,7 @@ impl End {
     }
 }
 
-/// What the boot ROM did to the flash (a sector erase, a page program), or
-/// what the firmware did to a register the emulator does not model (a read
-/// rp2040js answers with 0xffffffff, a write it drops).
+/// A flash operation of the boot ROM, or an access to an unmodelled register.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Op {
@@ -169,9 +166,7 @@ pub enum Level {
     Error,
 }
 
-/// Why the harness stopped (`Silent`: no log byte or pin edge for the
-/// silence time; `Asleep`: the core sleeps with nothing left to wake it;
-/// `Closed`: a live run's stdin closed).
+/// Why the harness stopped (see [`End::problem`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Why {

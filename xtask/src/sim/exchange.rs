@@ -25,9 +25,8 @@ pub const USB_START: Duration = Duration::from_secs(4);
 /// reply (160 bytes, 13.9 ms) takes to go out.
 const LINE_GAP: Duration = Duration::from_millis(40);
 
-/// The lines sent, each with its line end: good and bad commands, every
-/// line end, an overlong line, a control byte and a machine-mode line
-/// (its checksum is computed in [`script`]).
+/// The lines sent: good and bad commands, every line end, a control byte;
+/// [`script_lines`] adds an overlong and a machine-mode line.
 const SCRIPT: &[&[u8]] = &[
     b"help\r\n",
     b"status\n",
@@ -55,11 +54,9 @@ pub fn configure(config: &mut Config) {
     config.usb = vec![Chunk::new(lines.concat(), USB_START)];
 }
 
-/// The exchange of boot 0 against the host's replies, into `report`: its
-/// transcript, and the problems: a wrong or missing reply, a byte that found
-/// UART0's receive FIFO full, a device the emulator's USB host did not
-/// configure, or a `center` the frame task did not log as applied (it goes
-/// through the queue).
+/// Boot 0's exchange against the host's replies, into `report`: the
+/// transcript, and problems: a wrong or missing reply, a UART overrun, a
+/// USB device not configured, a `center` the frame task did not log.
 pub fn check(report: &mut Report) {
     let Some(boot) = report.boots.first() else {
         return;
@@ -158,9 +155,8 @@ fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
     })
 }
 
-/// `reply` with the values that depend on the frame it was answered at
-/// (the angles, pulses and uptime of `status`) replaced by `*`, if they
-/// have their form: a comma-separated list of integers.
+/// `reply` with `status`'s frame-dependent values (angles, pulses, uptime;
+/// if lists of integers) replaced by `*`.
 fn mask(reply: &[u8]) -> Vec<u8> {
     if !reply.starts_with(b"ok mode=") {
         return reply.to_vec();

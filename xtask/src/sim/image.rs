@@ -1,7 +1,5 @@
-//! The Pico image as the emulator's harness runs it: where its servos and
-//! trigger inputs are wired, what it needs from the ELF (the addresses of a
-//! few symbols; the flash contents come from its UF2), and the
-//! configuration every run of it starts from.
+//! The Pico image as the harness runs it: its wiring, the symbols it needs
+//! from the ELF (the flash comes from its UF2), the base configuration.
 
 use std::path::Path;
 
@@ -84,10 +82,8 @@ impl PicoImage {
     }
 }
 
-/// The harness's configuration for the Pico image `elf`, and the image:
-/// its UF2 written beside it (`<elf>.<extension>`, `cargo xtask uf2`'s
-/// file), its vector table and RTT log, the servo slices' compare writes
-/// reported.
+/// The image `elf` and the harness's configuration for it: its UF2
+/// (written to `<elf>.<extension>`), vector table, RTT, servo slices.
 pub fn config(elf: &Path, extension: &str) -> Result<(PicoImage, Config)> {
     let image = PicoImage::read(elf)?;
     let (flash, _) = uf2::write(elf, Board::Pico, extension)?;

@@ -1,7 +1,6 @@
-//! The trigger inputs' stage: a presence script (a sensor on GP2, a rest
-//! after 2 s with relax on, someone at 7 s) played into the shipped image;
-//! from the pulses, the rest, the pulses stopping, the soft wake and the
-//! glance towards the sensor, every pulse the host trace's duty.
+//! The trigger inputs' stage: a presence sensor on GP2 (a rest after 2 s,
+//! relaxed, someone at 7 s); from the pulses, the rest, the pulses
+//! stopping, the soft wake and the glance, every pulse the host trace's.
 
 use std::path::Path;
 use std::time::Duration;

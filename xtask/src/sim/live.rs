@@ -13,11 +13,9 @@ use anyhow::{Context, Result};
 
 use super::{event::Event, image, node, store::WORST};
 
-/// The harness's argument for a live run of `elf`: the settings store's
-/// flash functions as in the store run (`save` and `load` work), the servo
-/// slices' compare writes reported (`cc` events of slices 0, 1, 2: pitch,
-/// roll, yaw), the trigger inputs GP2..GP5 driven by `pin <n> 0|1` lines
-/// (at their pulls until driven, as on a board: a button reads released).
+/// The harness's argument for a live run of `elf`: the flash functions
+/// (`save` and `load` work), the servo slices' `cc` events, the trigger
+/// inputs driven by `pin <n> 0|1` lines (at their pulls until then).
 pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
     let (_, config) = image::config(elf, "live.uf2")?;
     node::ensure(root)?;
@@ -33,9 +31,8 @@ pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
     .json())
 }
 
-/// Starts `elf` live in the emulator ([`config`]): its stdin takes bytes
-/// for the head's USB serial port ([`send`]), its stdout has its events
-/// ([`events`]).
+/// Starts `elf` live: stdin takes bytes for the USB serial port
+/// ([`send`]), stdout has the events ([`events`]).
 pub fn start(root: &Path, elf: &Path) -> Result<Child> {
     Command::new("node")
         .arg("harness.mjs")

@@ -1,7 +1,5 @@
-//! Settings sectors as an earlier firmware would have left them: the
-//! version 1 fixture, or a record of any layout version written by the
-//! core's own `SettingsStore` over a NOR flash in RAM with the Pico's
-//! geometry.
+//! Settings sectors as a firmware would have left them: the version 1
+//! fixture, or a record written by the core's `SettingsStore` to RAM.
 
 use std::{
     future::Future,

@@ -1,10 +1,6 @@
-//! `cargo xtask sim --script FILE`: a trace script played into the shipped
-//! image (pin lines drive GP2 to GP5, console lines go to UART0 2 ms before
-//! their time, times from the first frame), every pulse checked against
-//! the host trace of the same script; radar lines go to GP13 as the
-//! LD2450's frames (`radar.rs`); at another
-//! servo rate (`--rate`) the image boots on settings of that rate planted
-//! in its settings sectors, and the trace and the check run at it.
+//! `cargo xtask sim --script FILE`: a trace script into the shipped image
+//! (pin lines on GP2 to GP5, console lines on UART0, radar lines on GP13;
+//! times from the first frame), every pulse against its host trace.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -29,10 +25,8 @@ pub const EARLY: Duration = Duration::from_millis(2);
 /// The radar's (an LD2450's) line rate.
 const BAUD: u32 = 256_000;
 
-/// The first frame a console line is taken at: the board's console reads
-/// its UART once the boot's work (the first loop sets) is done, some 40 ms
-/// after the first frame; a line timed earlier is taken here, in the
-/// emulator and in the host trace it is checked against alike.
+/// The console reads its UART some 40 ms after the first frame: an earlier
+/// line moves here, in the emulator and the host trace alike.
 pub const CONSOLE_UP: Duration = Duration::from_millis(100);
 
 /// The events of the script at `path`.
@@ -54,9 +48,8 @@ pub fn default_time(events: &[Event]) -> Duration {
     Duration::from_micros(last) + Duration::from_secs(5)
 }
 
-/// The board a script plays on: the servos' rate from the first frame (the
-/// image boots on settings of that rate) and the flash's unique id (none:
-/// the flash answers all ones, and the idle plays the paper's seeds).
+/// The board a script plays on: the servos' rate (planted in its settings)
+/// and the flash's unique id (none: all ones, the paper's seeds).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Board {
     pub rate: ServoRate,
@@ -75,11 +68,8 @@ pub enum Against {
     Written,
 }
 
-/// Runs `events` in the shipped image (built) for `time` of virtual time
-/// from its first frame (at most `wall` of wall time), the servos at `rate`
-/// from the first frame (the image boots on settings of that rate), and
-/// checks every pulse `against` the host trace or what was written
-/// (console lines before [`CONSOLE_UP`] moved there, in both).
+/// Runs `events` in the shipped image (built) for `time` from its first
+/// frame (at most `wall`) on `board`; every pulse checked `against`.
 pub fn play(
     root: &Path,
     metadata: &Metadata,
@@ -236,9 +226,8 @@ pub fn command(
     Ok(report.problems.is_empty())
 }
 
-/// The harness's `radar` for the radar lines of `events` (none: no radar
-/// wired), its frames from the script's time 0 to `time`, each in
-/// [`EARLY`] before the first servo frame at `rate` at or after its time.
+/// The harness's `radar` for the radar lines of `events` (none: none
+/// wired), to `time`, each line in [`EARLY`] before its frame at `rate`.
 pub fn line(events: &[Event], rate: ServoRate, time: Duration) -> Option<Value> {
     let lines: Vec<Value> = events
         .iter()

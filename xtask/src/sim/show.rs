@@ -1,7 +1,6 @@
-//! Show control in the emulator: `cargo xtask sim --dmx FILE`, and the
-//! stage that checks on the shipped image, from the pulses, that DMX and a
-//! Bottango session drive the head and that lost frames and the end of a
-//! curve hand it back to the idle (docs/dev/emulators.md, "Show control").
+//! Show control: `cargo xtask sim --dmx FILE`, and the stage: DMX and
+//! Bottango drive the head, lost frames and a curve's end hand it back to
+//! the idle (docs/dev/emulators.md, "Show control").
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
@@ -38,9 +37,8 @@ const SCRIPT: &str = "\
 const BOTTANGO: Duration = Duration::from_millis(10_500);
 const STOP: Duration = Duration::from_millis(12_600);
 
-/// The session's lines, with their hashes: the handshake, the sync, yaw
-/// and pitch registered, a curve each 200 ms after the sync, 1 s, eased in
-/// and out.
+/// The session's lines with their hashes: handshake, sync, yaw and pitch
+/// registered, a 1 s eased curve each 200 ms after the sync.
 fn bottango_lines() -> Vec<String> {
     [
         "hRQ,144",

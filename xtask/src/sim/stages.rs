@@ -1,6 +1,5 @@
-//! The emulator's stages of `cargo xtask test` that need no scenario file
-//! of their own: the pulses at 50 and 333 Hz, the watchdog drill, the
-//! console's exchanges and the emulator's own failures.
+//! The emulator stages without a module of their own: pulses at 50 and
+//! 333 Hz, the watchdog drill, the console, the emulator's failures.
 
 use std::{
     path::{Path, PathBuf},

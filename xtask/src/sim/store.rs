@@ -1,11 +1,7 @@
-//! The settings store on the emulated chip, from three starts of the
-//! settings sectors (noise, a record of an unknown version, a version 1
-//! record): `save` through the boot ROM's flash functions at their worst
-//! times, a power cycle, and the next boot on the saved settings
-//! (docs/dev/emulators.md, "Settings through a power cycle"). Lines that
-//! arrive on UART0 while the flash is erased (the interrupts off) are all
-//! answered after it, and the servos, held still meanwhile, go on within
-//! the limiter's idle speed and acceleration, no jump.
+//! The settings store from three starts (noise, an unknown version, a
+//! version 1 record): `save` at the flash's worst times, a power cycle, the
+//! next boot on the saved settings; lines sent during the erase answered
+//! after it, the servos going on without a jump (docs/dev/emulators.md).
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
@@ -61,9 +57,8 @@ const SAVED_PITCH_US: u32 = 1520;
 const UNKNOWN: &str =
     "settings: defaults; the store at 0x101fc000 holds settings of version 0, not 2";
 
-/// A start of the settings sectors: what they hold, their bytes, what the
-/// first boot must log about them (a level and a text), the neutral pulses
-/// from power-on, µs.
+/// A start: what the sectors hold, them, what boot 0 logs (level, text),
+/// the neutral pulses, µs.
 type Start = (
     &'static str,
     Fill,
@@ -232,11 +227,8 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
     (text, problems)
 }
 
-/// The largest change of each axis' angle from one pulse to the next, and
-/// of that change, from before the save to a second after it: within the
-/// limiter's idle speed and acceleration (a frame's worth, and a few counts
-/// of rounding), also where the motion goes on after a stall. A summary
-/// and the problems.
+/// Each axis' largest step and change of step around the save, within the
+/// idle speed and acceleration (and rounding); a summary and problems.
 fn steps_around_the_save(boot: &Boot) -> (String, Vec<String>) {
     let config = idle_head_core::driver::DriverConfig::DEFAULT;
     let frame_s = f64::from(config.frame_period.0) / 1e6;

@@ -1,8 +1,6 @@
-//! Console lines and DMX frames streamed into the shipped image in the
-//! emulator, each line answered once, in order, none lost, no frame late:
-//! a line every 2 ms for ten minutes on UART0 or USB, a flood on UART0 faster
-//! than the replies leave, a byte with a framing error, and DMX512 at the
-//! full universe rate for a minute (docs/dev/emulators.md, "Streams").
+//! Streams into the shipped image, each line answered once, in order, no
+//! frame late: a line every 2 ms on UART0 or USB, a UART flood, a framing
+//! error, DMX512 for a minute (docs/dev/emulators.md, "Streams").
 
 use std::{path::Path, time::Duration};
 
@@ -36,9 +34,8 @@ const START: Duration = Duration::from_secs(3);
 const EVERY: Duration = Duration::from_millis(2);
 pub const LENGTH: Duration = Duration::from_secs(600);
 
-/// The stream's cycle of lines, 20 ms of them: two actions a frame
-/// (queued for the frame task, answered once a frame has taken them; they
-/// leave the motion as it is), settings, and machine-mode lines.
+/// The stream's cycle, 20 ms: two actions a frame (answered once a frame
+/// takes them), settings, and machine-mode lines.
 const CYCLE: [StreamLine; 10] = [
     StreamLine::Plain("center"),
     StreamLine::Machine("watch off"),
@@ -77,9 +74,8 @@ impl Want {
     }
 }
 
-/// The first boot's replies on UART0 (or `usb`) against `want`, one for
-/// each of `count` lines: the replies and the problems (a reply that does
-/// not fit, the first five; a count off; a byte lost at UART0's FIFO).
+/// Boot 0's replies on UART0 (or `usb`) against `want` for `count` lines:
+/// them, and the problems (the first five misfits, a count off, overruns).
 fn replies(
     report: &Report,
     usb: bool,
@@ -117,9 +113,7 @@ fn wall(length: Duration) -> Duration {
     (START + length) * 3 + Duration::from_secs(120)
 }
 
-/// A line every 2 ms on `port` (`"uart"` or `"usb"`) for `length`: every
-/// line answered once, in order, its command's answer (the machine-mode ones
-/// with their own sequence number), no byte lost, every frame the host's.
+/// A line every 2 ms on `port` (`"uart"` or `"usb"`) for `length`.
 pub fn test_stream(
     root: &Path,
     metadata: &Metadata,
@@ -160,10 +154,8 @@ pub fn test_stream(
 /// Lines in each flood.
 const FLOOD_LINES: usize = 100;
 
-/// At 3 s 100 `status` lines back to back (0.7 ms a line; each reply takes
-/// 9.5 ms to go out), at 5 s as many in machine mode, at 7 s one more
-/// `status`: every line answered once, in order, no byte lost at UART0's
-/// FIFO (the board receives by DMA into a ring), every frame the host's.
+/// 100 `status` lines back to back at 3 s (0.7 ms a line, 9.5 a reply),
+/// as many in machine mode at 5 s, one more at 7 s.
 pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
     let machine = |n: usize| {
         let body = format!("#{n} status");
@@ -193,9 +185,7 @@ pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
     report.conclude(problems)
 }
 
-/// `sta`, a byte with a framing error, `tus`, then `status`: the first line
-/// must be answered `err line bytes lost …`, the second `ok mode=…`, and
-/// every pulse stays the host's.
+/// `sta`, a byte with a framing error, `tus`, then `status`.
 pub fn test_noise(root: &Path, metadata: &Metadata) -> Result<()> {
     let time = Duration::from_millis(3_500);
     let (_, report) = checked_run(root, metadata, time, WALL, |config| {
@@ -222,10 +212,7 @@ pub fn test_noise(root: &Path, metadata: &Metadata) -> Result<()> {
 /// How long DMX streams.
 const DMX_LENGTH: Duration = Duration::from_secs(60);
 
-/// DMX at the full universe rate for a minute, a change of a slot past the
-/// head's ten in every tenth frame: the head's `dmx` counters (asked over
-/// UART0 at the end) count every frame good, none short, long, of another
-/// start code or garbled, and no frame of the head's is late.
+/// DMX at the full universe rate for a minute; `dmx` asked at the end.
 pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     // The harness counts the frames that carry a change; the last one at the end.
     let end = START + DMX_LENGTH;
@@ -246,9 +233,8 @@ pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     crate::project::verdict(&problems)
 }
 
-/// The `dmx` counters of its `reply` against the frames sent in `boot`
-/// (`changes` of them changed the slots): every one good, no frame late;
-/// a summary and the problems.
+/// The `dmx` counters of `reply` against the frames `boot` sent (`changes`
+/// of them changes): every one good, no frame late. A summary, problems.
 pub(super) fn check_dmx(boot: &Boot, reply: &str, changes: usize) -> (String, Vec<String>) {
     let counter = |name| field(reply, name).and_then(|v| v.parse::<u64>().ok());
     let mut problems: Vec<String> = ["short", "long", "start_code", "garbled"]

@@ -1,7 +1,5 @@
 //! Registers rp2040js does not model (a read gives 0xffffffff, a write is
-//! dropped), as the harness counts the accesses to them: the gaps known not
-//! to matter for these images, with the reason, and any other, which a run
-//! shows in full.
+//! dropped): the gaps known not to matter, and any other in full.
 
 use std::fmt::Write as _;
 
