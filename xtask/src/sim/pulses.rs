@@ -277,6 +277,13 @@ mod tests {
         max: 6400,
     };
 
+    /// `train` checked against `wanted`; its problems as one text.
+    fn run(train: &Train, wanted: &[u16]) -> (ServoCheck, String) {
+        let check = check(train, wanted, &TIMING, LIMITS);
+        let problems = check.problems.join("\n");
+        (check, problems)
+    }
+
     /// The train the emulator gives for `duties`: frame k written at
     /// `k · 20 ms + 150 µs` (frame 0 at 0, enabling the slice half a period
     /// in), pulse n rising at `(n + ½) · P`.
@@ -308,13 +315,8 @@ mod tests {
     #[test]
     fn a_train_equal_to_the_host_passes() {
         let duties = ramp(100);
-        let check = check(
-            &train(&duties, 100.0 * 20e6 + 5e6),
-            &duties,
-            &TIMING,
-            LIMITS,
-        );
-        assert!(check.problems.is_empty(), "{:?}", check.problems);
+        let (check, problems) = run(&train(&duties, 100.0 * 20e6 + 5e6), &duties);
+        assert!(problems.is_empty(), "{problems}");
         assert_eq!((check.fresh, check.held, check.mismatches), (100, 0, 0));
         let (low, high) = check.periods.unwrap();
         assert!((low - 20e6).abs() < 1.0 && (high - 20e6).abs() < 1.0);
@@ -325,20 +327,9 @@ mod tests {
         let duties = ramp(100);
         let mut wrong = duties.clone();
         wrong[40] += 2;
-        let check = check(&train(&duties, 100.0 * 20e6 + 5e6), &wrong, &TIMING, LIMITS);
+        let (check, problems) = run(&train(&duties, 100.0 * 20e6 + 5e6), &wrong);
         assert_eq!(check.mismatches, 1);
-        assert!(
-            check
-                .problems
-                .iter()
-                .any(|p| p.starts_with("frame 40: wrote"))
-        );
-        assert!(
-            check
-                .problems
-                .iter()
-                .any(|p| p.starts_with("pulse 40 (frame 40)"))
-        );
+        assert!(problems.contains("frame 40: wrote") && problems.contains("pulse 40 (frame 40)"));
     }
 
     #[test]
@@ -346,13 +337,9 @@ mod tests {
         let duties = vec![4800; 60];
         let mut t = train(&duties, 60.0 * 20e6 + 5e6);
         t.writes.remove(31); // frame 30 never written
-        let check = check(&t, &duties, &TIMING, LIMITS);
+        let (check, problems) = run(&t, &duties);
         assert_eq!(check.mismatches, 0);
-        assert!(
-            check.problems.iter().any(|p| p.contains("carries frame")),
-            "{:?}",
-            check.problems
-        );
+        assert!(problems.contains("carries frame"), "{problems}");
     }
 
     #[test]
@@ -364,7 +351,7 @@ mod tests {
         if let Some(edge) = t.edges.iter_mut().rev().find(|e| e.1) {
             edge.0 += 2000.0; // the last period 2 µs long
         }
-        let problems = check(&t, &duties, &TIMING, LIMITS).problems.join("\n");
+        let (_, problems) = run(&t, &duties);
         for part in [
             "before the first frame",
             "not the neutral",
@@ -385,21 +372,14 @@ mod tests {
         t.edges.retain(|&(ns, _)| {
             !(20.4 * TIMING.period_ns()..40.0 * TIMING.period_ns()).contains(&ns)
         });
-        let check = check(&t, &duties, &TIMING, LIMITS);
-        assert!(check.problems.is_empty(), "{:?}", check.problems);
+        let (check, problems) = run(&t, &duties);
+        assert!(problems.is_empty(), "{problems}");
         assert_eq!((check.fresh, check.mismatches), (40, 0));
         // The host wanted pulses there: every frame of the gap is named.
         let mut wanted = duties.clone();
         wanted[25] = 4800;
-        let check = check_wanted(&t, &wanted);
-        assert!(
-            check
-                .problems
-                .iter()
-                .any(|p| p.contains("frame 25: wrote 0 counts")),
-            "{:?}",
-            check.problems
-        );
+        let (_, problems) = run(&t, &wanted);
+        assert!(problems.contains("frame 25: wrote 0 counts"), "{problems}");
     }
 
     #[test]
@@ -416,22 +396,10 @@ mod tests {
             enabled: Some(10.0),
             ..Train::default()
         };
-        let whole = Measured {
-            rise: 20.0,
-            width: 10.0,
-        };
+        let [early, whole] = [5.0, 20.0].map(|rise| Measured { rise, width: 10.0 });
         assert_eq!(measure(&train), vec![whole]);
-        let from_0 = spans(&train, 0.0);
-        let early = Measured {
-            rise: 5.0,
-            width: 10.0,
-        };
-        assert_eq!(from_0, vec![early, whole]);
+        assert_eq!(spans(&train, 0.0), vec![early, whole]);
         assert!(measure(&Train::default()).is_empty());
-    }
-
-    fn check_wanted(t: &Train, wanted: &[u16]) -> ServoCheck {
-        check(t, wanted, &TIMING, LIMITS)
     }
 
     #[test]
@@ -446,8 +414,8 @@ mod tests {
                 .push((rise + f64::from(duties[29]) * TIMING.count_ns, false));
         }
         t.edges.push((35.5 * period + 10.0, true)); // cut by the reset
-        let check = check(&t, &duties, &TIMING, LIMITS);
-        assert!(check.problems.is_empty(), "{:?}", check.problems);
+        let (check, problems) = run(&t, &duties);
+        assert!(problems.is_empty(), "{problems}");
         assert_eq!((check.fresh, check.held), (30, 5));
     }
 }

@@ -243,58 +243,42 @@ pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
     // Thumb `b .` (a loop on itself) and `wfi`; the runs' virtual time,
     // wall time and silence.
     let (b_self, wfi) = (0xe7fe, 0xbf30);
-    let (short, long) = (Duration::from_millis(50), Duration::from_secs(3600));
+    let [short, slow] = [50, 200].map(Duration::from_millis);
+    let [two, long] = [2, 3600].map(Duration::from_secs);
+    let hung = "no log byte and no pin edge";
+    let asleep = "sleeps with nothing left to wake it";
     let cases: [(&str, &[u16], [Duration; 3], &str); 3] = [
-        (
-            "hung",
-            &[b_self],
-            [Duration::from_secs(2), WALL, short],
-            "no log byte and no pin edge",
-        ),
-        (
-            "asleep",
-            &[wfi, b_self],
-            [Duration::from_secs(2), WALL, short],
-            "sleeps with nothing left to wake it",
-        ),
-        (
-            "slow",
-            &[b_self],
-            [long, Duration::from_millis(200), long],
-            "stopped after",
-        ),
+        ("hung", &[b_self], [two, WALL, short], hung),
+        ("asleep", &[wfi, b_self], [two, WALL, short], asleep),
+        ("slow", &[b_self], [long, slow, long], "stopped after"),
     ];
     let mut problems = Vec::new();
     for (name, code, [virtual_time, wall, silence], want) in cases {
         let flash = dir.join(format!("{name}.bin"));
         std::fs::write(&flash, synthetic(code)).context("writing a test image")?;
-        let vtor = VECTOR_TABLE;
+        let (vtor, config) = (VECTOR_TABLE, node::Config::default());
         let config = node::Config {
             flash,
             vtor,
             virtual_time,
             wall,
             silence,
-            ..node::Config::default()
+            ..config
         };
         match End::of(&node::run(root, &config)?)?.problem(silence) {
             Some(message) if message.contains(want) => println!("{name}: {message}"),
             other => problems.push(format!("{name}: expected `{want}`, got {other:?}")),
         }
     }
-    let missing = dir.join("no-such-elf");
+    let (missing, myself) = (dir.join("no-such-elf"), std::env::current_exe()?);
     for (path, want) in [
-        (missing.as_path(), "cargo build --release"),
-        (&std::env::current_exe()?, "is not a Pico image"),
+        (missing, "cargo build --release"),
+        (myself, "is not a Pico image"),
     ] {
-        match PicoImage::read(path) {
-            Err(error) if format!("{error:#}").contains(want) => {
-                println!("{}: {error:#}", path.display());
-            }
-            other => problems.push(format!(
-                "{}: expected `{want}`, got {other:?}",
-                path.display()
-            )),
+        let (read, path) = (PicoImage::read(&path), path.display());
+        match read {
+            Err(error) if format!("{error:#}").contains(want) => println!("{path}: {error:#}"),
+            other => problems.push(format!("{path}: expected `{want}`, got {other:?}")),
         }
     }
     project::verdict(&problems)

@@ -14,7 +14,7 @@ use super::{
     run::{self, Boot, Report},
     stages::{WALL, console_ram, shipped_image},
 };
-use crate::{project, project::Metadata};
+use crate::{log::LogLine, project, project::Metadata};
 
 /// Stage name.
 pub const STORE_STAGE: &str = "Pico image in the RP2040 emulator: `save` to flash with \
@@ -132,23 +132,23 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
         ));
         return (text, problems);
     };
-    if !first.power_cycled {
-        problems.push("the first boot did not end with the power cycle".to_owned());
-    }
+    problem_if!(
+        problems,
+        !first.power_cycled,
+        "the first boot did not end with the power cycle"
+    );
     for (b, boot) in report.boots.iter().enumerate() {
-        if boot.watchdog {
-            problems.push(format!("boot {b}: the watchdog reset the board"));
-        }
+        problem_if!(
+            problems,
+            boot.watchdog,
+            "boot {b}: the watchdog reset the board"
+        );
         let _ = writeln!(text, "boot {b}, UART0:");
         let replies = boot.uart_replies();
         // Boot 0: the replies to the lines sent during the save, last.
         let during = if b == 0 { DURING_SAVE_LINES } else { 0 };
-        let want = |i: usize| {
-            REPLIES[b]
-                .get(i)
-                .copied()
-                .or((i < REPLIES[b].len() + during).then_some(("ok pitch neutral=1520 ", "")))
-        };
+        let (count, pitch) = (REPLIES[b].len() + during, ("ok pitch neutral=1520 ", ""));
+        let want = |i: usize| REPLIES[b].get(i).copied().or((i < count).then_some(pitch));
         for (i, line) in replies.iter().enumerate() {
             let _ = writeln!(text, "  < {line}");
             match want(i) {
@@ -159,58 +159,59 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
                 None => problems.push(format!("boot {b}: an extra reply `{line}`")),
             }
         }
-        if replies.len() < REPLIES[b].len() + during {
-            let want = REPLIES[b].len() + during;
-            problems.push(format!("boot {b}: {} replies, not {want}", replies.len()));
-        }
+        let n = replies.len();
+        problem_if!(problems, n < count, "boot {b}: {n} replies, not {count}");
     }
     for (level, line) in logged {
-        let at_level =
-            |l: &crate::log::LogLine| l.level.as_deref() == Some(level) && l.message.contains(line);
-        if !first.log.iter().any(|(_, l)| at_level(l)) {
-            problems.push(format!("boot 0 did not log `{level} {line}`"));
-        }
+        let at_level = |l: &LogLine| l.level.as_deref() == Some(level) && l.message.contains(line);
+        let logged = first.log.iter().any(|(_, l)| at_level(l));
+        problem_if!(problems, !logged, "boot 0 did not log `{level} {line}`");
     }
     let [pitch, roll, yaw] = neutral;
     let first_neutral = format!("first frame: neutral pulses {pitch} {roll} {yaw} us");
-    if !first.says(&first_neutral) {
-        problems.push(format!("boot 0 did not log `{first_neutral}`"));
-    }
+    problem_if!(
+        problems,
+        !first.says(&first_neutral),
+        "boot 0 did not log `{first_neutral}`"
+    );
     for (erase, what) in [(true, "erases"), (false, "programs")] {
         let ops = first.flash.iter().filter(|op| op.0 == erase);
         let (n, bytes, ns) = ops.fold((0, 0, 0.0), |(n, b, t), op| (n + 1, b + op.1, t + op.2));
+        let ms = ns / 1e6;
         let _ = writeln!(
             text,
-            "boot 0, flash: {n} {what} ({bytes} B, busy {:.0} ms)",
-            ns / 1e6
+            "boot 0, flash: {n} {what} ({bytes} B, busy {ms:.0} ms)"
         );
     }
-    if !first.flash.iter().any(|op| !op.0) {
-        problems.push("boot 0's save did not program the flash".to_owned());
-    }
+    let programmed = first.flash.iter().any(|op| !op.0);
+    problem_if!(
+        problems,
+        !programmed,
+        "boot 0's save did not program the flash"
+    );
     let writes = &first.trains[0].writes;
     let gap = writes
         .windows(2)
         .map(|w| w[1].0 - w[0].0)
-        .fold(0.0, f64::max);
-    let _ = writeln!(
-        text,
-        "boot 0: longest gap between frames {:.0} ms",
-        gap / 1e6
-    );
+        .fold(0.0, f64::max)
+        / 1e6;
+    let _ = writeln!(text, "boot 0: longest gap between frames {gap:.0} ms");
     let (steps, over) = steps_around_the_save(first);
     text.push_str(&steps);
     problems.extend(over);
-    if !second.says("settings: loaded from flash") {
-        problems.push("boot 1 did not log the settings loaded from flash".to_owned());
-    }
+    let loaded = second.says("settings: loaded from flash");
+    problem_if!(
+        problems,
+        !loaded,
+        "boot 1 did not log the settings loaded from flash"
+    );
     let saved = [SAVED_PITCH_US, roll, yaw];
     let second_neutral = format!("first frame: neutral pulses {SAVED_PITCH_US} {roll} {yaw} us");
-    if !second.says(&second_neutral) {
-        problems.push(format!(
-            "boot 1 did not log the saved neutral pulses for its first frame (`{second_neutral}`)"
-        ));
-    }
+    problem_if!(
+        problems,
+        !second.says(&second_neutral),
+        "boot 1 did not log the saved neutral pulses for its first frame (`{second_neutral}`)"
+    );
     // The width of each servo's first pulse, whole µs.
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // a pulse: µs
     let first_us = second.trains.each_ref().map(|train| {
@@ -219,11 +220,11 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
         Some(((edges.get(rise + 1)?.0 - edges[rise].0) / 1e3).round() as u32)
     });
     let _ = writeln!(text, "boot 1: first pulses {first_us:?} us");
-    if first_us != saved.map(Some) {
-        problems.push(format!(
-            "boot 1's first pulses are {first_us:?} us, not {saved:?} (the saved neutral pulses)"
-        ));
-    }
+    problem_if!(
+        problems,
+        first_us != saved.map(Some),
+        "boot 1's first pulses are {first_us:?} us, not {saved:?} (the saved neutral pulses)"
+    );
     (text, problems)
 }
 
@@ -275,7 +276,6 @@ fn steps_around_the_save(boot: &Boot) -> (String, Vec<String>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::log::LogLine;
     use crate::sim::pulses::Train;
 
     /// Breaks a good report one way.
