@@ -31,17 +31,8 @@ pub const SCRIPT: &str = "\
 /// about 8.1 s, held and back) and checks it.
 #[allow(clippy::too_many_lines)] // the four checks of the module docs, in order
 pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
-    let events = script::parse(SCRIPT)?;
-    let time = (Duration::from_millis(12_500), super::WALL);
-    let against = script::Against::Host;
-    let report = script::play(
-        root,
-        metadata,
-        events,
-        time,
-        against,
-        script::Board::default(),
-    )?;
+    let time = Duration::from_millis(12_500);
+    let report = script::host(root, metadata, SCRIPT, time, script::Board::default())?;
     print!("{}", report.table());
     let boot = report.first()?;
     let timing = run::timing();

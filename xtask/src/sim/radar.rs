@@ -11,11 +11,10 @@ use anyhow::{Context, Result, anyhow, bail};
 use idle_head_core::seed::BoardId;
 use idle_head_core::servo::ServoRate;
 
-use super::image::SERVOS;
-use super::node::{Chunk, Config, FlashTiming, PinScript};
+use super::node::{Chunk, Config, FlashTiming};
 use super::pulses::angle;
 use super::run::{self, Boot, Report};
-use super::script::{self, Against, Board, EARLY, line};
+use super::script::{self, Board, line};
 use super::{WALL, dmx, planted, stages::shipped_image, stream};
 use crate::bench::tracking::{self, Walk};
 use crate::log::field;
@@ -70,16 +69,9 @@ fn yaw(boot: &Boot) -> Vec<f64> {
 pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
     let mut problems = Vec::new();
     // The walk.
-    let events = script::parse(&tracking::walk_script())?;
     let time = Duration::from_micros(tracking::WALK_RUN_US);
-    let report = script::play(
-        root,
-        metadata,
-        events,
-        (time, WALL),
-        Against::Host,
-        Board::default(),
-    )?;
+    let walk = tracking::walk_script();
+    let report = script::host(root, metadata, &walk, time, Board::default())?;
     println!("{}", report.verdict());
     problems.extend(report.problems.iter().map(|p| format!("walk: {p}")));
     let boot = report.first()?;
@@ -92,15 +84,16 @@ pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
         walk.rms / 1000.0,
         walk.largest / 1000.0
     );
-    if walk.rms.is_nan() || walk.rms > 5000.0 {
-        problems.push(format!(
-            "walk: RMS error {:.2}°, not within 5°",
-            walk.rms / 1000.0
-        ));
+    let rms = walk.rms / 1000.0;
+    if rms.is_nan() || rms > 5.0 {
+        problems.push(format!("walk: RMS error {rms:.2}°, not within 5°"));
     }
-    if !boot.says("track: turned to yaw") {
-        problems.push("walk: the frame task never logged `track: turned to yaw`".to_owned());
-    }
+    let turned = boot.says("track: turned to yaw");
+    problem_if!(
+        problems,
+        !turned,
+        "walk: the frame task never logged `track: turned to yaw`"
+    );
     // Two boards.
     let mut yaws = Vec::new();
     for uid in BOARDS {
@@ -113,46 +106,37 @@ pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
         .filter(|&k| (yaws[0][k] - yaws[1][k]).abs() > 30.0)
         .count();
     println!("two boards: yaw differs by more than a count in {differ} of {n} frames");
-    if differ < n / 2 {
-        problems.push(format!(
-            "two boards: the yaw differs in only {differ} of {n} frames"
-        ));
-    }
+    let few = differ < n / 2;
+    problem_if!(
+        problems,
+        few,
+        "two boards: the yaw differs in only {differ} of {n} frames"
+    );
     project::verdict(&problems)
 }
 
 /// One board of flash unique id `uid`: its run, checked against the host
 /// trace of its seeds, and `seed`'s reply; the problems and its yaw.
 fn board(root: &Path, metadata: &Metadata, uid: u64) -> Result<(Vec<String>, Vec<f64>)> {
-    let events = script::parse("3 seed\n")?;
     let board = Board {
         uid: Some(uid),
         ..Board::default()
     };
-    let time = Duration::from_secs(4);
-    let report = script::play(root, metadata, events, (time, WALL), Against::Host, board)?;
+    let report = script::host(root, metadata, "3 seed\n", Duration::from_secs(4), board)?;
     let boot = report.first()?;
     let seed = BoardId(uid).seed().context("an id that is no id")?;
-    let mut problems: Vec<String> = report
-        .problems
-        .iter()
-        .map(|p| format!("board {uid:016x}: {p}"))
-        .collect();
-    let replies = boot.uart_replies();
-    let want = format!("ok seed=board:{seed}");
-    println!(
-        "board {uid:016x}: {}, `seed` answers `{}`",
-        report.verdict(),
-        replies.join(" | ")
-    );
+    let mut problems = report.problems.clone();
+    let (replies, want) = (boot.uart_replies(), format!("ok seed=board:{seed}"));
+    let (verdict, answers) = (report.verdict(), replies.join(" | "));
+    println!("board {uid:016x}: {verdict}, `seed` answers `{answers}`");
     if replies != [want.clone()] {
-        problems.push(format!(
-            "board {uid:016x}: `seed` answered {replies:?}, not `{want}`"
-        ));
+        problems.push(format!("`seed` answered {replies:?}, not `{want}`"));
     }
     if !boot.says(&format!("board id {uid:016x}: seed board:{seed}")) {
-        problems.push(format!("board {uid:016x}: the boot did not log its id"));
+        problems.push("the boot did not log its id".to_owned());
     }
+    let problems = problems.iter().map(|p| format!("board {uid:016x}: {p}"));
+    let problems = problems.collect();
     Ok((problems, yaw(boot)))
 }
 
@@ -205,12 +189,7 @@ fn with_radar(
 ) -> Result<Report> {
     let radar = line(&script::parse(script)?, ServoRate::DEFAULT, end);
     let on = Chunk::new(b"radar on\r\n".to_vec(), Duration::from_millis(100));
-    let pins = PinScript {
-        anchor_slice: SERVOS[0].2,
-        early: EARLY,
-        lines: [vec![on], lines].concat(),
-        ..PinScript::default()
-    };
+    let pins = script::pin_script([vec![on], lines].concat());
     run::run_with(root, elf, query + Duration::from_secs(1), WALL, |config| {
         config.script = Some(pins);
         config.radar = radar;

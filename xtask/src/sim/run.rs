@@ -17,6 +17,9 @@ use super::{
 };
 use crate::log::{Defmt, LogLine};
 
+/// Wall-time limit of one emulator run.
+pub const WALL: Duration = Duration::from_secs(120);
+
 /// No log byte or pin edge for this long: a stuck run (50 frames).
 pub const SILENCE: Duration = Duration::from_secs(1);
 

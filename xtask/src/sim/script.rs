@@ -96,28 +96,18 @@ pub fn play(
     }
     // (Lines keep their order: a pin line before 0.1 s stays first.)
     events.sort_by_key(|e| e.at_us);
-    let mut script = PinScript {
-        anchor_slice: SERVOS[0].2,
-        early: EARLY,
-        ..PinScript::default()
-    };
+    let mut script = pin_script(Vec::new());
     for event in &events {
         let at = Duration::from_micros(event.at_us);
+        // A line goes in before the frame that takes it in the host trace.
+        let frame = Duration::from_micros(event.at_us.next_multiple_of(period));
         match event.kind {
-            Kind::Pin { input, high } => script.pins.push(PinLevel {
-                at,
-                pin: input,
-                high,
-            }),
+            Kind::Pin { input: pin, high } => script.pins.push(PinLevel { at, pin, high }),
             Kind::Act(_) | Kind::Console => {
-                // In before the frame that takes it in the host trace.
-                let frame = Duration::from_micros(event.at_us.next_multiple_of(period));
-                script
-                    .lines
-                    .push(Chunk::new(format!("{}\r\n", event.text), frame));
+                let line = format!("{}\r\n", event.text);
+                script.lines.push(Chunk::new(line, frame));
             }
-            // The radar's frames, below.
-            Kind::Radar(_) => {}
+            Kind::Radar(_) => {} // see `line`
         }
     }
     let radar = line(&events, rate, time);
@@ -125,13 +115,9 @@ pub fn play(
         rate,
         ..Settings::DEFAULT
     };
-    let planted = (rate != ServoRate::DEFAULT)
-        .then(|| {
-            planted::fill(&PICO.elf(metadata), |len| {
-                planted::settings_sectors(&settings, len)
-            })
-        })
-        .transpose()?;
+    let sectors = |len| planted::settings_sectors(&settings, len);
+    let planted = (rate != ServoRate::DEFAULT).then(|| planted::fill(&PICO.elf(metadata), sectors));
+    let planted = planted.transpose()?;
     // The boot before the first frame: well under a tenth of a second.
     let boot = Duration::from_millis(100);
     let mut report = run::run_with(root, &PICO.elf(metadata), time + boot, wall, |config| {
@@ -164,6 +150,31 @@ pub fn play(
     };
     run::check_at(&mut report, &expected, rate);
     Ok(report)
+}
+
+/// Boot 0's script: `lines` on UART0, each [`EARLY`], times from the first
+/// frame.
+pub fn pin_script(lines: Vec<Chunk>) -> PinScript {
+    let (anchor_slice, early) = (SERVOS[0].2, EARLY);
+    PinScript {
+        anchor_slice,
+        early,
+        lines,
+        ..PinScript::default()
+    }
+}
+
+/// The script `text` played on `board` for `time` (see [`play`]), checked
+/// against the host trace.
+pub fn host(
+    root: &Path,
+    metadata: &Metadata,
+    text: &str,
+    time: Duration,
+    board: Board,
+) -> Result<Report> {
+    let time = (time, run::WALL);
+    play(root, metadata, parse(text)?, time, Against::Host, board)
 }
 
 /// Whether a console line sets the servo rate (`servo rate <hz>`).

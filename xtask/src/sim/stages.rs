@@ -17,7 +17,7 @@ use super::{
     image::{PicoImage, SERVOS, VECTOR_TABLE},
     node,
     run::{self, Report},
-    script::{self, Against},
+    script,
 };
 use crate::{
     elf,
@@ -39,8 +39,7 @@ pub const FAILURES_STAGE: &str =
 
 /// Frames the pulse check must cover: a whole loop (1500) and then some.
 const MIN_FRAMES: usize = 1600;
-/// Wall-time limit of one emulator run.
-pub const WALL: Duration = Duration::from_secs(120);
+pub use super::run::WALL;
 /// As in `crates/firmware/src/hooks.rs`: the drill's frames in each boot,
 /// the watchdog timeout.
 const DRILL_FRAMES: usize = 150;
@@ -62,13 +61,11 @@ const RATE_SCRIPT: &str = "\
 /// [`RATE_STAGE`]: [`RATE_SCRIPT`] for 7 s into the image booted on 333 Hz
 /// settings, every pulse against the host trace at 333 Hz.
 pub fn test_rate(root: &Path, metadata: &Metadata) -> Result<()> {
-    let events = script::parse(RATE_SCRIPT)?;
-    let time = (Duration::from_secs(7), WALL);
     let board = script::Board {
         rate: ServoRate::MAX,
         uid: None,
     };
-    let report = script::play(root, metadata, events, time, Against::Host, board)?;
+    let report = script::host(root, metadata, RATE_SCRIPT, Duration::from_secs(7), board)?;
     print!("{}", report.table());
     let frames = report.boots.first().map_or(0, |boot| boot.servos[0].frames);
     let few = format!("{frames} frames checked, not the 2,300 of 7 s at 333 Hz");
