@@ -5,11 +5,11 @@
 use std::{
     io::{BufRead, BufReader, Write},
     path::Path,
-    process::{Child, ChildStdout, Command, Stdio},
+    process::{Child, ChildStdout, Stdio},
     time::Duration,
 };
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use super::{event::Event, image, node, store::WORST};
 
@@ -34,15 +34,8 @@ pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
 /// Starts `elf` live: stdin takes bytes for the USB serial port
 /// ([`send`]), stdout has the events ([`events`]).
 pub fn start(root: &Path, elf: &Path) -> Result<Child> {
-    Command::new("node")
-        .arg("harness.mjs")
-        .arg(config(root, elf)?.to_string())
-        .current_dir(node::folder(root))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .context("could not start `node` (is Node.js installed?)")
+    let config = config(root, elf)?.to_string();
+    node::harness(root, &config, Stdio::piped(), Stdio::inherit())
 }
 
 /// Sends `bytes` to the head's USB serial port: one line of hex digits.

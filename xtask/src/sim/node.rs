@@ -4,7 +4,7 @@
 use std::{
     io::{BufRead, BufReader, Read},
     path::{Path, PathBuf},
-    process::{Command, Stdio},
+    process::{Child, Command, Stdio},
     time::Duration,
 };
 
@@ -271,15 +271,12 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     let file = std::env::temp_dir().join(format!("idle-head-sim-{}-{n}.json", std::process::id()));
     std::fs::write(&file, config.json().to_string())
         .with_context(|| format!("writing {}", file.display()))?;
-    let child = Command::new("node")
-        .arg("harness.mjs")
-        .arg(format!("@{}", file.display()))
-        .current_dir(folder(root))
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .context("could not start `node` (is Node.js installed?)");
+    let child = harness(
+        root,
+        &format!("@{}", file.display()),
+        Stdio::null(),
+        Stdio::piped(),
+    );
     // Read to the end (past a bad line too: node never waits on a full
     // pipe); the first bad line is the error.
     let events = |stdout| -> Result<Vec<Event>> {
@@ -310,4 +307,16 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
         );
     }
     Ok(events)
+}
+
+/// Starts the harness with `arg` (its configuration, or `@` and a file of
+/// it); stdout piped.
+pub fn harness(root: &Path, arg: &str, stdin: Stdio, stderr: Stdio) -> Result<Child> {
+    let mut node = Command::new("node");
+    node.args(["harness.mjs", arg]).current_dir(folder(root));
+    node.stdin(stdin)
+        .stdout(Stdio::piped())
+        .stderr(stderr)
+        .spawn()
+        .context("could not start `node` (is Node.js installed?)")
 }

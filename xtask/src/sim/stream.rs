@@ -101,9 +101,9 @@ fn replies(
     Ok((replies, problems))
 }
 
-/// Loop sets generated in the first boot.
-fn sets(report: &Report) -> usize {
-    let log = report.boots.iter().take(1).flat_map(|b| &b.log);
+/// Loop sets generated in `boot`.
+fn sets(boot: &Boot) -> usize {
+    let log = boot.log.iter();
     log.filter(|(_, line)| line.message.starts_with("loop set "))
         .count()
 }
@@ -146,7 +146,7 @@ pub fn test_stream(
         "{port} stream: {count} lines, one every {} ms; {} replies; {} loop sets generated meanwhile",
         EVERY.as_millis(),
         replies.len(),
-        sets(&report)
+        sets(report.first()?)
     );
     report.conclude(problems)
 }
@@ -258,9 +258,7 @@ pub(super) fn check_dmx(boot: &Boot, reply: &str, changes: usize) -> (String, Ve
     if let Some(first) = late.first() {
         problems.push(format!("{} frames late: `{first}`", late.len()));
     }
-    let sets = (boot.log.iter())
-        .filter(|(_, line)| line.message.starts_with("loop set "))
-        .count();
+    let sets = sets(boot);
     let summary = format!(
         "DMX: {sent} frames of 512 slots sent by the last change, {good} counted good; {sets} loop \
          sets generated meanwhile; `{reply}`\n"
