@@ -231,7 +231,9 @@ impl Config {
 
 /// `bytes` as lower-case hex digits, as the harness reads them.
 pub fn hex_string(bytes: &[u8]) -> String {
-    bytes.iter().map(|byte| format!("{byte:02x}")).collect()
+    bytes
+        .iter()
+        .fold(String::new(), |hex, byte| hex + &format!("{byte:02x}"))
 }
 
 pub fn nanos(duration: Duration) -> u64 {

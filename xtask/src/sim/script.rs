@@ -155,12 +155,12 @@ pub fn play(
 /// Boot 0's script: `lines` on UART0, each [`EARLY`], times from the first
 /// frame.
 pub fn pin_script(lines: Vec<Chunk>) -> PinScript {
-    let (anchor_slice, early) = (SERVOS[0].2, EARLY);
+    let (anchor_slice, pins, early) = (SERVOS[0].2, Vec::new(), EARLY);
     PinScript {
         anchor_slice,
-        early,
+        pins,
         lines,
-        ..PinScript::default()
+        early,
     }
 }
 
