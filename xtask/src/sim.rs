@@ -53,8 +53,7 @@ pub use stream::{
 
 use crate::project::{self, Metadata, PICO};
 
-/// Plays `events` into the shipped image (built) for `time` from its first
-/// frame; every pulse checked against what the firmware wrote.
+/// Plays `events` into the shipped image, checked against what it wrote.
 pub fn play_script(
     root: &Path,
     metadata: &Metadata,

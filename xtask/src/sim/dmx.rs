@@ -32,8 +32,7 @@ pub struct Change {
     pub stop: bool,
 }
 
-/// Parses a DMX script (see the [module docs](self)); errors name the
-/// line.
+/// Parses a DMX script (see the [module docs](self)).
 pub fn parse(text: &str) -> Result<Vec<Change>> {
     let mut changes = Vec::new();
     for (n, line) in text.lines().enumerate() {

@@ -96,8 +96,7 @@ pub struct Unmodelled {
     pub count: u64,
 }
 
-/// How the harness ended: why, when, after how many instructions and how
-/// much wall time, and its error if it failed.
+/// How the harness ended.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct End {

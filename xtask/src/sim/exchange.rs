@@ -43,8 +43,7 @@ const SCRIPT: &[&[u8]] = &[
     b"seed 4294967296\n",
 ];
 
-/// The exchange on the harness's lines: the script's lines on UART0 from
-/// [`START`], [`LINE_GAP`] apart, and all of it over USB at [`USB_START`].
+/// The script on UART0 from [`START`], and over USB at [`USB_START`].
 pub fn configure(config: &mut Config) {
     let lines = script_lines();
     config.uart = (0_u32..)
@@ -115,8 +114,7 @@ fn script_lines() -> Vec<Vec<u8>> {
     lines
 }
 
-/// The replies the firmware must send for `script`, one per line: first
-/// on the UART, then on the USB port, with one service as on the board.
+/// The replies to `script` on the UART, then USB, from one service.
 fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
     let queue: &'static CommandQueue = Box::leak(Box::new(CommandQueue::new()));
     let link: &'static ConsoleLink = Box::leak(Box::new(ConsoleLink::new()));
@@ -188,8 +186,7 @@ fn mask(reply: &[u8]) -> Vec<u8> {
     out
 }
 
-/// What a port sent against `want` (from [`expected`]); the transcript
-/// and the problems found.
+/// What a port `sent` against `want`: the transcript and problems.
 fn compare(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>) {
     let got: Vec<Vec<u8>> = sent
         .split_inclusive(|&b| b == b'\n')

@@ -13,8 +13,7 @@ use crate::{board::Board, elf::XIP, uf2};
 /// Where boot2 leaves the vector table: right behind its own 256 bytes.
 pub const VECTOR_TABLE: u64 = XIP.start + 0x100;
 
-/// The servos as wired on the Pico (`crates/rp/src/pico.rs`): name, GPIO,
-/// PWM slice (channel A).
+/// The servos on the Pico (`crates/rp/src/pico.rs`): name, GPIO, slice.
 pub const SERVOS: [(&str, u8, u8); 3] = [("pitch", 16, 0), ("roll", 18, 1), ("yaw", 20, 2)];
 
 /// The trigger inputs' GPIOs, as wired on the Pico: GP2 to GP5.

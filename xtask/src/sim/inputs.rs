@@ -27,8 +27,7 @@ pub const SCRIPT: &str = "\
 7 pin 2 high
 ";
 
-/// `cargo xtask test`'s stage: plays [`SCRIPT`] for 12.5 s (the glance, from
-/// about 8.1 s, held and back) and checks it.
+/// The stage: [`SCRIPT`] for 12.5 s (the glance from 8.1 s, and back).
 #[allow(clippy::too_many_lines)] // the four checks of the module docs, in order
 pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     let time = Duration::from_millis(12_500);

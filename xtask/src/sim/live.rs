@@ -44,8 +44,7 @@ pub fn send(stdin: &mut impl Write, bytes: &[u8]) -> std::io::Result<()> {
     stdin.flush()
 }
 
-/// Hands each run of bytes the head sends on its USB serial port to
-/// `each` until the harness ends; returns why it ended.
+/// Hands the head's USB bytes to `each` until the end; why it ended.
 pub fn events(stdout: ChildStdout, mut each: impl FnMut(Vec<u8>)) -> String {
     let mut why = "the emulator stopped".to_owned();
     for line in BufReader::new(stdout).lines().map_while(Result::ok) {

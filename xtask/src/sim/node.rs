@@ -1,5 +1,4 @@
-//! Node, the emulator package and one run of `sim/harness.mjs`, whose
-//! configuration ([`Config`]) is the JSON its header describes.
+//! Node, the emulator package and a run of `sim/harness.mjs` ([`Config`]).
 
 use std::{
     io::{BufRead, BufReader, Read},
@@ -311,8 +310,7 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     Ok(events)
 }
 
-/// Starts the harness with `arg` (its configuration, or `@` and a file of
-/// it); stdout piped.
+/// Starts the harness on `arg` (its config, or `@file`), stdout piped.
 pub fn harness(root: &Path, arg: &str, stdin: Stdio, stderr: Stdio) -> Result<Child> {
     let mut node = Command::new("node");
     node.args(["harness.mjs", arg]).current_dir(folder(root));

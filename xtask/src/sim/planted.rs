@@ -21,8 +21,7 @@ const SECTOR: usize = 4096;
 /// The version 1 fixture, in the repository at this path.
 pub const VERSION_1_SECTORS: &str = "host-tests/fixtures/settings-v1-sectors.bin";
 
-/// The settings sectors of the version 1 fixture (`len` bytes, the Pico's
-/// settings region).
+/// The version 1 fixture's sectors (`len` bytes).
 pub fn version_1_sectors(root: &Path, len: usize) -> Result<Vec<u8>> {
     let path = root.join(VERSION_1_SECTORS);
     let bytes = std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;
@@ -43,8 +42,7 @@ pub fn store_of_version<const V: u16>(payload: &[u8], len: usize) -> Result<Vec<
     plant::<_, 256>(&record, len).with_context(|| format!("planting a version {V} record"))
 }
 
-/// `len` bytes of settings sectors holding `settings`, as a `save` leaves
-/// them (a board boots on them: at their servo rate, say).
+/// `len` bytes of settings sectors holding `settings`, as `save` leaves them.
 pub fn settings_sectors(settings: &Settings, len: usize) -> Result<Vec<u8>> {
     plant::<_, SETTINGS_BUFFER>(settings, len).context("planting the settings")
 }

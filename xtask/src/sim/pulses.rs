@@ -6,8 +6,7 @@
 
 use idle_head_core::driver::DriverConfig;
 
-/// The angle, m°, of a pulse of `width` ns on `axis`' servo (built-in
-/// calibration).
+/// The angle, m°, of a pulse of `width` ns on `axis`' servo.
 pub fn angle(axis: usize, width: f64) -> f64 {
     let servo = DriverConfig::DEFAULT.servos[axis];
     let neutral = f64::from(servo.neutral.0) * 1e3;

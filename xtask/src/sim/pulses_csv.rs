@@ -9,8 +9,7 @@ use anyhow::Result;
 
 use super::pulses::{self, Timing, Train};
 
-/// Writes the pulses on `trains`' pins (`[pitch, roll, yaw]`) to `path`;
-/// the rows written.
+/// Writes `trains`' pulses to `path`; the rows written.
 pub fn write(path: &Path, trains: &[Train; 3], timing: &Timing) -> Result<usize> {
     let text = rows(trains, timing);
     crate::project::write(path, &text)?;

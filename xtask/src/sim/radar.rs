@@ -197,8 +197,7 @@ fn with_radar(
     })
 }
 
-/// The problem, if the radar's `reply` did not count every frame `boot`
-/// sent, or counted one bad.
+/// The problem if `reply` missed a frame `boot` sent, or counted one bad.
 fn counted(boot: &Boot, reply: &str) -> Option<String> {
     let counter = |name| field(reply, name).and_then(|v| v.parse::<u64>().ok());
     (counter("frames") != Some(boot.radar_frames) || counter("bad") != Some(0))
@@ -272,9 +271,8 @@ mod tests {
 
     #[test]
     fn a_radar_file_holds_radar_lines_only() {
-        let dir = std::env::temp_dir().join(format!("radar-lines-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let (good, bad) = (dir.join("good.txt"), dir.join("bad.txt"));
+        let dir = tempfile::tempdir().unwrap();
+        let (good, bad) = (dir.path().join("good.txt"), dir.path().join("bad.txt"));
         std::fs::write(&good, "1 radar 0,1500\n2 radar none\n").unwrap();
         std::fs::write(&bad, "1 radar 0,1500\n2 nod\n").unwrap();
         let events = read(&good).unwrap();
@@ -285,6 +283,5 @@ mod tests {
             error.contains("line 2: `nod` is not a radar line"),
             "{error}"
         );
-        let _ = std::fs::remove_dir_all(dir);
     }
 }

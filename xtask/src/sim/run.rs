@@ -139,8 +139,7 @@ pub fn run_with(
     Ok(report)
 }
 
-/// Sorts the events into boots, each log decoded; a boot's peak stack is
-/// how far below `stack_top` it wrote.
+/// Sorts the events into boots, each log decoded, each peak stack found.
 pub fn sort(events: &[Event], defmt: &Defmt, stack_top: u64) -> Result<Report> {
     let mut report = Report::default();
     let mut decoder = None;
@@ -276,8 +275,7 @@ pub fn check_at(report: &mut Report, expected: &[[u16; 3]], rate: ServoRate) {
     }
 }
 
-/// The Pico's slice clock at `rate` (`idle_head_core::pwm_clock` checks
-/// that every rate has one).
+/// The Pico's slice clock at `rate` (`pwm_clock` checks every rate's).
 fn clock(rate: ServoRate) -> SliceClock {
     let none = SliceClock {
         divider_16ths: 0,

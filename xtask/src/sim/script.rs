@@ -152,8 +152,7 @@ pub fn play(
     Ok(report)
 }
 
-/// Boot 0's script: `lines` on UART0, each [`EARLY`], times from the first
-/// frame.
+/// Boot 0's script: `lines` on UART0, [`EARLY`], from the first frame.
 pub fn pin_script(lines: Vec<Chunk>) -> PinScript {
     let (anchor_slice, pins, early) = (SERVOS[0].2, Vec::new(), EARLY);
     PinScript {
@@ -164,8 +163,7 @@ pub fn pin_script(lines: Vec<Chunk>) -> PinScript {
     }
 }
 
-/// The script `text` played on `board` for `time` (see [`play`]), checked
-/// against the host trace.
+/// Plays `text` on `board` for `time`, checked against its host trace.
 pub fn host(
     root: &Path,
     metadata: &Metadata,
@@ -186,8 +184,7 @@ fn changes_rate(line: &str) -> bool {
     matches!(words.as_slice(), [servo, rate, _, ..] if servo == "servo" && rate == "rate")
 }
 
-/// The duties boot 0 wrote, frame by frame from frame 0 (its compare
-/// writes from the one its slice was enabled with on).
+/// The duties boot 0 wrote, from frame 0 (the write before the enable).
 fn written(report: &Report) -> Vec<[u16; 3]> {
     let Some(boot) = report.boots.first() else {
         return Vec::new();
@@ -206,8 +203,7 @@ fn written(report: &Report) -> Vec<[u16; 3]> {
     (0..n).map(duty).collect()
 }
 
-/// `cargo xtask sim --script FILE [--rate HZ] [--pulses CSV]` (and
-/// `--radar FILE`: its `events`).
+/// `cargo xtask sim --script FILE` or `--radar FILE`: its `events`.
 pub fn command(
     root: &Path,
     metadata: &Metadata,

@@ -77,8 +77,7 @@ pub fn command(root: &Path, metadata: &Metadata, args: &super::Args) -> Result<b
     Ok(report.problems.is_empty())
 }
 
-/// Per servo: pulses, shortest and longest, as measured; with `csv`, the
-/// CSV of them.
+/// Per servo: pulses, shortest, longest; with `csv`, their CSV.
 fn print_pulses(boot: &Boot, csv: Option<&Path>) -> Result<()> {
     println!("\nservo   pulses   min µs   max µs");
     for ((name, ..), train) in SERVOS.iter().zip(&boot.trains) {
@@ -102,8 +101,7 @@ pub fn test_show(root: &Path, metadata: &Metadata) -> Result<()> {
     show(root, metadata, None)
 }
 
-/// `cargo xtask sim --show [--pulses FILE.csv]`: the stage, its pulses
-/// written to `pulses` too.
+/// `cargo xtask sim --show [--pulses FILE.csv]`: the stage.
 pub fn show(root: &Path, metadata: &Metadata, pulses: Option<&Path>) -> Result<()> {
     let changes = dmx::parse(SCRIPT)?;
     let elf = stages::shipped_image(root, metadata)?;

@@ -215,8 +215,7 @@ pub fn test_console(
     report.conclude(console_ram(&elf, &report)?)
 }
 
-/// Prints the image's RAM in `report`'s run (static plus peak stack); the
-/// problem if over budget or the peak was not measured.
+/// Prints the image's RAM (static plus peak stack); a problem if over.
 pub fn console_ram(elf: &Path, report: &Report) -> Result<Option<String>> {
     let static_ram = elf::Image::read(elf)?.static_ram();
     let Some(stack) = report.peak_stack() else {
@@ -231,8 +230,7 @@ pub fn console_ram(elf: &Path, report: &Report) -> Result<Option<String>> {
     Ok((ram > budget).then(|| format!("Pico image RAM {sum} is over the {budget} B budget")))
 }
 
-/// A hung image, an image that sleeps for ever, a run out of wall time and
-/// files that are not Pico images: each ends with its own clear message.
+/// A hung, a sleeping, a slow image and non-images: each fails clearly.
 pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
     node::ensure(root)?;
     let dir = metadata.target_dir.join("sim-failures");

@@ -121,8 +121,7 @@ pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
     project::verdict(&problems)
 }
 
-/// The checks of the module docs, for a start whose first boot logs
-/// `logged` and runs on `neutral`: a transcript and the problems found.
+/// The module docs' checks for a start: a transcript and the problems.
 fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String, Vec<String>) {
     let (mut text, mut problems) = (String::new(), Vec::new());
     let [first, second] = report.boots.as_slice() else {

@@ -28,8 +28,7 @@ pub const FLOOD_STAGE: &str = "Pico image in the RP2040 emulator: a UART flood w
 pub const NOISE_STAGE: &str = "Pico image in the RP2040 emulator: a byte with a framing \
      error on UART0: its line answered `err line bytes lost`, the next one `ok`";
 
-/// When the stream starts (the fade-in is over), the time between lines,
-/// how long it lasts.
+/// The stream's start (after the fade-in), line spacing and length.
 const START: Duration = Duration::from_secs(3);
 const EVERY: Duration = Duration::from_millis(2);
 pub const LENGTH: Duration = Duration::from_secs(600);
