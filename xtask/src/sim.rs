@@ -152,7 +152,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE", group = "run")]
     pub script: Option<PathBuf>,
     /// Play radar lines (`<s> radar <x_mm>,<y_mm> ...` or `<s> radar none`)
-    /// into GP13 as an HLK-LD2450, checked as `--script`.
+    /// into GP13 as an HLK-LD2450, `radar on` sent first; checked as `--script`.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood", "script", "dmx", "show"])]
     pub radar: Option<PathBuf>,
     /// With `--script`: the servos' rate, Hz (50 to 333), planted in the
