@@ -1,7 +1,15 @@
-//! `cargo xtask sim`: the Pico image, as `cargo run --release` flashes it,
-//! in the RP2040 emulator rp2040js (Node.js, `sim/harness.mjs`, which
-//! reports raw facts as JSON lines). This module decodes the log, rebuilds
-//! the pulse trains and checks them against the host's duties.
+//! `cargo xtask sim`: the shipped Pico image in the RP2040 emulator
+//! rp2040js (`sim/harness.mjs` reports raw facts as JSON lines); here the
+//! log is decoded and the pulses checked against the host's duties.
+
+/// Pushes `format!(...)` onto `problems` if `cond` holds.
+macro_rules! problem_if {
+    ($problems:expr, $cond:expr, $($format:tt)+) => {
+        if $cond {
+            $problems.push(format!($($format)+));
+        }
+    };
+}
 
 mod dmx;
 mod event;
@@ -25,7 +33,8 @@ mod unmodelled;
 
 use std::{fmt::Write as _, path::Path, path::PathBuf, time::Duration};
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
+use idle_head_core::servo::ServoRate;
 
 pub use inputs::{INPUTS_STAGE, test_inputs};
 pub use node::{BYTE_TIME, Chunk, UartScript, folder as node_folder};
@@ -44,9 +53,7 @@ pub use stream::{
 
 use crate::project::{self, Metadata, PICO};
 
-/// Plays a script's `events` into the shipped image (built) for `time` from
-/// its first frame; every pulse checked against what the firmware wrote:
-/// on time, its own frame's, within the servos' limits (see `script.rs`).
+/// Plays `events` into the shipped image, checked against what it wrote.
 pub fn play_script(
     root: &Path,
     metadata: &Metadata,
@@ -54,15 +61,8 @@ pub fn play_script(
     time: Duration,
     wall: Duration,
 ) -> Result<Report> {
-    let against = script::Against::Written;
-    script::play(
-        root,
-        metadata,
-        events,
-        (time, wall),
-        against,
-        script::Board::default(),
-    )
+    let (against, board) = (script::Against::Written, script::Board::default());
+    script::play(root, metadata, events, (time, wall), against, board)
 }
 pub use radar::{RADAR_DMX_STAGE, RADAR_STAGE, test_radar, test_radar_dmx};
 
@@ -72,7 +72,7 @@ pub fn dmx_line(script: &str) -> Result<serde_json::Value> {
 }
 
 /// One PWM count of the servo slices at `rate`, ns.
-pub fn count_ns_at(rate: idle_head_core::servo::ServoRate) -> f64 {
+pub fn count_ns_at(rate: ServoRate) -> f64 {
     run::timing_at(rate).count_ns
 }
 
@@ -81,9 +81,7 @@ pub fn frame_ns() -> f64 {
     run::timing().frame_ns
 }
 
-/// Builds the shipped Pico image and runs it for `time` (at most `wall`),
-/// the harness configured by `setup`; the run sorted into boots, its
-/// pulses not checked against the host.
+/// Builds the shipped Pico image and runs it (see [`run::run_with`]).
 pub fn run_shipped(
     root: &Path,
     metadata: &Metadata,
@@ -95,98 +93,81 @@ pub fn run_shipped(
     run::run_with(root, &PICO.elf(metadata), time, wall, setup)
 }
 
-/// Options of `cargo xtask sim`: a plain run, or one of the runs the group
-/// `run` lets through (clap refuses two).
+/// Options of `cargo xtask sim`: a plain run or one of group `run`.
 #[allow(clippy::struct_excessive_bools)]
 #[derive(Debug, Clone, clap::Args)]
 #[command(group(clap::ArgGroup::new("run").multiple(false)))]
 pub struct Args {
-    /// Virtual time to run, in seconds (default: 32.5, a 30 s loop, the
-    /// 2 s fade-in and half a second of boot; with `--console`, 6).
+    /// Virtual time to run, in seconds (default 32.5: a loop, the fade-in
+    /// and the boot; with `--console`, 6).
     #[arg(long = "seconds", value_name = "S", value_parser = |s: &str| seconds(s, 3600.0))]
     pub virtual_time: Option<Duration>,
     /// Wall-time limit in seconds.
     #[arg(long, value_name = "S", default_value = "120", value_parser = |s: &str| seconds(s, 86_400.0))]
     pub timeout: Duration,
-    /// The watchdog drill instead: build the test image (`--features
-    /// watchdog-drill`, in target/watchdog-drill), whose frames stop after
-    /// 3 s, and check that the watchdog resets it and the next boot starts
-    /// softly again.
+    /// The watchdog drill instead: the test image's frames stop after 3 s;
+    /// the watchdog must reset it and the next boot start softly.
     #[arg(long, group = "run")]
     pub drill: bool,
-    /// The trigger inputs' check instead: a presence script (a sensor on
-    /// GP2, a rest after 2 s with relax on, someone at 7 s); the rest, the
-    /// pulses stopping, the soft wake and the glance checked from the
-    /// pulses, every pulse against the host trace.
+    /// The trigger inputs' check instead: a presence sensor on GP2 rests,
+    /// relaxes, wakes softly and glances; every pulse the host trace's.
     #[arg(long, group = "run")]
     pub inputs: bool,
-    /// The console instead: a scripted exchange over UART0 and then over
-    /// USB CDC-ACM, every reply checked, and the image's RAM with the peak
-    /// stack of that run against the budget.
+    /// The console instead: a scripted exchange over UART0, then USB, every
+    /// reply checked; the image's RAM with the run's peak stack in budget.
     #[arg(long, group = "run")]
     pub console: bool,
-    /// The settings store instead: from three starts of the settings
-    /// sectors, `save` over UART0 with the flash's worst-case erase times,
-    /// a power cycle, and the next boot on the saved settings.
+    /// The settings store instead: `save` with worst-case erase times, a
+    /// power cycle, the next boot on the saved settings.
     #[arg(long, group = "run")]
     pub store: bool,
-    /// Line noise on UART0 instead: a byte received with a framing error;
-    /// its line must be answered `err line bytes lost …`, the next one `ok`.
+    /// Line noise on UART0 instead: a line with a framing error must be
+    /// answered `err line bytes lost …`, the next one `ok`.
     #[arg(long, group = "run")]
     pub noise: bool,
-    /// A UART flood instead: 200 `status` lines back to back at 115200
-    /// baud, more than the replies keep up with, then one more line: every
-    /// line answered once, in order, none lost.
+    /// A UART flood instead: 200 `status` lines back to back, faster than
+    /// the replies: every line answered once, in order.
     #[arg(long, group = "run")]
     pub flood: bool,
-    /// A stream instead: a line every 2 ms on UART0 (`uart`) or the USB
-    /// serial port (`usb`) for `--seconds` (default 600), every line
-    /// answered once, in order, none lost, no frame late.
+    /// A stream instead: a line every 2 ms on UART0 or USB for `--seconds`
+    /// (default 600): every line answered once, in order, no frame late.
     #[arg(long, value_name = "PORT", value_parser = ["uart", "usb"], group = "run")]
     pub stream: Option<String>,
     /// List every access to a register the emulator does not model, also
-    /// the known gaps that do not matter (summed up in one line without).
+    /// the known harmless ones (one line without).
     #[arg(long, short)]
     pub verbose: bool,
-    /// The show control run instead (the stage of `cargo xtask test`): DMX
-    /// frames into GP9 and a Bottango session over USB, each checked from
-    /// the pulses on the servo pins.
+    /// The show control stage instead: DMX into GP9 and a Bottango session
+    /// over USB, checked from the pulses.
     #[arg(long, group = "run")]
     pub show: bool,
-    /// Play DMX512 into GP9 (UART1 RX): FILE has lines `<s> <slot>=<value>
-    /// …` (slots relative to the head's address, 1-based; values hold until
-    /// changed) and `<s> dmx stop`; frames at about 44 Hz with proper
-    /// breaks. Runs until 3 s after the last line unless `--seconds`.
+    /// Play DMX512 into GP9: lines `<s> <slot>=<value> …` (slots from the
+    /// head's address, 1-based) and `<s> dmx stop`; runs to 3 s after the
+    /// last line unless `--seconds`.
     #[arg(long, value_name = "FILE", group = "run")]
     pub dmx: Option<PathBuf>,
-    /// Play a trace script into the shipped image instead (`cargo xtask
-    /// trace --script`'s: pin lines drive GP2 to GP5, console lines go to
-    /// UART0, times from the first frame) and check every pulse against the
-    /// host trace of it. Without `--seconds`, to 5 s after its last line.
+    /// Play a trace script (`cargo xtask trace --script`'s) into the image
+    /// and check every pulse against its host trace. Without `--seconds`,
+    /// to 5 s after its last line.
     #[arg(long, value_name = "FILE", group = "run")]
     pub script: Option<PathBuf>,
-    /// Play a file of radar lines (`<s> radar <x_mm>,<y_mm> ...`, up to
-    /// three people, or `<s> radar none`) into GP13 as an HLK-LD2450's
-    /// frames, ten a second, with `radar on` sent first; every pulse
-    /// checked against the host trace of it. Without `--seconds`, to 5 s
-    /// after its last line.
+    /// Play radar lines (`<s> radar <x_mm>,<y_mm> ...` or `<s> radar none`)
+    /// into GP13 as an HLK-LD2450, `radar on` sent first; checked as `--script`.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood", "script", "dmx", "show"])]
     pub radar: Option<PathBuf>,
-    /// With `--script`: the servos' rate, Hz (50 to 333), from the first
-    /// frame: the image boots on settings of that rate (planted in its
-    /// settings sectors), and the host trace runs at it.
+    /// With `--script`: the servos' rate, Hz (50 to 333), planted in the
+    /// settings the image boots on; the host trace runs at it too.
     #[arg(long, value_name = "HZ", requires = "script", default_value_t = 50,
           value_parser = clap::value_parser!(u16).range(50..=333))]
     pub rate: u16,
-    /// With `--script`, `--dmx` or `--show` (or alone: the plain run, the
-    /// pulses not checked): write the pulses measured on GP16, GP18 and GP20
-    /// to this CSV, one row per frame: `t_ms,pitch_us,roll_us,yaw_us`.
+    /// With `--script`, `--dmx` or `--show` (alone: a plain run): the pulses
+    /// to this CSV, a row per frame: `t_ms,pitch_us,roll_us,yaw_us`.
     #[arg(long, value_name = "FILE.csv",
           conflicts_with_all = ["drill", "inputs", "console", "store", "noise", "flood", "stream"])]
     pub pulses: Option<PathBuf>,
 }
 
-/// One loop (30 s), the fade-in (2 s) and half a second for the boot.
+/// A loop (30 s), the fade-in (2 s) and half a second of boot.
 pub const DEFAULT_TIME: Duration = Duration::from_millis(32_500);
 
 /// Seconds above 0 and at most `max`.
@@ -203,19 +184,18 @@ pub fn command(args: &Args) -> Result<bool> {
     let (root, metadata) = crate::setup::prepare()?;
     let (root, md) = (root.as_path(), &metadata);
     PICO.build(root)?;
+    let (time, pulses) = ((args.virtual_time, args.timeout), args.pulses.as_ref());
     if let Some(path) = &args.script {
-        let rate = idle_head_core::servo::ServoRate::new(args.rate)
+        let rate = ServoRate::new(args.rate)
             .ok_or_else(|| anyhow::anyhow!("{} Hz: not a servo rate", args.rate))?;
-        let events = script::read(path)?;
-        let time = (args.virtual_time, args.timeout);
-        return script::command(root, md, events, time, rate, args.pulses.as_ref());
+        return script::command(root, md, script::read(path)?, time, rate, pulses);
     }
     if args.dmx.is_some() || args.pulses.is_some() && !args.show {
         return show::command(root, md, args);
     }
     if let Some(path) = &args.radar {
-        let time = (args.virtual_time, args.timeout);
-        return radar::command(root, md, path, time, args.pulses.as_ref());
+        let events = radar::read(path)?;
+        return script::command(root, md, events, time, ServoRate::DEFAULT, pulses);
     }
     let time = args.virtual_time;
     let result = if let Some(port) = &args.stream {
@@ -245,8 +225,7 @@ pub fn command(args: &Args) -> Result<bool> {
             stage(root, md)
         } else {
             let time = time.unwrap_or(DEFAULT_TIME);
-            let mut report = run::run_with(root, &PICO.elf(md), time, args.timeout, |_| {})?;
-            run::check(&mut report)?;
+            let (_, report) = stages::checked_run(root, md, time, args.timeout, |_| {})?;
             report.print(args.verbose);
             return Ok(report.problems.is_empty());
         }
@@ -261,7 +240,7 @@ pub fn command(args: &Args) -> Result<bool> {
 type Stage = fn(&Path, &Metadata) -> Result<()>;
 
 impl Report {
-    /// Frames that went out as their own pulse, on every servo, all boots.
+    /// Frames that went out as their own pulse on every servo, all boots.
     pub fn frames(&self) -> usize {
         let fresh = |boot: &Boot| boot.servos.iter().map(|s| s.fresh).min().unwrap_or(0);
         self.boots.iter().map(fresh).sum()
@@ -274,14 +253,11 @@ impl Report {
 
     /// The first boot, which every run has.
     pub fn first(&self) -> Result<&Boot> {
-        match self.boots.first() {
-            Some(boot) => Ok(boot),
-            None => bail!("no boot"),
-        }
+        self.boots.first().context("no boot")
     }
 
-    /// The peak stack: the larger of what the firmware logged and what the
-    /// emulated RAM shows at the end of each boot.
+    /// The larger of the peak stack the firmware logged and the emulated
+    /// RAM's at the end of each boot.
     pub fn peak_stack(&self) -> Option<u64> {
         self.logged_stack()
             .max(self.boots.iter().filter_map(|b| b.stack_peak).max())
@@ -292,24 +268,22 @@ impl Report {
         self.boots.iter().filter_map(logged).max()
     }
 
-    /// Prints the log ([`Report::log_text`]), the table, the verdict and
-    /// the summary line.
+    /// Prints the log, the table, the verdict and the summary line.
     pub fn print(&self, verbose: bool) {
         print!("{}{}", self.log_text(verbose), self.table());
         println!("{}\n{}", self.verdict(), self.summary());
     }
 
-    /// Prints the verdict and the summary line; fails with the run's
-    /// problems and the scenario's `more`, if any.
+    /// Prints the verdict and summary; fails with the run's problems and
+    /// the scenario's `more`, if any.
     pub fn conclude(&self, more: impl IntoIterator<Item = String>) -> Result<()> {
         println!("{}\n{}", self.verdict(), self.summary());
         let problems: Vec<String> = self.problems.iter().cloned().chain(more).collect();
         project::verdict(&problems)
     }
 
-    /// The decoded log with virtual times, boots and resets marked, and
-    /// what the emulator said (`verbose`: each access to a register it does
-    /// not model, also the known ones).
+    /// The decoded log with virtual times, boots and resets marked, and what
+    /// the emulator said (`verbose`: also the known unmodelled registers).
     pub fn log_text(&self, verbose: bool) -> String {
         let mut text = String::new();
         for (b, boot) in self.boots.iter().enumerate() {
@@ -335,7 +309,7 @@ impl Report {
         text + &unmodelled::lines(&self.unmodelled, verbose)
     }
 
-    /// Per boot and servo: pulses, frames, widths, periods; then the frame
+    /// Per boot and servo: pulses, frames, widths, periods; the frame
     /// update's cycles, the stack and the run.
     pub fn table(&self) -> String {
         let us = |counts: u32| f64::from(counts) * run::timing_at(self.rate).count_ns / 1e3;
@@ -350,9 +324,8 @@ impl Report {
             for ((name, pin, _), check) in image::SERVOS.iter().zip(&boot.servos) {
                 let widths = || check.pulses.iter().map(|p| p.counts);
                 let first = check.pulses.first().map_or(0, |p| p.counts);
-                let period = check
-                    .periods
-                    .map_or("-".to_owned(), |(lo, hi)| format!("{lo:.0}..{hi:.0}"));
+                let period =
+                    (check.periods).map_or("-".to_owned(), |(lo, hi)| format!("{lo:.0}..{hi:.0}"));
                 let _ = writeln!(
                     text,
                     "  {name:<6} GP{pin:<3} {:>7} {:>7} {:>5} {:>9.1} {:>9.1} {:>9.1}  {period:<21} {:>10}",
@@ -367,17 +340,13 @@ impl Report {
             }
         }
         // Each boot's first call is the start frame (neutral pulses only).
-        let start = self
-            .boots
-            .first()
-            .and_then(|b| b.frame_cycles.first())
-            .copied()
-            .unwrap_or(0);
-        let mut cycles: Vec<u64> = self
+        let start = self.boots.first().and_then(|b| b.frame_cycles.first());
+        let start = start.copied().unwrap_or(0);
+        let cycles = self
             .boots
             .iter()
-            .flat_map(|b| b.frame_cycles.iter().skip(1).copied())
-            .collect();
+            .flat_map(|b| &b.frame_cycles[1.min(b.frame_cycles.len())..]);
+        let mut cycles: Vec<u64> = cycles.copied().collect();
         cycles.sort_unstable();
         let _ = match (cycles.first(), cycles.last()) {
             (Some(min), Some(max)) => writeln!(
@@ -428,20 +397,16 @@ impl Report {
         let (low, high) = periods.fold((f64::INFINITY, 0.0_f64), |(l, h), (a, b)| {
             (l.min(a), h.max(b))
         });
-        let period = if low.is_finite() {
-            format!("{low:.0}..{high:.0}")
-        } else {
-            "-".to_owned()
-        };
+        let finite = low.is_finite();
+        let period = finite.then(|| format!("{low:.0}..{high:.0}"));
+        let period = period.unwrap_or_else(|| "-".to_owned());
         let count_ns = run::timing_at(self.rate).count_ns;
         let first = |s: &pulses::ServoCheck| {
             let us = |p: &pulses::Pulse| format!("{:.0}", f64::from(p.counts) * count_ns / 1e3);
             s.pulses.first().map_or("-".to_owned(), us)
         };
-        let first: Vec<String> = self
-            .boots
-            .first()
-            .map_or_else(Vec::new, |b| b.servos.iter().map(first).collect());
+        let first = self.boots.first().map(|b| b.servos.each_ref().map(first));
+        let first = first.map_or_else(Vec::new, Vec::from);
         format!(
             "sim summary frames={} pulses={pulses} mismatches={mismatches} period_ns={period} first_us={} watchdog_resets={}",
             self.frames(),

@@ -3,7 +3,7 @@
 //! `<seconds> <slot>=<value> …` (slots relative to the head's address,
 //! 1-based; values hold until changed) or `<seconds> dmx stop`.
 
-use std::{path::Path, time::Duration};
+use std::{fmt::Write as _, path::Path, time::Duration};
 
 use anyhow::{Context, Result, bail};
 use serde_json::{Value, json};
@@ -32,8 +32,7 @@ pub struct Change {
     pub stop: bool,
 }
 
-/// Parses a DMX script (see the [module docs](self)); errors name the
-/// line.
+/// Parses a DMX script (see the [module docs](self)).
 pub fn parse(text: &str) -> Result<Vec<Change>> {
     let mut changes = Vec::new();
     for (n, line) in text.lines().enumerate() {
@@ -98,6 +97,17 @@ pub fn parse(text: &str) -> Result<Vec<Change>> {
     }
     changes.sort_by_key(|c| c.at);
     Ok(changes)
+}
+
+/// Slot 11 (past the head's ten) set to 0 and 100 in turn every 0.23 s
+/// from `from` to before `to`.
+pub fn alternating(from: Duration, to: Duration) -> Result<Vec<Change>> {
+    let (mut text, mut at, mut k) = (String::new(), from, 0);
+    while at < to {
+        let _ = writeln!(text, "{:.3} 11={}", at.as_secs_f64(), k % 2 * 100);
+        (at, k) = (at + Duration::from_millis(230), k + 1);
+    }
+    parse(&text)
 }
 
 /// The harness's `dmx` configuration for `changes`.

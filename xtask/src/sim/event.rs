@@ -1,10 +1,10 @@
-//! The events `sim/harness.mjs` prints, one JSON object a line, tagged by
-//! `ev` (the harness's header lists them). An event this module does not
-//! know, or a field missing or of the wrong kind, is an error: the harness
-//! and its reader change together.
+//! The events `sim/harness.mjs` prints, a JSON object a line tagged by
+//! `ev`. An unknown event or field, or one missing, is an error: the
+//! harness and its reader change together.
 
 use anyhow::{Context, Result};
 use serde::{Deserialize, Deserializer};
+use std::time::Duration;
 
 /// One event of the harness. Times (`ns`) are virtual nanoseconds since
 /// power-on, across resets.
@@ -13,19 +13,14 @@ use serde::{Deserialize, Deserializer};
 pub enum Event {
     /// A boot starts (0: power-on).
     Boot { n: usize, ns: f64 },
-    /// Bytes from the RTT up-buffer (the defmt log), stamped with the first.
-    Rtt {
-        ns: f64,
-        #[serde(deserialize_with = "from_hex")]
-        hex: Vec<u8>,
-    },
+    /// Bytes of the defmt log, stamped with the first.
+    Rtt { ns: f64, hex: Hex },
     /// A watched pin changed level (`reset`: a reset released it).
     Edge {
         pin: u8,
         high: bool,
         ns: f64,
-        #[serde(default)]
-        reset: bool,
+        reset: Option<bool>,
     },
     /// The script drove an input pin.
     Drive { pin: u8, high: bool, ns: f64 },
@@ -50,53 +45,109 @@ pub enum Event {
     /// The lowest stack address written in a boot.
     Stack { n: usize, low: u64 },
     /// Bytes UART0 sent, stamped with the first.
-    Uart {
-        ns: f64,
-        #[serde(deserialize_with = "from_hex")]
-        hex: Vec<u8>,
-    },
-    /// The last byte of a UART script went onto UART0's RX line.
+    Uart { ns: f64, hex: Hex },
+    /// A UART script's last byte went onto UART0's RX line.
     UartRx { ns: f64, n: usize },
     /// A scripted byte found UART0's RX FIFO full.
     UartOverrun { ns: f64 },
-    /// The CDC-ACM host configured the device.
+    /// The USB host configured the device.
     UsbConnected { ns: f64 },
-    /// Bytes the device sent on its CDC-ACM IN endpoint.
-    Usb {
-        ns: f64,
-        #[serde(deserialize_with = "from_hex")]
-        hex: Vec<u8>,
-    },
-    /// The USB host sent a scripted chunk (a list of chunks only).
+    /// Bytes the device sent on its CDC-ACM port.
+    Usb { ns: f64, hex: Hex },
+    /// The USB host sent a scripted chunk.
     UsbIn { ns: f64, n: usize },
-    /// A DMX frame carrying a change ended (its last byte went out).
+    /// A DMX frame carrying a change ended.
     Dmx { ns: f64, frame: u64, changed: bool },
     /// The radar frames sent in the run, at its end.
     Radar { ns: f64, frames: u64 },
-    /// Accesses to a register rp2040js does not model, counted over the
-    /// run.
-    Unmodelled {
-        peripheral: String,
-        op: Op,
-        offset: u32,
-        count: u64,
-    },
+    /// Accesses to a register rp2040js does not model, over the run.
+    Unmodelled(Unmodelled),
     /// A complaint of the emulator.
     Emu { level: Level, msg: String },
     /// The run is over.
-    End {
-        why: Why,
-        ns: f64,
-        instructions: u64,
-        wall_ms: u64,
-        #[serde(default)]
-        msg: Option<String>,
-    },
+    End(End),
 }
 
-/// What the boot ROM did to the flash (a sector erase, a page program), or
-/// what the firmware did to a register the emulator does not model (a read
-/// rp2040js answers with 0xffffffff, a write it drops).
+/// Bytes, from lower-case hex digits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hex(pub Vec<u8>);
+
+impl<'de> Deserialize<'de> for Hex {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let text = String::deserialize(deserializer)?;
+        let byte = |i| {
+            text.get(i..i + 2)
+                .and_then(|pair| u8::from_str_radix(pair, 16).ok())
+        };
+        let bad = || serde::de::Error::custom(format!("bad hex: {text}"));
+        let bytes = (0..text.len()).step_by(2).map(|i| byte(i).ok_or_else(bad));
+        bytes.collect::<Result<_, _>>().map(Hex)
+    }
+}
+
+/// Accesses to one register the emulator does not model.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Unmodelled {
+    /// The peripheral as rp2040js names it, the register's offset in it.
+    pub peripheral: String,
+    pub op: Op,
+    pub offset: u32,
+    pub count: u64,
+}
+
+/// How the harness ended.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct End {
+    pub why: Why,
+    pub ns: f64,
+    pub instructions: u64,
+    pub wall_ms: u64,
+    #[serde(default, rename = "msg")]
+    pub error: Option<String>,
+}
+
+impl End {
+    /// How a run ended: its last `end` event.
+    pub fn of(events: &[Event]) -> Result<Self> {
+        let end = events.iter().rev().find_map(|e| match e {
+            Event::End(end) => Some(end.clone()),
+            _ => None,
+        });
+        end.context("the emulator harness ended without saying how")
+    }
+
+    /// Why the run did not reach its virtual time, if it did not.
+    pub fn problem(&self, silence: Duration) -> Option<String> {
+        let at = self.ns / 1e9;
+        let stuck = "the emulator made no progress";
+        Some(match self.why {
+            Why::Time => return None,
+            Why::Silent => format!(
+                "{stuck}: no log byte and no pin edge for {} s of virtual time (stopped at \
+                 {at:.3} s)",
+                silence.as_secs_f64()
+            ),
+            Why::Asleep => {
+                format!("{stuck}: the core sleeps with nothing left to wake it (at {at:.3} s)")
+            }
+            Why::Wall => format!(
+                "{stuck} in time: stopped after {:.1} s of wall time at {at:.3} s of virtual time \
+                 (raise with --timeout)",
+                Duration::from_millis(self.wall_ms).as_secs_f64()
+            ),
+            Why::Break => format!("the firmware hit a breakpoint at {at:.3} s"),
+            Why::Closed => format!("the live run's input closed at {at:.3} s"),
+            Why::Error => format!(
+                "the emulator stopped (error) at {at:.3} s: {}",
+                self.error.as_deref().unwrap_or("no reason given")
+            ),
+        })
+    }
+}
+
+/// A flash operation of the boot ROM, or an access to an unmodelled register.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Op {
@@ -114,9 +165,7 @@ pub enum Level {
     Error,
 }
 
-/// Why the harness stopped (`Silent`: no log byte or pin edge for the
-/// silence time; `Asleep`: the core sleeps with nothing left to wake it;
-/// `Closed`: a live run's stdin closed).
+/// Why the harness stopped (see [`End::problem`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Why {
@@ -145,20 +194,6 @@ impl Event {
     }
 }
 
-/// Lower-case hex digits as bytes.
-fn from_hex<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<u8>, D::Error> {
-    let text = String::deserialize(deserializer)?;
-    let byte = |i| {
-        text.get(i..i + 2)
-            .and_then(|pair| u8::from_str_radix(pair, 16).ok())
-    };
-    let bad = || serde::de::Error::custom(format!("bad hex: {text}"));
-    (0..text.len())
-        .step_by(2)
-        .map(|i| byte(i).ok_or_else(bad))
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -170,7 +205,7 @@ mod tests {
             rtt,
             Event::Rtt {
                 ns: 12.5,
-                hex: vec![0, 0xff, 0x10]
+                hex: Hex(vec![0, 0xff, 0x10])
             }
         );
         let edge = Event::parse(r#"{"ev":"edge","pin":16,"high":false,"ns":3,"reset":true}"#);
@@ -178,7 +213,7 @@ mod tests {
             pin: 16,
             high: false,
             ns: 3.0,
-            reset: true,
+            reset: Some(true),
         };
         assert_eq!(edge.unwrap(), want);
         for line in [

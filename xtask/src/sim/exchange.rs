@@ -25,9 +25,8 @@ pub const USB_START: Duration = Duration::from_secs(4);
 /// reply (160 bytes, 13.9 ms) takes to go out.
 const LINE_GAP: Duration = Duration::from_millis(40);
 
-/// The lines sent, each with its line end: good and bad commands, every
-/// line end, an overlong line, a control byte and a machine-mode line
-/// (its checksum is computed in [`script`]).
+/// The lines sent: good and bad commands, every line end, a control byte;
+/// [`script_lines`] adds an overlong and a machine-mode line.
 const SCRIPT: &[&[u8]] = &[
     b"help\r\n",
     b"status\n",
@@ -44,8 +43,7 @@ const SCRIPT: &[&[u8]] = &[
     b"seed 4294967296\n",
 ];
 
-/// The exchange on the harness's lines: the script's lines on UART0 from
-/// [`START`], [`LINE_GAP`] apart, and all of it over USB at [`USB_START`].
+/// The script on UART0 from [`START`], and over USB at [`USB_START`].
 pub fn configure(config: &mut Config) {
     let lines = script_lines();
     config.uart = (0_u32..)
@@ -55,11 +53,9 @@ pub fn configure(config: &mut Config) {
     config.usb = vec![Chunk::new(lines.concat(), USB_START)];
 }
 
-/// The exchange of boot 0 against the host's replies, into `report`: its
-/// transcript, and the problems: a wrong or missing reply, a byte that found
-/// UART0's receive FIFO full, a device the emulator's USB host did not
-/// configure, or a `center` the frame task did not log as applied (it goes
-/// through the queue).
+/// Boot 0's exchange against the host's replies, into `report`: the
+/// transcript, and problems: a wrong or missing reply, a UART overrun, a
+/// USB device not configured, a `center` the frame task did not log.
 pub fn check(report: &mut Report) {
     let Some(boot) = report.boots.first() else {
         return;
@@ -118,8 +114,7 @@ fn script_lines() -> Vec<Vec<u8>> {
     lines
 }
 
-/// The replies the firmware must send for `script`, one per line: first
-/// on the UART, then on the USB port, with one service as on the board.
+/// The replies to `script` on the UART, then USB, from one service.
 fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
     let queue: &'static CommandQueue = Box::leak(Box::new(CommandQueue::new()));
     let link: &'static ConsoleLink = Box::leak(Box::new(ConsoleLink::new()));
@@ -158,9 +153,8 @@ fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
     })
 }
 
-/// `reply` with the values that depend on the frame it was answered at
-/// (the angles, pulses and uptime of `status`) replaced by `*`, if they
-/// have their form: a comma-separated list of integers.
+/// `reply` with `status`'s frame-dependent values (angles, pulses, uptime;
+/// if lists of integers) replaced by `*`.
 fn mask(reply: &[u8]) -> Vec<u8> {
     if !reply.starts_with(b"ok mode=") {
         return reply.to_vec();
@@ -192,8 +186,7 @@ fn mask(reply: &[u8]) -> Vec<u8> {
     out
 }
 
-/// What a port sent against `want` (from [`expected`]); the transcript
-/// and the problems found.
+/// What a port `sent` against `want`: the transcript and problems.
 fn compare(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>) {
     let got: Vec<Vec<u8>> = sent
         .split_inclusive(|&b| b == b'\n')
@@ -239,26 +232,17 @@ fn compare(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>
     (transcript, problems)
 }
 
-/// `bytes` with its line end dropped and other control bytes escaped.
+/// `bytes` with its line end dropped, the rest escaped.
 fn printable(bytes: &[u8]) -> String {
-    let text = bytes
-        .strip_suffix(b"\r\n")
-        .or_else(|| bytes.strip_suffix(b"\n"))
-        .or_else(|| bytes.strip_suffix(b"\r"))
-        .unwrap_or(bytes);
-    text.utf8_chunks()
-        .flat_map(|chunk| {
-            let valid = chunk.valid().chars().map(|c| {
-                if c.is_control() {
-                    format!("\\x{:02x}", u32::from(c))
-                } else {
-                    c.to_string()
-                }
-            });
-            let invalid = chunk.invalid().iter().map(|b| format!("\\x{b:02x}"));
-            valid.chain(invalid).collect::<Vec<_>>()
-        })
-        .collect()
+    let line_end = |b: &u8| matches!(b, b'\r' | b'\n');
+    let end = bytes.len()
+        - bytes
+            .iter()
+            .rev()
+            .take(2)
+            .take_while(|b| line_end(b))
+            .count();
+    bytes[..end].escape_ascii().to_string()
 }
 
 #[cfg(test)]

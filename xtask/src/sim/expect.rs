@@ -13,14 +13,9 @@ use idle_head_core::pwm_clock::PICO_SERVO_CLOCK;
 /// embassy-time's tick rate on the RP2040 (its 1 MHz TIMER).
 const TICK_HZ: u64 = 1_000_000;
 
-/// The duties `[pitch, roll, yaw]` of frames `0..frames` of the Pico image
-/// (`crates/rp/src/lib.rs`: `DriverConfig::DEFAULT`, the default loops,
-/// `LOOP_DURATION` loops in its idle mode, never-repeating unless built
-/// with `fixed-loop`), every frame on time: the same `FrameLoop`,
-/// `IdlePlayer` and `FrameDriver` over channels whose maximum duty is the
-/// Pico's `TOP`, recording what they are given. The loop sets are generated
-/// by the same `LoopStream`, on the spot when a join is due (the image's
-/// generator task has them ready long before).
+/// The duties `[pitch, roll, yaw]` of frames `0..frames` of the Pico
+/// image, every frame on time: its `FrameLoop` and `FrameDriver` with the
+/// default config and loops, over channels of the Pico's `TOP` that record.
 pub fn pico_duties(frames: usize) -> Result<Vec<[u16; 3]>> {
     let config = DriverConfig::DEFAULT;
     let params = config.build().map_err(|e| anyhow!("{}", e.message()))?;

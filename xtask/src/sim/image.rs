@@ -1,7 +1,5 @@
-//! The Pico image as the emulator's harness runs it: where its servos and
-//! trigger inputs are wired, what it needs from the ELF (the addresses of a
-//! few symbols; the flash contents come from its UF2), and the
-//! configuration every run of it starts from.
+//! The Pico image as the harness runs it: its wiring, the symbols it needs
+//! from the ELF (the flash comes from its UF2), the base configuration.
 
 use std::path::Path;
 
@@ -15,8 +13,7 @@ use crate::{board::Board, elf::XIP, uf2};
 /// Where boot2 leaves the vector table: right behind its own 256 bytes.
 pub const VECTOR_TABLE: u64 = XIP.start + 0x100;
 
-/// The servos as wired on the Pico (`crates/rp/src/pico.rs`): name, GPIO,
-/// PWM slice (channel A).
+/// The servos on the Pico (`crates/rp/src/pico.rs`): name, GPIO, slice.
 pub const SERVOS: [(&str, u8, u8); 3] = [("pitch", 16, 0), ("roll", 18, 1), ("yaw", 20, 2)];
 
 /// The trigger inputs' GPIOs, as wired on the Pico: GP2 to GP5.
@@ -84,10 +81,8 @@ impl PicoImage {
     }
 }
 
-/// The harness's configuration for the Pico image `elf`, and the image:
-/// its UF2 written beside it (`<elf>.<extension>`, `cargo xtask uf2`'s
-/// file), its vector table and RTT log, the servo slices' compare writes
-/// reported.
+/// The image `elf` and the harness's configuration for it: its UF2
+/// (written to `<elf>.<extension>`), vector table, RTT, servo slices.
 pub fn config(elf: &Path, extension: &str) -> Result<(PicoImage, Config)> {
     let image = PicoImage::read(elf)?;
     let (flash, _) = uf2::write(elf, Board::Pico, extension)?;

@@ -1,7 +1,6 @@
-//! The trigger inputs' stage: a presence script (a sensor on GP2, a rest
-//! after 2 s with relax on, someone at 7 s) played into the shipped image;
-//! from the pulses, the rest, the pulses stopping, the soft wake and the
-//! glance towards the sensor, every pulse the host trace's duty.
+//! The trigger inputs' stage: a presence sensor on GP2 (a rest after 2 s,
+//! relaxed, someone at 7 s); from the pulses, the rest, the pulses
+//! stopping, the soft wake and the glance, every pulse the host trace's.
 
 use std::path::Path;
 use std::time::Duration;
@@ -28,21 +27,11 @@ pub const SCRIPT: &str = "\
 7 pin 2 high
 ";
 
-/// `cargo xtask test`'s stage: plays [`SCRIPT`] for 12.5 s (the glance, from
-/// about 8.1 s, held and back) and checks it.
+/// The stage: [`SCRIPT`] for 12.5 s (the glance from 8.1 s, and back).
 #[allow(clippy::too_many_lines)] // the four checks of the module docs, in order
 pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
-    let events = script::parse(SCRIPT)?;
-    let time = (Duration::from_millis(12_500), super::WALL);
-    let against = script::Against::Host;
-    let report = script::play(
-        root,
-        metadata,
-        events,
-        time,
-        against,
-        script::Board::default(),
-    )?;
+    let time = Duration::from_millis(12_500);
+    let report = script::host(root, metadata, SCRIPT, time, script::Board::default())?;
     print!("{}", report.table());
     let boot = report.first()?;
     let timing = run::timing();

@@ -5,19 +5,17 @@
 use std::{
     io::{BufRead, BufReader, Write},
     path::Path,
-    process::{Child, ChildStdout, Command, Stdio},
+    process::{Child, ChildStdout, Stdio},
     time::Duration,
 };
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use super::{event::Event, image, node, store::WORST};
 
-/// The harness's argument for a live run of `elf`: the settings store's
-/// flash functions as in the store run (`save` and `load` work), the servo
-/// slices' compare writes reported (`cc` events of slices 0, 1, 2: pitch,
-/// roll, yaw), the trigger inputs GP2..GP5 driven by `pin <n> 0|1` lines
-/// (at their pulls until driven, as on a board: a button reads released).
+/// The harness's argument for a live run of `elf`: the flash functions
+/// (`save` and `load` work), the servo slices' `cc` events, the trigger
+/// inputs driven by `pin <n> 0|1` lines (at their pulls until then).
 pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
     let (_, config) = image::config(elf, "live.uf2")?;
     node::ensure(root)?;
@@ -33,19 +31,11 @@ pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
     .json())
 }
 
-/// Starts `elf` live in the emulator ([`config`]): its stdin takes bytes
-/// for the head's USB serial port ([`send`]), its stdout has its events
-/// ([`events`]).
+/// Starts `elf` live: stdin takes bytes for the USB serial port
+/// ([`send`]), stdout has the events ([`events`]).
 pub fn start(root: &Path, elf: &Path) -> Result<Child> {
-    Command::new("node")
-        .arg("harness.mjs")
-        .arg(config(root, elf)?.to_string())
-        .current_dir(node::folder(root))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .context("could not start `node` (is Node.js installed?)")
+    let config = config(root, elf)?.to_string();
+    node::harness(root, &config, Stdio::piped(), Stdio::inherit())
 }
 
 /// Sends `bytes` to the head's USB serial port: one line of hex digits.
@@ -54,14 +44,13 @@ pub fn send(stdin: &mut impl Write, bytes: &[u8]) -> std::io::Result<()> {
     stdin.flush()
 }
 
-/// Hands each run of bytes the head sends on its USB serial port to
-/// `each` until the harness ends; returns why it ended.
+/// Hands the head's USB bytes to `each` until the end; why it ended.
 pub fn events(stdout: ChildStdout, mut each: impl FnMut(Vec<u8>)) -> String {
     let mut why = "the emulator stopped".to_owned();
     for line in BufReader::new(stdout).lines().map_while(Result::ok) {
         match Event::parse(&line) {
-            Ok(Event::Usb { hex, .. }) => each(hex),
-            Ok(Event::End { why: end, .. }) => why = format!("the emulator stopped ({end:?})"),
+            Ok(Event::Usb { hex, .. }) => each(hex.0),
+            Ok(Event::End(end)) => why = format!("the emulator stopped ({:?})", end.why),
             Ok(_) => {}
             Err(e) => why = format!("{e:#}"),
         }

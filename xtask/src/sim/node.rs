@@ -1,10 +1,9 @@
-//! Node, the emulator package and one run of `sim/harness.mjs`, whose
-//! configuration ([`Config`]) is the JSON its header describes.
+//! Node, the emulator package and a run of `sim/harness.mjs` ([`Config`]).
 
 use std::{
     io::{BufRead, BufReader, Read},
     path::{Path, PathBuf},
-    process::{Command, Stdio},
+    process::{Child, Command, Stdio},
     time::Duration,
 };
 
@@ -21,14 +20,13 @@ pub fn folder(root: &Path) -> PathBuf {
     root.join("sim")
 }
 
-/// Makes sure `node` and `npm` run (installing them with apt-get when root on
-/// Debian or Ubuntu) and that the pinned emulator is installed (`npm ci`).
+/// Makes sure `node` and `npm` run and the pinned emulator is installed.
 pub fn ensure(root: &Path) -> Result<()> {
     npm_ci(&folder(root), &["rp2040js"], &[])
 }
 
-/// Makes sure `node` and `npm` run and that `packages` are installed in
-/// `dir`'s `node_modules` as its `package-lock.json` pins them: else
+/// Makes sure `node` and `npm` run (apt-get installs them when root) and
+/// `packages` are in `dir` as its `package-lock.json` pins them, else
 /// `npm ci` there (with `env`).
 pub fn npm_ci(dir: &Path, packages: &[&str], env: &[(&str, &str)]) -> Result<()> {
     let what = "Node.js (20 or newer) and npm (packages `nodejs npm` on Debian and Ubuntu)";
@@ -59,8 +57,8 @@ pub fn npm_ci(dir: &Path, packages: &[&str], env: &[(&str, &str)]) -> Result<()>
     Ok(())
 }
 
-/// What the harness is asked to run (by default: nothing scripted, no
-/// ROM, no power cycle). Times go to it in ns, bytes as hex digits.
+/// The harness's run (default: nothing scripted, no ROM, no power cycle);
+/// times go to it in ns, bytes as hex digits.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Config {
     pub flash: PathBuf,
@@ -69,46 +67,40 @@ pub struct Config {
     pub pins: Vec<u8>,
     /// PWM slices whose compare writes to report.
     pub slices: Vec<u8>,
-    /// Function whose cycles to report per call, or 0.
+    /// Function whose cycles to report per call (0: none); stack region
+    /// to scan for paint.
     pub probe: u64,
-    /// Stack region to scan for paint, if painted.
     pub stack: Option<(u64, u64)>,
     #[serde(rename = "ns", serialize_with = "ns")]
     pub virtual_time: Duration,
     #[serde(rename = "wall_ms", serialize_with = "ms")]
     pub wall: Duration,
-    /// Virtual time without a log byte or a pin edge after which the run ends.
+    /// No log byte or pin edge for this long ends the run.
     #[serde(rename = "silence_ns", serialize_with = "ns")]
     pub silence: Duration,
     /// Bytes for UART0's RX line, per boot.
     pub uart: Vec<UartScript>,
-    /// Chunks for the USB serial port (CDC-ACM), each sent at its time
-    /// (boot 0).
+    /// Chunks for the USB serial port, each at its time (boot 0).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub usb: Vec<Chunk>,
-    /// DMX512 frames on UART1's RX line (`sim/dmx.mjs`).
+    /// DMX512 on UART1 RX (`sim/dmx.mjs`); a boot ROM with the flash
+    /// functions (`sim/rom.mjs`); bytes over the flash before power-on;
+    /// when the power goes off and on again.
     pub dmx: Option<Value>,
-    /// A boot ROM with the flash functions (`sim/rom.mjs`), if any.
     pub rom: Option<FlashTiming>,
-    /// Bytes written over the image's flash before power-on, and where.
     pub flash_fill: Option<Fill>,
-    /// Virtual times at which the power goes off and on again.
     #[serde(rename = "power_cycles_ns", serialize_with = "ns_each")]
     pub power_cycles: Vec<Duration>,
-    /// A live run: real time, stdin to the USB serial port, for as long
-    /// as stdin is open (`live.rs`).
+    /// A live run (`live.rs`): real time, stdin to the USB serial port.
     pub live: bool,
-    /// GPIOs the outside drives as inputs (at their pull until driven).
+    /// GPIOs driven from outside (at their pull until driven).
     pub inputs: Vec<u8>,
-    /// Boot 0's script of pin levels and console lines, if any.
     pub script: Option<PinScript>,
-    /// A stream of console lines made as they go out (`sim/stream.mjs`).
     pub stream: Option<LineStream>,
-    /// An HLK-LD2450 radar on GP13 (`sim/radar.mjs`; see `radar.rs`).
+    /// An HLK-LD2450 radar on GP13 (`sim/radar.mjs`).
     pub radar: Option<Value>,
-    /// The flash's unique id (none: the flash answers all ones).
-    #[serde(serialize_with = "uid")]
-    pub uid: Option<u64>,
+    /// The flash's unique id, 16 hex digits (none: it answers all ones).
+    pub uid: Option<String>,
 }
 
 /// Bytes sent at a time.
@@ -135,11 +127,10 @@ pub struct Fill {
     pub hex: Vec<u8>,
 }
 
-/// A stream of console lines on UART0 or USB (`sim/stream.mjs`): `count`
-/// lines, one every `every` from `start` on, cycling through `lines`.
+/// `count` console lines on `"uart"` or `"usb"`, one every `every` from
+/// `start` on, cycling through `lines` (`sim/stream.mjs`).
 #[derive(Debug, Clone, Serialize)]
 pub struct LineStream {
-    /// The port: `"uart"` or `"usb"`.
     pub port: &'static str,
     #[serde(rename = "start_ns", serialize_with = "ns")]
     pub start: Duration,
@@ -159,9 +150,8 @@ pub enum StreamLine {
     Machine(&'static str),
 }
 
-/// Boot 0's script, its times counted from the first frame (when the
-/// slice `anchor_slice` is enabled): pin levels, and console lines for
-/// UART0, each in `early` before its time.
+/// Boot 0's pin levels and UART0 lines (each `early`), times from the
+/// first frame (when `anchor_slice` is enabled).
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct PinScript {
     pub anchor_slice: u8,
@@ -189,9 +179,8 @@ pub struct FlashTiming {
     pub program: Duration,
 }
 
-/// Bytes the harness puts on UART0's RX line in one boot, from `start`
-/// (since the boot's start) on, one every `byte_time` (the line rate); the
-/// bytes at the indices in `errors` with a framing error (line noise).
+/// Bytes on UART0's RX line in boot `boot` from `start` on, one every
+/// `byte_time`; those at the indices in `errors` with a framing error.
 #[derive(Debug, Clone, Serialize)]
 pub struct UartScript {
     pub boot: usize,
@@ -205,21 +194,21 @@ pub struct UartScript {
 }
 
 impl UartScript {
-    /// `bytes` in boot `boot` from `start` on, at 115200 baud, undamaged.
+    /// At 115200 baud, undamaged.
     pub fn new(boot: usize, bytes: impl Into<Vec<u8>>, start: Duration) -> Self {
-        let (bytes, byte_time) = (bytes.into(), BYTE_TIME);
+        let (bytes, byte_time, errors) = (bytes.into(), BYTE_TIME, Vec::new());
         Self {
             boot,
             bytes,
             start,
             byte_time,
-            errors: Vec::new(),
+            errors,
         }
     }
 }
 
-/// What cortex-m-rt's `paint-stack` fills the stack with before `main`
-/// (the harness reads the stack's depth from what is left of it).
+/// cortex-m-rt's `paint-stack` fill: the harness reads the stack's depth
+/// from what is left of it.
 pub const STACK_PAINT: u32 = 0xcccc_cccc;
 
 /// One byte at 115200 baud, 8N1: 10 bits.
@@ -243,9 +232,7 @@ impl Config {
 pub fn hex_string(bytes: &[u8]) -> String {
     bytes
         .iter()
-        .map(|byte| format!("{byte:02x}"))
-        .collect::<Vec<_>>()
-        .concat()
+        .fold(String::new(), |hex, byte| hex + &format!("{byte:02x}"))
 }
 
 pub fn nanos(duration: Duration) -> u64 {
@@ -271,9 +258,8 @@ fn hex<S: Serializer>(bytes: &[u8], s: S) -> Result<S::Ok, S::Error> {
 /// Wall time the harness has beyond its own limit: node's start-up.
 const GRACE: Duration = Duration::from_secs(15);
 
-/// Runs the harness; returns its events, in order. Fails if node cannot be
-/// started, exits with an error, prints a line that is not a known event,
-/// or outlives the wall time (plus a grace).
+/// Runs the harness; its events, in order. Fails if node does not start,
+/// fails, prints a line that is no known event, or outlives the wall time.
 pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     // The configuration goes in a file: a run of a thousand scripted
     // chunks is more than a command line may carry.
@@ -286,17 +272,14 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     let file = std::env::temp_dir().join(format!("idle-head-sim-{}-{n}.json", std::process::id()));
     std::fs::write(&file, config.json().to_string())
         .with_context(|| format!("writing {}", file.display()))?;
-    let child = Command::new("node")
-        .arg("harness.mjs")
-        .arg(format!("@{}", file.display()))
-        .current_dir(folder(root))
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .context("could not start `node` (is Node.js installed?)");
-    // The events, read to the end of the output (also past a bad line, so
-    // that node never waits on a full pipe); the first bad line is the error.
+    let child = harness(
+        root,
+        &format!("@{}", file.display()),
+        Stdio::null(),
+        Stdio::piped(),
+    );
+    // Read to the end (past a bad line too: node never waits on a full
+    // pipe); the first bad line is the error.
     let events = |stdout| -> Result<Vec<Event>> {
         let lines = BufReader::new(stdout).lines().map_while(Result::ok);
         let events: Vec<Result<Event>> = lines.map(|line| Event::parse(&line)).collect();
@@ -318,7 +301,7 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
         );
     };
     let events = done.stdout?;
-    if !status.success() && !matches!(events.last(), Some(Event::End { .. })) {
+    if !status.success() && !matches!(events.last(), Some(Event::End(_))) {
         bail!(
             "the emulator harness failed ({status}):\n{}",
             done.stderr.trim_end()
@@ -327,11 +310,13 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     Ok(events)
 }
 
-/// A unique id as the harness reads it: 16 hex digits.
-#[allow(clippy::ref_option)]
-fn uid<S: serde::Serializer>(id: &Option<u64>, s: S) -> Result<S::Ok, S::Error> {
-    match id {
-        Some(id) => s.serialize_some(&format!("{id:016x}")),
-        None => s.serialize_none(),
-    }
+/// Starts the harness on `arg` (its config, or `@file`), stdout piped.
+pub fn harness(root: &Path, arg: &str, stdin: Stdio, stderr: Stdio) -> Result<Child> {
+    let mut node = Command::new("node");
+    node.args(["harness.mjs", arg]).current_dir(folder(root));
+    node.stdin(stdin)
+        .stdout(Stdio::piped())
+        .stderr(stderr)
+        .spawn()
+        .context("could not start `node` (is Node.js installed?)")
 }

@@ -1,7 +1,5 @@
-//! Settings sectors as an earlier firmware would have left them: the
-//! version 1 fixture, or a record of any layout version written by the
-//! core's own `SettingsStore` over a NOR flash in RAM with the Pico's
-//! geometry.
+//! Settings sectors as a firmware would have left them: the version 1
+//! fixture, or a record written by the core's `SettingsStore` to RAM.
 
 use std::{
     future::Future,
@@ -10,11 +8,12 @@ use std::{
     task::{Context, Poll, Waker},
 };
 
+use super::node::Fill;
 use anyhow::{Context as _, Result, bail};
 use embedded_storage_async::nor_flash::{
     ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash,
 };
-use idle_head_core::settings::{RawRecord, SETTINGS_BUFFER, Settings, SettingsStore};
+use idle_head_core::settings::{RawRecord, Record, SETTINGS_BUFFER, Settings, SettingsStore};
 
 /// The Pico's flash: erase sector and write unit.
 const SECTOR: usize = 4096;
@@ -22,8 +21,7 @@ const SECTOR: usize = 4096;
 /// The version 1 fixture, in the repository at this path.
 pub const VERSION_1_SECTORS: &str = "host-tests/fixtures/settings-v1-sectors.bin";
 
-/// The settings sectors of the version 1 fixture (`len` bytes, the Pico's
-/// settings region).
+/// The version 1 fixture's sectors (`len` bytes).
 pub fn version_1_sectors(root: &Path, len: usize) -> Result<Vec<u8>> {
     let path = root.join(VERSION_1_SECTORS);
     let bytes = std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;
@@ -40,28 +38,24 @@ pub fn version_1_sectors(root: &Path, len: usize) -> Result<Vec<u8>> {
 /// `len` bytes of settings sectors (whole sectors) holding one record of
 /// layout version `V` (its payload: `payload`), as the store writes it.
 pub fn store_of_version<const V: u16>(payload: &[u8], len: usize) -> Result<Vec<u8>> {
-    let flash = RamFlash(vec![0xff; len]);
-    let range = 0..u32::try_from(len)?;
     let record = RawRecord::<V, 240>::new(payload).context("a payload of at most 240 bytes")?;
-    let mut store: SettingsStore<RamFlash, _, 256> = SettingsStore::new(flash, range)
-        .map_err(|e| anyhow::anyhow!("the settings store refused the range: {e:?}"))?;
-    match ready(store.save(&record)).context("the store's save waited")? {
-        Ok(()) => Ok(store.into_flash().0),
-        Err(e) => bail!("planting a version {V} record: {e:?}"),
-    }
+    plant::<_, 256>(&record, len).with_context(|| format!("planting a version {V} record"))
 }
 
-/// `len` bytes of settings sectors holding `settings`, as a `save` leaves
-/// them (a board boots on them: at their servo rate, say).
+/// `len` bytes of settings sectors holding `settings`, as `save` leaves them.
 pub fn settings_sectors(settings: &Settings, len: usize) -> Result<Vec<u8>> {
+    plant::<_, SETTINGS_BUFFER>(settings, len).context("planting the settings")
+}
+
+/// `len` bytes of sectors the core's `SettingsStore` saved `record` to.
+fn plant<R: Record, const BUF: usize>(record: &R, len: usize) -> Result<Vec<u8>> {
     let flash = RamFlash(vec![0xff; len]);
-    let range = 0..u32::try_from(len)?;
-    let mut store: SettingsStore<RamFlash, Settings, SETTINGS_BUFFER> =
-        SettingsStore::new(flash, range)
+    let mut store: SettingsStore<RamFlash, R, BUF> =
+        SettingsStore::new(flash, 0..u32::try_from(len)?)
             .map_err(|e| anyhow::anyhow!("the settings store refused the range: {e:?}"))?;
-    match ready(store.save(settings)).context("the store's save waited")? {
+    match ready(store.save(record)).context("the store's save waited")? {
         Ok(()) => Ok(store.into_flash().0),
-        Err(e) => bail!("planting the settings: {e:?}"),
+        Err(e) => bail!("{e:?}"),
     }
 }
 
@@ -126,4 +120,27 @@ impl NorFlash for RamFlash {
         }
         Ok(())
     }
+}
+
+/// The settings sectors of the image `elf` filled with `sectors(len)`.
+pub fn fill(elf: &Path, sectors: impl FnOnce(usize) -> Result<Vec<u8>>) -> Result<Fill> {
+    let image = crate::elf::Image::read(elf)?;
+    let region = image.settings.context("the image has no settings region")?;
+    let hex = sectors(usize::try_from(region.end - region.start)?)?;
+    Ok(Fill {
+        addr: region.start,
+        hex,
+    })
+}
+
+/// `len` bytes of noise (xorshift32): a store no firmware wrote.
+pub fn noise(len: usize) -> Vec<u8> {
+    let mut x: u32 = 0x2545_f491;
+    let mut next = || {
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        x.to_le_bytes()[0]
+    };
+    (0..len).map(|_| next()).collect()
 }

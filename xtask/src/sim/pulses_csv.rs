@@ -1,8 +1,6 @@
-//! `--pulses FILE.csv`: the pulses an emulator run measured on the servo
-//! pins, one row per frame (`t_ms,pitch_us,roll_us,yaw_us`): row `k` is the
-//! PWM period `k` from the first pulse on, each width the pulse that rose
-//! in it (µs, to 0.1), or 0 where the period had none; `t_ms` has µs
-//! decimals where the period has them (3.003·k at 333 Hz).
+//! `--pulses FILE.csv`: row `k` (`t_ms,pitch_us,roll_us,yaw_us`) is PWM
+//! period `k` from the first pulse, each width the pulse that rose in it
+//! (0 for none).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -11,8 +9,7 @@ use anyhow::Result;
 
 use super::pulses::{self, Timing, Train};
 
-/// Writes the pulses on `trains`' pins (`[pitch, roll, yaw]`) to `path`;
-/// the rows written.
+/// Writes `trains`' pulses to `path`; the rows written.
 pub fn write(path: &Path, trains: &[Train; 3], timing: &Timing) -> Result<usize> {
     let text = rows(trains, timing);
     crate::project::write(path, &text)?;

@@ -1,44 +1,30 @@
-//! The radar in the emulator: a script's radar lines as an HLK-LD2450's
-//! frames on GP13 (`sim/radar.mjs` encodes them; `sim/pio.mjs` runs the
-//! firmware's PIO UART in step with the CPU), and the stages that check
-//! the shipped image with it:
-//!
-//! - a walk (2 m away, left to right at 1 m/s, `radar on` and `track on`
-//!   over UART0) is followed: the yaw within 5° RMS of the walker's bearing
-//!   after the first second, every pulse the host trace's duty;
-//! - two boards whose flashes have different unique ids play different
-//!   idle motion from the same image, each its own id's seeds as the host
-//!   trace computes them, and `seed` answers each its `board:<n>`;
-//! - DMX512 at the full universe rate on GP9 and the radar on GP13 at
-//!   once: every DMX frame counted good, every radar frame counted, none
-//!   bad, no servo frame late; and a `save` that erases flash sectors
-//!   (45 ms each with the interrupts off, the flash's typical time) while
-//!   the radar sends: every radar frame counted, none bad.
+//! The radar stages (an HLK-LD2450 on GP13, `sim/radar.mjs`): a walk is
+//! followed within 5° RMS; two boards' unique ids give their own seeds;
+//! DMX512 and the radar at once, and a flash erase meanwhile, lose no
+//! frame of either.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
 use anyhow::{Context, Result, anyhow, bail};
 use idle_head_core::seed::BoardId;
 use idle_head_core::servo::ServoRate;
 
-use super::image::SERVOS;
-use super::node::Chunk;
-use super::node::PinScript;
+use super::node::{Chunk, Config, FlashTiming};
 use super::pulses::angle;
-use super::run::{self, Boot};
-use super::script::{self, Against, Board, EARLY, line};
-use super::{WALL, dmx, stages::shipped_image, stream};
+use super::run::{self, Boot, Report};
+use super::script::{self, Board, line};
+use super::{WALL, dmx, planted, stages::shipped_image, stream};
 use crate::bench::tracking::{self, Walk};
-use crate::project::Metadata;
+use crate::log::field;
+use crate::project::{self, Metadata};
 use crate::trace::{Event, Kind};
 
 /// Stage names.
 pub const RADAR_STAGE: &str = "Pico image in the RP2040 emulator: a radar walk on GP13 is \
      followed within 5° of the bearing, every pulse the host trace's; two boards' unique ids \
      give two idle motions";
-/// See [`RADAR_STAGE`].
 pub const RADAR_DMX_STAGE: &str = "Pico image in the RP2040 emulator: DMX512 on GP9 and the \
      radar on GP13 at once: every frame of both counted, none lost; a flash erase loses no radar \
      frame";
@@ -68,24 +54,6 @@ pub fn read(path: &Path) -> Result<Vec<Event>> {
     Ok(events)
 }
 
-/// `cargo xtask sim --radar FILE`.
-pub fn command(
-    root: &Path,
-    metadata: &Metadata,
-    path: &Path,
-    time: (Option<Duration>, Duration),
-    pulses: Option<&PathBuf>,
-) -> Result<bool> {
-    script::command(
-        root,
-        metadata,
-        read(path)?,
-        time,
-        ServoRate::DEFAULT,
-        pulses,
-    )
-}
-
 /// The yaw of each frame of `boot`, m°, from its pulses.
 fn yaw(boot: &Boot) -> Vec<f64> {
     let timing = run::timing();
@@ -101,19 +69,12 @@ fn yaw(boot: &Boot) -> Vec<f64> {
 pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
     let mut problems = Vec::new();
     // The walk.
-    let events = script::parse(&tracking::walk_script())?;
     let time = Duration::from_micros(tracking::WALK_RUN_US);
-    let report = script::play(
-        root,
-        metadata,
-        events,
-        (time, WALL),
-        Against::Host,
-        Board::default(),
-    )?;
+    let walk = tracking::walk_script();
+    let report = script::host(root, metadata, &walk, time, Board::default())?;
     println!("{}", report.verdict());
     problems.extend(report.problems.iter().map(|p| format!("walk: {p}")));
-    let boot = report.boots.first().context("no boot")?;
+    let boot = report.first()?;
     let walk = Walk::of(&yaw(boot), u64::from(ServoRate::DEFAULT.period().0))?;
     println!(
         "walk: {} radar frames sent; the yaw {} ms behind the bearing, {:.2}° RMS and at most \
@@ -123,15 +84,16 @@ pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
         walk.rms / 1000.0,
         walk.largest / 1000.0
     );
-    if walk.rms.is_nan() || walk.rms > 5000.0 {
-        problems.push(format!(
-            "walk: RMS error {:.2}°, not within 5°",
-            walk.rms / 1000.0
-        ));
+    let rms = walk.rms / 1000.0;
+    if rms.is_nan() || rms > 5.0 {
+        problems.push(format!("walk: RMS error {rms:.2}°, not within 5°"));
     }
-    if !says(boot, "track: turned to yaw") {
-        problems.push("walk: the frame task never logged `track: turned to yaw`".to_owned());
-    }
+    let turned = boot.says("track: turned to yaw");
+    problem_if!(
+        problems,
+        !turned,
+        "walk: the frame task never logged `track: turned to yaw`"
+    );
     // Two boards.
     let mut yaws = Vec::new();
     for uid in BOARDS {
@@ -144,71 +106,46 @@ pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
         .filter(|&k| (yaws[0][k] - yaws[1][k]).abs() > 30.0)
         .count();
     println!("two boards: yaw differs by more than a count in {differ} of {n} frames");
-    if differ < n / 2 {
-        problems.push(format!(
-            "two boards: the yaw differs in only {differ} of {n} frames"
-        ));
-    }
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", problems.join("; "))
-    }
+    let few = differ < n / 2;
+    problem_if!(
+        problems,
+        few,
+        "two boards: the yaw differs in only {differ} of {n} frames"
+    );
+    project::verdict(&problems)
 }
 
 /// One board of flash unique id `uid`: its run, checked against the host
 /// trace of its seeds, and `seed`'s reply; the problems and its yaw.
 fn board(root: &Path, metadata: &Metadata, uid: u64) -> Result<(Vec<String>, Vec<f64>)> {
-    let events = script::parse("3 seed\n")?;
     let board = Board {
         uid: Some(uid),
         ..Board::default()
     };
-    let time = Duration::from_secs(4);
-    let report = script::play(root, metadata, events, (time, WALL), Against::Host, board)?;
-    let boot = report.boots.first().context("no boot")?;
+    let report = script::host(root, metadata, "3 seed\n", Duration::from_secs(4), board)?;
+    let boot = report.first()?;
     let seed = BoardId(uid).seed().context("an id that is no id")?;
-    let mut problems: Vec<String> = report
-        .problems
-        .iter()
-        .map(|p| format!("board {uid:016x}: {p}"))
-        .collect();
-    let replies = boot.uart_replies();
-    let want = format!("ok seed=board:{seed}");
-    println!(
-        "board {uid:016x}: {}, `seed` answers `{}`",
-        report.verdict(),
-        replies.join(" | ")
-    );
+    let mut problems = report.problems.clone();
+    let (replies, want) = (boot.uart_replies(), format!("ok seed=board:{seed}"));
+    let (verdict, answers) = (report.verdict(), replies.join(" | "));
+    println!("board {uid:016x}: {verdict}, `seed` answers `{answers}`");
     if replies != [want.clone()] {
-        problems.push(format!(
-            "board {uid:016x}: `seed` answered {replies:?}, not `{want}`"
-        ));
+        problems.push(format!("`seed` answered {replies:?}, not `{want}`"));
     }
-    if !says(boot, &format!("board id {uid:016x}: seed board:{seed}")) {
-        problems.push(format!("board {uid:016x}: the boot did not log its id"));
+    if !boot.says(&format!("board id {uid:016x}: seed board:{seed}")) {
+        problems.push("the boot did not log its id".to_owned());
     }
+    let problems = problems.iter().map(|p| format!("board {uid:016x}: {p}"));
+    let problems = problems.collect();
     Ok((problems, yaw(boot)))
 }
 
-/// Whether `boot`'s log has a line containing `text`.
-fn says(boot: &Boot, text: &str) -> bool {
-    boot.log.iter().any(|(_, line)| line.message.contains(text))
-}
-
-/// [`RADAR_DMX_STAGE`]: DMX512 at the full universe rate (a change of a
-/// slot past the head's every 0.23 s) and the radar (a person walking up
-/// and standing) from 1 s to 9 s; `dmx` and `radar` asked at 9.2 s.
+/// [`RADAR_DMX_STAGE`]: DMX512 and a person walking up, 1 s to 9 s;
+/// `dmx` and `radar` asked at 9.2 s.
 pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     let elf = shipped_image(root, metadata)?;
-    let (from, to) = (1.0, 9.0);
-    let mut text = String::new();
-    let mut k = 0;
-    while from + f64::from(k) * 0.23 < to {
-        let _ = writeln!(text, "{:.3} 11={}", from + f64::from(k) * 0.23, k % 2 * 100);
-        k += 1;
-    }
-    let changes = dmx::parse(&text)?;
+    let to = Duration::from_secs(9);
+    let changes = dmx::alternating(Duration::from_secs(1), to)?;
     let mut script = String::from("0 radar on\n");
     for i in 0..30 {
         let _ = writeln!(
@@ -218,26 +155,15 @@ pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
             3000 - 50 * i
         );
     }
-    let events = script::parse(&script)?;
     let query = Duration::from_millis(9200);
-    let radar = line(&events, ServoRate::DEFAULT, Duration::from_secs_f64(to));
-    let pins = PinScript {
-        anchor_slice: SERVOS[0].2,
-        early: EARLY,
-        lines: vec![
-            Chunk::new(b"radar on\r\n".to_vec(), Duration::from_millis(100)),
-            Chunk::new(b"dmx\r\nradar\r\n".to_vec(), query),
-        ],
-        ..PinScript::default()
-    };
-    let report = run::run_with(root, &elf, query + Duration::from_secs(1), WALL, |config| {
+    let lines = vec![Chunk::new(b"dmx\r\nradar\r\n".to_vec(), query)];
+    let radar = (script.as_str(), to);
+    let report = with_radar(root, &elf, radar, lines, query, |config| {
         config.dmx = Some(dmx::line(&changes));
-        config.script = Some(pins);
-        config.radar = radar;
     })?;
     // (The pulses are not the idle's: the radar turns the head. What is
     // checked is that no frame was late: the log says so.)
-    let boot = report.boots.first().context("no boot")?;
+    let boot = report.first()?;
     let replies = boot.uart_replies();
     let reply = |start: &str| replies.iter().find(|r| r.starts_with(start)).cloned();
     let dmx_reply = reply("ok dmx=").unwrap_or_default();
@@ -248,62 +174,58 @@ pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     problems.extend(counted(boot, &radar_reply));
     problems.extend(report.problems.iter().cloned());
     problems.extend(erase(root, &elf)?);
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        bail!("{}", problems.join("; "))
-    }
+    project::verdict(&problems)
 }
 
-/// The problem, if the radar's `reply` did not count every frame `boot`
-/// sent, or counted one bad.
+/// Runs `elf` to a second after `query`: the radar lines of `script` to
+/// its end, `radar on` at 0.1 s then `lines` on UART0, `setup` the rest.
+fn with_radar(
+    root: &Path,
+    elf: &Path,
+    (script, end): (&str, Duration),
+    lines: Vec<Chunk>,
+    query: Duration,
+    setup: impl FnOnce(&mut Config),
+) -> Result<Report> {
+    let radar = line(&script::parse(script)?, ServoRate::DEFAULT, end);
+    let on = Chunk::new(b"radar on\r\n".to_vec(), Duration::from_millis(100));
+    let pins = script::pin_script([vec![on], lines].concat());
+    run::run_with(root, elf, query + Duration::from_secs(1), WALL, |config| {
+        config.script = Some(pins);
+        config.radar = radar;
+        setup(config);
+    })
+}
+
+/// The problem if `reply` missed a frame `boot` sent, or counted one bad.
 fn counted(boot: &Boot, reply: &str) -> Option<String> {
-    let counter = |name: &str| -> Option<u64> {
-        reply
-            .split(' ')
-            .find_map(|f| f.strip_prefix(name)?.strip_prefix('=')?.parse().ok())
-    };
+    let counter = |name| field(reply, name).and_then(|v| v.parse::<u64>().ok());
     (counter("frames") != Some(boot.radar_frames) || counter("bad") != Some(0))
         .then(|| format!("radar: `{reply}` for {} frames sent", boot.radar_frames))
 }
 
 /// The flash's typical times (W25Q16JV): a sector erase, a page program.
-const TYPICAL: super::node::FlashTiming = super::node::FlashTiming {
+const TYPICAL: FlashTiming = FlashTiming {
     erase: Duration::from_millis(45),
     program: Duration::from_micros(400),
 };
 
-/// A `save` at 2 s over settings sectors full of noise (each erase 45 ms
-/// with the interrupts off, the flash's typical time) while a person stands in front of the radar
-/// from 1 s to 5 s; `radar` asked at 5.2 s. The problems.
+/// A `save` at 2 s over noise in the settings sectors (each erase 45 ms
+/// with the interrupts off) while a person stands before the radar from
+/// 1 s to 5 s; `radar` asked at 5.2 s. The problems.
 fn erase(root: &Path, elf: &Path) -> Result<Vec<String>> {
-    let region = crate::elf::Image::read(elf)?
-        .settings
-        .context("the image has no settings region")?;
-    let sectors = super::store::noise(usize::try_from(region.end - region.start)?);
-    let events = script::parse("0 radar on\n1 radar -400,1800\n")?;
+    let sectors = planted::fill(elf, |len| Ok(planted::noise(len)))?;
     let query = Duration::from_millis(5200);
-    let radar = line(&events, ServoRate::DEFAULT, Duration::from_secs(5));
-    let pins = PinScript {
-        anchor_slice: SERVOS[0].2,
-        early: EARLY,
-        lines: vec![
-            Chunk::new(b"radar on\r\n".to_vec(), Duration::from_millis(100)),
-            Chunk::new(b"save\r\n".to_vec(), Duration::from_secs(2)),
-            Chunk::new(b"radar\r\n".to_vec(), query),
-        ],
-        ..PinScript::default()
-    };
-    let report = run::run_with(root, elf, query + Duration::from_secs(1), WALL, |config| {
-        config.script = Some(pins);
-        config.radar = radar;
+    let lines = vec![
+        Chunk::new(b"save\r\n".to_vec(), Duration::from_secs(2)),
+        Chunk::new(b"radar\r\n".to_vec(), query),
+    ];
+    let radar = ("0 radar on\n1 radar -400,1800\n", Duration::from_secs(5));
+    let report = with_radar(root, elf, radar, lines, query, |config| {
         config.rom = Some(TYPICAL);
-        config.flash_fill = Some(super::node::Fill {
-            addr: region.start,
-            hex: sectors,
-        });
+        config.flash_fill = Some(sectors);
     })?;
-    let boot = report.boots.first().context("no boot")?;
+    let boot = report.first()?;
     let erased: f64 = boot.flash.iter().filter(|op| op.0).map(|op| op.2).sum();
     let reply = boot
         .uart_replies()
@@ -349,9 +271,8 @@ mod tests {
 
     #[test]
     fn a_radar_file_holds_radar_lines_only() {
-        let dir = std::env::temp_dir().join(format!("radar-lines-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let (good, bad) = (dir.join("good.txt"), dir.join("bad.txt"));
+        let dir = tempfile::tempdir().unwrap();
+        let (good, bad) = (dir.path().join("good.txt"), dir.path().join("bad.txt"));
         std::fs::write(&good, "1 radar 0,1500\n2 radar none\n").unwrap();
         std::fs::write(&bad, "1 radar 0,1500\n2 nod\n").unwrap();
         let events = read(&good).unwrap();
@@ -362,6 +283,5 @@ mod tests {
             error.contains("line 2: `nod` is not a radar line"),
             "{error}"
         );
-        let _ = std::fs::remove_dir_all(dir);
     }
 }

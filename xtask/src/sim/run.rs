@@ -9,63 +9,60 @@ use idle_head_core::pwm_clock::{PICO_SYS_HZ, SliceClock};
 use idle_head_core::servo::ServoRate;
 
 use super::{
-    event::{Event, Op, Why},
+    event::{End, Event, Op, Unmodelled},
     expect,
     image::{self, SERVOS},
     node,
     pulses::{self, Limits, ServoCheck, Timing, Train},
-    unmodelled::Unmodelled,
 };
 use crate::log::{Defmt, LogLine};
 
-/// Virtual time without a log byte or a pin edge after which a run is
-/// declared stuck: 50 frames.
+/// Wall-time limit of one emulator run.
+pub const WALL: Duration = Duration::from_secs(120);
+
+/// No log byte or pin edge for this long: a stuck run (50 frames).
 pub const SILENCE: Duration = Duration::from_secs(1);
 
-/// One boot: from power-on or a reset to the next reset or the end. Times
-/// are ns of virtual time since power-on.
+/// One boot, power-on or a reset to the next reset or the end; times in ns
+/// of virtual time since power-on.
 #[derive(Debug, Default)]
 pub struct Boot {
     pub start: f64,
     pub end: f64,
-    /// Whether the watchdog ended it; a power cycle.
+    /// Whether the watchdog or a power cycle ended it.
     pub watchdog: bool,
     pub power_cycled: bool,
     /// The decoded log, each line with the time its last byte left.
     pub log: Vec<(f64, LogLine)>,
-    /// Per servo, what the emulator reported, and the verdict on it.
+    /// Per servo, what the emulator reported and the verdict on it.
     pub trains: [Train; 3],
     pub servos: [ServoCheck; 3],
-    /// Cycles of each frame update, in order.
+    /// Cycles of each frame update; peak stack from the RAM at the end, B.
     pub frame_cycles: Vec<u64>,
-    /// Peak stack use, bytes, from the emulated RAM at the end.
     pub stack_peak: Option<u64>,
-    /// Bytes UART0 sent; scripted bytes that found its receive FIFO full;
-    /// when each UART script's last byte went onto the RX line.
+    /// Bytes UART0 sent; scripted bytes that found its RX FIFO full; when
+    /// each UART script's last byte went onto the RX line.
     pub uart: Vec<u8>,
     pub uart_overruns: usize,
     pub uart_lines: Vec<f64>,
-    /// When the emulator's USB host had configured the device; the bytes
-    /// the device sent on its CDC-ACM port; when each scripted USB chunk
-    /// went to it.
+    /// When the USB host configured the device; the bytes the device sent;
+    /// when each scripted USB chunk went to it.
     pub usb_connected: Option<f64>,
     pub usb: Vec<u8>,
     pub usb_in: Vec<f64>,
-    /// What the boot ROM erased (`true`) and programmed, in order: the
-    /// bytes, and how long it kept the flash busy (the interrupts off), ns.
+    /// The boot ROM's erases (`true`) and programs: bytes, busy ns.
     pub flash: Vec<(bool, u64, f64)>,
-    /// When each DMX frame that carried a change ended, and its number.
+    /// When each DMX frame carrying a change ended, and its number.
     pub dmx_changes: Vec<f64>,
     pub dmx_frames: Vec<u64>,
     /// The input pins the script drove: when, which GPIO, high or low.
     pub drives: Vec<(f64, u8, bool)>,
-    /// The radar frames sent to the end of the run.
+    /// Radar frames sent in the run.
     pub radar_frames: u64,
 }
 
 impl Boot {
-    /// The reply lines UART0 (or, with `usb`, the USB port) sent, without
-    /// their line ends.
+    /// The reply lines UART0 (`usb`: the USB port) sent, without line ends.
     pub fn replies(&self, usb: bool) -> Vec<String> {
         let bytes = String::from_utf8_lossy(if usb { &self.usb } else { &self.uart });
         bytes.split_terminator("\r\n").map(str::to_owned).collect()
@@ -82,89 +79,24 @@ impl Boot {
     }
 }
 
-/// How the harness ended: why ([`Why::Time`] when it ran the whole virtual
-/// time), when, after how many instructions and how much wall time, and
-/// its error if it failed.
-#[derive(Debug, Default)]
-pub struct End {
-    pub why: Why,
-    pub ns: f64,
-    pub instructions: u64,
-    pub wall_ms: u64,
-    pub error: Option<String>,
-}
-
-impl End {
-    /// How a run ended: its last `end` event.
-    pub fn of(events: &[Event]) -> Result<Self> {
-        match events.iter().rfind(|e| matches!(e, Event::End { .. })) {
-            Some(Event::End {
-                why,
-                ns,
-                instructions,
-                wall_ms,
-                msg,
-            }) => Ok(Self {
-                why: *why,
-                ns: *ns,
-                instructions: *instructions,
-                wall_ms: *wall_ms,
-                error: msg.clone(),
-            }),
-            _ => bail!("the emulator harness ended without saying how"),
-        }
-    }
-
-    /// Why the run did not reach its virtual time, if it did not.
-    pub fn problem(&self, silence: Duration) -> Option<String> {
-        let at = self.ns / 1e9;
-        let stuck = "the emulator made no progress";
-        Some(match self.why {
-            Why::Time => return None,
-            Why::Silent => format!(
-                "{stuck}: no log byte and no pin edge for {} s of virtual time (stopped at \
-                 {at:.3} s)",
-                silence.as_secs_f64()
-            ),
-            Why::Asleep => {
-                format!("{stuck}: the core sleeps with nothing left to wake it (at {at:.3} s)")
-            }
-            Why::Wall => format!(
-                "{stuck} in time: stopped after {:.1} s of wall time at {at:.3} s of virtual time \
-                 (raise with --timeout)",
-                Duration::from_millis(self.wall_ms).as_secs_f64()
-            ),
-            Why::Break => format!("the firmware hit a breakpoint at {at:.3} s"),
-            Why::Closed => format!("the live run's input closed at {at:.3} s"),
-            Why::Error => format!(
-                "the emulator stopped (error) at {at:.3} s: {}",
-                self.error.as_deref().unwrap_or("no reason given")
-            ),
-        })
-    }
-}
-
 /// Everything one run produced.
 #[derive(Debug, Default)]
 pub struct Report {
     pub boots: Vec<Boot>,
     pub end: End,
-    /// The emulator's complaints, each with how often it came.
+    /// The emulator's complaints and how often each came.
     pub emulator: Vec<(String, usize)>,
-    /// Accesses to peripherals the emulator does not model.
     pub unmodelled: Vec<Unmodelled>,
-    /// Problems with the run itself (it stopped early, a frame is missing...).
+    /// What is wrong with the run (it stopped early, a frame is missing...).
     pub problems: Vec<String>,
-    /// The console exchange as a transcript, if the run had one.
+    /// The console exchange's transcript, if any.
     pub exchange: Option<String>,
-    /// The servos' rate the pulses were checked at (50 Hz unless
-    /// [`check_at`] said).
+    /// The servos' rate the pulses were checked at.
     pub rate: ServoRate,
 }
 
-/// Runs `elf` for `virtual_time` (at most `wall` of wall time) with the
-/// harness configured by `setup`, and sorts what happened into boots; the
-/// pulses are not checked against the host.
+/// Runs `elf` for `virtual_time` (at most `wall`) with the harness set up
+/// by `setup`, sorted into boots; the pulses not checked.
 pub fn run_with(
     root: &Path,
     elf: &Path,
@@ -207,8 +139,7 @@ pub fn run_with(
     Ok(report)
 }
 
-/// Sorts the events into boots and decodes each boot's log; a boot's peak
-/// stack is how far below `stack_top` it wrote.
+/// Sorts the events into boots, each log decoded, each peak stack found.
 pub fn sort(events: &[Event], defmt: &Defmt, stack_top: u64) -> Result<Report> {
     let mut report = Report::default();
     let mut decoder = None;
@@ -231,29 +162,12 @@ pub fn sort(events: &[Event], defmt: &Defmt, stack_top: u64) -> Result<Report> {
                 Some((_, count)) => *count += 1,
                 None => report.emulator.push((msg.clone(), 1)),
             },
-            (
-                Event::Unmodelled {
-                    peripheral,
-                    op,
-                    offset,
-                    count,
-                },
-                _,
-            ) => {
-                let peripheral = peripheral.clone();
-                let (op, offset, count) = (*op, *offset, *count);
-                report.unmodelled.push(Unmodelled {
-                    peripheral,
-                    op,
-                    offset,
-                    count,
-                });
-            }
-            (Event::End { .. }, _) => {}
+            (Event::Unmodelled(access), _) => report.unmodelled.push(access.clone()),
+            (Event::End(_), _) => {}
             (_, None) => bail!("harness event before the first boot: {event:?}"),
             (Event::Rtt { ns, hex }, Some(boot)) => {
                 if let Some(decoder) = decoder.as_mut() {
-                    let lines = defmt.lines(decoder.as_mut(), hex);
+                    let lines = defmt.lines(decoder.as_mut(), &hex.0);
                     boot.log.extend(lines.into_iter().map(|line| (*ns, line)));
                 }
             }
@@ -279,7 +193,7 @@ fn into_boot(boot: &mut Boot, event: &Event) {
             pin,
             high,
             ns,
-            reset: false,
+            reset: None | Some(false),
         } => {
             if let Some(i) = by_pin(pin) {
                 boot.trains[i].edges.push((ns, high));
@@ -303,8 +217,8 @@ fn into_boot(boot: &mut Boot, event: &Event) {
         Event::Call { cycles, .. } => boot.frame_cycles.push(cycles),
         Event::Drive { pin, high, ns } => boot.drives.push((ns, pin, high)),
         Event::Watchdog { .. } => boot.watchdog = true,
-        Event::Uart { ref hex, .. } => boot.uart.extend(hex),
-        Event::Usb { ref hex, .. } => boot.usb.extend(hex),
+        Event::Uart { ref hex, .. } => boot.uart.extend(&hex.0),
+        Event::Usb { ref hex, .. } => boot.usb.extend(&hex.0),
         Event::UartOverrun { .. } => boot.uart_overruns += 1,
         Event::UartRx { ns, .. } => boot.uart_lines.push(ns),
         Event::UsbConnected { ns } => boot.usb_connected = Some(ns),
@@ -318,14 +232,11 @@ fn into_boot(boot: &mut Boot, event: &Event) {
         Event::Flash {
             op, len, busy_ns, ..
         } => boot.flash.push((op == Op::Erase, len, busy_ns)),
-        // A reset's pin release and a slice switched off are not needed;
-        // the rest is sorted in [`sort`].
-        _ => {}
+        _ => {} // a reset's pin release, a slice off: not needed
     }
 }
 
-/// Checks every boot's pulses against the host's duties for the shipped
-/// image's idle (`expect.rs`), at 50 Hz.
+/// Checks every boot's pulses against the shipped image's idle, 50 Hz.
 pub fn check(report: &mut Report) -> Result<()> {
     let trains = report.boots.iter().flat_map(|boot| &boot.trains);
     let frames = trains.map(|train| train.writes.len()).max().unwrap_or(0);
@@ -334,9 +245,8 @@ pub fn check(report: &mut Report) -> Result<()> {
     Ok(())
 }
 
-/// Checks every boot's pulses against `expected`, the duties the host
-/// computed for each frame from frame 0 (`[pitch, roll, yaw]`), for a run
-/// at `rate` from its first frame.
+/// Checks every boot's pulses against `expected` (the host's
+/// `[pitch, roll, yaw]` from frame 0) at `rate`.
 pub fn check_at(report: &mut Report, expected: &[[u16; 3]], rate: ServoRate) {
     report.rate = rate;
     let (timing, limits) = (timing_at(rate), limits_at(rate));
@@ -344,7 +254,6 @@ pub fn check_at(report: &mut Report, expected: &[[u16; 3]], rate: ServoRate) {
     for (b, boot) in report.boots.iter_mut().enumerate() {
         for (i, train) in boot.trains.iter_mut().enumerate() {
             train.end = boot.end;
-            train.reset = boot.watchdog;
             let duties: Vec<u16> = expected.iter().map(|frame| frame[i]).collect();
             let verdict = pulses::check(train, &duties, &timing, limits[i]);
             let name = SERVOS[i].0;
@@ -366,8 +275,7 @@ pub fn check_at(report: &mut Report, expected: &[[u16; 3]], rate: ServoRate) {
     }
 }
 
-/// The Pico's slice clock at `rate` (every rate has one:
-/// `idle_head_core::pwm_clock` checks it).
+/// The Pico's slice clock at `rate` (`pwm_clock` checks every rate's).
 fn clock(rate: ServoRate) -> SliceClock {
     let none = SliceClock {
         divider_16ths: 0,
@@ -376,12 +284,11 @@ fn clock(rate: ServoRate) -> SliceClock {
     SliceClock::for_period(PICO_SYS_HZ, rate.period()).unwrap_or(none)
 }
 
-/// The PWM timing of the Pico's servo slices at 50 Hz.
+/// The PWM timing of the Pico's servo slices at 50 Hz, or at `rate`.
 pub fn timing() -> Timing {
     timing_at(ServoRate::DEFAULT)
 }
 
-/// The PWM timing of the Pico's servo slices at `rate`.
 #[allow(clippy::cast_precision_loss)] // 312 500 ps
 pub fn timing_at(rate: ServoRate) -> Timing {
     let clock = clock(rate);

@@ -1,10 +1,6 @@
-//! `cargo xtask sim --script FILE`: a trace script played into the shipped
-//! image (pin lines drive GP2 to GP5, console lines go to UART0 2 ms before
-//! their time, times from the first frame), every pulse checked against
-//! the host trace of the same script; radar lines go to GP13 as the
-//! LD2450's frames (`radar.rs`); at another
-//! servo rate (`--rate`) the image boots on settings of that rate planted
-//! in its settings sectors, and the trace and the check run at it.
+//! `cargo xtask sim --script FILE`: a trace script into the shipped image
+//! (pin lines on GP2 to GP5, console lines on UART0, radar lines on GP13;
+//! times from the first frame), every pulse against its host trace.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -17,10 +13,9 @@ use idle_head_core::servo::ServoRate;
 use idle_head_core::settings::Settings;
 
 use super::image::{SERVOS, input_pins};
-use super::node::{Chunk, Fill, PinLevel, PinScript, nanos};
+use super::node::{Chunk, PinLevel, PinScript, nanos};
 use super::run::{self, Report};
 use super::{planted, pulses_csv};
-use crate::elf;
 use crate::project::{Metadata, PICO};
 use crate::trace::{self, Event, Kind, radar::PERIOD_US};
 
@@ -30,10 +25,8 @@ pub const EARLY: Duration = Duration::from_millis(2);
 /// The radar's (an LD2450's) line rate.
 const BAUD: u32 = 256_000;
 
-/// The first frame a console line is taken at: the board's console reads
-/// its UART once the boot's work (the first loop sets) is done, some 40 ms
-/// after the first frame; a line timed earlier is taken here, in the
-/// emulator and in the host trace it is checked against alike.
+/// The console reads its UART some 40 ms after the first frame: an earlier
+/// line moves here, in the emulator and the host trace alike.
 pub const CONSOLE_UP: Duration = Duration::from_millis(100);
 
 /// The events of the script at `path`.
@@ -55,9 +48,8 @@ pub fn default_time(events: &[Event]) -> Duration {
     Duration::from_micros(last) + Duration::from_secs(5)
 }
 
-/// The board a script plays on: the servos' rate from the first frame (the
-/// image boots on settings of that rate) and the flash's unique id (none:
-/// the flash answers all ones, and the idle plays the paper's seeds).
+/// The board a script plays on: the servos' rate (planted in its settings)
+/// and the flash's unique id (none: all ones, the paper's seeds).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Board {
     pub rate: ServoRate,
@@ -76,11 +68,8 @@ pub enum Against {
     Written,
 }
 
-/// Runs `events` in the shipped image (built) for `time` of virtual time
-/// from its first frame (at most `wall` of wall time), the servos at `rate`
-/// from the first frame (the image boots on settings of that rate), and
-/// checks every pulse `against` the host trace or what was written
-/// (console lines before [`CONSOLE_UP`] moved there, in both).
+/// Runs `events` in the shipped image (built) for `time` from its first
+/// frame (at most `wall`) on `board`; every pulse checked `against`.
 pub fn play(
     root: &Path,
     metadata: &Metadata,
@@ -107,47 +96,28 @@ pub fn play(
     }
     // (Lines keep their order: a pin line before 0.1 s stays first.)
     events.sort_by_key(|e| e.at_us);
-    let mut script = PinScript {
-        anchor_slice: SERVOS[0].2,
-        early: EARLY,
-        ..PinScript::default()
-    };
+    let mut script = pin_script(Vec::new());
     for event in &events {
         let at = Duration::from_micros(event.at_us);
+        // A line goes in before the frame that takes it in the host trace.
+        let frame = Duration::from_micros(event.at_us.next_multiple_of(period));
         match event.kind {
-            Kind::Pin { input, high } => script.pins.push(PinLevel {
-                at,
-                pin: input,
-                high,
-            }),
+            Kind::Pin { input: pin, high } => script.pins.push(PinLevel { at, pin, high }),
             Kind::Act(_) | Kind::Console => {
-                // In before the frame that takes it in the host trace.
-                let frame = Duration::from_micros(event.at_us.next_multiple_of(period));
-                script
-                    .lines
-                    .push(Chunk::new(format!("{}\r\n", event.text), frame));
+                let line = format!("{}\r\n", event.text);
+                script.lines.push(Chunk::new(line, frame));
             }
-            // The radar's frames, below.
-            Kind::Radar(_) => {}
+            Kind::Radar(_) => {} // see `line`
         }
     }
     let radar = line(&events, rate, time);
-    let planted = if rate == ServoRate::DEFAULT {
-        None
-    } else {
-        let image = elf::Image::read(&PICO.elf(metadata))?;
-        let region = image.settings.context("the image has no settings region")?;
-        let settings = Settings {
-            rate,
-            ..Settings::DEFAULT
-        };
-        let len = usize::try_from(region.end - region.start)?;
-        let hex = planted::settings_sectors(&settings, len)?;
-        Some(Fill {
-            addr: region.start,
-            hex,
-        })
+    let settings = Settings {
+        rate,
+        ..Settings::DEFAULT
     };
+    let sectors = |len| planted::settings_sectors(&settings, len);
+    let planted = (rate != ServoRate::DEFAULT).then(|| planted::fill(&PICO.elf(metadata), sectors));
+    let planted = planted.transpose()?;
     // The boot before the first frame: well under a tenth of a second.
     let boot = Duration::from_millis(100);
     let mut report = run::run_with(root, &PICO.elf(metadata), time + boot, wall, |config| {
@@ -155,7 +125,7 @@ pub fn play(
         config.script = Some(script);
         config.flash_fill = planted;
         config.radar = radar;
-        config.uid = board.uid;
+        config.uid = board.uid.map(|id| format!("{id:016x}"));
         // A head relaxed at rest is silent for as long as it rests (no
         // pulse, no log line but once a loop): the wall limit alone tells a
         // stuck run.
@@ -182,6 +152,29 @@ pub fn play(
     Ok(report)
 }
 
+/// Boot 0's script: `lines` on UART0, [`EARLY`], from the first frame.
+pub fn pin_script(lines: Vec<Chunk>) -> PinScript {
+    let (anchor_slice, pins, early) = (SERVOS[0].2, Vec::new(), EARLY);
+    PinScript {
+        anchor_slice,
+        pins,
+        lines,
+        early,
+    }
+}
+
+/// Plays `text` on `board` for `time`, checked against its host trace.
+pub fn host(
+    root: &Path,
+    metadata: &Metadata,
+    text: &str,
+    time: Duration,
+    board: Board,
+) -> Result<Report> {
+    let time = (time, run::WALL);
+    play(root, metadata, parse(text)?, time, Against::Host, board)
+}
+
 /// Whether a console line sets the servo rate (`servo rate <hz>`).
 fn changes_rate(line: &str) -> bool {
     let words: Vec<String> = line
@@ -191,8 +184,7 @@ fn changes_rate(line: &str) -> bool {
     matches!(words.as_slice(), [servo, rate, _, ..] if servo == "servo" && rate == "rate")
 }
 
-/// The duties boot 0 wrote, frame by frame from frame 0 (its compare
-/// writes from the one its slice was enabled with on).
+/// The duties boot 0 wrote, from frame 0 (the write before the enable).
 fn written(report: &Report) -> Vec<[u16; 3]> {
     let Some(boot) = report.boots.first() else {
         return Vec::new();
@@ -211,8 +203,7 @@ fn written(report: &Report) -> Vec<[u16; 3]> {
     (0..n).map(duty).collect()
 }
 
-/// `cargo xtask sim --script FILE [--rate HZ] [--pulses CSV]` (and
-/// `--radar FILE`: its `events`).
+/// `cargo xtask sim --script FILE` or `--radar FILE`: its `events`.
 pub fn command(
     root: &Path,
     metadata: &Metadata,
@@ -242,9 +233,8 @@ pub fn command(
     Ok(report.problems.is_empty())
 }
 
-/// The harness's `radar` for the radar lines of `events` (none: no radar
-/// wired), its frames from the script's time 0 to `time`, each in
-/// [`EARLY`] before the first servo frame at `rate` at or after its time.
+/// The harness's `radar` for the radar lines of `events` (none: none
+/// wired), to `time`, each line in [`EARLY`] before its frame at `rate`.
 pub fn line(events: &[Event], rate: ServoRate, time: Duration) -> Option<Value> {
     let lines: Vec<Value> = events
         .iter()

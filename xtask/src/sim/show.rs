@@ -1,7 +1,6 @@
-//! Show control in the emulator: `cargo xtask sim --dmx FILE`, and the
-//! stage that checks on the shipped image, from the pulses, that DMX and a
-//! Bottango session drive the head and that lost frames and the end of a
-//! curve hand it back to the idle (docs/dev/emulators.md, "Show control").
+//! Show control: `cargo xtask sim --dmx FILE`, and the stage: DMX and
+//! Bottango drive the head, lost frames and a curve's end hand it back to
+//! the idle (docs/dev/emulators.md, "Show control").
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
@@ -38,9 +37,8 @@ const SCRIPT: &str = "\
 const BOTTANGO: Duration = Duration::from_millis(10_500);
 const STOP: Duration = Duration::from_millis(12_600);
 
-/// The session's lines, with their hashes: the handshake, the sync, yaw
-/// and pitch registered, a curve each 200 ms after the sync, 1 s, eased in
-/// and out.
+/// The session's lines with their hashes: handshake, sync, yaw and pitch
+/// registered, a 1 s eased curve each 200 ms after the sync.
 fn bottango_lines() -> Vec<String> {
     [
         "hRQ,144",
@@ -58,10 +56,8 @@ fn bottango_lines() -> Vec<String> {
 /// the run's log and pulses, not checked against the host.
 pub fn command(root: &Path, metadata: &Metadata, args: &super::Args) -> Result<bool> {
     let changes = args.dmx.as_deref().map(dmx::read).transpose()?;
-    let last = changes
-        .as_ref()
-        .and_then(|c| c.last())
-        .map(|last| last.at + Duration::from_secs(3));
+    let last = changes.as_ref().and_then(|c| c.last());
+    let last = last.map(|last| last.at + Duration::from_secs(3));
     let time = args.virtual_time.or(last).unwrap_or(DEFAULT_TIME);
     let elf = stages::shipped_image(root, metadata)?;
     let report = run::run_with(root, &elf, time, args.timeout, |config| {
@@ -71,12 +67,9 @@ pub fn command(root: &Path, metadata: &Metadata, args: &super::Args) -> Result<b
     let boot = report.first()?;
     print_pulses(boot, args.pulses.as_deref())?;
     if let Some(changes) = &changes {
+        let (n, carried) = (changes.len(), boot.dmx_changes.len());
         let from = changes.first().map_or(0.0, |c| c.at.as_secs_f64());
-        let carried = boot.dmx_changes.len();
-        println!(
-            "dmx: {} change(s) from {from:.3} s on, {carried} frame(s) carrying one",
-            changes.len()
-        );
+        println!("dmx: {n} change(s) from {from:.3} s on, {carried} frame(s) carrying one");
     }
     for problem in &report.problems {
         println!("problem: {problem}");
@@ -84,8 +77,7 @@ pub fn command(root: &Path, metadata: &Metadata, args: &super::Args) -> Result<b
     Ok(report.problems.is_empty())
 }
 
-/// Per servo: pulses, shortest and longest, as measured; and with
-/// `--pulses`, the CSV of them.
+/// Per servo: pulses, shortest, longest; with `csv`, their CSV.
 fn print_pulses(boot: &Boot, csv: Option<&Path>) -> Result<()> {
     println!("\nservo   pulses   min µs   max µs");
     for ((name, ..), train) in SERVOS.iter().zip(&boot.trains) {
@@ -109,25 +101,17 @@ pub fn test_show(root: &Path, metadata: &Metadata) -> Result<()> {
     show(root, metadata, None)
 }
 
-/// `cargo xtask sim --show [--pulses FILE.csv]`: the stage, its pulses
-/// written to `pulses` too.
+/// `cargo xtask sim --show [--pulses FILE.csv]`: the stage.
 pub fn show(root: &Path, metadata: &Metadata, pulses: Option<&Path>) -> Result<()> {
     let changes = dmx::parse(SCRIPT)?;
     let elf = stages::shipped_image(root, metadata)?;
     let lines = bottango_lines();
-    let report = run::run_with(
-        root,
-        &elf,
-        Duration::from_secs(14),
-        stages::WALL,
-        |config| {
-            config.dmx = Some(dmx::line(&changes));
-            config.usb = vec![
-                Chunk::new(lines.concat(), BOTTANGO),
-                Chunk::new(b"STOP,h326\n", STOP),
-            ];
-        },
-    )?;
+    let time = Duration::from_secs(14);
+    let report = run::run_with(root, &elf, time, stages::WALL, |config| {
+        config.dmx = Some(dmx::line(&changes));
+        let stop = Chunk::new(b"STOP,h326\n", STOP);
+        config.usb = vec![Chunk::new(lines.concat(), BOTTANGO), stop];
+    })?;
     print!("{}", report.log_text(false));
     let boot = report.first()?;
     print_pulses(boot, pulses)?;
@@ -135,11 +119,9 @@ pub fn show(root: &Path, metadata: &Metadata, pulses: Option<&Path>) -> Result<(
     print!("{text}");
     problems.extend(report.problems.iter().cloned());
     problems.extend(stages::console_ram(&elf, &report)?);
-    if report.boots.len() != 1 {
-        problems.push(format!(
-            "{} boots: the watchdog reset the image",
-            report.boots.len()
-        ));
+    let boots = report.boots.len();
+    if boots != 1 {
+        problems.push(format!("{boots} boots: the watchdog reset the image"));
     }
     project::verdict(&problems)
 }
@@ -168,10 +150,10 @@ impl Pulses {
             for (n, t, _) in self.window(axis, from, to) {
                 let counts = self.servos[axis][n].width / run::timing().count_ns;
                 let want = self.idle.get(n).map_or(0.0, |d| f64::from(d[axis]));
+                let name = SERVOS[axis].0;
                 if (counts - want).abs() > 1.5 {
                     off.push(format!(
-                        "{} at {t:.3} s: {counts:.0} counts, not {want}",
-                        SERVOS[axis].0
+                        "{name} at {t:.3} s: {counts:.0} counts, not {want}"
                     ));
                 }
             }
@@ -203,10 +185,8 @@ impl Pulses {
 fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
     let servos = boot.trains.each_ref().map(pulses::measure);
     let frames = servos.iter().map(Vec::len).max().unwrap_or(0);
-    let p = Pulses {
-        servos,
-        idle: expect::pico_duties(frames)?,
-    };
+    let idle = expect::pico_duties(frames)?;
+    let p = Pulses { servos, idle };
     let (mut text, mut problems) = (String::new(), Vec::new());
     let (yaw, pitch) = (2, 0);
     // The gesture limit, 250 °/s, in m° a frame, and a count of rounding.
@@ -214,10 +194,7 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
 
     // 1. Mix 255, yaw coarse 200.
     let limits = DriverConfig::DEFAULT.servos[yaw].limits;
-    let (lo, hi) = (
-        f64::from(limits.min.millidegrees()),
-        f64::from(limits.max.millidegrees()),
-    );
+    let [lo, hi] = [limits.min, limits.max].map(|a| f64::from(a.millidegrees()));
     let want = lo + (hi - lo) * 51_200.0 / 65_535.0;
     let held = p.window(yaw, 4.3, 5.0);
     let worst = held.iter().map(|w| (w.2 - want).abs()).fold(0.0, f64::max);
@@ -235,18 +212,17 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
         fastest / 1e3,
         step / 1e3
     );
-    if held.len() < 30 || worst > 100.0 {
-        let (want, worst) = (want / 1e3, worst / 1e3);
-        problems.push(format!(
-            "yaw did not hold {want:.3}° under DMX (off by {worst:.3}°)"
-        ));
-    }
-    if fastest > step {
-        problems.push(format!(
-            "a yaw step of {:.3}° a frame: past the speed limit",
-            fastest / 1e3
-        ));
-    }
+    let (want_deg, worst_deg, fastest_deg) = (want / 1e3, worst / 1e3, fastest / 1e3);
+    problem_if!(
+        problems,
+        held.len() < 30 || worst > 100.0,
+        "yaw did not hold {want_deg:.3}° under DMX (off by {worst_deg:.3}°)"
+    );
+    problem_if!(
+        problems,
+        fastest > step,
+        "a yaw step of {fastest_deg:.3}° a frame: past the speed limit"
+    );
 
     // 2. The frames dropped at 5 s: lost at 6 s, and the idle's own pulses.
     let lost: Vec<f64> = (boot.log.iter())
@@ -257,11 +233,11 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
         text,
         "dmx signal lost at {lost:.3?} s (frames dropped at 5.0 s and 9.0 s)"
     );
-    if !lost.first().is_some_and(|&t| (5.95..6.2).contains(&t)) {
-        problems.push(format!(
-            "the first `dmx: signal lost` came at {lost:?} s, not 1 s after 5.0 s"
-        ));
-    }
+    problem_if!(
+        problems,
+        !lost.first().is_some_and(|&t| (5.95..6.2).contains(&t)),
+        "the first `dmx: signal lost` came at {lost:?} s, not 1 s after 5.0 s"
+    );
     let jumps: Vec<String> = (0..3)
         .map(|axis| (SERVOS[axis].0, p.fastest(axis, 5.0, 7.0)))
         .filter(|&(_, fastest)| fastest > step)
@@ -273,12 +249,12 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
         "hand-back: jumps past the limit: {jumps:?}; pulses off the idle's from 6.8 s to 7.0 s: {}",
         after_loss.len()
     );
-    if !jumps.is_empty() {
-        problems.push(format!(
-            "a jump after the frames dropped: {}",
-            jumps.join(", ")
-        ));
-    }
+    let jumped = jumps.join(", ");
+    problem_if!(
+        problems,
+        !jumps.is_empty(),
+        "a jump after the frames dropped: {jumped}"
+    );
     if let Some(first) = after_loss.first() {
         problems.push(format!(
             "not the idle's own pulses after the hand-back: {first}"
@@ -286,9 +262,7 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
     }
 
     // 3. One nod from the band entry at 7.5 s.
-    let nods = boot
-        .log
-        .iter()
+    let nods = (boot.log.iter())
         .filter(|(_, l)| l.message.contains(": dmx nod: ok"))
         .count();
     let during = p.off_idle(7.5, 8.5).len();
@@ -299,14 +273,16 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
          during it, {} after it (9.3 s to 10.5 s)",
         after.len()
     );
-    if nods != 1 {
-        problems.push(format!("{nods} nods logged for one band entry, not 1"));
-    }
-    if during < 20 {
-        problems.push(format!(
-            "only {during} pulses of a nod: the band entry played none"
-        ));
-    }
+    problem_if!(
+        problems,
+        nods != 1,
+        "{nods} nods logged for one band entry, not 1"
+    );
+    problem_if!(
+        problems,
+        during < 20,
+        "only {during} pulses of a nod: the band entry played none"
+    );
     if let Some(first) = after.first() {
         problems.push(format!("the nod went on: {first}"));
     }
@@ -333,24 +309,24 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
         top / 1e3,
         back.len()
     );
-    if !handshake || oks != lines.len() + 1 {
-        problems.push(format!(
-            "Bottango's session was not answered as expected: {usb:?}"
-        ));
-    }
-    if !(0.64..0.78).contains(&crossing) {
-        problems.push(format!(
-            "yaw crossed 10° {crossing:.3} s after the curve was sent, not about 0.7 s"
-        ));
-    }
+    problem_if!(
+        problems,
+        !handshake || oks != lines.len() + 1,
+        "Bottango's session was not answered as expected: {usb:?}"
+    );
+    problem_if!(
+        problems,
+        !(0.64..0.78).contains(&crossing),
+        "yaw crossed 10° {crossing:.3} s after the curve was sent, not about 0.7 s"
+    );
     for (axis, want) in [(yaw, 20_000.0), (pitch, 5_000.0)] {
         let top = p.top(axis, sent, sent + 2.0);
-        if (top - want).abs() > 150.0 {
-            let (name, top, want) = (SERVOS[axis].0, top / 1e3, want / 1e3);
-            problems.push(format!(
-                "{name} topped at {top:.3}°, not the curve's {want}°"
-            ));
-        }
+        let (name, top_deg, want_deg) = (SERVOS[axis].0, top / 1e3, want / 1e3);
+        problem_if!(
+            problems,
+            (top - want).abs() > 150.0,
+            "{name} topped at {top_deg:.3}°, not the curve's {want_deg}°"
+        );
     }
     if let Some(first) = back.first() {
         problems.push(format!("the idle did not resume after the curve: {first}"));

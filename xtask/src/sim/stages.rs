@@ -1,6 +1,5 @@
-//! The emulator's stages of `cargo xtask test` that need no scenario file
-//! of their own: the pulses at 50 and 333 Hz, the watchdog drill, the
-//! console's exchanges and the emulator's own failures.
+//! The emulator stages without a module of their own: pulses at 50 and
+//! 333 Hz, the watchdog drill, the console, the emulator's failures.
 
 use std::{
     path::{Path, PathBuf},
@@ -12,11 +11,13 @@ use idle_head_core::servo::ServoRate;
 use xshell::cmd;
 
 use super::{
-    DEFAULT_TIME, exchange,
+    DEFAULT_TIME,
+    event::End,
+    exchange,
     image::{PicoImage, SERVOS, VECTOR_TABLE},
     node,
-    run::{self, End, Report},
-    script::{self, Against},
+    run::{self, Report},
+    script,
 };
 use crate::{
     elf,
@@ -27,30 +28,23 @@ use crate::{
 /// Stage names.
 pub const PULSES_STAGE: &str =
     "Pico image in the RP2040 emulator: every pulse the host's duty, frame for frame";
-/// See [`PULSES_STAGE`].
 pub const DRILL_STAGE: &str =
     "watchdog drill in the RP2040 emulator: reset, logged, soft start again";
-/// See [`PULSES_STAGE`].
 pub const CONSOLE_STAGE: &str = "Pico image in the RP2040 emulator: the console's UART and USB \
      exchanges; its RAM within budget";
-/// See [`PULSES_STAGE`].
 pub const RATE_STAGE: &str = "Pico image in the RP2040 emulator at 333 Hz (booted on saved \
      settings): every pulse the host trace's duty, frame for frame";
-/// See [`PULSES_STAGE`].
 pub const FAILURES_STAGE: &str =
     "RP2040 emulator: a hung, a sleeping and a wrong image each fail clearly";
 
 /// Frames the pulse check must cover: a whole loop (1500) and then some.
 const MIN_FRAMES: usize = 1600;
-/// Wall-time limit of one emulator run.
-pub const WALL: Duration = Duration::from_secs(120);
-/// The drill image stops its frames after this many frames of each boot
-/// (`DRILL_FRAMES` in `crates/firmware/src/hooks.rs`).
+pub use super::run::WALL;
+/// As in `crates/firmware/src/hooks.rs`: the drill's frames in each boot,
+/// the watchdog timeout.
 const DRILL_FRAMES: usize = 150;
-/// The Pico's watchdog timeout (`WATCHDOG_TIMEOUT` in `crates/firmware/src/hooks.rs`).
 const WATCHDOG_MS: f64 = 100.0;
-/// The console run: both scripts (UART at 3 s, USB at 4 s) and a second
-/// for the last replies.
+/// The console run: UART script at 3 s, USB at 4 s, a second for replies.
 pub const CONSOLE_TIME: Duration = Duration::from_secs(6);
 
 /// The script of [`RATE_STAGE`]: the fade-in, then a nod, a look and its
@@ -64,35 +58,24 @@ const RATE_SCRIPT: &str = "\
 5.4 center
 ";
 
-/// [`RATE_STAGE`]: the shipped image booted on settings of 333 Hz and
-/// [`RATE_SCRIPT`] played into it for 7 s; every pulse checked against the
-/// host trace at 333 Hz (its 3003 µs period, 60 060 counts of 50 ns).
+/// [`RATE_STAGE`]: [`RATE_SCRIPT`] for 7 s into the image booted on 333 Hz
+/// settings, every pulse against the host trace at 333 Hz.
 pub fn test_rate(root: &Path, metadata: &Metadata) -> Result<()> {
-    let events = script::parse(RATE_SCRIPT)?;
-    let time = (Duration::from_secs(7), WALL);
-    let report = script::play(
-        root,
-        metadata,
-        events,
-        time,
-        Against::Host,
-        script::Board {
-            rate: ServoRate::MAX,
-            uid: None,
-        },
-    )?;
+    let board = script::Board {
+        rate: ServoRate::MAX,
+        uid: None,
+    };
+    let report = script::host(root, metadata, RATE_SCRIPT, Duration::from_secs(7), board)?;
     print!("{}", report.table());
     let frames = report.boots.first().map_or(0, |boot| boot.servos[0].frames);
     let few = format!("{frames} frames checked, not the 2,300 of 7 s at 333 Hz");
     report.conclude((frames < 2300).then_some(few))
 }
 
-/// The shipped Pico image (already built) for [`DEFAULT_TIME`]; fails unless
-/// every check passes over at least [`MIN_FRAMES`] frames and the loops'
-/// checksum is the host's. Returns the run for the memory stage.
+/// The shipped image for [`DEFAULT_TIME`]: every check passes over at least
+/// [`MIN_FRAMES`] frames, the loops' checksum the host's. Returns the run.
 pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
-    let mut report = run::run_with(root, &PICO.elf(metadata), DEFAULT_TIME, WALL, |_| {})?;
-    run::check(&mut report)?;
+    let (_, report) = checked_run(root, metadata, DEFAULT_TIME, WALL, |_| {})?;
     print!("{}{}", report.log_text(false), report.table());
     let mut problems = Vec::new();
     if report.frames() < MIN_FRAMES {
@@ -114,41 +97,48 @@ pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
     Ok(report)
 }
 
-/// Builds the drill image ([`build_drill`]), runs two of its boots (each 3 s of frames and the timeout) and checks the
-/// reset and the soft start after it.
+/// The shipped image (built) run for `time` (at most `wall`) with the
+/// harness set up by `setup`, every pulse checked against the host's idle.
+pub fn checked_run(
+    root: &Path,
+    metadata: &Metadata,
+    time: Duration,
+    wall: Duration,
+    setup: impl FnOnce(&mut node::Config),
+) -> Result<(PathBuf, Report)> {
+    let elf = shipped_image(root, metadata)?;
+    let mut report = run::run_with(root, &elf, time, wall, setup)?;
+    run::check(&mut report)?;
+    Ok((elf, report))
+}
+
+/// Runs two boots of the drill image (each 3 s of frames and the timeout);
+/// checks the reset and the soft start after it.
 pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
     let elf = build_drill(metadata)?;
     let mut report = run::run_with(root, &elf, Duration::from_millis(6_500), WALL, |_| {})?;
     run::check(&mut report)?;
     print!("{}{}", report.log_text(false), report.table());
     let mut problems = Vec::new();
-    let says = |boot: usize, text: &str| report.boots.get(boot).is_some_and(|b| b.says(text));
-    let mut want = |boot, text: &str, problem: &str| {
-        if !says(boot, text) {
-            problems.push(format!("boot {boot} did not log {problem}"));
+    let stop = format!("frames stop after frame {DRILL_FRAMES}");
+    for (boot, text, what) in [
+        (0, "boot: power-on", "a power-on boot"),
+        (0, &stop, "the drill's stop"),
+        (1, "last reset by the WATCHDOG", "the watchdog reset"),
+        (
+            1,
+            "first frame: neutral pulses 1500 1500 1500 us",
+            "neutral first pulses",
+        ),
+    ] {
+        if !report.boots.get(boot).is_some_and(|b| b.says(text)) {
+            problems.push(format!("boot {boot} did not log {what}"));
         }
-    };
-    want(0, "boot: power-on", "a power-on boot");
-    want(
-        0,
-        &format!("frames stop after frame {DRILL_FRAMES}"),
-        "the drill's stop",
-    );
-    want(1, "last reset by the WATCHDOG", "the watchdog reset");
-    want(
-        1,
-        "first frame: neutral pulses 1500 1500 1500 us",
-        "neutral first pulses",
-    );
+    }
     if !report.first()?.watchdog {
         problems.push("the watchdog did not reset the board after the frames stopped".to_owned());
     }
-    for (b, boot) in report
-        .boots
-        .iter()
-        .enumerate()
-        .filter(|(_, boot)| boot.watchdog)
-    {
+    for (b, boot) in report.boots.iter().enumerate().filter(|b| b.1.watchdog) {
         for (check, (name, ..)) in boot.servos.iter().zip(SERVOS) {
             // Frames 0..=DRILL_FRAMES, each its own pulse: neutral first and
             // the 2 s fade-in (checked against the host) before the stop.
@@ -179,18 +169,15 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
     report.conclude(problems)
 }
 
-/// Builds the shipped Pico image (`cargo build --release`, at once if it is
-/// up to date) and returns its ELF.
+/// Builds the shipped Pico image (if not up to date); its ELF.
 pub fn shipped_image(root: &Path, metadata: &Metadata) -> Result<PathBuf> {
     PICO.build(root)?;
     Ok(PICO.elf(metadata))
 }
 
-/// Builds the drill image (`--features watchdog-drill`) and returns its ELF,
-/// `target/watchdog-drill/…/pico`: the shipped ELF is never overwritten.
-/// Its intermediate files stay in the one target directory
-/// (`build.build-dir`), so it shares every dependency with the shipped
-/// image and only the three crates the feature changes compile again.
+/// Builds the drill image (`--features watchdog-drill`); its ELF, in
+/// `target/watchdog-drill/` (the shipped one stays). The shared
+/// `build.build-dir` recompiles only the crates the feature changes.
 pub fn build_drill(metadata: &Metadata) -> Result<PathBuf> {
     let build_dir = metadata.target_dir.to_string_lossy();
     let target = metadata.target_dir.join("watchdog-drill");
@@ -209,18 +196,15 @@ pub fn build_drill(metadata: &Metadata) -> Result<PathBuf> {
     Ok(target.join(TARGET).join("release").join(PICO.bin))
 }
 
-/// Runs the shipped image with the UART and USB exchanges: fails if a
-/// reply, a pulse or the run itself is wrong, or if its RAM (static plus
-/// the measured peak stack) is over the budget.
+/// The UART and USB exchanges: fails on a wrong reply, pulse or run, or
+/// the RAM (static plus measured peak stack) over budget.
 pub fn test_console(
     root: &Path,
     metadata: &Metadata,
     virtual_time: Duration,
     wall: Duration,
 ) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
-    let mut report = run::run_with(root, &elf, virtual_time, wall, exchange::configure)?;
-    run::check(&mut report)?;
+    let (elf, mut report) = checked_run(root, metadata, virtual_time, wall, exchange::configure)?;
     exchange::check(&mut report);
     print!("{}", report.log_text(false));
     print!(
@@ -231,9 +215,7 @@ pub fn test_console(
     report.conclude(console_ram(&elf, &report)?)
 }
 
-/// Prints the Pico image's RAM in `report`'s run, static plus the
-/// measured peak stack; the problem if it is over the budget or the peak
-/// was not measured.
+/// Prints the image's RAM (static plus peak stack); a problem if over.
 pub fn console_ram(elf: &Path, report: &Report) -> Result<Option<String>> {
     let static_ram = elf::Image::read(elf)?.static_ram();
     let Some(stack) = report.peak_stack() else {
@@ -248,8 +230,7 @@ pub fn console_ram(elf: &Path, report: &Report) -> Result<Option<String>> {
     Ok((ram > budget).then(|| format!("Pico image RAM {sum} is over the {budget} B budget")))
 }
 
-/// A hung image, an image that sleeps for ever, a run out of wall time and
-/// files that are not Pico images: each ends with its own clear message.
+/// A hung, a sleeping, a slow image and non-images: each fails clearly.
 pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
     node::ensure(root)?;
     let dir = metadata.target_dir.join("sim-failures");
@@ -257,58 +238,42 @@ pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
     // Thumb `b .` (a loop on itself) and `wfi`; the runs' virtual time,
     // wall time and silence.
     let (b_self, wfi) = (0xe7fe, 0xbf30);
-    let (short, long) = (Duration::from_millis(50), Duration::from_secs(3600));
+    let [short, slow] = [50, 200].map(Duration::from_millis);
+    let [two, long] = [2, 3600].map(Duration::from_secs);
+    let hung = "no log byte and no pin edge";
+    let asleep = "sleeps with nothing left to wake it";
     let cases: [(&str, &[u16], [Duration; 3], &str); 3] = [
-        (
-            "hung",
-            &[b_self],
-            [Duration::from_secs(2), WALL, short],
-            "no log byte and no pin edge",
-        ),
-        (
-            "asleep",
-            &[wfi, b_self],
-            [Duration::from_secs(2), WALL, short],
-            "sleeps with nothing left to wake it",
-        ),
-        (
-            "slow",
-            &[b_self],
-            [long, Duration::from_millis(200), long],
-            "stopped after",
-        ),
+        ("hung", &[b_self], [two, WALL, short], hung),
+        ("asleep", &[wfi, b_self], [two, WALL, short], asleep),
+        ("slow", &[b_self], [long, slow, long], "stopped after"),
     ];
     let mut problems = Vec::new();
     for (name, code, [virtual_time, wall, silence], want) in cases {
         let flash = dir.join(format!("{name}.bin"));
         std::fs::write(&flash, synthetic(code)).context("writing a test image")?;
-        let vtor = VECTOR_TABLE;
+        let (vtor, config) = (VECTOR_TABLE, node::Config::default());
         let config = node::Config {
             flash,
             vtor,
             virtual_time,
             wall,
             silence,
-            ..node::Config::default()
+            ..config
         };
         match End::of(&node::run(root, &config)?)?.problem(silence) {
             Some(message) if message.contains(want) => println!("{name}: {message}"),
             other => problems.push(format!("{name}: expected `{want}`, got {other:?}")),
         }
     }
-    let missing = dir.join("no-such-elf");
+    let (missing, myself) = (dir.join("no-such-elf"), std::env::current_exe()?);
     for (path, want) in [
-        (missing.as_path(), "cargo build --release"),
-        (&std::env::current_exe()?, "is not a Pico image"),
+        (missing, "cargo build --release"),
+        (myself, "is not a Pico image"),
     ] {
-        match PicoImage::read(path) {
-            Err(error) if format!("{error:#}").contains(want) => {
-                println!("{}: {error:#}", path.display());
-            }
-            other => problems.push(format!(
-                "{}: expected `{want}`, got {other:?}",
-                path.display()
-            )),
+        let (read, path) = (PicoImage::read(&path), path.display());
+        match read {
+            Err(error) if format!("{error:#}").contains(want) => println!("{path}: {error:#}"),
+            other => problems.push(format!("{path}: expected `{want}`, got {other:?}")),
         }
     }
     project::verdict(&problems)

@@ -1,15 +1,11 @@
-//! The settings store on the emulated chip, from three starts of the
-//! settings sectors (noise, a record of an unknown version, a version 1
-//! record): `save` through the boot ROM's flash functions at their worst
-//! times, a power cycle, and the next boot on the saved settings
-//! (docs/dev/emulators.md, "Settings through a power cycle"). Lines that
-//! arrive on UART0 while the flash is erased (the interrupts off) are all
-//! answered after it, and the servos, held still meanwhile, go on within
-//! the limiter's idle speed and acceleration, no jump.
+//! The settings store from three starts (noise, an unknown version, a
+//! version 1 record): `save` at the flash's worst times, a power cycle, the
+//! next boot on the saved settings; lines sent during the erase answered
+//! after it, the servos going on without a jump (docs/dev/emulators.md).
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use super::{
     node::{Fill, FlashTiming, UartScript},
@@ -18,7 +14,7 @@ use super::{
     run::{self, Boot, Report},
     stages::{WALL, console_ram, shipped_image},
 };
-use crate::{elf, project, project::Metadata};
+use crate::{log::LogLine, project, project::Metadata};
 
 /// Stage name.
 pub const STORE_STAGE: &str = "Pico image in the RP2040 emulator: `save` to flash with \
@@ -61,12 +57,11 @@ const SAVED_PITCH_US: u32 = 1520;
 const UNKNOWN: &str =
     "settings: defaults; the store at 0x101fc000 holds settings of version 0, not 2";
 
-/// A start of the settings sectors: what they hold, their bytes, what the
-/// first boot must log about them (a level and a text), the neutral pulses
-/// from power-on, µs.
+/// A start: what the sectors hold, them, what boot 0 logs (level, text),
+/// the neutral pulses, µs.
 type Start = (
     &'static str,
-    Vec<u8>,
+    Fill,
     &'static [(&'static str, &'static str)],
     [u32; 3],
 );
@@ -74,26 +69,24 @@ type Start = (
 /// Runs the scenario from every start and checks it (see the module docs).
 pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
     let elf = shipped_image(root, metadata)?;
-    let region = elf::Image::read(&elf)?
-        .settings
-        .context("the image has no settings region")?;
-    let len = usize::try_from(region.end - region.start)?;
     let starts: [Start; 3] = [
         (
             "foreign data",
-            noise(len),
+            planted::fill(&elf, |len| Ok(planted::noise(len)))?,
             &[("INFO", "settings: defaults (empty store")],
             [1500; 3],
         ),
         (
             "a record this firmware cannot read",
-            planted::store_of_version::<0>(b"an unknown layout", len)?,
+            planted::fill(&elf, |len| {
+                planted::store_of_version::<0>(b"an unknown layout", len)
+            })?,
             &[("WARN", UNKNOWN)],
             [1500; 3],
         ),
         (
             "a record of layout version 1",
-            planted::version_1_sectors(root, len)?,
+            planted::fill(&elf, |len| planted::version_1_sectors(root, len))?,
             &[
                 ("INFO", "settings: loaded from flash (version 1)"),
                 ("INFO", "settings: migrated from version 1 to 2"),
@@ -106,10 +99,7 @@ pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
         println!("settings sectors holding {what}:");
         let report = run::run_with(root, &elf, Duration::from_millis(8_500), WALL, |config| {
             config.rom = Some(WORST);
-            config.flash_fill = Some(Fill {
-                addr: region.start,
-                hex: sectors,
-            });
+            config.flash_fill = Some(sectors);
             config.power_cycles = vec![POWER_CYCLE];
             config.uart = vec![
                 UartScript::new(0, SCRIPTS[0], SCRIPT_AT[0]),
@@ -131,8 +121,7 @@ pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
     project::verdict(&problems)
 }
 
-/// The checks of the module docs, for a start whose first boot logs
-/// `logged` and runs on `neutral`: a transcript and the problems found.
+/// The module docs' checks for a start: a transcript and the problems.
 fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String, Vec<String>) {
     let (mut text, mut problems) = (String::new(), Vec::new());
     let [first, second] = report.boots.as_slice() else {
@@ -142,23 +131,23 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
         ));
         return (text, problems);
     };
-    if !first.power_cycled {
-        problems.push("the first boot did not end with the power cycle".to_owned());
-    }
+    problem_if!(
+        problems,
+        !first.power_cycled,
+        "the first boot did not end with the power cycle"
+    );
     for (b, boot) in report.boots.iter().enumerate() {
-        if boot.watchdog {
-            problems.push(format!("boot {b}: the watchdog reset the board"));
-        }
+        problem_if!(
+            problems,
+            boot.watchdog,
+            "boot {b}: the watchdog reset the board"
+        );
         let _ = writeln!(text, "boot {b}, UART0:");
         let replies = boot.uart_replies();
         // Boot 0: the replies to the lines sent during the save, last.
         let during = if b == 0 { DURING_SAVE_LINES } else { 0 };
-        let want = |i: usize| {
-            REPLIES[b]
-                .get(i)
-                .copied()
-                .or((i < REPLIES[b].len() + during).then_some(("ok pitch neutral=1520 ", "")))
-        };
+        let (count, pitch) = (REPLIES[b].len() + during, ("ok pitch neutral=1520 ", ""));
+        let want = |i: usize| REPLIES[b].get(i).copied().or((i < count).then_some(pitch));
         for (i, line) in replies.iter().enumerate() {
             let _ = writeln!(text, "  < {line}");
             match want(i) {
@@ -169,58 +158,59 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
                 None => problems.push(format!("boot {b}: an extra reply `{line}`")),
             }
         }
-        if replies.len() < REPLIES[b].len() + during {
-            let want = REPLIES[b].len() + during;
-            problems.push(format!("boot {b}: {} replies, not {want}", replies.len()));
-        }
+        let n = replies.len();
+        problem_if!(problems, n < count, "boot {b}: {n} replies, not {count}");
     }
     for (level, line) in logged {
-        let at_level =
-            |l: &crate::log::LogLine| l.level.as_deref() == Some(level) && l.message.contains(line);
-        if !first.log.iter().any(|(_, l)| at_level(l)) {
-            problems.push(format!("boot 0 did not log `{level} {line}`"));
-        }
+        let at_level = |l: &LogLine| l.level.as_deref() == Some(level) && l.message.contains(line);
+        let logged = first.log.iter().any(|(_, l)| at_level(l));
+        problem_if!(problems, !logged, "boot 0 did not log `{level} {line}`");
     }
     let [pitch, roll, yaw] = neutral;
     let first_neutral = format!("first frame: neutral pulses {pitch} {roll} {yaw} us");
-    if !first.says(&first_neutral) {
-        problems.push(format!("boot 0 did not log `{first_neutral}`"));
-    }
+    problem_if!(
+        problems,
+        !first.says(&first_neutral),
+        "boot 0 did not log `{first_neutral}`"
+    );
     for (erase, what) in [(true, "erases"), (false, "programs")] {
         let ops = first.flash.iter().filter(|op| op.0 == erase);
         let (n, bytes, ns) = ops.fold((0, 0, 0.0), |(n, b, t), op| (n + 1, b + op.1, t + op.2));
+        let ms = ns / 1e6;
         let _ = writeln!(
             text,
-            "boot 0, flash: {n} {what} ({bytes} B, busy {:.0} ms)",
-            ns / 1e6
+            "boot 0, flash: {n} {what} ({bytes} B, busy {ms:.0} ms)"
         );
     }
-    if !first.flash.iter().any(|op| !op.0) {
-        problems.push("boot 0's save did not program the flash".to_owned());
-    }
+    let programmed = first.flash.iter().any(|op| !op.0);
+    problem_if!(
+        problems,
+        !programmed,
+        "boot 0's save did not program the flash"
+    );
     let writes = &first.trains[0].writes;
     let gap = writes
         .windows(2)
         .map(|w| w[1].0 - w[0].0)
-        .fold(0.0, f64::max);
-    let _ = writeln!(
-        text,
-        "boot 0: longest gap between frames {:.0} ms",
-        gap / 1e6
-    );
+        .fold(0.0, f64::max)
+        / 1e6;
+    let _ = writeln!(text, "boot 0: longest gap between frames {gap:.0} ms");
     let (steps, over) = steps_around_the_save(first);
     text.push_str(&steps);
     problems.extend(over);
-    if !second.says("settings: loaded from flash") {
-        problems.push("boot 1 did not log the settings loaded from flash".to_owned());
-    }
+    let loaded = second.says("settings: loaded from flash");
+    problem_if!(
+        problems,
+        !loaded,
+        "boot 1 did not log the settings loaded from flash"
+    );
     let saved = [SAVED_PITCH_US, roll, yaw];
     let second_neutral = format!("first frame: neutral pulses {SAVED_PITCH_US} {roll} {yaw} us");
-    if !second.says(&second_neutral) {
-        problems.push(format!(
-            "boot 1 did not log the saved neutral pulses for its first frame (`{second_neutral}`)"
-        ));
-    }
+    problem_if!(
+        problems,
+        !second.says(&second_neutral),
+        "boot 1 did not log the saved neutral pulses for its first frame (`{second_neutral}`)"
+    );
     // The width of each servo's first pulse, whole µs.
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // a pulse: µs
     let first_us = second.trains.each_ref().map(|train| {
@@ -229,19 +219,16 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
         Some(((edges.get(rise + 1)?.0 - edges[rise].0) / 1e3).round() as u32)
     });
     let _ = writeln!(text, "boot 1: first pulses {first_us:?} us");
-    if first_us != saved.map(Some) {
-        problems.push(format!(
-            "boot 1's first pulses are {first_us:?} us, not {saved:?} (the saved neutral pulses)"
-        ));
-    }
+    problem_if!(
+        problems,
+        first_us != saved.map(Some),
+        "boot 1's first pulses are {first_us:?} us, not {saved:?} (the saved neutral pulses)"
+    );
     (text, problems)
 }
 
-/// The largest change of each axis' angle from one pulse to the next, and
-/// of that change, from before the save to a second after it: within the
-/// limiter's idle speed and acceleration (a frame's worth, and a few counts
-/// of rounding), also where the motion goes on after a stall. A summary
-/// and the problems.
+/// Each axis' largest step and change of step around the save, within the
+/// idle speed and acceleration (and rounding); a summary and problems.
 fn steps_around_the_save(boot: &Boot) -> (String, Vec<String>) {
     let config = idle_head_core::driver::DriverConfig::DEFAULT;
     let frame_s = f64::from(config.frame_period.0) / 1e6;
@@ -285,22 +272,9 @@ fn steps_around_the_save(boot: &Boot) -> (String, Vec<String>) {
     (text, problems)
 }
 
-/// `len` bytes of noise (xorshift32): a store no firmware wrote.
-pub(super) fn noise(len: usize) -> Vec<u8> {
-    let mut x: u32 = 0x2545_f491;
-    let mut next = || {
-        x ^= x << 13;
-        x ^= x >> 17;
-        x ^= x << 5;
-        x.to_le_bytes()[0]
-    };
-    (0..len).map(|_| next()).collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::log::LogLine;
     use crate::sim::pulses::Train;
 
     /// Breaks a good report one way.

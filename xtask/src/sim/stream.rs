@@ -1,10 +1,8 @@
-//! Console lines and DMX frames streamed into the shipped image in the
-//! emulator, each line answered once, in order, none lost, no frame late:
-//! a line every 2 ms for ten minutes on UART0 or USB, a flood on UART0 faster
-//! than the replies leave, a byte with a framing error, and DMX512 at the
-//! full universe rate for a minute (docs/dev/emulators.md, "Streams").
+//! Streams into the shipped image, each line answered once, in order, no
+//! frame late: a line every 2 ms on UART0 or USB, a UART flood, a framing
+//! error, DMX512 for a minute (docs/dev/emulators.md, "Streams").
 
-use std::{fmt::Write as _, path::Path, time::Duration};
+use std::{path::Path, time::Duration};
 
 use anyhow::Result;
 use idle_head_core::console::checksum;
@@ -13,36 +11,30 @@ use super::Boot;
 use super::{
     dmx,
     node::{LineStream, StreamLine, UartScript},
-    run::{self, Report},
-    stages::{WALL, shipped_image},
+    run::Report,
+    stages::{WALL, checked_run},
 };
 use crate::{log::field, project::Metadata};
 
 /// Stage names.
 pub const UART_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: a line every 2 ms on \
      UART0 for 10 minutes: every line answered once, in order, none lost, no frame late";
-/// See [`UART_STREAM_STAGE`].
 pub const USB_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: a line every 2 ms on \
      USB for 10 minutes: every line answered once, in order, none lost, no frame late";
-/// See [`UART_STREAM_STAGE`].
 pub const DMX_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: DMX512 at the full \
      universe rate for a minute across two loop generations: every frame decoded, none lost";
-/// See [`UART_STREAM_STAGE`].
 pub const FLOOD_STAGE: &str = "Pico image in the RP2040 emulator: a UART flood with no \
      flow control: every line answered once, in order, no byte lost, no frame late";
-/// See [`UART_STREAM_STAGE`].
 pub const NOISE_STAGE: &str = "Pico image in the RP2040 emulator: a byte with a framing \
      error on UART0: its line answered `err line bytes lost`, the next one `ok`";
 
-/// When the stream starts (the fade-in is over), the time between lines,
-/// how long it lasts.
+/// The stream's start (after the fade-in), line spacing and length.
 const START: Duration = Duration::from_secs(3);
 const EVERY: Duration = Duration::from_millis(2);
 pub const LENGTH: Duration = Duration::from_secs(600);
 
-/// The stream's cycle of lines, 20 ms of them: two actions a frame
-/// (queued for the frame task, answered once a frame has taken them; they
-/// leave the motion as it is), settings, and machine-mode lines.
+/// The stream's cycle, 20 ms: two actions a frame (answered once a frame
+/// takes them), settings, and machine-mode lines.
 const CYCLE: [StreamLine; 10] = [
     StreamLine::Plain("center"),
     StreamLine::Machine("watch off"),
@@ -81,9 +73,8 @@ impl Want {
     }
 }
 
-/// The first boot's replies on UART0 (or `usb`) against `want`, one for
-/// each of `count` lines: the replies and the problems (a reply that does
-/// not fit, the first five; a count off; a byte lost at UART0's FIFO).
+/// Boot 0's replies on UART0 (or `usb`) against `want` for `count` lines:
+/// them, and the problems (the first five misfits, a count off, overruns).
 fn replies(
     report: &Report,
     usb: bool,
@@ -109,9 +100,9 @@ fn replies(
     Ok((replies, problems))
 }
 
-/// Loop sets generated in the first boot.
-fn sets(report: &Report) -> usize {
-    let log = report.boots.iter().take(1).flat_map(|b| &b.log);
+/// Loop sets generated in `boot`.
+fn sets(boot: &Boot) -> usize {
+    let log = boot.log.iter();
     log.filter(|(_, line)| line.message.starts_with("loop set "))
         .count()
 }
@@ -121,29 +112,26 @@ fn wall(length: Duration) -> Duration {
     (START + length) * 3 + Duration::from_secs(120)
 }
 
-/// A line every 2 ms on `port` (`"uart"` or `"usb"`) for `length`: every
-/// line answered once, in order, its command's answer (the machine-mode ones
-/// with their own sequence number), no byte lost, every frame the host's.
+/// A line every 2 ms on `port` (`"uart"` or `"usb"`) for `length`.
 pub fn test_stream(
     root: &Path,
     metadata: &Metadata,
     port: &'static str,
     length: Duration,
 ) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
     let count = usize::try_from(length.as_micros() / EVERY.as_micros()).unwrap_or(usize::MAX);
     let time = START + length + Duration::from_secs(1);
-    let mut report = run::run_with(root, &elf, time, wall(length), |config| {
+    let (_, report) = checked_run(root, metadata, time, wall(length), |config| {
         let (start, every, lines) = (START, EVERY, CYCLE.to_vec());
-        config.stream = Some(LineStream {
+        let stream = LineStream {
             port,
             start,
             every,
             count,
             lines,
-        });
+        };
+        config.stream = Some(stream);
     })?;
-    run::check(&mut report)?;
     print!("{}", report.table());
     let (replies, problems) = replies(&report, port == "usb", count, |k| {
         match CYCLE[k % CYCLE.len()] {
@@ -157,7 +145,7 @@ pub fn test_stream(
         "{port} stream: {count} lines, one every {} ms; {} replies; {} loop sets generated meanwhile",
         EVERY.as_millis(),
         replies.len(),
-        sets(&report)
+        sets(report.first()?)
     );
     report.conclude(problems)
 }
@@ -165,18 +153,15 @@ pub fn test_stream(
 /// Lines in each flood.
 const FLOOD_LINES: usize = 100;
 
-/// At 3 s 100 `status` lines back to back (0.7 ms a line; each reply takes
-/// 9.5 ms to go out), at 5 s as many in machine mode, at 7 s one more
-/// `status`: every line answered once, in order, no byte lost at UART0's
-/// FIFO (the board receives by DMA into a ring), every frame the host's.
+/// 100 `status` lines back to back at 3 s (0.7 ms a line, 9.5 a reply),
+/// as many in machine mode at 5 s, one more at 7 s.
 pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
     let machine = |n: usize| {
         let body = format!("#{n} status");
         format!("{body} *{:02x}\r\n", checksum(body.as_bytes())).into_bytes()
     };
     let time = Duration::from_millis(7_500);
-    let mut report = run::run_with(root, &elf, time, WALL, |config| {
+    let (_, report) = checked_run(root, metadata, time, WALL, |config| {
         config.uart = vec![
             UartScript::new(0, b"status\r\n".repeat(FLOOD_LINES), Duration::from_secs(3)),
             UartScript::new(
@@ -187,7 +172,6 @@ pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
             UartScript::new(0, b"status\r\n", Duration::from_secs(7)),
         ];
     })?;
-    run::check(&mut report)?;
     print!("{}", report.table());
     let lines = 2 * FLOOD_LINES + 1;
     let (replies, problems) = replies(&report, false, lines, |k| match k {
@@ -200,19 +184,16 @@ pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
     report.conclude(problems)
 }
 
-/// `sta`, a byte with a framing error, `tus`, then `status`: the first line
-/// must be answered `err line bytes lost …`, the second `ok mode=…`, and
-/// every pulse stays the host's.
+/// `sta`, a byte with a framing error, `tus`, then `status`.
 pub fn test_noise(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
-    let mut report = run::run_with(root, &elf, Duration::from_millis(3_500), WALL, |config| {
+    let time = Duration::from_millis(3_500);
+    let (_, report) = checked_run(root, metadata, time, WALL, |config| {
         let noisy = UartScript::new(0, b"staXtus\r\nstatus\r\n", Duration::from_secs(3));
         config.uart = vec![UartScript {
             errors: vec![3],
             ..noisy
         }];
     })?;
-    run::check(&mut report)?;
     let want = [
         Want::Starts("err line bytes lost"),
         Want::Starts("ok mode="),
@@ -230,29 +211,17 @@ pub fn test_noise(root: &Path, metadata: &Metadata) -> Result<()> {
 /// How long DMX streams.
 const DMX_LENGTH: Duration = Duration::from_secs(60);
 
-/// DMX at the full universe rate for a minute, a change of a slot past the
-/// head's ten in every tenth frame: the head's `dmx` counters (asked over
-/// UART0 at the end) count every frame good, none short, long, of another
-/// start code or garbled, and no frame of the head's is late.
+/// DMX at the full universe rate for a minute; `dmx` asked at the end.
 pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
-    // A change every 0.23 s: the frames that carry one are counted by the
-    // harness; the last one at the end.
+    // The harness counts the frames that carry a change; the last one at the end.
     let end = START + DMX_LENGTH;
-    let mut text = String::new();
-    let (mut at, mut k) = (START, 0_u32);
-    while at < end {
-        let _ = writeln!(text, "{:.3} 11={}", at.as_secs_f64(), k % 2 * 100);
-        (at, k) = (at + Duration::from_millis(230), k + 1);
-    }
-    let changes = dmx::parse(&text)?;
+    let changes = dmx::alternating(START, end)?;
     let query = end + Duration::from_millis(50);
     let time = query + Duration::from_secs(1);
-    let mut report = run::run_with(root, &elf, time, wall(DMX_LENGTH), |config| {
+    let (_, report) = checked_run(root, metadata, time, wall(DMX_LENGTH), |config| {
         config.dmx = Some(dmx::line(&changes));
         config.uart = vec![UartScript::new(0, b"dmx\n", query)];
     })?;
-    run::check(&mut report)?;
     print!("{}", report.table());
     // (The pulses are not held to the idle's own: a console on the line
     // engages the show layer, mix 0 or not. No frame may be late.)
@@ -263,9 +232,8 @@ pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     crate::project::verdict(&problems)
 }
 
-/// The `dmx` counters of its `reply` against the frames sent in `boot`
-/// (`changes` of them changed the slots): every one good, no frame late;
-/// a summary and the problems.
+/// The `dmx` counters of `reply` against the frames `boot` sent (`changes`
+/// of them changes): every one good, no frame late. A summary, problems.
 pub(super) fn check_dmx(boot: &Boot, reply: &str, changes: usize) -> (String, Vec<String>) {
     let counter = |name| field(reply, name).and_then(|v| v.parse::<u64>().ok());
     let mut problems: Vec<String> = ["short", "long", "start_code", "garbled"]
@@ -289,9 +257,7 @@ pub(super) fn check_dmx(boot: &Boot, reply: &str, changes: usize) -> (String, Ve
     if let Some(first) = late.first() {
         problems.push(format!("{} frames late: `{first}`", late.len()));
     }
-    let sets = (boot.log.iter())
-        .filter(|(_, line)| line.message.starts_with("loop set "))
-        .count();
+    let sets = sets(boot);
     let summary = format!(
         "DMX: {sent} frames of 512 slots sent by the last change, {good} counted good; {sets} loop \
          sets generated meanwhile; `{reply}`\n"

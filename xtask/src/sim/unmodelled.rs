@@ -1,22 +1,9 @@
 //! Registers rp2040js does not model (a read gives 0xffffffff, a write is
-//! dropped), as the harness counts the accesses to them: the gaps known not
-//! to matter for these images, with the reason, and any other, which a run
-//! shows in full.
+//! dropped): the gaps known not to matter, and any other in full.
 
 use std::fmt::Write as _;
 
-use super::event::Op;
-
-/// Accesses to one register the emulator does not model.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Unmodelled {
-    /// The peripheral as rp2040js names it.
-    pub peripheral: String,
-    pub op: Op,
-    /// The register's offset in the peripheral.
-    pub offset: u32,
-    pub count: u64,
-}
+use super::event::{Op, Unmodelled};
 
 /// The known gaps, which embassy-rp's start-up touches: the peripheral, the
 /// writes covered (`None`: any access), why it does not matter. None
@@ -59,47 +46,44 @@ impl Unmodelled {
         let covers = |writes: Option<&[u32]>| {
             writes.is_none_or(|offsets| self.op == Op::Write && offsets.contains(&self.offset))
         };
-        KNOWN
-            .iter()
-            .find(|(peripheral, writes, _)| *peripheral == self.peripheral && covers(*writes))
-            .map(|(.., why)| *why)
+        let mut known = KNOWN.iter();
+        let gap =
+            known.find(|(peripheral, writes, _)| *peripheral == self.peripheral && covers(*writes));
+        gap.map(|(.., why)| *why)
     }
 }
 
-/// The lines a run prints about `accesses`: with `verbose`, each access and
-/// why a known one does not matter; without, one line for the known ones;
-/// each unknown one in full.
+/// What a run prints about `accesses`: each unknown one in full; the known
+/// ones each with why (`verbose`) or in one line.
 pub fn lines(accesses: &[Unmodelled], verbose: bool) -> String {
-    let mut text = String::new();
-    let mut known = (0, 0, Vec::new());
+    let (mut text, mut known, mut peripherals) = (String::new(), (0, 0), Vec::new());
     for access in accesses {
-        let op = match access.op {
-            Op::Read => "read from",
-            _ => "write to",
+        let op = if access.op == Op::Read {
+            "read from"
+        } else {
+            "write to"
         };
         let what = format!(
             "[{}] {op} 0x{:x} ({}x)",
             access.peripheral, access.offset, access.count
         );
-        match access.known() {
+        let _ = match access.known() {
             Some(why) if verbose => {
-                let _ = writeln!(text, "emulator: unmodelled register, {what}: known, {why}");
+                writeln!(text, "emulator: unmodelled register, {what}: known, {why}")
             }
             Some(_) => {
-                known.0 += access.count;
-                known.1 += 1;
-                if !known.2.contains(&access.peripheral.as_str()) {
-                    known.2.push(&access.peripheral);
+                known = (known.0 + access.count, known.1 + 1);
+                if !peripherals.contains(&access.peripheral.as_str()) {
+                    peripherals.push(&access.peripheral);
                 }
+                Ok(())
             }
-            None => {
-                let _ = writeln!(
-                    text,
-                    "emulator: unmodelled register, {what}: NOT a known gap (a read gives \
-                     0xffffffff, a write is dropped; see sim/unmodelled.rs)"
-                );
-            }
-        }
+            None => writeln!(
+                text,
+                "emulator: unmodelled register, {what}: NOT a known gap (a read gives \
+                 0xffffffff, a write is dropped; see sim/unmodelled.rs)"
+            ),
+        };
     }
     if known.1 > 0 {
         let summary = format!(
@@ -107,7 +91,7 @@ pub fn lines(accesses: &[Unmodelled], verbose: bool) -> String {
              matter here ({}; --verbose lists them)\n",
             known.0,
             known.1,
-            known.2.join(", ")
+            peripherals.join(", ")
         );
         text.insert_str(0, &summary);
     }
