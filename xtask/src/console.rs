@@ -15,7 +15,7 @@ use anyhow::{Context, Result, bail};
 use idle_head_core::console::usb_identity::{PID, PRODUCT, VID};
 
 pub use qemu::{Pace, qemu_session};
-pub use stages::piped_script;
+pub use stages::{piped_script, script};
 
 use crate::qemu::Echo;
 use crate::{log, project, setup};
