@@ -69,19 +69,15 @@ pub enum Echo {
 /// `sleep=on` follows the wall clock while it sleeps (a head at its true
 /// speed, for a person).
 pub fn qemu_command(elf: &Path, sleep: bool, args: &[&str]) -> Command {
+    let icount = format!("shift=0,sleep={}", if sleep { "on" } else { "off" });
     let mut command = Command::new(QEMU_BINARY);
-    let icount = if sleep {
-        "shift=0,sleep=on"
-    } else {
-        "shift=0,sleep=off"
-    };
     command.args([
         "-machine",
         "lm3s6965evb",
         "-cpu",
         "cortex-m0",
         "-icount",
-        icount,
+        &icount,
     ]);
     command.args(args).arg("-kernel").arg(elf);
     command

@@ -131,28 +131,24 @@ pub fn spawn_with_sockets(
 }
 
 /// QEMU running `elf` for a console: the run `pace` asks for, UART0 and
-/// UART1 (the hang-up line) on the character devices `serials` (QEMU's
-/// `-serial` arguments: a socket, `pty`, `null`).
-pub fn qemu_command(elf: &Path, pace: Pace, serials: [&str; 2]) -> Command {
+/// UART1 (the hang-up line) on the character devices `serials` (a socket,
+/// `pty`, `null`).
+pub fn qemu_command(elf: &Path, pace: Pace, [uart0, uart1]: [&str; 2]) -> Command {
     let (sleep, run) = match pace {
         Pace::RealTime => (true, "interactive"),
         Pace::Fast => (false, "console"),
     };
     let semihosting = format!("enable=on,target=native,arg=idle-head,arg={run}");
-    let [uart0, uart1] = serials;
-    let args = [
-        "-display",
-        "none",
-        "-monitor",
-        "none",
+    let mut command = qemu::qemu_command(elf, sleep, &["-display", "none", "-monitor", "none"]);
+    command.args([
         "-semihosting-config",
         &semihosting,
-    ];
-    qemu::qemu_command(
-        elf,
-        sleep,
-        &[&args[..], &["-serial", uart0, "-serial", uart1]].concat(),
-    )
+        "-serial",
+        uart0,
+        "-serial",
+        uart1,
+    ]);
+    command
 }
 
 /// Connects to a socket QEMU serves, waiting for it to appear.
