@@ -54,8 +54,7 @@ pub fn command(args: &Args) -> Result<bool> {
         eprintln!("console: QEMU running; type commands, end with Ctrl-D");
         let elf = project::QEMU.elf(&metadata);
         let session = qemu_session(&elf, stdin, &mut print, Pace::RealTime, Echo::Quiet, wait)?;
-        // The firmware's warnings and errors on stderr: stdout has the
-        // replies and the summary only.
+        // stdout has the replies and the summary only.
         for line in session.run.log.iter().filter(|l| l.is_problem()) {
             eprintln!("{}", line.snapshot());
         }
@@ -83,12 +82,10 @@ pub fn command(args: &Args) -> Result<bool> {
     Ok(ran && problems.is_empty())
 }
 
-/// The head among `ports`. Other hobby devices share its USB VID:PID (the
-/// V-USB shared pair for CDC-ACM serial devices, 16c0:27dd), so the
-/// product string decides: the one port with the pair and the head's
-/// product; failing that, the one port with the pair whose strings the
-/// system does not show. None, or more than one, is an error that lists
-/// what was found and asks for `--port`.
+/// The head among `ports`: other devices share its VID:PID (V-USB's shared
+/// pair for CDC-ACM), so the one with the head's product string, else the
+/// one whose strings the system does not show; none, or several, is an
+/// error listing what was found.
 fn pick_pico(ports: &[serialport::SerialPortInfo]) -> Result<PathBuf> {
     let shared: Vec<(&str, Option<&str>)> = (ports.iter())
         .filter_map(|p| match &p.port_type {
@@ -133,8 +130,7 @@ fn pick_pico(ports: &[serialport::SerialPortInfo]) -> Result<PathBuf> {
     }
 }
 
-/// The serial port at `path`, 115200 8N1, a read giving up after
-/// `timeout`.
+/// The serial port at `path`, 115200 8N1, reads timing out after `timeout`.
 pub(crate) fn open_port(path: &Path, timeout: Duration) -> Result<Box<dyn serialport::SerialPort>> {
     let name = path.to_string_lossy();
     let port = serialport::new(name.as_ref(), 115_200).timeout(timeout);

@@ -17,19 +17,13 @@ use crate::log::Run;
 use crate::qemu::{self, Echo};
 use crate::setup;
 
-/// Which run the image plays, and how QEMU's virtual clock runs while the
-/// core sleeps.
+/// Which run the image plays, and how QEMU's clock runs while it sleeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Pace {
     /// A clean head for a person (semihosting argument `interactive`: no
-    /// script, no injected faults, the board's 20 ms frames, until the
-    /// hang-up), its virtual clock with the wall clock (`-icount
-    /// shift=0,sleep=on`: one instruction a nanosecond while the core
-    /// works, the wall clock's pace while it sleeps, which is almost all
-    /// the time: so the head moves at its true speed).
+    /// script or faults, until the hang-up) at the wall clock's pace.
     RealTime,
-    /// The smoke run held for its console (semihosting argument `console`),
-    /// jumping over idle time (`sleep=off`): as fast as the host can.
+    /// The smoke run held for its console (`console`), idle time skipped.
     Fast,
 }
 
@@ -40,15 +34,13 @@ pub struct QemuSession {
     pub talk: Talk,
 }
 
-/// How long QEMU has to stop after the hang-up (the firmware fades out for
-/// a moment of virtual time, then prints its summary), and how long the
-/// reply reader waits for a byte after it.
+/// How long QEMU has to stop after the hang-up (the firmware fades out,
+/// then prints its summary), and the reply reader to read a byte.
 const AFTER_HANG_UP: Duration = Duration::from_secs(120);
 
-/// Runs `elf` in QEMU held for its console: sends `input` to UART0 as it
-/// comes, byte for byte, hands each reply line to `on_reply`, waits up to
-/// `wait` for the replies still due, then hangs up (a byte on UART1), so
-/// that the firmware fades out and prints its summary.
+/// Runs `elf` in QEMU held for its console: [`talk::converse`] on UART0,
+/// then the hang-up (a byte on UART1): the firmware fades out, prints its
+/// summary and exits, which closes the socket and ends the reader.
 pub fn qemu_session(
     elf: &Path,
     input: impl Read,
@@ -64,9 +56,6 @@ pub fn qemu_session(
         uart1,
     } = spawn_with_sockets(elf, pace, "console", Stdio::piped)?;
     let (run, talk) = qemu::finish(child, elf, AFTER_HANG_UP, echo, || {
-        // The conversation on UART0, then the hang-up on UART1: the
-        // firmware fades out, prints its summary and exits, which closes
-        // the socket and ends the reader.
         let mut console = connect(&uart0)?;
         let mut hang_up = connect(&uart1)?;
         let (reader, timeout) = (console.try_clone()?, console.try_clone()?);
@@ -98,11 +87,9 @@ pub struct Sockets {
     pub uart1: PathBuf,
 }
 
-/// Starts QEMU running `elf` for a console ([`qemu_command`]), UART0 and
-/// UART1 on sockets it serves, waiting for both to be connected
-/// ([`connect`]), in a folder of the temporary directory of its own
-/// (`idle-head-<tag>-<pid>`); its stdout and stderr are `output`
-/// (`Stdio::piped`, `Stdio::null`).
+/// Starts QEMU running `elf` for a console, UART0 and UART1 on sockets it
+/// serves (waiting for both to be connected) in a temporary folder of its
+/// own; its stdout and stderr are `output`.
 pub fn spawn_with_sockets(
     elf: &Path,
     pace: Pace,
