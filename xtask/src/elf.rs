@@ -130,8 +130,8 @@ impl Image {
         self.sections.iter().find(|section| section.name == name)
     }
 
-    /// Bytes of RAM taken before `main` runs: `.radar_ring + .data + .bss
-    /// + .uninit`.
+    /// Bytes of RAM taken before `main` runs (`.radar_ring`, `.data`,
+    /// `.bss`, `.uninit`).
     pub fn static_ram(&self) -> u64 {
         let ram =
             |s: &&Section| [".radar_ring", ".data", ".bss", ".uninit"].contains(&s.name.as_str());
