@@ -103,11 +103,6 @@ impl Stages<'_> {
 pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     let start = Instant::now();
     let (root, metadata) = setup::prepare()?;
-    let sh = project::shell(".")?;
-    let host_tests = project::shell("host-tests")?;
-    let core = project::shell("crates/core")?;
-    let firmware = project::shell("crates/firmware")?;
-    let xtask = project::shell("xtask")?;
     let figures_page = root.join(figures::PAGE);
     let figures_before = figures::read(&figures_page)?;
     let mut stages = Stages {
@@ -116,25 +111,8 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         left_out: 0,
     };
 
-    // 1. Host tests of the core, the firmware layer and the project commands.
-    stages.run("host tests (host-tests/)", || {
-        project::run(&host_tests, &[], cmd!(host_tests, "cargo test"))
-    });
-    stages.run("core crate: unit and doc tests (crates/core, host)", || {
-        project::run(&core, &[], cmd!(core, "cargo test"))
-    });
-    stages.run("firmware layer: host tests (crates/firmware)", || {
-        project::run(&firmware, &[], cmd!(firmware, "cargo test"))
-    });
-    stages.run("xtask unit tests", || {
-        project::run(&xtask, &[], cmd!(xtask, "cargo test --profile xtask"))
-    });
-
-    // 2. Formatting and lints: firmware (thumb, both packages) and host crates.
-    stages.run("rustfmt: every package of the workspace", || {
-        project::run(&sh, &[], cmd!(sh, "cargo fmt --all --check"))
-    });
-    clippy_stages(&mut stages);
+    // 1. Host tests, formatting, lints, the images that must compile.
+    cargo_stages(&mut stages);
 
     // 3. The Pico image: placement of the boot stage, memory budgets, no allocator.
     // (Also for any emulator stage: they run on the image built here.)
@@ -156,30 +134,6 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     // The Pico 2 on its own: its embassy-rp chip feature excludes the Pico's.
     stages.run(pico2::STAGE, || pico2::test(&metadata));
 
-    // The calibration image (same bin, feature `calibrate`): it must compile.
-    stages.run(
-        "Pico calibration image compiles (--features calibrate)",
-        || {
-            project::run(
-                &sh,
-                FIRMWARE_ENV,
-                cmd!(sh, "cargo check --release --features calibrate"),
-            )
-        },
-    );
-    // A board with servos and USB only, on the same `start` as the Pico's.
-    stages.run(
-        "minimal board example, servos and USB only (examples/minimal.rs): clippy, build",
-        || {
-            let clippy = "clippy --release --example minimal -- -D warnings";
-            let build = "build --release --example minimal";
-            for args in [clippy, build] {
-                let args = args.split_whitespace();
-                project::run(&sh, FIRMWARE_ENV, cmd!(sh, "cargo {args...}"))?;
-            }
-            Ok(())
-        },
-    );
     // The frame path cannot panic: this image links the frame update against
     // a panic handler that does not exist, so the link fails if any panic
     // path survives optimisation (boards/qemu/src/panic_proof.rs).
@@ -218,50 +172,48 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     Ok(stages.finish(start))
 }
 
-/// The clippy passes, `(name, folder, arguments)`; the firmware's (thumb)
-/// with `--release`, to share build scripts with the release builds.
-const CLIPPY: [(&str, &str, &str); 7] = [
-    (
-        "clippy: Pico image, RP support, firmware layer, core (thumbv6m)",
-        ".",
-        "--release --package idle-head --package idle-head-rp --package idle-head-firmware \
-         --package idle-head-core",
-    ),
-    (
-        "clippy: QEMU images, boards/qemu/ (thumbv6m)",
-        ".",
-        "--release --bins --package idle-head-qemu",
-    ),
-    (
-        "clippy: Pico 2 image, boards/pico2/ (thumbv8m.main)",
-        "boards/pico2",
-        "--release",
-    ),
-    (
-        "clippy: core crate and its unit tests (host)",
-        ".",
-        "--package idle-head-core --all-targets --target host-tuple",
-    ),
-    (
-        "clippy: firmware layer and its unit tests (host)",
-        ".",
-        "--package idle-head-firmware --all-targets --target host-tuple",
-    ),
-    ("clippy: host-tests", "host-tests", "--all-targets"),
-    ("clippy: xtask", "xtask", "--all-targets"),
+/// The stages that run cargo, `(name, folder, firmware, commands)`: the
+/// firmware's with its build environment (and `--release`, to share build
+/// scripts with the release builds), the commands' arguments separated by
+/// ` && `.
+#[rustfmt::skip] // a table, one stage a line
+const CARGO: [(&str, &str, bool, &str); 14] = [
+    ("host tests (host-tests/)", "host-tests", false, "test"),
+    ("core crate: unit and doc tests (crates/core, host)", "crates/core", false, "test"),
+    ("firmware layer: host tests (crates/firmware)", "crates/firmware", false, "test"),
+    ("xtask unit tests", "xtask", false, "test --profile xtask"),
+    ("rustfmt: every package of the workspace", ".", false, "fmt --all --check"),
+    ("clippy: Pico image, RP support, firmware layer, core (thumbv6m)", ".", true,
+     "clippy --release --package idle-head --package idle-head-rp --package idle-head-firmware \
+      --package idle-head-core -- -D warnings"),
+    ("clippy: QEMU images, boards/qemu/ (thumbv6m)", ".", true,
+     "clippy --release --bins --package idle-head-qemu -- -D warnings"),
+    ("clippy: Pico 2 image, boards/pico2/ (thumbv8m.main)", "boards/pico2", true,
+     "clippy --release -- -D warnings"),
+    ("clippy: core crate and its unit tests (host)", ".", false,
+     "clippy --package idle-head-core --all-targets --target host-tuple -- -D warnings"),
+    ("clippy: firmware layer and its unit tests (host)", ".", false,
+     "clippy --package idle-head-firmware --all-targets --target host-tuple -- -D warnings"),
+    ("clippy: host-tests", "host-tests", false, "clippy --all-targets -- -D warnings"),
+    ("clippy: xtask", "xtask", false, "clippy --all-targets -- -D warnings"),
+    // The calibration image (same bin, feature `calibrate`) must compile.
+    ("Pico calibration image compiles (--features calibrate)", ".", true,
+     "check --release --features calibrate"),
+    // A board with servos and USB only, on the same `start` as the Pico's.
+    ("minimal board example, servos and USB only (examples/minimal.rs): clippy, build", ".", true,
+     "clippy --release --example minimal -- -D warnings && build --release --example minimal"),
 ];
 
-fn clippy_stages(stages: &mut Stages<'_>) {
-    for (name, dir, args) in CLIPPY {
+fn cargo_stages(stages: &mut Stages<'_>) {
+    for (name, dir, firmware, commands) in CARGO {
         stages.run(name, || {
             let sh = project::shell(dir)?;
-            let args = args.split_whitespace();
-            let env = if name.contains("(thumb") {
-                FIRMWARE_ENV
-            } else {
-                &[]
-            };
-            project::run(&sh, env, cmd!(sh, "cargo clippy {args...} -- -D warnings"))
+            let env = if firmware { FIRMWARE_ENV } else { &[] };
+            for args in commands.split(" && ") {
+                let args = args.split_whitespace();
+                project::run(&sh, env, cmd!(sh, "cargo {args...}"))?;
+            }
+            Ok(())
         });
     }
 }
