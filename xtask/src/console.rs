@@ -143,53 +143,45 @@ mod tests {
 
     #[test]
     fn the_head_is_found_by_its_id_and_product_among_other_devices() {
-        let usb = |name: &str, vid, product: Option<&str>| serialport::SerialPortInfo {
-            port_name: name.to_owned(),
-            port_type: serialport::SerialPortType::UsbPort(serialport::UsbPortInfo {
-                vid,
-                pid: PID,
-                serial_number: None,
-                manufacturer: None,
-                product: product.map(str::to_owned),
-            }),
-        };
-        let other = usb("/dev/ttyACM0", VID, Some("some other gadget"));
-        let head = usb("/dev/ttyACM1", VID, Some(PRODUCT));
-        let arduino = usb("/dev/ttyACM2", 0x2341, Some(PRODUCT));
-        let (bare, bare2) = (
-            usb("/dev/ttyACM4", VID, None),
-            usb("/dev/ttyACM5", VID, None),
-        );
-        let pick = |ports: &[&serialport::SerialPortInfo]| {
-            let ports: Vec<_> = ports.iter().map(|&p| p.clone()).collect();
+        let pick = |ports: &[(&str, u16, Option<&str>)]| {
+            let usb = |&(name, vid, product): &(&str, u16, Option<&str>)| {
+                let (product, serial_number, manufacturer) =
+                    (product.map(str::to_owned), None, None);
+                let usb = serialport::UsbPortInfo {
+                    vid,
+                    pid: PID,
+                    serial_number,
+                    manufacturer,
+                    product,
+                };
+                let port_type = serialport::SerialPortType::UsbPort(usb);
+                serialport::SerialPortInfo {
+                    port_name: name.to_owned(),
+                    port_type,
+                }
+            };
+            let ports: Vec<_> = ports.iter().map(usb).collect();
             pick_pico(&ports).map_err(|e| e.to_string())
         };
-        assert_eq!(
-            pick(&[&other, &arduino, &head]).unwrap(),
-            PathBuf::from("/dev/ttyACM1")
-        );
+        let other = ("/dev/ttyACM0", VID, Some("some other gadget"));
+        let head = ("/dev/ttyACM1", VID, Some(PRODUCT));
+        let arduino = ("/dev/ttyACM2", 0x2341, Some(PRODUCT));
+        let (bare, bare2) = (("/dev/ttyACM4", VID, None), ("/dev/ttyACM5", VID, None));
+        let found = |name: &str| Ok(PathBuf::from(name));
+        assert_eq!(pick(&[other, arduino, head]), found("/dev/ttyACM1"));
         // The shared ID alone is not enough when the product says otherwise.
-        let err = pick(&[&other, &arduino]).unwrap_err();
+        let err = pick(&[other, arduino]).unwrap_err();
         assert!(
             err.contains("/dev/ttyACM0 (\"some other gadget\")"),
             "{err}"
         );
-        assert!(
-            pick(&[&arduino])
-                .unwrap_err()
-                .contains("is the head plugged in")
-        );
+        let err = pick(&[arduino]).unwrap_err();
+        assert!(err.contains("is the head plugged in"), "{err}");
         // Without product strings, one device of the ID is taken; two are not.
-        assert_eq!(
-            pick(&[&other, &bare]).unwrap(),
-            PathBuf::from("/dev/ttyACM4")
-        );
-        assert!(
-            pick(&[&bare, &bare2])
-                .unwrap_err()
-                .contains("without a product string")
-        );
-        let err = pick(&[&head, &head]).unwrap_err();
+        assert_eq!(pick(&[other, bare]), found("/dev/ttyACM4"));
+        let err = pick(&[bare, bare2]).unwrap_err();
+        assert!(err.contains("without a product string"), "{err}");
+        let err = pick(&[head, head]).unwrap_err();
         assert!(
             err.contains("/dev/ttyACM1, /dev/ttyACM1; give --port"),
             "{err}"

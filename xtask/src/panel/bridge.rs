@@ -3,7 +3,7 @@
 //! sends goes to every page connected.
 
 use std::{
-    io::{Read, Write},
+    io::{ErrorKind, Read, Write},
     net::Shutdown,
     os::unix::net::UnixStream,
     path::{Path, PathBuf},
@@ -156,8 +156,7 @@ impl Bridge {
                 match reader.read(&mut buf) {
                     Ok(0) => break why.to_owned(),
                     Ok(n) => hub.tell(&Note::Bytes(buf[..n].to_vec())),
-                    Err(e) if matches!(e.kind(), std::io::ErrorKind::Interrupted) => {}
-                    Err(e) if matches!(e.kind(), std::io::ErrorKind::TimedOut) => {}
+                    Err(e) if matches!(e.kind(), ErrorKind::Interrupted | ErrorKind::TimedOut) => {}
                     Err(e) => break format!("{why}: {e}"),
                 }
             };

@@ -126,15 +126,9 @@ fn serve(mut request: Request, panel: &Path, bridge: Option<Arc<Bridge>>) {
 }
 
 fn file(bytes: &[u8], kind: &str) -> Response<std::io::Cursor<Vec<u8>>> {
-    let header = |name: &str, value: &str| Header::from_bytes(name, value).ok();
-    let mut response = Response::from_data(bytes.to_vec());
-    for header in [
-        header("Content-Type", kind),
-        header("Cache-Control", "no-store"),
-    ] {
-        response.add_header(header.expect("a valid header"));
-    }
-    response
+    let header = |name: &str, value: &str| Header::from_bytes(name, value).expect("a valid header");
+    let response = Response::from_data(bytes.to_vec()).with_header(header("Content-Type", kind));
+    response.with_header(header("Cache-Control", "no-store"))
 }
 
 /// The file `path` names: the page's own (in `panel/`), or a dependency's.
