@@ -24,8 +24,7 @@ impl Defmt {
         let table = Table::parse(&bytes)
             .with_context(|| format!("reading the defmt table of {}", elf.display()))?
             .with_context(|| format!("{} has no defmt data", elf.display()))?;
-        let locations = table.get_locations(&bytes).ok();
-        let root = crate::project::root();
+        let (locations, root) = (table.get_locations(&bytes).ok(), crate::project::root());
         Ok(Self {
             table,
             locations,
@@ -59,10 +58,8 @@ impl Defmt {
         let location = (self.locations.as_ref())
             .and_then(|locations| locations.get(&frame.index()))
             .map(|location| {
-                let file = location
-                    .file
-                    .strip_prefix(&self.root)
-                    .unwrap_or(&location.file);
+                let file = &location.file;
+                let file = file.strip_prefix(&self.root).unwrap_or(file);
                 format!("{}:{}", file.display(), location.line)
             });
         LogLine {

@@ -56,24 +56,13 @@ mod tests {
     fn the_default_idle_limits_are_1200_and_240_millidegrees_a_frame() {
         let driver = DriverConfig::DEFAULT.build().unwrap();
         let params = BehaviourConfig::DEFAULT.build(&driver).unwrap();
+        let of = |step, turn| Steps { step, turn };
         for axis in Axis::ALL {
             let allowed = Steps::allowed(&params, axis, LimitMode::Idle);
-            assert_eq!(
-                allowed,
-                Steps {
-                    step: 1200.0,
-                    turn: 240.0
-                }
-            );
+            assert_eq!(allowed, of(1200.0, 240.0));
         }
         let steps = Steps::of(&[0.0, 1000.0, 2200.0, 3400.0]);
-        assert_eq!(
-            steps,
-            Steps {
-                step: 1200.0,
-                turn: 200.0
-            }
-        );
+        assert_eq!(steps, of(1200.0, 200.0));
         let yaw = Steps::allowed(&params, Axis::Yaw, LimitMode::Idle);
         assert!(steps.within(yaw));
         assert!(!Steps::of(&[0.0, 1201.0]).within(yaw));

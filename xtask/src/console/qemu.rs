@@ -49,12 +49,7 @@ pub fn qemu_session(
     echo: Echo,
     wait: Duration,
 ) -> Result<QemuSession> {
-    let Sockets {
-        child,
-        dir,
-        uart0,
-        uart1,
-    } = spawn_with_sockets(elf, pace, "console", Stdio::piped)?;
+    let (child, dir, [uart0, uart1]) = spawn_with_sockets(elf, pace, "console", Stdio::piped)?;
     let (run, talk) = qemu::finish(child, elf, AFTER_HANG_UP, echo, || {
         let mut console = connect(&uart0)?;
         let mut hang_up = connect(&uart1)?;
@@ -77,25 +72,16 @@ pub fn qemu_session(
     Ok(QemuSession { run, talk: talk? })
 }
 
-/// QEMU started by [`spawn_with_sockets`].
-pub struct Sockets {
-    pub child: Child,
-    /// The sockets' folder, for the caller to remove when QEMU is done.
-    pub dir: PathBuf,
-    pub uart0: PathBuf,
-    /// UART1's socket: the hang-up line.
-    pub uart1: PathBuf,
-}
-
 /// Starts QEMU running `elf` for a console, UART0 and UART1 on sockets it
 /// serves (waiting for both to be connected) in a temporary folder of its
-/// own; its stdout and stderr are `output`.
+/// own, its stdout and stderr `output`: QEMU, the folder (for the caller to
+/// remove), the sockets.
 pub fn spawn_with_sockets(
     elf: &Path,
     pace: Pace,
     tag: &str,
     output: fn() -> Stdio,
-) -> Result<Sockets> {
+) -> Result<(Child, PathBuf, [PathBuf; 2])> {
     let dir = std::env::temp_dir().join(format!("idle-head-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let [uart0, uart1] = ["uart0", "uart1"].map(|n| dir.join(format!("{n}.sock")));
@@ -109,12 +95,7 @@ pub fn spawn_with_sockets(
         .stderr(output())
         .spawn()
         .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
-    Ok(Sockets {
-        child,
-        dir,
-        uart0,
-        uart1,
-    })
+    Ok((child, dir, [uart0, uart1]))
 }
 
 /// QEMU running `elf` for a console: the run `pace` asks for, UART0 and
