@@ -93,8 +93,8 @@ pub fn missing(root: &Path) -> anyhow::Result<Vec<String>> {
 pub const MODULE_DOC_LINES: usize = 30;
 
 /// The Rust files under `crates/` whose module doc is [`MODULE_DOC_LINES`]
-/// long or longer, with its length.
-pub fn long_module_docs(root: &Path) -> anyhow::Result<Vec<(PathBuf, usize)>> {
+/// long or longer, as `file: n lines`.
+pub fn long_module_docs(root: &Path) -> anyhow::Result<Vec<String>> {
     let mut files = Vec::new();
     collect(&root.join("crates"), &mut files)?;
     files.sort();
@@ -104,13 +104,11 @@ pub fn long_module_docs(root: &Path) -> anyhow::Result<Vec<(PathBuf, usize)>> {
         .filter(|f| f.extension().is_some_and(|e| e == "rs"))
     {
         let text = fs::read_to_string(file)?;
-        let lines = text
-            .lines()
-            .skip_while(|l| !l.starts_with("//!"))
-            .take_while(|l| l.starts_with("//!"))
-            .count();
+        let doc = text.lines().skip_while(|l| !l.starts_with("//!"));
+        let lines = doc.take_while(|l| l.starts_with("//!")).count();
+        let file = file.strip_prefix(root).unwrap_or(file).display();
         if lines >= MODULE_DOC_LINES {
-            long.push((file.strip_prefix(root).unwrap_or(file).to_path_buf(), lines));
+            long.push(format!("{file}: {lines} lines"));
         }
     }
     Ok(long)
@@ -161,22 +159,15 @@ mod tests {
         let file = root.join("crates/core/src/lib.rs");
         assert!(exists(&root, &file, "crates/core/src/lib.rs"));
         // From the package's folder.
-        assert!(exists(
-            &root,
-            &root.join("boards/qemu/src/main.rs"),
-            "src/panic_proof.rs"
-        ));
+        let main = root.join("boards/qemu/src/main.rs");
+        assert!(exists(&root, &main, "src/panic_proof.rs"));
         assert!(!exists(&root, &file, "crates/core/src/gone.rs"));
         assert!(!exists(&root, &file, "src/bin/pico/"));
     }
 
     #[test]
     fn module_docs_are_short() {
-        let long = long_module_docs(&crate::project::root()).unwrap();
-        let list: Vec<String> = long
-            .iter()
-            .map(|(file, n)| format!("{}: {n} lines", file.display()))
-            .collect();
+        let list = long_module_docs(&crate::project::root()).unwrap();
         assert!(
             list.is_empty(),
             "module docs of {MODULE_DOC_LINES} lines or more (say what the module is; \
