@@ -98,9 +98,7 @@ fn update(path: &Path, key: &str, table: String) -> Result<bool> {
     if new == old {
         return Ok(false);
     }
-    let partial = path.with_extension("md.partial");
-    project::write(&partial, &new)?;
-    std::fs::rename(&partial, path).with_context(|| format!("writing {}", path.display()))?;
+    project::write(path, &new)?;
     Ok(true)
 }
 

@@ -5,6 +5,7 @@
 use std::{
     path::{Path, PathBuf},
     process::{Child, ChildStderr, ChildStdout, ExitStatus},
+    sync::atomic::{AtomicU32, Ordering},
     thread,
     time::Duration,
 };
@@ -113,12 +114,19 @@ pub fn finish<O: Send, E: Send, R>(
     })
 }
 
-/// Writes `contents` to `path`, creating its folder.
+/// Writes `contents` to `path`, creating its folder: through a file of
+/// this call's own, renamed over it, so that no reader (of the runs side by
+/// side) sees half a file.
 pub fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
+    static CALLS: AtomicU32 = AtomicU32::new(0);
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    std::fs::write(path, contents).with_context(|| format!("writing {}", path.display()))
+    let n = CALLS.fetch_add(1, Ordering::Relaxed);
+    let mut partial = path.as_os_str().to_owned();
+    partial.push(format!(".{}-{n}.partial", std::process::id()));
+    let written = std::fs::write(&partial, contents).and_then(|()| std::fs::rename(&partial, path));
+    written.with_context(|| format!("writing {}", path.display()))
 }
 
 /// Fails with every one of `problems`, if there are any.

@@ -94,16 +94,10 @@ pub fn start_block(data: &[u8]) -> Result<Range<u64>> {
 /// Makes the UF2 of the ELF at `elf` and writes it beside it (`…/pico` →
 /// `…/pico.uf2`, or another `extension`); returns its path and contents.
 pub fn write(elf: &Path, board: Board, extension: &str) -> Result<(PathBuf, Vec<u8>)> {
-    static CALLS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
     let data = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
     let bytes = make(&data, board).with_context(|| format!("the UF2 of {}", elf.display()))?;
     let path = elf.with_extension(extension);
-    // Through a file of this call's own, renamed over the UF2: emulator runs
-    // side by side convert the same ELF, and none may read half a file.
-    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let partial = elf.with_extension(format!("{extension}.{}-{n}", std::process::id()));
-    std::fs::write(&partial, &bytes).with_context(|| format!("writing {}", partial.display()))?;
-    std::fs::rename(&partial, &path).with_context(|| format!("writing {}", path.display()))?;
+    project::write(&path, &bytes)?;
     Ok((path, bytes))
 }
 
