@@ -221,11 +221,9 @@ fn cargo_stages(stages: &mut Stages<'_>) {
 /// An emulator stage: its name, and what it runs on images built already.
 type Emulated = (&'static str, fn(&Path, &Metadata) -> Result<()>);
 
-/// The stages in the RP2040 emulator, in the order of the score card: the
-/// full run builds their images, then runs them side by side as `cargo
-/// xtask test --stage NAME`, longest first, each one's output held back and
-/// printed in this order. Only the latency stage records figures, so no two
-/// write the figures page at once.
+/// The stages in the RP2040 emulator, in the order of the score card, run
+/// side by side on images built already (`cargo xtask test --stage NAME`),
+/// longest first. Only the latency stage records figures.
 const EMULATED: [Emulated; 16] = [
     (sim::PULSES_STAGE, |root, metadata| {
         let report = sim::test_pulses(root, metadata)?;

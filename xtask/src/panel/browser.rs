@@ -1,9 +1,8 @@
-//! The panel's browser tests, a stage of `cargo xtask test`: Debian's
-//! Chromium, headless, driven by playwright-core (`panel/tests/browser.mjs`)
-//! over Web Serial (the emulated Pico), the bridge of `panel --qemu`, a
-//! real serial port (QEMU's UART0 on a pty, through `console --port` and
-//! `panel --port`), and the radar's map on the telemetry of a host trace
-//! replayed by a fake serial port. Screenshots go to `target/panel/`.
+//! The panel's browser tests, a stage of `cargo xtask test`: headless
+//! Chromium driven by playwright-core (`panel/tests/browser.mjs`) over Web
+//! Serial (the emulated Pico), `panel --qemu`, a real serial port (QEMU's
+//! UART0 on a pty, through `console --port` and `panel --port`), and a
+//! replayed host trace (the radar's map). Screenshots: `target/panel/`.
 
 use std::{
     io::{BufRead, BufReader, Write},

@@ -1,9 +1,7 @@
-//! The panel's web server (`tiny_http`): the page's files, the dependencies
-//! it loads (`vendor/…`, from `panel/node_modules`), `bridge.json` (the
-//! head it is bridged to, if any), and the bridge: `GET /events` streams
-//! the head's bytes as server-sent events (hex digits, and an event `gone`
-//! with the reason when the head goes away), `POST /send` takes bytes for
-//! it. Every request has a thread of its own.
+//! The panel's web server (`tiny_http`, a thread a request): the page's
+//! files and dependencies (`vendor/…`), `bridge.json` (the head bridged
+//! to, if any), `GET /events` (the head's bytes as server-sent events of
+//! hex digits; `gone` with the reason when it goes away), `POST /send`.
 
 use std::{
     io::Write,
