@@ -6,9 +6,8 @@ use std::time::Duration;
 use clap::Args;
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N};
 
-/// Options of the commands that run QEMU: re-record the expected QEMU log
-/// instead of comparing against it; the wall-clock limit for one QEMU run;
-/// report the benchmark's instruction budget without failing on it.
+/// Options of the commands that run QEMU (`--bless`, `--timeout`,
+/// `--no-budget`).
 #[derive(Debug, Clone, Copy)]
 pub struct Options {
     pub bless: bool,

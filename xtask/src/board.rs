@@ -1,5 +1,4 @@
-//! The boards a user flashes: what the tools need to know to build an
-//! image for each, turn it into a UF2 and put it on the board.
+//! The boards a user flashes: their images, UF2 families and drives.
 
 use std::ops::Range;
 
@@ -12,9 +11,7 @@ use crate::project::{Image, PICO};
 /// to GP5, `input 2` to `input 5`.
 pub const PICO_INPUTS: [u8; 4] = [2, 3, 4, 5];
 
-/// What the Pico image's console answers for (`crates/rp/src/pico.rs`):
-/// its inputs, the DMX receiver and the radar; the host's models of its
-/// console take them.
+/// What the Pico image's console answers for (`crates/rp/src/pico.rs`).
 pub fn pico_parts() -> BoardParts {
     BoardParts {
         inputs: InputIds::new(&PICO_INPUTS).unwrap_or(InputIds::NONE),
@@ -27,8 +24,7 @@ pub fn pico_parts() -> BoardParts {
 /// Mainline, with its single-precision FPU).
 pub const PICO2_TARGET: &str = "thumbv8m.main-none-eabihf";
 
-/// A board whose boot ROM takes a UF2 file over USB and that a debug probe
-/// can flash.
+/// A board that takes a UF2 file over USB, or a debug probe.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Board {
     /// Raspberry Pi Pico (RP2040, 2 MiB flash): the root package.
@@ -60,8 +56,7 @@ impl Board {
     }
 
     /// The UF2 family its boot ROM accepts: `rp2040`, or `rp2350-arm-s`
-    /// (its Arm cores in Secure mode, which embassy-rp's start block
-    /// declares); the boot ROM ignores blocks of any other family.
+    /// (Arm Secure, as embassy-rp's start block declares).
     pub fn family_id(self) -> u32 {
         match self {
             Self::Pico => 0xe48b_ff56,
@@ -77,8 +72,8 @@ impl Board {
         }
     }
 
-    /// The `Board-ID` its boot ROM writes in `INFO_UF2.TXT` on the USB
-    /// drive of BOOTSEL mode, which is also the drive's label.
+    /// The `Board-ID` in `INFO_UF2.TXT` on its BOOTSEL drive, also the
+    /// drive's label.
     pub fn drive_label(self) -> &'static str {
         match self {
             Self::Pico => "RPI-RP2",
@@ -86,9 +81,8 @@ impl Board {
         }
     }
 
-    /// The settings store: the last four 4 KiB erase sectors of the flash
-    /// (2 MiB on the Pico, 4 MiB on the Pico 2, from `0x1000_0000`;
-    /// `SETTINGS` in the board's memory.x). No image reaches into it.
+    /// The settings store: the last four 4 KiB sectors of the flash
+    /// (`SETTINGS` in the board's memory.x).
     pub fn settings(self) -> Range<u32> {
         let end = 0x1000_0000
             + match self {

@@ -1,12 +1,8 @@
 //! `cargo xtask book`: the book built with mdBook into `target/book`, and
-//! every link in it checked.
-//!
-//! The links are checked by linkinator (npm, pinned in `xtask/book/`; it
-//! installs in seconds where a Rust link checker compiles for minutes): in
-//! the built book every page, picture and `#anchor` (against the ids mdBook
-//! gave its headings, the measured figures page included), and in the
-//! README every file of the repository and `#anchor` (against the heading
-//! ids GitHub gives the Markdown). Links to other sites are not followed.
+//! its links and the README's checked by linkinator (npm, pinned in
+//! `xtask/book/`: it installs in seconds where a Rust link checker compiles
+//! for minutes): every page, picture and `#anchor`; other sites are not
+//! followed.
 
 use std::path::Path;
 
@@ -23,8 +19,7 @@ const OUT: &str = "target/book";
 /// Links not followed: to any other site than linkinator's own server.
 const EXTERNAL: &str = "^https?://(?!localhost)";
 
-/// Builds the book and checks its links and the README's; fails on a
-/// build error or a broken link.
+/// Builds the book and checks its links and the README's.
 pub fn stage(root: &Path) -> Result<()> {
     let mdbook = setup::ensure_mdbook(&root.join("target").join("tools"))?;
     let tools = root.join("xtask/book");

@@ -6,17 +6,12 @@ use clap::CommandFactory;
 
 use crate::{cli::Cli, project};
 
-/// The page's lines that name `cargo xtask <name>`, joined.
-fn lines_naming<'a>(page: &'a str, name: &str) -> Vec<&'a str> {
-    let command = format!("cargo xtask {name}");
-    page.lines()
-        .filter(|line| {
-            line.match_indices(&command).any(|(at, _)| {
-                let next = line[at + command.len()..].chars().next();
-                !next.is_some_and(|c| c.is_ascii_alphanumeric() || c == '-')
-            })
-        })
-        .collect()
+/// Whether `line` names `word`, not a longer command or option.
+fn names(line: &str, word: &str) -> bool {
+    line.match_indices(word).any(|(at, _)| {
+        let next = line[at + word.len()..].chars().next();
+        !next.is_some_and(|c| c.is_ascii_alphanumeric() || c == '-')
+    })
 }
 
 /// What the page misses of the definition: commands, then options.
@@ -24,7 +19,8 @@ fn missing(page: &str) -> Vec<String> {
     let mut missing = Vec::new();
     for command in Cli::command().get_subcommands() {
         let name = command.get_name();
-        let lines = lines_naming(page, name);
+        let named = format!("cargo xtask {name}");
+        let lines: Vec<&str> = page.lines().filter(|l| names(l, &named)).collect();
         if lines.is_empty() {
             missing.push(format!("`cargo xtask {name}`"));
             continue;
@@ -35,13 +31,7 @@ fn missing(page: &str) -> Vec<String> {
                 continue;
             }
             let option = format!("--{long}");
-            let named = lines.iter().any(|line| {
-                line.match_indices(&option).any(|(at, _)| {
-                    let next = line[at + option.len()..].chars().next();
-                    !next.is_some_and(|c| c.is_ascii_alphanumeric() || c == '-')
-                })
-            });
-            if !named {
+            if !lines.iter().any(|line| names(line, &option)) {
                 missing.push(format!("`cargo xtask {name} {option}`"));
             }
         }

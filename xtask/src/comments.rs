@@ -1,15 +1,11 @@
-//! The paths the source's comments name must exist: a comment that points
-//! at a file since moved or renamed misleads the next reader. [`missing`]
-//! scans the comments of the Rust files and manifests under [`SCANNED`]
-//! for repository paths and lists those that are not there; the unit test
-//! below fails naming them. Module docs in `crates/` stay short too
-//! ([`long_module_docs`]).
+//! Unit tests of the source's comments: every repository path one names
+//! exists (a comment pointing at a moved file misleads), and module docs in
+//! `crates/` stay short.
 
 use std::fs;
 use std::path::{Path, PathBuf};
 
-/// The folders whose comments are scanned, from the repository root (the
-/// project commands' own included).
+/// The folders whose comments are scanned.
 pub const SCANNED: [&str; 5] = ["crates", "src", "boards", "host-tests", "xtask"];
 
 /// How a path a comment names starts: a folder at the repository's top.
@@ -32,26 +28,8 @@ const EXTENSIONS: [&str; 13] = [
     ".png",
 ];
 
-/// A path named in a comment that does not exist.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Missing {
-    /// The file whose comment names it, from the repository root.
-    pub file: PathBuf,
-    /// Its line, from 1.
-    pub line: usize,
-    /// The path as the comment spells it.
-    pub path: String,
-}
-
-impl std::fmt::Display for Missing {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}:{}: {}", self.file.display(), self.line, self.path)
-    }
-}
-
-/// The comment of a source line, if it has one: what follows `//` in a
-/// Rust file, `#` in a manifest (a rough cut: a `//` or `#` inside a
-/// string counts too, which only makes the scan look at more text).
+/// What follows `//` in a Rust line, `#` in a manifest's (inside a string
+/// too, which only makes the scan look at more text).
 fn comment(line: &str, rust: bool) -> Option<&str> {
     let marker = if rust { "//" } else { "#" };
     line.find(marker).map(|at| &line[at + marker.len()..])
@@ -83,12 +61,9 @@ fn exists(root: &Path, file: &Path, path: &str) -> bool {
         .any(|dir| dir.join("Cargo.toml").exists() && dir.join(path).exists())
 }
 
-/// Every path named in a comment under `root`'s [`SCANNED`] folders that
-/// does not exist, in file and line order.
-///
-/// # Errors
-/// A folder or file that cannot be read.
-pub fn missing(root: &Path) -> anyhow::Result<Vec<Missing>> {
+/// Every path named in a comment under [`SCANNED`] that does not exist, as
+/// `file:line: path`.
+pub fn missing(root: &Path) -> anyhow::Result<Vec<String>> {
     let mut files = Vec::new();
     for dir in SCANNED {
         collect(&root.join(dir), &mut files)?;
@@ -104,11 +79,8 @@ pub fn missing(root: &Path) -> anyhow::Result<Vec<Missing>> {
             };
             for path in paths_in(comment) {
                 if !exists(root, &file, path) {
-                    found.push(Missing {
-                        file: file.strip_prefix(root).unwrap_or(&file).to_path_buf(),
-                        line: n + 1,
-                        path: path.to_owned(),
-                    });
+                    let name = file.strip_prefix(root).unwrap_or(&file).display();
+                    found.push(format!("{name}:{}: {path}", n + 1));
                 }
             }
         }
@@ -120,13 +92,9 @@ pub fn missing(root: &Path) -> anyhow::Result<Vec<Missing>> {
 /// its invariants; the reasoning goes to the book (`docs/design/code.md`).
 pub const MODULE_DOC_LINES: usize = 30;
 
-/// The Rust files under `root`'s `crates/` whose module doc (the `//!`
-/// lines it opens with) is [`MODULE_DOC_LINES`] long or longer, with its
-/// length.
-///
-/// # Errors
-/// A folder or file that cannot be read.
-pub fn long_module_docs(root: &Path) -> anyhow::Result<Vec<(PathBuf, usize)>> {
+/// The Rust files under `crates/` whose module doc is [`MODULE_DOC_LINES`]
+/// long or longer, as `file: n lines`.
+pub fn long_module_docs(root: &Path) -> anyhow::Result<Vec<String>> {
     let mut files = Vec::new();
     collect(&root.join("crates"), &mut files)?;
     files.sort();
@@ -136,13 +104,11 @@ pub fn long_module_docs(root: &Path) -> anyhow::Result<Vec<(PathBuf, usize)>> {
         .filter(|f| f.extension().is_some_and(|e| e == "rs"))
     {
         let text = fs::read_to_string(file)?;
-        let lines = text
-            .lines()
-            .skip_while(|l| !l.starts_with("//!"))
-            .take_while(|l| l.starts_with("//!"))
-            .count();
+        let doc = text.lines().skip_while(|l| !l.starts_with("//!"));
+        let lines = doc.take_while(|l| l.starts_with("//!")).count();
+        let file = file.strip_prefix(root).unwrap_or(file).display();
         if lines >= MODULE_DOC_LINES {
-            long.push((file.strip_prefix(root).unwrap_or(file).to_path_buf(), lines));
+            long.push(format!("{file}: {lines} lines"));
         }
     }
     Ok(long)
@@ -193,22 +159,15 @@ mod tests {
         let file = root.join("crates/core/src/lib.rs");
         assert!(exists(&root, &file, "crates/core/src/lib.rs"));
         // From the package's folder.
-        assert!(exists(
-            &root,
-            &root.join("boards/qemu/src/main.rs"),
-            "src/panic_proof.rs"
-        ));
+        let main = root.join("boards/qemu/src/main.rs");
+        assert!(exists(&root, &main, "src/panic_proof.rs"));
         assert!(!exists(&root, &file, "crates/core/src/gone.rs"));
         assert!(!exists(&root, &file, "src/bin/pico/"));
     }
 
     #[test]
     fn module_docs_are_short() {
-        let long = long_module_docs(&crate::project::root()).unwrap();
-        let list: Vec<String> = long
-            .iter()
-            .map(|(file, n)| format!("{}: {n} lines", file.display()))
-            .collect();
+        let list = long_module_docs(&crate::project::root()).unwrap();
         assert!(
             list.is_empty(),
             "module docs of {MODULE_DOC_LINES} lines or more (say what the module is; \
@@ -219,8 +178,7 @@ mod tests {
 
     #[test]
     fn every_path_a_comment_names_exists() {
-        let missing = missing(&crate::project::root()).unwrap();
-        let list: Vec<String> = missing.iter().map(ToString::to_string).collect();
+        let list = missing(&crate::project::root()).unwrap();
         assert!(
             list.is_empty(),
             "comments name paths that do not exist:\n{}",

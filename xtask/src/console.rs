@@ -15,7 +15,7 @@ use anyhow::{Context, Result, bail};
 use idle_head_core::console::usb_identity::{PID, PRODUCT, VID};
 
 pub use qemu::{Pace, qemu_session};
-pub use stages::piped_script;
+pub use stages::{piped_script, script};
 
 use crate::qemu::Echo;
 use crate::{log, project, setup};
@@ -54,8 +54,7 @@ pub fn command(args: &Args) -> Result<bool> {
         eprintln!("console: QEMU running; type commands, end with Ctrl-D");
         let elf = project::QEMU.elf(&metadata);
         let session = qemu_session(&elf, stdin, &mut print, Pace::RealTime, Echo::Quiet, wait)?;
-        // The firmware's warnings and errors on stderr: stdout has the
-        // replies and the summary only.
+        // stdout has the replies and the summary only.
         for line in session.run.log.iter().filter(|l| l.is_problem()) {
             eprintln!("{}", line.snapshot());
         }
@@ -83,12 +82,10 @@ pub fn command(args: &Args) -> Result<bool> {
     Ok(ran && problems.is_empty())
 }
 
-/// The head among `ports`. Other hobby devices share its USB VID:PID (the
-/// V-USB shared pair for CDC-ACM serial devices, 16c0:27dd), so the
-/// product string decides: the one port with the pair and the head's
-/// product; failing that, the one port with the pair whose strings the
-/// system does not show. None, or more than one, is an error that lists
-/// what was found and asks for `--port`.
+/// The head among `ports`: other devices share its VID:PID (V-USB's shared
+/// pair for CDC-ACM), so the one with the head's product string, else the
+/// one whose strings the system does not show; none, or several, is an
+/// error listing what was found.
 fn pick_pico(ports: &[serialport::SerialPortInfo]) -> Result<PathBuf> {
     let shared: Vec<(&str, Option<&str>)> = (ports.iter())
         .filter_map(|p| match &p.port_type {
@@ -133,8 +130,7 @@ fn pick_pico(ports: &[serialport::SerialPortInfo]) -> Result<PathBuf> {
     }
 }
 
-/// The serial port at `path`, 115200 8N1, a read giving up after
-/// `timeout`.
+/// The serial port at `path`, 115200 8N1, reads timing out after `timeout`.
 pub(crate) fn open_port(path: &Path, timeout: Duration) -> Result<Box<dyn serialport::SerialPort>> {
     let name = path.to_string_lossy();
     let port = serialport::new(name.as_ref(), 115_200).timeout(timeout);
@@ -147,53 +143,45 @@ mod tests {
 
     #[test]
     fn the_head_is_found_by_its_id_and_product_among_other_devices() {
-        let usb = |name: &str, vid, product: Option<&str>| serialport::SerialPortInfo {
-            port_name: name.to_owned(),
-            port_type: serialport::SerialPortType::UsbPort(serialport::UsbPortInfo {
-                vid,
-                pid: PID,
-                serial_number: None,
-                manufacturer: None,
-                product: product.map(str::to_owned),
-            }),
-        };
-        let other = usb("/dev/ttyACM0", VID, Some("some other gadget"));
-        let head = usb("/dev/ttyACM1", VID, Some(PRODUCT));
-        let arduino = usb("/dev/ttyACM2", 0x2341, Some(PRODUCT));
-        let (bare, bare2) = (
-            usb("/dev/ttyACM4", VID, None),
-            usb("/dev/ttyACM5", VID, None),
-        );
-        let pick = |ports: &[&serialport::SerialPortInfo]| {
-            let ports: Vec<_> = ports.iter().map(|&p| p.clone()).collect();
+        let pick = |ports: &[(&str, u16, Option<&str>)]| {
+            let usb = |&(name, vid, product): &(&str, u16, Option<&str>)| {
+                let (product, serial_number, manufacturer) =
+                    (product.map(str::to_owned), None, None);
+                let usb = serialport::UsbPortInfo {
+                    vid,
+                    pid: PID,
+                    serial_number,
+                    manufacturer,
+                    product,
+                };
+                let port_type = serialport::SerialPortType::UsbPort(usb);
+                serialport::SerialPortInfo {
+                    port_name: name.to_owned(),
+                    port_type,
+                }
+            };
+            let ports: Vec<_> = ports.iter().map(usb).collect();
             pick_pico(&ports).map_err(|e| e.to_string())
         };
-        assert_eq!(
-            pick(&[&other, &arduino, &head]).unwrap(),
-            PathBuf::from("/dev/ttyACM1")
-        );
+        let other = ("/dev/ttyACM0", VID, Some("some other gadget"));
+        let head = ("/dev/ttyACM1", VID, Some(PRODUCT));
+        let arduino = ("/dev/ttyACM2", 0x2341, Some(PRODUCT));
+        let (bare, bare2) = (("/dev/ttyACM4", VID, None), ("/dev/ttyACM5", VID, None));
+        let found = |name: &str| Ok(PathBuf::from(name));
+        assert_eq!(pick(&[other, arduino, head]), found("/dev/ttyACM1"));
         // The shared ID alone is not enough when the product says otherwise.
-        let err = pick(&[&other, &arduino]).unwrap_err();
+        let err = pick(&[other, arduino]).unwrap_err();
         assert!(
             err.contains("/dev/ttyACM0 (\"some other gadget\")"),
             "{err}"
         );
-        assert!(
-            pick(&[&arduino])
-                .unwrap_err()
-                .contains("is the head plugged in")
-        );
+        let err = pick(&[arduino]).unwrap_err();
+        assert!(err.contains("is the head plugged in"), "{err}");
         // Without product strings, one device of the ID is taken; two are not.
-        assert_eq!(
-            pick(&[&other, &bare]).unwrap(),
-            PathBuf::from("/dev/ttyACM4")
-        );
-        assert!(
-            pick(&[&bare, &bare2])
-                .unwrap_err()
-                .contains("without a product string")
-        );
-        let err = pick(&[&head, &head]).unwrap_err();
+        assert_eq!(pick(&[other, bare]), found("/dev/ttyACM4"));
+        let err = pick(&[bare, bare2]).unwrap_err();
+        assert!(err.contains("without a product string"), "{err}");
+        let err = pick(&[head, head]).unwrap_err();
         assert!(
             err.contains("/dev/ttyACM1, /dev/ttyACM1; give --port"),
             "{err}"

@@ -1,7 +1,7 @@
 //! Reads a firmware ELF: section placement and sizes, memory budgets, and
 //! symbols that must not be linked.
 
-use std::{fmt::Write as _, ops::Range, path::Path};
+use std::{ops::Range, path::Path};
 
 use anyhow::{Context, Result, bail};
 
@@ -9,26 +9,17 @@ use crate::{board::Board, figures, project};
 use object::read::elf::{ElfFile32, ProgramHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, SectionKind, elf};
 
-/// RAM budget of the Pico image: static RAM (`.radar_ring + .data + .bss +
-/// .uninit`) plus the peak stack measured in the RP2040 emulator: 50 KiB,
-/// over the 48 KiB first set. The radar's receiver (its DMA ring and
-/// state), the board's optional parts and the settings read back took the
-/// static RAM to 38,964 B; the deepest stack, 10,584 B, comes in the
-/// settings store's run (a saved record read, decoded and validated, under
-/// the port and frame executors). Of the RP2040's 264 KiB.
+/// RAM budget of the Pico image (of the RP2040's 264 KiB): static RAM plus
+/// the peak stack measured in the RP2040 emulator, deepest in the settings
+/// store's run (a saved record read back under both executors).
 pub const RAM_BUDGET: u64 = 50 * 1024;
-/// Flash budget of the Pico image: everything stored in flash
-/// (`.boot2 + .vector_table + .text + .rodata` and `.data`'s initial values).
+/// Flash budget of the Pico image: every section stored in flash.
 pub const FLASH_BUDGET: u64 = 192 * 1024;
-/// Where the RP2040 maps its QSPI flash (XIP), and the end of the window a
-/// 16 MiB flash can occupy. Its boot ROM loads the 256-byte second stage
-/// (252 bytes of code and a CRC32) from the first page.
+/// The RP2040's XIP flash window (16 MiB at most).
 pub const XIP: Range<u64> = 0x1000_0000..0x1100_0000;
 
-/// Parts of the names of symbols that are only present when an allocator is
-/// linked (`alloc`'s shims and the `#[global_allocator]` glue). Recent
-/// compilers mangle the shims (`_RNv..7___rustc12___rust_alloc`), so names are
-/// matched by substring.
+/// Parts of the names of symbols linked only with an allocator (matched by
+/// substring: recent compilers mangle the shims).
 const ALLOCATOR_SYMBOLS: &[&str] = &[
     "__rust_alloc",
     "__rust_realloc",
@@ -43,8 +34,7 @@ pub struct Section {
     pub name: String,
     pub address: u64,
     pub size: u64,
-    /// Whether the section has contents in the file (and so in flash);
-    /// `.bss` and `.uninit` do not.
+    /// Has contents in the file, and so in flash (not `.bss`, `.uninit`).
     pub stored: bool,
 }
 
@@ -55,12 +45,10 @@ pub struct Image {
     pub sections: Vec<Section>,
     /// Allocator symbols found (there should be none).
     pub allocator_symbols: Vec<String>,
-    /// `[__settings_start, __settings_end)` from the linker script, if
-    /// the image has them (the Pico images do).
+    /// `[__settings_start, __settings_end)` from memory.x, if present.
     pub settings: Option<Range<u64>>,
-    /// End of the bytes stored in the XIP flash window: the highest load
-    /// address (`p_paddr + p_filesz`) of a loadable segment there, so
-    /// `.data`'s initial values count where they are stored.
+    /// End of the bytes stored in the XIP window: the highest load address
+    /// of a segment there (so `.data`'s initial values count).
     pub flash_end: u64,
 }
 
@@ -119,7 +107,6 @@ impl Image {
         let settings = symbol("__settings_start")
             .zip(symbol("__settings_end"))
             .map(|(start, end)| start..end);
-        // The highest load address of a segment stored in the XIP window;
         // 0 for an ELF that is not a 32-bit one.
         let flash_end = ElfFile32::<Endianness>::parse(data).map_or(0, |file| {
             let e = file.endian();
@@ -143,17 +130,15 @@ impl Image {
         self.sections.iter().find(|section| section.name == name)
     }
 
-    /// Bytes of RAM taken before `main` runs: `.data + .bss + .uninit`,
-    /// and the radar's DMA ring (`.radar_ring`, placed by the board's
-    /// `memory.x`).
+    /// Bytes of RAM taken before `main` runs (`.radar_ring`, `.data`,
+    /// `.bss`, `.uninit`).
     pub fn static_ram(&self) -> u64 {
         let ram =
             |s: &&Section| [".radar_ring", ".data", ".bss", ".uninit"].contains(&s.name.as_str());
         self.sections.iter().filter(ram).map(|s| s.size).sum()
     }
 
-    /// Bytes written to flash: every allocated section with contents
-    /// (this includes the initial values of `.data`).
+    /// Bytes written to flash: every section with contents.
     pub fn flash(&self) -> u64 {
         self.sections
             .iter()
@@ -204,9 +189,8 @@ impl Image {
         Ok(())
     }
 
-    /// Fails unless the image names the settings region of memory.x, it is
-    /// `board`'s ([`Board::settings`]), and nothing stored in flash reaches
-    /// into it.
+    /// Fails unless memory.x reserves `board`'s settings region and nothing
+    /// stored in flash reaches into it.
     pub fn check_settings_region(&self, board: Board) -> Result<()> {
         let Some(region) = self.settings.clone() else {
             bail!(
@@ -246,9 +230,8 @@ pub fn problems(checks: impl IntoIterator<Item = Result<()>>) -> Vec<String> {
         .collect()
 }
 
-/// Prints the Pico image's sections and budgets; fails if `.boot2` is misplaced,
-/// a budget is exceeded, an allocator is linked or the image reaches into the
-/// settings region.
+/// Prints the Pico image's sections and budgets; fails on a misplaced
+/// `.boot2`, a budget exceeded, an allocator, or the settings region reached.
 pub fn check_pico(path: &Path) -> Result<()> {
     let image = Image::show(path)?;
     let (flash, ram) = (image.flash(), image.static_ram());
@@ -259,22 +242,20 @@ pub fn check_pico(path: &Path) -> Result<()> {
         image.check_no_allocator(),
         image.check_settings_region(Board::Pico),
     ]);
-    if flash > FLASH_BUDGET {
-        problems.push(format!(
-            "flash use {flash} B is over the {FLASH_BUDGET} B budget"
-        ));
-    }
-    if ram > RAM_BUDGET {
-        problems.push(format!(
-            "static RAM use {ram} B is over the {RAM_BUDGET} B budget"
-        ));
+    for (what, used, budget) in [
+        ("flash", flash, FLASH_BUDGET),
+        ("static RAM", ram, RAM_BUDGET),
+    ] {
+        if used > budget {
+            problems.push(format!("{what} use {used} B is over the {budget} B budget"));
+        }
     }
     project::verdict(&problems)
 }
 
-/// Prints the QEMU image's sections and sizes (no budget: it is a test image);
-/// fails if the vector table is not where the LM3S6965 boots from (the start
-/// of its flash, `FLASH` in boards/qemu/memory.x) or an allocator is linked.
+/// Prints the QEMU image's sections (no budget: a test image); fails unless
+/// the vector table is at 0, where the LM3S6965 boots, and no allocator is
+/// linked.
 pub fn check_qemu(path: &Path) -> Result<()> {
     let image = Image::show(path)?;
     image.check_vector_table(0, "LM3S6965")?;
@@ -288,9 +269,8 @@ pub struct Peak {
     pub stack: u64,
 }
 
-/// Records static RAM, peak stack and their total for the Pico image (stack
-/// measured in the RP2040 emulator) and the QEMU smoke image; fails if the
-/// Pico image's total is over [`RAM_BUDGET`] or its peak is unknown.
+/// Records static RAM and peak stack of the Pico and QEMU images; fails if
+/// the Pico image's total is over [`RAM_BUDGET`] or its peak is unknown.
 pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
     let rows = [
         ("pico", "the RP2040 emulator", pico, Some(RAM_BUDGET)),
@@ -337,16 +317,10 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
 fn record_image(path: &Path, image: &Image) {
     let name = path.file_name().unwrap_or_default().to_string_lossy();
     let flash = image.flash();
-    let mut sections = String::new();
-    for s in &image.sections {
-        let _ = write!(
-            sections,
-            "{}`{}` {}",
-            if sections.is_empty() { "" } else { ", " },
-            s.name,
-            figures::bytes(s.size)
-        );
-    }
+    let sections: Vec<String> = (image.sections.iter())
+        .map(|s| format!("`{}` {}", s.name, figures::bytes(s.size)))
+        .collect();
+    let sections = sections.join(", ");
     let intro = format!(
         "Flash is every section stored in flash (`.data`'s initial values included); \
          static RAM is `.radar_ring + .data + .bss + .uninit`. Sections of `{name}`: {sections}."

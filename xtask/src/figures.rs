@@ -1,9 +1,7 @@
-//! Measured figures: the commands that measure (`elf`, `qemu`, `bench`,
-//! `metrics`) write each of their tables into the book's page of measured
-//! figures, `docs/design/figures.md`, as they go ([`record`]). The page is
-//! committed, so that links to it work on the repository's web view too;
-//! `cargo xtask test` fails when what it measured changed the page
-//! ([`stale`]). No figure in the docs is typed by hand.
+//! Measured figures: the commands that measure write their tables into
+//! the committed page `docs/design/figures.md` as they go ([`record`]);
+//! `cargo xtask test` fails when what it measured changed it ([`stale`]).
+//! No figure in the docs is typed by hand.
 
 // Sizes and counts are far below 2^52: the float conversions are exact.
 #![allow(clippy::cast_precision_loss)]
@@ -19,15 +17,6 @@ pub const STAGE: &str = "figures page: docs/design/figures.md has what this run 
 
 /// The page, from the repository's root.
 pub const PAGE: &str = "docs/design/figures.md";
-
-/// One table of the page, as the command that measured it recorded it:
-/// what the table shows (Markdown, said before it), its header and rows.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Table {
-    pub intro: String,
-    pub header: Vec<String>,
-    pub rows: Vec<Vec<String>>,
-}
 
 /// The page's sections: the title, the keys of the tables under it (a key
 /// is a prefix: `image ` takes every image's), and how to measure them.
@@ -45,8 +34,7 @@ const SECTIONS: [(&str, &[&str], &str); 6] = [
 ];
 const TEST: &str = "`cargo xtask test` measures these";
 
-/// The line above each table that names it, so that a command can replace
-/// its own tables and keep the others.
+/// The line above each table that names it (a command replaces its own).
 const MARK: (&str, &str) = ("<!-- figures: ", " -->");
 
 /// `1234567` as `1,234,567`.
@@ -84,40 +72,33 @@ pub fn of_ceiling(part: u64, ceiling: Option<u64>) -> String {
     ceiling.map_or_else(|| "no ceiling".to_owned(), of)
 }
 
-/// Prints the table `key` and writes it into the page (replacing the one
-/// there before; the others are kept). A table that cannot be written does
-/// not fail the check that measured it: it is reported.
+/// Prints the table `key` (`intro`, Markdown, above it) and writes it into
+/// the page in place of the one there before. A table that cannot be
+/// written does not fail the check that measured it: it is reported.
+#[allow(clippy::needless_pass_by_value)] // the callers hand their tables over
 pub fn record(key: &str, intro: String, header: &[&str], rows: Vec<Vec<String>>) {
     println!("{key}:\n  | {} |", header.join(" | "));
     for row in &rows {
         println!("  | {} |", row.join(" | "));
     }
-    let table = Table {
-        intro,
-        header: header.iter().map(|h| (*h).to_owned()).collect(),
-        rows,
-    };
     let path = project::root().join(PAGE);
-    match update(&path, key, &table) {
+    match update(&path, key, render_table(&intro, header, &rows)) {
         Ok(false) => println!("  ({key}: as {PAGE} has it)"),
         Ok(true) => println!("  ({key}: written into {PAGE}, which changed: commit it)"),
         Err(error) => println!("warning: {key} not written into {PAGE}: {error:#}"),
     }
 }
 
-/// Writes `table` as `key`'s into the page at `path`; whether the page
-/// changed.
-fn update(path: &Path, key: &str, table: &Table) -> Result<bool> {
+/// Writes `table` as `key`'s into the page at `path`; whether it changed.
+fn update(path: &Path, key: &str, table: String) -> Result<bool> {
     let old = read(path)?;
     let mut tables = parse(&old);
-    tables.insert(key.to_owned(), render_table(table));
+    tables.insert(key.to_owned(), table);
     let new = render(&tables);
     if new == old {
         return Ok(false);
     }
-    let partial = path.with_extension("md.partial");
-    project::write(&partial, &new)?;
-    std::fs::rename(&partial, path).with_context(|| format!("writing {}", path.display()))?;
+    project::write(path, &new)?;
     Ok(true)
 }
 
@@ -173,13 +154,14 @@ fn parse(page: &str) -> BTreeMap<String, String> {
     tables
 }
 
-fn render_table(table: &Table) -> String {
-    let line = |cells: &[String]| format!("| {} |\n", cells.join(" | "));
-    let mut out = format!("{}\n\n", table.intro);
-    out.push_str(&line(&table.header));
-    out.push_str(&line(&vec!["---".to_owned(); table.header.len()]));
-    for row in &table.rows {
-        out.push_str(&line(row));
+fn render_table(intro: &str, header: &[&str], rows: &[Vec<String>]) -> String {
+    let mut out = format!(
+        "{intro}\n\n| {} |\n|{}\n",
+        header.join(" | "),
+        " --- |".repeat(header.len())
+    );
+    for row in rows {
+        let _ = writeln!(out, "| {} |", row.join(" | "));
     }
     out.trim().to_owned()
 }
@@ -227,18 +209,20 @@ mod tests {
         );
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("figures.md");
-        let table = |value: &str| Table {
-            intro: "Sizes.".into(),
-            header: vec!["image".into(), "flash".into()],
-            rows: vec![vec!["pico".into(), value.into()]],
+        let table = |value: &str| {
+            render_table(
+                "Sizes.",
+                &["image", "flash"],
+                &[vec!["pico".into(), value.into()]],
+            )
         };
-        assert!(update(&path, "image pico", &table("100 B")).unwrap());
-        assert!(update(&path, "qemu", &table("7")).unwrap());
+        assert!(update(&path, "image pico", table("100 B")).unwrap());
+        assert!(update(&path, "qemu", table("7")).unwrap());
         let before = read(&path).unwrap();
         // The same figures again: the page stays as it is.
-        assert!(!update(&path, "image pico", &table("100 B")).unwrap());
+        assert!(!update(&path, "image pico", table("100 B")).unwrap());
         stale(&path, &before).unwrap();
-        assert!(update(&path, "image pico", &table("200 B")).unwrap());
+        assert!(update(&path, "image pico", table("200 B")).unwrap());
         let page = read(&path).unwrap();
         assert_eq!(parse(&page).len(), 2);
         assert!(page.contains(

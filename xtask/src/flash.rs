@@ -1,9 +1,8 @@
-//! `cargo xtask flash`: the runner of `cargo run --release` (see
-//! `.cargo/config.toml`). It copies the image's UF2 onto a board in
-//! BOOTSEL mode if one is mounted (someone held its button: that is the
-//! route they chose), else runs `probe-rs run` if it is installed, else
-//! writes the UF2 and says how to flash it. cargo holds no lock while its
-//! runner runs, so this nested `cargo xtask` cannot wait on it.
+//! `cargo xtask flash`, the runner of `cargo run --release`: copies the
+//! UF2 onto a board in BOOTSEL mode if one is mounted (someone held its
+//! button: the route they chose), else runs `probe-rs run` if installed,
+//! else writes the UF2 and says how to flash it. (cargo holds no lock while
+//! its runner runs: this nested `cargo xtask` cannot wait on it.)
 
 use std::{
     ffi::OsString,
@@ -35,9 +34,9 @@ pub struct Args {
     pub rest: Vec<OsString>,
 }
 
-/// What the runner looks at: the `PATH` searched for probe-rs (and the
-/// folder its relative entries start from), and the folders where
-/// removable drives are mounted (each a drive, or holding drives).
+/// What the runner looks at: the `PATH` for probe-rs (and the folder its
+/// relative entries start from), and where drives are mounted (each a
+/// drive, or holding drives).
 #[derive(Debug, Clone)]
 pub struct Surroundings {
     pub path: Option<OsString>,
@@ -63,16 +62,14 @@ impl Surroundings {
                 .chain(["/media", "/mnt", "/Volumes"].map(PathBuf::from))
                 .collect()
         };
-        let (path, cwd) = (
-            std::env::var_os("PATH"),
-            std::env::current_dir().unwrap_or_default(),
-        );
+        let (path, cwd) = (std::env::var_os("PATH"), std::env::current_dir());
+        let cwd = cwd.unwrap_or_default();
         Self { path, cwd, mounts }
     }
 }
 
-/// How the image goes onto the board: copied onto this mounted BOOTSEL
-/// drive, through this `probe-rs`, or no way found (say what to do).
+/// How the image goes onto the board: onto this BOOTSEL drive, through
+/// this `probe-rs`, or no way (say what to do).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Route {
     Drive(PathBuf),
@@ -80,9 +77,8 @@ pub enum Route {
     Instructions,
 }
 
-/// The route for `board` here: a BOOTSEL drive (one of `here`'s mounts, or
-/// a folder in one, whose `INFO_UF2.TXT` says `Board-ID: <label>`), else
-/// probe-rs, else instructions.
+/// The route for `board` here: a BOOTSEL drive (a mount, or a folder in
+/// one, whose `INFO_UF2.TXT` names the board), else probe-rs, else none.
 pub fn choose(board: Board, here: &Surroundings) -> Result<Route> {
     let id = format!("Board-ID: {}", board.drive_label());
     let is_drive = |dir: &PathBuf| {
@@ -118,8 +114,8 @@ pub fn choose(board: Board, here: &Surroundings) -> Result<Route> {
     }
 }
 
-/// What to do when nothing could flash the board; `uf2` is the image's UF2,
-/// ready to copy, and `mounts` where the runner looked for the board.
+/// What to do when nothing could flash the board: `uf2` is ready to copy,
+/// `mounts` where the runner looked.
 pub fn instructions(board: Board, uf2: &Path, mounts: &[PathBuf]) -> String {
     let (name, label, uf2) = (board.name(), board.drive_label(), project::relative(uf2));
     let uf2 = uf2.display();
@@ -157,9 +153,8 @@ pub fn command(args: &Args) -> Result<bool> {
     run(args, &Surroundings::here())
 }
 
-/// Flashes `args.elf` onto the board by the route [`choose`] finds in
-/// `here`. `Ok(false)` if there was none (the message says what to do) or
-/// probe-rs failed.
+/// Flashes `args.elf` by the route [`choose`] finds in `here`; `Ok(false)`
+/// if there was none or probe-rs failed.
 pub fn run(args: &Args, here: &Surroundings) -> Result<bool> {
     let board = args.board;
     let route = choose(board, here)?;
@@ -220,41 +215,37 @@ mod tests {
 
     fn here(path: &Path, mounts: &[&Path]) -> Surroundings {
         let mounts = mounts.iter().map(|m| m.to_path_buf()).collect();
-        Surroundings {
-            path: Some(path.as_os_str().to_owned()),
-            cwd: path.to_owned(),
-            mounts,
-        }
+        let (path, cwd) = (Some(path.as_os_str().to_owned()), path.to_owned());
+        Surroundings { path, cwd, mounts }
     }
 
     #[test]
     fn the_route_is_a_bootsel_drive_known_by_its_board_id_then_instructions() {
         let no_path = tempfile::tempdir().unwrap();
+        let no_path = no_path.path();
         let (pico, pico2) = (
             mount_with("RPI-RP2", PICO_INFO),
             mount_with("RP2350", PICO2_INFO),
         );
-        let both = here(no_path.path(), &[pico.path(), pico2.path()]);
+        let both = here(no_path, &[pico.path(), pico2.path()]);
+        let drive = pico.path().join("RPI-RP2");
         assert_eq!(
             choose(Board::Pico, &both).unwrap(),
-            Route::Drive(pico.path().join("RPI-RP2"))
+            Route::Drive(drive.clone())
         );
-        assert_eq!(
-            choose(Board::Pico2, &both).unwrap(),
-            Route::Drive(pico2.path().join("RP2350"))
-        );
+        let drive2 = pico2.path().join("RP2350");
+        assert_eq!(choose(Board::Pico2, &both).unwrap(), Route::Drive(drive2));
         // A drive called RPI-RP2 without the info file, or with another
         // board's, is not one; a mount that is itself the drive is.
         let plain = tempfile::tempdir().unwrap();
         std::fs::create_dir(plain.path().join("RPI-RP2")).unwrap();
         let other = mount_with("RPI-RP2", PICO2_INFO);
-        let neither = here(no_path.path(), &[plain.path(), other.path()]);
+        let neither = here(no_path, &[plain.path(), other.path()]);
         assert_eq!(choose(Board::Pico, &neither).unwrap(), Route::Instructions);
-        let letter = pico.path().join("RPI-RP2");
-        let itself = here(no_path.path(), &[&letter]);
+        let itself = here(no_path, &[&drive]);
         assert_eq!(
             choose(Board::Pico, &itself).unwrap(),
-            Route::Drive(letter.clone())
+            Route::Drive(drive.clone())
         );
         let text = instructions(Board::Pico2, Path::new("pico2.uf2"), &neither.mounts);
         assert!(
@@ -262,10 +253,7 @@ mod tests {
             "{text}"
         );
         let two = mount_with("RPI-RP2 1", PICO_INFO);
-        let error = choose(
-            Board::Pico,
-            &here(no_path.path(), &[pico.path(), two.path()]),
-        );
+        let error = choose(Board::Pico, &here(no_path, &[pico.path(), two.path()]));
         assert!(format!("{:#}", error.unwrap_err()).contains("2 boards in BOOTSEL mode"));
     }
 
@@ -277,25 +265,19 @@ mod tests {
         use std::os::unix::fs::PermissionsExt;
         let bin = tempfile::tempdir().unwrap();
         let (probe, log) = (bin.path().join("probe-rs"), bin.path().join("args.txt"));
-        std::fs::write(
-            &probe,
-            format!("#!/bin/sh\nprintf '%s\\n' \"$@\" > '{}'\n", log.display()),
-        )
-        .unwrap();
+        let script = format!("#!/bin/sh\nprintf '%s\\n' \"$@\" > '{}'\n", log.display());
+        std::fs::write(&probe, script).unwrap();
         std::fs::set_permissions(&probe, std::fs::Permissions::from_mode(0o755)).unwrap();
         let no_drives = tempfile::tempdir().unwrap();
         let here = here(bin.path(), &[no_drives.path()]);
         assert_eq!(choose(Board::Pico2, &here).unwrap(), Route::Probe(probe));
-        let rest = vec!["--no-location".into()];
-        let args = Args {
-            board: Board::Pico2,
-            elf: PathBuf::from("pico2"),
-            rest,
-        };
-        assert!(run(&args, &here).unwrap());
+        let (elf, rest) = (PathBuf::from("pico2"), vec!["--no-location".into()]);
+        let board = Board::Pico2;
+        assert!(run(&Args { board, elf, rest }, &here).unwrap());
         let passed = std::fs::read_to_string(log).unwrap();
+        let passed: Vec<&str> = passed.lines().collect();
         assert_eq!(
-            passed.lines().collect::<Vec<_>>(),
+            passed,
             ["run", "--chip", "RP235x", "pico2", "--no-location"]
         );
         let mounts = mount_with("RP2350", PICO2_INFO);

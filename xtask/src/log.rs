@@ -1,5 +1,4 @@
-//! The decoded log of one QEMU run: the types that running, plotting,
-//! snapshotting and benchmarking share.
+//! The decoded defmt log of a QEMU run.
 
 use std::{
     path::{Path, PathBuf},
@@ -11,8 +10,7 @@ use defmt_decoder::{DecodeError, Frame, Locations, StreamDecoder, Table};
 
 use crate::project::Exit;
 
-/// An ELF's defmt table, and its source locations (which need debug
-/// info: without them the log still decodes).
+/// An ELF's defmt table, and its source locations (if it has debug info).
 pub struct Defmt {
     table: Table,
     locations: Option<Locations>,
@@ -26,8 +24,7 @@ impl Defmt {
         let table = Table::parse(&bytes)
             .with_context(|| format!("reading the defmt table of {}", elf.display()))?
             .with_context(|| format!("{} has no defmt data", elf.display()))?;
-        let locations = table.get_locations(&bytes).ok();
-        let root = crate::project::root();
+        let (locations, root) = (table.get_locations(&bytes).ok(), crate::project::root());
         Ok(Self {
             table,
             locations,
@@ -46,14 +43,30 @@ impl Defmt {
         let mut lines = Vec::new();
         loop {
             match decoder.decode() {
-                Ok(frame) => lines.push(LogLine::from_frame(
-                    &frame,
-                    self.locations.as_ref(),
-                    &self.root,
-                )),
+                Ok(frame) => lines.push(self.line(&frame)),
                 Err(DecodeError::UnexpectedEof) => return lines,
-                Err(DecodeError::Malformed) => lines.push(LogLine::malformed()),
+                Err(DecodeError::Malformed) => lines.push(LogLine::new(
+                    "ERROR",
+                    "(malformed defmt frame: the log stream is corrupt)",
+                )),
             }
+        }
+    }
+
+    /// The line of a decoded frame, its location relative to the root.
+    fn line(&self, frame: &Frame<'_>) -> LogLine {
+        let location = (self.locations.as_ref())
+            .and_then(|locations| locations.get(&frame.index()))
+            .map(|location| {
+                let file = &location.file;
+                let file = file.strip_prefix(&self.root).unwrap_or(file);
+                format!("{}:{}", file.display(), location.line)
+            });
+        LogLine {
+            level: frame.level().map(|level| level.as_str().to_uppercase()),
+            message: frame.display_message().to_string(),
+            timestamp: frame.display_timestamp().map(|t| t.to_string()),
+            location,
         }
     }
 }
@@ -81,32 +94,8 @@ impl LogLine {
         }
     }
 
-    /// The line of a decoded frame; locations are shown relative to `root`.
-    pub fn from_frame(frame: &Frame<'_>, locations: Option<&Locations>, root: &Path) -> Self {
-        let location = locations
-            .and_then(|locations| locations.get(&frame.index()))
-            .map(|location| {
-                let file = location.file.strip_prefix(root).unwrap_or(&location.file);
-                format!("{}:{}", file.display(), location.line)
-            });
-        Self {
-            level: frame.level().map(|level| level.as_str().to_uppercase()),
-            message: frame.display_message().to_string(),
-            timestamp: frame.display_timestamp().map(|t| t.to_string()),
-            location,
-        }
-    }
-
-    /// Stands for bytes that do not decode.
-    pub fn malformed() -> Self {
-        Self::new(
-            "ERROR",
-            "(malformed defmt frame: the log stream is corrupt)",
-        )
-    }
-
-    /// The line as kept in the expected log: level and message, no timestamp
-    /// or location (those change with unrelated code changes).
+    /// The line as kept in the expected log: no timestamp or location
+    /// (those change with unrelated code).
     pub fn snapshot(&self) -> String {
         match &self.level {
             Some(level) => format!("{level:<5} {}", self.message),
@@ -143,7 +132,7 @@ pub struct Run {
 }
 
 impl Run {
-    /// QEMU exited with status 0 before the timeout.
+    /// Whether QEMU exited with 0 before the timeout.
     pub fn succeeded(&self) -> bool {
         matches!(self.exit, Exit::Status(status) if status.success())
     }
@@ -171,8 +160,7 @@ impl Run {
     }
 }
 
-/// The message of the last line of `log` that starts with `summary` (the
-/// firmware's closing `summary key=value ...` line).
+/// The message of the last `summary key=value ...` line of `log`.
 pub fn summary(log: &[LogLine]) -> Option<&str> {
     let line = log.iter().rfind(|line| line.message.starts_with("summary"));
     line.map(|line| line.message.as_str())
@@ -186,7 +174,7 @@ pub fn field<'a>(message: &'a str, key: &str) -> Option<&'a str> {
 }
 
 /// The [`field`] `key` of `message` as a number: decimal, or hexadecimal
-/// with `0x`, `_` separators allowed; an error names what is missing or wrong.
+/// with `0x`, `_` separators allowed.
 pub fn number(message: &str, key: &str) -> Result<u64> {
     let value = field(message, key).with_context(|| format!("`{message}` has no `{key}=`"))?;
     let digits = value.replace('_', "");

@@ -1,7 +1,5 @@
-//! Host-side project commands, run as `cargo xtask <command>` from any
-//! folder of the repository (the alias in `.cargo/config.toml` builds this
-//! crate for the host). `cargo xtask help` lists them; `cli.rs` defines
-//! them, docs/dev/xtask.md describes them.
+//! Host-side project commands, `cargo xtask <command>` from any folder of
+//! the repository: `cli.rs` defines them, docs/dev/xtask.md describes them.
 
 mod args;
 mod bench;

@@ -99,25 +99,17 @@ pub fn command(args: &Args) -> Result<bool> {
     Ok(true)
 }
 
-/// The kinds of file the page is made of, by extension, and the content
-/// type each is served as: what the server serves from `panel/` and what
-/// `--export` copies.
-const PAGE_TYPES: [(&str, &str); 5] = [
-    ("html", "text/html; charset=utf-8"),
-    ("css", "text/css; charset=utf-8"),
-    ("js", "text/javascript; charset=utf-8"),
-    ("svg", "image/svg+xml"),
-    ("png", "image/png"),
-];
-
-/// The content type of `file` if it is of a kind the page is made of
-/// ([`PAGE_TYPES`]).
+/// The content type of `file` if it is of a kind the page is made of:
+/// what the server serves from `panel/` and what `--export` copies.
 pub fn content_type(file: &Path) -> Option<&'static str> {
-    let extension = file.extension()?.to_str()?;
-    PAGE_TYPES
-        .iter()
-        .find(|(kind, _)| *kind == extension)
-        .map(|(_, content_type)| *content_type)
+    Some(match file.extension()?.to_str()? {
+        "html" => "text/html; charset=utf-8",
+        "css" => "text/css; charset=utf-8",
+        "js" => "text/javascript; charset=utf-8",
+        "svg" => "image/svg+xml",
+        "png" => "image/png",
+        _ => return None,
+    })
 }
 
 /// The files of the page in `panel/` (not its tests or package files),

@@ -1,23 +1,19 @@
-//! The Raspberry Pi Pico 2 image (boards/pico2, RP2350): where its boot
-//! ROM finds it, its memory, its UF2. The boot ROM has no second stage to
-//! load: it searches the first 4 KiB of flash for a block that declares
-//! the image (an `IMAGE_DEF`, which embassy-rp links into `.start_block`).
-//! No emulator runs this image: these checks are all that is known of it
-//! before it meets a board.
+//! The Pico 2 image (boards/pico2, RP2350): no emulator runs it, so these
+//! checks are all that is known of it before it meets a board. Its boot ROM
+//! searches the first 4 KiB of flash for the block that declares the image
+//! (embassy-rp's `IMAGE_DEF` in `.start_block`).
 
 use anyhow::{Context, Result};
 
 use crate::{board::Board, elf, project, uf2};
 
-/// The name of the stage of `cargo xtask test` that builds the Pico 2
-/// image and makes its UF2.
+/// The stage's name in `cargo xtask test`.
 pub const STAGE: &str = "Pico 2 build (boards/pico2): start block, settings sectors clear, UF2 \
                          family RP2350 Arm Secure";
 
-/// The stage [`STAGE`]: builds the image and prints its sections and
-/// sizes; fails unless the vector table is at the start of flash, a whole
-/// block lies in the first 4 KiB, the settings sectors are reserved and
-/// clear, and no allocator is linked; then makes its UF2.
+/// Builds the image and prints its sections; fails unless the vector
+/// table starts flash, the start block is in place, the settings sectors
+/// are reserved and clear, and no allocator is linked; then makes its UF2.
 pub fn test(metadata: &project::Metadata) -> Result<()> {
     let board = Board::Pico2;
     board.image().build(&project::root())?;

@@ -1,10 +1,11 @@
-//! Where things are in the repository, how commands run (the one process
-//! runner: [`run`] to the end with inherited output, [`finish`] with its
-//! output read as it comes and a time limit), and the firmware images.
+//! Where things are in the repository, the one process runner ([`run`]
+//! with inherited output, [`finish`] reading it as it comes, with a time
+//! limit), and the firmware images.
 
 use std::{
     path::{Path, PathBuf},
     process::{Child, ChildStderr, ChildStdout, ExitStatus},
+    sync::atomic::{AtomicU32, Ordering},
     thread,
     time::Duration,
 };
@@ -17,15 +18,13 @@ use xshell::{Cmd, Shell, cmd};
 /// The firmware's compilation target (ARMv6-M: RP2040's Cortex-M0+, QEMU's Cortex-M0).
 pub const TARGET: &str = "thumbv6m-none-eabi";
 
-/// The environment of every firmware build: the defmt level the expected
-/// QEMU log is recorded at, over whatever the caller's environment says.
+/// The environment of every firmware build: the expected QEMU log's defmt
+/// level, whatever the caller's environment says.
 pub const FIRMWARE_ENV: &[(&str, &str)] = &[("DEFMT_LOG", "info")];
 
-/// The repository root: the parent of this crate's directory. Commands run
-/// from any folder of the repository, so every path starts here.
+/// The repository root (commands run from any folder of it).
 pub fn root() -> PathBuf {
-    let xtask = Path::new(env!("CARGO_MANIFEST_DIR"));
-    xtask
+    Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .expect("xtask/ lives in the repository")
         .into()
@@ -43,9 +42,9 @@ pub fn shell(dir: &str) -> Result<Shell> {
     Ok(sh)
 }
 
-/// Echoes `cmd` on stderr the way a user would type it from the repository
-/// root (`(cd dir && VAR=value program args)`; stdout is for results), then
-/// runs it with `env` and inherited output; fails unless it exits with 0.
+/// Echoes `cmd` on stderr as typed from the repository root (`(cd dir &&
+/// VAR=value program args)`), then runs it with `env` and inherited output;
+/// fails unless it exits with 0.
 pub fn run(sh: &Shell, env: &[(&str, &str)], cmd: Cmd<'_>) -> Result<()> {
     let vars: Vec<String> = env.iter().map(|(k, v)| format!("{k}={v} ")).collect();
     let vars = vars.concat();
@@ -54,8 +53,7 @@ pub fn run(sh: &Shell, env: &[(&str, &str)], cmd: Cmd<'_>) -> Result<()> {
         _ => format!("{vars}{cmd}"),
     };
     eprintln!("$ {line}");
-    let cmd = cmd.envs(env.iter().copied()).quiet();
-    cmd.run().map_err(|error| anyhow!("{error}"))
+    (cmd.envs(env.iter().copied()).quiet().run()).map_err(|error| anyhow!("{error}"))
 }
 
 /// How a child process ended ([`finish`]).
@@ -75,10 +73,10 @@ pub struct Finished<O, E, R> {
     pub meanwhile: R,
 }
 
-/// Runs `child` (spawned with its stdout and stderr piped) to its end:
-/// `stdout` and `stderr` each read their pipe on a thread of their own (so
-/// that neither fills up and stalls it), `meanwhile` runs on this thread;
-/// once it returns, `child` has `timeout` to exit before it is killed.
+/// Runs `child` (its stdout and stderr piped) to its end: `stdout` and
+/// `stderr` read their pipes on threads of their own (neither may fill up
+/// and stall it) while `meanwhile` runs; then `child` has `timeout` to exit
+/// before it is killed.
 pub fn finish<O: Send, E: Send, R>(
     mut child: Child,
     name: &str,
@@ -116,12 +114,19 @@ pub fn finish<O: Send, E: Send, R>(
     })
 }
 
-/// Writes `contents` to `path`, creating its folder.
+/// Writes `contents` to `path`, creating its folder: through a file of
+/// this call's own, renamed over it, so that no reader (of the runs side by
+/// side) sees half a file.
 pub fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
+    static CALLS: AtomicU32 = AtomicU32::new(0);
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    std::fs::write(path, contents).with_context(|| format!("writing {}", path.display()))
+    let n = CALLS.fetch_add(1, Ordering::Relaxed);
+    let mut partial = path.as_os_str().to_owned();
+    partial.push(format!(".{}-{n}.partial", std::process::id()));
+    let written = std::fs::write(&partial, contents).and_then(|()| std::fs::rename(&partial, path));
+    written.with_context(|| format!("writing {}", path.display()))
 }
 
 /// Fails with every one of `problems`, if there are any.
@@ -132,9 +137,8 @@ pub fn verdict(problems: &[String]) -> Result<()> {
     }
 }
 
-/// Set by `cargo xtask test` on the emulator stages it runs side by side,
-/// once their images are built: [`Image::build`] then builds nothing, so
-/// that no two of them build at once.
+/// Set by `cargo xtask test` on the emulator stages it runs side by side on
+/// images built already: [`Image::build`] then builds nothing.
 pub const PREBUILT: &str = "IDLE_HEAD_PREBUILT";
 
 /// Whether [`PREBUILT`] is set.
@@ -142,15 +146,15 @@ pub fn prebuilt() -> bool {
     std::env::var_os(PREBUILT).is_some()
 }
 
-/// How many runs share the cores ([`PREBUILT`]'s value, else 1): each
-/// emulator run's wall-time limit is that many times its own.
+/// How many runs share the cores ([`PREBUILT`]'s value, else 1), by which
+/// an emulator run's wall-time limit grows.
 pub fn side_by_side() -> u32 {
     let value = std::env::var(PREBUILT).ok().and_then(|v| v.parse().ok());
     value.unwrap_or(1).max(1)
 }
 
-/// A firmware image: one `[[bin]]` of a package of the repository, built
-/// with `cargo build --release` in its folder into the one target directory.
+/// A firmware image: a `[[bin]]` of a package, built with `cargo build
+/// --release` in its folder.
 #[derive(Debug, Clone, Copy)]
 pub struct Image {
     /// Bin target name, also the ELF file name.
@@ -158,8 +162,7 @@ pub struct Image {
     /// The package's folder (its `.cargo/config.toml` picks the target).
     pub dir: &'static str,
     pub target: &'static str,
-    /// The package to select from the folder (`--package … --bin …`), if
-    /// it is not the folder's own.
+    /// The package to select (`--package … --bin …`), if not the folder's.
     pub package: Option<&'static str>,
 }
 
@@ -177,23 +180,25 @@ pub const QEMU: Image = Image::qemu("qemu");
 impl Image {
     /// Bin `bin` of the QEMU package (`boards/qemu/`), built from the root.
     pub const fn qemu(bin: &'static str) -> Self {
-        let package = Some("idle-head-qemu");
+        let (dir, target, package) = (".", TARGET, Some("idle-head-qemu"));
         Self {
             bin,
-            dir: ".",
-            target: TARGET,
+            dir,
+            target,
             package,
         }
     }
 
     /// Release ELF of this image in the target directory.
     pub fn elf(&self, metadata: &Metadata) -> PathBuf {
-        let dir = metadata.target_dir.join(self.target).join("release");
-        dir.join(self.bin)
+        metadata
+            .target_dir
+            .join(self.target)
+            .join("release")
+            .join(self.bin)
     }
 
-    /// `cargo build --release` for this image, as a user types it, with
-    /// the project's defmt level.
+    /// `cargo build --release` for this image, with [`FIRMWARE_ENV`].
     pub fn build(&self, root: &Path) -> Result<()> {
         if prebuilt() {
             return Ok(());
@@ -213,7 +218,7 @@ impl Image {
 /// The parts of `cargo metadata` this crate uses.
 #[derive(Debug)]
 pub struct Metadata {
-    /// Where cargo puts build output (`target/` unless configured otherwise).
+    /// Where cargo puts build output.
     pub target_dir: PathBuf,
 }
 

@@ -62,33 +62,26 @@ pub enum Echo {
     Quiet,
 }
 
-/// QEMU running `elf` with the options `args` (display, semihosting,
-/// serial ports). `-icount shift=0` makes one instruction one nanosecond of
-/// virtual time; `sleep=off` lets the virtual clock jump over the time the
-/// core sleeps (timing, and so the log, repeat exactly run after run),
-/// `sleep=on` follows the wall clock while it sleeps (a head at its true
-/// speed, for a person).
+/// QEMU running `elf` with `args`. `-icount shift=0`: an instruction a
+/// nanosecond of virtual time; with `sleep` the clock follows the wall
+/// clock while the core sleeps (a head at its true speed), without it
+/// jumps over that time (the log repeats exactly run after run).
 pub fn qemu_command(elf: &Path, sleep: bool, args: &[&str]) -> Command {
+    let icount = format!("shift=0,sleep={}", if sleep { "on" } else { "off" });
     let mut command = Command::new(QEMU_BINARY);
-    let icount = if sleep {
-        "shift=0,sleep=on"
-    } else {
-        "shift=0,sleep=off"
-    };
     command.args([
         "-machine",
         "lm3s6965evb",
         "-cpu",
         "cortex-m0",
         "-icount",
-        icount,
+        &icount,
     ]);
     command.args(args).arg("-kernel").arg(elf);
     command
 }
 
-/// Runs `elf` in QEMU, decoding its defmt output as it arrives; QEMU is
-/// killed after `timeout` of wall time.
+/// Runs `elf` in QEMU, decoding its log as it comes; killed after `timeout`.
 pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
     let semihosting = [
         "-nographic",
@@ -109,14 +102,10 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
     Ok(finish(child, elf, timeout, echo, || ())?.0)
 }
 
-/// Runs QEMU (`child`, running `elf`, its stdout and stderr piped) to its
-/// end, decoding its defmt log as it comes (echoed as `echo` says) and
-/// passing its messages on, while `meanwhile` runs; QEMU has `timeout`
-/// once `meanwhile` returns. What QEMU 7.2 prints at every start of the
-/// `lm3s6965evb` machine (its watchdog model's timer started at reset while
-/// the clock that drives it still reads 0 Hz; it stays stopped, as these
-/// images never load it) and its notes on waiting for a socket's
-/// connection say nothing about a run and are dropped.
+/// Runs QEMU (`child`, running `elf`) to its end with [`project::finish`],
+/// decoding its log (echoed as `echo` says) and passing its stderr on,
+/// without the notes that say nothing about a run: the watchdog model's
+/// zero-period timer at every start, the wait for a socket's connection.
 pub fn finish<R>(
     child: Child,
     elf: &Path,
@@ -162,9 +151,8 @@ pub fn finish<R>(
     ))
 }
 
-/// Checks the summary line: no missed frames, no pulse violations, and the
-/// checksum of the loops the firmware generated equals the one generated on
-/// the host by the same core library. Returns a one-line verdict.
+/// Checks the summary line: no missed frame, no pulse violation, and the
+/// loops' checksum the host's (same core library); a one-line verdict.
 pub fn check_summary(log: &[LogLine]) -> Result<String> {
     let summary = summary(log).context("the log has no `summary ...` line")?;
     let get = |key| number(summary, key);
@@ -189,9 +177,8 @@ pub fn check_summary(log: &[LogLine]) -> Result<String> {
     ))
 }
 
-/// Draws the three axes of the log's frame lines (`frame <n>: pitch=<deg>
-/// roll=<deg> yaw=<deg> deg, ...`: the decoder hands out text, so the log
-/// is the record) to the PNG `path`; returns how many there were.
+/// Draws the three axes of the log's frame lines to the PNG `path`; how
+/// many there were.
 fn plot_motion(log: &[LogLine], path: &Path) -> Result<usize> {
     let mut frames: Vec<(f64, [f64; 3])> =
         log.iter().filter_map(|l| frame_line(&l.message)).collect();
@@ -217,10 +204,9 @@ fn frame_line(message: &str) -> Option<(f64, [f64; 3])> {
     Some((frame.parse().ok()?, angles))
 }
 
-/// The QEMU smoke run's boot precompute (`precompute_insns` of its summary
-/// line) and the loop sets its log reports (`loop set <n> ready in <µs> us:
-/// … ([..] discarded) …`), for the measured figures. Only the smoke run's:
-/// a run with console traffic would count that traffic in its sets' times.
+/// The smoke run's boot precompute and loop sets (`loop set <n> ready in
+/// <µs> us: … ([..] discarded) …`), for the measured figures. Only the
+/// smoke run's: console traffic would count in its sets' times.
 #[allow(clippy::cast_precision_loss)] // instruction counts, far below 2^52
 pub fn record_figures(log: &[LogLine]) {
     let row = |set: String, insns: u64, discarded: String| {
@@ -237,8 +223,7 @@ pub fn record_figures(log: &[LogLine]) {
         let rest = line.message.strip_prefix("loop set ")?;
         let (set, rest) = rest.split_once(" ready in ")?;
         let (micros, rest) = rest.split_once(" us")?;
-        // Virtual time under `-icount shift=0`: one instruction a
-        // nanosecond, the frames that preempt the generator included.
+        // An instruction a nanosecond, preempting frames included.
         let insns = micros.parse::<u64>().ok()?.checked_mul(1000)?;
         let discarded = rest
             .split_once('(')

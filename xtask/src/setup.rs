@@ -13,8 +13,8 @@ use crate::{board::PICO2_TARGET, project};
 /// QEMU's system emulator for Arm.
 pub const QEMU_BINARY: &str = "qemu-system-arm";
 
-/// What a command that builds starts from: the toolchain made complete
-/// ([`ensure_toolchain`]), the repository root and cargo's metadata.
+/// What a command that builds starts from: the toolchain made complete,
+/// the repository root and cargo's metadata.
 pub fn prepare() -> Result<(PathBuf, project::Metadata)> {
     let root = project::root();
     ensure_toolchain(&root)?;
@@ -22,10 +22,8 @@ pub fn prepare() -> Result<(PathBuf, project::Metadata)> {
     Ok((root, metadata))
 }
 
-/// Adds the firmware targets, rustfmt and clippy to the toolchain the
-/// repository uses (the one named by `rust-toolchain.toml`, so rustup runs in
-/// the repository root). Without rustup, a toolchain installed some other
-/// way must bring these itself; the build says so if it does not.
+/// Adds the firmware targets, rustfmt and clippy to the repository's
+/// toolchain (`rust-toolchain.toml`) with rustup, if there is one.
 pub fn ensure_toolchain(root: &Path) -> Result<()> {
     let sh = Shell::new()?;
     sh.change_dir(root);
@@ -49,7 +47,6 @@ pub fn ensure_toolchain(root: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Makes sure `qemu-system-arm` runs (see [`ensure_program`]).
 pub fn ensure_qemu() -> Result<()> {
     ensure_program(
         QEMU_BINARY,
@@ -59,9 +56,8 @@ pub fn ensure_qemu() -> Result<()> {
     )
 }
 
-/// Makes sure `program` runs (`--version`): else installs `packages` with
-/// apt-get when running as root on Debian or Ubuntu, or says to install
-/// `what`.
+/// Makes sure `program` runs: else installs `packages` with apt-get as
+/// root on Debian or Ubuntu, or says to install `what`.
 pub fn ensure_program(program: &str, packages: &[&str], what: &str) -> Result<()> {
     if version(program).is_some() {
         return Ok(());
@@ -104,15 +100,12 @@ pub fn version(program: impl AsRef<std::ffi::OsStr>) -> Option<String> {
     Some(text.lines().next().unwrap_or_default().trim().to_owned())
 }
 
-/// The mdBook release the book is built with (`cargo xtask book`): pinned,
-/// as its HTML (and so the ids the link check reads) may change between
-/// releases.
+/// The mdBook release the book is built with: pinned, as the ids the link
+/// check reads may change between releases.
 pub const MDBOOK_VERSION: &str = "0.5.4";
 
-/// The `mdbook` program to run: the pinned release if it is on the `PATH`
-/// or in `tools`; else it is installed there with `cargo install` (a few
-/// minutes, once; `tools` leaves any other mdBook as it is). Only the HTML
-/// renderer and its search are built: the book needs no `serve` or `watch`.
+/// The pinned `mdbook`: on the `PATH` or in `tools`, else installed there
+/// with `cargo install` (HTML and search only: no `serve` or `watch`).
 pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
     let wanted = format!("mdbook v{MDBOOK_VERSION}");
     let local = tools.join("bin").join("mdbook");
@@ -129,11 +122,8 @@ pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
         tools_dir.display()
     );
     let sh = project::shell(".")?;
-    // The repository's .cargo/config.toml builds for the firmware's target:
-    // mdBook is a host program.
-    let info = cmd!(sh, "rustc -vV").quiet().read()?;
-    let host = info.lines().find_map(|line| line.strip_prefix("host: "));
-    let host = host.context("`rustc -vV` names no host")?;
+    // A host program, whatever .cargo/config.toml builds for.
+    let host = "host-tuple";
     let build_dir = tools.join("build");
     let install = cmd!(
         sh,

@@ -1,8 +1,7 @@
-//! The QEMU log kept on file (`boards/qemu/expected.log`), compared on every
-//! test run with snapbox. A `[..]` in a line matches any text within it;
-//! since snapbox pairs lines by position, each line of the run that a
-//! wildcard line matches is first replaced by it, so that re-recording
-//! (`--bless`) keeps the wildcards that still match.
+//! The expected QEMU log (`boards/qemu/expected.log`), compared with
+//! snapbox. A `[..]` matches any text within a line; each line of the run
+//! that a wildcard line matches is first replaced by it (snapbox pairs
+//! lines by position), so that `--bless` keeps the wildcards that match.
 
 use std::path::{Path, PathBuf};
 
@@ -11,8 +10,7 @@ use snapbox::{Assert, Data, filter::NormalizeToExpected};
 
 use crate::{log::Run, project};
 
-/// At most this many lines of a difference are printed; the full log is
-/// written to the target directory.
+/// At most this many lines of a difference are printed.
 const MAX_DIFF_LINES: usize = 200;
 
 /// `boards/qemu/expected.log`.
@@ -20,8 +18,7 @@ fn expected_path() -> PathBuf {
     project::root().join("boards/qemu/expected.log")
 }
 
-/// Re-records the expected log from `run`, keeping the wildcard lines that
-/// still match.
+/// Re-records the expected log from `run`.
 pub fn bless(run: &Run) -> Result<()> {
     let path = expected_path();
     let done = if record(&path, &run.text())? {
@@ -37,8 +34,8 @@ pub fn bless(run: &Run) -> Result<()> {
     Ok(())
 }
 
-/// Compares `run` with the expected log; prints the difference and fails on
-/// one. The actual log is also written to `actual` for inspection.
+/// Compares `run` with the expected log, writing it to `actual`; prints
+/// the difference and fails on one.
 pub fn compare(run: &Run, actual: &Path) -> Result<()> {
     let path = expected_path();
     let [expected, actual_name] =
@@ -66,26 +63,28 @@ pub fn compare(run: &Run, actual: &Path) -> Result<()> {
     )
 }
 
-/// Snapbox's verdict on the log `got` against the file at `path`: `Err`
-/// holds the difference.
-fn check(path: &Path, got: &str) -> Result<(), String> {
+/// The log `got` with the wildcards of the file at `path`, and the file.
+fn against(path: &Path, got: &str) -> (Assert, Data, Data) {
     let want = std::fs::read_to_string(path).unwrap_or_default();
     let got = Data::text(with_wildcards(&want, got));
     let assert = Assert::new().normalize_paths(false);
+    (assert, got, Data::read_from(path, None))
+}
+
+/// Snapbox's verdict on the log `got` against the file at `path`: `Err`
+/// holds the difference.
+fn check(path: &Path, got: &str) -> Result<(), String> {
+    let (assert, got, want) = against(path, got);
     assert
-        .try_eq(Some(&"this run"), got, Data::read_from(path, None))
+        .try_eq(Some(&"this run"), got, want)
         .map_err(|e| e.to_string())
 }
 
-/// Writes the log `got` to `path` as snapbox reads it against the file there
-/// (the wildcard lines that match kept), if that differs from the file.
-/// Returns whether it wrote.
+/// Writes the log `got` to `path` as snapbox reads it against the file there,
+/// if that differs from the file; whether it wrote.
 fn record(path: &Path, got: &str) -> Result<bool> {
-    let want = std::fs::read_to_string(path).unwrap_or_default();
-    let got = Data::text(with_wildcards(&want, got));
-    let (actual, expected) = Assert::new()
-        .normalize_paths(false)
-        .normalize(got, Data::read_from(path, None));
+    let (assert, got, want) = against(path, got);
+    let (actual, expected) = assert.normalize(got, want);
     if actual == expected {
         return Ok(false);
     }

@@ -1,7 +1,6 @@
 //! The speed and acceleration limits seen from the outside: the largest
-//! step and change of step of an axis' angles, one a frame, and what the
-//! behaviour's limits allow in a frame (the rule `host-tests/src/rig.rs`
-//! holds the frame engine to, there with a m° of rounding on each).
+//! step and change of step of an axis' angles, one a frame, against what
+//! the behaviour's limits allow (as `host-tests/src/rig.rs` checks).
 
 use idle_head_core::Axis;
 use idle_head_core::behaviour::{BehaviourParams, LimitMode};
@@ -29,9 +28,8 @@ impl Steps {
         Self { step, turn }
     }
 
-    /// What `params` allow `axis` in `mode` in one of their frames: the
-    /// largest speed for a frame, the largest acceleration for a frame
-    /// squared (60 °/s and 600 °/s² at 20 ms: 1200 m° and 240 m°).
+    /// What `params` allow `axis` in `mode` in a frame (60 °/s and 600 °/s²
+    /// at 20 ms: 1200 m° and 240 m°).
     pub fn allowed(params: &BehaviourParams, axis: Axis, mode: LimitMode) -> Self {
         let limits = params.limits(axis, mode);
         let frame_us = f64::from(params.frame_us());
@@ -58,24 +56,13 @@ mod tests {
     fn the_default_idle_limits_are_1200_and_240_millidegrees_a_frame() {
         let driver = DriverConfig::DEFAULT.build().unwrap();
         let params = BehaviourConfig::DEFAULT.build(&driver).unwrap();
+        let of = |step, turn| Steps { step, turn };
         for axis in Axis::ALL {
             let allowed = Steps::allowed(&params, axis, LimitMode::Idle);
-            assert_eq!(
-                allowed,
-                Steps {
-                    step: 1200.0,
-                    turn: 240.0
-                }
-            );
+            assert_eq!(allowed, of(1200.0, 240.0));
         }
         let steps = Steps::of(&[0.0, 1000.0, 2200.0, 3400.0]);
-        assert_eq!(
-            steps,
-            Steps {
-                step: 1200.0,
-                turn: 200.0
-            }
-        );
+        assert_eq!(steps, of(1200.0, 200.0));
         let yaw = Steps::allowed(&params, Axis::Yaw, LimitMode::Idle);
         assert!(steps.within(yaw));
         assert!(!Steps::of(&[0.0, 1201.0]).within(yaw));

@@ -3,22 +3,22 @@
 
 use std::{path::Path, time::Instant};
 
-use anyhow::{Result, bail};
+use anyhow::{Result, bail, ensure};
 
 use xshell::cmd;
 
 use crate::{
     args::Options,
     bench, book, console, elf, figures,
-    log::Run,
+    log::{self, Run},
     panel, pico2,
     project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
     qemu::{self, Echo},
     setup, sim, snapshot,
 };
 
-/// Runs stages one after another and keeps score: each stage's name, its
-/// error if it failed, and its seconds; and how many `--only` left out.
+/// The score: each stage's name, its error if it failed, its seconds; and
+/// how many `--only` left out.
 struct Stages<'a> {
     results: Vec<(String, Option<String>, f64)>,
     /// Only the stages whose name contains this run.
@@ -27,8 +27,8 @@ struct Stages<'a> {
 }
 
 impl Stages<'_> {
-    /// Runs one stage; `Ok(())` passes, an error fails it. A stage `--only`
-    /// leaves out does not run, and counts as passed for what follows.
+    /// Runs one stage unless `--only` leaves it out (it then counts as
+    /// passed for what follows).
     fn run(&mut self, name: &str, stage: impl FnOnce() -> Result<()>) -> bool {
         self.run_if(false, name, stage)
     }
@@ -50,7 +50,7 @@ impl Stages<'_> {
         self.only.is_none_or(|only| name.contains(only))
     }
 
-    /// Prints the output of a stage run apart, and scores it.
+    /// Prints the output of a stage run apart ([`run_apart`]), and scores it.
     fn record(&mut self, name: &str, (output, failed, seconds): Outcome) {
         println!("\n==> {name}");
         let _ = std::io::Write::write_all(&mut std::io::stdout(), &output);
@@ -67,12 +67,12 @@ impl Stages<'_> {
         passed
     }
 
-    /// Records a stage that could not run because an earlier one failed.
+    /// Fails a stage that cannot run because `by` failed.
     fn blocked(&mut self, name: &str, by: &str) {
         self.run(name, || bail!("not run, {by} failed"));
     }
 
-    /// Prints the score card and the closing `N passed, M failed` line.
+    /// Prints the score card and `N passed, M failed`.
     fn finish(&self, start: Instant) -> bool {
         let failed = self.results.iter().filter(|(_, f, _)| f.is_some()).count();
         println!("\nstages:");
@@ -103,11 +103,6 @@ impl Stages<'_> {
 pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     let start = Instant::now();
     let (root, metadata) = setup::prepare()?;
-    let sh = project::shell(".")?;
-    let host_tests = project::shell("host-tests")?;
-    let core = project::shell("crates/core")?;
-    let firmware = project::shell("crates/firmware")?;
-    let xtask = project::shell("xtask")?;
     let figures_page = root.join(figures::PAGE);
     let figures_before = figures::read(&figures_page)?;
     let mut stages = Stages {
@@ -116,25 +111,8 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         left_out: 0,
     };
 
-    // 1. Host tests of the core, the firmware layer and the project commands.
-    stages.run("host tests (host-tests/)", || {
-        project::run(&host_tests, &[], cmd!(host_tests, "cargo test"))
-    });
-    stages.run("core crate: unit and doc tests (crates/core, host)", || {
-        project::run(&core, &[], cmd!(core, "cargo test"))
-    });
-    stages.run("firmware layer: host tests (crates/firmware)", || {
-        project::run(&firmware, &[], cmd!(firmware, "cargo test"))
-    });
-    stages.run("xtask unit tests", || {
-        project::run(&xtask, &[], cmd!(xtask, "cargo test --profile xtask"))
-    });
-
-    // 2. Formatting and lints: firmware (thumb, both packages) and host crates.
-    stages.run("rustfmt: every package of the workspace", || {
-        project::run(&sh, &[], cmd!(sh, "cargo fmt --all --check"))
-    });
-    clippy_stages(&mut stages);
+    // 1. Host tests, formatting, lints, the images that must compile.
+    cargo_stages(&mut stages);
 
     // 3. The Pico image: placement of the boot stage, memory budgets, no allocator.
     // (Also for any emulator stage: they run on the image built here.)
@@ -156,30 +134,6 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     // The Pico 2 on its own: its embassy-rp chip feature excludes the Pico's.
     stages.run(pico2::STAGE, || pico2::test(&metadata));
 
-    // The calibration image (same bin, feature `calibrate`): it must compile.
-    stages.run(
-        "Pico calibration image compiles (--features calibrate)",
-        || {
-            project::run(
-                &sh,
-                FIRMWARE_ENV,
-                cmd!(sh, "cargo check --release --features calibrate"),
-            )
-        },
-    );
-    // A board with servos and USB only, on the same `start` as the Pico's.
-    stages.run(
-        "minimal board example, servos and USB only (examples/minimal.rs): clippy, build",
-        || {
-            let clippy = "clippy --release --example minimal -- -D warnings";
-            let build = "build --release --example minimal";
-            for args in [clippy, build] {
-                let args = args.split_whitespace();
-                project::run(&sh, FIRMWARE_ENV, cmd!(sh, "cargo {args...}"))?;
-            }
-            Ok(())
-        },
-    );
     // The frame path cannot panic: this image links the frame update against
     // a panic handler that does not exist, so the link fails if any panic
     // path survives optimisation (boards/qemu/src/panic_proof.rs).
@@ -218,52 +172,48 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     Ok(stages.finish(start))
 }
 
-/// The clippy passes: the firmware's (thumbv6m, `--release` to share build
-/// scripts and proc-macros with the release builds), the Pico 2's, and the
-/// host crates'; `(name, folder, firmware, arguments)`.
-const CLIPPY: [(&str, &str, bool, &str); 7] = [
-    (
-        "clippy: Pico image, RP support, firmware layer, core (thumbv6m)",
-        ".",
-        true,
-        "--release --package idle-head --package idle-head-rp --package idle-head-firmware \
-         --package idle-head-core",
-    ),
-    (
-        "clippy: QEMU images, boards/qemu/ (thumbv6m)",
-        ".",
-        true,
-        "--release --bins --package idle-head-qemu",
-    ),
-    (
-        "clippy: Pico 2 image, boards/pico2/ (thumbv8m.main)",
-        "boards/pico2",
-        true,
-        "--release",
-    ),
-    (
-        "clippy: core crate and its unit tests (host)",
-        ".",
-        false,
-        "--package idle-head-core --all-targets --target host-tuple",
-    ),
-    (
-        "clippy: firmware layer and its unit tests (host)",
-        ".",
-        false,
-        "--package idle-head-firmware --all-targets --target host-tuple",
-    ),
-    ("clippy: host-tests", "host-tests", false, "--all-targets"),
-    ("clippy: xtask", "xtask", false, "--all-targets"),
+/// The stages that run cargo, `(name, folder, firmware, commands)`: the
+/// firmware's with its build environment (and `--release`, to share build
+/// scripts with the release builds), the commands' arguments separated by
+/// ` && `.
+#[rustfmt::skip] // a table, one stage a line
+const CARGO: [(&str, &str, bool, &str); 14] = [
+    ("host tests (host-tests/)", "host-tests", false, "test"),
+    ("core crate: unit and doc tests (crates/core, host)", "crates/core", false, "test"),
+    ("firmware layer: host tests (crates/firmware)", "crates/firmware", false, "test"),
+    ("xtask unit tests", "xtask", false, "test --profile xtask"),
+    ("rustfmt: every package of the workspace", ".", false, "fmt --all --check"),
+    ("clippy: Pico image, RP support, firmware layer, core (thumbv6m)", ".", true,
+     "clippy --release --package idle-head --package idle-head-rp --package idle-head-firmware \
+      --package idle-head-core -- -D warnings"),
+    ("clippy: QEMU images, boards/qemu/ (thumbv6m)", ".", true,
+     "clippy --release --bins --package idle-head-qemu -- -D warnings"),
+    ("clippy: Pico 2 image, boards/pico2/ (thumbv8m.main)", "boards/pico2", true,
+     "clippy --release -- -D warnings"),
+    ("clippy: core crate and its unit tests (host)", ".", false,
+     "clippy --package idle-head-core --all-targets --target host-tuple -- -D warnings"),
+    ("clippy: firmware layer and its unit tests (host)", ".", false,
+     "clippy --package idle-head-firmware --all-targets --target host-tuple -- -D warnings"),
+    ("clippy: host-tests", "host-tests", false, "clippy --all-targets -- -D warnings"),
+    ("clippy: xtask", "xtask", false, "clippy --all-targets -- -D warnings"),
+    // The calibration image (same bin, feature `calibrate`) must compile.
+    ("Pico calibration image compiles (--features calibrate)", ".", true,
+     "check --release --features calibrate"),
+    // A board with servos and USB only, on the same `start` as the Pico's.
+    ("minimal board example, servos and USB only (examples/minimal.rs): clippy, build", ".", true,
+     "clippy --release --example minimal -- -D warnings && build --release --example minimal"),
 ];
 
-fn clippy_stages(stages: &mut Stages<'_>) {
-    for (name, dir, firmware, args) in CLIPPY {
+fn cargo_stages(stages: &mut Stages<'_>) {
+    for (name, dir, firmware, commands) in CARGO {
         stages.run(name, || {
             let sh = project::shell(dir)?;
-            let args = args.split_whitespace();
             let env = if firmware { FIRMWARE_ENV } else { &[] };
-            project::run(&sh, env, cmd!(sh, "cargo clippy {args...} -- -D warnings"))
+            for args in commands.split(" && ") {
+                let args = args.split_whitespace();
+                project::run(&sh, env, cmd!(sh, "cargo {args...}"))?;
+            }
+            Ok(())
         });
     }
 }
@@ -271,12 +221,9 @@ fn clippy_stages(stages: &mut Stages<'_>) {
 /// An emulator stage: its name, and what it runs on images built already.
 type Emulated = (&'static str, fn(&Path, &Metadata) -> Result<()>);
 
-/// The stages in the RP2040 emulator, in the order of the score card. Each
-/// runs on one core (the latency stage on as many as there are): the full
-/// run builds their images first, then runs them side by side as
-/// `cargo xtask test --stage NAME`, longest first, each one's output held
-/// back and printed in this order. Only the latency stage among them records
-/// figures (`target/figures.json` is never written by two at once).
+/// The stages in the RP2040 emulator, in the order of the score card, run
+/// side by side on images built already (`cargo xtask test --stage NAME`),
+/// longest first. Only the latency stage records figures.
 const EMULATED: [Emulated; 16] = [
     (sim::PULSES_STAGE, |root, metadata| {
         let report = sim::test_pulses(root, metadata)?;
@@ -306,8 +253,7 @@ const EMULATED: [Emulated; 16] = [
     (bench::LATENCY_STAGE, bench::latency_stage),
 ];
 
-/// Where the pulses stage leaves the peak stack it measured, for the RAM
-/// stage.
+/// Where the pulses stage leaves its peak stack for the RAM stage.
 fn peak_file(metadata: &Metadata) -> std::path::PathBuf {
     metadata.target_dir.join("sim-pulses-peak-stack")
 }
@@ -323,12 +269,10 @@ pub fn stage(name: &str) -> Result<bool> {
     Ok(true)
 }
 
-/// A stage's run in a process of its own: its output (stdout and stderr
-/// as they came), its error, its seconds.
+/// A stage run apart: its output (stdout and stderr), error, seconds.
 type Outcome = (Vec<u8>, Option<String>, f64);
 
-/// Runs `xtask test --stage name` with [`project::PREBUILT`] set to the
-/// number of runs at once, `cores`.
+/// Runs `xtask test --stage name`, [`project::PREBUILT`] set to `cores`.
 fn run_apart(name: &str, cores: usize) -> Outcome {
     let start = Instant::now();
     let run = || -> Result<(Vec<u8>, std::process::ExitStatus)> {
@@ -420,24 +364,24 @@ fn sim_stages(
             });
         }
         drop(sender);
+        // Scored in order, each as soon as those before it are.
         let mut done: Vec<Option<Outcome>> = vec![None; EMULATED.len()];
-        let mut next = 0;
-        let mut record = |done: &mut Vec<Option<Outcome>>, next: &mut usize| {
-            while let Some(&i) = chosen.get(*next) {
+        let mut pending = chosen.iter().peekable();
+        loop {
+            while let Some(&&i) = pending.peek() {
                 if let Some(by) = blocker(i) {
                     stages.blocked(EMULATED[i].0, by);
                 } else if let Some(outcome) = done[i].take() {
                     stages.record(EMULATED[i].0, outcome);
                 } else {
-                    return;
+                    break;
                 }
-                *next += 1;
+                pending.next();
             }
-        };
-        record(&mut done, &mut next);
-        for (i, outcome) in results {
+            let Ok((i, outcome)) = results.recv() else {
+                break;
+            };
             done[i] = Some(outcome);
-            record(&mut done, &mut next);
         }
     });
     stages.left_out += EMULATED.len() - chosen.len();
@@ -481,16 +425,14 @@ fn qemu_stages(
     }
     let mut run: Option<Run> = None;
     stages.run(RUN, || {
-        let done = qemu::run(&QEMU.elf(metadata), options.timeout, Echo::Problems)?;
+        let done = run.insert(qemu::run(
+            &QEMU.elf(metadata),
+            options.timeout,
+            Echo::Problems,
+        )?);
         println!("{}", done.describe());
-        let succeeded = done.succeeded();
-        let describe = done.describe();
-        run = Some(done);
-        if succeeded {
-            Ok(())
-        } else {
-            bail!("{describe}")
-        }
+        ensure!(done.succeeded(), "{}", done.describe());
+        Ok(())
     });
     let Some(run) = run else {
         for name in [SNAPSHOT, SUMMARY] {
@@ -513,13 +455,8 @@ fn qemu_stages(
         Ok(())
     });
     stages.run(SUMMARY, || {
-        if let Some(line) = run
-            .log
-            .iter()
-            .rev()
-            .find(|line| line.message.starts_with("summary"))
-        {
-            println!("{}", line.snapshot());
+        if let Some(line) = log::summary(&run.log) {
+            println!("{line}");
         }
         let verdict = qemu::check_summary(&run.log)?;
         println!("{verdict}");

@@ -1,9 +1,6 @@
-//! `cargo xtask uf2`: the firmware as a UF2 file, which a board in BOOTSEL
-//! mode flashes itself when it is copied onto the USB drive it shows.
-//!
-//! `elf2flash-core` (a port of the Pico SDK's `elf2uf2`) writes the blocks.
-//! Every emulator run of the Pico image boots from the UF2 written here
-//! (`sim/harness.mjs` lays its blocks into flash): that is its test.
+//! `cargo xtask uf2`: the firmware as a UF2 file for a board in BOOTSEL
+//! mode, written by `elf2flash-core`. Every emulator run of the Pico image
+//! boots from it (`sim/harness.mjs`): that is its test.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -52,9 +49,8 @@ pub fn make(elf: &[u8], board: Board) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// Fails unless the ELF has what the board's boot ROM starts an image
-/// from: on the Pico, the 256-byte second stage (`.boot2`) at the start of
-/// flash; on the Pico 2, a block in its first 4 KiB (`.start_block`).
+/// Fails unless the ELF has what the board's boot ROM starts: `.boot2`
+/// (Pico) or `.start_block` (Pico 2).
 pub fn check_boot(data: &[u8], board: Board) -> Result<()> {
     match board {
         Board::Pico => elf::Image::parse(data)
@@ -64,9 +60,8 @@ pub fn check_boot(data: &[u8], board: Board) -> Result<()> {
     }
 }
 
-/// The addresses of the `.start_block` section of the ELF `data`, checked:
-/// inside the first 4 KiB of flash, where the boot ROM searches, opening
-/// and closing with the block markers.
+/// The addresses of `.start_block` in the ELF `data`, checked: in the first
+/// 4 KiB of flash, where the boot ROM searches, between the block markers.
 pub fn start_block(data: &[u8]) -> Result<Range<u64>> {
     let file = object::File::parse(data).context("parsing the ELF")?;
     let section = file.section_by_name(".start_block").context(
@@ -99,16 +94,10 @@ pub fn start_block(data: &[u8]) -> Result<Range<u64>> {
 /// Makes the UF2 of the ELF at `elf` and writes it beside it (`…/pico` →
 /// `…/pico.uf2`, or another `extension`); returns its path and contents.
 pub fn write(elf: &Path, board: Board, extension: &str) -> Result<(PathBuf, Vec<u8>)> {
-    static CALLS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
     let data = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
     let bytes = make(&data, board).with_context(|| format!("the UF2 of {}", elf.display()))?;
     let path = elf.with_extension(extension);
-    // Through a file of this call's own, renamed over the UF2: emulator runs
-    // side by side convert the same ELF, and none may read half a file.
-    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let partial = elf.with_extension(format!("{extension}.{}-{n}", std::process::id()));
-    std::fs::write(&partial, &bytes).with_context(|| format!("writing {}", partial.display()))?;
-    std::fs::rename(&partial, &path).with_context(|| format!("writing {}", path.display()))?;
+    project::write(&path, &bytes)?;
     Ok((path, bytes))
 }
 
@@ -123,8 +112,6 @@ pub fn describe(path: &Path, board: Board, bytes: &[u8]) -> String {
     )
 }
 
-/// `cargo xtask uf2`: builds the board's image unless an ELF is given,
-/// writes its UF2 beside it and says how to flash it.
 pub fn command(args: &Args) -> Result<bool> {
     let elf = if let Some(elf) = &args.elf {
         elf.clone()

@@ -17,19 +17,13 @@ use crate::log::Run;
 use crate::qemu::{self, Echo};
 use crate::setup;
 
-/// Which run the image plays, and how QEMU's virtual clock runs while the
-/// core sleeps.
+/// Which run the image plays, and how QEMU's clock runs while it sleeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Pace {
     /// A clean head for a person (semihosting argument `interactive`: no
-    /// script, no injected faults, the board's 20 ms frames, until the
-    /// hang-up), its virtual clock with the wall clock (`-icount
-    /// shift=0,sleep=on`: one instruction a nanosecond while the core
-    /// works, the wall clock's pace while it sleeps, which is almost all
-    /// the time: so the head moves at its true speed).
+    /// script or faults, until the hang-up) at the wall clock's pace.
     RealTime,
-    /// The smoke run held for its console (semihosting argument `console`),
-    /// jumping over idle time (`sleep=off`): as fast as the host can.
+    /// The smoke run held for its console (`console`), idle time skipped.
     Fast,
 }
 
@@ -40,15 +34,13 @@ pub struct QemuSession {
     pub talk: Talk,
 }
 
-/// How long QEMU has to stop after the hang-up (the firmware fades out for
-/// a moment of virtual time, then prints its summary), and how long the
-/// reply reader waits for a byte after it.
+/// How long QEMU has to stop after the hang-up (the firmware fades out,
+/// then prints its summary), and the reply reader to read a byte.
 const AFTER_HANG_UP: Duration = Duration::from_secs(120);
 
-/// Runs `elf` in QEMU held for its console: sends `input` to UART0 as it
-/// comes, byte for byte, hands each reply line to `on_reply`, waits up to
-/// `wait` for the replies still due, then hangs up (a byte on UART1), so
-/// that the firmware fades out and prints its summary.
+/// Runs `elf` in QEMU held for its console: [`talk::converse`] on UART0,
+/// then the hang-up (a byte on UART1): the firmware fades out, prints its
+/// summary and exits, which closes the socket and ends the reader.
 pub fn qemu_session(
     elf: &Path,
     input: impl Read,
@@ -57,16 +49,8 @@ pub fn qemu_session(
     echo: Echo,
     wait: Duration,
 ) -> Result<QemuSession> {
-    let Sockets {
-        child,
-        dir,
-        uart0,
-        uart1,
-    } = spawn_with_sockets(elf, pace, "console", Stdio::piped)?;
+    let (child, dir, [uart0, uart1]) = spawn_with_sockets(elf, pace, "console", Stdio::piped)?;
     let (run, talk) = qemu::finish(child, elf, AFTER_HANG_UP, echo, || {
-        // The conversation on UART0, then the hang-up on UART1: the
-        // firmware fades out, prints its summary and exits, which closes
-        // the socket and ends the reader.
         let mut console = connect(&uart0)?;
         let mut hang_up = connect(&uart1)?;
         let (reader, timeout) = (console.try_clone()?, console.try_clone()?);
@@ -88,27 +72,16 @@ pub fn qemu_session(
     Ok(QemuSession { run, talk: talk? })
 }
 
-/// QEMU started by [`spawn_with_sockets`].
-pub struct Sockets {
-    pub child: Child,
-    /// The sockets' folder, for the caller to remove when QEMU is done.
-    pub dir: PathBuf,
-    pub uart0: PathBuf,
-    /// UART1's socket: the hang-up line.
-    pub uart1: PathBuf,
-}
-
-/// Starts QEMU running `elf` for a console ([`qemu_command`]), UART0 and
-/// UART1 on sockets it serves, waiting for both to be connected
-/// ([`connect`]), in a folder of the temporary directory of its own
-/// (`idle-head-<tag>-<pid>`); its stdout and stderr are `output`
-/// (`Stdio::piped`, `Stdio::null`).
+/// Starts QEMU running `elf` for a console, UART0 and UART1 on sockets it
+/// serves (waiting for both to be connected) in a temporary folder of its
+/// own, its stdout and stderr `output`: QEMU, the folder (for the caller to
+/// remove), the sockets.
 pub fn spawn_with_sockets(
     elf: &Path,
     pace: Pace,
     tag: &str,
     output: fn() -> Stdio,
-) -> Result<Sockets> {
+) -> Result<(Child, PathBuf, [PathBuf; 2])> {
     let dir = std::env::temp_dir().join(format!("idle-head-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let [uart0, uart1] = ["uart0", "uart1"].map(|n| dir.join(format!("{n}.sock")));
@@ -122,37 +95,28 @@ pub fn spawn_with_sockets(
         .stderr(output())
         .spawn()
         .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
-    Ok(Sockets {
-        child,
-        dir,
-        uart0,
-        uart1,
-    })
+    Ok((child, dir, [uart0, uart1]))
 }
 
 /// QEMU running `elf` for a console: the run `pace` asks for, UART0 and
-/// UART1 (the hang-up line) on the character devices `serials` (QEMU's
-/// `-serial` arguments: a socket, `pty`, `null`).
-pub fn qemu_command(elf: &Path, pace: Pace, serials: [&str; 2]) -> Command {
+/// UART1 (the hang-up line) on the character devices `serials` (a socket,
+/// `pty`, `null`).
+pub fn qemu_command(elf: &Path, pace: Pace, [uart0, uart1]: [&str; 2]) -> Command {
     let (sleep, run) = match pace {
         Pace::RealTime => (true, "interactive"),
         Pace::Fast => (false, "console"),
     };
     let semihosting = format!("enable=on,target=native,arg=idle-head,arg={run}");
-    let [uart0, uart1] = serials;
-    let args = [
-        "-display",
-        "none",
-        "-monitor",
-        "none",
+    let mut command = qemu::qemu_command(elf, sleep, &["-display", "none", "-monitor", "none"]);
+    command.args([
         "-semihosting-config",
         &semihosting,
-    ];
-    qemu::qemu_command(
-        elf,
-        sleep,
-        &[&args[..], &["-serial", uart0, "-serial", uart1]].concat(),
-    )
+        "-serial",
+        uart0,
+        "-serial",
+        uart1,
+    ]);
+    command
 }
 
 /// Connects to a socket QEMU serves, waiting for it to appear.

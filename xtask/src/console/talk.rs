@@ -1,8 +1,7 @@
-//! One conversation with a head, over any port: the bytes of the input go
-//! to the port as they are (no decoding: a line that is not UTF-8 reaches
-//! the head, which answers it with an error), each reply line comes back as
-//! bytes, and the replies are counted against the lines sent, which are
-//! counted as the head's own framer ends them.
+//! One conversation with a head over any port: the input's bytes go as
+//! they are (a line that is not UTF-8 reaches the head, which answers it),
+//! reply lines come back as bytes, counted against the lines sent as the
+//! head's own framer ends them.
 
 use std::{
     io::{ErrorKind, Read, Write},
@@ -15,12 +14,10 @@ use anyhow::Result;
 use idle_head_core::console::Framer;
 
 /// Counts the lines of a byte stream where the head's framer ends them (CR,
-/// LF or CR LF), so that the replies due are known whatever the line ends:
-/// the lines ended so far, and whether bytes follow the last line end.
+/// LF or CR LF), and whether bytes follow the last line end.
 #[derive(Debug, Default)]
 pub struct LineEnds {
-    /// Capacity 0: only its line ends are of use here, and every line end
-    /// yields exactly one outcome, however long the line.
+    /// Capacity 0: every line end yields one outcome, however long the line.
     framer: Framer<0>,
     pub lines: usize,
     pub open: bool,
@@ -42,8 +39,7 @@ impl LineEnds {
     }
 }
 
-/// How a conversation went: lines sent, replies, and what ended it before
-/// its end, if anything did.
+/// How a conversation went: lines sent, replies, what ended it early.
 #[derive(Debug)]
 pub struct Talk {
     pub sent: usize,
@@ -71,9 +67,8 @@ fn send(port: &mut impl Write, ends: &mut LineEnds, bytes: &[u8]) -> Result<(), 
         .map_err(|e| format!("writing to the port failed: {e}"))
 }
 
-/// Splits `reader`'s bytes into reply lines (their CR LF or LF taken off),
-/// handed to `each`, until the stream ends (`Ok`), a read fails (`Err`), or
-/// `stop` is set (checked when a read times out).
+/// Hands `reader`'s lines to `each` (without CR LF or LF) until the stream
+/// ends, a read fails, or `stop` is set (checked when a read times out).
 fn read_replies(
     mut reader: impl Read,
     stop: &AtomicBool,
@@ -107,14 +102,12 @@ fn read_replies(
     }
 }
 
-/// The conversation: this thread sends `input` to `port` as it comes, byte
-/// for byte (a last line without a line end gets an LF, so that it is
-/// answered); a reader thread hands each reply line read from `replies` to
+/// The conversation: `input` goes to `port` as it comes (a last line
+/// without a line end gets an LF); a thread hands each line of `replies` to
 /// `on_reply`. Once the input ends, it waits up to `wait` for the replies
-/// still due, then calls `hang_up`, after which the reader must end: at the
-/// end of `replies`, or at its next read timeout. Nothing ends it silently:
-/// a failed read of the input, a failed write to the port, and the port
-/// closing before the hang-up are [`Talk::early`].
+/// due, then calls `hang_up`, after which the reader must end (at the end
+/// of `replies` or its next read timeout). A failed read or write, and the
+/// port closing before the hang-up, are [`Talk::early`].
 pub fn converse(
     mut input: impl Read,
     port: &mut impl Write,

@@ -3,7 +3,7 @@
 //! sends goes to every page connected.
 
 use std::{
-    io::{Read, Write},
+    io::{ErrorKind, Read, Write},
     net::Shutdown,
     os::unix::net::UnixStream,
     path::{Path, PathBuf},
@@ -17,7 +17,7 @@ use anyhow::{Context, Result, anyhow};
 
 use crate::console::{
     Pace, open_port,
-    qemu::{Sockets, connect, spawn_with_sockets},
+    qemu::{connect, spawn_with_sockets},
 };
 use crate::sim::live;
 
@@ -117,12 +117,8 @@ impl Bridge {
 
     /// The QEMU image `elf`, a clean head at real time, over its UART0.
     pub fn qemu(elf: &Path) -> Result<Self> {
-        let Sockets {
-            child,
-            dir,
-            uart0,
-            uart1,
-        } = spawn_with_sockets(elf, Pace::RealTime, "panel", Stdio::null)?;
+        let (child, dir, [uart0, uart1]) =
+            spawn_with_sockets(elf, Pace::RealTime, "panel", Stdio::null)?;
         let console = connect(&uart0)?;
         let reader = console.try_clone()?;
         let mut bridge = Self::new(
@@ -156,8 +152,7 @@ impl Bridge {
                 match reader.read(&mut buf) {
                     Ok(0) => break why.to_owned(),
                     Ok(n) => hub.tell(&Note::Bytes(buf[..n].to_vec())),
-                    Err(e) if matches!(e.kind(), std::io::ErrorKind::Interrupted) => {}
-                    Err(e) if matches!(e.kind(), std::io::ErrorKind::TimedOut) => {}
+                    Err(e) if matches!(e.kind(), ErrorKind::Interrupted | ErrorKind::TimedOut) => {}
                     Err(e) => break format!("{why}: {e}"),
                 }
             };

@@ -1,9 +1,8 @@
-//! The panel's browser tests, a stage of `cargo xtask test`: Debian's
-//! Chromium, headless, driven by playwright-core (`panel/tests/browser.mjs`)
-//! over Web Serial (the emulated Pico), the bridge of `panel --qemu`, a
-//! real serial port (QEMU's UART0 on a pty, through `console --port` and
-//! `panel --port`), and the radar's map on the telemetry of a host trace
-//! replayed by a fake serial port. Screenshots go to `target/panel/`.
+//! The panel's browser tests, a stage of `cargo xtask test`: headless
+//! Chromium driven by playwright-core (`panel/tests/browser.mjs`) over Web
+//! Serial (the emulated Pico), `panel --qemu`, a real serial port (QEMU's
+//! UART0 on a pty, through `console --port` and `panel --port`), and a
+//! replayed host trace (the radar's map). Screenshots: `target/panel/`.
 
 use std::{
     io::{BufRead, BufReader, Write},
@@ -14,9 +13,10 @@ use std::{
 };
 
 use anyhow::{Context, Result, bail};
+use serde_json::{Value, json};
 
 use super::{Bridge, ensure_dependencies, server::Server};
-use crate::console::{Pace, qemu::qemu_command};
+use crate::console::{self, Pace, qemu::qemu_command};
 use crate::project::{Metadata, PICO, QEMU};
 use crate::{setup, sim, trace};
 
@@ -30,56 +30,33 @@ const CHROMIUM: &str = "/usr/bin/chromium";
 pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
     let start = Instant::now();
     setup::ensure_program(CHROMIUM, &["chromium"], "Chromium")?;
-    let chromium = PathBuf::from(CHROMIUM);
     ensure_dependencies(root)?;
     setup::ensure_qemu()?;
     PICO.build(root)?;
     QEMU.build(root)?;
     let shots = metadata.target_dir.join("panel");
-    let mut report = Vec::new();
-
-    // 1. Web Serial, the emulated Pico.
-    let (stop, _) = mpsc::channel();
-    let plain = Server::start(root, "127.0.0.1:0".parse()?, None, stop)?;
     let harness = sim::live::config(root, &PICO.elf(metadata))?;
-    report.push(browser(
-        root,
-        &chromium,
-        &serde_json::json!({
-            "session": "serial",
-            "url": format!("http://{}/", plain.address),
-            "harness": { "cwd": sim::node_folder(root), "arg": harness.to_string() },
-            "shots": shots,
-            "label": "web-serial",
-        }),
-    )?);
-    drop(plain);
-
-    // 2. The bridge to QEMU.
-    let (stop, _) = mpsc::channel();
-    let bridged = Server::start(
-        root,
-        "127.0.0.1:0".parse()?,
-        Some(Bridge::qemu(&QEMU.elf(metadata))?),
-        stop,
-    )?;
-    report.push(browser(
-        root,
-        &chromium,
-        &serde_json::json!({
-            "session": "bridge",
-            "url": format!("http://{}/", bridged.address),
-            "shots": shots,
-            "label": "qemu",
-        }),
-    )?);
-    drop(bridged);
-
-    // 3. A real serial port: QEMU's UART0 as a pseudo-terminal.
-    report.push(serial_port(root, &chromium, &QEMU.elf(metadata), &shots)?);
-
-    // 4. The radar's map: the telemetry of a scripted walk, replayed.
-    report.push(replay(root, &chromium, &shots)?);
+    let harness = json!({ "cwd": sim::node_folder(root), "arg": harness.to_string() });
+    let report = [
+        // Web Serial, the emulated Pico.
+        session(
+            root,
+            &shots,
+            None,
+            json!({ "session": "serial", "label": "web-serial", "harness": harness }),
+        )?,
+        // The bridge to QEMU.
+        session(
+            root,
+            &shots,
+            Some(Bridge::qemu(&QEMU.elf(metadata))?),
+            json!({ "session": "bridge", "label": "qemu" }),
+        )?,
+        // A real serial port: QEMU's UART0 as a pseudo-terminal.
+        serial_port(root, &QEMU.elf(metadata), &shots)?,
+        // The radar's map: the telemetry of a scripted walk, replayed.
+        replay(root, &shots)?,
+    ];
     Ok(format!(
         "{}; {:.0} s",
         report.join("; "),
@@ -87,10 +64,14 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
     ))
 }
 
-/// Runs one browser session; its last line.
-fn browser(root: &Path, chromium: &Path, config: &serde_json::Value) -> Result<String> {
-    let mut config = config.clone();
-    config["chromium"] = serde_json::json!(chromium);
+/// Serves the page, bridged to `bridge` if given, and runs one browser
+/// session on it (`config`, for `panel/tests/browser.mjs`); its last line.
+fn session(root: &Path, shots: &Path, bridge: Option<Bridge>, mut config: Value) -> Result<String> {
+    let (stop, _) = mpsc::channel();
+    let server = Server::start(root, "127.0.0.1:0".parse()?, bridge, stop)?;
+    config["url"] = json!(format!("http://{}/", server.address));
+    config["chromium"] = json!(CHROMIUM);
+    config["shots"] = json!(shots);
     let out = Command::new("node")
         .arg("tests/browser.mjs")
         .arg(config.to_string())
@@ -101,152 +82,74 @@ fn browser(root: &Path, chromium: &Path, config: &serde_json::Value) -> Result<S
         .context("could not start node")?;
     let text = String::from_utf8_lossy(&out.stdout);
     print!("{text}");
+    let label = &config["label"];
     if !out.status.success() {
-        let why = text
-            .lines()
-            .rfind(|l| l.starts_with("FAILED"))
-            .unwrap_or("failed");
-        bail!("browser session {}: {why}", config["label"]);
+        let why = text.lines().rfind(|l| l.starts_with("FAILED"));
+        bail!("browser session {label}: {}", why.unwrap_or("failed"));
     }
-    Ok(text
+    let nod = text
         .lines()
-        .rfind(|l| l.contains("Nod: the pitch readout swung"))
-        .map_or_else(
-            || format!("{} passed", config["label"]),
-            |l| format!("{}: {l}", config["label"]),
-        ))
+        .rfind(|l| l.contains("Nod: the pitch readout swung"));
+    Ok(nod.map_or_else(|| format!("{label} passed"), |l| format!("{label}: {l}")))
 }
 
 /// The lines the page sends as it connects and every 2 s after: their
 /// replies are the console's, at the end of the replayed run.
-const PAGE_ASKS: [&str; 18] = [
-    "help",
-    "status",
-    "servo pitch",
-    "servo roll",
-    "servo yaw",
-    "servo rate",
-    "rest after",
-    "idle",
-    "look duck",
-    "seed",
-    "input 2",
-    "input 3",
-    "input 4",
-    "input 5",
-    "dmx",
-    "radar",
-    "track",
-    "watch 20",
-];
+const PAGE_ASKS: &str = "help|status|servo pitch|servo roll|servo yaw|servo rate|rest after|idle|\
+                         look duck|seed|input 2|input 3|input 4|input 5|dmx|radar|track|watch 20";
 
 /// The radar's map: the host trace of `panel/tests/radar-replay.txt` (the
 /// core's frame engine, tracker and console service, as on a board), its
-/// telemetry lines (`watch 20`, the core's own) replayed to the page by a
-/// fake serial port in real time, which answers the page's lines with the
-/// console's replies at the end of the run.
-fn replay(root: &Path, chromium: &Path, shots: &Path) -> Result<String> {
+/// telemetry lines (`watch 20`) replayed to the page by a fake serial port
+/// in real time, which answers the page's lines with the console's replies
+/// at the end of the run.
+fn replay(root: &Path, shots: &Path) -> Result<String> {
     let path = root.join("panel/tests/radar-replay.txt");
     let script =
         std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     let (_, params) = trace::built_in()?;
     let events = trace::parse_script(&script, &params)?;
     let end = events.last().map_or(0, |e| e.at_us) + 1_500_000;
-    let run = trace::simulate_watched(
-        end,
-        None,
-        idle_head_core::servo::ServoRate::DEFAULT,
-        &events,
-        Some(20),
-        &PAGE_ASKS,
-    )?;
+    let asks: Vec<&str> = PAGE_ASKS.split('|').collect();
+    let rate = idle_head_core::servo::ServoRate::DEFAULT;
+    let run = trace::simulate_watched(end, None, rate, &events, Some(20), &asks)?;
     let lines = run.watch.map(|w| w.lines).unwrap_or_default();
-    let answers: serde_json::Map<String, serde_json::Value> = PAGE_ASKS
+    let answers: serde_json::Map<String, Value> = asks
         .iter()
         .zip(run.answers)
         .map(|(ask, reply)| ((*ask).to_owned(), reply.into()))
         .collect();
-    let (stop, _) = mpsc::channel();
-    let plain = Server::start(root, "127.0.0.1:0".parse()?, None, stop)?;
-    let session = browser(
+    let replay = json!({ "lines": lines, "answers": answers });
+    session(
         root,
-        chromium,
-        &serde_json::json!({
-            "session": "replay",
-            "url": format!("http://{}/", plain.address),
-            "shots": shots,
-            "label": "radar-replay",
-            "replay": { "lines": lines, "answers": answers },
-        }),
-    );
-    drop(plain);
-    session
+        shots,
+        None,
+        json!({ "session": "replay", "label": "radar-replay", "replay": replay }),
+    )
 }
 
 /// QEMU with UART0 on a pseudo-terminal: `cargo xtask console --port` with
 /// a piped script, then the panel bridged to it (`panel --port`).
-fn serial_port(root: &Path, chromium: &Path, elf: &Path, shots: &Path) -> Result<String> {
-    let mut qemu = Pty::start(elf)?;
-    let pty = qemu.path.clone();
-    println!("QEMU's UART0 is {}", pty.display());
-    // `cargo xtask console --port`, as a person would run it.
-    let exe = std::env::current_exe().context("the xtask's own path")?;
-    let mut console = Command::new(&exe)
-        .args(["console", "--port"])
-        .arg(&pty)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .context("starting `cargo xtask console --port`")?;
-    console
-        .stdin
-        .take()
-        .context("its stdin")?
-        .write_all(b"help\nstatus\nnod\nservo yaw max 3000\nwatch off\n")?;
-    let out = console.wait_with_output()?;
-    let text = String::from_utf8_lossy(&out.stdout);
-    print!("{text}");
-    let want = [
-        "ok commands:",
-        "ok mode=",
-        "ok nod amp_mdeg=",
-        "err invalid yaw servo: max_pulse 3000",
-        "ok watch=off",
-    ];
-    let lines: Vec<&str> = text.lines().collect();
-    if !out.status.success()
-        || lines.len() != want.len()
-        || !lines.iter().zip(want).all(|(l, w)| l.starts_with(w))
-    {
-        bail!("`cargo xtask console --port {}`: {lines:?}", pty.display());
-    }
-    let console_report = format!(
-        "console --port {}: {} replies as expected",
-        pty.display(),
-        want.len()
-    );
-    // `cargo xtask panel --port`: the page bridged to the same port.
-    let (stop, _) = mpsc::channel();
-    let server = Server::start(
+fn serial_port(root: &Path, elf: &Path, shots: &Path) -> Result<String> {
+    let qemu = Pty::start(elf)?;
+    let pty = qemu.path.display().to_string();
+    println!("QEMU's UART0 is {pty}");
+    let want =
+        "ok commands:|ok mode=|ok nod amp_mdeg=|err invalid yaw servo: max_pulse 3000|ok watch=off";
+    let want: Vec<&str> = want.split('|').collect();
+    let script = b"help\nstatus\nnod\nservo yaw max 3000\nwatch off\n";
+    console::script(&["--port", &pty], script, &want, 0)?;
+    let bridge = Some(Bridge::port(&qemu.path)?);
+    let session = session(
         root,
-        "127.0.0.1:0".parse()?,
-        Some(Bridge::port(&pty)?),
-        stop,
+        shots,
+        bridge,
+        json!({ "session": "bridge", "label": "serial-port" }),
     )?;
-    let session = browser(
-        root,
-        chromium,
-        &serde_json::json!({
-            "session": "bridge",
-            "url": format!("http://{}/", server.address),
-            "shots": shots,
-            "label": "serial-port",
-        }),
-    );
-    drop(server);
-    qemu.stop();
-    Ok(format!("{console_report}; {}", session?))
+    Ok(format!(
+        "console --port {pty}: {} replies as expected; {session}",
+        want.len()
+    ))
 }
 
 /// QEMU, its UART0 on a pseudo-terminal, UART1 nowhere (no hang-up: it is
@@ -263,7 +166,7 @@ impl Pty {
     fn start(elf: &Path) -> Result<Self> {
         let qmp = std::env::temp_dir().join(format!("idle-head-qmp-{}.sock", std::process::id()));
         let _ = std::fs::remove_file(&qmp);
-        let mut child = qemu_command(elf, Pace::RealTime, ["pty", "null"])
+        let child = qemu_command(elf, Pace::RealTime, ["pty", "null"])
             .arg("-qmp")
             .arg(format!("unix:{},server=on,wait=off", qmp.display()))
             .stdin(Stdio::null())
@@ -271,21 +174,14 @@ impl Pty {
             .stderr(Stdio::null())
             .spawn()
             .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
-        let path = match pty_path(&qmp) {
-            Ok(path) => path,
-            Err(e) => {
-                let _ = child.kill();
-                let _ = child.wait();
-                return Err(e);
-            }
+        // Dropped on an error: QEMU is stopped.
+        let mut pty = Self {
+            child,
+            path: PathBuf::new(),
         };
+        pty.path = pty_path(&qmp)?;
         let _ = std::fs::remove_file(&qmp);
-        Ok(Self { child, path })
-    }
-
-    fn stop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        Ok(pty)
     }
 }
 
@@ -315,6 +211,7 @@ fn pty_path(qmp: &Path) -> Result<PathBuf> {
 
 impl Drop for Pty {
     fn drop(&mut self) {
-        self.stop();
+        let _ = self.child.kill();
+        let _ = self.child.wait();
     }
 }

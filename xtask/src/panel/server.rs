@@ -1,9 +1,7 @@
-//! The panel's web server (`tiny_http`): the page's files, the dependencies
-//! it loads (`vendor/…`, from `panel/node_modules`), `bridge.json` (the
-//! head it is bridged to, if any), and the bridge: `GET /events` streams
-//! the head's bytes as server-sent events (hex digits, and an event `gone`
-//! with the reason when the head goes away), `POST /send` takes bytes for
-//! it. Every request has a thread of its own.
+//! The panel's web server (`tiny_http`, a thread a request): the page's
+//! files and dependencies (`vendor/…`), `bridge.json` (the head bridged
+//! to, if any), `GET /events` (the head's bytes as server-sent events of
+//! hex digits; `gone` with the reason when it goes away), `POST /send`.
 
 use std::{
     io::Write,
@@ -126,15 +124,9 @@ fn serve(mut request: Request, panel: &Path, bridge: Option<Arc<Bridge>>) {
 }
 
 fn file(bytes: &[u8], kind: &str) -> Response<std::io::Cursor<Vec<u8>>> {
-    let header = |name: &str, value: &str| Header::from_bytes(name, value).ok();
-    let mut response = Response::from_data(bytes.to_vec());
-    for header in [
-        header("Content-Type", kind),
-        header("Cache-Control", "no-store"),
-    ] {
-        response.add_header(header.expect("a valid header"));
-    }
-    response
+    let header = |name: &str, value: &str| Header::from_bytes(name, value).expect("a valid header");
+    let response = Response::from_data(bytes.to_vec()).with_header(header("Content-Type", kind));
+    response.with_header(header("Cache-Control", "no-store"))
 }
 
 /// The file `path` names: the page's own (in `panel/`), or a dependency's.
