@@ -26,7 +26,7 @@ pub mod latency;
 mod paths;
 pub mod tracking;
 
-pub use latency::stage as latency_stage;
+pub use paths::stage as latency_stage;
 
 use crate::console::{Pace, qemu_session};
 use crate::figures::{self, thousands};
@@ -351,7 +351,7 @@ pub fn command(options: Options) -> Result<bool> {
     let qemu = run_and_check(&root, &metadata, options, None);
     // How the head follows people, in the host trace.
     let tracking = tracking::stage();
-    let latency = latency::stage(&root, &metadata);
+    let latency = paths::stage(&root, &metadata);
     let results = [
         ("bench", &qemu),
         ("tracking", &tracking),

@@ -11,14 +11,11 @@ use std::{fmt::Write as _, path::Path, time::Duration};
 use anyhow::{Result, bail};
 use idle_head_core::servo::ServoRate;
 
-use crate::metrics::{parallel, percentile};
+use crate::figures;
+use crate::metrics::percentile;
 use crate::project::Metadata;
 use crate::sim::pulses::{self, Measured};
 use crate::sim::{Boot, dmx_line, parse_script, play_script, run_shipped, script_time};
-use crate::{figures, project};
-
-pub use super::paths::PATHS;
-use super::paths::count;
 
 /// Events per row, at least; more are scheduled, for the ones skipped.
 pub const EVENTS: usize = 1000;
@@ -137,34 +134,12 @@ impl Row {
     }
 }
 
-/// Every latency row, printed and recorded; fails if a row misses its goal
-/// (or could not be measured). The runs are independent emulators: as many
-/// at once as there are cores.
-pub fn stage(root: &Path, metadata: &Metadata) -> Result<()> {
-    // One at a time when `cargo xtask test` runs it beside other stages.
-    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
-    let cores = if crate::project::prebuilt() { 1 } else { cores };
-    let results = parallel(PATHS.len(), cores, |i| {
-        PATHS[i](root, metadata, crate::sim::WALL)
-    });
-    let (mut rows, mut misses) = (Vec::new(), Vec::new());
-    for result in results {
-        match result {
-            Ok(row) => {
-                print!("{}", row.lines());
-                rows.push(row.figure());
-                misses.extend(row.misses());
-            }
-            Err(error) => misses.push(format!("{error:#}")),
-        }
+/// Fails unless `got` is `want`: `<got> <what>, not <want>`.
+pub fn count(got: usize, want: usize, what: &str) -> Result<()> {
+    if got != want {
+        bail!("{got} {what}, not {want}");
     }
-    let intro = "Latency, measured in the RP2040 emulator on the shipped image, from an event \
-                 to the first servo pulse that shows it, in ms \
-                 ([the emulators](../dev/emulators.md#latency-of-an-input-edge)).";
-    let wait = "longest wait of a port task for the CPU";
-    let header = ["row", "events", "p50", "p99", "max", "goal (p99)", wait];
-    figures::record("latency", intro.to_owned(), &header, rows);
-    project::verdict(&misses)
+    Ok(())
 }
 
 /// Event times from `start`, each a random `gap` (from, to) after the last

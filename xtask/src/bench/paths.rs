@@ -1,7 +1,8 @@
-//! The latency rows of the console's ports and of Bottango: a `look` over
-//! USB and over UART0 (each line's last byte against yaw's first pulse
-//! that moves), and a Bottango curve over USB (its start against the
-//! same). See `latency.rs` for the method and the other paths.
+//! Every latency path ([`PATHS`]) and the stage that runs them all. Here
+//! the console's ports and Bottango: a `look` over USB and over UART0
+//! (each line's last byte against yaw's first pulse that moves), and a
+//! Bottango curve over USB (its start against the same); `latency.rs`
+//! has the method, the rows, DMX and the input edge.
 
 // Times in ns of virtual time, far below 2^52, and positive.
 #![allow(
@@ -16,9 +17,11 @@ use anyhow::{Context, Result, bail};
 use idle_head_core::bottango::hash;
 use idle_head_core::servo::ServoRate;
 
-use super::latency::{self, LOOK_GAP, Row, SCHEDULED, schedule};
+use super::latency::{self, LOOK_GAP, Row, SCHEDULED, count, schedule};
+use crate::metrics::parallel;
 use crate::project::Metadata;
 use crate::sim::{BYTE_TIME, Boot, Chunk, UartScript, run_shipped};
+use crate::{figures, project};
 
 /// A path's run, for its row.
 pub type Measure = fn(&Path, &Metadata, Duration) -> Result<Row>;
@@ -48,14 +51,6 @@ fn all_ok(replies: &[u8], what: &str) -> Result<()> {
         Some(line) => bail!("{what}: a line refused: {line:?}"),
         None => Ok(()),
     }
-}
-
-/// Fails unless `got` is `want`: `<got> <what>, not <want>`.
-pub fn count(got: usize, want: usize, what: &str) -> Result<()> {
-    if got != want {
-        bail!("{got} {what}, not {want}");
-    }
-    Ok(())
 }
 
 /// The first boot of the shipped image run until 0.5 s after `last`, its
@@ -200,4 +195,34 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
     let last = times.last().copied().unwrap_or_default();
     let boot = usb_run((root, metadata, wall), last, chunks, "bottango")?;
     latency::row("bottango", &events, &boot)
+}
+
+/// Every latency row, printed and recorded; fails if a row misses its goal
+/// (or could not be measured). The runs are independent emulators: as many
+/// at once as there are cores.
+pub fn stage(root: &Path, metadata: &Metadata) -> Result<()> {
+    // One at a time when `cargo xtask test` runs it beside other stages.
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+    let cores = if crate::project::prebuilt() { 1 } else { cores };
+    let results = parallel(PATHS.len(), cores, |i| {
+        PATHS[i](root, metadata, crate::sim::WALL)
+    });
+    let (mut rows, mut misses) = (Vec::new(), Vec::new());
+    for result in results {
+        match result {
+            Ok(row) => {
+                print!("{}", row.lines());
+                rows.push(row.figure());
+                misses.extend(row.misses());
+            }
+            Err(error) => misses.push(format!("{error:#}")),
+        }
+    }
+    let intro = "Latency, measured in the RP2040 emulator on the shipped image, from an event \
+                 to the first servo pulse that shows it, in ms \
+                 ([the emulators](../dev/emulators.md#latency-of-an-input-edge)).";
+    let wait = "longest wait of a port task for the CPU";
+    let header = ["row", "events", "p50", "p99", "max", "goal (p99)", wait];
+    figures::record("latency", intro.to_owned(), &header, rows);
+    project::verdict(&misses)
 }
