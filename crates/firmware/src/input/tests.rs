@@ -342,34 +342,26 @@ fn somebody(task: &Task) {
         .publish(Some(seen), Counters::default());
 }
 
-#[test]
-fn the_radar_wakes_a_resting_head_and_only_while_it_is_on() {
-    // Off: a sighting is nobody, for the inputs.
-    let mut task = Task::new(InputSettings::DEFAULT, 0);
-    resting(&task);
-    task.wake(100, false);
-    somebody(&task);
-    task.wake(200, false);
-    assert!(
-        task.taken()
-            .iter()
-            .all(|a| !matches!(a, Action::Wake { .. }))
-    );
-    // On: the first sighting with somebody wakes the head.
+/// Whether a resting head, the radar `on` or off, is woken when the radar
+/// sees somebody.
+fn woken_by_a_sighting(on: bool) -> bool {
     let mut task = Task::new(InputSettings::DEFAULT, 0);
     let mut settings = task.links.show.track.settings();
-    settings.radar = true;
+    settings.radar = on;
     task.links.show.track.set(settings);
     resting(&task);
     task.wake(100, false);
     somebody(&task);
     task.wake(200, false);
-    assert!(
-        task.taken()
-            .iter()
-            .any(|a| matches!(a, Action::Wake { .. })),
-        "a radar sighting wakes the head"
-    );
+    task.taken()
+        .iter()
+        .any(|a| matches!(a, Action::Wake { .. }))
+}
+
+#[test]
+fn the_radar_wakes_a_resting_head_and_only_while_it_is_on() {
+    assert!(!woken_by_a_sighting(false), "off: a sighting is nobody");
+    assert!(woken_by_a_sighting(true), "a radar sighting wakes the head");
 }
 
 #[test]
