@@ -296,16 +296,24 @@ impl Port for UartPort {
 #[embassy_rp::interrupt]
 unsafe fn UART0_IRQ() {
     let regs = pac::UART0;
-    TX.lock(|tx| {
+    let moved = TX.lock(|tx| {
         let mut tx = tx.borrow_mut();
+        let mut moved = false;
         while !regs.uartfr().read().txff() {
             let Some(byte) = tx.pop_front() else { break };
             regs.uartdr().write(|w| w.set_data(byte));
+            moved = true;
         }
         if tx.is_empty() {
             regs.uartimsc().modify(|w| w.set_txim(false));
         }
+        moved
     });
     regs.uarticr().write(|w| w.set_txic(true));
-    TX_ROOM.signal(());
+    // Only room made wakes the writer: the writer pends this interrupt
+    // itself, and a signal with the FIFO still full would send it round
+    // again at once, spinning until the line drains.
+    if moved {
+        TX_ROOM.signal(());
+    }
 }
