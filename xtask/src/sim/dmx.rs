@@ -40,57 +40,35 @@ pub fn parse(text: &str) -> Result<Vec<Change>> {
         if line.is_empty() {
             continue;
         }
-        let at = || format!("line {}: `{line}`", n + 1);
+        let here = format!("line {}: `{line}`", n + 1);
         let mut words = line.split_whitespace();
         let seconds: f64 = words
             .next()
             .unwrap_or_default()
             .parse()
-            .with_context(|| format!("{}: the time in seconds first", at()))?;
+            .with_context(|| format!("{here}: the time in seconds first"))?;
         if !(0.0..=3600.0).contains(&seconds) {
-            bail!("{}: the time must be 0 to 3600 s", at());
+            bail!("{here}: the time must be 0 to 3600 s");
         }
-        let rest: Vec<&str> = words.collect();
-        if rest == ["dmx", "stop"] {
-            changes.push(Change {
-                at: Duration::from_secs_f64(seconds),
-                set: Vec::new(),
-                stop: true,
-            });
-            continue;
-        }
-        if rest.is_empty() {
-            bail!(
-                "{}: nothing to set (`<slot>=<value> ...` or `dmx stop`)",
-                at()
-            );
-        }
-        let mut set = Vec::new();
-        for word in rest {
+        let last = SLOTS - ADDRESS + 1;
+        let slot_value = |word: &&str| -> Result<(u16, u8)> {
             let (slot, value) = word
                 .split_once('=')
-                .with_context(|| format!("{}: `{word}` is not `<slot>=<value>`", at()))?;
-            let slot: u16 = slot
-                .parse()
-                .ok()
-                .filter(|s| (1..=SLOTS - ADDRESS + 1).contains(s))
-                .with_context(|| {
-                    format!(
-                        "{}: slot `{slot}` must be 1 to {}",
-                        at(),
-                        SLOTS - ADDRESS + 1
-                    )
-                })?;
-            let value: u8 = value
-                .parse()
-                .with_context(|| format!("{}: value `{value}` must be 0 to 255", at()))?;
-            set.push((slot, value));
-        }
-        changes.push(Change {
-            at: Duration::from_secs_f64(seconds),
-            set,
-            stop: false,
-        });
+                .with_context(|| format!("{here}: `{word}` is not `<slot>=<value>`"))?;
+            let slot = (slot.parse().ok())
+                .filter(|s| (1..=last).contains(s))
+                .with_context(|| format!("{here}: slot `{slot}` must be 1 to {last}"))?;
+            let value = (value.parse())
+                .with_context(|| format!("{here}: value `{value}` must be 0 to 255"))?;
+            Ok((slot, value))
+        };
+        let (set, stop) = match words.collect::<Vec<_>>().as_slice() {
+            ["dmx", "stop"] => (Vec::new(), true),
+            [] => bail!("{here}: nothing to set (`<slot>=<value> ...` or `dmx stop`)"),
+            words => (words.iter().map(slot_value).collect::<Result<_>>()?, false),
+        };
+        let at = Duration::from_secs_f64(seconds);
+        changes.push(Change { at, set, stop });
     }
     if changes.is_empty() {
         bail!("no line: a DMX script needs at least one change");
