@@ -107,11 +107,13 @@ fn script_lines() -> Vec<Vec<u8>> {
     let mut long = vec![b'a'; 97];
     long.extend(b"\r\n");
     lines.push(long);
-    // Machine mode: `#<seq> <command> *<crc>`.
-    let body = "#7 help";
-    let crc = checksum(body.as_bytes());
-    lines.push(format!("{body} *{crc:02x}\r\n").into_bytes());
+    lines.push(machine("#7 help"));
     lines
+}
+
+/// A line in machine mode: `body` (`#<seq> <command>`), then ` *<crc>`.
+pub fn machine(body: &str) -> Vec<u8> {
+    format!("{body} *{:02x}\r\n", checksum(body.as_bytes())).into_bytes()
 }
 
 /// The replies to `script` on the UART, then USB, from one service.
@@ -156,34 +158,26 @@ fn expected(script: &[u8]) -> [Vec<Vec<u8>>; 2] {
 /// `reply` with `status`'s frame-dependent values (angles, pulses, uptime;
 /// if lists of integers) replaced by `*`.
 fn mask(reply: &[u8]) -> Vec<u8> {
-    if !reply.starts_with(b"ok mode=") {
+    let text = String::from_utf8_lossy(reply);
+    if !text.starts_with("ok mode=") {
         return reply.to_vec();
     }
-    let mut out = Vec::with_capacity(reply.len());
-    for (i, word) in reply.split(|&b| b == b' ').enumerate() {
-        if i > 0 {
-            out.push(b' ');
+    let integer = |n: &str| {
+        let digits = n.strip_prefix('-').unwrap_or(n);
+        !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
+    };
+    let mask_word = |word: &str| {
+        let numbers = |key: &&str| {
+            word.strip_prefix(*key)
+                .is_some_and(|v| v.split(',').all(integer))
+        };
+        match ["mdeg=", "us=", "uptime_ms="].into_iter().find(numbers) {
+            Some(key) => format!("{key}*"),
+            None => word.to_owned(),
         }
-        let masked = ["mdeg=", "us=", "uptime_ms="].iter().find_map(|key| {
-            let value = word.strip_prefix(key.as_bytes())?;
-            let numbers = value.split(|&b| b == b',').all(|n| {
-                !n.is_empty()
-                    && n.strip_prefix(b"-")
-                        .unwrap_or(n)
-                        .iter()
-                        .all(u8::is_ascii_digit)
-            });
-            numbers.then_some(key)
-        });
-        match masked {
-            Some(key) => {
-                out.extend(key.as_bytes());
-                out.push(b'*');
-            }
-            None => out.extend(word),
-        }
-    }
-    out
+    };
+    let words: Vec<String> = text.split(' ').map(mask_word).collect();
+    words.join(" ").into_bytes()
 }
 
 /// What a port `sent` against `want`: the transcript and problems.
@@ -234,15 +228,9 @@ fn compare(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>
 
 /// `bytes` with its line end dropped, the rest escaped.
 fn printable(bytes: &[u8]) -> String {
-    let line_end = |b: &u8| matches!(b, b'\r' | b'\n');
-    let end = bytes.len()
-        - bytes
-            .iter()
-            .rev()
-            .take(2)
-            .take_while(|b| line_end(b))
-            .count();
-    bytes[..end].escape_ascii().to_string()
+    let bytes = bytes.strip_suffix(b"\n").unwrap_or(bytes);
+    let bytes = bytes.strip_suffix(b"\r").unwrap_or(bytes);
+    bytes.escape_ascii().to_string()
 }
 
 #[cfg(test)]

@@ -10,6 +10,7 @@ use idle_head_core::console::checksum;
 use super::Boot;
 use super::{
     dmx,
+    exchange::machine,
     node::{LineStream, StreamLine, UartScript},
     run::Report,
     stages::{WALL, checked_run},
@@ -157,17 +158,15 @@ const FLOOD_LINES: usize = 100;
 /// 100 `status` lines back to back at 3 s (0.7 ms a line, 9.5 a reply),
 /// as many in machine mode at 5 s, one more at 7 s.
 pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
-    let machine = |n: usize| {
-        let body = format!("#{n} status");
-        format!("{body} *{:02x}\r\n", checksum(body.as_bytes())).into_bytes()
-    };
     let time = Duration::from_millis(7_500);
     let (_, report) = checked_run(root, metadata, time, WALL, |config| {
         config.uart = vec![
             UartScript::new(0, b"status\r\n".repeat(FLOOD_LINES), Duration::from_secs(3)),
             UartScript::new(
                 0,
-                (1..=FLOOD_LINES).flat_map(machine).collect::<Vec<u8>>(),
+                (1..=FLOOD_LINES)
+                    .flat_map(|n| machine(&format!("#{n} status")))
+                    .collect::<Vec<u8>>(),
                 Duration::from_secs(5),
             ),
             UartScript::new(0, b"status\r\n", Duration::from_secs(7)),
