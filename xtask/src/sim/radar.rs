@@ -17,7 +17,7 @@ use super::run::{self, Boot, Report};
 use super::script::{self, Board, line};
 use super::{WALL, dmx, planted, stages::shipped_image, stream};
 use crate::bench::tracking::{self, Walk};
-use crate::log::field;
+use crate::log::number;
 use crate::project::{self, Metadata};
 use crate::trace::{Event, Kind};
 
@@ -164,12 +164,9 @@ pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     // (The pulses are not the idle's: the radar turns the head. What is
     // checked is that no frame was late: the log says so.)
     let boot = report.first()?;
-    let replies = boot.uart_replies();
-    let reply = |start: &str| replies.iter().find(|r| r.starts_with(start)).cloned();
-    let dmx_reply = reply("ok dmx=").unwrap_or_default();
-    let (summary, mut problems) = stream::check_dmx(boot, &dmx_reply, changes.len());
+    let (summary, mut problems) = stream::check_dmx(boot, &boot.reply("ok dmx="), changes.len());
     print!("{summary}");
-    let radar_reply = reply("ok radar=").unwrap_or_default();
+    let radar_reply = boot.reply("ok radar=");
     println!("radar: {} frames sent; `{radar_reply}`", boot.radar_frames);
     problems.extend(counted(boot, &radar_reply));
     problems.extend(report.problems.iter().cloned());
@@ -199,7 +196,7 @@ fn with_radar(
 
 /// The problem if `reply` missed a frame `boot` sent, or counted one bad.
 fn counted(boot: &Boot, reply: &str) -> Option<String> {
-    let counter = |name| field(reply, name).and_then(|v| v.parse::<u64>().ok());
+    let counter = |name| number(reply, name).ok();
     (counter("frames") != Some(boot.radar_frames) || counter("bad") != Some(0))
         .then(|| format!("radar: `{reply}` for {} frames sent", boot.radar_frames))
 }
@@ -227,11 +224,7 @@ fn erase(root: &Path, elf: &Path) -> Result<Vec<String>> {
     })?;
     let boot = report.first()?;
     let erased: f64 = boot.flash.iter().filter(|op| op.0).map(|op| op.2).sum();
-    let reply = boot
-        .uart_replies()
-        .into_iter()
-        .find(|r| r.starts_with("ok radar="))
-        .unwrap_or_default();
+    let reply = boot.reply("ok radar=");
     println!(
         "save: {:.0} ms of sector erases with the interrupts off; radar: {} frames sent; `{reply}`",
         erased / 1e6,

@@ -73,6 +73,12 @@ impl Boot {
         self.replies(false)
     }
 
+    /// The first reply line on UART0 starting with `start` (none: empty).
+    pub fn reply(&self, start: &str) -> String {
+        let mut replies = self.uart_replies().into_iter();
+        replies.find(|r| r.starts_with(start)).unwrap_or_default()
+    }
+
     /// Whether a line of the log contains `text`.
     pub fn says(&self, text: &str) -> bool {
         self.log.iter().any(|(_, line)| line.message.contains(text))

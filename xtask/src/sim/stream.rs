@@ -15,7 +15,7 @@ use super::{
     run::Report,
     stages::{WALL, checked_run},
 };
-use crate::{log::field, project::Metadata};
+use crate::{log::number, project::Metadata};
 
 /// Stage names.
 pub const UART_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: a line every 2 ms on \
@@ -246,7 +246,7 @@ pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
 /// The `dmx` counters of `reply` against the frames `boot` sent (`changes`
 /// of them changes): every one good, no frame late. A summary, problems.
 pub(super) fn check_dmx(boot: &Boot, reply: &str, changes: usize) -> (String, Vec<String>) {
-    let counter = |name| field(reply, name).and_then(|v| v.parse::<u64>().ok());
+    let counter = |name| number(reply, name).ok();
     let mut problems: Vec<String> = ["short", "long", "start_code", "garbled"]
         .into_iter()
         .filter(|name| counter(name) != Some(0))
