@@ -53,8 +53,8 @@ pub fn configure(config: &mut Config) {
     config.usb = vec![Chunk::new(lines.concat(), USB_START)];
 }
 
-/// Boot 0's exchange against the host's replies, into `report`: the
-/// transcript, and problems: a wrong or missing reply, a UART overrun, a
+/// Boot 0's exchange against the host's replies: prints the transcript;
+/// into `report`, problems: a wrong or missing reply, a UART overrun, a
 /// USB device not configured, a `center` the frame task did not log.
 pub fn check(report: &mut Report) {
     let Some(boot) = report.boots.first() else {
@@ -65,14 +65,12 @@ pub fn check(report: &mut Report) {
     let (transcript, problems) = compare(&script, &uart_want, &boot.uart);
     let (len, out) = (script.len(), boot.uart.len());
     let start = START.as_secs_f64();
-    let mut text = format!(
+    print!(
         "UART0 exchange ({len} bytes in from {start:.1} s at 115200 baud, {out} bytes out):\n{transcript}"
     );
     let mut found: Vec<String> = problems.into_iter().map(|p| format!("UART: {p}")).collect();
     match boot.uart_lines.last() {
-        Some(ns) => {
-            let _ = writeln!(text, "  (last byte in at {:.4} s)", ns / 1e9);
-        }
+        Some(ns) => println!("  (last byte in at {:.4} s)", ns / 1e9),
         None => found.push("the harness did not send the whole UART script".to_owned()),
     }
     if boot.uart_overruns > 0 {
@@ -85,8 +83,7 @@ pub fn check(report: &mut Report) {
     match boot.usb_connected {
         Some(ns) => {
             let (at, start, out) = (ns / 1e9, USB_START.as_secs_f64(), boot.usb.len());
-            let _ = write!(
-                text,
+            print!(
                 "USB CDC-ACM exchange (enumerated and configured at {at:.4} s; {len} bytes in at {start:.1} s, {out} bytes out):\n{usb}"
             );
             found.extend(usb_problems.into_iter().map(|p| format!("USB: {p}")));
@@ -97,7 +94,6 @@ pub fn check(report: &mut Report) {
         found.push("the frame task did not log the UART's `center` as applied (`frame <n>: center: ok ...`)".to_owned());
     }
     report.problems.extend(found);
-    report.exchange = Some(text);
 }
 
 /// The script's lines, each with its line end.

@@ -95,8 +95,6 @@ pub struct Report {
     pub unmodelled: Vec<Unmodelled>,
     /// What is wrong with the run (it stopped early, a frame is missing...).
     pub problems: Vec<String>,
-    /// The console exchange's transcript, if any.
-    pub exchange: Option<String>,
     /// The servos' rate the pulses were checked at.
     pub rate: ServoRate,
 }

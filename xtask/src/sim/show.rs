@@ -2,7 +2,7 @@
 //! Bottango drive the head, lost frames and a curve's end hand it back to
 //! the idle (docs/dev/emulators.md, "Show control").
 
-use std::{fmt::Write as _, path::Path, time::Duration};
+use std::{path::Path, time::Duration};
 
 use anyhow::Result;
 use idle_head_core::bottango::hash;
@@ -115,8 +115,7 @@ pub fn show(root: &Path, metadata: &Metadata, pulses: Option<&Path>) -> Result<(
     print!("{}", report.log_text(false));
     let boot = report.first()?;
     print_pulses(boot, pulses)?;
-    let (text, mut problems) = check(boot, &lines)?;
-    print!("{text}");
+    let mut problems = check(boot, &lines)?;
     problems.extend(report.problems.iter().cloned());
     problems.extend(stages::console_ram(&elf, &report)?);
     let boots = report.boots.len();
@@ -180,14 +179,14 @@ impl Pulses {
     }
 }
 
-/// The acceptance checks on boot 0: what they found, and the problems.
+/// The acceptance checks on boot 0: prints what they found; the problems.
 #[allow(clippy::too_many_lines)] // one check after another, in the order of the module docs
-fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
+fn check(boot: &Boot, lines: &[String]) -> Result<Vec<String>> {
     let servos = boot.trains.each_ref().map(pulses::measure);
     let frames = servos.iter().map(Vec::len).max().unwrap_or(0);
     let idle = expect::pico_duties(frames)?;
     let p = Pulses { servos, idle };
-    let (mut text, mut problems) = (String::new(), Vec::new());
+    let mut problems = Vec::new();
     let (yaw, pitch) = (2, 0);
     // The gesture limit, 250 °/s, in m° a frame, and a count of rounding.
     let step = 250.0 * 20.0 + 0.5 * 11.1;
@@ -200,8 +199,7 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
     let worst = held.iter().map(|w| (w.2 - want).abs()).fold(0.0, f64::max);
     let fastest = p.fastest(yaw, 3.4, 5.0);
     let at = held.last().map_or(f64::NAN, |w| w.2);
-    let _ = writeln!(
-        text,
+    println!(
         "dmx mix 255, yaw coarse 200: yaw at {:.3}° ({:.4} of its way, 200/255 = {:.4}), at most \
          {:.3}° off over {} pulses; fastest step {:.2}° a frame (limit {:.2}°)",
         at / 1e3,
@@ -229,10 +227,7 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
         .filter(|(_, l)| l.message.contains("dmx: signal lost"))
         .map(|(ns, _)| ns / 1e9)
         .collect();
-    let _ = writeln!(
-        text,
-        "dmx signal lost at {lost:.3?} s (frames dropped at 5.0 s and 9.0 s)"
-    );
+    println!("dmx signal lost at {lost:.3?} s (frames dropped at 5.0 s and 9.0 s)");
     problem_if!(
         problems,
         !lost.first().is_some_and(|&t| (5.95..6.2).contains(&t)),
@@ -244,8 +239,7 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
         .map(|(name, fastest)| format!("{name} {:.3}°", fastest / 1e3))
         .collect();
     let after_loss = p.off_idle(6.8, 7.0);
-    let _ = writeln!(
-        text,
+    println!(
         "hand-back: jumps past the limit: {jumps:?}; pulses off the idle's from 6.8 s to 7.0 s: {}",
         after_loss.len()
     );
@@ -267,8 +261,7 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
         .count();
     let during = p.off_idle(7.5, 8.5).len();
     let after = p.off_idle(9.3, 10.5);
-    let _ = writeln!(
-        text,
+    println!(
         "dmx trigger 20 (nod band) at 7.5 s: {nods} nod(s) logged, {during} pulses off the idle's \
          during it, {} after it (9.3 s to 10.5 s)",
         after.len()
@@ -300,8 +293,7 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
         .find(|w| w.2 >= 10_000.0)
         .map_or(f64::NAN, |w| w.1 - sent);
     let back = p.off_idle(sent + 1.9, STOP.as_secs_f64() + 1.3);
-    let _ = writeln!(
-        text,
+    println!(
         "Bottango (USB from {sent:.3} s): handshake {handshake}, {oks} OK for {} lines; yaw past \
          10° {crossing:.3} s after the lines, top {:.3}°; pulses off the idle's after the \
          hand-back: {}",
@@ -331,5 +323,5 @@ fn check(boot: &Boot, lines: &[String]) -> Result<(String, Vec<String>)> {
     if let Some(first) = back.first() {
         problems.push(format!("the idle did not resume after the curve: {first}"));
     }
-    Ok((text, problems))
+    Ok(problems)
 }

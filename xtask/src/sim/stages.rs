@@ -205,13 +205,9 @@ pub fn test_console(
     wall: Duration,
 ) -> Result<()> {
     let (elf, mut report) = checked_run(root, metadata, virtual_time, wall, exchange::configure)?;
-    exchange::check(&mut report);
     print!("{}", report.log_text(false));
-    print!(
-        "{}{}",
-        report.exchange.as_deref().unwrap_or_default(),
-        report.table()
-    );
+    exchange::check(&mut report);
+    print!("{}", report.table());
     report.conclude(console_ram(&elf, &report)?)
 }
 

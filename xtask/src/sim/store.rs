@@ -3,7 +3,7 @@
 //! next boot on the saved settings; lines sent during the erase answered
 //! after it, the servos going on without a jump (docs/dev/emulators.md).
 
-use std::{fmt::Write as _, path::Path, time::Duration};
+use std::{path::Path, time::Duration};
 
 use anyhow::Result;
 
@@ -112,8 +112,7 @@ pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
             ];
         })?;
         print!("{}", report.log_text(false));
-        let (text, found) = check(&report, logged, neutral);
-        print!("{text}");
+        let found = check(&report, logged, neutral);
         let found = found.into_iter().chain(report.problems.iter().cloned());
         let found = found.chain(console_ram(&elf, &report)?);
         problems.extend(found.map(|p| format!("from {what}: {p}")));
@@ -121,15 +120,15 @@ pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
     project::verdict(&problems)
 }
 
-/// The module docs' checks for a start: a transcript and the problems.
-fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String, Vec<String>) {
-    let (mut text, mut problems) = (String::new(), Vec::new());
+/// The module docs' checks for a start: prints a transcript; the problems.
+fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> Vec<String> {
+    let mut problems = Vec::new();
     let [first, second] = report.boots.as_slice() else {
         let n = report.boots.len();
         problems.push(format!(
             "{n} boots instead of two (power-on, then the power cycle)"
         ));
-        return (text, problems);
+        return problems;
     };
     problem_if!(
         problems,
@@ -142,14 +141,14 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
             boot.watchdog,
             "boot {b}: the watchdog reset the board"
         );
-        let _ = writeln!(text, "boot {b}, UART0:");
+        println!("boot {b}, UART0:");
         let replies = boot.uart_replies();
         // Boot 0: the replies to the lines sent during the save, last.
         let during = if b == 0 { DURING_SAVE_LINES } else { 0 };
         let (count, pitch) = (REPLIES[b].len() + during, ("ok pitch neutral=1520 ", ""));
         let want = |i: usize| REPLIES[b].get(i).copied().or((i < count).then_some(pitch));
         for (i, line) in replies.iter().enumerate() {
-            let _ = writeln!(text, "  < {line}");
+            println!("  < {line}");
             match want(i) {
                 Some((start, part)) if line.starts_with(start) && line.contains(part) => {}
                 Some((start, part)) => problems.push(format!(
@@ -177,10 +176,7 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
         let ops = first.flash.iter().filter(|op| op.0 == erase);
         let (n, bytes, ns) = ops.fold((0, 0, 0.0), |(n, b, t), op| (n + 1, b + op.1, t + op.2));
         let ms = ns / 1e6;
-        let _ = writeln!(
-            text,
-            "boot 0, flash: {n} {what} ({bytes} B, busy {ms:.0} ms)"
-        );
+        println!("boot 0, flash: {n} {what} ({bytes} B, busy {ms:.0} ms)");
     }
     let programmed = first.flash.iter().any(|op| !op.0);
     problem_if!(
@@ -194,10 +190,8 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
         .map(|w| w[1].0 - w[0].0)
         .fold(0.0, f64::max)
         / 1e6;
-    let _ = writeln!(text, "boot 0: longest gap between frames {gap:.0} ms");
-    let (steps, over) = steps_around_the_save(first);
-    text.push_str(&steps);
-    problems.extend(over);
+    println!("boot 0: longest gap between frames {gap:.0} ms");
+    problems.extend(steps_around_the_save(first));
     let loaded = second.says("settings: loaded from flash");
     problem_if!(
         problems,
@@ -218,25 +212,25 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> (String
         let rise = edges.iter().position(|&(_, high)| high)?;
         Some(((edges.get(rise + 1)?.0 - edges[rise].0) / 1e3).round() as u32)
     });
-    let _ = writeln!(text, "boot 1: first pulses {first_us:?} us");
+    println!("boot 1: first pulses {first_us:?} us");
     problem_if!(
         problems,
         first_us != saved.map(Some),
         "boot 1's first pulses are {first_us:?} us, not {saved:?} (the saved neutral pulses)"
     );
-    (text, problems)
+    problems
 }
 
 /// Each axis' largest step and change of step around the save, within the
-/// idle speed and acceleration (and rounding); a summary and problems.
-fn steps_around_the_save(boot: &Boot) -> (String, Vec<String>) {
+/// idle speed and acceleration (and rounding): prints them; the problems.
+fn steps_around_the_save(boot: &Boot) -> Vec<String> {
     let config = idle_head_core::driver::DriverConfig::DEFAULT;
     let frame_s = f64::from(config.frame_period.0) / 1e6;
     let (from, to) = (
         SCRIPT_AT[0].as_secs_f64() - 0.5,
         POWER_CYCLE.as_secs_f64() - 0.2,
     );
-    let (mut text, mut problems) = (String::new(), Vec::new());
+    let mut problems = Vec::new();
     for (axis, train) in boot.trains.iter().enumerate() {
         let limits = config.motion[axis];
         // Each pulse is the angle rounded to a count, and the pulse map's
@@ -257,8 +251,7 @@ fn steps_around_the_save(boot: &Boot) -> (String, Vec<String>) {
         let sharpest = (steps.windows(2))
             .filter(|w| w[1] != 0.0)
             .fold(0.0_f64, |m, w| m.max((w[1] - w[0]).abs()));
-        let _ = writeln!(
-            text,
+        println!(
             "boot 0, axis {axis} around the save: steps up to {fastest:.0} m° a frame (limit \
              {speed:.0}), their change up to {sharpest:.0} m° (limit {accel:.0})"
         );
@@ -269,7 +262,7 @@ fn steps_around_the_save(boot: &Boot) -> (String, Vec<String>) {
             ));
         }
     }
-    (text, problems)
+    problems
 }
 
 #[cfg(test)]
@@ -330,7 +323,7 @@ mod tests {
 
     #[test]
     fn a_good_run_passes_and_each_failure_is_named() {
-        let (_, problems) = check(&good(), LOGGED, NEUTRAL);
+        let problems = check(&good(), LOGGED, NEUTRAL);
         assert!(problems.is_empty(), "{problems:?}");
         let failing: [(&str, Breaker); 8] = [
             ("the watchdog reset the board", |r| {
@@ -369,20 +362,20 @@ mod tests {
         for (want, break_it) in failing {
             let mut report = good();
             break_it(&mut report);
-            let (_, problems) = check(&report, LOGGED, NEUTRAL);
+            let problems = check(&report, LOGGED, NEUTRAL);
             assert!(
                 problems.iter().any(|p| p.contains(want)),
                 "`{want}` not among {problems:?}"
             );
         }
-        let (_, problems) = check(&good(), &[("WARN", "holds settings of version 0")], NEUTRAL);
+        let problems = check(&good(), &[("WARN", "holds settings of version 0")], NEUTRAL);
         assert!(
             problems
                 .iter()
                 .any(|p| p.contains("did not log `WARN holds settings"))
         );
         // Another start's neutral pulses: both boots are checked against them.
-        let problems = check(&good(), LOGGED, [1520, 1480, 1510]).1.join("\n");
+        let problems = check(&good(), LOGGED, [1520, 1480, 1510]).join("\n");
         assert!(problems.contains("boot 0 did not log `first frame: neutral pulses 1520 1480"));
         assert!(
             problems.contains("boot 1's first pulses are [Some(1520), Some(1500), Some(1500)]")
@@ -412,13 +405,13 @@ mod tests {
             trains: [train(&smooth), train(&smooth), train(&smooth)],
             ..Boot::default()
         };
-        assert_eq!(steps_around_the_save(&boot).1, Vec::<String>::new());
+        assert_eq!(steps_around_the_save(&boot), Vec::<String>::new());
         // A step of 1.5° out of a standstill: a jump.
         let jump: Vec<f64> = (smooth.iter().enumerate())
             .map(|(k, w)| if k < 25 { *w } else { w + per_mdeg * 1500.0 })
             .collect();
         boot.trains[2] = train(&jump);
-        let problems = steps_around_the_save(&boot).1;
+        let problems = steps_around_the_save(&boot);
         assert_eq!(problems.len(), 1, "{problems:?}");
         assert!(problems[0].starts_with("axis 2 jumped around the save"));
     }
