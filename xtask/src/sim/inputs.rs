@@ -35,7 +35,7 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     print!("{}", report.table());
     let boot = report.first()?;
     let timing = run::timing();
-    let period = f64::from(timing.period_counts) * timing.count_ns;
+    let period = timing.period_ns();
     let pulses: [&Vec<Pulse>; 3] = [0, 1, 2].map(|i| &boot.servos[i].pulses);
     // The angle of a pulse on axis `i`, and a count of the servo clock
     // there (the rounding of a measured pulse), m°.

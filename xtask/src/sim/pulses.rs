@@ -23,7 +23,7 @@ pub struct Timing {
 }
 
 impl Timing {
-    fn period_ns(&self) -> f64 {
+    pub fn period_ns(&self) -> f64 {
         f64::from(self.period_counts) * self.count_ns
     }
 }

@@ -19,7 +19,7 @@ pub fn write(path: &Path, trains: &[Train; 3], timing: &Timing) -> Result<usize>
 /// The CSV's text.
 #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // periods and counts, far below 2^52
 fn rows(trains: &[Train; 3], timing: &Timing) -> String {
-    let period = f64::from(timing.period_counts) * timing.count_ns;
+    let period = timing.period_ns();
     let measured = trains.each_ref().map(pulses::measure);
     let starts = measured
         .iter()
@@ -78,11 +78,7 @@ mod tests {
 
     #[test]
     fn a_row_per_period_a_period_apart_at_any_rate_and_0_where_there_was_no_pulse() {
-        let timing = Timing {
-            count_ns: 312.5,
-            period_counts: 64_000,
-            frame_ns: 20e6,
-        };
+        let timing = crate::sim::run::timing();
         let neutral: &[(u32, u32)] = &[(0, 4800), (1, 4800), (3, 4800)];
         let trains = make(
             [&[(0, 4800), (1, 4801), (3, 4803)], neutral, neutral],
