@@ -179,15 +179,13 @@ pub struct FlashTiming {
     pub program: Duration,
 }
 
-/// Bytes on UART0's RX line in boot `boot` from `start` on, one every
+/// Bytes on UART0's RX line in boot `boot` from their time on, one every
 /// `byte_time`; those at the indices in `errors` with a framing error.
 #[derive(Debug, Clone, Serialize)]
 pub struct UartScript {
     pub boot: usize,
-    #[serde(rename = "hex", serialize_with = "hex")]
-    pub bytes: Vec<u8>,
-    #[serde(rename = "at_ns", serialize_with = "ns")]
-    pub start: Duration,
+    #[serde(flatten)]
+    pub bytes: Chunk,
     #[serde(rename = "byte_ns", serialize_with = "ns")]
     pub byte_time: Duration,
     pub errors: Vec<usize>,
@@ -196,11 +194,11 @@ pub struct UartScript {
 impl UartScript {
     /// At 115200 baud, undamaged.
     pub fn new(boot: usize, bytes: impl Into<Vec<u8>>, start: Duration) -> Self {
-        let (bytes, byte_time, errors) = (bytes.into(), BYTE_TIME, Vec::new());
+        let (bytes, byte_time) = (Chunk::new(bytes, start), BYTE_TIME);
+        let errors = Vec::new();
         Self {
             boot,
             bytes,
-            start,
             byte_time,
             errors,
         }
