@@ -18,6 +18,7 @@ use super::{
     stages,
 };
 use crate::project::{self, Metadata};
+use crate::steps::Steps;
 
 /// Stage name.
 pub const SHOW_STAGE: &str = "Pico image in the RP2040 emulator: DMX and Bottango drive the \
@@ -133,11 +134,11 @@ struct Pulses {
 
 impl Pulses {
     /// `axis`' pulses rising within `[from, to)` s: their index, time (s)
-    /// and angle (m°).
+    /// and angle (°).
     fn window(&self, axis: usize, from: f64, to: f64) -> Vec<(usize, f64, f64)> {
         (self.servos[axis].iter().enumerate())
             .filter(|(_, p)| (from * 1e9..to * 1e9).contains(&p.rise))
-            .map(|(n, p)| (n, p.rise / 1e9, angle(axis, p.width)))
+            .map(|(n, p)| (n, p.rise / 1e9, angle(axis, p.width) / 1e3))
             .collect()
     }
 
@@ -161,16 +162,13 @@ impl Pulses {
     }
 
     /// The largest change of `axis`' angle from one pulse to the next within
-    /// `[from, to)` s, m°.
+    /// `[from, to)` s, °.
     fn fastest(&self, axis: usize, from: f64, to: f64) -> f64 {
-        let window = self.window(axis, from, to);
-        window
-            .windows(2)
-            .map(|w| (w[1].2 - w[0].2).abs())
-            .fold(0.0, f64::max)
+        let angles: Vec<f64> = self.window(axis, from, to).iter().map(|w| w.2).collect();
+        Steps::of(&angles).step
     }
 
-    /// The highest angle of `axis` within `[from, to)` s, m°.
+    /// The highest angle of `axis` within `[from, to)` s, °.
     fn top(&self, axis: usize, from: f64, to: f64) -> f64 {
         self.window(axis, from, to)
             .iter()
@@ -188,38 +186,33 @@ fn check(boot: &Boot, lines: &[String]) -> Result<Vec<String>> {
     let p = Pulses { servos, idle };
     let mut problems = Vec::new();
     let (yaw, pitch) = (2, 0);
-    // The gesture limit, 250 °/s, in m° a frame, and a count of rounding.
-    let step = 250.0 * 20.0 + 0.5 * 11.1;
+    // The gesture limit, 250 °/s, in ° a frame, and a count of rounding.
+    let step = 250.0 * 0.02 + 0.5 * 0.0111;
 
     // 1. Mix 255, yaw coarse 200.
     let limits = DriverConfig::DEFAULT.servos[yaw].limits;
-    let [lo, hi] = [limits.min, limits.max].map(|a| f64::from(a.millidegrees()));
+    let [lo, hi] = [limits.min, limits.max].map(|a| f64::from(a.millidegrees()) / 1e3);
     let want = lo + (hi - lo) * 51_200.0 / 65_535.0;
     let held = p.window(yaw, 4.3, 5.0);
     let worst = held.iter().map(|w| (w.2 - want).abs()).fold(0.0, f64::max);
     let fastest = p.fastest(yaw, 3.4, 5.0);
     let at = held.last().map_or(f64::NAN, |w| w.2);
     println!(
-        "dmx mix 255, yaw coarse 200: yaw at {:.3}° ({:.4} of its way, 200/255 = {:.4}), at most \
-         {:.3}° off over {} pulses; fastest step {:.2}° a frame (limit {:.2}°)",
-        at / 1e3,
+        "dmx mix 255, yaw coarse 200: yaw at {at:.3}° ({:.4} of its way, 200/255 = {:.4}), at \
+         most {worst:.3}° off over {} pulses; fastest step {fastest:.2}° a frame (limit {step:.2}°)",
         (at - lo) / (hi - lo),
         200.0 / 255.0,
-        worst / 1e3,
         held.len(),
-        fastest / 1e3,
-        step / 1e3
     );
-    let (want_deg, worst_deg, fastest_deg) = (want / 1e3, worst / 1e3, fastest / 1e3);
     problem_if!(
         problems,
-        held.len() < 30 || worst > 100.0,
-        "yaw did not hold {want_deg:.3}° under DMX (off by {worst_deg:.3}°)"
+        held.len() < 30 || worst > 0.1,
+        "yaw did not hold {want:.3}° under DMX (off by {worst:.3}°)"
     );
     problem_if!(
         problems,
         fastest > step,
-        "a yaw step of {fastest_deg:.3}° a frame: past the speed limit"
+        "a yaw step of {fastest:.3}° a frame: past the speed limit"
     );
 
     // 2. The frames dropped at 5 s: lost at 6 s, and the idle's own pulses.
@@ -236,7 +229,7 @@ fn check(boot: &Boot, lines: &[String]) -> Result<Vec<String>> {
     let jumps: Vec<String> = (0..3)
         .map(|axis| (SERVOS[axis].0, p.fastest(axis, 5.0, 7.0)))
         .filter(|&(_, fastest)| fastest > step)
-        .map(|(name, fastest)| format!("{name} {:.3}°", fastest / 1e3))
+        .map(|(name, fastest)| format!("{name} {fastest:.3}°"))
         .collect();
     let after_loss = p.off_idle(6.8, 7.0);
     println!(
@@ -290,15 +283,14 @@ fn check(boot: &Boot, lines: &[String]) -> Result<Vec<String>> {
     let top = p.top(yaw, sent, sent + 2.0);
     let crossing = curve
         .iter()
-        .find(|w| w.2 >= 10_000.0)
+        .find(|w| w.2 >= 10.0)
         .map_or(f64::NAN, |w| w.1 - sent);
     let back = p.off_idle(sent + 1.9, STOP.as_secs_f64() + 1.3);
     println!(
         "Bottango (USB from {sent:.3} s): handshake {handshake}, {oks} OK for {} lines; yaw past \
-         10° {crossing:.3} s after the lines, top {:.3}°; pulses off the idle's after the \
+         10° {crossing:.3} s after the lines, top {top:.3}°; pulses off the idle's after the \
          hand-back: {}",
         lines.len() + 1,
-        top / 1e3,
         back.len()
     );
     problem_if!(
@@ -311,13 +303,12 @@ fn check(boot: &Boot, lines: &[String]) -> Result<Vec<String>> {
         !(0.64..0.78).contains(&crossing),
         "yaw crossed 10° {crossing:.3} s after the curve was sent, not about 0.7 s"
     );
-    for (axis, want) in [(yaw, 20_000.0), (pitch, 5_000.0)] {
-        let top = p.top(axis, sent, sent + 2.0);
-        let (name, top_deg, want_deg) = (SERVOS[axis].0, top / 1e3, want / 1e3);
+    for (axis, want) in [(yaw, 20.0), (pitch, 5.0)] {
+        let (name, top) = (SERVOS[axis].0, p.top(axis, sent, sent + 2.0));
         problem_if!(
             problems,
-            (top - want).abs() > 150.0,
-            "{name} topped at {top_deg:.3}°, not the curve's {want_deg}°"
+            (top - want).abs() > 0.15,
+            "{name} topped at {top:.3}°, not the curve's {want}°"
         );
     }
     if let Some(first) = back.first() {
