@@ -16,11 +16,6 @@ pub const VECTOR_TABLE: u64 = XIP.start + 0x100;
 /// The servos on the Pico (`crates/rp/src/pico.rs`): name, GPIO, slice.
 pub const SERVOS: [(&str, u8, u8); 3] = [("pitch", 16, 0), ("roll", 18, 1), ("yaw", 20, 2)];
 
-/// The trigger inputs' GPIOs, as wired on the Pico: GP2 to GP5.
-pub fn input_pins() -> Vec<u8> {
-    crate::board::PICO_INPUTS.to_vec()
-}
-
 /// The parts of a Pico ELF the emulator run uses.
 #[derive(Debug)]
 pub struct PicoImage {

@@ -20,7 +20,7 @@ pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
     let (_, config) = image::config(elf, "live.uf2")?;
     node::ensure(root)?;
     let wall = Duration::from_secs(24 * 3600);
-    let (rom, inputs) = (Some(WORST), image::input_pins());
+    let (rom, inputs) = (Some(WORST), crate::board::PICO_INPUTS.to_vec());
     Ok(node::Config {
         wall,
         rom,

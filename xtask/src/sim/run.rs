@@ -281,11 +281,7 @@ pub fn check_at(report: &mut Report, expected: &[[u16; 3]], rate: ServoRate) {
 
 /// The Pico's slice clock at `rate` (`pwm_clock` checks every rate's).
 fn clock(rate: ServoRate) -> SliceClock {
-    let none = SliceClock {
-        divider_16ths: 0,
-        top: 0,
-    };
-    SliceClock::for_period(PICO_SYS_HZ, rate.period()).unwrap_or(none)
+    SliceClock::for_period(PICO_SYS_HZ, rate.period()).expect("a slice clock for every rate")
 }
 
 /// The PWM timing of the Pico's servo slices at 50 Hz, or at `rate`.

@@ -12,7 +12,7 @@ use idle_head_core::seed::BoardId;
 use idle_head_core::servo::ServoRate;
 use idle_head_core::settings::Settings;
 
-use super::image::{SERVOS, input_pins};
+use super::image::SERVOS;
 use super::node::{Chunk, PinLevel, PinScript, nanos};
 use super::run::{self, Report};
 use super::{planted, pulses_csv};
@@ -121,7 +121,7 @@ pub fn play(
     // The boot before the first frame: well under a tenth of a second.
     let boot = Duration::from_millis(100);
     let mut report = run::run_with(root, &PICO.elf(metadata), time + boot, wall, |config| {
-        config.inputs = input_pins();
+        config.inputs = crate::board::PICO_INPUTS.to_vec();
         config.script = Some(script);
         config.flash_fill = planted;
         config.radar = radar;
