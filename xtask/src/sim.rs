@@ -226,7 +226,8 @@ pub fn command(args: &Args) -> Result<bool> {
         } else {
             let time = time.unwrap_or(DEFAULT_TIME);
             let (_, report) = stages::checked_run(root, md, time, args.timeout, |_| {})?;
-            report.print(args.verbose);
+            print!("{}{}", report.log_text(args.verbose), report.table());
+            println!("{}\n{}", report.verdict(), report.summary());
             return Ok(report.problems.is_empty());
         }
     };
@@ -266,12 +267,6 @@ impl Report {
     fn logged_stack(&self) -> Option<u64> {
         let logged = |boot: &Boot| logged_peak_stack(boot.log.iter().map(|(_, line)| line));
         self.boots.iter().filter_map(logged).max()
-    }
-
-    /// Prints the log, the table, the verdict and the summary line.
-    pub fn print(&self, verbose: bool) {
-        print!("{}{}", self.log_text(verbose), self.table());
-        println!("{}\n{}", self.verdict(), self.summary());
     }
 
     /// Prints the verdict and summary; fails with the run's problems and
