@@ -10,9 +10,8 @@ use std::{
 
 use super::node::Fill;
 use anyhow::{Context as _, Result, bail};
-use embedded_storage_async::nor_flash::{
-    ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash,
-};
+use embedded_storage_async::nor_flash::NorFlashErrorKind::{self, OutOfBounds};
+use embedded_storage_async::nor_flash::{ErrorType, NorFlash, ReadNorFlash};
 use idle_head_core::settings::{RawRecord, Record, SETTINGS_BUFFER, Settings, SettingsStore};
 
 /// The Pico's flash: erase sector and write unit.
@@ -70,21 +69,12 @@ fn ready<F: Future>(future: F) -> Option<F::Output> {
 /// NOR flash in RAM: erased bytes read `0xff`, a write clears bits.
 struct RamFlash(Vec<u8>);
 
-#[derive(Debug)]
-struct OutOfBounds;
-
-impl NorFlashError for OutOfBounds {
-    fn kind(&self) -> NorFlashErrorKind {
-        NorFlashErrorKind::OutOfBounds
-    }
-}
-
 impl ErrorType for RamFlash {
-    type Error = OutOfBounds;
+    type Error = NorFlashErrorKind;
 }
 
 impl RamFlash {
-    fn span(&mut self, offset: u32, len: usize) -> Result<&mut [u8], OutOfBounds> {
+    fn span(&mut self, offset: u32, len: usize) -> Result<&mut [u8], NorFlashErrorKind> {
         let start = usize::try_from(offset).map_err(|_| OutOfBounds)?;
         self.0.get_mut(start..start + len).ok_or(OutOfBounds)
     }
