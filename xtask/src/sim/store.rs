@@ -10,7 +10,7 @@ use anyhow::Result;
 use super::{
     node::{Fill, FlashTiming, UartScript},
     planted,
-    pulses::{angle, measure},
+    pulses::{angle, measure, spans},
     run::{self, Boot, Report},
     stages::{WALL, console_ram, shipped_image},
 };
@@ -207,10 +207,10 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> Vec<Str
     );
     // The width of each servo's first pulse, whole µs.
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // a pulse: µs
-    let first_us = second.trains.each_ref().map(|train| {
-        let edges = &train.edges;
-        let rise = edges.iter().position(|&(_, high)| high)?;
-        Some(((edges.get(rise + 1)?.0 - edges[rise].0) / 1e3).round() as u32)
+    let first_us = (second.trains.each_ref()).map(|train| {
+        spans(train, 0.0)
+            .first()
+            .map(|p| (p.width / 1e3).round() as u32)
     });
     println!("boot 1: first pulses {first_us:?} us");
     problem_if!(
