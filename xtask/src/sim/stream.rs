@@ -174,7 +174,7 @@ pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
     })?;
     print!("{}", report.table());
     let lines = 2 * FLOOD_LINES + 1;
-    let (replies, problems) = replies(&report, false, lines, |k| match k {
+    let (replies, mut problems) = replies(&report, false, lines, |k| match k {
         k if (FLOOD_LINES..2 * FLOOD_LINES).contains(&k) => {
             Want::Machine(k + 1 - FLOOD_LINES, "ok mode=")
         }
@@ -186,7 +186,6 @@ pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
     // writer that spun until the line drained cost 1M).
     let per_line = report.end.instructions / lines as u64;
     println!("UART flood: {per_line} instructions a line, the run's all");
-    let mut problems = problems;
     if per_line > 100_000 {
         problems.push(format!(
             "{per_line} instructions a line: the console spins while its replies wait"
