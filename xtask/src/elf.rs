@@ -99,11 +99,7 @@ impl Image {
             .collect();
         allocator_symbols.sort();
         allocator_symbols.dedup();
-        let symbol = |name: &str| {
-            file.symbols()
-                .find(|s| s.name() == Ok(name))
-                .map(|s| s.address())
-        };
+        let symbol = |name| file.symbol_by_name(name).map(|s| s.address());
         let settings = symbol("__settings_start")
             .zip(symbol("__settings_end"))
             .map(|(start, end)| start..end);
