@@ -180,12 +180,11 @@ pub const QEMU: Image = Image::qemu("qemu");
 impl Image {
     /// Bin `bin` of the QEMU package (`boards/qemu/`), built from the root.
     pub const fn qemu(bin: &'static str) -> Self {
-        let (dir, target, package) = (".", TARGET, Some("idle-head-qemu"));
         Self {
             bin,
-            dir,
-            target,
-            package,
+            dir: ".",
+            target: TARGET,
+            package: Some("idle-head-qemu"),
         }
     }
 
