@@ -78,15 +78,14 @@ pub struct Results {
 }
 
 impl Results {
-    /// Loops whose value `row` passes `past`.
-    fn count(&self, row: usize, past: impl Fn(f64) -> bool) -> usize {
-        self.loops.iter().filter(|m| past(m[row])).count()
+    /// Loops whose [`ROWS`]' values pass `past`.
+    fn count(&self, past: impl Fn(&[f64; 6]) -> bool) -> usize {
+        self.loops.iter().filter(|m| past(m)).count()
     }
 
     /// Loops past the continuity limit on either ratio.
     fn discontinuous(&self) -> usize {
-        let past = |m: &&[f64; 6]| m[0] > CONTINUITY_LIMIT || m[1] > CONTINUITY_LIMIT;
-        self.loops.iter().filter(past).count()
+        self.count(|m| m[0] > CONTINUITY_LIMIT || m[1] > CONTINUITY_LIMIT)
     }
 }
 
@@ -189,14 +188,10 @@ pub fn command(args: &Args) -> Result<bool> {
              {}); outside [α1, α2]: {}; start ≠ 0: {}; rejected: {}",
             result.discontinuous(),
             args.seeds,
-            result.count(0, |v| v > CONTINUITY_LIMIT),
-            result.count(1, |v| v > CONTINUITY_LIMIT),
-            result
-                .loops
-                .iter()
-                .filter(|m| m[3] < 0.0 || m[4] < 0.0)
-                .count(),
-            result.count(5, |v| v != 0.0),
+            result.count(|m| m[0] > CONTINUITY_LIMIT),
+            result.count(|m| m[1] > CONTINUITY_LIMIT),
+            result.count(|m| m[3] < 0.0 || m[4] < 0.0),
+            result.count(|m| m[5] != 0.0),
             result.rejected.len(),
         );
         for (seed, reason) in result.rejected.iter().take(3) {
