@@ -141,7 +141,6 @@ pub fn verdict(problems: &[String]) -> Result<()> {
 /// images built already: [`Image::build`] then builds nothing.
 pub const PREBUILT: &str = "IDLE_HEAD_PREBUILT";
 
-/// Whether [`PREBUILT`] is set.
 pub fn prebuilt() -> bool {
     std::env::var_os(PREBUILT).is_some()
 }

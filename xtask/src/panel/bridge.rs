@@ -36,7 +36,6 @@ pub enum Note {
 pub struct Hub(Mutex<(Vec<mpsc::Sender<Note>>, Option<String>)>);
 
 impl Hub {
-    /// A page joins.
     pub fn join(&self) -> mpsc::Receiver<Note> {
         let (tx, rx) = mpsc::channel();
         if let Ok(mut hub) = self.0.lock() {
@@ -86,7 +85,6 @@ impl Bridge {
         }
     }
 
-    /// Writes `bytes` to the head.
     pub fn write(&self, bytes: &[u8]) -> Result<()> {
         let mut writer = self
             .writer

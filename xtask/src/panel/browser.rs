@@ -20,7 +20,6 @@ use crate::console::{self, Pace, qemu::qemu_command};
 use crate::project::{Metadata, PICO, QEMU};
 use crate::{setup, sim, trace};
 
-/// The stage's name.
 pub const STAGE: &str = "panel in a real browser: Web Serial (emulated Pico), bridge (QEMU), serial port (pty), radar map (replay)";
 
 /// Debian's Chromium.
