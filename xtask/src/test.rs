@@ -90,10 +90,8 @@ impl Stages<'_> {
             0 => String::new(),
             n => format!(" ({n} left out by --only)"),
         };
-        println!(
-            "{} passed, {failed} failed{left_out}",
-            self.results.len() - failed
-        );
+        let passed = self.results.len() - failed;
+        println!("{passed} passed, {failed} failed{left_out}");
         failed == 0
     }
 }
@@ -412,10 +410,11 @@ fn qemu_stages(
     const SUMMARY: &str = "QEMU summary: missed=0 pulse_violations=0, checksum = host's";
     const CONSOLE: &str = "cargo xtask console --qemu with a piped script";
 
+    let image = QEMU.elf(metadata);
     let built = stages.run(BUILD, || {
         setup::ensure_qemu()?;
         QEMU.build(root)?;
-        elf::check_qemu(&QEMU.elf(metadata))
+        elf::check_qemu(&image)
     });
     if !built {
         for name in [RUN, SNAPSHOT, SUMMARY] {
@@ -425,11 +424,7 @@ fn qemu_stages(
     }
     let mut run: Option<Run> = None;
     stages.run(RUN, || {
-        let done = run.insert(qemu::run(
-            &QEMU.elf(metadata),
-            options.timeout,
-            Echo::Problems,
-        )?);
+        let done = run.insert(qemu::run(&image, options.timeout, Echo::Problems)?);
         println!("{}", done.describe());
         ensure!(done.succeeded(), "{}", done.describe());
         Ok(())

@@ -39,11 +39,8 @@ pub fn script(args: &[&str], script: &[u8], want: &[&str], more: usize) -> Resul
             "line {i}: {got:?}, want {want:?}"
         );
     }
-    ensure!(
-        out.status.success(),
-        "`cargo xtask console` failed ({})",
-        out.status
-    );
+    let status = out.status;
+    ensure!(status.success(), "`cargo xtask console` failed ({status})");
     Ok(lines)
 }
 
@@ -72,9 +69,8 @@ pub fn piped_script() -> Result<String> {
     if !summary.starts_with("summary ") || !summary.contains(" missed=0 pulse_violations=0 ") {
         bail!("last line {summary:?}");
     }
+    let n = want.len();
     Ok(format!(
-        "console --qemu: {} lines, {} replies, then {summary}",
-        want.len(),
-        want.len()
+        "console --qemu: {n} lines, {n} replies, then {summary}"
     ))
 }
