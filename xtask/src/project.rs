@@ -205,11 +205,8 @@ impl Image {
         sh.change_dir(root.join(self.dir));
         let select = self.package.map(|p| ["--package", p, "--bin", self.bin]);
         let select = select.iter().flatten();
-        run(
-            &sh,
-            FIRMWARE_ENV,
-            cmd!(sh, "cargo build --release {select...}"),
-        )
+        let build = cmd!(sh, "cargo build --release {select...}");
+        run(&sh, FIRMWARE_ENV, build)
     }
 }
 

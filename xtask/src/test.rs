@@ -99,6 +99,7 @@ impl Stages<'_> {
 /// `cargo xtask test`, all stages or `only` those whose name contains it.
 /// `Ok(false)` when a stage failed.
 pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
+    const PICO_IMAGE: &str = "Pico image: .boot2 placement, memory budgets, no allocator";
     let start = Instant::now();
     let (root, metadata) = setup::prepare()?;
     let figures_page = root.join(figures::PAGE);
@@ -119,15 +120,9 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         PICO.build(&root)
     });
     if pico_built {
-        stages.run(
-            "Pico image: .boot2 placement, memory budgets, no allocator",
-            || elf::check_pico(&PICO.elf(&metadata)),
-        );
+        stages.run(PICO_IMAGE, || elf::check_pico(&PICO.elf(&metadata)));
     } else {
-        stages.blocked(
-            "Pico image: .boot2 placement, memory budgets, no allocator",
-            "the Pico build",
-        );
+        stages.blocked(PICO_IMAGE, "the Pico build");
     }
     // The Pico 2 on its own: its embassy-rp chip feature excludes the Pico's.
     stages.run(pico2::STAGE, || pico2::test(&metadata));
