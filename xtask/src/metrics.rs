@@ -135,12 +135,8 @@ pub fn run(args: Args, closure: Closure) -> Result<Results> {
     let threads = thread::available_parallelism().map_or(1, usize::from) as u32;
     let chunk = args.seeds.div_ceil(threads);
     let part = |t: usize| {
-        let t = t as u32;
-        measure(
-            (t * chunk).min(args.seeds)..((t + 1) * chunk).min(args.seeds),
-            args,
-            closure,
-        )
+        let [from, to] = [t, t + 1].map(|t| (t as u32 * chunk).min(args.seeds));
+        measure(from..to, args, closure)
     };
     let mut all = Results::default();
     for part in parallel(threads as usize, threads as usize, part) {
@@ -154,16 +150,13 @@ pub fn run(args: Args, closure: Closure) -> Result<Results> {
 /// `cargo xtask metrics`. `Ok(false)` never: the command reports, it does not judge.
 pub fn command(args: &Args) -> Result<bool> {
     let args = *args;
-    let (n, w) = (args.shape.n(), args.shape.w());
+    let (seeds, n, w) = (args.seeds, args.shape.n(), args.shape.w());
     for axis in Axis::ALL {
         let (_, cfg) = config(axis.index() as u32, args, Closure::Seamless);
         cfg.validate(axis, n)
             .map_err(|error| AxisError { axis, error })?;
     }
-    println!(
-        "$ cargo xtask metrics --seeds {} --n {n} --w {w}",
-        args.seeds
-    );
+    println!("$ cargo xtask metrics --seeds {seeds} --n {n} --w {w}");
     let range = |axis: Axis| {
         let r = DEFAULT_HEAD.axis(axis).range;
         format!("{} [{}°, {}°]", axis.name(), deg(r.min), deg(r.max))
@@ -171,7 +164,7 @@ pub fn command(args: &Args) -> Result<bool> {
     println!(
         "seeds: seed_i = i·2654435761 + 12345 mod 2^32, i = 0..{}; seed i runs on axis i mod 3 \
          with that axis' default range (Table 2): {}; N = {n}, W = {w}, Mdeg16 storage.",
-        args.seeds - 1,
+        seeds - 1,
         Axis::ALL.map(range).join(", ")
     );
     println!(
@@ -184,10 +177,9 @@ pub fn command(args: &Args) -> Result<bool> {
         let result = run(args, closure)?;
         let name = closure_name(closure);
         println!(
-            "{name:<9} continuity > {CONTINUITY_LIMIT}: {} of {} seeds (velocity {}, acceleration \
-             {}); outside [α1, α2]: {}; start ≠ 0: {}; rejected: {}",
+            "{name:<9} continuity > {CONTINUITY_LIMIT}: {} of {seeds} seeds (velocity {}, \
+             acceleration {}); outside [α1, α2]: {}; start ≠ 0: {}; rejected: {}",
             result.discontinuous(),
-            args.seeds,
             result.count(|m| m[0] > CONTINUITY_LIMIT),
             result.count(|m| m[1] > CONTINUITY_LIMIT),
             result.count(|m| m[3] < 0.0 || m[4] < 0.0),
@@ -199,11 +191,8 @@ pub fn command(args: &Args) -> Result<bool> {
         }
         record_figures(closure, &result, args);
     }
-    println!(
-        "{} loops in {:.1} s",
-        2 * u64::from(args.seeds),
-        start.elapsed().as_secs_f64()
-    );
+    let seconds = start.elapsed().as_secs_f64();
+    println!("{} loops in {seconds:.1} s", 2 * u64::from(seeds));
     Ok(true)
 }
 
