@@ -67,11 +67,8 @@ impl Image {
         for s in &image.sections {
             println!("  {:<16} {:#010x}  {:>7}", s.name, s.address, s.size);
         }
-        println!(
-            "  flash {} B, static RAM {} B (.data + .bss + .uninit)",
-            image.flash(),
-            image.static_ram()
-        );
+        let (flash, ram) = (image.flash(), image.static_ram());
+        println!("  flash {flash} B, static RAM {ram} B (.data + .bss + .uninit)");
         Ok(image)
     }
 
@@ -202,18 +199,16 @@ impl Image {
                  uses {expected:#010x?}"
             );
         }
-        if self.flash_end > region.start {
+        let (start, end) = (region.start, self.flash_end);
+        if end > start {
             bail!(
-                "the image's flash contents end at {:#010x}, inside the settings region at \
-                 {:#010x}",
-                self.flash_end,
-                region.start
+                "the image's flash contents end at {end:#010x}, inside the settings region at \
+                 {start:#010x}"
             );
         }
+        let kib = (region.end - start) / 1024;
         println!(
-            "  settings region {region:#010x?} ({} KiB) clear: the image ends at {:#010x}",
-            (region.end - region.start) / 1024,
-            self.flash_end
+            "  settings region {region:#010x?} ({kib} KiB) clear: the image ends at {end:#010x}"
         );
         Ok(())
     }
