@@ -97,12 +97,8 @@ pub fn choose(board: Board, here: &Surroundings) -> Result<Route> {
     drives.dedup();
     match drives.as_slice() {
         [drive] => Ok(Route::Drive(drive.clone())),
-        [] => Ok(
-            match which::which_in("probe-rs", here.path.as_deref(), &here.cwd) {
-                Ok(probe) => Route::Probe(probe),
-                Err(_) => Route::Instructions,
-            },
-        ),
+        [] => Ok(which::which_in("probe-rs", here.path.as_deref(), &here.cwd)
+            .map_or(Route::Instructions, Route::Probe)),
         several => {
             let list: Vec<String> = several.iter().map(|d| d.display().to_string()).collect();
             bail!(

@@ -113,10 +113,8 @@ pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
         return Ok(program);
     }
     let tools_dir = project::relative(tools);
-    println!(
-        "installing {wanted} into {} (a few minutes, once)",
-        tools_dir.display()
-    );
+    let tools_dir = tools_dir.display();
+    println!("installing {wanted} into {tools_dir} (a few minutes, once)");
     let sh = project::shell(".")?;
     // A host program, whatever .cargo/config.toml builds for.
     let host = "host-tuple";
