@@ -52,7 +52,7 @@ pub fn command(args: &Args) -> Result<bool> {
     let root = project::root();
     if args.test {
         let (root, metadata) = setup::prepare()?;
-        println!("{}", browser::stage(&root, &metadata)?);
+        browser::stage(&root, &metadata)?;
         return Ok(true);
     }
     ensure_dependencies(&root)?;

@@ -11,7 +11,8 @@ use crate::{
     args::Options,
     bench, book, console, elf, figures,
     log::{self, Run},
-    panel, pico2,
+    panel::browser,
+    pico2,
     project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
     qemu::{self, Echo},
     setup, sim, snapshot,
@@ -151,10 +152,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     });
 
     // The panel in a real browser (Chromium, headless).
-    stages.run(panel::browser::STAGE, || {
-        println!("{}", panel::browser::stage(&root, &metadata)?);
-        Ok(())
-    });
+    stages.run(browser::STAGE, || browser::stage(&root, &metadata));
 
     // 6. The book, with the figures measured above, and its links.
     stages.run(book::STAGE, || book::stage(&root));
@@ -440,10 +438,7 @@ fn qemu_stages(
             snapshot::compare(&run, &metadata.target_dir.join("qemu-actual.log"))
         }
     });
-    stages.run(CONSOLE, || {
-        println!("{}", console::piped_script()?);
-        Ok(())
-    });
+    stages.run(CONSOLE, console::piped_script);
     stages.run(SUMMARY, || {
         if let Some(line) = log::summary(&run.log) {
             println!("{line}");
