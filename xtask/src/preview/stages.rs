@@ -329,11 +329,8 @@ mod tests {
         let mut lcg = Lcg::new(127);
         assert_eq!(paper[0], 0.0);
         for i in 1..6 {
-            let step = if lcg.next_value() >= 1 << 31 {
-                0.5
-            } else {
-                -0.5
-            };
+            let up = lcg.next_value() >= 1 << 31;
+            let step = if up { 0.5 } else { -0.5 };
             assert_eq!(paper[i] - paper[i - 1], step);
         }
         // The seamless walk is periodic; its first step e(0) − D/N, e(0) from r(1).
