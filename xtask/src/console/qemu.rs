@@ -103,14 +103,8 @@ pub fn qemu_command(elf: &Path, pace: Pace, [uart0, uart1]: [&str; 2]) -> Comman
     };
     let semihosting = format!("enable=on,target=native,arg=idle-head,arg={run}");
     let mut command = qemu::qemu_command(elf, sleep, &["-display", "none", "-monitor", "none"]);
-    command.args([
-        "-semihosting-config",
-        &semihosting,
-        "-serial",
-        uart0,
-        "-serial",
-        uart1,
-    ]);
+    command.args(["-semihosting-config", &semihosting]);
+    command.args(["-serial", uart0, "-serial", uart1]);
     command
 }
 
