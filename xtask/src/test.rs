@@ -328,11 +328,8 @@ fn sim_stages(
         }
     };
     // Longest first: the two 10-minute streams, the DMX stream, the latency rows.
-    let mut queue: Vec<usize> = chosen
-        .iter()
-        .copied()
-        .filter(|&i| blocker(i).is_none())
-        .collect();
+    let mut queue = chosen.clone();
+    queue.retain(|&i| blocker(i).is_none());
     let long = [
         sim::UART_STREAM_STAGE,
         sim::USB_STREAM_STAGE,
