@@ -122,21 +122,14 @@ mod tests {
 
     #[test]
     fn paths_are_told_from_words() {
-        assert_eq!(
-            paths_in(" see `crates/core/src/lib.rs`, docs/design/idle.md and boards/qemu/."),
-            [
-                "crates/core/src/lib.rs",
-                "docs/design/idle.md",
-                "boards/qemu/"
-            ]
-        );
+        let text = " see `crates/core/src/lib.rs`, docs/design/idle.md and boards/qemu/.";
+        let paths = "crates/core/src/lib.rs docs/design/idle.md boards/qemu/";
+        assert_eq!(paths_in(text).join(" "), paths);
         // Not repository paths: a crate's name, a URL, an elision; of a
         // glob, the folder.
         assert!(paths_in("idle_head_core::console, https://docs.rs/x/y.html").is_empty());
-        assert_eq!(
-            paths_in("docs/design/*.md, src/...rs, the src/ folder's"),
-            ["docs/design/", "src/"]
-        );
+        let folders = paths_in("docs/design/*.md, src/...rs, the src/ folder's");
+        assert_eq!(folders, ["docs/design/", "src/"]);
     }
 
     #[test]
