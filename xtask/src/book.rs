@@ -26,21 +26,12 @@ pub fn stage(root: &Path) -> Result<()> {
     node::npm_ci(&tools, &["linkinator"], &[])?;
     let linkinator = tools.join("node_modules/.bin/linkinator");
     let sh = project::shell(".")?;
-    project::run(&sh, &[], cmd!(sh, "{mdbook} build docs --dest-dir {OUT}"))?;
+    let run = |cmd| project::run(&sh, &[], cmd);
+    run(cmd!(sh, "{mdbook} build docs --dest-dir {OUT}"))?;
     let check = ["--check-fragments", "--verbosity", "error", "--skip"];
-    project::run(
-        &sh,
-        &[],
-        cmd!(sh, "{linkinator} {OUT} --recurse {check...} {EXTERNAL}"),
-    )?;
-    project::run(
-        &sh,
-        &[],
-        cmd!(
-            sh,
-            "{linkinator} README.md --markdown {check...} {EXTERNAL}"
-        ),
-    )?;
+    for target in [[OUT, "--recurse"], ["README.md", "--markdown"]] {
+        run(cmd!(sh, "{linkinator} {target...} {check...} {EXTERNAL}"))?;
+    }
     println!("every link resolves; open {OUT}/index.html");
     Ok(())
 }

@@ -8,19 +8,9 @@ use std::path::{Path, PathBuf};
 /// The folders whose comments are scanned.
 pub const SCANNED: [&str; 5] = ["crates", "src", "boards", "host-tests", "xtask"];
 
-/// How a path a comment names starts: a folder at the repository's top.
-const PREFIXES: [&str; 10] = [
-    "crates/",
-    "src/",
-    "docs/",
-    "boards/",
-    "host-tests/",
-    "xtask/",
-    "sim/",
-    "panel/",
-    ".cargo/",
-    ".ci/",
-];
+/// How a path a comment names starts: a folder at the repository's top
+/// (separated by spaces).
+const PREFIXES: &str = "crates/ src/ docs/ boards/ host-tests/ xtask/ sim/ panel/ .cargo/ .ci/";
 
 /// How a path a comment names ends, if it names a file.
 const EXTENSIONS: [&str; 13] = [
@@ -42,7 +32,7 @@ pub fn paths_in(text: &str) -> Vec<&str> {
     text.split(|c: char| !is_path_char(c))
         .map(|word| word.trim_end_matches(['.', ',']))
         .filter(|word| {
-            PREFIXES.iter().any(|p| word.starts_with(p))
+            PREFIXES.split(' ').any(|p| word.starts_with(p))
                 && !word.contains("...")
                 && (word.ends_with('/') || EXTENSIONS.iter().any(|e| word.ends_with(e)))
         })
@@ -64,13 +54,8 @@ fn exists(root: &Path, file: &Path, path: &str) -> bool {
 /// Every path named in a comment under [`SCANNED`] that does not exist, as
 /// `file:line: path`.
 pub fn missing(root: &Path) -> anyhow::Result<Vec<String>> {
-    let mut files = Vec::new();
-    for dir in SCANNED {
-        collect(&root.join(dir), &mut files)?;
-    }
-    files.sort();
     let mut found = Vec::new();
-    for file in files {
+    for file in files(root, &SCANNED)? {
         let rust = file.extension().is_some_and(|e| e == "rs");
         let text = fs::read_to_string(&file)?;
         for (n, line) in text.lines().enumerate() {
@@ -95,18 +80,13 @@ pub const MODULE_DOC_LINES: usize = 30;
 /// The Rust files under `crates/` whose module doc is [`MODULE_DOC_LINES`]
 /// long or longer, as `file: n lines`.
 pub fn long_module_docs(root: &Path) -> anyhow::Result<Vec<String>> {
-    let mut files = Vec::new();
-    collect(&root.join("crates"), &mut files)?;
-    files.sort();
     let mut long = Vec::new();
-    for file in files
-        .iter()
-        .filter(|f| f.extension().is_some_and(|e| e == "rs"))
-    {
-        let text = fs::read_to_string(file)?;
+    // A manifest has no `//!` lines: its count is 0.
+    for file in files(root, &["crates"])? {
+        let text = fs::read_to_string(&file)?;
         let doc = text.lines().skip_while(|l| !l.starts_with("//!"));
         let lines = doc.take_while(|l| l.starts_with("//!")).count();
-        let file = file.strip_prefix(root).unwrap_or(file).display();
+        let file = file.strip_prefix(root).unwrap_or(&file).display();
         if lines >= MODULE_DOC_LINES {
             long.push(format!("{file}: {lines} lines"));
         }
@@ -114,20 +94,26 @@ pub fn long_module_docs(root: &Path) -> anyhow::Result<Vec<String>> {
     Ok(long)
 }
 
-/// The Rust files and manifests under `dir`, build output left out.
-fn collect(dir: &Path, files: &mut Vec<PathBuf>) -> anyhow::Result<()> {
-    for entry in fs::read_dir(dir)? {
-        let path = entry?.path();
-        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
-        if path.is_dir() {
-            if name != "target" && !name.starts_with('.') {
-                collect(&path, files)?;
+/// The Rust files and manifests under `root`'s `dirs`, build output left
+/// out, in order.
+fn files(root: &Path, dirs: &[&str]) -> anyhow::Result<Vec<PathBuf>> {
+    let mut todo: Vec<PathBuf> = dirs.iter().map(|dir| root.join(dir)).collect();
+    let mut files = Vec::new();
+    while let Some(dir) = todo.pop() {
+        for entry in fs::read_dir(dir)? {
+            let path = entry?.path();
+            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            if path.is_dir() {
+                if name != "target" && !name.starts_with('.') {
+                    todo.push(path);
+                }
+            } else if path.extension().is_some_and(|e| e == "rs") || name == "Cargo.toml" {
+                files.push(path);
             }
-        } else if path.extension().is_some_and(|e| e == "rs") || name == "Cargo.toml" {
-            files.push(path);
         }
     }
-    Ok(())
+    files.sort();
+    Ok(files)
 }
 
 #[cfg(test)]
@@ -136,21 +122,14 @@ mod tests {
 
     #[test]
     fn paths_are_told_from_words() {
-        assert_eq!(
-            paths_in(" see `crates/core/src/lib.rs`, docs/design/idle.md and boards/qemu/."),
-            [
-                "crates/core/src/lib.rs",
-                "docs/design/idle.md",
-                "boards/qemu/"
-            ]
-        );
+        let text = " see `crates/core/src/lib.rs`, docs/design/idle.md and boards/qemu/.";
+        let paths = "crates/core/src/lib.rs docs/design/idle.md boards/qemu/";
+        assert_eq!(paths_in(text).join(" "), paths);
         // Not repository paths: a crate's name, a URL, an elision; of a
         // glob, the folder.
         assert!(paths_in("idle_head_core::console, https://docs.rs/x/y.html").is_empty());
-        assert_eq!(
-            paths_in("docs/design/*.md, src/...rs, the src/ folder's"),
-            ["docs/design/", "src/"]
-        );
+        let folders = paths_in("docs/design/*.md, src/...rs, the src/ folder's");
+        assert_eq!(folders, ["docs/design/", "src/"]);
     }
 
     #[test]

@@ -67,11 +67,8 @@ impl Image {
         for s in &image.sections {
             println!("  {:<16} {:#010x}  {:>7}", s.name, s.address, s.size);
         }
-        println!(
-            "  flash {} B, static RAM {} B (.data + .bss + .uninit)",
-            image.flash(),
-            image.static_ram()
-        );
+        let (flash, ram) = (image.flash(), image.static_ram());
+        println!("  flash {flash} B, static RAM {ram} B (.data + .bss + .uninit)");
         Ok(image)
     }
 
@@ -99,11 +96,7 @@ impl Image {
             .collect();
         allocator_symbols.sort();
         allocator_symbols.dedup();
-        let symbol = |name: &str| {
-            file.symbols()
-                .find(|s| s.name() == Ok(name))
-                .map(|s| s.address())
-        };
+        let symbol = |name| file.symbol_by_name(name).map(|s| s.address());
         let settings = symbol("__settings_start")
             .zip(symbol("__settings_end"))
             .map(|(start, end)| start..end);
@@ -206,18 +199,16 @@ impl Image {
                  uses {expected:#010x?}"
             );
         }
-        if self.flash_end > region.start {
+        let (start, end) = (region.start, self.flash_end);
+        if end > start {
             bail!(
-                "the image's flash contents end at {:#010x}, inside the settings region at \
-                 {:#010x}",
-                self.flash_end,
-                region.start
+                "the image's flash contents end at {end:#010x}, inside the settings region at \
+                 {start:#010x}"
             );
         }
+        let kib = (region.end - start) / 1024;
         println!(
-            "  settings region {region:#010x?} ({} KiB) clear: the image ends at {:#010x}",
-            (region.end - region.start) / 1024,
-            self.flash_end
+            "  settings region {region:#010x?} ({kib} KiB) clear: the image ends at {end:#010x}"
         );
         Ok(())
     }
@@ -293,14 +284,8 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
     if !rows.is_empty() {
         let intro = "RAM: static RAM plus the deepest the stack went, measured by painting it \
                      ([Memory](memory.md#how-the-stack-is-measured)).";
-        let header = [
-            "image",
-            "stack measured in",
-            "static RAM",
-            "peak stack",
-            "total",
-            "of the ceiling",
-        ];
+        let header = "image|stack measured in|static RAM|peak stack|total|of the ceiling";
+        let header: Vec<&str> = header.split('|').collect();
         figures::record("ram", intro.to_owned(), &header, rows);
     }
     let pico =

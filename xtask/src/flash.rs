@@ -97,12 +97,8 @@ pub fn choose(board: Board, here: &Surroundings) -> Result<Route> {
     drives.dedup();
     match drives.as_slice() {
         [drive] => Ok(Route::Drive(drive.clone())),
-        [] => Ok(
-            match which::which_in("probe-rs", here.path.as_deref(), &here.cwd) {
-                Ok(probe) => Route::Probe(probe),
-                Err(_) => Route::Instructions,
-            },
-        ),
+        [] => Ok(which::which_in("probe-rs", here.path.as_deref(), &here.cwd)
+            .map_or(Route::Instructions, Route::Probe)),
         several => {
             let list: Vec<String> = several.iter().map(|d| d.display().to_string()).collect();
             bail!(
@@ -222,39 +218,36 @@ mod tests {
     #[test]
     fn the_route_is_a_bootsel_drive_known_by_its_board_id_then_instructions() {
         let no_path = tempfile::tempdir().unwrap();
-        let no_path = no_path.path();
+        let route = |board, mounts: &[&Path]| {
+            let here = here(no_path.path(), mounts);
+            choose(board, &here).map_err(|e| format!("{e:#}"))
+        };
         let (pico, pico2) = (
             mount_with("RPI-RP2", PICO_INFO),
             mount_with("RP2350", PICO2_INFO),
         );
-        let both = here(no_path, &[pico.path(), pico2.path()]);
+        let both = [pico.path(), pico2.path()];
         let drive = pico.path().join("RPI-RP2");
-        assert_eq!(
-            choose(Board::Pico, &both).unwrap(),
-            Route::Drive(drive.clone())
-        );
+        assert_eq!(route(Board::Pico, &both), Ok(Route::Drive(drive.clone())));
         let drive2 = pico2.path().join("RP2350");
-        assert_eq!(choose(Board::Pico2, &both).unwrap(), Route::Drive(drive2));
+        assert_eq!(route(Board::Pico2, &both), Ok(Route::Drive(drive2)));
         // A drive called RPI-RP2 without the info file, or with another
         // board's, is not one; a mount that is itself the drive is.
         let plain = tempfile::tempdir().unwrap();
         std::fs::create_dir(plain.path().join("RPI-RP2")).unwrap();
         let other = mount_with("RPI-RP2", PICO2_INFO);
-        let neither = here(no_path, &[plain.path(), other.path()]);
-        assert_eq!(choose(Board::Pico, &neither).unwrap(), Route::Instructions);
-        let itself = here(no_path, &[&drive]);
-        assert_eq!(
-            choose(Board::Pico, &itself).unwrap(),
-            Route::Drive(drive.clone())
-        );
-        let text = instructions(Board::Pico2, Path::new("pico2.uf2"), &neither.mounts);
+        let neither = [plain.path(), other.path()];
+        assert_eq!(route(Board::Pico, &neither), Ok(Route::Instructions));
+        assert_eq!(route(Board::Pico, &[&drive]), Ok(Route::Drive(drive)));
+        let looked = neither.map(Path::to_path_buf);
+        let text = instructions(Board::Pico2, Path::new("pico2.uf2"), &looked);
         assert!(
             text.contains("probe-rs-tools") && text.contains("called RP2350"),
             "{text}"
         );
         let two = mount_with("RPI-RP2 1", PICO_INFO);
-        let error = choose(Board::Pico, &here(no_path, &[pico.path(), two.path()]));
-        assert!(format!("{:#}", error.unwrap_err()).contains("2 boards in BOOTSEL mode"));
+        let error = route(Board::Pico, &[pico.path(), two.path()]).unwrap_err();
+        assert!(error.contains("2 boards in BOOTSEL mode"), "{error}");
     }
 
     /// probe-rs gets the chip, the ELF and the arguments after it; a board
@@ -275,11 +268,7 @@ mod tests {
         let board = Board::Pico2;
         assert!(run(&Args { board, elf, rest }, &here).unwrap());
         let passed = std::fs::read_to_string(log).unwrap();
-        let passed: Vec<&str> = passed.lines().collect();
-        assert_eq!(
-            passed,
-            ["run", "--chip", "RP235x", "pico2", "--no-location"]
-        );
+        assert_eq!(passed, "run\n--chip\nRP235x\npico2\n--no-location\n");
         let mounts = mount_with("RP2350", PICO2_INFO);
         let drive = Surroundings {
             mounts: vec![mounts.path().to_owned()],

@@ -78,15 +78,14 @@ pub struct Results {
 }
 
 impl Results {
-    /// Loops whose value `row` passes `past`.
-    fn count(&self, row: usize, past: impl Fn(f64) -> bool) -> usize {
-        self.loops.iter().filter(|m| past(m[row])).count()
+    /// Loops whose [`ROWS`]' values pass `past`.
+    fn count(&self, past: impl Fn(&[f64; 6]) -> bool) -> usize {
+        self.loops.iter().filter(|m| past(m)).count()
     }
 
     /// Loops past the continuity limit on either ratio.
     fn discontinuous(&self) -> usize {
-        let past = |m: &&[f64; 6]| m[0] > CONTINUITY_LIMIT || m[1] > CONTINUITY_LIMIT;
-        self.loops.iter().filter(past).count()
+        self.count(|m| m[0] > CONTINUITY_LIMIT || m[1] > CONTINUITY_LIMIT)
     }
 }
 
@@ -136,12 +135,8 @@ pub fn run(args: Args, closure: Closure) -> Result<Results> {
     let threads = thread::available_parallelism().map_or(1, usize::from) as u32;
     let chunk = args.seeds.div_ceil(threads);
     let part = |t: usize| {
-        let t = t as u32;
-        measure(
-            (t * chunk).min(args.seeds)..((t + 1) * chunk).min(args.seeds),
-            args,
-            closure,
-        )
+        let [from, to] = [t, t + 1].map(|t| (t as u32 * chunk).min(args.seeds));
+        measure(from..to, args, closure)
     };
     let mut all = Results::default();
     for part in parallel(threads as usize, threads as usize, part) {
@@ -155,16 +150,13 @@ pub fn run(args: Args, closure: Closure) -> Result<Results> {
 /// `cargo xtask metrics`. `Ok(false)` never: the command reports, it does not judge.
 pub fn command(args: &Args) -> Result<bool> {
     let args = *args;
-    let (n, w) = (args.shape.n(), args.shape.w());
+    let (seeds, n, w) = (args.seeds, args.shape.n(), args.shape.w());
     for axis in Axis::ALL {
         let (_, cfg) = config(axis.index() as u32, args, Closure::Seamless);
         cfg.validate(axis, n)
             .map_err(|error| AxisError { axis, error })?;
     }
-    println!(
-        "$ cargo xtask metrics --seeds {} --n {n} --w {w}",
-        args.seeds
-    );
+    println!("$ cargo xtask metrics --seeds {seeds} --n {n} --w {w}");
     let range = |axis: Axis| {
         let r = DEFAULT_HEAD.axis(axis).range;
         format!("{} [{}°, {}°]", axis.name(), deg(r.min), deg(r.max))
@@ -172,7 +164,7 @@ pub fn command(args: &Args) -> Result<bool> {
     println!(
         "seeds: seed_i = i·2654435761 + 12345 mod 2^32, i = 0..{}; seed i runs on axis i mod 3 \
          with that axis' default range (Table 2): {}; N = {n}, W = {w}, Mdeg16 storage.",
-        args.seeds - 1,
+        seeds - 1,
         Axis::ALL.map(range).join(", ")
     );
     println!(
@@ -185,18 +177,13 @@ pub fn command(args: &Args) -> Result<bool> {
         let result = run(args, closure)?;
         let name = closure_name(closure);
         println!(
-            "{name:<9} continuity > {CONTINUITY_LIMIT}: {} of {} seeds (velocity {}, acceleration \
-             {}); outside [α1, α2]: {}; start ≠ 0: {}; rejected: {}",
+            "{name:<9} continuity > {CONTINUITY_LIMIT}: {} of {seeds} seeds (velocity {}, \
+             acceleration {}); outside [α1, α2]: {}; start ≠ 0: {}; rejected: {}",
             result.discontinuous(),
-            args.seeds,
-            result.count(0, |v| v > CONTINUITY_LIMIT),
-            result.count(1, |v| v > CONTINUITY_LIMIT),
-            result
-                .loops
-                .iter()
-                .filter(|m| m[3] < 0.0 || m[4] < 0.0)
-                .count(),
-            result.count(5, |v| v != 0.0),
+            result.count(|m| m[0] > CONTINUITY_LIMIT),
+            result.count(|m| m[1] > CONTINUITY_LIMIT),
+            result.count(|m| m[3] < 0.0 || m[4] < 0.0),
+            result.count(|m| m[5] != 0.0),
             result.rejected.len(),
         );
         for (seed, reason) in result.rejected.iter().take(3) {
@@ -204,11 +191,8 @@ pub fn command(args: &Args) -> Result<bool> {
         }
         record_figures(closure, &result, args);
     }
-    println!(
-        "{} loops in {:.1} s",
-        2 * u64::from(args.seeds),
-        start.elapsed().as_secs_f64()
-    );
+    let seconds = start.elapsed().as_secs_f64();
+    println!("{} loops in {seconds:.1} s", 2 * u64::from(seeds));
     Ok(true)
 }
 

@@ -52,7 +52,7 @@ pub fn command(args: &Args) -> Result<bool> {
     let root = project::root();
     if args.test {
         let (root, metadata) = setup::prepare()?;
-        println!("{}", browser::stage(&root, &metadata)?);
+        browser::stage(&root, &metadata)?;
         return Ok(true);
     }
     ensure_dependencies(&root)?;
@@ -181,13 +181,7 @@ mod tests {
         ] {
             assert_eq!(content_type(Path::new(file)), Some(kind), "{file}");
         }
-        for file in [
-            "package.json",
-            "package-lock.json",
-            "browser.mjs",
-            "tests",
-            ".html",
-        ] {
+        for file in "package.json package-lock.json browser.mjs tests .html".split(' ') {
             assert_eq!(content_type(Path::new(file)), None, "{file}");
         }
         let files = page_files(&project::root()).unwrap();

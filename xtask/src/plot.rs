@@ -64,13 +64,11 @@ pub struct Curve {
 impl Curve {
     /// A solid curve through `points`.
     pub fn new(label: impl Into<String>, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
-        let label = label.into();
-        let dashed = false;
         Self {
-            label,
+            label: label.into(),
             color,
             points,
-            dashed,
+            dashed: false,
         }
     }
 
@@ -127,17 +125,13 @@ pub fn motion(
         (Axis::Roll, ORANGE),
         (Axis::Yaw, GREEN),
     ];
-    let panels = colors.map(panel).into();
-    let panel_height = 250;
-    draw(
-        &Figure {
-            title,
-            notes,
-            panels,
-            panel_height,
-        },
-        path,
-    )
+    let figure = Figure {
+        title,
+        notes,
+        panels: colors.map(panel).into(),
+        panel_height: 250,
+    };
+    draw(&figure, path)
 }
 
 /// Draws `figure` to the PNG `path`, creating its folder.

@@ -141,7 +141,6 @@ pub fn verdict(problems: &[String]) -> Result<()> {
 /// images built already: [`Image::build`] then builds nothing.
 pub const PREBUILT: &str = "IDLE_HEAD_PREBUILT";
 
-/// Whether [`PREBUILT`] is set.
 pub fn prebuilt() -> bool {
     std::env::var_os(PREBUILT).is_some()
 }
@@ -180,12 +179,11 @@ pub const QEMU: Image = Image::qemu("qemu");
 impl Image {
     /// Bin `bin` of the QEMU package (`boards/qemu/`), built from the root.
     pub const fn qemu(bin: &'static str) -> Self {
-        let (dir, target, package) = (".", TARGET, Some("idle-head-qemu"));
         Self {
             bin,
-            dir,
-            target,
-            package,
+            dir: ".",
+            target: TARGET,
+            package: Some("idle-head-qemu"),
         }
     }
 
@@ -207,11 +205,8 @@ impl Image {
         sh.change_dir(root.join(self.dir));
         let select = self.package.map(|p| ["--package", p, "--bin", self.bin]);
         let select = select.iter().flatten();
-        run(
-            &sh,
-            FIRMWARE_ENV,
-            cmd!(sh, "cargo build --release {select...}"),
-        )
+        let build = cmd!(sh, "cargo build --release {select...}");
+        run(&sh, FIRMWARE_ENV, build)
     }
 }
 

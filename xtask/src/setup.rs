@@ -74,16 +74,12 @@ pub fn ensure_program(program: &str, packages: &[&str], what: &str) -> Result<()
     }
     println!("{program} is missing: installing {list}");
     let sh = project::shell(".")?;
-    let env = [("DEBIAN_FRONTEND", "noninteractive")];
-    project::run(&sh, &env, cmd!(sh, "apt-get update -q"))?;
-    project::run(
-        &sh,
-        &env,
-        cmd!(
-            sh,
-            "apt-get install -y -q --no-install-recommends {packages...}"
-        ),
-    )?;
+    let apt_get = |cmd| project::run(&sh, &[("DEBIAN_FRONTEND", "noninteractive")], cmd);
+    apt_get(cmd!(sh, "apt-get update -q"))?;
+    apt_get(cmd!(
+        sh,
+        "apt-get install -y -q --no-install-recommends {packages...}"
+    ))?;
     let ran = version(program).map(|_| ());
     ran.with_context(|| format!("`{program}` still does not run after installing {list}"))
 }
@@ -117,10 +113,8 @@ pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
         return Ok(program);
     }
     let tools_dir = project::relative(tools);
-    println!(
-        "installing {wanted} into {} (a few minutes, once)",
-        tools_dir.display()
-    );
+    let tools_dir = tools_dir.display();
+    println!("installing {wanted} into {tools_dir} (a few minutes, once)");
     let sh = project::shell(".")?;
     // A host program, whatever .cargo/config.toml builds for.
     let host = "host-tuple";

@@ -11,7 +11,8 @@ use crate::{
     args::Options,
     bench, book, console, elf, figures,
     log::{self, Run},
-    panel, pico2,
+    panel::browser,
+    pico2,
     project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
     qemu::{self, Echo},
     setup, sim, snapshot,
@@ -90,10 +91,8 @@ impl Stages<'_> {
             0 => String::new(),
             n => format!(" ({n} left out by --only)"),
         };
-        println!(
-            "{} passed, {failed} failed{left_out}",
-            self.results.len() - failed
-        );
+        let passed = self.results.len() - failed;
+        println!("{passed} passed, {failed} failed{left_out}");
         failed == 0
     }
 }
@@ -101,6 +100,7 @@ impl Stages<'_> {
 /// `cargo xtask test`, all stages or `only` those whose name contains it.
 /// `Ok(false)` when a stage failed.
 pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
+    const PICO_IMAGE: &str = "Pico image: .boot2 placement, memory budgets, no allocator";
     let start = Instant::now();
     let (root, metadata) = setup::prepare()?;
     let figures_page = root.join(figures::PAGE);
@@ -121,15 +121,9 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         PICO.build(&root)
     });
     if pico_built {
-        stages.run(
-            "Pico image: .boot2 placement, memory budgets, no allocator",
-            || elf::check_pico(&PICO.elf(&metadata)),
-        );
+        stages.run(PICO_IMAGE, || elf::check_pico(&PICO.elf(&metadata)));
     } else {
-        stages.blocked(
-            "Pico image: .boot2 placement, memory budgets, no allocator",
-            "the Pico build",
-        );
+        stages.blocked(PICO_IMAGE, "the Pico build");
     }
     // The Pico 2 on its own: its embassy-rp chip feature excludes the Pico's.
     stages.run(pico2::STAGE, || pico2::test(&metadata));
@@ -158,10 +152,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     });
 
     // The panel in a real browser (Chromium, headless).
-    stages.run(panel::browser::STAGE, || {
-        println!("{}", panel::browser::stage(&root, &metadata)?);
-        Ok(())
-    });
+    stages.run(browser::STAGE, || browser::stage(&root, &metadata));
 
     // 6. The book, with the figures measured above, and its links.
     stages.run(book::STAGE, || book::stage(&root));
@@ -337,11 +328,8 @@ fn sim_stages(
         }
     };
     // Longest first: the two 10-minute streams, the DMX stream, the latency rows.
-    let mut queue: Vec<usize> = chosen
-        .iter()
-        .copied()
-        .filter(|&i| blocker(i).is_none())
-        .collect();
+    let mut queue = chosen.clone();
+    queue.retain(|&i| blocker(i).is_none());
     let long = [
         sim::UART_STREAM_STAGE,
         sim::USB_STREAM_STAGE,
@@ -412,10 +400,11 @@ fn qemu_stages(
     const SUMMARY: &str = "QEMU summary: missed=0 pulse_violations=0, checksum = host's";
     const CONSOLE: &str = "cargo xtask console --qemu with a piped script";
 
+    let image = QEMU.elf(metadata);
     let built = stages.run(BUILD, || {
         setup::ensure_qemu()?;
         QEMU.build(root)?;
-        elf::check_qemu(&QEMU.elf(metadata))
+        elf::check_qemu(&image)
     });
     if !built {
         for name in [RUN, SNAPSHOT, SUMMARY] {
@@ -425,11 +414,7 @@ fn qemu_stages(
     }
     let mut run: Option<Run> = None;
     stages.run(RUN, || {
-        let done = run.insert(qemu::run(
-            &QEMU.elf(metadata),
-            options.timeout,
-            Echo::Problems,
-        )?);
+        let done = run.insert(qemu::run(&image, options.timeout, Echo::Problems)?);
         println!("{}", done.describe());
         ensure!(done.succeeded(), "{}", done.describe());
         Ok(())
@@ -450,10 +435,7 @@ fn qemu_stages(
             snapshot::compare(&run, &metadata.target_dir.join("qemu-actual.log"))
         }
     });
-    stages.run(CONSOLE, || {
-        println!("{}", console::piped_script()?);
-        Ok(())
-    });
+    stages.run(CONSOLE, console::piped_script);
     stages.run(SUMMARY, || {
         if let Some(line) = log::summary(&run.log) {
             println!("{line}");

@@ -29,11 +29,16 @@ const MARKERS: (u32, u32) = (0xffff_ded3, 0xab12_3579);
 /// Size of a UF2 block; each carries one 256-byte flash page.
 const BLOCK: usize = 512;
 
-/// The UF2 of the ELF `elf` for `board`.
+/// The UF2 of the ELF `elf` for `board`: refused unless it has what the
+/// board's boot ROM starts, `.boot2` (Pico) or `.start_block` (Pico 2).
 pub fn make(elf: &[u8], board: Board) -> Result<Vec<u8>> {
-    check_boot(elf, board)?;
+    let image = elf::Image::parse(elf).context("parsing the ELF")?;
+    match board {
+        Board::Pico => image.check_boot2()?,
+        Board::Pico2 => start_block(elf).map(|_| ())?,
+    }
     let settings = board.settings().start;
-    let end = elf::Image::parse(elf)?.flash_end;
+    let end = image.flash_end;
     if end > u64::from(settings) {
         bail!(
             "the image's flash contents end at {end:#010x}, in the settings sectors from {settings:#010x}: flashing it would overwrite the saved settings"
@@ -47,17 +52,6 @@ pub fn make(elf: &[u8], board: Board) -> Result<Vec<u8>> {
     elf2flash_core::elf2uf2(elf, &mut bytes, chip, elf2flash_core::NoProgress)
         .context("writing the UF2 blocks")?;
     Ok(bytes)
-}
-
-/// Fails unless the ELF has what the board's boot ROM starts: `.boot2`
-/// (Pico) or `.start_block` (Pico 2).
-pub fn check_boot(data: &[u8], board: Board) -> Result<()> {
-    match board {
-        Board::Pico => elf::Image::parse(data)
-            .context("parsing the ELF")?
-            .check_boot2(),
-        Board::Pico2 => start_block(data).map(|_| ()),
-    }
 }
 
 /// The addresses of `.start_block` in the ELF `data`, checked: in the first

@@ -54,19 +54,14 @@ pub fn qemu_session(
         let mut console = connect(&uart0)?;
         let mut hang_up = connect(&uart1)?;
         let (reader, timeout) = (console.try_clone()?, console.try_clone()?);
-        Ok::<_, anyhow::Error>(talk::converse(
-            input,
-            &mut console,
-            reader,
-            on_reply,
-            wait,
-            || {
-                hang_up.write_all(b"\0")?;
-                // A firmware that does not stop must not hold the reader for ever.
-                timeout.set_read_timeout(Some(AFTER_HANG_UP))?;
-                Ok(())
-            },
-        ))
+        let end = || -> Result<()> {
+            hang_up.write_all(b"\0")?;
+            // A firmware that does not stop must not hold the reader for ever.
+            timeout.set_read_timeout(Some(AFTER_HANG_UP))?;
+            Ok(())
+        };
+        let talk = talk::converse(input, &mut console, reader, on_reply, wait, end);
+        Ok::<_, anyhow::Error>(talk)
     })?;
     let _ = std::fs::remove_dir_all(&dir);
     Ok(QemuSession { run, talk: talk? })
@@ -108,14 +103,8 @@ pub fn qemu_command(elf: &Path, pace: Pace, [uart0, uart1]: [&str; 2]) -> Comman
     };
     let semihosting = format!("enable=on,target=native,arg=idle-head,arg={run}");
     let mut command = qemu::qemu_command(elf, sleep, &["-display", "none", "-monitor", "none"]);
-    command.args([
-        "-semihosting-config",
-        &semihosting,
-        "-serial",
-        uart0,
-        "-serial",
-        uart1,
-    ]);
+    command.args(["-semihosting-config", &semihosting]);
+    command.args(["-serial", uart0, "-serial", uart1]);
     command
 }
 

@@ -36,7 +36,6 @@ pub enum Note {
 pub struct Hub(Mutex<(Vec<mpsc::Sender<Note>>, Option<String>)>);
 
 impl Hub {
-    /// A page joins.
     pub fn join(&self) -> mpsc::Receiver<Note> {
         let (tx, rx) = mpsc::channel();
         if let Ok(mut hub) = self.0.lock() {
@@ -74,9 +73,9 @@ pub struct Bridge {
 }
 
 impl Bridge {
-    fn new(name: String, kind: &'static str, writer: Box<dyn Write + Send>) -> Self {
+    fn new(name: impl Into<String>, kind: &'static str, writer: Box<dyn Write + Send>) -> Self {
         Self {
-            name,
+            name: name.into(),
             kind,
             hub: std::sync::Arc::default(),
             writer: Mutex::new(writer),
@@ -86,7 +85,6 @@ impl Bridge {
         }
     }
 
-    /// Writes `bytes` to the head.
     pub fn write(&self, bytes: &[u8]) -> Result<()> {
         let mut writer = self
             .writer
@@ -105,7 +103,7 @@ impl Bridge {
             .zip(stdout)
             .context("the harness's stdin and stdout")?;
         let name = "the shipped Pico image in the RP2040 emulator (USB serial port)";
-        let mut bridge = Self::new(name.to_owned(), "sim", Box::new(HexLines(stdin)));
+        let mut bridge = Self::new(name, "sim", Box::new(HexLines(stdin)));
         bridge.child = Some(child);
         let hub = std::sync::Arc::clone(&bridge.hub);
         thread::spawn(move || {
@@ -121,11 +119,7 @@ impl Bridge {
             spawn_with_sockets(elf, Pace::RealTime, "panel", Stdio::null)?;
         let console = connect(&uart0)?;
         let reader = console.try_clone()?;
-        let mut bridge = Self::new(
-            "the QEMU image (UART0)".to_owned(),
-            "qemu",
-            Box::new(console),
-        );
+        let mut bridge = Self::new("the QEMU image (UART0)", "qemu", Box::new(console));
         (bridge.child, bridge.dir) = (Some(child), Some(dir));
         bridge.hang_up = Some(connect(&uart1)?);
         bridge.read(reader, "QEMU's UART0 closed");

@@ -20,14 +20,13 @@ use crate::console::{self, Pace, qemu::qemu_command};
 use crate::project::{Metadata, PICO, QEMU};
 use crate::{setup, sim, trace};
 
-/// The stage's name.
 pub const STAGE: &str = "panel in a real browser: Web Serial (emulated Pico), bridge (QEMU), serial port (pty), radar map (replay)";
 
 /// Debian's Chromium.
 const CHROMIUM: &str = "/usr/bin/chromium";
 
-/// The stage: every session; a summary line of what it measured.
-pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
+/// The stage: every session, then a summary line of what it measured.
+pub fn stage(root: &Path, metadata: &Metadata) -> Result<()> {
     let start = Instant::now();
     setup::ensure_program(CHROMIUM, &["chromium"], "Chromium")?;
     ensure_dependencies(root)?;
@@ -57,11 +56,9 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<String> {
         // The radar's map: the telemetry of a scripted walk, replayed.
         replay(root, &shots)?,
     ];
-    Ok(format!(
-        "{}; {:.0} s",
-        report.join("; "),
-        start.elapsed().as_secs_f64()
-    ))
+    let seconds = start.elapsed().as_secs_f64();
+    println!("{}; {seconds:.0} s", report.join("; "));
+    Ok(())
 }
 
 /// Serves the page, bridged to `bridge` if given, and runs one browser

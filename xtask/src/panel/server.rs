@@ -82,12 +82,8 @@ impl Drop for Server {
 }
 
 fn serve(mut request: Request, panel: &Path, bridge: Option<Arc<Bridge>>) {
-    let path = request
-        .url()
-        .split(['?', '#'])
-        .next()
-        .unwrap_or_default()
-        .to_owned();
+    let url = request.url();
+    let path = url.split(['?', '#']).next().unwrap_or(url).to_owned();
     let text = |status, body: &str| Response::from_string(body).with_status_code(status);
     let answer = match (request.method(), path.as_str(), bridge) {
         (Method::Get, "/events", Some(bridge)) => {

@@ -107,14 +107,8 @@ impl Args {
                 None => axis.name().to_owned(),
             };
             let spec = |axis: Axis| {
-                (
-                    LoopSpec {
-                        axis,
-                        n,
-                        cfg: *DEFAULT_HEAD.axis(axis),
-                    },
-                    stem(axis),
-                )
+                let cfg = *DEFAULT_HEAD.axis(axis);
+                (LoopSpec { axis, n, cfg }, stem(axis))
             };
             Axis::ALL.map(spec).into()
         };

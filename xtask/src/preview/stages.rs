@@ -48,26 +48,22 @@ pub fn closure_name(closure: Closure) -> &'static str {
     }
 }
 
-/// The paper closure's open walk in degrees: u(0) = 0, u(n) = u(n−1) ± δ with
-/// the sign of r(n).
-pub fn paper_walk(seed: u32, n: usize, delta: f64) -> Vec<f64> {
+/// The closure's walk in degrees. Paper: the open walk u(0) = 0, u(n) =
+/// u(n−1) ± δ with the sign of r(n). Seamless: the periodic walk, e(k) = ±1
+/// from r(k+1), walk(n) = δ·Σ_{k≤n} (e(k) − D/N) with D = Σ e; walk(N−1) = 0.
+fn walk(closure: Closure, seed: u32, n: usize, delta: f64) -> Vec<f64> {
     let mut lcg = Lcg::new(seed);
-    let steps = (1..n).map(|_| f64::from(step_of(lcg.next_value())) * delta);
-    let walk = steps.scan(0.0, |u, step| {
-        *u += step;
-        Some(*u)
-    });
-    std::iter::once(0.0).chain(walk).take(n).collect()
-}
-
-/// The seamless closure's periodic walk in degrees: e(k) = ±1 from r(k+1),
-/// walk(n) = δ·Σ_{k≤n} (e(k) − D/N) with D = Σ e; walk(N−1) = 0.
-pub fn seamless_walk(seed: u32, n: usize, delta: f64) -> Vec<f64> {
-    let mut lcg = Lcg::new(seed);
-    let steps: Vec<f64> = (0..n)
+    let mut steps: Vec<f64> = (0..n)
         .map(|_| f64::from(step_of(lcg.next_value())))
         .collect();
-    let drift = steps.iter().sum::<f64>() / n as f64;
+    let drift = match closure {
+        Closure::Paper => {
+            steps.insert(0, 0.0);
+            steps.truncate(n);
+            0.0
+        }
+        Closure::Seamless => steps.iter().sum::<f64>() / n as f64,
+    };
     let walk = steps.iter().scan(0.0, |u, e| {
         *u += (e - drift) * delta;
         Some(*u)
@@ -138,10 +134,7 @@ impl Stages {
             .map_err(|error| AxisError { axis, error })?;
 
         let delta = deg(cfg.step);
-        let walk = match cfg.closure {
-            Closure::Paper => paper_walk(cfg.seed, n, delta),
-            Closure::Seamless => seamless_walk(cfg.seed, n, delta),
-        };
+        let walk = walk(cfg.closure, cfg.seed, n, delta);
         let smoothed: Vec<f64> = recorder.0.iter().map(|s| s * delta).collect();
         let shift = mean(&walk) - mean(&smoothed);
         let smoothed: Vec<f64> = smoothed.iter().map(|s| s + shift).collect();
@@ -332,21 +325,18 @@ mod tests {
     #[test]
     fn the_walks_normalisation_and_taper() {
         // The paper's walk steps by the top bit of r(n).
-        let walk = paper_walk(127, 6, 0.5);
+        let paper = walk(Closure::Paper, 127, 6, 0.5);
         let mut lcg = Lcg::new(127);
-        assert_eq!(walk[0], 0.0);
+        assert_eq!(paper[0], 0.0);
         for i in 1..6 {
-            let step = if lcg.next_value() >= 1 << 31 {
-                0.5
-            } else {
-                -0.5
-            };
-            assert_eq!(walk[i] - walk[i - 1], step);
+            let up = lcg.next_value() >= 1 << 31;
+            let step = if up { 0.5 } else { -0.5 };
+            assert_eq!(paper[i] - paper[i - 1], step);
         }
         // The seamless walk is periodic; its first step e(0) − D/N, e(0) from r(1).
-        let walk = seamless_walk(8821, 900, 1.0);
-        assert!(walk[899].abs() < 1e-9, "ends at zero: {}", walk[899]);
-        assert!((walk[0] - f64::from(step_of(Lcg::new(8821).next_value()))).abs() < 1.0);
+        let looped = walk(Closure::Seamless, 8821, 900, 1.0);
+        assert!(looped[899].abs() < 1e-9, "ends at zero: {}", looped[899]);
+        assert!((looped[0] - f64::from(step_of(Lcg::new(8821).next_value()))).abs() < 1.0);
         assert_eq!(normalize(&[2.0, 4.0, 3.0], -4.0, 12.0), [-4.0, 12.0, 4.0]);
         assert_eq!(normalize(&[1.0, 1.0], -1.0, 1.0), [-1.0, -1.0]);
         let h = taper(5);
