@@ -8,9 +8,19 @@ use std::path::{Path, PathBuf};
 /// The folders whose comments are scanned.
 pub const SCANNED: [&str; 5] = ["crates", "src", "boards", "host-tests", "xtask"];
 
-/// How a path a comment names starts: a folder at the repository's top
-/// (separated by spaces).
-const PREFIXES: &str = "crates/ src/ docs/ boards/ host-tests/ xtask/ sim/ panel/ .cargo/ .ci/";
+/// How a path a comment names starts: a folder at the repository's top.
+const PREFIXES: [&str; 10] = [
+    "crates/",
+    "src/",
+    "docs/",
+    "boards/",
+    "host-tests/",
+    "xtask/",
+    "sim/",
+    "panel/",
+    ".cargo/",
+    ".ci/",
+];
 
 /// How a path a comment names ends, if it names a file.
 const EXTENSIONS: [&str; 13] = [
@@ -32,7 +42,7 @@ pub fn paths_in(text: &str) -> Vec<&str> {
     text.split(|c: char| !is_path_char(c))
         .map(|word| word.trim_end_matches(['.', ',']))
         .filter(|word| {
-            PREFIXES.split(' ').any(|p| word.starts_with(p))
+            PREFIXES.iter().any(|p| word.starts_with(p))
                 && !word.contains("...")
                 && (word.ends_with('/') || EXTENSIONS.iter().any(|e| word.ends_with(e)))
         })

@@ -284,8 +284,14 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
     if !rows.is_empty() {
         let intro = "RAM: static RAM plus the deepest the stack went, measured by painting it \
                      ([Memory](memory.md#how-the-stack-is-measured)).";
-        let header = "image|stack measured in|static RAM|peak stack|total|of the ceiling";
-        let header: Vec<&str> = header.split('|').collect();
+        let header = [
+            "image",
+            "stack measured in",
+            "static RAM",
+            "peak stack",
+            "total",
+            "of the ceiling",
+        ];
         figures::record("ram", intro.to_owned(), &header, rows);
     }
     let pico =

@@ -268,7 +268,11 @@ mod tests {
         let board = Board::Pico2;
         assert!(run(&Args { board, elf, rest }, &here).unwrap());
         let passed = std::fs::read_to_string(log).unwrap();
-        assert_eq!(passed, "run\n--chip\nRP235x\npico2\n--no-location\n");
+        let passed: Vec<&str> = passed.lines().collect();
+        assert_eq!(
+            passed,
+            ["run", "--chip", "RP235x", "pico2", "--no-location"]
+        );
         let mounts = mount_with("RP2350", PICO2_INFO);
         let drive = Surroundings {
             mounts: vec![mounts.path().to_owned()],

@@ -181,7 +181,13 @@ mod tests {
         ] {
             assert_eq!(content_type(Path::new(file)), Some(kind), "{file}");
         }
-        for file in "package.json package-lock.json browser.mjs tests .html".split(' ') {
+        for file in [
+            "package.json",
+            "package-lock.json",
+            "browser.mjs",
+            "tests",
+            ".html",
+        ] {
             assert_eq!(content_type(Path::new(file)), None, "{file}");
         }
         let files = page_files(&project::root()).unwrap();
