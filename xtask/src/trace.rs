@@ -31,7 +31,7 @@ use idle_head_firmware::config::IDLE_MODE;
 use host::Origin;
 pub use host::Watch;
 use marks::Mark;
-pub use script::{Event, Kind, parse as parse_script};
+pub use script::{Event, Kind, parse as parse_script, show_seconds};
 
 use crate::{project, steps::Steps};
 
