@@ -69,15 +69,9 @@ pub enum Echo {
 pub fn qemu_command(elf: &Path, sleep: bool, args: &[&str]) -> Command {
     let icount = format!("shift=0,sleep={}", if sleep { "on" } else { "off" });
     let mut command = Command::new(QEMU_BINARY);
-    command.args([
-        "-machine",
-        "lm3s6965evb",
-        "-cpu",
-        "cortex-m0",
-        "-icount",
-        &icount,
-    ]);
-    command.args(args).arg("-kernel").arg(elf);
+    command.args(["-machine", "lm3s6965evb", "-cpu", "cortex-m0"]);
+    command.args(["-icount", &icount]).args(args);
+    command.arg("-kernel").arg(elf);
     command
 }
 
