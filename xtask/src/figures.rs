@@ -62,14 +62,11 @@ pub fn kib(value: u64) -> String {
 
 /// `part` bytes against a ceiling, if there is one: `62 % of 196,608 B`.
 pub fn of_ceiling(part: u64, ceiling: Option<u64>) -> String {
-    let of = |whole: u64| {
-        format!(
-            "{:.0} % of {}",
-            part as f64 / whole.max(1) as f64 * 100.0,
-            bytes(whole)
-        )
+    let Some(whole) = ceiling else {
+        return "no ceiling".to_owned();
     };
-    ceiling.map_or_else(|| "no ceiling".to_owned(), of)
+    let percent = part as f64 / whole.max(1) as f64 * 100.0;
+    format!("{percent:.0} % of {}", bytes(whole))
 }
 
 /// Prints the table `key` (`intro`, Markdown, above it) and writes it into
