@@ -416,21 +416,15 @@ const INSNS_PER_COUNT: u64 = 80;
 /// fade-out starts at frame 1800, a line every 20 frames.
 const LINES: usize = 80;
 
-/// The console's input: `watch 50`, then nothing until [`LINES`] telemetry
+/// The console's input after `watch 50`: nothing until [`LINES`] telemetry
 /// lines came (or the deadline passed), then the end (the host hangs up).
 struct Streaming<'a> {
-    sent: bool,
     seen: &'a AtomicUsize,
     deadline: Instant,
 }
 
 impl Read for Streaming<'_> {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        if !std::mem::replace(&mut self.sent, true) {
-            let line = b"watch 50\n";
-            buf[..line.len()].copy_from_slice(line);
-            return Ok(line.len());
-        }
+    fn read(&mut self, _: &mut [u8]) -> std::io::Result<usize> {
         while self.seen.load(Ordering::Acquire) < LINES && Instant::now() < self.deadline {
             std::thread::sleep(Duration::from_millis(5));
         }
@@ -463,11 +457,11 @@ fn telemetry_check(elf: &Path, timeout: Duration, plain: Option<&Run>) -> Result
         None => frame_work(&qemu::run(elf, timeout, Echo::Problems)?.log)?,
     };
     let seen = AtomicUsize::new(0);
-    let input = Streaming {
-        sent: false,
+    let deadline = Instant::now() + timeout;
+    let input = b"watch 50\n".chain(Streaming {
         seen: &seen,
-        deadline: Instant::now() + timeout,
-    };
+        deadline,
+    });
     let mut count = |line: &[u8]| {
         if line.starts_with(b"~ ") {
             seen.fetch_add(1, Ordering::AcqRel);
