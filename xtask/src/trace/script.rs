@@ -104,25 +104,21 @@ fn event(line: usize, text: &str, params: &BehaviourParams) -> Result<Event, Str
         .map(|(t, c)| (t, c.trim()))
         .ok_or_else(|| format!("`{text}`: expected `<seconds> <command>`"))?;
     let at_us = seconds(time).map_err(|e| e.to_string())?;
-    let radar = command
-        .strip_prefix("radar")
-        .filter(|rest| rest.starts_with(char::is_whitespace))
-        .map(str::trim)
-        .filter(|rest| *rest == "none" || rest.contains(','));
-    let pin = (command.strip_prefix("pin")).filter(|rest| rest.starts_with(char::is_whitespace));
-    let kind = if let Some(pin) = pin {
-        self::pin(pin.trim())?
-    } else if let Some(people) = radar {
-        self::radar(people)?
-    } else {
-        match console::parse(command.as_bytes()) {
+    let (word, rest) = command
+        .split_once(char::is_whitespace)
+        .unwrap_or((command, ""));
+    let rest = rest.trim();
+    let kind = match word {
+        "pin" if !rest.is_empty() => pin(rest)?,
+        "radar" if rest == "none" || rest.contains(',') => radar(rest)?,
+        _ => match console::parse(command.as_bytes()) {
             Ok(Command::Act(action)) => {
                 params.check(&action).map_err(|e| e.to_string())?;
                 Kind::Act(action)
             }
             Ok(_) => Kind::Console,
             Err(e) => return Err(e.describe(command.as_bytes()).to_string()),
-        }
+        },
     };
     Ok(Event {
         line,
