@@ -39,15 +39,10 @@ const MARK: (&str, &str) = ("<!-- figures: ", " -->");
 
 /// `1234567` as `1,234,567`.
 pub fn thousands(value: u64) -> String {
-    let digits = value.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
+    match value {
+        0..1000 => value.to_string(),
+        _ => format!("{},{:03}", thousands(value / 1000), value % 1000),
     }
-    out
 }
 
 /// `value` bytes, with separators.
