@@ -86,11 +86,10 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
     let words = std::iter::once(command.get_program()).chain(command.get_args());
     let words: Vec<_> = words.map(|w| w.to_string_lossy()).collect();
     println!("$ {}", words.join(" "));
-    let piped = command
+    let child = command
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    let child = piped
+        .stderr(Stdio::piped())
         .spawn()
         .with_context(|| format!("could not start {QEMU_BINARY}"))?;
     Ok(finish(child, elf, timeout, echo, || ())?.0)
@@ -134,15 +133,8 @@ pub fn finish<R>(
         }
     };
     let done = project::finish(child, QEMU_BINARY, timeout, decode, forward, meanwhile)?;
-    let elapsed = start.elapsed();
-    Ok((
-        Run {
-            log: done.stdout,
-            exit: done.exit,
-            elapsed,
-        },
-        done.meanwhile,
-    ))
+    let (log, exit, elapsed) = (done.stdout, done.exit, start.elapsed());
+    Ok((Run { log, exit, elapsed }, done.meanwhile))
 }
 
 /// Checks the summary line: no missed frame, no pulse violation, and the
