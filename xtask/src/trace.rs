@@ -349,11 +349,8 @@ pub fn command(args: &Args) -> Result<bool> {
     println!("wrote {} ({} frames)", out.display(), trace.rows.len());
     if let (Some(path), Some(watch)) = (&args.telemetry, &trace.watch) {
         project::write(path, watch.lines.join("\n") + "\n")?;
-        let (lines, hz) = (watch.lines.len(), args.watch);
-        println!(
-            "wrote {} ({lines} telemetry lines, {hz} a second)",
-            path.display()
-        );
+        let (path, lines, hz) = (path.display(), watch.lines.len(), args.watch);
+        println!("wrote {path} ({lines} telemetry lines, {hz} a second)");
     }
     if let Some(png) = &args.png {
         let png = png.clone().map_or_else(|| default("trace.png"), Ok)?;
