@@ -101,19 +101,17 @@ pub struct Trace {
     pub answers: Vec<String>,
 }
 
-/// A PWM channel that keeps the last duty, counted as the Pico's slice
-/// counts its period.
+/// A PWM channel counted as the Pico's slice counts its period (the duty
+/// written is the frame's report's, which the trace keeps).
 #[derive(Clone, Copy)]
-struct Channel {
-    duty: u16,
-    clock: SliceClock,
-}
+struct Channel(SliceClock);
 
 impl Channel {
     fn at(period: Microseconds) -> Result<Self> {
-        let clock = SliceClock::for_period(PICO_SYS_HZ, period)
-            .map_err(|_| anyhow!("no Pico clock for {} µs", period.0))?;
-        Ok(Self { duty: 0, clock })
+        let clock = SliceClock::for_period(PICO_SYS_HZ, period);
+        clock
+            .map(Self)
+            .map_err(|_| anyhow!("no Pico clock for {} µs", period.0))
     }
 }
 
@@ -123,18 +121,17 @@ impl embedded_hal::pwm::ErrorType for Channel {
 
 impl embedded_hal::pwm::SetDutyCycle for Channel {
     fn max_duty_cycle(&self) -> u16 {
-        self.clock.top
+        self.0.top
     }
 
-    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Self::Error> {
-        self.duty = duty;
+    fn set_duty_cycle(&mut self, _: u16) -> Result<(), Self::Error> {
         Ok(())
     }
 }
 
 impl SetPeriod for Channel {
     fn set_period(&mut self, period: Microseconds) -> Result<(), Self::Error> {
-        self.clock = SliceClock::for_period(PICO_SYS_HZ, period)
+        self.0 = SliceClock::for_period(PICO_SYS_HZ, period)
             .map_err(|_| embedded_hal::pwm::ErrorKind::Other)?;
         Ok(())
     }
@@ -275,7 +272,7 @@ pub fn simulate_watched(
         if let Some(watch) = watch.as_mut() {
             watch.frame(t_us, &status);
         }
-        let count_ps = driver.channels_mut()[0].clock.count_ps(PICO_SYS_HZ);
+        let count_ps = driver.channels_mut()[0].0.count_ps(PICO_SYS_HZ);
         let servos = report.servos;
         rows.push(Row {
             t_us,
