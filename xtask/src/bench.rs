@@ -261,11 +261,8 @@ impl FrameRow {
     pub fn label(&self) -> String {
         let scenario = (self.scenario.as_ref()).map(|s| format!(" ({})", s.replace('+', " + ")));
         let rate = (self.rate != 50).then(|| format!(" at {} Hz", self.rate));
-        format!(
-            "frame{}{}",
-            scenario.unwrap_or_default(),
-            rate.unwrap_or_default()
-        )
+        let (scenario, rate) = (scenario.unwrap_or_default(), rate.unwrap_or_default());
+        format!("frame{scenario}{rate}")
     }
 
     /// The share of the CPU the frame update takes at the row's rate, %:

@@ -160,12 +160,8 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
     let sync = Duration::from_nanos((t0 + (k + 0.5) * frame) as u64);
     let clock_ms = (k * frame / 1e6).round() as u64;
     // The curves' starts, whole ms after the sync's clock.
-    let times = schedule(
-        Duration::from_secs(4),
-        SCHEDULED + 1,
-        CURVE_GAP,
-        0xb077_a160,
-    );
+    let after = Duration::from_secs(4);
+    let times = schedule(after, SCHEDULED + 1, CURVE_GAP, 0xb077_a160);
     let ms_after = |at: Duration| ((at.as_secs_f64() * 1e9 - t0) / 1e6).round() as u64 - clock_ms;
     let setup = bottango_lines(&["hRQ,144", "rMTR,yaw,-20000,20000,3000,4096"]);
     let mut chunks = vec![
@@ -182,11 +178,8 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
             (4096 + STEP, 4096)
         };
         let step = format!("sC,yaw,{start},40,{from},0,{},{to},0,0", to - from);
-        let hold = format!(
-            "sC,yaw,{},{},{to},0,0,{to},0,0",
-            start + 40,
-            next - start - 40
-        );
+        let (at, held) = (start + 40, next - start - 40);
+        let hold = format!("sC,yaw,{at},{held},{to},0,0,{to},0,0");
         let lines = bottango_lines(&[&step, &hold]);
         chunks.push(Chunk::new(lines, pair[0].saturating_sub(AHEAD)));
         events.push(t0 + (clock_ms + start) as f64 * 1e6);
