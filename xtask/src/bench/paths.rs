@@ -178,8 +178,8 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
             (4096 + STEP, 4096)
         };
         let step = format!("sC,yaw,{start},40,{from},0,{},{to},0,0", to - from);
-        let (at, held) = (start + 40, next - start - 40);
-        let hold = format!("sC,yaw,{at},{held},{to},0,0,{to},0,0");
+        let (at, ms) = (start + 40, next - start - 40);
+        let hold = format!("sC,yaw,{at},{ms},{to},0,0,{to},0,0");
         let lines = bottango_lines(&[&step, &hold]);
         chunks.push(Chunk::new(lines, pair[0].saturating_sub(AHEAD)));
         events.push(t0 + (clock_ms + start) as f64 * 1e6);

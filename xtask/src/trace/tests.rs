@@ -148,11 +148,8 @@ fn a_presence_script_rests_relaxes_wakes_and_glances() {
     // Then the glance towards the sensor: yaw at −20° (the idle's
     // ducked sway aside), held about 2 s, then back.
     let near = |ms: u64| (at(ms).angles[2] + 20_000).abs() < 2500;
-    let held: Vec<u64> = (13_000..17_000)
-        .step_by(20)
-        .filter(|&ms| near(ms))
-        .collect();
-    assert!(held.len() >= 100, "{} frames near -20°", held.len());
+    let held = (13_000..17_000).step_by(20).filter(|&ms| near(ms)).count();
+    assert!(held >= 100, "{held} frames near -20°");
     assert!(!near(19_000));
     let wake = trace.marks.iter().find(|m| m.reply.starts_with("ok wake"));
     let wake = wake.unwrap();
