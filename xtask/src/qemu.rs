@@ -214,11 +214,8 @@ pub fn record_figures(log: &[LogLine]) {
         let discarded = rest
             .split_once('(')
             .and_then(|(_, a)| a.split_once(" discarded)"));
-        Some(row(
-            set.to_owned(),
-            insns,
-            discarded.map_or("", |d| d.0).to_owned(),
-        ))
+        let discarded = discarded.map_or("", |d| d.0).to_owned();
+        Some(row(set.to_owned(), insns, discarded))
     });
     let intro = "The QEMU smoke run's loop sets ([never-repeating idle](idle.md#in-the-background)): \
                  the boot's set 0, timed before the first frame, and the sets generated in the \
