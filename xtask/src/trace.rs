@@ -108,10 +108,9 @@ struct Channel(SliceClock);
 
 impl Channel {
     fn at(period: Microseconds) -> Result<Self> {
-        let clock = SliceClock::for_period(PICO_SYS_HZ, period);
-        clock
-            .map(Self)
-            .map_err(|_| anyhow!("no Pico clock for {} µs", period.0))
+        let clock = SliceClock::for_period(PICO_SYS_HZ, period)
+            .map_err(|_| anyhow!("no Pico clock for {} µs", period.0))?;
+        Ok(Self(clock))
     }
 }
 

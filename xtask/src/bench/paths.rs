@@ -53,13 +53,13 @@ fn all_ok(replies: &[u8], what: &str) -> Result<()> {
     }
 }
 
-/// A path's run: the project, the wall time it may take.
-type Run<'a> = (&'a Path, &'a Metadata, Duration);
+/// Where and how long the shipped image runs: the project, the wall time.
+type Shipped<'a> = (&'a Path, &'a Metadata, Duration);
 
 /// The first boot of the shipped image, set up by `setup`, run until 0.5 s
 /// after `last`.
 fn first_boot(
-    (root, metadata, wall): Run,
+    (root, metadata, wall): Shipped,
     last: Duration,
     setup: impl FnOnce(&mut node::Config),
 ) -> Result<Boot> {
@@ -69,7 +69,7 @@ fn first_boot(
 }
 
 /// [`first_boot`] with `chunks` sent to the USB port, every reply `ok`.
-fn usb_run(run: Run, last: Duration, chunks: Vec<Chunk>, what: &str) -> Result<Boot> {
+fn usb_run(run: Shipped, last: Duration, chunks: Vec<Chunk>, what: &str) -> Result<Boot> {
     let boot = first_boot(run, last, |config| config.usb = chunks)?;
     all_ok(&boot.usb, what)?;
     Ok(boot)
@@ -114,7 +114,7 @@ pub fn uart_look_200_hz(root: &Path, metadata: &Metadata, wall: Duration) -> Res
 /// A run of `look` lines over UART0 at times seeded by `seed` after `setup`
 /// (one or more lines, at 2.5 s): each line's arrival, and the boot, every
 /// line answered `ok`.
-fn uart_looks(run: Run, setup: &[u8], seed: u32) -> Result<(Vec<f64>, Boot)> {
+fn uart_looks(run: Shipped, setup: &[u8], seed: u32) -> Result<(Vec<f64>, Boot)> {
     let times = schedule(Duration::from_secs(4), SCHEDULED, LOOK_GAP, seed);
     let mut scripts = vec![UartScript::new(0, setup, Duration::from_millis(2500))];
     scripts.extend(times.iter().enumerate().map(|(k, &at)| {
@@ -125,8 +125,8 @@ fn uart_looks(run: Run, setup: &[u8], seed: u32) -> Result<(Vec<f64>, Boot)> {
     let last = times.last().copied().unwrap_or_default();
     let boot = first_boot(run, last, |config| config.uart = scripts)?;
     // One script for the setup, one for each look.
-    let (sent, scripts) = (boot.uart_lines.len(), times.len() + 1);
-    count(sent, scripts, "UART scripts went out")?;
+    let (sent, want) = (boot.uart_lines.len(), times.len() + 1);
+    count(sent, want, "UART scripts went out")?;
     all_ok(&boot.uart, "uart look")?;
     Ok((boot.uart_lines.iter().skip(1).copied().collect(), boot))
 }
