@@ -127,11 +127,9 @@ impl Verdict {
             row.map(|row| row.engine as f64)
                 .with_context(|| format!("the benchmark reported no `{label}` row"))
         };
-        let w = [engine("w15")?, engine("w59")?, engine("w239")?];
+        let [w15, w59, w239] = [engine("w15")?, engine("w59")?, engine("w239")?];
         let [n450, n900, n1800] = [engine("n450")?, engine("n900")?, engine("n1800")?];
-        let (max, min) = w
-            .iter()
-            .fold((0.0_f64, f64::MAX), |(hi, lo), &e| (hi.max(e), lo.min(e)));
+        let (max, min) = (w15.max(w59).max(w239), w15.min(w59).min(w239));
         Ok(Self {
             default: engine("default")? as u64,
             flatness: max / min.max(1.0),
@@ -192,7 +190,7 @@ pub const IDLE_MEDIAN_AT_333_HZ: u64 = 1300;
 
 /// A `frame bench ...` line: instructions per frame update over a loop at
 /// the servo rate `rate` (Hz; 50 in a log without `rate=`), with `scenario`
-/// playing over the idle (if any); `max_at` is the frame that took `max`.
+/// playing over the idle (if any); the line's `max_at` is not kept.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FrameRow {
     pub rate: u64,
@@ -201,7 +199,6 @@ pub struct FrameRow {
     pub min: u64,
     pub median: u64,
     pub max: u64,
-    pub max_at: u64,
     pub mean: u64,
 }
 
@@ -213,8 +210,8 @@ impl FrameRow {
             .iter()
             .filter_map(|l| l.message.strip_prefix("frame bench "));
         let row = |m: &str| -> Result<Self> {
-            let keys = ["frames", "min", "median", "max", "max_at", "mean"];
-            let [frames, min, median, max, max_at, mean] = numbers(m, keys)?;
+            let keys = ["frames", "min", "median", "max", "mean"];
+            let [frames, min, median, max, mean] = numbers(m, keys)?;
             let rate = field(m, "rate").map_or(Ok(50), |_| number(m, "rate"))?;
             let scenario = field(m, "scenario").map(str::to_owned);
             Ok(Self {
@@ -224,7 +221,6 @@ impl FrameRow {
                 min,
                 median,
                 max,
-                max_at,
                 mean,
             })
         };
@@ -265,11 +261,8 @@ impl FrameRow {
     pub fn label(&self) -> String {
         let scenario = (self.scenario.as_ref()).map(|s| format!(" ({})", s.replace('+', " + ")));
         let rate = (self.rate != 50).then(|| format!(" at {} Hz", self.rate));
-        format!(
-            "frame{}{}",
-            scenario.unwrap_or_default(),
-            rate.unwrap_or_default()
-        )
+        let (scenario, rate) = (scenario.unwrap_or_default(), rate.unwrap_or_default());
+        format!("frame{scenario}{rate}")
     }
 
     /// The share of the CPU the frame update takes at the row's rate, %:
@@ -420,21 +413,15 @@ const INSNS_PER_COUNT: u64 = 80;
 /// fade-out starts at frame 1800, a line every 20 frames.
 const LINES: usize = 80;
 
-/// The console's input: `watch 50`, then nothing until [`LINES`] telemetry
+/// The console's input after `watch 50`: nothing until [`LINES`] telemetry
 /// lines came (or the deadline passed), then the end (the host hangs up).
 struct Streaming<'a> {
-    sent: bool,
     seen: &'a AtomicUsize,
     deadline: Instant,
 }
 
 impl Read for Streaming<'_> {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        if !std::mem::replace(&mut self.sent, true) {
-            let line = b"watch 50\n";
-            buf[..line.len()].copy_from_slice(line);
-            return Ok(line.len());
-        }
+    fn read(&mut self, _: &mut [u8]) -> std::io::Result<usize> {
         while self.seen.load(Ordering::Acquire) < LINES && Instant::now() < self.deadline {
             std::thread::sleep(Duration::from_millis(5));
         }
@@ -467,11 +454,11 @@ fn telemetry_check(elf: &Path, timeout: Duration, plain: Option<&Run>) -> Result
         None => frame_work(&qemu::run(elf, timeout, Echo::Problems)?.log)?,
     };
     let seen = AtomicUsize::new(0);
-    let input = Streaming {
-        sent: false,
+    let deadline = Instant::now() + timeout;
+    let input = b"watch 50\n".chain(Streaming {
         seen: &seen,
-        deadline: Instant::now() + timeout,
-    };
+        deadline,
+    });
     let mut count = |line: &[u8]| {
         if line.starts_with(b"~ ") {
             seen.fetch_add(1, Ordering::AcqRel);

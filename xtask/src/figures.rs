@@ -39,15 +39,10 @@ const MARK: (&str, &str) = ("<!-- figures: ", " -->");
 
 /// `1234567` as `1,234,567`.
 pub fn thousands(value: u64) -> String {
-    let digits = value.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
+    match value {
+        0..1000 => value.to_string(),
+        _ => format!("{},{:03}", thousands(value / 1000), value % 1000),
     }
-    out
 }
 
 /// `value` bytes, with separators.
@@ -62,14 +57,11 @@ pub fn kib(value: u64) -> String {
 
 /// `part` bytes against a ceiling, if there is one: `62 % of 196,608 B`.
 pub fn of_ceiling(part: u64, ceiling: Option<u64>) -> String {
-    let of = |whole: u64| {
-        format!(
-            "{:.0} % of {}",
-            part as f64 / whole.max(1) as f64 * 100.0,
-            bytes(whole)
-        )
+    let Some(whole) = ceiling else {
+        return "no ceiling".to_owned();
     };
-    ceiling.map_or_else(|| "no ceiling".to_owned(), of)
+    let percent = part as f64 / whole.max(1) as f64 * 100.0;
+    format!("{percent:.0} % of {}", bytes(whole))
 }
 
 /// Prints the table `key` (`intro`, Markdown, above it) and writes it into

@@ -69,15 +69,9 @@ pub enum Echo {
 pub fn qemu_command(elf: &Path, sleep: bool, args: &[&str]) -> Command {
     let icount = format!("shift=0,sleep={}", if sleep { "on" } else { "off" });
     let mut command = Command::new(QEMU_BINARY);
-    command.args([
-        "-machine",
-        "lm3s6965evb",
-        "-cpu",
-        "cortex-m0",
-        "-icount",
-        &icount,
-    ]);
-    command.args(args).arg("-kernel").arg(elf);
+    command.args(["-machine", "lm3s6965evb", "-cpu", "cortex-m0"]);
+    command.args(["-icount", &icount]).args(args);
+    command.arg("-kernel").arg(elf);
     command
 }
 
@@ -92,11 +86,10 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
     let words = std::iter::once(command.get_program()).chain(command.get_args());
     let words: Vec<_> = words.map(|w| w.to_string_lossy()).collect();
     println!("$ {}", words.join(" "));
-    let piped = command
+    let child = command
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    let child = piped
+        .stderr(Stdio::piped())
         .spawn()
         .with_context(|| format!("could not start {QEMU_BINARY}"))?;
     Ok(finish(child, elf, timeout, echo, || ())?.0)
@@ -140,15 +133,8 @@ pub fn finish<R>(
         }
     };
     let done = project::finish(child, QEMU_BINARY, timeout, decode, forward, meanwhile)?;
-    let elapsed = start.elapsed();
-    Ok((
-        Run {
-            log: done.stdout,
-            exit: done.exit,
-            elapsed,
-        },
-        done.meanwhile,
-    ))
+    let (log, exit, elapsed) = (done.stdout, done.exit, start.elapsed());
+    Ok((Run { log, exit, elapsed }, done.meanwhile))
 }
 
 /// Checks the summary line: no missed frame, no pulse violation, and the
@@ -228,11 +214,8 @@ pub fn record_figures(log: &[LogLine]) {
         let discarded = rest
             .split_once('(')
             .and_then(|(_, a)| a.split_once(" discarded)"));
-        Some(row(
-            set.to_owned(),
-            insns,
-            discarded.map_or("", |d| d.0).to_owned(),
-        ))
+        let discarded = discarded.map_or("", |d| d.0).to_owned();
+        Some(row(set.to_owned(), insns, discarded))
     });
     let intro = "The QEMU smoke run's loop sets ([never-repeating idle](idle.md#in-the-background)): \
                  the boot's set 0, timed before the first frame, and the sets generated in the \

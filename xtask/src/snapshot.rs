@@ -26,11 +26,8 @@ pub fn bless(run: &Run) -> Result<()> {
     } else {
         "already matches this run"
     };
-    println!(
-        "{} {done} ({} lines)",
-        project::relative(&path).display(),
-        run.log.len()
-    );
+    let (path, lines) = (project::relative(&path), run.log.len());
+    println!("{} {done} ({lines} lines)", path.display());
     Ok(())
 }
 

@@ -31,7 +31,7 @@ use idle_head_firmware::config::IDLE_MODE;
 use host::Origin;
 pub use host::Watch;
 use marks::Mark;
-pub use script::{Event, Kind, parse as parse_script};
+pub use script::{Event, Kind, parse as parse_script, show_seconds};
 
 use crate::{project, steps::Steps};
 
@@ -101,19 +101,16 @@ pub struct Trace {
     pub answers: Vec<String>,
 }
 
-/// A PWM channel that keeps the last duty, counted as the Pico's slice
-/// counts its period.
+/// A PWM channel counted as the Pico's slice counts its period (the duty
+/// written is the frame's report's, which the trace keeps).
 #[derive(Clone, Copy)]
-struct Channel {
-    duty: u16,
-    clock: SliceClock,
-}
+struct Channel(SliceClock);
 
 impl Channel {
     fn at(period: Microseconds) -> Result<Self> {
         let clock = SliceClock::for_period(PICO_SYS_HZ, period)
             .map_err(|_| anyhow!("no Pico clock for {} µs", period.0))?;
-        Ok(Self { duty: 0, clock })
+        Ok(Self(clock))
     }
 }
 
@@ -123,18 +120,17 @@ impl embedded_hal::pwm::ErrorType for Channel {
 
 impl embedded_hal::pwm::SetDutyCycle for Channel {
     fn max_duty_cycle(&self) -> u16 {
-        self.clock.top
+        self.0.top
     }
 
-    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Self::Error> {
-        self.duty = duty;
+    fn set_duty_cycle(&mut self, _: u16) -> Result<(), Self::Error> {
         Ok(())
     }
 }
 
 impl SetPeriod for Channel {
     fn set_period(&mut self, period: Microseconds) -> Result<(), Self::Error> {
-        self.clock = SliceClock::for_period(PICO_SYS_HZ, period)
+        self.0 = SliceClock::for_period(PICO_SYS_HZ, period)
             .map_err(|_| embedded_hal::pwm::ErrorKind::Other)?;
         Ok(())
     }
@@ -275,7 +271,7 @@ pub fn simulate_watched(
         if let Some(watch) = watch.as_mut() {
             watch.frame(t_us, &status);
         }
-        let count_ps = driver.channels_mut()[0].clock.count_ps(PICO_SYS_HZ);
+        let count_ps = driver.channels_mut()[0].0.count_ps(PICO_SYS_HZ);
         let servos = report.servos;
         rows.push(Row {
             t_us,
@@ -349,11 +345,8 @@ pub fn command(args: &Args) -> Result<bool> {
     println!("wrote {} ({} frames)", out.display(), trace.rows.len());
     if let (Some(path), Some(watch)) = (&args.telemetry, &trace.watch) {
         project::write(path, watch.lines.join("\n") + "\n")?;
-        let (lines, hz) = (watch.lines.len(), args.watch);
-        println!(
-            "wrote {} ({lines} telemetry lines, {hz} a second)",
-            path.display()
-        );
+        let (path, lines, hz) = (path.display(), watch.lines.len(), args.watch);
+        println!("wrote {path} ({lines} telemetry lines, {hz} a second)");
     }
     if let Some(png) = &args.png {
         let png = png.clone().map_or_else(|| default("trace.png"), Ok)?;

@@ -16,6 +16,7 @@ use crate::metrics::percentile;
 use crate::project::Metadata;
 use crate::sim::pulses::{self, Measured};
 use crate::sim::{Boot, dmx_line, parse_script, play_script, run_shipped, script_time};
+use crate::trace::show_seconds;
 
 /// Events per row, at least; more are scheduled, for the ones skipped.
 pub const EVENTS: usize = 1000;
@@ -60,22 +61,23 @@ impl Row {
         [0.5, 0.99, 1.0].map(|q| percentile(&self.ms, q))
     }
 
+    /// Whether p99 is within the goal.
+    fn met(&self) -> bool {
+        self.spread()[1] <= self.goal_ms
+    }
+
     /// The row for the measured figures: label, events, p50, p99, max, goal,
     /// the port tasks' longest wait.
     pub fn figure(&self) -> Vec<String> {
         let [p50, p99, max] = self.spread().map(|ms| format!("{ms:.1}"));
-        let missed = if self.spread()[1] <= self.goal_ms {
-            ""
-        } else {
-            " (missed)"
-        };
+        let missed = if self.met() { "" } else { " (missed)" };
         let waited =
             (self.waited_us).map_or_else(|| "not logged".to_owned(), |us| format!("{us} µs"));
-        let events = figures::thousands(self.ms.len() as u64);
+        let (name, events) = (format!("latency {}", self.name), self.ms.len() as u64);
         let goal = format!("{:.0}{missed}", self.goal_ms);
         vec![
-            format!("latency {}", self.name),
-            events,
+            name,
+            figures::thousands(events),
             p50,
             p99,
             max,
@@ -94,7 +96,7 @@ impl Row {
         let slowest: Vec<String> = (self.worst.iter())
             .map(|(at, ms)| format!("{ms:.1} ms at {at:.3} s"))
             .collect();
-        let met = if p99 <= self.goal_ms { "met" } else { "missed" };
+        let met = if self.met() { "met" } else { "missed" };
         let _ = writeln!(
             text,
             "  (ms; goal p99 ≤ {} ms: {met}; events per fifth of the frame: {:?}; slowest: {})",
@@ -102,7 +104,7 @@ impl Row {
             self.phases,
             slowest.join(", ")
         );
-        if p99 > self.goal_ms {
+        if !self.met() {
             text += "  (where the time goes: the wait for the next frame (0 to a frame), the \
                      PWM's latch to the next period (a tenth of one), and the transport before \
                      the frame)\n";
@@ -116,9 +118,8 @@ impl Row {
     /// The misses of the row's goals (p99 within its goal, the port tasks'
     /// wait within [`PORT_WAIT_US`]), if any.
     pub fn misses(&self) -> Option<String> {
-        let p99 = self.spread()[1];
-        let mut misses = Vec::new();
-        if p99.is_nan() || p99 > self.goal_ms {
+        let (p99, mut misses) = (self.spread()[1], Vec::new());
+        if !self.met() {
             misses.push(format!("p99 {p99:.1} ms over {} ms", self.goal_ms));
         }
         match self.waited_us {
@@ -301,7 +302,7 @@ fn press_script(times: &[Duration]) -> String {
     let mut text = String::from(
         "0 idle off\n0 input 2 button look 0 2000 100 hold=stay\n0 input 3 button look 0 0 100 hold=stay\n",
     );
-    let show = |at: Duration| format!("{}.{:06}", at.as_secs(), at.subsec_micros());
+    let show = |at: Duration| show_seconds(u64::try_from(at.as_micros()).unwrap_or(u64::MAX));
     for (k, &at) in times.iter().enumerate() {
         let (pin, press, release) = (2 + k % 2, show(at), show(at + HELD));
         let _ = writeln!(text, "{press} pin {pin} low\n{release} pin {pin} high");
@@ -333,43 +334,37 @@ mod tests {
 
     #[test]
     fn percentiles_goals_and_schedules() {
-        let row = Row {
+        let row = |ms: Vec<f64>, waited_us, goal_ms| Row {
             name: "x",
-            ms: (1..=200).map(f64::from).collect(),
+            ms,
             skipped: 0,
             phases: [0; 5],
             worst: Vec::new(),
-            waited_us: Some(300),
-            goal_ms: GOAL_MS,
+            waited_us,
+            goal_ms,
         };
-        assert_eq!(row.spread()[..2], [100.0, 198.0]);
-        let lines = row.lines();
+        let slow = row((1..=200).map(f64::from).collect(), Some(300), GOAL_MS);
+        assert_eq!(slow.spread()[..2], [100.0, 198.0]);
+        let lines = slow.lines();
         assert!(lines.starts_with("latency x p50=100.0 p99=198.0 max=200.0 events=200"));
-        assert!(row.lines().contains("where the time goes"));
-        assert_eq!(row.misses().unwrap(), "latency x: p99 198.0 ms over 25 ms");
-        let fast = Row {
-            ms: vec![10.0; 100],
-            ..row.clone()
-        };
+        assert!(lines.contains("where the time goes"));
+        assert_eq!(slow.misses().unwrap(), "latency x: p99 198.0 ms over 25 ms");
+        let fast = row(vec![10.0; 100], Some(300), GOAL_MS);
         assert_eq!(fast.misses(), None);
         assert!(!fast.lines().contains("where the time goes"));
-        let waited = Row {
-            waited_us: Some(1001),
-            ..fast.clone()
-        };
-        assert!(waited.misses().unwrap().contains("waited 1001 µs"));
-        let unlogged = Row {
-            waited_us: None,
-            ..fast.clone()
-        };
-        assert!(unlogged.misses().unwrap().contains("not logged"));
-        let at_200_hz = Row {
-            ms: vec![8.5; 100],
-            goal_ms: GOAL_200_HZ_MS,
-            ..fast
-        };
-        let misses = at_200_hz.misses().unwrap();
-        assert_eq!(misses, "latency x: p99 8.5 ms over 8 ms");
+        for (ms, waited, goal, miss) in [
+            (
+                10.0,
+                Some(1001),
+                GOAL_MS,
+                "a port task waited 1001 µs, over 1000 µs",
+            ),
+            (10.0, None, GOAL_MS, "the port tasks' wait was not logged"),
+            (8.5, Some(300), GOAL_200_HZ_MS, "p99 8.5 ms over 8 ms"),
+        ] {
+            let misses = row(vec![ms; 100], waited, goal).misses();
+            assert_eq!(misses.unwrap(), format!("latency x: {miss}"));
+        }
         let times = schedule(Duration::from_secs(1), 100, DMX_GAP, 7);
         assert_eq!(times, schedule(Duration::from_secs(1), 100, DMX_GAP, 7));
         let gaps = times.windows(2).map(|w| w[1].saturating_sub(w[0]));

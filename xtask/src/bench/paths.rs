@@ -20,7 +20,7 @@ use idle_head_core::servo::ServoRate;
 use super::latency::{self, LOOK_GAP, Row, SCHEDULED, count, schedule};
 use crate::metrics::parallel;
 use crate::project::Metadata;
-use crate::sim::{BYTE_TIME, Boot, Chunk, UartScript, run_shipped};
+use crate::sim::{BYTE_TIME, Boot, Chunk, UartScript, node, run_shipped};
 use crate::{figures, project};
 
 /// A path's run, for its row.
@@ -53,17 +53,24 @@ fn all_ok(replies: &[u8], what: &str) -> Result<()> {
     }
 }
 
-/// The first boot of the shipped image run until 0.5 s after `last`, its
-/// USB port sent `chunks`, every reply `ok`.
-fn usb_run(
-    (root, metadata, wall): (&Path, &Metadata, Duration),
+/// Where and how long the shipped image runs: the project, the wall time.
+type Shipped<'a> = (&'a Path, &'a Metadata, Duration);
+
+/// The first boot of the shipped image, set up by `setup`, run until 0.5 s
+/// after `last`.
+fn first_boot(
+    (root, metadata, wall): Shipped,
     last: Duration,
-    chunks: Vec<Chunk>,
-    what: &str,
+    setup: impl FnOnce(&mut node::Config),
 ) -> Result<Boot> {
     let end = last + Duration::from_millis(500);
-    let report = run_shipped(root, metadata, end, wall, |config| config.usb = chunks)?;
-    let boot = report.boots.into_iter().next().context("no boot")?;
+    let report = run_shipped(root, metadata, end, wall, setup)?;
+    report.boots.into_iter().next().context("no boot")
+}
+
+/// [`first_boot`] with `chunks` sent to the USB port, every reply `ok`.
+fn usb_run(run: Shipped, last: Duration, chunks: Vec<Chunk>, what: &str) -> Result<Boot> {
+    let boot = first_boot(run, last, |config| config.usb = chunks)?;
     all_ok(&boot.usb, what)?;
     Ok(boot)
 }
@@ -107,11 +114,7 @@ pub fn uart_look_200_hz(root: &Path, metadata: &Metadata, wall: Duration) -> Res
 /// A run of `look` lines over UART0 at times seeded by `seed` after `setup`
 /// (one or more lines, at 2.5 s): each line's arrival, and the boot, every
 /// line answered `ok`.
-fn uart_looks(
-    (root, metadata, wall): (&Path, &Metadata, Duration),
-    setup: &[u8],
-    seed: u32,
-) -> Result<(Vec<f64>, Boot)> {
+fn uart_looks(run: Shipped, setup: &[u8], seed: u32) -> Result<(Vec<f64>, Boot)> {
     let times = schedule(Duration::from_secs(4), SCHEDULED, LOOK_GAP, seed);
     let mut scripts = vec![UartScript::new(0, setup, Duration::from_millis(2500))];
     scripts.extend(times.iter().enumerate().map(|(k, &at)| {
@@ -119,15 +122,11 @@ fn uart_looks(
         let on_the_wire = BYTE_TIME * u32::try_from(line.len()).unwrap_or(u32::MAX);
         UartScript::new(0, line, at.saturating_sub(on_the_wire))
     }));
-    let end = times.last().copied().unwrap_or_default() + Duration::from_millis(500);
-    let report = run_shipped(root, metadata, end, wall, |config| config.uart = scripts)?;
-    let boot = report.boots.into_iter().next().context("no boot")?;
+    let last = times.last().copied().unwrap_or_default();
+    let boot = first_boot(run, last, |config| config.uart = scripts)?;
     // One script for the setup, one for each look.
-    count(
-        boot.uart_lines.len(),
-        times.len() + 1,
-        "UART scripts went out",
-    )?;
+    let (sent, want) = (boot.uart_lines.len(), times.len() + 1);
+    count(sent, want, "UART scripts went out")?;
     all_ok(&boot.uart, "uart look")?;
     Ok((boot.uart_lines.iter().skip(1).copied().collect(), boot))
 }
@@ -161,12 +160,8 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
     let sync = Duration::from_nanos((t0 + (k + 0.5) * frame) as u64);
     let clock_ms = (k * frame / 1e6).round() as u64;
     // The curves' starts, whole ms after the sync's clock.
-    let times = schedule(
-        Duration::from_secs(4),
-        SCHEDULED + 1,
-        CURVE_GAP,
-        0xb077_a160,
-    );
+    let after = Duration::from_secs(4);
+    let times = schedule(after, SCHEDULED + 1, CURVE_GAP, 0xb077_a160);
     let ms_after = |at: Duration| ((at.as_secs_f64() * 1e9 - t0) / 1e6).round() as u64 - clock_ms;
     let setup = bottango_lines(&["hRQ,144", "rMTR,yaw,-20000,20000,3000,4096"]);
     let mut chunks = vec![
@@ -183,11 +178,8 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
             (4096 + STEP, 4096)
         };
         let step = format!("sC,yaw,{start},40,{from},0,{},{to},0,0", to - from);
-        let hold = format!(
-            "sC,yaw,{},{},{to},0,0,{to},0,0",
-            start + 40,
-            next - start - 40
-        );
+        let (at, ms) = (start + 40, next - start - 40);
+        let hold = format!("sC,yaw,{at},{ms},{to},0,0,{to},0,0");
         let lines = bottango_lines(&[&step, &hold]);
         chunks.push(Chunk::new(lines, pair[0].saturating_sub(AHEAD)));
         events.push(t0 + (clock_ms + start) as f64 * 1e6);

@@ -66,7 +66,6 @@ fn frame_rows_are_held_to_their_own_ceilings_and_named() {
         min: 930,
         median: 945,
         max: 1861,
-        max_at: 1,
         mean: 1084,
     };
     assert_eq!(rows[0], want);

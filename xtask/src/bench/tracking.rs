@@ -18,7 +18,7 @@ use idle_head_core::Axis;
 use idle_head_core::servo::ServoRate;
 
 use crate::figures;
-use crate::trace::{self, radar::PERIOD_US};
+use crate::trace::{self, radar::PERIOD_US, show_seconds};
 
 /// The stage of `cargo xtask test`.
 pub const STAGE: &str = "tracking figures in the host trace: a walk 2 m away at 1 m/s followed \
@@ -58,22 +58,14 @@ pub fn walk_script() -> String {
     let mut text = String::from("0 radar on\n0 track on\n");
     for t in (WALK_FROM_US..=WALK_FROM_US + WALK_US).step_by(PERIOD_US as usize) {
         let x = walker_x(t as f64).round();
-        let _ = writeln!(text, "{} radar {x},{DISTANCE_MM}", seconds(t));
+        let _ = writeln!(text, "{} radar {x},{DISTANCE_MM}", show_seconds(t));
     }
-    let _ = writeln!(
-        text,
-        "{} radar none",
-        seconds(WALK_FROM_US + WALK_US + PERIOD_US)
-    );
-    text
+    let end = show_seconds(WALK_FROM_US + WALK_US + PERIOD_US);
+    text + &format!("{end} radar none\n")
 }
 
 /// How long a walk run lasts: the walk, the hold after it, a return.
 pub const WALK_RUN_US: u64 = WALK_FROM_US + WALK_US + 1_500_000;
-
-fn seconds(us: u64) -> String {
-    format!("{}.{:06}", us / 1_000_000, us % 1_000_000)
-}
 
 /// The walk's figures from the yaw (m°) of each frame (frame `k` at `k ·
 /// period_us`).
@@ -87,13 +79,17 @@ pub struct Walk {
     pub largest: f64,
 }
 
+/// The yaw's room in the built-in configuration, m°: the head follows to
+/// its limit and no further.
+fn yaw_room() -> Result<[f64; 2]> {
+    let room = trace::built_in()?.1.room(Axis::Yaw);
+    Ok([room.min, room.max].map(|a| f64::from(a.millidegrees())))
+}
+
 impl Walk {
-    /// The figures of `yaw`; the bearing held to the yaw's room (the head
-    /// follows to its limit and no further).
+    /// The figures of `yaw`; the bearing held to the [`yaw_room`].
     pub fn of(yaw: &[f64], period_us: u64) -> Result<Self> {
-        let (_, params) = trace::built_in()?;
-        let room = params.room(Axis::Yaw);
-        let [lo, hi] = [room.min, room.max].map(|a| f64::from(a.millidegrees()));
+        let [lo, hi] = yaw_room()?;
         let from = usize::try_from((WALK_FROM_US + 1_000_000) / period_us)?;
         let to = usize::try_from((WALK_FROM_US + WALK_US) / period_us)?.min(yaw.len());
         if from >= to {
@@ -148,7 +144,7 @@ fn standing_script(noise: i32, seed: u32) -> String {
     let mut text = String::from("0 radar on\n");
     for t in (2_000_000..2_000_000 + STANDING_US).step_by(PERIOD_US as usize) {
         let (x, y) = (STANDING.0 + draw(), STANDING.1 + draw());
-        let _ = writeln!(text, "{} radar {x},{y}", seconds(t));
+        let _ = writeln!(text, "{} radar {x},{y}", show_seconds(t));
     }
     text
 }
@@ -228,19 +224,17 @@ mod tests {
 
     #[test]
     fn a_yaw_that_follows_100_ms_late_has_a_lag_of_100_ms() {
-        let (_, params) = trace::built_in().unwrap();
-        let room = params.room(Axis::Yaw);
-        let [lo, hi] = [room.min, room.max].map(|a| f64::from(a.millidegrees()));
-        let exact: Vec<f64> = (0..400)
-            .map(|k| bearing(f64::from(k) * 20e3).clamp(lo, hi))
-            .collect();
-        let walk = Walk::of(&exact, 20_000).unwrap();
+        let [lo, hi] = yaw_room().unwrap();
+        let late_by = |us: f64| {
+            let yaw: Vec<f64> = (0..400)
+                .map(|k| bearing(f64::from(k) * 20e3 - us).clamp(lo, hi))
+                .collect();
+            Walk::of(&yaw, 20_000).unwrap()
+        };
+        let walk = late_by(0.0);
         assert_eq!(walk.lag_ms, 0);
         assert!(walk.rms < 1.0 && walk.largest < 1.0, "{walk:?}");
-        let late: Vec<f64> = (0..400)
-            .map(|k| bearing(f64::from(k) * 20e3 - 100e3).clamp(lo, hi))
-            .collect();
-        let walk = Walk::of(&late, 20_000).unwrap();
+        let walk = late_by(100e3);
         assert_eq!(walk.lag_ms, 100);
         // 100 ms at up to 28°/s (straight in front, 1 m/s at 2 m).
         assert!(walk.rms > 1000.0 && walk.largest < 2900.0, "{walk:?}");

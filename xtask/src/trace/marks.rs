@@ -132,12 +132,9 @@ pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
     let gesture = |i: &usize| marks[*i].kind == Kind::Gesture && applied(&marks[*i]);
     let gestures: Vec<usize> = (0..marks.len()).filter(gesture).collect();
     for pair in gestures.windows(2) {
-        let next = marks[pair[1]].t_ms;
+        let end = marks[pair[1]].t_ms + u64::from(blend_ms);
         let mark = &mut marks[pair[0]];
-        let end = next + u64::from(blend_ms);
-        if mark.t_ms + mark.span_ms > end {
-            mark.span_ms = end - mark.t_ms;
-        }
+        mark.span_ms = mark.span_ms.min(end.saturating_sub(mark.t_ms));
     }
     // A return follows its look in the list; the next gaze move after the
     // look is the one that cancels or cuts it.

@@ -4,9 +4,15 @@ use idle_head_core::behaviour::LimitMode;
 use crate::steps::Steps;
 
 fn run(script: &str, seconds: u64) -> Trace {
-    let (_, params) = built_in().unwrap();
-    let events = script::parse(script, &params).unwrap();
-    simulate(seconds * 1_000_000, None, ServoRate::DEFAULT, &events).unwrap()
+    watched(script, seconds, None, &[])
+}
+
+/// The trace of `script` over `seconds`, with a `watch` and the replies to
+/// `ask` after it.
+fn watched(script: &str, seconds: u64, watch: Option<u8>, ask: &[&str]) -> Trace {
+    let events = script::parse(script, &built_in().unwrap().1).unwrap();
+    let micros = seconds * 1_000_000;
+    simulate_watched(micros, None, ServoRate::DEFAULT, &events, watch, ask).unwrap()
 }
 
 #[test]
@@ -142,11 +148,8 @@ fn a_presence_script_rests_relaxes_wakes_and_glances() {
     // Then the glance towards the sensor: yaw at −20° (the idle's
     // ducked sway aside), held about 2 s, then back.
     let near = |ms: u64| (at(ms).angles[2] + 20_000).abs() < 2500;
-    let held: Vec<u64> = (13_000..17_000)
-        .step_by(20)
-        .filter(|&ms| near(ms))
-        .collect();
-    assert!(held.len() >= 100, "{} frames near -20°", held.len());
+    let held = (13_000..17_000).step_by(20).filter(|&ms| near(ms)).count();
+    assert!(held >= 100, "{held} frames near -20°");
     assert!(!near(19_000));
     let wake = trace.marks.iter().find(|m| m.reply.starts_with("ok wake"));
     let wake = wake.unwrap();
@@ -179,18 +182,7 @@ fn a_button_runs_its_action_within_a_frame_of_its_edge() {
 #[test]
 fn the_telemetry_of_a_trace_carries_the_radars_people() {
     let script = "0 idle off\n1 radar on\n1.2 radar 400,2000 -900,3000\n";
-    let (_, params) = built_in().unwrap();
-    let events = script::parse(script, &params).unwrap();
-    let asks = ["radar", "track"];
-    let trace = simulate_watched(
-        3_000_000,
-        None,
-        ServoRate::DEFAULT,
-        &events,
-        Some(20),
-        &asks,
-    );
-    let trace = trace.unwrap();
+    let trace = watched(script, 3, Some(20), &["radar", "track"]);
     let lines = trace.watch.unwrap().lines;
     // 3 s at 20 a second: ticks at 0, 50, …, 2950 ms, each taken by the
     // first 20 ms frame at or after it.
