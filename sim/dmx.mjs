@@ -11,10 +11,10 @@
 // - A byte that finds the FIFO full is lost, and the next character carries
 //   the overrun flag (OE, bit 11), as on the chip (rp2040js drops it
 //   silently).
-// - Everything else (the FIFO, UARTDR's flags, the receive interrupt) is
-//   rp2040js's own. It raises the receive interrupt at every byte rather
-//   than at the FIFO's trigger level or after a pause: the firmware's
-//   handler reads whatever is there either way.
+// - The receive interrupt comes at the FIFO's trigger level and after a
+//   pause of 32 bit periods, as on the chip (uart.mjs); rp2040js raises it
+//   at every byte.
+// - Everything else (the FIFO, UARTDR's flags) is rp2040js's own.
 //
 // The line: frames back to back, each a break, a mark after break, the
 // start code 0 and `slots` slots at `byte_ns` a byte (11 bits at 250 kbaud:
@@ -30,6 +30,8 @@
 //   {"ev":"dmx","ns":..,"frame":n,"changed":true}   the last byte of the
 //       first frame that carries a change went out (its end)
 
+import { receiveInterruptsAsOnTheChip } from './uart.mjs';
+
 const UARTDR_FE = 1 << 8;
 const UARTDR_BE = 1 << 10;
 const UARTDR_OE = 1 << 11;
@@ -43,6 +45,7 @@ export function dmxLine(cfg, emit) {
   let now = () => 0;
   let overrun = false;
   let checked = false;
+  let interrupts = null; // the receive interrupts as on the chip
   let rng = 0x1f2e3d4c;
   const random = () => {
     rng ^= rng << 13;
@@ -116,15 +119,16 @@ export function dmxLine(cfg, emit) {
       uart = chipUart;
       now = clock;
       overrun = false;
+      interrupts = receiveInterruptsAsOnTheChip(uart, clock);
     },
-    // When the next character is due (Infinity if none).
+    // When the next character is due, or the receive timeout (Infinity if neither).
     due() {
-      if (frame) return frame.times[frame.at];
-      return next;
+      return Math.min(frame ? frame.times[frame.at] : next, interrupts.due());
     },
     // Puts every character whose time has come into UART1's FIFO.
     feed() {
       const t = now();
+      interrupts.check();
       for (;;) {
         if (!frame) {
           if (t < next) return;

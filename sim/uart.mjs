@@ -119,3 +119,61 @@ export function uartAsOnTheChip(uart, now) {
     }
   };
 }
+
+// The PL011's receive interrupts, which rp2040js raises at every byte (it
+// models no trigger level and no timeout; UARTIFLS is not even kept). On
+// the chip:
+// - RXINTR (UARTRIS bit 4) rises when the receive FIFO fills to the level
+//   UARTIFLS's RXIFLSEL sets (4, 8, 16, 24 or 28 of its 32 characters; 16
+//   after reset), and falls when reads take it below that level;
+// - RTINTR (bit 6), the receive timeout, rises when characters wait in the
+//   FIFO and none came for 32 bit periods, and falls when reads empty it;
+// - a write to UARTICR clears either (rp2040js's own).
+// So a handler that empties the FIFO runs once per few characters, not per
+// character. Returns `due()`, when the timeout would rise (Infinity if
+// none can), and `check()`, which raises it once its time has come.
+const UARTIFLS = 0x34;
+const RXINTR = 1 << 4;
+const RTINTR = 1 << 6;
+const RX_LEVELS = [4, 8, 16, 24, 28];
+
+export function receiveInterruptsAsOnTheChip(uart, now) {
+  let ifls = 0x12; // both levels at 1/2 after reset
+  let timeoutAt = Infinity; // 32 bit periods after the last character came
+  const level = () => RX_LEVELS[(ifls >> 3) & 7] ?? 28;
+  const raise = (bits) => {
+    uart.interruptStatus |= bits;
+    uart.rp2040.setInterrupt(uart.irq, !!(uart.interruptStatus & uart.interruptMask));
+  };
+  uart.feedByte = (value) => {
+    uart.rxFIFO.push(value);
+    timeoutAt = now() + (32 * 1e9) / (uart.baudRate || 115200);
+    if (uart.rxFIFO.itemCount >= level()) raise(RXINTR);
+  };
+  const read = uart.readUint32.bind(uart);
+  uart.readUint32 = (offset) => {
+    if (offset === UARTIFLS) return ifls;
+    if (offset !== 0x00) return read(offset);
+    const value = uart.rxFIFO.pull();
+    if (uart.rxFIFO.itemCount < level()) uart.interruptStatus &= ~RXINTR;
+    if (uart.rxFIFO.empty) {
+      uart.interruptStatus &= ~RTINTR;
+      timeoutAt = Infinity;
+    }
+    uart.checkInterrupts();
+    return value;
+  };
+  const write = uart.writeUint32.bind(uart);
+  uart.writeUint32 = (offset, value) => {
+    if (offset === UARTIFLS) ifls = value & 0x3f;
+    else write(offset, value);
+  };
+  return {
+    due: () => timeoutAt,
+    check() {
+      if (now() < timeoutAt) return;
+      timeoutAt = Infinity;
+      if (!uart.rxFIFO.empty) raise(RTINTR);
+    },
+  };
+}

@@ -9,7 +9,7 @@ use super::event::{Op, Unmodelled};
 /// writes covered (`None`: any access), why it does not matter. None
 /// changes what the firmware does here, which the pulse, console and store
 /// checks of the same runs show.
-const KNOWN: [(&str, Option<&[u32]>, &str); 5] = [
+const KNOWN: [(&str, Option<&[u32]>, &str); 4] = [
     (
         "ROSC_BASE",
         None,
@@ -25,11 +25,6 @@ const KNOWN: [(&str, Option<&[u32]>, &str); 5] = [
         Some(&[0x34]),
         "UARTIFLS, the FIFO trigger levels: the transmit level set is the reset value \
          sim/uart.mjs models; the receive side interrupts at every byte, sooner than the chip",
-    ),
-    (
-        "UART1",
-        Some(&[0x34]),
-        "UARTIFLS of the DMX receiver, whose handler reads whatever the FIFO holds",
     ),
     (
         "USB",
