@@ -103,17 +103,6 @@ pub const MDBOOK_VERSION: &str = "0.5.4";
 /// The pinned `mdbook`: on the `PATH` or in `tools`, else installed there
 /// with `cargo install` (HTML and search only: no `serve` or `watch`).
 pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
-    mdbook(tools, false)
-}
-
-/// [`ensure_mdbook`] on a thread of its own and without output, so that a
-/// first install compiles while other stages run; whatever fails, the
-/// book stage's own [`ensure_mdbook`] after it tries again and says.
-pub fn ensure_mdbook_beside(tools: PathBuf) -> std::thread::JoinHandle<()> {
-    std::thread::spawn(move || drop(mdbook(&tools, true)))
-}
-
-fn mdbook(tools: &Path, quiet: bool) -> Result<PathBuf> {
     let wanted = format!("mdbook v{MDBOOK_VERSION}");
     let local = tools.join("bin").join("mdbook");
     let pinned = |program: &PathBuf| version(program).as_deref() == Some(wanted.as_str());
@@ -125,9 +114,7 @@ fn mdbook(tools: &Path, quiet: bool) -> Result<PathBuf> {
     }
     let tools_dir = project::relative(tools);
     let tools_dir = tools_dir.display();
-    if !quiet {
-        println!("installing {wanted} into {tools_dir} (a few minutes, once)");
-    }
+    println!("installing {wanted} into {tools_dir} (a few minutes, once)");
     let sh = project::shell(".")?;
     // A host program, whatever .cargo/config.toml builds for.
     let host = "host-tuple";
@@ -136,11 +123,7 @@ fn mdbook(tools: &Path, quiet: bool) -> Result<PathBuf> {
         sh,
         "cargo install mdbook --locked --version {MDBOOK_VERSION} --no-default-features --features search --target {host} --target-dir {build_dir} --root {tools}"
     );
-    if quiet {
-        install.quiet().ignore_stdout().ignore_stderr().run()?;
-    } else {
-        project::run(&sh, &[], install)?;
-    }
+    project::run(&sh, &[], install)?;
     if !pinned(&local) {
         bail!(
             "installed {wanted}, but {} does not run as it",

@@ -110,10 +110,6 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         only,
         left_out: 0,
     };
-    // The book's tool installs (once) while the stages before it run.
-    let mdbook = stages
-        .chosen(book::STAGE)
-        .then(|| setup::ensure_mdbook_beside(root.join("target").join("tools")));
 
     // 1. Host tests, formatting, lints, the images that must compile.
     cargo_stages(&mut stages);
@@ -159,10 +155,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     stages.run(browser::STAGE, || browser::stage(&root, &metadata));
 
     // 6. The book, with the figures measured above, and its links.
-    stages.run(book::STAGE, || {
-        mdbook.map(std::thread::JoinHandle::join);
-        book::stage(&root)
-    });
+    stages.run(book::STAGE, || book::stage(&root));
     stages.run(figures::STAGE, || {
         figures::stale(&figures_page, &figures_before)
     });
