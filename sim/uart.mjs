@@ -143,7 +143,7 @@ export function receiveInterruptsAsOnTheChip(uart, now) {
   const level = () => RX_LEVELS[(ifls >> 3) & 7] ?? 28;
   const raise = (bits) => {
     uart.interruptStatus |= bits;
-    uart.rp2040.setInterrupt(uart.irq, !!(uart.interruptStatus & uart.interruptMask));
+    uart.checkInterrupts();
   };
   uart.feedByte = (value) => {
     uart.rxFIFO.push(value);
