@@ -123,10 +123,12 @@ pub async fn serve<P: Port, H: Handler>(
     let mut buf = [0; READ_CHUNK];
     // Bytes read and not yet taken: `buf[at..read]`.
     let (mut at, mut read) = (0, 0);
+    let wait = place.frame * OUTCOME_FRAMES;
     let mut replies = Replies {
         outbox: Outbox::new(),
         out: [0; PORT_REPLY],
-        wait: place.frame * OUTCOME_FRAMES,
+        wait,
+        wait_ms: u32::try_from(wait.as_millis()).unwrap_or(u32::MAX),
     };
     let mut watch = Watch::default();
     place.link.set_watch(place.port, 0);
@@ -231,11 +233,14 @@ async fn at_or_never(at: Instant) {
 }
 
 /// A port's replies on their way out ([`Outbox`]), with the buffer they
-/// are written from and how long one waits for the frame task.
+/// are written from and how long one waits for the frame task (also in
+/// ms, converted once: a 64-bit division costs hundreds of instructions
+/// on a Cortex-M0+).
 struct Replies {
     outbox: Outbox,
     out: [u8; PORT_REPLY],
     wait: Duration,
+    wait_ms: u32,
 }
 
 impl Replies {
@@ -245,8 +250,7 @@ impl Replies {
         while let Some(outcome) = place.link.take_outcome(place.port) {
             self.outbox.resolve(&outcome);
         }
-        let waited_ms = self.wait.as_millis() as u32;
-        self.outbox.expire(Instant::now().as_ticks(), waited_ms);
+        self.outbox.expire(Instant::now().as_ticks(), self.wait_ms);
         loop {
             let n = self.outbox.take_ready(&mut self.out);
             if n == 0 {
