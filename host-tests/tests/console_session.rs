@@ -331,3 +331,38 @@ fn a_line_that_lost_bytes_is_answered_so() {
     assert_eq!(handler.commands, [Command::Status]);
     assert_eq!(handler.rejected, [InputError::Line(LineError::Lost)]);
 }
+
+/// Numbers in replies are written as `format!` writes them, with and
+/// without leading zeros, at every decimal and 32-bit boundary (the
+/// digits below 2^32 take a path of their own).
+#[test]
+fn numbers_are_written_as_format_writes_them() {
+    use idle_head_core::text::{Describe, Text, display};
+    struct Zeros(u64, usize);
+    impl Describe for Zeros {
+        fn describe(&self, out: &mut dyn Text) {
+            out.zeros(self.0, self.1);
+        }
+    }
+    impl std::fmt::Display for Zeros {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            display(self, f)
+        }
+    }
+    let mut values = vec![u64::from(u32::MAX), 1 << 32, (1 << 32) + 1, u64::MAX];
+    for k in 0..20 {
+        let p = 10_u64.pow(k);
+        values.extend([p - 1, p, p + 1, p.saturating_mul(7).saturating_add(3)]);
+        let big = p.saturating_mul(1_000_000_000);
+        values.extend([big, big.saturating_add(1), big - 1]);
+    }
+    for n in values {
+        for width in [1, 3, 9, 10, 18, 20] {
+            assert_eq!(
+                Zeros(n, width).to_string(),
+                format!("{n:0width$}"),
+                "{n} {width}"
+            );
+        }
+    }
+}

@@ -61,18 +61,29 @@ impl dyn Text + '_ {
     }
 
     /// Appends `n` in decimal with at least `width` digits (leading zeros).
-    pub fn zeros(&mut self, mut n: u64, width: usize) -> &mut Self {
+    pub fn zeros(&mut self, n: u64, width: usize) -> &mut Self {
         // u64::MAX has 20 digits.
         const MOST: usize = 20;
         let mut digits = [b'0'; MOST];
         let mut start = MOST;
+        // The digits below 2^32 in 32-bit arithmetic: a Cortex-M0+ divides
+        // a u64 in software, at hundreds of instructions a digit.
+        let (mut high, mut low) = match u32::try_from(n) {
+            Ok(low) => (0, low),
+            Err(_) => (n / 1_000_000_000, (n % 1_000_000_000) as u32),
+        };
         for slot in digits.iter_mut().rev() {
-            if n == 0 && MOST - start >= width {
+            if high == 0 && low == 0 && MOST - start >= width {
                 break;
             }
-            *slot = b'0' + (n % 10) as u8;
-            n /= 10;
+            *slot = b'0' + (low % 10) as u8;
+            low /= 10;
             start -= 1;
+            // Nine digits of `low` are out: the next come from `high`.
+            if high != 0 && (MOST - start).is_multiple_of(9) {
+                low = (high % 1_000_000_000) as u32;
+                high /= 1_000_000_000;
+            }
         }
         if let Some(Ok(s)) = digits.get(start..).map(core::str::from_utf8) {
             self.put(s);
