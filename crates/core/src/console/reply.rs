@@ -274,6 +274,19 @@ impl<'a> Reply<'a> {
         buf.get(..len).unwrap_or_default()
     }
 
+    /// Appends one byte if it fits before the limit.
+    fn put_byte(&mut self, byte: u8) -> bool {
+        if self.len >= self.limit {
+            return false;
+        }
+        let Some(dst) = self.buf.get_mut(self.len) else {
+            return false;
+        };
+        *dst = byte;
+        self.len += 1;
+        true
+    }
+
     /// Appends one character if it fits before the limit.
     fn put_char(&mut self, c: char) -> bool {
         let mut utf8 = [0; 4];
@@ -305,8 +318,13 @@ impl Reply<'_> {
             return;
         }
         for c in s.chars() {
-            let c = if c.is_control() { '?' } else { c };
-            if !self.put_char(c) {
+            // ASCII, almost every character, a byte at a time.
+            let fits = if c.is_ascii() {
+                self.put_byte(if c.is_ascii_control() { b'?' } else { c as u8 })
+            } else {
+                self.put_char(if c.is_control() { '?' } else { c })
+            };
+            if !fits {
                 self.truncated = true;
                 break;
             }
