@@ -59,12 +59,14 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
     let Some(first) = words.next() else {
         return Err(words.error_here(ParseErrorKind::Empty));
     };
-    let command = if first.lower() == Word::Is(Kw::Idle) && words.peek().is_none() {
+    // The keyword is looked up once: a lookup is a bisection of them all.
+    let keyword = first.lower();
+    let command = if keyword == Word::Is(Kw::Idle) && words.peek().is_none() {
         Command::IdleQuery
-    } else if let Some(action) = motion(first, &mut words)? {
+    } else if let Some(action) = motion_as(first, keyword, &mut words)? {
         Command::Act(action)
     } else {
-        match first.lower() {
+        match keyword {
             Word::Is(Kw::Help) => Command::Help,
             Word::Is(Kw::Status) => Command::Status,
             Word::Is(Kw::Save) => Command::Save,
@@ -91,10 +93,19 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
 /// `idle`, `stop`, `rest` or `wake`. `None` for any other first word (and
 /// for the settings `rest` and `look` take: `rest after …`, `look duck …`).
 fn motion(first: Token<'_>, words: &mut Words<'_>) -> Result<Option<Action>, ParseError> {
+    motion_as(first, first.lower(), words)
+}
+
+/// [`motion`] with `first`'s keyword looked up already.
+fn motion_as(
+    first: Token<'_>,
+    keyword: Word,
+    words: &mut Words<'_>,
+) -> Result<Option<Action>, ParseError> {
     if let Some(kind) = first.gesture() {
         return gesture(words, kind).map(Some);
     }
-    let action = match first.lower() {
+    let action = match keyword {
         Word::Is(Kw::Stop) => Action::Stop,
         Word::Is(Kw::Look) if !duck::follows(words) => look(words)?,
         Word::Is(Kw::Center | Kw::Centre) => Action::Center {
