@@ -7,8 +7,11 @@
 //! it is polled; a poll that runs in the port executor's interrupt
 //! (`SWI_IRQ_0`) is a port task's. A task's first poll is no wake: at boot
 //! the task that spawns the others runs to its end before they start.
+//! The port executor is known by its first poll; the hooks of the other
+//! executors (the frame task's among them) return at once from then on.
 
 use core::cell::Cell;
+use core::sync::atomic::{AtomicU32, Ordering};
 
 use cortex_m::peripheral::SCB;
 use cortex_m::peripheral::scb::VectActive;
@@ -35,6 +38,9 @@ static WAITS: Mutex<CriticalSectionRawMutex, Waits> = Mutex::new(Waits {
     longest: Cell::new(0),
 });
 
+/// The port executor's id, once it polled a task (0 before).
+static PORT_EXECUTOR: AtomicU32 = AtomicU32::new(0);
+
 /// The longest a port task waited for the CPU since boot, µs.
 #[must_use]
 pub fn port_wait_us() -> u32 {
@@ -47,7 +53,10 @@ fn in_port_executor() -> bool {
 }
 
 #[unsafe(no_mangle)]
-extern "Rust" fn _embassy_trace_task_ready_begin(_executor_id: u32, task_id: u32) {
+extern "Rust" fn _embassy_trace_task_ready_begin(executor_id: u32, task_id: u32) {
+    if executor_id != PORT_EXECUTOR.load(Ordering::Relaxed) {
+        return;
+    }
     let now = Instant::now().as_micros();
     WAITS.lock(|w| {
         // Woken again before its poll: the first wake counts.
@@ -64,10 +73,19 @@ extern "Rust" fn _embassy_trace_task_ready_begin(_executor_id: u32, task_id: u32
 }
 
 #[unsafe(no_mangle)]
-extern "Rust" fn _embassy_trace_task_exec_begin(_executor_id: u32, task_id: u32) {
+extern "Rust" fn _embassy_trace_task_exec_begin(executor_id: u32, task_id: u32) {
+    let port = PORT_EXECUTOR.load(Ordering::Relaxed);
+    if port == 0 && in_port_executor() {
+        PORT_EXECUTOR.store(executor_id, Ordering::Relaxed);
+    } else if executor_id != port {
+        return;
+    }
     let now = Instant::now().as_micros();
-    let port = in_port_executor();
     WAITS.lock(|w| {
+        let first = !w.started.iter().any(|s| s.get() == Some(task_id));
+        if first && let Some(free) = w.started.iter().find(|s| s.get().is_none()) {
+            free.set(Some(task_id));
+        }
         let Some(slot) = w
             .woken
             .iter()
@@ -75,11 +93,7 @@ extern "Rust" fn _embassy_trace_task_exec_begin(_executor_id: u32, task_id: u32)
         else {
             return;
         };
-        let first = !w.started.iter().any(|s| s.get() == Some(task_id));
-        if first && let Some(free) = w.started.iter().find(|s| s.get().is_none()) {
-            free.set(Some(task_id));
-        }
-        if let (Some((_, woken)), true, false) = (slot.take(), port, first) {
+        if let (Some((_, woken)), false) = (slot.take(), first) {
             let waited = u32::try_from(now.saturating_sub(woken)).unwrap_or(u32::MAX);
             w.longest.set(w.longest.get().max(waited));
         }
