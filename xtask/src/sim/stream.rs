@@ -144,10 +144,12 @@ pub fn test_stream(
         }
     })?;
     println!(
-        "{port} stream: {count} lines, one every {} ms; {} replies; {} loop sets generated meanwhile",
+        "{port} stream: {count} lines, one every {} ms; {} replies; {} loop sets generated \
+         meanwhile; {} instructions a line, the run's all",
         EVERY.as_millis(),
         replies.len(),
-        sets(report.first()?)
+        sets(report.first()?),
+        report.end.instructions / count.max(1) as u64
     );
     report.conclude(problems)
 }
