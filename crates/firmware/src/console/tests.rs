@@ -1,9 +1,13 @@
-//! The telemetry's pacing (`watch`) and when it stops.
+//! The telemetry's pacing (`watch`) and when it stops; a port's lines and
+//! their replies through [`serve`].
+
+use std::collections::VecDeque;
 
 use embassy_time::{Duration, Instant};
-use idle_head_core::console::ConsoleLink;
+use idle_head_core::command::Command;
+use idle_head_core::console::{ConsoleLink, DualSession, Reply};
 
-use super::{Place, Watch, telemetry_rate};
+use super::{Gone, Place, Port, Received, Watch, serve, telemetry_rate};
 
 fn ms(ms: u64) -> Instant {
     Instant::from_millis(ms)
@@ -111,4 +115,51 @@ fn a_bottango_session_has_no_telemetry_but_keeps_the_rate() {
     assert_eq!(telemetry_rate(true, true, place), 0);
     assert_eq!(link.watch(0), 5);
     assert_eq!(telemetry_rate(true, false, place), 5);
+}
+
+/// A port that hands out its input in the chunks given, keeps what is
+/// written to it, and is gone after the last chunk.
+struct Chunks {
+    input: VecDeque<&'static [u8]>,
+    written: Vec<u8>,
+}
+
+impl Port for Chunks {
+    async fn read(&mut self, buf: &mut [u8]) -> Result<Received, Gone> {
+        let chunk = self.input.pop_front().ok_or(Gone)?;
+        buf[..chunk.len()].copy_from_slice(chunk);
+        Ok(Received::Bytes(chunk.len()))
+    }
+
+    async fn write(&mut self, bytes: &[u8]) -> Result<(), Gone> {
+        self.written.extend_from_slice(bytes);
+        Ok(())
+    }
+}
+
+#[test]
+fn every_line_is_answered_once_in_order_wherever_the_reads_cut_it() {
+    let link = ConsoleLink::new();
+    let place = Place {
+        port: 0,
+        link: &link,
+        frame: Duration::from_millis(20),
+    };
+    let mut port = Chunks {
+        input: VecDeque::from([&b"stat"[..], b"us\r", b"\nhelp\r\nzz\n\nsave", b"\r\n"]),
+        written: Vec::new(),
+    };
+    let mut seen = Vec::new();
+    let mut handler = |command: Command, _: &mut Reply<'_>| seen.push(command);
+    let mut session = DualSession::new(None);
+    let gone = embassy_futures::block_on(serve(&mut port, &mut session, &mut handler, place));
+    assert_eq!(gone, Gone);
+    assert_eq!(seen, [Command::Status, Command::Help, Command::Save]);
+    let written = String::from_utf8(port.written).unwrap();
+    let replies: Vec<&str> = written.split_terminator("\r\n").collect();
+    assert_eq!(replies.len(), 5, "{written:?}");
+    assert_eq!(replies[..2], ["ok", "ok"], "{written:?}");
+    assert!(replies[2].starts_with("err syntax"), "{written:?}");
+    assert!(replies[3].starts_with("err"), "an empty line: {written:?}");
+    assert_eq!(replies[4], "ok", "{written:?}");
 }
