@@ -272,25 +272,51 @@ impl Replies {
     ) -> Result<usize, Gone> {
         let was = session.bottango();
         let mut taken = 0;
-        for &byte in bytes {
-            if !self.outbox.has_room() {
-                break;
-            }
-            taken += 1;
-            if let Some(reply) = session.push(byte, handler)
-                && let Some(now) = self.outbox.reply(reply)
-                && !now.is_empty()
-            {
-                port.write(now).await?;
-            }
-            if let Some(later) = session.take_later() {
-                let due = (Instant::now() + self.wait).as_ticks();
-                // (Room was checked before the byte.)
-                let _ = self.outbox.wait(later, due);
+        while let Some(rest) = bytes.get(taken..)
+            && !rest.is_empty()
+            && self.outbox.has_room()
+        {
+            let (took, now) = self.take_line(session, handler, rest);
+            taken += took;
+            if now > 0 {
+                port.write(self.out.get(..now).unwrap_or_default()).await?;
             }
         }
         log_mode(was, session.bottango());
         Ok(taken)
+    }
+
+    /// Takes `bytes` into `session` up to the end of the first line (the
+    /// bytes of a line go in with no await among them: an async loop a
+    /// byte costs several times as much). Returns how many it took and the
+    /// length of the reply to write now, copied to `out` (0: none, the
+    /// reply is held or waits, or no line ended).
+    fn take_line<H: Handler>(
+        &mut self,
+        session: &mut DualSession<'_>,
+        handler: &mut H,
+        bytes: &[u8],
+    ) -> (usize, usize) {
+        for (at, &byte) in bytes.iter().enumerate() {
+            let mut now = 0;
+            let reply = session.push(byte, handler);
+            let ended = reply.is_some();
+            if let Some(line) = reply.and_then(|reply| self.outbox.reply(reply))
+                && let Some(out) = self.out.get_mut(..line.len())
+            {
+                out.copy_from_slice(line);
+                now = line.len();
+            }
+            if let Some(later) = session.take_later() {
+                let due = (Instant::now() + self.wait).as_ticks();
+                // (Room was checked before the line.)
+                let _ = self.outbox.wait(later, due);
+            } else if !ended {
+                continue;
+            }
+            return (at + 1, now);
+        }
+        (bytes.len(), 0)
     }
 }
 
