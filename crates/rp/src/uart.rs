@@ -14,9 +14,10 @@
 //! belongs to. Should the ring ever be lapped, the port reports the lost
 //! bytes (the line in progress is answered `err line bytes lost`).
 //!
-//! Bytes to send wait in a buffer of [`TX_BYTES`], from which UART0's
-//! interrupt fills the transmit FIFO: a reply is handed over at once, and
-//! the console goes on reading while it goes out.
+//! Bytes to send go straight into the transmit FIFO while it has room and
+//! nothing waits before them; the rest wait in a buffer of [`TX_BYTES`],
+//! from which UART0's interrupt fills the FIFO: a reply is handed over at
+//! once, and the console goes on reading while it goes out.
 
 use core::cell::{RefCell, UnsafeCell};
 use core::ptr;
@@ -274,17 +275,33 @@ impl Port for UartPort {
     async fn write(&mut self, bytes: &[u8]) -> Result<(), Gone> {
         let mut rest = bytes;
         loop {
-            let taken = TX.lock(|tx| {
+            let (taken, queued) = TX.lock(|tx| {
                 let mut tx = tx.borrow_mut();
-                rest.iter()
-                    .take_while(|&&b| tx.push_back(b).is_ok())
-                    .count()
+                let regs = pac::UART0;
+                // With nothing queued before them, bytes go straight into
+                // the transmit FIFO while it has room (a short reply fits
+                // whole: no interrupt needed).
+                let mut direct = 0;
+                if tx.is_empty() {
+                    for &byte in rest {
+                        if regs.uartfr().read().txff() {
+                            break;
+                        }
+                        regs.uartdr().write(|w| w.set_data(byte));
+                        direct += 1;
+                    }
+                }
+                let later = rest.get(direct..).unwrap_or_default();
+                let queued = later.iter().take_while(|&&b| tx.push_back(b).is_ok());
+                (direct + queued.count(), !tx.is_empty())
             });
             rest = rest.get(taken..).unwrap_or_default();
-            // The interrupt moves them into the FIFO (it only comes by
-            // itself once the FIFO drains to its trigger level).
-            pac::UART0.uartimsc().modify(|w| w.set_txim(true));
-            interrupt::UART0_IRQ.pend();
+            if queued {
+                // The interrupt moves them into the FIFO (it only comes by
+                // itself once the FIFO drains to its trigger level).
+                pac::UART0.uartimsc().modify(|w| w.set_txim(true));
+                interrupt::UART0_IRQ.pend();
+            }
             if rest.is_empty() {
                 return Ok(());
             }
