@@ -54,6 +54,11 @@ impl<'a> Driver<'a> {
     /// switches to Bottango's protocol (every motor of an earlier session
     /// deregistered) and the handshake's answer is written to `out`.
     pub fn handshake(&mut self, line: &[u8], out: &mut Out<'_>) -> bool {
+        // Every console line comes here: most are no handshake by their
+        // first bytes, and need no hash summed.
+        if !line.starts_with(b"hRQ,") {
+            return false;
+        }
         let (Some(curves), Ok(Command::Handshake(code))) = (self.curves, line::parse(line)) else {
             return false;
         };
