@@ -307,14 +307,16 @@ impl Replies {
                 out.copy_from_slice(line);
                 now = line.len();
             }
-            if let Some(later) = session.take_later() {
+            let later = session.take_later();
+            let waits = later.is_some();
+            if let Some(later) = later {
                 let due = (Instant::now() + self.wait).as_ticks();
                 // (Room was checked before the line.)
                 let _ = self.outbox.wait(later, due);
-            } else if !ended {
-                continue;
             }
-            return (at + 1, now);
+            if ended || waits {
+                return (at + 1, now);
+            }
         }
         (bytes.len(), 0)
     }

@@ -13,6 +13,15 @@ fn ms(ms: u64) -> Instant {
     Instant::from_millis(ms)
 }
 
+/// Port `port` on `link`, at 50 frames a second.
+fn place(link: &ConsoleLink, port: u8) -> Place<'_> {
+    Place {
+        port,
+        link,
+        frame: Duration::from_millis(20),
+    }
+}
+
 /// The times (ms) at which lines go out at `rate` lines a second over
 /// `span` ms, the port looking every `step` ms (a frame, say) and writing
 /// as soon as a line is due; each write takes `write` ms.
@@ -87,11 +96,7 @@ fn ticks_missed_by_a_slow_host_are_counted_lost_not_sent_in_a_burst() {
 #[test]
 fn a_port_the_host_closed_stops_its_watch_for_good() {
     let link = ConsoleLink::new();
-    let place = Place {
-        port: 1,
-        link: &link,
-        frame: Duration::from_millis(20),
-    };
+    let place = place(&link, 1);
     link.set_watch(0, 7);
     link.set_watch(1, 5);
     assert_eq!(telemetry_rate(true, false, place), 5);
@@ -106,11 +111,7 @@ fn a_port_the_host_closed_stops_its_watch_for_good() {
 #[test]
 fn a_bottango_session_has_no_telemetry_but_keeps_the_rate() {
     let link = ConsoleLink::new();
-    let place = Place {
-        port: 0,
-        link: &link,
-        frame: Duration::from_millis(20),
-    };
+    let place = place(&link, 0);
     link.set_watch(0, 5);
     assert_eq!(telemetry_rate(true, true, place), 0);
     assert_eq!(link.watch(0), 5);
@@ -140,11 +141,7 @@ impl Port for Chunks {
 #[test]
 fn every_line_is_answered_once_in_order_wherever_the_reads_cut_it() {
     let link = ConsoleLink::new();
-    let place = Place {
-        port: 0,
-        link: &link,
-        frame: Duration::from_millis(20),
-    };
+    let place = place(&link, 0);
     let mut port = Chunks {
         input: VecDeque::from([&b"stat"[..], b"us\r", b"\nhelp\r\nzz\n\nsave", b"\r\n"]),
         written: Vec::new(),

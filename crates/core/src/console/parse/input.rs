@@ -36,7 +36,7 @@ pub(super) fn input(words: &mut Words<'_>) -> Result<Command, ParseError> {
             let Some(first) = words.next() else {
                 return Err(words.error_here(ParseErrorKind::Missing(MOTION)));
             };
-            let Some(action) = super::motion(first, words)? else {
+            let Some(action) = super::motion(first, first.lower(), words)? else {
                 return Err(first.error(ParseErrorKind::UnknownWord { expected: MOTION }));
             };
             InputRole::Button(action)

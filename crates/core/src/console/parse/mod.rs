@@ -59,11 +59,11 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
     let Some(first) = words.next() else {
         return Err(words.error_here(ParseErrorKind::Empty));
     };
-    // The keyword is looked up once: a lookup is a bisection of them all.
+    // The keyword is looked up once.
     let keyword = first.lower();
     let command = if keyword == Word::Is(Kw::Idle) && words.peek().is_none() {
         Command::IdleQuery
-    } else if let Some(action) = motion_as(first, keyword, &mut words)? {
+    } else if let Some(action) = motion(first, keyword, &mut words)? {
         Command::Act(action)
     } else {
         match keyword {
@@ -92,12 +92,9 @@ pub fn parse(line: &[u8]) -> Result<Command, ParseError> {
 /// up to the end, not checked for more): a gesture, `look`, `center`,
 /// `idle`, `stop`, `rest` or `wake`. `None` for any other first word (and
 /// for the settings `rest` and `look` take: `rest after …`, `look duck …`).
-fn motion(first: Token<'_>, words: &mut Words<'_>) -> Result<Option<Action>, ParseError> {
-    motion_as(first, first.lower(), words)
-}
-
-/// [`motion`] with `first`'s keyword looked up already.
-fn motion_as(
+/// `keyword` is `first`'s, looked up by the caller (a lookup is a bisection
+/// of all the keywords).
+fn motion(
     first: Token<'_>,
     keyword: Word,
     words: &mut Words<'_>,
