@@ -86,7 +86,14 @@
 
 import { readFileSync } from 'node:fs';
 import { RP2040 } from 'rp2040js';
-import { flashUniqueId, roscRandomBit, sevAsOnTheChip, unmodelledCounter, xipControlAsOnTheChip } from './chip.mjs';
+import {
+  flashUniqueId,
+  roscRandomBit,
+  sevAsOnTheChip,
+  sramFirst,
+  unmodelledCounter,
+  xipControlAsOnTheChip,
+} from './chip.mjs';
 import { pioInStep } from './pio.mjs';
 import { RADAR_PIN, radarLine } from './radar.mjs';
 import { romImage, serveRom } from './rom.mjs';
@@ -218,6 +225,7 @@ function powerUp(kept) {
   xipControlAsOnTheChip(chip);
   roscRandomBit(chip);
   flashUniqueId(chip, cfg.uid);
+  sramFirst(chip);
   if ((cfg.usb || cfg.live || stream?.port === 'usb') && boot === 0) usb.attach(chip);
   chip.uart[0].onByte = (byte) => {
     if (uartTx.bytes.length === 0) uartTx.ns = now();
