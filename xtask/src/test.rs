@@ -101,6 +101,8 @@ impl Stages<'_> {
 /// `Ok(false)` when a stage failed.
 pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     const PICO_IMAGE: &str = "Pico image: .boot2 placement, memory budgets, no allocator";
+    const DRILL_BUILD: &str =
+        "watchdog drill image (cargo build --release --features watchdog-drill)";
     let start = Instant::now();
     let (root, metadata) = setup::prepare()?;
     let figures_page = root.join(figures::PAGE);
@@ -111,51 +113,59 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         left_out: 0,
     };
 
-    // 1. Host tests, formatting, lints, the images that must compile.
-    cargo_stages(&mut stages);
-
-    // 3. The Pico image: placement of the boot stage, memory budgets, no allocator.
-    // (Also for any emulator stage: they run on the image built here.)
+    // 1. The Pico image and the watchdog drill's: the emulator stages run on
+    // them in the background, at a low priority, while the stages below take
+    // the cores first (their links and waits leave a core idle at times).
     let emulated = EMULATED.iter().any(|(name, _)| stages.chosen(name));
     let pico_built = stages.run_if(emulated, "Pico build (cargo build --release)", || {
         PICO.build(&root)
     });
     if pico_built {
+        // The placement of the boot stage, memory budgets, no allocator.
         stages.run(PICO_IMAGE, || elf::check_pico(&PICO.elf(&metadata)));
     } else {
         stages.blocked(PICO_IMAGE, "the Pico build");
     }
-    // The Pico 2 on its own: its embassy-rp chip feature excludes the Pico's.
-    stages.run(pico2::STAGE, || pico2::test(&metadata));
+    let drill = stages.chosen(sim::DRILL_STAGE);
+    let drill_built = stages.run_if(drill, DRILL_BUILD, || sim::build_drill(&metadata).map(drop));
+    let _ = std::fs::remove_file(peak_file(&metadata));
+    std::thread::scope(|scope| {
+        let background = Background::start(scope, &stages, &root, pico_built, drill_built);
 
-    // The frame path cannot panic: this image links the frame update against
-    // a panic handler that does not exist, so the link fails if any panic
-    // path survives optimisation (boards/qemu/src/panic_proof.rs).
-    stages.run(
-        "frame path has no panic path (link of frame-path-proof)",
-        || project::Image::qemu("frame-path-proof").build(&root),
-    );
+        // 2. Host tests, formatting, lints, the images that must compile.
+        cargo_stages(&mut stages);
+        // The Pico 2 on its own: its embassy-rp chip feature excludes the Pico's.
+        stages.run(pico2::STAGE, || pico2::test(&metadata));
 
-    // 4. The QEMU run against the log on file, and the firmware's own verdict.
-    let qemu_run = qemu_stages(&mut stages, &root, &metadata, options);
+        // The frame path cannot panic: this image links the frame update against
+        // a panic handler that does not exist, so the link fails if any panic
+        // path survives optimisation (boards/qemu/src/panic_proof.rs).
+        stages.run(
+            "frame path has no panic path (link of frame-path-proof)",
+            || project::Image::qemu("frame-path-proof").build(&root),
+        );
 
-    // The Pico image in the RP2040 emulator, the watchdog drill, and its RAM
-    // with the peak stack measured there.
-    sim_stages(&mut stages, &root, &metadata, pico_built, qemu_run.as_ref());
+        // 3. The QEMU run against the log on file, and the firmware's own verdict.
+        let qemu_run = qemu_stages(&mut stages, &root, &metadata, options);
 
-    // 5. The boot-time benchmark in QEMU and the default set's instruction
-    // budget; its telemetry check compares against the QEMU run above.
-    stages.run(bench::tracking::STAGE, bench::tracking::stage);
-    stages.run(bench::STAGE, || {
-        setup::ensure_qemu()?;
-        bench::run_and_check(&root, &metadata, options, qemu_run.as_ref())
+        // 4. The boot-time benchmark in QEMU and the default set's instruction
+        // budget; its telemetry check compares against the QEMU run above.
+        stages.run(bench::tracking::STAGE, bench::tracking::stage);
+        stages.run(bench::STAGE, || {
+            setup::ensure_qemu()?;
+            bench::run_and_check(&root, &metadata, options, qemu_run.as_ref())
+        });
+
+        // The panel in a real browser (Chromium, headless).
+        stages.run(browser::STAGE, || browser::stage(&root, &metadata));
+
+        // 5. The book and its links (the figures it shows are checked below).
+        stages.run(book::STAGE, || book::stage(&root));
+
+        // 6. The emulator stages' results, and the RAM with the peak stack
+        // measured there.
+        background.record(&mut stages, &metadata, qemu_run.as_ref());
     });
-
-    // The panel in a real browser (Chromium, headless).
-    stages.run(browser::STAGE, || browser::stage(&root, &metadata));
-
-    // 6. The book, with the figures measured above, and its links.
-    stages.run(book::STAGE, || book::stage(&root));
     stages.run(figures::STAGE, || {
         figures::stale(&figures_page, &figures_before)
     });
@@ -268,7 +278,17 @@ fn run_apart(name: &str, cores: usize) -> Outcome {
     let start = Instant::now();
     let run = || -> Result<(Vec<u8>, std::process::ExitStatus)> {
         let (mut reader, writer) = std::io::pipe()?;
-        let mut command = std::process::Command::new(std::env::current_exe()?);
+        // At a low priority where `nice` exists: the stages in the foreground
+        // take the cores first.
+        let exe = std::env::current_exe()?;
+        let mut command = match which::which("nice") {
+            Ok(nice) => {
+                let mut nice = std::process::Command::new(nice);
+                nice.args(["-n", "10"]).arg(exe);
+                nice
+            }
+            Err(_) => std::process::Command::new(exe),
+        };
         command
             .args(["test", "--stage", name])
             .env(project::PREBUILT, cores.to_string());
@@ -292,72 +312,85 @@ fn run_apart(name: &str, cores: usize) -> Outcome {
     (output, failed, start.elapsed().as_secs_f64())
 }
 
-fn sim_stages(
-    stages: &mut Stages<'_>,
-    root: &Path,
-    metadata: &Metadata,
-    pico_built: bool,
-    qemu_run: Option<&Run>,
-) {
-    const MEMORY: &str = "RAM: static + peak stack of the Pico image within its budget";
-    const DRILL_BUILD: &str =
-        "watchdog drill image (cargo build --release --features watchdog-drill)";
-    let drill = stages.chosen(sim::DRILL_STAGE);
-    let drill_built = stages.run_if(drill, DRILL_BUILD, || sim::build_drill(metadata).map(drop));
-    let _ = std::fs::remove_file(peak_file(metadata));
-    let chosen: Vec<usize> = (0..EMULATED.len())
-        .filter(|&i| stages.chosen(EMULATED[i].0))
-        .collect();
-    let node = chosen.is_empty() || {
-        let ensured = sim::node::ensure(root);
-        if let Err(error) = &ensured {
-            println!("the emulator cannot run: {error:#}");
-        }
-        ensured.is_ok()
-    };
-    let blocker = |i: usize| {
-        let name = EMULATED[i].0;
-        if !pico_built {
-            Some("the Pico build")
-        } else if !node {
-            Some("the emulator's setup")
-        } else if name == sim::DRILL_STAGE && !drill_built {
-            Some("the drill image's build")
-        } else {
-            None
-        }
-    };
-    // Longest first: the two 10-minute streams, the DMX stream, the latency rows.
-    let mut queue = chosen.clone();
-    queue.retain(|&i| blocker(i).is_none());
-    let long = [
-        sim::UART_STREAM_STAGE,
-        sim::USB_STREAM_STAGE,
-        sim::DMX_STREAM_STAGE,
-        bench::LATENCY_STAGE,
-    ];
-    let rank = |i: &usize| long.iter().position(|name| *name == EMULATED[*i].0);
-    queue.sort_by_key(|i| rank(i).unwrap_or(long.len()));
-    let queue = std::sync::Mutex::new(queue.into_iter());
-    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
-    let (sender, results) = std::sync::mpsc::channel();
-    std::thread::scope(|scope| {
+/// The emulator stages ([`EMULATED`]) run apart, side by side, in the
+/// background; their results are scored in order by [`Background::record`].
+struct Background {
+    chosen: Vec<usize>,
+    /// What keeps a chosen stage from running, by its index in [`EMULATED`].
+    blocked: Vec<Option<&'static str>>,
+    results: std::sync::mpsc::Receiver<(usize, Outcome)>,
+}
+
+impl Background {
+    /// Starts one worker a core on `scope`, longest stages first.
+    fn start<'scope>(
+        scope: &'scope std::thread::Scope<'scope, '_>,
+        stages: &Stages<'_>,
+        root: &Path,
+        pico_built: bool,
+        drill_built: bool,
+    ) -> Self {
+        let chosen: Vec<usize> = (0..EMULATED.len())
+            .filter(|&i| stages.chosen(EMULATED[i].0))
+            .collect();
+        let node = chosen.is_empty() || {
+            let ensured = sim::node::ensure(root);
+            if let Err(error) = &ensured {
+                println!("the emulator cannot run: {error:#}");
+            }
+            ensured.is_ok()
+        };
+        let blocked = (0..EMULATED.len())
+            .map(|i| {
+                if !pico_built {
+                    Some("the Pico build")
+                } else if !node {
+                    Some("the emulator's setup")
+                } else if EMULATED[i].0 == sim::DRILL_STAGE && !drill_built {
+                    Some("the drill image's build")
+                } else {
+                    None
+                }
+            })
+            .collect::<Vec<_>>();
+        // Longest first: the two 10-minute streams, the DMX stream, the latency rows.
+        let mut queue = chosen.clone();
+        queue.retain(|&i| blocked[i].is_none());
+        let long = [
+            sim::UART_STREAM_STAGE,
+            sim::USB_STREAM_STAGE,
+            sim::DMX_STREAM_STAGE,
+            bench::LATENCY_STAGE,
+        ];
+        let rank = |i: &usize| long.iter().position(|name| *name == EMULATED[*i].0);
+        queue.sort_by_key(|i| rank(i).unwrap_or(long.len()));
+        let queue = std::sync::Arc::new(std::sync::Mutex::new(queue.into_iter()));
+        let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+        let (sender, results) = std::sync::mpsc::channel();
         for _ in 0..cores {
-            let sender = sender.clone();
-            let queue = &queue;
+            let (sender, queue) = (sender.clone(), queue.clone());
             scope.spawn(move || {
                 while let Some(i) = queue.lock().ok().and_then(|mut q| q.next()) {
                     let _ = sender.send((i, run_apart(EMULATED[i].0, cores)));
                 }
             });
         }
-        drop(sender);
-        // Scored in order, each as soon as those before it are.
+        Self {
+            chosen,
+            blocked,
+            results,
+        }
+    }
+
+    /// Scores each stage in order as soon as those before it are, then the
+    /// RAM with the peak stack measured in the pulses stage.
+    fn record(self, stages: &mut Stages<'_>, metadata: &Metadata, qemu_run: Option<&Run>) {
+        const MEMORY: &str = "RAM: static + peak stack of the Pico image within its budget";
         let mut done: Vec<Option<Outcome>> = vec![None; EMULATED.len()];
-        let mut pending = chosen.iter().peekable();
+        let mut pending = self.chosen.iter().peekable();
         loop {
             while let Some(&&i) = pending.peek() {
-                if let Some(by) = blocker(i) {
+                if let Some(by) = self.blocked[i] {
                     stages.blocked(EMULATED[i].0, by);
                 } else if let Some(outcome) = done[i].take() {
                     stages.record(EMULATED[i].0, outcome);
@@ -366,26 +399,26 @@ fn sim_stages(
                 }
                 pending.next();
             }
-            let Ok((i, outcome)) = results.recv() else {
+            let Ok((i, outcome)) = self.results.recv() else {
                 break;
             };
             done[i] = Some(outcome);
         }
-    });
-    stages.left_out += EMULATED.len() - chosen.len();
-    stages.run(MEMORY, || {
-        let peak = |elf: &Path, stack: Option<u64>| -> Result<Option<elf::Peak>> {
-            let Some(stack) = stack else { return Ok(None) };
-            let static_ram = elf::Image::read(elf)?.static_ram();
-            Ok(Some(elf::Peak { static_ram, stack }))
-        };
-        let stack = std::fs::read_to_string(peak_file(metadata)).ok();
-        let stack = stack.and_then(|s| s.trim().parse().ok());
-        let pico = peak(&PICO.elf(metadata), stack)?;
-        let qemu_peak = qemu_run.and_then(|run| sim::logged_peak_stack(&run.log));
-        let qemu = peak(&QEMU.elf(metadata), qemu_peak)?;
-        elf::check_ram(pico, qemu)
-    });
+        stages.left_out += EMULATED.len() - self.chosen.len();
+        stages.run(MEMORY, || {
+            let peak = |elf: &Path, stack: Option<u64>| -> Result<Option<elf::Peak>> {
+                let Some(stack) = stack else { return Ok(None) };
+                let static_ram = elf::Image::read(elf)?.static_ram();
+                Ok(Some(elf::Peak { static_ram, stack }))
+            };
+            let stack = std::fs::read_to_string(peak_file(metadata)).ok();
+            let stack = stack.and_then(|s| s.trim().parse().ok());
+            let pico = peak(&PICO.elf(metadata), stack)?;
+            let qemu_peak = qemu_run.and_then(|run| sim::logged_peak_stack(&run.log));
+            let qemu = peak(&QEMU.elf(metadata), qemu_peak)?;
+            elf::check_ram(pico, qemu)
+        });
+    }
 }
 
 fn qemu_stages(
