@@ -276,10 +276,11 @@ impl Replies {
             && !rest.is_empty()
             && self.outbox.has_room()
         {
-            let (took, now) = self.take_line(session, handler, rest);
+            let (took, reply_len) = self.take_line(session, handler, rest);
             taken += took;
-            if now > 0 {
-                port.write(self.out.get(..now).unwrap_or_default()).await?;
+            if reply_len > 0 {
+                port.write(self.out.get(..reply_len).unwrap_or_default())
+                    .await?;
             }
         }
         log_mode(was, session.bottango());
@@ -298,14 +299,14 @@ impl Replies {
         bytes: &[u8],
     ) -> (usize, usize) {
         for (at, &byte) in bytes.iter().enumerate() {
-            let mut now = 0;
+            let mut reply_len = 0;
             let reply = session.push(byte, handler);
             let ended = reply.is_some();
             if let Some(line) = reply.and_then(|reply| self.outbox.reply(reply))
                 && let Some(out) = self.out.get_mut(..line.len())
             {
                 out.copy_from_slice(line);
-                now = line.len();
+                reply_len = line.len();
             }
             let later = session.take_later();
             let waits = later.is_some();
@@ -315,7 +316,7 @@ impl Replies {
                 let _ = self.outbox.wait(later, due);
             }
             if ended || waits {
-                return (at + 1, now);
+                return (at + 1, reply_len);
             }
         }
         (bytes.len(), 0)

@@ -182,10 +182,21 @@ pub fn parse(line: &[u8]) -> Result<Command<'_>, LineError> {
     Ok(command)
 }
 
+/// The handshake's name.
+const HANDSHAKE: &[u8] = b"hRQ";
+
+/// Whether `line` starts as a handshake (`hRQ,`) does: a look at its first
+/// bytes, before [`parse`] sums its hash.
+#[must_use]
+pub fn may_be_handshake(line: &[u8]) -> bool {
+    line.strip_prefix(HANDSHAKE)
+        .is_some_and(|rest| rest.starts_with(b","))
+}
+
 /// The commands' names, in the order `parse` matches them.
 const NAMES: [&[u8]; 13] = [
-    b"hRQ", b"hMOD", b"OK", b"tSYN", b"STOP", b"xE", b"xUE", b"xC", b"xUC", b"rMTR", b"upE", b"sC",
-    b"sCI",
+    HANDSHAKE, b"hMOD", b"OK", b"tSYN", b"STOP", b"xE", b"xUE", b"xC", b"xUC", b"rMTR", b"upE",
+    b"sC", b"sCI",
 ];
 
 /// The parameters after the command's name.

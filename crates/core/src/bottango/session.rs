@@ -56,7 +56,7 @@ impl<'a> Driver<'a> {
     pub fn handshake(&mut self, line: &[u8], out: &mut Out<'_>) -> bool {
         // Every console line comes here: most are no handshake by their
         // first bytes, and need no hash summed.
-        if !line.starts_with(b"hRQ,") {
+        if !line::may_be_handshake(line) {
             return false;
         }
         let (Some(curves), Ok(Command::Handshake(code))) = (self.curves, line::parse(line)) else {
