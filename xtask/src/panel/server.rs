@@ -1,18 +1,25 @@
-//! The panel's web server (`tiny_http`, a thread a request): the page's
-//! files and dependencies (`vendor/…`), `bridge.json` (the head bridged
-//! to, if any), `GET /events` (the head's bytes as server-sent events of
-//! hex digits; `gone` with the reason when it goes away), `POST /send`.
+//! The panel's web server, a thread a connection and one request each
+//! (`Connection: close`): the page's files and dependencies (`vendor/…`),
+//! `bridge.json` (the head bridged to, if any), `GET /events` (the head's
+//! bytes as server-sent events of hex digits; `gone` with the reason when
+//! it goes away), `POST /send`. Requests are parsed by httparse. (Not
+//! `tiny_http` 0.12: its thread pool can leave a new connection unserved
+//! while its threads hold a browser's kept-alive ones.)
 
 use std::{
-    io::Write,
-    net::SocketAddr,
+    io::{self, BufRead, BufReader, Read, Write},
+    net::{Ipv4Addr, Ipv6Addr, SocketAddr, TcpListener, TcpStream},
     path::{Path, PathBuf},
-    sync::{Arc, mpsc},
+    sync::{
+        Arc,
+        atomic::{AtomicBool, Ordering},
+        mpsc,
+    },
     thread,
+    time::Duration,
 };
 
-use anyhow::{Context, Result, anyhow};
-use tiny_http::{Header, Method, Request, Response};
+use anyhow::{Context, Result};
 
 use super::bridge::{Bridge, Note};
 use super::{VENDOR, content_type};
@@ -21,9 +28,15 @@ use super::{VENDOR, content_type};
 /// copy): the page offers Web Serial.
 pub const NO_BRIDGE: &str = r#"{"bridge":null}"#;
 
+/// The longest request head, and body, read; a client that sends neither
+/// in this long is let go.
+const HEAD_LIMIT: usize = 16 * 1024;
+const BODY_LIMIT: u64 = 1 << 20;
+const READ_TIMEOUT: Duration = Duration::from_secs(10);
+
 /// The running server; dropping it stops it (and its bridge).
 pub struct Server {
-    http: Arc<tiny_http::Server>,
+    stop: Arc<AtomicBool>,
     accepting: Option<thread::JoinHandle<()>>,
     pub address: SocketAddr,
 }
@@ -38,10 +51,9 @@ impl Server {
         bridge: Option<Bridge>,
         stopped: mpsc::Sender<String>,
     ) -> Result<Self> {
-        let http =
-            tiny_http::Server::http(listen).map_err(|e| anyhow!("listening on {listen}: {e}"))?;
-        let http = Arc::new(http);
-        let address = http.server_addr().to_ip().context("a TCP address")?;
+        let listener =
+            TcpListener::bind(listen).with_context(|| format!("listening on {listen}"))?;
+        let address = listener.local_addr()?;
         let bridge = bridge.map(Arc::new);
         if let Some(bridge) = &bridge {
             let notes = bridge.hub.join();
@@ -55,15 +67,20 @@ impl Server {
             });
         }
         let panel = root.join("panel");
-        let serving = Arc::clone(&http);
+        let stop = Arc::new(AtomicBool::new(false));
+        let stopping = Arc::clone(&stop);
         let accepting = thread::spawn(move || {
-            for request in serving.incoming_requests() {
+            for stream in listener.incoming() {
+                if stopping.load(Ordering::Acquire) {
+                    break;
+                }
+                let Ok(stream) = stream else { continue };
                 let (panel, bridge) = (panel.clone(), bridge.clone());
-                thread::spawn(move || serve(request, &panel, bridge));
+                thread::spawn(move || serve(stream, &panel, bridge));
             }
         });
         Ok(Self {
-            http,
+            stop,
             accepting: Some(accepting),
             address,
         })
@@ -73,56 +90,98 @@ impl Server {
 impl Drop for Server {
     fn drop(&mut self) {
         // The accepting thread holds the bridge; a request holds it while
-        // it is answered, an event stream not at all.
-        self.http.unblock();
-        if let Some(accepting) = self.accepting.take() {
+        // it is answered, an event stream not at all. A connection of our
+        // own wakes the thread to see it is told to stop.
+        self.stop.store(true, Ordering::Release);
+        let mut wake = self.address;
+        if wake.ip().is_unspecified() {
+            wake.set_ip(match wake {
+                SocketAddr::V4(_) => Ipv4Addr::LOCALHOST.into(),
+                SocketAddr::V6(_) => Ipv6Addr::LOCALHOST.into(),
+            });
+        }
+        if TcpStream::connect(wake).is_ok()
+            && let Some(accepting) = self.accepting.take()
+        {
             let _ = accepting.join();
         }
     }
 }
 
-fn serve(mut request: Request, panel: &Path, bridge: Option<Arc<Bridge>>) {
-    let url = request.url();
-    let path = url.split(['?', '#']).next().unwrap_or(url).to_owned();
-    let text = |status, body: &str| Response::from_string(body).with_status_code(status);
-    let answer = match (request.method(), path.as_str(), bridge) {
-        (Method::Get, "/events", Some(bridge)) => {
+/// One request on `stream`, answered; the connection then closes.
+fn serve(stream: TcpStream, panel: &Path, bridge: Option<Arc<Bridge>>) -> io::Result<()> {
+    stream.set_nodelay(true)?;
+    stream.set_read_timeout(Some(READ_TIMEOUT))?;
+    let mut out = stream.try_clone()?;
+    let mut reader = BufReader::new(stream);
+    let mut head = Vec::new();
+    while !(head.ends_with(b"\r\n\r\n") || head.ends_with(b"\n\n")) {
+        let limit = (HEAD_LIMIT - head.len()) as u64;
+        if limit == 0 || (&mut reader).take(limit).read_until(b'\n', &mut head)? == 0 {
+            return answer(&mut out, "400 Bad Request", TEXT, b"an incomplete request");
+        }
+    }
+    let mut headers = [httparse::EMPTY_HEADER; 64];
+    let mut request = httparse::Request::new(&mut headers);
+    if !matches!(request.parse(&head), Ok(httparse::Status::Complete(_))) {
+        return answer(&mut out, "400 Bad Request", TEXT, b"not an HTTP request");
+    }
+    let length = request
+        .headers
+        .iter()
+        .find(|h| h.name.eq_ignore_ascii_case("content-length"))
+        .and_then(|h| std::str::from_utf8(h.value).ok()?.trim().parse().ok())
+        .unwrap_or(0u64);
+    let mut body = Vec::new();
+    reader.take(length.min(BODY_LIMIT)).read_to_end(&mut body)?;
+    let url = request.path.unwrap_or("/");
+    let path = url.split(['?', '#']).next().unwrap_or(url);
+    match (request.method.unwrap_or(""), path, bridge) {
+        ("GET", "/events", Some(bridge)) => {
             let notes = bridge.hub.join();
             drop(bridge);
-            let _ = events(request.into_writer(), &notes);
-            return;
+            events(out, &notes)
         }
-        (Method::Post, "/send", Some(bridge)) => {
-            let mut bytes = Vec::new();
-            let sent = request.as_reader().read_to_end(&mut bytes);
-            match sent
-                .map_err(anyhow::Error::from)
-                .and_then(|_| bridge.write(&bytes))
-            {
-                Ok(()) => text(200, "sent"),
-                Err(e) => text(503, &format!("not sent: {e:#}")),
+        ("POST", "/send", Some(bridge)) => match bridge.write(&body) {
+            Ok(()) => answer(&mut out, "200 OK", TEXT, b"sent"),
+            Err(e) => {
+                let why = format!("not sent: {e:#}");
+                answer(&mut out, "503 Service Unavailable", TEXT, why.as_bytes())
             }
-        }
-        (Method::Get, "/bridge.json", bridge) => {
+        },
+        ("GET", "/bridge.json", bridge) => {
             let body = bridge.map_or_else(
                 || NO_BRIDGE.to_owned(),
                 |b| serde_json::json!({"bridge": b.kind, "name": b.name}).to_string(),
             );
-            file(&body.into_bytes(), "application/json")
+            answer(&mut out, "200 OK", "application/json", body.as_bytes())
         }
-        (Method::Get, path, _) => match page_file(panel, path) {
-            Some((bytes, kind)) => file(&bytes, kind),
-            None => text(404, "not found"),
+        ("GET", path, _) => match page_file(panel, path) {
+            Some((bytes, kind)) => answer(&mut out, "200 OK", kind, &bytes),
+            None => answer(&mut out, "404 Not Found", TEXT, b"not found"),
         },
-        _ => text(405, "the page is static: GET it"),
-    };
-    let _ = request.respond(answer);
+        _ => answer(
+            &mut out,
+            "405 Method Not Allowed",
+            TEXT,
+            b"the page is static: GET it",
+        ),
+    }
 }
 
-fn file(bytes: &[u8], kind: &str) -> Response<std::io::Cursor<Vec<u8>>> {
-    let header = |name: &str, value: &str| Header::from_bytes(name, value).expect("a valid header");
-    let response = Response::from_data(bytes.to_vec()).with_header(header("Content-Type", kind));
-    response.with_header(header("Cache-Control", "no-store"))
+const TEXT: &str = "text/plain; charset=utf-8";
+
+/// A whole response; the page's files are never cached (they change as
+/// the panel is worked on).
+fn answer(out: &mut TcpStream, status: &str, kind: &str, body: &[u8]) -> io::Result<()> {
+    let length = body.len();
+    write!(
+        out,
+        "HTTP/1.1 {status}\r\nContent-Type: {kind}\r\nContent-Length: {length}\r\n\
+         Cache-Control: no-store\r\nConnection: close\r\n\r\n"
+    )?;
+    out.write_all(body)?;
+    out.flush()
 }
 
 /// The file `path` names: the page's own (in `panel/`), or a dependency's.
@@ -141,7 +200,7 @@ fn page_file(panel: &Path, path: &str) -> Option<(Vec<u8>, &'static str)> {
 }
 
 /// The event stream: the head's bytes, until it goes away or the page does.
-fn events(mut out: Box<dyn Write + Send>, notes: &mpsc::Receiver<Note>) -> std::io::Result<()> {
+fn events(mut out: TcpStream, notes: &mpsc::Receiver<Note>) -> io::Result<()> {
     out.write_all(
         b"HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\n\
           Connection: close\r\n\r\n",
@@ -160,4 +219,54 @@ fn events(mut out: Box<dyn Write + Send>, notes: &mpsc::Receiver<Note>) -> std::
         out.flush()?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The whole reply to `request`, read until the server closes.
+    fn ask(address: SocketAddr, request: &str) -> String {
+        let mut stream = TcpStream::connect(address).unwrap();
+        stream
+            .set_read_timeout(Some(Duration::from_secs(5)))
+            .unwrap();
+        stream.write_all(request.as_bytes()).unwrap();
+        let mut reply = String::new();
+        stream.read_to_string(&mut reply).unwrap();
+        reply
+    }
+
+    #[test]
+    fn idle_connections_hold_no_request_up_and_every_answer_closes_its_own() {
+        let (stopped, _) = mpsc::channel();
+        let root = crate::project::root();
+        let server = Server::start(&root, "127.0.0.1:0".parse().unwrap(), None, stopped).unwrap();
+        // A browser opens connections ahead of its requests and may leave
+        // some idle.
+        let idle: Vec<_> = (0..16)
+            .map(|_| TcpStream::connect(server.address).unwrap())
+            .collect();
+        let reply = ask(
+            server.address,
+            "GET /bridge.json HTTP/1.1\r\nHost: a\r\n\r\n",
+        );
+        assert!(reply.starts_with("HTTP/1.1 200 OK\r\n"), "{reply}");
+        assert!(reply.contains("\r\nConnection: close\r\n"), "{reply}");
+        assert!(reply.ends_with(&format!("\r\n\r\n{NO_BRIDGE}")), "{reply}");
+        for (request, status) in [
+            ("POST /send HTTP/1.1\r\nContent-Length: 3\r\n\r\nabc", "405"),
+            ("GET /../Cargo.toml HTTP/1.1\r\n\r\n", "404"),
+            ("GET /vendor/../../Cargo.toml HTTP/1.1\r\n\r\n", "404"),
+            ("a request?\r\n\r\n", "400"),
+        ] {
+            let reply = ask(server.address, request);
+            assert!(
+                reply.starts_with(&format!("HTTP/1.1 {status} ")),
+                "{request:?}: {reply}"
+            );
+        }
+        drop(idle);
+        drop(server);
+    }
 }
