@@ -164,8 +164,8 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         background.record(&mut stages, &metadata, qemu_run.as_ref());
     });
     // The panel in a real browser (Chromium, headless), with the cores to
-    // itself: under load a page's script has been seen to never arrive (the
-    // page's `load` more than 30 s late).
+    // itself: beside the emulator stages, the page once waited more than the
+    // 3 s it allows for a reply from the QEMU image it is bridged to.
     stages.run(browser::STAGE, || browser::stage(&root, &metadata));
     stages.run(figures::STAGE, || {
         figures::stale(&figures_page, &figures_before)
