@@ -118,14 +118,12 @@ fn serve(stream: TcpStream, panel: &Path, bridge: Option<Arc<Bridge>>) -> io::Re
     while !(head.ends_with(b"\r\n\r\n") || head.ends_with(b"\n\n")) {
         let limit = (HEAD_LIMIT - head.len()) as u64;
         if limit == 0 || (&mut reader).take(limit).read_until(b'\n', &mut head)? == 0 {
-            return answer(&mut out, "400 Bad Request", TEXT, b"an incomplete request");
+            break;
         }
     }
     let mut headers = [httparse::EMPTY_HEADER; 64];
     let mut request = httparse::Request::new(&mut headers);
-    if !matches!(request.parse(&head), Ok(httparse::Status::Complete(_))) {
-        return answer(&mut out, "400 Bad Request", TEXT, b"not an HTTP request");
-    }
+    let parsed = matches!(request.parse(&head), Ok(httparse::Status::Complete(_)));
     let length = request
         .headers
         .iter()
@@ -136,51 +134,60 @@ fn serve(stream: TcpStream, panel: &Path, bridge: Option<Arc<Bridge>>) -> io::Re
     reader.take(length.min(BODY_LIMIT)).read_to_end(&mut body)?;
     let url = request.path.unwrap_or("/");
     let path = url.split(['?', '#']).next().unwrap_or(url);
-    match (request.method.unwrap_or(""), path, bridge) {
-        ("GET", "/events", Some(bridge)) => {
+    let (status, kind, reply) = match (parsed, request.method.unwrap_or(""), path, bridge) {
+        (false, ..) => (
+            "400 Bad Request",
+            TEXT,
+            b"not a whole HTTP request".to_vec(),
+        ),
+        (_, "GET", "/events", Some(bridge)) => {
             let notes = bridge.hub.join();
             drop(bridge);
-            events(out, &notes)
+            return events(out, &notes);
         }
-        ("POST", "/send", Some(bridge)) => match bridge.write(&body) {
-            Ok(()) => answer(&mut out, "200 OK", TEXT, b"sent"),
-            Err(e) => {
-                let why = format!("not sent: {e:#}");
-                answer(&mut out, "503 Service Unavailable", TEXT, why.as_bytes())
-            }
+        (_, "POST", "/send", Some(bridge)) => match bridge.write(&body) {
+            Ok(()) => ("200 OK", TEXT, b"sent".to_vec()),
+            Err(e) => (
+                "503 Service Unavailable",
+                TEXT,
+                format!("not sent: {e:#}").into(),
+            ),
         },
-        ("GET", "/bridge.json", bridge) => {
+        (_, "GET", "/bridge.json", bridge) => {
             let body = bridge.map_or_else(
                 || NO_BRIDGE.to_owned(),
                 |b| serde_json::json!({"bridge": b.kind, "name": b.name}).to_string(),
             );
-            answer(&mut out, "200 OK", "application/json", body.as_bytes())
+            ("200 OK", "application/json", body.into_bytes())
         }
-        ("GET", path, _) => match page_file(panel, path) {
-            Some((bytes, kind)) => answer(&mut out, "200 OK", kind, &bytes),
-            None => answer(&mut out, "404 Not Found", TEXT, b"not found"),
+        (_, "GET", path, _) => match page_file(panel, path) {
+            Some((bytes, kind)) => ("200 OK", kind, bytes),
+            None => ("404 Not Found", TEXT, b"not found".to_vec()),
         },
-        _ => answer(
-            &mut out,
+        _ => (
             "405 Method Not Allowed",
             TEXT,
-            b"the page is static: GET it",
+            b"the page is static: GET it".to_vec(),
         ),
-    }
+    };
+    answer(&mut out, status, kind, Some(&reply))
 }
 
 const TEXT: &str = "text/plain; charset=utf-8";
 
-/// A whole response; the page's files are never cached (they change as
+/// A response, after which the connection closes: `body` whole, or `None`
+/// when a stream follows. Nothing is cached (the page's files change as
 /// the panel is worked on).
-fn answer(out: &mut TcpStream, status: &str, kind: &str, body: &[u8]) -> io::Result<()> {
-    let length = body.len();
+fn answer(out: &mut TcpStream, status: &str, kind: &str, body: Option<&[u8]>) -> io::Result<()> {
+    let length = body.map_or(String::new(), |b| {
+        format!("Content-Length: {}\r\n", b.len())
+    });
     write!(
         out,
-        "HTTP/1.1 {status}\r\nContent-Type: {kind}\r\nContent-Length: {length}\r\n\
-         Cache-Control: no-store\r\nConnection: close\r\n\r\n"
+        "HTTP/1.1 {status}\r\nContent-Type: {kind}\r\n{length}Cache-Control: no-store\r\n\
+         Connection: close\r\n\r\n"
     )?;
-    out.write_all(body)?;
+    out.write_all(body.unwrap_or_default())?;
     out.flush()
 }
 
@@ -201,11 +208,7 @@ fn page_file(panel: &Path, path: &str) -> Option<(Vec<u8>, &'static str)> {
 
 /// The event stream: the head's bytes, until it goes away or the page does.
 fn events(mut out: TcpStream, notes: &mpsc::Receiver<Note>) -> io::Result<()> {
-    out.write_all(
-        b"HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\n\
-          Connection: close\r\n\r\n",
-    )?;
-    out.flush()?;
+    answer(&mut out, "200 OK", "text/event-stream", None)?;
     for note in notes {
         match note {
             Note::Bytes(bytes) => {
