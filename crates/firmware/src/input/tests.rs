@@ -239,6 +239,23 @@ fn new_settings_from_the_console_take_effect_at_the_next_wake() {
     assert_eq!(task.taken(), [NOD]);
 }
 
+#[test]
+fn new_settings_pending_when_something_else_wakes_the_task_take_effect_then() {
+    let mut task = Task::new(InputSettings::DEFAULT, RELEASED);
+    task.links.console.set_inputs(button());
+    // The press woke the task before its wait saw the settings' signal.
+    task.set(500, PRESSED);
+    assert_eq!(task.source.pulls[0], Some(Pull::Up));
+    assert_eq!(task.last.1, 0b0001, "the button is watched");
+    assert!(
+        !task.links.console.take_inputs_changed(),
+        "the change was taken"
+    );
+    task.set(600, RELEASED);
+    task.set(1000, PRESSED);
+    assert_eq!(task.taken(), [NOD]);
+}
+
 /// Another source than pins: presence announced by messages on a bus
 /// (`[input, level]`, from a sensor on another board), one input numbered
 /// 40. No pulls: it ignores them.
