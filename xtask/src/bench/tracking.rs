@@ -173,48 +173,46 @@ pub fn stage() -> Result<()> {
     let walk = Walk::of(&yaw_of(&walk_script(), WALK_RUN_US)?, period)?;
     let pp = noise_pp(NOISE_MM)?;
     let deg = |mdeg: f64| format!("{:.2}°", mdeg / 1000.0);
-    let rows = vec![
-        vec![
+    // Each figure, what was measured, its acceptance, and whether it is met.
+    let checks = [
+        (
             "walk 2 m away, left to right at 1 m/s: the yaw's lag behind the bearing".to_owned(),
             format!("{} ms", walk.lag_ms),
             format!("≤ {MAX_LAG_MS} ms"),
-        ],
-        vec![
+            walk.lag_ms <= MAX_LAG_MS,
+        ),
+        (
             "the same walk: RMS error against the bearing after the first second".to_owned(),
             deg(walk.rms),
             format!("≤ {}", deg(MAX_RMS)),
-        ],
-        vec![
+            walk.rms <= MAX_RMS,
+        ),
+        (
             "the same walk: largest error after the first second".to_owned(),
             deg(walk.largest),
             "-".to_owned(),
-        ],
-        vec![
+            true,
+        ),
+        (
             format!(
                 "a person standing at 2.06 m, ±{NOISE_MM} mm of radar noise on x and y: the \
                  yaw's peak-to-peak against the run without ({NOISE_SEEDS} noise seeds)"
             ),
             deg(f64::from(pp)),
             format!("< {}", deg(f64::from(MAX_NOISE_PP))),
-        ],
+            pp < MAX_NOISE_PP,
+        ),
     ];
+    let misses: Vec<String> = (checks.iter().filter(|f| !f.3))
+        .map(|(figure, measured, acceptance, _)| format!("{figure}: {measured}, not {acceptance}"))
+        .collect();
+    let rows = checks.into_iter().map(|(f, m, a, _)| vec![f, m, a]);
     let intro = "How the head follows people, measured in the host trace (`cargo xtask trace`: \
                  the firmware's core frame by frame at 50 Hz, the radar's frames ten a second, \
                  the idle playing under the gaze; [attention and \
                  tracking](attention.md)). The bearing is held to the yaw's limits.";
     let header = ["figure", "measured", "acceptance"];
-    figures::record("tracking", intro.to_owned(), &header, rows);
-    let mut misses = Vec::new();
-    if walk.lag_ms > MAX_LAG_MS {
-        misses.push(format!("the yaw lags the walker by {} ms", walk.lag_ms));
-    }
-    if walk.rms > MAX_RMS {
-        misses.push(format!("the walk's RMS error is {}", deg(walk.rms)));
-    }
-    if pp >= MAX_NOISE_PP {
-        let pp = deg(f64::from(pp));
-        misses.push(format!("radar noise moves the yaw {pp} peak-to-peak"));
-    }
+    figures::record("tracking", intro.to_owned(), &header, rows.collect());
     crate::project::verdict(&misses)
 }
 
