@@ -261,21 +261,4 @@ line 10: at 7 s, before line 9 (at 8.5 s): lines must be in time order
 line 12: at 8.9 s, before line 11 (at 9 s): lines must be in time order"
         );
     }
-
-    #[test]
-    fn pins_and_console_lines() {
-        let script = "\
-0 input 2 presence -20000
-0 rest after 5
-1.5 pin 2 high
-2 servo pitch neutral 1520
-3 pin 2 low
-";
-        let events = parse(script, &params()).unwrap();
-        let kinds: Vec<Kind> = events.iter().map(|e| e.kind).collect();
-        let pin = |high| Kind::Pin { input: 2, high };
-        let console = Kind::Console;
-        assert_eq!(kinds, [console, console, pin(true), console, pin(false)]);
-        assert_eq!(events[2].at_us, 1_500_000);
-    }
 }

@@ -1,7 +1,4 @@
 use super::*;
-use idle_head_core::behaviour::LimitMode;
-
-use crate::steps::Steps;
 
 fn run(script: &str, seconds: u64) -> Trace {
     watched(script, seconds, None, &[])
@@ -108,54 +105,6 @@ fn a_scripted_nod_moves_pitch_only_and_answers() {
     assert!(
         (dip - 6000 - ducked).abs() <= 3,
         "{dip}, ducked by {ducked}"
-    );
-}
-
-#[test]
-fn a_presence_script_rests_relaxes_wakes_and_glances() {
-    let trace = run(
-        "\
-0 input 2 presence -20000
-0 rest after 5
-0 rest relax on
-12 pin 2 high
-16 pin 2 low
-",
-        20,
-    );
-    let at = |ms: u64| trace.rows[usize::try_from(ms / 20).unwrap()];
-    // Rested 5 s in, there after the 3 s glide: the pose held, the
-    // pulses off.
-    for ms in (8020..12060).step_by(20) {
-        assert_eq!(at(ms).angles, [8000, 0, 0], "{ms} ms");
-        assert_eq!(at(ms).pulses, [0; 3], "{ms} ms");
-    }
-    assert!(at(7980).pulses.iter().all(|&p| p > 0));
-    // Woken by the sensor 50 ms after its edge: the first pulse is the
-    // last before the gap, and the idle comes back within the idle
-    // limits until the glance starts, a second later.
-    assert_eq!(at(12_060).pulses, at(7980).pulses);
-    // (Exactly: the angles are the limiter's own, no measurement's.)
-    let (_, params) = built_in().unwrap();
-    for axis in Axis::ALL {
-        let angle = |ms: u64| f64::from(at(ms).angles[axis.index()]);
-        let wake: Vec<f64> = (12_040..=13_060).step_by(20).map(angle).collect();
-        let steps = Steps::of(&wake);
-        let allowed = Steps::allowed(&params, axis, LimitMode::Idle);
-        assert!(steps.within(allowed), "{axis:?}: {steps:?}");
-    }
-    assert_ne!(at(13_060).angles, [8000, 0, 0]);
-    // Then the glance towards the sensor: yaw at −20° (the idle's
-    // ducked sway aside), held about 2 s, then back.
-    let near = |ms: u64| (at(ms).angles[2] + 20_000).abs() < 2500;
-    let held = (13_000..17_000).step_by(20).filter(|&ms| near(ms)).count();
-    assert!(held >= 100, "{held} frames near -20°");
-    assert!(!near(19_000));
-    let wake = trace.marks.iter().find(|m| m.reply.starts_with("ok wake"));
-    let wake = wake.unwrap();
-    assert_eq!(
-        (wake.t_ms, wake.reply.as_str()),
-        (12_060, "ok wake ms=1000")
     );
 }
 
