@@ -179,20 +179,10 @@ pub fn at_rate(rate: ServoRate) -> Result<(DriverParams, BehaviourParams)> {
 }
 
 /// Runs `micros` of frames at `rate` with `events` (sorted by time); the
-/// idle from `seed` (`[pitch, roll, yaw]`, else Table 2's).
+/// idle from `seed` (`[pitch, roll, yaw]`, else Table 2's); the telemetry
+/// lines of a `watch` (if `watch` gives its lines a second), and the
+/// console's replies to `ask` after the last frame.
 pub fn simulate(
-    micros: u64,
-    seed: Option<[u32; 3]>,
-    rate: ServoRate,
-    events: &[Event],
-) -> Result<Trace> {
-    simulate_watched(micros, seed, rate, events, None, &[])
-}
-
-/// As [`simulate`], with the telemetry lines of a `watch` (if `watch`
-/// gives its lines a second), and the console's replies to `ask` after the
-/// last frame.
-pub fn simulate_watched(
     micros: u64,
     seed: Option<[u32; 3]>,
     rate: ServoRate,
@@ -311,7 +301,7 @@ pub fn command(args: &Args) -> Result<bool> {
         [seed, lcg.next_value(), lcg.next_value()]
     });
     let watch = args.telemetry.as_ref().map(|_| args.watch);
-    let trace = simulate_watched(args.micros, seeds, rate, &events, watch, &[])?;
+    let trace = simulate(args.micros, seeds, rate, &events, watch, &[])?;
     let default = |name: &str| -> Result<PathBuf> {
         let target = project::metadata(&project::root())?.target_dir;
         Ok(target.join("trace").join(name))

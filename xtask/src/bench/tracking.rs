@@ -124,7 +124,7 @@ impl Walk {
 fn yaw_of(script: &str, micros: u64) -> Result<Vec<f64>> {
     let (_, params) = trace::built_in()?;
     let events = trace::parse_script(script, &params)?;
-    let run = trace::simulate(micros, None, ServoRate::DEFAULT, &events)?;
+    let run = trace::simulate(micros, None, ServoRate::DEFAULT, &events, None, &[])?;
     let yaw = run
         .rows
         .iter()

@@ -109,7 +109,7 @@ fn replay(root: &Path, shots: &Path) -> Result<String> {
     let end = events.last().map_or(0, |e| e.at_us) + 1_500_000;
     let asks: Vec<&str> = PAGE_ASKS.split('|').collect();
     let rate = idle_head_core::servo::ServoRate::DEFAULT;
-    let run = trace::simulate_watched(end, None, rate, &events, Some(20), &asks)?;
+    let run = trace::simulate(end, None, rate, &events, Some(20), &asks)?;
     let lines = run.watch.map(|w| w.lines).unwrap_or_default();
     let answers: serde_json::Map<String, Value> = asks
         .iter()

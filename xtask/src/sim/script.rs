@@ -143,6 +143,8 @@ pub fn play(
                 seeds,
                 rate,
                 &events,
+                None,
+                &[],
             )?;
             host.rows.iter().map(|row| row.duties).collect()
         }

@@ -9,7 +9,7 @@ fn run(script: &str, seconds: u64) -> Trace {
 fn watched(script: &str, seconds: u64, watch: Option<u8>, ask: &[&str]) -> Trace {
     let events = script::parse(script, &built_in().unwrap().1).unwrap();
     let micros = seconds * 1_000_000;
-    simulate_watched(micros, None, ServoRate::DEFAULT, &events, watch, ask).unwrap()
+    simulate(micros, None, ServoRate::DEFAULT, &events, watch, ask).unwrap()
 }
 
 #[test]
