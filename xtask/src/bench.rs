@@ -176,13 +176,10 @@ impl Verdict {
 }
 
 /// The frame rows the image must report, by rate (Hz) and scenario, with
-/// their ceilings on the median and the max. Idle (playback, fade, limits,
-/// mapping, three PWM writes): 1,200 at the median, about 10 µs on a
-/// 125 MHz RP2040; 1,300 at 333 Hz, where the duty is counted from the
-/// exact angle (so that a look's first 5 ms frame at 200 Hz, 16 mdeg,
-/// reaches the pulse), 0.35 % of its frame. With a gesture and a look,
-/// whose shapes are evaluated afresh every frame: 2,000. The costliest
-/// frame: 4,000.
+/// their ceilings on the median and the max. Idle: 1,200 at the median,
+/// about 10 µs on a 125 MHz RP2040; 1,300 at 333 Hz, where the duty is
+/// counted from the exact angle. With a gesture and a look, evaluated
+/// afresh every frame: 2,000. The costliest frame: 4,000.
 pub const CEILINGS: [(u64, Option<&str>, [u64; 2]); 4] = [
     (50, None, [1200, 4000]),
     (50, Some("gesture+look"), [2000, 4000]),

@@ -1,12 +1,9 @@
 //! `cargo xtask trace`: the firmware's frames simulated on the host, as CSV
 //! (and PNG). The core's frame engine runs frame by frame as the frame task
-//! does, with the built-in configuration at 50 Hz or `--rate` (a script's
-//! `servo rate` changes it between two frames, as on the board); a
-//! script's motion lines go through the same queue, its console lines
-//! through the console's service, its pin lines into the input task
-//! (`host.rs`). A row per frame:
-//! `frame,t_ms,pitch_mdeg,roll_mdeg,yaw_mdeg,pitch_ns,roll_ns,yaw_ns`
-//! (`t_ms` with µs decimals where it has them).
+//! does (a script's `servo rate` changes the rate between two frames, as on
+//! the board); a script's motion lines go through the same queue, its
+//! console lines through the console's service, its pin lines into the
+//! input task (`host.rs`).
 
 mod host;
 mod marks;

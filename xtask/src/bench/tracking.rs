@@ -1,12 +1,8 @@
 //! How well the head follows people, measured in the host trace (the
-//! firmware's core, frame by frame, deterministic): a walk 2 m away, left
-//! to right at 1 m/s (the yaw's lag behind the walker's bearing and its RMS
-//! error after the first second) and a person standing still at 2.06 m
-//! with ±40 mm of uniform noise on the radar's x and y (the yaw's
-//! peak-to-peak against the same run without noise). The radar's lines go
-//! through the trace's script, ten a second, as the radar sends them; the
-//! emulator's radar stage plays the same walk into the shipped image
-//! (`xtask/src/sim/radar.rs`).
+//! firmware's core, frame by frame, deterministic): a walk in front of the
+//! head and a person standing still under radar noise ([`STAGE`]), the
+//! radar's lines in the trace's script. The emulator's radar stage plays
+//! the same walk into the shipped image (`xtask/src/sim/radar.rs`).
 
 // Angles and times far below 2^52: the float conversions are exact.
 #![allow(clippy::cast_precision_loss)]

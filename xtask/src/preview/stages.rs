@@ -1,12 +1,8 @@
 //! The stages of one loop in f64 degrees, from the engine's own trace, with
-//! the loop's metrics: `walk`, the random walk of step δ (the seamless
-//! closure's circular walk detrended, walk(n) = δ·Σ_{k≤n} (e(k) − D/N));
-//! `smoothed`, the engine's smoothed walk shifted to the walk's mean (the
-//! engine defines it only up to a constant); `normalized`, the paper's
-//! min-max normalisation into [α1, α2]; `final`, the stored loop in
-//! playback order, from the split point p: `final(i)` is the closure's last
-//! stage at (i + p) mod N (held to a reference implementation by
-//! `host-tests`); and their figure.
+//! the loop's metrics: `walk`, `smoothed` (shifted to the walk's mean: the
+//! engine defines it only up to a constant), `normalized` and `final`, the
+//! stored loop in playback order from the split point p (held to a
+//! reference implementation by `host-tests`); and their figure.
 
 // Sample indices (< 2^13) and angles are small: float conversions are exact
 // or far below the printed resolution.
