@@ -153,7 +153,7 @@ pub struct Args {
     pub script: Option<PathBuf>,
     /// Play radar lines (`<s> radar <x_mm>,<y_mm> ...` or `<s> radar none`)
     /// into GP13 as an HLK-LD2450, `radar on` sent first; checked as `--script`.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["drill", "console", "store", "noise", "flood", "script", "dmx", "show"])]
+    #[arg(long, value_name = "FILE", group = "run")]
     pub radar: Option<PathBuf>,
     /// With `--script`: the servos' rate, Hz (50 to 333), planted in the
     /// settings the image boots on; the host trace runs at it too.
@@ -184,18 +184,19 @@ pub fn command(args: &Args) -> Result<bool> {
     let (root, metadata) = crate::setup::prepare()?;
     let (root, md) = (root.as_path(), &metadata);
     PICO.build(root)?;
-    let (time, pulses) = ((args.virtual_time, args.timeout), args.pulses.as_ref());
-    if let Some(path) = &args.script {
+    let (time, pulses) = ((args.virtual_time, args.timeout), args.pulses.as_deref());
+    let script = match (&args.script, &args.radar) {
+        (Some(path), _) => Some(script::read(path)?),
+        (_, Some(path)) => Some(radar::read(path)?),
+        _ => None,
+    };
+    if let Some(events) = script {
         let rate = ServoRate::new(args.rate)
             .ok_or_else(|| anyhow::anyhow!("{} Hz: not a servo rate", args.rate))?;
-        return script::command(root, md, script::read(path)?, time, rate, pulses);
+        return script::command(root, md, events, time, rate, pulses);
     }
-    if args.dmx.is_some() || args.pulses.is_some() && !args.show {
+    if args.dmx.is_some() || pulses.is_some() && !args.show {
         return show::command(root, md, args);
-    }
-    if let Some(path) = &args.radar {
-        let events = radar::read(path)?;
-        return script::command(root, md, events, time, ServoRate::DEFAULT, pulses);
     }
     let time = args.virtual_time;
     let result = if let Some(port) = &args.stream {
@@ -212,7 +213,7 @@ pub fn command(args: &Args) -> Result<bool> {
         }
         test_console(root, md, time, args.timeout)
     } else if args.show {
-        show::show(root, md, args.pulses.as_deref())
+        show::show(root, md, pulses)
     } else {
         let stages: [(bool, Stage); 5] = [
             (args.inputs, test_inputs),
@@ -225,7 +226,7 @@ pub fn command(args: &Args) -> Result<bool> {
             stage(root, md)
         } else {
             let time = time.unwrap_or(DEFAULT_TIME);
-            let (_, report) = stages::checked_run(root, md, time, args.timeout, |_| {})?;
+            let report = stages::checked_run(root, md, time, args.timeout, |_| {})?;
             print!("{}{}", report.log_text(args.verbose), report.table());
             println!("{}\n{}", report.verdict(), report.summary());
             return Ok(report.problems.is_empty());

@@ -62,6 +62,15 @@ pub struct Measured {
     pub width: f64,
 }
 
+impl Train {
+    /// The compare writes from frame 0 (the write just before the enable).
+    pub fn frames(&self) -> Option<&[(f64, u16)]> {
+        let enabled = self.enabled?;
+        let first = self.writes.iter().rposition(|&(t, _)| t <= enabled)?;
+        Some(&self.writes[first..])
+    }
+}
+
 /// The complete pulses of `train` from `from` (ns) on; one still high at the
 /// end is left out.
 pub fn spans(train: &Train, from: f64) -> Vec<Measured> {
@@ -113,23 +122,17 @@ const SHOWN: usize = 3;
 pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -> ServoCheck {
     let mut out = ServoCheck::default();
     let ms = |ns: f64| ns / 1e6;
-    let Some(enabled) = train.enabled else {
-        let pulses = train.edges.iter().any(|&(_, high)| high);
-        let problem = if pulses {
-            "pulses on a slice that was never enabled"
-        } else {
-            "the slice was never enabled: no frame"
+    let Some(frames) = train.frames() else {
+        let problem = match train.enabled {
+            Some(_) => "the slice was enabled before any duty was written",
+            None if train.edges.iter().any(|&(_, high)| high) => {
+                "pulses on a slice that was never enabled"
+            }
+            None => "the slice was never enabled: no frame",
         };
         out.problems.push(problem.to_owned());
         return out;
     };
-    // Frame 0 is the compare write just before the enable; the rest follow.
-    let Some(first) = train.writes.iter().rposition(|&(t, _)| t <= enabled) else {
-        let problem = "the slice was enabled before any duty was written";
-        out.problems.push(problem.to_owned());
-        return out;
-    };
-    let frames = &train.writes[first..];
     out.frames = frames.len();
     if expected.len() < frames.len() {
         let (n, host) = (frames.len(), expected.len());

@@ -9,11 +9,13 @@ use anyhow::Result;
 
 use super::pulses::{self, Timing, Train};
 
-/// Writes `trains`' pulses to `path`; the rows written.
-pub fn write(path: &Path, trains: &[Train; 3], timing: &Timing) -> Result<usize> {
+/// Writes `trains`' pulses to `path` and says how many rows.
+pub fn write(path: &Path, trains: &[Train; 3], timing: &Timing) -> Result<()> {
     let text = rows(trains, timing);
     crate::project::write(path, &text)?;
-    Ok(text.lines().count() - 1)
+    let rows = text.lines().count() - 1;
+    println!("wrote {} ({rows} frames)", path.display());
+    Ok(())
 }
 
 /// The CSV's text.
@@ -87,7 +89,7 @@ mod tests {
         );
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("out/pulses.csv");
-        assert_eq!(write(&path, &trains, &timing).unwrap(), 4);
+        write(&path, &trains, &timing).unwrap();
         assert_eq!(
             std::fs::read_to_string(&path).unwrap(),
             "t_ms,pitch_us,roll_us,yaw_us\n0,1500.0,1500.0,1500.0\n20,1500.3,1500.0,1500.0\n\

@@ -15,10 +15,10 @@ use super::node::{Chunk, Config, FlashTiming};
 use super::pulses::angle;
 use super::run::{self, Boot, Report};
 use super::script::{self, Board, line};
-use super::{WALL, dmx, planted, stages::shipped_image, stream};
+use super::{WALL, dmx, planted, stream};
 use crate::bench::tracking::{self, Walk};
 use crate::log::number;
-use crate::project::{self, Metadata};
+use crate::project::{self, Metadata, PICO};
 use crate::trace::{Event, Kind};
 
 /// Stage names.
@@ -126,7 +126,7 @@ fn board(root: &Path, metadata: &Metadata, uid: u64) -> Result<(Vec<String>, Vec
     let boot = report.first()?;
     let seed = BoardId(uid).seed().context("an id that is no id")?;
     let mut problems = report.problems.clone();
-    let (replies, want) = (boot.uart_replies(), format!("ok seed=board:{seed}"));
+    let (replies, want) = (boot.replies(false), format!("ok seed=board:{seed}"));
     let (verdict, answers) = (report.verdict(), replies.join(" | "));
     println!("board {uid:016x}: {verdict}, `seed` answers `{answers}`");
     if replies != [want.clone()] {
@@ -143,7 +143,6 @@ fn board(root: &Path, metadata: &Metadata, uid: u64) -> Result<(Vec<String>, Vec
 /// [`RADAR_DMX_STAGE`]: DMX512 and a person walking up, 1 s to 9 s;
 /// `dmx` and `radar` asked at 9.2 s.
 pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
     let to = Duration::from_secs(9);
     let changes = dmx::alternating(Duration::from_secs(1), to)?;
     let mut script = String::from("0 radar on\n");
@@ -158,7 +157,7 @@ pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     let query = Duration::from_millis(9200);
     let lines = vec![Chunk::new(b"dmx\r\nradar\r\n".to_vec(), query)];
     let radar = (script.as_str(), to);
-    let report = with_radar(root, &elf, radar, lines, query, |config| {
+    let report = with_radar(root, metadata, radar, lines, query, |config| {
         config.dmx = Some(dmx::line(&changes));
     })?;
     // (The pulses are not the idle's: the radar turns the head. What is
@@ -170,15 +169,15 @@ pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     println!("radar: {} frames sent; `{radar_reply}`", boot.radar_frames);
     problems.extend(counted(boot, &radar_reply));
     problems.extend(report.problems.iter().cloned());
-    problems.extend(erase(root, &elf)?);
+    problems.extend(erase(root, metadata)?);
     project::verdict(&problems)
 }
 
-/// Runs `elf` to a second after `query`: the radar lines of `script` to
+/// Runs the shipped image to a second after `query`: the radar lines of `script` to
 /// its end, `radar on` at 0.1 s then `lines` on UART0, `setup` the rest.
 fn with_radar(
     root: &Path,
-    elf: &Path,
+    metadata: &Metadata,
     (script, end): (&str, Duration),
     lines: Vec<Chunk>,
     query: Duration,
@@ -187,11 +186,17 @@ fn with_radar(
     let radar = line(&script::parse(script)?, ServoRate::DEFAULT, end);
     let on = Chunk::new(b"radar on\r\n".to_vec(), Duration::from_millis(100));
     let pins = script::pin_script([vec![on], lines].concat());
-    run::run_with(root, elf, query + Duration::from_secs(1), WALL, |config| {
-        config.script = Some(pins);
-        config.radar = radar;
-        setup(config);
-    })
+    super::run_shipped(
+        root,
+        metadata,
+        query + Duration::from_secs(1),
+        WALL,
+        |config| {
+            config.script = Some(pins);
+            config.radar = radar;
+            setup(config);
+        },
+    )
 }
 
 /// The problem if `reply` missed a frame `boot` sent, or counted one bad.
@@ -210,15 +215,15 @@ const TYPICAL: FlashTiming = FlashTiming {
 /// A `save` at 2 s over noise in the settings sectors (each erase 45 ms
 /// with the interrupts off) while a person stands before the radar from
 /// 1 s to 5 s; `radar` asked at 5.2 s. The problems.
-fn erase(root: &Path, elf: &Path) -> Result<Vec<String>> {
-    let sectors = planted::fill(elf, |len| Ok(planted::noise(len)))?;
+fn erase(root: &Path, metadata: &Metadata) -> Result<Vec<String>> {
+    let sectors = planted::fill(&PICO.elf(metadata), |len| Ok(planted::noise(len)))?;
     let query = Duration::from_millis(5200);
     let lines = vec![
         Chunk::new(b"save\r\n".to_vec(), Duration::from_secs(2)),
         Chunk::new(b"radar\r\n".to_vec(), query),
     ];
     let radar = ("0 radar on\n1 radar -400,1800\n", Duration::from_secs(5));
-    let report = with_radar(root, elf, radar, lines, query, |config| {
+    let report = with_radar(root, metadata, radar, lines, query, |config| {
         config.rom = Some(TYPICAL);
         config.flash_fill = Some(sectors);
     })?;

@@ -68,14 +68,9 @@ impl Boot {
         bytes.split_terminator("\r\n").map(str::to_owned).collect()
     }
 
-    /// The reply lines UART0 sent.
-    pub fn uart_replies(&self) -> Vec<String> {
-        self.replies(false)
-    }
-
     /// The first reply line on UART0 starting with `start` (none: empty).
     pub fn reply(&self, start: &str) -> String {
-        let mut replies = self.uart_replies().into_iter();
+        let mut replies = self.replies(false).into_iter();
         replies.find(|r| r.starts_with(start)).unwrap_or_default()
     }
 

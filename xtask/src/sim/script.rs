@@ -2,7 +2,7 @@
 //! (pin lines on GP2 to GP5, console lines on UART0, radar lines on GP13;
 //! times from the first frame), every pulse against its host trace.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
@@ -192,13 +192,8 @@ fn written(report: &Report) -> Vec<[u16; 3]> {
         return Vec::new();
     };
     let frames = boot.trains.each_ref().map(|train| {
-        let enabled = train
-            .enabled
-            .and_then(|at| train.writes.iter().rposition(|w| w.0 <= at));
-        train.writes[enabled.unwrap_or(0)..]
-            .iter()
-            .map(|&(_, d)| d)
-            .collect::<Vec<u16>>()
+        let frames = train.frames().unwrap_or_default();
+        frames.iter().map(|&(_, d)| d).collect::<Vec<u16>>()
     });
     let n = frames.iter().map(Vec::len).max().unwrap_or(0);
     let duty = |k: usize| core::array::from_fn(|i| frames[i].get(k).copied().unwrap_or(0));
@@ -212,7 +207,7 @@ pub fn command(
     events: Vec<Event>,
     (time, wall): (Option<Duration>, Duration),
     rate: ServoRate,
-    pulses: Option<&PathBuf>,
+    pulses: Option<&Path>,
 ) -> Result<bool> {
     let time = time.unwrap_or_else(|| default_time(&events));
     let board = Board { rate, uid: None };
@@ -220,7 +215,7 @@ pub fn command(
     print!("{}", report.log_text(false));
     let boot = report.first()?;
     println!("UART0 replies:");
-    for reply in boot.uart_replies() {
+    for reply in boot.replies(false) {
         println!("  < {reply}");
     }
     print!("{}", report.table());
@@ -229,8 +224,7 @@ pub fn command(
         .replace("the host's duty", "the host trace's duty");
     println!("{verdict}\n{}", report.summary());
     if let Some(path) = pulses {
-        let rows = pulses_csv::write(path, &boot.trains, &run::timing_at(rate))?;
-        println!("wrote {} ({rows} frames)", path.display());
+        pulses_csv::write(path, &boot.trains, &run::timing_at(rate))?;
     }
     Ok(report.problems.is_empty())
 }

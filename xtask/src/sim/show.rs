@@ -17,7 +17,7 @@ use super::{
     run::{self, Boot},
     stages,
 };
-use crate::project::{self, Metadata};
+use crate::project::{self, Metadata, PICO};
 use crate::steps::Steps;
 
 /// Stage name.
@@ -60,8 +60,7 @@ pub fn command(root: &Path, metadata: &Metadata, args: &super::Args) -> Result<b
     let last = changes.as_ref().and_then(|c| c.last());
     let last = last.map(|last| last.at + Duration::from_secs(3));
     let time = args.virtual_time.or(last).unwrap_or(DEFAULT_TIME);
-    let elf = stages::shipped_image(root, metadata)?;
-    let report = run::run_with(root, &elf, time, args.timeout, |config| {
+    let report = super::run_shipped(root, metadata, time, args.timeout, |config| {
         config.dmx = changes.as_deref().map(dmx::line);
     })?;
     print!("{}", report.log_text(args.verbose));
@@ -90,11 +89,9 @@ fn print_pulses(boot: &Boot, csv: Option<&Path>) -> Result<()> {
         let max = widths.iter().copied().fold(0.0, f64::max);
         println!("{name:<6} {:>7} {min:>8.1} {max:>8.1}", widths.len());
     }
-    if let Some(path) = csv {
-        let rows = pulses_csv::write(path, &boot.trains, &run::timing())?;
-        println!("{rows} rows of pulses written to {}", path.display());
-    }
-    Ok(())
+    csv.map_or(Ok(()), |path| {
+        pulses_csv::write(path, &boot.trains, &run::timing())
+    })
 }
 
 /// The stage: see the [module docs](self).
@@ -105,10 +102,9 @@ pub fn test_show(root: &Path, metadata: &Metadata) -> Result<()> {
 /// `cargo xtask sim --show [--pulses FILE.csv]`: the stage.
 pub fn show(root: &Path, metadata: &Metadata, pulses: Option<&Path>) -> Result<()> {
     let changes = dmx::parse(SCRIPT)?;
-    let elf = stages::shipped_image(root, metadata)?;
     let lines = bottango_lines();
     let time = Duration::from_secs(14);
-    let report = run::run_with(root, &elf, time, stages::WALL, |config| {
+    let report = super::run_shipped(root, metadata, time, stages::WALL, |config| {
         config.dmx = Some(dmx::line(&changes));
         let stop = Chunk::new(b"STOP,h326\n", STOP);
         config.usb = vec![Chunk::new(lines.concat(), BOTTANGO), stop];
@@ -118,7 +114,7 @@ pub fn show(root: &Path, metadata: &Metadata, pulses: Option<&Path>) -> Result<(
     print_pulses(boot, pulses)?;
     let mut problems = check(boot, &lines)?;
     problems.extend(report.problems.iter().cloned());
-    problems.extend(stages::console_ram(&elf, &report)?);
+    problems.extend(stages::console_ram(&PICO.elf(metadata), &report)?);
     let boots = report.boots.len();
     if boots != 1 {
         problems.push(format!("{boots} boots: the watchdog reset the image"));

@@ -75,7 +75,7 @@ pub fn test_rate(root: &Path, metadata: &Metadata) -> Result<()> {
 /// The shipped image for [`DEFAULT_TIME`]: every check passes over at least
 /// [`MIN_FRAMES`] frames, the loops' checksum the host's. Returns the run.
 pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
-    let (_, report) = checked_run(root, metadata, DEFAULT_TIME, WALL, |_| {})?;
+    let report = checked_run(root, metadata, DEFAULT_TIME, WALL, |_| {})?;
     print!("{}{}", report.log_text(false), report.table());
     let mut problems = Vec::new();
     if report.frames() < MIN_FRAMES {
@@ -105,11 +105,10 @@ pub fn checked_run(
     time: Duration,
     wall: Duration,
     setup: impl FnOnce(&mut node::Config),
-) -> Result<(PathBuf, Report)> {
-    let elf = shipped_image(root, metadata)?;
-    let mut report = run::run_with(root, &elf, time, wall, setup)?;
+) -> Result<Report> {
+    let mut report = super::run_shipped(root, metadata, time, wall, setup)?;
     run::check(&mut report)?;
-    Ok((elf, report))
+    Ok(report)
 }
 
 /// Runs two boots of the drill image (each 3 s of frames and the timeout);
@@ -169,12 +168,6 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
     report.conclude(problems)
 }
 
-/// Builds the shipped Pico image (if not up to date); its ELF.
-pub fn shipped_image(root: &Path, metadata: &Metadata) -> Result<PathBuf> {
-    PICO.build(root)?;
-    Ok(PICO.elf(metadata))
-}
-
 /// Builds the drill image (`--features watchdog-drill`); its ELF, in
 /// `target/watchdog-drill/` (the shipped one stays). The shared
 /// `build.build-dir` recompiles only the crates the feature changes.
@@ -204,11 +197,11 @@ pub fn test_console(
     virtual_time: Duration,
     wall: Duration,
 ) -> Result<()> {
-    let (elf, mut report) = checked_run(root, metadata, virtual_time, wall, exchange::configure)?;
+    let mut report = checked_run(root, metadata, virtual_time, wall, exchange::configure)?;
     print!("{}", report.log_text(false));
     exchange::check(&mut report);
     print!("{}", report.table());
-    report.conclude(console_ram(&elf, &report)?)
+    report.conclude(console_ram(&PICO.elf(metadata), &report)?)
 }
 
 /// Prints the image's RAM (static plus peak stack); a problem if over.

@@ -12,9 +12,10 @@ use super::{
     planted,
     pulses::{angle, measure, spans},
     run::{self, Boot, Report},
-    stages::{WALL, console_ram, shipped_image},
+    stages::{WALL, console_ram},
 };
-use crate::{log::LogLine, project, project::Metadata};
+use crate::log::LogLine;
+use crate::project::{self, Metadata, PICO};
 
 /// Stage name.
 pub const STORE_STAGE: &str = "Pico image in the RP2040 emulator: `save` to flash with \
@@ -68,7 +69,8 @@ type Start = (
 
 /// Runs the scenario from every start and checks it (see the module docs).
 pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
-    let elf = shipped_image(root, metadata)?;
+    PICO.build(root)?;
+    let elf = PICO.elf(metadata);
     let starts: [Start; 3] = [
         (
             "foreign data",
@@ -142,7 +144,7 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> Vec<Str
             "boot {b}: the watchdog reset the board"
         );
         println!("boot {b}, UART0:");
-        let replies = boot.uart_replies();
+        let replies = boot.replies(false);
         // Boot 0: the replies to the lines sent during the save, last.
         let during = if b == 0 { DURING_SAVE_LINES } else { 0 };
         let (count, pitch) = (REPLIES[b].len() + during, ("ok pitch neutral=1520 ", ""));

@@ -123,7 +123,7 @@ pub fn test_stream(
 ) -> Result<()> {
     let count = usize::try_from(length.as_micros() / EVERY.as_micros()).unwrap_or(usize::MAX);
     let time = START + length + Duration::from_secs(1);
-    let (_, report) = checked_run(root, metadata, time, wall(length), |config| {
+    let report = checked_run(root, metadata, time, wall(length), |config| {
         let (start, every, lines) = (START, EVERY, CYCLE.to_vec());
         let stream = LineStream {
             port,
@@ -161,7 +161,7 @@ const FLOOD_LINES: usize = 100;
 /// as many in machine mode at 5 s, one more at 7 s.
 pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
     let time = Duration::from_millis(7_500);
-    let (_, report) = checked_run(root, metadata, time, WALL, |config| {
+    let report = checked_run(root, metadata, time, WALL, |config| {
         config.uart = vec![
             UartScript::new(0, b"status\r\n".repeat(FLOOD_LINES), Duration::from_secs(3)),
             UartScript::new(
@@ -199,7 +199,7 @@ pub fn test_flood(root: &Path, metadata: &Metadata) -> Result<()> {
 /// `sta`, a byte with a framing error, `tus`, then `status`.
 pub fn test_noise(root: &Path, metadata: &Metadata) -> Result<()> {
     let time = Duration::from_millis(3_500);
-    let (_, report) = checked_run(root, metadata, time, WALL, |config| {
+    let report = checked_run(root, metadata, time, WALL, |config| {
         let noisy = UartScript::new(0, b"staXtus\r\nstatus\r\n", Duration::from_secs(3));
         config.uart = vec![UartScript {
             errors: vec![3],
@@ -230,7 +230,7 @@ pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     let changes = dmx::alternating(START, end)?;
     let query = end + Duration::from_millis(50);
     let time = query + Duration::from_secs(1);
-    let (_, report) = checked_run(root, metadata, time, wall(DMX_LENGTH), |config| {
+    let report = checked_run(root, metadata, time, wall(DMX_LENGTH), |config| {
         config.dmx = Some(dmx::line(&changes));
         config.uart = vec![UartScript::new(0, b"dmx\n", query)];
     })?;
@@ -238,8 +238,7 @@ pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     // (The pulses are not held to the idle's own: a console on the line
     // engages the show layer, mix 0 or not. No frame may be late.)
     let boot = report.first()?;
-    let reply = boot.uart_replies().into_iter().next().unwrap_or_default();
-    let (text, problems) = check_dmx(boot, &reply, changes.len());
+    let (text, problems) = check_dmx(boot, &boot.reply("ok dmx="), changes.len());
     print!("{text}");
     crate::project::verdict(&problems)
 }
