@@ -4,7 +4,7 @@
 //! head's own framer ends them.
 
 use std::{
-    io::{ErrorKind, Read, Write},
+    io::{BufRead, BufReader, ErrorKind, Read, Write},
     sync::atomic::{AtomicBool, AtomicUsize, Ordering},
     thread,
     time::{Duration, Instant},
@@ -70,24 +70,18 @@ fn send(port: &mut impl Write, ends: &mut LineEnds, bytes: &[u8]) -> Result<(), 
 /// Hands `reader`'s lines to `each` (without CR LF or LF) until the stream
 /// ends, a read fails, or `stop` is set (checked when a read times out).
 fn read_replies(
-    mut reader: impl Read,
+    reader: impl Read,
     stop: &AtomicBool,
     mut each: impl FnMut(&[u8]),
 ) -> std::io::Result<()> {
-    let (mut line, mut buf) = (Vec::new(), [0_u8; 4096]);
+    let (mut reader, mut line) = (BufReader::new(reader), Vec::new());
     loop {
-        match reader.read(&mut buf) {
+        // A timed-out read keeps what it read of the line in `line`.
+        match reader.read_until(b'\n', &mut line) {
             Ok(0) => return Ok(()),
-            Ok(n) => {
-                for &b in &buf[..n] {
-                    if b != b'\n' {
-                        line.push(b);
-                        continue;
-                    }
-                    if line.last() == Some(&b'\r') {
-                        line.pop();
-                    }
-                    each(&line);
+            Ok(_) => {
+                if let Some(reply) = line.strip_suffix(b"\n") {
+                    each(reply.strip_suffix(b"\r").unwrap_or(reply));
                     line.clear();
                 }
             }
@@ -96,7 +90,6 @@ fn read_replies(
                     return Ok(());
                 }
             }
-            Err(e) if e.kind() == ErrorKind::Interrupted => {}
             Err(e) => return Err(e),
         }
     }
