@@ -1,9 +1,6 @@
 //! Installs what the commands need and is missing.
 
-use std::{
-    path::{Path, PathBuf},
-    process::{Command, Stdio},
-};
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use xshell::{Shell, cmd};
@@ -13,26 +10,17 @@ use crate::{board::PICO2_TARGET, project};
 /// QEMU's system emulator for Arm.
 pub const QEMU_BINARY: &str = "qemu-system-arm";
 
-/// What a command that builds starts from: the toolchain made complete,
-/// the repository root and cargo's metadata.
+/// What a command that builds starts from: the repository's toolchain
+/// (`rust-toolchain.toml`) given its firmware targets, rustfmt and clippy
+/// with rustup (if there is one), the repository root, cargo's metadata.
 pub fn prepare() -> Result<(PathBuf, project::Metadata)> {
-    let root = project::root();
-    ensure_toolchain(&root)?;
-    let metadata = project::metadata(&root)?;
-    Ok((root, metadata))
-}
-
-/// Adds the firmware targets, rustfmt and clippy to the repository's
-/// toolchain (`rust-toolchain.toml`) with rustup, if there is one.
-pub fn ensure_toolchain(root: &Path) -> Result<()> {
-    let sh = Shell::new()?;
-    sh.change_dir(root);
+    let sh = project::shell(".")?;
     for (what, wanted) in [
         ("target", [project::TARGET, PICO2_TARGET]),
         ("component", ["rustfmt", "clippy"]),
     ] {
         let Ok(list) = cmd!(sh, "rustup {what} list --installed").quiet().read() else {
-            return Ok(());
+            break;
         };
         // Components are listed with their host (`clippy-x86_64-…`).
         let installed = |name: &&str| {
@@ -44,9 +32,11 @@ pub fn ensure_toolchain(root: &Path) -> Result<()> {
             project::run(&sh, &[], cmd!(sh, "rustup {what} add {missing...}"))?;
         }
     }
-    Ok(())
+    let root = project::root();
+    Ok((root.clone(), project::metadata(&root)?))
 }
 
+/// Makes sure QEMU's Arm system emulator runs ([`ensure_program`]).
 pub fn ensure_qemu() -> Result<()> {
     ensure_program(
         QEMU_BINARY,
@@ -66,14 +56,13 @@ pub fn ensure_program(program: &str, packages: &[&str], what: &str) -> Result<()
     if !Path::new("/etc/debian_version").exists() || version("apt-get").is_none() {
         bail!("`{program}` was not found; install {what} and run the command again");
     }
-    let root = Command::new("id").arg("-u").output();
-    if !root.is_ok_and(|out| out.stdout.trim_ascii() == b"0") {
+    let sh = project::shell(".")?;
+    if cmd!(sh, "id -u").quiet().read().ok().as_deref() != Some("0") {
         bail!(
             "`{program}` was not found; install it with `sudo apt-get install {list}` and run the command again"
         );
     }
     println!("{program} is missing: installing {list}");
-    let sh = project::shell(".")?;
     let apt_get = |cmd| project::run(&sh, &[("DEBIAN_FRONTEND", "noninteractive")], cmd);
     apt_get(cmd!(sh, "apt-get update -q"))?;
     apt_get(cmd!(
@@ -85,14 +74,10 @@ pub fn ensure_program(program: &str, packages: &[&str], what: &str) -> Result<()
 }
 
 /// First line of `<program> --version`, if it runs.
-pub fn version(program: impl AsRef<std::ffi::OsStr>) -> Option<String> {
-    let out = Command::new(program)
-        .arg("--version")
-        .stdin(Stdio::null())
-        .output()
-        .ok();
-    let out = out.filter(|out| out.status.success())?;
-    let text = String::from_utf8_lossy(&out.stdout);
+pub fn version(program: impl AsRef<Path>) -> Option<String> {
+    let sh = Shell::new().ok()?;
+    let version = cmd!(sh, "{program} --version");
+    let text = version.quiet().ignore_stderr().read().ok()?;
     Some(text.lines().next().unwrap_or_default().trim().to_owned())
 }
 
