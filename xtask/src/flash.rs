@@ -8,10 +8,10 @@ use std::{
     ffi::OsString,
     io::Write as _,
     path::{Path, PathBuf},
-    process::Command,
 };
 
 use anyhow::{Context, Result, bail};
+use xshell::{Shell, cmd};
 
 use crate::{board::Board, project, uf2};
 
@@ -150,21 +150,14 @@ pub fn command(args: &Args) -> Result<bool> {
 }
 
 /// Flashes `args.elf` by the route [`choose`] finds in `here`; `Ok(false)`
-/// if there was none or probe-rs failed.
+/// if there was none, an error if probe-rs failed.
 pub fn run(args: &Args, here: &Surroundings) -> Result<bool> {
     let board = args.board;
     let route = choose(board, here)?;
     if let Route::Probe(probe) = route {
-        let chip = board.probe_rs_chip();
-        eprintln!("$ probe-rs run --chip {chip} {}", args.elf.display());
-        let run = Command::new(&probe)
-            .args(["run", "--chip", chip])
-            .arg(&args.elf)
-            .args(&args.rest)
-            .status();
-        return Ok(run
-            .with_context(|| format!("running {}", probe.display()))?
-            .success());
+        let (sh, chip, elf, rest) = (Shell::new()?, board.probe_rs_chip(), &args.elf, &args.rest);
+        cmd!(sh, "{probe} run --chip {chip} {elf} {rest...}").run()?;
+        return Ok(true);
     }
     let (path, bytes) = uf2::write(&args.elf, board, "uf2")?;
     let Route::Drive(drive) = route else {
