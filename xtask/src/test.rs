@@ -281,15 +281,11 @@ fn run_apart(name: &str, cores: usize) -> Outcome {
         let (mut reader, writer) = std::io::pipe()?;
         // At a low priority where `nice` exists: the stages in the foreground
         // take the cores first.
-        let exe = std::env::current_exe()?;
-        let mut command = match which::which("nice") {
-            Ok(nice) => {
-                let mut nice = std::process::Command::new(nice);
-                nice.args(["-n", "10"]).arg(exe);
-                nice
-            }
-            Err(_) => std::process::Command::new(exe),
-        };
+        let (exe, nice) = (std::env::current_exe()?, which::which("nice").ok());
+        let mut command = std::process::Command::new(nice.as_ref().unwrap_or(&exe));
+        if nice.is_some() {
+            command.args(["-n", "10"]).arg(exe);
+        }
         command
             .args(["test", "--stage", name])
             .env(project::PREBUILT, cores.to_string());
@@ -388,22 +384,19 @@ impl Background {
     fn record(self, stages: &mut Stages<'_>, metadata: &Metadata, qemu_run: Option<&Run>) {
         const MEMORY: &str = "RAM: static + peak stack of the Pico image within its budget";
         let mut done: Vec<Option<Outcome>> = vec![None; EMULATED.len()];
-        let mut pending = self.chosen.iter().peekable();
-        loop {
-            while let Some(&&i) = pending.peek() {
-                if let Some(by) = self.blocked[i] {
-                    stages.blocked(EMULATED[i].0, by);
-                } else if let Some(outcome) = done[i].take() {
-                    stages.record(EMULATED[i].0, outcome);
-                } else {
-                    break;
-                }
-                pending.next();
+        for &i in &self.chosen {
+            if let Some(by) = self.blocked[i] {
+                stages.blocked(EMULATED[i].0, by);
+                continue;
             }
-            let Ok((i, outcome)) = self.results.recv() else {
-                break;
-            };
-            done[i] = Some(outcome);
+            while done[i].is_none() {
+                let Ok((j, outcome)) = self.results.recv() else {
+                    break;
+                };
+                done[j] = Some(outcome);
+            }
+            let lost = || (Vec::new(), Some("its worker stopped".to_owned()), 0.0);
+            stages.record(EMULATED[i].0, done[i].take().unwrap_or_else(lost));
         }
         stages.left_out += EMULATED.len() - self.chosen.len();
         stages.run(MEMORY, || {
