@@ -7,8 +7,6 @@ mod board;
 mod book;
 mod cli;
 #[cfg(test)]
-mod cli_doc;
-#[cfg(test)]
 mod comments;
 mod console;
 mod elf;
