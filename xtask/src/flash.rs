@@ -34,13 +34,11 @@ pub struct Args {
     pub rest: Vec<OsString>,
 }
 
-/// What the runner looks at: the `PATH` for probe-rs (and the folder its
-/// relative entries start from), and where drives are mounted (each a
-/// drive, or holding drives).
+/// What the runner looks at: the `PATH` for probe-rs, and where drives are
+/// mounted (each a drive, or holding drives).
 #[derive(Debug, Clone)]
 pub struct Surroundings {
     pub path: Option<OsString>,
-    pub cwd: PathBuf,
     pub mounts: Vec<PathBuf>,
 }
 
@@ -62,9 +60,8 @@ impl Surroundings {
                 .chain(["/media", "/mnt", "/Volumes"].map(PathBuf::from))
                 .collect()
         };
-        let (path, cwd) = (std::env::var_os("PATH"), std::env::current_dir());
-        let cwd = cwd.unwrap_or_default();
-        Self { path, cwd, mounts }
+        let path = std::env::var_os("PATH");
+        Self { path, mounts }
     }
 }
 
@@ -97,8 +94,10 @@ pub fn choose(board: Board, here: &Surroundings) -> Result<Route> {
     drives.dedup();
     match drives.as_slice() {
         [drive] => Ok(Route::Drive(drive.clone())),
-        [] => Ok(which::which_in("probe-rs", here.path.as_deref(), &here.cwd)
-            .map_or(Route::Instructions, Route::Probe)),
+        [] => Ok(
+            which::which_in("probe-rs", here.path.as_deref(), std::env::current_dir()?)
+                .map_or(Route::Instructions, Route::Probe),
+        ),
         several => {
             let list: Vec<String> = several.iter().map(|d| d.display().to_string()).collect();
             bail!(
@@ -204,8 +203,8 @@ mod tests {
 
     fn here(path: &Path, mounts: &[&Path]) -> Surroundings {
         let mounts = mounts.iter().map(|m| m.to_path_buf()).collect();
-        let (path, cwd) = (Some(path.as_os_str().to_owned()), path.to_owned());
-        Surroundings { path, cwd, mounts }
+        let path = Some(path.as_os_str().to_owned());
+        Surroundings { path, mounts }
     }
 
     #[test]
