@@ -140,17 +140,16 @@ fn export(root: &Path, dir: &Path) -> Result<()> {
     let panel = root.join("panel");
     std::fs::create_dir_all(dir.join("vendor/uplot"))
         .with_context(|| format!("creating {}", dir.display()))?;
-    for file in page_files(root)? {
-        std::fs::copy(panel.join(&file), dir.join(&file))
-            .with_context(|| format!("copying {}", file.display()))?;
-    }
     std::fs::write(dir.join("bridge.json"), server::NO_BRIDGE)?;
-    for (url, file) in VENDOR {
-        std::fs::copy(
-            panel.join("node_modules").join(file),
-            dir.join("vendor").join(url),
-        )
-        .with_context(|| format!("copying {file}"))?;
+    let page = page_files(root)?
+        .into_iter()
+        .map(|f| (panel.join(&f), dir.join(f)));
+    let vendor = VENDOR.map(|(url, file)| {
+        let from = panel.join("node_modules").join(file);
+        (from, dir.join("vendor").join(url))
+    });
+    for (from, to) in page.chain(vendor) {
+        std::fs::copy(&from, to).with_context(|| format!("copying {}", from.display()))?;
     }
     Ok(())
 }
