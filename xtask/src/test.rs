@@ -330,13 +330,8 @@ impl Background {
         let chosen: Vec<usize> = (0..EMULATED.len())
             .filter(|&i| stages.chosen(EMULATED[i].0))
             .collect();
-        let node = chosen.is_empty() || {
-            let ensured = sim::node::ensure(root);
-            if let Err(error) = &ensured {
-                println!("the emulator cannot run: {error:#}");
-            }
-            ensured.is_ok()
-        };
+        let cannot = |error: &anyhow::Error| println!("the emulator cannot run: {error:#}");
+        let node = chosen.is_empty() || sim::node::ensure(root).inspect_err(cannot).is_ok();
         let blocked = (0..EMULATED.len())
             .map(|i| {
                 if !pico_built {
