@@ -3,7 +3,7 @@
 
 use std::{ops::Range, path::Path};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, bail, ensure};
 
 use crate::{board::Board, figures, project};
 use object::read::elf::{ElfFile32, ProgramHeader};
@@ -173,12 +173,11 @@ impl Image {
 
     /// Fails unless the image links no allocator.
     pub fn check_no_allocator(&self) -> Result<()> {
-        if !self.allocator_symbols.is_empty() {
-            bail!(
-                "an allocator is linked (symbols {}); the firmware must not allocate",
-                self.allocator_symbols.join(", ")
-            );
-        }
+        ensure!(
+            self.allocator_symbols.is_empty(),
+            "an allocator is linked (symbols {}); the firmware must not allocate",
+            self.allocator_symbols.join(", ")
+        );
         Ok(())
     }
 
@@ -193,19 +192,17 @@ impl Image {
         };
         let expected = board.settings();
         let expected = u64::from(expected.start)..u64::from(expected.end);
-        if region != expected {
-            bail!(
-                "the settings region is {region:#010x?} in memory.x, but the firmware's store \
-                 uses {expected:#010x?}"
-            );
-        }
+        ensure!(
+            region == expected,
+            "the settings region is {region:#010x?} in memory.x, but the firmware's store \
+             uses {expected:#010x?}"
+        );
         let (start, end) = (region.start, self.flash_end);
-        if end > start {
-            bail!(
-                "the image's flash contents end at {end:#010x}, inside the settings region at \
-                 {start:#010x}"
-            );
-        }
+        ensure!(
+            end <= start,
+            "the image's flash contents end at {end:#010x}, inside the settings region at \
+             {start:#010x}"
+        );
         let kib = (region.end - start) / 1024;
         println!(
             "  settings region {region:#010x?} ({kib} KiB) clear: the image ends at {end:#010x}"

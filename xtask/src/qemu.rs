@@ -7,7 +7,7 @@ use std::{
     time::{Duration, Instant},
 };
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, ensure};
 
 use crate::figures::{self, thousands};
 use crate::{
@@ -169,9 +169,7 @@ fn plot_motion(log: &[LogLine], path: &Path) -> Result<usize> {
     let mut frames: Vec<(f64, [f64; 3])> =
         log.iter().filter_map(|l| frame_line(&l.message)).collect();
     frames.sort_by(|a, b| a.0.total_cmp(&b.0));
-    if frames.len() < 2 {
-        bail!("fewer than two frame lines in the log");
-    }
+    ensure!(frames.len() >= 2, "fewer than two frame lines in the log");
     let title = format!("The QEMU run's motion: {} logged frames", frames.len());
     let notes = vec!["angles as the firmware logged them".to_owned()];
     plot::motion(path, title, notes, "frame", &frames, &[])?;

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, bail, ensure};
 use xshell::{Shell, cmd};
 
 use crate::{board::PICO2_TARGET, project};
@@ -57,11 +57,10 @@ pub fn ensure_program(program: &str, packages: &[&str], what: &str) -> Result<()
         bail!("`{program}` was not found; install {what} and run the command again");
     }
     let sh = project::shell(".")?;
-    if cmd!(sh, "id -u").quiet().read().ok().as_deref() != Some("0") {
-        bail!(
-            "`{program}` was not found; install it with `sudo apt-get install {list}` and run the command again"
-        );
-    }
+    ensure!(
+        cmd!(sh, "id -u").quiet().read().ok().as_deref() == Some("0"),
+        "`{program}` was not found; install it with `sudo apt-get install {list}` and run the command again"
+    );
     println!("{program} is missing: installing {list}");
     let apt_get = |cmd| project::run(&sh, &[("DEBIAN_FRONTEND", "noninteractive")], cmd);
     apt_get(cmd!(sh, "apt-get update -q"))?;
@@ -115,11 +114,10 @@ pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
         ("CARGO_PROFILE_RELEASE_DEBUG", "false"),
     ];
     project::run(&sh, &quick, install)?;
-    if !pinned(&local) {
-        bail!(
-            "installed {wanted}, but {} does not run as it",
-            local.display()
-        );
-    }
+    ensure!(
+        pinned(&local),
+        "installed {wanted}, but {} does not run as it",
+        local.display()
+    );
     Ok(local)
 }

@@ -5,7 +5,7 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, ensure};
 use elf2flash_core::boards::{BoardInfo, RP2040, RP2350};
 use object::{Object, ObjectSection};
 
@@ -39,11 +39,10 @@ pub fn make(elf: &[u8], board: Board) -> Result<Vec<u8>> {
     }
     let settings = board.settings().start;
     let end = image.flash_end;
-    if end > u64::from(settings) {
-        bail!(
-            "the image's flash contents end at {end:#010x}, in the settings sectors from {settings:#010x}: flashing it would overwrite the saved settings"
-        );
-    }
+    ensure!(
+        end <= u64::from(settings),
+        "the image's flash contents end at {end:#010x}, in the settings sectors from {settings:#010x}: flashing it would overwrite the saved settings"
+    );
     let chip: &dyn BoardInfo = match board {
         Board::Pico => &RP2040,
         Board::Pico2 => &RP2350,
@@ -64,24 +63,22 @@ pub fn start_block(data: &[u8]) -> Result<Range<u64>> {
     )?;
     let range = section.address()..section.address() + section.size();
     let search = elf::XIP.start..elf::XIP.start + 0x1000;
-    if range.start < search.start || range.end > search.end {
-        bail!(
-            "`.start_block` is at {range:#010x?}, outside the first 4 KiB of flash where the boot \
-             ROM searches"
-        );
-    }
+    ensure!(
+        range.start >= search.start && range.end <= search.end,
+        "`.start_block` is at {range:#010x?}, outside the first 4 KiB of flash where the boot \
+         ROM searches"
+    );
     let bytes = section.data().context("reading `.start_block`")?;
     let word = |at: usize| Some(u32::from_le_bytes(bytes.get(at..at + 4)?.try_into().ok()?));
     let last = bytes.len().checked_sub(4).and_then(word);
-    if word(0) != Some(MARKERS.0) || last != Some(MARKERS.1) {
-        bail!(
-            "`.start_block` ({} B) does not open with {:#010x} and close with {:#010x}: not a \
-             block the boot ROM reads",
-            bytes.len(),
-            MARKERS.0,
-            MARKERS.1
-        );
-    }
+    ensure!(
+        word(0) == Some(MARKERS.0) && last == Some(MARKERS.1),
+        "`.start_block` ({} B) does not open with {:#010x} and close with {:#010x}: not a \
+         block the boot ROM reads",
+        bytes.len(),
+        MARKERS.0,
+        MARKERS.1
+    );
     Ok(range)
 }
 
