@@ -14,6 +14,7 @@ use std::{
 };
 
 use anyhow::{Context, Result, anyhow};
+use wait_timeout::ChildExt;
 
 use crate::console::{
     Pace, open_port,
@@ -168,12 +169,7 @@ impl Drop for Bridge {
             *writer = Box::new(std::io::sink());
         }
         if let Some(mut child) = self.child.take() {
-            for _ in 0..150 {
-                if matches!(child.try_wait(), Ok(Some(_))) {
-                    break;
-                }
-                thread::sleep(Duration::from_millis(20));
-            }
+            let _ = child.wait_timeout(Duration::from_secs(3));
             let _ = child.kill();
             let _ = child.wait();
         }
