@@ -110,10 +110,8 @@ impl LogLine {
 
     /// Prints the line with its timestamp, and the location of a problem.
     pub fn print(&self) {
-        match &self.timestamp {
-            Some(timestamp) => println!("{timestamp} {}", self.snapshot()),
-            None => println!("{}", self.snapshot()),
-        }
+        let timestamp = self.timestamp.as_ref().map(|t| format!("{t} "));
+        println!("{}{}", timestamp.unwrap_or_default(), self.snapshot());
         if self.is_problem()
             && let Some(location) = &self.location
         {
