@@ -68,9 +68,11 @@ impl Stages<'_> {
         passed
     }
 
-    /// Fails a stage that cannot run because `by` failed.
-    fn blocked(&mut self, name: &str, by: &str) {
-        self.run(name, || bail!("not run, {by} failed"));
+    /// Fails the stages `names`, which cannot run because `by` failed.
+    fn blocked(&mut self, names: &[&str], by: &str) {
+        for name in names {
+            self.run(name, || bail!("not run, {by} failed"));
+        }
     }
 
     /// Prints the score card and `N passed, M failed`.
@@ -124,7 +126,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         // The placement of the boot stage, memory budgets, no allocator.
         stages.run(PICO_IMAGE, || elf::check_pico(&PICO.elf(&metadata)));
     } else {
-        stages.blocked(PICO_IMAGE, "the Pico build");
+        stages.blocked(&[PICO_IMAGE], "the Pico build");
     }
     let drill = stages.chosen(sim::DRILL_STAGE);
     let drill_built = stages.run_if(drill, DRILL_BUILD, || sim::build_drill(&metadata).map(drop));
@@ -381,7 +383,7 @@ impl Background {
         let mut done: Vec<Option<Outcome>> = vec![None; EMULATED.len()];
         for &i in &self.chosen {
             if let Some(by) = self.blocked[i] {
-                stages.blocked(EMULATED[i].0, by);
+                stages.blocked(&[EMULATED[i].0], by);
                 continue;
             }
             while done[i].is_none() {
@@ -429,9 +431,7 @@ fn qemu_stages(
         elf::check_qemu(&image)
     });
     if !built {
-        for name in [RUN, SNAPSHOT, SUMMARY] {
-            stages.blocked(name, BUILD);
-        }
+        stages.blocked(&[RUN, SNAPSHOT, SUMMARY], BUILD);
         return None;
     }
     let mut run: Option<Run> = None;
@@ -442,9 +442,7 @@ fn qemu_stages(
         Ok(())
     });
     let Some(run) = run else {
-        for name in [SNAPSHOT, SUMMARY] {
-            stages.blocked(name, RUN);
-        }
+        stages.blocked(&[SNAPSHOT, SUMMARY], RUN);
         return None;
     };
     stages.run(SNAPSHOT, || {
