@@ -49,10 +49,8 @@ pub fn qemu_session(
     echo: Echo,
     wait: Duration,
 ) -> Result<QemuSession> {
-    let (child, dir, [uart0, uart1]) = spawn_with_sockets(elf, pace, "console", Stdio::piped)?;
+    let (child, [mut console, mut hang_up]) = spawn_connected(elf, pace, "console", Stdio::piped)?;
     let (run, talk) = qemu::finish(child, elf, AFTER_HANG_UP, echo, || {
-        let mut console = connect(&uart0)?;
-        let mut hang_up = connect(&uart1)?;
         let (reader, timeout) = (console.try_clone()?, console.try_clone()?);
         let end = || -> Result<()> {
             hang_up.write_all(b"\0")?;
@@ -63,20 +61,19 @@ pub fn qemu_session(
         let talk = talk::converse(input, &mut console, reader, on_reply, wait, end);
         Ok::<_, anyhow::Error>(talk)
     })?;
-    let _ = std::fs::remove_dir_all(&dir);
     Ok(QemuSession { run, talk: talk? })
 }
 
-/// Starts QEMU running `elf` for a console, UART0 and UART1 on sockets it
-/// serves (waiting for both to be connected) in a temporary folder of its
-/// own, its stdout and stderr `output`: QEMU, the folder (for the caller to
-/// remove), the sockets.
-pub fn spawn_with_sockets(
+/// Starts QEMU running `elf` for a console, its stdout and stderr `output`,
+/// UART0 and UART1 on sockets it serves in a temporary folder of its own
+/// (removed once both are connected; QEMU is stopped if they cannot be):
+/// QEMU and the two connections.
+pub fn spawn_connected(
     elf: &Path,
     pace: Pace,
     tag: &str,
     output: fn() -> Stdio,
-) -> Result<(Child, PathBuf, [PathBuf; 2])> {
+) -> Result<(Child, [UnixStream; 2])> {
     let dir = std::env::temp_dir().join(format!("idle-head-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let [uart0, uart1] = ["uart0", "uart1"].map(|n| dir.join(format!("{n}.sock")));
@@ -84,13 +81,20 @@ pub fn spawn_with_sockets(
         let _ = std::fs::remove_file(path);
     }
     let serial = |path: &PathBuf| format!("unix:{},server=on,wait=on", path.display());
-    let child = qemu_command(elf, pace, [&serial(&uart0), &serial(&uart1)])
+    let mut child = qemu_command(elf, pace, [&serial(&uart0), &serial(&uart1)])
         .stdin(Stdio::null())
         .stdout(output())
         .stderr(output())
         .spawn()
         .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
-    Ok((child, dir, [uart0, uart1]))
+    // QEMU waits for each connection in turn before the image starts.
+    let connected = connect(&uart0).and_then(|uart0| Ok([uart0, connect(&uart1)?]));
+    let _ = std::fs::remove_dir_all(&dir);
+    if connected.is_err() {
+        let _ = child.kill();
+        let _ = child.wait();
+    }
+    Ok((child, connected?))
 }
 
 /// QEMU running `elf` for a console: the run `pace` asks for, UART0 and

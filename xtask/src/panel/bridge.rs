@@ -6,7 +6,7 @@ use std::{
     io::{ErrorKind, Read, Write},
     net::Shutdown,
     os::unix::net::UnixStream,
-    path::{Path, PathBuf},
+    path::Path,
     process::{Child, Stdio},
     sync::{Mutex, mpsc},
     thread,
@@ -16,10 +16,7 @@ use std::{
 use anyhow::{Context, Result, anyhow};
 use wait_timeout::ChildExt;
 
-use crate::console::{
-    Pace, open_port,
-    qemu::{connect, spawn_with_sockets},
-};
+use crate::console::{Pace, open_port, qemu::spawn_connected};
 use crate::sim::live;
 
 /// What the head says, for each page connected.
@@ -67,10 +64,9 @@ pub struct Bridge {
     pub hub: std::sync::Arc<Hub>,
     writer: Mutex<Box<dyn Write + Send>>,
     /// What to stop when the bridge goes: a process, QEMU's hang-up line
-    /// (UART1) and its sockets' folder.
+    /// (UART1).
     child: Option<Child>,
     hang_up: Option<UnixStream>,
-    dir: Option<PathBuf>,
 }
 
 impl Bridge {
@@ -82,7 +78,6 @@ impl Bridge {
             writer: Mutex::new(writer),
             child: None,
             hang_up: None,
-            dir: None,
         }
     }
 
@@ -116,13 +111,11 @@ impl Bridge {
 
     /// The QEMU image `elf`, a clean head at real time, over its UART0.
     pub fn qemu(elf: &Path) -> Result<Self> {
-        let (child, dir, [uart0, uart1]) =
-            spawn_with_sockets(elf, Pace::RealTime, "panel", Stdio::null)?;
-        let console = connect(&uart0)?;
+        let (child, [console, hang_up]) =
+            spawn_connected(elf, Pace::RealTime, "panel", Stdio::null)?;
         let reader = console.try_clone()?;
         let mut bridge = Self::new("the QEMU image (UART0)", "qemu", Box::new(console));
-        (bridge.child, bridge.dir) = (Some(child), Some(dir));
-        bridge.hang_up = Some(connect(&uart1)?);
+        (bridge.child, bridge.hang_up) = (Some(child), Some(hang_up));
         bridge.read(reader, "QEMU's UART0 closed");
         Ok(bridge)
     }
@@ -172,9 +165,6 @@ impl Drop for Bridge {
             let _ = child.wait_timeout(Duration::from_secs(3));
             let _ = child.kill();
             let _ = child.wait();
-        }
-        if let Some(dir) = self.dir.take() {
-            let _ = std::fs::remove_dir_all(dir);
         }
     }
 }
