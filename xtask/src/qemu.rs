@@ -86,13 +86,19 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
     let words = std::iter::once(command.get_program()).chain(command.get_args());
     let words: Vec<_> = words.map(|w| w.to_string_lossy()).collect();
     println!("$ {}", words.join(" "));
-    let child = command
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .with_context(|| format!("could not start {QEMU_BINARY}"))?;
+    let child = spawn(&mut command, Stdio::piped)?;
     Ok(finish(child, elf, timeout, echo, || ())?.0)
+}
+
+/// Starts QEMU's `command`, stdin closed, its stdout and stderr `output`.
+pub fn spawn(command: &mut Command, output: fn() -> Stdio) -> Result<Child> {
+    let command = command
+        .stdin(Stdio::null())
+        .stdout(output())
+        .stderr(output());
+    command
+        .spawn()
+        .with_context(|| format!("could not start {QEMU_BINARY}"))
 }
 
 /// Runs QEMU (`child`, running `elf`) to its end with [`project::finish`],

@@ -15,7 +15,6 @@ use anyhow::{Context, Result};
 use super::talk::{self, Talk};
 use crate::log::Run;
 use crate::qemu::{self, Echo};
-use crate::setup;
 
 /// Which run the image plays, and how QEMU's clock runs while it sleeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -81,12 +80,8 @@ pub fn spawn_connected(
         let _ = std::fs::remove_file(path);
     }
     let serial = |path: &PathBuf| format!("unix:{},server=on,wait=on", path.display());
-    let mut child = qemu_command(elf, pace, [&serial(&uart0), &serial(&uart1)])
-        .stdin(Stdio::null())
-        .stdout(output())
-        .stderr(output())
-        .spawn()
-        .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
+    let mut command = qemu_command(elf, pace, [&serial(&uart0), &serial(&uart1)]);
+    let mut child = qemu::spawn(&mut command, output)?;
     // QEMU waits for each connection in turn before the image starts.
     let connected = connect(&uart0).and_then(|uart0| Ok([uart0, connect(&uart1)?]));
     let _ = std::fs::remove_dir_all(&dir);

@@ -18,7 +18,7 @@ use serde_json::{Value, json};
 use super::{Bridge, ensure_dependencies, server::Server};
 use crate::console::{self, Pace, qemu::qemu_command};
 use crate::project::{Metadata, PICO, QEMU};
-use crate::{setup, sim, trace};
+use crate::{qemu, setup, sim, trace};
 
 pub const STAGE: &str = "panel in a real browser: Web Serial (emulated Pico), bridge (QEMU), serial port (pty), radar map (replay)";
 
@@ -163,14 +163,9 @@ impl Pty {
     fn start(elf: &Path) -> Result<Self> {
         let qmp = std::env::temp_dir().join(format!("idle-head-qmp-{}.sock", std::process::id()));
         let _ = std::fs::remove_file(&qmp);
-        let child = qemu_command(elf, Pace::RealTime, ["pty", "null"])
-            .arg("-qmp")
-            .arg(format!("unix:{},server=on,wait=off", qmp.display()))
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .with_context(|| format!("could not start {}", setup::QEMU_BINARY))?;
+        let monitor = format!("unix:{},server=on,wait=off", qmp.display());
+        let mut command = qemu_command(elf, Pace::RealTime, ["pty", "null"]);
+        let child = qemu::spawn(command.args(["-qmp", &monitor]), Stdio::null)?;
         // Dropped on an error: QEMU is stopped.
         let mut pty = Self {
             child,
