@@ -3,8 +3,9 @@
 //! limit), and the firmware images.
 
 use std::{
+    io::Write,
     path::{Path, PathBuf},
-    process::{Child, ChildStderr, ChildStdout, ExitStatus},
+    process::{Child, ChildStderr, ChildStdout, Command, ExitStatus, Stdio},
     sync::atomic::{AtomicU32, Ordering},
     thread,
     time::Duration,
@@ -112,6 +113,21 @@ pub fn finish<O: Send, E: Send, R>(
             meanwhile,
         })
     })
+}
+
+/// Runs `command` with `input` on its stdin and its stderr passed on; its
+/// stdout, printed as well, and how it ended.
+pub fn output(command: &mut Command, input: &[u8]) -> Result<(String, ExitStatus)> {
+    let program = command.get_program().to_string_lossy().into_owned();
+    let io = command.stdin(Stdio::piped()).stdout(Stdio::piped());
+    let mut child = io
+        .spawn()
+        .with_context(|| format!("could not start {program}"))?;
+    child.stdin.take().context("its stdin")?.write_all(input)?;
+    let out = child.wait_with_output()?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    print!("{text}");
+    Ok((text, out.status))
 }
 
 /// Writes `contents` to `path`, creating its folder: through a file of
@@ -233,7 +249,6 @@ pub fn metadata(root: &Path) -> Result<Metadata> {
 #[cfg(test)]
 mod tests {
     use std::io::Read;
-    use std::process::{Command, Stdio};
 
     use super::*;
 

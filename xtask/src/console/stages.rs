@@ -1,12 +1,11 @@
 //! `cargo xtask console` run as a person runs it, a script piped in: the
 //! console stage of `cargo xtask test`, and the panel's serial port session.
 
-use std::{
-    io::Write,
-    process::{Command, Stdio},
-};
+use std::process::Command;
 
 use anyhow::{Context, Result, bail, ensure};
+
+use crate::project;
 
 /// Runs `cargo xtask console <args>` itself with `script` piped into its
 /// stdin; fails unless it succeeds and its stdout is `want`, one reply a
@@ -14,18 +13,7 @@ use anyhow::{Context, Result, bail, ensure};
 /// lines. Its stdout's lines.
 pub fn script(args: &[&str], script: &[u8], want: &[&str], more: usize) -> Result<Vec<String>> {
     let exe = std::env::current_exe().context("the xtask's own path")?;
-    let mut child = Command::new(exe)
-        .arg("console")
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .with_context(|| format!("starting `cargo xtask console {}`", args.join(" ")))?;
-    child.stdin.take().context("its stdin")?.write_all(script)?;
-    let out = child.wait_with_output()?;
-    let text = String::from_utf8_lossy(&out.stdout);
-    print!("{text}");
+    let (text, status) = project::output(Command::new(exe).arg("console").args(args), script)?;
     let lines: Vec<String> = text.lines().map(str::to_owned).collect();
     ensure!(
         lines.len() == want.len() + more,
@@ -39,7 +27,6 @@ pub fn script(args: &[&str], script: &[u8], want: &[&str], more: usize) -> Resul
             "line {i}: {got:?}, want {want:?}"
         );
     }
-    let status = out.status;
     ensure!(status.success(), "`cargo xtask console` failed ({status})");
     Ok(lines)
 }

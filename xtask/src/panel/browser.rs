@@ -18,7 +18,7 @@ use serde_json::{Value, json};
 use super::{Bridge, ensure_dependencies, server::Server};
 use crate::console::{self, Pace, qemu::qemu_command};
 use crate::project::{Metadata, PICO, QEMU};
-use crate::{qemu, setup, sim, trace};
+use crate::{project, qemu, setup, sim, trace};
 
 pub const STAGE: &str = "panel in a real browser: Web Serial (emulated Pico), bridge (QEMU), serial port (pty), radar map (replay)";
 
@@ -69,18 +69,11 @@ fn session(root: &Path, shots: &Path, bridge: Option<Bridge>, mut config: Value)
     config["url"] = json!(format!("http://{}/", server.address));
     config["chromium"] = json!(CHROMIUM);
     config["shots"] = json!(shots);
-    let out = Command::new("node")
-        .arg("tests/browser.mjs")
-        .arg(config.to_string())
-        .current_dir(root.join("panel"))
-        .stdin(Stdio::null())
-        .stderr(Stdio::inherit())
-        .output()
-        .context("could not start node")?;
-    let text = String::from_utf8_lossy(&out.stdout);
-    print!("{text}");
+    let mut node = Command::new("node");
+    node.args(["tests/browser.mjs", &config.to_string()]);
+    let (text, status) = project::output(node.current_dir(root.join("panel")), b"")?;
     let label = &config["label"];
-    if !out.status.success() {
+    if !status.success() {
         let why = text.lines().rfind(|l| l.starts_with("FAILED"));
         bail!("browser session {label}: {}", why.unwrap_or("failed"));
     }
