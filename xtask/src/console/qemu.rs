@@ -1,16 +1,16 @@
-//! A console session with the firmware in QEMU: UART0 on one socket for the
-//! conversation, UART1 on another for the hang-up.
+//! A console session with the firmware in QEMU: UART0 on one loopback
+//! connection for the conversation, UART1 on another for the hang-up.
 
 use std::{
-    io::{Read, Write},
-    os::unix::net::UnixStream,
-    path::{Path, PathBuf},
+    io::{ErrorKind, Read, Write},
+    net::{Ipv4Addr, TcpListener, TcpStream},
+    path::Path,
     process::{Child, Command, Stdio},
     thread,
     time::{Duration, Instant},
 };
 
-use anyhow::{Context, Result};
+use anyhow::{Result, bail, ensure};
 
 use super::talk::{self, Talk};
 use crate::log::Run;
@@ -48,7 +48,7 @@ pub fn qemu_session(
     echo: Echo,
     wait: Duration,
 ) -> Result<QemuSession> {
-    let (child, [mut console, mut hang_up]) = spawn_connected(elf, pace, "console", Stdio::piped)?;
+    let (child, [mut console, mut hang_up]) = spawn_connected(elf, pace, Stdio::piped)?;
     let (run, talk) = qemu::finish(child, elf, AFTER_HANG_UP, echo, || {
         let (reader, timeout) = (console.try_clone()?, console.try_clone()?);
         let end = || -> Result<()> {
@@ -64,27 +64,21 @@ pub fn qemu_session(
 }
 
 /// Starts QEMU running `elf` for a console, its stdout and stderr `output`,
-/// UART0 and UART1 on sockets it serves in a temporary folder of its own
-/// (removed once both are connected; QEMU is stopped if they cannot be):
-/// QEMU and the two connections.
+/// UART0 and UART1 connected to loopback ports listened on here (QEMU
+/// connects before the image starts; it is stopped if it does not): QEMU
+/// and the two connections.
 pub fn spawn_connected(
     elf: &Path,
     pace: Pace,
-    tag: &str,
     output: fn() -> Stdio,
-) -> Result<(Child, [UnixStream; 2])> {
-    let dir = std::env::temp_dir().join(format!("idle-head-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let [uart0, uart1] = ["uart0", "uart1"].map(|n| dir.join(format!("{n}.sock")));
-    for path in [&uart0, &uart1] {
-        let _ = std::fs::remove_file(path);
-    }
-    let serial = |path: &PathBuf| format!("unix:{},server=on,wait=on", path.display());
-    let mut command = qemu_command(elf, pace, [&serial(&uart0), &serial(&uart1)]);
+) -> Result<(Child, [TcpStream; 2])> {
+    let [uart0, uart1] = [listen()?, listen()?];
+    let serial = |listener: &TcpListener| -> Result<String> {
+        Ok(format!("tcp:{},nodelay=on", listener.local_addr()?))
+    };
+    let mut command = qemu_command(elf, pace, [&serial(&uart0)?, &serial(&uart1)?]);
     let mut child = qemu::spawn(&mut command, output)?;
-    // QEMU waits for each connection in turn before the image starts.
-    let connected = connect(&uart0).and_then(|uart0| Ok([uart0, connect(&uart1)?]));
-    let _ = std::fs::remove_dir_all(&dir);
+    let connected = accept(&uart0, &mut child).and_then(|u0| Ok([u0, accept(&uart1, &mut child)?]));
     if connected.is_err() {
         let _ = child.kill();
         let _ = child.wait();
@@ -107,16 +101,34 @@ pub fn qemu_command(elf: &Path, pace: Pace, [uart0, uart1]: [&str; 2]) -> Comman
     command
 }
 
-/// Connects to a socket QEMU serves, waiting for it to appear.
-pub fn connect(path: &Path) -> Result<UnixStream> {
+/// A listener on a free loopback port, for QEMU to connect a character
+/// device to (`tcp:ADDR`).
+pub fn listen() -> Result<TcpListener> {
+    Ok(TcpListener::bind((Ipv4Addr::LOCALHOST, 0))?)
+}
+
+/// The connection QEMU (`child`) makes to `listener` as it starts.
+pub fn accept(listener: &TcpListener, child: &mut Child) -> Result<TcpStream> {
     let deadline = Instant::now() + Duration::from_secs(20);
+    listener.set_nonblocking(true)?;
     loop {
-        match UnixStream::connect(path) {
-            Ok(stream) => return Ok(stream),
-            Err(e) if Instant::now() > deadline => {
-                return Err(e).with_context(|| format!("connecting to {}", path.display()));
+        match listener.accept() {
+            Ok((stream, _)) => {
+                stream.set_nonblocking(false)?;
+                stream.set_nodelay(true)?;
+                return Ok(stream);
             }
-            Err(_) => thread::sleep(Duration::from_millis(20)),
+            Err(e) if e.kind() != ErrorKind::WouldBlock => return Err(e.into()),
+            Err(_) => {
+                if let Some(status) = child.try_wait()? {
+                    bail!("QEMU stopped ({status}) before it connected to {listener:?}");
+                }
+                ensure!(
+                    Instant::now() < deadline,
+                    "QEMU did not connect within 20 s"
+                );
+                thread::sleep(Duration::from_millis(20));
+            }
         }
     }
 }

@@ -4,8 +4,7 @@
 
 use std::{
     io::{ErrorKind, Read, Write},
-    net::Shutdown,
-    os::unix::net::UnixStream,
+    net::{Shutdown, TcpStream},
     path::Path,
     process::{Child, Stdio},
     sync::{Mutex, mpsc},
@@ -66,7 +65,7 @@ pub struct Bridge {
     /// What to stop when the bridge goes: a process, QEMU's hang-up line
     /// (UART1).
     child: Option<Child>,
-    hang_up: Option<UnixStream>,
+    hang_up: Option<TcpStream>,
 }
 
 impl Bridge {
@@ -111,8 +110,7 @@ impl Bridge {
 
     /// The QEMU image `elf`, a clean head at real time, over its UART0.
     pub fn qemu(elf: &Path) -> Result<Self> {
-        let (child, [console, hang_up]) =
-            spawn_connected(elf, Pace::RealTime, "panel", Stdio::null)?;
+        let (child, [console, hang_up]) = spawn_connected(elf, Pace::RealTime, Stdio::null)?;
         let reader = console.try_clone()?;
         let mut bridge = Self::new("the QEMU image (UART0)", "qemu", Box::new(console));
         (bridge.child, bridge.hang_up) = (Some(child), Some(hang_up));

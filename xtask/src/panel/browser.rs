@@ -6,6 +6,7 @@
 
 use std::{
     io::{BufRead, BufReader, Write},
+    net::TcpStream,
     path::{Path, PathBuf},
     process::{Child, Command, Stdio},
     sync::mpsc,
@@ -154,9 +155,8 @@ impl Pty {
     /// (this QEMU writes no message saying so, and cannot link it to a
     /// path of our choosing).
     fn start(elf: &Path) -> Result<Self> {
-        let qmp = std::env::temp_dir().join(format!("idle-head-qmp-{}.sock", std::process::id()));
-        let _ = std::fs::remove_file(&qmp);
-        let monitor = format!("unix:{},server=on,wait=off", qmp.display());
+        let qmp = console::qemu::listen()?;
+        let monitor = format!("tcp:{}", qmp.local_addr()?);
         let mut command = qemu_command(elf, Pace::RealTime, ["pty", "null"]);
         let child = qemu::spawn(command.args(["-qmp", &monitor]), Stdio::null)?;
         // Dropped on an error: QEMU is stopped.
@@ -164,16 +164,14 @@ impl Pty {
             child,
             path: PathBuf::new(),
         };
-        pty.path = pty_path(&qmp)?;
-        let _ = std::fs::remove_file(&qmp);
+        pty.path = pty_path(console::qemu::accept(&qmp, &mut pty.child)?)?;
         Ok(pty)
     }
 }
 
-/// The pseudo-terminal of QEMU's `serial0`, from its QMP monitor at `qmp`
-/// (`query-chardev`: `"filename": "pty:/dev/pts/N"`).
-fn pty_path(qmp: &Path) -> Result<PathBuf> {
-    let stream = crate::console::qemu::connect(qmp)?;
+/// The pseudo-terminal of QEMU's `serial0`, from its QMP monitor on
+/// `stream` (`query-chardev`: `"filename": "pty:/dev/pts/N"`).
+fn pty_path(stream: TcpStream) -> Result<PathBuf> {
     stream.set_read_timeout(Some(Duration::from_secs(10)))?;
     let mut writer = stream.try_clone()?;
     let mut lines = BufReader::new(stream).lines();
