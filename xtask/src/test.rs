@@ -431,9 +431,11 @@ fn qemu_stages(
         elf::check_qemu(&image)
     });
     if !built {
-        stages.blocked(&[RUN, SNAPSHOT, SUMMARY], BUILD);
+        stages.blocked(&[CONSOLE, RUN, SNAPSHOT, SUMMARY], BUILD);
         return None;
     }
+    // It needs the image only (so `--only console` runs it too).
+    stages.run(CONSOLE, console::piped_script);
     let mut run: Option<Run> = None;
     stages.run(RUN, || {
         let done = run.insert(qemu::run(&image, options.timeout, Echo::Problems)?);
@@ -455,7 +457,6 @@ fn qemu_stages(
             snapshot::compare(&run, &metadata.target_dir.join("qemu-actual.log"))
         }
     });
-    stages.run(CONSOLE, console::piped_script);
     stages.run(SUMMARY, || {
         if let Some(line) = log::summary(&run.log) {
             println!("{line}");
