@@ -22,7 +22,6 @@
 // sessions share is in common.mjs; the settings' read-back in settings.mjs.
 
 import { spawn } from 'node:child_process';
-import { fileURLToPath } from 'node:url';
 import { browser, cfg, check, fakeSerial, readout, say, sayLog, shot, sleep, until, watchErrors } from './common.mjs';
 import { replaySession } from './replay.mjs';
 import { CHANGED, changeSettings, loadReadsBack, readsBack } from './settings.mjs';
@@ -44,9 +43,10 @@ async function nodSwings(page) {
   return swing;
 }
 
-/** The README's picture of the panel (docs/images/panel.png), taken on
- * the shipped image in the emulator once connected, the idle moving the
- * readouts and a nod under way: a head at work, not a refusal. */
+/** The README's picture of the panel (panel-front.png, which is
+ * docs/images/panel.png), taken on the shipped image in the emulator once
+ * connected, the idle moving the readouts and a nod under way: a head at
+ * work, not a refusal. */
 async function frontPage(page) {
   await until(async () => (await page.locator('#state').textContent()).startsWith('connected'), 20000, 'connected');
   const pose = async () => Promise.all(['pitch', 'roll', 'yaw'].map((a) => readout(page, a)));
@@ -65,9 +65,7 @@ async function frontPage(page) {
   await sleep(300);
   const moved = (await pose()).map((v, i) => Math.abs(v - start[i]));
   check(Math.max(...moved) > 0.5, `the front page's picture: connected, the readouts moved by ${moved.map((v) => v.toFixed(1)).join('°, ')}°, a nod under way`);
-  const path = fileURLToPath(new URL('../../docs/images/panel.png', import.meta.url));
-  await page.screenshot({ path });
-  say(`screenshot ${path}`);
+  await shot(page, 'front');
 }
 
 /** What every session checks once connected: status, a calibration
