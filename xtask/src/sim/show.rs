@@ -17,7 +17,7 @@ use super::{
     run::{self, Boot},
     stages,
 };
-use crate::project::{self, Metadata, PICO};
+use crate::project::{self, Metadata};
 use crate::steps::Steps;
 
 /// Stage name.
@@ -114,7 +114,7 @@ pub fn show(root: &Path, metadata: &Metadata, pulses: Option<&Path>) -> Result<(
     print_pulses(boot, pulses)?;
     let mut problems = check(boot, &lines)?;
     problems.extend(report.problems.iter().cloned());
-    problems.extend(stages::console_ram(&PICO.elf(metadata), &report)?);
+    problems.extend(stages::console_ram(metadata, &report)?);
     let boots = report.boots.len();
     if boots != 1 {
         problems.push(format!("{boots} boots: the watchdog reset the image"));

@@ -201,12 +201,13 @@ pub fn test_console(
     print!("{}", report.log_text(false));
     exchange::check(&mut report);
     print!("{}", report.table());
-    report.conclude(console_ram(&PICO.elf(metadata), &report)?)
+    report.conclude(console_ram(metadata, &report)?)
 }
 
-/// Prints the image's RAM (static plus peak stack); a problem if over.
-pub fn console_ram(elf: &Path, report: &Report) -> Result<Option<String>> {
-    let static_ram = elf::Image::read(elf)?.static_ram();
+/// Prints the shipped image's RAM (static plus `report`'s peak stack); a
+/// problem if over.
+pub fn console_ram(metadata: &Metadata, report: &Report) -> Result<Option<String>> {
+    let static_ram = elf::Image::read(&PICO.elf(metadata))?.static_ram();
     let Some(stack) = report.peak_stack() else {
         let problem = "its peak stack was not measured";
         return Ok(Some(format!(

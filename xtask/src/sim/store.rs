@@ -116,7 +116,7 @@ pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
         print!("{}", report.log_text(false));
         let found = check(&report, logged, neutral);
         let found = found.into_iter().chain(report.problems.iter().cloned());
-        let found = found.chain(console_ram(&elf, &report)?);
+        let found = found.chain(console_ram(metadata, &report)?);
         problems.extend(found.map(|p| format!("from {what}: {p}")));
     }
     project::verdict(&problems)
