@@ -163,7 +163,7 @@ pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     // (The pulses are not the idle's: the radar turns the head. What is
     // checked is that no frame was late: the log says so.)
     let boot = report.first()?;
-    let (summary, mut problems) = stream::check_dmx(boot, &boot.reply("ok dmx="), changes.len());
+    let (summary, mut problems) = stream::check_dmx(boot, changes.len());
     print!("{summary}");
     let radar_reply = boot.reply("ok radar=");
     println!("radar: {} frames sent; `{radar_reply}`", boot.radar_frames);

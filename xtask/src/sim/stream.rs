@@ -238,15 +238,17 @@ pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     // (The pulses are not held to the idle's own: a console on the line
     // engages the show layer, mix 0 or not. No frame may be late.)
     let boot = report.first()?;
-    let (text, problems) = check_dmx(boot, &boot.reply("ok dmx="), changes.len());
+    let (text, problems) = check_dmx(boot, changes.len());
     print!("{text}");
     crate::project::verdict(&problems)
 }
 
-/// The `dmx` counters of `reply` against the frames `boot` sent (`changes`
-/// of them changes): every one good, no frame late. A summary, problems.
-pub(super) fn check_dmx(boot: &Boot, reply: &str, changes: usize) -> (String, Vec<String>) {
-    let counter = |name| number(reply, name).ok();
+/// The counters of `boot`'s `ok dmx=` reply against the frames it sent
+/// (`changes` of them changes): every one good, no frame late. A summary,
+/// problems.
+pub(super) fn check_dmx(boot: &Boot, changes: usize) -> (String, Vec<String>) {
+    let reply = boot.reply("ok dmx=");
+    let counter = |name| number(&reply, name).ok();
     let mut problems: Vec<String> = ["short", "long", "start_code", "garbled"]
         .into_iter()
         .filter(|name| counter(name) != Some(0))
