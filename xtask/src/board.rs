@@ -2,6 +2,7 @@
 
 use std::ops::Range;
 
+use elf2flash_core::boards::{BoardInfo, RP2040, RP2350};
 use idle_head_core::console::BoardParts;
 use idle_head_core::input::InputIds;
 
@@ -55,12 +56,13 @@ impl Board {
         }
     }
 
-    /// The UF2 family its boot ROM accepts: `rp2040`, or `rp2350-arm-s`
-    /// (Arm Secure, as embassy-rp's start block declares).
-    pub fn family_id(self) -> u32 {
+    /// Its chip for elf2flash, whose UF2 family its boot ROM accepts:
+    /// `rp2040`, or `rp2350-arm-s` (Arm Secure, as embassy-rp's start block
+    /// declares).
+    pub fn uf2_chip(self) -> &'static dyn BoardInfo {
         match self {
-            Self::Pico => 0xe48b_ff56,
-            Self::Pico2 => 0xe48b_ff59,
+            Self::Pico => &RP2040,
+            Self::Pico2 => &RP2350,
         }
     }
 

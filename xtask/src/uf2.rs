@@ -6,7 +6,6 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, ensure};
-use elf2flash_core::boards::{BoardInfo, RP2040, RP2350};
 use object::{Object, ObjectSection};
 
 use crate::{board::Board, elf, project};
@@ -43,11 +42,7 @@ pub fn make(elf: &[u8], board: Board) -> Result<Vec<u8>> {
         end <= u64::from(settings),
         "the image's flash contents end at {end:#010x}, in the settings sectors from {settings:#010x}: flashing it would overwrite the saved settings"
     );
-    let chip: &dyn BoardInfo = match board {
-        Board::Pico => &RP2040,
-        Board::Pico2 => &RP2350,
-    };
-    let mut bytes = Vec::new();
+    let (chip, mut bytes) = (board.uf2_chip(), Vec::new());
     elf2flash_core::elf2uf2(elf, &mut bytes, chip, elf2flash_core::NoProgress)
         .context("writing the UF2 blocks")?;
     Ok(bytes)
@@ -98,7 +93,7 @@ pub fn describe(path: &Path, board: Board, bytes: &[u8]) -> String {
         "{}: {} blocks of 256 B, family {:#010x} for the {}",
         project::relative(path).display(),
         bytes.len() / BLOCK,
-        board.family_id(),
+        board.uf2_chip().family_id(),
         board.name()
     )
 }
