@@ -250,23 +250,21 @@ pub fn check_qemu(path: &Path) -> Result<()> {
     image.check_no_allocator()
 }
 
-/// A peak stack and the static RAM of the image it was measured with.
-#[derive(Debug, Clone, Copy)]
-pub struct Peak {
-    pub static_ram: u64,
-    pub stack: u64,
-}
-
-/// Records static RAM and peak stack of the Pico and QEMU images; fails if
-/// the Pico image's total is over [`RAM_BUDGET`] or its peak is unknown.
-pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
+/// Records static RAM and peak stack of the Pico and QEMU images (each its
+/// ELF and the peak stack measured with it, if it was); fails if the Pico
+/// image's total is over [`RAM_BUDGET`] or its peak is unknown.
+pub fn check_ram(pico: (&Path, Option<u64>), qemu: (&Path, Option<u64>)) -> Result<()> {
+    let measured = |(elf, stack): (&Path, Option<u64>)| -> Result<Option<(u64, u64)>> {
+        (stack.map(|stack| Ok((Image::read(elf)?.static_ram(), stack)))).transpose()
+    };
+    let (pico, qemu) = (measured(pico)?, measured(qemu)?);
     let rows = [
         ("pico", "the RP2040 emulator", pico, Some(RAM_BUDGET)),
         ("qemu", "QEMU (lm3s6965evb)", qemu, None),
     ];
     let rows: Vec<Vec<String>> = (rows.into_iter())
         .filter_map(|(image, measured_in, peak, budget)| {
-            let Peak { static_ram, stack } = peak?;
+            let (static_ram, stack) = peak?;
             let total = static_ram + stack;
             Some(vec![
                 image.to_owned(),
@@ -291,9 +289,9 @@ pub fn check_ram(pico: Option<Peak>, qemu: Option<Peak>) -> Result<()> {
         ];
         figures::record("ram", intro.to_owned(), &header, rows);
     }
-    let pico =
+    let (static_ram, stack) =
         pico.context("the Pico image's peak stack was not measured (the emulator run failed)")?;
-    let total = pico.static_ram + pico.stack;
+    let total = static_ram + stack;
     if total > RAM_BUDGET {
         bail!("RAM use {total} B (static + peak stack) is over the {RAM_BUDGET} B budget");
     }

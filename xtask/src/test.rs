@@ -397,17 +397,10 @@ impl Background {
         }
         stages.left_out += EMULATED.len() - self.chosen.len();
         stages.run(MEMORY, || {
-            let peak = |elf: &Path, stack: Option<u64>| -> Result<Option<elf::Peak>> {
-                let Some(stack) = stack else { return Ok(None) };
-                let static_ram = elf::Image::read(elf)?.static_ram();
-                Ok(Some(elf::Peak { static_ram, stack }))
-            };
             let stack = std::fs::read_to_string(peak_file(metadata)).ok();
             let stack = stack.and_then(|s| s.trim().parse().ok());
-            let pico = peak(&PICO.elf(metadata), stack)?;
-            let qemu_peak = qemu_run.and_then(|run| sim::logged_peak_stack(&run.log));
-            let qemu = peak(&QEMU.elf(metadata), qemu_peak)?;
-            elf::check_ram(pico, qemu)
+            let qemu = qemu_run.and_then(|run| sim::logged_peak_stack(&run.log));
+            elf::check_ram((&PICO.elf(metadata), stack), (&QEMU.elf(metadata), qemu))
         });
     }
 }
