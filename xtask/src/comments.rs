@@ -61,48 +61,9 @@ fn exists(root: &Path, file: &Path, path: &str) -> bool {
         .any(|dir| dir.join("Cargo.toml").exists() && dir.join(path).exists())
 }
 
-/// Every path named in a comment under [`SCANNED`] that does not exist, as
-/// `file:line: path`.
-pub fn missing(root: &Path) -> anyhow::Result<Vec<String>> {
-    let mut found = Vec::new();
-    for file in files(root, &SCANNED)? {
-        let rust = file.extension().is_some_and(|e| e == "rs");
-        let text = fs::read_to_string(&file)?;
-        for (n, line) in text.lines().enumerate() {
-            let Some(comment) = comment(line, rust) else {
-                continue;
-            };
-            for path in paths_in(comment) {
-                if !exists(root, &file, path) {
-                    let name = file.strip_prefix(root).unwrap_or(&file).display();
-                    found.push(format!("{name}:{}: {path}", n + 1));
-                }
-            }
-        }
-    }
-    Ok(found)
-}
-
 /// The longest a module doc in `crates/` may be: what the module is and
 /// its invariants; the reasoning goes to the book (`docs/design/code.md`).
 pub const MODULE_DOC_LINES: usize = 30;
-
-/// The Rust files under `crates/` whose module doc is [`MODULE_DOC_LINES`]
-/// long or longer, as `file: n lines`.
-pub fn long_module_docs(root: &Path) -> anyhow::Result<Vec<String>> {
-    let mut long = Vec::new();
-    // A manifest has no `//!` lines: its count is 0.
-    for file in files(root, &["crates"])? {
-        let text = fs::read_to_string(&file)?;
-        let doc = text.lines().skip_while(|l| !l.starts_with("//!"));
-        let lines = doc.take_while(|l| l.starts_with("//!")).count();
-        let file = file.strip_prefix(root).unwrap_or(&file).display();
-        if lines >= MODULE_DOC_LINES {
-            long.push(format!("{file}: {lines} lines"));
-        }
-    }
-    Ok(long)
-}
 
 /// The Rust files and manifests under `root`'s `dirs`, build output left
 /// out, in order.
@@ -156,7 +117,18 @@ mod tests {
 
     #[test]
     fn module_docs_are_short() {
-        let list = long_module_docs(&crate::project::root()).unwrap();
+        let root = crate::project::root();
+        let mut list = Vec::new();
+        // A manifest has no `//!` lines: its count is 0.
+        for file in files(&root, &["crates"]).unwrap() {
+            let text = fs::read_to_string(&file).unwrap();
+            let doc = text.lines().skip_while(|l| !l.starts_with("//!"));
+            let lines = doc.take_while(|l| l.starts_with("//!")).count();
+            let file = file.strip_prefix(&root).unwrap_or(&file).display();
+            if lines >= MODULE_DOC_LINES {
+                list.push(format!("{file}: {lines} lines"));
+            }
+        }
         assert!(
             list.is_empty(),
             "module docs of {MODULE_DOC_LINES} lines or more (say what the module is; \
@@ -165,9 +137,26 @@ mod tests {
         );
     }
 
+    /// Every path named in a comment under [`SCANNED`] exists.
     #[test]
     fn every_path_a_comment_names_exists() {
-        let list = missing(&crate::project::root()).unwrap();
+        let root = crate::project::root();
+        let mut list = Vec::new();
+        for file in files(&root, &SCANNED).unwrap() {
+            let rust = file.extension().is_some_and(|e| e == "rs");
+            let text = fs::read_to_string(&file).unwrap();
+            for (n, line) in text.lines().enumerate() {
+                let Some(comment) = comment(line, rust) else {
+                    continue;
+                };
+                for path in paths_in(comment) {
+                    if !exists(&root, &file, path) {
+                        let name = file.strip_prefix(&root).unwrap_or(&file).display();
+                        list.push(format!("{name}:{}: {path}", n + 1));
+                    }
+                }
+            }
+        }
         assert!(
             list.is_empty(),
             "comments name paths that do not exist:\n{}",
