@@ -143,13 +143,9 @@ Both routes step by step: docs/user/flashing.md"
     )
 }
 
-/// `cargo xtask flash` on this machine.
-pub fn command(args: &Args) -> Result<bool> {
-    run(args, &Surroundings::here())
-}
-
-/// Flashes `args.elf` by the route [`choose`] finds in `here`; `Ok(false)`
-/// if there was none, an error if probe-rs failed.
+/// `cargo xtask flash`: flashes `args.elf` by the route [`choose`] finds in
+/// `here` (this machine's, or a test's); `Ok(false)` if there was none, an
+/// error if probe-rs failed.
 pub fn run(args: &Args, here: &Surroundings) -> Result<bool> {
     let board = args.board;
     let route = choose(board, here)?;

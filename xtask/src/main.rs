@@ -68,7 +68,7 @@ fn main() -> ExitCode {
         Some(Command::Console(args)) => console::command(&args),
         Some(Command::Panel(args)) => panel::command(&args),
         Some(Command::Uf2(args)) => uf2::command(&args),
-        Some(Command::Flash(args)) => flash::command(&args),
+        Some(Command::Flash(args)) => flash::run(&args, &flash::Surroundings::here()),
         Some(Command::Book) => book::command(),
     };
     match result {
