@@ -134,24 +134,17 @@ fn serve(stream: TcpStream, panel: &Path, bridge: Option<Arc<Bridge>>) -> io::Re
     reader.take(length.min(BODY_LIMIT)).read_to_end(&mut body)?;
     let url = request.path.unwrap_or("/");
     let path = url.split(['?', '#']).next().unwrap_or(url);
+    let text = |status, body: &str| (status, "text/plain; charset=utf-8", body.into());
     let (status, kind, reply) = match (parsed, request.method.unwrap_or(""), path, bridge) {
-        (false, ..) => (
-            "400 Bad Request",
-            TEXT,
-            b"not a whole HTTP request".to_vec(),
-        ),
+        (false, ..) => text("400 Bad Request", "not a whole HTTP request"),
         (_, "GET", "/events", Some(bridge)) => {
             let notes = bridge.hub.join();
             drop(bridge);
             return events(out, &notes);
         }
         (_, "POST", "/send", Some(bridge)) => match bridge.write(&body) {
-            Ok(()) => ("200 OK", TEXT, b"sent".to_vec()),
-            Err(e) => (
-                "503 Service Unavailable",
-                TEXT,
-                format!("not sent: {e:#}").into(),
-            ),
+            Ok(()) => text("200 OK", "sent"),
+            Err(e) => text("503 Service Unavailable", &format!("not sent: {e:#}")),
         },
         (_, "GET", "/bridge.json", bridge) => {
             let body = bridge.map_or_else(
@@ -162,18 +155,12 @@ fn serve(stream: TcpStream, panel: &Path, bridge: Option<Arc<Bridge>>) -> io::Re
         }
         (_, "GET", path, _) => match page_file(panel, path) {
             Some((bytes, kind)) => ("200 OK", kind, bytes),
-            None => ("404 Not Found", TEXT, b"not found".to_vec()),
+            None => text("404 Not Found", "not found"),
         },
-        _ => (
-            "405 Method Not Allowed",
-            TEXT,
-            b"the page is static: GET it".to_vec(),
-        ),
+        _ => text("405 Method Not Allowed", "the page is static: GET it"),
     };
     answer(&mut out, status, kind, Some(&reply))
 }
-
-const TEXT: &str = "text/plain; charset=utf-8";
 
 /// A response, after which the connection closes: `body` whole, or `None`
 /// when a stream follows. Nothing is cached (the page's files change as
