@@ -135,7 +135,17 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         let background = Background::start(scope, &stages, &root, pico_built, drill_built);
 
         // 2. Host tests, formatting, lints, the images that must compile.
-        cargo_stages(&mut stages);
+        for (name, dir, firmware, commands) in CARGO {
+            stages.run(name, || {
+                let sh = project::shell(dir)?;
+                let env = if firmware { FIRMWARE_ENV } else { &[] };
+                for args in commands.split(" && ") {
+                    let args = args.split_whitespace();
+                    project::run(&sh, env, cmd!(sh, "cargo {args...}"))?;
+                }
+                Ok(())
+            });
+        }
         // The Pico 2 on its own: its embassy-rp chip feature excludes the Pico's.
         stages.run(pico2::STAGE, || pico2::test(&metadata));
 
@@ -207,20 +217,6 @@ const CARGO: [(&str, &str, bool, &str); 14] = [
     ("minimal board example, servos and USB only (examples/minimal.rs): clippy, build", ".", true,
      "clippy --release --example minimal -- -D warnings && build --release --example minimal"),
 ];
-
-fn cargo_stages(stages: &mut Stages<'_>) {
-    for (name, dir, firmware, commands) in CARGO {
-        stages.run(name, || {
-            let sh = project::shell(dir)?;
-            let env = if firmware { FIRMWARE_ENV } else { &[] };
-            for args in commands.split(" && ") {
-                let args = args.split_whitespace();
-                project::run(&sh, env, cmd!(sh, "cargo {args...}"))?;
-            }
-            Ok(())
-        });
-    }
-}
 
 /// An emulator stage: its name, and what it runs on images built already.
 type Emulated = (&'static str, fn(&Path, &Metadata) -> Result<()>);
@@ -314,9 +310,9 @@ fn run_apart(name: &str, cores: usize) -> Outcome {
 /// The emulator stages ([`EMULATED`]) run apart, side by side, in the
 /// background; their results are scored in order by [`Background::record`].
 struct Background {
-    chosen: Vec<usize>,
-    /// What keeps a chosen stage from running, by its index in [`EMULATED`].
-    blocked: Vec<Option<&'static str>>,
+    /// The chosen stages' indices in [`EMULATED`], each with what keeps it
+    /// from running, if anything.
+    chosen: Vec<(usize, Option<&'static str>)>,
     results: std::sync::mpsc::Receiver<(usize, Outcome)>,
 }
 
@@ -334,22 +330,23 @@ impl Background {
             .collect();
         let cannot = |error: &anyhow::Error| println!("the emulator cannot run: {error:#}");
         let node = chosen.is_empty() || sim::node::ensure(root).inspect_err(cannot).is_ok();
-        let blocked = (0..EMULATED.len())
-            .map(|i| {
-                if !pico_built {
-                    Some("the Pico build")
-                } else if !node {
-                    Some("the emulator's setup")
-                } else if EMULATED[i].0 == sim::DRILL_STAGE && !drill_built {
-                    Some("the drill image's build")
-                } else {
-                    None
-                }
-            })
-            .collect::<Vec<_>>();
+        let blocked = |i: usize| {
+            if !pico_built {
+                Some("the Pico build")
+            } else if !node {
+                Some("the emulator's setup")
+            } else if EMULATED[i].0 == sim::DRILL_STAGE && !drill_built {
+                Some("the drill image's build")
+            } else {
+                None
+            }
+        };
+        let chosen: Vec<_> = chosen.into_iter().map(|i| (i, blocked(i))).collect();
         // Longest first: the two 10-minute streams, the DMX stream, the latency rows.
-        let mut queue = chosen.clone();
-        queue.retain(|&i| blocked[i].is_none());
+        let queue = chosen
+            .iter()
+            .filter_map(|&(i, by)| by.is_none().then_some(i));
+        let mut queue: Vec<usize> = queue.collect();
         let long = [
             sim::UART_STREAM_STAGE,
             sim::USB_STREAM_STAGE,
@@ -369,11 +366,7 @@ impl Background {
                 }
             });
         }
-        Self {
-            chosen,
-            blocked,
-            results,
-        }
+        Self { chosen, results }
     }
 
     /// Scores each stage in order as soon as those before it are, then the
@@ -381,8 +374,8 @@ impl Background {
     fn record(self, stages: &mut Stages<'_>, metadata: &Metadata, qemu_run: Option<&Run>) {
         const MEMORY: &str = "RAM: static + peak stack of the Pico image within its budget";
         let mut done: Vec<Option<Outcome>> = vec![None; EMULATED.len()];
-        for &i in &self.chosen {
-            if let Some(by) = self.blocked[i] {
+        for &(i, blocked) in &self.chosen {
+            if let Some(by) = blocked {
                 stages.blocked(&[EMULATED[i].0], by);
                 continue;
             }
