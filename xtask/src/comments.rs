@@ -49,15 +49,11 @@ pub fn paths_in(text: &str) -> Vec<&str> {
         .collect()
 }
 
-/// Whether `path`, named in `file`, exists: from the repository root, or
-/// from the package `file` belongs to (a board's `src/main.rs`).
+/// Whether `path`, named in `file`, exists: from the folder of a package
+/// `file` is in, the repository root's or another (a board's `src/main.rs`).
 fn exists(root: &Path, file: &Path, path: &str) -> bool {
-    if root.join(path).exists() {
-        return true;
-    }
     file.ancestors()
-        .skip(1)
-        .take_while(|dir| dir.starts_with(root) && *dir != root)
+        .take_while(|dir| dir.starts_with(root))
         .any(|dir| dir.join("Cargo.toml").exists() && dir.join(path).exists())
 }
 
