@@ -50,13 +50,11 @@ pub fn qemu_session(
 ) -> Result<QemuSession> {
     let (child, [mut console, mut hang_up]) = spawn_connected(elf, pace, Stdio::piped)?;
     let (run, talk) = qemu::finish(child, elf, AFTER_HANG_UP, echo, || {
-        let (reader, timeout) = (console.try_clone()?, console.try_clone()?);
-        let end = || -> Result<()> {
-            hang_up.write_all(b"\0")?;
-            // A firmware that does not stop must not hold the reader for ever.
-            timeout.set_read_timeout(Some(AFTER_HANG_UP))?;
-            Ok(())
-        };
+        let reader = console.try_clone()?;
+        // A firmware that does not stop must not hold the reader for ever
+        // after the hang-up (a read that times out before it reads on).
+        reader.set_read_timeout(Some(AFTER_HANG_UP))?;
+        let end = || Ok(hang_up.write_all(b"\0")?);
         let talk = talk::converse(input, &mut console, reader, on_reply, wait, end);
         Ok::<_, anyhow::Error>(talk)
     })?;
