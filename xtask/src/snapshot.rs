@@ -3,7 +3,7 @@
 //! that a wildcard line matches is first replaced by it (snapbox pairs
 //! lines by position), so that `--bless` keeps the wildcards that match.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::{Result, anyhow, bail};
 use snapbox::{Assert, Data, filter::NormalizeToExpected};
@@ -13,14 +13,12 @@ use crate::{log::Run, project};
 /// At most this many lines of a difference are printed.
 const MAX_DIFF_LINES: usize = 200;
 
-/// `boards/qemu/expected.log`.
-fn expected_path() -> PathBuf {
-    project::root().join("boards/qemu/expected.log")
-}
+/// The expected log, from the repository root.
+const EXPECTED: &str = "boards/qemu/expected.log";
 
 /// Re-records the expected log from `run`.
 pub fn bless(run: &Run) -> Result<()> {
-    let path = expected_path();
+    let path = project::root().join(EXPECTED);
     let done = if record(&path, &run.text())? {
         "re-recorded"
     } else {
@@ -34,7 +32,7 @@ pub fn bless(run: &Run) -> Result<()> {
 /// Compares `run` with the expected log, writing it to `actual`; prints
 /// the difference and fails on one.
 pub fn compare(run: &Run, actual: &Path) -> Result<()> {
-    let path = expected_path();
+    let path = project::root().join(EXPECTED);
     let [expected, actual_name] =
         [&path, actual].map(|p| project::relative(p).display().to_string());
     let got = run.text();
