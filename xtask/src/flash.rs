@@ -250,11 +250,11 @@ mod tests {
         std::fs::write(&probe, script).unwrap();
         std::fs::set_permissions(&probe, std::fs::Permissions::from_mode(0o755)).unwrap();
         let no_drives = tempfile::tempdir().unwrap();
-        let here = here(bin.path(), &[no_drives.path()]);
-        assert_eq!(choose(Board::Pico2, &here).unwrap(), Route::Probe(probe));
+        let probed = here(bin.path(), &[no_drives.path()]);
+        assert_eq!(choose(Board::Pico2, &probed).unwrap(), Route::Probe(probe));
         let (elf, rest) = (PathBuf::from("pico2"), vec!["--no-location".into()]);
         let board = Board::Pico2;
-        assert!(run(&Args { board, elf, rest }, &here).unwrap());
+        assert!(run(&Args { board, elf, rest }, &probed).unwrap());
         let passed = std::fs::read_to_string(log).unwrap();
         let passed: Vec<&str> = passed.lines().collect();
         assert_eq!(
@@ -262,13 +262,10 @@ mod tests {
             ["run", "--chip", "RP235x", "pico2", "--no-location"]
         );
         let mounts = mount_with("RP2350", PICO2_INFO);
-        let drive = Surroundings {
-            mounts: vec![mounts.path().to_owned()],
-            ..here
-        };
-        assert!(matches!(
-            choose(Board::Pico2, &drive).unwrap(),
-            Route::Drive(_)
-        ));
+        let (drive, both) = (
+            mounts.path().join("RP2350"),
+            here(bin.path(), &[mounts.path()]),
+        );
+        assert_eq!(choose(Board::Pico2, &both).unwrap(), Route::Drive(drive));
     }
 }
