@@ -68,7 +68,7 @@ impl Image {
             println!("  {:<16} {:#010x}  {:>7}", s.name, s.address, s.size);
         }
         let (flash, ram) = (image.flash(), image.static_ram());
-        println!("  flash {flash} B, static RAM {ram} B (.data + .bss + .uninit)");
+        println!("  flash {flash} B, static RAM {ram} B (.radar_ring + .data + .bss + .uninit)");
         Ok(image)
     }
 
