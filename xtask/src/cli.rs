@@ -49,7 +49,7 @@ pub enum Command {
         #[arg(long)]
         no_budget: bool,
         /// Run only the stages whose name contains this text (the others
-        /// are listed as skipped), e.g. `--only emulator`.
+        /// are counted as left out), e.g. `--only emulator`.
         #[arg(long, value_name = "TEXT")]
         only: Option<String>,
         /// One emulator stage, exactly this name, on images already built:
