@@ -124,26 +124,15 @@ pub fn stale(path: &Path, before: &str) -> Result<()> {
     )
 }
 
-/// The tables of a page, each as its text, by key.
+/// The tables of a page, each as its text (up to the next mark or heading),
+/// by key.
 fn parse(page: &str) -> BTreeMap<String, String> {
-    let mut tables = BTreeMap::new();
-    let mut current: Option<(String, String)> = None;
-    for line in page.lines() {
-        let mark = line
-            .strip_prefix(MARK.0)
-            .and_then(|rest| rest.strip_suffix(MARK.1));
-        if mark.is_some() || line.starts_with("## ") {
-            tables.extend(current.take().map(|(k, t)| (k, t.trim().to_owned())));
-        }
-        if let Some(key) = mark {
-            current = Some((key.to_owned(), String::new()));
-        } else if let Some((_, text)) = &mut current {
-            text.push_str(line);
-            text.push('\n');
-        }
-    }
-    tables.extend(current.map(|(k, t)| (k, t.trim().to_owned())));
-    tables
+    let table = |marked: &str| {
+        let (key, text) = marked.split_once(MARK.1)?;
+        let text = text.split("\n## ").next().unwrap_or_default();
+        Some((key.to_owned(), text.trim().to_owned()))
+    };
+    page.split(MARK.0).skip(1).filter_map(table).collect()
 }
 
 fn render_table(intro: &str, header: &[&str], rows: &[Vec<String>]) -> String {
