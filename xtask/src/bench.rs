@@ -95,9 +95,8 @@ pub fn rows(log: &[LogLine]) -> Result<Vec<Row>> {
     let row = |m: &str| -> Result<Row> {
         let label = field(m, "row").with_context(|| format!("`{m}` has no `row=`"))?;
         let [n, w, engine, direct] = numbers(m, ["n", "w", "engine", "direct"])?;
-        let label = label.to_owned();
         Ok(Row {
-            label,
+            label: label.to_owned(),
             n,
             w,
             engine,
@@ -333,27 +332,23 @@ pub fn run_and_check(
     Ok(())
 }
 
-/// `cargo xtask bench`: the rows in QEMU, then the latency rows in the
-/// RP2040 emulator. `Ok(false)` when either failed.
+/// `cargo xtask bench`: the rows in QEMU, the tracking figures in the host
+/// trace, then the latency rows in the RP2040 emulator. `Ok(false)` when
+/// any failed.
 pub fn command(options: Options) -> Result<bool> {
     let (root, metadata) = setup::prepare()?;
     setup::ensure_qemu()?;
-    let qemu = run_and_check(&root, &metadata, options, None);
-    // How the head follows people, in the host trace.
-    let tracking = tracking::stage();
-    let latency = paths::stage(&root, &metadata);
     let results = [
-        ("bench", &qemu),
-        ("tracking", &tracking),
-        ("latency", &latency),
+        ("bench", run_and_check(&root, &metadata, options, None)),
+        ("tracking", tracking::stage()),
+        ("latency", paths::stage(&root, &metadata)),
     ];
-    for (what, error) in results
-        .iter()
-        .filter_map(|(w, r)| Some((w, r.as_ref().err()?)))
-    {
-        println!("{what} FAILED: {error:#}");
+    for (what, result) in &results {
+        if let Err(error) = result {
+            println!("{what} FAILED: {error:#}");
+        }
     }
-    Ok(qemu.is_ok() && tracking.is_ok() && latency.is_ok())
+    Ok(results.iter().all(|(_, result)| result.is_ok()))
 }
 
 /// The benchmark's rows, for the measured figures.
