@@ -12,14 +12,13 @@ use crate::plot::{self, GREY, RED};
 use plotters::style::RGBColor;
 
 /// What kind of motion a mark stands for: a gesture, a move of the gaze
-/// (`look`, `center`), a look's return to the centre, a rest or a wake,
-/// anything else (idle, stop, a refused command).
+/// (`look`, `center`), a look's return to the centre, anything else (a rest
+/// or a wake, idle, stop, a refused command).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
     Gesture,
     Gaze,
     Return,
-    Rest,
     Other,
 }
 
@@ -60,7 +59,7 @@ pub fn marks(
         Ok(Applied::Gesture(plan)) => (vec![plan.kind.axis()], plan.duration, Kind::Gesture),
         Ok(Applied::Look(look)) => (gaze.clone(), look.duration, Kind::Gaze),
         Ok(Applied::Center(ms)) => (gaze.clone(), *ms, Kind::Gaze),
-        Ok(Applied::Rest(ms) | Applied::Wake(ms)) => (Axis::ALL.to_vec(), *ms, Kind::Rest),
+        Ok(Applied::Rest(ms) | Applied::Wake(ms)) => (Axis::ALL.to_vec(), *ms, Kind::Other),
         _ => (vec![], Millis(0), Kind::Other),
     };
     let label = match outcome {
