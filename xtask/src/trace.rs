@@ -269,7 +269,10 @@ pub fn simulate(
         t_us += u64::from(driver.params().config().frame_period.0);
     }
     marks::settle(&mut marks, params.config().blend.0, t_us / 1000);
-    events[next..].iter().for_each(script::not_run);
+    for event in &events[next..] {
+        let (number, at) = (event.line, show_seconds(event.at_us));
+        println!("line {number}: at {at} s, after the trace's end: not run");
+    }
     let answers = ask.iter().map(|line| beside.line(line).0).collect();
     Ok(Trace {
         rows,

@@ -56,12 +56,6 @@ pub fn show_seconds(us: u64) -> String {
     }
 }
 
-/// Says that `event` came after the trace's end.
-pub fn not_run(event: &Event) {
-    let (line, at) = (event.line, show_seconds(event.at_us));
-    println!("line {line}: at {at} s, after the trace's end: not run");
-}
-
 /// Parses a script: its events, in time order. A script is a program, read
 /// top to bottom: a line timed before the line above it is an error (lines
 /// at the same time run in line order). Every bad line is reported, each
