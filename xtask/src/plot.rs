@@ -71,12 +71,6 @@ impl Curve {
             dashed: false,
         }
     }
-
-    /// A solid curve of `values`, one per index.
-    pub fn indexed(label: impl Into<String>, color: RGBColor, values: &[f64]) -> Self {
-        let points = (0..).map(f64::from).zip(values.iter().copied());
-        Self::new(label, color, points.collect())
-    }
 }
 
 /// A command on the motion plot: from and to (x), the axes it shades (none:
@@ -100,7 +94,7 @@ pub fn motion(
     rows: &[(f64, [f64; 3])],
     marks: &[Mark],
 ) -> Result<()> {
-    let panel = |(axis, color): (Axis, RGBColor)| {
+    let panel = |axis: Axis, color| {
         let i = axis.index();
         let points = rows.iter().map(|r| (r.0, r.1[i])).collect();
         let on = |m: &&Mark| m.axes.contains(&axis);
@@ -120,15 +114,13 @@ pub fn motion(
                 .collect(),
         }
     };
-    let colors = [
-        (Axis::Pitch, BLUE),
-        (Axis::Roll, ORANGE),
-        (Axis::Yaw, GREEN),
-    ];
+    let colors = [BLUE, ORANGE, GREEN];
     let figure = Figure {
         title,
         notes,
-        panels: colors.map(panel).into(),
+        panels: Axis::ALL
+            .map(|axis| panel(axis, colors[axis.index()]))
+            .into(),
         panel_height: 250,
     };
     draw(&figure, path)

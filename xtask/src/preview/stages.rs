@@ -234,7 +234,10 @@ pub fn draw(stages: &Stages, path: &Path) -> Result<()> {
     // (dashed) if `marker` says where to mark it.
     let panel = |title: String, curves: &[(&str, RGBColor, &[f64])], marker: Option<_>| {
         let mut curves: Vec<Curve> = (curves.iter())
-            .map(|&(label, color, values)| Curve::indexed(label, color, values))
+            .map(|&(label, color, values)| {
+                let points = (0..).map(f64::from).zip(values.iter().copied());
+                Curve::new(label, color, points.collect())
+            })
             .collect();
         let range = format!("[α1, α2] = [{a1}°, {a2}°]");
         for (label, y) in marker
