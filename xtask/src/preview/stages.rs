@@ -71,15 +71,10 @@ fn walk(closure: Closure, seed: u32, n: usize, delta: f64) -> Vec<f64> {
 pub fn normalize(values: &[f64], a1: f64, a2: f64) -> Vec<f64> {
     let min = values.iter().copied().fold(f64::INFINITY, f64::min);
     let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let span = max - min;
-    let scale = |s: f64| {
-        if span > 0.0 {
-            a1 + (s - min) * (a2 - a1) / span
-        } else {
-            a1
-        }
-    };
-    values.iter().map(|&s| scale(s)).collect()
+    // A flat stage (no span) maps to a1.
+    let span = (max - min).max(f64::MIN_POSITIVE);
+    let scale = |s: &f64| a1 + (s - min) * (a2 - a1) / span;
+    values.iter().map(scale).collect()
 }
 
 /// The length-N Hann taper of the paper closure: ½ − ½·cos(2πn/(N−1)).
@@ -239,26 +234,22 @@ pub fn draw(stages: &Stages, path: &Path) -> Result<()> {
                 Curve::new(label, color, points.collect())
             })
             .collect();
-        let range = format!("[α1, α2] = [{a1}°, {a2}°]");
-        for (label, y) in marker
-            .iter()
-            .flat_map(|_| [(range.clone(), a1), (String::new(), a2)])
-        {
-            let points = vec![(0.0, y), ((n.max(2) - 1) as f64, y)];
-            curves.push(Curve {
-                dashed: true,
-                ..Curve::new(label, GREY, points)
-            });
+        if marker.is_some() {
+            let range = format!("[α1, α2] = [{a1}°, {a2}°]");
+            for (label, y) in [(range, a1), (String::new(), a2)] {
+                let points = vec![(0.0, y), ((n.max(2) - 1) as f64, y)];
+                curves.push(Curve {
+                    dashed: true,
+                    ..Curve::new(label, GREY, points)
+                });
+            }
         }
-        let x_desc = "sample index n (generation order)".to_owned();
-        let y_desc = "angle (°)".to_owned();
-        let markers = marker.into_iter().collect();
         Panel {
             title,
-            x_desc,
-            y_desc,
+            x_desc: "sample index n (generation order)".to_owned(),
+            y_desc: "angle (°)".to_owned(),
             curves,
-            markers,
+            markers: marker.into_iter().collect(),
             spans: Vec::new(),
         }
     };
