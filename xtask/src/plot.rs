@@ -13,9 +13,9 @@
     clippy::cast_sign_loss
 )]
 
-use std::{path::Path, sync::Once};
+use std::{path::Path, sync::LazyLock};
 
-use anyhow::{Result, anyhow};
+use anyhow::{Result, anyhow, ensure};
 use idle_head_core::Axis;
 use plotters::{coord::Shift, prelude::*, style::FontStyle};
 
@@ -128,19 +128,15 @@ pub fn motion(
 
 /// Draws `figure` to the PNG `path`, creating its folder.
 pub fn draw(figure: &Figure, path: &Path) -> Result<()> {
-    static FONT_ONCE: Once = Once::new();
-    let mut font = Ok(());
-    FONT_ONCE.call_once(|| {
-        for (style, bytes) in [
+    static FONT_LOADED: LazyLock<bool> = LazyLock::new(|| {
+        let styles = [
             (FontStyle::Normal, dejavu::sans::regular()),
             (FontStyle::Bold, dejavu::sans::bold()),
-        ] {
-            if plotters::style::register_font(FONT, style, bytes).is_err() {
-                font = Err(anyhow!("the DejaVu Sans font did not load"));
-            }
-        }
+        ];
+        let register = |(style, bytes)| plotters::style::register_font(FONT, style, bytes).is_ok();
+        styles.into_iter().all(register)
     });
-    font?;
+    ensure!(*FONT_LOADED, "the DejaVu Sans font did not load");
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
     }
