@@ -191,9 +191,7 @@ impl Watch {
         if t_us < self.next_us {
             return;
         }
-        while self.next_us <= t_us {
-            self.next_us += self.period_us;
-        }
+        self.next_us = (t_us / self.period_us + 1) * self.period_us;
         let mut out = [0; TELEMETRY_LINE];
         let line = telemetry_line(status, 0, &mut out);
         let line = String::from_utf8_lossy(line).trim_end().to_owned();

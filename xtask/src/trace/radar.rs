@@ -53,12 +53,11 @@ impl Radar {
 
 /// A sighting of a radar line's people.
 fn sighting(seen: &[Option<(i32, i32)>; 3]) -> Sighting {
-    let mut s = Sighting::NOBODY;
-    for (slot, p) in s.people.iter_mut().zip(seen) {
-        *slot = p.map(|(x, y)| Person {
-            x: Millimetres(x),
-            y: Millimetres(y),
-        });
+    let person = |(x, y)| Person {
+        x: Millimetres(x),
+        y: Millimetres(y),
+    };
+    Sighting {
+        people: seen.map(|p| p.map(person)),
     }
-    s
 }
