@@ -25,7 +25,6 @@ use idle_head_core::servo::{ServoRate, SetPeriod};
 use idle_head_core::{Axis, Microseconds, Playback, Timestamp};
 use idle_head_firmware::config::IDLE_MODE;
 
-use host::Origin;
 pub use host::Watch;
 use marks::Mark;
 pub use script::{Event, Kind, parse as parse_script, show_seconds};
@@ -206,7 +205,7 @@ pub fn simulate(
         // The script's lines due, and the input task's wakes between them.
         while let Some(event) = events.get(next).filter(|e| e.at_us <= t_us) {
             beside.wake_until(event.at_us, rest);
-            if !beside.take(event, next, rest) {
+            if !beside.take(event, rest) {
                 break;
             }
             next += 1;
@@ -233,12 +232,9 @@ pub fn simulate(
         let (ms, mut taken) = (t_us / 1000, std::mem::take(&mut beside.origins).into_iter());
         let mixer = *head.mixer().params();
         head.drain(&mut driver, &queue, |_, outcome| {
-            let (text, number) = match taken.next() {
-                Some(Origin::Line(i)) => (events[i].text.clone(), events[i].line),
-                Some(Origin::Other(text)) => (text, 0),
-                None => return,
-            };
-            marks.extend(marks::marks(&text, number, ms, outcome, &mixer));
+            if let Some((text, line)) = taken.next() {
+                marks.extend(marks::marks(&text, line, ms, outcome, &mixer));
+            }
         });
         beside.origins.extend(taken);
         let sighting = show.track.take();

@@ -16,21 +16,14 @@ use idle_head_core::settings::{RamStorage, Settings, SettingsSource};
 
 use super::{Event, Kind};
 
-/// Where an action in the queue came from: a script line (its index in the
-/// events), or what to call another source (the console, an input).
-#[derive(Debug, Clone)]
-pub enum Origin {
-    Line(usize),
-    Other(String),
-}
-
 /// The console's service and the input task, with the origin of each
-/// action they queued, oldest first.
+/// action they queued, oldest first: the command as written (or what to
+/// call its source) and its script line (0: not a script's motion line).
 pub struct Beside<'a> {
     service: ConsoleService<'a, RamStorage>,
     queue: &'a CommandQueue,
     link: &'a ConsoleLink,
-    pub origins: Vec<Origin>,
+    pub origins: Vec<(String, usize)>,
     inputs: Inputs,
     /// The levels pin lines set (`None`: the input's idle level).
     driven: [Option<bool>; SLOTS],
@@ -89,9 +82,9 @@ impl<'a> Beside<'a> {
         (text, self.queue.len() > before)
     }
 
-    /// Takes `event` (the script's `index`-th) with the head in `rest`;
-    /// `false` if it has to wait for the next frame (the queue is full).
-    pub fn take(&mut self, event: &Event, index: usize, rest: RestState) -> bool {
+    /// Takes `event` with the head in `rest`; `false` if it has to wait
+    /// for the next frame (the queue is full).
+    pub fn take(&mut self, event: &Event, rest: RestState) -> bool {
         match event.kind {
             Kind::Act(action) => {
                 if self.queue.try_submit(action).is_err() {
@@ -100,14 +93,14 @@ impl<'a> Beside<'a> {
                     println!("line {line}: command queue full at {ms} ms, `{text}` waits a frame");
                     return false;
                 }
-                self.origins.push(Origin::Line(index));
+                self.origins.push((event.text.clone(), event.line));
                 return true;
             }
             Kind::Console => {
                 let (reply, queued) = self.line(&event.text);
                 println!("{:>9} ms  {}: {reply}", event.at_us / 1000, event.text);
                 if queued {
-                    self.origins.push(Origin::Other(event.text.clone()));
+                    self.origins.push((event.text.clone(), 0));
                 }
             }
             Kind::Pin { input, high } => {
@@ -153,8 +146,8 @@ impl<'a> Beside<'a> {
                 full = true;
                 break;
             }
-            let origin = format!("inputs: {}", ActionLine(&action));
-            self.origins.push(Origin::Other(origin));
+            self.origins
+                .push((format!("inputs: {}", ActionLine(&action)), 0));
             self.inputs.sent();
         }
         self.link.publish_inputs(self.inputs.status(&settings));
