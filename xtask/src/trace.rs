@@ -19,9 +19,10 @@ use idle_head_core::behaviour::{
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
-use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig, Lcg};
+use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig};
 use idle_head_core::pwm_clock::{PICO_SYS_HZ, SliceClock};
 use idle_head_core::servo::{ServoRate, SetPeriod};
+use idle_head_core::settings::Settings;
 use idle_head_core::{Axis, Microseconds, Playback, Timestamp};
 use idle_head_firmware::config::IDLE_MODE;
 
@@ -37,8 +38,8 @@ pub struct Args {
     /// Simulated time in seconds (decimals allowed: 2.5).
     #[arg(long = "seconds", value_name = "s", value_parser = positive_seconds)]
     pub micros: u64,
-    /// Idle loops from seed n (pitch n, roll and yaw the next two values of
-    /// the paper's LCG); default: the Table 2 loops.
+    /// The idle loops the console's `seed n` gives a board; default: the
+    /// Table 2 loops.
     #[arg(long, value_name = "n")]
     pub seed: Option<u32>,
     /// The commands and their times, one per line: `<seconds> <command>`.
@@ -291,11 +292,7 @@ pub fn command(args: &Args) -> Result<bool> {
         }
         None => Vec::new(),
     };
-    // `--seed n`: pitch n, roll and yaw the next two values of the paper's LCG.
-    let seeds = args.seed.map(|seed| {
-        let mut lcg = Lcg::new(seed);
-        [seed, lcg.next_value(), lcg.next_value()]
-    });
+    let seeds = args.seed.map(Settings::seeds_from);
     let watch = args.telemetry.as_ref().map(|_| args.watch);
     let trace = simulate(args.micros, seeds, rate, &events, watch, &[])?;
     let default = |name: &str| -> Result<PathBuf> {
