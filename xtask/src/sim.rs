@@ -184,18 +184,15 @@ pub fn command(args: &Args) -> Result<bool> {
     let (root, metadata) = crate::setup::prepare()?;
     let (root, md) = (root.as_path(), &metadata);
     PICO.build(root)?;
-    let (time, pulses) = ((args.virtual_time, args.timeout), args.pulses.as_deref());
     let script = match (&args.script, &args.radar) {
         (Some(path), _) => Some(script::read(path)?),
         (_, Some(path)) => Some(radar::read(path)?),
         _ => None,
     };
     if let Some(events) = script {
-        let rate = ServoRate::new(args.rate)
-            .ok_or_else(|| anyhow::anyhow!("{} Hz: not a servo rate", args.rate))?;
-        return script::command(root, md, events, time, rate, pulses);
+        return script::command(root, md, events, args);
     }
-    if args.dmx.is_some() || pulses.is_some() && !args.show {
+    if args.dmx.is_some() || args.pulses.is_some() && !args.show {
         return show::command(root, md, args);
     }
     let time = args.virtual_time;
@@ -213,10 +210,13 @@ pub fn command(args: &Args) -> Result<bool> {
         }
         test_console(root, md, time, args.timeout)
     } else if args.show {
-        show::show(root, md, pulses)
+        show::show(root, md, args.pulses.as_deref())
     } else {
-        let stages: [(bool, Stage); 5] = [
-            (args.inputs, test_inputs),
+        let stages = [
+            (
+                args.inputs,
+                test_inputs as fn(&Path, &Metadata) -> Result<()>,
+            ),
             (args.drill, test_drill),
             (args.flood, test_flood),
             (args.noise, test_noise),
@@ -237,9 +237,6 @@ pub fn command(args: &Args) -> Result<bool> {
     }
     Ok(result.is_ok())
 }
-
-/// A run of its own that `cargo xtask test` runs as a stage.
-type Stage = fn(&Path, &Metadata) -> Result<()>;
 
 impl Report {
     /// Frames that went out as their own pulse on every servo, all boots.

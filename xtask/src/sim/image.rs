@@ -47,11 +47,7 @@ impl PicoImage {
         if file.section_by_name(".boot2").is_none() {
             bail!("no `.boot2` section (an image for another board?)");
         }
-        let symbol = |name: &str| {
-            file.symbols()
-                .find(|s| s.name() == Ok(name))
-                .map(|s| s.address())
-        };
+        let symbol = |name| file.symbol_by_name(name).map(|s| s.address());
         let rtt =
             symbol("_SEGGER_RTT").context("no `_SEGGER_RTT` symbol: the image has no RTT log")?;
         let stack = (

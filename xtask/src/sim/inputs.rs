@@ -15,7 +15,6 @@ use crate::project::Metadata;
 use crate::steps::Steps;
 use crate::trace;
 
-/// The stage's name.
 pub const INPUTS_STAGE: &str = "Pico image in the RP2040 emulator: a presence sensor rests, \
      relaxes, wakes softly and glances; every pulse the host trace's";
 

@@ -194,13 +194,11 @@ pub struct UartScript {
 impl UartScript {
     /// At 115200 baud, undamaged.
     pub fn new(boot: usize, bytes: impl Into<Vec<u8>>, start: Duration) -> Self {
-        let (bytes, byte_time) = (Chunk::new(bytes, start), BYTE_TIME);
-        let errors = Vec::new();
         Self {
             boot,
-            bytes,
-            byte_time,
-            errors,
+            bytes: Chunk::new(bytes, start),
+            byte_time: BYTE_TIME,
+            errors: Vec::new(),
         }
     }
 }

@@ -52,17 +52,12 @@ fn plant<R: Record, const BUF: usize>(record: &R, len: usize) -> Result<Vec<u8>>
     let mut store: SettingsStore<RamFlash, R, BUF> =
         SettingsStore::new(flash, 0..u32::try_from(len)?)
             .map_err(|e| anyhow::anyhow!("the settings store refused the range: {e:?}"))?;
-    match ready(store.save(record)).context("the store's save waited")? {
-        Ok(()) => Ok(store.into_flash().0),
-        Err(e) => bail!("{e:?}"),
-    }
-}
-
-/// Polls `future` once: [`RamFlash`] never waits.
-fn ready<F: Future>(future: F) -> Option<F::Output> {
-    match pin!(future).poll(&mut Context::from_waker(Waker::noop())) {
-        Poll::Ready(output) => Some(output),
-        Poll::Pending => None,
+    // Polled once: [`RamFlash`] never waits.
+    let saved = pin!(store.save(record)).poll(&mut Context::from_waker(Waker::noop()));
+    match saved {
+        Poll::Ready(Ok(())) => Ok(store.into_flash().0),
+        Poll::Ready(Err(e)) => bail!("{e:?}"),
+        Poll::Pending => bail!("the store's save waited"),
     }
 }
 

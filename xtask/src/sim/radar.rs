@@ -21,7 +21,6 @@ use crate::log::number;
 use crate::project::{self, Metadata, PICO};
 use crate::trace::{Event, Kind};
 
-/// Stage names.
 pub const RADAR_STAGE: &str = "Pico image in the RP2040 emulator: a radar walk on GP13 is \
      followed within 5° of the bearing, every pulse the host trace's; two boards' unique ids \
      give two idle motions";

@@ -205,12 +205,13 @@ pub fn command(
     root: &Path,
     metadata: &Metadata,
     events: Vec<Event>,
-    (time, wall): (Option<Duration>, Duration),
-    rate: ServoRate,
-    pulses: Option<&Path>,
+    args: &super::Args,
 ) -> Result<bool> {
-    let time = time.unwrap_or_else(|| default_time(&events));
+    let rate = ServoRate::new(args.rate)
+        .ok_or_else(|| anyhow::anyhow!("{} Hz: not a servo rate", args.rate))?;
+    let time = args.virtual_time.unwrap_or_else(|| default_time(&events));
     let board = Board { rate, uid: None };
+    let wall = args.timeout;
     let report = play(root, metadata, events, (time, wall), Against::Host, board)?;
     print!("{}", report.log_text(false));
     let boot = report.first()?;
@@ -223,7 +224,7 @@ pub fn command(
         .verdict()
         .replace("the host's duty", "the host trace's duty");
     println!("{verdict}\n{}", report.summary());
-    if let Some(path) = pulses {
+    if let Some(path) = &args.pulses {
         pulses_csv::write(path, &boot.trains, &run::timing_at(rate))?;
     }
     Ok(report.problems.is_empty())

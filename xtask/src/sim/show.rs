@@ -20,7 +20,6 @@ use super::{
 use crate::project::{self, Metadata};
 use crate::steps::Steps;
 
-/// Stage name.
 pub const SHOW_STAGE: &str = "Pico image in the RP2040 emulator: DMX and Bottango drive the \
      head, lost frames and the end of a curve hand back to the idle";
 

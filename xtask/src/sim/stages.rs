@@ -25,7 +25,6 @@ use crate::{
     reference,
 };
 
-/// Stage names.
 pub const PULSES_STAGE: &str =
     "Pico image in the RP2040 emulator: every pulse the host's duty, frame for frame";
 pub const DRILL_STAGE: &str =

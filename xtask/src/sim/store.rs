@@ -17,7 +17,6 @@ use super::{
 use crate::log::LogLine;
 use crate::project::{self, Metadata, PICO};
 
-/// Stage name.
 pub const STORE_STAGE: &str = "Pico image in the RP2040 emulator: `save` to flash with \
      worst-case erase times, power cycle, the next boot on the saved settings";
 

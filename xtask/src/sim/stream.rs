@@ -17,7 +17,6 @@ use super::{
 };
 use crate::{log::number, project::Metadata};
 
-/// Stage names.
 pub const UART_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: a line every 2 ms on \
      UART0 for 10 minutes: every line answered once, in order, none lost, no frame late";
 pub const USB_STREAM_STAGE: &str = "Pico image in the RP2040 emulator: a line every 2 ms on \
