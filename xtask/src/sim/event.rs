@@ -75,13 +75,11 @@ pub struct Hex(pub Vec<u8>);
 impl<'de> Deserialize<'de> for Hex {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         let text = String::deserialize(deserializer)?;
-        let byte = |i| {
-            text.get(i..i + 2)
-                .and_then(|pair| u8::from_str_radix(pair, 16).ok())
-        };
-        let bad = || serde::de::Error::custom(format!("bad hex: {text}"));
-        let bytes = (0..text.len()).step_by(2).map(|i| byte(i).ok_or_else(bad));
-        bytes.collect::<Result<_, _>>().map(Hex)
+        let byte = |i| u8::from_str_radix(text.get(i..i + 2)?, 16).ok();
+        let bytes: Option<_> = (0..text.len()).step_by(2).map(byte).collect();
+        bytes
+            .map(Hex)
+            .ok_or_else(|| serde::de::Error::custom(format!("bad hex: {text}")))
     }
 }
 

@@ -156,12 +156,11 @@ pub fn play(
 
 /// Boot 0's script: `lines` on UART0, [`EARLY`], from the first frame.
 pub fn pin_script(lines: Vec<Chunk>) -> PinScript {
-    let (anchor_slice, pins, early) = (SERVOS[0].2, Vec::new(), EARLY);
     PinScript {
-        anchor_slice,
-        pins,
+        anchor_slice: SERVOS[0].2,
         lines,
-        early,
+        early: EARLY,
+        ..PinScript::default()
     }
 }
 

@@ -240,14 +240,13 @@ pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
     for (name, code, [virtual_time, wall, silence], want) in cases {
         let flash = dir.join(format!("{name}.bin"));
         std::fs::write(&flash, synthetic(code)).context("writing a test image")?;
-        let (vtor, config) = (VECTOR_TABLE, node::Config::default());
         let config = node::Config {
             flash,
-            vtor,
+            vtor: VECTOR_TABLE,
             virtual_time,
             wall,
             silence,
-            ..config
+            ..node::Config::default()
         };
         match End::of(&node::run(root, &config)?)?.problem(silence) {
             Some(message) if message.contains(want) => println!("{name}: {message}"),

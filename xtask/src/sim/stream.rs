@@ -123,15 +123,13 @@ pub fn test_stream(
     let count = usize::try_from(length.as_micros() / EVERY.as_micros()).unwrap_or(usize::MAX);
     let time = START + length + Duration::from_secs(1);
     let report = checked_run(root, metadata, time, wall(length), |config| {
-        let (start, every, lines) = (START, EVERY, CYCLE.to_vec());
-        let stream = LineStream {
+        config.stream = Some(LineStream {
             port,
-            start,
-            every,
+            start: START,
+            every: EVERY,
             count,
-            lines,
-        };
-        config.stream = Some(stream);
+            lines: CYCLE.to_vec(),
+        });
     })?;
     print!("{}", report.table());
     let (replies, problems) = replies(&report, port == "usb", count, |k| {
