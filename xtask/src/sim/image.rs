@@ -77,16 +77,12 @@ impl PicoImage {
 pub fn config(elf: &Path, extension: &str) -> Result<(PicoImage, Config)> {
     let image = PicoImage::read(elf)?;
     let (flash, _) = uf2::write(elf, Board::Pico, extension)?;
-    let slices = SERVOS.iter().map(|s| s.2).collect();
-    let (vtor, rtt) = (VECTOR_TABLE, image.rtt);
-    Ok((
-        image,
-        Config {
-            flash,
-            vtor,
-            rtt,
-            slices,
-            ..Config::default()
-        },
-    ))
+    let config = Config {
+        flash,
+        vtor: VECTOR_TABLE,
+        rtt: image.rtt,
+        slices: SERVOS.iter().map(|s| s.2).collect(),
+        ..Config::default()
+    };
+    Ok((image, config))
 }

@@ -19,12 +19,10 @@ use super::{event::Event, image, node, store::WORST};
 pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
     let (_, config) = image::config(elf, "live.uf2")?;
     node::ensure(root)?;
-    let wall = Duration::from_secs(24 * 3600);
-    let (rom, inputs) = (Some(WORST), crate::board::PICO_INPUTS.to_vec());
     Ok(node::Config {
-        wall,
-        rom,
-        inputs,
+        wall: Duration::from_secs(24 * 3600),
+        rom: Some(WORST),
+        inputs: crate::board::PICO_INPUTS.to_vec(),
         live: true,
         ..config
     }
