@@ -11,7 +11,7 @@ macro_rules! problem_if {
     };
 }
 
-mod dmx;
+pub mod dmx;
 mod event;
 mod exchange;
 mod expect;
@@ -23,8 +23,8 @@ mod planted;
 pub mod pulses;
 mod pulses_csv;
 mod radar;
-mod run;
-mod script;
+pub mod run;
+pub mod script;
 mod show;
 mod stages;
 mod store;
@@ -34,13 +34,12 @@ mod unmodelled;
 use std::{fmt::Write as _, path::Path, path::PathBuf, time::Duration};
 
 use anyhow::{Context, Result, bail};
-use idle_head_core::servo::ServoRate;
 
 pub use inputs::{INPUTS_STAGE, test_inputs};
 pub use node::{BYTE_TIME, Chunk, UartScript, folder as node_folder};
 pub use run::{Boot, Report, logged_peak_stack};
 pub use script::{default_time as script_time, parse as parse_script};
-pub use show::{SHOW_STAGE, test_show};
+pub use show::{SHOW_STAGE, bottango_lines, test_show};
 pub use stages::{
     CONSOLE_STAGE, CONSOLE_TIME, DRILL_STAGE, FAILURES_STAGE, PULSES_STAGE, RATE_STAGE, WALL,
     build_drill, test_console, test_drill, test_failures, test_pulses, test_rate,
@@ -53,33 +52,7 @@ pub use stream::{
 
 use crate::project::{self, Metadata, PICO};
 
-/// Plays `events` into the shipped image, checked against what it wrote.
-pub fn play_script(
-    root: &Path,
-    metadata: &Metadata,
-    events: Vec<crate::trace::Event>,
-    time: Duration,
-    wall: Duration,
-) -> Result<Report> {
-    let (against, board) = (script::Against::Written, script::Board::default());
-    script::play(root, metadata, events, (time, wall), against, board)
-}
 pub use radar::{RADAR_DMX_STAGE, RADAR_STAGE, test_radar, test_radar_dmx};
-
-/// The harness's DMX line for a DMX script's text (see `xtask/src/sim/dmx.rs`).
-pub fn dmx_line(script: &str) -> Result<serde_json::Value> {
-    Ok(dmx::line(&dmx::parse(script)?))
-}
-
-/// One PWM count of the servo slices at `rate`, ns.
-pub fn count_ns_at(rate: ServoRate) -> f64 {
-    run::timing_at(rate).count_ns
-}
-
-/// The frame period, ns.
-pub fn frame_ns() -> f64 {
-    run::timing().frame_ns
-}
 
 /// Builds the shipped Pico image and runs it (see [`run::run_with`]).
 pub fn run_shipped(

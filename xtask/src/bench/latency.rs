@@ -15,7 +15,8 @@ use crate::figures;
 use crate::metrics::percentile;
 use crate::project::Metadata;
 use crate::sim::pulses::{self, Measured};
-use crate::sim::{Boot, dmx_line, parse_script, play_script, run_shipped, script_time};
+use crate::sim::script::{Against, Board, play};
+use crate::sim::{Boot, parse_script, run_shipped, script_time};
 use crate::trace::show_seconds;
 
 /// Events per row, at least; more are scheduled, for the ones skipped.
@@ -211,7 +212,7 @@ pub fn row_at(
     goal_ms: f64,
 ) -> Result<Row> {
     let pulses = &pulses::measure(&boot.trains[2]);
-    let count_ns = crate::sim::count_ns_at(rate);
+    let count_ns = crate::sim::run::timing_at(rate).count_ns;
     let frame_ns = f64::from(rate.period().0) * 1e3;
     let (mut ms, mut worst, mut skipped, mut phases) = (Vec::new(), Vec::new(), 0, [0; 5]);
     let first = pulses.first().map_or(0.0, |p| p.rise);
@@ -264,7 +265,7 @@ pub fn dmx(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
         // 101, 100, 101, …: every event a change from the set-up's 100.
         let _ = writeln!(script, "{:.6} 1={}", at.as_secs_f64(), 101 - k % 2);
     }
-    let line = dmx_line(&script)?;
+    let line = crate::sim::dmx::line(&crate::sim::dmx::parse(&script)?);
     let end = times.last().copied().unwrap_or(start) + Duration::from_millis(500);
     let report = run_shipped(root, metadata, end, wall, |config| config.dmx = Some(line))?;
     let boot = report.first()?;
@@ -284,7 +285,8 @@ pub fn input_edge(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Ro
     let times = schedule(Duration::from_secs(2), SCHEDULED, PRESS_GAP, 0x2545_f491);
     let events = parse_script(&press_script(&times))?;
     let time = script_time(&events);
-    let report = play_script(root, metadata, events, time, wall.max(SCRIPT_WALL))?;
+    let (limits, board) = ((time, wall.max(SCRIPT_WALL)), Board::default());
+    let report = play(root, metadata, events, limits, Against::Written, board)?;
     if !report.problems.is_empty() {
         let problems = report.problems.join("\n  ");
         bail!("the input edge's run failed its checks:\n  {problems}");

@@ -14,13 +14,12 @@
 use std::{path::Path, time::Duration};
 
 use anyhow::{Context, Result, bail};
-use idle_head_core::bottango::hash;
 use idle_head_core::servo::ServoRate;
 
 use super::latency::{self, LOOK_GAP, Row, SCHEDULED, count, schedule};
 use crate::metrics::parallel;
 use crate::project::Metadata;
-use crate::sim::{BYTE_TIME, Boot, Chunk, UartScript, node, run_shipped};
+use crate::sim::{BYTE_TIME, Boot, Chunk, UartScript, bottango_lines, node, run_shipped};
 use crate::{figures, project};
 
 /// A path's run, for its row.
@@ -139,12 +138,6 @@ const AHEAD: Duration = Duration::from_millis(120);
 /// −20° to 20°): 256 is 1.25°.
 const STEP: i32 = 256;
 
-/// Bottango lines with their hashes.
-fn bottango_lines(bodies: &[&str]) -> Vec<u8> {
-    let line = |body: &&str| format!("{body},h{}\n", hash(body.as_bytes()));
-    bodies.iter().map(line).collect::<String>().into_bytes()
-}
-
 /// `latency bottango`: a Bottango session over USB steps yaw by 1.25° and
 /// holds it, curve after curve, each sent ahead of its start; each step's
 /// start (on the head's clock, which `tSYN` ties to a frame) against yaw's
@@ -153,7 +146,7 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
     // When the first frame goes out: the head's clock counts from it.
     let first = run_shipped(root, metadata, Duration::from_secs(1), wall, |_| {})?;
     let t0 = first.first()?.trains[2].enabled.context("no first frame")?;
-    let frame = crate::sim::frame_ns();
+    let frame = crate::sim::run::timing().frame_ns;
     // The sync in the middle of a frame after 2.6 s: the clock it marks is
     // the frame before, whatever the line's few µs of transport.
     let k = ((2.6e9 - t0) / frame).ceil();
@@ -163,11 +156,11 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
     let after = Duration::from_secs(4);
     let times = schedule(after, SCHEDULED + 1, CURVE_GAP, 0xb077_a160);
     let ms_after = |at: Duration| ((at.as_secs_f64() * 1e9 - t0) / 1e6).round() as u64 - clock_ms;
-    let setup = bottango_lines(&["hRQ,144", "rMTR,yaw,-20000,20000,3000,4096"]);
+    let setup = bottango_lines(&["hRQ,144", "rMTR,yaw,-20000,20000,3000,4096"]).concat();
     let mut chunks = vec![
         Chunk::new(b"idle off\n", Duration::from_secs(2)),
         Chunk::new(setup, Duration::from_millis(2300)),
-        Chunk::new(bottango_lines(&["tSYN,0"]), sync),
+        Chunk::new(bottango_lines(&["tSYN,0"]).concat(), sync),
     ];
     let mut events = Vec::new();
     for (i, pair) in times.windows(2).enumerate() {
@@ -180,7 +173,7 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
         let step = format!("sC,yaw,{start},40,{from},0,{},{to},0,0", to - from);
         let (at, ms) = (start + 40, next - start - 40);
         let hold = format!("sC,yaw,{at},{ms},{to},0,0,{to},0,0");
-        let lines = bottango_lines(&[&step, &hold]);
+        let lines = bottango_lines(&[&step, &hold]).concat();
         chunks.push(Chunk::new(lines, pair[0].saturating_sub(AHEAD)));
         events.push(t0 + (clock_ms + start) as f64 * 1e6);
     }

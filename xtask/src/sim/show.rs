@@ -37,19 +37,21 @@ const SCRIPT: &str = "\
 const BOTTANGO: Duration = Duration::from_millis(10_500);
 const STOP: Duration = Duration::from_millis(12_600);
 
-/// The session's lines with their hashes: handshake, sync, yaw and pitch
-/// registered, a 1 s eased curve each 200 ms after the sync.
-fn bottango_lines() -> Vec<String> {
-    [
-        "hRQ,144",
-        "tSYN,0",
-        "rMTR,yaw,-20000,20000,3000,4096",
-        "rMTR,pitch,-10000,10000,3000,4096",
-        "sC,yaw,200,1000,4096,333,0,8192,-333,0",
-        "sC,pitch,200,1000,4096,333,0,6144,-333,0",
-    ]
-    .map(|body| format!("{body},h{}\n", hash(body.as_bytes())))
-    .to_vec()
+/// The session: handshake, sync, yaw and pitch registered, a 1 s eased
+/// curve each 200 ms after the sync.
+const SESSION: [&str; 6] = [
+    "hRQ,144",
+    "tSYN,0",
+    "rMTR,yaw,-20000,20000,3000,4096",
+    "rMTR,pitch,-10000,10000,3000,4096",
+    "sC,yaw,200,1000,4096,333,0,8192,-333,0",
+    "sC,pitch,200,1000,4096,333,0,6144,-333,0",
+];
+
+/// Bottango lines with their hashes.
+pub fn bottango_lines(bodies: &[&str]) -> Vec<String> {
+    let line = |body: &&str| format!("{body},h{}\n", hash(body.as_bytes()));
+    bodies.iter().map(line).collect()
 }
 
 /// `cargo xtask sim --dmx FILE [--pulses FILE.csv]` (either alone too):
@@ -101,7 +103,7 @@ pub fn test_show(root: &Path, metadata: &Metadata) -> Result<()> {
 /// `cargo xtask sim --show [--pulses FILE.csv]`: the stage.
 pub fn show(root: &Path, metadata: &Metadata, pulses: Option<&Path>) -> Result<()> {
     let changes = dmx::parse(SCRIPT)?;
-    let lines = bottango_lines();
+    let lines = bottango_lines(&SESSION);
     let time = Duration::from_secs(14);
     let report = super::run_shipped(root, metadata, time, stages::WALL, |config| {
         config.dmx = Some(dmx::line(&changes));
