@@ -185,11 +185,8 @@ pub fn command(args: &Args) -> Result<bool> {
     } else if args.show {
         show::show(root, md, args.pulses.as_deref())
     } else {
-        let stages = [
-            (
-                args.inputs,
-                test_inputs as fn(&Path, &Metadata) -> Result<()>,
-            ),
+        let stages: [(bool, Stage); 5] = [
+            (args.inputs, test_inputs),
             (args.drill, test_drill),
             (args.flood, test_flood),
             (args.noise, test_noise),
@@ -210,6 +207,9 @@ pub fn command(args: &Args) -> Result<bool> {
     }
     Ok(result.is_ok())
 }
+
+/// A run of its own that `cargo xtask test` runs as a stage.
+type Stage = fn(&Path, &Metadata) -> Result<()>;
 
 impl Report {
     /// Frames that went out as their own pulse on every servo, all boots.
