@@ -5,6 +5,7 @@ use std::time::Duration;
 
 use clap::Args;
 use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N};
+use idle_head_core::servo::ServoRate;
 
 /// Options of the commands that run QEMU (`--bless`, `--timeout`,
 /// `--no-budget`).
@@ -32,6 +33,13 @@ pub fn at_least_one<T: std::str::FromStr + From<u8> + PartialOrd>(text: &str) ->
         Ok(value) if value >= T::from(1) => Ok(value),
         _ => Err("expected a whole number, at least 1".to_owned()),
     }
+}
+
+/// `--rate` (trace, sim): a servo rate in Hz, as the firmware takes it.
+pub fn servo_rate(text: &str) -> Result<ServoRate, String> {
+    let (min, max) = (ServoRate::MIN.hz(), ServoRate::MAX.hz());
+    let hz = text.parse().ok().and_then(ServoRate::new);
+    hz.ok_or_else(|| format!("expected a servo rate, {min} to {max} Hz"))
 }
 
 /// `--n` and `--w` (preview, metrics).

@@ -146,6 +146,7 @@ mod tests {
             (&["qemu", "--no-budget"], "--no-budget"),
             (&["metrics", "--seeds", "0"], "--seeds"),
             (&["sim", "--drill", "--store"], "--store"),
+            (&["trace", "--seconds", "1", "--rate", "0"], "--rate"),
             (&["flash"], "<ELF>"),
             (&["deploy"], "deploy"),
         ] {

@@ -34,6 +34,7 @@ mod unmodelled;
 use std::{fmt::Write as _, path::Path, path::PathBuf, time::Duration};
 
 use anyhow::{Context, Result, bail};
+use idle_head_core::servo::ServoRate;
 
 pub use inputs::{INPUTS_STAGE, test_inputs};
 pub use node::{BYTE_TIME, Chunk, UartScript, folder as node_folder};
@@ -130,9 +131,9 @@ pub struct Args {
     pub radar: Option<PathBuf>,
     /// With `--script`: the servos' rate, Hz (50 to 333), planted in the
     /// settings the image boots on; the host trace runs at it too.
-    #[arg(long, value_name = "HZ", requires = "script", default_value_t = 50,
-          value_parser = clap::value_parser!(u16).range(50..=333))]
-    pub rate: u16,
+    #[arg(long, value_name = "HZ", requires = "script", default_value = "50",
+          value_parser = crate::args::servo_rate)]
+    pub rate: ServoRate,
     /// With `--script`, `--dmx` or `--show` (alone: a plain run): the pulses
     /// to this CSV, a row per frame: `t_ms,pitch_us,roll_us,yaw_us`.
     #[arg(long, value_name = "FILE.csv",

@@ -47,9 +47,8 @@ pub struct Args {
     pub script: Option<PathBuf>,
     /// The servos' rate (and the frame rate) from the first frame, Hz
     /// (50 to 333; a script's `servo rate` changes it later).
-    #[arg(long, value_name = "hz", default_value_t = 50,
-          value_parser = clap::value_parser!(u16).range(50..=333))]
-    pub rate: u16,
+    #[arg(long, value_name = "hz", default_value = "50", value_parser = crate::args::servo_rate)]
+    pub rate: ServoRate,
     /// The CSV to write [default: trace/trace.csv in the target directory].
     #[arg(long, value_name = "csv")]
     pub out: Option<PathBuf>,
@@ -282,7 +281,7 @@ pub fn simulate(
 /// `cargo xtask trace`: the CSV, and the PNG if asked for, to trace/ in the
 /// target directory (build output, not the repository) unless told otherwise.
 pub fn command(args: &Args) -> Result<bool> {
-    let rate = ServoRate::new(args.rate).context("not a servo rate")?;
+    let rate = args.rate;
     let (_, params) = at_rate(rate)?;
     let events = match &args.script {
         Some(path) => {

@@ -206,8 +206,7 @@ pub fn command(
     events: Vec<Event>,
     args: &super::Args,
 ) -> Result<bool> {
-    let rate = ServoRate::new(args.rate)
-        .ok_or_else(|| anyhow::anyhow!("{} Hz: not a servo rate", args.rate))?;
+    let rate = args.rate;
     let time = args.virtual_time.unwrap_or_else(|| default_time(&events));
     let board = Board { rate, uid: None };
     let wall = args.timeout;
