@@ -11,7 +11,7 @@ use idle_head_core::Angle;
 use idle_head_core::driver::{DriverConfig, DriverParams};
 
 /// Cases for a property test: `default`, or `PROPTEST_CASES` when set, for
-/// a longer soak (`PROPTEST_CASES=20000 cargo test --release --test driver`;
+/// a longer soak (`PROPTEST_CASES=20000 cargo test --release driver::`;
 /// a case count written in a test's config would otherwise override
 /// proptest's own variable). A value that is not a number is reported.
 #[must_use]

@@ -1,7 +1,7 @@
 //! A look lands where it was asked: over many seeds' idle loops, the head
 //! stays within a few degrees of a held look's target, and keeps swaying.
 //!
-//! The figure (`cargo test --test behaviour_look -- --nocapture` prints it):
+//! The figure (`cargo test behaviour_look:: -- --nocapture` prints it):
 //! `look 8000 -15000 hold=stay` 11 s in, then 20 s held, for 64 seeds.
 
 use host_tests::behaviour::look;

@@ -4,7 +4,7 @@
 //! well-formed reply that agrees with a reference line discipline and the
 //! parser.
 //!
-//! `cargo test --test console_fuzz -- --nocapture` prints the figures.
+//! `cargo test console_fuzz:: -- --nocapture` prints the figures.
 //! The cases come from fixed seeds (plain loops, not proptest: shrinking
 //! a million cases is not needed to find a panic, and too slow).
 

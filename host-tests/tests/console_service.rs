@@ -4,7 +4,7 @@
 //! lines. Exactly one reply per line, no panic, and the head never leaves
 //! the limits its calibration has at that frame.
 //!
-//! `cargo test --release --test console_service -- --nocapture` prints
+//! `cargo test --release console_service:: -- --nocapture` prints
 //! the figures.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};

@@ -20,7 +20,7 @@
 //!   the file).
 //!
 //! A mismatch fails with the file and line, the expected reply and the
-//! one given. `BLESS=1 cargo test --test doc_transcripts` writes the
+//! one given. `BLESS=1 cargo test doc_transcripts::` writes the
 //! replies given into the documents instead (single-line replies of plain
 //! blocks only; review the diff).
 

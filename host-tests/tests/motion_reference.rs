@@ -1,6 +1,6 @@
 //! The integer O(N) engine against the direct-form f64 reference.
 
-mod reference;
+use crate::reference;
 
 use idle_head_core::Axis;
 use idle_head_core::motion::{

@@ -3,7 +3,7 @@
 //! byte of hundreds of saves in a row of the firmware's own [`Settings`]
 //! record, and random corruption.
 //!
-//! `cargo test --test settings_store -- --nocapture` prints the figures.
+//! `cargo test settings_store:: -- --nocapture` prints the figures.
 
 use embedded_storage_async::nor_flash::{NorFlash, ReadNorFlash};
 use futures::executor::block_on;

@@ -1,7 +1,7 @@
 //! A head that looks at you: the radar's people through attention and the
 //! gaze, on the whole frame engine (mixer, idle, driver and its limits).
 //!
-//! `cargo test --test tracking -- --nocapture` prints the tracking figures
+//! `cargo test tracking:: -- --nocapture` prints the tracking figures
 //! of the design notes (`docs/design/attention.md`): a walk 2 m away, left
 //! to right at 1 m/s (the yaw's lag, its RMS error against the bearing
 //! after the first second) and a person standing still with ±40 mm of

@@ -30,7 +30,7 @@ pub const REPLY: usize = idle_head_core::console::PORT_REPLY;
 ///
 /// With `FUZZ_SEED=<n>` in the environment every seed is moved by `n`: the
 /// fuzz and store tests then run on cases no run has seen, for a soak
-/// (`FUZZ_SEED=7 cargo test --release --test console_fuzz`). Unset, or 0,
+/// (`FUZZ_SEED=7 cargo test --release console_fuzz::`). Unset, or 0,
 /// the cases are CI's.
 #[must_use]
 pub fn rng(seed: u64) -> TestRng {

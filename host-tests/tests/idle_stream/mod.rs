@@ -3,7 +3,7 @@
 //! never-repeat measure over an hour, against the fixed loop.
 //!
 //! The smoothness and never-repeat tests are long: run them with
-//! `cargo test --release --test idle_stream -- --nocapture` to see the
+//! `cargo test --release idle_stream:: -- --nocapture` to see the
 //! figures they print.
 
 use idle_head_core::idle::{
