@@ -31,10 +31,9 @@ fn timing() -> IdleTiming {
 }
 
 /// The player of `config`'s stream in `mode`, generating on the spot.
-fn player(
-    config: HeadConfig,
-    mode: IdleMode,
-) -> IdlePlayer<Box<Set>, GenerateOnTake<Box<Set>, DEFAULT_N>> {
+type Player = IdlePlayer<Box<Set>, GenerateOnTake<Box<Set>, DEFAULT_N>>;
+
+fn player(config: HeadConfig, mode: IdleMode) -> Player {
     let t = timing();
     let mut stream = Stream::new(config, &t);
     let mut first = Box::new(Set::new());
@@ -49,6 +48,20 @@ fn play(config: HeadConfig, mode: IdleMode, frames: usize) -> Vec<[i32; 3]> {
     (0..frames as u64)
         .map(|k| p.offsets(at(k)).map(|a| a.millidegrees()))
         .collect()
+}
+
+/// Plays `p` from frame 0 on, skipping frames (`1 + (k·7 + 3) mod skip`
+/// a step), each frame it plays (at `at(k)`) checked against `all`.
+fn check_skipping(mut p: Player, all: &[[i32; 3]], at: impl Fn(u64) -> Timestamp, skip: u64) {
+    let mut k = 0u64;
+    while k < all.len() as u64 {
+        assert_eq!(
+            p.offsets(at(k)).map(|a| a.millidegrees()),
+            all[k as usize],
+            "frame {k}"
+        );
+        k += 1 + (k * 7 + 3) % skip;
+    }
 }
 
 /// The default configuration with three seeds drawn from `index`
@@ -191,32 +204,15 @@ fn at_333_hz_a_frame_does_not_depend_on_the_frames_before_it_either() {
         .map(|k| p.offsets(at(k)).map(|a| a.millidegrees()))
         .collect();
     assert_eq!(p.stats().joins, 2);
-    let mut p = fresh();
-    let mut k = 0u64;
-    while k < frames {
-        assert_eq!(
-            p.offsets(at(k)).map(|a| a.millidegrees()),
-            all[k as usize],
-            "frame {k}"
-        );
-        k += 1 + (k * 7 + 3) % 5;
-    }
+    check_skipping(fresh(), &all, at, 5);
 }
 
 #[test]
 fn a_frame_does_not_depend_on_the_frames_skipped_before_it() {
     let all = play(DEFAULT_HEAD, IdleMode::NeverRepeating, 4500);
-    let mut p = player(DEFAULT_HEAD, IdleMode::NeverRepeating);
-    let mut k = 0u64;
-    while k < 4500 {
-        assert_eq!(
-            p.offsets(at(k)).map(|a| a.millidegrees()),
-            all[k as usize],
-            "frame {k}"
-        );
-        // Skip 0 to 6 frames, through joins too.
-        k += 1 + (k * 7 + 3) % 7;
-    }
+    // Skip 0 to 6 frames, through joins too.
+    let p = player(DEFAULT_HEAD, IdleMode::NeverRepeating);
+    check_skipping(p, &all, at, 7);
 }
 
 #[test]
