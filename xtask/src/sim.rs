@@ -47,7 +47,7 @@ pub use stages::{
 };
 pub use store::{STORE_STAGE, test_store};
 pub use stream::{
-    DMX_STREAM_STAGE, FLOOD_STAGE, LENGTH as STREAM_LENGTH, NOISE_STAGE, UART_STREAM_STAGE,
+    DMX_STREAM_STAGE, FLOOD_STAGE, NOISE_STAGE, TEST_LENGTH as STREAM_LENGTH, UART_STREAM_STAGE,
     USB_STREAM_STAGE, test_dmx, test_flood, test_noise, test_stream,
 };
 

@@ -342,7 +342,7 @@ impl Background {
             }
         };
         let chosen: Vec<_> = chosen.into_iter().map(|i| (i, blocked(i))).collect();
-        // Longest first: the two 10-minute streams, the DMX stream, the latency rows.
+        // Longest first: the two console streams, the DMX stream, the latency rows.
         let queue = chosen
             .iter()
             .filter_map(|&(i, by)| by.is_none().then_some(i));
