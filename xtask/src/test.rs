@@ -342,16 +342,16 @@ impl Background {
             }
         };
         let chosen: Vec<_> = chosen.into_iter().map(|i| (i, blocked(i))).collect();
-        // Longest first: the two console streams, the DMX stream, the latency rows.
+        // Longest first: the latency rows, the two console streams, the DMX stream.
         let queue = chosen
             .iter()
             .filter_map(|&(i, by)| by.is_none().then_some(i));
         let mut queue: Vec<usize> = queue.collect();
         let long = [
+            bench::LATENCY_STAGE,
             sim::UART_STREAM_STAGE,
             sim::USB_STREAM_STAGE,
             sim::DMX_STREAM_STAGE,
-            bench::LATENCY_STAGE,
         ];
         let rank = |i: &usize| long.iter().position(|name| *name == EMULATED[*i].0);
         queue.sort_by_key(|i| rank(i).unwrap_or(long.len()));
