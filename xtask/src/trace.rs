@@ -1,8 +1,6 @@
 //! `cargo xtask trace`: the firmware's frames simulated on the host, as CSV
-//! (and PNG). The core's frame engine runs frame by frame as the frame task
-//! does (a script's `servo rate` changes the rate between two frames, as on
-//! the board); a script's motion lines go through the same queue, its
-//! console lines through the console's service, its pin lines into the
+//! (and PNG): the core's frame engine, frame by frame as the frame task runs
+//! it, fed by the script through the queue, the console's service and the
 //! input task (`host.rs`).
 
 mod host;
@@ -10,7 +8,7 @@ mod marks;
 pub mod radar;
 mod script;
 
-use std::{fmt::Write as _, fs, path::PathBuf};
+use std::{fmt::Write as _, fs, path::Path, path::PathBuf};
 
 use anyhow::{Context, Result, anyhow};
 use idle_head_core::behaviour::{
@@ -132,8 +130,7 @@ impl SetPeriod for Channel {
     }
 }
 
-/// The idle loops' configuration for `seeds` `[pitch, roll, yaw]` (or
-/// Table 2's).
+/// The idle loops' configuration for `[pitch, roll, yaw]` seeds (or Table 2's).
 fn config(seeds: Option<[u32; 3]>) -> HeadConfig {
     let mut config = DEFAULT_HEAD;
     if let Some([pitch, roll, yaw]) = seeds {
@@ -158,8 +155,7 @@ pub fn idle(config: HeadConfig, playback: Playback, seed: Option<[u32; 3]>) -> R
     Ok(IdlePlayer::new(first, supply, timing, IDLE_MODE))
 }
 
-/// The built-in driver's parameters and the behaviour's built on them:
-/// what the board runs.
+/// [`at_rate`] at 50 Hz: what the board runs.
 pub fn built_in() -> Result<(DriverParams, BehaviourParams)> {
     at_rate(ServoRate::DEFAULT)
 }
@@ -174,10 +170,9 @@ pub fn at_rate(rate: ServoRate) -> Result<(DriverParams, BehaviourParams)> {
     Ok((driver, params))
 }
 
-/// Runs `micros` of frames at `rate` with `events` (sorted by time); the
-/// idle from `seed` (`[pitch, roll, yaw]`, else Table 2's); the telemetry
-/// lines of a `watch` (if `watch` gives its lines a second), and the
-/// console's replies to `ask` after the last frame.
+/// Runs `micros` of frames at `rate` with `events` (sorted by time), the
+/// idle from `seed` (else Table 2's), a `watch` at `watch` lines a second,
+/// and the console's replies to `ask` after the last frame.
 pub fn simulate(
     micros: u64,
     seed: Option<[u32; 3]>,
@@ -283,14 +278,11 @@ pub fn simulate(
 pub fn command(args: &Args) -> Result<bool> {
     let rate = args.rate;
     let (_, params) = at_rate(rate)?;
-    let events = match &args.script {
-        Some(path) => {
-            let text = fs::read_to_string(path)
-                .with_context(|| format!("reading the script {}", path.display()))?;
-            script::parse(&text, &params).with_context(|| format!("{}", path.display()))?
-        }
-        None => Vec::new(),
-    };
+    let events = args
+        .script
+        .as_deref()
+        .map(|path| read_script(path, &params));
+    let events = events.transpose()?.unwrap_or_default();
     let seeds = args.seed.map(Settings::seeds_from);
     let watch = args.telemetry.as_ref().map(|_| args.watch);
     let trace = simulate(args.micros, seeds, rate, &events, watch, &[])?;
@@ -336,6 +328,13 @@ pub fn command(args: &Args) -> Result<bool> {
         println!("wrote {}", png.display());
     }
     Ok(true)
+}
+
+/// The events of the script at `path`.
+pub fn read_script(path: &Path, params: &BehaviourParams) -> Result<Vec<Event>> {
+    let text = fs::read_to_string(path)
+        .with_context(|| format!("reading the script {}", path.display()))?;
+    script::parse(&text, params).with_context(|| format!("{}", path.display()))
 }
 
 /// `t_us` in ms, with µs decimals where it has them (`2500`, `2498.496`).

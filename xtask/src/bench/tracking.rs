@@ -118,8 +118,8 @@ impl Walk {
 
 /// The yaw of each frame of the host trace of `script`, m°.
 fn yaw_of(script: &str, micros: u64) -> Result<Vec<f64>> {
-    let (_, params) = trace::built_in()?;
-    let events = trace::parse_script(script, &params)?;
+    let events = crate::sim::parse_script(script)?;
+
     let run = trace::simulate(micros, None, ServoRate::DEFAULT, &events, None, &[])?;
     let yaw = |row: &trace::Row| f64::from(row.angles[Axis::Yaw.index()]);
     Ok(run.rows.iter().map(yaw).collect())

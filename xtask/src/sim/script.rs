@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::time::Duration;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use serde_json::{Value, json};
 
 use idle_head_core::seed::BoardId;
@@ -31,9 +31,7 @@ pub const CONSOLE_UP: Duration = Duration::from_millis(100);
 
 /// The events of the script at `path`.
 pub fn read(path: &Path) -> Result<Vec<Event>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("reading the script {}", path.display()))?;
-    parse(&text).with_context(|| format!("{}", path.display()))
+    trace::read_script(path, &trace::built_in()?.1)
 }
 
 /// The events of a script's `text`.
