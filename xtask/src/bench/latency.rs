@@ -1,10 +1,7 @@
-//! The latency rows of `cargo xtask bench`: how long an input takes to
-//! reach the servo pins, measured in the RP2040 emulator on the shipped
-//! image (docs/dev/emulators.md, "Latency"). One run per path, at least
-//! [`EVENTS`] events at seeded random times, so that their phases against
-//! the frame spread evenly, each timed by [`response`]. A row gives the
-//! latencies' median, 99th percentile and largest, in ms, against its goal
-//! for p99, and the longest a port task waited for the CPU.
+//! The latency rows of `cargo xtask bench`: from an input to the servo pins,
+//! in the RP2040 emulator on the shipped image (docs/dev/emulators.md). A
+//! run per path, [`EVENTS`] or more at seeded random phases, each timed by
+//! [`response`]; p50, p99 and max in ms, p99 against its goal.
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
@@ -40,11 +37,9 @@ const SCRIPT_WALL: Duration = Duration::from_secs(600);
 /// The longest a port task may wait for the CPU, µs.
 pub const PORT_WAIT_US: u32 = 1000;
 
-/// One latency row: its name (`dmx`, `usb look`, …), the latencies (ms,
-/// sorted), the events skipped (the axis still moved), the events per fifth
-/// of the frame, the three slowest (when, s, and their latency), the
-/// longest a port task waited for the CPU (µs, as the image logged it), and
-/// the goal for p99 (ms).
+/// One latency row: latencies (ms, sorted), events skipped (the axis still
+/// moved), events per fifth of the frame, the three slowest (s, ms), the
+/// port tasks' longest wait for the CPU (µs, as logged), the p99 goal (ms).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Row {
     pub name: &'static str,
@@ -178,12 +173,9 @@ pub enum Response {
     After(f64),
 }
 
-/// The response to an event at `at` (ns: when the input has fully arrived,
-/// the end of the DMX frame that carries the change, the USB host's
-/// hand-over of a line's last byte, a button's edge) on an axis whose
-/// pulses are `pulses`: the rise of the first pulse whose width differs
-/// from the baseline, the axis at rest before the event (the last two
-/// pulses of equal width), by more than one and a half PWM counts.
+/// The response to an event at `at` (ns, once the input has fully arrived)
+/// on an axis with `pulses`: the rise of the first pulse more than 1.5 PWM
+/// counts off the baseline (the last two pulses before, of equal width).
 pub fn response(pulses: &[Measured], at: f64, count_ns: f64) -> Response {
     let before = pulses.partition_point(|p| p.rise < at);
     let baseline = before.checked_sub(2).map(|i| (&pulses[i], &pulses[i + 1]));
@@ -275,12 +267,9 @@ pub fn dmx(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
     row("dmx", &events, boot)
 }
 
-/// `latency input edge`: with the idle off (so that a pulse moves only
-/// because of a press), two buttons, GP2 and GP3, each with a short look
-/// (`look 0 2000 100 hold=stay`, and back to 0), pressed in turn; each
-/// press's edge against yaw's first pulse that moves. Every pulse of the
-/// run is checked too (each its own frame's duty, on time, within the
-/// servos' limits), and every press must move the head.
+/// `latency input edge`: the idle off, GP2 and GP3 buttons each with a
+/// short look, pressed in turn; each edge against yaw's first pulse that
+/// moves. Every pulse is checked too ([`Against::Written`]).
 pub fn input_edge(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
     let times = schedule(Duration::from_secs(2), SCHEDULED, PRESS_GAP, 0x2545_f491);
     let events = parse_script(&press_script(&times))?;

@@ -26,8 +26,7 @@ pub fn ensure(root: &Path) -> Result<()> {
 }
 
 /// Makes sure `node` and `npm` run (apt-get installs them when root) and
-/// `packages` are in `dir` as its `package-lock.json` pins them, else
-/// `npm ci` there (with `env`).
+/// `packages` are in `dir` as `package-lock.json` pins them (else `npm ci`).
 pub fn npm_ci(dir: &Path, packages: &[&str], env: &[(&str, &str)]) -> Result<()> {
     let what = "Node.js (20 or newer) and npm (packages `nodejs npm` on Debian and Ubuntu)";
     for program in ["node", "npm"] {
@@ -268,12 +267,8 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     let file = std::env::temp_dir().join(format!("idle-head-sim-{}-{n}.json", std::process::id()));
     std::fs::write(&file, config.json().to_string())
         .with_context(|| format!("writing {}", file.display()))?;
-    let child = harness(
-        root,
-        &format!("@{}", file.display()),
-        Stdio::null(),
-        Stdio::piped(),
-    );
+    let arg = format!("@{}", file.display());
+    let child = harness(root, &arg, Stdio::null(), Stdio::piped());
     // Read to the end (past a bad line too: node never waits on a full
     // pipe); the first bad line is the error.
     let events = |stdout| -> Result<Vec<Event>> {

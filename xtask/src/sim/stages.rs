@@ -76,12 +76,9 @@ pub fn test_rate(root: &Path, metadata: &Metadata) -> Result<()> {
 pub fn test_pulses(root: &Path, metadata: &Metadata) -> Result<Report> {
     let report = checked_run(root, metadata, DEFAULT_TIME, WALL, |_| {})?;
     print!("{}{}", report.log_text(false), report.table());
-    let mut problems = Vec::new();
-    if report.frames() < MIN_FRAMES {
-        problems.push(format!(
-            "{} frames checked, fewer than {MIN_FRAMES}",
-            report.frames()
-        ));
+    let (mut problems, frames) = (Vec::new(), report.frames());
+    if frames < MIN_FRAMES {
+        problems.push(format!("{frames} frames checked, fewer than {MIN_FRAMES}"));
     }
     if report.watchdog_resets() > 0 {
         problems.push("the watchdog reset the shipped image".to_owned());
@@ -140,18 +137,16 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
         for (check, (name, ..)) in boot.servos.iter().zip(SERVOS) {
             // Frames 0..=DRILL_FRAMES, each its own pulse: neutral first and
             // the 2 s fade-in (checked against the host) before the stop.
-            if check.fresh != DRILL_FRAMES + 1 {
-                let want = DRILL_FRAMES + 1;
+            let (fresh, held, want) = (check.fresh, check.held, DRILL_FRAMES + 1);
+            if fresh != want {
                 problems.push(format!(
-                    "boot {b}, {name}: {} frames went out, not {want}",
-                    check.fresh
+                    "boot {b}, {name}: {fresh} frames went out, not {want}"
                 ));
             }
             // The last duty is held until the reset, 100 ms: 5 periods.
-            if check.held > 6 {
+            if held > 6 {
                 problems.push(format!(
-                    "boot {b}, {name}: {} pulses held before the reset",
-                    check.held
+                    "boot {b}, {name}: {held} pulses held before the reset"
                 ));
             }
         }
@@ -167,9 +162,8 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
     report.conclude(problems)
 }
 
-/// Builds the drill image (`--features watchdog-drill`); its ELF, in
-/// `target/watchdog-drill/` (the shipped one stays). The shared
-/// `build.build-dir` recompiles only the crates the feature changes.
+/// Builds the drill image (`--features watchdog-drill`) into
+/// `target/watchdog-drill/`, beside the shipped one; its ELF.
 pub fn build_drill(metadata: &Metadata) -> Result<PathBuf> {
     let build_dir = metadata.target_dir.to_string_lossy();
     let target = metadata.target_dir.join("watchdog-drill");
@@ -208,10 +202,8 @@ pub fn test_console(
 pub fn console_ram(metadata: &Metadata, report: &Report) -> Result<Option<String>> {
     let static_ram = elf::Image::read(&PICO.elf(metadata))?.static_ram();
     let Some(stack) = report.peak_stack() else {
-        let problem = "its peak stack was not measured";
-        return Ok(Some(format!(
-            "Pico image RAM: {static_ram} B static, but {problem}"
-        )));
+        let problem = format!("Pico image RAM: {static_ram} B static, but no peak stack measured");
+        return Ok(Some(problem));
     };
     let (ram, budget) = (static_ram + stack, elf::RAM_BUDGET);
     let sum = format!("{ram} B (static {static_ram} B + peak stack {stack} B)");
