@@ -59,7 +59,7 @@ impl Image {
         Self::parse(&data).with_context(|| format!("parsing {}", path.display()))
     }
 
-    /// Parses the ELF at `path` and prints its sections and sizes.
+    /// [`Image::read`], printing the sections and sizes.
     pub fn show(path: &Path) -> Result<Self> {
         let image = Self::read(path)?;
         println!("{}", path.display());
@@ -123,8 +123,7 @@ impl Image {
         self.sections.iter().find(|section| section.name == name)
     }
 
-    /// Bytes of RAM taken before `main` runs (`.radar_ring`, `.data`,
-    /// `.bss`, `.uninit`).
+    /// Bytes of RAM taken before `main` runs.
     pub fn static_ram(&self) -> u64 {
         let ram =
             |s: &&Section| [".radar_ring", ".data", ".bss", ".uninit"].contains(&s.name.as_str());
@@ -241,18 +240,16 @@ pub fn check_pico(path: &Path) -> Result<()> {
     project::verdict(&problems)
 }
 
-/// Prints the QEMU image's sections (no budget: a test image); fails unless
-/// the vector table is at 0, where the LM3S6965 boots, and no allocator is
-/// linked.
+/// Prints the QEMU image's sections (a test image: no budget); fails on a
+/// vector table off 0, where the LM3S6965 boots, or an allocator.
 pub fn check_qemu(path: &Path) -> Result<()> {
     let image = Image::show(path)?;
     image.check_vector_table(0, "LM3S6965")?;
     image.check_no_allocator()
 }
 
-/// Records static RAM and peak stack of the Pico and QEMU images (each its
-/// ELF and the peak stack measured with it, if it was); fails if the Pico
-/// image's total is over [`RAM_BUDGET`] or its peak is unknown.
+/// Records static RAM and peak stack (if measured) of the Pico and QEMU
+/// ELFs; fails if the Pico's is unknown or over [`RAM_BUDGET`].
 pub fn check_ram(pico: (&Path, Option<u64>), qemu: (&Path, Option<u64>)) -> Result<()> {
     let measured = |(elf, stack): (&Path, Option<u64>)| -> Result<Option<(u64, u64)>> {
         (stack.map(|stack| Ok((Image::read(elf)?.static_ram(), stack)))).transpose()
