@@ -199,7 +199,7 @@ fn events(mut out: TcpStream, notes: &mpsc::Receiver<Note>) -> io::Result<()> {
     for note in notes {
         match note {
             Note::Bytes(bytes) => {
-                write!(out, "data: {}\n\n", crate::sim::node::hex_string(&bytes))?;
+                write!(out, "data: {}\n\n", hex::encode(&bytes))?;
             }
             Note::Gone(why) => {
                 write!(out, "event: gone\ndata: {why}\n\n")?;

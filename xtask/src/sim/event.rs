@@ -3,7 +3,7 @@
 //! harness and its reader change together.
 
 use anyhow::{Context, Result};
-use serde::{Deserialize, Deserializer};
+use serde::Deserialize;
 use std::time::Duration;
 
 /// One event of the harness. Times (`ns`) are virtual nanoseconds since
@@ -68,20 +68,9 @@ pub enum Event {
     End(End),
 }
 
-/// Bytes, from lower-case hex digits.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Hex(pub Vec<u8>);
-
-impl<'de> Deserialize<'de> for Hex {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let text = String::deserialize(deserializer)?;
-        let byte = |i| u8::from_str_radix(text.get(i..i + 2)?, 16).ok();
-        let bytes: Option<_> = (0..text.len()).step_by(2).map(byte).collect();
-        bytes
-            .map(Hex)
-            .ok_or_else(|| serde::de::Error::custom(format!("bad hex: {text}")))
-    }
-}
+/// Bytes, from hex digits.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct Hex(#[serde(with = "hex")] pub Vec<u8>);
 
 /// Accesses to one register the emulator does not model.
 #[derive(Debug, Clone, PartialEq, Eq, Deserialize)]

@@ -38,7 +38,7 @@ pub fn start(root: &Path, elf: &Path) -> Result<Child> {
 
 /// Sends `bytes` to the head's USB serial port: one line of hex digits.
 pub fn send(stdin: &mut impl Write, bytes: &[u8]) -> std::io::Result<()> {
-    stdin.write_all(format!("{}\n", node::hex_string(bytes)).as_bytes())?;
+    stdin.write_all(format!("{}\n", hex::encode(bytes)).as_bytes())?;
     stdin.flush()
 }
 

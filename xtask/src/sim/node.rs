@@ -105,7 +105,7 @@ pub struct Config {
 /// Bytes sent at a time.
 #[derive(Debug, Clone, Serialize)]
 pub struct Chunk {
-    #[serde(rename = "hex", serialize_with = "hex")]
+    #[serde(rename = "hex", serialize_with = "hex::serialize")]
     pub bytes: Vec<u8>,
     #[serde(rename = "at_ns", serialize_with = "ns")]
     pub at: Duration,
@@ -122,7 +122,7 @@ impl Chunk {
 #[derive(Debug, Clone, Serialize)]
 pub struct Fill {
     pub addr: u64,
-    #[serde(serialize_with = "hex")]
+    #[serde(serialize_with = "hex::serialize")]
     pub hex: Vec<u8>,
 }
 
@@ -223,13 +223,6 @@ impl Config {
     }
 }
 
-/// `bytes` as lower-case hex digits, as the harness reads them.
-pub fn hex_string(bytes: &[u8]) -> String {
-    bytes
-        .iter()
-        .fold(String::new(), |hex, byte| hex + &format!("{byte:02x}"))
-}
-
 pub fn nanos(duration: Duration) -> u64 {
     u64::try_from(duration.as_nanos()).unwrap_or(u64::MAX)
 }
@@ -244,10 +237,6 @@ fn ms<S: Serializer>(duration: &Duration, s: S) -> Result<S::Ok, S::Error> {
 
 fn ns_each<S: Serializer>(durations: &[Duration], s: S) -> Result<S::Ok, S::Error> {
     s.collect_seq(durations.iter().map(|d| nanos(*d)))
-}
-
-fn hex<S: Serializer>(bytes: &[u8], s: S) -> Result<S::Ok, S::Error> {
-    s.serialize_str(&hex_string(bytes))
 }
 
 /// Wall time the harness has beyond its own limit: node's start-up.
