@@ -81,10 +81,8 @@ impl Bridge {
     }
 
     pub fn write(&self, bytes: &[u8]) -> Result<()> {
-        let mut writer = self
-            .writer
-            .lock()
-            .map_err(|_| anyhow!("the writer panicked"))?;
+        let writer = self.writer.lock();
+        let mut writer = writer.map_err(|_| anyhow!("the writer panicked"))?;
         writer.write_all(bytes)?;
         Ok(writer.flush()?)
     }
@@ -94,9 +92,8 @@ impl Bridge {
     pub fn sim(root: &Path, elf: &Path) -> Result<Self> {
         let mut child = live::start(root, elf)?;
         let (stdin, stdout) = (child.stdin.take(), child.stdout.take());
-        let (stdin, stdout) = stdin
-            .zip(stdout)
-            .context("the harness's stdin and stdout")?;
+        let pipes = stdin.zip(stdout).context("the harness's stdin and stdout");
+        let (stdin, stdout) = pipes?;
         let name = "the shipped Pico image in the RP2040 emulator (USB serial port)";
         let mut bridge = Self::new(name, "sim", Box::new(HexLines(stdin)));
         bridge.child = Some(child);

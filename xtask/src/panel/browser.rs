@@ -37,21 +37,13 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<()> {
     let shots = metadata.target_dir.join("panel");
     let harness = sim::live::config(root, &PICO.elf(metadata))?;
     let harness = json!({ "cwd": sim::node_folder(root), "arg": harness.to_string() });
+    let serial = json!({ "session": "serial", "label": "web-serial", "harness": harness });
+    let qemu = json!({ "session": "bridge", "label": "qemu" });
     let report = [
         // Web Serial, the emulated Pico.
-        session(
-            root,
-            &shots,
-            None,
-            json!({ "session": "serial", "label": "web-serial", "harness": harness }),
-        )?,
+        session(root, &shots, None, serial)?,
         // The bridge to QEMU.
-        session(
-            root,
-            &shots,
-            Some(Bridge::qemu(&QEMU.elf(metadata))?),
-            json!({ "session": "bridge", "label": "qemu" }),
-        )?,
+        session(root, &shots, Some(Bridge::qemu(&QEMU.elf(metadata))?), qemu)?,
         // A real serial port: QEMU's UART0 as a pseudo-terminal.
         serial_port(root, &QEMU.elf(metadata), &shots)?,
         // The radar's map: the telemetry of a scripted walk, replayed.
@@ -111,12 +103,8 @@ fn replay(root: &Path, shots: &Path) -> Result<String> {
         .map(|(ask, reply)| ((*ask).to_owned(), reply.into()))
         .collect();
     let replay = json!({ "lines": lines, "answers": answers });
-    session(
-        root,
-        shots,
-        None,
-        json!({ "session": "replay", "label": "radar-replay", "replay": replay }),
-    )
+    let config = json!({ "session": "replay", "label": "radar-replay", "replay": replay });
+    session(root, shots, None, config)
 }
 
 /// QEMU with UART0 on a pseudo-terminal: `cargo xtask console --port` with
@@ -130,16 +118,11 @@ fn serial_port(root: &Path, elf: &Path, shots: &Path) -> Result<String> {
     let want: Vec<&str> = want.split('|').collect();
     let script = b"help\nstatus\nnod\nservo yaw max 3000\nwatch off\n";
     console::script(&["--port", &pty], script, &want, 0)?;
-    let bridge = Some(Bridge::port(&qemu.path)?);
-    let session = session(
-        root,
-        shots,
-        bridge,
-        json!({ "session": "bridge", "label": "serial-port" }),
-    )?;
+    let config = json!({ "session": "bridge", "label": "serial-port" });
+    let session = session(root, shots, Some(Bridge::port(&qemu.path)?), config)?;
+    let n = want.len();
     Ok(format!(
-        "console --port {pty}: {} replies as expected; {session}",
-        want.len()
+        "console --port {pty}: {n} replies as expected; {session}"
     ))
 }
 

@@ -1,10 +1,8 @@
 //! The panel's web server, a thread a connection and one request each
-//! (`Connection: close`): the page's files and dependencies (`vendor/…`),
-//! `bridge.json` (the head bridged to, if any), `GET /events` (the head's
-//! bytes as server-sent events of hex digits; `gone` with the reason when
-//! it goes away), `POST /send`. Requests are parsed by httparse. (Not
-//! `tiny_http` 0.12: its thread pool can leave a new connection unserved
-//! while its threads hold a browser's kept-alive ones.)
+//! (`Connection: close`, so that no kept-alive connection holds a thread):
+//! the page's files, `vendor/…`, `bridge.json`, `GET /events` (the head's
+//! bytes as server-sent events of hex digits, `gone` when it goes away),
+//! `POST /send`.
 
 use std::{
     io::{self, BufRead, BufReader, Read, Write},
@@ -198,9 +196,7 @@ fn events(mut out: TcpStream, notes: &mpsc::Receiver<Note>) -> io::Result<()> {
     answer(&mut out, "200 OK", "text/event-stream", None)?;
     for note in notes {
         match note {
-            Note::Bytes(bytes) => {
-                write!(out, "data: {}\n\n", hex::encode(&bytes))?;
-            }
+            Note::Bytes(bytes) => write!(out, "data: {}\n\n", hex::encode(&bytes))?,
             Note::Gone(why) => {
                 write!(out, "event: gone\ndata: {why}\n\n")?;
                 return out.flush();
