@@ -54,8 +54,7 @@ pub fn configure(config: &mut Config) {
 }
 
 /// Boot 0's exchange against the host's replies: prints the transcript;
-/// into `report`, problems: a wrong or missing reply, a UART overrun, a
-/// USB device not configured, a `center` the frame task did not log.
+/// its problems into `report`.
 pub fn check(report: &mut Report) {
     let Some(boot) = report.boots.first() else {
         return;
@@ -194,14 +193,10 @@ fn compare(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>
         let _ = writeln!(transcript, "  > {line}");
         match got.get(i) {
             Some(reply) => {
-                let _ = writeln!(transcript, "  < {}", printable(reply));
+                let (n, got, wanted) = (i + 1, printable(reply), printable(want));
+                let _ = writeln!(transcript, "  < {got}");
                 if reply != want {
-                    problems.push(format!(
-                        "reply {} is `{}`, not `{}`",
-                        i + 1,
-                        printable(reply),
-                        printable(want)
-                    ));
+                    problems.push(format!("reply {n} is `{got}`, not `{wanted}`"));
                 }
             }
             None => {
@@ -209,12 +204,9 @@ fn compare(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>
             }
         }
     }
-    if got.len() != want.len() {
-        problems.push(format!(
-            "{} reply lines for {} lines sent",
-            got.len(),
-            want.len()
-        ));
+    let (replies, sent) = (got.len(), want.len());
+    if replies != sent {
+        problems.push(format!("{replies} reply lines for {sent} lines sent"));
     }
     if got.last().is_some_and(|l| !l.ends_with(b"\r\n")) {
         problems.push("the last reply does not end in CR LF".to_owned());

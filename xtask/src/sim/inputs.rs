@@ -45,9 +45,8 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     let gaps = pulses[0]
         .windows(2)
         .map(|w| (w[1].rise - w[0].rise, w[0], w[1]));
-    let (span, before, after) = gaps
-        .reduce(|a, b| if b.0 > a.0 { b } else { a })
-        .context("no pulses")?;
+    let longest = gaps.reduce(|a, b| if b.0 > a.0 { b } else { a });
+    let (span, before, after) = longest.context("no pulses")?;
     let us = |p: Pulse| f64::from(p.counts) * timing.count_ns / 1e3;
     println!(
         "pitch: last pulse before the gap {:.1} µs at {:.3} s, first after {:.1} µs at {:.3} s \
@@ -70,9 +69,8 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
         .into_iter()
         .all(|p| (degrees(0, p) - rest).abs() <= count(0))
     {
-        problems.push(
-            "the head did not hold the rest pose (pitch 8°) before the pulses stopped".into(),
-        );
+        let problem = "the head did not hold the rest pose (pitch 8°) before the pulses stopped";
+        problems.push(problem.into());
     }
     // 2. Relaxed: seconds without pulses on every servo, ending after the
     // sensor's edge.
@@ -103,13 +101,10 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
         };
         let last_before = first.checked_sub(1).map(|k| pulses[i][k].counts);
         if last_before.is_none_or(|c| c.abs_diff(pulses[i][first].counts) > 1) {
-            problems.push(format!(
-                "{name}: the first pulse after the gap is not the last before it"
-            ));
+            let problem = "the first pulse after the gap is not the last before it";
+            problems.push(format!("{name}: {problem}"));
         }
-        let wake: Vec<f64> = pulses[i][first..]
-            .iter()
-            .take(50)
+        let wake: Vec<f64> = (pulses[i][first..].iter().take(50))
             .map(|p| degrees(i, p))
             .collect();
         let steps = Steps::of(&wake);

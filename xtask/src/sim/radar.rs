@@ -146,12 +146,8 @@ pub fn test_radar_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     let changes = dmx::alternating(Duration::from_secs(1), to)?;
     let mut script = String::from("0 radar on\n");
     for i in 0..30 {
-        let _ = writeln!(
-            script,
-            "{:.1} radar 300,{}",
-            1.0 + f64::from(i) * 0.1,
-            3000 - 50 * i
-        );
+        let (at, y) = (1.0 + f64::from(i) * 0.1, 3000 - 50 * i);
+        let _ = writeln!(script, "{at:.1} radar 300,{y}");
     }
     let query = Duration::from_millis(9200);
     let lines = vec![Chunk::new(b"dmx\r\nradar\r\n".to_vec(), query)];
@@ -185,17 +181,12 @@ fn with_radar(
     let radar = line(&script::parse(script)?, ServoRate::DEFAULT, end);
     let on = Chunk::new(b"radar on\r\n".to_vec(), Duration::from_millis(100));
     let pins = script::pin_script([vec![on], lines].concat());
-    super::run_shipped(
-        root,
-        metadata,
-        query + Duration::from_secs(1),
-        WALL,
-        |config| {
-            config.script = Some(pins);
-            config.radar = radar;
-            setup(config);
-        },
-    )
+    let time = query + Duration::from_secs(1);
+    super::run_shipped(root, metadata, time, WALL, |config| {
+        config.script = Some(pins);
+        config.radar = radar;
+        setup(config);
+    })
 }
 
 /// The problem if `reply` missed a frame `boot` sent, or counted one bad.

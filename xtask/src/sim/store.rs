@@ -123,14 +123,13 @@ pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
 
 /// The module docs' checks for a start: prints a transcript; the problems.
 fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> Vec<String> {
-    let mut problems = Vec::new();
     let [first, second] = report.boots.as_slice() else {
         let n = report.boots.len();
-        problems.push(format!(
+        return vec![format!(
             "{n} boots instead of two (power-on, then the power cycle)"
-        ));
-        return problems;
+        )];
     };
+    let mut problems = Vec::new();
     problem_if!(
         problems,
         !first.power_cycled,
@@ -185,13 +184,11 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> Vec<Str
         !programmed,
         "boot 0's save did not program the flash"
     );
-    let writes = &first.trains[0].writes;
-    let gap = writes
-        .windows(2)
-        .map(|w| w[1].0 - w[0].0)
-        .fold(0.0, f64::max)
-        / 1e6;
-    println!("boot 0: longest gap between frames {gap:.0} ms");
+    let gaps = first.trains[0].writes.windows(2).map(|w| w[1].0 - w[0].0);
+    println!(
+        "boot 0: longest gap between frames {:.0} ms",
+        gaps.fold(0.0, f64::max) / 1e6
+    );
     problems.extend(steps_around_the_save(first));
     let loaded = second.says("settings: loaded from flash");
     problem_if!(
