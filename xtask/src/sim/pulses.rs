@@ -1,7 +1,6 @@
 //! Checks one servo's pulse train from the emulator against the host's
-//! duties, frame for frame: each pulse carries the duty of the last compare
-//! write before its rise, and the pulse of PWM period `n` must carry frame
-//! `n` (a late or lost frame shows as a pulse carrying another; pulses
+//! duties, frame for frame: a pulse carries the last compare write before
+//! its rise, and the pulse of PWM period `n` must carry frame `n` (pulses
 //! after the last frame repeat it, held). Why: docs/dev/emulators.md.
 
 use idle_head_core::driver::DriverConfig;
@@ -120,8 +119,7 @@ const SHOWN: usize = 3;
 /// frame 0, at least as many as were written).
 #[allow(clippy::too_many_lines)] // one pass over the train
 pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -> ServoCheck {
-    let mut out = ServoCheck::default();
-    let ms = |ns: f64| ns / 1e6;
+    let (mut out, ms) = (ServoCheck::default(), |ns: f64| ns / 1e6);
     let Some(frames) = train.frames() else {
         let problem = match train.enabled {
             Some(_) => "the slice was enabled before any duty was written",
@@ -136,8 +134,9 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
     out.frames = frames.len();
     if expected.len() < frames.len() {
         let (n, host) = (frames.len(), expected.len());
-        let problem = format!("{n} frames written but only {host} expected from the host");
-        out.problems.push(problem);
+        out.problems.push(format!(
+            "{n} frames written but only {host} expected from the host"
+        ));
         return out;
     }
     let start = frames[0].0;
@@ -301,10 +300,9 @@ mod tests {
             let written = if k == 0 { 0.0 } else { k as f64 * 20e6 + 150e3 };
             t.writes.push((written, duty));
             let rise = (k as f64 + 0.5) * period + 10.0;
-            if rise + f64::from(duty) * TIMING.count_ns < end {
-                t.edges.push((rise, true));
-                t.edges
-                    .push((rise + f64::from(duty) * TIMING.count_ns, false));
+            let fall = rise + f64::from(duty) * TIMING.count_ns;
+            if fall < end {
+                t.edges.extend([(rise, true), (fall, false)]);
             }
         }
         t
@@ -407,9 +405,8 @@ mod tests {
         let period = TIMING.period_ns();
         for n in 30..35 {
             let rise = (f64::from(n) + 0.5) * period + 10.0;
-            t.edges.push((rise, true));
-            t.edges
-                .push((rise + f64::from(duties[29]) * TIMING.count_ns, false));
+            let fall = rise + f64::from(duties[29]) * TIMING.count_ns;
+            t.edges.extend([(rise, true), (fall, false)]);
         }
         t.edges.push((35.5 * period + 10.0, true)); // cut by the reset
         let (check, problems) = run(&t, &duties);
