@@ -1,7 +1,7 @@
 //! Node, the emulator package and a run of `sim/harness.mjs` ([`Config`]).
 
 use std::{
-    io::{BufRead, BufReader, Read},
+    io::{BufRead, BufReader, Read, Write},
     path::{Path, PathBuf},
     process::{Child, Command, Stdio},
     time::Duration,
@@ -247,16 +247,13 @@ const GRACE: Duration = Duration::from_secs(15);
 pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     // The configuration goes in a file: a run of a thousand scripted
     // chunks is more than a command line may carry.
-    static RUNS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
     let config = &Config {
         wall: config.wall * project::side_by_side(),
         ..config.clone()
     };
-    let n = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let file = std::env::temp_dir().join(format!("idle-head-sim-{}-{n}.json", std::process::id()));
-    std::fs::write(&file, config.json().to_string())
-        .with_context(|| format!("writing {}", file.display()))?;
-    let arg = format!("@{}", file.display());
+    let mut file = tempfile::Builder::new().suffix(".json").tempfile()?;
+    file.write_all(config.json().to_string().as_bytes())?;
+    let arg = format!("@{}", file.path().display());
     let child = harness(root, &arg, Stdio::null(), Stdio::piped());
     // Read to the end (past a bad line too: node never waits on a full
     // pipe); the first bad line is the error.
@@ -271,9 +268,7 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
         text
     };
     let limit = config.wall + GRACE;
-    let done = child.and_then(|child| project::finish(child, "node", limit, events, all, || ()));
-    let _ = std::fs::remove_file(&file);
-    let done = done?;
+    let done = child.and_then(|child| project::finish(child, "node", limit, events, all, || ()))?;
     let Exit::Status(status) = done.exit else {
         bail!(
             "the emulator made no progress: node was killed after {} s of wall time",
