@@ -1,8 +1,6 @@
-//! `cargo xtask book`: the book built with mdBook into `target/book`, and
-//! its links and the README's checked by linkinator (npm, pinned in
-//! `xtask/book/`: it installs in seconds where a Rust link checker compiles
-//! for minutes): every page, picture and `#anchor`; other sites are not
-//! followed.
+//! `cargo xtask book`: the book built with mdBook into `target/book`, its
+//! links and the README's checked by linkinator (pinned in `xtask/book/`),
+//! anchors included; other sites are not followed.
 
 use std::path::Path;
 

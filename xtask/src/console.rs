@@ -1,7 +1,5 @@
-//! `cargo xtask console`: talk to a head, stdin to it and its replies to
-//! stdout, one per line, the bytes unchanged both ways. `--qemu` runs the
-//! firmware in QEMU, `--port` opens a serial port, neither finds the Pico
-//! by its USB VID:PID. Also the console stage of `cargo xtask test`.
+//! `cargo xtask console`: stdin to a head (QEMU, a serial port, or the
+//! Pico found by its USB VID:PID), its replies to stdout, bytes unchanged.
 
 pub mod qemu;
 mod stages;

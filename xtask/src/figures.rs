@@ -1,7 +1,6 @@
 //! Measured figures: the commands that measure write their tables into
-//! the committed page `docs/design/figures.md` as they go ([`record`]);
-//! `cargo xtask test` fails when what it measured changed it ([`stale`]).
-//! No figure in the docs is typed by hand.
+//! `docs/design/figures.md` ([`record`]); `cargo xtask test` fails when
+//! what it measured changed the page ([`stale`]).
 
 // Sizes and counts are far below 2^52: the float conversions are exact.
 #![allow(clippy::cast_precision_loss)]

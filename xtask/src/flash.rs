@@ -1,8 +1,6 @@
-//! `cargo xtask flash`, the runner of `cargo run --release`: copies the
-//! UF2 onto a board in BOOTSEL mode if one is mounted (someone held its
-//! button: the route they chose), else runs `probe-rs run` if installed,
-//! else writes the UF2 and says how to flash it. (cargo holds no lock while
-//! its runner runs: this nested `cargo xtask` cannot wait on it.)
+//! `cargo xtask flash`, the runner of `cargo run --release`: onto a mounted
+//! BOOTSEL drive (someone held its button: their choice), else through
+//! `probe-rs run`, else the UF2 and how to flash it.
 
 use std::{
     ffi::OsString,

@@ -1,7 +1,6 @@
-//! `cargo xtask metrics`: the distributions of the loop metrics over many
-//! seeds, both closures, each loop generated as the firmware does and
-//! measured by [`LoopMetrics`]. Range columns are relative to the loop's own
-//! [α1, α2]; percentiles are nearest-rank.
+//! `cargo xtask metrics`: the loop metrics ([`LoopMetrics`]) over many
+//! seeds, both closures; ranges relative to the loop's own [α1, α2],
+//! percentiles nearest-rank.
 
 // Counts and angles are small: float conversions are exact or harmless.
 #![allow(

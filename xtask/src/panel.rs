@@ -1,7 +1,5 @@
-//! `cargo xtask panel`: the browser control panel (`panel/`, static files,
-//! uPlot from `panel/node_modules`) served on localhost, bridged to a head
-//! (`server.rs`): the emulated Pico, QEMU, or a serial port; without a
-//! bridge the page uses Web Serial. `--export DIR` writes it for any host.
+//! `cargo xtask panel`: the browser control panel (`panel/`) served on
+//! localhost and bridged to a head, or exported for any static host.
 
 mod bridge;
 pub mod browser;

@@ -1,7 +1,5 @@
 //! The Pico 2 image (boards/pico2, RP2350): no emulator runs it, so these
-//! checks are all that is known of it before it meets a board. Its boot ROM
-//! searches the first 4 KiB of flash for the block that declares the image
-//! (embassy-rp's `IMAGE_DEF` in `.start_block`).
+//! checks are all that is known of it before it meets a board.
 
 use anyhow::{Context, Result};
 

@@ -1,9 +1,6 @@
-//! Every PNG of the project commands (`trace` and `qemu`: the three axes
-//! over time; `preview`: a loop's stages): a figure of stacked panels
-//! (curves, shaded spans, labelled markers), drawn by plotters with a
-//! built-in font so that a plot looks the same on every machine. A curve
-//! with more points than its panel has pixel columns is drawn as each
-//! column's range and mean.
+//! Every PNG of the project commands: stacked panels of curves, spans and
+//! markers, drawn by plotters with a built-in font (the same on every
+//! machine); a curve denser than its pixels as each column's range and mean.
 
 // Sample counts and pixel positions are far below f64's exact range.
 #![allow(

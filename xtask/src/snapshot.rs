@@ -1,7 +1,6 @@
 //! The expected QEMU log (`boards/qemu/expected.log`), compared with
-//! snapbox. A `[..]` matches any text within a line; each line of the run
-//! that a wildcard line matches is first replaced by it (snapbox pairs
-//! lines by position), so that `--bless` keeps the wildcards that match.
+//! snapbox; a run's line a `[..]` line matches is replaced by it first, so
+//! that `--bless` keeps the wildcards that still match.
 
 use std::path::Path;
 

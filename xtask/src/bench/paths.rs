@@ -1,8 +1,6 @@
-//! Every latency path ([`PATHS`]) and the stage that runs them all. Here
-//! the console's ports and Bottango: a `look` over USB and over UART0
-//! (each line's last byte against yaw's first pulse that moves), and a
-//! Bottango curve over USB (its start against the same); `latency.rs`
-//! has the method, the rows, DMX and the input edge.
+//! Every latency path ([`PATHS`]) and the stage that runs them all; here
+//! the console's ports and Bottango, in `latency.rs` the method, the rows,
+//! DMX and the input edge.
 
 // Times in ns of virtual time, far below 2^52, and positive.
 #![allow(

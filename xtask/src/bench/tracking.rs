@@ -1,8 +1,6 @@
-//! How well the head follows people, measured in the host trace (the
-//! firmware's core, frame by frame, deterministic): a walk in front of the
-//! head and a person standing still under radar noise ([`STAGE`]), the
-//! radar's lines in the trace's script. The emulator's radar stage plays
-//! the same walk into the shipped image (`xtask/src/sim/radar.rs`).
+//! How well the head follows people, in the host trace: a walk in front of
+//! the head and a person standing still under radar noise ([`STAGE`]). The
+//! emulator's radar stage plays the same walk (`xtask/src/sim/radar.rs`).
 
 // Angles and times far below 2^52: the float conversions are exact.
 #![allow(clippy::cast_precision_loss)]

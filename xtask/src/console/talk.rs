@@ -1,7 +1,5 @@
-//! One conversation with a head over any port: the input's bytes go as
-//! they are (a line that is not UTF-8 reaches the head, which answers it),
-//! reply lines come back as bytes, counted against the lines sent as the
-//! head's own framer ends them.
+//! One conversation with a head over any port: bytes go as they are, both
+//! ways; replies are counted against the lines the head's framer ends.
 
 use std::{
     io::{BufRead, BufReader, ErrorKind, Read, Write},

@@ -1,8 +1,6 @@
-//! The panel's browser tests, a stage of `cargo xtask test`: headless
-//! Chromium driven by playwright-core (`panel/tests/browser.mjs`) over Web
-//! Serial (the emulated Pico), `panel --qemu`, a real serial port (QEMU's
-//! UART0 on a pty, through `console --port` and `panel --port`), and a
-//! replayed host trace (the radar's map). Screenshots: `target/panel/`.
+//! The panel's browser tests: headless Chromium driven by playwright-core
+//! (`panel/tests/browser.mjs`) over each way to reach a head. Screenshots:
+//! `target/panel/`.
 
 use std::{
     io::{BufRead, BufReader, Write},

@@ -1,7 +1,5 @@
-//! `cargo xtask preview`: the stages of a loop, from the core's engine on
-//! the host, as `<out>/<stem>.csv` (`n,walk,smoothed,normalized,final` in
-//! degrees, `stages.rs`) and `<out>/<stem>.png` (panels in the style of the
-//! paper's Figures 6 and 7, drawn by [`crate::plot`]).
+//! `cargo xtask preview`: the stages of a loop from the core's engine, as
+//! `<out>/<stem>.csv` and `.png` (`stages.rs`).
 
 mod stages;
 

@@ -1,8 +1,6 @@
-//! The stages of one loop in f64 degrees, from the engine's own trace, with
-//! the loop's metrics: `walk`, `smoothed` (shifted to the walk's mean: the
-//! engine defines it only up to a constant), `normalized` and `final`, the
-//! stored loop in playback order from the split point p (held to a
-//! reference implementation by `host-tests`); and their figure.
+//! The stages of one loop in f64 degrees from the engine's own trace
+//! (`walk`, `smoothed`, shifted to the walk's mean as the engine leaves its
+//! constant open, `normalized`, `final`), its metrics and its figure.
 
 // Sample indices (< 2^13) and angles are small: float conversions are exact
 // or far below the printed resolution.

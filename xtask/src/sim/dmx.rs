@@ -1,7 +1,6 @@
-//! `cargo xtask sim --dmx FILE`: a lighting console on the DMX input
-//! (UART1 RX, GP9), frames as `sim/dmx.mjs` sends them. A line is
-//! `<seconds> <slot>=<value> …` (slots relative to the head's address,
-//! 1-based; values hold until changed) or `<seconds> dmx stop`.
+//! `cargo xtask sim --dmx FILE`: a lighting console on the DMX input (GP9),
+//! a line `<seconds> <slot>=<value> …` (from the head's address, 1-based)
+//! or `<seconds> dmx stop`.
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 

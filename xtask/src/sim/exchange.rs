@@ -1,8 +1,6 @@
-//! A scripted console exchange over the Pico's UART0, then over its USB
-//! serial port, in the emulator: one reply per line, each the one the host
-//! computes with the same core `Session` and `ConsoleService`, in order
-//! (fields that depend on the frame a line arrives at are wildcards, `*`).
-//! The script moves nothing, so the pulses are checked as always.
+//! A scripted console exchange over the Pico's UART0, then USB, in the
+//! emulator: each reply the one the host's core `ConsoleService` gives
+//! (frame-dependent fields masked as `*`).
 
 use std::{cell::RefCell, fmt::Write as _, time::Duration};
 

@@ -1,7 +1,5 @@
-//! The radar stages (an HLK-LD2450 on GP13, `sim/radar.mjs`): a walk is
-//! followed within 5° RMS; two boards' unique ids give their own seeds;
-//! DMX512 and the radar at once, and a flash erase meanwhile, lose no
-//! frame of either.
+//! The radar stages (an HLK-LD2450 on GP13, `sim/radar.mjs`): see
+//! [`RADAR_STAGE`] and [`RADAR_DMX_STAGE`].
 
 use std::fmt::Write as _;
 use std::path::Path;

@@ -1,7 +1,6 @@
 //! The settings store from three starts (noise, an unknown version, a
-//! version 1 record): `save` at the flash's worst times, a power cycle, the
-//! next boot on the saved settings; lines sent during the erase answered
-//! after it, the servos going on without a jump (docs/dev/emulators.md).
+//! version 1 record): [`STORE_STAGE`], with the lines sent during the erase
+//! answered after it and no jump of the servos (docs/dev/emulators.md).
 
 use std::{path::Path, time::Duration};
 

@@ -1,8 +1,5 @@
-//! What runs beside the frame task on a board, on the host: the console's
-//! service and the input task, the firmware's core code on the trace's queue
-//! and link, and the telemetry lines a port would stream (`watch <hz>`).
-//! The input task wakes as on the board: at a pin's change, at its
-//! deadlines, and when the console changes its settings.
+//! What runs beside the frame task, on the host: the console's service, the
+//! input task (woken as on the board) and the telemetry of `watch <hz>`.
 
 use idle_head_core::behaviour::{CommandQueue, RestState, ShowLink};
 use idle_head_core::console::{

@@ -1,10 +1,6 @@
 //! The radar in the trace: a script's radar lines as the LD2450's frames,
-//! ten a second from the first radar line on, handed to the frame task as
-//! the board's receiver hands them over (`sim/radar.mjs` sends the
-//! emulator's on the same schedule, so that both take each sighting at the
-//! same frame). Frame `k` is due at `k` · 100 ms and sees the people of the
-//! last radar line at or before then; the first frame at or after that takes
-//! it. A script without radar lines has no radar.
+//! frame `k` due at `k` · 100 ms with the last line's people by then, on
+//! the schedule `sim/radar.mjs` keeps in the emulator.
 
 use idle_head_core::Millimetres;
 use idle_head_core::behaviour::ShowLink;

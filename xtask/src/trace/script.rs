@@ -1,11 +1,6 @@
-//! Trace scripts: `<seconds> <command>` per line, the command in the
-//! console's words (parsed by the core's `console::parse`): a motion command
-//! is queued for the frame task as the console would queue it; any other
-//! console line (`input 2 presence -20000`, `rest after 5`, `servo …`) goes
-//! through the console's service. `<seconds> pin <n> high|low` (`n` 2 to 5,
-//! as `input <n>`) sets a trigger input's level (each starts at its idle
-//! level: a button's pull-up keeps it high, a presence sensor's pull-down
-//! low); `<seconds> radar none|<x>,<y> …` says what the radar sees.
+//! Trace scripts: `<seconds> <command>` a line, the command in the console's
+//! words (the core's `console::parse`), or `pin <n> high|low`, or `radar …`
+//! (docs/dev/xtask.md, "The trace", has the format).
 
 use anyhow::{Result, bail};
 use idle_head_core::behaviour::BehaviourParams;
@@ -23,9 +18,7 @@ pub struct Event {
 }
 
 /// What a scripted line is: a motion command for the frame task's queue,
-/// another console line for the console's service, a trigger input's level
-/// (`input` 2 to 5), or up to three people at `(x, y)` mm the radar sees
-/// from then on.
+/// another console line, an input's level, up to three people (mm) on radar.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
     Act(Action),
