@@ -428,11 +428,9 @@ fn frame_work(log: &[LogLine]) -> Result<(u64, u64)> {
     }
 }
 
-/// The frame work with telemetry streaming: runs the QEMU smoke image `elf`
-/// with `watch 50` on UART0 through the smoke schedule, against its plain
-/// run (`plain`, else run here). The frame work it logs (average and worst)
-/// must stay within one `SysTick` count: telemetry is written by the
-/// console task, never on the frame path. The bench's line about it.
+/// The smoke image `elf` with `watch 50` streaming on UART0 against its
+/// plain run (`plain`, else run here): the frame work it logs must stay
+/// within one `SysTick` count (telemetry is off the frame path).
 fn telemetry_check(elf: &Path, timeout: Duration, plain: Option<&Run>) -> Result<String> {
     let without = match plain {
         Some(run) => frame_work(&run.log)?,

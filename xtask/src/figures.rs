@@ -63,9 +63,8 @@ pub fn of_ceiling(part: u64, ceiling: Option<u64>) -> String {
     format!("{percent:.0} % of {}", bytes(whole))
 }
 
-/// Prints the table `key` (`intro`, Markdown, above it) and writes it into
-/// the page in place of the one there before. A table that cannot be
-/// written does not fail the check that measured it: it is reported.
+/// Prints the table `key` (`intro` above it) and writes it into the page in
+/// place of the one there; failing to write is reported, not an error.
 #[allow(clippy::needless_pass_by_value)] // the callers hand their tables over
 pub fn record(key: &str, intro: String, header: &[&str], rows: Vec<Vec<String>>) {
     println!("{key}:\n  | {} |", header.join(" | "));

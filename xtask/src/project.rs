@@ -1,6 +1,5 @@
-//! Where things are in the repository, the one process runner ([`run`]
-//! with inherited output, [`finish`] reading it as it comes, with a time
-//! limit), and the firmware images.
+//! Where things are in the repository, the process runners ([`run`],
+//! [`finish`] with a time limit), and the firmware images.
 
 use std::{
     io::Write,
@@ -130,9 +129,8 @@ pub fn output(command: &mut Command, input: &[u8]) -> Result<(String, ExitStatus
     Ok((text, out.status))
 }
 
-/// Writes `contents` to `path`, creating its folder: through a file of
-/// this call's own, renamed over it, so that no reader (of the runs side by
-/// side) sees half a file.
+/// Writes `contents` to `path`, creating its folder, through a file renamed
+/// over it (no reader of the runs side by side sees half a file).
 pub fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
     static CALLS: AtomicU32 = AtomicU32::new(0);
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {

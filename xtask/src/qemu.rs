@@ -102,9 +102,7 @@ pub fn spawn(command: &mut Command, output: fn() -> Stdio) -> Result<Child> {
 }
 
 /// Runs QEMU (`child`, running `elf`) to its end with [`project::finish`],
-/// decoding its log (echoed as `echo` says) and passing its stderr on,
-/// without the notes that say nothing about a run: the watchdog model's
-/// zero-period timer at every start, the wait for a socket's connection.
+/// decoding its log (echoed as `echo` says), passing on its stderr's news.
 pub fn finish<R>(
     child: Child,
     elf: &Path,

@@ -62,9 +62,7 @@ pub fn qemu_session(
 }
 
 /// Starts QEMU running `elf` for a console, its stdout and stderr `output`,
-/// UART0 and UART1 connected to loopback ports listened on here (QEMU
-/// connects before the image starts; it is stopped if it does not): QEMU
-/// and the two connections.
+/// UART0 and UART1 connected to loopback ports here (else it is stopped).
 pub fn spawn_connected(
     elf: &Path,
     pace: Pace,
@@ -84,9 +82,8 @@ pub fn spawn_connected(
     Ok((child, connected?))
 }
 
-/// QEMU running `elf` for a console: the run `pace` asks for, UART0 and
-/// UART1 (the hang-up line) on the character devices `serials` (a socket,
-/// `pty`, `null`).
+/// QEMU running `elf` for a console at `pace`, UART0 and UART1 (the hang-up
+/// line) on the character devices given (a socket, `pty`, `null`).
 pub fn qemu_command(elf: &Path, pace: Pace, [uart0, uart1]: [&str; 2]) -> Command {
     let (sleep, run) = match pace {
         Pace::RealTime => (true, "interactive"),

@@ -95,12 +95,10 @@ fn read_replies(
     }
 }
 
-/// The conversation: `input` goes to `port` as it comes (a last line
-/// without a line end gets an LF); a thread hands each line of `replies` to
-/// `on_reply`. Once the input ends, it waits up to `wait` for the replies
-/// due, then calls `hang_up`, after which the reader must end (at the end
-/// of `replies` or its next read timeout). A failed read or write, and the
-/// port closing before the hang-up, are [`Talk::early`].
+/// The conversation: `input` to `port` as it comes (an LF ends a last line
+/// without one), each line of `replies` to `on_reply` from a thread; then up
+/// to `wait` for the replies due, and `hang_up`, after which the reader must
+/// end. A failed read or write, or the port closing first, is [`Talk::early`].
 pub fn converse(
     mut input: impl Read,
     port: &mut impl Write,

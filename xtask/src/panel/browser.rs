@@ -79,11 +79,9 @@ fn session(root: &Path, shots: &Path, bridge: Option<Bridge>, mut config: Value)
 const PAGE_ASKS: &str = "help|status|servo pitch|servo roll|servo yaw|servo rate|rest after|idle|\
                          look duck|seed|input 2|input 3|input 4|input 5|dmx|radar|track|watch 20";
 
-/// The radar's map: the host trace of `panel/tests/radar-replay.txt` (the
-/// core's frame engine, tracker and console service, as on a board), its
-/// telemetry lines (`watch 20`) replayed to the page by a fake serial port
-/// in real time, which answers the page's lines with the console's replies
-/// at the end of the run.
+/// The radar's map: the host trace of `panel/tests/radar-replay.txt`, its
+/// telemetry replayed by a fake serial port that answers the page's lines
+/// with the console's replies at the end of the run.
 fn replay(root: &Path, shots: &Path) -> Result<String> {
     let path = root.join("panel/tests/radar-replay.txt");
     let script =
