@@ -10,9 +10,8 @@ use crate::{board::PICO2_TARGET, project};
 /// QEMU's system emulator for Arm.
 pub const QEMU_BINARY: &str = "qemu-system-arm";
 
-/// What a command that builds starts from: the repository's toolchain
-/// (`rust-toolchain.toml`) given its firmware targets, rustfmt and clippy
-/// with rustup (if there is one), the repository root, cargo's metadata.
+/// What a command that builds starts from: the firmware targets, rustfmt
+/// and clippy added with rustup (if any); the repository root, its metadata.
 pub fn prepare() -> Result<(PathBuf, project::Metadata)> {
     let sh = project::shell(".")?;
     for (what, wanted) in [

@@ -13,9 +13,8 @@ use idle_head_core::pwm_clock::PICO_SERVO_CLOCK;
 /// embassy-time's tick rate on the RP2040 (its 1 MHz TIMER).
 const TICK_HZ: u64 = 1_000_000;
 
-/// The duties `[pitch, roll, yaw]` of frames `0..frames` of the Pico
-/// image, every frame on time: its `FrameLoop` and `FrameDriver` with the
-/// default config and loops, over channels of the Pico's `TOP` that record.
+/// The duties `[pitch, roll, yaw]` of frames `0..frames` of the Pico image,
+/// every frame on time: its `FrameLoop` and `FrameDriver` on the defaults.
 pub fn pico_duties(frames: usize) -> Result<Vec<[u16; 3]>> {
     let config = DriverConfig::DEFAULT;
     let params = config.build().map_err(|e| anyhow!("{}", e.message()))?;

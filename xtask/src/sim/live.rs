@@ -13,9 +13,8 @@ use anyhow::Result;
 
 use super::{event::Event, image, node, store::WORST};
 
-/// The harness's argument for a live run of `elf`: the flash functions
-/// (`save` and `load` work), the servo slices' `cc` events, the trigger
-/// inputs driven by `pin <n> 0|1` lines (at their pulls until then).
+/// The harness's argument for a live run of `elf`: flash functions for
+/// `save` and `load`, the trigger inputs driven by `pin <n> 0|1` lines.
 pub fn config(root: &Path, elf: &Path) -> Result<serde_json::Value> {
     let (_, config) = image::config(elf, "live.uf2")?;
     node::ensure(root)?;

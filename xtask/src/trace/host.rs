@@ -156,8 +156,7 @@ impl<'a> Beside<'a> {
     }
 }
 
-/// A stream of telemetry lines: its tick's period and next tick (µs), the
-/// lines so far (without their line ends): the core's own line of the
+/// A stream of telemetry lines (no line ends): the core's own line of the
 /// status the first frame at or after each tick published.
 #[derive(Debug, Clone)]
 pub struct Watch {

@@ -1,6 +1,5 @@
-//! What the script's commands did, as marks for the summary and the plot:
-//! when each was applied, how long its motion lasts and on which axes, and
-//! the return to the centre a look plans after its hold; and the plot.
+//! What the script's commands did, as marks for the summary and the plot
+//! (a look's planned return to the centre included); and the plot.
 
 use idle_head_core::behaviour::{Applied, BehaviourError, BehaviourParams};
 use idle_head_core::command::{Action, Hold, LookRequest};
@@ -11,9 +10,8 @@ use super::Trace;
 use crate::plot::{self, GREY, RED};
 use plotters::style::RGBColor;
 
-/// What kind of motion a mark stands for: a gesture, a move of the gaze
-/// (`look`, `center`), a look's return to the centre, anything else (a rest
-/// or a wake, idle, stop, a refused command).
+/// What kind of motion a mark stands for (`Other`: a rest or a wake, idle,
+/// stop, a refused command).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
     Gesture,
@@ -162,8 +160,7 @@ pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
 }
 
 /// Draws `trace` to the PNG `path`: the three axes over time (in minutes
-/// past five of them), each command marked where it was applied and its
-/// motion shaded on the axes it moves.
+/// past five of them), each command marked and its motion shaded.
 #[allow(clippy::cast_precision_loss)] // frame times, far below 2^52
 pub fn draw(trace: &Trace, seed: Option<u32>, path: &std::path::Path) -> anyhow::Result<()> {
     let end_ms = trace.rows.last().map_or(0, |r| r.t_us / 1000);
