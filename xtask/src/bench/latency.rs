@@ -69,17 +69,10 @@ impl Row {
         let missed = if self.met() { "" } else { " (missed)" };
         let waited =
             (self.waited_us).map_or_else(|| "not logged".to_owned(), |us| format!("{us} µs"));
-        let (name, events) = (format!("latency {}", self.name), self.ms.len() as u64);
+        let name = format!("latency {}", self.name);
+        let n = figures::thousands(self.ms.len() as u64);
         let goal = format!("{:.0}{missed}", self.goal_ms);
-        vec![
-            name,
-            figures::thousands(events),
-            p50,
-            p99,
-            max,
-            goal,
-            waited,
-        ]
+        vec![name, n, p50, p99, max, goal, waited]
     }
 
     /// `latency <name> p50=… p99=… max=… events=… skipped=…`, and the spread.
@@ -343,13 +336,9 @@ mod tests {
         let fast = row(vec![10.0; 100], Some(300), GOAL_MS);
         assert_eq!(fast.misses(), None);
         assert!(!fast.lines().contains("where the time goes"));
+        let slow_port = "a port task waited 1001 µs, over 1000 µs";
         for (ms, waited, goal, miss) in [
-            (
-                10.0,
-                Some(1001),
-                GOAL_MS,
-                "a port task waited 1001 µs, over 1000 µs",
-            ),
+            (10.0, Some(1001), GOAL_MS, slow_port),
             (10.0, None, GOAL_MS, "the port tasks' wait was not logged"),
             (8.5, Some(300), GOAL_200_HZ_MS, "p99 8.5 ms over 8 ms"),
         ] {

@@ -82,11 +82,8 @@ mod tests {
     fn a_row_per_period_a_period_apart_at_any_rate_and_0_where_there_was_no_pulse() {
         let timing = crate::sim::run::timing();
         let neutral: &[(u32, u32)] = &[(0, 4800), (1, 4800), (3, 4800)];
-        let trains = make(
-            [&[(0, 4800), (1, 4801), (3, 4803)], neutral, neutral],
-            &timing,
-            1e6,
-        );
+        let pitch: &[(u32, u32)] = &[(0, 4800), (1, 4801), (3, 4803)];
+        let trains = make([pitch, neutral, neutral], &timing, 1e6);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("out/pulses.csv");
         write(&path, &trains, &timing).unwrap();

@@ -136,14 +136,8 @@ pub fn play(
             let seeds = board
                 .uid
                 .map(|id| Settings::DEFAULT.idle_seeds(BoardId(id)));
-            let host = trace::simulate(
-                u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX),
-                seeds,
-                rate,
-                &events,
-                None,
-                &[],
-            )?;
+            let micros = u64::try_from((time + 2 * boot).as_micros()).unwrap_or(u64::MAX);
+            let host = trace::simulate(micros, seeds, rate, &events, None, &[])?;
             host.rows.iter().map(|row| row.duties).collect()
         }
         Against::Written => written(&report),

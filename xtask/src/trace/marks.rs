@@ -171,11 +171,8 @@ pub fn draw(trace: &Trace, seed: Option<u32>, path: &std::path::Path) -> anyhow:
     };
     let at = |ms: u64| ms as f64 / ms_per_unit;
     // A look's return in blue, a refused command's line in red.
-    let (blue, light_blue, orange) = (
-        RGBColor(70, 110, 160),
-        RGBColor(214, 230, 245),
-        RGBColor(255, 228, 196),
-    );
+    let (blue, light_blue) = (RGBColor(70, 110, 160), RGBColor(214, 230, 245));
+    let orange = RGBColor(255, 228, 196);
     let marks: Vec<plot::Mark> = (trace.marks.iter())
         .map(|m| {
             let back = m.kind == Kind::Return;
