@@ -208,10 +208,8 @@ mod tests {
             let here = here(no_path.path(), mounts);
             choose(board, &here).map_err(|e| format!("{e:#}"))
         };
-        let (pico, pico2) = (
-            mount_with("RPI-RP2", PICO_INFO),
-            mount_with("RP2350", PICO2_INFO),
-        );
+        let pico = mount_with("RPI-RP2", PICO_INFO);
+        let pico2 = mount_with("RP2350", PICO2_INFO);
         let both = [pico.path(), pico2.path()];
         let drive = pico.path().join("RPI-RP2");
         assert_eq!(route(Board::Pico, &both), Ok(Route::Drive(drive.clone())));
@@ -260,10 +258,8 @@ mod tests {
             ["run", "--chip", "RP235x", "pico2", "--no-location"]
         );
         let mounts = mount_with("RP2350", PICO2_INFO);
-        let (drive, both) = (
-            mounts.path().join("RP2350"),
-            here(bin.path(), &[mounts.path()]),
-        );
-        assert_eq!(choose(Board::Pico2, &both).unwrap(), Route::Drive(drive));
+        let both = here(bin.path(), &[mounts.path()]);
+        let drive = Route::Drive(mounts.path().join("RP2350"));
+        assert_eq!(choose(Board::Pico2, &both).unwrap(), drive);
     }
 }

@@ -294,24 +294,20 @@ mod tests {
     fn good() -> Report {
         let status = "ok mode=running settings=flash inputs=-,-,-,- seed=board rate=50\r\n";
         let pitch = "ok pitch neutral=1520 per-degree=11111\r\n";
-        let mut first = boot(
-            &[
-                "settings: defaults (empty store at 0x101fc000)",
-                "first frame: neutral pulses 1500 1500 1500 us; watchdog armed (100 ms)",
-            ],
-            &format!("ok\r\nok\r\n{status}{}", pitch.repeat(DURING_SAVE_LINES)),
-            [1500.0; 3],
-        );
+        let log = [
+            "settings: defaults (empty store at 0x101fc000)",
+            "first frame: neutral pulses 1500 1500 1500 us; watchdog armed (100 ms)",
+        ];
+        let uart = format!("ok\r\nok\r\n{status}{}", pitch.repeat(DURING_SAVE_LINES));
+        let mut first = boot(&log, &uart, [1500.0; 3]);
         first.power_cycled = true;
         first.flash = vec![(false, 256, 3e6)];
-        let second = boot(
-            &[
-                "settings: loaded from flash (version 2) at 0x101fc000",
-                "first frame: neutral pulses 1520 1500 1500 us; watchdog armed (100 ms)",
-            ],
-            &format!("ok\r\nok\r\n{pitch}{status}"),
-            [1520.0, 1500.0, 1500.0],
-        );
+        let log = [
+            "settings: loaded from flash (version 2) at 0x101fc000",
+            "first frame: neutral pulses 1520 1500 1500 us; watchdog armed (100 ms)",
+        ];
+        let uart = format!("ok\r\nok\r\n{pitch}{status}");
+        let second = boot(&log, &uart, [1520.0, 1500.0, 1500.0]);
         Report {
             boots: vec![first, second],
             ..Report::default()
