@@ -116,15 +116,12 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
     print!("{}{}", report.log_text(false), report.table());
     let mut problems = Vec::new();
     let stop = format!("frames stop after frame {DRILL_FRAMES}");
+    let neutral = "first frame: neutral pulses 1500 1500 1500 us";
     for (boot, text, what) in [
         (0, "boot: power-on", "a power-on boot"),
         (0, &stop, "the drill's stop"),
         (1, "last reset by the WATCHDOG", "the watchdog reset"),
-        (
-            1,
-            "first frame: neutral pulses 1500 1500 1500 us",
-            "neutral first pulses",
-        ),
+        (1, neutral, "neutral first pulses"),
     ] {
         if !report.boots.get(boot).is_some_and(|b| b.says(text)) {
             problems.push(format!("boot {boot} did not log {what}"));
