@@ -223,10 +223,8 @@ fn check(report: &Report, logged: &[(&str, &str)], neutral: [u32; 3]) -> Vec<Str
 fn steps_around_the_save(boot: &Boot) -> Vec<String> {
     let config = idle_head_core::driver::DriverConfig::DEFAULT;
     let frame_s = f64::from(config.frame_period.0) / 1e6;
-    let (from, to) = (
-        SCRIPT_AT[0].as_secs_f64() - 0.5,
-        POWER_CYCLE.as_secs_f64() - 0.2,
-    );
+    let from = SCRIPT_AT[0].as_secs_f64() - 0.5;
+    let to = POWER_CYCLE.as_secs_f64() - 0.2;
     let mut problems = Vec::new();
     for (axis, train) in boot.trains.iter().enumerate() {
         let limits = config.motion[axis];
