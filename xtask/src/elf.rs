@@ -6,8 +6,9 @@ use std::{ops::Range, path::Path};
 use anyhow::{Context, Result, bail, ensure};
 
 use crate::{board::Board, figures, project};
+use object::SectionKind::{UninitializedData, UninitializedTls};
 use object::read::elf::{ElfFile32, ProgramHeader};
-use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, SectionKind, elf};
+use object::{Endianness, Object, ObjectSection, ObjectSymbol, SectionFlags, elf};
 
 /// RAM budget of the Pico image (of the RP2040's 264 KiB): static RAM plus
 /// the peak stack measured in the RP2040 emulator, deepest in the settings
@@ -82,10 +83,7 @@ impl Image {
                 name: s.name().unwrap_or("?").to_owned(),
                 address: s.address(),
                 size: s.size(),
-                stored: !matches!(
-                    s.kind(),
-                    SectionKind::UninitializedData | SectionKind::UninitializedTls
-                ),
+                stored: !matches!(s.kind(), UninitializedData | UninitializedTls),
             })
             .collect();
         sections.sort_by_key(|section| section.address);

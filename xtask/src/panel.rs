@@ -156,11 +156,8 @@ fn export(root: &Path, dir: &Path) -> Result<()> {
 /// `panel/node_modules` (Playwright's browser download off: the tests use
 /// the system's Chromium).
 pub fn ensure_dependencies(root: &Path) -> Result<()> {
-    crate::sim::node::npm_ci(
-        &root.join("panel"),
-        &["uplot", "playwright-core"],
-        &[("PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD", "1")],
-    )
+    let env = [("PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD", "1")];
+    crate::sim::node::npm_ci(&root.join("panel"), &["uplot", "playwright-core"], &env)
 }
 
 #[cfg(test)]

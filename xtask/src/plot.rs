@@ -242,10 +242,8 @@ fn draw_panel(area: &Area<'_>, panel: &Panel) -> Drawn {
         };
         rows[row] = left + width + GAP;
         let y = 2 + row as i32 * height;
-        let back = Rectangle::new(
-            [(GAP - 1, y), (GAP + width + 1, y + height)],
-            WHITE.mix(0.85).filled(),
-        );
+        let corners = [(GAP - 1, y), (GAP + width + 1, y + height)];
+        let back = Rectangle::new(corners, WHITE.mix(0.85).filled());
         let text = Text::new(label.clone(), (GAP, y), font.color(color));
         chart
             .plotting_area()

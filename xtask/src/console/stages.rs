@@ -22,10 +22,8 @@ pub fn script(args: &[&str], script: &[u8], want: &[&str], more: usize) -> Resul
         want.len()
     );
     for (i, (got, want)) in lines.iter().zip(want).enumerate() {
-        ensure!(
-            got.starts_with(want) && (*want != "ok" || got == "ok"),
-            "line {i}: {got:?}, want {want:?}"
-        );
+        let good = got.starts_with(want) && (*want != "ok" || got == "ok");
+        ensure!(good, "line {i}: {got:?}, want {want:?}");
     }
     ensure!(status.success(), "`cargo xtask console` failed ({status})");
     Ok(lines)

@@ -45,12 +45,8 @@ fn rows(trains: &[Train; 3], timing: &Timing) -> String {
     let mut text = String::from("t_ms,pitch_us,roll_us,yaw_us\n");
     let [pitch, roll, yaw] = &widths;
     for (k, ((&p, &r), &y)) in pitch.iter().zip(roll).zip(yaw).take(frames).enumerate() {
-        let [p, r, y] = [p, r, y].map(us);
-        let _ = writeln!(
-            text,
-            "{},{p:.1},{r:.1},{y:.1}",
-            crate::trace::ms(k as u64 * period_us)
-        );
+        let ([p, r, y], t) = ([p, r, y].map(us), crate::trace::ms(k as u64 * period_us));
+        let _ = writeln!(text, "{t},{p:.1},{r:.1},{y:.1}");
     }
     text
 }
