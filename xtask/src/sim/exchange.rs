@@ -1,6 +1,7 @@
 //! A scripted console exchange over the Pico's UART0, then USB, in the
 //! emulator: each reply the one the host's core `ConsoleService` gives
-//! (frame-dependent fields masked as `*`).
+//! (frame-dependent fields masked as `*`). The script moves nothing, so the
+//! pulses are checked against the idle as always.
 
 use std::{cell::RefCell, fmt::Write as _, time::Duration};
 
