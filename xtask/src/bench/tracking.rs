@@ -116,8 +116,10 @@ impl Walk {
 
 /// The yaw of each frame of the host trace of `script`, m°.
 fn yaw_of(script: &str, micros: u64) -> Result<Vec<f64>> {
-    let events = crate::sim::parse_script(script)?;
-
+    // Through the trace, not `sim::parse_script`: sim's radar stage takes
+    // this walk, and the shortcut would close an import circle.
+    let (_, params) = trace::built_in()?;
+    let events = trace::parse_script(script, &params)?;
     let run = trace::simulate(micros, None, ServoRate::DEFAULT, &events, None, &[])?;
     let yaw = |row: &trace::Row| f64::from(row.angles[Axis::Yaw.index()]);
     Ok(run.rows.iter().map(yaw).collect())

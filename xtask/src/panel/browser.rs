@@ -87,7 +87,6 @@ fn replay(root: &Path, shots: &Path) -> Result<String> {
     let script =
         std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     let events = sim::parse_script(&script)?;
-
     let end = events.last().map_or(0, |e| e.at_us) + 1_500_000;
     let asks: Vec<&str> = PAGE_ASKS.split('|').collect();
     let rate = idle_head_core::servo::ServoRate::DEFAULT;
