@@ -118,7 +118,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     // 1. The Pico image and the watchdog drill's: the emulator stages run on
     // them in the background, at a low priority, while the stages below take
     // the cores first (their links and waits leave a core idle at times).
-    let emulated = EMULATED.iter().any(|(name, _)| stages.chosen(name));
+    let emulated = (EMULATED.iter()).any(|(name, _)| needs_image(name) && stages.chosen(name));
     let pico_built = stages.run_if(emulated, "Pico build (cargo build --release)", || {
         PICO.build(&root)
     });
@@ -168,11 +168,9 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
             bench::run_and_check(&root, &metadata, options, qemu_run.as_ref())
         });
 
-        // 5. The book and its links (the figures it shows are checked below).
-        stages.run(book::STAGE, || book::stage(&root));
-
-        // 6. The emulator stages' results, and the RAM with the peak stack
-        // measured there.
+        // 5. The host tests, the book and the emulator stages' results (all
+        // run in the background), and the RAM with the peak stack measured
+        // in the emulator.
         background.record(&mut stages, &metadata, qemu_run.as_ref());
     });
     // The panel in a real browser (Chromium, headless), with the cores to
@@ -191,8 +189,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
 /// scripts with the release builds), the commands' arguments separated by
 /// ` && `.
 #[rustfmt::skip] // a table, one stage a line
-const CARGO: [(&str, &str, bool, &str); 14] = [
-    ("host tests (host-tests/)", "host-tests", false, "test"),
+const CARGO: [(&str, &str, bool, &str); 13] = [
     ("core crate: unit and doc tests (crates/core, host)", "crates/core", false, "test"),
     ("firmware layer: host tests (crates/firmware)", "crates/firmware", false, "test"),
     ("xtask unit tests", "xtask", false, "test --profile xtask"),
@@ -218,13 +215,30 @@ const CARGO: [(&str, &str, bool, &str); 14] = [
      "clippy --release --example minimal -- -D warnings && build --release --example minimal"),
 ];
 
-/// An emulator stage: its name, and what it runs on images built already.
+/// A stage run apart: its name, and what it runs.
 type Emulated = (&'static str, fn(&Path, &Metadata) -> Result<()>);
 
-/// The stages in the RP2040 emulator, in the order of the score card, run
-/// side by side on images built already (`cargo xtask test --stage NAME`),
-/// longest first. Only the latency stage records figures.
-const EMULATED: [Emulated; 16] = [
+/// The host tests (their build, then their run, which holds no cargo lock)
+/// and the book (mdBook's install in its own folder): off the foreground's
+/// critical path, beside the emulator stages.
+const HOST_TESTS: &str = "host tests (host-tests/)";
+
+/// Whether the stage `name` runs on the Pico images (not the host tests,
+/// not the book).
+fn needs_image(name: &str) -> bool {
+    name != HOST_TESTS && name != book::STAGE
+}
+
+/// The stages run side by side in the background, in the order of the
+/// score card (`cargo xtask test --stage NAME`), longest first: the host
+/// tests, the book, then the ones in the RP2040 emulator, on images built
+/// already. Only the latency stage records figures.
+const EMULATED: [Emulated; 18] = [
+    (HOST_TESTS, |_, _| {
+        let sh = project::shell("host-tests")?;
+        project::run(&sh, &[], cmd!(sh, "cargo test"))
+    }),
+    (book::STAGE, |root, _| book::stage(root)),
     (sim::PULSES_STAGE, |root, metadata| {
         let report = sim::test_pulses(root, metadata)?;
         let stack = report.peak_stack().map(|s| s.to_string());
@@ -329,9 +343,12 @@ impl Background {
             .filter(|&i| stages.chosen(EMULATED[i].0))
             .collect();
         let cannot = |error: &anyhow::Error| println!("the emulator cannot run: {error:#}");
-        let node = chosen.is_empty() || sim::node::ensure(root).inspect_err(cannot).is_ok();
+        let emulated = chosen.iter().any(|&i| needs_image(EMULATED[i].0));
+        let node = !emulated || sim::node::ensure(root).inspect_err(cannot).is_ok();
         let blocked = |i: usize| {
-            if !pico_built {
+            if !needs_image(EMULATED[i].0) {
+                None
+            } else if !pico_built {
                 Some("the Pico build")
             } else if !node {
                 Some("the emulator's setup")
@@ -342,16 +359,19 @@ impl Background {
             }
         };
         let chosen: Vec<_> = chosen.into_iter().map(|i| (i, blocked(i))).collect();
-        // Longest first: the latency rows, the two console streams, the DMX stream.
+        // Longest first: the latency rows, the host tests, the two console
+        // streams, the DMX stream, the book.
         let queue = chosen
             .iter()
             .filter_map(|&(i, by)| by.is_none().then_some(i));
         let mut queue: Vec<usize> = queue.collect();
         let long = [
             bench::LATENCY_STAGE,
+            HOST_TESTS,
             sim::UART_STREAM_STAGE,
             sim::USB_STREAM_STAGE,
             sim::DMX_STREAM_STAGE,
+            book::STAGE,
         ];
         let rank = |i: &usize| long.iter().position(|name| *name == EMULATED[*i].0);
         queue.sort_by_key(|i| rank(i).unwrap_or(long.len()));
