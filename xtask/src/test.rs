@@ -189,7 +189,9 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
 /// scripts with the release builds), the commands' arguments separated by
 /// ` && `.
 #[rustfmt::skip] // a table, one stage a line
-const CARGO: [(&str, &str, bool, &str); 13] = [
+const CARGO: [(&str, &str, bool, &str); 14] = [
+    // Built here, at full priority: their run is a background stage.
+    ("host tests: build (host-tests/)", "host-tests", false, "test --no-run"),
     ("core crate: unit and doc tests (crates/core, host)", "crates/core", false, "test"),
     ("firmware layer: host tests (crates/firmware)", "crates/firmware", false, "test"),
     ("xtask unit tests", "xtask", false, "test --profile xtask"),
@@ -218,9 +220,10 @@ const CARGO: [(&str, &str, bool, &str); 13] = [
 /// A stage run apart: its name, and what it runs.
 type Emulated = (&'static str, fn(&Path, &Metadata) -> Result<()>);
 
-/// The host tests (their build, then their run, which holds no cargo lock)
-/// and the book (mdBook's install in its own folder): off the foreground's
-/// critical path, beside the emulator stages.
+/// The host tests' run (built in the foreground; `cargo test` holds no
+/// cargo lock while its tests run) and the book (mdBook installs into its
+/// own folder): off the foreground's critical path, beside the emulator
+/// stages.
 const HOST_TESTS: &str = "host tests (host-tests/)";
 
 /// Whether the stage `name` runs on the Pico images (not the host tests,
@@ -359,17 +362,18 @@ impl Background {
             }
         };
         let chosen: Vec<_> = chosen.into_iter().map(|i| (i, blocked(i))).collect();
-        // Longest first: the latency rows, the host tests, the two console
-        // streams, the DMX stream, the book.
+        // Longest first: the latency rows, the two console streams, then the
+        // host tests (built in the foreground by then), the DMX stream and
+        // the book.
         let queue = chosen
             .iter()
             .filter_map(|&(i, by)| by.is_none().then_some(i));
         let mut queue: Vec<usize> = queue.collect();
         let long = [
             bench::LATENCY_STAGE,
-            HOST_TESTS,
             sim::UART_STREAM_STAGE,
             sim::USB_STREAM_STAGE,
+            HOST_TESTS,
             sim::DMX_STREAM_STAGE,
             book::STAGE,
         ];
