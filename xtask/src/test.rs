@@ -220,22 +220,21 @@ const CARGO: [(&str, &str, bool, &str); 14] = [
 /// A stage run apart: its name, and what it runs.
 type Emulated = (&'static str, fn(&Path, &Metadata) -> Result<()>);
 
-/// The host tests' run (built in the foreground; `cargo test` holds no
-/// cargo lock while its tests run) and the book (mdBook installs into its
-/// own folder): off the foreground's critical path, beside the emulator
-/// stages.
+/// The host tests' run: built in the foreground, run in the background
+/// (`cargo test` holds no cargo lock while its tests run).
 const HOST_TESTS: &str = "host tests (host-tests/)";
 
-/// Whether the stage `name` runs on the Pico images (not the host tests,
-/// not the book).
+/// Whether the background stage `name` runs on the Pico images: all but the
+/// host tests' run and the book (mdBook installs into its own folder).
 fn needs_image(name: &str) -> bool {
     name != HOST_TESTS && name != book::STAGE
 }
 
-/// The stages run side by side in the background, in the order of the
-/// score card (`cargo xtask test --stage NAME`), longest first: the host
-/// tests, the book, then the ones in the RP2040 emulator, on images built
-/// already. Only the latency stage records figures.
+/// The stages run side by side in the background (`cargo xtask test
+/// --stage NAME`), in the order of the score card: the host tests, the
+/// book, then the ones in the RP2040 emulator, on images built already.
+/// [`Background::start`] starts the longest first. Only the latency stage
+/// records figures.
 const EMULATED: [Emulated; 18] = [
     (HOST_TESTS, |_, _| {
         let sh = project::shell("host-tests")?;
