@@ -24,37 +24,39 @@ fn never_repeat(samples: &[[i32; 3]], window: usize) -> ((f64, usize), [(f64, us
     });
     let inv: [f64; 3] = sigma2.map(|s| 1.0 / (s * window as f64));
     let lags: Vec<usize> = (window..=n - window).collect();
+    // Each lag's windows slide over the squared differences, taken again at
+    // the window's tail rather than stored: exact sums in integers. A
+    // thread stops once its minima are all exactly 0 (as the fixed loop's
+    // are at its period): no later lag can be smaller.
     let run = |lags: &[usize]| {
         let mut pose = (f64::MAX, 0);
         let mut axes = [(f64::MAX, 0); 3];
-        let mut d = vec![[0i64; 3]; n];
         for &lag in lags {
             let m = n - lag;
-            for t in 0..m {
-                for a in 0..3 {
-                    let x = i64::from(samples[t][a] - samples[t + lag][a]);
-                    d[t][a] = x * x;
-                }
-            }
-            // Sliding sums, exact in integers.
+            let (x, y) = (&samples[..m], &samples[lag..]);
+            let square = |t: usize, a: usize| i64::from(x[t][a] - y[t][a]).pow(2);
             let mut sum = [0i64; 3];
             for t in 0..m {
-                for a in 0..3 {
-                    sum[a] += d[t][a];
+                for (a, s) in sum.iter_mut().enumerate() {
+                    *s += square(t, a);
                 }
-                if t + 1 >= window {
-                    let norm: [f64; 3] = std::array::from_fn(|a| sum[a] as f64 * inv[a]);
-                    let p = (norm[0] + norm[1] + norm[2]) / 3.0;
-                    if p < pose.0 {
-                        pose = (p, lag);
-                    }
-                    for a in 0..3 {
-                        if norm[a] < axes[a].0 {
-                            axes[a] = (norm[a], lag);
-                        }
-                        sum[a] -= d[t + 1 - window][a];
-                    }
+                if t + 1 < window {
+                    continue;
                 }
+                let norm: [f64; 3] = std::array::from_fn(|a| sum[a] as f64 * inv[a]);
+                let p = (norm[0] + norm[1] + norm[2]) / 3.0;
+                if p < pose.0 {
+                    pose = (p, lag);
+                }
+                for (a, s) in sum.iter_mut().enumerate() {
+                    if norm[a] < axes[a].0 {
+                        axes[a] = (norm[a], lag);
+                    }
+                    *s -= square(t + 1 - window, a);
+                }
+            }
+            if pose.0 == 0.0 && axes.iter().all(|a| a.0 == 0.0) {
+                break;
             }
         }
         (pose, axes)

@@ -4,10 +4,10 @@
 use std::thread;
 
 use idle_head_core::Axis;
-use idle_head_core::idle::{IdleMode, IdlePlayer, MAX_DRAWS, NoSupply};
+use idle_head_core::idle::{IdleMode, IdlePlayer, LoopSupply, MAX_DRAWS, NoSupply};
 use idle_head_core::motion::HeadConfig;
 
-use super::{FRAME_US, Set, Stream, at, config_for, play, timing};
+use super::{FRAME_US, Set, Stream, at, config_for, timing};
 
 /// The ratios of a window `x`: max|d1|/P95|d1| and max|d2|/P95|d2| over
 /// the whole window, then the same maxima taken over `region` only (the
@@ -105,31 +105,43 @@ const JOINS: usize = 50;
 /// Frames on either side of a join counted as its region.
 const MARGIN: usize = 10;
 
-/// The first `loops` sets of `config`'s stream, each played alone for one
-/// loop (from its entry, `loop_frames` frames each): their interiors; with
-/// what the sets discarded (into `s`).
-fn each_loop_alone(
-    config: HeadConfig,
-    loops: usize,
-    loop_frames: usize,
-    s: &mut Smoothness,
-) -> Vec<[i32; 3]> {
-    let t = timing();
-    let mut stream = Stream::new(config, &t);
-    let mut set = Set::new();
-    let mut frames = Vec::with_capacity(loops * loop_frames);
-    for _ in 0..loops {
+/// The first `count` sets of `config`'s stream, what they discarded
+/// counted into `s` for the first `counted`.
+fn sets(config: HeadConfig, count: usize, counted: usize, s: &mut Smoothness) -> Vec<Set> {
+    let mut stream = Stream::new(config, &timing());
+    let mut sets = Vec::with_capacity(count);
+    for number in 0..count {
+        let mut set = Set::new();
         let info = stream.next_into(&mut set).unwrap();
+        sets.push(set);
+        if number >= counted {
+            continue;
+        }
         for d in info.discarded {
             s.drawn += 1 + u64::from(d);
             s.discarded += u64::from(d);
             s.most_discarded = s.most_discarded.max(d);
             s.fallbacks += u64::from(d + 1 == MAX_DRAWS);
         }
-        let mut p = IdlePlayer::new(&set, NoSupply, t, IdleMode::FixedLoop);
-        frames.extend((0..loop_frames as u64).map(|k| p.offsets(at(k)).map(|a| a.millidegrees())));
     }
-    frames
+    sets
+}
+
+/// Sets generated already, handed to the player in order: the stream
+/// [`super::play`] would generate on each take, generated once here for
+/// both the stream and each loop alone.
+struct Prepared<'a>(std::slice::Iter<'a, Set>);
+
+impl<'a> LoopSupply<&'a Set> for Prepared<'a> {
+    fn take(&mut self) -> Option<&'a Set> {
+        Some(
+            self.0
+                .next()
+                .expect("the stream took more sets than prepared"),
+        )
+    }
+
+    fn give_back(&mut self, _: &'a Set) {}
 }
 
 /// Measures seeds `from..to`: per seed, 50 joins (51 loops per axis), each
@@ -147,9 +159,21 @@ fn measure(from: u64, to: u64) -> Smoothness {
     let mut s = Smoothness::default();
     let mut x = vec![0; loop_frames];
     for seed in from..to {
-        let config = config_for(seed);
-        let stream = play(config, IdleMode::NeverRepeating, frames);
-        let alone = each_loop_alone(config, JOINS + 1, loop_frames, &mut s);
+        // The stream takes a set at each of its joins: JOINS + 2 at most.
+        let sets = sets(config_for(seed), JOINS + 3, JOINS + 1, &mut s);
+        let supply = Prepared(sets[1..].iter());
+        let mut p = IdlePlayer::new(&sets[0], supply, t, IdleMode::NeverRepeating);
+        let stream: Vec<[i32; 3]> = (0..frames as u64)
+            .map(|k| p.offsets(at(k)).map(|a| a.millidegrees()))
+            .collect();
+        // Each of the first JOINS + 1 sets played alone, one loop from its entry.
+        let mut alone = Vec::with_capacity((JOINS + 1) * loop_frames);
+        for set in &sets[..=JOINS] {
+            let mut p = IdlePlayer::new(set, NoSupply, t, IdleMode::FixedLoop);
+            alone.extend(
+                (0..loop_frames as u64).map(|k| p.offsets(at(k)).map(|a| a.millidegrees())),
+            );
+        }
         for k in 1..=JOINS {
             let centre = k * period + join / 2;
             let around_join = centre - loop_frames / 2..centre + loop_frames / 2;
