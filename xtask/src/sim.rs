@@ -158,13 +158,11 @@ pub fn command(args: &Args) -> Result<bool> {
     let (root, metadata) = crate::setup::prepare()?;
     let (root, md) = (root.as_path(), &metadata);
     PICO.build(root)?;
-    let script = match (&args.script, &args.radar) {
-        (Some(path), _) => Some(script::read(path)?),
-        (_, Some(path)) => Some(radar::read(path)?),
-        _ => None,
-    };
-    if let Some(events) = script {
-        return script::command(root, md, events, args);
+    if let Some(path) = &args.script {
+        return script::command(root, md, script::read(path)?, args);
+    }
+    if let Some(path) = &args.radar {
+        return script::command(root, md, radar::read(path)?, args);
     }
     if args.dmx.is_some() || args.pulses.is_some() && !args.show {
         return show::command(root, md, args);
@@ -219,7 +217,6 @@ impl Report {
         self.boots.iter().map(fresh).sum()
     }
 
-    /// Watchdog resets during the run.
     pub fn watchdog_resets(&self) -> usize {
         self.boots.iter().filter(|boot| boot.watchdog).count()
     }
@@ -308,20 +305,20 @@ impl Report {
         }
         // Each boot's first call is the start frame (neutral pulses only).
         let start = self.boots.first().and_then(|b| b.frame_cycles.first());
-        let start = start.copied().unwrap_or(0);
         let cycles = self
             .boots
             .iter()
-            .flat_map(|b| &b.frame_cycles[1.min(b.frame_cycles.len())..]);
+            .flat_map(|b| b.frame_cycles.iter().skip(1));
         let mut cycles: Vec<u64> = cycles.copied().collect();
         cycles.sort_unstable();
         let _ = match (cycles.first(), cycles.last()) {
             (Some(min), Some(max)) => writeln!(
                 text,
                 "\nframe update (FrameLoop::write), RP2040 cycles as rp2040js counts them: min {min}, \
-                 median {}, max {max} over {} frames (start frame {start})",
+                 median {}, max {max} over {} frames (start frame {})",
                 cycles[cycles.len() / 2],
                 cycles.len(),
+                start.unwrap_or(&0),
             ),
             _ => writeln!(text, "\nframe update: no call seen"),
         };
@@ -348,11 +345,8 @@ impl Report {
                 self.frames()
             );
         }
-        let mut text = format!("sim: FAILED ({} problems):", self.problems.len());
-        for problem in &self.problems {
-            let _ = write!(text, "\n  {problem}");
-        }
-        text
+        let (n, problems) = (self.problems.len(), self.problems.join("\n  "));
+        format!("sim: FAILED ({n} problems):\n  {problems}")
     }
 
     /// The closing `sim summary ...` line.
@@ -361,19 +355,14 @@ impl Report {
         let pulses: usize = servos().map(|s| s.pulses.len()).sum();
         let mismatches: usize = servos().map(|s| s.mismatches).sum();
         let periods = servos().filter_map(|s| s.periods);
-        let (low, high) = periods.fold((f64::INFINITY, 0.0_f64), |(l, h), (a, b)| {
-            (l.min(a), h.max(b))
-        });
-        let finite = low.is_finite();
-        let period = finite.then(|| format!("{low:.0}..{high:.0}"));
-        let period = period.unwrap_or_else(|| "-".to_owned());
+        let period = periods.reduce(|(l, h), (a, b)| (l.min(a), h.max(b)));
+        let period = period.map_or("-".to_owned(), |(l, h)| format!("{l:.0}..{h:.0}"));
         let count_ns = run::timing_at(self.rate).count_ns;
-        let first = |s: &pulses::ServoCheck| {
-            let us = |p: &pulses::Pulse| format!("{:.0}", f64::from(p.counts) * count_ns / 1e3);
-            s.pulses.first().map_or("-".to_owned(), us)
-        };
-        let first = self.boots.first().map(|b| b.servos.each_ref().map(first));
-        let first = first.map_or_else(Vec::new, Vec::from);
+        let us = |p: &pulses::Pulse| format!("{:.0}", f64::from(p.counts) * count_ns / 1e3);
+        let first = self.boots.iter().take(1).flat_map(|b| &b.servos);
+        let first: Vec<String> = first
+            .map(|s| s.pulses.first().map_or("-".to_owned(), us))
+            .collect();
         format!(
             "sim summary frames={} pulses={pulses} mismatches={mismatches} period_ns={period} first_us={} watchdog_resets={}",
             self.frames(),
