@@ -1,7 +1,7 @@
 //! Node, the emulator package and a run of `sim/harness.mjs` ([`Config`]).
 
 use std::{
-    io::{BufRead, BufReader, Read, Write},
+    io::{BufRead, BufReader, Write},
     path::{Path, PathBuf},
     process::{Child, Command, Stdio},
     time::Duration,
@@ -33,10 +33,8 @@ pub fn npm_ci(dir: &Path, packages: &[&str], env: &[(&str, &str)]) -> Result<()>
         setup::ensure_program(program, &["nodejs", "npm"], what)?;
     }
     let read = |path: PathBuf| -> Value {
-        let json = std::fs::read(path)
-            .ok()
-            .and_then(|b| serde_json::from_slice(&b).ok());
-        json.unwrap_or_default()
+        let bytes = std::fs::read(path).unwrap_or_default();
+        serde_json::from_slice(&bytes).unwrap_or_default()
     };
     let lock = read(dir.join("package-lock.json"));
     if lock.is_null() {
@@ -262,11 +260,7 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
         let events: Vec<Result<Event>> = lines.map(|line| Event::parse(&line)).collect();
         events.into_iter().collect()
     };
-    let all = |mut stderr: std::process::ChildStderr| {
-        let mut text = String::new();
-        let _ = stderr.read_to_string(&mut text);
-        text
-    };
+    let all = |stderr| std::io::read_to_string(stderr).unwrap_or_default();
     let limit = config.wall + GRACE;
     let done = child.and_then(|child| project::finish(child, "node", limit, events, all, || ()))?;
     let Exit::Status(status) = done.exit else {
