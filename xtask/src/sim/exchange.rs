@@ -58,9 +58,10 @@ pub fn check(report: &mut Report) {
     let Some(boot) = report.boots.first() else {
         return;
     };
-    let script = script_lines().concat();
+    let lines = script_lines();
+    let script = lines.concat();
     let [uart_want, usb_want] = expected(&script);
-    let (transcript, problems) = compare(&script, &uart_want, &boot.uart);
+    let (transcript, problems) = compare(&lines, &uart_want, &boot.uart);
     let (len, out) = (script.len(), boot.uart.len());
     let start = START.as_secs_f64();
     print!(
@@ -77,7 +78,7 @@ pub fn check(report: &mut Report) {
             "{n} UART bytes found the receive FIFO full (the firmware did not read in time)"
         ));
     }
-    let (usb, usb_problems) = compare(&script, &usb_want, &boot.usb);
+    let (usb, usb_problems) = compare(&lines, &usb_want, &boot.usb);
     match boot.usb_connected {
         Some(ns) => {
             let (at, start, out) = (ns / 1e9, USB_START.as_secs_f64(), boot.usb.len());
@@ -98,9 +99,7 @@ pub fn check(report: &mut Report) {
 fn script_lines() -> Vec<Vec<u8>> {
     let mut lines: Vec<Vec<u8>> = SCRIPT.iter().map(|line| line.to_vec()).collect();
     // An overlong line: one byte past the protocol's 96.
-    let mut long = vec![b'a'; 97];
-    long.extend(b"\r\n");
-    lines.push(long);
+    lines.push(format!("{}\r\n", "a".repeat(97)).into_bytes());
     lines.push(machine("#7 help"));
     lines
 }
@@ -156,10 +155,7 @@ fn mask(reply: &[u8]) -> Vec<u8> {
     if !text.starts_with("ok mode=") {
         return reply.to_vec();
     }
-    let integer = |n: &str| {
-        let digits = n.strip_prefix('-').unwrap_or(n);
-        !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
-    };
+    let integer = |n: &str| n.parse::<i64>().is_ok();
     let mask_word = |word: &str| {
         let numbers = |key: &&str| {
             word.strip_prefix(*key)
@@ -174,8 +170,8 @@ fn mask(reply: &[u8]) -> Vec<u8> {
     words.join(" ").into_bytes()
 }
 
-/// What a port `sent` against `want`: the transcript and problems.
-fn compare(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>) {
+/// What a port `sent` against `want`, beside the script's `lines`: transcript, problems.
+fn compare(lines: &[Vec<u8>], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>) {
     let got: Vec<Vec<u8>> = sent
         .split_inclusive(|&b| b == b'\n')
         .filter(|line| !line.is_empty())
@@ -183,24 +179,14 @@ fn compare(script: &[u8], want: &[Vec<u8>], sent: &[u8]) -> (String, Vec<String>
         .collect();
     let mut transcript = String::new();
     let mut problems = Vec::new();
-    let lines: Vec<&[u8]> = script
-        .split_inclusive(|&b| b == b'\n' || b == b'\r')
-        .filter(|line| !matches!(line, [b'\n' | b'\r']))
-        .collect();
     for (i, want) in want.iter().enumerate() {
         let line = lines.get(i).map_or_else(String::new, |l| printable(l));
-        let _ = writeln!(transcript, "  > {line}");
-        match got.get(i) {
-            Some(reply) => {
-                let (n, got, wanted) = (i + 1, printable(reply), printable(want));
-                let _ = writeln!(transcript, "  < {got}");
-                if reply != want {
-                    problems.push(format!("reply {n} is `{got}`, not `{wanted}`"));
-                }
-            }
-            None => {
-                let _ = writeln!(transcript, "  < (nothing)");
-            }
+        let reply = got.get(i);
+        let shown = reply.map_or_else(|| "(nothing)".to_owned(), |r| printable(r));
+        let _ = writeln!(transcript, "  > {line}\n  < {shown}");
+        if reply.is_some_and(|r| r != want) {
+            let (n, wanted) = (i + 1, printable(want));
+            problems.push(format!("reply {n} is `{shown}`, not `{wanted}`"));
         }
     }
     let (replies, sent) = (got.len(), want.len());
@@ -271,15 +257,15 @@ mod tests {
 
     #[test]
     fn a_missing_or_wrong_reply_is_a_problem() {
-        let script = script_lines().concat();
-        let [want, _] = expected(&script);
+        let lines = script_lines();
+        let [want, _] = expected(&lines.concat());
         let all: Vec<u8> = want.concat();
-        assert!(compare(&script, &want, &all).1.is_empty());
+        assert!(compare(&lines, &want, &all).1.is_empty());
         let short = &all[..all.len() - 3];
-        assert!(!compare(&script, &want, short).1.is_empty());
+        assert!(!compare(&lines, &want, short).1.is_empty());
         let mut wrong = all.clone();
         wrong[0] = b'x';
-        assert!(!compare(&script, &want, &wrong).1.is_empty());
-        assert!(!compare(&script, &want, &[]).1.is_empty());
+        assert!(!compare(&lines, &want, &wrong).1.is_empty());
+        assert!(!compare(&lines, &want, &[]).1.is_empty());
     }
 }
