@@ -29,12 +29,10 @@ const BAUD: u32 = 256_000;
 /// line moves here, in the emulator and the host trace alike.
 pub const CONSOLE_UP: Duration = Duration::from_millis(100);
 
-/// The events of the script at `path`.
 pub fn read(path: &Path) -> Result<Vec<Event>> {
     trace::read_script(path, &trace::built_in()?.1)
 }
 
-/// The events of a script's `text`.
 pub fn parse(text: &str) -> Result<Vec<Event>> {
     let (_, params) = trace::built_in()?;
     trace::parse_script(text, &params)
@@ -170,11 +168,9 @@ pub fn host(
 
 /// Whether a console line sets the servo rate (`servo rate <hz>`).
 fn changes_rate(line: &str) -> bool {
-    let words: Vec<String> = line
-        .split_whitespace()
-        .map(str::to_ascii_lowercase)
-        .collect();
-    matches!(words.as_slice(), [servo, rate, _, ..] if servo == "servo" && rate == "rate")
+    let line = line.to_ascii_lowercase();
+    let words: Vec<&str> = line.split_whitespace().collect();
+    matches!(words.as_slice(), ["servo", "rate", _, ..])
 }
 
 /// The duties boot 0 wrote, from frame 0 (the write before the enable).

@@ -123,9 +123,8 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
         (1, "last reset by the WATCHDOG", "the watchdog reset"),
         (1, neutral, "neutral first pulses"),
     ] {
-        if !report.boots.get(boot).is_some_and(|b| b.says(text)) {
-            problems.push(format!("boot {boot} did not log {what}"));
-        }
+        let logged = report.boots.get(boot).is_some_and(|b| b.says(text));
+        problem_if!(problems, !logged, "boot {boot} did not log {what}");
     }
     if !report.first()?.watchdog {
         problems.push("the watchdog did not reset the board after the frames stopped".to_owned());
@@ -242,10 +241,9 @@ pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
             other => problems.push(format!("{name}: expected `{want}`, got {other:?}")),
         }
     }
-    let (missing, myself) = (dir.join("no-such-elf"), std::env::current_exe()?);
     for (path, want) in [
-        (missing, "cargo build --release"),
-        (myself, "is not a Pico image"),
+        (dir.join("no-such-elf"), "cargo build --release"),
+        (std::env::current_exe()?, "is not a Pico image"),
     ] {
         let (read, path) = (PicoImage::read(&path), path.display());
         match read {
