@@ -134,16 +134,13 @@ pub fn test_drill(root: &Path, metadata: &Metadata) -> Result<()> {
             // Frames 0..=DRILL_FRAMES, each its own pulse: neutral first and
             // the 2 s fade-in (checked against the host) before the stop.
             let (fresh, held, want) = (check.fresh, check.held, DRILL_FRAMES + 1);
+            let servo = format!("boot {b}, {name}");
             if fresh != want {
-                problems.push(format!(
-                    "boot {b}, {name}: {fresh} frames went out, not {want}"
-                ));
+                problems.push(format!("{servo}: {fresh} frames went out, not {want}"));
             }
             // The last duty is held until the reset, 100 ms: 5 periods.
             if held > 6 {
-                problems.push(format!(
-                    "boot {b}, {name}: {held} pulses held before the reset"
-                ));
+                problems.push(format!("{servo}: {held} pulses held before the reset"));
             }
         }
         let last_write = boot.trains[0].writes.last().map_or(boot.start, |w| w.0);
