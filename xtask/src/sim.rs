@@ -33,7 +33,7 @@ mod unmodelled;
 
 use std::{fmt::Write as _, path::Path, path::PathBuf, time::Duration};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, ensure};
 use idle_head_core::servo::ServoRate;
 
 pub use inputs::{INPUTS_STAGE, test_inputs};
@@ -174,12 +174,11 @@ pub fn command(args: &Args) -> Result<bool> {
     } else if args.console {
         let time = time.unwrap_or(CONSOLE_TIME);
         let least = exchange::USB_START + Duration::from_secs(1);
-        if time < least {
-            bail!(
-                "console: the USB script starts at {:?}; run at least {least:?}",
-                exchange::USB_START
-            );
-        }
+        ensure!(
+            time >= least,
+            "console: the USB script starts at {:?}; run at least {least:?}",
+            exchange::USB_START
+        );
         test_console(root, md, time, args.timeout)
     } else if args.show {
         show::show(root, md, args.pulses.as_deref())
