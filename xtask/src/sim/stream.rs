@@ -107,8 +107,9 @@ fn replies(
     Ok((replies, problems))
 }
 
-/// Loop sets generated in `boot` from `from` (s) on.
-fn sets(boot: &Boot, from: f64) -> usize {
+/// Loop sets generated in `boot` from `from` on.
+fn sets(boot: &Boot, from: Duration) -> usize {
+    let from = from.as_nanos() as f64;
     let log = boot.log.iter().filter(|(at, _)| *at >= from);
     log.filter(|(_, line)| line.message.starts_with("loop set "))
         .count()
@@ -145,7 +146,7 @@ pub fn test_stream(
             StreamLine::Plain(_) => Want::Exactly("ok watch=off"),
         }
     })?;
-    let sets = sets(report.first()?, START.as_secs_f64());
+    let sets = sets(report.first()?, START);
     println!(
         "{port} stream: {count} lines, one every {} ms; {} replies; {sets} loop sets generated \
          meanwhile; {} instructions a line, the run's all",
@@ -268,7 +269,7 @@ pub(super) fn check_dmx(boot: &Boot, changes: usize) -> (String, Vec<String>) {
     if let Some(first) = late.first() {
         problems.push(format!("{} frames late: `{first}`", late.len()));
     }
-    let sets = sets(boot, 0.0);
+    let sets = sets(boot, Duration::ZERO);
     let summary = format!(
         "DMX: {sent} frames of 512 slots sent by the last change, {good} counted good; {sets} loop \
          sets generated meanwhile; `{reply}`\n"
