@@ -181,13 +181,7 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
                 "pulse {n} at {at:.3} ms carries frame {frame}: a frame {why} before it"
             ));
         }
-        let (want, written) = (expected[frame], frames[frame].1);
-        if written != want && !mismatched[frame] {
-            mismatched[frame] = true;
-            kinds[1].push(format!(
-                "frame {frame}: wrote {written} counts, the host {want}"
-            ));
-        }
+        let want = expected[frame];
         if counts.abs_diff(u32::from(want)) > 1 {
             mismatched[frame] = true;
             let at = ms(r);
@@ -217,12 +211,13 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
         }
         last_period = Some((n, r));
     }
-    // Frames written with duty 0 (no pulse) the host did not give 0.
-    for (frame, &(_, duty)) in frames.iter().enumerate() {
-        if duty == 0 && expected[frame] != 0 && !mismatched[frame] {
+    // Every frame's written duty, whether a pulse carried it or not (duty 0).
+    for (frame, (&(_, written), &want)) in frames.iter().zip(expected).enumerate() {
+        if written != want {
             mismatched[frame] = true;
-            let want = expected[frame];
-            kinds[1].push(format!("frame {frame}: wrote 0 counts, the host {want}"));
+            kinds[1].push(format!(
+                "frame {frame}: wrote {written} counts, the host {want}"
+            ));
         }
     }
     out.mismatches = mismatched.iter().filter(|&&m| m).count();
