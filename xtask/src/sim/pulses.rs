@@ -161,6 +161,7 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
         };
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // a width, < 2^16
         let counts = (width / timing.count_ns).round().max(0.0) as u32;
+        let at = ms(r);
         out.pulses.push(Pulse {
             rise: r,
             counts,
@@ -176,7 +177,6 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
             } else {
                 "came twice"
             };
-            let at = ms(r);
             kinds[0].push(format!(
                 "pulse {n} at {at:.3} ms carries frame {frame}: a frame {why} before it"
             ));
@@ -184,13 +184,12 @@ pub fn check(train: &Train, expected: &[u16], timing: &Timing, limits: Limits) -
         let want = expected[frame];
         if counts.abs_diff(u32::from(want)) > 1 {
             mismatched[frame] = true;
-            let at = ms(r);
             kinds[2].push(format!(
                 "pulse {n} (frame {frame}) at {at:.3} ms: {counts} counts, the host {want}"
             ));
         }
         if counts + 1 < u32::from(limits.min) || counts > u32::from(limits.max) + 1 {
-            let (at, min, max) = (ms(r), limits.min, limits.max);
+            let (min, max) = (limits.min, limits.max);
             kinds[3].push(format!(
                 "pulse {n} at {at:.3} ms: {counts} counts, outside the servo's [{min}, {max}]"
             ));
