@@ -9,7 +9,7 @@ use std::{
 };
 
 use super::node::Fill;
-use anyhow::{Context as _, Result, bail};
+use anyhow::{Context as _, Result, bail, ensure};
 use embedded_storage_async::nor_flash::NorFlashErrorKind::{self, OutOfBounds};
 use embedded_storage_async::nor_flash::{ErrorType, NorFlash, ReadNorFlash};
 use idle_head_core::settings::{RawRecord, Record, SETTINGS_BUFFER, Settings, SettingsStore};
@@ -17,20 +17,16 @@ use idle_head_core::settings::{RawRecord, Record, SETTINGS_BUFFER, Settings, Set
 /// The Pico's flash: erase sector and write unit.
 const SECTOR: usize = 4096;
 
-/// The version 1 fixture, in the repository at this path.
-pub const VERSION_1_SECTORS: &str = "host-tests/fixtures/settings-v1-sectors.bin";
-
 /// The version 1 fixture's sectors (`len` bytes).
 pub fn version_1_sectors(root: &Path, len: usize) -> Result<Vec<u8>> {
-    let path = root.join(VERSION_1_SECTORS);
+    let path = root.join("host-tests/fixtures/settings-v1-sectors.bin");
     let bytes = std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;
-    if bytes.len() != len {
-        bail!(
-            "{} holds {} bytes, not the {len} of the settings region",
-            path.display(),
-            bytes.len()
-        );
-    }
+    ensure!(
+        bytes.len() == len,
+        "{} holds {} bytes, not the {len} of the settings region",
+        path.display(),
+        bytes.len()
+    );
     Ok(bytes)
 }
 
