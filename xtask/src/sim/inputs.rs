@@ -27,7 +27,6 @@ pub const SCRIPT: &str = "\
 ";
 
 /// The stage: [`SCRIPT`] for 12.5 s (the glance from 8.1 s, and back).
-#[allow(clippy::too_many_lines)] // the four checks of the module docs, in order
 pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     let time = Duration::from_millis(12_500);
     let report = script::host(root, metadata, SCRIPT, time, script::Board::default())?;
@@ -62,13 +61,10 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     // 1. Rested: at the rest pose when the pulses stopped (the glide had
     // arrived: its last frames there too), within a count.
     let rest = f64::from(BehaviourConfig::DEFAULT.rest.pose[0].millidegrees());
-    let last = pulses[0]
+    let mut last = pulses[0]
         .iter()
         .filter(|p| p.rise <= before.rise && before.rise - p.rise < 2.5 * period);
-    if !last
-        .into_iter()
-        .all(|p| (degrees(0, p) - rest).abs() <= count(0))
-    {
+    if !last.all(|p| (degrees(0, p) - rest).abs() <= count(0)) {
         let problem = "the head did not hold the rest pose (pitch 8°) before the pulses stopped";
         problems.push(problem.into());
     }
