@@ -18,7 +18,6 @@ pub fn write(path: &Path, trains: &[Train; 3], timing: &Timing) -> Result<()> {
     Ok(())
 }
 
-/// The CSV's text.
 #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // periods and counts, far below 2^52
 fn rows(trains: &[Train; 3], timing: &Timing) -> String {
     let period = timing.period_ns();
@@ -28,24 +27,23 @@ fn rows(trains: &[Train; 3], timing: &Timing) -> String {
         .filter_map(|pulses| pulses.first().map(|p| p.rise));
     let first = starts.fold(f64::INFINITY, f64::min);
     let widths = measured.map(|pulses| {
-        let mut out: Vec<Option<u32>> = Vec::new();
+        let mut us = Vec::new();
         for pulse in pulses {
             let k = ((pulse.rise - first) / period).round().max(0.0) as usize;
-            if out.len() <= k {
-                out.resize(k + 1, None);
+            if us.len() <= k {
+                us.resize(k + 1, 0.0);
             }
             // In whole counts, as the pulse check counts them.
-            out[k] = Some((pulse.width / timing.count_ns).round().max(0.0) as u32);
+            us[k] = (pulse.width / timing.count_ns).round().max(0.0) * timing.count_ns / 1e3;
         }
-        out
+        us
     });
-    let frames = widths.iter().map(Vec::len).min().unwrap_or(0);
-    let us = |counts: Option<u32>| counts.map_or(0.0, |c| f64::from(c) * timing.count_ns / 1e3);
     let period_us = (timing.frame_ns / 1e3).round() as u64;
     let mut text = String::from("t_ms,pitch_us,roll_us,yaw_us\n");
     let [pitch, roll, yaw] = &widths;
-    for (k, ((&p, &r), &y)) in pitch.iter().zip(roll).zip(yaw).take(frames).enumerate() {
-        let ([p, r, y], t) = ([p, r, y].map(us), crate::trace::ms(k as u64 * period_us));
+    // As many rows as the shortest servo's periods (`zip` stops there).
+    for (k, ((p, r), y)) in pitch.iter().zip(roll).zip(yaw).enumerate() {
+        let t = crate::trace::ms(k as u64 * period_us);
         let _ = writeln!(text, "{t},{p:.1},{r:.1},{y:.1}");
     }
     text
