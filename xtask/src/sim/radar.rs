@@ -73,15 +73,14 @@ pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
     problems.extend(report.problems.iter().map(|p| format!("walk: {p}")));
     let boot = report.first()?;
     let walk = Walk::of(&yaw(boot), u64::from(ServoRate::DEFAULT.period().0))?;
+    let rms = walk.rms / 1000.0;
     println!(
-        "walk: {} radar frames sent; the yaw {} ms behind the bearing, {:.2}° RMS and at most \
+        "walk: {} radar frames sent; the yaw {} ms behind the bearing, {rms:.2}° RMS and at most \
          {:.2}° from it after the first second",
         boot.radar_frames,
         walk.lag_ms,
-        walk.rms / 1000.0,
         walk.largest / 1000.0
     );
-    let rms = walk.rms / 1000.0;
     if rms.is_nan() || rms > 5.0 {
         problems.push(format!("walk: RMS error {rms:.2}°, not within 5°"));
     }
