@@ -266,9 +266,7 @@ fn check(boot: &Boot, lines: &[String]) -> Result<Vec<String>> {
         during < 20,
         "only {during} pulses of a nod: the band entry played none"
     );
-    if let Some(first) = after.first() {
-        problems.push(format!("the nod went on: {first}"));
-    }
+    problems.extend(after.first().map(|p| format!("the nod went on: {p}")));
 
     // 4. Bottango over USB: yaw past 10° 0.7 s after the lines (0.2 s and
     // half the curve, a frame either way), at the curve's 20° at its top.
