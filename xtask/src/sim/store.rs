@@ -353,18 +353,12 @@ mod tests {
         for (want, break_it) in failing {
             let mut report = good();
             break_it(&mut report);
-            let problems = check(&report, LOGGED, NEUTRAL);
-            assert!(
-                problems.iter().any(|p| p.contains(want)),
-                "`{want}` not among {problems:?}"
-            );
+            let problems = check(&report, LOGGED, NEUTRAL).join("\n");
+            assert!(problems.contains(want), "`{want}` not among\n{problems}");
         }
-        let problems = check(&good(), &[("WARN", "holds settings of version 0")], NEUTRAL);
-        assert!(
-            problems
-                .iter()
-                .any(|p| p.contains("did not log `WARN holds settings"))
-        );
+        let problems =
+            check(&good(), &[("WARN", "holds settings of version 0")], NEUTRAL).join("\n");
+        assert!(problems.contains("did not log `WARN holds settings"));
         // Another start's neutral pulses: both boots are checked against them.
         let problems = check(&good(), LOGGED, [1520, 1480, 1510]).join("\n");
         assert!(problems.contains("boot 0 did not log `first frame: neutral pulses 1520 1480"));
