@@ -38,13 +38,12 @@ const KNOWN: [(&str, Option<&[u32]>, &str); 4] = [
 impl Unmodelled {
     /// Why this access does not matter, if it is a known gap.
     fn known(&self) -> Option<&'static str> {
-        let covers = |writes: Option<&[u32]>| {
-            writes.is_none_or(|offsets| self.op == Op::Write && offsets.contains(&self.offset))
-        };
-        let mut known = KNOWN.iter();
-        let gap =
-            known.find(|(peripheral, writes, _)| *peripheral == self.peripheral && covers(*writes));
-        gap.map(|(.., why)| *why)
+        let &(.., why) = KNOWN.iter().find(|(peripheral, writes, _)| {
+            *peripheral == self.peripheral
+                && writes
+                    .is_none_or(|offsets| self.op == Op::Write && offsets.contains(&self.offset))
+        })?;
+        Some(why)
     }
 }
 
