@@ -107,7 +107,6 @@ pub fn line(changes: &[Change]) -> Value {
     })
 }
 
-/// Reads and parses the script at `path`.
 pub fn read(path: &Path) -> Result<Vec<Change>> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("reading the DMX script {}", path.display()))?;
