@@ -59,10 +59,8 @@ mod tests {
         pulses.map(|pulses| {
             let edges = pulses.iter().flat_map(|&(k, counts)| {
                 let rise = t0 + f64::from(k) * timing.frame_ns;
-                [
-                    (rise, true),
-                    (rise + f64::from(counts) * timing.count_ns, false),
-                ]
+                let fall = rise + f64::from(counts) * timing.count_ns;
+                [(rise, true), (fall, false)]
             });
             Train {
                 edges: edges.collect(),
