@@ -97,10 +97,9 @@ pub fn test_radar(root: &Path, metadata: &Metadata) -> Result<()> {
         problems.extend(found);
         yaws.push(yaw);
     }
-    let n = yaws[0].len().min(yaws[1].len());
-    let differ = (0..n)
-        .filter(|&k| (yaws[0][k] - yaws[1][k]).abs() > 30.0)
-        .count();
+    let frames = yaws[0].iter().zip(&yaws[1]);
+    let n = frames.len();
+    let differ = frames.filter(|&(a, b)| (a - b).abs() > 30.0).count();
     println!("two boards: yaw differs by more than a count in {differ} of {n} frames");
     let few = differ < n / 2;
     problem_if!(
