@@ -18,7 +18,7 @@ pub fn write(path: &Path, trains: &[Train; 3], timing: &Timing) -> Result<()> {
     Ok(())
 }
 
-#[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // periods and counts, far below 2^52
+#[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // a period index and µs, far below 2^52
 fn rows(trains: &[Train; 3], timing: &Timing) -> String {
     let period = timing.period_ns();
     let measured = trains.each_ref().map(pulses::measure);
