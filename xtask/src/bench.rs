@@ -64,7 +64,6 @@ const FLAT_LIMIT: f64 = 1.5;
 /// n1800/n450 is pulled below 4 by the fixed cost.
 const MARGINAL_TOLERANCE: f64 = 0.1;
 
-/// The numbers `keys` of the log line `message`.
 fn numbers<const N: usize>(message: &str, keys: [&str; N]) -> Result<[u64; N]> {
     let mut out = [0; N];
     for (value, key) in out.iter_mut().zip(keys) {
@@ -114,7 +113,6 @@ pub struct Verdict {
 }
 
 impl Verdict {
-    /// Reads the verdict from the rows; fails if a row it needs is missing.
     pub fn of(rows: &[Row]) -> Result<Self> {
         let engine = |label: &str| -> Result<f64> {
             let row = rows.iter().find(|row| row.label == label);
@@ -229,13 +227,10 @@ impl FrameRow {
         Ok(rows)
     }
 
-    /// This row's ceiling on the median and the max, if its rate and
-    /// scenario have one.
+    /// This row's `[median, max]` ceiling, if its rate and scenario have one.
     pub fn ceiling(&self) -> Option<[u64; 2]> {
-        let own = |c: &&(u64, Option<&str>, [u64; 2])| {
-            (c.0, c.1) == (self.rate, self.scenario.as_deref())
-        };
-        CEILINGS.iter().find(own).map(|c| c.2)
+        let own = (self.rate, self.scenario.as_deref());
+        CEILINGS.iter().find(|c| (c.0, c.1) == own).map(|c| c.2)
     }
 
     /// The median and the max within this row's ceiling (a row without

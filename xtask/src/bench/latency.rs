@@ -57,7 +57,6 @@ impl Row {
         [0.5, 0.99, 1.0].map(|q| percentile(&self.ms, q))
     }
 
-    /// Whether p99 is within the goal.
     fn met(&self) -> bool {
         self.spread()[1] <= self.goal_ms
     }
@@ -347,10 +346,7 @@ mod tests {
         }
         let times = schedule(Duration::from_secs(1), 100, DMX_GAP, 7);
         assert_eq!(times, schedule(Duration::from_secs(1), 100, DMX_GAP, 7));
-        let gaps = times.windows(2).map(|w| w[1].saturating_sub(w[0]));
-        assert!(
-            gaps.into_iter()
-                .all(|gap| (DMX_GAP.0..DMX_GAP.1).contains(&gap))
-        );
+        let mut gaps = times.windows(2).map(|w| w[1].saturating_sub(w[0]));
+        assert!(gaps.all(|gap| (DMX_GAP.0..DMX_GAP.1).contains(&gap)));
     }
 }
