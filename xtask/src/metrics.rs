@@ -77,7 +77,6 @@ pub struct Results {
 }
 
 impl Results {
-    /// Loops whose [`ROWS`]' values pass `past`.
     fn count(&self, past: impl Fn(&[f64; 6]) -> bool) -> usize {
         self.loops.iter().filter(|m| past(m)).count()
     }
@@ -88,7 +87,6 @@ impl Results {
     }
 }
 
-/// Generates and measures seeds `range` for `closure`.
 fn measure(range: std::ops::Range<u32>, args: Args, closure: Closure) -> Result<Results> {
     let kernel = HannKernel::new(args.shape.w())?;
     let (mut buffer, mut scratch) = (vec![Mdeg16(0); args.shape.n()], vec![0; args.shape.n()]);

@@ -118,7 +118,6 @@ impl Args {
     }
 }
 
-/// `cargo xtask preview`.
 pub fn command(args: &Args) -> Result<bool> {
     let loops = args.loops()?;
     let out = (args.out.clone()).unwrap_or_else(|| project::root().join("preview"));

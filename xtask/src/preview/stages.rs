@@ -30,7 +30,6 @@ pub struct LoopSpec {
     pub cfg: AxisConfig,
 }
 
-/// An [`Angle`] in degrees.
 pub fn deg(angle: Angle) -> f64 {
     f64::from(angle.millidegrees()) / f64::from(Angle::SCALE)
 }
@@ -185,6 +184,10 @@ impl Stages {
         let LoopSpec { cfg, .. } = self.spec;
         let inside = cfg.range.contains(m.min) && cfg.range.contains(m.max);
         let (d1, d2, lively) = (m.velocity_ratio, m.acceleration_ratio, m.liveliness);
+        let split = match cfg.closure {
+            Closure::Paper => format!("drawn from {} zero crossings", self.info.crossings),
+            Closure::Seamless => "where the smoothed loop crosses the level that maps to 0°".into(),
+        };
         vec![
             format!("continuity: max|d1|/P95|d1| = {d1:.2}, max|d2|/P95|d2| = {d2:.2}"),
             format!("liveliness (min over 10 segments of mean|d1| / mean|d1|) = {lively:.2}"),
@@ -197,17 +200,10 @@ impl Stages {
                 deg(cfg.range.max),
                 deg(m.start),
             ),
-            match cfg.closure {
-                Closure::Paper => format!(
-                    "split p = {} (drawn from {} zero crossings); {} up-steps in the walk",
-                    self.info.split, self.info.crossings, self.info.up_steps
-                ),
-                Closure::Seamless => format!(
-                    "split p = {} (where the smoothed loop crosses the level that maps to 0°); \
-                     {} up-steps in the walk",
-                    self.info.split, self.info.up_steps
-                ),
-            },
+            format!(
+                "split p = {} ({split}); {} up-steps in the walk",
+                self.info.split, self.info.up_steps
+            ),
         ]
     }
 }
