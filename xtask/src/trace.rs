@@ -278,9 +278,11 @@ pub fn simulate(
 pub fn command(args: &Args) -> Result<bool> {
     let rate = args.rate;
     let (_, params) = at_rate(rate)?;
-    let script = args.script.as_deref();
-    let events = script.map(|path| read_script(path, &params)).transpose()?;
-    let events = events.unwrap_or_default();
+    let events = args
+        .script
+        .as_deref()
+        .map(|path| read_script(path, &params));
+    let events = events.transpose()?.unwrap_or_default();
     let seeds = args.seed.map(Settings::seeds_from);
     let watch = args.telemetry.as_ref().map(|_| args.watch);
     let trace = simulate(args.micros, seeds, rate, &events, watch, &[])?;
@@ -328,7 +330,6 @@ pub fn command(args: &Args) -> Result<bool> {
     Ok(true)
 }
 
-/// The events of the script at `path`.
 pub fn read_script(path: &Path, params: &BehaviourParams) -> Result<Vec<Event>> {
     let text = fs::read_to_string(path)
         .with_context(|| format!("reading the script {}", path.display()))?;

@@ -35,7 +35,6 @@ pub struct Mark {
 }
 
 impl Mark {
-    /// Whether the head refused it.
     pub fn refused(&self) -> bool {
         self.reply.starts_with("err")
     }

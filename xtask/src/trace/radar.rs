@@ -19,7 +19,6 @@ pub struct Radar {
 }
 
 impl Radar {
-    /// The radar lines of `events` (in time order).
     pub fn of(events: &[Event]) -> Self {
         let radar = |e: &Event| match e.kind {
             Kind::Radar(seen) => Some((e.at_us, sighting(&seen))),
@@ -47,7 +46,6 @@ impl Radar {
     }
 }
 
-/// A sighting of a radar line's people.
 fn sighting(seen: &[Option<(i32, i32)>; 3]) -> Sighting {
     let person = |(x, y)| Person {
         x: Millimetres(x),

@@ -115,11 +115,8 @@ fn a_button_runs_its_action_within_a_frame_of_its_edge() {
     // Pressed at 3 s (the press counts at its edge), taken by the frame
     // due then, which is already a step into the nod.
     assert_eq!(nod.t_ms, 3000);
-    assert!(
-        nod.reply.starts_with("ok nod amp_mdeg=6000 "),
-        "{}",
-        nod.reply
-    );
+    let reply = &nod.reply;
+    assert!(reply.starts_with("ok nod amp_mdeg=6000 "), "{reply}");
     let idle = run("", 5);
     let first = (150..250).find(|&k| trace.rows[k].angles[0] != idle.rows[k].angles[0]);
     assert_eq!(first, Some(150));
