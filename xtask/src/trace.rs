@@ -17,7 +17,7 @@ use idle_head_core::behaviour::{
 use idle_head_core::console::{ConsoleLink, HeadMode, HeadStatus};
 use idle_head_core::driver::{DriverConfig, DriverParams, FrameDriver};
 use idle_head_core::idle::{GenerateOnTake, IdlePlayer, IdleTiming, LoopSet, LoopStream};
-use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N, HeadConfig};
+use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N};
 use idle_head_core::pwm_clock::{PICO_SYS_HZ, SliceClock};
 use idle_head_core::servo::{ServoRate, SetPeriod};
 use idle_head_core::settings::Settings;
@@ -130,27 +130,23 @@ impl SetPeriod for Channel {
     }
 }
 
-/// The idle loops' configuration for `[pitch, roll, yaw]` seeds (or Table 2's).
-fn config(seeds: Option<[u32; 3]>) -> HeadConfig {
-    let mut config = DEFAULT_HEAD;
-    if let Some([pitch, roll, yaw]) = seeds {
-        (config.pitch.seed, config.roll.seed, config.yaw.seed) = (pitch, roll, yaw);
-    }
-    config
-}
-
 /// The firmware's idle source: its stream of loop sets (never-repeating
 /// unless built with `fixed-loop`), each generated when its join is due.
 pub type Idle =
     IdlePlayer<Box<LoopSet<DEFAULT_N>>, GenerateOnTake<Box<LoopSet<DEFAULT_N>>, DEFAULT_N>>;
 
-pub fn idle(config: HeadConfig, playback: Playback, seed: Option<[u32; 3]>) -> Result<Idle> {
+/// The idle of the `[pitch, roll, yaw]` seeds (else Table 2's loops).
+pub fn idle(playback: Playback, seeds: Option<[u32; 3]>) -> Result<Idle> {
+    let mut config = DEFAULT_HEAD;
+    if let Some([pitch, roll, yaw]) = seeds {
+        (config.pitch.seed, config.roll.seed, config.yaw.seed) = (pitch, roll, yaw);
+    }
     let timing = IdleTiming::new(playback).map_err(|e| anyhow!("{}", e.message()))?;
     let mut stream = LoopStream::new(config, &timing);
     let mut first = Box::new(LoopSet::new());
     stream
         .next_into(&mut first)
-        .map_err(|e| anyhow!("idle loops of seed {seed:?}: {e}"))?;
+        .map_err(|e| anyhow!("idle loops of seed {seeds:?}: {e}"))?;
     let supply = GenerateOnTake::new(stream, Box::new(LoopSet::new()));
     Ok(IdlePlayer::new(first, supply, timing, IDLE_MODE))
 }
@@ -186,7 +182,7 @@ pub fn simulate(
     let period = driver_params.config().frame_period;
     let playback =
         Playback::new(LOOP_DURATION, period, DEFAULT_N).map_err(|e| anyhow!("playback: {e:?}"))?;
-    let mut head = Head::new(idle(config(seed), playback, seed)?, params);
+    let mut head = Head::new(idle(playback, seed)?, params);
     let mut driver = FrameDriver::new([Channel::at(period)?; 3], driver_params);
     let (queue, link, show) = (CommandQueue::new(), ConsoleLink::new(), ShowLink::new());
     let mut beside = host::Beside::new(&queue, &link, &show, rate)?;

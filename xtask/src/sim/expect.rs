@@ -3,7 +3,7 @@
 use anyhow::{Result, anyhow, bail};
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use idle_head_core::driver::{DriverConfig, FrameDriver};
-use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N};
+use idle_head_core::motion::DEFAULT_N;
 use idle_head_firmware::config::LOOP_DURATION;
 use idle_head_firmware::frame::FrameLoop;
 
@@ -20,7 +20,7 @@ pub fn pico_duties(frames: usize) -> Result<Vec<[u16; 3]>> {
     let params = config.build().map_err(|e| anyhow!("{}", e.message()))?;
     let playback = Playback::new(LOOP_DURATION, config.frame_period, DEFAULT_N)
         .map_err(|e| anyhow!("playback: {e:?}"))?;
-    let idle = crate::trace::idle(DEFAULT_HEAD, playback, None)?;
+    let idle = crate::trace::idle(playback, None)?;
     let mut frame_loop = FrameLoop::new(idle, config.frame_period, TICK_HZ, 0)
         .map_err(|e| anyhow!("frame loop: {e:?}"))?;
     let mut driver = FrameDriver::new([(); 3].map(|()| Recorder::default()), params);

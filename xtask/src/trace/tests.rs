@@ -22,7 +22,7 @@ fn idle_only_is_the_plain_frame_loop() {
     assert_eq!(trace.rows[0].pulses, [1_500_000; 3]);
     let driver = DriverConfig::DEFAULT.build().unwrap();
     let playback = Playback::new(LOOP_DURATION, driver.config().frame_period, DEFAULT_N).unwrap();
-    let mut source = idle(config(None), playback, None).unwrap();
+    let mut source = idle(playback, None).unwrap();
     let period = driver.config().frame_period;
     let mut plain = FrameDriver::new([Channel::at(period).unwrap(); 3], driver);
     for row in &trace.rows {
