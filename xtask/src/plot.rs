@@ -91,7 +91,7 @@ pub fn motion(
     rows: &[(f64, [f64; 3])],
     marks: &[Mark],
 ) -> Result<()> {
-    let panel = |axis: Axis, color| {
+    let panel = |axis: Axis| {
         let i = axis.index();
         let points = rows.iter().map(|r| (r.0, r.1[i])).collect();
         let on = |m: &&Mark| m.axes.contains(&axis);
@@ -100,10 +100,8 @@ pub fn motion(
             title: format!("{} (°)", axis.name()),
             x_desc: x_desc.to_owned(),
             y_desc: "angle (°)".to_owned(),
-            curves: vec![Curve::new(axis.name(), color, points)],
-            spans: marks
-                .iter()
-                .filter(on)
+            curves: vec![Curve::new(axis.name(), [BLUE, ORANGE, GREEN][i], points)],
+            spans: (marks.iter().filter(on))
                 .map(|m| (m.from, m.to, m.shade))
                 .collect(),
             markers: (marks.iter().filter(marked))
@@ -111,13 +109,10 @@ pub fn motion(
                 .collect(),
         }
     };
-    let colors = [BLUE, ORANGE, GREEN];
     let figure = Figure {
         title,
         notes,
-        panels: Axis::ALL
-            .map(|axis| panel(axis, colors[axis.index()]))
-            .into(),
+        panels: Axis::ALL.map(panel).into(),
         panel_height: 250,
     };
     draw(&figure, path)
