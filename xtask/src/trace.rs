@@ -274,10 +274,7 @@ pub fn simulate(
 pub fn command(args: &Args) -> Result<bool> {
     let rate = args.rate;
     let (_, params) = at_rate(rate)?;
-    let events = args
-        .script
-        .as_deref()
-        .map(|path| read_script(path, &params));
+    let events = (args.script.as_deref()).map(|path| read_script(path, &params));
     let events = events.transpose()?.unwrap_or_default();
     let seeds = args.seed.map(Settings::seeds_from);
     let watch = args.telemetry.as_ref().map(|_| args.watch);
