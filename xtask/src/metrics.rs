@@ -41,11 +41,8 @@ pub struct Args {
 pub fn config(i: u32, args: Args, closure: Closure) -> (Axis, AxisConfig) {
     let axis = Axis::ALL[(i % 3) as usize];
     let seed = i.wrapping_mul(2_654_435_761).wrapping_add(12_345);
-    let cfg = DEFAULT_HEAD
-        .axis(axis)
-        .with_seed(seed)
-        .with_window(args.shape.w());
-    (axis, cfg.with_closure(closure))
+    let cfg = DEFAULT_HEAD.axis(axis).with_seed(seed);
+    (axis, cfg.with_window(args.shape.w()).with_closure(closure))
 }
 
 /// What is measured of a loop of a configuration.
