@@ -126,6 +126,7 @@ fn return_duration(params: &BehaviourParams, pitch: Angle, yaw: Angle) -> Option
 pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
     let applied = |m: &Mark| !m.refused();
     let gesture = |i: &usize| marks[*i].kind == Kind::Gesture && applied(&marks[*i]);
+    let gaze = |m: &&Mark| m.kind == Kind::Gaze && applied(m);
     let gestures: Vec<usize> = (0..marks.len()).filter(gesture).collect();
     for pair in gestures.windows(2) {
         let end = marks[pair[1]].t_ms + u64::from(blend_ms);
@@ -139,10 +140,7 @@ pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
         if marks[i].kind != Kind::Return {
             continue;
         }
-        let next_move = marks[i + 1..]
-            .iter()
-            .find(|m| m.kind == Kind::Gaze && applied(m));
-        let next_move = next_move.map(|m| m.t_ms);
+        let next_move = marks[i + 1..].iter().find(gaze).map(|m| m.t_ms);
         let mark = &mut marks[i];
         match next_move {
             Some(t) if t <= mark.t_ms => keep[i] = false,
