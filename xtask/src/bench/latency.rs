@@ -185,9 +185,8 @@ pub fn row(name: &'static str, events: &[f64], boot: &Boot) -> Result<Row> {
     row_at(name, events, boot, ServoRate::DEFAULT, GOAL_MS)
 }
 
-/// The row of `events` (ns) on yaw's pulses in `boot`, the servos at
-/// `rate` (its frames, and its PWM count for the response), with the goal
-/// `goal_ms` for p99.
+/// [`row`] with the servos at `rate` (its frames, and its PWM count for the
+/// response), against the p99 goal `goal_ms`.
 pub fn row_at(
     name: &'static str,
     events: &[f64],
