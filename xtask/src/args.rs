@@ -27,7 +27,6 @@ pub struct Timeout {
     pub timeout: u64,
 }
 
-/// A whole number, at least 1.
 pub fn at_least_one<T: std::str::FromStr + From<u8> + PartialOrd>(text: &str) -> Result<T, String> {
     match text.parse() {
         Ok(value) if value >= T::from(1) => Ok(value),
@@ -54,7 +53,6 @@ pub struct LoopShape {
 }
 
 impl LoopShape {
-    /// Samples per loop.
     pub fn n(&self) -> usize {
         self.n.unwrap_or(DEFAULT_N)
     }

@@ -143,14 +143,12 @@ mod tests {
     fn the_head_is_found_by_its_id_and_product_among_other_devices() {
         let pick = |ports: &[(&str, u16, Option<&str>)]| {
             let usb = |&(name, vid, product): &(&str, u16, Option<&str>)| {
-                let (product, serial_number, manufacturer) =
-                    (product.map(str::to_owned), None, None);
                 let usb = serialport::UsbPortInfo {
                     vid,
                     pid: PID,
-                    serial_number,
-                    manufacturer,
-                    product,
+                    serial_number: None,
+                    manufacturer: None,
+                    product: product.map(str::to_owned),
                 };
                 let port_type = serialport::SerialPortType::UsbPort(usb);
                 serialport::SerialPortInfo {

@@ -54,7 +54,6 @@ pub struct Image {
 }
 
 impl Image {
-    /// Parses the ELF at `path`.
     pub fn read(path: &Path) -> Result<Self> {
         let data = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
         Self::parse(&data).with_context(|| format!("parsing {}", path.display()))
@@ -73,7 +72,6 @@ impl Image {
         Ok(image)
     }
 
-    /// Parses the ELF `data`.
     pub fn parse(data: &[u8]) -> Result<Self> {
         let file = object::File::parse(data)?;
         let allocated = |s: &object::Section<'_, '_>| matches!(s.flags(), SectionFlags::Elf { sh_flags } if sh_flags & u64::from(elf::SHF_ALLOC) != 0);
@@ -349,10 +347,7 @@ mod tests {
         assert!(into.unwrap_err().contains("inside the settings region"));
         let moved = check(Some(0x1010_0000..0x1010_4000), 0x1000_c000);
         assert!(moved.unwrap_err().contains("the firmware's store uses"));
-        assert!(
-            check(None, 0x1000_c000)
-                .unwrap_err()
-                .contains("must reserve")
-        );
+        let unreserved = check(None, 0x1000_c000);
+        assert!(unreserved.unwrap_err().contains("must reserve"));
     }
 }

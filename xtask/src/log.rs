@@ -18,7 +18,6 @@ pub struct Defmt {
 }
 
 impl Defmt {
-    /// The table of the ELF at `elf`.
     pub fn read(elf: &Path) -> Result<Self> {
         let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
         let table = Table::parse(&bytes)

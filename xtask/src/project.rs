@@ -227,7 +227,6 @@ impl Image {
 /// The parts of `cargo metadata` this crate uses.
 #[derive(Debug)]
 pub struct Metadata {
-    /// Where cargo puts build output.
     pub target_dir: PathBuf,
 }
 

@@ -12,10 +12,8 @@ use crate::{log::Run, project};
 /// At most this many lines of a difference are printed.
 const MAX_DIFF_LINES: usize = 200;
 
-/// The expected log, from the repository root.
 const EXPECTED: &str = "boards/qemu/expected.log";
 
-/// Re-records the expected log from `run`.
 pub fn bless(run: &Run) -> Result<()> {
     let path = project::root().join(EXPECTED);
     let done = if record(&path, &run.text())? {

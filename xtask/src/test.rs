@@ -123,7 +123,6 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         PICO.build(&root)
     });
     if pico_built {
-        // The placement of the boot stage, memory budgets, no allocator.
         stages.run(PICO_IMAGE, || elf::check_pico(&PICO.elf(&metadata)));
     } else {
         stages.blocked(&[PICO_IMAGE], "the Pico build");
@@ -149,9 +148,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         // The Pico 2 on its own: its embassy-rp chip feature excludes the Pico's.
         stages.run(pico2::STAGE, || pico2::test(&metadata));
 
-        // The frame path cannot panic: this image links the frame update against
-        // a panic handler that does not exist, so the link fails if any panic
-        // path survives optimisation (boards/qemu/src/panic_proof.rs).
+        // The link fails if a panic path survives (boards/qemu/src/panic_proof.rs).
         stages.run(
             "frame path has no panic path (link of frame-path-proof)",
             || project::Image::qemu("frame-path-proof").build(&root),
@@ -302,8 +299,8 @@ fn run_apart(name: &str, cores: usize) -> Outcome {
         }
         command
             .args(["test", "--stage", name])
-            .env(project::PREBUILT, cores.to_string());
-        command.stdin(std::process::Stdio::null());
+            .env(project::PREBUILT, cores.to_string())
+            .stdin(std::process::Stdio::null());
         let mut child = command.stdout(writer.try_clone()?).stderr(writer).spawn()?;
         drop(command);
         let mut output = Vec::new();
@@ -361,9 +358,7 @@ impl Background {
             }
         };
         let chosen: Vec<_> = chosen.into_iter().map(|i| (i, blocked(i))).collect();
-        // Longest first: the latency rows, the two console streams, then the
-        // host tests (built in the foreground by then), the DMX stream and
-        // the book.
+        // Longest first (the host tests are built in the foreground by then).
         let queue = chosen
             .iter()
             .filter_map(|&(i, by)| by.is_none().then_some(i));
