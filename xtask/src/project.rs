@@ -10,7 +10,7 @@ use std::{
     time::Duration,
 };
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, anyhow, bail, ensure};
 use cargo_metadata::MetadataCommand;
 use wait_timeout::ChildExt;
 use xshell::{Cmd, Shell, cmd};
@@ -145,10 +145,8 @@ pub fn write(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
 
 /// Fails with every one of `problems`, if there are any.
 pub fn verdict(problems: &[String]) -> Result<()> {
-    match problems {
-        [] => Ok(()),
-        _ => bail!("{}", problems.join("; ")),
-    }
+    ensure!(problems.is_empty(), "{}", problems.join("; "));
+    Ok(())
 }
 
 /// Set by `cargo xtask test` on the emulator stages it runs side by side on

@@ -125,16 +125,13 @@ pub fn converse(
         });
         let mut buf = [0_u8; 4096];
         while !reading.is_finished() {
-            let n = match input.read(&mut buf) {
+            let sent = match input.read(&mut buf) {
                 Ok(0) => break,
-                Ok(n) => n,
+                Ok(n) => send(port, &mut ends, &buf[..n]),
                 Err(e) if e.kind() == ErrorKind::Interrupted => continue,
-                Err(e) => {
-                    early = Some(format!("reading the input failed: {e}"));
-                    break;
-                }
+                Err(e) => Err(format!("reading the input failed: {e}")),
             };
-            if let Err(e) = send(port, &mut ends, &buf[..n]) {
+            if let Err(e) = sent {
                 early = Some(e);
                 break;
             }

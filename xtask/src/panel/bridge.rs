@@ -91,9 +91,8 @@ impl Bridge {
     /// USB serial port.
     pub fn sim(root: &Path, elf: &Path) -> Result<Self> {
         let mut child = live::start(root, elf)?;
-        let (stdin, stdout) = (child.stdin.take(), child.stdout.take());
-        let pipes = stdin.zip(stdout).context("the harness's stdin and stdout");
-        let (stdin, stdout) = pipes?;
+        let pipes = child.stdin.take().zip(child.stdout.take());
+        let (stdin, stdout) = pipes.context("the harness's stdin and stdout")?;
         let name = "the shipped Pico image in the RP2040 emulator (USB serial port)";
         let mut bridge = Self::new(name, "sim", Box::new(HexLines(stdin)));
         bridge.child = Some(child);
