@@ -60,8 +60,11 @@ pub fn command(args: &Args) -> Result<bool> {
             Some(line) => println!("{line}"),
             None => println!("no summary line: {}", session.run.describe()),
         }
-        let port = "QEMU's UART0".to_owned();
-        (session.talk, port, session.run.succeeded())
+        (
+            session.talk,
+            "QEMU's UART0".to_owned(),
+            session.run.succeeded(),
+        )
     } else {
         let port = match &args.port {
             Some(port) => port.clone(),

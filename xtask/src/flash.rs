@@ -41,7 +41,6 @@ pub struct Surroundings {
 }
 
 impl Surroundings {
-    /// This machine's.
     pub fn here() -> Self {
         let mounts = if cfg!(windows) {
             (b'A'..=b'Z')

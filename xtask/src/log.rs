@@ -124,7 +124,6 @@ impl LogLine {
 pub struct Run {
     pub log: Vec<LogLine>,
     pub exit: Exit,
-    /// Wall time of the run.
     pub elapsed: Duration,
 }
 

@@ -45,7 +45,6 @@ pub struct Args {
     pub test: bool,
 }
 
-/// `cargo xtask panel`.
 pub fn command(args: &Args) -> Result<bool> {
     let root = project::root();
     if args.test {

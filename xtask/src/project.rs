@@ -61,7 +61,6 @@ pub fn run(sh: &Shell, env: &[(&str, &str)], cmd: Cmd<'_>) -> Result<()> {
 pub enum Exit {
     /// QEMU exited (semihosting exit code, 0 = success).
     Status(ExitStatus),
-    /// Killed after the timeout.
     TimedOut(Duration),
 }
 

@@ -54,7 +54,6 @@ pub fn command(options: Options) -> Result<bool> {
 /// How much of the log to print while QEMU runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Echo {
-    /// Every decoded line.
     All,
     /// Warnings and errors only (with their source location).
     Problems,

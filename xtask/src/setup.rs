@@ -7,7 +7,6 @@ use xshell::{Shell, cmd};
 
 use crate::{board::PICO2_TARGET, project};
 
-/// QEMU's system emulator for Arm.
 pub const QEMU_BINARY: &str = "qemu-system-arm";
 
 /// What a command that builds starts from: the firmware targets, rustfmt
@@ -99,12 +98,11 @@ pub fn ensure_mdbook(tools: &Path) -> Result<PathBuf> {
     let tools_dir = tools_dir.display();
     println!("installing {wanted} into {tools_dir} (a minute or so, once)");
     let sh = project::shell(".")?;
-    // A host program, whatever .cargo/config.toml builds for.
-    let host = "host-tuple";
+    // `host-tuple`: a host program, whatever .cargo/config.toml builds for.
     let build_dir = tools.join("build");
     let install = cmd!(
         sh,
-        "cargo install mdbook --locked --version {MDBOOK_VERSION} --no-default-features --features search --target {host} --target-dir {build_dir} --root {tools}"
+        "cargo install mdbook --locked --version {MDBOOK_VERSION} --no-default-features --features search --target host-tuple --target-dir {build_dir} --root {tools}"
     );
     // Unoptimised: it compiles in half the time, and the book still builds
     // in under a second.

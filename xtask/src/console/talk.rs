@@ -24,7 +24,6 @@ pub struct LineEnds {
 }
 
 impl LineEnds {
-    /// Takes a run of bytes.
     pub fn feed(&mut self, bytes: &[u8]) {
         for &byte in bytes {
             if self.framer.push(byte).is_some() {

@@ -21,7 +21,6 @@ use crate::sim::live;
 /// What the head says, for each page connected.
 #[derive(Debug, Clone)]
 pub enum Note {
-    /// Bytes from the head.
     Bytes(Vec<u8>),
     /// The head went away, and why.
     Gone(String),
