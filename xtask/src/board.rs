@@ -85,7 +85,7 @@ impl Board {
 
     /// The settings store: the last four 4 KiB sectors of the flash
     /// (`SETTINGS` in the board's memory.x).
-    pub fn settings(self) -> Range<u32> {
+    pub fn settings(self) -> Range<u64> {
         let end = 0x1000_0000
             + match self {
                 Self::Pico => 2 << 20,

@@ -9,7 +9,6 @@ use xshell::cmd;
 
 use crate::{project, setup, sim::node};
 
-/// The stage's name in `cargo xtask test`.
 pub const STAGE: &str = "book: built with mdBook into target/book, every link and anchor resolves";
 
 /// Where the book is built, as `docs/book.toml`'s `build-dir` also says.
@@ -17,7 +16,6 @@ const OUT: &str = "target/book";
 /// Links not followed: to any other site than linkinator's own server.
 const EXTERNAL: &str = "^https?://(?!localhost)";
 
-/// Builds the book and checks its links and the README's.
 pub fn stage(root: &Path) -> Result<()> {
     let mdbook = setup::ensure_mdbook(&root.join("target").join("tools"))?;
     let tools = root.join("xtask/book");

@@ -5,7 +5,6 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-/// The folders whose comments are scanned.
 pub const SCANNED: [&str; 5] = ["crates", "src", "boards", "host-tests", "xtask"];
 
 /// How a path a comment names starts: a folder at the repository's top.

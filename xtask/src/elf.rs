@@ -186,7 +186,6 @@ impl Image {
             );
         };
         let expected = board.settings();
-        let expected = u64::from(expected.start)..u64::from(expected.end);
         ensure!(
             region == expected,
             "the settings region is {region:#010x?} in memory.x, but the firmware's store \
@@ -206,7 +205,6 @@ impl Image {
     }
 }
 
-/// The errors of `checks`, as problems.
 pub fn problems(checks: impl IntoIterator<Item = Result<()>>) -> Vec<String> {
     (checks.into_iter())
         .filter_map(|check| check.err().map(|e| format!("{e:#}")))
@@ -329,8 +327,7 @@ mod tests {
 
     #[test]
     fn the_settings_region_must_be_reserved_and_clear() {
-        let pico = Board::Pico.settings();
-        let region = u64::from(pico.start)..u64::from(pico.end);
+        let region = Board::Pico.settings();
         let check = |settings: Option<Range<u64>>, flash_end| {
             let image = Image {
                 settings,

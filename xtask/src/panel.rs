@@ -132,7 +132,6 @@ pub const VENDOR: [(&str, &str); 2] = [
     ("uplot/uPlot.min.css", "uplot/dist/uPlot.min.css"),
 ];
 
-/// Writes the page and its dependencies to `dir`.
 fn export(root: &Path, dir: &Path) -> Result<()> {
     let panel = root.join("panel");
     std::fs::create_dir_all(dir.join("vendor/uplot"))

@@ -5,7 +5,6 @@ use anyhow::{Context, Result};
 
 use crate::{board::Board, elf, project, uf2};
 
-/// The stage's name in `cargo xtask test`.
 pub const STAGE: &str = "Pico 2 build (boards/pico2): start block, settings sectors clear, UF2 \
                          family RP2350 Arm Secure";
 

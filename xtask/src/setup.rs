@@ -34,7 +34,6 @@ pub fn prepare() -> Result<(PathBuf, project::Metadata)> {
     Ok((root.clone(), project::metadata(&root)?))
 }
 
-/// Makes sure QEMU's Arm system emulator runs ([`ensure_program`]).
 pub fn ensure_qemu() -> Result<()> {
     ensure_program(
         QEMU_BINARY,

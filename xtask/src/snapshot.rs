@@ -9,7 +9,6 @@ use snapbox::{Assert, Data, filter::NormalizeToExpected};
 
 use crate::{log::Run, project};
 
-/// At most this many lines of a difference are printed.
 const MAX_DIFF_LINES: usize = 200;
 
 const EXPECTED: &str = "boards/qemu/expected.log";

@@ -39,7 +39,7 @@ pub fn make(elf: &[u8], board: Board) -> Result<Vec<u8>> {
     let settings = board.settings().start;
     let end = image.flash_end;
     ensure!(
-        end <= u64::from(settings),
+        end <= settings,
         "the image's flash contents end at {end:#010x}, in the settings sectors from {settings:#010x}: flashing it would overwrite the saved settings"
     );
     let (chip, mut bytes) = (board.uf2_chip(), Vec::new());

@@ -38,13 +38,9 @@ pub fn stage(root: &Path, metadata: &Metadata) -> Result<()> {
     let serial = json!({ "session": "serial", "label": "web-serial", "harness": harness });
     let qemu = json!({ "session": "bridge", "label": "qemu" });
     let report = [
-        // Web Serial, the emulated Pico.
         session(root, &shots, None, serial)?,
-        // The bridge to QEMU.
         session(root, &shots, Some(Bridge::qemu(&QEMU.elf(metadata))?), qemu)?,
-        // A real serial port: QEMU's UART0 as a pseudo-terminal.
         serial_port(root, &QEMU.elf(metadata), &shots)?,
-        // The radar's map: the telemetry of a scripted walk, replayed.
         replay(root, &shots)?,
     ];
     let seconds = start.elapsed().as_secs_f64();
