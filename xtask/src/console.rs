@@ -60,11 +60,8 @@ pub fn command(args: &Args) -> Result<bool> {
             Some(line) => println!("{line}"),
             None => println!("no summary line: {}", session.run.describe()),
         }
-        (
-            session.talk,
-            "QEMU's UART0".to_owned(),
-            session.run.succeeded(),
-        )
+        let port = "QEMU's UART0".to_owned();
+        (session.talk, port, session.run.succeeded())
     } else {
         let port = match &args.port {
             Some(port) => port.clone(),
