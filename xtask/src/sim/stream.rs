@@ -109,7 +109,7 @@ fn replies(
 
 /// Loop sets generated in `boot` from `from` on.
 fn sets(boot: &Boot, from: Duration) -> usize {
-    let from = from.as_nanos() as f64;
+    let from = from.as_secs_f64() * 1e9;
     let log = boot.log.iter().filter(|(at, _)| *at >= from);
     log.filter(|(_, line)| line.message.starts_with("loop set "))
         .count()
