@@ -118,7 +118,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     // 1. The Pico image and the watchdog drill's: the emulator stages run on
     // them in the background, at a low priority, while the stages below take
     // the cores first (their links and waits leave a core idle at times).
-    let emulated = (EMULATED.iter()).any(|(name, _)| needs_image(name) && stages.chosen(name));
+    let emulated = (APART.iter()).any(|(name, _)| needs_image(name) && stages.chosen(name));
     let pico_built = stages.run_if(emulated, "Pico build (cargo build --release)", || {
         PICO.build(&root)
     });
@@ -215,7 +215,7 @@ const CARGO: [(&str, &str, bool, &str); 14] = [
 ];
 
 /// A stage run apart: its name, and what it runs.
-type Emulated = (&'static str, fn(&Path, &Metadata) -> Result<()>);
+type Apart = (&'static str, fn(&Path, &Metadata) -> Result<()>);
 
 /// The host tests' run: built in the foreground, run in the background
 /// (`cargo test` holds no cargo lock while its tests run).
@@ -232,7 +232,7 @@ fn needs_image(name: &str) -> bool {
 /// book, then the ones in the RP2040 emulator, on images built already.
 /// [`Background::start`] starts the longest first. Only the latency stage
 /// records figures.
-const EMULATED: [Emulated; 18] = [
+const APART: [Apart; 18] = [
     (HOST_TESTS, |_, _| {
         let sh = project::shell("host-tests")?;
         project::run(&sh, &[], cmd!(sh, "cargo test"))
@@ -271,10 +271,10 @@ fn peak_file(metadata: &Metadata) -> std::path::PathBuf {
     metadata.target_dir.join("sim-pulses-peak-stack")
 }
 
-/// `cargo xtask test --stage NAME`: one of [`EMULATED`], on images built
+/// `cargo xtask test --stage NAME`: one of [`APART`], on images built
 /// already.
 pub fn stage(name: &str) -> Result<bool> {
-    let Some((_, run)) = EMULATED.iter().find(|(stage, _)| *stage == name) else {
+    let Some((_, run)) = APART.iter().find(|(stage, _)| *stage == name) else {
         bail!("no emulator stage is called `{name}`");
     };
     let root = project::root();
@@ -320,10 +320,10 @@ fn run_apart(name: &str, cores: usize) -> Outcome {
     (output, failed, start.elapsed().as_secs_f64())
 }
 
-/// The emulator stages ([`EMULATED`]) run apart, side by side, in the
-/// background; their results are scored in order by [`Background::record`].
+/// The stages of [`APART`], side by side in the background; their results
+/// are scored in order by [`Background::record`].
 struct Background {
-    /// The chosen stages' indices in [`EMULATED`], each with what keeps it
+    /// The chosen stages' indices in [`APART`], each with what keeps it
     /// from running, if anything.
     chosen: Vec<(usize, Option<&'static str>)>,
     results: std::sync::mpsc::Receiver<(usize, Outcome)>,
@@ -338,20 +338,20 @@ impl Background {
         pico_built: bool,
         drill_built: bool,
     ) -> Self {
-        let chosen: Vec<usize> = (0..EMULATED.len())
-            .filter(|&i| stages.chosen(EMULATED[i].0))
+        let chosen: Vec<usize> = (0..APART.len())
+            .filter(|&i| stages.chosen(APART[i].0))
             .collect();
         let cannot = |error: &anyhow::Error| println!("the emulator cannot run: {error:#}");
-        let emulated = chosen.iter().any(|&i| needs_image(EMULATED[i].0));
+        let emulated = chosen.iter().any(|&i| needs_image(APART[i].0));
         let node = !emulated || sim::node::ensure(root).inspect_err(cannot).is_ok();
         let blocked = |i: usize| {
-            if !needs_image(EMULATED[i].0) {
+            if !needs_image(APART[i].0) {
                 None
             } else if !pico_built {
                 Some("the Pico build")
             } else if !node {
                 Some("the emulator's setup")
-            } else if EMULATED[i].0 == sim::DRILL_STAGE && !drill_built {
+            } else if APART[i].0 == sim::DRILL_STAGE && !drill_built {
                 Some("the drill image's build")
             } else {
                 None
@@ -371,7 +371,7 @@ impl Background {
             sim::DMX_STREAM_STAGE,
             book::STAGE,
         ];
-        let rank = |i: &usize| long.iter().position(|name| *name == EMULATED[*i].0);
+        let rank = |i: &usize| long.iter().position(|name| *name == APART[*i].0);
         queue.sort_by_key(|i| rank(i).unwrap_or(long.len()));
         let queue = std::sync::Arc::new(std::sync::Mutex::new(queue.into_iter()));
         let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
@@ -380,7 +380,7 @@ impl Background {
             let (sender, queue) = (sender.clone(), queue.clone());
             scope.spawn(move || {
                 while let Some(i) = queue.lock().ok().and_then(|mut q| q.next()) {
-                    let _ = sender.send((i, run_apart(EMULATED[i].0, cores)));
+                    let _ = sender.send((i, run_apart(APART[i].0, cores)));
                 }
             });
         }
@@ -391,10 +391,10 @@ impl Background {
     /// RAM with the peak stack measured in the pulses stage.
     fn record(self, stages: &mut Stages<'_>, metadata: &Metadata, qemu_run: Option<&Run>) {
         const MEMORY: &str = "RAM: static + peak stack of the Pico image within its budget";
-        let mut done: Vec<Option<Outcome>> = vec![None; EMULATED.len()];
+        let mut done: Vec<Option<Outcome>> = vec![None; APART.len()];
         for &(i, blocked) in &self.chosen {
             if let Some(by) = blocked {
-                stages.blocked(&[EMULATED[i].0], by);
+                stages.blocked(&[APART[i].0], by);
                 continue;
             }
             while done[i].is_none() {
@@ -404,9 +404,9 @@ impl Background {
                 done[j] = Some(outcome);
             }
             let lost = || (Vec::new(), Some("its worker stopped".to_owned()), 0.0);
-            stages.record(EMULATED[i].0, done[i].take().unwrap_or_else(lost));
+            stages.record(APART[i].0, done[i].take().unwrap_or_else(lost));
         }
-        stages.left_out += EMULATED.len() - self.chosen.len();
+        stages.left_out += APART.len() - self.chosen.len();
         stages.run(MEMORY, || {
             let stack = std::fs::read_to_string(peak_file(metadata)).ok();
             let stack = stack.and_then(|s| s.trim().parse().ok());
