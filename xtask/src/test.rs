@@ -184,7 +184,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
 /// The stages that run cargo, `(name, folder, firmware, commands)`: the
 /// firmware's with its build environment (and `--release`, to share build
 /// scripts with the release builds), the commands' arguments separated by
-/// ` && `.
+/// ` && `; the host's clippy passes take the profile of the build before them.
 #[rustfmt::skip] // a table, one stage a line
 const CARGO: [(&str, &str, bool, &str); 14] = [
     // Built here, at full priority: their run is a background stage.
@@ -201,11 +201,14 @@ const CARGO: [(&str, &str, bool, &str); 14] = [
     ("clippy: Pico 2 image, boards/pico2/ (thumbv8m.main)", "boards/pico2", true,
      "clippy --release -- -D warnings"),
     ("clippy: core crate and its unit tests (host)", ".", false,
-     "clippy --package idle-head-core --all-targets --target host-tuple -- -D warnings"),
+     "clippy --profile test --package idle-head-core --all-targets --target host-tuple \
+      -- -D warnings"),
     ("clippy: firmware layer and its unit tests (host)", ".", false,
-     "clippy --package idle-head-firmware --all-targets --target host-tuple -- -D warnings"),
-    ("clippy: host-tests", "host-tests", false, "clippy --all-targets -- -D warnings"),
-    ("clippy: xtask", "xtask", false, "clippy --all-targets -- -D warnings"),
+     "clippy --profile test --package idle-head-firmware --all-targets --target host-tuple \
+      -- -D warnings"),
+    ("clippy: host-tests", "host-tests", false,
+     "clippy --profile test --all-targets -- -D warnings"),
+    ("clippy: xtask", "xtask", false, "clippy --profile xtask --all-targets -- -D warnings"),
     // The calibration image (same bin, feature `calibrate`) must compile.
     ("Pico calibration image compiles (--features calibrate)", ".", true,
      "check --release --features calibrate"),
