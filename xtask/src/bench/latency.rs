@@ -8,12 +8,13 @@ use std::{fmt::Write as _, path::Path, time::Duration};
 use anyhow::{Result, bail};
 use idle_head_core::servo::ServoRate;
 
+use super::paths::first_boot;
 use crate::figures;
 use crate::metrics::percentile;
 use crate::project::Metadata;
 use crate::sim::pulses::{self, Measured};
 use crate::sim::script::{Against, Board, play};
-use crate::sim::{Boot, parse_script, run_shipped, script_time};
+use crate::sim::{Boot, parse_script, script_time};
 use crate::trace::show_seconds;
 
 /// Events per row, at least; more are scheduled, for the ones skipped.
@@ -249,9 +250,8 @@ pub fn dmx(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row> {
         let _ = writeln!(script, "{:.6} 1={}", at.as_secs_f64(), 101 - k % 2);
     }
     let line = crate::sim::dmx::line(&crate::sim::dmx::parse(&script)?);
-    let end = times.last().copied().unwrap_or(start) + Duration::from_millis(500);
-    let report = run_shipped(root, metadata, end, wall, |config| config.dmx = Some(line))?;
-    let boot = report.first()?;
+    let run = (root, metadata, wall);
+    let boot = &first_boot(run, &times, |config| config.dmx = Some(line))?;
     // The first change is the set-up's.
     let events: Vec<f64> = boot.dmx_changes.iter().skip(1).copied().collect();
     count(events.len(), times.len(), "DMX frames carried a change")?;

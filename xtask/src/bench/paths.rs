@@ -51,23 +51,23 @@ fn all_ok(replies: &[u8], what: &str) -> Result<()> {
 }
 
 /// Where and how long the shipped image runs: the project, the wall time.
-type Shipped<'a> = (&'a Path, &'a Metadata, Duration);
+pub type Shipped<'a> = (&'a Path, &'a Metadata, Duration);
 
 /// The first boot of the shipped image, set up by `setup`, run until 0.5 s
-/// after `last`.
-fn first_boot(
+/// after the last of the events at `times`.
+pub fn first_boot(
     (root, metadata, wall): Shipped,
-    last: Duration,
+    times: &[Duration],
     setup: impl FnOnce(&mut node::Config),
 ) -> Result<Boot> {
-    let end = last + Duration::from_millis(500);
+    let end = times.last().copied().unwrap_or_default() + Duration::from_millis(500);
     let report = run_shipped(root, metadata, end, wall, setup)?;
     report.boots.into_iter().next().context("no boot")
 }
 
 /// [`first_boot`] with `chunks` sent to the USB port, every reply `ok`.
-fn usb_run(run: Shipped, last: Duration, chunks: Vec<Chunk>, what: &str) -> Result<Boot> {
-    let boot = first_boot(run, last, |config| config.usb = chunks)?;
+fn usb_run(run: Shipped, times: &[Duration], chunks: Vec<Chunk>, what: &str) -> Result<Boot> {
+    let boot = first_boot(run, times, |config| config.usb = chunks)?;
     all_ok(&boot.usb, what)?;
     Ok(boot)
 }
@@ -78,8 +78,7 @@ pub fn usb_look(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
     let mut chunks = vec![Chunk::new(b"idle off\n", Duration::from_millis(2500))];
     let looks = times.iter().enumerate();
     chunks.extend(looks.map(|(k, at)| Chunk::new(look_line(k), *at)));
-    let last = times.last().copied().unwrap_or_default();
-    let boot = usb_run((root, metadata, wall), last, chunks, "usb look")?;
+    let boot = usb_run((root, metadata, wall), &times, chunks, "usb look")?;
     let events: Vec<f64> = boot.usb_in.iter().skip(1).copied().collect();
     count(events.len(), times.len(), "USB lines went out")?;
     latency::row("usb look", &events, &boot)
@@ -119,8 +118,7 @@ fn uart_looks(run: Shipped, setup: &[u8], seed: u32) -> Result<(Vec<f64>, Boot)>
         let on_the_wire = BYTE_TIME * u32::try_from(line.len()).unwrap_or(u32::MAX);
         UartScript::new(0, line, at.saturating_sub(on_the_wire))
     }));
-    let last = times.last().copied().unwrap_or_default();
-    let boot = first_boot(run, last, |config| config.uart = scripts)?;
+    let boot = first_boot(run, &times, |config| config.uart = scripts)?;
     // One script for the setup, one for each look.
     let (sent, want) = (boot.uart_lines.len(), times.len() + 1);
     count(sent, want, "UART scripts went out")?;
@@ -175,8 +173,7 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
         chunks.push(Chunk::new(lines, pair[0].saturating_sub(AHEAD)));
         events.push(t0 + (clock_ms + start) as f64 * 1e6);
     }
-    let last = times.last().copied().unwrap_or_default();
-    let boot = usb_run((root, metadata, wall), last, chunks, "bottango")?;
+    let boot = usb_run((root, metadata, wall), &times, chunks, "bottango")?;
     latency::row("bottango", &events, &boot)
 }
 
