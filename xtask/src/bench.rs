@@ -28,7 +28,7 @@ use crate::figures::{self, thousands};
 use crate::log::{LogLine, Run, field, number};
 use crate::{
     args::Options,
-    project::{Image, Metadata, QEMU},
+    project::{self, Image, Metadata, QEMU},
     qemu::{self, Echo},
     setup,
 };
@@ -331,12 +331,8 @@ pub fn command(options: Options) -> Result<bool> {
         ("tracking", tracking::stage()),
         ("latency", paths::stage(&root, &metadata)),
     ];
-    for (what, result) in &results {
-        if let Err(error) = result {
-            println!("{what} FAILED: {error:#}");
-        }
-    }
-    Ok(results.iter().all(|(_, result)| result.is_ok()))
+    let passed = results.map(|(what, result)| project::passed(what, &result));
+    Ok(!passed.contains(&false))
 }
 
 /// The benchmark's rows, for the measured figures.

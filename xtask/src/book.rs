@@ -35,11 +35,5 @@ pub fn stage(root: &Path) -> Result<()> {
 /// `cargo xtask book`. `Ok(false)` when the build or the link check failed.
 pub fn command() -> Result<bool> {
     let (root, _) = setup::prepare()?;
-    match stage(&root) {
-        Ok(()) => Ok(true),
-        Err(error) => {
-            println!("book FAILED: {error:#}");
-            Ok(false)
-        }
-    }
+    Ok(project::passed("book", &stage(&root)))
 }

@@ -148,6 +148,14 @@ pub fn verdict(problems: &[String]) -> Result<()> {
     Ok(())
 }
 
+/// Whether a command's `what` passed; if not, `<what> FAILED: <error>`.
+pub fn passed(what: &str, result: &Result<()>) -> bool {
+    if let Err(error) = result {
+        println!("{what} FAILED: {error:#}");
+    }
+    result.is_ok()
+}
+
 /// Set by `cargo xtask test` on the emulator stages it runs side by side on
 /// images built already: [`Image::build`] then builds nothing.
 pub const PREBUILT: &str = "IDLE_HEAD_PREBUILT";

@@ -200,10 +200,7 @@ pub fn command(args: &Args) -> Result<bool> {
             return Ok(report.problems.is_empty());
         }
     };
-    if let Err(error) = &result {
-        println!("sim FAILED: {error:#}");
-    }
-    Ok(result.is_ok())
+    Ok(project::passed("sim", &result))
 }
 
 /// A run of its own that `cargo xtask test` runs as a stage.
