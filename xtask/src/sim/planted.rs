@@ -10,12 +10,12 @@ use std::{
 
 use super::node::Fill;
 use anyhow::{Context as _, Result, bail, ensure};
-use embedded_storage_async::nor_flash::NorFlashErrorKind::{self, OutOfBounds};
-use embedded_storage_async::nor_flash::{ErrorType, NorFlash, ReadNorFlash};
 use idle_head_core::settings::{RawRecord, Record, SETTINGS_BUFFER, Settings, SettingsStore};
+use sequential_storage::mock_flash::{MockFlashBase, WriteCountCheck};
 
-/// The Pico's flash: erase sector and write unit.
-const SECTOR: usize = 4096;
+/// The Pico's settings sectors: bytes read and written one at a time, 4 KiB
+/// sectors, four of them (as `host-tests` has them).
+type PicoSectors = MockFlashBase<4, 1, 4096>;
 
 /// The version 1 fixture's sectors (`len` bytes).
 pub fn version_1_sectors(root: &Path, len: usize) -> Result<Vec<u8>> {
@@ -44,62 +44,23 @@ pub fn settings_sectors(settings: &Settings, len: usize) -> Result<Vec<u8>> {
 
 /// `len` bytes of sectors the core's `SettingsStore` saved `record` to.
 fn plant<R: Record, const BUF: usize>(record: &R, len: usize) -> Result<Vec<u8>> {
-    let flash = RamFlash(vec![0xff; len]);
-    let mut store: SettingsStore<RamFlash, R, BUF> =
-        SettingsStore::new(flash, 0..u32::try_from(len)?)
-            .map_err(|e| anyhow::anyhow!("the settings store refused the range: {e:?}"))?;
-    // Polled once: [`RamFlash`] never waits.
+    // Erased bytes read 0xff, a write clears bits, as on the chip; any
+    // number of writes between erases, at any alignment.
+    let flash = PicoSectors::new(WriteCountCheck::Disabled, None, false);
+    let range = PicoSectors::FULL_FLASH_RANGE;
+    ensure!(
+        usize::try_from(range.end) == Ok(len),
+        "the settings region is {len} bytes, not the Pico's {}",
+        range.end
+    );
+    let mut store: SettingsStore<PicoSectors, R, BUF> = SettingsStore::new(flash, range)
+        .map_err(|e| anyhow::anyhow!("the settings store refused the range: {e:?}"))?;
+    // Polled once: the mock flash never waits.
     let saved = pin!(store.save(record)).poll(&mut Context::from_waker(Waker::noop()));
     match saved {
-        Poll::Ready(Ok(())) => Ok(store.into_flash().0),
+        Poll::Ready(Ok(())) => Ok(store.into_flash().as_bytes().to_vec()),
         Poll::Ready(Err(e)) => bail!("{e:?}"),
         Poll::Pending => bail!("the store's save waited"),
-    }
-}
-
-/// NOR flash in RAM: erased bytes read `0xff`, a write clears bits.
-struct RamFlash(Vec<u8>);
-
-impl ErrorType for RamFlash {
-    type Error = NorFlashErrorKind;
-}
-
-impl RamFlash {
-    fn span(&mut self, offset: u32, len: usize) -> Result<&mut [u8], NorFlashErrorKind> {
-        let start = usize::try_from(offset).map_err(|_| OutOfBounds)?;
-        self.0.get_mut(start..start + len).ok_or(OutOfBounds)
-    }
-}
-
-impl ReadNorFlash for RamFlash {
-    const READ_SIZE: usize = 1;
-
-    async fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), Self::Error> {
-        bytes.copy_from_slice(self.span(offset, bytes.len())?);
-        Ok(())
-    }
-
-    fn capacity(&self) -> usize {
-        self.0.len()
-    }
-}
-
-impl NorFlash for RamFlash {
-    const WRITE_SIZE: usize = 1;
-    const ERASE_SIZE: usize = SECTOR;
-
-    async fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
-        let len =
-            usize::try_from(to.checked_sub(from).ok_or(OutOfBounds)?).map_err(|_| OutOfBounds)?;
-        self.span(from, len)?.fill(0xff);
-        Ok(())
-    }
-
-    async fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Self::Error> {
-        for (cell, byte) in self.span(offset, bytes.len())?.iter_mut().zip(bytes) {
-            *cell &= byte;
-        }
-        Ok(())
     }
 }
 
