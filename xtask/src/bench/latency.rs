@@ -5,16 +5,15 @@
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use idle_head_core::servo::ServoRate;
 
-use super::paths::first_boot;
 use crate::figures;
 use crate::metrics::percentile;
 use crate::project::Metadata;
 use crate::sim::pulses::{self, Measured};
 use crate::sim::script::{Against, Board, play};
-use crate::sim::{Boot, parse_script, script_time};
+use crate::sim::{Boot, node, parse_script, run_shipped, script_time};
 use crate::trace::show_seconds;
 
 /// Events per row, at least; more are scheduled, for the ones skipped.
@@ -237,6 +236,21 @@ pub fn row_at(
         waited_us,
         goal_ms,
     })
+}
+
+/// Where and how long the shipped image runs: the project, the wall time.
+pub type Shipped<'a> = (&'a Path, &'a Metadata, Duration);
+
+/// The first boot of the shipped image, set up by `setup`, run until 0.5 s
+/// after the last of the events at `times`.
+pub fn first_boot(
+    (root, metadata, wall): Shipped,
+    times: &[Duration],
+    setup: impl FnOnce(&mut node::Config),
+) -> Result<Boot> {
+    let end = times.last().copied().unwrap_or_default() + Duration::from_millis(500);
+    let report = run_shipped(root, metadata, end, wall, setup)?;
+    report.boots.into_iter().next().context("no boot")
 }
 
 /// `latency dmx`: a console at full mix moves yaw one coarse step up and

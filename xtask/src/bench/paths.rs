@@ -14,10 +14,10 @@ use std::{path::Path, time::Duration};
 use anyhow::{Context, Result, bail};
 use idle_head_core::servo::ServoRate;
 
-use super::latency::{self, LOOK_GAP, Row, SCHEDULED, count, schedule};
+use super::latency::{self, LOOK_GAP, Row, SCHEDULED, Shipped, count, first_boot, schedule};
 use crate::metrics::parallel;
 use crate::project::Metadata;
-use crate::sim::{BYTE_TIME, Boot, Chunk, UartScript, bottango_lines, node, run_shipped};
+use crate::sim::{BYTE_TIME, Boot, Chunk, UartScript, bottango_lines, run_shipped};
 use crate::{figures, project};
 
 /// A path's run, for its row.
@@ -48,21 +48,6 @@ fn all_ok(replies: &[u8], what: &str) -> Result<()> {
         Some(line) => bail!("{what}: a line refused: {line:?}"),
         None => Ok(()),
     }
-}
-
-/// Where and how long the shipped image runs: the project, the wall time.
-pub type Shipped<'a> = (&'a Path, &'a Metadata, Duration);
-
-/// The first boot of the shipped image, set up by `setup`, run until 0.5 s
-/// after the last of the events at `times`.
-pub fn first_boot(
-    (root, metadata, wall): Shipped,
-    times: &[Duration],
-    setup: impl FnOnce(&mut node::Config),
-) -> Result<Boot> {
-    let end = times.last().copied().unwrap_or_default() + Duration::from_millis(500);
-    let report = run_shipped(root, metadata, end, wall, setup)?;
-    report.boots.into_iter().next().context("no boot")
 }
 
 /// [`first_boot`] with `chunks` sent to the USB port, every reply `ok`.
