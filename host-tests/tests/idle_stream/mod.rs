@@ -44,7 +44,15 @@ fn player(config: HeadConfig, mode: IdleMode) -> Player {
 
 /// Frames `0..frames` of `config`'s idle in `mode`, `[pitch, roll, yaw]` in m°.
 fn play(config: HeadConfig, mode: IdleMode, frames: usize) -> Vec<[i32; 3]> {
-    let mut p = player(config, mode);
+    played(&mut player(config, mode), frames)
+}
+
+/// Frames `0..frames` of the player `p`, `[pitch, roll, yaw]` in m°.
+fn played<H, S>(p: &mut IdlePlayer<H, S>, frames: usize) -> Vec<[i32; 3]>
+where
+    H: std::ops::Deref<Target = Set>,
+    S: LoopSupply<H>,
+{
     (0..frames as u64)
         .map(|k| p.offsets(at(k)).map(|a| a.millidegrees()))
         .collect()

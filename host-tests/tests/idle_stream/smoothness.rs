@@ -7,7 +7,7 @@ use idle_head_core::Axis;
 use idle_head_core::idle::{IdleMode, IdlePlayer, LoopSupply, MAX_DRAWS, NoSupply};
 use idle_head_core::motion::HeadConfig;
 
-use super::{FRAME_US, Set, Stream, at, config_for, timing};
+use super::{FRAME_US, Set, Stream, config_for, played, timing};
 
 /// The ratios of a window `x`: max|d1|/P95|d1| and max|d2|/P95|d2| over
 /// the whole window, then the same maxima taken over `region` only (the
@@ -163,16 +163,12 @@ fn measure(from: u64, to: u64) -> Smoothness {
         let sets = sets(config_for(seed), JOINS + 3, JOINS + 1, &mut s);
         let supply = Prepared(sets[1..].iter());
         let mut p = IdlePlayer::new(&sets[0], supply, t, IdleMode::NeverRepeating);
-        let stream: Vec<[i32; 3]> = (0..frames as u64)
-            .map(|k| p.offsets(at(k)).map(|a| a.millidegrees()))
-            .collect();
+        let stream = played(&mut p, frames);
         // Each of the first JOINS + 1 sets played alone, one loop from its entry.
         let mut alone = Vec::with_capacity((JOINS + 1) * loop_frames);
         for set in &sets[..=JOINS] {
             let mut p = IdlePlayer::new(set, NoSupply, t, IdleMode::FixedLoop);
-            alone.extend(
-                (0..loop_frames as u64).map(|k| p.offsets(at(k)).map(|a| a.millidegrees())),
-            );
+            alone.extend(played(&mut p, loop_frames));
         }
         for k in 1..=JOINS {
             let centre = k * period + join / 2;
