@@ -20,8 +20,15 @@ pub struct Radar {
 
 impl Radar {
     pub fn of(events: &[Event]) -> Self {
+        let person = |(x, y)| Person {
+            x: Millimetres(x),
+            y: Millimetres(y),
+        };
         let radar = |e: &Event| match e.kind {
-            Kind::Radar(seen) => Some((e.at_us, sighting(&seen))),
+            Kind::Radar(seen) => {
+                let people = seen.map(|p| p.map(person));
+                Some((e.at_us, Sighting { people }))
+            }
             _ => None,
         };
         let lines: Vec<(u64, Sighting)> = events.iter().filter_map(radar).collect();
@@ -43,15 +50,5 @@ impl Radar {
             };
             show.track.publish(Some(seen), counters);
         }
-    }
-}
-
-fn sighting(seen: &[Option<(i32, i32)>; 3]) -> Sighting {
-    let person = |(x, y)| Person {
-        x: Millimetres(x),
-        y: Millimetres(y),
-    };
-    Sighting {
-        people: seen.map(|p| p.map(person)),
     }
 }
