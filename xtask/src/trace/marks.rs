@@ -124,9 +124,8 @@ fn return_duration(params: &BehaviourParams, pitch: Angle, yaw: Angle) -> Option
 /// comes while it plays; a return after `end_ms` is left out. The marks end
 /// up in time order.
 pub fn settle(marks: &mut Vec<Mark>, blend_ms: u32, end_ms: u64) {
-    let applied = |m: &Mark| !m.refused();
-    let gesture = |i: &usize| marks[*i].kind == Kind::Gesture && applied(&marks[*i]);
-    let gaze = |m: &&Mark| m.kind == Kind::Gaze && applied(m);
+    let gesture = |i: &usize| marks[*i].kind == Kind::Gesture && !marks[*i].refused();
+    let gaze = |m: &&Mark| m.kind == Kind::Gaze && !m.refused();
     let gestures: Vec<usize> = (0..marks.len()).filter(gesture).collect();
     for pair in gestures.windows(2) {
         let end = marks[pair[1]].t_ms + u64::from(blend_ms);
