@@ -272,13 +272,12 @@ pub fn simulate(
 /// `cargo xtask trace`: the CSV, and the PNG if asked for, to trace/ in the
 /// target directory (build output, not the repository) unless told otherwise.
 pub fn command(args: &Args) -> Result<bool> {
-    let rate = args.rate;
-    let (_, params) = at_rate(rate)?;
+    let (_, params) = at_rate(args.rate)?;
     let events = (args.script.as_deref()).map(|path| read_script(path, &params));
     let events = events.transpose()?.unwrap_or_default();
     let seeds = args.seed.map(Settings::seeds_from);
     let watch = args.telemetry.as_ref().map(|_| args.watch);
-    let trace = simulate(args.micros, seeds, rate, &events, watch, &[])?;
+    let trace = simulate(args.micros, seeds, args.rate, &events, watch, &[])?;
     let default = |name: &str| -> Result<PathBuf> {
         let target = project::metadata(&project::root())?.target_dir;
         Ok(target.join("trace").join(name))
@@ -287,8 +286,7 @@ pub fn command(args: &Args) -> Result<bool> {
     let mut csv = "frame,t_ms,pitch_mdeg,roll_mdeg,yaw_mdeg,pitch_ns,roll_ns,yaw_ns\n".to_owned();
     for (frame, row) in trace.rows.iter().enumerate() {
         let ([p, r, y], [pn, rn, yn]) = (row.angles, row.pulses);
-        let t = ms(row.t_us);
-        let _ = writeln!(csv, "{frame},{t},{p},{r},{y},{pn},{rn},{yn}");
+        let _ = writeln!(csv, "{frame},{},{p},{r},{y},{pn},{rn},{yn}", ms(row.t_us));
     }
     project::write(&out, csv)?;
     for mark in &trace.marks {
