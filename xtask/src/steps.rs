@@ -49,13 +49,10 @@ impl Steps {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use idle_head_core::behaviour::BehaviourConfig;
-    use idle_head_core::driver::DriverConfig;
 
     #[test]
     fn the_default_idle_limits_are_1200_and_240_millidegrees_a_frame() {
-        let driver = DriverConfig::DEFAULT.build().unwrap();
-        let params = BehaviourConfig::DEFAULT.build(&driver).unwrap();
+        let (_, params) = crate::trace::built_in().unwrap();
         let of = |step, turn| Steps { step, turn };
         for axis in Axis::ALL {
             let allowed = Steps::allowed(&params, axis, LimitMode::Idle);
