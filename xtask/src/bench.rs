@@ -428,10 +428,9 @@ fn telemetry_check(elf: &Path, timeout: Duration, plain: Option<&Run>) -> Result
         None => frame_work(&qemu::run(elf, timeout, Echo::Problems)?.log)?,
     };
     let seen = AtomicUsize::new(0);
-    let deadline = Instant::now() + timeout;
     let input = b"watch 50\n".chain(Streaming {
         seen: &seen,
-        deadline,
+        deadline: Instant::now() + timeout,
     });
     let mut count = |line: &[u8]| {
         if line.starts_with(b"~ ") {

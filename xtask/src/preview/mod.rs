@@ -119,11 +119,10 @@ impl Args {
 }
 
 pub fn command(args: &Args) -> Result<bool> {
-    let loops = args.loops()?;
     let out = (args.out.clone()).unwrap_or_else(|| project::root().join("preview"));
     // Paths as the user would name them: relative to the current folder.
     let here = std::env::current_dir().unwrap_or_default();
-    for (spec, stem) in loops {
+    for (spec, stem) in args.loops()? {
         let stages = Stages::compute(spec)?;
         let [csv, png] = ["csv", "png"].map(|ext| out.join(format!("{stem}.{ext}")));
         project::write(&csv, stages.csv())?;
