@@ -98,12 +98,10 @@ impl Walk {
         };
         let mean_square = |e: &[f64]| e.iter().map(|e| e * e).sum::<f64>() / e.len().max(1) as f64;
         // Where the bearing is inside the limits, in 10 ms steps.
+        let fit = |ms: i64| mean_square(&errors(ms as f64 * 1000.0, true));
         let lag_ms = (-20..=50)
             .map(|steps| steps * 10)
-            .min_by(|&a, &b| {
-                let fit = |ms: i64| mean_square(&errors(ms as f64 * 1000.0, true));
-                fit(a).total_cmp(&fit(b))
-            })
+            .min_by(|&a, &b| fit(a).total_cmp(&fit(b)))
             .unwrap_or(0);
         let plain = errors(0.0, false);
         Ok(Self {
