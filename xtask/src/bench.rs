@@ -438,10 +438,10 @@ fn telemetry_check(elf: &Path, timeout: Duration, plain: Option<&Run>) -> Result
         }
     };
     let wait = Duration::from_secs(5);
-    let session = qemu_session(elf, input, &mut count, Pace::Fast, Echo::Problems, wait)?;
+    let (run, _) = qemu_session(elf, input, &mut count, Pace::Fast, Echo::Problems, wait)?;
     let lines = seen.load(Ordering::Acquire);
-    let with = frame_work(&session.run.log)?;
-    let verdict = qemu::check_summary(&session.run.log)?;
+    let with = frame_work(&run.log)?;
+    let verdict = qemu::check_summary(&run.log)?;
     if lines < LINES {
         bail!("telemetry: only {lines} lines streamed during the run");
     }

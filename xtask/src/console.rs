@@ -51,17 +51,17 @@ pub fn command(args: &Args) -> Result<bool> {
         project::QEMU.build(&root)?;
         eprintln!("console: QEMU running; type commands, end with Ctrl-D");
         let elf = project::QEMU.elf(&metadata);
-        let session = qemu_session(&elf, stdin, &mut print, Pace::RealTime, Echo::Quiet, wait)?;
+        let (run, talk) = qemu_session(&elf, stdin, &mut print, Pace::RealTime, Echo::Quiet, wait)?;
         // stdout has the replies and the summary only.
-        for line in session.run.log.iter().filter(|l| l.is_problem()) {
+        for line in run.log.iter().filter(|l| l.is_problem()) {
             eprintln!("{}", line.snapshot());
         }
-        match log::summary(&session.run.log) {
+        match log::summary(&run.log) {
             Some(line) => println!("{line}"),
-            None => println!("no summary line: {}", session.run.describe()),
+            None => println!("no summary line: {}", run.describe()),
         }
         let port = "QEMU's UART0".to_owned();
-        (session.talk, port, session.run.succeeded())
+        (talk, port, run.succeeded())
     } else {
         let port = match &args.port {
             Some(port) => port.clone(),

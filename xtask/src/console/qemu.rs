@@ -26,20 +26,15 @@ pub enum Pace {
     Fast,
 }
 
-/// A QEMU run with its console: the firmware's log and exit, and the
-/// conversation (lines sent, replies, what ended it early).
-pub struct QemuSession {
-    pub run: Run,
-    pub talk: Talk,
-}
-
 /// How long QEMU has to stop after the hang-up (the firmware fades out,
 /// then prints its summary), and the reply reader to read a byte.
 const AFTER_HANG_UP: Duration = Duration::from_secs(120);
 
 /// Runs `elf` in QEMU held for its console: [`talk::converse`] on UART0,
 /// then the hang-up (a byte on UART1): the firmware fades out, prints its
-/// summary and exits, which closes the socket and ends the reader.
+/// summary and exits, which closes the socket and ends the reader. The run
+/// (the firmware's log and exit) and the conversation (lines sent, replies,
+/// what ended it early).
 pub fn qemu_session(
     elf: &Path,
     input: impl Read,
@@ -47,7 +42,7 @@ pub fn qemu_session(
     pace: Pace,
     echo: Echo,
     wait: Duration,
-) -> Result<QemuSession> {
+) -> Result<(Run, Talk)> {
     let (child, [mut console, mut hang_up]) = spawn_connected(elf, pace, Stdio::piped)?;
     let (run, talk) = qemu::finish(child, elf, AFTER_HANG_UP, echo, || {
         let reader = console.try_clone()?;
@@ -58,7 +53,7 @@ pub fn qemu_session(
         let talk = talk::converse(input, &mut console, reader, on_reply, wait, end);
         Ok::<_, anyhow::Error>(talk)
     })?;
-    Ok(QemuSession { run, talk: talk? })
+    Ok((run, talk?))
 }
 
 /// Starts QEMU running `elf` for a console, its stdout and stderr `output`,
