@@ -56,10 +56,7 @@ impl Server {
         if let Some(bridge) = &bridge {
             let notes = bridge.hub.join();
             thread::spawn(move || {
-                if let Some(why) = notes.iter().find_map(|n| match n {
-                    Note::Gone(why) => Some(why),
-                    Note::Bytes(_) => None,
-                }) {
+                if let Some(Note::Gone(why)) = notes.iter().find(|n| matches!(n, Note::Gone(_))) {
                     let _ = stopped.send(format!("the head went away ({why})"));
                 }
             });
