@@ -158,16 +158,12 @@ impl Pty {
 /// `stream` (`query-chardev`: `"filename": "pty:/dev/pts/N"`).
 fn pty_path(stream: TcpStream) -> Result<PathBuf> {
     stream.set_read_timeout(Some(Duration::from_secs(10)))?;
-    let mut writer = stream.try_clone()?;
-    let mut lines = BufReader::new(stream).lines();
-    writer.write_all(b"{\"execute\":\"qmp_capabilities\"}\n{\"execute\":\"query-chardev\"}\n")?;
-    for line in lines.by_ref() {
-        let reply: serde_json::Value = serde_json::from_str(&line?)?;
-        let Some(devices) = reply["return"].as_array() else {
-            continue;
-        };
-        if let Some(file) = devices
-            .iter()
+    (&stream)
+        .write_all(b"{\"execute\":\"qmp_capabilities\"}\n{\"execute\":\"query-chardev\"}\n")?;
+    for line in BufReader::new(stream).lines() {
+        let reply: Value = serde_json::from_str(&line?)?;
+        // The replies without a `return` list (the greeting, events) pass.
+        if let Some(file) = (reply["return"].as_array().into_iter().flatten())
             .filter(|d| d["label"] == "serial0")
             .find_map(|d| d["filename"].as_str()?.strip_prefix("pty:"))
         {
