@@ -164,23 +164,17 @@ mod tests {
         let arduino = ("/dev/ttyACM2", 0x2341, Some(PRODUCT));
         let (bare, bare2) = (("/dev/ttyACM4", VID, None), ("/dev/ttyACM5", VID, None));
         let found = |name: &str| Ok(PathBuf::from(name));
+        let fails = |ports: &[(&str, u16, Option<&str>)], says: &str| {
+            let err = pick(ports).unwrap_err();
+            assert!(err.contains(says), "{err}");
+        };
         assert_eq!(pick(&[other, arduino, head]), found("/dev/ttyACM1"));
         // The shared ID alone is not enough when the product says otherwise.
-        let err = pick(&[other, arduino]).unwrap_err();
-        assert!(
-            err.contains("/dev/ttyACM0 (\"some other gadget\")"),
-            "{err}"
-        );
-        let err = pick(&[arduino]).unwrap_err();
-        assert!(err.contains("is the head plugged in"), "{err}");
+        fails(&[other, arduino], "/dev/ttyACM0 (\"some other gadget\")");
+        fails(&[arduino], "is the head plugged in");
         // Without product strings, one device of the ID is taken; two are not.
         assert_eq!(pick(&[other, bare]), found("/dev/ttyACM4"));
-        let err = pick(&[bare, bare2]).unwrap_err();
-        assert!(err.contains("without a product string"), "{err}");
-        let err = pick(&[head, head]).unwrap_err();
-        assert!(
-            err.contains("/dev/ttyACM1, /dev/ttyACM1; give --port"),
-            "{err}"
-        );
+        fails(&[bare, bare2], "without a product string");
+        fails(&[head, head], "/dev/ttyACM1, /dev/ttyACM1; give --port");
     }
 }
