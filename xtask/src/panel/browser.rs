@@ -112,8 +112,8 @@ fn replay(root: &Path, shots: &Path) -> Result<String> {
 /// QEMU with UART0 on a pseudo-terminal: `cargo xtask console --port` with
 /// a piped script, then the panel bridged to it (`panel --port`).
 fn serial_port(root: &Path, elf: &Path, shots: &Path) -> Result<String> {
-    let qemu = Pty::start(elf)?;
-    let pty = qemu.path.display().to_string();
+    let (_qemu, path) = Pty::start(elf)?;
+    let pty = path.display().to_string();
     println!("QEMU's UART0 is {pty}");
     let want =
         "ok commands:|ok mode=|ok nod amp_mdeg=|err invalid yaw servo: max_pulse 3000|ok watch=off";
@@ -121,7 +121,7 @@ fn serial_port(root: &Path, elf: &Path, shots: &Path) -> Result<String> {
     let script = b"help\nstatus\nnod\nservo yaw max 3000\nwatch off\n";
     console::script(&["--port", &pty], script, &want, 0)?;
     let config = json!({ "session": "bridge", "label": "serial-port" });
-    let session = session(root, shots, Some(Bridge::port(&qemu.path)?), config)?;
+    let session = session(root, shots, Some(Bridge::port(&path)?), config)?;
     let n = want.len();
     Ok(format!(
         "console --port {pty}: {n} replies as expected; {session}"
@@ -129,28 +129,21 @@ fn serial_port(root: &Path, elf: &Path, shots: &Path) -> Result<String> {
 }
 
 /// QEMU, its UART0 on a pseudo-terminal, UART1 nowhere (no hang-up: it is
-/// stopped when done).
-struct Pty {
-    child: Child,
-    path: PathBuf,
-}
+/// stopped when dropped).
+struct Pty(Child);
 
 impl Pty {
     /// Starts QEMU and asks its QMP monitor where the pseudo-terminal is
     /// (this QEMU writes no message saying so, and cannot link it to a
-    /// path of our choosing).
-    fn start(elf: &Path) -> Result<Self> {
+    /// path of our choosing). QEMU, and the pseudo-terminal's path.
+    fn start(elf: &Path) -> Result<(Self, PathBuf)> {
         let qmp = console::qemu::listen()?;
         let monitor = format!("tcp:{}", qmp.local_addr()?);
         let mut command = qemu_command(elf, Pace::RealTime, ["pty", "null"]);
-        let child = qemu::spawn(command.args(["-qmp", &monitor]), Stdio::null)?;
         // Dropped on an error: QEMU is stopped.
-        let mut pty = Self {
-            child,
-            path: PathBuf::new(),
-        };
-        pty.path = pty_path(console::qemu::accept(&qmp, &mut pty.child)?)?;
-        Ok(pty)
+        let mut pty = Self(qemu::spawn(command.args(["-qmp", &monitor]), Stdio::null)?);
+        let path = pty_path(console::qemu::accept(&qmp, &mut pty.0)?)?;
+        Ok((pty, path))
     }
 }
 
@@ -175,7 +168,7 @@ fn pty_path(stream: TcpStream) -> Result<PathBuf> {
 
 impl Drop for Pty {
     fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        let _ = self.0.kill();
+        let _ = self.0.wait();
     }
 }
