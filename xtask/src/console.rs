@@ -60,8 +60,7 @@ pub fn command(args: &Args) -> Result<bool> {
             Some(line) => println!("{line}"),
             None => println!("no summary line: {}", run.describe()),
         }
-        let port = "QEMU's UART0".to_owned();
-        (talk, port, run.succeeded())
+        (talk, "QEMU's UART0".to_owned(), run.succeeded())
     } else {
         let port = match &args.port {
             Some(port) => port.clone(),
