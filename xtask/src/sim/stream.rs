@@ -236,16 +236,13 @@ pub fn test_dmx(root: &Path, metadata: &Metadata) -> Result<()> {
     print!("{}", report.table());
     // (The pulses are not held to the idle's own: a console on the line
     // engages the show layer, mix 0 or not. No frame may be late.)
-    let boot = report.first()?;
-    let (text, problems) = check_dmx(boot, changes.len());
-    print!("{text}");
-    crate::project::verdict(&problems)
+    crate::project::verdict(&check_dmx(report.first()?, changes.len()))
 }
 
 /// The counters of `boot`'s `ok dmx=` reply against the frames it sent
-/// (`changes` of them changes): every one good, no frame late. A summary,
-/// problems.
-pub(super) fn check_dmx(boot: &Boot, changes: usize) -> (String, Vec<String>) {
+/// (`changes` of them changes): every one good, no frame late. Prints a
+/// summary; the problems.
+pub(super) fn check_dmx(boot: &Boot, changes: usize) -> Vec<String> {
     let reply = boot.reply("ok dmx=");
     let counter = |name| number(&reply, name).ok();
     let mut problems: Vec<String> = ["short", "long", "start_code", "garbled"]
@@ -270,9 +267,9 @@ pub(super) fn check_dmx(boot: &Boot, changes: usize) -> (String, Vec<String>) {
         problems.push(format!("{} frames late: `{first}`", late.len()));
     }
     let sets = sets(boot, Duration::ZERO);
-    let summary = format!(
+    println!(
         "DMX: {sent} frames of 512 slots sent by the last change, {good} counted good; {sets} loop \
-         sets generated meanwhile; `{reply}`\n"
+         sets generated meanwhile; `{reply}`"
     );
-    (summary, problems)
+    problems
 }
