@@ -146,11 +146,7 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
     let mut events = Vec::new();
     for (i, pair) in times.windows(2).enumerate() {
         let (start, next) = (ms_after(pair[0]), ms_after(pair[1]));
-        let (from, to) = if i % 2 == 0 {
-            (4096, 4096 + STEP)
-        } else {
-            (4096 + STEP, 4096)
-        };
+        let (from, to) = [(4096, 4096 + STEP), (4096 + STEP, 4096)][i % 2];
         let step = format!("sC,yaw,{start},40,{from},0,{},{to},0,0", to - from);
         let (at, ms) = (start + 40, next - start - 40);
         let hold = format!("sC,yaw,{at},{ms},{to},0,0,{to},0,0");
