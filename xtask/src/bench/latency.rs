@@ -5,7 +5,7 @@
 
 use std::{fmt::Write as _, path::Path, time::Duration};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, bail, ensure};
 use idle_head_core::servo::ServoRate;
 
 use crate::figures;
@@ -125,9 +125,7 @@ impl Row {
 
 /// Fails unless `got` is `want`: `<got> <what>, not <want>`.
 pub fn count(got: usize, want: usize, what: &str) -> Result<()> {
-    if got != want {
-        bail!("{got} {what}, not {want}");
-    }
+    ensure!(got == want, "{got} {what}, not {want}");
     Ok(())
 }
 
@@ -212,12 +210,11 @@ pub fn row_at(
             }
         }
     }
-    if ms.len() < EVENTS {
-        bail!(
-            "{name}: {} events measured ({skipped} skipped), fewer than {EVENTS}",
-            ms.len()
-        );
-    }
+    ensure!(
+        ms.len() >= EVENTS,
+        "{name}: {} events measured ({skipped} skipped), fewer than {EVENTS}",
+        ms.len()
+    );
     ms.sort_by(f64::total_cmp);
     worst.sort_by(|a, b| b.1.total_cmp(&a.1));
     worst.truncate(3);
