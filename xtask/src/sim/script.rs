@@ -34,8 +34,7 @@ pub fn read(path: &Path) -> Result<Vec<Event>> {
 }
 
 pub fn parse(text: &str) -> Result<Vec<Event>> {
-    let (_, params) = trace::built_in()?;
-    trace::parse_script(text, &params)
+    trace::parse_script(text, &trace::built_in()?.1)
 }
 
 /// How long a script runs when not told: to 5 s after its last line.
@@ -178,12 +177,9 @@ fn written(report: &Report) -> Vec<[u16; 3]> {
     let Some(boot) = report.boots.first() else {
         return Vec::new();
     };
-    let frames = boot.trains.each_ref().map(|train| {
-        let frames = train.frames().unwrap_or_default();
-        frames.iter().map(|&(_, d)| d).collect::<Vec<u16>>()
-    });
-    let n = frames.iter().map(Vec::len).max().unwrap_or(0);
-    let duty = |k: usize| core::array::from_fn(|i| frames[i].get(k).copied().unwrap_or(0));
+    let frames = boot.trains.each_ref().map(|t| t.frames().unwrap_or(&[]));
+    let n = frames.iter().map(|f| f.len()).max().unwrap_or(0);
+    let duty = |k: usize| core::array::from_fn(|i| frames[i].get(k).map_or(0, |f| f.1));
     (0..n).map(duty).collect()
 }
 
