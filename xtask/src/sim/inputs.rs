@@ -88,13 +88,11 @@ pub fn test_inputs(root: &Path, metadata: &Metadata) -> Result<()> {
     let (_, params) = trace::built_in()?;
     for axis in Axis::ALL {
         let (i, name) = (axis.index(), axis.name());
-        let Some(first) = pulses[i]
-            .iter()
-            .position(|p| p.rise >= after.rise - period / 2.0)
-        else {
+        let first = pulses[i].partition_point(|p| p.rise < after.rise - period / 2.0);
+        if first == pulses[i].len() {
             problems.push(format!("{name}: no pulse after the gap"));
             continue;
-        };
+        }
         let last_before = first.checked_sub(1).map(|k| pulses[i][k].counts);
         if last_before.is_none_or(|c| c.abs_diff(pulses[i][first].counts) > 1) {
             let problem = "the first pulse after the gap is not the last before it";
