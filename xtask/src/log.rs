@@ -1,9 +1,6 @@
 //! The decoded defmt log of a QEMU run.
 
-use std::{
-    path::{Path, PathBuf},
-    time::Duration,
-};
+use std::{path::Path, time::Duration};
 
 use anyhow::{Context, Result};
 use defmt_decoder::{DecodeError, Frame, Locations, StreamDecoder, Table};
@@ -14,7 +11,6 @@ use crate::project::Exit;
 pub struct Defmt {
     table: Table,
     locations: Option<Locations>,
-    root: PathBuf,
 }
 
 impl Defmt {
@@ -23,12 +19,8 @@ impl Defmt {
         let table = Table::parse(&bytes)
             .with_context(|| format!("reading the defmt table of {}", elf.display()))?
             .with_context(|| format!("{} has no defmt data", elf.display()))?;
-        let (locations, root) = (table.get_locations(&bytes).ok(), crate::project::root());
-        Ok(Self {
-            table,
-            locations,
-            root,
-        })
+        let locations = table.get_locations(&bytes).ok();
+        Ok(Self { table, locations })
     }
 
     /// A decoder for one stream (a run, a boot).
@@ -57,8 +49,7 @@ impl Defmt {
         let location = (self.locations.as_ref())
             .and_then(|locations| locations.get(&frame.index()))
             .map(|location| {
-                let file = &location.file;
-                let file = file.strip_prefix(&self.root).unwrap_or(file);
+                let file = crate::project::relative(&location.file);
                 format!("{}:{}", file.display(), location.line)
             });
         LogLine {
@@ -102,7 +93,6 @@ impl LogLine {
         }
     }
 
-    /// Whether this is a warning or an error.
     pub fn is_problem(&self) -> bool {
         matches!(self.level.as_deref(), Some("WARN" | "ERROR"))
     }
