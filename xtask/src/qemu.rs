@@ -91,11 +91,10 @@ pub fn run(elf: &Path, timeout: Duration, echo: Echo) -> Result<Run> {
 
 /// Starts QEMU's `command`, stdin closed, its stdout and stderr `output`.
 pub fn spawn(command: &mut Command, output: fn() -> Stdio) -> Result<Child> {
-    let command = command
+    command
         .stdin(Stdio::null())
         .stdout(output())
-        .stderr(output());
-    command
+        .stderr(output())
         .spawn()
         .with_context(|| format!("could not start {QEMU_BINARY}"))
 }
