@@ -362,10 +362,9 @@ impl Background {
         };
         let chosen: Vec<_> = chosen.into_iter().map(|i| (i, blocked(i))).collect();
         // Longest first (the host tests are built in the foreground by then).
-        let queue = chosen
-            .iter()
-            .filter_map(|&(i, by)| by.is_none().then_some(i));
-        let mut queue: Vec<usize> = queue.collect();
+        let mut queue: Vec<usize> = (chosen.iter())
+            .filter_map(|&(i, by)| by.is_none().then_some(i))
+            .collect();
         let long = [
             bench::LATENCY_STAGE,
             sim::UART_STREAM_STAGE,
