@@ -46,8 +46,7 @@ pub fn shell(dir: &str) -> Result<Shell> {
 /// VAR=value program args)`), then runs it with `env` and inherited output;
 /// fails unless it exits with 0.
 pub fn run(sh: &Shell, env: &[(&str, &str)], cmd: Cmd<'_>) -> Result<()> {
-    let vars: Vec<String> = env.iter().map(|(k, v)| format!("{k}={v} ")).collect();
-    let vars = vars.concat();
+    let vars: String = env.iter().flat_map(|&(k, v)| [k, "=", v, " "]).collect();
     let line = match sh.current_dir().strip_prefix(root()) {
         Ok(sub) if !sub.as_os_str().is_empty() => format!("(cd {} && {vars}{cmd})", sub.display()),
         _ => format!("{vars}{cmd}"),
