@@ -85,6 +85,7 @@ fn files(root: &Path, dirs: &[&str]) -> anyhow::Result<Vec<PathBuf>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::project::relative;
 
     #[test]
     fn paths_are_told_from_words() {
@@ -119,9 +120,8 @@ mod tests {
             let text = fs::read_to_string(&file).unwrap();
             let doc = text.lines().skip_while(|l| !l.starts_with("//!"));
             let lines = doc.take_while(|l| l.starts_with("//!")).count();
-            let file = file.strip_prefix(&root).unwrap_or(&file).display();
             if lines >= MODULE_DOC_LINES {
-                list.push(format!("{file}: {lines} lines"));
+                list.push(format!("{}: {lines} lines", relative(&file).display()));
             }
         }
         assert!(
@@ -146,8 +146,7 @@ mod tests {
                 };
                 for path in paths_in(comment) {
                     if !exists(&root, &file, path) {
-                        let name = file.strip_prefix(&root).unwrap_or(&file).display();
-                        list.push(format!("{name}:{}: {path}", n + 1));
+                        list.push(format!("{}:{}: {path}", relative(&file).display(), n + 1));
                     }
                 }
             }
