@@ -166,7 +166,6 @@ impl Image {
         }
     }
 
-    /// Fails unless the image links no allocator.
     pub fn check_no_allocator(&self) -> Result<()> {
         ensure!(
             self.allocator_symbols.is_empty(),

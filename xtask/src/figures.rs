@@ -11,7 +11,6 @@ use anyhow::{Context, Result, bail};
 
 use crate::project;
 
-/// The stage's name in `cargo xtask test`.
 pub const STAGE: &str = "figures page: docs/design/figures.md has what this run measured";
 
 /// The page, from the repository's root.

@@ -13,7 +13,6 @@ use xshell::{Shell, cmd};
 
 use crate::{board::Board, project, uf2};
 
-/// `cargo xtask flash`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The board the image is for.

@@ -10,7 +10,6 @@ use object::{Object, ObjectSection};
 
 use crate::{board::Board, elf, project};
 
-/// `cargo xtask uf2`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The board the image is for.
