@@ -7,7 +7,7 @@ use std::{path::Path, time::Duration};
 use anyhow::Result;
 
 use super::{
-    node::{Fill, FlashTiming, UartScript},
+    node::{FlashTiming, UartScript},
     planted,
     pulses::{angle, measure, spans},
     run::{self, Boot, Report},
@@ -56,20 +56,13 @@ const SAVED_PITCH_US: u32 = 1520;
 const UNKNOWN: &str =
     "settings: defaults; the store at 0x101fc000 holds settings of version 0, not 2";
 
-/// A start: what the sectors hold, them, what boot 0 logs (level, text),
-/// the neutral pulses, µs.
-type Start = (
-    &'static str,
-    Fill,
-    &'static [(&'static str, &'static str)],
-    [u32; 3],
-);
-
 /// Runs the scenario from every start and checks it (see the module docs).
 pub fn test_store(root: &Path, metadata: &Metadata) -> Result<()> {
     PICO.build(root)?;
     let elf = PICO.elf(metadata);
-    let starts: [Start; 3] = [
+    // Each start: what the sectors hold, them, what boot 0 logs (level,
+    // text), the neutral pulses, µs.
+    let starts: [(_, _, &[_], _); 3] = [
         (
             "foreign data",
             planted::fill(&elf, |len| Ok(planted::noise(len)))?,
