@@ -7,7 +7,7 @@ use std::{
     time::Duration,
 };
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, bail, ensure};
 use serde::{Serialize, Serializer};
 use serde_json::Value;
 use xshell::{Shell, cmd};
@@ -245,10 +245,8 @@ const GRACE: Duration = Duration::from_secs(15);
 pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
     // The configuration goes in a file: a run of a thousand scripted
     // chunks is more than a command line may carry.
-    let config = &Config {
-        wall: config.wall * project::side_by_side(),
-        ..config.clone()
-    };
+    let mut config = config.clone();
+    config.wall *= project::side_by_side();
     let mut file = tempfile::Builder::new().suffix(".json").tempfile()?;
     file.write_all(config.json().to_string().as_bytes())?;
     let arg = format!("@{}", file.path().display());
@@ -270,12 +268,11 @@ pub fn run(root: &Path, config: &Config) -> Result<Vec<Event>> {
         );
     };
     let events = done.stdout?;
-    if !status.success() && !matches!(events.last(), Some(Event::End(_))) {
-        bail!(
-            "the emulator harness failed ({status}):\n{}",
-            done.stderr.trim_end()
-        );
-    }
+    ensure!(
+        status.success() || matches!(events.last(), Some(Event::End(_))),
+        "the emulator harness failed ({status}):\n{}",
+        done.stderr.trim_end()
+    );
     Ok(events)
 }
 
