@@ -30,9 +30,7 @@ fn rows(trains: &[Train; 3], timing: &Timing) -> String {
         let mut us = Vec::new();
         for pulse in pulses {
             let k = ((pulse.rise - first) / period).round().max(0.0) as usize;
-            if us.len() <= k {
-                us.resize(k + 1, 0.0);
-            }
+            us.resize(us.len().max(k + 1), 0.0);
             // In whole counts, as the pulse check counts them.
             us[k] = (pulse.width / timing.count_ns).round().max(0.0) * timing.count_ns / 1e3;
         }
