@@ -5,7 +5,10 @@ use std::{
     io::Write,
     path::{Path, PathBuf},
     process::{Child, ChildStderr, ChildStdout, Command, ExitStatus, Stdio},
-    sync::atomic::{AtomicU32, Ordering},
+    sync::{
+        OnceLock,
+        atomic::{AtomicU32, Ordering},
+    },
     thread,
     time::Duration,
 };
@@ -18,9 +21,21 @@ use xshell::{Cmd, Shell, cmd};
 /// The firmware's compilation target (ARMv6-M: RP2040's Cortex-M0+, QEMU's Cortex-M0).
 pub const TARGET: &str = "thumbv6m-none-eabi";
 
+/// Variables set for a command, whatever the caller's environment says.
+pub type Env = &'static [(&'static str, &'static str)];
+
 /// The environment of every firmware build: the expected QEMU log's defmt
-/// level, whatever the caller's environment says.
-pub const FIRMWARE_ENV: &[(&str, &str)] = &[("DEFMT_LOG", "info")];
+/// level.
+pub const FIRMWARE_ENV: Env = &[("DEFMT_LOG", "info")];
+
+/// A host build linted as it compiles, as `cargo clippy -- -D warnings`
+/// lints: clippy's driver (rustup's proxy) compiles the workspace's packages,
+/// so the dependencies are compiled once, not again by a check. Not for the
+/// firmware images: the driver turns MIR optimisations off.
+pub const LINTED: Env = &[
+    ("RUSTC_WORKSPACE_WRAPPER", "clippy-driver"),
+    ("CLIPPY_ARGS", "-Dwarnings"),
+];
 
 /// The repository root (commands run from any folder of it).
 pub fn root() -> PathBuf {
@@ -153,6 +168,27 @@ pub fn passed(what: &str, result: &Result<()>) -> bool {
         println!("{what} FAILED: {error:#}");
     }
     result.is_ok()
+}
+
+/// The program a stage apart or a console runs: this one, or the copy of it
+/// [`keep_exe`] made.
+static EXE: OnceLock<PathBuf> = OnceLock::new();
+
+pub fn exe() -> Result<PathBuf> {
+    Ok(EXE.get().cloned().unwrap_or(std::env::current_exe()?))
+}
+
+/// Copies this program into `dir`, for [`exe`]: `cargo xtask test` builds the
+/// xtask again where it lies (its lint stage) while its stages start it.
+pub fn keep_exe(dir: &Path) -> Result<()> {
+    let exe = std::env::current_exe()?;
+    let copy = dir.join(exe.file_name().context("the xtask's file name")?);
+    let partial = copy.with_extension("partial");
+    std::fs::create_dir_all(dir)?;
+    let copied = std::fs::copy(&exe, &partial).and_then(|_| std::fs::rename(&partial, &copy));
+    copied.with_context(|| format!("copying the xtask to {}", copy.display()))?;
+    let _ = EXE.set(copy);
+    Ok(())
 }
 
 /// Set by `cargo xtask test` on the emulator stages it runs side by side on

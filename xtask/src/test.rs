@@ -13,7 +13,7 @@ use crate::{
     log::{self, Run},
     panel::browser,
     pico2,
-    project::{self, FIRMWARE_ENV, Metadata, PICO, QEMU},
+    project::{self, FIRMWARE_ENV, LINTED, Metadata, PICO, QEMU},
     qemu::{self, Echo},
     setup, sim, snapshot,
 };
@@ -107,6 +107,7 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         "watchdog drill image (cargo build --release --features watchdog-drill)";
     let start = Instant::now();
     let (root, metadata) = setup::prepare()?;
+    project::keep_exe(&metadata.target_dir.join("xtask-stages"))?;
     let figures_page = root.join(figures::PAGE);
     let figures_before = figures::read(&figures_page)?;
     let mut stages = Stages {
@@ -134,10 +135,9 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
         let background = Background::start(scope, &stages, &root, pico_built, drill_built);
 
         // 2. Host tests, formatting, lints, the images that must compile.
-        for (name, dir, firmware, commands) in CARGO {
+        for (name, dir, env, commands) in CARGO {
             stages.run(name, || {
                 let sh = project::shell(dir)?;
-                let env = if firmware { FIRMWARE_ENV } else { &[] };
                 for args in commands.split(" && ") {
                     let args = args.split_whitespace();
                     project::run(&sh, env, cmd!(sh, "cargo {args...}"))?;
@@ -181,39 +181,34 @@ pub fn command(options: Options, only: Option<&str>) -> Result<bool> {
     Ok(stages.finish(start))
 }
 
-/// The stages that run cargo, `(name, folder, firmware, commands)`: the
+/// The stages that run cargo, `(name, folder, environment, commands)`: the
 /// firmware's with its build environment (and `--release`, to share build
-/// scripts with the release builds), the commands' arguments separated by
-/// ` && `; the host's clippy passes take the profile of the build before them.
+/// scripts with the release builds), the host's builds linted as they compile
+/// ([`LINTED`]: clippy with `-D warnings`, on every target `cargo clippy
+/// --all-targets` lints: a library, its tests, the doc tests' library), the
+/// commands' arguments separated by ` && `.
 #[rustfmt::skip] // a table, one stage a line
-const CARGO: [(&str, &str, bool, &str); 14] = [
+const CARGO: [(&str, &str, project::Env, &str); 10] = [
     // Built here, at full priority: their run is a background stage.
-    ("host tests: build (host-tests/)", "host-tests", false, "test --no-run"),
-    ("core crate: unit and doc tests (crates/core, host)", "crates/core", false, "test"),
-    ("firmware layer: host tests (crates/firmware)", "crates/firmware", false, "test"),
-    ("xtask unit tests", "xtask", false, "test --profile xtask"),
-    ("rustfmt: every package of the workspace", ".", false, "fmt --all --check"),
-    ("clippy: Pico image, RP support, firmware layer, core (thumbv6m)", ".", true,
+    ("host tests: build, clippy (host-tests/)", "host-tests", LINTED, "test --no-run"),
+    ("core crate: clippy, unit and doc tests (crates/core, host)", "crates/core", LINTED, "test"),
+    ("firmware layer: clippy, host tests (crates/firmware)", "crates/firmware", LINTED, "test"),
+    ("xtask: clippy, unit tests", "xtask", LINTED,
+     "build --profile xtask --all-targets && test --profile xtask"),
+    ("rustfmt: every package of the workspace", ".", &[], "fmt --all --check"),
+    ("clippy: Pico image, RP support, firmware layer, core (thumbv6m)", ".", FIRMWARE_ENV,
      "clippy --release --package idle-head --package idle-head-rp --package idle-head-firmware \
       --package idle-head-core -- -D warnings"),
-    ("clippy: QEMU images, boards/qemu/ (thumbv6m)", ".", true,
+    ("clippy: QEMU images, boards/qemu/ (thumbv6m)", ".", FIRMWARE_ENV,
      "clippy --release --bins --package idle-head-qemu -- -D warnings"),
-    ("clippy: Pico 2 image, boards/pico2/ (thumbv8m.main)", "boards/pico2", true,
+    ("clippy: Pico 2 image, boards/pico2/ (thumbv8m.main)", "boards/pico2", FIRMWARE_ENV,
      "clippy --release -- -D warnings"),
-    ("clippy: core crate and its unit tests (host)", ".", false,
-     "clippy --profile test --package idle-head-core --all-targets --target host-tuple \
-      -- -D warnings"),
-    ("clippy: firmware layer and its unit tests (host)", ".", false,
-     "clippy --profile test --package idle-head-firmware --all-targets --target host-tuple \
-      -- -D warnings"),
-    ("clippy: host-tests", "host-tests", false,
-     "clippy --profile test --all-targets -- -D warnings"),
-    ("clippy: xtask", "xtask", false, "clippy --profile xtask --all-targets -- -D warnings"),
     // The calibration image (same bin, feature `calibrate`) must compile.
-    ("Pico calibration image compiles (--features calibrate)", ".", true,
+    ("Pico calibration image compiles (--features calibrate)", ".", FIRMWARE_ENV,
      "check --release --features calibrate"),
     // A board with servos and USB only, on the same `start` as the Pico's.
-    ("minimal board example, servos and USB only (examples/minimal.rs): clippy, build", ".", true,
+    ("minimal board example, servos and USB only (examples/minimal.rs): clippy, build", ".",
+     FIRMWARE_ENV,
      "clippy --release --example minimal -- -D warnings && build --release --example minimal"),
 ];
 
@@ -238,7 +233,7 @@ fn needs_image(name: &str) -> bool {
 const APART: [Apart; 18] = [
     (HOST_TESTS, |_, _| {
         let sh = project::shell("host-tests")?;
-        project::run(&sh, &[], cmd!(sh, "cargo test"))
+        project::run(&sh, LINTED, cmd!(sh, "cargo test"))
     }),
     (book::STAGE, |root, _| book::stage(root)),
     (sim::PULSES_STAGE, |root, metadata| {
@@ -295,7 +290,7 @@ fn run_apart(name: &str, cores: usize) -> Outcome {
         let (mut reader, writer) = std::io::pipe()?;
         // At a low priority where `nice` exists: the stages in the foreground
         // take the cores first.
-        let (exe, nice) = (std::env::current_exe()?, which::which("nice").ok());
+        let (exe, nice) = (project::exe()?, which::which("nice").ok());
         let mut command = std::process::Command::new(nice.as_ref().unwrap_or(&exe));
         if nice.is_some() {
             command.args(["-n", "10"]).arg(exe);

@@ -3,7 +3,7 @@
 
 use std::process::Command;
 
-use anyhow::{Context, Result, bail, ensure};
+use anyhow::{Result, bail, ensure};
 
 use crate::project;
 
@@ -12,7 +12,7 @@ use crate::project;
 /// line (a bare `ok` exactly, the others as the line's start), then `more`
 /// lines. Its stdout's lines.
 pub fn script(args: &[&str], script: &[u8], want: &[&str], more: usize) -> Result<Vec<String>> {
-    let exe = std::env::current_exe().context("the xtask's own path")?;
+    let exe = project::exe()?;
     let (text, status) = project::output(Command::new(exe).arg("console").args(args), script)?;
     let lines: Vec<String> = text.lines().map(str::to_owned).collect();
     ensure!(

@@ -240,7 +240,7 @@ pub fn test_failures(root: &Path, metadata: &Metadata) -> Result<()> {
     }
     for (path, want) in [
         (dir.join("no-such-elf"), "cargo build --release"),
-        (std::env::current_exe()?, "is not a Pico image"),
+        (crate::project::exe()?, "is not a Pico image"),
     ] {
         let (read, path) = (PicoImage::read(&path), path.display());
         match read {
