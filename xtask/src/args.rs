@@ -4,7 +4,7 @@
 use std::time::Duration;
 
 use clap::Args;
-use idle_head_core::motion::{DEFAULT_HEAD, DEFAULT_N};
+use idle_head_core::motion::DEFAULT_N;
 use idle_head_core::servo::ServoRate;
 
 /// Options of the commands that run QEMU (`--bless`, `--timeout`,
@@ -41,7 +41,7 @@ pub fn servo_rate(text: &str) -> Result<ServoRate, String> {
     hz.ok_or_else(|| format!("expected a servo rate, {min} to {max} Hz"))
 }
 
-/// `--n` and `--w` (preview, metrics).
+/// `--n` and `--w` of `cargo xtask preview`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Args)]
 pub struct LoopShape {
     /// Samples per loop [default: 900].
@@ -55,13 +55,5 @@ pub struct LoopShape {
 impl LoopShape {
     pub fn n(&self) -> usize {
         self.n.unwrap_or(DEFAULT_N)
-    }
-
-    /// Hann window taps (the default rows' window, paper Table 2, the same
-    /// for the three axes).
-    pub fn w(&self) -> u16 {
-        const { assert!(DEFAULT_HEAD.pitch.window == DEFAULT_HEAD.yaw.window) };
-        const { assert!(DEFAULT_HEAD.roll.window == DEFAULT_HEAD.yaw.window) };
-        self.w.unwrap_or(DEFAULT_HEAD.yaw.window)
     }
 }

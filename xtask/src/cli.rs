@@ -3,7 +3,7 @@
 
 use clap::{Parser, Subcommand};
 
-use crate::{args::Timeout, console, flash, metrics, panel, preview, sim, trace, uf2};
+use crate::{args::Timeout, console, flash, panel, preview, sim, trace, uf2};
 
 /// Project commands of idle-head: build and run the firmware in QEMU, test,
 /// benchmark, and look at the loops it plays.
@@ -73,12 +73,6 @@ pub enum Command {
     /// and <out>/<stem>.png. Without loop options (--axis, --seed, --n, --w,
     /// --range, --closure) the three default axes, as pitch.*, roll.*, yaw.*.
     Preview(preview::Args),
-    /// Loop-quality metrics of both closures over many seeds.
-    ///
-    /// Seed i is i*2654435761 + 12345 (mod 2^32) on axis i mod 3 with that
-    /// axis' default row; prints the distributions (min, median, p99, max)
-    /// of the loop metrics and how many seeds break continuity ≤ 3.
-    Metrics(metrics::Args),
     /// Run the Pico image in the RP2040 emulator: its log, every servo pulse
     /// checked against the host.
     ///
@@ -144,7 +138,6 @@ mod tests {
             (&["qemu", "--timeout", "0"][..], "--timeout"),
             (&["bench", "--bless"], "--bless"),
             (&["qemu", "--no-budget"], "--no-budget"),
-            (&["metrics", "--seeds", "0"], "--seeds"),
             (&["sim", "--drill", "--store"], "--store"),
             (&["trace", "--seconds", "1", "--rate", "0"], "--rate"),
             (&["flash"], "<ELF>"),

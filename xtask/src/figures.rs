@@ -18,17 +18,12 @@ pub const PAGE: &str = "docs/design/figures.md";
 
 /// The page's sections: the title, the keys of the tables under it (a key
 /// is a prefix: `image ` takes every image's), and how to measure them.
-const SECTIONS: [(&str, &[&str], &str); 6] = [
+const SECTIONS: [(&str, &[&str], &str); 5] = [
     ("Memory", &["image ", "ram"], TEST),
     ("Frame cost", &["frames", "latency"], TEST),
     ("Tracking", &["tracking"], TEST),
     ("Boot precompute", &["precompute"], TEST),
     ("Idle loop sets", &["qemu"], TEST),
-    (
-        "Loop quality",
-        &["metrics "],
-        "`cargo xtask metrics` measures these",
-    ),
 ];
 const TEST: &str = "`cargo xtask test` measures these";
 
@@ -149,14 +144,14 @@ fn render_table(intro: &str, header: &[&str], rows: &[Vec<String>]) -> String {
 fn render(tables: &BTreeMap<String, String>) -> String {
     let mut out = String::from(
         "# Measured figures\n\n\
-         <!-- Written by the commands that measure (`cargo xtask test`, `bench`, \
-         `metrics`): do not edit. -->\n\n\
+         <!-- Written by the commands that measure (`cargo xtask test`, `bench`): \
+         do not edit. -->\n\n\
          These figures are written by the project's tools as they measure, never by \
          hand. `cargo xtask test` measures the images' sizes, their RAM with the peak \
          stack, the QEMU run, the benchmark, the latency rows and the tracking figures, \
          writes them here and fails when this page said otherwise (commit the page it \
          wrote); `cargo xtask bench` measures the benchmark, the tracking figures and \
-         the latency rows, `cargo xtask metrics` the loop quality.\n",
+         the latency rows.\n",
     );
     for (title, keys, how) in SECTIONS {
         let _ = write!(out, "\n## {title}\n");
@@ -209,7 +204,6 @@ mod tests {
         ));
         assert!(!page.contains("100 B"));
         assert!(page.contains("## Idle loop sets\n\n<!-- figures: qemu -->\n\nSizes."));
-        assert!(page.contains("## Loop quality\n\nNot measured yet: `cargo xtask metrics`"));
         // A run that measured other figures than the page had fails, naming them.
         let error = stale(&path, &before).unwrap_err().to_string();
         assert!(error.contains("was stale (image pico)"), "{error}");

@@ -13,7 +13,6 @@ mod elf;
 mod figures;
 mod flash;
 mod log;
-mod metrics;
 mod panel;
 mod pico2;
 mod plot;
@@ -62,7 +61,6 @@ fn main() -> ExitCode {
             bench::command(options(false, timeout, no_budget))
         }
         Some(Command::Preview(args)) => preview::command(&args),
-        Some(Command::Metrics(args)) => metrics::command(&args),
         Some(Command::Sim(args)) => sim::command(&args),
         Some(Command::Trace(args)) => trace::command(&args),
         Some(Command::Console(args)) => console::command(&args),

@@ -9,7 +9,6 @@ use anyhow::{Context, Result, bail, ensure};
 use idle_head_core::servo::ServoRate;
 
 use crate::figures;
-use crate::metrics::percentile;
 use crate::project::Metadata;
 use crate::sim::pulses::{self, Measured};
 use crate::sim::script::{Against, Board, play};
@@ -36,6 +35,17 @@ const HELD: Duration = Duration::from_millis(30);
 const SCRIPT_WALL: Duration = Duration::from_secs(600);
 /// The longest a port task may wait for the CPU, µs.
 pub const PORT_WAIT_US: u32 = 1000;
+
+/// Nearest-rank percentile `q` (0..=1) of sorted values.
+#[allow(
+    clippy::cast_precision_loss,
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss
+)]
+fn percentile(sorted: &[f64], q: f64) -> f64 {
+    let rank = ((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len().max(1));
+    sorted.get(rank - 1).copied().unwrap_or(f64::NAN)
+}
 
 /// One latency row: latencies (ms, sorted), events skipped (the axis still
 /// moved), events per fifth of the frame, the three slowest (s, ms), the
@@ -336,6 +346,10 @@ mod tests {
             waited_us,
             goal_ms,
         };
+        let values: Vec<f64> = (1..=100).map(f64::from).collect();
+        let ranks = [0.0, 0.5, 0.99, 1.0].map(|q| percentile(&values, q));
+        assert_eq!(ranks[..], [1.0, 50.0, 99.0, 100.0]);
+        assert!(percentile(&[], 0.5).is_nan());
         let slow = row((1..=200).map(f64::from).collect(), Some(300), GOAL_MS);
         assert_eq!(slow.spread()[..2], [100.0, 198.0]);
         let lines = slow.lines();

@@ -15,7 +15,6 @@ use anyhow::{Context, Result, bail};
 use idle_head_core::servo::ServoRate;
 
 use super::latency::{self, LOOK_GAP, Row, SCHEDULED, Shipped, count, first_boot, schedule};
-use crate::metrics::parallel;
 use crate::project::Metadata;
 use crate::sim::{BYTE_TIME, Boot, Chunk, UartScript, bottango_lines, run_shipped};
 use crate::{figures, project};
@@ -156,6 +155,28 @@ pub fn bottango(root: &Path, metadata: &Metadata, wall: Duration) -> Result<Row>
     }
     let boot = usb_run((root, metadata, wall), &times, chunks, "bottango")?;
     latency::row("bottango", &events, &boot)
+}
+
+/// `job` of 0 to `count` − 1, `cores` at a time, in order; a job that
+/// panicked is an error.
+fn parallel<T: Send>(
+    count: usize,
+    cores: usize,
+    job: impl Fn(usize) -> Result<T> + Sync,
+) -> Vec<Result<T>> {
+    let mut results = Vec::new();
+    for batch in (0..count).collect::<Vec<_>>().chunks(cores.max(1)) {
+        std::thread::scope(|scope| {
+            let job = &job;
+            let runs: Vec<_> = batch.iter().map(|&i| scope.spawn(move || job(i))).collect();
+            let panicked = || Err(anyhow::anyhow!("a worker thread panicked"));
+            results.extend(
+                runs.into_iter()
+                    .map(|run| run.join().unwrap_or_else(|_| panicked())),
+            );
+        });
+    }
+    results
 }
 
 /// Every latency row, printed and recorded; fails if a row misses its goal

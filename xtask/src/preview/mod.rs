@@ -13,7 +13,7 @@ use idle_head_core::{
 
 use crate::{args::LoopShape, project};
 use stages::LoopSpec;
-pub use stages::{Stages, closure_name, deg};
+pub use stages::Stages;
 
 /// Options of `cargo xtask preview` (its help text is in `cli.rs`).
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
